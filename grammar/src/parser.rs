@@ -1,0 +1,481 @@
+//! Text to syntax tree. The file is split at top-level item keywords and
+//! each item parsed on its own, so one syntax error does not hide the next.
+
+use std::sync::LazyLock;
+
+use pest::Parser as _;
+use pest::iterators::{Pair, Pairs};
+use pest::pratt_parser::{Assoc, Op, PrattParser};
+
+use crate::ast::*;
+use crate::diagnostic::{Diagnostic, FileId, codes};
+
+#[derive(pest_derive::Parser)]
+#[grammar = "lens.pest"]
+struct LensParser;
+
+/// Deepest bracket nesting accepted. Deeper input is refused before pest
+/// sees it, so no input can overflow the parser's stack.
+pub const MAX_NESTING: usize = 64;
+
+static PRATT: LazyLock<PrattParser<Rule>> = LazyLock::new(|| {
+    PrattParser::new()
+        .op(Op::infix(Rule::range_op, Assoc::Left))
+        .op(Op::infix(Rule::add, Assoc::Left) | Op::infix(Rule::sub, Assoc::Left))
+        .op(Op::infix(Rule::mul, Assoc::Left) | Op::infix(Rule::div, Assoc::Left))
+        .op(Op::prefix(Rule::neg))
+        .op(Op::infix(Rule::pow, Assoc::Right))
+});
+
+/// Parses one source file. Always returns a tree (possibly partial) and the
+/// syntax diagnostics found, in source order.
+pub fn parse(source: &str, file: FileId) -> (File, Vec<Diagnostic>) {
+    let mut diags = Vec::new();
+    if source.len() > u32::MAX as usize / 2 {
+        diags.push(Diagnostic::error(codes::TOO_LARGE, "file is too large (over 2 GiB)", file, Span::new(0, 0)));
+        return (File::default(), diags);
+    }
+    let scan = scan(source);
+    if let Some(at) = scan.too_deep_at {
+        diags.push(
+            Diagnostic::error(
+                codes::TOO_DEEP,
+                format!("brackets are nested more than {MAX_NESTING} deep"),
+                file,
+                Span::new(at, at + 1),
+            )
+            .with_label("this bracket is too deep")
+            .with_help("split the expression with `let` constants"),
+        );
+        return (File::default(), diags);
+    }
+    let mut items = Vec::new();
+    for (start, end) in scan.chunks {
+        let text = &source[start..end];
+        if text.trim().is_empty() {
+            continue;
+        }
+        let mut b = Builder { file, offset: start, diags: &mut diags };
+        match LensParser::parse(Rule::file, text) {
+            Ok(mut pairs) => {
+                let file_pair = pairs.next().expect("file rule");
+                for p in file_pair.into_inner() {
+                    if p.as_rule() != Rule::EOI {
+                        items.push(b.item(p));
+                    }
+                }
+            }
+            Err(e) => {
+                let d = b.syntax_error(text, e);
+                diags.push(d);
+            }
+        }
+    }
+    (File { items }, diags)
+}
+
+struct Scan {
+    chunks: Vec<(usize, usize)>,
+    too_deep_at: Option<usize>,
+}
+
+/// One pass over the bytes: bracket depth (outside comments and strings) and
+/// the byte offsets where top-level items start.
+fn scan(src: &str) -> Scan {
+    let b = src.as_bytes();
+    let mut depth = 0usize;
+    let mut starts = vec![0usize];
+    let mut i = 0;
+    let mut at_word_start = true;
+    while i < b.len() {
+        let c = b[i];
+        match c {
+            b'/' if b.get(i + 1) == Some(&b'/') => {
+                while i < b.len() && b[i] != b'\n' {
+                    i += 1;
+                }
+                at_word_start = true;
+                continue;
+            }
+            b'/' if b.get(i + 1) == Some(&b'*') => {
+                i += 2;
+                while i < b.len() && !(b[i] == b'*' && b.get(i + 1) == Some(&b'/')) {
+                    i += 1;
+                }
+                i = (i + 2).min(b.len());
+                at_word_start = true;
+                continue;
+            }
+            b'"' => {
+                i += 1;
+                while i < b.len() && b[i] != b'"' && b[i] != b'\n' {
+                    i += if b[i] == b'\\' { 2 } else { 1 };
+                }
+                i = (i + 1).min(b.len());
+                at_word_start = false;
+                continue;
+            }
+            b'(' | b'[' | b'{' => {
+                depth += 1;
+                if depth > MAX_NESTING {
+                    return Scan { chunks: vec![], too_deep_at: Some(i) };
+                }
+            }
+            b')' | b']' | b'}' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+        let is_word = c.is_ascii_alphanumeric() || c == b'_';
+        if is_word && at_word_start && depth == 0 && i > 0 {
+            let rest = &src[i..];
+            let kw = ["use", "let", "job", "surface", "tool", "machine", "strategy"].iter().find(|k| {
+                rest.starts_with(*k)
+                    && !rest[k.len()..].starts_with(|ch: char| ch.is_ascii_alphanumeric() || ch == '_')
+            });
+            if kw.is_some() && preceded_by_line_start(b, i) {
+                starts.push(i);
+            }
+        }
+        at_word_start = !is_word;
+        i += 1;
+    }
+    let mut chunks = Vec::with_capacity(starts.len());
+    for (k, &s) in starts.iter().enumerate() {
+        let e = starts.get(k + 1).copied().unwrap_or(src.len());
+        chunks.push((s, e));
+    }
+    Scan { chunks, too_deep_at: None }
+}
+
+/// Items are split only at keywords that begin a line, so `a: 1 mm, tool: t`
+/// style text stays in one piece even if a bracket is missing.
+fn preceded_by_line_start(b: &[u8], i: usize) -> bool {
+    let mut j = i;
+    while j > 0 {
+        match b[j - 1] {
+            b' ' | b'\t' | b'\r' => j -= 1,
+            b'\n' => return true,
+            _ => return false,
+        }
+    }
+    true
+}
+
+struct Builder<'d> {
+    file: FileId,
+    offset: usize,
+    diags: &'d mut Vec<Diagnostic>,
+}
+
+impl Builder<'_> {
+    fn span(&self, p: &Pair<Rule>) -> Span {
+        let s = p.as_span();
+        Span::new(s.start() + self.offset, s.end() + self.offset)
+    }
+
+    fn ident(&self, p: Pair<Rule>) -> Ident {
+        Ident { span: self.span(&p), name: p.as_str().to_string() }
+    }
+
+    fn item(&mut self, p: Pair<Rule>) -> Item {
+        let span = self.span(&p);
+        let rule = p.as_rule();
+        let mut inner = p.into_inner();
+        let kind = match rule {
+            Rule::use_item => {
+                let _kw = inner.next();
+                let target = inner.next().expect("use target");
+                match target.as_rule() {
+                    Rule::string => {
+                        let span = self.span(&target);
+                        ItemKind::Use(UseTarget::File { path: self.string(target), span })
+                    }
+                    _ => ItemKind::Use(UseTarget::Std(target.into_inner().map(|s| self.ident(s)).collect())),
+                }
+            }
+            Rule::let_item => {
+                let _kw = inner.next();
+                let name = self.ident(inner.next().expect("let name"));
+                let value = self.expr(inner.next().expect("let value"));
+                ItemKind::Let { name, value }
+            }
+            Rule::decl_item => {
+                let kind = match inner.next().expect("decl kind").as_str() {
+                    "surface" => DeclKind::Surface,
+                    "tool" => DeclKind::Tool,
+                    "machine" => DeclKind::Machine,
+                    _ => DeclKind::Strategy,
+                };
+                let name = self.ident(inner.next().expect("decl name"));
+                let value = self.expr(inner.next().expect("decl value"));
+                ItemKind::Decl { kind, name, value }
+            }
+            _ => {
+                let _kw = inner.next();
+                let name = self.ident(inner.next().expect("job name"));
+                let body = self.block(inner.next().expect("job body"));
+                ItemKind::Job { name, body }
+            }
+        };
+        Item { kind, span }
+    }
+
+    fn expr(&mut self, p: Pair<Rule>) -> Expr {
+        let pairs = p.into_inner();
+        self.pratt(pairs)
+    }
+
+    fn pratt(&mut self, pairs: Pairs<Rule>) -> Expr {
+        // The closures below all need `self`; pest's Pratt API takes them
+        // separately, so share `self` through a RefCell.
+        let me = std::cell::RefCell::new(self);
+        PRATT
+            .map_primary(|p| me.borrow_mut().operand(p))
+            .map_prefix(|op, rhs| {
+                let span = me.borrow().span(&op).to(rhs.span);
+                Expr { kind: ExprKind::Unary { op: UnaryOp::Neg, operand: Box::new(rhs) }, span }
+            })
+            .map_infix(|lhs, op, rhs| {
+                let op = match op.as_rule() {
+                    Rule::add => BinaryOp::Add,
+                    Rule::sub => BinaryOp::Sub,
+                    Rule::mul => BinaryOp::Mul,
+                    Rule::div => BinaryOp::Div,
+                    Rule::pow => BinaryOp::Pow,
+                    _ => BinaryOp::Range,
+                };
+                let span = lhs.span.to(rhs.span);
+                Expr { kind: ExprKind::Binary { op, lhs: Box::new(lhs), rhs: Box::new(rhs) }, span }
+            })
+            .parse(pairs)
+    }
+
+    fn operand(&mut self, p: Pair<Rule>) -> Expr {
+        let mut inner = p.into_inner();
+        let mut e = self.primary(inner.next().expect("primary"));
+        for post in inner {
+            let span = e.span.to(self.span(&post));
+            e = match post.as_rule() {
+                Rule::call_args => {
+                    let args = post.into_inner().map(|a| self.arg(a)).collect();
+                    Expr { kind: ExprKind::Call { callee: Box::new(e), args }, span }
+                }
+                _ => {
+                    let block = self.block(post);
+                    Expr { kind: ExprKind::WithBlock { base: Box::new(e), block }, span }
+                }
+            };
+        }
+        e
+    }
+
+    fn arg(&mut self, p: Pair<Rule>) -> Arg {
+        let mut inner: Vec<Pair<Rule>> = p.into_inner().collect();
+        let value = self.expr(inner.pop().expect("arg value"));
+        let name = inner.pop().map(|n| self.ident(n));
+        Arg { name, value }
+    }
+
+    fn primary(&mut self, p: Pair<Rule>) -> Expr {
+        let span = self.span(&p);
+        let kind = match p.as_rule() {
+            Rule::quantity => return self.quantity(p),
+            Rule::string => ExprKind::Str(self.string(p)),
+            Rule::ident => ExprKind::Name(p.as_str().to_string()),
+            Rule::paren => {
+                let inner = self.expr(p.into_inner().next().expect("paren expr"));
+                return Expr { kind: inner.kind, span };
+            }
+            Rule::list => ExprKind::List(p.into_inner().map(|e| self.expr(e)).collect()),
+            _ => ExprKind::Block(self.block(p)),
+        };
+        Expr { kind, span }
+    }
+
+    fn quantity(&mut self, p: Pair<Rule>) -> Expr {
+        let span = self.span(&p);
+        let mut inner = p.into_inner();
+        let num = inner.next().expect("number");
+        let value: f64 = num.as_str().parse().unwrap_or(f64::INFINITY);
+        if !value.is_finite() {
+            self.diags.push(
+                Diagnostic::error(codes::BAD_NUMBER, "number is too large", self.file, self.span(&num))
+                    .with_label("this does not fit in a 64-bit float")
+                    .with_help("write it in a larger unit, or check for a typo in the exponent"),
+            );
+        }
+        let unit = inner.next().map(|u| {
+            let uspan = self.span(&u);
+            let mut parts = Vec::new();
+            for (k, part) in u.into_inner().enumerate() {
+                let pspan = self.span(&part);
+                let mut pi = part.into_inner();
+                let name = pi.next().expect("unit name").as_str().to_string();
+                let mut power: i32 = pi.next().map(|x| x.as_str().parse().unwrap_or(1)).unwrap_or(1);
+                if power == 0 {
+                    self.diags.push(
+                        Diagnostic::error(codes::BAD_UNIT_POWER, "a unit to the power zero", self.file, pspan)
+                            .with_label("remove this unit or give it a non-zero power"),
+                    );
+                    power = 1;
+                }
+                if k > 0 {
+                    power = -power;
+                }
+                parts.push(UnitPart { name, power, span: pspan });
+            }
+            Unit { parts, span: uspan }
+        });
+        let value = if value.is_finite() { value } else { 0.0 };
+        Expr { kind: ExprKind::Quantity { value, unit }, span }
+    }
+
+    fn string(&mut self, p: Pair<Rule>) -> String {
+        let body = p.into_inner().next().expect("string body");
+        let start = self.span(&body).start as usize;
+        let raw = body.as_str();
+        let mut out = String::with_capacity(raw.len());
+        let mut chars = raw.char_indices();
+        while let Some((i, c)) = chars.next() {
+            if c != '\\' {
+                out.push(c);
+                continue;
+            }
+            match chars.next() {
+                Some((_, '"')) => out.push('"'),
+                Some((_, '\\')) => out.push('\\'),
+                Some((_, 'n')) => out.push('\n'),
+                Some((_, 't')) => out.push('\t'),
+                Some((j, other)) => {
+                    let span = Span::new(start + i, start + j + other.len_utf8());
+                    self.diags.push(
+                        Diagnostic::error(codes::BAD_ESCAPE, format!("unknown escape `\\{other}` in a string"), self.file, span)
+                            .with_help("the escapes are \\\" \\\\ \\n \\t"),
+                    );
+                }
+                None => {}
+            }
+        }
+        out
+    }
+
+    fn block(&mut self, p: Pair<Rule>) -> Block {
+        let span = self.span(&p);
+        let mut entries = Vec::new();
+        for e in p.into_inner() {
+            let rule = e.as_rule();
+            let mut inner: Vec<Pair<Rule>> = e.into_inner().collect();
+            let last = inner.pop().expect("entry value");
+            let value = self.expr(last);
+            let mut names = inner.into_iter().map(|n| self.ident(n));
+            let name = names.next().expect("entry name");
+            entries.push(match rule {
+                Rule::param_entry => Entry::Param { name, value },
+                _ => Entry::Formula { name, params: names.collect(), body: value },
+            });
+        }
+        Block { entries, span }
+    }
+
+    fn syntax_error(&self, text: &str, e: pest::error::Error<Rule>) -> Diagnostic {
+        use pest::error::{ErrorVariant, InputLocation};
+        let at = match e.location {
+            InputLocation::Pos(p) => p,
+            InputLocation::Span((s, _)) => s,
+        };
+        let found = describe_found(text, at);
+        let (message, expected) = match &e.variant {
+            ErrorVariant::ParsingError { positives, .. } => {
+                let mut words: Vec<&str> = positives.iter().filter_map(|r| describe_rule(*r)).collect();
+                words.sort_unstable();
+                words.dedup();
+                let expected = match words.len() {
+                    0 => String::new(),
+                    1 => words[0].to_string(),
+                    _ => {
+                        let (last, rest) = words.split_last().expect("non-empty");
+                        format!("{} or {}", rest.join(", "), last)
+                    }
+                };
+                (format!("unexpected {found}"), expected)
+            }
+            ErrorVariant::CustomError { message } => (message.clone(), String::new()),
+        };
+        let end = (at + found_len(text, at)).min(text.len());
+        let span = Span::new(at + self.offset, end + self.offset);
+        let mut d = Diagnostic::error(codes::SYNTAX, message, self.file, span);
+        if !expected.is_empty() {
+            d = d.with_label(format!("expected {expected}"));
+        }
+        if let Some(h) = syntax_hint(text, at) {
+            d = d.with_help(h);
+        }
+        d
+    }
+}
+
+/// Plain words for the rules a user can be told were expected; `None`
+/// hides a rule that only makes sense inside the grammar.
+fn describe_rule(r: Rule) -> Option<&'static str> {
+    Some(match r {
+        Rule::EOI => "end of file",
+        Rule::use_item | Rule::kw_use => "`use`",
+        Rule::let_item | Rule::kw_let => "`let`",
+        Rule::decl_item | Rule::decl_kind => "a declaration (`surface`, `tool`, `machine`, `strategy`)",
+        Rule::job_item | Rule::kw_job => "`job`",
+        Rule::std_path => "a module path like `std::tools`",
+        Rule::ident => "a name",
+        Rule::param_name => "a parameter name",
+        Rule::expr | Rule::operand | Rule::quantity | Rule::number => "a value",
+        Rule::paren => "`(`",
+        Rule::list => "`[`",
+        Rule::block => "`{`",
+        Rule::call_args => "`(`",
+        Rule::param_entry | Rule::formula_entry => "a parameter (`name: value`)",
+        Rule::range_op | Rule::add | Rule::sub | Rule::mul | Rule::div | Rule::pow => "an operator",
+        Rule::neg => "`-`",
+        Rule::string => "a string",
+        Rule::unit | Rule::unit_part | Rule::unit_name => "a unit",
+        Rule::unit_power => "a whole-number power",
+        Rule::arg => "an argument",
+        _ => return None,
+    })
+}
+
+fn found_len(text: &str, at: usize) -> usize {
+    let rest = &text[at..];
+    let word: usize = rest
+        .char_indices()
+        .take_while(|(_, c)| c.is_alphanumeric() || *c == '_')
+        .map(|(_, c)| c.len_utf8())
+        .sum();
+    if word > 0 { word } else { rest.chars().next().map_or(0, char::len_utf8) }
+}
+
+fn describe_found(text: &str, at: usize) -> String {
+    let rest = &text[at..];
+    match rest.chars().next() {
+        None => "end of file".to_string(),
+        Some(c) if c.is_alphanumeric() || c == '_' => format!("`{}`", &rest[..found_len(text, at)]),
+        Some('\n') | Some('\r') => "end of line".to_string(),
+        Some(c) if c.is_control() => format!("control character U+{:04X}", c as u32),
+        Some(c) => format!("`{c}`"),
+    }
+}
+
+fn syntax_hint(text: &str, at: usize) -> Option<String> {
+    let rest = &text[at..];
+    if rest.starts_with('=') && !rest.starts_with("==") {
+        return Some("parameters are written `name: value`, with a colon".into());
+    }
+    if rest.starts_with(';') {
+        return Some("lines need no `;`; separate parameters with new lines or commas".into());
+    }
+    if rest.is_empty() {
+        let opens = text.matches('{').count() + text.matches('(').count() + text.matches('[').count();
+        let closes = text.matches('}').count() + text.matches(')').count() + text.matches(']').count();
+        if opens > closes {
+            return Some("a bracket is not closed".into());
+        }
+    }
+    None
+}

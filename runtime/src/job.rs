@@ -1,0 +1,21 @@
+//! A checked, fully resolved job: what the compiler hands the runtime.
+
+use crate::machine::Lathe;
+use crate::surface::RotationalSurface;
+use crate::tool::RoundNoseTool;
+use crate::toolpath::ProfileTurning;
+
+/// One job with every parameter in internal units (mm, rad, s).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Job {
+    pub name: String,
+    /// Names the user gave each part, for the program header.
+    pub surface_name: String,
+    pub tool_name: String,
+    pub machine_name: String,
+    pub strategy_name: String,
+    pub surface: RotationalSurface,
+    pub tool: RoundNoseTool,
+    pub machine: Lathe,
+    pub strategy: ProfileTurning,
+}

@@ -1,0 +1,15 @@
+//! Everything that executes a lens-machining job, usable as a Rust library
+//! without the language: surfaces, tools, machines, toolpath strategies and
+//! the dialect emitters that turn a move stream into a program.
+//!
+//! Internal units: one per dimension — millimetres, radians, seconds.
+
+pub mod format;
+pub mod job;
+pub mod machine;
+pub mod program;
+pub mod surface;
+pub mod tool;
+pub mod toolpath;
+
+pub use job::Job;

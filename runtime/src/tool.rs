@@ -1,0 +1,13 @@
+//! Cutting tools.
+
+/// A round-nose (single-point diamond) turning tool, referenced at the
+/// centre of its nose circle.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RoundNoseTool {
+    /// Nose radius ρ (mm).
+    pub nose_radius: f64,
+    /// Clearance angle (rad): the steepest surface slope the flank clears.
+    pub clearance_angle: f64,
+    /// Rake angle (rad); recorded in the header, not used by planning.
+    pub rake_angle: f64,
+}

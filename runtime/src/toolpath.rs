@@ -1,0 +1,271 @@
+//! Profile turning: the tool-nose centre path is the surface profile offset
+//! by the nose radius along its normal, sampled so that the chords between
+//! points stay within the chord tolerance of the exact offset curve.
+
+use nalgebra::Vector2;
+
+use crate::job::Job;
+use crate::surface::RotationalSurface;
+
+/// Feed as the user gave it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Feed {
+    /// mm per radian of spindle rotation (mm/rev ÷ 2π).
+    PerRevolution(f64),
+    /// mm/s.
+    PerTime(f64),
+}
+
+/// A facing cut across the profile, from `start_radius` to `end_radius`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProfileTurning {
+    pub feed: Feed,
+    /// Spindle speed (rad/s), constant.
+    pub spindle_speed: f64,
+    /// Largest distance (mm) between the exact tool-centre curve and the chords.
+    pub chord_tolerance: f64,
+    /// Radius (mm) where the cut starts; the aperture edge if `None`.
+    pub start_radius: Option<f64>,
+    /// Radius (mm) where the cut ends (0: the centre).
+    pub end_radius: f64,
+    /// Height (mm) above the highest tool-centre point for rapid moves.
+    pub retract: f64,
+}
+
+/// One motion in the dialect-independent move stream.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Move {
+    /// Positioning at rapid rate, out of the material.
+    Rapid { x: f64, z: f64 },
+    /// Cutting motion at the programmed feed.
+    Feed { x: f64, z: f64 },
+}
+
+/// A planned path and what planning learned about the part.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Toolpath {
+    pub moves: Vec<Move>,
+    /// Tool-centre points of the cut (the feed moves), in cutting order.
+    pub cut_points: usize,
+    /// Length (mm) of the cutting moves.
+    pub cut_length: f64,
+    /// Cutting feed as a speed (mm/s).
+    pub feed_speed: f64,
+    /// Smallest concave radius of curvature on the profile and where (r, mm).
+    pub min_concave_radius: Option<(f64, f64)>,
+    /// Steepest profile slope (rad) and where (r, mm).
+    pub max_slope: (f64, f64),
+}
+
+impl Toolpath {
+    /// Estimated cutting time (s), rapids excluded.
+    pub fn cutting_time(&self) -> f64 {
+        self.cut_length / self.feed_speed
+    }
+}
+
+/// Why a job cannot be planned as given. Each carries the figures a
+/// diagnostic needs; the compiler turns them into user errors.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PlanError {
+    /// The nose is larger than the smallest concave radius of curvature:
+    /// it cannot reach the bottom of the bowl without cutting its sides.
+    NoseTooLarge { nose_radius: f64, min_radius: f64, at_radius: f64 },
+    /// The path leaves an axis's travel.
+    OutOfTravel { axis: char, value: f64, min: f64, max: f64 },
+    /// The cutting feed exceeds the machine's maximum (mm/s).
+    FeedTooHigh { feed: f64, max: f64 },
+    /// The spindle speed exceeds the machine's maximum (rad/s).
+    SpindleTooFast { speed: f64, max: f64 },
+    /// The surface is undefined (or the offset not finite) at this radius.
+    Undefined { at_radius: f64 },
+}
+
+/// Number of radii at which the profile is scanned for curvature and slope.
+const SCAN_POINTS: usize = 4096;
+
+/// Plans the profile-turning path of `job`, or says every reason it cannot.
+pub fn plan_profile_turning(job: &Job) -> Result<Toolpath, Vec<PlanError>> {
+    let surf = &job.surface;
+    let strat = &job.strategy;
+    let rho = job.tool.nose_radius;
+    let start = strat.start_radius.unwrap_or(surf.aperture_radius);
+    let end = strat.end_radius;
+    let mut errors = Vec::new();
+
+    // Scan the profile: curvature and slope over the cut.
+    let mut min_concave: Option<(f64, f64)> = None;
+    let mut max_slope = (0.0f64, 0.0f64);
+    for i in 0..=SCAN_POINTS {
+        let r = end + (start - end) * i as f64 / SCAN_POINTS as f64;
+        let p = surf.eval(r);
+        if !(p.z.is_finite() && p.dz.is_finite() && p.d2z.is_finite()) {
+            errors.push(PlanError::Undefined { at_radius: r });
+            return Err(errors);
+        }
+        let slope = p.dz.atan().abs();
+        if slope > max_slope.0 {
+            max_slope = (slope, r);
+        }
+        if p.d2z > 0.0 {
+            let radius = (1.0 + p.dz * p.dz).powf(1.5) / p.d2z;
+            if min_concave.is_none_or(|(m, _)| radius < m) {
+                min_concave = Some((radius, r));
+            }
+        }
+    }
+    if let Some((min_radius, at_radius)) = min_concave
+        && rho > min_radius
+    {
+        errors.push(PlanError::NoseTooLarge { nose_radius: rho, min_radius, at_radius });
+    }
+
+    let feed_speed = match strat.feed {
+        Feed::PerRevolution(f) => f * strat.spindle_speed,
+        Feed::PerTime(v) => v,
+    };
+    if feed_speed > job.machine.max_feed {
+        errors.push(PlanError::FeedTooHigh { feed: feed_speed, max: job.machine.max_feed });
+    }
+    if strat.spindle_speed > job.machine.max_spindle_speed {
+        errors.push(PlanError::SpindleTooFast { speed: strat.spindle_speed, max: job.machine.max_spindle_speed });
+    }
+
+    let centre = |r: f64| tool_centre(surf, rho, r);
+    let cut = sample_offset_curve(&centre, start, end, strat.chord_tolerance);
+    if cut.iter().any(|c| !(c.x.is_finite() && c.y.is_finite())) {
+        errors.push(PlanError::Undefined { at_radius: start });
+        return Err(errors);
+    }
+
+    let top = cut.iter().map(|c| c.y).fold(f64::NEG_INFINITY, f64::max);
+    let safe_z = top + strat.retract;
+    let mut moves = Vec::with_capacity(cut.len() + 4);
+    moves.push(Move::Rapid { x: cut[0].x, z: safe_z });
+    moves.push(Move::Feed { x: cut[0].x, z: cut[0].y });
+    let mut cut_length = (safe_z - cut[0].y).abs();
+    for w in cut.windows(2) {
+        cut_length += (w[1] - w[0]).norm();
+    }
+    moves.extend(cut.iter().skip(1).map(|c| Move::Feed { x: c.x, z: c.y }));
+    let last = cut[cut.len() - 1];
+    moves.push(Move::Rapid { x: last.x, z: safe_z });
+
+    let (lo_x, hi_x) = job.machine.travel_x;
+    let (lo_z, hi_z) = job.machine.travel_z;
+    for m in &moves {
+        let (Move::Rapid { x, z } | Move::Feed { x, z }) = *m;
+        if x < lo_x || x > hi_x {
+            errors.push(PlanError::OutOfTravel { axis: 'X', value: x, min: lo_x, max: hi_x });
+            break;
+        }
+        if z < lo_z || z > hi_z {
+            errors.push(PlanError::OutOfTravel { axis: 'Z', value: z, min: lo_z, max: hi_z });
+            break;
+        }
+    }
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+    Ok(Toolpath {
+        cut_points: cut.len(),
+        moves,
+        cut_length,
+        feed_speed,
+        min_concave_radius: min_concave,
+        max_slope,
+    })
+}
+
+/// The nose centre when the nose touches the profile at radius `r`: the
+/// profile point moved by ρ along the unit normal that points to the tool.
+pub fn tool_centre(surf: &RotationalSurface, nose_radius: f64, r: f64) -> Vector2<f64> {
+    let p = surf.eval(r);
+    let normal = Vector2::new(-p.dz, 1.0).normalize();
+    Vector2::new(r, p.z) + nose_radius * normal
+}
+
+/// Samples the curve `c(t)` for t from `a` to `b` so that no chord strays
+/// more than `tol` from it: uniform seeds, then bisection wherever the
+/// curve's midpoint (or quarter points) lies too far from the chord.
+pub fn sample_offset_curve(c: &dyn Fn(f64) -> Vector2<f64>, a: f64, b: f64, tol: f64) -> Vec<Vector2<f64>> {
+    const SEEDS: usize = 32;
+    const MAX_DEPTH: u32 = 40;
+    let mut out = vec![c(a)];
+    for i in 0..SEEDS {
+        let t0 = a + (b - a) * i as f64 / SEEDS as f64;
+        let t1 = a + (b - a) * (i + 1) as f64 / SEEDS as f64;
+        // Depth-first bisection with an explicit stack, emitting in order.
+        let mut stack = vec![(t0, c(t0), t1, c(t1), 0u32)];
+        while let Some((s0, p0, s1, p1, depth)) = stack.pop() {
+            let too_far = [0.25, 0.5, 0.75].iter().any(|f| {
+                let q = c(s0 + (s1 - s0) * f);
+                distance_to_segment(q, p0, p1) > tol
+            });
+            if too_far && depth < MAX_DEPTH {
+                let sm = 0.5 * (s0 + s1);
+                let pm = c(sm);
+                stack.push((sm, pm, s1, p1, depth + 1));
+                stack.push((s0, p0, sm, pm, depth + 1));
+            } else {
+                out.push(p1);
+            }
+        }
+    }
+    out
+}
+
+fn distance_to_segment(q: Vector2<f64>, a: Vector2<f64>, b: Vector2<f64>) -> f64 {
+    let ab = b - a;
+    let len2 = ab.norm_squared();
+    if len2 == 0.0 {
+        return (q - a).norm();
+    }
+    let t = ((q - a).dot(&ab) / len2).clamp(0.0, 1.0);
+    (q - (a + t * ab)).norm()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::surface::Sense;
+
+    fn sphere(sense: Sense) -> RotationalSurface {
+        RotationalSurface { radius: 5.0, conic: 0.0, sense, terms: vec![], aperture_radius: 2.0 }
+    }
+
+    #[test]
+    fn convex_sphere_offset_is_a_larger_sphere() {
+        // The nose centre over a convex sphere of radius R lies on a sphere of
+        // radius R + ρ about the same centre (0, −R).
+        let s = sphere(Sense::Convex);
+        for r in [0.0, 0.5, 1.9] {
+            let c = tool_centre(&s, 0.3, r);
+            let d = (c - Vector2::new(0.0, -5.0)).norm();
+            assert!((d - 5.3).abs() < 1e-12, "r={r}: {d}");
+        }
+    }
+
+    #[test]
+    fn concave_sphere_offset_is_a_smaller_sphere() {
+        let s = sphere(Sense::Concave);
+        let c = tool_centre(&s, 0.3, 1.2);
+        assert!(((c - Vector2::new(0.0, 5.0)).norm() - 4.7).abs() < 1e-12);
+    }
+
+    #[test]
+    fn samples_stay_within_chord_tolerance() {
+        let s = sphere(Sense::Convex);
+        let f = |t: f64| tool_centre(&s, 0.3, t);
+        let pts = sample_offset_curve(&f, 2.0, 0.0, 1e-5);
+        // Every chord's midpoint on the exact circle R + ρ is within tolerance:
+        // sagitta of a chord of length L on radius Rc is L²/(8 Rc).
+        for w in pts.windows(2) {
+            let l = (w[1] - w[0]).norm();
+            assert!(l * l / (8.0 * 5.3) <= 1e-5 * 1.0001, "chord {l}");
+        }
+        assert!(pts.len() > 10);
+        assert_eq!(pts[0].x, f(2.0).x);
+        assert_eq!(pts.last().unwrap().x, 0.0);
+    }
+}
