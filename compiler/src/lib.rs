@@ -1,1 +1,15 @@
+//! The `.lens` compiler: loading and name resolution, unit and type
+//! checking, lowering to the runtime's job description, diagnostics
+//! rendering, and the driver the `lensc` binary calls.
 
+pub mod check;
+pub mod codes;
+pub mod driver;
+pub mod loader;
+pub mod lower;
+pub mod render;
+pub mod schema;
+pub mod source;
+pub mod suggest;
+pub mod units;
+pub mod value;

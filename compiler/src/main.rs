@@ -1,1 +1,175 @@
-fn main(){}
+//! The `lensc` command line: `check` and `build`. Exit codes: 0 success
+//! (warnings allowed), 1 errors in the input, 2 usage errors, 101 an
+//! internal error.
+
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand, ValueEnum};
+use lensc::driver::{self, Checked};
+use lensc::loader::{RealFs, plain_io_error};
+use lensc::render;
+
+#[derive(Parser)]
+#[command(name = "lensc", version, about = "Compile lens-machining jobs (.lens files) into machine programs")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+    /// How diagnostics are printed: for people, or one JSON object per line on stdout.
+    #[arg(long, global = true, value_enum, default_value_t = MessageFormat::Human)]
+    message_format: MessageFormat,
+    /// Colour in human diagnostics.
+    #[arg(long, global = true, value_enum, default_value_t = ColorChoice::Auto)]
+    color: ColorChoice,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Check files for errors without building anything.
+    Check {
+        /// The .lens files to check.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+    },
+    /// Check a file and write a program for each of its jobs.
+    Build {
+        /// The .lens file to build.
+        file: PathBuf,
+        /// Build only this job.
+        #[arg(long)]
+        job: Option<String>,
+        /// Write the program in this dialect (the machine must support it).
+        #[arg(long, value_parser = ["linuxcnc"])]
+        dialect: Option<String>,
+        /// Directory for the programs.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+    },
+}
+
+#[derive(Clone, Copy, ValueEnum, PartialEq)]
+enum MessageFormat {
+    Human,
+    Json,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum ColorChoice {
+    Auto,
+    Always,
+    Never,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    // Deep but valid input is bounded by the parser's nesting limit; a large
+    // stack keeps the recursive checker far from the edge all the same.
+    let worker = std::thread::Builder::new().stack_size(256 << 20).spawn(move || run(cli));
+    match worker.map(|h| h.join()) {
+        Ok(Ok(code)) => ExitCode::from(code),
+        _ => ExitCode::from(101),
+    }
+}
+
+fn run(cli: Cli) -> u8 {
+    let color = match cli.color {
+        ColorChoice::Always => true,
+        ColorChoice::Never => false,
+        ColorChoice::Auto => std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none(),
+    };
+    let out = Output { format: cli.message_format, color };
+    match cli.command {
+        Command::Check { files } => {
+            let mut code = 0;
+            for f in &files {
+                let Some(c) = load(&out, f) else {
+                    code = 1;
+                    continue;
+                };
+                out.diagnostics(&c, c.diags());
+                if c.has_errors() {
+                    code = 1;
+                }
+            }
+            code
+        }
+        Command::Build { file, job, dialect: _, out: dir } => {
+            let Some(c) = load(&out, &file) else { return 1 };
+            out.diagnostics(&c, c.diags());
+            if c.has_errors() {
+                return 1;
+            }
+            if let Some(name) = &job
+                && !c.checked.jobs.iter().any(|j| &j.name.name == name)
+            {
+                let names: Vec<&str> = c.checked.jobs.iter().map(|j| j.name.name.as_str()).collect();
+                eprintln!("error: {} has no job `{name}` (its jobs: {})", file.display(), if names.is_empty() { "none".into() } else { names.join(", ") });
+                return 2;
+            }
+            if c.checked.jobs.is_empty() {
+                let d = lensc_grammar::Diagnostic::error(lensc::codes::NO_JOB, "this file has no job to build", lensc_grammar::FileId(0), lensc_grammar::Span::new(0, 0))
+                    .with_help("add `job NAME { surface: …, tool: …, machine: …, strategy: … }`");
+                out.diagnostics(&c, &[d]);
+                return 1;
+            }
+            let (programs, diags) = driver::plan_and_emit(&c, job.as_deref(), &file.display().to_string());
+            out.diagnostics(&c, &diags);
+            if diags.iter().any(|d| d.is_error()) {
+                return 1;
+            }
+            for (name, text, path) in programs {
+                let target = dir.join(&name);
+                if let Err(e) = driver::write_atomic(&target, &text) {
+                    eprintln!("error[{}]: cannot write {}: {}", lensc::codes::CANNOT_WRITE, target.display(), plain_io_error(&e));
+                    return 1;
+                }
+                eprintln!(
+                    "wrote {} ({} lines, {} cut points, estimated cutting time {:.1} s)",
+                    target.display(),
+                    text.lines().count(),
+                    path.cut_points,
+                    path.cutting_time()
+                );
+            }
+            0
+        }
+    }
+}
+
+struct Output {
+    format: MessageFormat,
+    color: bool,
+}
+
+impl Output {
+    fn diagnostics(&self, c: &Checked, diags: &[lensc_grammar::Diagnostic]) {
+        let result = match self.format {
+            MessageFormat::Human => render::human(diags, &c.loaded.sources, self.color, &mut std::io::stderr().lock()),
+            MessageFormat::Json => render::json_lines(diags, &c.loaded.sources, &mut std::io::stdout().lock()),
+        };
+        // A closed pipe is no reason to fail the build.
+        let _ = result;
+        let _ = std::io::stdout().flush();
+    }
+}
+
+/// Loads and checks a root file; reports an unreadable file itself.
+fn load(out: &Output, path: &Path) -> Option<Checked> {
+    match driver::check_path(&RealFs, path) {
+        Ok(c) => Some(c),
+        Err(e) => {
+            let msg = format!("cannot read {}: {}", path.display(), plain_io_error(&e));
+            match out.format {
+                MessageFormat::Human => eprintln!("error[{}]: {msg}", lensc::codes::CANNOT_READ),
+                MessageFormat::Json => println!(
+                    "{}",
+                    serde_json::json!({"severity": "error", "code": lensc::codes::CANNOT_READ, "message": msg,
+                        "file": path.display().to_string(), "line": 0, "column": 0,
+                        "span": {"start": 0, "end": 0}, "labels": [], "help": null})
+                ),
+            }
+            None
+        }
+    }
+}

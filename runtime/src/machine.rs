@@ -13,6 +13,12 @@ impl Dialect {
             Dialect::LinuxCnc => "linuxcnc",
         }
     }
+    pub fn from_name(name: &str) -> Option<Dialect> {
+        match name {
+            "linuxcnc" => Some(Dialect::LinuxCnc),
+            _ => None,
+        }
+    }
     /// Program file extension.
     pub fn extension(self) -> &'static str {
         match self {

@@ -143,11 +143,12 @@ fn rounded_eq(a: f64, b: f64, d: u32) -> bool {
     a.is_finite() && (a * s).round() == (b * s).round()
 }
 
-/// A header figure: shortest round-trip form, which never has an exponent
-/// for the magnitudes that appear in a job description.
+/// A header figure to 10 decimals (0.1 pm in mm), trailing zeros trimmed:
+/// no exponent, and `1e-5` shows as `0.00001`, not `0.000009999…`.
 fn num(v: f64) -> String {
-    let s = format!("{v}");
-    if s.contains('e') { format!("{v:.12}") } else { s }
+    let s = format!("{v:.10}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" { "0".into() } else { s.to_string() }
 }
 
 fn duration(secs: f64) -> String {

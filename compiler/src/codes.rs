@@ -1,0 +1,66 @@
+//! Every diagnostic code the compiler emits, with what it means. Syntax
+//! codes (E0001–E0009) live in `lensc_grammar::diagnostic::codes`. A code is
+//! never reused for another meaning.
+
+pub const UNKNOWN_NAME: &str = "E0100";
+pub const DUPLICATE_NAME: &str = "E0101";
+pub const UNKNOWN_MODULE: &str = "E0102";
+pub const CANNOT_READ: &str = "E0103";
+pub const IMPORT_CYCLE: &str = "E0104";
+pub const NOT_IN_MODULE: &str = "E0105";
+pub const SELF_REFERENCE: &str = "E0106";
+pub const UNKNOWN_UNIT: &str = "E0110";
+pub const DIMENSION_MISMATCH: &str = "E0111";
+pub const BAD_ARGUMENT_DIMENSION: &str = "E0112";
+pub const ARGUMENT_COUNT: &str = "E0113";
+pub const BAD_EXPONENT: &str = "E0114";
+pub const MATH_DOMAIN: &str = "E0115";
+pub const NOT_CALLABLE: &str = "E0116";
+pub const FORMULA_DIMENSION: &str = "E0117";
+pub const UNKNOWN_COORDINATE: &str = "E0118";
+pub const WRONG_VALUE: &str = "E0119";
+pub const UNKNOWN_PARAMETER: &str = "E0120";
+pub const MISSING_PARAMETER: &str = "E0121";
+pub const PARAMETER_DIMENSION: &str = "E0122";
+pub const OUT_OF_RANGE: &str = "E0123";
+pub const WRONG_KIND: &str = "E0124";
+pub const DUPLICATE_PARAMETER: &str = "E0125";
+pub const UNKNOWN_WORD: &str = "E0126";
+pub const CONIC_DOMAIN: &str = "E0127";
+pub const CONFLICTING_PARAMETERS: &str = "E0128";
+pub const DECLARATION_KIND: &str = "E0129";
+pub const NO_JOB: &str = "E0130";
+pub const UNSUPPORTED_COMBINATION: &str = "E0131";
+pub const OUTSIDE_APERTURE: &str = "E0133";
+pub const NOSE_TOO_LARGE: &str = "E0140";
+pub const OUT_OF_TRAVEL: &str = "E0141";
+pub const FEED_TOO_HIGH: &str = "E0142";
+pub const SPINDLE_TOO_FAST: &str = "E0143";
+pub const UNDEFINED_ON_PATH: &str = "E0144";
+pub const NOT_PRINTABLE: &str = "E0150";
+pub const CANNOT_WRITE: &str = "E0151";
+
+pub const UNUSED: &str = "W0001";
+
+/// All codes, for the uniqueness test and the reference in README.
+pub const ALL: &[&str] = &[
+    UNKNOWN_NAME, DUPLICATE_NAME, UNKNOWN_MODULE, CANNOT_READ, IMPORT_CYCLE, NOT_IN_MODULE,
+    SELF_REFERENCE, UNKNOWN_UNIT, DIMENSION_MISMATCH, BAD_ARGUMENT_DIMENSION, ARGUMENT_COUNT,
+    BAD_EXPONENT, MATH_DOMAIN, NOT_CALLABLE, FORMULA_DIMENSION, UNKNOWN_COORDINATE, WRONG_VALUE,
+    UNKNOWN_PARAMETER, MISSING_PARAMETER, PARAMETER_DIMENSION, OUT_OF_RANGE, WRONG_KIND,
+    DUPLICATE_PARAMETER, UNKNOWN_WORD, CONIC_DOMAIN, CONFLICTING_PARAMETERS, DECLARATION_KIND,
+    NO_JOB, UNSUPPORTED_COMBINATION, OUTSIDE_APERTURE, NOSE_TOO_LARGE, OUT_OF_TRAVEL,
+    FEED_TOO_HIGH, SPINDLE_TOO_FAST, UNDEFINED_ON_PATH, NOT_PRINTABLE, CANNOT_WRITE, UNUSED,
+];
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn codes_are_unique() {
+        let mut all = super::ALL.to_vec();
+        all.sort_unstable();
+        let n = all.len();
+        all.dedup();
+        assert_eq!(n, all.len());
+    }
+}

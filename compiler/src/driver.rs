@@ -1,0 +1,174 @@
+//! The compiler's entry points: check a file, build a file's jobs into
+//! programs. Pure apart from the `FileSystem` it reads through and the
+//! atomic writes of `build`.
+
+use std::path::{Path, PathBuf};
+
+use lensc_grammar::{Diagnostic, FileId, Span};
+use lensc_runtime::program::{self, ProgramError, Provenance};
+use lensc_runtime::toolpath::{self, PlanError, Toolpath};
+
+use crate::check::{self, trim_num};
+use crate::codes;
+use crate::loader::{self, FileSystem, Loaded};
+use crate::lower;
+
+/// The result of checking one file: its sources and everything found.
+pub struct Checked {
+    pub loaded: Loaded,
+    pub checked: check::Checked,
+}
+
+impl Checked {
+    pub fn diags(&self) -> &[Diagnostic] {
+        &self.checked.diags
+    }
+    pub fn has_errors(&self) -> bool {
+        self.checked.has_errors()
+    }
+}
+
+/// Loads and checks `path`. An I/O error on the root file itself is the
+/// caller's to report.
+pub fn check_path(fs: &dyn FileSystem, path: &Path) -> std::io::Result<Checked> {
+    let loaded = loader::load(fs, path)?;
+    let checked = check::check(&loaded);
+    Ok(Checked { loaded, checked })
+}
+
+/// Checks source text given directly.
+pub fn check_text(fs: &dyn FileSystem, name: &str, text: &[u8]) -> Checked {
+    let loaded = loader::load_text(fs, name, text);
+    let checked = check::check(&loaded);
+    Checked { loaded, checked }
+}
+
+pub struct BuildOptions {
+    /// Build only this job; all jobs of the file if `None`.
+    pub job: Option<String>,
+    pub out_dir: PathBuf,
+}
+
+/// A program that was built.
+pub struct Built {
+    pub job: String,
+    pub path: PathBuf,
+    pub text: String,
+    pub toolpath: Toolpath,
+}
+
+/// Builds programs (without writing them) for the checked jobs. Returns
+/// the programs and any further diagnostics.
+pub fn plan_and_emit(c: &Checked, only: Option<&str>, source_name: &str) -> (Vec<(String, String, Toolpath)>, Vec<Diagnostic>) {
+    let mut diags = Vec::new();
+    let mut out = Vec::new();
+    let jobs: Vec<&check::CheckedJob> = c.checked.jobs.iter().filter(|j| only.is_none_or(|n| j.name.name == n)).collect();
+    let prov = Provenance {
+        source: source_name.to_string(),
+        source_hash: source_hash(&c.loaded),
+        lensc_version: env!("CARGO_PKG_VERSION").to_string(),
+    };
+    for job in jobs {
+        let lowered = match lower::lower(job) {
+            Ok(j) => j,
+            Err(mut d) => {
+                diags.append(&mut d);
+                continue;
+            }
+        };
+        let (file, span) = lower::job_site(job);
+        let path = match toolpath::plan_profile_turning(&lowered) {
+            Ok(p) => p,
+            Err(errs) => {
+                diags.extend(errs.into_iter().map(|e| plan_diagnostic(e, file, span)));
+                continue;
+            }
+        };
+        match program::emit(&lowered, &path, &prov) {
+            Ok(text) => out.push((format!("{}.{}", lowered.name, lowered.machine.dialect.extension()), text, path)),
+            Err(ProgramError::NotPrintable { word, value }) => diags.push(
+                Diagnostic::error(codes::NOT_PRINTABLE, format!("the program would contain {word}{value}, which no controller accepts"), file, span)
+                    .with_label("no program was written for this job"),
+            ),
+        }
+    }
+    (out, diags)
+}
+
+/// FNV-1a 64 over every loaded source, in load order.
+pub fn source_hash(l: &Loaded) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for (_, f) in l.sources.iter() {
+        for b in f.text.bytes().chain(std::iter::once(0u8)) {
+            h ^= u64::from(b);
+            h = h.wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    h
+}
+
+fn plan_diagnostic(e: PlanError, file: FileId, span: Span) -> Diagnostic {
+    let um = |mm: f64| trim_num(mm * 1000.0);
+    match e {
+        PlanError::NoseTooLarge { nose_radius, min_radius, at_radius } => Diagnostic::error(
+            codes::NOSE_TOO_LARGE,
+            format!(
+                "the tool's nose radius ({} um) is larger than the surface's smallest concave radius of curvature ({} um, at r = {} mm): the tool would gouge",
+                um(nose_radius),
+                um(min_radius),
+                trim_num(at_radius)
+            ),
+            file,
+            span,
+        )
+        .with_label("this job")
+        .with_help("use a tool whose nose radius is below the smallest concave radius of curvature"),
+        PlanError::OutOfTravel { axis, value, min, max } => Diagnostic::error(
+            codes::OUT_OF_TRAVEL,
+            format!("the path moves {axis} to {} mm, outside the machine's travel {} .. {} mm", trim_num(value), trim_num(min), trim_num(max)),
+            file,
+            span,
+        )
+        .with_label("this job")
+        .with_help("check the machine's travel, the aperture and the retract height"),
+        PlanError::FeedTooHigh { feed, max } => Diagnostic::error(
+            codes::FEED_TOO_HIGH,
+            format!("the cutting feed ({} mm/min) is above the machine's maximum ({} mm/min)", trim_num(feed * 60.0), trim_num(max * 60.0)),
+            file,
+            span,
+        )
+        .with_label("this job")
+        .with_help("lower the feed or the spindle speed"),
+        PlanError::SpindleTooFast { speed, max } => {
+            let rpm = |w: f64| trim_num(w * 60.0 / (2.0 * std::f64::consts::PI));
+            Diagnostic::error(
+                codes::SPINDLE_TOO_FAST,
+                format!("the spindle speed ({} rpm) is above the machine's maximum ({} rpm)", rpm(speed), rpm(max)),
+                file,
+                span,
+            )
+            .with_label("this job")
+        }
+        PlanError::Undefined { at_radius } => Diagnostic::error(
+            codes::UNDEFINED_ON_PATH,
+            format!("the surface or the tool path is undefined at r = {} mm", trim_num(at_radius)),
+            file,
+            span,
+        )
+        .with_label("this job"),
+    }
+}
+
+/// Writes `text` to `path` atomically: a temporary file in the same
+/// directory, flushed, then renamed over the target. On failure the
+/// target is untouched and no temporary file is left behind.
+pub fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {
+    use std::io::Write;
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir)?;
+    let mut tmp = tempfile::Builder::new().prefix(".lensc-").suffix(".tmp").tempfile_in(dir)?;
+    tmp.write_all(text.as_bytes())?;
+    tmp.as_file().sync_all()?;
+    tmp.persist(path).map_err(|e| e.error)?;
+    Ok(())
+}

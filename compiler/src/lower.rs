@@ -1,0 +1,145 @@
+//! Lowering: a checked job to the runtime's job description, with the
+//! checks that need several parts at once (is this strategy able to cut
+//! this surface on this machine?).
+
+use lensc_grammar::{Diagnostic, FileId};
+use lensc_runtime::Job;
+use lensc_runtime::machine::{Dialect, Lathe};
+use lensc_runtime::surface::{RotationalSurface, Sense};
+use lensc_runtime::tool::RoundNoseTool;
+use lensc_runtime::toolpath::{Feed, ProfileTurning};
+
+use crate::check::{CheckedJob, aperture_radius, trim_num};
+use crate::codes;
+use crate::units::Dim;
+use crate::value::{self, Field, Object, Value};
+
+/// Lowers one checked job, or says why it cannot be built.
+pub fn lower(job: &CheckedJob) -> Result<Job, Vec<Diagnostic>> {
+    let part = |name: &str| value::object(&job.fields, name).expect("checked job part");
+    let (surface, tool, machine, strategy) = (part("surface"), part("tool"), part("machine"), part("strategy"));
+    let mut errors = Vec::new();
+    let at = |name: &str| {
+        let f = value::field(&job.fields, name).expect("checked job part");
+        (f.file, f.span)
+    };
+
+    let unsupported = |what: &str, name: &str, detail: String| {
+        let (file, span) = at(name);
+        Diagnostic::error(codes::UNSUPPORTED_COMBINATION, what.to_string(), file, span).with_label(detail)
+    };
+
+    if strategy.kind.name != "profile_turning" {
+        errors.push(unsupported("lensc cannot build this strategy yet", "strategy", format!("`{}`", strategy.kind.name)));
+    }
+    if machine.kind.name != "lathe" {
+        errors.push(
+            unsupported("profile turning needs a lathe", "machine", format!("this is a `{}`", machine.kind.name)),
+        );
+    }
+    if tool.kind.name != "round_nose" {
+        errors.push(unsupported("profile turning needs a round-nose tool", "tool", format!("this is a `{}`", tool.kind.name)));
+    }
+    let surf = match rotational(surface) {
+        Some(s) => Some(s),
+        None => {
+            errors.push(
+                unsupported(
+                    "profile turning needs a rotationally symmetric surface with a circular aperture",
+                    "surface",
+                    format!("this is a `{}`", surface.kind.name),
+                )
+                .with_help("conic, sphere and asphere surfaces with `aperture: circle(…)` can be turned"),
+            );
+            None
+        }
+    };
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+    let surf = surf.expect("checked above");
+    let f = &strategy.fields;
+    let from = value::num(f, "from");
+    if let Some(start) = from
+        && start > surf.aperture_radius
+    {
+        let fld = value::field(f, "from").expect("from");
+        errors.push(
+            Diagnostic::error(
+                codes::OUTSIDE_APERTURE,
+                format!("the cut starts at r = {} mm, outside the aperture (radius {} mm)", trim_num(start), trim_num(surf.aperture_radius)),
+                fld.file,
+                fld.span,
+            )
+            .with_label("beyond the aperture")
+            .with_help("start at or inside the aperture edge"),
+        );
+    }
+    let feed = match value::field(f, "feed").map(|x| &x.value) {
+        Some(Value::Num(v, d)) if *d == Dim::FEED_PER_REV => Feed::PerRevolution(*v),
+        Some(Value::Num(v, _)) => Feed::PerTime(*v),
+        _ => unreachable!("feed is required and checked"),
+    };
+    let strat = ProfileTurning {
+        feed,
+        spindle_speed: value::num(f, "spindle_speed").expect("required"),
+        chord_tolerance: value::num(f, "chord_tolerance").unwrap_or(10e-6),
+        start_radius: from,
+        end_radius: value::num(f, "to").unwrap_or(0.0),
+        retract: value::num(f, "retract").unwrap_or(1.0),
+    };
+    let m = &machine.fields;
+    let travel = value::block(m, "travel").expect("required");
+    let spindle = value::block(m, "spindle").expect("required");
+    let lathe = Lathe {
+        dialect: value::word(m, "dialect").and_then(Dialect::from_name).expect("the schema admits only known dialects"),
+        resolution: value::num(m, "resolution").expect("required"),
+        travel_x: value::range(travel, "x").expect("required"),
+        travel_z: value::range(travel, "z").expect("required"),
+        max_feed: value::num(m, "max_feed").expect("required"),
+        max_spindle_speed: value::num(spindle, "max_speed").expect("required"),
+    };
+    let t = &tool.fields;
+    let cutter = RoundNoseTool {
+        nose_radius: value::num(t, "nose_radius").expect("required"),
+        clearance_angle: value::num(t, "clearance").expect("required"),
+        rake_angle: value::num(t, "rake").unwrap_or(0.0),
+    };
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+    let name_of = |p: &str, o: &Object| job.part_names.get(p).cloned().unwrap_or_else(|| o.kind.name.to_string());
+    Ok(Job {
+        name: job.name.name.clone(),
+        surface_name: name_of("surface", surface),
+        tool_name: name_of("tool", tool),
+        machine_name: name_of("machine", machine),
+        strategy_name: name_of("strategy", strategy),
+        surface: surf,
+        tool: cutter,
+        machine: lathe,
+        strategy: strat,
+    })
+}
+
+/// The runtime surface for a conic, sphere or asphere with a circular aperture.
+fn rotational(o: &Object) -> Option<RotationalSurface> {
+    if !matches!(o.kind.name, "conic" | "sphere" | "asphere") {
+        return None;
+    }
+    let f: &[Field] = &o.fields;
+    let aperture_radius = aperture_radius(value::object(f, "aperture")?)?;
+    let terms = (1..=20u32).filter_map(|j| value::num(f, &format!("A{j}")).map(|a| (j, a))).collect();
+    Some(RotationalSurface {
+        radius: value::num(f, "radius")?,
+        conic: value::num(f, "conic").unwrap_or(0.0),
+        sense: if value::word(f, "sense")? == "convex" { Sense::Convex } else { Sense::Concave },
+        terms,
+        aperture_radius,
+    })
+}
+
+/// Where a plan error should point: the job's name.
+pub fn job_site(job: &CheckedJob) -> (FileId, lensc_grammar::Span) {
+    (job.file, job.name.span)
+}
