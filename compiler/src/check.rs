@@ -12,7 +12,7 @@ use lensc_grammar::{Diagnostic, FileId};
 use crate::codes;
 use crate::loader::{Import, Loaded};
 use crate::schema::{self, Category, Check, Kind, Param, Ty};
-use crate::suggest::did_you_mean;
+use lensc_grammar::suggest::did_you_mean;
 use crate::units::{self, Dim};
 use crate::value::{self, Field, Formula, Object, Value};
 
@@ -76,6 +76,13 @@ pub fn check(loaded: &Loaded) -> Checked {
     }
     let jobs = c.check_jobs();
     c.warn_unused();
+    let root = &loaded.files[0];
+    if root.ast.items.is_empty() && loaded.diags.is_empty() {
+        c.diags.push(
+            Diagnostic::error(codes::EMPTY_FILE, "this file declares nothing", root.id, Span::new(0, 0))
+                .with_help("a job file declares a surface, a tool, a machine, a strategy and a job"),
+        );
+    }
     let mut diags = loaded.diags.clone();
     diags.append(&mut c.diags);
     Checked { jobs, diags }
@@ -246,12 +253,12 @@ impl<'a> Checker<'a> {
         candidates.extend(FUNCTIONS);
         candidates.extend(schema::KINDS.iter().map(|k| k.name));
         let mut d = Diagnostic::error(codes::UNKNOWN_NAME, format!("unknown name `{name}`"), file, span).with_label("not defined");
-        if let Some(s) = did_you_mean(name, candidates) {
+        if COORDINATES.contains(&name) {
+            d = d.with_help("coordinates can only be used inside a surface formula such as `z(x, y) = …`");
+        } else if let Some(s) = did_you_mean(name, candidates) {
             d = d.with_help(format!("did you mean `{s}`?"));
         } else if units::lookup(name).is_some() {
             d = d.with_help(format!("`{name}` is a unit: write it right after a number, as in `1 {name}`"));
-        } else if COORDINATES.contains(&name) {
-            d = d.with_help("coordinates can only be used inside a surface formula such as `z(x, y) = …`");
         }
         self.err(d);
     }

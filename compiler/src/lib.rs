@@ -10,6 +10,5 @@ pub mod lower;
 pub mod render;
 pub mod schema;
 pub mod source;
-pub mod suggest;
 pub mod units;
 pub mod value;

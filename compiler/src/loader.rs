@@ -12,7 +12,7 @@ use lensc_grammar::{Diagnostic, FileId};
 
 use crate::codes;
 use crate::source::SourceMap;
-use crate::suggest::did_you_mean;
+use lensc_grammar::suggest::did_you_mean;
 
 /// The standard library: module name and its text.
 pub const STDLIB: &[(&str, &str)] = &[

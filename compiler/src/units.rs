@@ -58,8 +58,26 @@ impl Dim {
             Dim::FEED_PER_REV => ("mm/rev".into(), 2.0 * PI),
             Dim::ROTATIONAL_SPEED => ("rpm".into(), 60.0 / (2.0 * PI)),
             Dim::FREQUENCY => ("Hz".into(), 1.0),
-            _ => (self.to_string(), 1.0),
+            _ => (self.base_units(), 1.0),
         }
+    }
+}
+
+impl Dim {
+    /// The base units of this dimension written out: `mm`, `mm/s^2`, `1/mm^3`.
+    pub fn base_units(self) -> String {
+        let mut num = Vec::new();
+        let mut den = Vec::new();
+        for (sym, e) in [("mm", self.length), ("rad", self.angle), ("s", self.time)] {
+            let part = |p: i8| if p == 1 { sym.to_string() } else { format!("{sym}^{p}") };
+            if e > 0 {
+                num.push(part(e));
+            } else if e < 0 {
+                den.push(part(-e));
+            }
+        }
+        let n = if num.is_empty() { "1".to_string() } else { num.join("·") };
+        if den.is_empty() { n } else { format!("{n}/{}", den.join("·")) }
     }
 }
 
@@ -76,24 +94,7 @@ impl fmt::Display for Dim {
             Dim::ROTATIONAL_SPEED => "a rotational speed",
             Dim::FREQUENCY => "a frequency",
             Dim::ACCELERATION => "an acceleration",
-            _ => {
-                let mut num = Vec::new();
-                let mut den = Vec::new();
-                for (sym, e) in [("mm", self.length), ("rad", self.angle), ("s", self.time)] {
-                    let part = |p: i8| if p == 1 { sym.to_string() } else { format!("{sym}^{p}") };
-                    if e > 0 {
-                        num.push(part(e));
-                    } else if e < 0 {
-                        den.push(part(-e));
-                    }
-                }
-                let n = if num.is_empty() { "1".to_string() } else { num.join("·") };
-                return if den.is_empty() {
-                    write!(f, "a quantity in {n}")
-                } else {
-                    write!(f, "a quantity in {n}/{}", den.join("·"))
-                };
-            }
+            _ => return write!(f, "a quantity in {}", self.base_units()),
         };
         f.write_str(name)
     }

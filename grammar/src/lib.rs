@@ -5,6 +5,7 @@
 pub mod ast;
 pub mod diagnostic;
 pub mod parser;
+pub mod suggest;
 
 pub use ast::Span;
 pub use diagnostic::{Diagnostic, FileId, Label, Severity};

@@ -66,7 +66,7 @@ pub fn parse(source: &str, file: FileId) -> (File, Vec<Diagnostic>) {
                 }
             }
             Err(e) => {
-                let d = b.syntax_error(text, e);
+                let d = b.syntax_error(source, text, e);
                 diags.push(d);
             }
         }
@@ -125,15 +125,11 @@ fn scan(src: &str) -> Scan {
             _ => {}
         }
         let is_word = c.is_ascii_alphanumeric() || c == b'_';
-        if is_word && at_word_start && depth == 0 && i > 0 {
-            let rest = &src[i..];
-            let kw = ["use", "let", "job", "surface", "tool", "machine", "strategy"].iter().find(|k| {
-                rest.starts_with(*k)
-                    && !rest[k.len()..].starts_with(|ch: char| ch.is_ascii_alphanumeric() || ch == '_')
-            });
-            if kw.is_some() && preceded_by_line_start(b, i) {
-                starts.push(i);
-            }
+        if is_word && at_word_start && i > 0 && starts_item(&src[i..]) && preceded_by_line_start(b, i) {
+            // Also inside an unclosed bracket: an item keyword at the start of
+            // a line followed by a name cannot continue the previous item,
+            // so a missing `)` or `}` does not swallow the rest of the file.
+            starts.push(i);
         }
         at_word_start = !is_word;
         i += 1;
@@ -144,6 +140,18 @@ fn scan(src: &str) -> Scan {
         chunks.push((s, e));
     }
     Scan { chunks, too_deep_at: None }
+}
+
+/// `surface name`, `let name`, `use "…"`, `use std…`: an item keyword followed
+/// by a name or string, not a parameter such as `surface: s`.
+fn starts_item(rest: &str) -> bool {
+    ["use", "let", "job", "surface", "tool", "machine", "strategy"].iter().any(|k| {
+        rest.starts_with(k) && {
+            let after = &rest[k.len()..];
+            let trimmed = after.trim_start_matches([' ', '\t']);
+            trimmed.len() < after.len() && trimmed.starts_with(|ch: char| ch.is_ascii_alphabetic() || ch == '_' || ch == '"')
+        }
+    })
 }
 
 /// Items are split only at keywords that begin a line, so `a: 1 mm, tool: t`
@@ -349,6 +357,7 @@ impl Builder<'_> {
                     let span = Span::new(start + i, start + j + other.len_utf8());
                     self.diags.push(
                         Diagnostic::error(codes::BAD_ESCAPE, format!("unknown escape `\\{other}` in a string"), self.file, span)
+                            .with_label("not an escape")
                             .with_help("the escapes are \\\" \\\\ \\n \\t"),
                     );
                 }
@@ -376,13 +385,16 @@ impl Builder<'_> {
         Block { entries, span }
     }
 
-    fn syntax_error(&self, text: &str, e: pest::error::Error<Rule>) -> Diagnostic {
+    /// `text` is the item that failed, `source` the whole file: what was
+    /// found is described from the whole file, so an item cut short by the
+    /// next one reports that item's keyword, not "end of file".
+    fn syntax_error(&self, source: &str, text: &str, e: pest::error::Error<Rule>) -> Diagnostic {
         use pest::error::{ErrorVariant, InputLocation};
         let at = match e.location {
             InputLocation::Pos(p) => p,
             InputLocation::Span((s, _)) => s,
         };
-        let found = describe_found(text, at);
+        let found = describe_found(source, self.offset + at);
         let (message, expected) = match &e.variant {
             ErrorVariant::ParsingError { positives, .. } => {
                 let mut words: Vec<&str> = positives.iter().filter_map(|r| describe_rule(*r)).collect();
@@ -400,12 +412,14 @@ impl Builder<'_> {
             }
             ErrorVariant::CustomError { message } => (message.clone(), String::new()),
         };
-        let end = (at + found_len(text, at)).min(text.len());
-        let span = Span::new(at + self.offset, end + self.offset);
+        let abs = self.offset + at;
+        let span = Span::new(abs, abs + found_len(source, abs));
         let mut d = Diagnostic::error(codes::SYNTAX, message, self.file, span);
-        if !expected.is_empty() {
-            d = d.with_label(format!("expected {expected}"));
-        }
+        d = d.with_label(if expected.is_empty() {
+            "expected `surface`, `tool`, `machine`, `strategy`, `job`, `let` or `use`".to_string()
+        } else {
+            format!("expected {expected}")
+        });
         if let Some(h) = syntax_hint(text, at) {
             d = d.with_help(h);
         }
@@ -464,6 +478,14 @@ fn describe_found(text: &str, at: usize) -> String {
 
 fn syntax_hint(text: &str, at: usize) -> Option<String> {
     let rest = &text[at..];
+    let word = &rest[..found_len(text, at)];
+    let keywords = ["use", "let", "job", "surface", "tool", "machine", "strategy"];
+    if let Some(k) = crate::suggest::did_you_mean(word, keywords) {
+        return Some(format!("did you mean `{k}`?"));
+    }
+    if rest.starts_with('"') {
+        return Some("this string is not closed before the end of its line".into());
+    }
     if rest.starts_with('=') && !rest.starts_with("==") {
         return Some("parameters are written `name: value`, with a colon".into());
     }

@@ -1,0 +1,55 @@
+//! "Did you mean" suggestions by edit distance.
+
+/// The candidate closest to `word`, if it is close enough to be a likely typo.
+pub fn did_you_mean<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+    let n = word.chars().count();
+    // One- and two-letter names are too short for a guess to mean anything.
+    let limit = if n < 3 { 0 } else { (n / 3).max(1) };
+    candidates
+        .into_iter()
+        .filter(|c| *c != word)
+        .map(|c| (distance(&word.to_lowercase(), &c.to_lowercase()), c))
+        .filter(|(d, _)| *d <= limit)
+        .min_by(|a, b| a.0.cmp(&b.0).then(a.1.cmp(b.1)))
+        .map(|(_, c)| c)
+}
+
+/// Edit distance over characters where swapping two neighbours counts as
+/// one edit (optimal string alignment): `mni` is one edit from `min`.
+fn distance(a: &str, b: &str) -> usize {
+    let a: Vec<char> = a.chars().collect();
+    let b: Vec<char> = b.chars().collect();
+    let w = b.len() + 1;
+    let mut d = vec![0usize; (a.len() + 1) * w];
+    for i in 0..=a.len() {
+        d[i * w] = i;
+    }
+    for (j, slot) in d.iter_mut().enumerate().take(w) {
+        *slot = j;
+    }
+    for i in 1..=a.len() {
+        for j in 1..=b.len() {
+            let cost = usize::from(a[i - 1] != b[j - 1]);
+            let mut v = (d[(i - 1) * w + j] + 1).min(d[i * w + j - 1] + 1).min(d[(i - 1) * w + j - 1] + cost);
+            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
+                v = v.min(d[(i - 2) * w + j - 2] + 1);
+            }
+            d[i * w + j] = v;
+        }
+    }
+    d[a.len() * w + b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn suggests_close_names_only() {
+        assert_eq!(did_you_mean("radus", ["radius", "conic"]), Some("radius"));
+        assert_eq!(did_you_mean("nose_radus", ["nose_radius", "clearance"]), Some("nose_radius"));
+        assert_eq!(did_you_mean("zzz", ["radius", "conic"]), None);
+        assert_eq!(did_you_mean("mni", ["min", "mm"]), Some("min"));
+        assert_eq!(did_you_mean("x", ["a", "y"]), None);
+    }
+}
