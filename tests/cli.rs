@@ -1,0 +1,152 @@
+//! The `lensc` binary as a user and a CI pipeline meet it: exit codes,
+//! JSON diagnostics, `--help`, atomic output.
+
+mod common;
+
+use common::{lensc, root, text};
+
+const GOOD: &str = "examples/kim2008_convex_asphere.lens";
+
+#[test]
+fn check_clean_file_exits_zero() {
+    let out = lensc(&root(), &["check", GOOD]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+}
+
+#[test]
+fn check_bad_file_exits_one_with_diagnostics() {
+    let out = lensc(&root(), &["check", "tests/bad/many_errors_at_once.lens"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = text(&out.stderr);
+    assert!(err.contains("[E0123]") && err.contains("[E0120]"), "{err}");
+}
+
+#[test]
+fn check_reports_every_file_given() {
+    let out = lensc(&root(), &["check", "--message-format", "json", "tests/bad/sin_of_length.lens", GOOD, "tests/bad/unknown_unit.lens"]);
+    assert_eq!(out.status.code(), Some(1));
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("sin_of_length.lens") && stdout.contains("unknown_unit.lens"), "{stdout}");
+}
+
+#[test]
+fn missing_file_is_a_user_error() {
+    let out = lensc(&root(), &["check", "no/such/file.lens"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out.stderr).contains("no such file"));
+}
+
+#[test]
+fn usage_errors_exit_two() {
+    assert_eq!(lensc(&root(), &["check"]).status.code(), Some(2));
+    assert_eq!(lensc(&root(), &["frobnicate"]).status.code(), Some(2));
+    assert_eq!(lensc(&root(), &["build", GOOD, "--dialect", "klingon"]).status.code(), Some(2));
+    assert_eq!(lensc(&root(), &["check", "--message-format", "xml", GOOD]).status.code(), Some(2));
+    let dir = tempfile::tempdir().expect("tmp");
+    let out_dir = dir.path().to_str().expect("utf8");
+    assert_eq!(lensc(&root(), &["build", GOOD, "--job", "nope", "--out", out_dir]).status.code(), Some(2));
+}
+
+#[test]
+fn help_on_every_subcommand() {
+    for args in [&["--help"][..], &["check", "--help"], &["build", "--help"], &["help", "build"]] {
+        let out = lensc(&root(), args);
+        assert_eq!(out.status.code(), Some(0), "{args:?}");
+        assert!(text(&out.stdout).contains("Usage"), "{args:?}");
+    }
+    let build = text(&lensc(&root(), &["build", "--help"]).stdout);
+    for flag in ["--job", "--dialect", "--out", "--message-format", "--color"] {
+        assert!(build.contains(flag), "build --help lacks {flag}");
+    }
+}
+
+#[test]
+fn json_diagnostics_are_one_object_per_line_on_stdout() {
+    let out = lensc(&root(), &["check", "--message-format", "json", "tests/bad/many_errors_at_once.lens"]);
+    assert_eq!(out.status.code(), Some(1));
+    let stdout = text(&out.stdout);
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert!(lines.len() >= 6);
+    for l in lines {
+        let v: serde_json::Value = serde_json::from_str(l).expect("json line");
+        assert_eq!(v["file"], "tests/bad/many_errors_at_once.lens");
+        assert!(v["code"].as_str().expect("code").starts_with('E') || v["severity"] == "warning");
+    }
+    assert!(text(&out.stderr).is_empty(), "human output leaked: {}", text(&out.stderr));
+}
+
+#[test]
+fn color_always_and_never() {
+    let bad = "tests/bad/sin_of_length.lens";
+    let always = lensc(&root(), &["check", "--color", "always", bad]);
+    assert!(text(&always.stderr).contains('\u{1b}'));
+    let never = lensc(&root(), &["check", "--color", "never", bad]);
+    assert!(!text(&never.stderr).contains('\u{1b}'));
+}
+
+#[test]
+fn build_writes_program_to_out_dir() {
+    let dir = tempfile::tempdir().expect("tmp");
+    std::fs::copy(root().join(GOOD), dir.path().join("job.lens")).expect("copy");
+    // Default output directory: out/ in the working directory.
+    let out = lensc(dir.path(), &["build", "job.lens"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let program = std::fs::read_to_string(dir.path().join("out/kim_convex.ngc")).expect("program");
+    assert!(program.starts_with("(lensc "));
+    assert!(program.trim_end().ends_with("M2"));
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path().join("out")).expect("out").map(|e| e.expect("e").file_name()).collect();
+    assert_eq!(leftovers.len(), 1, "temporary files left: {leftovers:?}");
+}
+
+#[test]
+fn failed_build_leaves_earlier_output_untouched() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let src = std::fs::read_to_string(root().join(GOOD)).expect("read");
+    std::fs::write(dir.path().join("job.lens"), &src).expect("write");
+    assert_eq!(lensc(dir.path(), &["build", "job.lens"]).status.code(), Some(0));
+    let before = std::fs::read(dir.path().join("out/kim_convex.ngc")).expect("program");
+
+    // Same job, now with a nose larger than any concave radius… on a convex
+    // part there is none, so break it another way: a spindle over the limit.
+    let broken = src.replace("spindle_speed: 1000 rpm", "spindle_speed: 9000 rpm");
+    assert_ne!(broken, src);
+    std::fs::write(dir.path().join("job.lens"), broken).expect("write");
+    let out = lensc(dir.path(), &["build", "job.lens"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out.stderr).contains("E0143"), "{}", text(&out.stderr));
+    assert_eq!(std::fs::read(dir.path().join("out/kim_convex.ngc")).expect("program"), before);
+    let names: Vec<_> = std::fs::read_dir(dir.path().join("out")).expect("out").map(|e| e.expect("e").file_name()).collect();
+    assert_eq!(names.len(), 1, "partial files left: {names:?}");
+}
+
+#[test]
+fn plan_errors_name_their_location() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let src = "use std::machines::linuxcnc_lathe
+use std::strategies::finish_turning
+// A concave sphere of radius 0.3 mm cannot be cut with a 0.5 mm nose.
+surface bowl = sphere { radius: 0.3 mm, sense: concave, aperture: circle(radius: 0.2 mm) }
+tool big = round_nose { nose_radius: 0.5 mm, clearance: 7 deg }
+job gouge { surface: bowl, tool: big, machine: linuxcnc_lathe, strategy: finish_turning }
+";
+    std::fs::write(dir.path().join("gouge.lens"), src).expect("write");
+    let out = lensc(dir.path(), &["build", "gouge.lens", "--message-format", "json"]);
+    assert_eq!(out.status.code(), Some(1));
+    let stdout = text(&out.stdout);
+    let v: serde_json::Value = serde_json::from_str(stdout.lines().next().expect("a diagnostic")).expect("json");
+    assert_eq!(v["code"], "E0140");
+    assert!(v["message"].as_str().expect("msg").contains("300 um"), "{v}");
+    assert!(!dir.path().join("out/gouge.ngc").exists());
+}
+
+#[test]
+fn build_only_the_named_job() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let src = std::fs::read_to_string(root().join(GOOD)).expect("read")
+        + "\njob second { surface: convex_asphere, tool: wheel, machine: grinder, strategy: grind }\n";
+    std::fs::write(dir.path().join("two.lens"), src).expect("write");
+    let out = lensc(dir.path(), &["build", "two.lens", "--job", "second", "--out", "progs"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert!(dir.path().join("progs/second.ngc").exists());
+    assert!(!dir.path().join("progs/kim_convex.ngc").exists());
+}
