@@ -14,6 +14,39 @@ use crate::diagnostic::{Diagnostic, FileId, codes};
 #[grammar = "lens.pest"]
 struct LensParser;
 
+/// Deepest expression tree accepted (operators, calls, brackets together).
+pub const MAX_EXPR_DEPTH: u32 = 200;
+
+/// Longest run of operators in a row (`- - - x`) and most `^` in one item:
+/// pest parses prefix operators and right-associative powers recursively.
+pub const MAX_OPERATOR_RUN: usize = 32;
+pub const MAX_POWERS_PER_ITEM: usize = 64;
+
+/// Depth of an expression tree. Only called on trees already bounded by
+/// `MAX_EXPR_DEPTH`, so its recursion is bounded too.
+fn depth(e: &Expr) -> u32 {
+    1 + match &e.kind {
+        ExprKind::Unary { operand, .. } => depth(operand),
+        ExprKind::Binary { lhs, rhs, .. } => depth(lhs).max(depth(rhs)),
+        ExprKind::Call { callee, args } => args.iter().map(|a| depth(&a.value)).fold(depth(callee), u32::max),
+        ExprKind::WithBlock { base, block } => block_depth(block).max(depth(base)),
+        ExprKind::Block(b) => block_depth(b),
+        ExprKind::List(items) => items.iter().map(depth).max().unwrap_or(0),
+        _ => 0,
+    }
+}
+
+fn block_depth(b: &Block) -> u32 {
+    b.entries
+        .iter()
+        .map(|e| match e {
+            Entry::Param { value, .. } => depth(value),
+            Entry::Formula { body, .. } => depth(body),
+        })
+        .max()
+        .unwrap_or(0)
+}
+
 /// Deepest bracket nesting accepted. Deeper input is refused before pest
 /// sees it, so no input can overflow the parser's stack.
 pub const MAX_NESTING: usize = 64;
@@ -37,15 +70,15 @@ pub fn parse(source: &str, file: FileId) -> (File, Vec<Diagnostic>) {
     }
     let scan = scan(source);
     if let Some(at) = scan.too_deep_at {
+        let (message, label) = match scan.why {
+            TooDeep::Brackets => (format!("brackets are nested more than {MAX_NESTING} deep"), "this bracket is too deep"),
+            TooDeep::OperatorRun => (format!("more than {MAX_OPERATOR_RUN} operators in a row"), "one operator too many"),
+            TooDeep::Powers => (format!("more than {MAX_POWERS_PER_ITEM} powers `^` in one item"), "one power too many"),
+        };
         diags.push(
-            Diagnostic::error(
-                codes::TOO_DEEP,
-                format!("brackets are nested more than {MAX_NESTING} deep"),
-                file,
-                Span::new(at, at + 1),
-            )
-            .with_label("this bracket is too deep")
-            .with_help("split the expression with `let` constants"),
+            Diagnostic::error(codes::TOO_DEEP, message, file, Span::new(at, at + 1))
+                .with_label(label)
+                .with_help("split the expression with `let` constants"),
         );
         return (File::default(), diags);
     }
@@ -77,6 +110,13 @@ pub fn parse(source: &str, file: FileId) -> (File, Vec<Diagnostic>) {
 struct Scan {
     chunks: Vec<(usize, usize)>,
     too_deep_at: Option<usize>,
+    why: TooDeep,
+}
+
+enum TooDeep {
+    Brackets,
+    OperatorRun,
+    Powers,
 }
 
 /// One pass over the bytes: bracket depth (outside comments and strings) and
@@ -87,8 +127,21 @@ fn scan(src: &str) -> Scan {
     let mut starts = vec![0usize];
     let mut i = 0;
     let mut at_word_start = true;
+    let mut op_run = 0usize;
+    let mut powers = 0usize;
     while i < b.len() {
         let c = b[i];
+        match c {
+            b'-' | b'+' | b'*' | b'/' | b'^' if !(c == b'/' && matches!(b.get(i + 1), Some(b'/' | b'*'))) => {
+                op_run += 1;
+                powers += usize::from(c == b'^');
+                if op_run > MAX_OPERATOR_RUN || powers > MAX_POWERS_PER_ITEM {
+                    return Scan { chunks: vec![], too_deep_at: Some(i), why: if op_run > MAX_OPERATOR_RUN { TooDeep::OperatorRun } else { TooDeep::Powers } };
+                }
+            }
+            b' ' | b'\t' | b'\r' | b'\n' => {}
+            _ => op_run = 0,
+        }
         match c {
             b'/' if b.get(i + 1) == Some(&b'/') => {
                 while i < b.len() && b[i] != b'\n' {
@@ -118,7 +171,7 @@ fn scan(src: &str) -> Scan {
             b'(' | b'[' | b'{' => {
                 depth += 1;
                 if depth > MAX_NESTING {
-                    return Scan { chunks: vec![], too_deep_at: Some(i) };
+                    return Scan { chunks: vec![], too_deep_at: Some(i), why: TooDeep::Brackets };
                 }
             }
             b')' | b']' | b'}' => depth = depth.saturating_sub(1),
@@ -130,6 +183,7 @@ fn scan(src: &str) -> Scan {
             // a line followed by a name cannot continue the previous item,
             // so a missing `)` or `}` does not swallow the rest of the file.
             starts.push(i);
+            powers = 0;
         }
         at_word_start = !is_word;
         i += 1;
@@ -139,7 +193,7 @@ fn scan(src: &str) -> Scan {
         let e = starts.get(k + 1).copied().unwrap_or(src.len());
         chunks.push((s, e));
     }
-    Scan { chunks, too_deep_at: None }
+    Scan { chunks, too_deep_at: None, why: TooDeep::Brackets }
 }
 
 /// `surface name`, `let name`, `use "…"`, `use std…`: an item keyword followed
@@ -234,15 +288,21 @@ impl Builder<'_> {
 
     fn pratt(&mut self, pairs: Pairs<Rule>) -> Expr {
         // The closures below all need `self`; pest's Pratt API takes them
-        // separately, so share `self` through a RefCell.
+        // separately, so share `self` through a RefCell. Each node carries
+        // its depth so that chains like `1 + 1 + … + 1` stop at the limit.
         let me = std::cell::RefCell::new(self);
-        PRATT
-            .map_primary(|p| me.borrow_mut().operand(p))
-            .map_prefix(|op, rhs| {
-                let span = me.borrow().span(&op).to(rhs.span);
-                Expr { kind: ExprKind::Unary { op: UnaryOp::Neg, operand: Box::new(rhs) }, span }
+        let (e, _) = PRATT
+            .map_primary(|p| {
+                let e = me.borrow_mut().operand(p);
+                let d = depth(&e);
+                (e, d)
             })
-            .map_infix(|lhs, op, rhs| {
+            .map_prefix(|op, (rhs, d)| {
+                let span = me.borrow().span(&op).to(rhs.span);
+                let e = Expr { kind: ExprKind::Unary { op: UnaryOp::Neg, operand: Box::new(rhs) }, span };
+                me.borrow_mut().limit_depth(e, d + 1)
+            })
+            .map_infix(|(lhs, dl), op, (rhs, dr)| {
                 let op = match op.as_rule() {
                     Rule::add => BinaryOp::Add,
                     Rule::sub => BinaryOp::Sub,
@@ -252,14 +312,30 @@ impl Builder<'_> {
                     _ => BinaryOp::Range,
                 };
                 let span = lhs.span.to(rhs.span);
-                Expr { kind: ExprKind::Binary { op, lhs: Box::new(lhs), rhs: Box::new(rhs) }, span }
+                let e = Expr { kind: ExprKind::Binary { op, lhs: Box::new(lhs), rhs: Box::new(rhs) }, span };
+                me.borrow_mut().limit_depth(e, dl.max(dr) + 1)
             })
-            .parse(pairs)
+            .parse(pairs);
+        e
+    }
+
+    /// Replaces a node deeper than `MAX_EXPR_DEPTH` by `Invalid` (reported
+    /// once, where the limit was crossed), so no later pass recurses deeper.
+    fn limit_depth(&mut self, e: Expr, d: u32) -> (Expr, u32) {
+        if d == MAX_EXPR_DEPTH + 1 {
+            self.diags.push(
+                Diagnostic::error(codes::TOO_DEEP, format!("this expression is nested more than {MAX_EXPR_DEPTH} operations deep"), self.file, e.span)
+                    .with_label("too deep")
+                    .with_help("split the expression with `let` constants"),
+            );
+        }
+        if d > MAX_EXPR_DEPTH { (Expr { kind: ExprKind::Invalid, span: e.span }, d) } else { (e, d) }
     }
 
     fn operand(&mut self, p: Pair<Rule>) -> Expr {
         let mut inner = p.into_inner();
         let mut e = self.primary(inner.next().expect("primary"));
+        let mut d = depth(&e);
         for post in inner {
             let span = e.span.to(self.span(&post));
             e = match post.as_rule() {
@@ -272,6 +348,8 @@ impl Builder<'_> {
                     Expr { kind: ExprKind::WithBlock { base: Box::new(e), block }, span }
                 }
             };
+            d += 1;
+            e = self.limit_depth(e, d).0;
         }
         e
     }
