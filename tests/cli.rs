@@ -23,10 +23,23 @@ fn check_bad_file_exits_one_with_diagnostics() {
 
 #[test]
 fn check_reports_every_file_given() {
-    let out = lensc(&root(), &["check", "--message-format", "json", "tests/bad/sin_of_length.lens", GOOD, "tests/bad/unknown_unit.lens"]);
+    let out = lensc(
+        &root(),
+        &[
+            "check",
+            "--message-format",
+            "json",
+            "tests/bad/sin_of_length.lens",
+            GOOD,
+            "tests/bad/unknown_unit.lens",
+        ],
+    );
     assert_eq!(out.status.code(), Some(1));
     let stdout = text(&out.stdout);
-    assert!(stdout.contains("sin_of_length.lens") && stdout.contains("unknown_unit.lens"), "{stdout}");
+    assert!(
+        stdout.contains("sin_of_length.lens") && stdout.contains("unknown_unit.lens"),
+        "{stdout}"
+    );
 }
 
 #[test]
@@ -40,16 +53,36 @@ fn missing_file_is_a_user_error() {
 fn usage_errors_exit_two() {
     assert_eq!(lensc(&root(), &["check"]).status.code(), Some(2));
     assert_eq!(lensc(&root(), &["frobnicate"]).status.code(), Some(2));
-    assert_eq!(lensc(&root(), &["build", GOOD, "--dialect", "klingon"]).status.code(), Some(2));
-    assert_eq!(lensc(&root(), &["check", "--message-format", "xml", GOOD]).status.code(), Some(2));
+    assert_eq!(
+        lensc(&root(), &["build", GOOD, "--dialect", "klingon"])
+            .status
+            .code(),
+        Some(2)
+    );
+    assert_eq!(
+        lensc(&root(), &["check", "--message-format", "xml", GOOD])
+            .status
+            .code(),
+        Some(2)
+    );
     let dir = tempfile::tempdir().expect("tmp");
     let out_dir = dir.path().to_str().expect("utf8");
-    assert_eq!(lensc(&root(), &["build", GOOD, "--job", "nope", "--out", out_dir]).status.code(), Some(2));
+    assert_eq!(
+        lensc(&root(), &["build", GOOD, "--job", "nope", "--out", out_dir])
+            .status
+            .code(),
+        Some(2)
+    );
 }
 
 #[test]
 fn help_on_every_subcommand() {
-    for args in [&["--help"][..], &["check", "--help"], &["build", "--help"], &["help", "build"]] {
+    for args in [
+        &["--help"][..],
+        &["check", "--help"],
+        &["build", "--help"],
+        &["help", "build"],
+    ] {
         let out = lensc(&root(), args);
         assert_eq!(out.status.code(), Some(0), "{args:?}");
         assert!(text(&out.stdout).contains("Usage"), "{args:?}");
@@ -62,7 +95,15 @@ fn help_on_every_subcommand() {
 
 #[test]
 fn json_diagnostics_are_one_object_per_line_on_stdout() {
-    let out = lensc(&root(), &["check", "--message-format", "json", "tests/bad/many_errors_at_once.lens"]);
+    let out = lensc(
+        &root(),
+        &[
+            "check",
+            "--message-format",
+            "json",
+            "tests/bad/many_errors_at_once.lens",
+        ],
+    );
     assert_eq!(out.status.code(), Some(1));
     let stdout = text(&out.stdout);
     let lines: Vec<&str> = stdout.lines().collect();
@@ -72,7 +113,11 @@ fn json_diagnostics_are_one_object_per_line_on_stdout() {
         assert_eq!(v["file"], "tests/bad/many_errors_at_once.lens");
         assert!(v["code"].as_str().expect("code").starts_with('E') || v["severity"] == "warning");
     }
-    assert!(text(&out.stderr).is_empty(), "human output leaked: {}", text(&out.stderr));
+    assert!(
+        text(&out.stderr).is_empty(),
+        "human output leaked: {}",
+        text(&out.stderr)
+    );
 }
 
 #[test]
@@ -94,7 +139,10 @@ fn build_writes_program_to_out_dir() {
     let program = std::fs::read_to_string(dir.path().join("out/kim_convex.ngc")).expect("program");
     assert!(program.starts_with("(lensc "));
     assert!(program.trim_end().ends_with("M2"));
-    let leftovers: Vec<_> = std::fs::read_dir(dir.path().join("out")).expect("out").map(|e| e.expect("e").file_name()).collect();
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path().join("out"))
+        .expect("out")
+        .map(|e| e.expect("e").file_name())
+        .collect();
     assert_eq!(leftovers.len(), 1, "temporary files left: {leftovers:?}");
 }
 
@@ -103,7 +151,10 @@ fn failed_build_leaves_earlier_output_untouched() {
     let dir = tempfile::tempdir().expect("tmp");
     let src = std::fs::read_to_string(root().join(GOOD)).expect("read");
     std::fs::write(dir.path().join("job.lens"), &src).expect("write");
-    assert_eq!(lensc(dir.path(), &["build", "job.lens"]).status.code(), Some(0));
+    assert_eq!(
+        lensc(dir.path(), &["build", "job.lens"]).status.code(),
+        Some(0)
+    );
     let before = std::fs::read(dir.path().join("out/kim_convex.ngc")).expect("program");
 
     // Same job, now with a nose larger than any concave radius… on a convex
@@ -114,8 +165,14 @@ fn failed_build_leaves_earlier_output_untouched() {
     let out = lensc(dir.path(), &["build", "job.lens"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(text(&out.stderr).contains("E0143"), "{}", text(&out.stderr));
-    assert_eq!(std::fs::read(dir.path().join("out/kim_convex.ngc")).expect("program"), before);
-    let names: Vec<_> = std::fs::read_dir(dir.path().join("out")).expect("out").map(|e| e.expect("e").file_name()).collect();
+    assert_eq!(
+        std::fs::read(dir.path().join("out/kim_convex.ngc")).expect("program"),
+        before
+    );
+    let names: Vec<_> = std::fs::read_dir(dir.path().join("out"))
+        .expect("out")
+        .map(|e| e.expect("e").file_name())
+        .collect();
     assert_eq!(names.len(), 1, "partial files left: {names:?}");
 }
 
@@ -130,12 +187,19 @@ tool big = round_nose { nose_radius: 0.5 mm, clearance: 7 deg }
 job gouge { surface: bowl, tool: big, machine: linuxcnc_lathe, strategy: finish_turning }
 ";
     std::fs::write(dir.path().join("gouge.lens"), src).expect("write");
-    let out = lensc(dir.path(), &["build", "gouge.lens", "--message-format", "json"]);
+    let out = lensc(
+        dir.path(),
+        &["build", "gouge.lens", "--message-format", "json"],
+    );
     assert_eq!(out.status.code(), Some(1));
     let stdout = text(&out.stdout);
-    let v: serde_json::Value = serde_json::from_str(stdout.lines().next().expect("a diagnostic")).expect("json");
+    let v: serde_json::Value =
+        serde_json::from_str(stdout.lines().next().expect("a diagnostic")).expect("json");
     assert_eq!(v["code"], "E0140");
-    assert!(v["message"].as_str().expect("msg").contains("300 um"), "{v}");
+    assert!(
+        v["message"].as_str().expect("msg").contains("300 um"),
+        "{v}"
+    );
     assert!(!dir.path().join("out/gouge.ngc").exists());
 }
 
@@ -145,7 +209,10 @@ fn build_only_the_named_job() {
     let src = std::fs::read_to_string(root().join(GOOD)).expect("read")
         + "\njob second { surface: convex_asphere, tool: wheel, machine: grinder, strategy: grind }\n";
     std::fs::write(dir.path().join("two.lens"), src).expect("write");
-    let out = lensc(dir.path(), &["build", "two.lens", "--job", "second", "--out", "progs"]);
+    let out = lensc(
+        dir.path(),
+        &["build", "two.lens", "--job", "second", "--out", "progs"],
+    );
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     assert!(dir.path().join("progs/second.ngc").exists());
     assert!(!dir.path().join("progs/kim_convex.ngc").exists());

@@ -21,8 +21,16 @@ fn assert_well_formed(c: &Checked) {
         assert!(!d.message.is_empty());
         for l in &d.labels {
             let text = &c.loaded.sources.get(l.file).text;
-            assert!(l.span.start <= l.span.end && (l.span.end as usize) <= text.len(), "{:?} in {} bytes", l.span, text.len());
-            assert!(text.is_char_boundary(l.span.start as usize) && text.is_char_boundary(l.span.end as usize));
+            assert!(
+                l.span.start <= l.span.end && (l.span.end as usize) <= text.len(),
+                "{:?} in {} bytes",
+                l.span,
+                text.len()
+            );
+            assert!(
+                text.is_char_boundary(l.span.start as usize)
+                    && text.is_char_boundary(l.span.end as usize)
+            );
         }
     }
     let mut sink = Vec::new();
@@ -31,12 +39,84 @@ fn assert_well_formed(c: &Checked) {
 }
 
 const TOKENS: &[&str] = &[
-    "surface", "tool", "machine", "strategy", "job", "let", "use", "s", "t", "m", "x", "y", "z", "r", "conic", "sphere",
-    "asphere", "freeform", "circle", "rect", "round_nose", "lathe", "profile_turning", "radius", "sense", "convex",
-    "aperture", "diameter", "nose_radius", "clearance", "sin", "sqrt", "atan2", "min", "std", "::", "machines",
-    "linuxcnc_lathe", "1", "-20", "0.5", "1e3", "1e999", "85 um", "7 deg", "7°", "3 µm", "5 rad/mm", "2 um/rev",
-    "1000 rpm", "25 g", "1 mm^-3", "=", ":", ",", "{", "}", "(", ")", "[", "]", "+", "-", "*", "/", "^", "..",
-    "\"a.lens\"", "\"", "\n", " ", "//c\n", "/*", "*/", "\\", ";", "é", "\u{0}",
+    "surface",
+    "tool",
+    "machine",
+    "strategy",
+    "job",
+    "let",
+    "use",
+    "s",
+    "t",
+    "m",
+    "x",
+    "y",
+    "z",
+    "r",
+    "conic",
+    "sphere",
+    "asphere",
+    "freeform",
+    "circle",
+    "rect",
+    "round_nose",
+    "lathe",
+    "profile_turning",
+    "radius",
+    "sense",
+    "convex",
+    "aperture",
+    "diameter",
+    "nose_radius",
+    "clearance",
+    "sin",
+    "sqrt",
+    "atan2",
+    "min",
+    "std",
+    "::",
+    "machines",
+    "linuxcnc_lathe",
+    "1",
+    "-20",
+    "0.5",
+    "1e3",
+    "1e999",
+    "85 um",
+    "7 deg",
+    "7°",
+    "3 µm",
+    "5 rad/mm",
+    "2 um/rev",
+    "1000 rpm",
+    "25 g",
+    "1 mm^-3",
+    "=",
+    ":",
+    ",",
+    "{",
+    "}",
+    "(",
+    ")",
+    "[",
+    "]",
+    "+",
+    "-",
+    "*",
+    "/",
+    "^",
+    "..",
+    "\"a.lens\"",
+    "\"",
+    "\n",
+    " ",
+    "//c\n",
+    "/*",
+    "*/",
+    "\\",
+    ";",
+    "é",
+    "\u{0}",
 ];
 
 fn tokens() -> impl Strategy<Value = String> {
@@ -55,7 +135,15 @@ fn fragments() -> impl Strategy<Value = String> {
         "machine m = linuxcnc_lathe { resolution: 10 nm }\n",
         "strategy g = profile_turning { feed: 2 um/rev, spindle_speed: 500 rpm }\n",
         "job j { surface: s, tool: t, machine: m, strategy: g }\n",
-        "let a = b\n", "let b = a\n", "radius: -1 mm\n", "}\n", "{\n", "sense: ", "concave", "(", ")",
+        "let a = b\n",
+        "let b = a\n",
+        "radius: -1 mm\n",
+        "}\n",
+        "{\n",
+        "sense: ",
+        "concave",
+        "(",
+        ")",
     ];
     prop::collection::vec(prop::sample::select(F), 0..12).prop_map(|t| t.concat())
 }
@@ -115,7 +203,9 @@ proptest! {
 
 #[test]
 fn pathological_nesting_is_refused_without_overflow() {
-    let deep = |open: &str, close: &str, n: usize| format!("let a = {}1 mm{}\n", open.repeat(n), close.repeat(n));
+    let deep = |open: &str, close: &str, n: usize| {
+        format!("let a = {}1 mm{}\n", open.repeat(n), close.repeat(n))
+    };
     for src in [
         deep("(", ")", 1_000_000),
         deep("[", "]", 100_000),
@@ -128,7 +218,13 @@ fn pathological_nesting_is_refused_without_overflow() {
         format!("let a = 1{}\n", " * (2 + (3".repeat(30)),
     ] {
         let c = check(src.as_bytes());
-        assert!(c.diags().iter().any(|d| d.code == "E0002" || d.code == "E0001"), "{}", &src[..60]);
+        assert!(
+            c.diags()
+                .iter()
+                .any(|d| d.code == "E0002" || d.code == "E0001"),
+            "{}",
+            &src[..60]
+        );
         assert_well_formed(&c);
     }
 }

@@ -31,7 +31,15 @@ fn interpret(program: &Path) -> String {
     let _one_at_a_time = RS274.lock().unwrap_or_else(|e| e.into_inner());
     let out = rs274().arg(program).output().expect("run rs274");
     let stdout = text(&out.stdout);
-    assert_eq!(out.status.code(), Some(0), "rs274 rejected {} ({:?}):\n{}\n{}", program.display(), out.status, stdout, text(&out.stderr));
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "rs274 rejected {} ({:?}):\n{}\n{}",
+        program.display(),
+        out.status,
+        stdout,
+        text(&out.stderr)
+    );
     stdout
 }
 
@@ -41,7 +49,11 @@ fn feeds(canon: &str) -> Vec<(f64, f64)> {
         .lines()
         .filter_map(|l| l.split_once("STRAIGHT_FEED(").map(|(_, rest)| rest))
         .map(|args| {
-            let v: Vec<f64> = args.trim_end_matches(')').split(',').map(|s| s.trim().parse().expect("number")).collect();
+            let v: Vec<f64> = args
+                .trim_end_matches(')')
+                .split(',')
+                .map(|s| s.trim().parse().expect("number"))
+                .collect();
             (v[0], v[2])
         })
         .collect()
@@ -64,7 +76,11 @@ fn kim_centre_z_at(x: f64) -> f64 {
     let (mut lo, mut hi) = (0.0, 1.6);
     for _ in 0..200 {
         let mid = 0.5 * (lo + hi);
-        if kim_centre(mid).0 < x { lo = mid } else { hi = mid }
+        if kim_centre(mid).0 < x {
+            lo = mid
+        } else {
+            hi = mid
+        }
     }
     kim_centre(0.5 * (lo + hi)).1
 }
@@ -73,7 +89,15 @@ fn kim_centre_z_at(x: f64) -> f64 {
 fn every_example_program_passes_rs274() {
     let dir = tempfile::tempdir().expect("tmp");
     for ex in examples() {
-        let out = lensc(&root(), &["build", ex.to_str().expect("utf8"), "--out", dir.path().to_str().expect("utf8")]);
+        let out = lensc(
+            &root(),
+            &[
+                "build",
+                ex.to_str().expect("utf8"),
+                "--out",
+                dir.path().to_str().expect("utf8"),
+            ],
+        );
         assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     }
     let mut n = 0;
@@ -91,7 +115,15 @@ fn every_example_program_passes_rs274() {
 #[test]
 fn canonical_moves_lie_on_the_offset_curve() {
     let dir = tempfile::tempdir().expect("tmp");
-    let out = lensc(&root(), &["build", "examples/kim2008_convex_asphere.lens", "--out", dir.path().to_str().expect("utf8")]);
+    let out = lensc(
+        &root(),
+        &[
+            "build",
+            "examples/kim2008_convex_asphere.lens",
+            "--out",
+            dir.path().to_str().expect("utf8"),
+        ],
+    );
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     let program = dir.path().join("kim_convex.ngc");
     let moves = feeds(&interpret(&program));
@@ -101,10 +133,17 @@ fn canonical_moves_lie_on_the_offset_curve() {
     // rs274 prints 4 decimals: each coordinate is within 0.5e-4 mm.
     for &(x, z) in cut {
         let want = kim_centre_z_at(x);
-        assert!((z - want).abs() <= 0.6e-4, "rs274 move X{x} Z{z}: curve at {want}");
+        assert!(
+            (z - want).abs() <= 0.6e-4,
+            "rs274 move X{x} Z{z}: curve at {want}"
+        );
     }
     // The cut sweeps the whole aperture, from the edge to the axis.
-    assert!((moves[0].0 - kim_centre(1.6).0).abs() < 1e-4, "starts at X{}", moves[0].0);
+    assert!(
+        (moves[0].0 - kim_centre(1.6).0).abs() < 1e-4,
+        "starts at X{}",
+        moves[0].0
+    );
     assert!(cut.last().expect("last").0.abs() < 1e-4);
 }
 
@@ -114,15 +153,27 @@ fn program_points_and_chords_are_within_tolerance() {
     // points at that precision, and the middle of every chord against the
     // 10 nm chord tolerance plus rounding.
     let dir = tempfile::tempdir().expect("tmp");
-    let out = lensc(&root(), &["build", "examples/kim2008_convex_asphere.lens", "--out", dir.path().to_str().expect("utf8")]);
+    let out = lensc(
+        &root(),
+        &[
+            "build",
+            "examples/kim2008_convex_asphere.lens",
+            "--out",
+            dir.path().to_str().expect("utf8"),
+        ],
+    );
     assert_eq!(out.status.code(), Some(0));
     let program = std::fs::read_to_string(dir.path().join("kim_convex.ngc")).expect("program");
     let (mut x, mut z) = (f64::NAN, f64::NAN);
     let mut pts = Vec::new();
     for line in program.lines().filter(|l| !l.starts_with('(')) {
         for w in line.split_whitespace() {
-            if let Some(v) = w.strip_prefix('X') { x = v.parse().expect("X") }
-            if let Some(v) = w.strip_prefix('Z') { z = v.parse().expect("Z") }
+            if let Some(v) = w.strip_prefix('X') {
+                x = v.parse().expect("X")
+            }
+            if let Some(v) = w.strip_prefix('Z') {
+                z = v.parse().expect("Z")
+            }
         }
         if line.contains("G1") {
             pts.push((x, z));
@@ -131,7 +182,10 @@ fn program_points_and_chords_are_within_tolerance() {
     let cut = &pts[1..];
     let rounding = 0.5e-5 * 2.0;
     for &(x, z) in cut {
-        assert!((z - kim_centre_z_at(x)).abs() <= rounding, "point X{x} Z{z}");
+        assert!(
+            (z - kim_centre_z_at(x)).abs() <= rounding,
+            "point X{x} Z{z}"
+        );
     }
     for w in cut.windows(2) {
         let (mx, mz) = (0.5 * (w[0].0 + w[1].0), 0.5 * (w[0].1 + w[1].1));

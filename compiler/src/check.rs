@@ -6,18 +6,22 @@
 use std::collections::HashMap;
 use std::rc::Rc;
 
-use lensc_grammar::ast::{BinaryOp, Block, DeclKind, Entry, Expr, ExprKind, Ident, ItemKind, Span, UnaryOp};
+use lensc_grammar::ast::{
+    BinaryOp, Block, DeclKind, Entry, Expr, ExprKind, Ident, ItemKind, Span, UnaryOp,
+};
 use lensc_grammar::{Diagnostic, FileId};
 
 use crate::codes;
 use crate::loader::{Import, Loaded};
 use crate::schema::{self, Category, Check, Kind, Param, Ty};
-use lensc_grammar::suggest::did_you_mean;
 use crate::units::{self, Dim};
 use crate::value::{self, Field, Formula, Object, Value};
+use lensc_grammar::suggest::did_you_mean;
 
 /// Built-in math functions.
-pub const FUNCTIONS: &[&str] = &["sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sqrt", "abs", "exp", "ln", "min", "max"];
+pub const FUNCTIONS: &[&str] = &[
+    "sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sqrt", "abs", "exp", "ln", "min", "max",
+];
 
 /// Coordinates a surface formula may use.
 const COORDINATES: &[&str] = &["x", "y", "r"];
@@ -69,7 +73,14 @@ struct Checker<'a> {
 
 /// Checks a loaded file set. Diagnostics from loading come first.
 pub fn check(loaded: &Loaded) -> Checked {
-    let mut c = Checker { loaded, diags: Vec::new(), decls: Vec::new(), scopes: Vec::new(), state: Vec::new(), used: Vec::new() };
+    let mut c = Checker {
+        loaded,
+        diags: Vec::new(),
+        decls: Vec::new(),
+        scopes: Vec::new(),
+        state: Vec::new(),
+        used: Vec::new(),
+    };
     c.build_scopes();
     for i in 0..c.decls.len() {
         c.decl_value(i);
@@ -79,8 +90,13 @@ pub fn check(loaded: &Loaded) -> Checked {
     let root = &loaded.files[0];
     if root.ast.items.is_empty() && loaded.diags.is_empty() {
         c.diags.push(
-            Diagnostic::error(codes::EMPTY_FILE, "this file declares nothing", root.id, Span::new(0, 0))
-                .with_help("a job file declares a surface, a tool, a machine, a strategy and a job"),
+            Diagnostic::error(
+                codes::EMPTY_FILE,
+                "this file declares nothing",
+                root.id,
+                Span::new(0, 0),
+            )
+            .with_help("a job file declares a surface, a tool, a machine, a strategy and a job"),
         );
     }
     let mut diags = loaded.diags.clone();
@@ -108,23 +124,41 @@ impl<'a> Checker<'a> {
                 if let Some(&prev) = scope.get(name.name.as_str()) {
                     let first = self.decls[prev].name.span;
                     self.err(
-                        Diagnostic::error(codes::DUPLICATE_NAME, format!("`{}` is defined twice", name.name), pf.id, name.span)
-                            .with_label("second definition")
-                            .with_note(pf.id, first, "first defined here")
-                            .with_help("rename one of them"),
+                        Diagnostic::error(
+                            codes::DUPLICATE_NAME,
+                            format!("`{}` is defined twice", name.name),
+                            pf.id,
+                            name.span,
+                        )
+                        .with_label("second definition")
+                        .with_note(pf.id, first, "first defined here")
+                        .with_help("rename one of them"),
                     );
                     continue;
                 }
-                if FUNCTIONS.contains(&name.name.as_str()) || schema::kind(&name.name).is_some() || COORDINATES.contains(&name.name.as_str()) {
+                if FUNCTIONS.contains(&name.name.as_str())
+                    || schema::kind(&name.name).is_some()
+                    || COORDINATES.contains(&name.name.as_str())
+                {
                     self.err(
-                        Diagnostic::error(codes::DUPLICATE_NAME, format!("`{}` is a built-in name", name.name), pf.id, name.span)
-                            .with_label("this would hide the built-in")
-                            .with_help("choose another name"),
+                        Diagnostic::error(
+                            codes::DUPLICATE_NAME,
+                            format!("`{}` is a built-in name", name.name),
+                            pf.id,
+                            name.span,
+                        )
+                        .with_label("this would hide the built-in")
+                        .with_help("choose another name"),
                     );
                     continue;
                 }
                 scope.insert(name.name.as_str(), self.decls.len());
-                self.decls.push(Decl { file: pf.id, name, kind, value });
+                self.decls.push(Decl {
+                    file: pf.id,
+                    name,
+                    kind,
+                    value,
+                });
                 self.state.push(State::Todo);
                 self.used.push(false);
             }
@@ -143,10 +177,15 @@ impl<'a> Checker<'a> {
                                     let prev_span = self.decls[prev].name.span;
                                     let prev_file = self.decls[prev].file;
                                     self.err(
-                                        Diagnostic::error(codes::DUPLICATE_NAME, format!("`{}` is already defined", name.name), pf.id, name.span)
-                                            .with_label("imported here")
-                                            .with_note(prev_file, prev_span, "also defined here")
-                                            .with_help("rename the local definition"),
+                                        Diagnostic::error(
+                                            codes::DUPLICATE_NAME,
+                                            format!("`{}` is already defined", name.name),
+                                            pf.id,
+                                            name.span,
+                                        )
+                                        .with_label("imported here")
+                                        .with_note(prev_file, prev_span, "also defined here")
+                                        .with_help("rename the local definition"),
                                     );
                                 } else {
                                     scope.insert(name.name.as_str(), i);
@@ -155,8 +194,13 @@ impl<'a> Checker<'a> {
                             }
                             None => {
                                 let module = loaded.sources.get(*file).name.clone();
-                                let mut d = Diagnostic::error(codes::NOT_IN_MODULE, format!("`{module}` has no item `{}`", name.name), pf.id, name.span)
-                                    .with_label("not found");
+                                let mut d = Diagnostic::error(
+                                    codes::NOT_IN_MODULE,
+                                    format!("`{module}` has no item `{}`", name.name),
+                                    pf.id,
+                                    name.span,
+                                )
+                                .with_label("not found");
                                 let names: Vec<&str> = source.keys().copied().collect();
                                 let mut sorted = names.clone();
                                 sorted.sort_unstable();
@@ -186,9 +230,14 @@ impl<'a> Checker<'a> {
                 let d = &self.decls[i];
                 let (file, span, name) = (d.file, d.name.span, d.name.name.clone());
                 self.err(
-                    Diagnostic::error(codes::SELF_REFERENCE, format!("`{name}` is defined in terms of itself"), file, span)
-                        .with_label("this definition needs its own value")
-                        .with_help("break the cycle by giving one of the values directly"),
+                    Diagnostic::error(
+                        codes::SELF_REFERENCE,
+                        format!("`{name}` is defined in terms of itself"),
+                        file,
+                        span,
+                    )
+                    .with_label("this definition needs its own value")
+                    .with_help("break the cycle by giving one of the values directly"),
                 );
                 self.state[i] = State::Done(Value::Error);
                 return Value::Error;
@@ -196,7 +245,12 @@ impl<'a> Checker<'a> {
             State::Todo => {}
         }
         self.state[i] = State::Busy;
-        let (file, expr, kind, name) = (self.decls[i].file, self.decls[i].value, self.decls[i].kind, self.decls[i].name);
+        let (file, expr, kind, name) = (
+            self.decls[i].file,
+            self.decls[i].value,
+            self.decls[i].kind,
+            self.decls[i].name,
+        );
         let mut v = self.eval(file, expr, &[]);
         if let Some(kind) = kind {
             v = self.expect_category(file, expr.span, v, Category::of(kind), Some((kind, name)));
@@ -210,15 +264,27 @@ impl<'a> Checker<'a> {
     }
 
     /// Checks that a declaration's value was made by a kind of the category.
-    fn expect_category(&mut self, file: FileId, span: Span, v: Value, cat: Category, decl: Option<(DeclKind, &Ident)>) -> Value {
+    fn expect_category(
+        &mut self,
+        file: FileId,
+        span: Span,
+        v: Value,
+        cat: Category,
+        decl: Option<(DeclKind, &Ident)>,
+    ) -> Value {
         match &v {
             Value::Object(o) if o.kind.category == cat => v,
             Value::Error => v,
             Value::Kind(k) if k.category == cat => {
                 self.err(
-                    Diagnostic::error(codes::WRONG_VALUE, format!("`{}` needs its parameters", k.name), file, span)
-                        .with_label("a kind, not a value")
-                        .with_help(format!("write `{} {{ … }}` with its parameters", k.name)),
+                    Diagnostic::error(
+                        codes::WRONG_VALUE,
+                        format!("`{}` needs its parameters", k.name),
+                        file,
+                        span,
+                    )
+                    .with_label("a kind, not a value")
+                    .with_help(format!("write `{} {{ … }}` with its parameters", k.name)),
                 );
                 Value::Error
             }
@@ -229,12 +295,25 @@ impl<'a> Checker<'a> {
             other => {
                 let what = other.describe();
                 let msg = match decl {
-                    Some((k, name)) => format!("`{}` is declared as {} but its value is {what}", name.name, Category::of(k).noun()),
+                    Some((k, name)) => format!(
+                        "`{}` is declared as {} but its value is {what}",
+                        name.name,
+                        Category::of(k).noun()
+                    ),
                     None => format!("expected {} but found {what}", cat.noun()),
                 };
-                let mut d = Diagnostic::error(codes::DECLARATION_KIND, msg, file, span).with_label(format!("this is {what}"));
-                let kinds: Vec<&str> = schema::KINDS.iter().filter(|k| k.category == cat).map(|k| k.name).collect();
-                d = d.with_help(format!("{} is made by one of: {}", cat.noun(), kinds.join(", ")));
+                let mut d = Diagnostic::error(codes::DECLARATION_KIND, msg, file, span)
+                    .with_label(format!("this is {what}"));
+                let kinds: Vec<&str> = schema::KINDS
+                    .iter()
+                    .filter(|k| k.category == cat)
+                    .map(|k| k.name)
+                    .collect();
+                d = d.with_help(format!(
+                    "{} is made by one of: {}",
+                    cat.noun(),
+                    kinds.join(", ")
+                ));
                 self.err(d);
                 Value::Error
             }
@@ -252,13 +331,23 @@ impl<'a> Checker<'a> {
         let mut candidates: Vec<&str> = scope.keys().copied().collect();
         candidates.extend(FUNCTIONS);
         candidates.extend(schema::KINDS.iter().map(|k| k.name));
-        let mut d = Diagnostic::error(codes::UNKNOWN_NAME, format!("unknown name `{name}`"), file, span).with_label("not defined");
+        let mut d = Diagnostic::error(
+            codes::UNKNOWN_NAME,
+            format!("unknown name `{name}`"),
+            file,
+            span,
+        )
+        .with_label("not defined");
         if COORDINATES.contains(&name) {
-            d = d.with_help("coordinates can only be used inside a surface formula such as `z(x, y) = …`");
+            d = d.with_help(
+                "coordinates can only be used inside a surface formula such as `z(x, y) = …`",
+            );
         } else if let Some(s) = did_you_mean(name, candidates) {
             d = d.with_help(format!("did you mean `{s}`?"));
         } else if units::lookup(name).is_some() {
-            d = d.with_help(format!("`{name}` is a unit: write it right after a number, as in `1 {name}`"));
+            d = d.with_help(format!(
+                "`{name}` is a unit: write it right after a number, as in `1 {name}`"
+            ));
         }
         self.err(d);
     }
@@ -269,7 +358,9 @@ impl<'a> Checker<'a> {
         match &e.kind {
             ExprKind::Invalid => Value::Error,
             ExprKind::Quantity { value, unit } => {
-                let Some(unit) = unit else { return Value::Num(*value, Dim::NONE) };
+                let Some(unit) = unit else {
+                    return Value::Num(*value, Dim::NONE);
+                };
                 let mut factor = 1.0;
                 let mut dim = Dim::NONE;
                 let mut ok = true;
@@ -278,14 +369,19 @@ impl<'a> Checker<'a> {
                         Some(u) => {
                             factor *= u.factor.powi(part.power);
                             match u.dim.pow(part.power) {
-                                Some(d) => dim = dim.mul(d),
+                                Some(d) => dim = dim * d,
                                 None => ok = false,
                             }
                         }
                         None => {
                             ok = false;
-                            let mut d = Diagnostic::error(codes::UNKNOWN_UNIT, format!("unknown unit `{}`", part.name), file, part.span)
-                                .with_label("not a unit lensc knows");
+                            let mut d = Diagnostic::error(
+                                codes::UNKNOWN_UNIT,
+                                format!("unknown unit `{}`", part.name),
+                                file,
+                                part.span,
+                            )
+                            .with_label("not a unit lensc knows");
                             d = d.with_help(match did_you_mean(&part.name, units::UNITS.iter().map(|u| u.name)) {
                                 Some(s) => format!("did you mean `{s}`?"),
                                 None if part.name.len() == 1 || self.scopes[file.0 as usize].contains_key(part.name.as_str()) || coords.contains(&part.name) =>
@@ -296,7 +392,11 @@ impl<'a> Checker<'a> {
                         }
                     }
                 }
-                if ok { Value::Num(value * factor, dim) } else { Value::Error }
+                if ok {
+                    Value::Num(value * factor, dim)
+                } else {
+                    Value::Error
+                }
             }
             ExprKind::Str(s) => Value::Str(s.clone()),
             ExprKind::Name(n) => {
@@ -315,7 +415,10 @@ impl<'a> Checker<'a> {
                 }
                 Value::Word(n.clone())
             }
-            ExprKind::Unary { op: UnaryOp::Neg, operand } => {
+            ExprKind::Unary {
+                op: UnaryOp::Neg,
+                operand,
+            } => {
                 let v = self.eval(file, operand, coords);
                 match v {
                     Value::Num(x, d) => Value::Num(-x, d),
@@ -333,7 +436,9 @@ impl<'a> Checker<'a> {
             ExprKind::Call { callee, args } => {
                 let f = self.eval(file, callee, coords);
                 match f {
-                    Value::Function(name) => self.call_function(file, name, e.span, callee.span, args, coords),
+                    Value::Function(name) => {
+                        self.call_function(file, name, e.span, callee.span, args, coords)
+                    }
                     Value::Kind(k) => {
                         let mut fields = Vec::new();
                         let mut positional = 0;
@@ -344,9 +449,18 @@ impl<'a> Checker<'a> {
                                 None => {
                                     let Some(p) = k.positional.get(positional) else {
                                         self.err(
-                                            Diagnostic::error(codes::ARGUMENT_COUNT, format!("`{}` takes only named arguments", k.name), file, a.value.span)
-                                                .with_label("unnamed argument")
-                                                .with_help(format!("write `name: value`; `{}` has: {}", k.name, param_list(k.params))),
+                                            Diagnostic::error(
+                                                codes::ARGUMENT_COUNT,
+                                                format!("`{}` takes only named arguments", k.name),
+                                                file,
+                                                a.value.span,
+                                            )
+                                            .with_label("unnamed argument")
+                                            .with_help(format!(
+                                                "write `name: value`; `{}` has: {}",
+                                                k.name,
+                                                param_list(k.params)
+                                            )),
                                         );
                                         continue;
                                     };
@@ -354,7 +468,16 @@ impl<'a> Checker<'a> {
                                     (p.to_string(), a.value.span)
                                 }
                             };
-                            self.push_field(&mut fields, Field { name, name_span, value: v, span: a.value.span, file });
+                            self.push_field(
+                                &mut fields,
+                                Field {
+                                    name,
+                                    name_span,
+                                    value: v,
+                                    span: a.value.span,
+                                    file,
+                                },
+                            );
                         }
                         self.construct(k, fields, callee.span, file)
                     }
@@ -365,8 +488,17 @@ impl<'a> Checker<'a> {
                         Value::Error
                     }
                     Value::Word(w) => {
-                        let mut d = Diagnostic::error(codes::UNKNOWN_NAME, format!("unknown function `{w}`"), file, callee.span).with_label("not defined");
-                        let cands = FUNCTIONS.iter().copied().chain(schema::KINDS.iter().map(|k| k.name));
+                        let mut d = Diagnostic::error(
+                            codes::UNKNOWN_NAME,
+                            format!("unknown function `{w}`"),
+                            file,
+                            callee.span,
+                        )
+                        .with_label("not defined");
+                        let cands = FUNCTIONS
+                            .iter()
+                            .copied()
+                            .chain(schema::KINDS.iter().map(|k| k.name));
                         d = d.with_help(match did_you_mean(&w, cands) {
                             Some(s) => format!("did you mean `{s}`?"),
                             None => format!("the functions are: {}", FUNCTIONS.join(", ")),
@@ -376,8 +508,13 @@ impl<'a> Checker<'a> {
                     }
                     other => {
                         self.err(
-                            Diagnostic::error(codes::NOT_CALLABLE, format!("{} cannot be called", other.describe()), file, callee.span)
-                                .with_label("not a function"),
+                            Diagnostic::error(
+                                codes::NOT_CALLABLE,
+                                format!("{} cannot be called", other.describe()),
+                                file,
+                                callee.span,
+                            )
+                            .with_label("not a function"),
                         );
                         Value::Error
                     }
@@ -400,12 +537,25 @@ impl<'a> Checker<'a> {
                         Value::Error
                     }
                     Value::Word(w) => {
-                        let mut d = Diagnostic::error(codes::UNKNOWN_NAME, format!("unknown kind `{w}`"), file, base.span).with_label("not a kind or declaration");
+                        let mut d = Diagnostic::error(
+                            codes::UNKNOWN_NAME,
+                            format!("unknown kind `{w}`"),
+                            file,
+                            base.span,
+                        )
+                        .with_label("not a kind or declaration");
                         let mut cands: Vec<&str> = schema::KINDS.iter().map(|k| k.name).collect();
                         cands.extend(self.scopes[file.0 as usize].keys().copied());
                         d = d.with_help(match did_you_mean(&w, cands) {
                             Some(s) => format!("did you mean `{s}`?"),
-                            None => format!("the kinds are: {}", schema::KINDS.iter().map(|k| k.name).collect::<Vec<_>>().join(", ")),
+                            None => format!(
+                                "the kinds are: {}",
+                                schema::KINDS
+                                    .iter()
+                                    .map(|k| k.name)
+                                    .collect::<Vec<_>>()
+                                    .join(", ")
+                            ),
                         });
                         self.err(d);
                         self.block_fields(file, block, coords);
@@ -422,7 +572,12 @@ impl<'a> Checker<'a> {
                 }
             }
             ExprKind::Block(block) => Value::Block(Rc::new(self.block_fields(file, block, coords))),
-            ExprKind::List(items) => Value::List(items.iter().map(|i| (self.eval(file, i, coords), i.span)).collect()),
+            ExprKind::List(items) => Value::List(
+                items
+                    .iter()
+                    .map(|i| (self.eval(file, i, coords), i.span))
+                    .collect(),
+            ),
         }
     }
 
@@ -430,10 +585,15 @@ impl<'a> Checker<'a> {
         if let Some(prev) = fields.iter().find(|p| p.name == f.name) {
             let first = prev.name_span;
             self.err(
-                Diagnostic::error(codes::DUPLICATE_PARAMETER, format!("`{}` is given twice", f.name), f.file, f.name_span)
-                    .with_label("given again here")
-                    .with_note(f.file, first, "first given here")
-                    .with_help("remove one of them"),
+                Diagnostic::error(
+                    codes::DUPLICATE_PARAMETER,
+                    format!("`{}` is given twice", f.name),
+                    f.file,
+                    f.name_span,
+                )
+                .with_label("given again here")
+                .with_note(f.file, first, "first given here")
+                .with_help("remove one of them"),
             );
             return;
         }
@@ -446,7 +606,13 @@ impl<'a> Checker<'a> {
             let f = match entry {
                 Entry::Param { name, value } => {
                     let v = self.eval(file, value, coords);
-                    Field { name: name.name.clone(), name_span: name.span, value: v, span: value.span, file }
+                    Field {
+                        name: name.name.clone(),
+                        name_span: name.span,
+                        value: v,
+                        span: value.span,
+                        file,
+                    }
                 }
                 Entry::Formula { name, params, body } => {
                     let mut ok = true;
@@ -463,16 +629,25 @@ impl<'a> Checker<'a> {
                     let names: Vec<String> = params.iter().map(|p| p.name.clone()).collect();
                     let v = self.eval(file, body, &names);
                     let value = match v {
-                        Value::Num(_, dim) if ok => {
-                            Value::Formula(Rc::new(Formula { params: names, result: dim, body: body.clone(), file }))
-                        }
+                        Value::Num(_, dim) if ok => Value::Formula(Rc::new(Formula {
+                            params: names,
+                            result: dim,
+                            body: body.clone(),
+                            file,
+                        })),
                         Value::Num(..) | Value::Error => Value::Error,
                         other => {
                             self.expect_number(file, body.span, &other, "use as a formula");
                             Value::Error
                         }
                     };
-                    Field { name: name.name.clone(), name_span: name.span, value, span: body.span, file }
+                    Field {
+                        name: name.name.clone(),
+                        name_span: name.span,
+                        value,
+                        span: body.span,
+                        file,
+                    }
                 }
             };
             self.push_field(&mut fields, f);
@@ -489,13 +664,25 @@ impl<'a> Checker<'a> {
                 self.unknown_name(file, span, &w);
             }
             other => self.err(
-                Diagnostic::error(codes::WRONG_VALUE, format!("cannot {action} {}", other.describe()), file, span)
-                    .with_label("expected a number or quantity"),
+                Diagnostic::error(
+                    codes::WRONG_VALUE,
+                    format!("cannot {action} {}", other.describe()),
+                    file,
+                    span,
+                )
+                .with_label("expected a number or quantity"),
             ),
         }
     }
 
-    fn binary(&mut self, file: FileId, op: BinaryOp, span: Span, (a, sa): (Value, Span), (b, sb): (Value, Span)) -> Value {
+    fn binary(
+        &mut self,
+        file: FileId,
+        op: BinaryOp,
+        span: Span,
+        (a, sa): (Value, Span),
+        (b, sb): (Value, Span),
+    ) -> Value {
         let (x, da, y, db) = match (&a, &b) {
             (Value::Num(x, da), Value::Num(y, db)) => (*x, *da, *y, *db),
             _ => {
@@ -519,12 +706,22 @@ impl<'a> Checker<'a> {
                         BinaryOp::Sub => "subtract",
                         _ => "make a range from",
                     };
-                    let mut d = Diagnostic::error(codes::DIMENSION_MISMATCH, format!("cannot {what} {da} and {db}"), file, span)
-                        .with_label(format!("`{}` needs both sides of one dimension", op.symbol()))
-                        .with_note(file, sa, format!("this is {da}"))
-                        .with_note(file, sb, format!("this is {db}"));
+                    let mut d = Diagnostic::error(
+                        codes::DIMENSION_MISMATCH,
+                        format!("cannot {what} {da} and {db}"),
+                        file,
+                        span,
+                    )
+                    .with_label(format!(
+                        "`{}` needs both sides of one dimension",
+                        op.symbol()
+                    ))
+                    .with_note(file, sa, format!("this is {da}"))
+                    .with_note(file, sb, format!("this is {db}"));
                     if da.is_none() || db.is_none() {
-                        d = d.with_help("a plain number has no unit: write the unit after it, as in `3 um`");
+                        d = d.with_help(
+                            "a plain number has no unit: write the unit after it, as in `3 um`",
+                        );
                     }
                     self.err(d);
                     return Value::Error;
@@ -534,26 +731,42 @@ impl<'a> Checker<'a> {
                     BinaryOp::Sub => Value::Num(x - y, da),
                     _ => {
                         if x.is_nan() || y.is_nan() {
-                            self.err(Diagnostic::error(codes::WRONG_VALUE, "a range's ends must be constants", file, span).with_label("depends on a coordinate"));
+                            self.err(
+                                Diagnostic::error(
+                                    codes::WRONG_VALUE,
+                                    "a range's ends must be constants",
+                                    file,
+                                    span,
+                                )
+                                .with_label("depends on a coordinate"),
+                            );
                             return Value::Error;
                         }
                         Value::Range(x, y, da)
                     }
                 }
             }
-            BinaryOp::Mul => Value::Num(x * y, da.mul(db)),
+            BinaryOp::Mul => Value::Num(x * y, da * db),
             BinaryOp::Div => {
                 if y == 0.0 {
-                    self.err(Diagnostic::error(codes::MATH_DOMAIN, "division by zero", file, sb).with_label("this is zero"));
+                    self.err(
+                        Diagnostic::error(codes::MATH_DOMAIN, "division by zero", file, sb)
+                            .with_label("this is zero"),
+                    );
                     return Value::Error;
                 }
-                Value::Num(x / y, da.div(db))
+                Value::Num(x / y, da / db)
             }
             BinaryOp::Pow => {
                 if !db.is_none() {
                     self.err(
-                        Diagnostic::error(codes::BAD_EXPONENT, format!("an exponent must be a plain number, not {db}"), file, sb)
-                            .with_label("has a unit"),
+                        Diagnostic::error(
+                            codes::BAD_EXPONENT,
+                            format!("an exponent must be a plain number, not {db}"),
+                            file,
+                            sb,
+                        )
+                        .with_label("has a unit"),
                     );
                     return Value::Error;
                 }
@@ -562,16 +775,28 @@ impl<'a> Checker<'a> {
                 }
                 if y.is_nan() || y.fract() != 0.0 || y.abs() > 12.0 {
                     self.err(
-                        Diagnostic::error(codes::BAD_EXPONENT, format!("{da} can only be raised to a whole-number constant power"), file, sb)
-                            .with_label("not a small whole number")
-                            .with_help("use sqrt for square roots; other powers of a unit have no meaning"),
+                        Diagnostic::error(
+                            codes::BAD_EXPONENT,
+                            format!("{da} can only be raised to a whole-number constant power"),
+                            file,
+                            sb,
+                        )
+                        .with_label("not a small whole number")
+                        .with_help(
+                            "use sqrt for square roots; other powers of a unit have no meaning",
+                        ),
                     );
                     return Value::Error;
                 }
                 match da.pow(y as i32) {
                     Some(d) => Value::Num(x.powi(y as i32), d),
                     None => {
-                        self.err(Diagnostic::error(codes::BAD_EXPONENT, "the power of the unit is too large", file, span));
+                        self.err(Diagnostic::error(
+                            codes::BAD_EXPONENT,
+                            "the power of the unit is too large",
+                            file,
+                            span,
+                        ));
                         Value::Error
                     }
                 }
@@ -579,14 +804,27 @@ impl<'a> Checker<'a> {
         }
     }
 
-    fn call_function(&mut self, file: FileId, name: &'static str, span: Span, callee: Span, args: &[lensc_grammar::ast::Arg], coords: &[String]) -> Value {
+    fn call_function(
+        &mut self,
+        file: FileId,
+        name: &'static str,
+        span: Span,
+        callee: Span,
+        args: &[lensc_grammar::ast::Arg],
+        coords: &[String],
+    ) -> Value {
         let mut vals = Vec::new();
         let mut bad = false;
         for a in args {
             if let Some(n) = &a.name {
                 self.err(
-                    Diagnostic::error(codes::ARGUMENT_COUNT, format!("`{name}` takes no named arguments"), file, n.span)
-                        .with_label("remove this name"),
+                    Diagnostic::error(
+                        codes::ARGUMENT_COUNT,
+                        format!("`{name}` takes no named arguments"),
+                        file,
+                        n.span,
+                    )
+                    .with_label("remove this name"),
                 );
                 bad = true;
             }
@@ -614,9 +852,14 @@ impl<'a> Checker<'a> {
                 _ => "1 argument",
             };
             self.err(
-                Diagnostic::error(codes::ARGUMENT_COUNT, format!("`{name}` takes {want}, not {}", vals.len()), file, span)
-                    .with_label("wrong number of arguments")
-                    .with_note(file, callee, "this function"),
+                Diagnostic::error(
+                    codes::ARGUMENT_COUNT,
+                    format!("`{name}` takes {want}, not {}", vals.len()),
+                    file,
+                    span,
+                )
+                .with_label("wrong number of arguments")
+                .with_note(file, callee, "this function"),
             );
             return Value::Error;
         }
@@ -636,7 +879,10 @@ impl<'a> Checker<'a> {
         };
         let domain = |me: &mut Self, ok: bool, what: &str| {
             if !ok && !x.is_nan() {
-                me.err(Diagnostic::error(codes::MATH_DOMAIN, format!("`{name}` of {what}"), file, s).with_label("outside the function's domain"));
+                me.err(
+                    Diagnostic::error(codes::MATH_DOMAIN, format!("`{name}` of {what}"), file, s)
+                        .with_label("outside the function's domain"),
+                );
                 return false;
             }
             true
@@ -657,7 +903,9 @@ impl<'a> Checker<'a> {
                 if !need(self, d.is_none(), "a plain number", d, s) {
                     return Value::Error;
                 }
-                if name != "atan" && !domain(self, (-1.0..=1.0).contains(&x), "a number outside -1 ..= 1") {
+                if name != "atan"
+                    && !domain(self, (-1.0..=1.0).contains(&x), "a number outside -1 ..= 1")
+                {
                     return Value::Error;
                 }
                 let v = match name {
@@ -671,9 +919,16 @@ impl<'a> Checker<'a> {
                 let (x2, d2, s2) = vals[1];
                 if d != d2 {
                     self.err(
-                        Diagnostic::error(codes::BAD_ARGUMENT_DIMENSION, format!("`atan2` needs two arguments of one dimension, not {d} and {d2}"), file, span)
-                            .with_note(file, s, format!("this is {d}"))
-                            .with_note(file, s2, format!("this is {d2}")),
+                        Diagnostic::error(
+                            codes::BAD_ARGUMENT_DIMENSION,
+                            format!(
+                                "`atan2` needs two arguments of one dimension, not {d} and {d2}"
+                            ),
+                            file,
+                            span,
+                        )
+                        .with_note(file, s, format!("this is {d}"))
+                        .with_note(file, s2, format!("this is {d2}")),
                     );
                     return Value::Error;
                 }
@@ -687,7 +942,13 @@ impl<'a> Checker<'a> {
                     Value::Num(x.sqrt(), h)
                 }
                 None => {
-                    need(self, false, "a quantity with even powers of its units (like an area)", d, s);
+                    need(
+                        self,
+                        false,
+                        "a quantity with even powers of its units (like an area)",
+                        d,
+                        s,
+                    );
                     Value::Error
                 }
             },
@@ -711,13 +972,24 @@ impl<'a> Checker<'a> {
                 for &(y, dy, sy) in &vals[1..] {
                     if dy != d {
                         self.err(
-                            Diagnostic::error(codes::BAD_ARGUMENT_DIMENSION, format!("`{name}` needs arguments of one dimension, not {d} and {dy}"), file, sy)
-                                .with_label(format!("this is {dy}"))
-                                .with_note(file, s, format!("this is {d}")),
+                            Diagnostic::error(
+                                codes::BAD_ARGUMENT_DIMENSION,
+                                format!(
+                                    "`{name}` needs arguments of one dimension, not {d} and {dy}"
+                                ),
+                                file,
+                                sy,
+                            )
+                            .with_label(format!("this is {dy}"))
+                            .with_note(file, s, format!("this is {d}")),
                         );
                         return Value::Error;
                     }
-                    acc = if name == "min" { acc.min(y) } else { acc.max(y) };
+                    acc = if name == "min" {
+                        acc.min(y)
+                    } else {
+                        acc.max(y)
+                    };
                 }
                 Value::Num(acc, d)
             }
@@ -726,12 +998,30 @@ impl<'a> Checker<'a> {
 
     // ---- kinds and parameters ---------------------------------------------
 
-    fn construct(&mut self, kind: &'static Kind, fields: Vec<Field>, head: Span, file: FileId) -> Value {
-        let ok = self.validate(kind.params, &fields, &format!("`{}`", kind.name), head, file, kind.exclusive);
+    fn construct(
+        &mut self,
+        kind: &'static Kind,
+        fields: Vec<Field>,
+        head: Span,
+        file: FileId,
+    ) -> Value {
+        let ok = self.validate(
+            kind.params,
+            &fields,
+            &format!("`{}`", kind.name),
+            head,
+            file,
+            kind.exclusive,
+        );
         if !ok {
             return Value::Error;
         }
-        let obj = Object { kind, fields, head, file };
+        let obj = Object {
+            kind,
+            fields,
+            head,
+            file,
+        };
         if !self.kind_rules(&obj) {
             return Value::Error;
         }
@@ -739,12 +1029,25 @@ impl<'a> Checker<'a> {
     }
 
     /// Validates fields against parameters; true if all is well.
-    fn validate(&mut self, params: &'static [Param], fields: &[Field], owner: &str, head: Span, file: FileId, exclusive: &[(&[&str], bool)]) -> bool {
+    fn validate(
+        &mut self,
+        params: &'static [Param],
+        fields: &[Field],
+        owner: &str,
+        head: Span,
+        file: FileId,
+        exclusive: &[(&[&str], bool)],
+    ) -> bool {
         let before = self.error_count();
         for f in fields {
             let Some(p) = params.iter().find(|p| p.name == f.name) else {
-                let mut d = Diagnostic::error(codes::UNKNOWN_PARAMETER, format!("{owner} has no parameter `{}`", f.name), f.file, f.name_span)
-                    .with_label("unknown parameter");
+                let mut d = Diagnostic::error(
+                    codes::UNKNOWN_PARAMETER,
+                    format!("{owner} has no parameter `{}`", f.name),
+                    f.file,
+                    f.name_span,
+                )
+                .with_label("unknown parameter");
                 d = d.with_help(match did_you_mean(&f.name, params.iter().map(|p| p.name)) {
                     Some(s) => format!("did you mean `{s}`?"),
                     None => format!("{owner} takes: {}", param_list(params)),
@@ -757,25 +1060,46 @@ impl<'a> Checker<'a> {
         for p in params.iter().filter(|p| p.required) {
             if value::field(fields, p.name).is_none() {
                 self.err(
-                    Diagnostic::error(codes::MISSING_PARAMETER, format!("{owner} is missing `{}`", p.name), file, head)
-                        .with_label(format!("needs `{}`", p.name))
-                        .with_help(format!("add `{}: …`, {}", p.name, ty_words(&p.ty)) + &format!(" ({})", p.doc)),
+                    Diagnostic::error(
+                        codes::MISSING_PARAMETER,
+                        format!("{owner} is missing `{}`", p.name),
+                        file,
+                        head,
+                    )
+                    .with_label(format!("needs `{}`", p.name))
+                    .with_help(
+                        format!("add `{}: …`, {}", p.name, ty_words(&p.ty))
+                            + &format!(" ({})", p.doc),
+                    ),
                 );
             }
         }
         for (group, exactly_one) in exclusive {
-            let given: Vec<&Field> = group.iter().filter_map(|n| value::field(fields, n)).collect();
+            let given: Vec<&Field> = group
+                .iter()
+                .filter_map(|n| value::field(fields, n))
+                .collect();
             if given.len() > 1 {
                 self.err(
-                    Diagnostic::error(codes::CONFLICTING_PARAMETERS, format!("{owner} takes only one of {}", quoted(group)), given[1].file, given[1].name_span)
-                        .with_label("second of them")
-                        .with_note(given[0].file, given[0].name_span, "first of them")
-                        .with_help("keep one"),
+                    Diagnostic::error(
+                        codes::CONFLICTING_PARAMETERS,
+                        format!("{owner} takes only one of {}", quoted(group)),
+                        given[1].file,
+                        given[1].name_span,
+                    )
+                    .with_label("second of them")
+                    .with_note(given[0].file, given[0].name_span, "first of them")
+                    .with_help("keep one"),
                 );
             } else if given.is_empty() && *exactly_one {
                 self.err(
-                    Diagnostic::error(codes::MISSING_PARAMETER, format!("{owner} needs one of {}", quoted(group)), file, head)
-                        .with_label("give one of them"),
+                    Diagnostic::error(
+                        codes::MISSING_PARAMETER,
+                        format!("{owner} needs one of {}", quoted(group)),
+                        file,
+                        head,
+                    )
+                    .with_label("give one of them"),
                 );
             }
         }
@@ -792,11 +1116,23 @@ impl<'a> Checker<'a> {
             (_, Value::Error) => {}
             (Ty::Quantity(dims), Value::Num(v, d)) => {
                 if !dims.contains(d) {
-                    let want = dims.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(" or ");
-                    let mut diag = Diagnostic::error(codes::PARAMETER_DIMENSION, format!("`{}` must be {want}, but this is {d}", p.name), file, span)
-                        .with_label(format!("this is {d}"));
+                    let want = dims
+                        .iter()
+                        .map(|d| d.to_string())
+                        .collect::<Vec<_>>()
+                        .join(" or ");
+                    let mut diag = Diagnostic::error(
+                        codes::PARAMETER_DIMENSION,
+                        format!("`{}` must be {want}, but this is {d}", p.name),
+                        file,
+                        span,
+                    )
+                    .with_label(format!("this is {d}"));
                     diag = diag.with_help(if d.is_none() {
-                        format!("write a unit after the number, for example {}", example_unit(dims[0]))
+                        format!(
+                            "write a unit after the number, for example {}",
+                            example_unit(dims[0])
+                        )
                     } else {
                         format!("`{}` is {}: {}", p.name, want, p.doc)
                     });
@@ -815,20 +1151,34 @@ impl<'a> Checker<'a> {
                     let rule = match p.check {
                         Check::Positive => "must be greater than zero".to_string(),
                         Check::NonNegative => "cannot be negative".to_string(),
-                        Check::HalfOpen(lo, hi) => format!("must be at least {} and less than {} {unit}", trim_num(lo * factor), trim_num(hi * factor)),
+                        Check::HalfOpen(lo, hi) => format!(
+                            "must be at least {} and less than {} {unit}",
+                            trim_num(lo * factor),
+                            trim_num(hi * factor)
+                        ),
                         Check::Any => unreachable!(),
                     };
                     self.err(
-                        Diagnostic::error(codes::OUT_OF_RANGE, format!("`{}` {rule}, but it is {}", p.name, shown.trim_end()), file, span)
-                            .with_label("out of range")
-                            .with_help(format!("`{}`: {}", p.name, p.doc)),
+                        Diagnostic::error(
+                            codes::OUT_OF_RANGE,
+                            format!("`{}` {rule}, but it is {}", p.name, shown.trim_end()),
+                            file,
+                            span,
+                        )
+                        .with_label("out of range")
+                        .with_help(format!("`{}`: {}", p.name, p.doc)),
                     );
                 }
             }
             (Ty::Word(words), Value::Word(w)) => {
                 if !words.contains(&w.as_str()) {
-                    let mut d = Diagnostic::error(codes::UNKNOWN_WORD, format!("`{}` cannot be `{w}`", p.name), file, span)
-                        .with_label(format!("expected {}", one_of(words)));
+                    let mut d = Diagnostic::error(
+                        codes::UNKNOWN_WORD,
+                        format!("`{}` cannot be `{w}`", p.name),
+                        file,
+                        span,
+                    )
+                    .with_label(format!("expected {}", one_of(words)));
                     if let Some(s) = did_you_mean(w, words.iter().copied()) {
                         d = d.with_help(format!("did you mean `{s}`?"));
                     } else {
@@ -848,43 +1198,80 @@ impl<'a> Checker<'a> {
             (Ty::Range(dim), Value::Range(lo, hi, d)) => {
                 if d != dim {
                     self.err(
-                        Diagnostic::error(codes::PARAMETER_DIMENSION, format!("the ends of `{}` must be {dim}, but they are {d}", p.name), file, span)
-                            .with_label(format!("this is {d}")),
+                        Diagnostic::error(
+                            codes::PARAMETER_DIMENSION,
+                            format!("the ends of `{}` must be {dim}, but they are {d}", p.name),
+                            file,
+                            span,
+                        )
+                        .with_label(format!("this is {d}")),
                     );
                 } else if lo >= hi {
                     self.err(
-                        Diagnostic::error(codes::OUT_OF_RANGE, format!("the range of `{}` is empty or reversed", p.name), file, span)
-                            .with_label("the start must be below the end"),
+                        Diagnostic::error(
+                            codes::OUT_OF_RANGE,
+                            format!("the range of `{}` is empty or reversed", p.name),
+                            file,
+                            span,
+                        )
+                        .with_label("the start must be below the end"),
                     );
                 }
             }
             (Ty::Formula { coords, result }, Value::Formula(fm)) => {
                 if let Some(bad) = fm.params.iter().find(|c| !coords.contains(&c.as_str())) {
                     self.err(
-                        Diagnostic::error(codes::UNKNOWN_COORDINATE, format!("`{}` is written in {}, not `{bad}`", p.name, quoted(coords)), file, f.name_span)
-                            .with_label("wrong coordinates"),
+                        Diagnostic::error(
+                            codes::UNKNOWN_COORDINATE,
+                            format!("`{}` is written in {}, not `{bad}`", p.name, quoted(coords)),
+                            file,
+                            f.name_span,
+                        )
+                        .with_label("wrong coordinates"),
                     );
                 }
                 if fm.result != *result {
                     self.err(
-                        Diagnostic::error(codes::FORMULA_DIMENSION, format!("the formula for `{}` must give {result}, but it gives {}", p.name, fm.result), file, span)
-                            .with_label(format!("this is {}", fm.result))
-                            .with_help(if fm.result.is_none() { "multiply by a length, as in `0.02 mm * sin(…)`" } else { "check the units of each term" }),
+                        Diagnostic::error(
+                            codes::FORMULA_DIMENSION,
+                            format!(
+                                "the formula for `{}` must give {result}, but it gives {}",
+                                p.name, fm.result
+                            ),
+                            file,
+                            span,
+                        )
+                        .with_label(format!("this is {}", fm.result))
+                        .with_help(if fm.result.is_none() {
+                            "multiply by a length, as in `0.02 mm * sin(…)`"
+                        } else {
+                            "check the units of each term"
+                        }),
                     );
                 }
             }
             (_, v) => {
                 let v = v.clone();
-                if let Value::Word(w) = &v {
-                    if matches!(p.ty, Ty::Quantity(_) | Ty::Range(_)) {
-                        self.unknown_name(file, span, w);
-                        return;
-                    }
+                if let Value::Word(w) = &v
+                    && matches!(p.ty, Ty::Quantity(_) | Ty::Range(_))
+                {
+                    self.unknown_name(file, span, w);
+                    return;
                 }
                 self.err(
-                    Diagnostic::error(codes::WRONG_VALUE, format!("`{}` must be {}, but this is {}", p.name, ty_words(&p.ty), v.describe()), file, span)
-                        .with_label("wrong kind of value")
-                        .with_help(format!("`{}`: {}", p.name, p.doc)),
+                    Diagnostic::error(
+                        codes::WRONG_VALUE,
+                        format!(
+                            "`{}` must be {}, but this is {}",
+                            p.name,
+                            ty_words(&p.ty),
+                            v.describe()
+                        ),
+                        file,
+                        span,
+                    )
+                    .with_label("wrong kind of value")
+                    .with_help(format!("`{}`: {}", p.name, p.doc)),
                 );
             }
         }
@@ -894,10 +1281,20 @@ impl<'a> Checker<'a> {
     fn kind_rules(&mut self, o: &Object) -> bool {
         match o.kind.name {
             "conic" | "sphere" | "asphere" => {
-                let (Some(r), Some(ap)) = (value::num(&o.fields, "radius"), value::object(&o.fields, "aperture")) else { return true };
+                let (Some(r), Some(ap)) = (
+                    value::num(&o.fields, "radius"),
+                    value::object(&o.fields, "aperture"),
+                ) else {
+                    return true;
+                };
                 let k = value::num(&o.fields, "conic").unwrap_or(0.0);
-                let Some(ar) = aperture_radius(ap) else { return true };
-                let Some(limit) = lensc_runtime::surface::RotationalSurface::conic_limit(r, k) else { return true };
+                let Some(ar) = aperture_radius(ap) else {
+                    return true;
+                };
+                let Some(limit) = lensc_runtime::surface::RotationalSurface::conic_limit(r, k)
+                else {
+                    return true;
+                };
                 if ar >= limit {
                     let ap_field = value::field(&o.fields, "aperture").expect("aperture");
                     self.err(
@@ -916,13 +1313,19 @@ impl<'a> Checker<'a> {
                 true
             }
             "profile_turning" => {
-                if let (Some(from), Some(to)) = (value::num(&o.fields, "from"), value::num(&o.fields, "to"))
+                if let (Some(from), Some(to)) =
+                    (value::num(&o.fields, "from"), value::num(&o.fields, "to"))
                     && from <= to
                 {
                     let f = value::field(&o.fields, "from").expect("from");
                     self.err(
-                        Diagnostic::error(codes::OUT_OF_RANGE, "the cut must start at a larger radius than it ends", f.file, f.span)
-                            .with_label("`from` is not above `to`"),
+                        Diagnostic::error(
+                            codes::OUT_OF_RANGE,
+                            "the cut must start at a larger radius than it ends",
+                            f.file,
+                            f.span,
+                        )
+                        .with_label("`from` is not above `to`"),
                     );
                     return false;
                 }
@@ -940,12 +1343,19 @@ impl<'a> Checker<'a> {
         let mut jobs: Vec<CheckedJob> = Vec::new();
         let mut seen: HashMap<&str, Span> = HashMap::new();
         for item in &root.ast.items {
-            let ItemKind::Job { name, body } = &item.kind else { continue };
+            let ItemKind::Job { name, body } = &item.kind else {
+                continue;
+            };
             if let Some(first) = seen.get(name.name.as_str()) {
                 self.err(
-                    Diagnostic::error(codes::DUPLICATE_NAME, format!("job `{}` is defined twice", name.name), root.id, name.span)
-                        .with_label("second definition")
-                        .with_note(root.id, *first, "first defined here"),
+                    Diagnostic::error(
+                        codes::DUPLICATE_NAME,
+                        format!("job `{}` is defined twice", name.name),
+                        root.id,
+                        name.span,
+                    )
+                    .with_label("second definition")
+                    .with_note(root.id, *first, "first defined here"),
                 );
                 continue;
             }
@@ -959,8 +1369,20 @@ impl<'a> Checker<'a> {
                     part_names.insert(p.name.clone(), n.clone());
                 }
             }
-            if self.validate(schema::JOB_PARAMS, &fields, &format!("job `{}`", name.name), name.span, root.id, &[]) {
-                jobs.push(CheckedJob { name: name.clone(), file: root.id, fields, part_names });
+            if self.validate(
+                schema::JOB_PARAMS,
+                &fields,
+                &format!("job `{}`", name.name),
+                name.span,
+                root.id,
+                &[],
+            ) {
+                jobs.push(CheckedJob {
+                    name: name.clone(),
+                    file: root.id,
+                    fields,
+                    part_names,
+                });
             }
         }
         jobs
@@ -970,9 +1392,14 @@ impl<'a> Checker<'a> {
         for (i, d) in self.decls.iter().enumerate() {
             if d.file == FileId(0) && !self.used[i] {
                 self.diags.push(
-                    Diagnostic::warning(codes::UNUSED, format!("`{}` is never used", d.name.name), d.file, d.name.span)
-                        .with_label("defined here")
-                        .with_help("remove it, or use it in a job"),
+                    Diagnostic::warning(
+                        codes::UNUSED,
+                        format!("`{}` is never used", d.name.name),
+                        d.file,
+                        d.name.span,
+                    )
+                    .with_label("defined here")
+                    .with_help("remove it, or use it in a job"),
                 );
             }
         }
@@ -988,7 +1415,10 @@ fn merge(base: &[Field], over: Vec<Field>) -> Vec<Field> {
             Some(slot) => {
                 if let (Value::Block(a), Value::Block(b)) = (&slot.value, &f.value) {
                     let merged = merge(a, b.as_ref().clone());
-                    *slot = Field { value: Value::Block(Rc::new(merged)), ..f };
+                    *slot = Field {
+                        value: Value::Block(Rc::new(merged)),
+                        ..f
+                    };
                 } else {
                     *slot = f;
                 }
@@ -1025,7 +1455,11 @@ fn one_of(words: &[&str]) -> String {
 
 fn ty_words(ty: &Ty) -> String {
     match ty {
-        Ty::Quantity(dims) => dims.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(" or "),
+        Ty::Quantity(dims) => dims
+            .iter()
+            .map(|d| d.to_string())
+            .collect::<Vec<_>>()
+            .join(" or "),
         Ty::Word(words) => one_of(words),
         Ty::Object(c) => c.noun().to_string(),
         Ty::Block(_) => "a block `{ … }`".into(),

@@ -43,26 +43,21 @@ pub fn check_text(fs: &dyn FileSystem, name: &str, text: &[u8]) -> Checked {
     Checked { loaded, checked }
 }
 
-pub struct BuildOptions {
-    /// Build only this job; all jobs of the file if `None`.
-    pub job: Option<String>,
-    pub out_dir: PathBuf,
-}
-
-/// A program that was built.
-pub struct Built {
-    pub job: String,
-    pub path: PathBuf,
-    pub text: String,
-    pub toolpath: Toolpath,
-}
-
 /// Builds programs (without writing them) for the checked jobs. Returns
 /// the programs and any further diagnostics.
-pub fn plan_and_emit(c: &Checked, only: Option<&str>, source_name: &str) -> (Vec<(String, String, Toolpath)>, Vec<Diagnostic>) {
+pub fn plan_and_emit(
+    c: &Checked,
+    only: Option<&str>,
+    source_name: &str,
+) -> (Vec<(String, String, Toolpath)>, Vec<Diagnostic>) {
     let mut diags = Vec::new();
     let mut out = Vec::new();
-    let jobs: Vec<&check::CheckedJob> = c.checked.jobs.iter().filter(|j| only.is_none_or(|n| j.name.name == n)).collect();
+    let jobs: Vec<&check::CheckedJob> = c
+        .checked
+        .jobs
+        .iter()
+        .filter(|j| only.is_none_or(|n| j.name.name == n))
+        .collect();
     let prov = Provenance {
         source: source_name.to_string(),
         source_hash: source_hash(&c.loaded),
@@ -85,10 +80,19 @@ pub fn plan_and_emit(c: &Checked, only: Option<&str>, source_name: &str) -> (Vec
             }
         };
         match program::emit(&lowered, &path, &prov) {
-            Ok(text) => out.push((format!("{}.{}", lowered.name, lowered.machine.dialect.extension()), text, path)),
+            Ok(text) => out.push((
+                format!("{}.{}", lowered.name, lowered.machine.dialect.extension()),
+                text,
+                path,
+            )),
             Err(ProgramError::NotPrintable { word, value }) => diags.push(
-                Diagnostic::error(codes::NOT_PRINTABLE, format!("the program would contain {word}{value}, which no controller accepts"), file, span)
-                    .with_label("no program was written for this job"),
+                Diagnostic::error(
+                    codes::NOT_PRINTABLE,
+                    format!("the program would contain {word}{value}, which no controller accepts"),
+                    file,
+                    span,
+                )
+                .with_label("no program was written for this job"),
             ),
         }
     }
@@ -164,9 +168,15 @@ fn plan_diagnostic(e: PlanError, file: FileId, span: Span) -> Diagnostic {
 /// target is untouched and no temporary file is left behind.
 pub fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {
     use std::io::Write;
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     std::fs::create_dir_all(dir)?;
-    let mut tmp = tempfile::Builder::new().prefix(".lensc-").suffix(".tmp").tempfile_in(dir)?;
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".lensc-")
+        .suffix(".tmp")
+        .tempfile_in(dir)?;
     tmp.write_all(text.as_bytes())?;
     tmp.as_file().sync_all()?;
     tmp.persist(path).map_err(|e| e.error)?;

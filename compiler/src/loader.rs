@@ -70,17 +70,45 @@ impl Loaded {
 /// Loads `root` (as the user named it) and the closure of its `use`s.
 pub fn load(fs: &dyn FileSystem, root: &Path) -> Result<Loaded, std::io::Error> {
     let bytes = fs.read(root)?;
-    let mut l = Loader { fs, loaded: Loaded { sources: SourceMap::default(), files: Vec::new(), diags: Vec::new() }, keys: HashMap::new(), stack: Vec::new() };
+    let mut l = Loader {
+        fs,
+        loaded: Loaded {
+            sources: SourceMap::default(),
+            files: Vec::new(),
+            diags: Vec::new(),
+        },
+        keys: HashMap::new(),
+        stack: Vec::new(),
+    };
     let key = Key::Path(fs.canonical(root));
-    l.add(key, root.display().to_string(), Some(root.to_path_buf()), bytes);
+    l.add(
+        key,
+        root.display().to_string(),
+        Some(root.to_path_buf()),
+        bytes,
+    );
     Ok(l.loaded)
 }
 
 /// Loads source text given directly (tests, benchmarks); `use` of a path
 /// is resolved relative to the working directory.
 pub fn load_text(fs: &dyn FileSystem, name: &str, text: &[u8]) -> Loaded {
-    let mut l = Loader { fs, loaded: Loaded { sources: SourceMap::default(), files: Vec::new(), diags: Vec::new() }, keys: HashMap::new(), stack: Vec::new() };
-    l.add(Key::Path(PathBuf::from(name)), name.to_string(), Some(PathBuf::from(name)), text.to_vec());
+    let mut l = Loader {
+        fs,
+        loaded: Loaded {
+            sources: SourceMap::default(),
+            files: Vec::new(),
+            diags: Vec::new(),
+        },
+        keys: HashMap::new(),
+        stack: Vec::new(),
+    };
+    l.add(
+        Key::Path(PathBuf::from(name)),
+        name.to_string(),
+        Some(PathBuf::from(name)),
+        text.to_vec(),
+    );
     l.loaded
 }
 
@@ -109,12 +137,21 @@ impl Loader<'_> {
         };
         let id = self.loaded.sources.add(name, path.clone(), text);
         self.keys.insert(key.clone(), id);
-        self.loaded.files.push(ParsedFile { id, ast: ast::File::default(), imports: Vec::new() });
+        self.loaded.files.push(ParsedFile {
+            id,
+            ast: ast::File::default(),
+            imports: Vec::new(),
+        });
         if let Some(at) = utf8_error {
             self.loaded.diags.push(
-                Diagnostic::error(syntax_codes::NOT_UTF8, "this file is not valid UTF-8", id, Span::new(at, at + 3))
-                    .with_label("the first byte that is not UTF-8")
-                    .with_help("save the file as UTF-8; units like µm and ° need it"),
+                Diagnostic::error(
+                    syntax_codes::NOT_UTF8,
+                    "this file is not valid UTF-8",
+                    id,
+                    Span::new(at, at + 3),
+                )
+                .with_label("the first byte that is not UTF-8")
+                .with_help("save the file as UTF-8; units like µm and ° need it"),
             );
             return id;
         }
@@ -134,22 +171,39 @@ impl Loader<'_> {
         id
     }
 
-    fn resolve_use(&mut self, from: FileId, from_path: Option<&Path>, target: &UseTarget, span: Span, imports: &mut Vec<Import>) {
+    fn resolve_use(
+        &mut self,
+        from: FileId,
+        from_path: Option<&Path>,
+        target: &UseTarget,
+        span: Span,
+        imports: &mut Vec<Import>,
+    ) {
         match target {
             UseTarget::Std(segs) => {
                 if segs[0].name != "std" {
                     self.loaded.diags.push(
-                        Diagnostic::error(codes::UNKNOWN_MODULE, format!("unknown module `{}`", segs[0].name), from, segs[0].span)
-                            .with_label("only `std` modules are named this way")
-                            .with_help("use another file by its path in quotes: use \"common.lens\""),
+                        Diagnostic::error(
+                            codes::UNKNOWN_MODULE,
+                            format!("unknown module `{}`", segs[0].name),
+                            from,
+                            segs[0].span,
+                        )
+                        .with_label("only `std` modules are named this way")
+                        .with_help("use another file by its path in quotes: use \"common.lens\""),
                     );
                     return;
                 }
                 let Some(module) = segs.get(1) else { return };
                 let Some(&(mname, text)) = STDLIB.iter().find(|(n, _)| *n == module.name) else {
                     let names: Vec<&str> = STDLIB.iter().map(|(n, _)| *n).collect();
-                    let mut d = Diagnostic::error(codes::UNKNOWN_MODULE, format!("the standard library has no module `{}`", module.name), from, module.span)
-                        .with_label("no such module");
+                    let mut d = Diagnostic::error(
+                        codes::UNKNOWN_MODULE,
+                        format!("the standard library has no module `{}`", module.name),
+                        from,
+                        module.span,
+                    )
+                    .with_label("no such module");
                     d = d.with_help(match did_you_mean(&module.name, names.iter().copied()) {
                         Some(s) => format!("did you mean `{s}`?"),
                         None => format!("the modules are: {}", names.join(", ")),
@@ -159,17 +213,30 @@ impl Loader<'_> {
                 };
                 if segs.len() > 3 {
                     self.loaded.diags.push(
-                        Diagnostic::error(codes::UNKNOWN_MODULE, "a `use` path names a module and at most one item", from, segs[3].span.to(segs[segs.len() - 1].span))
-                            .with_label("remove this"),
+                        Diagnostic::error(
+                            codes::UNKNOWN_MODULE,
+                            "a `use` path names a module and at most one item",
+                            from,
+                            segs[3].span.to(segs[segs.len() - 1].span),
+                        )
+                        .with_label("remove this"),
                     );
                 }
                 let key = Key::Std(mname.to_string());
                 let file = match self.keys.get(&key) {
                     Some(&f) => f,
-                    None => self.add(key, format!("std/{mname}.lens"), None, text.as_bytes().to_vec()),
+                    None => self.add(
+                        key,
+                        format!("std/{mname}.lens"),
+                        None,
+                        text.as_bytes().to_vec(),
+                    ),
                 };
                 match segs.get(2) {
-                    Some(name) => imports.push(Import::One { file, name: name.clone() }),
+                    Some(name) => imports.push(Import::One {
+                        file,
+                        name: name.clone(),
+                    }),
                     None => imports.push(Import::All { file, span }),
                 }
             }
@@ -178,12 +245,20 @@ impl Loader<'_> {
                 let full = base.join(path);
                 let key = Key::Path(self.fs.canonical(&full));
                 if let Some(pos) = self.stack.iter().position(|(k, _)| *k == key) {
-                    let mut chain: Vec<String> = self.stack[pos..].iter().map(|(_, f)| self.loaded.sources.get(*f).name.clone()).collect();
+                    let mut chain: Vec<String> = self.stack[pos..]
+                        .iter()
+                        .map(|(_, f)| self.loaded.sources.get(*f).name.clone())
+                        .collect();
                     chain.push(self.loaded.sources.get(self.stack[pos].1).name.clone());
                     self.loaded.diags.push(
                         Diagnostic::error(codes::IMPORT_CYCLE, "import cycle", from, *pspan)
-                            .with_label("this `use` leads back to a file that is still being loaded")
-                            .with_help(format!("the cycle is {}; move what both files need into a third file", chain.join(" → "))),
+                            .with_label(
+                                "this `use` leads back to a file that is still being loaded",
+                            )
+                            .with_help(format!(
+                                "the cycle is {}; move what both files need into a third file",
+                                chain.join(" → ")
+                            )),
                     );
                     return;
                 }
@@ -197,9 +272,14 @@ impl Loader<'_> {
                         imports.push(Import::All { file: f, span });
                     }
                     Err(e) => self.loaded.diags.push(
-                        Diagnostic::error(codes::CANNOT_READ, format!("cannot read `{}`: {}", full.display(), plain_io_error(&e)), from, *pspan)
-                            .with_label("used here")
-                            .with_help("paths are relative to the file that uses them"),
+                        Diagnostic::error(
+                            codes::CANNOT_READ,
+                            format!("cannot read `{}`: {}", full.display(), plain_io_error(&e)),
+                            from,
+                            *pspan,
+                        )
+                        .with_label("used here")
+                        .with_help("paths are relative to the file that uses them"),
                     ),
                 }
             }

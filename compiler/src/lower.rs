@@ -17,7 +17,12 @@ use crate::value::{self, Field, Object, Value};
 /// Lowers one checked job, or says why it cannot be built.
 pub fn lower(job: &CheckedJob) -> Result<Job, Vec<Diagnostic>> {
     let part = |name: &str| value::object(&job.fields, name).expect("checked job part");
-    let (surface, tool, machine, strategy) = (part("surface"), part("tool"), part("machine"), part("strategy"));
+    let (surface, tool, machine, strategy) = (
+        part("surface"),
+        part("tool"),
+        part("machine"),
+        part("strategy"),
+    );
     let mut errors = Vec::new();
     let at = |name: &str| {
         let f = value::field(&job.fields, name).expect("checked job part");
@@ -26,19 +31,30 @@ pub fn lower(job: &CheckedJob) -> Result<Job, Vec<Diagnostic>> {
 
     let unsupported = |what: &str, name: &str, detail: String| {
         let (file, span) = at(name);
-        Diagnostic::error(codes::UNSUPPORTED_COMBINATION, what.to_string(), file, span).with_label(detail)
+        Diagnostic::error(codes::UNSUPPORTED_COMBINATION, what.to_string(), file, span)
+            .with_label(detail)
     };
 
     if strategy.kind.name != "profile_turning" {
-        errors.push(unsupported("lensc cannot build this strategy yet", "strategy", format!("`{}`", strategy.kind.name)));
+        errors.push(unsupported(
+            "lensc cannot build this strategy yet",
+            "strategy",
+            format!("`{}`", strategy.kind.name),
+        ));
     }
     if machine.kind.name != "lathe" {
-        errors.push(
-            unsupported("profile turning needs a lathe", "machine", format!("this is a `{}`", machine.kind.name)),
-        );
+        errors.push(unsupported(
+            "profile turning needs a lathe",
+            "machine",
+            format!("this is a `{}`", machine.kind.name),
+        ));
     }
     if tool.kind.name != "round_nose" {
-        errors.push(unsupported("profile turning needs a round-nose tool", "tool", format!("this is a `{}`", tool.kind.name)));
+        errors.push(unsupported(
+            "profile turning needs a round-nose tool",
+            "tool",
+            format!("this is a `{}`", tool.kind.name),
+        ));
     }
     let surf = match rotational(surface) {
         Some(s) => Some(s),
@@ -67,7 +83,11 @@ pub fn lower(job: &CheckedJob) -> Result<Job, Vec<Diagnostic>> {
         errors.push(
             Diagnostic::error(
                 codes::OUTSIDE_APERTURE,
-                format!("the cut starts at r = {} mm, outside the aperture (radius {} mm)", trim_num(start), trim_num(surf.aperture_radius)),
+                format!(
+                    "the cut starts at r = {} mm, outside the aperture (radius {} mm)",
+                    trim_num(start),
+                    trim_num(surf.aperture_radius)
+                ),
                 fld.file,
                 fld.span,
             )
@@ -92,7 +112,9 @@ pub fn lower(job: &CheckedJob) -> Result<Job, Vec<Diagnostic>> {
     let travel = value::block(m, "travel").expect("required");
     let spindle = value::block(m, "spindle").expect("required");
     let lathe = Lathe {
-        dialect: value::word(m, "dialect").and_then(Dialect::from_name).expect("the schema admits only known dialects"),
+        dialect: value::word(m, "dialect")
+            .and_then(Dialect::from_name)
+            .expect("the schema admits only known dialects"),
         resolution: value::num(m, "resolution").expect("required"),
         travel_x: value::range(travel, "x").expect("required"),
         travel_z: value::range(travel, "z").expect("required"),
@@ -108,7 +130,12 @@ pub fn lower(job: &CheckedJob) -> Result<Job, Vec<Diagnostic>> {
     if !errors.is_empty() {
         return Err(errors);
     }
-    let name_of = |p: &str, o: &Object| job.part_names.get(p).cloned().unwrap_or_else(|| o.kind.name.to_string());
+    let name_of = |p: &str, o: &Object| {
+        job.part_names
+            .get(p)
+            .cloned()
+            .unwrap_or_else(|| o.kind.name.to_string())
+    };
     Ok(Job {
         name: job.name.name.clone(),
         surface_name: name_of("surface", surface),
@@ -129,11 +156,17 @@ fn rotational(o: &Object) -> Option<RotationalSurface> {
     }
     let f: &[Field] = &o.fields;
     let aperture_radius = aperture_radius(value::object(f, "aperture")?)?;
-    let terms = (1..=20u32).filter_map(|j| value::num(f, &format!("A{j}")).map(|a| (j, a))).collect();
+    let terms = (1..=20u32)
+        .filter_map(|j| value::num(f, &format!("A{j}")).map(|a| (j, a)))
+        .collect();
     Some(RotationalSurface {
         radius: value::num(f, "radius")?,
         conic: value::num(f, "conic").unwrap_or(0.0),
-        sense: if value::word(f, "sense")? == "convex" { Sense::Convex } else { Sense::Concave },
+        sense: if value::word(f, "sense")? == "convex" {
+            Sense::Convex
+        } else {
+            Sense::Concave
+        },
         terms,
         aperture_radius,
     })

@@ -12,7 +12,11 @@ use lensc::loader::{RealFs, plain_io_error};
 use lensc::render;
 
 #[derive(Parser)]
-#[command(name = "lensc", version, about = "Compile lens-machining jobs (.lens files) into machine programs")]
+#[command(
+    name = "lensc",
+    version,
+    about = "Compile lens-machining jobs (.lens files) into machine programs"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -65,7 +69,9 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     // Deep but valid input is bounded by the parser's nesting limit; a large
     // stack keeps the recursive checker far from the edge all the same.
-    let worker = std::thread::Builder::new().stack_size(256 << 20).spawn(move || run(cli));
+    let worker = std::thread::Builder::new()
+        .stack_size(256 << 20)
+        .spawn(move || run(cli));
     match worker.map(|h| h.join()) {
         Ok(Ok(code)) => ExitCode::from(code),
         _ => ExitCode::from(101),
@@ -76,9 +82,14 @@ fn run(cli: Cli) -> u8 {
     let color = match cli.color {
         ColorChoice::Always => true,
         ColorChoice::Never => false,
-        ColorChoice::Auto => std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none(),
+        ColorChoice::Auto => {
+            std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none()
+        }
     };
-    let out = Output { format: cli.message_format, color };
+    let out = Output {
+        format: cli.message_format,
+        color,
+    };
     match cli.command {
         Command::Check { files } => {
             let mut code = 0;
@@ -94,7 +105,12 @@ fn run(cli: Cli) -> u8 {
             }
             code
         }
-        Command::Build { file, job, dialect: _, out: dir } => {
+        Command::Build {
+            file,
+            job,
+            dialect: _,
+            out: dir,
+        } => {
             let Some(c) = load(&out, &file) else { return 1 };
             out.diagnostics(&c, c.diags());
             if c.has_errors() {
@@ -103,17 +119,36 @@ fn run(cli: Cli) -> u8 {
             if let Some(name) = &job
                 && !c.checked.jobs.iter().any(|j| &j.name.name == name)
             {
-                let names: Vec<&str> = c.checked.jobs.iter().map(|j| j.name.name.as_str()).collect();
-                eprintln!("error: {} has no job `{name}` (its jobs: {})", file.display(), if names.is_empty() { "none".into() } else { names.join(", ") });
+                let names: Vec<&str> = c
+                    .checked
+                    .jobs
+                    .iter()
+                    .map(|j| j.name.name.as_str())
+                    .collect();
+                eprintln!(
+                    "error: {} has no job `{name}` (its jobs: {})",
+                    file.display(),
+                    if names.is_empty() {
+                        "none".into()
+                    } else {
+                        names.join(", ")
+                    }
+                );
                 return 2;
             }
             if c.checked.jobs.is_empty() {
-                let d = lensc_grammar::Diagnostic::error(lensc::codes::NO_JOB, "this file has no job to build", lensc_grammar::FileId(0), lensc_grammar::Span::new(0, 0))
-                    .with_help("add `job NAME { surface: …, tool: …, machine: …, strategy: … }`");
+                let d = lensc_grammar::Diagnostic::error(
+                    lensc::codes::NO_JOB,
+                    "this file has no job to build",
+                    lensc_grammar::FileId(0),
+                    lensc_grammar::Span::new(0, 0),
+                )
+                .with_help("add `job NAME { surface: …, tool: …, machine: …, strategy: … }`");
                 out.diagnostics(&c, &[d]);
                 return 1;
             }
-            let (programs, diags) = driver::plan_and_emit(&c, job.as_deref(), &file.display().to_string());
+            let (programs, diags) =
+                driver::plan_and_emit(&c, job.as_deref(), &file.display().to_string());
             out.diagnostics(&c, &diags);
             if diags.iter().any(|d| d.is_error()) {
                 return 1;
@@ -121,7 +156,12 @@ fn run(cli: Cli) -> u8 {
             for (name, text, path) in programs {
                 let target = dir.join(&name);
                 if let Err(e) = driver::write_atomic(&target, &text) {
-                    eprintln!("error[{}]: cannot write {}: {}", lensc::codes::CANNOT_WRITE, target.display(), plain_io_error(&e));
+                    eprintln!(
+                        "error[{}]: cannot write {}: {}",
+                        lensc::codes::CANNOT_WRITE,
+                        target.display(),
+                        plain_io_error(&e)
+                    );
                     return 1;
                 }
                 eprintln!(
@@ -145,8 +185,15 @@ struct Output {
 impl Output {
     fn diagnostics(&self, c: &Checked, diags: &[lensc_grammar::Diagnostic]) {
         let result = match self.format {
-            MessageFormat::Human => render::human(diags, &c.loaded.sources, self.color, &mut std::io::stderr().lock()),
-            MessageFormat::Json => render::json_lines(diags, &c.loaded.sources, &mut std::io::stdout().lock()),
+            MessageFormat::Human => render::human(
+                diags,
+                &c.loaded.sources,
+                self.color,
+                &mut std::io::stderr().lock(),
+            ),
+            MessageFormat::Json => {
+                render::json_lines(diags, &c.loaded.sources, &mut std::io::stdout().lock())
+            }
         };
         // A closed pipe is no reason to fail the build.
         let _ = result;

@@ -11,8 +11,17 @@ use serde_json::json;
 use crate::source::SourceMap;
 
 /// Renders diagnostics as ariadne reports.
-pub fn human(diags: &[Diagnostic], sources: &SourceMap, color: bool, out: &mut dyn Write) -> std::io::Result<()> {
-    let mut cache = ariadne::sources(sources.iter().map(|(_, f)| (f.name.clone(), f.text.clone())));
+pub fn human(
+    diags: &[Diagnostic],
+    sources: &SourceMap,
+    color: bool,
+    out: &mut dyn Write,
+) -> std::io::Result<()> {
+    let mut cache = ariadne::sources(
+        sources
+            .iter()
+            .map(|(_, f)| (f.name.clone(), f.text.clone())),
+    );
     for d in diags {
         let p = d.primary();
         let name = |id| sources.get(id).name.clone();
@@ -26,7 +35,11 @@ pub fn human(diags: &[Diagnostic], sources: &SourceMap, color: bool, out: &mut d
             Severity::Warning => (ReportKind::Warning, Color::Yellow),
         };
         let mut r = Report::build(kind, (name(p.file), clamp(p.file, p.span)))
-            .with_config(Config::default().with_index_type(IndexType::Byte).with_color(color))
+            .with_config(
+                Config::default()
+                    .with_index_type(IndexType::Byte)
+                    .with_color(color),
+            )
             .with_code(d.code)
             .with_message(&d.message);
         for (i, l) in d.labels.iter().enumerate() {
@@ -48,7 +61,11 @@ pub fn human(diags: &[Diagnostic], sources: &SourceMap, color: bool, out: &mut d
 }
 
 /// One JSON object per diagnostic per line.
-pub fn json_lines(diags: &[Diagnostic], sources: &SourceMap, out: &mut dyn Write) -> std::io::Result<()> {
+pub fn json_lines(
+    diags: &[Diagnostic],
+    sources: &SourceMap,
+    out: &mut dyn Write,
+) -> std::io::Result<()> {
     for d in diags {
         writeln!(out, "{}", json_value(d, sources))?;
     }

@@ -51,7 +51,10 @@ pub enum Ty {
     /// `lo .. hi`, both of this dimension.
     Range(Dim),
     /// `name(coords) = expr` giving this dimension, over these coordinates.
-    Formula { coords: &'static [&'static str], result: Dim },
+    Formula {
+        coords: &'static [&'static str],
+        result: Dim,
+    },
 }
 
 /// Allowed values of a quantity, in base units.
@@ -74,10 +77,22 @@ pub struct Param {
 }
 
 const fn req(name: &'static str, ty: Ty, check: Check, doc: &'static str) -> Param {
-    Param { name, ty, required: true, check, doc }
+    Param {
+        name,
+        ty,
+        required: true,
+        check,
+        doc,
+    }
 }
 const fn opt(name: &'static str, ty: Ty, check: Check, doc: &'static str) -> Param {
-    Param { name, ty, required: false, check, doc }
+    Param {
+        name,
+        ty,
+        required: false,
+        check,
+        doc,
+    }
 }
 
 pub const LENGTH: Ty = Ty::Quantity(&[Dim::LENGTH]);
@@ -103,10 +118,30 @@ impl Kind {
     }
 }
 
-const SENSE: Param = req("sense", Ty::Word(&["convex", "concave"]), Check::Any, "which side is material: convex (a dome) or concave (a bowl)");
-const APERTURE: Param = req("aperture", Ty::Object(Category::Aperture), Check::Any, "the region to machine");
-const VERTEX_RADIUS: Param = req("radius", LENGTH, Check::Positive, "vertex radius of curvature (magnitude; `sense` gives the side)");
-const CONIC_CONSTANT: Param = opt("conic", NUMBER, Check::Any, "conic constant k (0 sphere, -1 paraboloid); default 0");
+const SENSE: Param = req(
+    "sense",
+    Ty::Word(&["convex", "concave"]),
+    Check::Any,
+    "which side is material: convex (a dome) or concave (a bowl)",
+);
+const APERTURE: Param = req(
+    "aperture",
+    Ty::Object(Category::Aperture),
+    Check::Any,
+    "the region to machine",
+);
+const VERTEX_RADIUS: Param = req(
+    "radius",
+    LENGTH,
+    Check::Positive,
+    "vertex radius of curvature (magnitude; `sense` gives the side)",
+);
+const CONIC_CONSTANT: Param = opt(
+    "conic",
+    NUMBER,
+    Check::Any,
+    "conic constant k (0 sphere, -1 paraboloid); default 0",
+);
 
 macro_rules! coefficients {
     ($($name:literal = $p:literal),* $(,)?) => {
@@ -136,9 +171,26 @@ pub static KINDS: &[Kind] = &[
         name: "asphere",
         category: Category::Surface,
         params: coefficients!(
-            "A1" = 1, "A2" = 2, "A3" = 3, "A4" = 4, "A5" = 5, "A6" = 6, "A7" = 7, "A8" = 8, "A9" = 9, "A10" = 10,
-            "A11" = 11, "A12" = 12, "A13" = 13, "A14" = 14, "A15" = 15, "A16" = 16, "A17" = 17, "A18" = 18,
-            "A19" = 19, "A20" = 20
+            "A1" = 1,
+            "A2" = 2,
+            "A3" = 3,
+            "A4" = 4,
+            "A5" = 5,
+            "A6" = 6,
+            "A7" = 7,
+            "A8" = 8,
+            "A9" = 9,
+            "A10" = 10,
+            "A11" = 11,
+            "A12" = 12,
+            "A13" = 13,
+            "A14" = 14,
+            "A15" = 15,
+            "A16" = 16,
+            "A17" = 17,
+            "A18" = 18,
+            "A19" = 19,
+            "A20" = 20
         ),
         positional: &[],
         exclusive: &[],
@@ -148,9 +200,27 @@ pub static KINDS: &[Kind] = &[
         name: "freeform",
         category: Category::Surface,
         params: &[
-            req("z", Ty::Formula { coords: &["x", "y"], result: Dim::LENGTH }, Check::Any, "the height z(x, y), a length"),
-            req("domain", Ty::Object(Category::Aperture), Check::Any, "where the formula applies"),
-            opt("sense", Ty::Word(&["convex", "concave"]), Check::Any, "material side; the formula's z is already signed"),
+            req(
+                "z",
+                Ty::Formula {
+                    coords: &["x", "y"],
+                    result: Dim::LENGTH,
+                },
+                Check::Any,
+                "the height z(x, y), a length",
+            ),
+            req(
+                "domain",
+                Ty::Object(Category::Aperture),
+                Check::Any,
+                "where the formula applies",
+            ),
+            opt(
+                "sense",
+                Ty::Word(&["convex", "concave"]),
+                Check::Any,
+                "material side; the formula's z is already signed",
+            ),
         ],
         positional: &[],
         exclusive: &[],
@@ -182,10 +252,30 @@ pub static KINDS: &[Kind] = &[
         name: "round_nose",
         category: Category::Tool,
         params: &[
-            req("nose_radius", LENGTH, Check::Positive, "radius of the cutting edge's nose"),
-            req("clearance", ANGLE, Check::HalfOpen(0.0, DEG90), "clearance angle of the flank"),
-            opt("rake", ANGLE, Check::HalfOpen(-DEG90, DEG90), "rake angle; default 0°"),
-            opt("included_angle", ANGLE, Check::HalfOpen(0.0, std::f64::consts::PI), "opening angle of the cutting edge"),
+            req(
+                "nose_radius",
+                LENGTH,
+                Check::Positive,
+                "radius of the cutting edge's nose",
+            ),
+            req(
+                "clearance",
+                ANGLE,
+                Check::HalfOpen(0.0, DEG90),
+                "clearance angle of the flank",
+            ),
+            opt(
+                "rake",
+                ANGLE,
+                Check::HalfOpen(-DEG90, DEG90),
+                "rake angle; default 0°",
+            ),
+            opt(
+                "included_angle",
+                ANGLE,
+                Check::HalfOpen(0.0, std::f64::consts::PI),
+                "opening angle of the cutting edge",
+            ),
         ],
         positional: &[],
         exclusive: &[],
@@ -195,16 +285,44 @@ pub static KINDS: &[Kind] = &[
         name: "lathe",
         category: Category::Machine,
         params: &[
-            req("dialect", Ty::Word(&["linuxcnc"]), Check::Any, "the controller's program dialect"),
-            req("resolution", LENGTH, Check::Positive, "smallest programmable step"),
-            req("travel", Ty::Block(&[
-                req("x", Ty::Range(Dim::LENGTH), Check::Any, "X (radius) travel"),
-                req("z", Ty::Range(Dim::LENGTH), Check::Any, "Z travel"),
-            ]), Check::Any, "axis travel"),
-            req("max_feed", Ty::Quantity(&[Dim::SPEED]), Check::Positive, "fastest cutting feed"),
-            req("spindle", Ty::Block(&[
-                req("max_speed", Ty::Quantity(&[Dim::ROTATIONAL_SPEED]), Check::Positive, "spindle speed limit"),
-            ]), Check::Any, "the work spindle"),
+            req(
+                "dialect",
+                Ty::Word(&["linuxcnc"]),
+                Check::Any,
+                "the controller's program dialect",
+            ),
+            req(
+                "resolution",
+                LENGTH,
+                Check::Positive,
+                "smallest programmable step",
+            ),
+            req(
+                "travel",
+                Ty::Block(&[
+                    req("x", Ty::Range(Dim::LENGTH), Check::Any, "X (radius) travel"),
+                    req("z", Ty::Range(Dim::LENGTH), Check::Any, "Z travel"),
+                ]),
+                Check::Any,
+                "axis travel",
+            ),
+            req(
+                "max_feed",
+                Ty::Quantity(&[Dim::SPEED]),
+                Check::Positive,
+                "fastest cutting feed",
+            ),
+            req(
+                "spindle",
+                Ty::Block(&[req(
+                    "max_speed",
+                    Ty::Quantity(&[Dim::ROTATIONAL_SPEED]),
+                    Check::Positive,
+                    "spindle speed limit",
+                )]),
+                Check::Any,
+                "the work spindle",
+            ),
         ],
         positional: &[],
         exclusive: &[],
@@ -214,12 +332,42 @@ pub static KINDS: &[Kind] = &[
         name: "profile_turning",
         category: Category::Strategy,
         params: &[
-            req("feed", Ty::Quantity(&[Dim::FEED_PER_REV, Dim::SPEED]), Check::Positive, "feed per revolution or feed speed"),
-            req("spindle_speed", Ty::Quantity(&[Dim::ROTATIONAL_SPEED]), Check::Positive, "constant spindle speed"),
-            opt("chord_tolerance", LENGTH, Check::Positive, "largest chord deviation from the exact tool-centre path; default 10 nm"),
-            opt("from", LENGTH, Check::NonNegative, "radius where the cut starts; default the aperture edge"),
-            opt("to", LENGTH, Check::NonNegative, "radius where the cut ends; default 0"),
-            opt("retract", LENGTH, Check::Positive, "clearance above the part for rapid moves; default 1 mm"),
+            req(
+                "feed",
+                Ty::Quantity(&[Dim::FEED_PER_REV, Dim::SPEED]),
+                Check::Positive,
+                "feed per revolution or feed speed",
+            ),
+            req(
+                "spindle_speed",
+                Ty::Quantity(&[Dim::ROTATIONAL_SPEED]),
+                Check::Positive,
+                "constant spindle speed",
+            ),
+            opt(
+                "chord_tolerance",
+                LENGTH,
+                Check::Positive,
+                "largest chord deviation from the exact tool-centre path; default 10 nm",
+            ),
+            opt(
+                "from",
+                LENGTH,
+                Check::NonNegative,
+                "radius where the cut starts; default the aperture edge",
+            ),
+            opt(
+                "to",
+                LENGTH,
+                Check::NonNegative,
+                "radius where the cut ends; default 0",
+            ),
+            opt(
+                "retract",
+                LENGTH,
+                Check::Positive,
+                "clearance above the part for rapid moves; default 1 mm",
+            ),
         ],
         positional: &[],
         exclusive: &[],
@@ -229,10 +377,30 @@ pub static KINDS: &[Kind] = &[
 
 /// The parameters of a job block.
 pub static JOB_PARAMS: &[Param] = &[
-    req("surface", Ty::Object(Category::Surface), Check::Any, "the surface to make"),
-    req("tool", Ty::Object(Category::Tool), Check::Any, "the tool that cuts it"),
-    req("machine", Ty::Object(Category::Machine), Check::Any, "the machine that moves the tool"),
-    req("strategy", Ty::Object(Category::Strategy), Check::Any, "how the path is planned"),
+    req(
+        "surface",
+        Ty::Object(Category::Surface),
+        Check::Any,
+        "the surface to make",
+    ),
+    req(
+        "tool",
+        Ty::Object(Category::Tool),
+        Check::Any,
+        "the tool that cuts it",
+    ),
+    req(
+        "machine",
+        Ty::Object(Category::Machine),
+        Check::Any,
+        "the machine that moves the tool",
+    ),
+    req(
+        "strategy",
+        Ty::Object(Category::Strategy),
+        Check::Any,
+        "how the path is planned",
+    ),
 ];
 
 pub fn kind(name: &str) -> Option<&'static Kind> {

@@ -27,13 +27,11 @@ impl Dim {
     pub const ACCELERATION: Dim = Dim::new(1, 0, -2);
 
     pub const fn new(length: i8, angle: i8, time: i8) -> Dim {
-        Dim { length, angle, time }
-    }
-    pub fn mul(self, o: Dim) -> Dim {
-        Dim::new(self.length + o.length, self.angle + o.angle, self.time + o.time)
-    }
-    pub fn div(self, o: Dim) -> Dim {
-        Dim::new(self.length - o.length, self.angle - o.angle, self.time - o.time)
+        Dim {
+            length,
+            angle,
+            time,
+        }
     }
     /// `self^p`, or `None` if a power leaves the i8 range.
     pub fn pow(self, p: i32) -> Option<Dim> {
@@ -69,15 +67,29 @@ impl Dim {
         let mut num = Vec::new();
         let mut den = Vec::new();
         for (sym, e) in [("mm", self.length), ("rad", self.angle), ("s", self.time)] {
-            let part = |p: i8| if p == 1 { sym.to_string() } else { format!("{sym}^{p}") };
+            let part = |p: i8| {
+                if p == 1 {
+                    sym.to_string()
+                } else {
+                    format!("{sym}^{p}")
+                }
+            };
             if e > 0 {
                 num.push(part(e));
             } else if e < 0 {
                 den.push(part(-e));
             }
         }
-        let n = if num.is_empty() { "1".to_string() } else { num.join("·") };
-        if den.is_empty() { n } else { format!("{n}/{}", den.join("·")) }
+        let n = if num.is_empty() {
+            "1".to_string()
+        } else {
+            num.join("·")
+        };
+        if den.is_empty() {
+            n
+        } else {
+            format!("{n}/{}", den.join("·"))
+        }
     }
 }
 
@@ -97,6 +109,28 @@ impl fmt::Display for Dim {
             _ => return write!(f, "a quantity in {}", self.base_units()),
         };
         f.write_str(name)
+    }
+}
+
+impl std::ops::Mul for Dim {
+    type Output = Dim;
+    fn mul(self, o: Dim) -> Dim {
+        Dim::new(
+            self.length + o.length,
+            self.angle + o.angle,
+            self.time + o.time,
+        )
+    }
+}
+
+impl std::ops::Div for Dim {
+    type Output = Dim;
+    fn div(self, o: Dim) -> Dim {
+        Dim::new(
+            self.length - o.length,
+            self.angle - o.angle,
+            self.time - o.time,
+        )
     }
 }
 

@@ -10,11 +10,17 @@ pub struct Span {
 
 impl Span {
     pub fn new(start: usize, end: usize) -> Span {
-        Span { start: start as u32, end: end as u32 }
+        Span {
+            start: start as u32,
+            end: end as u32,
+        }
     }
     /// The smallest span covering both.
     pub fn to(self, other: Span) -> Span {
-        Span { start: self.start.min(other.start), end: self.end.max(other.end) }
+        Span {
+            start: self.start.min(other.start),
+            end: self.end.max(other.end),
+        }
     }
     pub fn range(self) -> std::ops::Range<usize> {
         self.start as usize..self.end as usize
@@ -46,7 +52,11 @@ pub enum ItemKind {
     /// `let name = expr`
     Let { name: Ident, value: Expr },
     /// `surface name = expr` (and tool, machine, strategy)
-    Decl { kind: DeclKind, name: Ident, value: Expr },
+    Decl {
+        kind: DeclKind,
+        name: Ident,
+        value: Expr,
+    },
     /// `job name { ... }`
     Job { name: Ident, body: Block },
 }
@@ -87,14 +97,30 @@ pub struct Expr {
 #[derive(Clone, Debug, PartialEq)]
 pub enum ExprKind {
     /// A number with the unit written after it, if any: `85 um`.
-    Quantity { value: f64, unit: Option<Unit> },
+    Quantity {
+        value: f64,
+        unit: Option<Unit>,
+    },
     Str(String),
     Name(String),
-    Unary { op: UnaryOp, operand: Box<Expr> },
-    Binary { op: BinaryOp, lhs: Box<Expr>, rhs: Box<Expr> },
-    Call { callee: Box<Expr>, args: Vec<Arg> },
+    Unary {
+        op: UnaryOp,
+        operand: Box<Expr>,
+    },
+    Binary {
+        op: BinaryOp,
+        lhs: Box<Expr>,
+        rhs: Box<Expr>,
+    },
+    Call {
+        callee: Box<Expr>,
+        args: Vec<Arg>,
+    },
     /// `base { entries }`: a constructor or a copy of `base` with entries replaced.
-    WithBlock { base: Box<Expr>, block: Block },
+    WithBlock {
+        base: Box<Expr>,
+        block: Block,
+    },
     Block(Block),
     List(Vec<Expr>),
     /// Stands where the parser refused a node (e.g. nesting too deep); an
@@ -155,7 +181,11 @@ pub enum Entry {
     /// `name: expr`
     Param { name: Ident, value: Expr },
     /// `z(x, y) = expr`
-    Formula { name: Ident, params: Vec<Ident>, body: Expr },
+    Formula {
+        name: Ident,
+        params: Vec<Ident>,
+        body: Expr,
+    },
 }
 
 impl Entry {

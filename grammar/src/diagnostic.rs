@@ -46,12 +46,24 @@ impl Diagnostic {
             severity: Severity::Error,
             code,
             message: message.into(),
-            labels: vec![Label { file, span, message: String::new() }],
+            labels: vec![Label {
+                file,
+                span,
+                message: String::new(),
+            }],
             help: None,
         }
     }
-    pub fn warning(code: &'static str, message: impl Into<String>, file: FileId, span: Span) -> Self {
-        Diagnostic { severity: Severity::Warning, ..Diagnostic::error(code, message, file, span) }
+    pub fn warning(
+        code: &'static str,
+        message: impl Into<String>,
+        file: FileId,
+        span: Span,
+    ) -> Self {
+        Diagnostic {
+            severity: Severity::Warning,
+            ..Diagnostic::error(code, message, file, span)
+        }
     }
     /// Sets the primary label's text.
     pub fn with_label(mut self, text: impl Into<String>) -> Self {
@@ -60,7 +72,11 @@ impl Diagnostic {
     }
     /// Adds a secondary label.
     pub fn with_note(mut self, file: FileId, span: Span, text: impl Into<String>) -> Self {
-        self.labels.push(Label { file, span, message: text.into() });
+        self.labels.push(Label {
+            file,
+            span,
+            message: text.into(),
+        });
         self
     }
     pub fn with_help(mut self, help: impl Into<String>) -> Self {

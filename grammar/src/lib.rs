@@ -2,6 +2,11 @@
 //! node carries a byte span, and diagnostics as plain data. It knows nothing
 //! about machining.
 
+// pest is built without its `std` feature (whose per-rule stack probe cost a
+// third of parse time; `parser::scan` bounds nesting instead), and its
+// derive then names `alloc` directly.
+extern crate alloc;
+
 pub mod ast;
 pub mod diagnostic;
 pub mod parser;

@@ -28,7 +28,10 @@ fn depth(e: &Expr) -> u32 {
     1 + match &e.kind {
         ExprKind::Unary { operand, .. } => depth(operand),
         ExprKind::Binary { lhs, rhs, .. } => depth(lhs).max(depth(rhs)),
-        ExprKind::Call { callee, args } => args.iter().map(|a| depth(&a.value)).fold(depth(callee), u32::max),
+        ExprKind::Call { callee, args } => args
+            .iter()
+            .map(|a| depth(&a.value))
+            .fold(depth(callee), u32::max),
         ExprKind::WithBlock { base, block } => block_depth(block).max(depth(base)),
         ExprKind::Block(b) => block_depth(b),
         ExprKind::List(items) => items.iter().map(depth).max().unwrap_or(0),
@@ -65,15 +68,29 @@ static PRATT: LazyLock<PrattParser<Rule>> = LazyLock::new(|| {
 pub fn parse(source: &str, file: FileId) -> (File, Vec<Diagnostic>) {
     let mut diags = Vec::new();
     if source.len() > u32::MAX as usize / 2 {
-        diags.push(Diagnostic::error(codes::TOO_LARGE, "file is too large (over 2 GiB)", file, Span::new(0, 0)));
+        diags.push(Diagnostic::error(
+            codes::TOO_LARGE,
+            "file is too large (over 2 GiB)",
+            file,
+            Span::new(0, 0),
+        ));
         return (File::default(), diags);
     }
     let scan = scan(source);
     if let Some(at) = scan.too_deep_at {
         let (message, label) = match scan.why {
-            TooDeep::Brackets => (format!("brackets are nested more than {MAX_NESTING} deep"), "this bracket is too deep"),
-            TooDeep::OperatorRun => (format!("more than {MAX_OPERATOR_RUN} operators in a row"), "one operator too many"),
-            TooDeep::Powers => (format!("more than {MAX_POWERS_PER_ITEM} powers `^` in one item"), "one power too many"),
+            TooDeep::Brackets => (
+                format!("brackets are nested more than {MAX_NESTING} deep"),
+                "this bracket is too deep",
+            ),
+            TooDeep::OperatorRun => (
+                format!("more than {MAX_OPERATOR_RUN} operators in a row"),
+                "one operator too many",
+            ),
+            TooDeep::Powers => (
+                format!("more than {MAX_POWERS_PER_ITEM} powers `^` in one item"),
+                "one power too many",
+            ),
         };
         diags.push(
             Diagnostic::error(codes::TOO_DEEP, message, file, Span::new(at, at + 1))
@@ -88,7 +105,11 @@ pub fn parse(source: &str, file: FileId) -> (File, Vec<Diagnostic>) {
         if text.trim().is_empty() {
             continue;
         }
-        let mut b = Builder { file, offset: start, diags: &mut diags };
+        let mut b = Builder {
+            file,
+            offset: start,
+            diags: &mut diags,
+        };
         match LensParser::parse(Rule::file, text) {
             Ok(mut pairs) => {
                 let file_pair = pairs.next().expect("file rule");
@@ -132,11 +153,21 @@ fn scan(src: &str) -> Scan {
     while i < b.len() {
         let c = b[i];
         match c {
-            b'-' | b'+' | b'*' | b'/' | b'^' if !(c == b'/' && matches!(b.get(i + 1), Some(b'/' | b'*'))) => {
+            b'-' | b'+' | b'*' | b'/' | b'^'
+                if !(c == b'/' && matches!(b.get(i + 1), Some(b'/' | b'*'))) =>
+            {
                 op_run += 1;
                 powers += usize::from(c == b'^');
                 if op_run > MAX_OPERATOR_RUN || powers > MAX_POWERS_PER_ITEM {
-                    return Scan { chunks: vec![], too_deep_at: Some(i), why: if op_run > MAX_OPERATOR_RUN { TooDeep::OperatorRun } else { TooDeep::Powers } };
+                    return Scan {
+                        chunks: vec![],
+                        too_deep_at: Some(i),
+                        why: if op_run > MAX_OPERATOR_RUN {
+                            TooDeep::OperatorRun
+                        } else {
+                            TooDeep::Powers
+                        },
+                    };
                 }
             }
             b' ' | b'\t' | b'\r' | b'\n' => {}
@@ -171,14 +202,23 @@ fn scan(src: &str) -> Scan {
             b'(' | b'[' | b'{' => {
                 depth += 1;
                 if depth > MAX_NESTING {
-                    return Scan { chunks: vec![], too_deep_at: Some(i), why: TooDeep::Brackets };
+                    return Scan {
+                        chunks: vec![],
+                        too_deep_at: Some(i),
+                        why: TooDeep::Brackets,
+                    };
                 }
             }
             b')' | b']' | b'}' => depth = depth.saturating_sub(1),
             _ => {}
         }
         let is_word = c.is_ascii_alphanumeric() || c == b'_';
-        if is_word && at_word_start && i > 0 && starts_item(&src[i..]) && preceded_by_line_start(b, i) {
+        if is_word
+            && at_word_start
+            && i > 0
+            && starts_item(&src[i..])
+            && preceded_by_line_start(b, i)
+        {
             // Also inside an unclosed bracket: an item keyword at the start of
             // a line followed by a name cannot continue the previous item,
             // so a missing `)` or `}` does not swallow the rest of the file.
@@ -193,17 +233,27 @@ fn scan(src: &str) -> Scan {
         let e = starts.get(k + 1).copied().unwrap_or(src.len());
         chunks.push((s, e));
     }
-    Scan { chunks, too_deep_at: None, why: TooDeep::Brackets }
+    Scan {
+        chunks,
+        too_deep_at: None,
+        why: TooDeep::Brackets,
+    }
 }
 
 /// `surface name`, `let name`, `use "…"`, `use std…`: an item keyword followed
 /// by a name or string, not a parameter such as `surface: s`.
 fn starts_item(rest: &str) -> bool {
-    ["use", "let", "job", "surface", "tool", "machine", "strategy"].iter().any(|k| {
+    [
+        "use", "let", "job", "surface", "tool", "machine", "strategy",
+    ]
+    .iter()
+    .any(|k| {
         rest.starts_with(k) && {
             let after = &rest[k.len()..];
             let trimmed = after.trim_start_matches([' ', '\t']);
-            trimmed.len() < after.len() && trimmed.starts_with(|ch: char| ch.is_ascii_alphabetic() || ch == '_' || ch == '"')
+            trimmed.len() < after.len()
+                && trimmed
+                    .starts_with(|ch: char| ch.is_ascii_alphabetic() || ch == '_' || ch == '"')
         }
     })
 }
@@ -235,7 +285,10 @@ impl Builder<'_> {
     }
 
     fn ident(&self, p: Pair<Rule>) -> Ident {
-        Ident { span: self.span(&p), name: p.as_str().to_string() }
+        Ident {
+            span: self.span(&p),
+            name: p.as_str().to_string(),
+        }
     }
 
     fn item(&mut self, p: Pair<Rule>) -> Item {
@@ -249,9 +302,14 @@ impl Builder<'_> {
                 match target.as_rule() {
                     Rule::string => {
                         let span = self.span(&target);
-                        ItemKind::Use(UseTarget::File { path: self.string(target), span })
+                        ItemKind::Use(UseTarget::File {
+                            path: self.string(target),
+                            span,
+                        })
                     }
-                    _ => ItemKind::Use(UseTarget::Std(target.into_inner().map(|s| self.ident(s)).collect())),
+                    _ => ItemKind::Use(UseTarget::Std(
+                        target.into_inner().map(|s| self.ident(s)).collect(),
+                    )),
                 }
             }
             Rule::let_item => {
@@ -299,7 +357,13 @@ impl Builder<'_> {
             })
             .map_prefix(|op, (rhs, d)| {
                 let span = me.borrow().span(&op).to(rhs.span);
-                let e = Expr { kind: ExprKind::Unary { op: UnaryOp::Neg, operand: Box::new(rhs) }, span };
+                let e = Expr {
+                    kind: ExprKind::Unary {
+                        op: UnaryOp::Neg,
+                        operand: Box::new(rhs),
+                    },
+                    span,
+                };
                 me.borrow_mut().limit_depth(e, d + 1)
             })
             .map_infix(|(lhs, dl), op, (rhs, dr)| {
@@ -312,7 +376,14 @@ impl Builder<'_> {
                     _ => BinaryOp::Range,
                 };
                 let span = lhs.span.to(rhs.span);
-                let e = Expr { kind: ExprKind::Binary { op, lhs: Box::new(lhs), rhs: Box::new(rhs) }, span };
+                let e = Expr {
+                    kind: ExprKind::Binary {
+                        op,
+                        lhs: Box::new(lhs),
+                        rhs: Box::new(rhs),
+                    },
+                    span,
+                };
                 me.borrow_mut().limit_depth(e, dl.max(dr) + 1)
             })
             .parse(pairs);
@@ -324,12 +395,27 @@ impl Builder<'_> {
     fn limit_depth(&mut self, e: Expr, d: u32) -> (Expr, u32) {
         if d == MAX_EXPR_DEPTH + 1 {
             self.diags.push(
-                Diagnostic::error(codes::TOO_DEEP, format!("this expression is nested more than {MAX_EXPR_DEPTH} operations deep"), self.file, e.span)
-                    .with_label("too deep")
-                    .with_help("split the expression with `let` constants"),
+                Diagnostic::error(
+                    codes::TOO_DEEP,
+                    format!("this expression is nested more than {MAX_EXPR_DEPTH} operations deep"),
+                    self.file,
+                    e.span,
+                )
+                .with_label("too deep")
+                .with_help("split the expression with `let` constants"),
             );
         }
-        if d > MAX_EXPR_DEPTH { (Expr { kind: ExprKind::Invalid, span: e.span }, d) } else { (e, d) }
+        if d > MAX_EXPR_DEPTH {
+            (
+                Expr {
+                    kind: ExprKind::Invalid,
+                    span: e.span,
+                },
+                d,
+            )
+        } else {
+            (e, d)
+        }
     }
 
     fn operand(&mut self, p: Pair<Rule>) -> Expr {
@@ -341,11 +427,23 @@ impl Builder<'_> {
             e = match post.as_rule() {
                 Rule::call_args => {
                     let args = post.into_inner().map(|a| self.arg(a)).collect();
-                    Expr { kind: ExprKind::Call { callee: Box::new(e), args }, span }
+                    Expr {
+                        kind: ExprKind::Call {
+                            callee: Box::new(e),
+                            args,
+                        },
+                        span,
+                    }
                 }
                 _ => {
                     let block = self.block(post);
-                    Expr { kind: ExprKind::WithBlock { base: Box::new(e), block }, span }
+                    Expr {
+                        kind: ExprKind::WithBlock {
+                            base: Box::new(e),
+                            block,
+                        },
+                        span,
+                    }
                 }
             };
             d += 1;
@@ -369,7 +467,10 @@ impl Builder<'_> {
             Rule::ident => ExprKind::Name(p.as_str().to_string()),
             Rule::paren => {
                 let inner = self.expr(p.into_inner().next().expect("paren expr"));
-                return Expr { kind: inner.kind, span };
+                return Expr {
+                    kind: inner.kind,
+                    span,
+                };
             }
             Rule::list => ExprKind::List(p.into_inner().map(|e| self.expr(e)).collect()),
             _ => ExprKind::Block(self.block(p)),
@@ -384,9 +485,14 @@ impl Builder<'_> {
         let value: f64 = num.as_str().parse().unwrap_or(f64::INFINITY);
         if !value.is_finite() {
             self.diags.push(
-                Diagnostic::error(codes::BAD_NUMBER, "number is too large", self.file, self.span(&num))
-                    .with_label("this does not fit in a 64-bit float")
-                    .with_help("write it in a larger unit, or check for a typo in the exponent"),
+                Diagnostic::error(
+                    codes::BAD_NUMBER,
+                    "number is too large",
+                    self.file,
+                    self.span(&num),
+                )
+                .with_label("this does not fit in a 64-bit float")
+                .with_help("write it in a larger unit, or check for a typo in the exponent"),
             );
         }
         let unit = inner.next().map(|u| {
@@ -396,23 +502,38 @@ impl Builder<'_> {
                 let pspan = self.span(&part);
                 let mut pi = part.into_inner();
                 let name = pi.next().expect("unit name").as_str().to_string();
-                let mut power: i32 = pi.next().map(|x| x.as_str().parse().unwrap_or(1)).unwrap_or(1);
+                let mut power: i32 = pi
+                    .next()
+                    .map(|x| x.as_str().parse().unwrap_or(1))
+                    .unwrap_or(1);
                 if power == 0 {
                     self.diags.push(
-                        Diagnostic::error(codes::BAD_UNIT_POWER, "a unit to the power zero", self.file, pspan)
-                            .with_label("remove this unit or give it a non-zero power"),
+                        Diagnostic::error(
+                            codes::BAD_UNIT_POWER,
+                            "a unit to the power zero",
+                            self.file,
+                            pspan,
+                        )
+                        .with_label("remove this unit or give it a non-zero power"),
                     );
                     power = 1;
                 }
                 if k > 0 {
                     power = -power;
                 }
-                parts.push(UnitPart { name, power, span: pspan });
+                parts.push(UnitPart {
+                    name,
+                    power,
+                    span: pspan,
+                });
             }
             Unit { parts, span: uspan }
         });
         let value = if value.is_finite() { value } else { 0.0 };
-        Expr { kind: ExprKind::Quantity { value, unit }, span }
+        Expr {
+            kind: ExprKind::Quantity { value, unit },
+            span,
+        }
     }
 
     fn string(&mut self, p: Pair<Rule>) -> String {
@@ -434,9 +555,14 @@ impl Builder<'_> {
                 Some((j, other)) => {
                     let span = Span::new(start + i, start + j + other.len_utf8());
                     self.diags.push(
-                        Diagnostic::error(codes::BAD_ESCAPE, format!("unknown escape `\\{other}` in a string"), self.file, span)
-                            .with_label("not an escape")
-                            .with_help("the escapes are \\\" \\\\ \\n \\t"),
+                        Diagnostic::error(
+                            codes::BAD_ESCAPE,
+                            format!("unknown escape `\\{other}` in a string"),
+                            self.file,
+                            span,
+                        )
+                        .with_label("not an escape")
+                        .with_help("the escapes are \\\" \\\\ \\n \\t"),
                     );
                 }
                 None => {}
@@ -457,7 +583,11 @@ impl Builder<'_> {
             let name = names.next().expect("entry name");
             entries.push(match rule {
                 Rule::param_entry => Entry::Param { name, value },
-                _ => Entry::Formula { name, params: names.collect(), body: value },
+                _ => Entry::Formula {
+                    name,
+                    params: names.collect(),
+                    body: value,
+                },
             });
         }
         Block { entries, span }
@@ -475,7 +605,8 @@ impl Builder<'_> {
         let found = describe_found(source, self.offset + at);
         let (message, expected) = match &e.variant {
             ErrorVariant::ParsingError { positives, .. } => {
-                let mut words: Vec<&str> = positives.iter().filter_map(|r| describe_rule(*r)).collect();
+                let mut words: Vec<&str> =
+                    positives.iter().filter_map(|r| describe_rule(*r)).collect();
                 words.sort_unstable();
                 words.dedup();
                 let expected = match words.len() {
@@ -512,7 +643,9 @@ fn describe_rule(r: Rule) -> Option<&'static str> {
         Rule::EOI => "end of file",
         Rule::use_item | Rule::kw_use => "`use`",
         Rule::let_item | Rule::kw_let => "`let`",
-        Rule::decl_item | Rule::decl_kind => "a declaration (`surface`, `tool`, `machine`, `strategy`)",
+        Rule::decl_item | Rule::decl_kind => {
+            "a declaration (`surface`, `tool`, `machine`, `strategy`)"
+        }
         Rule::job_item | Rule::kw_job => "`job`",
         Rule::std_path => "a module path like `std::tools`",
         Rule::ident => "a name",
@@ -540,7 +673,11 @@ fn found_len(text: &str, at: usize) -> usize {
         .take_while(|(_, c)| c.is_alphanumeric() || *c == '_')
         .map(|(_, c)| c.len_utf8())
         .sum();
-    if word > 0 { word } else { rest.chars().next().map_or(0, char::len_utf8) }
+    if word > 0 {
+        word
+    } else {
+        rest.chars().next().map_or(0, char::len_utf8)
+    }
 }
 
 fn describe_found(text: &str, at: usize) -> String {
@@ -557,7 +694,9 @@ fn describe_found(text: &str, at: usize) -> String {
 fn syntax_hint(text: &str, at: usize) -> Option<String> {
     let rest = &text[at..];
     let word = &rest[..found_len(text, at)];
-    let keywords = ["use", "let", "job", "surface", "tool", "machine", "strategy"];
+    let keywords = [
+        "use", "let", "job", "surface", "tool", "machine", "strategy",
+    ];
     if let Some(k) = crate::suggest::did_you_mean(word, keywords) {
         return Some(format!("did you mean `{k}`?"));
     }
@@ -571,8 +710,10 @@ fn syntax_hint(text: &str, at: usize) -> Option<String> {
         return Some("lines need no `;`; separate parameters with new lines or commas".into());
     }
     if rest.is_empty() {
-        let opens = text.matches('{').count() + text.matches('(').count() + text.matches('[').count();
-        let closes = text.matches('}').count() + text.matches(')').count() + text.matches(']').count();
+        let opens =
+            text.matches('{').count() + text.matches('(').count() + text.matches('[').count();
+        let closes =
+            text.matches('}').count() + text.matches(')').count() + text.matches(']').count();
         if opens > closes {
             return Some("a bracket is not closed".into());
         }

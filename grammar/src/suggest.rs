@@ -1,7 +1,10 @@
 //! "Did you mean" suggestions by edit distance.
 
 /// The candidate closest to `word`, if it is close enough to be a likely typo.
-pub fn did_you_mean<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+pub fn did_you_mean<'a>(
+    word: &str,
+    candidates: impl IntoIterator<Item = &'a str>,
+) -> Option<&'a str> {
     let n = word.chars().count();
     // One- and two-letter names are too short for a guess to mean anything.
     let limit = if n < 3 { 0 } else { (n / 3).max(1) };
@@ -30,7 +33,9 @@ fn distance(a: &str, b: &str) -> usize {
     for i in 1..=a.len() {
         for j in 1..=b.len() {
             let cost = usize::from(a[i - 1] != b[j - 1]);
-            let mut v = (d[(i - 1) * w + j] + 1).min(d[i * w + j - 1] + 1).min(d[(i - 1) * w + j - 1] + cost);
+            let mut v = (d[(i - 1) * w + j] + 1)
+                .min(d[i * w + j - 1] + 1)
+                .min(d[(i - 1) * w + j - 1] + cost);
             if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
                 v = v.min(d[(i - 2) * w + j - 2] + 1);
             }
@@ -47,7 +52,10 @@ mod tests {
     #[test]
     fn suggests_close_names_only() {
         assert_eq!(did_you_mean("radus", ["radius", "conic"]), Some("radius"));
-        assert_eq!(did_you_mean("nose_radus", ["nose_radius", "clearance"]), Some("nose_radius"));
+        assert_eq!(
+            did_you_mean("nose_radus", ["nose_radius", "clearance"]),
+            Some("nose_radius")
+        );
         assert_eq!(did_you_mean("zzz", ["radius", "conic"]), None);
         assert_eq!(did_you_mean("mni", ["min", "mm"]), Some("min"));
         assert_eq!(did_you_mean("x", ["a", "y"]), None);

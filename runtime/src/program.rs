@@ -34,24 +34,43 @@ pub fn emit(job: &Job, path: &Toolpath, prov: &Provenance) -> Result<String, Pro
     }
 }
 
-fn emit_linuxcnc_lathe(job: &Job, path: &Toolpath, prov: &Provenance) -> Result<String, ProgramError> {
+fn emit_linuxcnc_lathe(
+    job: &Job,
+    path: &Toolpath,
+    prov: &Provenance,
+) -> Result<String, ProgramError> {
     let d = decimals_for(job.machine.resolution);
     let mut out = String::with_capacity(64 * path.moves.len() + 1024);
     let s = &job.surface;
     let comment = |out: &mut String, text: &str| {
         // RS274NGC comments cannot nest parentheses.
-        let clean: String = text.chars().map(|c| match c {
-            '(' => '[',
-            ')' => ']',
-            c if c.is_control() => ' ',
-            c => c,
-        }).collect();
+        let clean: String = text
+            .chars()
+            .map(|c| match c {
+                '(' => '[',
+                ')' => ']',
+                c if c.is_control() => ' ',
+                c => c,
+            })
+            .collect();
         let _ = writeln!(out, "({clean})");
     };
-    comment(&mut out, &format!("lensc {}: job {}", prov.lensc_version, job.name));
-    comment(&mut out, &format!("source {} fnv1a64 {:016x}", prov.source, prov.source_hash));
-    comment(&mut out, "units mm; X is the radius [G8], Z along the spindle axis, +Z out of the material");
-    comment(&mut out, "coordinates are the centre of the tool nose; no cutter compensation");
+    comment(
+        &mut out,
+        &format!("lensc {}: job {}", prov.lensc_version, job.name),
+    );
+    comment(
+        &mut out,
+        &format!("source {} fnv1a64 {:016x}", prov.source, prov.source_hash),
+    );
+    comment(
+        &mut out,
+        "units mm; X is the radius [G8], Z along the spindle axis, +Z out of the material",
+    );
+    comment(
+        &mut out,
+        "coordinates are the centre of the tool nose; no cutter compensation",
+    );
     let mut surf = format!(
         "surface {}: conic R {} mm, k {}, {}: material on the -Z side",
         job.surface_name,
@@ -66,7 +85,11 @@ fn emit_linuxcnc_lathe(job: &Job, path: &Toolpath, prov: &Provenance) -> Result<
     comment(&mut out, &surf);
     comment(
         &mut out,
-        &format!("tool {}: round nose, nose radius {} mm", job.tool_name, num(job.tool.nose_radius)),
+        &format!(
+            "tool {}: round nose, nose radius {} mm",
+            job.tool_name,
+            num(job.tool.nose_radius)
+        ),
     );
     comment(
         &mut out,
@@ -77,8 +100,18 @@ fn emit_linuxcnc_lathe(job: &Job, path: &Toolpath, prov: &Provenance) -> Result<
             num(job.strategy.chord_tolerance)
         ),
     );
-    comment(&mut out, &format!("machine {}: {} lathe", job.machine_name, job.machine.dialect.name()));
-    comment(&mut out, &format!("estimated cutting time {}", duration(path.cutting_time())));
+    comment(
+        &mut out,
+        &format!(
+            "machine {}: {} lathe",
+            job.machine_name,
+            job.machine.dialect.name()
+        ),
+    );
+    comment(
+        &mut out,
+        &format!("estimated cutting time {}", duration(path.cutting_time())),
+    );
     out.push_str("G18 G21 G90 G8 G40 G49 G80 G94\n");
 
     let rpm = job.strategy.spindle_speed * 60.0 / (2.0 * PI);
@@ -135,7 +168,14 @@ fn emit_linuxcnc_lathe(job: &Job, path: &Toolpath, prov: &Provenance) -> Result<
 }
 
 fn word(out: &mut String, letter: char, value: f64, decimals: u32) -> Result<(), ProgramError> {
-    if push_fixed(out, value, decimals) { Ok(()) } else { Err(ProgramError::NotPrintable { word: letter, value }) }
+    if push_fixed(out, value, decimals) {
+        Ok(())
+    } else {
+        Err(ProgramError::NotPrintable {
+            word: letter,
+            value,
+        })
+    }
 }
 
 fn rounded_eq(a: f64, b: f64, d: u32) -> bool {
@@ -154,5 +194,11 @@ fn num(v: f64) -> String {
 fn duration(secs: f64) -> String {
     let total = secs.round() as u64;
     let (h, m, s) = (total / 3600, total / 60 % 60, total % 60);
-    if h > 0 { format!("{h} h {m} min {s} s") } else if m > 0 { format!("{m} min {s} s") } else { format!("{s} s") }
+    if h > 0 {
+        format!("{h} h {m} min {s} s")
+    } else if m > 0 {
+        format!("{m} min {s} s")
+    } else {
+        format!("{s} s")
+    }
 }

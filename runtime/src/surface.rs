@@ -81,7 +81,11 @@ impl RotationalSurface {
             }
         }
         let s = self.sense.sign();
-        ProfilePoint { z: s * z, dz: s * dz, d2z: s * d2z }
+        ProfilePoint {
+            z: s * z,
+            dz: s * dz,
+            d2z: s * d2z,
+        }
     }
 }
 
@@ -90,7 +94,13 @@ mod tests {
     use super::*;
 
     fn surf(k: f64, sense: Sense, terms: Vec<(u32, f64)>) -> RotationalSurface {
-        RotationalSurface { radius: 4.0, conic: k, sense, terms, aperture_radius: 1.5 }
+        RotationalSurface {
+            radius: 4.0,
+            conic: k,
+            sense,
+            terms,
+            aperture_radius: 1.5,
+        }
     }
 
     #[test]
@@ -101,7 +111,9 @@ mod tests {
             let want = 4.0 - (16.0f64 - r * r).sqrt();
             assert!((s.eval(r).z - want).abs() < 1e-15, "r={r}");
         }
-        assert!((surf(0.0, Sense::Convex, vec![]).eval(1.0).z + (4.0 - 15f64.sqrt())).abs() < 1e-15);
+        assert!(
+            (surf(0.0, Sense::Convex, vec![]).eval(1.0).z + (4.0 - 15f64.sqrt())).abs() < 1e-15
+        );
     }
 
     #[test]

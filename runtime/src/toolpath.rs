@@ -70,9 +70,18 @@ impl Toolpath {
 pub enum PlanError {
     /// The nose is larger than the smallest concave radius of curvature:
     /// it cannot reach the bottom of the bowl without cutting its sides.
-    NoseTooLarge { nose_radius: f64, min_radius: f64, at_radius: f64 },
+    NoseTooLarge {
+        nose_radius: f64,
+        min_radius: f64,
+        at_radius: f64,
+    },
     /// The path leaves an axis's travel.
-    OutOfTravel { axis: char, value: f64, min: f64, max: f64 },
+    OutOfTravel {
+        axis: char,
+        value: f64,
+        min: f64,
+        max: f64,
+    },
     /// The cutting feed exceeds the machine's maximum (mm/s).
     FeedTooHigh { feed: f64, max: f64 },
     /// The spindle speed exceeds the machine's maximum (rad/s).
@@ -117,7 +126,11 @@ pub fn plan_profile_turning(job: &Job) -> Result<Toolpath, Vec<PlanError>> {
     if let Some((min_radius, at_radius)) = min_concave
         && rho > min_radius
     {
-        errors.push(PlanError::NoseTooLarge { nose_radius: rho, min_radius, at_radius });
+        errors.push(PlanError::NoseTooLarge {
+            nose_radius: rho,
+            min_radius,
+            at_radius,
+        });
     }
 
     let feed_speed = match strat.feed {
@@ -125,10 +138,16 @@ pub fn plan_profile_turning(job: &Job) -> Result<Toolpath, Vec<PlanError>> {
         Feed::PerTime(v) => v,
     };
     if feed_speed > job.machine.max_feed {
-        errors.push(PlanError::FeedTooHigh { feed: feed_speed, max: job.machine.max_feed });
+        errors.push(PlanError::FeedTooHigh {
+            feed: feed_speed,
+            max: job.machine.max_feed,
+        });
     }
     if strat.spindle_speed > job.machine.max_spindle_speed {
-        errors.push(PlanError::SpindleTooFast { speed: strat.spindle_speed, max: job.machine.max_spindle_speed });
+        errors.push(PlanError::SpindleTooFast {
+            speed: strat.spindle_speed,
+            max: job.machine.max_spindle_speed,
+        });
     }
 
     let centre = |r: f64| tool_centre(surf, rho, r);
@@ -141,26 +160,45 @@ pub fn plan_profile_turning(job: &Job) -> Result<Toolpath, Vec<PlanError>> {
     let top = cut.iter().map(|c| c.y).fold(f64::NEG_INFINITY, f64::max);
     let safe_z = top + strat.retract;
     let mut moves = Vec::with_capacity(cut.len() + 4);
-    moves.push(Move::Rapid { x: cut[0].x, z: safe_z });
-    moves.push(Move::Feed { x: cut[0].x, z: cut[0].y });
+    moves.push(Move::Rapid {
+        x: cut[0].x,
+        z: safe_z,
+    });
+    moves.push(Move::Feed {
+        x: cut[0].x,
+        z: cut[0].y,
+    });
     let mut cut_length = (safe_z - cut[0].y).abs();
     for w in cut.windows(2) {
         cut_length += (w[1] - w[0]).norm();
     }
     moves.extend(cut.iter().skip(1).map(|c| Move::Feed { x: c.x, z: c.y }));
     let last = cut[cut.len() - 1];
-    moves.push(Move::Rapid { x: last.x, z: safe_z });
+    moves.push(Move::Rapid {
+        x: last.x,
+        z: safe_z,
+    });
 
     let (lo_x, hi_x) = job.machine.travel_x;
     let (lo_z, hi_z) = job.machine.travel_z;
     for m in &moves {
         let (Move::Rapid { x, z } | Move::Feed { x, z }) = *m;
         if x < lo_x || x > hi_x {
-            errors.push(PlanError::OutOfTravel { axis: 'X', value: x, min: lo_x, max: hi_x });
+            errors.push(PlanError::OutOfTravel {
+                axis: 'X',
+                value: x,
+                min: lo_x,
+                max: hi_x,
+            });
             break;
         }
         if z < lo_z || z > hi_z {
-            errors.push(PlanError::OutOfTravel { axis: 'Z', value: z, min: lo_z, max: hi_z });
+            errors.push(PlanError::OutOfTravel {
+                axis: 'Z',
+                value: z,
+                min: lo_z,
+                max: hi_z,
+            });
             break;
         }
     }
@@ -188,7 +226,12 @@ pub fn tool_centre(surf: &RotationalSurface, nose_radius: f64, r: f64) -> Vector
 /// Samples the curve `c(t)` for t from `a` to `b` so that no chord strays
 /// more than `tol` from it: uniform seeds, then bisection wherever the
 /// curve's midpoint (or quarter points) lies too far from the chord.
-pub fn sample_offset_curve(c: &dyn Fn(f64) -> Vector2<f64>, a: f64, b: f64, tol: f64) -> Vec<Vector2<f64>> {
+pub fn sample_offset_curve(
+    c: &dyn Fn(f64) -> Vector2<f64>,
+    a: f64,
+    b: f64,
+    tol: f64,
+) -> Vec<Vector2<f64>> {
     const SEEDS: usize = 32;
     const MAX_DEPTH: u32 = 40;
     let mut out = vec![c(a)];
@@ -231,7 +274,13 @@ mod tests {
     use crate::surface::Sense;
 
     fn sphere(sense: Sense) -> RotationalSurface {
-        RotationalSurface { radius: 5.0, conic: 0.0, sense, terms: vec![], aperture_radius: 2.0 }
+        RotationalSurface {
+            radius: 5.0,
+            conic: 0.0,
+            sense,
+            terms: vec![],
+            aperture_radius: 2.0,
+        }
     }
 
     #[test]

@@ -6,12 +6,20 @@ use std::process::{Command, Output};
 
 /// The repository root.
 pub fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").canonicalize().expect("repo root")
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("..")
+        .canonicalize()
+        .expect("repo root")
 }
 
 /// Runs the real `lensc` binary in `cwd`.
 pub fn lensc(cwd: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_lensc")).current_dir(cwd).args(args).env("NO_COLOR", "1").output().expect("run lensc")
+    Command::new(env!("CARGO_BIN_EXE_lensc"))
+        .current_dir(cwd)
+        .args(args)
+        .env("NO_COLOR", "1")
+        .output()
+        .expect("run lensc")
 }
 
 /// Every `.lens` file in examples/.
