@@ -48,3 +48,33 @@ fn every_example_builds() {
         );
     }
 }
+
+#[test]
+fn example_programs_match_their_snapshots() {
+    let dir = tempfile::tempdir().expect("tmp");
+    for ex in examples() {
+        let rel = ex
+            .strip_prefix(root())
+            .expect("inside repo")
+            .to_str()
+            .expect("utf8")
+            .to_string();
+        let out = lensc(
+            &root(),
+            &["build", &rel, "--out", dir.path().to_str().expect("utf8")],
+        );
+        assert_eq!(out.status.code(), Some(0), "{rel}: {}", text(&out.stderr));
+    }
+    let mut programs: Vec<_> = std::fs::read_dir(dir.path())
+        .expect("out")
+        .map(|e| e.expect("e").path())
+        .collect();
+    programs.sort();
+    for p in programs {
+        let name = p.file_name().expect("name").to_string_lossy().to_string();
+        let program = std::fs::read_to_string(&p).expect("program");
+        insta::with_settings!({ snapshot_path => "snapshots/programs", prepend_module_to_snapshot => false, omit_expression => true }, {
+            insta::assert_snapshot!(name, program);
+        });
+    }
+}

@@ -2,7 +2,7 @@
 //! programs. Pure apart from the `FileSystem` it reads through and the
 //! atomic writes of `build`.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use lensc_grammar::{Diagnostic, FileId, Span};
 use lensc_runtime::program::{self, ProgramError, Provenance};

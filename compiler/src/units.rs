@@ -185,3 +185,28 @@ pub const UNITS: &[UnitDef] = &[
 pub fn lookup(name: &str) -> Option<&'static UnitDef> {
     UNITS.iter().find(|u| u.name == name)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn base_units_and_conversions() {
+        assert_eq!(lookup("um").expect("um").factor, 1e-3);
+        assert_eq!(lookup("µm").expect("µm").dim, Dim::LENGTH);
+        let rpm = lookup("rpm").expect("rpm");
+        assert!((1000.0 * rpm.factor - 104.719_755_119_659_77).abs() < 1e-12);
+        assert_eq!(lookup("g").expect("g").factor, 9806.65);
+        assert_eq!(Dim::LENGTH / Dim::ANGLE, Dim::FEED_PER_REV);
+        assert_eq!(Dim::ANGLE / Dim::LENGTH * Dim::LENGTH, Dim::ANGLE);
+        assert_eq!(Dim::new(2, 0, -2).sqrt(), Some(Dim::SPEED));
+        assert_eq!(Dim::LENGTH.sqrt(), None);
+    }
+
+    #[test]
+    fn dimensions_read_as_words() {
+        assert_eq!(Dim::FEED_PER_REV.to_string(), "a feed per revolution");
+        assert_eq!(Dim::new(-3, 0, 0).to_string(), "a quantity in 1/mm^3");
+        assert_eq!(Dim::new(1, 0, -2).base_units(), "mm/s^2");
+    }
+}

@@ -15,3 +15,6 @@ pub mod suggest;
 pub use ast::Span;
 pub use diagnostic::{Diagnostic, FileId, Label, Severity};
 pub use parser::parse;
+
+#[cfg(test)]
+mod tests;

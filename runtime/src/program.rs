@@ -71,8 +71,15 @@ fn emit_linuxcnc_lathe(
         &mut out,
         "coordinates are the centre of the tool nose; no cutter compensation",
     );
+    let kind = if !s.terms.is_empty() {
+        "asphere"
+    } else if s.conic == 0.0 {
+        "sphere"
+    } else {
+        "conic"
+    };
     let mut surf = format!(
-        "surface {}: conic R {} mm, k {}, {}: material on the -Z side",
+        "surface {}: {kind} R {} mm, k {}, {}: material on the -Z side",
         job.surface_name,
         num(s.radius),
         num(s.conic),
@@ -94,10 +101,10 @@ fn emit_linuxcnc_lathe(
     comment(
         &mut out,
         &format!(
-            "strategy {}: profile turning, {} points, chord tolerance {} mm",
+            "strategy {}: profile turning, {} points, chord tolerance {} nm",
             job.strategy_name,
             path.cut_points,
-            num(job.strategy.chord_tolerance)
+            num(job.strategy.chord_tolerance * 1e6)
         ),
     );
     comment(
