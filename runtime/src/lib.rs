@@ -5,6 +5,7 @@
 //! Internal units: one per dimension — millimetres, radians, seconds.
 
 pub mod format;
+pub mod ir;
 pub mod job;
 pub mod machine;
 pub mod program;
