@@ -81,6 +81,7 @@ fn help_on_every_subcommand() {
         &["--help"][..],
         &["check", "--help"],
         &["build", "--help"],
+        &["sample", "--help"],
         &["help", "build"],
     ] {
         let out = lensc(&root(), args);
@@ -216,4 +217,113 @@ fn build_only_the_named_job() {
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     assert!(dir.path().join("progs/second.ngc").exists());
     assert!(!dir.path().join("progs/kim_convex.ngc").exists());
+}
+
+/// Parses `lensc sample` CSV output into rows.
+fn csv_rows(out: &std::process::Output) -> Vec<Vec<f64>> {
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let csv = text(&out.stdout);
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next(),
+        Some("x,y,z,dzdx,dzdy,curvature_x,curvature_y")
+    );
+    lines
+        .map(|l| l.split(',').map(|c| c.parse().expect("number")).collect())
+        .collect()
+}
+
+#[test]
+fn sample_radial_matches_the_closed_form_conic() {
+    let rows = csv_rows(&lensc(
+        &root(),
+        &[
+            "sample",
+            GOOD,
+            "--surface",
+            "convex_asphere",
+            "--radial",
+            "9",
+        ],
+    ));
+    assert_eq!(rows.len(), 9);
+    let (c, k) = (1.0 / 22.405, 43.098);
+    for r in &rows {
+        let (x, y) = (r[0], r[1]);
+        assert_eq!(y, 0.0);
+        let u = 1.0 - (1.0 + k) * c * c * x * x;
+        let z = -(c * x * x / (1.0 + u.sqrt()));
+        let dz = -(c * x / u.sqrt());
+        let d2z = -(c / (u * u.sqrt()));
+        assert!((r[2] - z).abs() < 1e-15, "z at {x}: {} vs {z}", r[2]);
+        assert!((r[3] - dz).abs() < 1e-14, "dz/dx at {x}");
+        assert!(
+            (r[5] - d2z / (1.0 + dz * dz).powf(1.5)).abs() < 1e-13,
+            "curvature at {x}"
+        );
+    }
+    assert_eq!(
+        rows[8][0], 1.6,
+        "the radial samples end at the aperture edge"
+    );
+}
+
+#[test]
+fn sample_grid_and_points_on_the_seed_002_pattern() {
+    let ex = "examples/liu_roller_pattern.lens";
+    let grid = csv_rows(&lensc(
+        &root(),
+        &["sample", ex, "--surface", "pattern", "--grid", "3"],
+    ));
+    assert_eq!(grid.len(), 9);
+    let dir = tempfile::tempdir().expect("tmp");
+    let pts = dir.path().join("pts.csv");
+    std::fs::write(&pts, "x,y\n0,0\n0.3141592653589793,0\n").expect("write");
+    let rows = csv_rows(&lensc(
+        &root(),
+        &[
+            "sample",
+            ex,
+            "--surface",
+            "pattern",
+            "--points",
+            pts.to_str().expect("utf8"),
+        ],
+    ));
+    // z = 0.02 (sin 5x + cos(10y/3)) − 0.04: at the origin −0.02, dz/dx 0.1;
+    // at x = π/10 the top of the sine: z = 0, dz/dx = 0, curvature −0.5.
+    assert!((rows[0][2] + 0.02).abs() < 1e-15 && (rows[0][3] - 0.1).abs() < 1e-15);
+    assert!(
+        rows[1][2].abs() < 1e-15 && rows[1][3].abs() < 1e-15 && (rows[1][5] + 0.5).abs() < 1e-14,
+        "{:?}",
+        rows[1]
+    );
+}
+
+#[test]
+fn sample_usage_errors() {
+    assert_eq!(
+        lensc(&root(), &["sample", GOOD, "--surface", "convex_asphere"])
+            .status
+            .code(),
+        Some(2)
+    );
+    assert_eq!(
+        lensc(
+            &root(),
+            &["sample", GOOD, "--surface", "nope", "--grid", "3"]
+        )
+        .status
+        .code(),
+        Some(2)
+    );
+    assert_eq!(
+        lensc(
+            &root(),
+            &["sample", GOOD, "--surface", "wheel", "--grid", "3"]
+        )
+        .status
+        .code(),
+        Some(2)
+    );
 }

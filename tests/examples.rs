@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{examples, lensc, root, text};
+use common::{buildable_examples, examples, lensc, root, surface_names, text};
 
 #[test]
 fn every_example_checks_clean() {
@@ -29,7 +29,7 @@ fn every_example_checks_clean() {
 #[test]
 fn every_example_builds() {
     let dir = tempfile::tempdir().expect("tmp");
-    for ex in examples() {
+    for ex in buildable_examples() {
         let out = lensc(
             &root(),
             &[
@@ -52,7 +52,7 @@ fn every_example_builds() {
 #[test]
 fn example_programs_match_their_snapshots() {
     let dir = tempfile::tempdir().expect("tmp");
-    for ex in examples() {
+    for ex in buildable_examples() {
         let rel = ex
             .strip_prefix(root())
             .expect("inside repo")
@@ -76,5 +76,46 @@ fn example_programs_match_their_snapshots() {
         insta::with_settings!({ snapshot_path => "snapshots/programs", prepend_module_to_snapshot => false, omit_expression => true }, {
             insta::assert_snapshot!(name, program);
         });
+    }
+}
+
+#[test]
+fn every_surface_of_every_example_samples() {
+    for ex in examples() {
+        for name in surface_names(&ex) {
+            let out = lensc(
+                &root(),
+                &[
+                    "sample",
+                    ex.to_str().expect("utf8"),
+                    "--surface",
+                    &name,
+                    "--grid",
+                    "5",
+                ],
+            );
+            assert_eq!(
+                out.status.code(),
+                Some(0),
+                "{} {name}: {}",
+                ex.display(),
+                text(&out.stderr)
+            );
+            let csv = text(&out.stdout);
+            let mut lines = csv.lines();
+            assert_eq!(
+                lines.next(),
+                Some("x,y,z,dzdx,dzdy,curvature_x,curvature_y")
+            );
+            let rows: Vec<Vec<f64>> = lines
+                .map(|l| l.split(',').map(|c| c.parse().expect("number")).collect())
+                .collect();
+            assert!(!rows.is_empty(), "{} {name}: no points", ex.display());
+            assert!(
+                rows.iter().flatten().all(|v| v.is_finite()),
+                "{} {name}: {csv}",
+                ex.display()
+            );
+        }
     }
 }

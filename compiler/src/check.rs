@@ -39,6 +39,9 @@ pub struct CheckedJob {
 pub struct Checked {
     pub jobs: Vec<CheckedJob>,
     pub diags: Vec<Diagnostic>,
+    /// Every surface, tool, machine and strategy the root file can name
+    /// (its own and those it uses) that checked, by name.
+    pub declarations: HashMap<String, Rc<Object>>,
 }
 
 impl Checked {
@@ -69,6 +72,9 @@ struct Checker<'a> {
     scopes: Vec<HashMap<&'a str, usize>>,
     state: Vec<State>,
     used: Vec<bool>,
+    /// While a formula body is evaluated: the constants it names, so that
+    /// lowering can build its IR without the scopes.
+    formula_constants: Option<HashMap<String, f64>>,
 }
 
 /// Checks a loaded file set. Diagnostics from loading come first.
@@ -80,6 +86,7 @@ pub fn check(loaded: &Loaded) -> Checked {
         scopes: Vec::new(),
         state: Vec::new(),
         used: Vec::new(),
+        formula_constants: None,
     };
     c.build_scopes();
     for i in 0..c.decls.len() {
@@ -99,9 +106,21 @@ pub fn check(loaded: &Loaded) -> Checked {
             .with_help("a job file declares a surface, a tool, a machine, a strategy and a job"),
         );
     }
+    let mut declarations = HashMap::new();
+    if let Some(scope) = c.scopes.first() {
+        for (&name, &i) in scope {
+            if let (Some(_), State::Done(Value::Object(o))) = (c.decls[i].kind, &c.state[i]) {
+                declarations.insert(name.to_string(), o.clone());
+            }
+        }
+    }
     let mut diags = loaded.diags.clone();
     diags.append(&mut c.diags);
-    Checked { jobs, diags }
+    Checked {
+        jobs,
+        diags,
+        declarations,
+    }
 }
 
 impl<'a> Checker<'a> {
@@ -404,7 +423,11 @@ impl<'a> Checker<'a> {
                     return Value::Num(f64::NAN, Dim::LENGTH);
                 }
                 if let Some(i) = self.lookup(file, n) {
-                    return self.decl_value(i);
+                    let v = self.decl_value(i);
+                    if let (Some(consts), Value::Num(x, _)) = (&mut self.formula_constants, &v) {
+                        consts.insert(n.clone(), *x);
+                    }
+                    return v;
                 }
                 if FUNCTIONS.contains(&n.as_str()) {
                     let f = FUNCTIONS.iter().find(|f| **f == n).expect("function");
@@ -627,13 +650,17 @@ impl<'a> Checker<'a> {
                         }
                     }
                     let names: Vec<String> = params.iter().map(|p| p.name.clone()).collect();
+                    let outer = self.formula_constants.replace(HashMap::new());
                     let v = self.eval(file, body, &names);
+                    let constants =
+                        std::mem::replace(&mut self.formula_constants, outer).unwrap_or_default();
                     let value = match v {
                         Value::Num(_, dim) if ok => Value::Formula(Rc::new(Formula {
                             params: names,
                             result: dim,
                             body: body.clone(),
                             file,
+                            constants,
                         })),
                         Value::Num(..) | Value::Error => Value::Error,
                         other => {
@@ -1388,8 +1415,18 @@ impl<'a> Checker<'a> {
         jobs
     }
 
+    /// Unused definitions are worth a warning in a job file; a file with no
+    /// job (a library of surfaces or tools) is all definitions by design.
     fn warn_unused(&mut self) {
+        let has_jobs = self.loaded.files[0]
+            .ast
+            .items
+            .iter()
+            .any(|i| matches!(i.kind, ItemKind::Job { .. }));
         for (i, d) in self.decls.iter().enumerate() {
+            if !has_jobs && d.kind.is_some() {
+                continue;
+            }
             if d.file == FileId(0) && !self.used[i] {
                 self.diags.push(
                     Diagnostic::warning(

@@ -182,3 +182,98 @@ pub fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {
     tmp.persist(path).map_err(|e| e.error)?;
     Ok(())
 }
+
+/// Where `lensc sample` evaluates a surface.
+pub enum SamplePoints {
+    /// n × n over the domain's bounding box, points inside the domain.
+    Grid(usize),
+    /// n points from the centre of the domain to its edge along +x.
+    Radial(usize),
+    /// Given points (mm).
+    Points(Vec<(f64, f64)>),
+}
+
+/// One sample: x, y, z (mm), dz/dx, dz/dy, curvature along x and y (1/mm).
+pub type Sample = [f64; 7];
+
+/// Evaluates a declared surface at the requested points.
+pub fn sample(c: &Checked, surface: &str, at: &SamplePoints) -> Result<Vec<Sample>, String> {
+    let Some(obj) = c.checked.declarations.get(surface) else {
+        let mut names: Vec<&str> = c
+            .checked
+            .declarations
+            .iter()
+            .filter(|(_, o)| o.kind.category == crate::schema::Category::Surface)
+            .map(|(n, _)| n.as_str())
+            .collect();
+        names.sort_unstable();
+        return Err(format!(
+            "no surface `{surface}` (surfaces: {})",
+            if names.is_empty() {
+                "none".into()
+            } else {
+                names.join(", ")
+            }
+        ));
+    };
+    if obj.kind.category != crate::schema::Category::Surface {
+        return Err(format!(
+            "`{surface}` is {}, not a surface",
+            obj.kind.category.noun()
+        ));
+    }
+    let lowered = crate::surfaces::lower_surface(obj)
+        .map_err(|e| format!("`{surface}` cannot be evaluated yet: {e:?}"))?;
+    let f = lensc_runtime::ir::Interpreter::new(&lowered.tape);
+    let domain = lowered.domain;
+    let ((x0, x1), (y0, y1)) = domain.bounds();
+    let (xs, ys): (Vec<f64>, Vec<f64>) = match at {
+        SamplePoints::Grid(n) => {
+            let n = (*n).max(1);
+            let step = |a: f64, b: f64, i: usize| {
+                if n == 1 {
+                    0.5 * (a + b)
+                } else {
+                    a + (b - a) * i as f64 / (n - 1) as f64
+                }
+            };
+            (0..n)
+                .flat_map(|j| (0..n).map(move |i| (step(x0, x1, i), step(y0, y1, j))))
+                .filter(|&(x, y)| domain.contains(x, y))
+                .unzip()
+        }
+        SamplePoints::Radial(n) => {
+            let n = (*n).max(1);
+            let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+            (0..n)
+                .map(|i| {
+                    (
+                        if n == 1 {
+                            cx
+                        } else {
+                            cx + (x1 - cx) * i as f64 / (n - 1) as f64
+                        },
+                        cy,
+                    )
+                })
+                .unzip()
+        }
+        SamplePoints::Points(p) => p.iter().copied().unzip(),
+    };
+    let mut out = vec![0.0; 6 * xs.len()];
+    lensc_runtime::ir::SurfaceFn::eval_batch(&f, &xs, &ys, &mut out);
+    Ok((0..xs.len())
+        .map(|i| {
+            let o = &out[6 * i..6 * i + 6];
+            [
+                xs[i],
+                ys[i],
+                o[0],
+                o[1],
+                o[2],
+                lensc_runtime::analysis::curvature_x(o),
+                lensc_runtime::analysis::curvature_y(o),
+            ]
+        })
+        .collect())
+}

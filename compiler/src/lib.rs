@@ -10,5 +10,6 @@ pub mod lower;
 pub mod render;
 pub mod schema;
 pub mod source;
+pub mod surfaces;
 pub mod units;
 pub mod value;

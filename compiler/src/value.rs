@@ -76,6 +76,8 @@ pub struct Formula {
     pub result: Dim,
     pub body: Expr,
     pub file: FileId,
+    /// Every `let` or other constant the body names, in base units.
+    pub constants: std::collections::HashMap<String, f64>,
 }
 
 pub fn field<'a>(fields: &'a [Field], name: &str) -> Option<&'a Field> {

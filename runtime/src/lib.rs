@@ -4,6 +4,7 @@
 //!
 //! Internal units: one per dimension — millimetres, radians, seconds.
 
+pub mod analysis;
 pub mod format;
 pub mod ir;
 pub mod job;

@@ -36,3 +36,27 @@ pub fn examples() -> Vec<PathBuf> {
 pub fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
 }
+
+/// Whether a job file declares at least one job (files without one are
+/// libraries of surfaces and the like: checked and sampled, not built).
+pub fn has_job(path: &Path) -> bool {
+    std::fs::read_to_string(path)
+        .expect("read")
+        .lines()
+        .any(|l| l.starts_with("job "))
+}
+
+/// Examples that declare a job.
+pub fn buildable_examples() -> Vec<PathBuf> {
+    examples().into_iter().filter(|p| has_job(p)).collect()
+}
+
+/// Names of the surfaces a file declares at the start of a line.
+pub fn surface_names(path: &Path) -> Vec<String> {
+    std::fs::read_to_string(path)
+        .expect("read")
+        .lines()
+        .filter_map(|l| l.strip_prefix("surface "))
+        .filter_map(|l| l.split_whitespace().next().map(str::to_string))
+        .collect()
+}
