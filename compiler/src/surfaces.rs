@@ -197,3 +197,50 @@ fn lower_expr(g: &mut Graph, f: &Formula, e: &Expr) -> Id {
         _ => g.constant_node(f64::NAN),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lensc_runtime::ir::{Interpreter, SurfaceFn};
+    use lensc_runtime::surface::{RotationalSurface, Sense};
+
+    /// The IR sag (in r² form, differentiated symbolically) against the
+    /// runtime's closed-form profile (differentiated by hand), along x and,
+    /// by symmetry, along y.
+    #[test]
+    fn ir_sag_matches_closed_form_profile() {
+        let terms = vec![(3, 2e-4), (4, 1.5e-4), (6, -3e-6), (8, 2e-8), (16, 1e-14)];
+        for (radius, k, sense) in [(22.405, 43.098, Sense::Convex), (4.254, -3.359, Sense::Concave), (8.5, -0.62, Sense::Convex), (5.0, 0.0, Sense::Concave)] {
+            let closed = RotationalSurface { radius, conic: k, sense, terms: terms.clone(), aperture_radius: 1.5 };
+            let mut g = Graph::new();
+            let z = rotational_sag(&mut g, radius, k, &terms, sense.sign());
+            let f = Interpreter::new(&SurfaceTape::new(g, z));
+            for r in [0.05, 0.4, 0.9, 1.5] {
+                let p = closed.eval(r);
+                let ox = f.eval(r, 0.0);
+                let oy = f.eval(0.0, r);
+                let tol = |a: f64| 1e-13 * (1.0 + a.abs());
+                assert!((ox[0] - p.z).abs() <= tol(p.z), "z R={radius} r={r}: {} vs {}", ox[0], p.z);
+                assert!((ox[1] - p.dz).abs() <= tol(p.dz), "dz/dx R={radius} r={r}: {} vs {}", ox[1], p.dz);
+                assert!((ox[3] - p.d2z).abs() <= tol(p.d2z), "d2z/dx2 R={radius} r={r}: {} vs {}", ox[3], p.d2z);
+                assert!((oy[0] - p.z).abs() <= tol(p.z) && (oy[2] - p.dz).abs() <= tol(p.dz) && (oy[5] - p.d2z).abs() <= tol(p.d2z));
+                assert!(ox[2].abs() < 1e-15 && ox[4].abs() < 1e-15, "no slope across the section");
+            }
+        }
+    }
+
+    /// A sphere's sag against R − sqrt(R² − r²) in 2-D, off the axes
+    /// (written r²/(R + sqrt(R² − r²)) to avoid cancellation).
+    #[test]
+    fn sphere_sag_off_axis() {
+        let mut g = Graph::new();
+        let z = rotational_sag(&mut g, 20.0, 0.0, &[], 1.0);
+        let f = Interpreter::new(&SurfaceTape::new(g, z));
+        for (x, y) in [(0.3, 0.4), (-0.6, 0.8), (0.85, -0.1)] {
+            let r2 = x * x + y * y;
+            let want = r2 / (20.0 + (400.0f64 - r2).sqrt());
+            let got = f.eval(x, y)[0];
+            assert!((got - want).abs() <= 4e-16 * want, "{got} vs {want}");
+        }
+    }
+}
