@@ -1032,24 +1032,25 @@ impl<'a> Checker<'a> {
         head: Span,
         file: FileId,
     ) -> Value {
-        let ok = self.validate(
+        let ok = self.validate_with(
             kind.params,
+            kind.family,
             &fields,
             &format!("`{}`", kind.name),
             head,
             file,
             kind.exclusive,
         );
-        if !ok {
-            return Value::Error;
-        }
         let obj = Object {
             kind,
             fields,
             head,
             file,
         };
-        if !self.kind_rules(&obj) {
+        // The sign rule reads only fields it checks itself, so it runs even
+        // when another parameter is wrong: every error is reported.
+        let signs_ok = kind.param("convention").is_none() || self.sign_rule(&obj);
+        if !ok || !signs_ok || !self.kind_rules(&obj) {
             return Value::Error;
         }
         Value::Object(Rc::new(obj))
@@ -1065,8 +1066,28 @@ impl<'a> Checker<'a> {
         file: FileId,
         exclusive: &[(&[&str], bool)],
     ) -> bool {
+        self.validate_with(params, None, fields, owner, head, file, exclusive)
+    }
+
+    /// Validates fields against parameters and a family of coefficient
+    /// names (`X2Y1`, `Z4`…); true if all is well.
+    #[allow(clippy::too_many_arguments)]
+    fn validate_with(
+        &mut self,
+        params: &'static [Param],
+        family: Option<&schema::Family>,
+        fields: &[Field],
+        owner: &str,
+        head: Span,
+        file: FileId,
+        exclusive: &[(&[&str], bool)],
+    ) -> bool {
         let before = self.error_count();
         for f in fields {
+            if let Some(p) = family.and_then(|fam| (fam.param)(&f.name)) {
+                self.check_param(&p, f, owner);
+                continue;
+            }
             let Some(p) = params.iter().find(|p| p.name == f.name) else {
                 let mut d = Diagnostic::error(
                     codes::UNKNOWN_PARAMETER,
@@ -1077,7 +1098,14 @@ impl<'a> Checker<'a> {
                 .with_label("unknown parameter");
                 d = d.with_help(match did_you_mean(&f.name, params.iter().map(|p| p.name)) {
                     Some(s) => format!("did you mean `{s}`?"),
-                    None => format!("{owner} takes: {}", param_list(params)),
+                    None => match family {
+                        Some(fam) => format!(
+                            "{owner} takes: {}, and {}",
+                            param_list(params),
+                            fam.describe
+                        ),
+                        None => format!("{owner} takes: {}", param_list(params)),
+                    },
                 });
                 self.err(d);
                 continue;
@@ -1137,7 +1165,7 @@ impl<'a> Checker<'a> {
         self.diags.iter().filter(|d| d.is_error()).count()
     }
 
-    fn check_param(&mut self, p: &'static Param, f: &Field, owner: &str) {
+    fn check_param(&mut self, p: &Param, f: &Field, owner: &str) {
         let (file, span) = (f.file, f.span);
         match (&p.ty, &f.value) {
             (_, Value::Error) => {}
@@ -1150,7 +1178,7 @@ impl<'a> Checker<'a> {
                         .join(" or ");
                     let mut diag = Diagnostic::error(
                         codes::PARAMETER_DIMENSION,
-                        format!("`{}` must be {want}, but this is {d}", p.name),
+                        format!("`{}` must be {want}, but this is {d}", f.name),
                         file,
                         span,
                     )
@@ -1161,7 +1189,7 @@ impl<'a> Checker<'a> {
                             example_unit(dims[0])
                         )
                     } else {
-                        format!("`{}` is {}: {}", p.name, want, p.doc)
+                        format!("`{}` is {}: {}", f.name, want, p.doc)
                     });
                     self.err(diag);
                     return;
@@ -1188,12 +1216,12 @@ impl<'a> Checker<'a> {
                     self.err(
                         Diagnostic::error(
                             codes::OUT_OF_RANGE,
-                            format!("`{}` {rule}, but it is {}", p.name, shown.trim_end()),
+                            format!("`{}` {rule}, but it is {}", f.name, shown.trim_end()),
                             file,
                             span,
                         )
                         .with_label("out of range")
-                        .with_help(format!("`{}`: {}", p.name, p.doc)),
+                        .with_help(format!("`{}`: {}", f.name, p.doc)),
                     );
                 }
             }
@@ -1201,7 +1229,7 @@ impl<'a> Checker<'a> {
                 if !words.contains(&w.as_str()) {
                     let mut d = Diagnostic::error(
                         codes::UNKNOWN_WORD,
-                        format!("`{}` cannot be `{w}`", p.name),
+                        format!("`{}` cannot be `{w}`", f.name),
                         file,
                         span,
                     )
@@ -1209,7 +1237,7 @@ impl<'a> Checker<'a> {
                     if let Some(s) = did_you_mean(w, words.iter().copied()) {
                         d = d.with_help(format!("did you mean `{s}`?"));
                     } else {
-                        d = d.with_help(format!("`{}`: {}", p.name, p.doc));
+                        d = d.with_help(format!("`{}`: {}", f.name, p.doc));
                     }
                     self.err(d);
                 }
@@ -1219,7 +1247,7 @@ impl<'a> Checker<'a> {
                 self.expect_category(file, span, v.clone(), *cat, None);
             }
             (Ty::Block(sub), Value::Block(fields)) => {
-                let owner = format!("`{}` of {owner}", p.name);
+                let owner = format!("`{}` of {owner}", f.name);
                 self.validate(sub, fields, &owner, f.name_span, file, &[]);
             }
             (Ty::Range(dim), Value::Range(lo, hi, d)) => {
@@ -1227,7 +1255,7 @@ impl<'a> Checker<'a> {
                     self.err(
                         Diagnostic::error(
                             codes::PARAMETER_DIMENSION,
-                            format!("the ends of `{}` must be {dim}, but they are {d}", p.name),
+                            format!("the ends of `{}` must be {dim}, but they are {d}", f.name),
                             file,
                             span,
                         )
@@ -1237,7 +1265,7 @@ impl<'a> Checker<'a> {
                     self.err(
                         Diagnostic::error(
                             codes::OUT_OF_RANGE,
-                            format!("the range of `{}` is empty or reversed", p.name),
+                            format!("the range of `{}` is empty or reversed", f.name),
                             file,
                             span,
                         )
@@ -1250,7 +1278,7 @@ impl<'a> Checker<'a> {
                     self.err(
                         Diagnostic::error(
                             codes::UNKNOWN_COORDINATE,
-                            format!("`{}` is written in {}, not `{bad}`", p.name, quoted(coords)),
+                            format!("`{}` is written in {}, not `{bad}`", f.name, quoted(coords)),
                             file,
                             f.name_span,
                         )
@@ -1263,7 +1291,7 @@ impl<'a> Checker<'a> {
                             codes::FORMULA_DIMENSION,
                             format!(
                                 "the formula for `{}` must give {result}, but it gives {}",
-                                p.name, fm.result
+                                f.name, fm.result
                             ),
                             file,
                             span,
@@ -1290,7 +1318,7 @@ impl<'a> Checker<'a> {
                         codes::WRONG_VALUE,
                         format!(
                             "`{}` must be {}, but this is {}",
-                            p.name,
+                            f.name,
                             ty_words(&p.ty),
                             v.describe()
                         ),
@@ -1298,7 +1326,7 @@ impl<'a> Checker<'a> {
                         span,
                     )
                     .with_label("wrong kind of value")
-                    .with_help(format!("`{}`: {}", p.name, p.doc)),
+                    .with_help(format!("`{}`: {}", f.name, p.doc)),
                 );
             }
         }
@@ -1307,9 +1335,9 @@ impl<'a> Checker<'a> {
     /// Rules that tie several parameters of one kind together.
     fn kind_rules(&mut self, o: &Object) -> bool {
         match o.kind.name {
-            "conic" | "sphere" | "asphere" => {
+            "conic" | "sphere" | "asphere" | "cylinder" | "acylinder" | "toroid" => {
                 let (Some(r), Some(ap)) = (
-                    value::num(&o.fields, "radius"),
+                    value::num(&o.fields, "radius").map(f64::abs),
                     value::object(&o.fields, "aperture"),
                 ) else {
                     return true;
@@ -1339,6 +1367,68 @@ impl<'a> Checker<'a> {
                 }
                 true
             }
+            "zernike" => {
+                if value::word(&o.fields, "ordering") != Some("fringe") {
+                    return true;
+                }
+                let mut ok = true;
+                for f in &o.fields {
+                    if let Some(j) = f.name.strip_prefix('Z').and_then(|j| j.parse::<u32>().ok())
+                        && !(1..=37).contains(&j)
+                    {
+                        self.err(
+                            Diagnostic::error(
+                                codes::UNKNOWN_PARAMETER,
+                                format!("fringe Zernike terms are `Z1` … `Z37`, not `{}`", f.name),
+                                f.file,
+                                f.name_span,
+                            )
+                            .with_label("no such fringe term")
+                            .with_help("use `ordering: ansi` for more terms (numbered from `Z0`)"),
+                        );
+                        ok = false;
+                    }
+                }
+                ok
+            }
+            "ellipsoid" => {
+                let f = &o.fields;
+                let (Some(a), Some(b), Some(ap)) = (
+                    value::num(f, "a"),
+                    value::num(f, "b"),
+                    value::object(f, "aperture"),
+                ) else {
+                    return true;
+                };
+                // The cap is defined inside x²/a² + y²/b² < 1.
+                let reach = match ap.kind.name {
+                    "circle" => aperture_radius(ap).map(|r| r / a.min(b)),
+                    _ => value::range(&ap.fields, "x")
+                        .zip(value::range(&ap.fields, "y"))
+                        .map(|((x0, x1), (y0, y1))| {
+                            let (x, y) = (x0.abs().max(x1.abs()), y0.abs().max(y1.abs()));
+                            (x * x / (a * a) + y * y / (b * b)).sqrt()
+                        }),
+                };
+                if reach.is_some_and(|q| q >= 1.0) {
+                    let ap_field = value::field(f, "aperture").expect("aperture");
+                    self.err(
+                        Diagnostic::error(
+                            codes::CONIC_DOMAIN,
+                            "the aperture reaches beyond the ellipsoid's rim (x²/a² + y²/b² = 1)",
+                            ap_field.file,
+                            ap_field.span,
+                        )
+                        .with_label(format!(
+                            "reaches {} of the way to the rim",
+                            trim_num(reach.unwrap_or(0.0))
+                        ))
+                        .with_help("keep the aperture inside the semi-axes a and b"),
+                    );
+                    return false;
+                }
+                true
+            }
             "profile_turning" => {
                 if let (Some(from), Some(to)) =
                     (value::num(&o.fields, "from"), value::num(&o.fields, "to"))
@@ -1360,6 +1450,73 @@ impl<'a> Checker<'a> {
             }
             _ => true,
         }
+    }
+
+    /// The material side is given either by a positive radius and `sense`,
+    /// or by a signed radius with `convention: optical`, never both.
+    fn sign_rule(&mut self, o: &Object) -> bool {
+        let f = &o.fields;
+        let optical = value::word(f, "convention") == Some("optical");
+        let radii: Vec<&Field> = ["radius", "radius_x", "radius_y"]
+            .iter()
+            .filter_map(|n| value::field(f, n))
+            .collect();
+        let mut ok = true;
+        if optical {
+            if let Some(sense) = value::field(f, "sense") {
+                let conv = value::field(f, "convention").expect("convention");
+                self.err(
+                    Diagnostic::error(codes::CONFLICTING_PARAMETERS, "`sense` and `convention: optical` both say which side is material", sense.file, sense.name_span)
+                        .with_label("remove this")
+                        .with_note(conv.file, conv.span, "the radius's sign says it here")
+                        .with_help("with `convention: optical` the sign of the radius gives the side: R > 0 convex, R < 0 concave"),
+                );
+                ok = false;
+            }
+            for r in radii {
+                if matches!(r.value, Value::Num(v, _) if v == 0.0) {
+                    self.err(
+                        Diagnostic::error(
+                            codes::OUT_OF_RANGE,
+                            format!("`{}` cannot be zero", r.name),
+                            r.file,
+                            r.span,
+                        )
+                        .with_label("zero radius")
+                        .with_help("a flat surface is a `plane`"),
+                    );
+                    ok = false;
+                }
+            }
+            return ok;
+        }
+        if value::field(f, "sense").is_none()
+            && (!radii.is_empty()
+                || o.kind
+                    .params
+                    .iter()
+                    .any(|p| p.name == "radius" && p.required))
+        {
+            self.err(
+                Diagnostic::error(codes::MISSING_PARAMETER, format!("`{}` is missing `sense`", o.kind.name), o.file, o.head)
+                    .with_label("needs `sense`")
+                    .with_help("add `sense: convex` (a dome) or `sense: concave` (a bowl), or give a signed radius with `convention: optical`"),
+            );
+            ok = false;
+        }
+        for r in radii {
+            if let Value::Num(v, _) = r.value
+                && v <= 0.0
+            {
+                self.err(
+                    Diagnostic::error(codes::OUT_OF_RANGE, format!("`{}` must be greater than zero, but it is {} mm", r.name, trim_num(v)), r.file, r.span)
+                        .with_label("out of range")
+                        .with_help("with `sense`, the radius is a magnitude; a signed radius as in lens design needs `convention: optical` (R < 0 concave)"),
+                );
+                ok = false;
+            }
+        }
+        ok
     }
 
     // ---- jobs -----------------------------------------------------------------

@@ -156,18 +156,33 @@ fn rotational(o: &Object) -> Option<RotationalSurface> {
     }
     let f: &[Field] = &o.fields;
     let aperture_radius = aperture_radius(value::object(f, "aperture")?)?;
-    let terms = (1..=20u32)
+    let terms: Vec<(u32, f64)> = (1..=20u32)
         .filter_map(|j| value::num(f, &format!("A{j}")).map(|a| (j, a)))
         .collect();
+    // The runtime profile takes |R| and a sense; the optical convention's
+    // sag is seen from the other side (see surfaces::Side), so its
+    // coefficients change sign when R < 0 makes the surface concave.
+    let side = crate::surfaces::Side::of(f);
+    let radius = value::num(f, "radius")?;
+    let convex = if side.signed {
+        radius > 0.0
+    } else {
+        side.sigma < 0.0
+    };
+    let flip = if side.signed && radius < 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
     Some(RotationalSurface {
-        radius: value::num(f, "radius")?,
+        radius: radius.abs(),
         conic: value::num(f, "conic").unwrap_or(0.0),
-        sense: if value::word(f, "sense")? == "convex" {
+        sense: if convex {
             Sense::Convex
         } else {
             Sense::Concave
         },
-        terms,
+        terms: terms.into_iter().map(|(j, a)| (j, flip * a)).collect(),
         aperture_radius,
     })
 }

@@ -100,11 +100,26 @@ pub const NUMBER: Ty = Ty::Quantity(&[Dim::NONE]);
 pub const ANGLE: Ty = Ty::Quantity(&[Dim::ANGLE]);
 const DEG90: f64 = std::f64::consts::FRAC_PI_2;
 
+/// A family of parameters named by a pattern (`X2Y1`, `Z11`): a
+/// description for messages, and the parameter a name stands for.
+pub struct Family {
+    pub describe: &'static str,
+    pub param: fn(&str) -> Option<Param>,
+}
+
+impl std::fmt::Debug for Family {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.describe)
+    }
+}
+
 #[derive(Debug)]
 pub struct Kind {
     pub name: &'static str,
     pub category: Category,
     pub params: &'static [Param],
+    /// Coefficients named by a pattern, beyond `params`.
+    pub family: Option<&'static Family>,
     /// Parameter names that positional arguments fill, in order.
     pub positional: &'static [&'static str],
     /// At most one of each group may be given; `exactly_one` groups need one.
@@ -118,11 +133,17 @@ impl Kind {
     }
 }
 
-const SENSE: Param = req(
+const SENSE: Param = opt(
     "sense",
     Ty::Word(&["convex", "concave"]),
     Check::Any,
-    "which side is material: convex (a dome) or concave (a bowl)",
+    "which side is material: convex (a dome) or concave (a bowl); needed unless `convention: optical`",
+);
+const CONVENTION: Param = opt(
+    "convention",
+    Ty::Word(&["sense", "optical"]),
+    Check::Any,
+    "`sense` (default): radius is a magnitude and `sense` gives the side; `optical`: radius is signed as in lens design, light along +z into the material, R > 0 convex and R < 0 concave as the tool sees it",
 );
 const APERTURE: Param = req(
     "aperture",
@@ -133,28 +154,123 @@ const APERTURE: Param = req(
 const VERTEX_RADIUS: Param = req(
     "radius",
     LENGTH,
-    Check::Positive,
-    "vertex radius of curvature (magnitude; `sense` gives the side)",
+    Check::Any,
+    "vertex radius of curvature: a positive magnitude with `sense`, signed with `convention: optical`",
 );
 const CONIC_CONSTANT: Param = opt(
     "conic",
     NUMBER,
     Check::Any,
-    "conic constant k (0 sphere, -1 paraboloid); default 0",
+    "conic constant k (0 sphere, -1 paraboloid, < -1 hyperboloid); default 0",
 );
 
-macro_rules! coefficients {
-    ($($name:literal = $p:literal),* $(,)?) => {
-        &[VERTEX_RADIUS, CONIC_CONSTANT, SENSE, APERTURE,
-          $(opt($name, Ty::Quantity(&[Dim::new(1 - $p, 0, 0)]), Check::Any, "coefficient of |r|^j, in mm^(1-j)")),*]
-    };
+/// `A1` … `A20`: the coefficient of |r|^j (or |u|^j for a cylinder), in mm^(1−j).
+pub static POWER_COEFFICIENTS: Family = Family {
+    describe: "coefficients `A1` … `A20` named by their power, in mm^(1-j)",
+    param: |name| {
+        let j: i8 = name.strip_prefix('A')?.parse().ok()?;
+        (1..=20).contains(&j).then_some(Param {
+            name: "A",
+            ty: Ty::Quantity(power_dims(j)),
+            required: false,
+            check: Check::Any,
+            doc: "coefficient of |r|^j, in mm^(1-j)",
+        })
+    },
+};
+
+/// `XiYj`: the coefficient of x^i y^j (i + j from 1 to 20), in mm^(1−i−j).
+pub static XY_COEFFICIENTS: Family = Family {
+    describe: "coefficients `XiYj` of x^i y^j (1 <= i + j <= 20), in mm^(1-i-j)",
+    param: |name| {
+        let (i, j) = xy_powers(name)?;
+        Some(Param {
+            name: "XiYj",
+            ty: Ty::Quantity(power_dims((i + j) as i8)),
+            required: false,
+            check: Check::Any,
+            doc: "coefficient of x^i y^j, in mm^(1-i-j)",
+        })
+    },
+};
+
+/// `Z1`, `Z2`, …: Zernike coefficients (lengths), in the surface's ordering.
+pub static ZERNIKE_COEFFICIENTS: Family = Family {
+    describe: "Zernike coefficients (lengths) numbered in the chosen `ordering`: `Z1` … `Z37` fringe, `Z0` … `Z230` ansi",
+    param: |name| {
+        let j: u32 = name.strip_prefix('Z')?.parse().ok()?;
+        (0..=230).contains(&j).then_some(Param {
+            name: "Zj",
+            ty: LENGTH,
+            required: false,
+            check: Check::Any,
+            doc: "Zernike coefficient, a length",
+        })
+    },
+};
+
+/// The (i, j) of a name `XiYj`, if it is one with 1 ≤ i + j ≤ 20.
+pub fn xy_powers(name: &str) -> Option<(u32, u32)> {
+    let rest = name.strip_prefix('X')?;
+    let (i, j) = rest.split_once('Y')?;
+    let (i, j): (u32, u32) = (i.parse().ok()?, j.parse().ok()?);
+    (1..=20).contains(&(i + j)).then_some((i, j))
 }
+
+/// The dimension mm^(1−n) of a coefficient of a term of total power n,
+/// as a static slice for `Ty::Quantity`.
+fn power_dims(n: i8) -> &'static [Dim] {
+    const fn d(n: i8) -> [Dim; 1] {
+        [Dim::new(1 - n, 0, 0)]
+    }
+    static DIMS: [[Dim; 1]; 21] = [
+        d(0),
+        d(1),
+        d(2),
+        d(3),
+        d(4),
+        d(5),
+        d(6),
+        d(7),
+        d(8),
+        d(9),
+        d(10),
+        d(11),
+        d(12),
+        d(13),
+        d(14),
+        d(15),
+        d(16),
+        d(17),
+        d(18),
+        d(19),
+        d(20),
+    ];
+    &DIMS[n.clamp(0, 20) as usize]
+}
+
+const AXIS: Param = req(
+    "axis",
+    Ty::Word(&["x", "y"]),
+    Check::Any,
+    "the direction the profile is extruded along; the profile varies across it",
+);
 
 pub static KINDS: &[Kind] = &[
     Kind {
+        name: "plane",
+        category: Category::Surface,
+        params: &[APERTURE],
+        family: None,
+        positional: &[],
+        exclusive: &[],
+        doc: "a flat surface at z = 0",
+    },
+    Kind {
         name: "sphere",
         category: Category::Surface,
-        params: &[VERTEX_RADIUS, SENSE, APERTURE],
+        params: &[VERTEX_RADIUS, SENSE, CONVENTION, APERTURE],
+        family: None,
         positional: &[],
         exclusive: &[],
         doc: "a sphere of the given radius",
@@ -162,7 +278,8 @@ pub static KINDS: &[Kind] = &[
     Kind {
         name: "conic",
         category: Category::Surface,
-        params: &[VERTEX_RADIUS, CONIC_CONSTANT, SENSE, APERTURE],
+        params: &[VERTEX_RADIUS, CONIC_CONSTANT, SENSE, CONVENTION, APERTURE],
+        family: None,
         positional: &[],
         exclusive: &[],
         doc: "a conic of revolution: sag = r²/R / (1 + sqrt(1 - (1+k) r²/R²))",
@@ -170,31 +287,171 @@ pub static KINDS: &[Kind] = &[
     Kind {
         name: "asphere",
         category: Category::Surface,
-        params: coefficients!(
-            "A1" = 1,
-            "A2" = 2,
-            "A3" = 3,
-            "A4" = 4,
-            "A5" = 5,
-            "A6" = 6,
-            "A7" = 7,
-            "A8" = 8,
-            "A9" = 9,
-            "A10" = 10,
-            "A11" = 11,
-            "A12" = 12,
-            "A13" = 13,
-            "A14" = 14,
-            "A15" = 15,
-            "A16" = 16,
-            "A17" = 17,
-            "A18" = 18,
-            "A19" = 19,
-            "A20" = 20
-        ),
+        params: &[VERTEX_RADIUS, CONIC_CONSTANT, SENSE, CONVENTION, APERTURE],
+        family: Some(&POWER_COEFFICIENTS),
         positional: &[],
         exclusive: &[],
         doc: "a conic plus Σ Aj |r|^j, each coefficient named by its power j",
+    },
+    Kind {
+        name: "cylinder",
+        category: Category::Surface,
+        params: &[VERTEX_RADIUS, AXIS, SENSE, CONVENTION, APERTURE],
+        family: None,
+        positional: &[],
+        exclusive: &[],
+        doc: "a circular cylinder: a circle of the given radius across `axis`, extruded along it",
+    },
+    Kind {
+        name: "acylinder",
+        category: Category::Surface,
+        params: &[
+            VERTEX_RADIUS,
+            CONIC_CONSTANT,
+            AXIS,
+            SENSE,
+            CONVENTION,
+            APERTURE,
+        ],
+        family: Some(&POWER_COEFFICIENTS),
+        positional: &[],
+        exclusive: &[],
+        doc: "an aspheric profile (conic plus Σ Aj |u|^j) across `axis`, extruded along it",
+    },
+    Kind {
+        name: "biconic",
+        category: Category::Surface,
+        params: &[
+            req(
+                "radius_x",
+                LENGTH,
+                Check::Any,
+                "vertex radius of the x–z section (a magnitude with `sense`, signed with `convention: optical`)",
+            ),
+            req(
+                "radius_y",
+                LENGTH,
+                Check::Any,
+                "vertex radius of the y–z section (as `radius_x`)",
+            ),
+            opt(
+                "conic_x",
+                NUMBER,
+                Check::Any,
+                "conic constant of the x–z section; default 0",
+            ),
+            opt(
+                "conic_y",
+                NUMBER,
+                Check::Any,
+                "conic constant of the y–z section; default 0",
+            ),
+            SENSE,
+            CONVENTION,
+            APERTURE,
+        ],
+        family: None,
+        positional: &[],
+        exclusive: &[],
+        doc: "z = (cx x² + cy y²) / (1 + sqrt(1 - (1+kx) cx² x² - (1+ky) cy² y²))",
+    },
+    Kind {
+        name: "toroid",
+        category: Category::Surface,
+        params: &[
+            VERTEX_RADIUS,
+            CONIC_CONSTANT,
+            req(
+                "rotation_radius",
+                LENGTH,
+                Check::Positive,
+                "distance from the vertex to the axis the y–z profile sweeps about (parallel to y)",
+            ),
+            SENSE,
+            CONVENTION,
+            APERTURE,
+        ],
+        family: Some(&POWER_COEFFICIENTS),
+        positional: &[],
+        exclusive: &[],
+        doc: "a y–z profile (conic plus Σ Aj |y|^j) swept about an axis parallel to y at `rotation_radius`",
+    },
+    Kind {
+        name: "ellipsoid",
+        category: Category::Surface,
+        params: &[
+            req("a", LENGTH, Check::Positive, "semi-axis along x"),
+            req("b", LENGTH, Check::Positive, "semi-axis along y"),
+            req(
+                "c",
+                LENGTH,
+                Check::Positive,
+                "semi-axis along z (the depth scale)",
+            ),
+            req(
+                "sense",
+                Ty::Word(&["convex", "concave"]),
+                Check::Any,
+                "convex (a cap) or concave (a dimple)",
+            ),
+            APERTURE,
+        ],
+        family: None,
+        positional: &[],
+        exclusive: &[],
+        doc: "the cap of an ellipsoid: z = c (1 - sqrt(1 - x²/a² - y²/b²))",
+    },
+    Kind {
+        name: "xy_polynomial",
+        category: Category::Surface,
+        params: &[
+            opt(
+                "radius",
+                LENGTH,
+                Check::Any,
+                "vertex radius of the conic base; a plane if absent",
+            ),
+            CONIC_CONSTANT,
+            SENSE,
+            CONVENTION,
+            APERTURE,
+        ],
+        family: Some(&XY_COEFFICIENTS),
+        positional: &[],
+        exclusive: &[],
+        doc: "a conic base plus Σ Cij x^i y^j, each coefficient named `XiYj`",
+    },
+    Kind {
+        name: "zernike",
+        category: Category::Surface,
+        params: &[
+            opt(
+                "radius",
+                LENGTH,
+                Check::Any,
+                "vertex radius of the conic base; a plane if absent",
+            ),
+            CONIC_CONSTANT,
+            SENSE,
+            CONVENTION,
+            APERTURE,
+            req(
+                "norm_radius",
+                LENGTH,
+                Check::Positive,
+                "normalisation radius of the Zernike terms",
+            ),
+            req(
+                "ordering",
+                Ty::Word(&["fringe", "ansi"]),
+                Check::Any,
+                "fringe (unnormalised, Z1 … Z37, Z1 piston) or ansi (ANSI Z80.28: Z0 piston, Z4 defocus, normalised)",
+            ),
+        ],
+        family: Some(&ZERNIKE_COEFFICIENTS),
+        positional: &[],
+        exclusive: &[],
+        doc: "a conic base plus Zernike polynomials over the normalisation radius",
     },
     Kind {
         name: "freeform",
@@ -222,6 +479,7 @@ pub static KINDS: &[Kind] = &[
                 "material side; the formula's z is already signed",
             ),
         ],
+        family: None,
         positional: &[],
         exclusive: &[],
         doc: "a height written as a formula of x and y",
@@ -233,6 +491,7 @@ pub static KINDS: &[Kind] = &[
             opt("diameter", LENGTH, Check::Positive, "diameter"),
             opt("radius", LENGTH, Check::Positive, "radius"),
         ],
+        family: None,
         positional: &[],
         exclusive: &[(&["diameter", "radius"], true)],
         doc: "a circular aperture centred on the axis",
@@ -244,6 +503,7 @@ pub static KINDS: &[Kind] = &[
             req("x", Ty::Range(Dim::LENGTH), Check::Any, "x from .. to"),
             req("y", Ty::Range(Dim::LENGTH), Check::Any, "y from .. to"),
         ],
+        family: None,
         positional: &[],
         exclusive: &[],
         doc: "a rectangle x × y",
@@ -277,6 +537,7 @@ pub static KINDS: &[Kind] = &[
                 "opening angle of the cutting edge",
             ),
         ],
+        family: None,
         positional: &[],
         exclusive: &[],
         doc: "a round-nose diamond turning tool, referenced at its nose centre",
@@ -324,6 +585,7 @@ pub static KINDS: &[Kind] = &[
                 "the work spindle",
             ),
         ],
+        family: None,
         positional: &[],
         exclusive: &[],
         doc: "a 2-axis lathe: X (radius) and Z (spindle axis)",
@@ -369,6 +631,7 @@ pub static KINDS: &[Kind] = &[
                 "clearance above the part for rapid moves; default 1 mm",
             ),
         ],
+        family: None,
         positional: &[],
         exclusive: &[],
         doc: "one facing pass along the profile with the nose centre offset along the normal",

@@ -25,46 +25,352 @@ pub enum LowerError {
     Aperture(&'static str),
 }
 
+/// How the material side enters the height: z = σ · sag(c), with c the
+/// signed vertex curvature used in the sag formula.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Side {
+    /// +1 or −1: multiplies the whole sag (coefficients included).
+    pub sigma: f64,
+    /// Whether the radius is used with its sign (optical convention).
+    pub signed: bool,
+}
+
+impl Side {
+    /// Reads `sense` / `convention` of a checked surface. With `sense`,
+    /// radii are magnitudes and σ = +1 concave, −1 convex (Lin's s). With
+    /// `convention: optical` (light along +z into the material), the sag is
+    /// the lens designer's, seen from the other side: σ = −1 and radii keep
+    /// their sign, so R > 0 is convex to the tool.
+    pub fn of(f: &[value::Field]) -> Side {
+        if value::word(f, "convention") == Some("optical") {
+            Side {
+                sigma: -1.0,
+                signed: true,
+            }
+        } else {
+            Side {
+                sigma: if value::word(f, "sense") == Some("convex") {
+                    -1.0
+                } else {
+                    1.0
+                },
+                signed: false,
+            }
+        }
+    }
+    /// The curvature 1/R the sag formula uses.
+    pub fn curvature(self, radius: f64) -> f64 {
+        if self.signed {
+            1.0 / radius
+        } else {
+            1.0 / radius.abs()
+        }
+    }
+}
+
 /// Lowers a checked surface object.
 pub fn lower_surface(o: &Object) -> Result<LoweredSurface, LowerError> {
     let f = &o.fields;
-    match o.kind.name {
+    let side = Side::of(f);
+    let k = value::num(f, "conic").unwrap_or(0.0);
+    let mut g = Graph::new();
+    let z = match o.kind.name {
+        "plane" => g.constant_node(0.0),
         "sphere" | "conic" | "asphere" => {
-            let ap =
-                value::object(f, "aperture").ok_or(LowerError::Aperture("missing aperture"))?;
-            let domain = domain_of(ap)?;
-            let radius = value::num(f, "radius").ok_or(LowerError::Unsupported("radius"))?;
-            let k = value::num(f, "conic").unwrap_or(0.0);
-            let sign = if value::word(f, "sense") == Some("convex") {
-                -1.0
+            let c =
+                side.curvature(value::num(f, "radius").ok_or(LowerError::Unsupported("radius"))?);
+            let r2 = radius_squared(&mut g);
+            let sag = conic_sag(&mut g, c, k, r2);
+            let sag = add_power_terms(&mut g, sag, r2, &power_terms(f));
+            let s = g.constant_node(side.sigma);
+            g.mul(s, sag)
+        }
+        "cylinder" | "acylinder" => {
+            let c =
+                side.curvature(value::num(f, "radius").ok_or(LowerError::Unsupported("radius"))?);
+            // Extruded along `axis`: the profile varies across it.
+            let u = if value::word(f, "axis") == Some("x") {
+                g.y()
             } else {
-                1.0
+                g.x()
             };
-            let terms: Vec<(u32, f64)> = (1..=20u32)
-                .filter_map(|j| value::num(f, &format!("A{j}")).map(|a| (j, a)))
+            let u2 = g.powi(u, 2);
+            let sag = conic_sag(&mut g, c, k, u2);
+            let sag = add_power_terms(&mut g, sag, u2, &power_terms(f));
+            let s = g.constant_node(side.sigma);
+            g.mul(s, sag)
+        }
+        "biconic" => {
+            let cx = side
+                .curvature(value::num(f, "radius_x").ok_or(LowerError::Unsupported("radius_x"))?);
+            let cy = side
+                .curvature(value::num(f, "radius_y").ok_or(LowerError::Unsupported("radius_y"))?);
+            let (kx, ky) = (
+                value::num(f, "conic_x").unwrap_or(0.0),
+                value::num(f, "conic_y").unwrap_or(0.0),
+            );
+            let (x, y) = (g.x(), g.y());
+            let x2 = g.powi(x, 2);
+            let y2 = g.powi(y, 2);
+            let num = {
+                let a = g.constant_node(cx);
+                let b = g.constant_node(cy);
+                let ax = g.mul(a, x2);
+                let by = g.mul(b, y2);
+                g.add(ax, by)
+            };
+            let root = {
+                let qa = g.constant_node((1.0 + kx) * cx * cx);
+                let qb = g.constant_node((1.0 + ky) * cy * cy);
+                let ta = g.mul(qa, x2);
+                let tb = g.mul(qb, y2);
+                let t = g.add(ta, tb);
+                let one = g.constant_node(1.0);
+                let u = g.sub(one, t);
+                g.sqrt(u)
+            };
+            let one = g.constant_node(1.0);
+            let den = g.add(one, root);
+            let sag = g.div(num, den);
+            let s = g.constant_node(side.sigma);
+            g.mul(s, sag)
+        }
+        "toroid" => {
+            let c =
+                side.curvature(value::num(f, "radius").ok_or(LowerError::Unsupported("radius"))?);
+            let rr = value::num(f, "rotation_radius")
+                .ok_or(LowerError::Unsupported("rotation_radius"))?;
+            // The rotation axis lies on the profile's side of the vertex.
+            let rr = if c < 0.0 { -rr } else { rr };
+            let y = g.y();
+            let y2 = g.powi(y, 2);
+            let zy = conic_sag(&mut g, c, k, y2);
+            let zy = add_power_terms(&mut g, zy, y2, &power_terms(f));
+            let x = g.x();
+            let x2 = g.powi(x, 2);
+            let r = g.constant_node(rr);
+            let d = g.sub(r, zy);
+            let d2 = g.powi(d, 2);
+            let under = g.sub(d2, x2);
+            let root = g.sqrt(under);
+            // z = Rr − sign(Rr) sqrt((Rr − z_y)² − x²)
+            let signed_root = if rr < 0.0 { g.neg(root) } else { root };
+            let sag = g.sub(r, signed_root);
+            let s = g.constant_node(side.sigma);
+            g.mul(s, sag)
+        }
+        "ellipsoid" => {
+            let (a, b, c) = (
+                value::num(f, "a").unwrap_or(1.0),
+                value::num(f, "b").unwrap_or(1.0),
+                value::num(f, "c").unwrap_or(1.0),
+            );
+            let (x, y) = (g.x(), g.y());
+            let x2 = g.powi(x, 2);
+            let y2 = g.powi(y, 2);
+            let ia = g.constant_node(1.0 / (a * a));
+            let ib = g.constant_node(1.0 / (b * b));
+            let tx = g.mul(ia, x2);
+            let ty = g.mul(ib, y2);
+            let t = g.add(tx, ty);
+            let one = g.constant_node(1.0);
+            let u = g.sub(one, t);
+            let root = g.sqrt(u);
+            let depth = g.sub(one, root);
+            let cc = g.constant_node(c * side.sigma);
+            g.mul(cc, depth)
+        }
+        "xy_polynomial" => {
+            let r2 = radius_squared(&mut g);
+            let mut sag = match value::num(f, "radius") {
+                Some(radius) => conic_sag(&mut g, side.curvature(radius), k, r2),
+                None => g.constant_node(0.0),
+            };
+            let (x, y) = (g.x(), g.y());
+            let mut terms: Vec<(u32, u32, f64)> = f
+                .iter()
+                .filter_map(|fl| {
+                    let (i, j) = crate::schema::xy_powers(&fl.name)?;
+                    match fl.value {
+                        Value::Num(v, _) => Some((i, j, v)),
+                        _ => None,
+                    }
+                })
                 .collect();
-            let mut g = Graph::new();
-            let z = rotational_sag(&mut g, radius, k, &terms, sign);
-            Ok(LoweredSurface {
-                tape: SurfaceTape::new(g, z),
-                domain,
-            })
+            terms.sort_by_key(|t| (t.0, t.1));
+            for (i, j, cij) in terms {
+                let xi = g.powi(x, i as i32);
+                let yj = g.powi(y, j as i32);
+                let m = g.mul(xi, yj);
+                let cc = g.constant_node(cij);
+                let t = g.mul(cc, m);
+                sag = g.add(sag, t);
+            }
+            let s = g.constant_node(side.sigma);
+            g.mul(s, sag)
+        }
+        "zernike" => {
+            let r2 = radius_squared(&mut g);
+            let mut sag = match value::num(f, "radius") {
+                Some(radius) => conic_sag(&mut g, side.curvature(radius), k, r2),
+                None => g.constant_node(0.0),
+            };
+            let norm =
+                value::num(f, "norm_radius").ok_or(LowerError::Unsupported("norm_radius"))?;
+            let ansi = value::word(f, "ordering") == Some("ansi");
+            let mut terms: Vec<(u32, f64)> = f
+                .iter()
+                .filter_map(|fl| {
+                    let j: u32 = fl.name.strip_prefix('Z')?.parse().ok()?;
+                    match fl.value {
+                        Value::Num(v, _) => Some((j, v)),
+                        _ => None,
+                    }
+                })
+                .collect();
+            terms.sort_by_key(|t| t.0);
+            for (j, coef) in terms {
+                let (n, m) = if ansi {
+                    zernike_ansi(j)
+                } else {
+                    zernike_fringe(j).ok_or(LowerError::Unsupported("fringe index above 37"))?
+                };
+                let norm_factor = if ansi {
+                    (2.0 * f64::from(n + 1) / if m == 0 { 2.0 } else { 1.0 }).sqrt()
+                } else {
+                    1.0
+                };
+                let zt = zernike_term(&mut g, n, m, norm);
+                let cc = g.constant_node(coef * norm_factor);
+                let t = g.mul(cc, zt);
+                sag = g.add(sag, t);
+            }
+            let s = g.constant_node(side.sigma);
+            g.mul(s, sag)
         }
         "freeform" => {
-            let dom = value::object(f, "domain").ok_or(LowerError::Aperture("missing domain"))?;
-            let domain = domain_of(dom)?;
             let Some(Value::Formula(formula)) = value::field(f, "z").map(|fl| &fl.value) else {
                 return Err(LowerError::Unsupported("freeform without a formula"));
             };
-            let mut g = Graph::new();
-            let z = lower_formula(&mut g, formula);
-            Ok(LoweredSurface {
-                tape: SurfaceTape::new(g, z),
-                domain,
-            })
+            lower_formula(&mut g, formula)
         }
-        other => Err(LowerError::Unsupported(other)),
+        other => return Err(LowerError::Unsupported(other)),
+    };
+    let region = value::object(f, "aperture")
+        .or_else(|| value::object(f, "domain"))
+        .ok_or(LowerError::Aperture("missing aperture"))?;
+    let domain = domain_of(region)?;
+    Ok(LoweredSurface {
+        tape: SurfaceTape::new(g, z),
+        domain,
+    })
+}
+
+/// x² + y².
+fn radius_squared(g: &mut Graph) -> Id {
+    let (x, y) = (g.x(), g.y());
+    let x2 = g.powi(x, 2);
+    let y2 = g.powi(y, 2);
+    g.add(x2, y2)
+}
+
+/// c s / (1 + sqrt(1 − (1+k) c² s)) with s = r² (or u²): the conic sag,
+/// smooth through the vertex.
+fn conic_sag(g: &mut Graph, c: f64, k: f64, s: Id) -> Id {
+    let cc = g.constant_node(c);
+    let num = g.mul(cc, s);
+    let q = g.constant_node((1.0 + k) * c * c);
+    let qs = g.mul(q, s);
+    let one = g.constant_node(1.0);
+    let u = g.sub(one, qs);
+    let root = g.sqrt(u);
+    let den = g.add(one, root);
+    g.div(num, den)
+}
+
+/// The `Aj` coefficients of a checked surface, by power.
+fn power_terms(f: &[value::Field]) -> Vec<(u32, f64)> {
+    (1..=20u32)
+        .filter_map(|j| value::num(f, &format!("A{j}")).map(|a| (j, a)))
+        .collect()
+}
+
+/// sag + Σ A_j (s)^(j/2), with s = r² (whole powers for even j).
+fn add_power_terms(g: &mut Graph, mut sag: Id, s: Id, terms: &[(u32, f64)]) -> Id {
+    for &(j, a) in terms {
+        let t = if j % 2 == 0 {
+            g.powi(s, (j / 2) as i32)
+        } else {
+            let half = g.constant_node(f64::from(j) / 2.0);
+            g.binary(Binary::Pow, s, half)
+        };
+        let ac = g.constant_node(a);
+        let term = g.mul(ac, t);
+        sag = g.add(sag, term);
     }
+    sag
+}
+
+/// (n, m) of ANSI Z80.28 index j (from 0): m < 0 is a sine term.
+pub fn zernike_ansi(j: u32) -> (u32, i32) {
+    let n = ((-3.0 + (9.0 + 8.0 * f64::from(j)).sqrt()) / 2.0).ceil() as u32;
+    let m = 2 * j as i32 - (n * (n + 2)) as i32;
+    (n, m)
+}
+
+/// (n, m) of fringe index j (1 … 37): m < 0 is a sine term. Z1 … Z36 follow
+/// the fringe rule; Z37 is the 12th-order spherical term.
+pub fn zernike_fringe(j: u32) -> Option<(u32, i32)> {
+    match j {
+        0 => None,
+        37 => Some((12, 0)),
+        1..=36 => {
+            let k = (f64::from(j).sqrt().ceil() as u32) - 1;
+            let t = j - k * k - 1;
+            let m = k - t / 2;
+            let n = 2 * k - m;
+            Some((n, if t % 2 == 1 { -(m as i32) } else { m as i32 }))
+        }
+        _ => None,
+    }
+}
+
+/// R_n^|m|(ρ) · cos(mθ) (m ≥ 0) or · sin(|m|θ) (m < 0), over ρ = r / norm,
+/// written as a polynomial in x and y: [R_n^m(ρ)/ρ^m] · Re or Im (u + iv)^m.
+fn zernike_term(g: &mut Graph, n: u32, m: i32, norm: f64) -> Id {
+    let ma = m.unsigned_abs();
+    let inv = g.constant_node(1.0 / norm);
+    let (x, y) = (g.x(), g.y());
+    let u = g.mul(x, inv);
+    let v = g.mul(y, inv);
+    // Re and Im of (u + iv)^|m|.
+    let one = g.constant_node(1.0);
+    let zero = g.constant_node(0.0);
+    let (mut re, mut im) = (one, zero);
+    for _ in 0..ma {
+        let a = g.mul(re, u);
+        let b = g.mul(im, v);
+        let c = g.mul(re, v);
+        let d = g.mul(im, u);
+        re = g.sub(a, b);
+        im = g.add(c, d);
+    }
+    let angular = if m < 0 { im } else { re };
+    // R_n^m(ρ)/ρ^m = Σ_s (−1)^s (n−s)! / (s! ((n+m)/2 − s)! ((n−m)/2 − s)!) (ρ²)^((n−m)/2 − s)
+    let u2 = g.powi(u, 2);
+    let v2 = g.powi(v, 2);
+    let rho2 = g.add(u2, v2);
+    let fact = |k: u32| (1..=k).map(f64::from).product::<f64>();
+    let mut radial = g.constant_node(0.0);
+    for s in 0..=(n - ma) / 2 {
+        let coef = if s % 2 == 0 { 1.0 } else { -1.0 } * fact(n - s)
+            / (fact(s) * fact((n + ma) / 2 - s) * fact((n - ma) / 2 - s));
+        let p = g.powi(rho2, ((n - ma) / 2 - s) as i32);
+        let cc = g.constant_node(coef);
+        let t = g.mul(cc, p);
+        radial = g.add(radial, t);
+    }
+    g.mul(radial, angular)
 }
 
 fn domain_of(ap: &Object) -> Result<Domain, LowerError> {
@@ -80,39 +386,12 @@ fn domain_of(ap: &Object) -> Result<Domain, LowerError> {
     }
 }
 
-/// z = s · (c r² / (1 + sqrt(1 − (1+k) c² r²)) + Σ A_j (r²)^(j/2)), written
-/// in r² = x² + y² so it is smooth through the axis.
+/// z = s · (c r² / (1 + sqrt(1 − (1+k) c² r²)) + Σ A_j (r²)^(j/2)) with
+/// c = 1/radius, written in r² = x² + y² so it is smooth through the axis.
 pub fn rotational_sag(g: &mut Graph, radius: f64, k: f64, terms: &[(u32, f64)], sign: f64) -> Id {
-    let (x, y) = (g.x(), g.y());
-    let x2 = g.powi(x, 2);
-    let y2 = g.powi(y, 2);
-    let r2 = g.add(x2, y2);
-    let c = 1.0 / radius;
-    let cr2 = {
-        let cc = g.constant_node(c);
-        g.mul(cc, r2)
-    };
-    let root = {
-        let q = g.constant_node((1.0 + k) * c * c);
-        let qr2 = g.mul(q, r2);
-        let one = g.constant_node(1.0);
-        let u = g.sub(one, qr2);
-        g.sqrt(u)
-    };
-    let one = g.constant_node(1.0);
-    let den = g.add(one, root);
-    let mut sag = g.div(cr2, den);
-    for &(j, a) in terms {
-        let t = if j % 2 == 0 {
-            g.powi(r2, (j / 2) as i32)
-        } else {
-            let half = g.constant_node(f64::from(j) / 2.0);
-            g.binary(Binary::Pow, r2, half)
-        };
-        let ac = g.constant_node(a);
-        let term = g.mul(ac, t);
-        sag = g.add(sag, term);
-    }
+    let r2 = radius_squared(g);
+    let sag = conic_sag(g, 1.0 / radius, k, r2);
+    let sag = add_power_terms(g, sag, r2, terms);
     let s = g.constant_node(sign);
     g.mul(s, sag)
 }
@@ -210,8 +489,19 @@ mod tests {
     #[test]
     fn ir_sag_matches_closed_form_profile() {
         let terms = vec![(3, 2e-4), (4, 1.5e-4), (6, -3e-6), (8, 2e-8), (16, 1e-14)];
-        for (radius, k, sense) in [(22.405, 43.098, Sense::Convex), (4.254, -3.359, Sense::Concave), (8.5, -0.62, Sense::Convex), (5.0, 0.0, Sense::Concave)] {
-            let closed = RotationalSurface { radius, conic: k, sense, terms: terms.clone(), aperture_radius: 1.5 };
+        for (radius, k, sense) in [
+            (22.405, 43.098, Sense::Convex),
+            (4.254, -3.359, Sense::Concave),
+            (8.5, -0.62, Sense::Convex),
+            (5.0, 0.0, Sense::Concave),
+        ] {
+            let closed = RotationalSurface {
+                radius,
+                conic: k,
+                sense,
+                terms: terms.clone(),
+                aperture_radius: 1.5,
+            };
             let mut g = Graph::new();
             let z = rotational_sag(&mut g, radius, k, &terms, sense.sign());
             let f = Interpreter::new(&SurfaceTape::new(g, z));
@@ -220,11 +510,33 @@ mod tests {
                 let ox = f.eval(r, 0.0);
                 let oy = f.eval(0.0, r);
                 let tol = |a: f64| 1e-13 * (1.0 + a.abs());
-                assert!((ox[0] - p.z).abs() <= tol(p.z), "z R={radius} r={r}: {} vs {}", ox[0], p.z);
-                assert!((ox[1] - p.dz).abs() <= tol(p.dz), "dz/dx R={radius} r={r}: {} vs {}", ox[1], p.dz);
-                assert!((ox[3] - p.d2z).abs() <= tol(p.d2z), "d2z/dx2 R={radius} r={r}: {} vs {}", ox[3], p.d2z);
-                assert!((oy[0] - p.z).abs() <= tol(p.z) && (oy[2] - p.dz).abs() <= tol(p.dz) && (oy[5] - p.d2z).abs() <= tol(p.d2z));
-                assert!(ox[2].abs() < 1e-15 && ox[4].abs() < 1e-15, "no slope across the section");
+                assert!(
+                    (ox[0] - p.z).abs() <= tol(p.z),
+                    "z R={radius} r={r}: {} vs {}",
+                    ox[0],
+                    p.z
+                );
+                assert!(
+                    (ox[1] - p.dz).abs() <= tol(p.dz),
+                    "dz/dx R={radius} r={r}: {} vs {}",
+                    ox[1],
+                    p.dz
+                );
+                assert!(
+                    (ox[3] - p.d2z).abs() <= tol(p.d2z),
+                    "d2z/dx2 R={radius} r={r}: {} vs {}",
+                    ox[3],
+                    p.d2z
+                );
+                assert!(
+                    (oy[0] - p.z).abs() <= tol(p.z)
+                        && (oy[2] - p.dz).abs() <= tol(p.dz)
+                        && (oy[5] - p.d2z).abs() <= tol(p.d2z)
+                );
+                assert!(
+                    ox[2].abs() < 1e-15 && ox[4].abs() < 1e-15,
+                    "no slope across the section"
+                );
             }
         }
     }
@@ -242,5 +554,208 @@ mod tests {
             let got = f.eval(x, y)[0];
             assert!((got - want).abs() <= 4e-16 * want, "{got} vs {want}");
         }
+    }
+
+    /// Checks `src` and lowers its surface `name`; evaluates at (x, y).
+    fn eval_surface(src: &str, name: &str, x: f64, y: f64) -> [f64; 6] {
+        let c = crate::driver::check_text(&crate::loader::RealFs, "t.lens", src.as_bytes());
+        assert!(!c.has_errors(), "{:?}", c.diags());
+        let o = c.checked.declarations.get(name).expect("surface");
+        let l = lower_surface(o).expect("lowers");
+        Interpreter::new(&l.tape).eval(x, y)
+    }
+
+    fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() <= 1e-14 * (1.0 + a.abs().max(b.abs()))
+    }
+
+    #[test]
+    fn zernike_indices_follow_the_tables() {
+        // Fringe: Z1 piston, Z4 defocus, Z5/Z6 astigmatism, Z9 spherical,
+        // Z10 trefoil, Z16 5th-order spherical, Z36 (10,0), Z37 (12,0).
+        assert_eq!(zernike_fringe(1), Some((0, 0)));
+        assert_eq!(zernike_fringe(2), Some((1, 1)));
+        assert_eq!(zernike_fringe(3), Some((1, -1)));
+        assert_eq!(zernike_fringe(4), Some((2, 0)));
+        assert_eq!(zernike_fringe(6), Some((2, -2)));
+        assert_eq!(zernike_fringe(9), Some((4, 0)));
+        assert_eq!(zernike_fringe(10), Some((3, 3)));
+        assert_eq!(zernike_fringe(16), Some((6, 0)));
+        assert_eq!(zernike_fringe(36), Some((10, 0)));
+        assert_eq!(zernike_fringe(37), Some((12, 0)));
+        assert_eq!(zernike_fringe(38), None);
+        // ANSI Z80.28: j = (n(n+2) + m)/2.
+        for n in 0..12u32 {
+            for m in (-(n as i32)..=n as i32).step_by(2) {
+                let j = ((n * (n + 2)) as i32 + m) / 2;
+                assert_eq!(zernike_ansi(j as u32), (n, m), "j={j}");
+            }
+        }
+    }
+
+    #[test]
+    fn zernike_terms_match_their_polynomials() {
+        let base = "surface w = zernike { norm_radius: 2 mm, ordering: ORD, aperture: circle(radius: 2 mm), TERM: 1 um }";
+        let at = |ord: &str, term: &str, x: f64, y: f64| {
+            eval_surface(&base.replace("ORD", ord).replace("TERM", term), "w", x, y)[0]
+        };
+        let (x, y): (f64, f64) = (0.7, -1.1);
+        let (rho, th) = ((x * x + y * y).sqrt() / 2.0, f64::atan2(y, x));
+        let um = 1e-3;
+        // Fringe Z9 = 6ρ⁴ − 6ρ² + 1; Z8 = (3ρ³ − 2ρ) sin θ; Z10 = ρ³ cos 3θ.
+        assert!(close(
+            at("fringe", "Z9", x, y),
+            um * (6.0 * rho.powi(4) - 6.0 * rho * rho + 1.0)
+        ));
+        assert!(close(
+            at("fringe", "Z8", x, y),
+            um * (3.0 * rho.powi(3) - 2.0 * rho) * th.sin()
+        ));
+        assert!(close(
+            at("fringe", "Z10", x, y),
+            um * rho.powi(3) * (3.0 * th).cos()
+        ));
+        // ANSI j = 12 is (4, 0) normalised by sqrt(5); j = 3 is (2, −2) by sqrt(6).
+        assert!(close(
+            at("ansi", "Z12", x, y),
+            um * 5f64.sqrt() * (6.0 * rho.powi(4) - 6.0 * rho * rho + 1.0)
+        ));
+        assert!(close(
+            at("ansi", "Z3", x, y),
+            um * 6f64.sqrt() * rho * rho * (2.0 * th).sin()
+        ));
+    }
+
+    #[test]
+    fn cylinder_toroid_biconic_ellipsoid_and_xy_polynomial() {
+        let (x, y) = (0.3, -0.45);
+        // A cylinder along y varies only with x.
+        let cyl = eval_surface(
+            "surface c = cylinder { radius: 2 mm, axis: y, sense: concave, aperture: circle(radius: 1 mm) }",
+            "c",
+            x,
+            y,
+        );
+        assert!(
+            close(cyl[0], x * x / (2.0 + (4.0 - x * x).sqrt())) && cyl[2] == 0.0 && cyl[5] == 0.0
+        );
+        // A biconic with equal radii and conics is the conic of revolution.
+        let bic = eval_surface(
+            "surface b = biconic { radius_x: 3 mm, radius_y: 3 mm, conic_x: -0.5, conic_y: -0.5, sense: convex, aperture: circle(radius: 1 mm) }",
+            "b",
+            x,
+            y,
+        );
+        let con = eval_surface(
+            "surface b = conic { radius: 3 mm, conic: -0.5, sense: convex, aperture: circle(radius: 1 mm) }",
+            "b",
+            x,
+            y,
+        );
+        for k in 0..6 {
+            assert!(
+                close(bic[k], con[k]),
+                "output {k}: {} vs {}",
+                bic[k],
+                con[k]
+            );
+        }
+        // A toroid whose rotation radius equals its profile radius is a sphere.
+        let tor = eval_surface(
+            "surface t = toroid { radius: 4 mm, rotation_radius: 4 mm, sense: concave, aperture: circle(radius: 1 mm) }",
+            "t",
+            x,
+            y,
+        );
+        let sph = eval_surface(
+            "surface t = sphere { radius: 4 mm, sense: concave, aperture: circle(radius: 1 mm) }",
+            "t",
+            x,
+            y,
+        );
+        for k in 0..6 {
+            assert!(
+                close(tor[k], sph[k]),
+                "output {k}: {} vs {}",
+                tor[k],
+                sph[k]
+            );
+        }
+        // At x = 0 a toroid is its y–z profile; along x a circle of the rotation radius.
+        let tor = eval_surface(
+            "surface t = toroid { radius: 4 mm, rotation_radius: 10 mm, sense: concave, aperture: circle(radius: 1 mm) }",
+            "t",
+            0.0,
+            y,
+        );
+        assert!(close(tor[0], y * y / (4.0 + (16.0 - y * y).sqrt())));
+        let tor = eval_surface(
+            "surface t = toroid { radius: 4 mm, rotation_radius: 10 mm, sense: concave, aperture: circle(radius: 1 mm) }",
+            "t",
+            x,
+            0.0,
+        );
+        assert!(close(tor[0], x * x / (10.0 + (100.0 - x * x).sqrt())));
+        // Seed 002's lenslet: a = b = 0.505 mm, c = 1.01 mm, a dimple.
+        let e = eval_surface(
+            "surface e = ellipsoid { a: 0.505 mm, b: 0.505 mm, c: 1.01 mm, sense: concave, aperture: circle(diameter: 0.1 mm) }",
+            "e",
+            0.03,
+            0.04,
+        );
+        assert!(close(
+            e[0],
+            1.01 * (1.0 - (1.0f64 - 0.0025 / (0.505 * 0.505)).sqrt())
+        ));
+        // XY polynomial on a plane: 0.01 x²y − 0.002 y³ (coefficients in mm^-2).
+        let p = eval_surface(
+            "surface p = xy_polynomial { aperture: circle(radius: 1 mm), X2Y1: 0.01 mm^-2, X0Y3: -0.002 mm^-2 }",
+            "p",
+            x,
+            y,
+        );
+        assert!(close(p[0], 0.01 * x * x * y - 0.002 * y * y * y));
+        assert!(close(p[4], 0.02 * x));
+    }
+
+    #[test]
+    fn optical_sign_convention_matches_sense() {
+        // Kim 2008's concave R = −4.254 mm, k = −3.359 in the optical
+        // convention is the same surface as |R| with `sense: concave`; a
+        // positive optical R is convex. Coefficients follow the sag's sign.
+        let (x, y) = (0.4, 0.9);
+        let opt = eval_surface(
+            "surface s = asphere { radius: -4.254 mm, conic: -3.359, convention: optical, A4: 1e-3 mm^-3, aperture: circle(radius: 1.5 mm) }",
+            "s",
+            x,
+            y,
+        );
+        let sen = eval_surface(
+            "surface s = asphere { radius: 4.254 mm, conic: -3.359, sense: concave, A4: -1e-3 mm^-3, aperture: circle(radius: 1.5 mm) }",
+            "s",
+            x,
+            y,
+        );
+        for k in 0..6 {
+            assert!(
+                close(opt[k], sen[k]),
+                "output {k}: {} vs {}",
+                opt[k],
+                sen[k]
+            );
+        }
+        let opt = eval_surface(
+            "surface s = conic { radius: 22.405 mm, conic: 43.098, convention: optical, aperture: circle(radius: 1.6 mm) }",
+            "s",
+            x,
+            y,
+        );
+        let sen = eval_surface(
+            "surface s = conic { radius: 22.405 mm, conic: 43.098, sense: convex, aperture: circle(radius: 1.6 mm) }",
+            "s",
+            x,
+            y,
+        );
+        assert!(close(opt[0], sen[0]) && opt[0] < 0.0);
     }
 }
