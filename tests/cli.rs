@@ -327,3 +327,44 @@ fn sample_usage_errors() {
         Some(2)
     );
 }
+
+fn analyse(file: &str, surface: &str) -> serde_json::Value {
+    let out = lensc(&root(), &["analyse", file, "--surface", surface]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    serde_json::from_slice(&out.stdout).expect("json")
+}
+
+#[test]
+fn analyse_reproduces_seed_002_figures() {
+    // Liu et al.: minimum radius of curvature 2 mm, maximum slope 3.81° in
+    // the cutting (circumferential, y) direction and 5.71° axially (x).
+    let a = analyse("examples/liu_roller_pattern.lens", "pattern");
+    let v = |p: &str| a.pointer(p).and_then(serde_json::Value::as_f64).expect(p);
+    assert_eq!(format!("{:.2}", v("/max_slope_y_deg/value")), "3.81");
+    assert_eq!(format!("{:.2}", v("/max_slope_x_deg/value")), "5.71");
+    let r = v("/min_radius_of_curvature_mm/convex_x/value")
+        .min(v("/min_radius_of_curvature_mm/concave_x/value"));
+    assert_eq!(format!("{r:.3}"), "2.000");
+    assert!((v("/sag_mm/pv") - 0.08).abs() < 1e-12);
+}
+
+#[test]
+fn analyse_seed_003_lenslet() {
+    // Sphere R = 20 mm over 1.7 mm: sag 18.07 µm (Table 1: 18 µm), edge
+    // slope asin(0.85/20) = 2.436°. The x–z section at y is a circle of
+    // radius sqrt(R² − y²): smallest at the rim, y = ±0.85 mm.
+    let a = analyse("examples/hashimoto2025_lenslet.lens", "lenslet");
+    let v = |p: &str| a.pointer(p).and_then(serde_json::Value::as_f64).expect(p);
+    let sag = 0.85f64.powi(2) / (20.0 + (400.0 - 0.85f64.powi(2)).sqrt());
+    assert!((v("/sag_mm/pv") - sag).abs() < 1e-12, "{}", v("/sag_mm/pv"));
+    assert!((v("/max_slope_deg/value") - (0.85f64 / 20.0).asin().to_degrees()).abs() < 1e-9);
+    assert!(
+        (v("/min_radius_of_curvature_mm/concave_x/value") - (400.0f64 - 0.7225).sqrt()).abs()
+            < 1e-9
+    );
+    assert!(
+        a.pointer("/min_radius_of_curvature_mm/convex_x")
+            .expect("key")
+            .is_null()
+    );
+}

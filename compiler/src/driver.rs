@@ -196,9 +196,12 @@ pub enum SamplePoints {
 /// One sample: x, y, z (mm), dz/dx, dz/dy, curvature along x and y (1/mm).
 pub type Sample = [f64; 7];
 
-/// Evaluates a declared surface at the requested points.
-pub fn sample(c: &Checked, surface: &str, at: &SamplePoints) -> Result<Vec<Sample>, String> {
-    let Some(obj) = c.checked.declarations.get(surface) else {
+/// The declared surface `name`, lowered to IR, or a message saying why not.
+pub fn declared_surface(
+    c: &Checked,
+    name: &str,
+) -> Result<crate::surfaces::LoweredSurface, String> {
+    let Some(obj) = c.checked.declarations.get(name) else {
         let mut names: Vec<&str> = c
             .checked
             .declarations
@@ -208,7 +211,7 @@ pub fn sample(c: &Checked, surface: &str, at: &SamplePoints) -> Result<Vec<Sampl
             .collect();
         names.sort_unstable();
         return Err(format!(
-            "no surface `{surface}` (surfaces: {})",
+            "no surface `{name}` (surfaces: {})",
             if names.is_empty() {
                 "none".into()
             } else {
@@ -218,12 +221,55 @@ pub fn sample(c: &Checked, surface: &str, at: &SamplePoints) -> Result<Vec<Sampl
     };
     if obj.kind.category != crate::schema::Category::Surface {
         return Err(format!(
-            "`{surface}` is {}, not a surface",
+            "`{name}` is {}, not a surface",
             obj.kind.category.noun()
         ));
     }
-    let lowered = crate::surfaces::lower_surface(obj)
-        .map_err(|e| format!("`{surface}` cannot be evaluated yet: {e:?}"))?;
+    crate::surfaces::lower_surface(obj)
+        .map_err(|e| format!("`{name}` cannot be evaluated yet: {e:?}"))
+}
+
+/// The analysis of a surface as the JSON object the reports carry (its
+/// fields are documented in README.md, "Surface analysis").
+pub fn analysis_json(
+    name: &str,
+    kind: &str,
+    l: &crate::surfaces::LoweredSurface,
+    grid: usize,
+) -> serde_json::Value {
+    use lensc_runtime::analysis::{Domain, Extremum, analyse};
+    use serde_json::json;
+    let f = lensc_runtime::ir::Interpreter::new(&l.tape);
+    let a = analyse(&f, &l.domain, grid);
+    let at =
+        |e: &Extremum, scale: f64| json!({ "value": e.value * scale, "x_mm": e.x, "y_mm": e.y });
+    let deg = 180.0 / std::f64::consts::PI;
+    let radius = |e: &Option<Extremum>| e.as_ref().map_or(serde_json::Value::Null, |e| at(e, 1.0));
+    let domain = match l.domain {
+        Domain::Circle { radius } => json!({ "circle": { "radius_mm": radius } }),
+        Domain::Rect { x, y } => json!({ "rect": { "x_mm": [x.0, x.1], "y_mm": [y.0, y.1] } }),
+    };
+    json!({
+        "surface": name,
+        "kind": kind,
+        "domain": domain,
+        "grid": grid,
+        "sag_mm": { "min": at(&a.sag_min, 1.0), "max": at(&a.sag_max, 1.0), "pv": a.pv() },
+        "max_slope_deg": at(&a.max_slope, deg),
+        "max_slope_x_deg": at(&a.max_slope_x, deg),
+        "max_slope_y_deg": at(&a.max_slope_y, deg),
+        "min_radius_of_curvature_mm": {
+            "concave_x": radius(&a.min_radius_concave_x),
+            "convex_x": radius(&a.min_radius_convex_x),
+            "concave_y": radius(&a.min_radius_concave_y),
+            "convex_y": radius(&a.min_radius_convex_y),
+        },
+    })
+}
+
+/// Evaluates a declared surface at the requested points.
+pub fn sample(c: &Checked, surface: &str, at: &SamplePoints) -> Result<Vec<Sample>, String> {
+    let lowered = declared_surface(c, surface)?;
     let f = lensc_runtime::ir::Interpreter::new(&lowered.tape);
     let domain = lowered.domain;
     let ((x0, x1), (y0, y1)) = domain.bounds();

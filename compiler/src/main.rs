@@ -50,6 +50,18 @@ enum Command {
         #[arg(long, default_value = "out")]
         out: PathBuf,
     },
+    /// Analyse a surface over its aperture: sag range, slopes and radii of
+    /// curvature with where they occur, as JSON on stdout.
+    Analyse {
+        /// The .lens file that declares the surface.
+        file: PathBuf,
+        /// The surface's name.
+        #[arg(long)]
+        surface: String,
+        /// Grid points per side before refinement.
+        #[arg(long, default_value_t = 201, value_name = "N")]
+        grid: usize,
+    },
     /// Evaluate a surface: CSV on stdout with the header
     /// x,y,z,dzdx,dzdy,curvature_x,curvature_y (mm and 1/mm).
     #[command(group(clap::ArgGroup::new("at").required(true).args(["grid", "radial", "points"])))]
@@ -123,6 +135,38 @@ fn run(cli: Cli) -> u8 {
                 }
             }
             code
+        }
+        Command::Analyse {
+            file,
+            surface,
+            grid,
+        } => {
+            let Some(c) = load(&out, &file) else { return 1 };
+            out.diagnostics(&c, c.diags());
+            if c.has_errors() {
+                return 1;
+            }
+            match driver::declared_surface(&c, &surface) {
+                Ok(l) => {
+                    let kind = c
+                        .checked
+                        .declarations
+                        .get(&surface)
+                        .map_or("", |o| o.kind.name);
+                    let v = driver::analysis_json(&surface, kind, &l, grid.max(2));
+                    // A closed pipe (`| head`) is not an error.
+                    let _ = writeln!(
+                        std::io::stdout().lock(),
+                        "{}",
+                        serde_json::to_string_pretty(&v).unwrap_or_default()
+                    );
+                    0
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    2
+                }
+            }
         }
         Command::Sample {
             file,
@@ -269,12 +313,13 @@ fn load(out: &Output, path: &Path) -> Option<Checked> {
             let msg = format!("cannot read {}: {}", path.display(), plain_io_error(&e));
             match out.format {
                 MessageFormat::Human => eprintln!("error[{}]: {msg}", lensc::codes::CANNOT_READ),
-                MessageFormat::Json => println!(
+                MessageFormat::Json => drop(writeln!(
+                    std::io::stdout().lock(),
                     "{}",
                     serde_json::json!({"severity": "error", "code": lensc::codes::CANNOT_READ, "message": msg,
                         "file": path.display().to_string(), "line": 0, "column": 0,
                         "span": {"start": 0, "end": 0}, "labels": [], "help": null})
-                ),
+                )),
             }
             None
         }
