@@ -155,6 +155,14 @@ impl<'a> Checker<'a> {
                     );
                     continue;
                 }
+                if schema::is_word(&name.name) {
+                    self.err(
+                        Diagnostic::error(codes::DUPLICATE_NAME, format!("`{}` is a word lensc uses as a value", name.name), pf.id, name.span)
+                            .with_label("this name would hide the word")
+                            .with_help(format!("`{}` is the value of a parameter (as in `sense: convex`); choose another name", name.name)),
+                    );
+                    continue;
+                }
                 if FUNCTIONS.contains(&name.name.as_str())
                     || schema::kind(&name.name).is_some()
                     || COORDINATES.contains(&name.name.as_str())
@@ -1364,6 +1372,55 @@ impl<'a> Checker<'a> {
                         .with_help("reduce the aperture, or check the sign of the conic constant"),
                     );
                     return false;
+                }
+                true
+            }
+            "wrap" => {
+                let f = &o.fields;
+                let (Some(design), Some(roller)) =
+                    (value::object(f, "surface"), value::object(f, "onto"))
+                else {
+                    return true;
+                };
+                let Some(radius) = value::num(&roller.fields, "radius") else {
+                    return true;
+                };
+                let region = value::object(&design.fields, "aperture")
+                    .or_else(|| value::object(&design.fields, "domain"));
+                let length = match region {
+                    Some(r) if r.kind.name == "rect" => {
+                        value::range(&r.fields, "y").map(|(a, b)| b - a)
+                    }
+                    Some(r) => aperture_radius(r).map(|a| 2.0 * a),
+                    None => None,
+                };
+                let Some(length) = length else { return true };
+                let circumference = 2.0 * std::f64::consts::PI * radius;
+                let at = value::field(f, "onto").expect("onto");
+                // Within 1 µm the design closes on itself.
+                if length > circumference + 1e-3 {
+                    self.err(
+                        Diagnostic::error(
+                            codes::WRAP_OVERLAP,
+                            format!("the design is {} mm long around the roller, more than its circumference 2π·{} = {} mm: it would overlap itself", trim_num(length), trim_num(radius), trim_num(circumference)),
+                            at.file,
+                            at.span,
+                        )
+                        .with_label("this roller is too small for the design")
+                        .with_help(format!("a roller for this design has radius L/2π = {} mm", trim_num(length / (2.0 * std::f64::consts::PI)))),
+                    );
+                    return false;
+                }
+                if length < circumference - 1e-3 {
+                    self.diags.push(
+                        Diagnostic::warning(
+                            codes::WRAP_GAP,
+                            format!("the design is {} mm long around the roller, shorter than its circumference {} mm: a {} mm gap is left", trim_num(length), trim_num(circumference), trim_num(circumference - length)),
+                            at.file,
+                            at.span,
+                        )
+                        .with_label("the design does not close around this roller"),
+                    );
                 }
                 true
             }

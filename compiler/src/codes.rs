@@ -33,6 +33,7 @@ pub const NO_JOB: &str = "E0130";
 pub const UNSUPPORTED_COMBINATION: &str = "E0131";
 pub const EMPTY_FILE: &str = "E0132";
 pub const OUTSIDE_APERTURE: &str = "E0133";
+pub const WRAP_OVERLAP: &str = "E0134";
 pub const NOSE_TOO_LARGE: &str = "E0140";
 pub const OUT_OF_TRAVEL: &str = "E0141";
 pub const FEED_TOO_HIGH: &str = "E0142";
@@ -42,6 +43,7 @@ pub const NOT_PRINTABLE: &str = "E0150";
 pub const CANNOT_WRITE: &str = "E0151";
 
 pub const UNUSED: &str = "W0001";
+pub const WRAP_GAP: &str = "W0002";
 
 /// All codes, for the uniqueness test and the reference in README.
 pub const ALL: &[&str] = &[
@@ -76,6 +78,8 @@ pub const ALL: &[&str] = &[
     UNSUPPORTED_COMBINATION,
     EMPTY_FILE,
     OUTSIDE_APERTURE,
+    WRAP_OVERLAP,
+    WRAP_GAP,
     NOSE_TOO_LARGE,
     OUT_OF_TRAVEL,
     FEED_TOO_HIGH,

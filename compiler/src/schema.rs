@@ -15,6 +15,7 @@ pub enum Category {
     Machine,
     Strategy,
     Aperture,
+    Roller,
 }
 
 impl Category {
@@ -33,6 +34,7 @@ impl Category {
             Category::Machine => "a machine",
             Category::Strategy => "a strategy",
             Category::Aperture => "an aperture",
+            Category::Roller => "a roller",
         }
     }
 }
@@ -485,6 +487,77 @@ pub static KINDS: &[Kind] = &[
         doc: "a height written as a formula of x and y",
     },
     Kind {
+        name: "wrap",
+        category: Category::Surface,
+        params: &[
+            req(
+                "surface",
+                Ty::Object(Category::Surface),
+                Check::Any,
+                "the flat design: x along the roller's axis, y around it",
+            ),
+            req(
+                "onto",
+                Ty::Object(Category::Roller),
+                Check::Any,
+                "the roller it is wrapped onto",
+            ),
+        ],
+        family: None,
+        positional: &["surface"],
+        exclusive: &[],
+        doc: "a flat design wrapped onto a roller: y becomes the arc length R·c around it",
+    },
+    Kind {
+        name: "off_axis",
+        category: Category::Surface,
+        params: &[
+            req(
+                "parent",
+                Ty::Object(Category::Surface),
+                Check::Any,
+                "the parent surface the section is cut from",
+            ),
+            req(
+                "x",
+                LENGTH,
+                Check::Any,
+                "x of the section's centre on the parent",
+            ),
+            req(
+                "y",
+                LENGTH,
+                Check::Any,
+                "y of the section's centre on the parent",
+            ),
+            opt(
+                "tilt",
+                Ty::Word(&["keep", "remove"]),
+                Check::Any,
+                "`keep` (default) the parent's slope at the centre, or `remove` it (the section mounted square to the spindle, small-angle)",
+            ),
+            APERTURE,
+        ],
+        family: None,
+        positional: &["parent"],
+        exclusive: &[],
+        doc: "an off-axis section of a parent surface, in coordinates centred on (x, y), its height zero there",
+    },
+    Kind {
+        name: "roller",
+        category: Category::Roller,
+        params: &[req(
+            "radius",
+            LENGTH,
+            Check::Positive,
+            "the roller's radius",
+        )],
+        family: None,
+        positional: &[],
+        exclusive: &[],
+        doc: "a cylindrical roller to wrap a design onto",
+    },
+    Kind {
         name: "circle",
         category: Category::Aperture,
         params: &[
@@ -668,4 +741,17 @@ pub static JOB_PARAMS: &[Param] = &[
 
 pub fn kind(name: &str) -> Option<&'static Kind> {
     KINDS.iter().find(|k| k.name == name)
+}
+
+/// Whether `name` is a word some parameter takes (`convex`, `linuxcnc`…):
+/// such names cannot be declared, so `sense: convex` always means the word.
+pub fn is_word(name: &str) -> bool {
+    fn in_params(params: &[Param], name: &str) -> bool {
+        params.iter().any(|p| match p.ty {
+            Ty::Word(words) => words.contains(&name),
+            Ty::Block(sub) => in_params(sub, name),
+            _ => false,
+        })
+    }
+    KINDS.iter().any(|k| in_params(k.params, name)) || in_params(JOB_PARAMS, name)
 }

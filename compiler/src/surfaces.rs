@@ -4,7 +4,7 @@
 
 use lensc_grammar::ast::{BinaryOp, Expr, ExprKind, UnaryOp};
 use lensc_runtime::analysis::Domain;
-use lensc_runtime::ir::{Binary, Graph, Id, SurfaceTape, Unary, Var};
+use lensc_runtime::ir::{Binary, Graph, Id, SurfaceTape, Unary};
 
 use crate::check::aperture_radius;
 use crate::units;
@@ -70,18 +70,39 @@ impl Side {
 
 /// Lowers a checked surface object.
 pub fn lower_surface(o: &Object) -> Result<LoweredSurface, LowerError> {
+    let mut g = Graph::new();
+    let (x, y) = (g.x(), g.y());
+    let z = height(&mut g, o, x, y)?;
+    let region = value::object(&o.fields, "aperture")
+        .or_else(|| value::object(&o.fields, "domain"))
+        .or_else(|| {
+            value::object(&o.fields, "surface").and_then(|s| {
+                value::object(&s.fields, "aperture").or_else(|| value::object(&s.fields, "domain"))
+            })
+        })
+        .ok_or(LowerError::Aperture("missing aperture"))?;
+    let domain = domain_of(region)?;
+    Ok(LoweredSurface {
+        tape: SurfaceTape::new(g, z),
+        domain,
+    })
+}
+
+/// The height of surface `o` at the coordinates `x`, `y` (nodes of `g`),
+/// built into `g`: sections and wrapped designs build their parent's height
+/// at moved coordinates.
+pub fn height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError> {
     let f = &o.fields;
     let side = Side::of(f);
     let k = value::num(f, "conic").unwrap_or(0.0);
-    let mut g = Graph::new();
     let z = match o.kind.name {
         "plane" => g.constant_node(0.0),
         "sphere" | "conic" | "asphere" => {
             let c =
                 side.curvature(value::num(f, "radius").ok_or(LowerError::Unsupported("radius"))?);
-            let r2 = radius_squared(&mut g);
-            let sag = conic_sag(&mut g, c, k, r2);
-            let sag = add_power_terms(&mut g, sag, r2, &power_terms(f));
+            let r2 = radius_squared(g, x, y);
+            let sag = conic_sag(g, c, k, r2);
+            let sag = add_power_terms(g, sag, r2, &power_terms(f));
             let s = g.constant_node(side.sigma);
             g.mul(s, sag)
         }
@@ -90,13 +111,13 @@ pub fn lower_surface(o: &Object) -> Result<LoweredSurface, LowerError> {
                 side.curvature(value::num(f, "radius").ok_or(LowerError::Unsupported("radius"))?);
             // Extruded along `axis`: the profile varies across it.
             let u = if value::word(f, "axis") == Some("x") {
-                g.y()
+                y
             } else {
-                g.x()
+                x
             };
             let u2 = g.powi(u, 2);
-            let sag = conic_sag(&mut g, c, k, u2);
-            let sag = add_power_terms(&mut g, sag, u2, &power_terms(f));
+            let sag = conic_sag(g, c, k, u2);
+            let sag = add_power_terms(g, sag, u2, &power_terms(f));
             let s = g.constant_node(side.sigma);
             g.mul(s, sag)
         }
@@ -109,7 +130,6 @@ pub fn lower_surface(o: &Object) -> Result<LoweredSurface, LowerError> {
                 value::num(f, "conic_x").unwrap_or(0.0),
                 value::num(f, "conic_y").unwrap_or(0.0),
             );
-            let (x, y) = (g.x(), g.y());
             let x2 = g.powi(x, 2);
             let y2 = g.powi(y, 2);
             let num = {
@@ -142,11 +162,9 @@ pub fn lower_surface(o: &Object) -> Result<LoweredSurface, LowerError> {
                 .ok_or(LowerError::Unsupported("rotation_radius"))?;
             // The rotation axis lies on the profile's side of the vertex.
             let rr = if c < 0.0 { -rr } else { rr };
-            let y = g.y();
             let y2 = g.powi(y, 2);
-            let zy = conic_sag(&mut g, c, k, y2);
-            let zy = add_power_terms(&mut g, zy, y2, &power_terms(f));
-            let x = g.x();
+            let zy = conic_sag(g, c, k, y2);
+            let zy = add_power_terms(g, zy, y2, &power_terms(f));
             let x2 = g.powi(x, 2);
             let r = g.constant_node(rr);
             let d = g.sub(r, zy);
@@ -165,7 +183,6 @@ pub fn lower_surface(o: &Object) -> Result<LoweredSurface, LowerError> {
                 value::num(f, "b").unwrap_or(1.0),
                 value::num(f, "c").unwrap_or(1.0),
             );
-            let (x, y) = (g.x(), g.y());
             let x2 = g.powi(x, 2);
             let y2 = g.powi(y, 2);
             let ia = g.constant_node(1.0 / (a * a));
@@ -181,12 +198,11 @@ pub fn lower_surface(o: &Object) -> Result<LoweredSurface, LowerError> {
             g.mul(cc, depth)
         }
         "xy_polynomial" => {
-            let r2 = radius_squared(&mut g);
+            let r2 = radius_squared(g, x, y);
             let mut sag = match value::num(f, "radius") {
-                Some(radius) => conic_sag(&mut g, side.curvature(radius), k, r2),
+                Some(radius) => conic_sag(g, side.curvature(radius), k, r2),
                 None => g.constant_node(0.0),
             };
-            let (x, y) = (g.x(), g.y());
             let mut terms: Vec<(u32, u32, f64)> = f
                 .iter()
                 .filter_map(|fl| {
@@ -210,9 +226,9 @@ pub fn lower_surface(o: &Object) -> Result<LoweredSurface, LowerError> {
             g.mul(s, sag)
         }
         "zernike" => {
-            let r2 = radius_squared(&mut g);
+            let r2 = radius_squared(g, x, y);
             let mut sag = match value::num(f, "radius") {
-                Some(radius) => conic_sag(&mut g, side.curvature(radius), k, r2),
+                Some(radius) => conic_sag(g, side.curvature(radius), k, r2),
                 None => g.constant_node(0.0),
             };
             let norm =
@@ -240,7 +256,7 @@ pub fn lower_surface(o: &Object) -> Result<LoweredSurface, LowerError> {
                 } else {
                     1.0
                 };
-                let zt = zernike_term(&mut g, n, m, norm);
+                let zt = zernike_term(g, (x, y), n, m, norm);
                 let cc = g.constant_node(coef * norm_factor);
                 let t = g.mul(cc, zt);
                 sag = g.add(sag, t);
@@ -252,23 +268,51 @@ pub fn lower_surface(o: &Object) -> Result<LoweredSurface, LowerError> {
             let Some(Value::Formula(formula)) = value::field(f, "z").map(|fl| &fl.value) else {
                 return Err(LowerError::Unsupported("freeform without a formula"));
             };
-            lower_formula(&mut g, formula)
+            lower_formula(g, formula, x, y)
+        }
+        "wrap" => {
+            // The flat design; the roller only maps y to the arc around it.
+            let design = value::object(f, "surface")
+                .ok_or(LowerError::Unsupported("wrap without a design"))?;
+            height(g, design, x, y)?
+        }
+        "off_axis" => {
+            let parent = value::object(f, "parent")
+                .ok_or(LowerError::Unsupported("off_axis without a parent"))?;
+            let (x0, y0) = (
+                value::num(f, "x").unwrap_or(0.0),
+                value::num(f, "y").unwrap_or(0.0),
+            );
+            let cx = g.constant_node(x0);
+            let cy = g.constant_node(y0);
+            let px = g.add(x, cx);
+            let py = g.add(y, cy);
+            let zp = height(g, parent, px, py)?;
+            // The parent's height and slope at the centre, as constants.
+            let mut h = Graph::new();
+            let (hx, hy) = (h.x(), h.y());
+            let hz = height(&mut h, parent, hx, hy)?;
+            let at = lensc_runtime::ir::Interpreter::new(&SurfaceTape::new(h, hz));
+            let o0 = lensc_runtime::ir::SurfaceFn::eval(&at, x0, y0);
+            let z0 = g.constant_node(o0[0]);
+            let mut z = g.sub(zp, z0);
+            if value::word(f, "tilt") == Some("remove") {
+                let sx = g.constant_node(o0[1]);
+                let sy = g.constant_node(o0[2]);
+                let tx = g.mul(sx, x);
+                let ty = g.mul(sy, y);
+                let plane = g.add(tx, ty);
+                z = g.sub(z, plane);
+            }
+            z
         }
         other => return Err(LowerError::Unsupported(other)),
     };
-    let region = value::object(f, "aperture")
-        .or_else(|| value::object(f, "domain"))
-        .ok_or(LowerError::Aperture("missing aperture"))?;
-    let domain = domain_of(region)?;
-    Ok(LoweredSurface {
-        tape: SurfaceTape::new(g, z),
-        domain,
-    })
+    Ok(z)
 }
 
 /// x² + y².
-fn radius_squared(g: &mut Graph) -> Id {
-    let (x, y) = (g.x(), g.y());
+fn radius_squared(g: &mut Graph, x: Id, y: Id) -> Id {
     let x2 = g.powi(x, 2);
     let y2 = g.powi(y, 2);
     g.add(x2, y2)
@@ -337,10 +381,9 @@ pub fn zernike_fringe(j: u32) -> Option<(u32, i32)> {
 
 /// R_n^|m|(ρ) · cos(mθ) (m ≥ 0) or · sin(|m|θ) (m < 0), over ρ = r / norm,
 /// written as a polynomial in x and y: [R_n^m(ρ)/ρ^m] · Re or Im (u + iv)^m.
-fn zernike_term(g: &mut Graph, n: u32, m: i32, norm: f64) -> Id {
+fn zernike_term(g: &mut Graph, (x, y): (Id, Id), n: u32, m: i32, norm: f64) -> Id {
     let ma = m.unsigned_abs();
     let inv = g.constant_node(1.0 / norm);
-    let (x, y) = (g.x(), g.y());
     let u = g.mul(x, inv);
     let v = g.mul(y, inv);
     // Re and Im of (u + iv)^|m|.
@@ -389,19 +432,22 @@ fn domain_of(ap: &Object) -> Result<Domain, LowerError> {
 /// z = s · (c r² / (1 + sqrt(1 − (1+k) c² r²)) + Σ A_j (r²)^(j/2)) with
 /// c = 1/radius, written in r² = x² + y² so it is smooth through the axis.
 pub fn rotational_sag(g: &mut Graph, radius: f64, k: f64, terms: &[(u32, f64)], sign: f64) -> Id {
-    let r2 = radius_squared(g);
+    let (x, y) = (g.x(), g.y());
+    let r2 = radius_squared(g, x, y);
     let sag = conic_sag(g, 1.0 / radius, k, r2);
     let sag = add_power_terms(g, sag, r2, terms);
     let s = g.constant_node(sign);
     g.mul(s, sag)
 }
 
-/// Lowers a checked formula body (in base units: mm and rad).
-pub fn lower_formula(g: &mut Graph, f: &Formula) -> Id {
-    lower_expr(g, f, &f.body)
+/// Lowers a checked formula body (in base units: mm and rad) at the
+/// coordinates `x`, `y`.
+pub fn lower_formula(g: &mut Graph, f: &Formula, x: Id, y: Id) -> Id {
+    lower_expr(g, f, (x, y), &f.body)
 }
 
-fn lower_expr(g: &mut Graph, f: &Formula, e: &Expr) -> Id {
+fn lower_expr(g: &mut Graph, f: &Formula, at: (Id, Id), e: &Expr) -> Id {
+    let (x, y) = at;
     match &e.kind {
         ExprKind::Quantity { value, unit } => {
             let factor: f64 = unit
@@ -412,13 +458,10 @@ fn lower_expr(g: &mut Graph, f: &Formula, e: &Expr) -> Id {
             g.constant_node(value * factor)
         }
         ExprKind::Name(n) => match n.as_str() {
-            "x" if f.params.iter().any(|p| p == "x") => g.var(Var::X),
-            "y" if f.params.iter().any(|p| p == "y") => g.var(Var::Y),
+            "x" if f.params.iter().any(|p| p == "x") => x,
+            "y" if f.params.iter().any(|p| p == "y") => y,
             "r" if f.params.iter().any(|p| p == "r") => {
-                let (x, y) = (g.x(), g.y());
-                let x2 = g.powi(x, 2);
-                let y2 = g.powi(y, 2);
-                let r2 = g.add(x2, y2);
+                let r2 = radius_squared(g, x, y);
                 g.sqrt(r2)
             }
             other => g.constant_node(f.constants.get(other).copied().unwrap_or(f64::NAN)),
@@ -427,12 +470,12 @@ fn lower_expr(g: &mut Graph, f: &Formula, e: &Expr) -> Id {
             op: UnaryOp::Neg,
             operand,
         } => {
-            let a = lower_expr(g, f, operand);
+            let a = lower_expr(g, f, at, operand);
             g.neg(a)
         }
         ExprKind::Binary { op, lhs, rhs } => {
-            let a = lower_expr(g, f, lhs);
-            let b = lower_expr(g, f, rhs);
+            let a = lower_expr(g, f, at, lhs);
+            let b = lower_expr(g, f, at, rhs);
             let op = match op {
                 BinaryOp::Add => Binary::Add,
                 BinaryOp::Sub => Binary::Sub,
@@ -447,7 +490,10 @@ fn lower_expr(g: &mut Graph, f: &Formula, e: &Expr) -> Id {
                 ExprKind::Name(n) => n.as_str(),
                 _ => "",
             };
-            let a: Vec<Id> = args.iter().map(|a| lower_expr(g, f, &a.value)).collect();
+            let a: Vec<Id> = args
+                .iter()
+                .map(|a| lower_expr(g, f, at, &a.value))
+                .collect();
             let unary = |op| move |g: &mut Graph, a: &[Id]| g.unary(op, a[0]);
             match name {
                 "sin" => unary(Unary::Sin)(g, &a),
@@ -757,5 +803,31 @@ mod tests {
             y,
         );
         assert!(close(opt[0], sen[0]) && opt[0] < 0.0);
+    }
+
+    #[test]
+    fn off_axis_section_and_wrap() {
+        // An off-axis section of a paraboloid z = r²/(2R) centred at (3, 0):
+        // z(x, y) = ((x+3)² + y² − 9)/(2R); with the tilt removed, x²+y² over 2R.
+        let src = "surface p = conic { radius: 10 mm, conic: -1, sense: concave, aperture: circle(radius: 5 mm) }
+surface s = off_axis(p, x: 3 mm, y: 0 mm, aperture: circle(radius: 1 mm))
+surface t = off_axis(p, x: 3 mm, y: 0 mm, tilt: remove, aperture: circle(radius: 1 mm))";
+        let (x, y) = (0.4, -0.7);
+        let s = eval_surface(src, "s", x, y);
+        assert!(
+            close(s[0], ((x + 3.0) * (x + 3.0) + y * y - 9.0) / 20.0)
+                && close(s[1], (x + 3.0) / 10.0)
+        );
+        let t = eval_surface(src, "t", x, y);
+        assert!(close(t[0], (x * x + y * y) / 20.0) && close(t[1], x / 10.0));
+        // A wrapped design evaluates as the flat design.
+        let w = eval_surface(
+            "surface f = freeform { z(x, y) = 0.02 mm * sin(5 rad/mm * x), domain: rect(x: 0 mm .. 6 mm, y: 0 mm .. 18.84955592153876 mm) }
+surface w = wrap(f, onto: roller(radius: 3 mm))",
+            "w",
+            0.3,
+            1.0,
+        );
+        assert!(close(w[0], 0.02 * 1.5f64.sin()));
     }
 }
