@@ -5,6 +5,7 @@
 pub mod check;
 pub mod codes;
 pub mod driver;
+pub mod jit;
 pub mod loader;
 pub mod lower;
 pub mod render;
