@@ -10,7 +10,7 @@ use proptest::prelude::*;
 
 const TOL: f64 = 1e-13;
 
-const UNARY: [Unary; 11] = [
+const UNARY: [Unary; 12] = [
     Unary::Neg,
     Unary::Sqrt,
     Unary::Abs,
@@ -22,6 +22,7 @@ const UNARY: [Unary; 11] = [
     Unary::Atan,
     Unary::Exp,
     Unary::Ln,
+    Unary::Floor,
 ];
 
 const BINARY: [Binary; 8] = [
@@ -611,6 +612,7 @@ enum Step {
     Unary(usize, usize),
     Binary(usize, usize, usize),
     PowI(usize, i32),
+    Select(usize, usize, usize),
 }
 
 fn step_strategy() -> impl Strategy<Value = Step> {
@@ -620,6 +622,8 @@ fn step_strategy() -> impl Strategy<Value = Step> {
         (0..BINARY.len(), any::<usize>(), any::<usize>())
             .prop_map(|(o, a, b)| Step::Binary(o, a, b)),
         (any::<usize>(), -6i32..=6).prop_map(|(a, n)| Step::PowI(a, n)),
+        (any::<usize>(), any::<usize>(), any::<usize>())
+            .prop_map(|(c, a, b)| Step::Select(c, a, b)),
     ]
 }
 
@@ -632,6 +636,7 @@ fn build_random(g: &mut Graph, steps: &[Step]) -> Id {
             Step::Unary(o, a) => g.unary(UNARY[o], pick(a)),
             Step::Binary(o, a, b) => g.binary(BINARY[o], pick(a), pick(b)),
             Step::PowI(a, n) => g.powi(pick(a), n),
+            Step::Select(c, a, b) => g.select(pick(c), pick(a), pick(b)),
         };
         vals.push(v);
     }
@@ -664,4 +669,48 @@ proptest! {
             prop_assert!(agree(*a, *b), "value {} (output {} of point {}): {:e} vs JIT {:e}", k, k % 6, k / 6, a, b);
         }
     }
+}
+
+#[test]
+fn select_takes_one_branch_and_hides_the_others_nan() {
+    // z = sqrt(1 − x² − y²) inside the unit disc, 0 outside: the sqrt is NaN
+    // outside, and neither the value nor a derivative may show it.
+    let t = tape(|g| {
+        let (x, y) = (g.x(), g.y());
+        let x2 = g.powi(x, 2);
+        let y2 = g.powi(y, 2);
+        let r2 = g.add(x2, y2);
+        let one = g.constant_node(1.0);
+        let u = g.sub(one, r2);
+        let cap = g.sqrt(u);
+        let zero = g.constant_node(0.0);
+        let c = g.sub(r2, one);
+        g.select(c, cap, zero)
+    });
+    let xs: Vec<f64> = (0..101).map(|i| -2.0 + 0.04 * i as f64).collect();
+    let ys: Vec<f64> = xs.iter().map(|x| 0.3 * x).collect();
+    let got = check_batch(&t, &xs, &ys);
+    assert!(
+        got.iter().all(|v| v.is_finite()),
+        "a NaN leaked through select"
+    );
+    assert!(got.chunks(6).any(|o| o[0] > 0.5) && got.chunks(6).any(|o| o[0] == 0.0));
+}
+
+#[test]
+fn floor_makes_cell_coordinates() {
+    // u = x − p·floor(x/p): the position inside a cell of pitch p = 0.35.
+    let t = tape(|g| {
+        let x = g.x();
+        let inv = g.constant_node(1.0 / 0.35);
+        let q = g.mul(x, inv);
+        let f = g.floor(q);
+        let p = g.constant_node(0.35);
+        let c = g.mul(p, f);
+        let u = g.sub(x, c);
+        let y = g.y();
+        g.mul(u, y)
+    });
+    let got = check(&t, 500);
+    assert!(got.chunks(6).all(|o| o[1].is_finite()));
 }

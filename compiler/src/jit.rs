@@ -307,6 +307,12 @@ impl Emitter<'_> {
                     let neg = b.ins().fcmp(FloatCC::LessThan, get(a), zero);
                     select(b, lanes, neg, one, zero)
                 }
+                Node::Select(c, t, f) => {
+                    // t where c < 0 (false for NaN), else f.
+                    let zero = constant(b, lanes, 0f64.to_bits());
+                    let neg = b.ins().fcmp(FloatCC::LessThan, get(c), zero);
+                    select(b, lanes, neg, get(t), get(f))
+                }
             };
             val[id.0 as usize] = Some(v);
         }
@@ -340,6 +346,7 @@ impl Emitter<'_> {
             Unary::Neg => b.ins().fneg(a),
             Unary::Sqrt => b.ins().sqrt(a),
             Unary::Abs => b.ins().fabs(a),
+            Unary::Floor => b.ins().floor(a),
             Unary::Sin => self.call(b, lanes, Libm::Sin, &[a])?,
             Unary::Cos => self.call(b, lanes, Libm::Cos, &[a])?,
             Unary::Tan => self.call(b, lanes, Libm::Tan, &[a])?,

@@ -34,6 +34,9 @@ pub enum Unary {
     Atan,
     Exp,
     Ln,
+    /// Largest whole number not above the argument (cell indices of arrays);
+    /// its derivative is zero wherever it is defined.
+    Floor,
 }
 
 /// Functions of two arguments.
@@ -63,6 +66,10 @@ pub enum Node {
     /// 1 where the argument is negative, else 0 — the derivative of `Abs`,
     /// `Min` and `Max` needs a step; its own derivative is zero.
     Step(Id),
+    /// `a` where `c` < 0, else `b` (so NaN in `c` selects `b`). Unlike a
+    /// product with a step, the branch not taken never leaks a NaN:
+    /// lenslets are evaluated only inside their apertures.
+    Select(Id, Id, Id),
 }
 
 /// A deduplicating, simplifying expression arena.
@@ -241,6 +248,21 @@ impl Graph {
         }
     }
 
+    /// `a` where `c` < 0, else `b`.
+    pub fn select(&mut self, c: Id, a: Id, b: Id) -> Id {
+        if let Some(cv) = self.constant(c) {
+            return if cv < 0.0 { a } else { b };
+        }
+        if a == b {
+            return a;
+        }
+        self.intern(Node::Select(c, a, b))
+    }
+
+    pub fn floor(&mut self, a: Id) -> Id {
+        self.unary(Unary::Floor, a)
+    }
+
     fn step(&mut self, a: Id) -> Id {
         if let Some(c) = self.constant(a) {
             return self.constant_node(if c < 0.0 { 1.0 } else { 0.0 });
@@ -275,7 +297,14 @@ impl Graph {
             return d;
         }
         let d = match self.node(id) {
-            Node::Const(_) | Node::Step(_) => self.constant_node(0.0),
+            Node::Const(_) | Node::Step(_) | Node::Unary(Unary::Floor, _) => {
+                self.constant_node(0.0)
+            }
+            Node::Select(c, a, b) => {
+                let da = self.derivative(a, var);
+                let db = self.derivative(b, var);
+                self.select(c, da, db)
+            }
             Node::Var(v) => self.constant_node(if v == var { 1.0 } else { 0.0 }),
             Node::PowI(a, n) => {
                 let da = self.derivative(a, var);
@@ -342,6 +371,7 @@ impl Graph {
                         let one = self.constant_node(1.0);
                         self.div(one, a)
                     }
+                    Unary::Floor => unreachable!("handled above"),
                 };
                 self.mul(outer, da)
             }
@@ -421,6 +451,7 @@ pub fn apply_unary(op: Unary, a: f64) -> f64 {
         Unary::Atan => a.atan(),
         Unary::Exp => a.exp(),
         Unary::Ln => a.ln(),
+        Unary::Floor => a.floor(),
     }
 }
 
@@ -480,6 +511,11 @@ impl SurfaceTape {
                     live[a.0 as usize] = true;
                     live[b.0 as usize] = true;
                 }
+                Node::Select(c, a, b) => {
+                    live[c.0 as usize] = true;
+                    live[a.0 as usize] = true;
+                    live[b.0 as usize] = true;
+                }
                 Node::Const(_) | Node::Var(_) => {}
             }
         }
@@ -518,6 +554,7 @@ enum Op {
     Binary(Binary, usize, usize),
     PowI(usize, i32),
     Step(usize),
+    Select(usize, usize, usize),
 }
 
 impl Interpreter {
@@ -535,6 +572,7 @@ impl Interpreter {
                 Node::Binary(op, a, b) => Op::Binary(op, s(a), s(b)),
                 Node::PowI(a, n) => Op::PowI(s(a), n),
                 Node::Step(a) => Op::Step(s(a)),
+                Node::Select(c, a, b) => Op::Select(s(c), s(a), s(b)),
             });
         }
         let outputs = tape.outputs.map(|o| slot_of[o.0 as usize]);
@@ -565,6 +603,13 @@ impl SurfaceFn for Interpreter {
                             1.0
                         } else {
                             0.0
+                        }
+                    }
+                    Op::Select(c, a, b) => {
+                        if v[c] < 0.0 {
+                            v[a]
+                        } else {
+                            v[b]
                         }
                     }
                 };
