@@ -1207,6 +1207,7 @@ impl<'a> Checker<'a> {
                     Check::Positive => *v > 0.0,
                     Check::NonNegative => *v >= 0.0,
                     Check::HalfOpen(lo, hi) => *v >= lo && *v < hi,
+                    Check::Count => v.fract() == 0.0 && (1.0..=100_000.0).contains(v),
                 };
                 if !ok {
                     let (unit, factor) = d.display_unit();
@@ -1219,6 +1220,7 @@ impl<'a> Checker<'a> {
                             trim_num(lo * factor),
                             trim_num(hi * factor)
                         ),
+                        Check::Count => "must be a whole number from 1 to 100000".to_string(),
                         Check::Any => unreachable!(),
                     };
                     self.err(
@@ -1385,15 +1387,10 @@ impl<'a> Checker<'a> {
                 let Some(radius) = value::num(&roller.fields, "radius") else {
                     return true;
                 };
-                let region = value::object(&design.fields, "aperture")
-                    .or_else(|| value::object(&design.fields, "domain"));
-                let length = match region {
-                    Some(r) if r.kind.name == "rect" => {
-                        value::range(&r.fields, "y").map(|(a, b)| b - a)
-                    }
-                    Some(r) => aperture_radius(r).map(|a| 2.0 * a),
-                    None => None,
-                };
+                let length = crate::surfaces::surface_domain(design).map(|d| match d {
+                    lensc_runtime::analysis::Domain::Rect { y, .. } => y.1 - y.0,
+                    lensc_runtime::analysis::Domain::Circle { radius } => 2.0 * radius,
+                });
                 let Some(length) = length else { return true };
                 let circumference = 2.0 * std::f64::consts::PI * radius;
                 let at = value::field(f, "onto").expect("onto");

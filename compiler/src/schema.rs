@@ -67,6 +67,8 @@ pub enum Check {
     NonNegative,
     /// lo ≤ v < hi
     HalfOpen(f64, f64),
+    /// A whole number from 1 to 100 000.
+    Count,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -250,6 +252,19 @@ fn power_dims(n: i8) -> &'static [Dim] {
     ];
     &DIMS[n.clamp(0, 20) as usize]
 }
+
+const LENSLET: Param = req(
+    "lenslet",
+    Ty::Object(Category::Surface),
+    Check::Any,
+    "the surface repeated, clipped to its own aperture, its rim at the array's land (z = 0); where lenslets overlap the deepest cut wins",
+);
+const ARRAY_APERTURE: Param = opt(
+    "aperture",
+    Ty::Object(Category::Aperture),
+    Check::Any,
+    "the region of the array to machine; default the rectangle around every cell",
+);
 
 const AXIS: Param = req(
     "axis",
@@ -542,6 +557,82 @@ pub static KINDS: &[Kind] = &[
         positional: &["parent"],
         exclusive: &[],
         doc: "an off-axis section of a parent surface, in coordinates centred on (x, y), its height zero there",
+    },
+    Kind {
+        name: "grid",
+        category: Category::Surface,
+        params: &[
+            LENSLET,
+            req(
+                "pitch_x",
+                LENGTH,
+                Check::Positive,
+                "centre-to-centre distance along x",
+            ),
+            req(
+                "pitch_y",
+                LENGTH,
+                Check::Positive,
+                "centre-to-centre distance along y",
+            ),
+            req("count_x", NUMBER, Check::Count, "lenslets along x"),
+            req("count_y", NUMBER, Check::Count, "lenslets along y"),
+            ARRAY_APERTURE,
+        ],
+        family: None,
+        positional: &["lenslet"],
+        exclusive: &[],
+        doc: "a rectangular array of a lenslet, centred on the origin",
+    },
+    Kind {
+        name: "hex_grid",
+        category: Category::Surface,
+        params: &[
+            LENSLET,
+            req(
+                "pitch",
+                LENGTH,
+                Check::Positive,
+                "centre-to-centre distance to every neighbour",
+            ),
+            req("count_x", NUMBER, Check::Count, "lenslets per row"),
+            req(
+                "count_y",
+                NUMBER,
+                Check::Positive,
+                "rows (every other row shifted by half a pitch)",
+            ),
+            ARRAY_APERTURE,
+        ],
+        family: None,
+        positional: &["lenslet"],
+        exclusive: &[],
+        doc: "a hexagonal array of a lenslet, rows along x, centred on the origin",
+    },
+    Kind {
+        name: "linear_array",
+        category: Category::Surface,
+        params: &[
+            LENSLET,
+            req(
+                "pitch",
+                LENGTH,
+                Check::Positive,
+                "centre-to-centre distance; the seam is the pitch less the lenslet's aperture width",
+            ),
+            req("count", NUMBER, Check::Count, "number of lenslets"),
+            opt(
+                "axis",
+                Ty::Word(&["x", "y"]),
+                Check::Any,
+                "the direction the lenslets repeat along; default x",
+            ),
+            ARRAY_APERTURE,
+        ],
+        family: None,
+        positional: &["lenslet"],
+        exclusive: &[],
+        doc: "a row of a lenslet (a cylinder, say) with seams between them",
     },
     Kind {
         name: "roller",
