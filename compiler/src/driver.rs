@@ -196,6 +196,17 @@ pub enum SamplePoints {
 /// One sample: x, y, z (mm), dz/dx, dz/dy, curvature along x and y (1/mm).
 pub type Sample = [f64; 7];
 
+/// The backend that evaluates surfaces: a JIT kernel, or the reference
+/// interpreter should cranelift refuse the tape (they agree to 1e-13, see
+/// tests/jit_conformance.rs and tests/surface_kinds.rs).
+/// The second value names the backend used (reports carry it).
+pub fn evaluator(tape: &lensc_runtime::ir::SurfaceTape) -> (Box<dyn lensc_runtime::ir::SurfaceFn>, &'static str) {
+    match crate::jit::JitSurface::compile(tape) {
+        Ok(j) => (Box::new(j), "jit"),
+        Err(_) => (Box::new(lensc_runtime::ir::Interpreter::new(tape)), "interpreter"),
+    }
+}
+
 /// The declared surface `name`, lowered to IR, or a message saying why not.
 pub fn declared_surface(
     c: &Checked,
@@ -239,8 +250,8 @@ pub fn analysis_json(
 ) -> serde_json::Value {
     use lensc_runtime::analysis::{Domain, Extremum, analyse};
     use serde_json::json;
-    let f = lensc_runtime::ir::Interpreter::new(&l.tape);
-    let a = analyse(&f, &l.domain, grid);
+    let (f, backend) = evaluator(&l.tape);
+    let a = analyse(f.as_ref(), &l.domain, grid);
     let at =
         |e: &Extremum, scale: f64| json!({ "value": e.value * scale, "x_mm": e.x, "y_mm": e.y });
     let deg = 180.0 / std::f64::consts::PI;
@@ -254,6 +265,7 @@ pub fn analysis_json(
         "kind": kind,
         "domain": domain,
         "grid": grid,
+        "backend": backend,
         "sag_mm": { "min": at(&a.sag_min, 1.0), "max": at(&a.sag_max, 1.0), "pv": a.pv() },
         "max_slope_deg": at(&a.max_slope, deg),
         "max_slope_x_deg": at(&a.max_slope_x, deg),
@@ -270,7 +282,7 @@ pub fn analysis_json(
 /// Evaluates a declared surface at the requested points.
 pub fn sample(c: &Checked, surface: &str, at: &SamplePoints) -> Result<Vec<Sample>, String> {
     let lowered = declared_surface(c, surface)?;
-    let f = lensc_runtime::ir::Interpreter::new(&lowered.tape);
+    let (f, _) = evaluator(&lowered.tape);
     let domain = lowered.domain;
     let ((x0, x1), (y0, y1)) = domain.bounds();
     let (xs, ys): (Vec<f64>, Vec<f64>) = match at {
@@ -307,7 +319,7 @@ pub fn sample(c: &Checked, surface: &str, at: &SamplePoints) -> Result<Vec<Sampl
         SamplePoints::Points(p) => p.iter().copied().unzip(),
     };
     let mut out = vec![0.0; 6 * xs.len()];
-    lensc_runtime::ir::SurfaceFn::eval_batch(&f, &xs, &ys, &mut out);
+    f.eval_batch(&xs, &ys, &mut out);
     Ok((0..xs.len())
         .map(|i| {
             let o = &out[6 * i..6 * i + 6];
