@@ -346,7 +346,10 @@ fn analyse_reproduces_seed_002_figures() {
         .min(v("/min_radius_of_curvature_mm/concave_x/value"));
     assert_eq!(format!("{r:.3}"), "2.000");
     assert!((v("/sag_mm/pv") - 0.08).abs() < 1e-12);
-    assert_eq!(a["backend"], "jit", "surfaces are evaluated by JIT-compiled kernels");
+    assert_eq!(
+        a["backend"], "jit",
+        "surfaces are evaluated by JIT-compiled kernels"
+    );
 }
 
 #[test]

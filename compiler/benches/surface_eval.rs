@@ -1,6 +1,7 @@
 //! Surface evaluation speed: ns per point for the six outputs (z and its
-//! first and second derivatives) of two surfaces, four ways, measured in
-//! the same run:
+//! first and second derivatives) of three surfaces — a conic with A4…A16,
+//! seed 002's sinusoidal freeform and seed 003's 10 × 10 lens array, each
+//! the tape lensc's own lowering builds — four ways, in the same run:
 //!   interpreter — `lensc_runtime::ir::Interpreter` over the batch
 //!   JIT scalar  — the cranelift kernel called once per point (`eval`)
 //!   JIT batch   — the cranelift kernel called once for 10^5 points
@@ -15,7 +16,7 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use lensc::jit::JitSurface;
-use lensc_runtime::ir::{Graph, Id, Interpreter, SurfaceFn, SurfaceTape, Unary};
+use lensc_runtime::ir::{Graph, Interpreter, SurfaceFn, SurfaceTape};
 
 const POINTS: usize = 100_000;
 const RUNS: usize = 15;
@@ -49,28 +50,24 @@ const A: [(i32, f64); 7] = [
 ];
 const APERTURE: f64 = 5.0;
 
+/// The tape lensc itself builds for `surface NAME` of `src`.
+fn lowered(src: &str, name: &str) -> SurfaceTape {
+    let c = lensc::driver::check_text(&lensc::loader::RealFs, "bench.lens", src.as_bytes());
+    assert!(!c.has_errors(), "bench source has errors");
+    lensc::driver::declared_surface(&c, name)
+        .expect("lowers")
+        .tape
+}
+
 fn asphere_tape() -> SurfaceTape {
-    let mut g = Graph::new();
-    let (x, y) = (g.x(), g.y());
-    let x2 = g.powi(x, 2);
-    let y2 = g.powi(y, 2);
-    let r2 = g.add(x2, y2);
-    let cc = g.constant_node(C);
-    let num = g.mul(cc, r2);
-    let kk = g.constant_node((1.0 + K) * C * C);
-    let t = g.mul(kk, r2);
-    let one = g.constant_node(1.0);
-    let u = g.sub(one, t);
-    let s = g.sqrt(u);
-    let den = g.add(one, s);
-    let mut z: Id = g.div(num, den);
+    let mut src = format!(
+        "surface s = asphere {{ radius: {} mm, conic: {K}, sense: concave, aperture: circle(radius: {APERTURE} mm)",
+        1.0 / C
+    );
     for (j, aj) in A {
-        let p = g.powi(r2, j / 2);
-        let ca = g.constant_node(aj);
-        let term = g.mul(ca, p);
-        z = g.add(z, term);
+        src += &format!(", A{j}: {aj:e} mm^-{}", j - 1);
     }
-    SurfaceTape::new(g, z)
+    lowered(&(src + " }"), "s")
 }
 
 /// z = f(s), s = x² + y²: z_x = 2x f', z_xx = 2f' + 4x² f'', z_xy = 4xy f''.
@@ -119,20 +116,10 @@ fn asphere_points() -> (Vec<f64>, Vec<f64>) {
 // ---- the sinusoidal freeform -----------------------------------------------
 
 fn freeform_tape() -> SurfaceTape {
-    let mut g = Graph::new();
-    let (x, y) = (g.x(), g.y());
-    let five = g.constant_node(5.0);
-    let fx = g.mul(five, x);
-    let s = g.unary(Unary::Sin, fx);
-    let ky = g.constant_node(10.0 / 3.0);
-    let fy = g.mul(ky, y);
-    let c = g.unary(Unary::Cos, fy);
-    let sum = g.add(s, c);
-    let amp = g.constant_node(0.02);
-    let a = g.mul(amp, sum);
-    let off = g.constant_node(0.04);
-    let z = g.sub(a, off);
-    SurfaceTape::new(g, z)
+    lowered(
+        "surface f = freeform { z(x, y) = 0.02 mm * (sin(5 rad/mm * x) + cos(10 rad/(3 mm) * y)) - 0.04 mm, domain: rect(x: 0 mm .. 6.283185307179586 mm, y: 0 mm .. 18.84955592153876 mm) }",
+        "f",
+    )
 }
 
 /// z = 0.02 (sin 5x + cos(10y/3)) − 0.04 and its exact derivatives.
@@ -160,6 +147,56 @@ fn freeform_points() -> (Vec<f64>, Vec<f64>) {
                 std::f64::consts::TAU * u / side as f64,
                 18.85 * v / side as f64,
             )
+        })
+        .unzip()
+}
+
+// ---- seed 003's 10 × 10 lens array ------------------------------------------
+
+const PITCH: f64 = 3.5;
+const LENS_R: f64 = 20.0;
+const LENS_A: f64 = 0.85;
+
+fn array_tape() -> SurfaceTape {
+    lowered(
+        "surface l = sphere { radius: 20 mm, sense: concave, aperture: circle(diameter: 1.7 mm) }
+surface a = grid(l, pitch_x: 3.5 mm, pitch_y: 3.5 mm, count_x: 10, count_y: 10)",
+        "a",
+    )
+}
+
+/// The same array by hand: the point's cell, then the concave sphere
+/// (its rim on the land at z = 0) inside the lenslet, the land outside.
+#[inline(never)]
+fn array_by_hand(xs: &[f64], ys: &[f64], out: &mut [f64]) {
+    let rim = LENS_A * LENS_A / (LENS_R + (LENS_R * LENS_R - LENS_A * LENS_A).sqrt());
+    let centre = |t: f64| (t / PITCH + 5.0).floor().clamp(0.0, 9.0) * PITCH - 4.5 * PITCH;
+    for ((&x, &y), o) in xs.iter().zip(ys).zip(out.chunks_exact_mut(6)) {
+        let (u, v) = (x - centre(x), y - centre(y));
+        let s = u * u + v * v;
+        if s < LENS_A * LENS_A {
+            // z = R − sqrt(R² − s) − rim, as the sag of a sphere.
+            let q = (LENS_R * LENS_R - s).sqrt();
+            let f1 = 1.0 / (2.0 * q);
+            let f2 = 1.0 / (4.0 * q * q * q);
+            o[0] = s / (LENS_R + q) - rim;
+            o[1] = 2.0 * u * f1;
+            o[2] = 2.0 * v * f1;
+            o[3] = 2.0 * f1 + 4.0 * u * u * f2;
+            o[4] = 4.0 * u * v * f2;
+            o[5] = 2.0 * f1 + 4.0 * v * v * f2;
+        } else {
+            o.fill(0.0);
+        }
+    }
+}
+
+fn array_points() -> (Vec<f64>, Vec<f64>) {
+    let side = (POINTS as f64).sqrt() as usize;
+    (0..POINTS)
+        .map(|i| {
+            let (u, v) = ((i % side) as f64 + 0.31, (i / side) as f64 + 0.47);
+            (35.0 * u / side as f64 - 17.5, 35.0 * v / side as f64 - 17.5)
         })
         .unzip()
 }
@@ -235,13 +272,15 @@ fn measure(name: &'static str, tape: &SurfaceTape, pts: (Vec<f64>, Vec<f64>), ha
 fn main() {
     let asphere = asphere_tape();
     let freeform = freeform_tape();
+    let array = array_tape();
     println!(
         "surface_eval: {POINTS} points, six outputs each, best of {RUNS} runs (compile: best of {COMPILES})"
     );
     println!(
-        "live tape nodes: asphere {}, freeform {}",
+        "live tape nodes: asphere {}, freeform {}, lens array {}",
         asphere.live_nodes().len(),
-        freeform.live_nodes().len()
+        freeform.live_nodes().len(),
+        array.live_nodes().len()
     );
     let rows = [
         measure("conic+A4..A16", &asphere, asphere_points(), asphere_by_hand),
@@ -251,6 +290,7 @@ fn main() {
             freeform_points(),
             freeform_by_hand,
         ),
+        measure("10x10 array", &array, array_points(), array_by_hand),
     ];
     println!();
     println!(

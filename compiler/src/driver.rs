@@ -200,10 +200,15 @@ pub type Sample = [f64; 7];
 /// interpreter should cranelift refuse the tape (they agree to 1e-13, see
 /// tests/jit_conformance.rs and tests/surface_kinds.rs).
 /// The second value names the backend used (reports carry it).
-pub fn evaluator(tape: &lensc_runtime::ir::SurfaceTape) -> (Box<dyn lensc_runtime::ir::SurfaceFn>, &'static str) {
+pub fn evaluator(
+    tape: &lensc_runtime::ir::SurfaceTape,
+) -> (Box<dyn lensc_runtime::ir::SurfaceFn>, &'static str) {
     match crate::jit::JitSurface::compile(tape) {
         Ok(j) => (Box::new(j), "jit"),
-        Err(_) => (Box::new(lensc_runtime::ir::Interpreter::new(tape)), "interpreter"),
+        Err(_) => (
+            Box::new(lensc_runtime::ir::Interpreter::new(tape)),
+            "interpreter",
+        ),
     }
 }
 

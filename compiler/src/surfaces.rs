@@ -70,14 +70,101 @@ impl Side {
 
 /// Lowers a checked surface object.
 pub fn lower_surface(o: &Object) -> Result<LoweredSurface, LowerError> {
+    let domain = surface_domain(o).ok_or(LowerError::Aperture("no aperture or domain"))?;
+    if let Some(tape) = radial_tape(o) {
+        return Ok(LoweredSurface { tape, domain });
+    }
     let mut g = Graph::new();
     let (x, y) = (g.x(), g.y());
     let z = height(&mut g, o, x, y)?;
-    let domain = surface_domain(o).ok_or(LowerError::Aperture("no aperture or domain"))?;
     Ok(LoweredSurface {
         tape: SurfaceTape::new(g, z),
         domain,
     })
+}
+
+/// Rotationally symmetric surfaces z = f(s), s = x² + y², differentiated
+/// through s: f, f' and f'' are built once in s (exactly, by the graph's
+/// own differentiation) and combined by the chain rule,
+///   z_x = 2x f',  z_xx = 2f' + 4x² f'',  z_xy = 4xy f''  (and in y),
+/// which is the tape a careful hand would write, a third the size of
+/// differentiating in x and y directly.
+fn radial_tape(o: &Object) -> Option<SurfaceTape> {
+    if !matches!(o.kind.name, "sphere" | "conic" | "asphere") {
+        return None;
+    }
+    let f = &o.fields;
+    let side = Side::of(f);
+    let c = side.curvature(value::num(f, "radius")?);
+    let k = value::num(f, "conic").unwrap_or(0.0);
+    // f(s) in a scratch graph whose x stands for s. The conic's own
+    // derivatives in s are written in closed form (g = c s/(1 + q),
+    // q = sqrt(1 − κ s), κ = (1+k)c²: g' = c/(2q), g'' = cκ/(4q³)); the
+    // polynomial's come from the graph's differentiation of its Horner form.
+    let mut h = Graph::new();
+    let s = h.x();
+    let kappa = (1.0 + k) * c * c;
+    let q = {
+        let kc = h.constant_node(kappa);
+        let ks = h.mul(kc, s);
+        let one = h.constant_node(1.0);
+        let u = h.sub(one, ks);
+        h.sqrt(u)
+    };
+    let g0 = {
+        let cc = h.constant_node(c);
+        let num = h.mul(cc, s);
+        let one = h.constant_node(1.0);
+        let den = h.add(one, q);
+        h.div(num, den)
+    };
+    let g1 = {
+        let half_c = h.constant_node(c / 2.0);
+        h.div(half_c, q)
+    };
+    let g2 = {
+        let ck = h.constant_node(c * kappa / 4.0);
+        let q3 = h.powi(q, 3);
+        h.div(ck, q3)
+    };
+    let zero = h.constant_node(0.0);
+    let p0 = add_power_terms(&mut h, zero, s, &power_terms(f));
+    let p1 = h.derivative(p0, lensc_runtime::ir::Var::X);
+    let p2 = h.derivative(p1, lensc_runtime::ir::Var::X);
+    let sigma = h.constant_node(side.sigma);
+    let mut sum = |a: Id, b: Id| {
+        let t = h.add(a, b);
+        h.mul(sigma, t)
+    };
+    let (f0, f1, f2) = (sum(g0, p0), sum(g1, p1), sum(g2, p2));
+    // Compose with s = x² + y².
+    let mut g = Graph::new();
+    let (x, y) = (g.x(), g.y());
+    let s = radius_squared(&mut g, x, y);
+    let map = g.import(&h, s, s);
+    let (f0, f1, f2) = (map[f0.0 as usize], map[f1.0 as usize], map[f2.0 as usize]);
+    let two = g.constant_node(2.0);
+    let four = g.constant_node(4.0);
+    let tf1 = g.mul(two, f1);
+    let ff2 = g.mul(four, f2);
+    let zx = {
+        let t = g.mul(tf1, x);
+        t
+    };
+    let zy = g.mul(tf1, y);
+    let x2 = g.powi(x, 2);
+    let y2 = g.powi(y, 2);
+    let xy = g.mul(x, y);
+    let zxx = {
+        let t = g.mul(ff2, x2);
+        g.add(tf1, t)
+    };
+    let zyy = {
+        let t = g.mul(ff2, y2);
+        g.add(tf1, t)
+    };
+    let zxy = g.mul(ff2, xy);
+    Some(SurfaceTape::with_outputs(g, [f0, zx, zy, zxx, zxy, zyy]))
 }
 
 /// The height of surface `o` at the coordinates `x`, `y` (nodes of `g`),
@@ -571,15 +658,33 @@ fn power_terms(f: &[value::Field]) -> Vec<(u32, f64)> {
         .collect()
 }
 
-/// sag + Σ A_j (s)^(j/2), with s = r² (whole powers for even j).
+/// sag + Σ A_j (s)^(j/2), with s = r². The even terms are one polynomial
+/// in s, evaluated by Horner's rule (fewer nodes, and so fewer in every
+/// derivative); odd terms are real powers of s.
 fn add_power_terms(g: &mut Graph, mut sag: Id, s: Id, terms: &[(u32, f64)]) -> Id {
-    for &(j, a) in terms {
-        let t = if j % 2 == 0 {
-            g.powi(s, (j / 2) as i32)
-        } else {
-            let half = g.constant_node(f64::from(j) / 2.0);
-            g.binary(Binary::Pow, s, half)
-        };
+    let mut even: Vec<(u32, f64)> = terms
+        .iter()
+        .filter(|(j, _)| j % 2 == 0)
+        .map(|&(j, a)| (j / 2, a))
+        .collect();
+    even.sort_unstable_by_key(|t| t.0);
+    if let Some(&(lowest, _)) = even.first() {
+        // Σ a_m s^m = s^lowest · (a_lowest + s (a_next + s (…)))
+        let top = even.last().expect("non-empty").0;
+        let mut poly = g.constant_node(0.0);
+        for m in (lowest..=top).rev() {
+            let a = even.iter().find(|t| t.0 == m).map_or(0.0, |t| t.1);
+            let times = g.mul(poly, s);
+            let ac = g.constant_node(a);
+            poly = g.add(times, ac);
+        }
+        let base = g.powi(s, lowest as i32);
+        let t = g.mul(base, poly);
+        sag = g.add(sag, t);
+    }
+    for &(j, a) in terms.iter().filter(|(j, _)| j % 2 == 1) {
+        let half = g.constant_node(f64::from(j) / 2.0);
+        let t = g.binary(Binary::Pow, s, half);
         let ac = g.constant_node(a);
         let term = g.mul(ac, t);
         sag = g.add(sag, term);

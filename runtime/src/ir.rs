@@ -290,6 +290,28 @@ impl Graph {
         self.unary(Unary::Sqrt, a)
     }
 
+    /// Copies the expression `root` of `other` into this graph with its
+    /// coordinates replaced by the nodes `x` and `y` (composition), and
+    /// returns the copy of every node it needed, indexed like `other`.
+    pub fn import(&mut self, other: &Graph, x: Id, y: Id) -> Vec<Id> {
+        let mut map: Vec<Id> = Vec::with_capacity(other.len());
+        for &n in other.nodes() {
+            let m = |i: Id| map[i.0 as usize];
+            let id = match n {
+                Node::Const(bits) => self.constant_node(f64::from_bits(bits)),
+                Node::Var(Var::X) => x,
+                Node::Var(Var::Y) => y,
+                Node::Unary(op, a) => self.unary(op, m(a)),
+                Node::Binary(op, a, b) => self.binary(op, m(a), m(b)),
+                Node::PowI(a, k) => self.powi(m(a), k),
+                Node::Step(a) => self.step(m(a)),
+                Node::Select(c, a, b) => self.select(m(c), m(a), m(b)),
+            };
+            map.push(id);
+        }
+        map
+    }
+
     /// d(node)/d(var), built in this graph. Exact: each rule is the
     /// derivative of the node's function, applied through the chain rule.
     pub fn derivative(&mut self, id: Id, var: Var) -> Id {
@@ -492,6 +514,13 @@ impl SurfaceTape {
             graph,
             outputs: [z, zx, zy, zxx, zxy, zyy],
         }
+    }
+
+    /// A tape whose six outputs were built by the caller (for instance by
+    /// the chain rule through an intermediate variable); they must be the
+    /// exact value and derivatives, in the order of `OUTPUTS`.
+    pub fn with_outputs(graph: Graph, outputs: [Id; 6]) -> SurfaceTape {
+        SurfaceTape { graph, outputs }
     }
 
     /// The nodes the outputs need, in tape order (dead nodes dropped).
