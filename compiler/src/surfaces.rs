@@ -147,10 +147,7 @@ fn radial_tape(o: &Object) -> Option<SurfaceTape> {
     let four = g.constant_node(4.0);
     let tf1 = g.mul(two, f1);
     let ff2 = g.mul(four, f2);
-    let zx = {
-        let t = g.mul(tf1, x);
-        t
-    };
+    let zx = g.mul(tf1, x);
     let zy = g.mul(tf1, y);
     let x2 = g.powi(x, 2);
     let y2 = g.powi(y, 2);
