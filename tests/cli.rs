@@ -372,3 +372,37 @@ fn analyse_seed_003_lenslet() {
             .is_null()
     );
 }
+
+#[test]
+fn annular_aperture_cuts_from_outer_to_inner_edge() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let src = "use std::machines::linuxcnc_lathe
+use std::strategies::finish_turning
+// A concave sphere R = 10 mm cut only on the ring 1 mm <= r <= 2 mm.
+surface ring = sphere { radius: 10 mm, sense: concave, aperture: annulus(inner: 1 mm, outer: 2 mm) }
+tool t = round_nose { nose_radius: 0.5 mm, clearance: 7 deg }
+job ring_cut { surface: ring, tool: t, machine: linuxcnc_lathe, strategy: finish_turning }
+";
+    std::fs::write(dir.path().join("ring.lens"), src).expect("write");
+    let out = lensc(dir.path(), &["build", "ring.lens"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let program = std::fs::read_to_string(dir.path().join("out/ring_cut.ngc")).expect("program");
+    // Every X word, from the first rapid over the start to the last cut.
+    let xs: Vec<f64> = program
+        .lines()
+        .filter(|l| !l.starts_with('('))
+        .filter_map(|l| l.split_whitespace().find_map(|w| w.strip_prefix('X')))
+        .map(|v| v.parse().expect("X"))
+        .collect();
+    // The nose centre over a concave sphere sits on the sphere of radius
+    // R − ρ about the same centre: x_c = r (R − ρ)/R.
+    let (first, last) = (xs[0], *xs.last().expect("moves"));
+    // (The lathe's resolution is 0.1 µm: four decimals.)
+    assert!((first - 2.0 * 9.5 / 10.0).abs() < 1e-4, "starts at {first}");
+    assert!((last - 1.0 * 9.5 / 10.0).abs() < 1e-4, "ends at {last}");
+    let bad = "surface bad_ring = sphere { radius: 10 mm, sense: concave, aperture: annulus(inner: 2 mm, outer: 1 mm) }\n";
+    std::fs::write(dir.path().join("bad.lens"), bad).expect("write");
+    let out = lensc(dir.path(), &["check", "bad.lens"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out.stderr).contains("inner radius"));
+}

@@ -1377,6 +1377,23 @@ impl<'a> Checker<'a> {
                 }
                 true
             }
+            "annulus" => {
+                let (Some(inner), Some(outer)) = (
+                    value::num(&o.fields, "inner"),
+                    value::num(&o.fields, "outer"),
+                ) else {
+                    return true;
+                };
+                if inner >= outer {
+                    let f = value::field(&o.fields, "inner").expect("inner");
+                    self.err(
+                        Diagnostic::error(codes::OUT_OF_RANGE, format!("the annulus's inner radius ({} mm) is not inside its outer radius ({} mm)", trim_num(inner), trim_num(outer)), f.file, f.span)
+                            .with_label("not below `outer`"),
+                    );
+                    return false;
+                }
+                true
+            }
             "wrap" => {
                 let f = &o.fields;
                 let (Some(design), Some(roller)) =
@@ -1389,7 +1406,10 @@ impl<'a> Checker<'a> {
                 };
                 let length = crate::surfaces::surface_domain(design).map(|d| match d {
                     lensc_runtime::analysis::Domain::Rect { y, .. } => y.1 - y.0,
-                    lensc_runtime::analysis::Domain::Circle { radius } => 2.0 * radius,
+                    lensc_runtime::analysis::Domain::Circle { radius }
+                    | lensc_runtime::analysis::Domain::Annulus { outer: radius, .. } => {
+                        2.0 * radius
+                    }
                 });
                 let Some(length) = length else { return true };
                 let circumference = 2.0 * std::f64::consts::PI * radius;
@@ -1678,11 +1698,23 @@ fn merge(base: &[Field], over: Vec<Field>) -> Vec<Field> {
 }
 
 /// The radius of a circular aperture, if it is one.
+/// The outer radius of a circular or annular aperture.
 pub fn aperture_radius(ap: &Object) -> Option<f64> {
-    if ap.kind.name != "circle" {
-        return None;
+    match ap.kind.name {
+        "circle" => value::num(&ap.fields, "radius")
+            .or_else(|| value::num(&ap.fields, "diameter").map(|d| d / 2.0)),
+        "annulus" => value::num(&ap.fields, "outer"),
+        _ => None,
     }
-    value::num(&ap.fields, "radius").or_else(|| value::num(&ap.fields, "diameter").map(|d| d / 2.0))
+}
+
+/// The inner radius of an annular aperture (0 for a circle).
+pub fn aperture_inner_radius(ap: &Object) -> f64 {
+    if ap.kind.name == "annulus" {
+        value::num(&ap.fields, "inner").unwrap_or(0.0)
+    } else {
+        0.0
+    }
 }
 
 fn param_list(params: &[Param]) -> String {

@@ -263,6 +263,9 @@ pub fn analysis_json(
     let radius = |e: &Option<Extremum>| e.as_ref().map_or(serde_json::Value::Null, |e| at(e, 1.0));
     let domain = match l.domain {
         Domain::Circle { radius } => json!({ "circle": { "radius_mm": radius } }),
+        Domain::Annulus { inner, outer } => {
+            json!({ "annulus": { "inner_mm": inner, "outer_mm": outer } })
+        }
         Domain::Rect { x, y } => json!({ "rect": { "x_mm": [x.0, x.1], "y_mm": [y.0, y.1] } }),
     };
     json!({

@@ -9,7 +9,7 @@ use lensc_runtime::surface::{RotationalSurface, Sense};
 use lensc_runtime::tool::RoundNoseTool;
 use lensc_runtime::toolpath::{Feed, ProfileTurning};
 
-use crate::check::{CheckedJob, aperture_radius, trim_num};
+use crate::check::{CheckedJob, aperture_inner_radius, aperture_radius, trim_num};
 use crate::codes;
 use crate::units::Dim;
 use crate::value::{self, Field, Object, Value};
@@ -105,7 +105,10 @@ pub fn lower(job: &CheckedJob) -> Result<Job, Vec<Diagnostic>> {
         spindle_speed: value::num(f, "spindle_speed").expect("required"),
         chord_tolerance: value::num(f, "chord_tolerance").unwrap_or(10e-6),
         start_radius: from,
-        end_radius: value::num(f, "to").unwrap_or(0.0),
+        // An annular aperture's cut ends at its inner edge.
+        end_radius: value::num(f, "to").unwrap_or_else(|| {
+            value::object(&surface.fields, "aperture").map_or(0.0, |a| aperture_inner_radius(a))
+        }),
         retract: value::num(f, "retract").unwrap_or(1.0),
     };
     let m = &machine.fields;

@@ -661,6 +661,18 @@ pub static KINDS: &[Kind] = &[
         doc: "a circular aperture centred on the axis",
     },
     Kind {
+        name: "annulus",
+        category: Category::Aperture,
+        params: &[
+            req("inner", LENGTH, Check::NonNegative, "inner radius"),
+            req("outer", LENGTH, Check::Positive, "outer radius"),
+        ],
+        family: None,
+        positional: &[],
+        exclusive: &[],
+        doc: "a ring about the axis, inner ≤ r ≤ outer",
+    },
+    Kind {
         name: "rect",
         category: Category::Aperture,
         params: &[

@@ -403,6 +403,15 @@ fn inside(g: &mut Graph, domain: &Domain, u: Id, v: Id) -> Id {
             let a2 = g.constant_node(radius * radius);
             g.sub(r2, a2)
         }
+        Domain::Annulus { inner, outer } => {
+            // max(r² − outer², inner² − r²)
+            let r2 = radius_squared(g, u, v);
+            let o2 = g.constant_node(outer * outer);
+            let i2 = g.constant_node(inner * inner);
+            let a = g.sub(r2, o2);
+            let b = g.sub(i2, r2);
+            g.binary(Binary::Max, a, b)
+        }
         Domain::Rect {
             x: (x0, x1),
             y: (y0, y1),
@@ -424,7 +433,7 @@ fn inside(g: &mut Graph, domain: &Domain, u: Id, v: Id) -> Id {
 /// Half the extent of a lenslet's aperture along x and y.
 fn half_extent(d: &Domain) -> (f64, f64) {
     match *d {
-        Domain::Circle { radius } => (radius, radius),
+        Domain::Circle { radius } | Domain::Annulus { outer: radius, .. } => (radius, radius),
         Domain::Rect { x, y } => (x.0.abs().max(x.1.abs()), y.0.abs().max(y.1.abs())),
     }
 }
@@ -460,7 +469,7 @@ fn array_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerErro
         let z = height(&mut h, lenslet, u, v)?;
         let f = lensc_runtime::ir::Interpreter::new(&SurfaceTape::new(h, z));
         let at = match ap {
-            Domain::Circle { radius } => (radius, 0.0),
+            Domain::Circle { radius } | Domain::Annulus { outer: radius, .. } => (radius, 0.0),
             Domain::Rect { x, y } => (x.1, 0.5 * (y.0 + y.1)),
         };
         lensc_runtime::ir::SurfaceFn::eval(&f, at.0, at.1)[0]
@@ -755,6 +764,13 @@ fn domain_of(ap: &Object) -> Result<Domain, LowerError> {
         "circle" => aperture_radius(ap)
             .map(|radius| Domain::Circle { radius })
             .ok_or(LowerError::Aperture("circle")),
+        "annulus" => match (
+            value::num(&ap.fields, "inner"),
+            value::num(&ap.fields, "outer"),
+        ) {
+            (Some(inner), Some(outer)) => Ok(Domain::Annulus { inner, outer }),
+            _ => Err(LowerError::Aperture("annulus")),
+        },
         "rect" => match (value::range(&ap.fields, "x"), value::range(&ap.fields, "y")) {
             (Some(x), Some(y)) => Ok(Domain::Rect { x, y }),
             _ => Err(LowerError::Aperture("rect")),

@@ -14,6 +14,8 @@ use crate::ir::SurfaceFn;
 pub enum Domain {
     /// A disc about the origin.
     Circle { radius: f64 },
+    /// A ring about the origin: inner ≤ r ≤ outer.
+    Annulus { inner: f64, outer: f64 },
     /// x0 ≤ x ≤ x1, y0 ≤ y ≤ y1.
     Rect { x: (f64, f64), y: (f64, f64) },
 }
@@ -22,6 +24,10 @@ impl Domain {
     pub fn contains(&self, x: f64, y: f64) -> bool {
         match *self {
             Domain::Circle { radius } => x * x + y * y <= radius * radius * (1.0 + 1e-12),
+            Domain::Annulus { inner, outer } => {
+                let r2 = x * x + y * y;
+                r2 >= inner * inner * (1.0 - 1e-12) && r2 <= outer * outer * (1.0 + 1e-12)
+            }
             Domain::Rect {
                 x: (x0, x1),
                 y: (y0, y1),
@@ -31,7 +37,9 @@ impl Domain {
     /// The bounding box ((x0, x1), (y0, y1)).
     pub fn bounds(&self) -> ((f64, f64), (f64, f64)) {
         match *self {
-            Domain::Circle { radius } => ((-radius, radius), (-radius, radius)),
+            Domain::Circle { radius } | Domain::Annulus { outer: radius, .. } => {
+                ((-radius, radius), (-radius, radius))
+            }
             Domain::Rect { x, y } => (x, y),
         }
     }
