@@ -213,6 +213,21 @@ pub static ZERNIKE_COEFFICIENTS: Family = Family {
     },
 };
 
+/// `Q0` … `Q20`: Forbes Q-bfs coefficients (lengths).
+pub static QBFS_COEFFICIENTS: Family = Family {
+    describe: "Forbes Q-bfs coefficients `Q0` … `Q20` (lengths)",
+    param: |name| {
+        let m: usize = name.strip_prefix('Q')?.parse().ok()?;
+        (m <= 20).then_some(Param {
+            name: "Qm",
+            ty: LENGTH,
+            required: false,
+            check: Check::Any,
+            doc: "Q-bfs coefficient a_m, a length",
+        })
+    },
+};
+
 /// The (i, j) of a name `XiYj`, if it is one with 1 ≤ i + j ≤ 20.
 pub fn xy_powers(name: &str) -> Option<(u32, u32)> {
     let rest = name.strip_prefix('X')?;
@@ -469,6 +484,31 @@ pub static KINDS: &[Kind] = &[
         positional: &[],
         exclusive: &[],
         doc: "a conic base plus Zernike polynomials over the normalisation radius",
+    },
+    Kind {
+        name: "qbfs",
+        category: Category::Surface,
+        params: &[
+            req(
+                "radius",
+                LENGTH,
+                Check::Any,
+                "radius of the best-fit sphere (a magnitude with `sense`, signed with `convention: optical`)",
+            ),
+            SENSE,
+            CONVENTION,
+            req(
+                "norm_radius",
+                LENGTH,
+                Check::Positive,
+                "ρ_max, the normalisation radius (usually the aperture's)",
+            ),
+            APERTURE,
+        ],
+        family: Some(&QBFS_COEFFICIENTS),
+        positional: &[],
+        exclusive: &[],
+        doc: "Forbes Q-bfs: best-fit sphere plus u²(1-u²)/sqrt(1-c²ρ²) Σ a_m Q_m(u²), u = ρ/ρ_max",
     },
     Kind {
         name: "freeform",

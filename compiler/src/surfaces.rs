@@ -90,7 +90,7 @@ pub fn lower_surface(o: &Object) -> Result<LoweredSurface, LowerError> {
 /// which is the tape a careful hand would write, a third the size of
 /// differentiating in x and y directly.
 fn radial_tape(o: &Object) -> Option<SurfaceTape> {
-    if !matches!(o.kind.name, "sphere" | "conic" | "asphere") {
+    if !matches!(o.kind.name, "sphere" | "conic" | "asphere" | "qbfs") {
         return None;
     }
     let f = &o.fields;
@@ -128,7 +128,11 @@ fn radial_tape(o: &Object) -> Option<SurfaceTape> {
         h.div(ck, q3)
     };
     let zero = h.constant_node(0.0);
-    let p0 = add_power_terms(&mut h, zero, s, &power_terms(f));
+    let p0 = if o.kind.name == "qbfs" {
+        qbfs_departure(&mut h, s, c, f)?
+    } else {
+        add_power_terms(&mut h, zero, s, &power_terms(f))
+    };
     let p1 = h.derivative(p0, lensc_runtime::ir::Var::X);
     let p2 = h.derivative(p1, lensc_runtime::ir::Var::X);
     let sigma = h.constant_node(side.sigma);
@@ -162,6 +166,56 @@ fn radial_tape(o: &Object) -> Option<SurfaceTape> {
     };
     let zxy = g.mul(ff2, xy);
     Some(SurfaceTape::with_outputs(g, [f0, zx, zy, zxx, zxy, zyy]))
+}
+
+/// Forbes's Q-bfs departure in s = ρ²: u²(1 − u²)/sqrt(1 − c² s) · Σ a_m Q_m(u²),
+/// u² = s/ρ_max², the sum evaluated as one Chebyshev series by Clenshaw's
+/// recurrence.
+fn qbfs_departure(h: &mut Graph, s: Id, c: f64, f: &[value::Field]) -> Option<Id> {
+    let norm = value::num(f, "norm_radius")?;
+    let coeffs: Vec<(usize, f64)> = (0..=lensc_runtime::forbes::MAX_ORDER)
+        .filter_map(|m| value::num(f, &format!("Q{m}")).map(|a| (m, a)))
+        .collect();
+    let top = coeffs.iter().map(|t| t.0).max().unwrap_or(0);
+    let q = lensc_runtime::forbes::qbfs_chebyshev(top);
+    // b_k = Σ_m a_m c_mk: the whole sum in the Chebyshev basis.
+    let mut b = vec![0.0; top + 1];
+    for &(m, a) in &coeffs {
+        for (bk, ck) in b.iter_mut().zip(&q[m]) {
+            *bk += a * ck;
+        }
+    }
+    let inv = h.constant_node(1.0 / (norm * norm));
+    let x = h.mul(s, inv);
+    let two = h.constant_node(2.0);
+    let one = h.constant_node(1.0);
+    let tx = h.mul(two, x);
+    let t = h.sub(tx, one);
+    // Clenshaw: y_k = b_k + 2t y_{k+1} − y_{k+2}; sum = b_0 + t y_1 − y_2.
+    let zero = h.constant_node(0.0);
+    let (mut y1, mut y2) = (zero, zero);
+    for k in (1..=top).rev() {
+        let bk = h.constant_node(b[k]);
+        let tt = h.mul(two, t);
+        let a = h.mul(tt, y1);
+        let sum = h.add(bk, a);
+        let y = h.sub(sum, y2);
+        y2 = y1;
+        y1 = y;
+    }
+    let b0 = h.constant_node(b[0]);
+    let ty = h.mul(t, y1);
+    let first = h.add(b0, ty);
+    let series = h.sub(first, y2);
+    // u²(1 − u²) / sqrt(1 − c² s)
+    let omx = h.sub(one, x);
+    let pre = h.mul(x, omx);
+    let cc = h.constant_node(c * c);
+    let cs = h.mul(cc, s);
+    let under = h.sub(one, cs);
+    let root = h.sqrt(under);
+    let scaled = h.div(pre, root);
+    Some(h.mul(scaled, series))
 }
 
 /// The height of surface `o` at the coordinates `x`, `y` (nodes of `g`),
@@ -1257,5 +1311,30 @@ surface h = hex_grid(l, pitch: 1 mm, count_x: 3, count_y: 2)";
             );
         }
         assert_eq!(eval_surface(src, "h", 0.25, -row / 2.0)[0], 0.0);
+    }
+
+    #[test]
+    fn qbfs_is_the_sphere_plus_the_published_departure() {
+        // Best-fit sphere R = 25 mm, ρ_max = 4 mm, a_0 … a_3 in µm.
+        let src = "surface q = qbfs { radius: 25 mm, sense: concave, norm_radius: 4 mm, aperture: circle(radius: 4 mm), Q0: 2 um, Q1: -1 um, Q2: 0.5 um, Q3: 0.25 um }";
+        let (x, y): (f64, f64) = (1.3, -2.1);
+        let rho2 = x * x + y * y;
+        let u2 = rho2 / 16.0;
+        let q = [
+            1.0,
+            (13.0 - 16.0 * u2) / 19f64.sqrt(),
+            (2.0f64 / 95.0).sqrt() * (29.0 - 4.0 * u2 * (25.0 - 19.0 * u2)),
+            (2.0f64 / 2545.0).sqrt() * (207.0 - 4.0 * u2 * (315.0 - u2 * (577.0 - 320.0 * u2))),
+        ];
+        let a = [2e-3, -1e-3, 0.5e-3, 0.25e-3];
+        let c = 1.0 / 25.0;
+        let sum: f64 = a.iter().zip(q).map(|(a, q)| a * q).sum();
+        let want = c * rho2 / (1.0 + (1.0 - c * c * rho2).sqrt())
+            + u2 * (1.0 - u2) / (1.0 - c * c * rho2).sqrt() * sum;
+        let got = eval_surface(src, "q", x, y)[0];
+        assert!((got - want).abs() < 1e-15, "{got} vs {want}");
+        // At the edge (u = 1) the departure vanishes: the best-fit sphere.
+        let edge = eval_surface(src, "q", 4.0, 0.0)[0];
+        assert!((edge - c * 16.0 / (1.0 + (1.0f64 - c * c * 16.0).sqrt())).abs() < 1e-15);
     }
 }

@@ -5,6 +5,7 @@
 //! Internal units: one per dimension — millimetres, radians, seconds.
 
 pub mod analysis;
+pub mod forbes;
 pub mod format;
 pub mod ir;
 pub mod job;
