@@ -146,20 +146,20 @@ mod tests {
         for i in 0..n {
             let u = (std::f64::consts::FRAC_PI_2 * (i as f64 + 0.5) / n as f64).sin();
             let s: Vec<f64> = q.iter().map(|c| slope(c, u)).collect();
-            for a in 0..q.len() {
-                for b in 0..q.len() {
-                    g[a][b] += s[a] * s[b];
+            for (row, sa) in g.iter_mut().zip(&s) {
+                for (cell, sb) in row.iter_mut().zip(&s) {
+                    *cell += sa * sb;
                 }
             }
         }
         let unit = g[0][0];
-        for a in 0..q.len() {
-            for b in 0..q.len() {
+        for (a, row) in g.iter().enumerate() {
+            for (b, cell) in row.iter().enumerate() {
                 let want = if a == b { 1.0 } else { 0.0 };
                 assert!(
-                    (g[a][b] / unit - want).abs() < 1e-11,
+                    (cell / unit - want).abs() < 1e-11,
                     "<{a},{b}> = {}",
-                    g[a][b] / unit
+                    cell / unit
                 );
             }
         }
