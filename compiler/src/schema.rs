@@ -675,6 +675,35 @@ pub static KINDS: &[Kind] = &[
         doc: "a row of a lenslet (a cylinder, say) with seams between them",
     },
     Kind {
+        name: "tilt",
+        category: Category::Surface,
+        params: &[
+            req(
+                "parent",
+                Ty::Object(Category::Surface),
+                Check::Any,
+                "the surface to tilt",
+            ),
+            req(
+                "about",
+                Ty::Word(&["x", "y"]),
+                Check::Any,
+                "the axis through the vertex it turns about",
+            ),
+            req(
+                "angle",
+                ANGLE,
+                Check::HalfOpen(-std::f64::consts::FRAC_PI_4, std::f64::consts::FRAC_PI_4),
+                "the turn, right-handed about `about`, under 45° either way",
+            ),
+            APERTURE,
+        ],
+        family: None,
+        positional: &["parent"],
+        exclusive: &[],
+        doc: "a surface turned about the x or y axis through its vertex, as a height over the machine's x–y plane",
+    },
+    Kind {
         name: "roller",
         category: Category::Roller,
         params: &[req(
