@@ -140,11 +140,34 @@ fn build_writes_program_to_out_dir() {
     let program = std::fs::read_to_string(dir.path().join("out/kim_convex.ngc")).expect("program");
     assert!(program.starts_with("(lensc "));
     assert!(program.trim_end().ends_with("M2"));
-    let leftovers: Vec<_> = std::fs::read_dir(dir.path().join("out"))
+    let mut leftovers: Vec<String> = std::fs::read_dir(dir.path().join("out"))
         .expect("out")
-        .map(|e| e.expect("e").file_name())
+        .map(|e| e.expect("e").file_name().to_string_lossy().into_owned())
         .collect();
-    assert_eq!(leftovers.len(), 1, "temporary files left: {leftovers:?}");
+    leftovers.sort();
+    assert_eq!(
+        leftovers,
+        ["kim_convex.ngc", "kim_convex.report.json"],
+        "temporary files left"
+    );
+    // The report: provenance, the program, the toolpath and the surface.
+    let report: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("out/kim_convex.report.json")).expect("report"),
+    )
+    .expect("json");
+    assert_eq!(report["job"], "kim_convex");
+    assert_eq!(report["program"]["file"], "kim_convex.ngc");
+    assert_eq!(
+        report["program"]["lines"].as_u64(),
+        Some(program.lines().count() as u64)
+    );
+    assert_eq!(report["surface"]["kind"], "conic");
+    assert_eq!(report["surface"]["backend"], "jit");
+    let pv = report["surface"]["sag_mm"]["pv"].as_f64().expect("pv");
+    let c = 1.0 / 22.405;
+    let sag = c * 1.6 * 1.6 / (1.0 + (1.0f64 - 44.098 * c * c * 2.56).sqrt());
+    assert!((pv - sag).abs() < 1e-12, "{pv} vs {sag}");
+    assert!(report["toolpath"]["cutting_time_s"].as_f64().expect("time") > 0.0);
 }
 
 #[test]
@@ -174,7 +197,7 @@ fn failed_build_leaves_earlier_output_untouched() {
         .expect("out")
         .map(|e| e.expect("e").file_name())
         .collect();
-    assert_eq!(names.len(), 1, "partial files left: {names:?}");
+    assert_eq!(names.len(), 2, "partial files left: {names:?}");
 }
 
 #[test]

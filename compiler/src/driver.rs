@@ -43,13 +43,24 @@ pub fn check_text(fs: &dyn FileSystem, name: &str, text: &[u8]) -> Checked {
     Checked { loaded, checked }
 }
 
-/// Builds programs (without writing them) for the checked jobs. Returns
-/// the programs and any further diagnostics.
+/// One job's output, not yet written.
+pub struct Built {
+    /// File name of the program (`JOB.ngc`); the report is `JOB.report.json`.
+    pub program_name: String,
+    pub report_name: String,
+    pub program: String,
+    pub toolpath: Toolpath,
+    /// The build report (fields documented in README.md, "Build report").
+    pub report: serde_json::Value,
+}
+
+/// Builds programs and reports (without writing them) for the checked
+/// jobs. Returns them and any further diagnostics.
 pub fn plan_and_emit(
     c: &Checked,
     only: Option<&str>,
     source_name: &str,
-) -> (Vec<(String, String, Toolpath)>, Vec<Diagnostic>) {
+) -> (Vec<Built>, Vec<Diagnostic>) {
     let mut diags = Vec::new();
     let mut out = Vec::new();
     let jobs: Vec<&check::CheckedJob> = c
@@ -80,11 +91,24 @@ pub fn plan_and_emit(
             }
         };
         match program::emit(&lowered, &path, &prov) {
-            Ok(text) => out.push((
-                format!("{}.{}", lowered.name, lowered.machine.dialect.extension()),
-                text,
-                path,
-            )),
+            Ok(text) => {
+                let program_name =
+                    format!("{}.{}", lowered.name, lowered.machine.dialect.extension());
+                let surface =
+                    crate::value::object(&job.fields, "surface").expect("checked job part");
+                let name = job.part_names.get("surface").cloned().unwrap_or_default();
+                let analysis = crate::surfaces::lower_surface(surface)
+                    .map(|l| analysis_json(&name, surface.kind.name, &l, 201))
+                    .unwrap_or(serde_json::Value::Null);
+                let report = build_report(&lowered, &prov, &program_name, &text, &path, analysis);
+                out.push(Built {
+                    report_name: format!("{}.report.json", lowered.name),
+                    program_name,
+                    program: text,
+                    toolpath: path,
+                    report,
+                });
+            }
             Err(ProgramError::NotPrintable { word, value }) => diags.push(
                 Diagnostic::error(
                     codes::NOT_PRINTABLE,
@@ -97,6 +121,41 @@ pub fn plan_and_emit(
         }
     }
     (out, diags)
+}
+
+/// The report written beside a program.
+fn build_report(
+    job: &lensc_runtime::Job,
+    prov: &Provenance,
+    program_name: &str,
+    text: &str,
+    path: &Toolpath,
+    surface: serde_json::Value,
+) -> serde_json::Value {
+    use serde_json::json;
+    json!({
+        "job": job.name,
+        "lensc_version": prov.lensc_version,
+        "source": prov.source,
+        "source_fnv1a64": format!("{:016x}", prov.source_hash),
+        "program": {
+            "file": program_name,
+            "dialect": job.machine.dialect.name(),
+            "lines": text.lines().count(),
+            "bytes": text.len(),
+        },
+        "toolpath": {
+            "strategy": "profile_turning",
+            "cut_points": path.cut_points,
+            "cut_length_mm": path.cut_length,
+            "feed_mm_per_min": path.feed_speed * 60.0,
+            "cutting_time_s": path.cutting_time(),
+            "chord_tolerance_mm": job.strategy.chord_tolerance,
+            "max_profile_slope_deg": path.max_slope.0.to_degrees(),
+            "min_concave_radius_mm": path.min_concave_radius.map(|(r, at)| json!({ "value": r, "at_radius_mm": at })),
+        },
+        "surface": surface,
+    })
 }
 
 /// FNV-1a 64 over every loaded source, in load order.

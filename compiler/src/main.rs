@@ -257,23 +257,30 @@ fn run(cli: Cli) -> u8 {
             if diags.iter().any(|d| d.is_error()) {
                 return 1;
             }
-            for (name, text, path) in programs {
-                let target = dir.join(&name);
-                if let Err(e) = driver::write_atomic(&target, &text) {
-                    eprintln!(
-                        "error[{}]: cannot write {}: {}",
-                        lensc::codes::CANNOT_WRITE,
-                        target.display(),
-                        plain_io_error(&e)
-                    );
-                    return 1;
+            for built in programs {
+                let target = dir.join(&built.program_name);
+                let report_path = dir.join(&built.report_name);
+                let report = serde_json::to_string_pretty(&built.report).unwrap_or_default() + "\n";
+                // The report is written first: a program on disk always has
+                // its report beside it.
+                for (path, text) in [(&report_path, &report), (&target, &built.program)] {
+                    if let Err(e) = driver::write_atomic(path, text) {
+                        eprintln!(
+                            "error[{}]: cannot write {}: {}",
+                            lensc::codes::CANNOT_WRITE,
+                            path.display(),
+                            plain_io_error(&e)
+                        );
+                        return 1;
+                    }
                 }
                 eprintln!(
-                    "wrote {} ({} lines, {} cut points, estimated cutting time {:.1} s)",
+                    "wrote {} ({} lines, {} cut points, estimated cutting time {:.1} s) and {}",
                     target.display(),
-                    text.lines().count(),
-                    path.cut_points,
-                    path.cutting_time()
+                    built.program.lines().count(),
+                    built.toolpath.cut_points,
+                    built.toolpath.cutting_time(),
+                    report_path.display()
                 );
             }
             0
