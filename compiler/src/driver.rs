@@ -83,7 +83,26 @@ pub fn plan_and_emit(
             }
         };
         let (file, span) = lower::job_site(job);
-        let path = match toolpath::plan_profile_turning(&lowered) {
+        // The planner follows the surface as the JIT evaluates it.
+        let surface = crate::value::object(&job.fields, "surface").expect("checked job part");
+        let lowered_surface = match crate::surfaces::lower_surface(surface) {
+            Ok(l) => l,
+            Err(e) => {
+                diags.push(
+                    Diagnostic::error(
+                        codes::UNSUPPORTED_COMBINATION,
+                        format!("this surface cannot be evaluated yet: {e:?}"),
+                        file,
+                        span,
+                    )
+                    .with_label("this job"),
+                );
+                continue;
+            }
+        };
+        let (kernel, _) = evaluator(&lowered_surface.tape);
+        let profile = lensc_runtime::surface::SectionAlongX(kernel.as_ref());
+        let path = match toolpath::plan_profile_turning(&lowered, &profile) {
             Ok(p) => p,
             Err(errs) => {
                 diags.extend(errs.into_iter().map(|e| plan_diagnostic(e, file, span)));
@@ -94,12 +113,8 @@ pub fn plan_and_emit(
             Ok(text) => {
                 let program_name =
                     format!("{}.{}", lowered.name, lowered.machine.dialect.extension());
-                let surface =
-                    crate::value::object(&job.fields, "surface").expect("checked job part");
                 let name = job.part_names.get("surface").cloned().unwrap_or_default();
-                let analysis = crate::surfaces::lower_surface(surface)
-                    .map(|l| analysis_json(&name, surface.kind.name, &l, 201))
-                    .unwrap_or(serde_json::Value::Null);
+                let analysis = analysis_json(&name, surface.kind.name, &lowered_surface, 201);
                 let report = build_report(&lowered, &prov, &program_name, &text, &path, analysis);
                 out.push(Built {
                     report_name: format!("{}.report.json", lowered.name),

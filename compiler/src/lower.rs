@@ -5,14 +5,14 @@
 use lensc_grammar::{Diagnostic, FileId};
 use lensc_runtime::Job;
 use lensc_runtime::machine::{Dialect, Lathe};
-use lensc_runtime::surface::{RotationalSurface, Sense};
+use lensc_runtime::surface::SurfaceInfo;
 use lensc_runtime::tool::RoundNoseTool;
 use lensc_runtime::toolpath::{Feed, ProfileTurning};
 
 use crate::check::{CheckedJob, aperture_inner_radius, aperture_radius, trim_num};
 use crate::codes;
 use crate::units::Dim;
-use crate::value::{self, Field, Object, Value};
+use crate::value::{self, Object, Value};
 
 /// Lowers one checked job, or says why it cannot be built.
 pub fn lower(job: &CheckedJob) -> Result<Job, Vec<Diagnostic>> {
@@ -56,7 +56,7 @@ pub fn lower(job: &CheckedJob) -> Result<Job, Vec<Diagnostic>> {
             format!("this is a `{}`", tool.kind.name),
         ));
     }
-    let surf = match rotational(surface) {
+    let surf = match surface_info(surface) {
         Some(s) => Some(s),
         None => {
             errors.push(
@@ -65,7 +65,7 @@ pub fn lower(job: &CheckedJob) -> Result<Job, Vec<Diagnostic>> {
                     "surface",
                     format!("this is a `{}`", surface.kind.name),
                 )
-                .with_help("conic, sphere and asphere surfaces with `aperture: circle(…)` can be turned"),
+                .with_help("sphere, conic, asphere and qbfs surfaces with a circle or annulus aperture can be turned"),
             );
             None
         }
@@ -152,40 +152,58 @@ pub fn lower(job: &CheckedJob) -> Result<Job, Vec<Diagnostic>> {
     })
 }
 
-/// The runtime surface for a conic, sphere or asphere with a circular aperture.
-fn rotational(o: &Object) -> Option<RotationalSurface> {
-    if !matches!(o.kind.name, "conic" | "sphere" | "asphere") {
+/// What the program header says about a surface of revolution that can be
+/// turned (sphere, conic, asphere, Q-bfs with a circular or annular
+/// aperture), or `None` if it is not one.
+fn surface_info(o: &Object) -> Option<SurfaceInfo> {
+    if !matches!(o.kind.name, "sphere" | "conic" | "asphere" | "qbfs") {
         return None;
     }
-    let f: &[Field] = &o.fields;
-    let aperture_radius = aperture_radius(value::object(f, "aperture")?)?;
-    let terms: Vec<(u32, f64)> = (1..=20u32)
-        .filter_map(|j| value::num(f, &format!("A{j}")).map(|a| (j, a)))
-        .collect();
-    // The runtime profile takes |R| and a sense; the optical convention's
-    // sag is seen from the other side (see surfaces::Side), so its
-    // coefficients change sign when R < 0 makes the surface concave.
-    let side = crate::surfaces::Side::of(f);
-    let radius = value::num(f, "radius")?;
+    let ap = value::object(&o.fields, "aperture")?;
+    let aperture_radius = aperture_radius(ap)?;
+    let side = crate::surfaces::Side::of(&o.fields);
+    let radius = value::num(&o.fields, "radius")?;
     let convex = if side.signed {
         radius > 0.0
     } else {
         side.sigma < 0.0
     };
-    let flip = if side.signed && radius < 0.0 {
-        -1.0
+    let mut words = vec![o.kind.name.to_string()];
+    for fl in &o.fields {
+        match (&fl.value, fl.name.as_str()) {
+            (_, "sense" | "convention" | "aperture") => {}
+            (Value::Num(v, d), name) => {
+                let (unit, factor) = d.display_unit();
+                words.push(format!(
+                    "{name} {}{}{unit}",
+                    exact_num(v * factor),
+                    if unit.is_empty() { "" } else { " " }
+                ));
+            }
+            _ => {}
+        }
+    }
+    let inner = aperture_inner_radius(ap);
+    let aperture = if inner > 0.0 {
+        format!(
+            "annular aperture {} .. {} mm",
+            trim_num(inner),
+            trim_num(aperture_radius)
+        )
     } else {
-        1.0
+        format!("aperture radius {} mm", trim_num(aperture_radius))
     };
-    Some(RotationalSurface {
-        radius: radius.abs(),
-        conic: value::num(f, "conic").unwrap_or(0.0),
-        sense: if convex {
-            Sense::Convex
-        } else {
-            Sense::Concave
-        },
-        terms: terms.into_iter().map(|(j, a)| (j, flip * a)).collect(),
+    let side_words = if side.signed {
+        ", radius signed as in lens design"
+    } else {
+        ""
+    };
+    Some(SurfaceInfo {
+        description: format!(
+            "{}, {aperture}; {}: material on the -Z side{side_words}",
+            words.join(", "),
+            if convex { "convex" } else { "concave" }
+        ),
         aperture_radius,
     })
 }
@@ -193,4 +211,16 @@ fn rotational(o: &Object) -> Option<RotationalSurface> {
 /// Where a plan error should point: the job's name.
 pub fn job_site(job: &CheckedJob) -> (FileId, lensc_grammar::Span) {
     (job.file, job.name.span)
+}
+
+/// A parameter as a header states it: the shortest decimal that reads
+/// back as the same f64 (never an exponent), or 12 decimals when a unit
+/// conversion left a long tail (0.08499999999999999).
+fn exact_num(v: f64) -> String {
+    let s = format!("{v}");
+    if s.trim_start_matches('-').len() <= 17 {
+        return s;
+    }
+    let t = format!("{v:.12}");
+    t.trim_end_matches('0').trim_end_matches('.').to_string()
 }

@@ -1,7 +1,7 @@
 //! A checked, fully resolved job: what the compiler hands the runtime.
 
 use crate::machine::Lathe;
-use crate::surface::RotationalSurface;
+use crate::surface::SurfaceInfo;
 use crate::tool::RoundNoseTool;
 use crate::toolpath::ProfileTurning;
 
@@ -14,7 +14,9 @@ pub struct Job {
     pub tool_name: String,
     pub machine_name: String,
     pub strategy_name: String,
-    pub surface: RotationalSurface,
+    /// The surface as the header states it; its geometry reaches the
+    /// planner as a `Profile`.
+    pub surface: SurfaceInfo,
     pub tool: RoundNoseTool,
     pub machine: Lathe,
     pub strategy: ProfileTurning,

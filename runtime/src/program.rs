@@ -41,7 +41,6 @@ fn emit_linuxcnc_lathe(
 ) -> Result<String, ProgramError> {
     let d = decimals_for(job.machine.resolution);
     let mut out = String::with_capacity(64 * path.moves.len() + 1024);
-    let s = &job.surface;
     let comment = |out: &mut String, text: &str| {
         // RS274NGC comments cannot nest parentheses.
         let clean: String = text
@@ -71,24 +70,7 @@ fn emit_linuxcnc_lathe(
         &mut out,
         "coordinates are the centre of the tool nose; no cutter compensation",
     );
-    let kind = if !s.terms.is_empty() {
-        "asphere"
-    } else if s.conic == 0.0 {
-        "sphere"
-    } else {
-        "conic"
-    };
-    let mut surf = format!(
-        "surface {}: {kind} R {} mm, k {}, {}: material on the -Z side",
-        job.surface_name,
-        num(s.radius),
-        num(s.conic),
-        s.sense.name()
-    );
-    for (j, a) in &s.terms {
-        let _ = write!(surf, ", A{j} {}", num(*a));
-    }
-    let _ = write!(surf, ", aperture radius {} mm", num(s.aperture_radius));
+    let surf = format!("surface {}: {}", job.surface_name, job.surface.description);
     comment(&mut out, &surf);
     comment(
         &mut out,

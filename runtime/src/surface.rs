@@ -55,6 +55,42 @@ pub struct ProfilePoint {
     pub d2z: f64,
 }
 
+/// A section z(r) of a rotationally symmetric surface with its exact
+/// first and second derivatives: what profile turning follows.
+pub trait Profile {
+    fn point(&self, r: f64) -> ProfilePoint;
+}
+
+impl Profile for RotationalSurface {
+    fn point(&self, r: f64) -> ProfilePoint {
+        self.eval(r)
+    }
+}
+
+/// Any evaluated surface read along +x at y = 0 (for a surface of
+/// revolution, its profile): z, ∂z/∂x and ∂²z/∂x².
+pub struct SectionAlongX<'a>(pub &'a dyn crate::ir::SurfaceFn);
+
+impl Profile for SectionAlongX<'_> {
+    fn point(&self, r: f64) -> ProfilePoint {
+        let o = self.0.eval(r, 0.0);
+        ProfilePoint {
+            z: o[0],
+            dz: o[1],
+            d2z: o[3],
+        }
+    }
+}
+
+/// What a program header says about the surface it makes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SurfaceInfo {
+    /// Kind and parameters in words, with the material side.
+    pub description: String,
+    /// Outer radius of the aperture (mm).
+    pub aperture_radius: f64,
+}
+
 impl RotationalSurface {
     /// The largest radius where the conic is defined, if it is bounded
     /// (1 − (1+k) r²/R² ≥ 0).

@@ -5,7 +5,7 @@
 use nalgebra::Vector2;
 
 use crate::job::Job;
-use crate::surface::RotationalSurface;
+use crate::surface::Profile;
 
 /// Feed as the user gave it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -93,8 +93,9 @@ pub enum PlanError {
 /// Number of radii at which the profile is scanned for curvature and slope.
 const SCAN_POINTS: usize = 4096;
 
-/// Plans the profile-turning path of `job`, or says every reason it cannot.
-pub fn plan_profile_turning(job: &Job) -> Result<Toolpath, Vec<PlanError>> {
+/// Plans the profile-turning path of `job` along `profile` (the surface's
+/// section, from the JIT kernel in a build), or says every reason it cannot.
+pub fn plan_profile_turning(job: &Job, profile: &dyn Profile) -> Result<Toolpath, Vec<PlanError>> {
     let surf = &job.surface;
     let strat = &job.strategy;
     let rho = job.tool.nose_radius;
@@ -107,7 +108,7 @@ pub fn plan_profile_turning(job: &Job) -> Result<Toolpath, Vec<PlanError>> {
     let mut max_slope = (0.0f64, 0.0f64);
     for i in 0..=SCAN_POINTS {
         let r = end + (start - end) * i as f64 / SCAN_POINTS as f64;
-        let p = surf.eval(r);
+        let p = profile.point(r);
         if !(p.z.is_finite() && p.dz.is_finite() && p.d2z.is_finite()) {
             errors.push(PlanError::Undefined { at_radius: r });
             return Err(errors);
@@ -150,7 +151,7 @@ pub fn plan_profile_turning(job: &Job) -> Result<Toolpath, Vec<PlanError>> {
         });
     }
 
-    let centre = |r: f64| tool_centre(surf, rho, r);
+    let centre = |r: f64| tool_centre(profile, rho, r);
     let cut = sample_offset_curve(&centre, start, end, strat.chord_tolerance);
     if cut.iter().any(|c| !(c.x.is_finite() && c.y.is_finite())) {
         errors.push(PlanError::Undefined { at_radius: start });
@@ -217,8 +218,8 @@ pub fn plan_profile_turning(job: &Job) -> Result<Toolpath, Vec<PlanError>> {
 
 /// The nose centre when the nose touches the profile at radius `r`: the
 /// profile point moved by ρ along the unit normal that points to the tool.
-pub fn tool_centre(surf: &RotationalSurface, nose_radius: f64, r: f64) -> Vector2<f64> {
-    let p = surf.eval(r);
+pub fn tool_centre(profile: &dyn Profile, nose_radius: f64, r: f64) -> Vector2<f64> {
+    let p = profile.point(r);
     let normal = Vector2::new(-p.dz, 1.0).normalize();
     Vector2::new(r, p.z) + nose_radius * normal
 }
@@ -271,7 +272,7 @@ fn distance_to_segment(q: Vector2<f64>, a: Vector2<f64>, b: Vector2<f64>) -> f64
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::surface::Sense;
+    use crate::surface::{RotationalSurface, Sense};
 
     fn sphere(sense: Sense) -> RotationalSurface {
         RotationalSurface {
