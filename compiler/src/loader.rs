@@ -70,29 +70,21 @@ impl Loaded {
 /// Loads `root` (as the user named it) and the closure of its `use`s.
 pub fn load(fs: &dyn FileSystem, root: &Path) -> Result<Loaded, std::io::Error> {
     let bytes = fs.read(root)?;
-    let mut l = Loader {
-        fs,
-        loaded: Loaded {
-            sources: SourceMap::default(),
-            files: Vec::new(),
-            diags: Vec::new(),
-        },
-        keys: HashMap::new(),
-        stack: Vec::new(),
-    };
-    let key = Key::Path(fs.canonical(root));
-    l.add(
-        key,
-        root.display().to_string(),
-        Some(root.to_path_buf()),
-        bytes,
-    );
-    Ok(l.loaded)
+    Ok(load_bytes(fs, Key::Path(fs.canonical(root)), root, bytes))
 }
 
 /// Loads source text given directly (tests, benchmarks); `use` of a path
 /// is resolved relative to the working directory.
 pub fn load_text(fs: &dyn FileSystem, name: &str, text: &[u8]) -> Loaded {
+    load_bytes(
+        fs,
+        Key::Path(PathBuf::from(name)),
+        Path::new(name),
+        text.to_vec(),
+    )
+}
+
+fn load_bytes(fs: &dyn FileSystem, key: Key, path: &Path, bytes: Vec<u8>) -> Loaded {
     let mut l = Loader {
         fs,
         loaded: Loaded {
@@ -104,10 +96,10 @@ pub fn load_text(fs: &dyn FileSystem, name: &str, text: &[u8]) -> Loaded {
         stack: Vec::new(),
     };
     l.add(
-        Key::Path(PathBuf::from(name)),
-        name.to_string(),
-        Some(PathBuf::from(name)),
-        text.to_vec(),
+        key,
+        path.display().to_string(),
+        Some(path.to_path_buf()),
+        bytes,
     );
     l.loaded
 }
