@@ -1345,7 +1345,8 @@ impl<'a> Checker<'a> {
     /// Rules that tie several parameters of one kind together.
     fn kind_rules(&mut self, o: &Object) -> bool {
         match o.kind.name {
-            "conic" | "sphere" | "asphere" | "cylinder" | "acylinder" | "toroid" | "qbfs" => {
+            "conic" | "sphere" | "asphere" | "cylinder" | "acylinder" | "toroid" | "qbfs"
+            | "qcon" => {
                 let (Some(r), Some(ap)) = (
                     value::num(&o.fields, "radius").map(f64::abs),
                     value::object(&o.fields, "aperture"),

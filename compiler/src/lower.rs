@@ -65,7 +65,7 @@ pub fn lower(job: &CheckedJob) -> Result<Job, Vec<Diagnostic>> {
                     "surface",
                     format!("this is a `{}`", surface.kind.name),
                 )
-                .with_help("sphere, conic, asphere and qbfs surfaces with a circle or annulus aperture can be turned"),
+                .with_help("sphere, conic, asphere, qbfs and qcon surfaces with a circle or annulus aperture can be turned"),
             );
             None
         }
@@ -153,10 +153,13 @@ pub fn lower(job: &CheckedJob) -> Result<Job, Vec<Diagnostic>> {
 }
 
 /// What the program header says about a surface of revolution that can be
-/// turned (sphere, conic, asphere, Q-bfs with a circular or annular
+/// turned (sphere, conic, asphere, Q-bfs, Q-con with a circular or annular
 /// aperture), or `None` if it is not one.
 fn surface_info(o: &Object) -> Option<SurfaceInfo> {
-    if !matches!(o.kind.name, "sphere" | "conic" | "asphere" | "qbfs") {
+    if !matches!(
+        o.kind.name,
+        "sphere" | "conic" | "asphere" | "qbfs" | "qcon"
+    ) {
         return None;
     }
     let ap = value::object(&o.fields, "aperture")?;

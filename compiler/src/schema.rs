@@ -228,6 +228,21 @@ pub static QBFS_COEFFICIENTS: Family = Family {
     },
 };
 
+/// `Q0` … `Q20`: Forbes Q-con coefficients (lengths).
+pub static QCON_COEFFICIENTS: Family = Family {
+    describe: "Forbes Q-con coefficients `Q0` … `Q20` (lengths)",
+    param: |name| {
+        let m: usize = name.strip_prefix('Q')?.parse().ok()?;
+        (m <= 20).then_some(Param {
+            name: "Qm",
+            ty: LENGTH,
+            required: false,
+            check: Check::Any,
+            doc: "Q-con coefficient a_m, a length",
+        })
+    },
+};
+
 /// The (i, j) of a name `XiYj`, if it is one with 1 ≤ i + j ≤ 20.
 pub fn xy_powers(name: &str) -> Option<(u32, u32)> {
     let rest = name.strip_prefix('X')?;
@@ -509,6 +524,32 @@ pub static KINDS: &[Kind] = &[
         positional: &[],
         exclusive: &[],
         doc: "Forbes Q-bfs: best-fit sphere plus u²(1-u²)/sqrt(1-c²ρ²) Σ a_m Q_m(u²), u = ρ/ρ_max",
+    },
+    Kind {
+        name: "qcon",
+        category: Category::Surface,
+        params: &[
+            req(
+                "radius",
+                LENGTH,
+                Check::Any,
+                "vertex radius of the base conic (a magnitude with `sense`, signed with `convention: optical`)",
+            ),
+            opt("conic", NUMBER, Check::Any, "conic constant k of the base"),
+            SENSE,
+            CONVENTION,
+            req(
+                "norm_radius",
+                LENGTH,
+                Check::Positive,
+                "ρ_max, the normalisation radius (usually the aperture's)",
+            ),
+            APERTURE,
+        ],
+        family: Some(&QCON_COEFFICIENTS),
+        positional: &[],
+        exclusive: &[],
+        doc: "Forbes Q-con: a conic plus u⁴ Σ a_m Q_m^con(u²), Q_m^con(x) = P_m^(0,4)(2x-1), u = ρ/ρ_max",
     },
     Kind {
         name: "freeform",

@@ -83,14 +83,13 @@ pub fn lower_surface(o: &Object) -> Result<LoweredSurface, LowerError> {
     })
 }
 
-/// Rotationally symmetric surfaces z = f(s), s = x² + y², differentiated
-/// through s: f, f' and f'' are built once in s (exactly, by the graph's
-/// own differentiation) and combined by the chain rule,
-///   z_x = 2x f',  z_xx = 2f' + 4x² f'',  z_xy = 4xy f''  (and in y),
-/// which is the tape a careful hand would write, a third the size of
-/// differentiating in x and y directly.
-fn radial_tape(o: &Object) -> Option<SurfaceTape> {
-    if !matches!(o.kind.name, "sphere" | "conic" | "asphere" | "qbfs") {
+/// f(s), f'(s) and f''(s) of a surface of revolution, in a scratch graph
+/// whose x stands for s = x² + y².
+fn radial_profile(o: &Object) -> Option<(Graph, [Id; 3])> {
+    if !matches!(
+        o.kind.name,
+        "sphere" | "conic" | "asphere" | "qbfs" | "qcon"
+    ) {
         return None;
     }
     let f = &o.fields;
@@ -128,10 +127,10 @@ fn radial_tape(o: &Object) -> Option<SurfaceTape> {
         h.div(ck, q3)
     };
     let zero = h.constant_node(0.0);
-    let p0 = if o.kind.name == "qbfs" {
-        qbfs_departure(&mut h, s, c, f)?
-    } else {
-        add_power_terms(&mut h, zero, s, &power_terms(f))
+    let p0 = match o.kind.name {
+        "qbfs" => qbfs_departure(&mut h, s, c, f)?,
+        "qcon" => qcon_departure(&mut h, s, f)?,
+        _ => add_power_terms(&mut h, zero, s, &power_terms(f)),
     };
     let p1 = h.derivative(p0, lensc_runtime::ir::Var::X);
     let p2 = h.derivative(p1, lensc_runtime::ir::Var::X);
@@ -141,6 +140,17 @@ fn radial_tape(o: &Object) -> Option<SurfaceTape> {
         h.mul(sigma, t)
     };
     let (f0, f1, f2) = (sum(g0, p0), sum(g1, p1), sum(g2, p2));
+    Some((h, [f0, f1, f2]))
+}
+
+/// Rotationally symmetric surfaces z = f(s), s = x² + y², differentiated
+/// through s: f, f' and f'' are built once in s (exactly, by the graph's
+/// own differentiation) and combined by the chain rule,
+///   z_x = 2x f',  z_xx = 2f' + 4x² f'',  z_xy = 4xy f''  (and in y),
+/// which is the tape a careful hand would write, a third the size of
+/// differentiating in x and y directly.
+fn radial_tape(o: &Object) -> Option<SurfaceTape> {
+    let (h, [f0, f1, f2]) = radial_profile(o)?;
     // Compose with s = x² + y².
     let mut g = Graph::new();
     let (x, y) = (g.x(), g.y());
@@ -187,26 +197,8 @@ fn qbfs_departure(h: &mut Graph, s: Id, c: f64, f: &[value::Field]) -> Option<Id
     }
     let inv = h.constant_node(1.0 / (norm * norm));
     let x = h.mul(s, inv);
-    let two = h.constant_node(2.0);
+    let series = chebyshev_series(h, x, &b);
     let one = h.constant_node(1.0);
-    let tx = h.mul(two, x);
-    let t = h.sub(tx, one);
-    // Clenshaw: y_k = b_k + 2t y_{k+1} − y_{k+2}; sum = b_0 + t y_1 − y_2.
-    let zero = h.constant_node(0.0);
-    let (mut y1, mut y2) = (zero, zero);
-    for k in (1..=top).rev() {
-        let bk = h.constant_node(b[k]);
-        let tt = h.mul(two, t);
-        let a = h.mul(tt, y1);
-        let sum = h.add(bk, a);
-        let y = h.sub(sum, y2);
-        y2 = y1;
-        y1 = y;
-    }
-    let b0 = h.constant_node(b[0]);
-    let ty = h.mul(t, y1);
-    let first = h.add(b0, ty);
-    let series = h.sub(first, y2);
     // u²(1 − u²) / sqrt(1 − c² s)
     let omx = h.sub(one, x);
     let pre = h.mul(x, omx);
@@ -216,6 +208,53 @@ fn qbfs_departure(h: &mut Graph, s: Id, c: f64, f: &[value::Field]) -> Option<Id
     let root = h.sqrt(under);
     let scaled = h.div(pre, root);
     Some(h.mul(scaled, series))
+}
+
+/// Forbes's Q-con departure from the conic in s = ρ²: u⁴ Σ a_m Q_m^con(u²),
+/// u² = s/ρ_max², with Q_m^con(x) = P_m^(0,4)(2x − 1); the sum evaluated
+/// as one Chebyshev series.
+fn qcon_departure(h: &mut Graph, s: Id, f: &[value::Field]) -> Option<Id> {
+    let norm = value::num(f, "norm_radius")?;
+    let coeffs: Vec<(usize, f64)> = (0..=lensc_runtime::forbes::MAX_ORDER)
+        .filter_map(|m| value::num(f, &format!("Q{m}")).map(|a| (m, a)))
+        .collect();
+    let top = coeffs.iter().map(|t| t.0).max().unwrap_or(0);
+    let q = lensc_runtime::forbes::qcon_chebyshev(top);
+    let mut b = vec![0.0; top + 1];
+    for &(m, a) in &coeffs {
+        for (bk, ck) in b.iter_mut().zip(&q[m]) {
+            *bk += a * ck;
+        }
+    }
+    let inv = h.constant_node(1.0 / (norm * norm));
+    let x = h.mul(s, inv);
+    let series = chebyshev_series(h, x, &b);
+    let x2 = h.powi(x, 2);
+    Some(h.mul(x2, series))
+}
+
+/// Σ_k b_k T_k(2x − 1) by Clenshaw's recurrence:
+/// y_k = b_k + 2t y_{k+1} − y_{k+2}; the sum is b_0 + t y_1 − y_2.
+fn chebyshev_series(h: &mut Graph, x: Id, b: &[f64]) -> Id {
+    let two = h.constant_node(2.0);
+    let one = h.constant_node(1.0);
+    let tx = h.mul(two, x);
+    let t = h.sub(tx, one);
+    let zero = h.constant_node(0.0);
+    let (mut y1, mut y2) = (zero, zero);
+    for &bk in b.iter().skip(1).rev() {
+        let bk = h.constant_node(bk);
+        let tt = h.mul(two, t);
+        let a = h.mul(tt, y1);
+        let sum = h.add(bk, a);
+        let y = h.sub(sum, y2);
+        y2 = y1;
+        y1 = y;
+    }
+    let b0 = h.constant_node(b.first().copied().unwrap_or(0.0));
+    let ty = h.mul(t, y1);
+    let first = h.add(b0, ty);
+    h.sub(first, y2)
 }
 
 /// The height of surface `o` at the coordinates `x`, `y` (nodes of `g`),
@@ -235,6 +274,11 @@ pub fn height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError>
             let sag = add_power_terms(g, sag, r2, &power_terms(f));
             let s = g.constant_node(side.sigma);
             g.mul(s, sag)
+        }
+        "qbfs" | "qcon" => {
+            let (h, [f0, _, _]) = radial_profile(o).ok_or(LowerError::Unsupported(o.kind.name))?;
+            let s = radius_squared(g, x, y);
+            g.import(&h, s, s)[f0.0 as usize]
         }
         "cylinder" | "acylinder" => {
             let c =
@@ -1387,6 +1431,36 @@ surface h = hex_grid(l, pitch: 1 mm, count_x: 3, count_y: 2)";
         // At the edge (u = 1) the departure vanishes: the best-fit sphere.
         let edge = eval_surface(src, "q", 4.0, 0.0)[0];
         assert!((edge - c * 16.0 / (1.0 + (1.0f64 - c * c * 16.0).sqrt())).abs() < 1e-15);
+    }
+
+    #[test]
+    fn qcon_is_the_conic_plus_the_published_departure() {
+        // Conic R = 12 mm, k = −0.8, ρ_max = 3 mm; Forbes 2007's closed forms
+        // Q_0 = 1, Q_1 = −(5 − 6x), Q_2 = 15 − 14x(3 − 2x).
+        let src = "surface q = qcon { radius: 12 mm, conic: -0.8, sense: convex, norm_radius: 3 mm, aperture: circle(radius: 3 mm), Q0: 1.5 um, Q1: -0.4 um, Q2: 0.2 um }
+surface l = qcon { radius: 12 mm, conic: -0.8, sense: convex, norm_radius: 0.4 mm, aperture: circle(radius: 0.4 mm), Q1: 1 um }
+surface a = grid(l, pitch_x: 1 mm, pitch_y: 1 mm, count_x: 2, count_y: 2)";
+        let (x, y): (f64, f64) = (0.9, -2.2);
+        let rho2 = x * x + y * y;
+        let u2 = rho2 / 9.0;
+        let (c, k) = (1.0 / 12.0, -0.8);
+        let q = [1.0, -(5.0 - 6.0 * u2), 15.0 - 14.0 * u2 * (3.0 - 2.0 * u2)];
+        let a = [1.5e-3, -0.4e-3, 0.2e-3];
+        let sum: f64 = a.iter().zip(q).map(|(a, q)| a * q).sum();
+        let sag = c * rho2 / (1.0 + (1.0 - (1.0 + k) * c * c * rho2).sqrt()) + u2 * u2 * sum;
+        let got = eval_surface(src, "q", x, y)[0];
+        assert!((got + sag).abs() < 1e-15, "{got} vs {}", -sag);
+        // In an array the lenslet is the same surface about its centre, its
+        // rim (ρ = 0.4 mm) at the land.
+        let lens = |r2: f64| {
+            let u2 = r2 / 0.16;
+            c * r2 / (1.0 + (1.0 - (1.0 + k) * c * c * r2).sqrt())
+                + u2 * u2 * 1e-3 * -(5.0 - 6.0 * u2)
+        };
+        let (dx, dy) = (0.1, -0.25);
+        let want = lens(0.16) - lens(dx * dx + dy * dy);
+        let got = eval_surface(src, "a", 0.5 + dx, 0.5 + dy)[0];
+        assert!(close(got, want), "{got} vs {want}");
     }
 
     #[test]

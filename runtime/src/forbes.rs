@@ -11,6 +11,11 @@
 //! unlike monomials), the integrals done exactly by Gauss–Chebyshev
 //! quadrature. Tests compare Q_1 … Q_3 with the closed forms published
 //! with them and check orthonormality with an independent quadrature.
+//!
+//! Q-con (same paper) adds u⁴ Σ a_m Q_m^con(u²) to a conic, with
+//! Q_m^con(x) = P_m^(0,4)(2x − 1), the Jacobi polynomials; they are
+//! converted here to the same Chebyshev basis so one Clenshaw sum serves
+//! both.
 
 /// Highest order a surface may use.
 pub const MAX_ORDER: usize = 20;
@@ -93,6 +98,45 @@ pub fn qbfs_chebyshev(max: usize) -> Vec<Vec<f64>> {
     qs.into_iter().map(|(c, _)| c).collect()
 }
 
+/// P_n^(0,4)(t) by the Jacobi three-term recurrence (α = 0, β = 4):
+/// 2n(n+4)(2n+2) P_n = (2n+3)[(2n+4)(2n+2) t − 16] P_{n−1}
+///                     − 2(n−1)(n+3)(2n+4) P_{n−2}.
+pub fn jacobi_0_4(n: usize, t: f64) -> f64 {
+    let (mut p0, mut p1) = (1.0, 3.0 * t - 2.0);
+    if n == 0 {
+        return p0;
+    }
+    for k in 2..=n {
+        let k = k as f64;
+        let a = (2.0 * k + 3.0) * ((2.0 * k + 4.0) * (2.0 * k + 2.0) * t - 16.0);
+        let b = 2.0 * (k - 1.0) * (k + 3.0) * (2.0 * k + 4.0);
+        let p = (a * p1 - b * p0) / (2.0 * k * (k + 4.0) * (2.0 * k + 2.0));
+        p0 = p1;
+        p1 = p;
+    }
+    p1
+}
+
+/// Row m: Q_m^con = Σ_k c[m][k] T_k(2x − 1), for m = 0 … max: the values at
+/// max + 1 Chebyshev nodes transformed back, exact for these degrees.
+pub fn qcon_chebyshev(max: usize) -> Vec<Vec<f64>> {
+    let n = max.min(MAX_ORDER) + 1;
+    let theta = |j: usize| std::f64::consts::PI * (j as f64 + 0.5) / n as f64;
+    (0..n)
+        .map(|m| {
+            (0..n)
+                .map(|k| {
+                    let sum: f64 = (0..n)
+                        .map(|j| jacobi_0_4(m, theta(j).cos()) * (k as f64 * theta(j)).cos())
+                        .sum();
+                    let scale = if k == 0 { 1.0 } else { 2.0 };
+                    scale * sum / n as f64
+                })
+                .collect()
+        })
+        .collect()
+}
+
 /// Σ_k c_k T_k(2x − 1), for tests and checks outside the IR.
 pub fn eval_chebyshev(c: &[f64], x: f64) -> f64 {
     let (t, _) = chebyshev(c.len().max(2) - 1, 2.0 * x - 1.0);
@@ -126,6 +170,53 @@ mod tests {
                 "{} vs {q3}",
                 eval_chebyshev(&q[3], x)
             );
+        }
+    }
+
+    #[test]
+    fn qcon_polynomials_match_the_published_forms() {
+        // Forbes 2007, eq. (A.1)-(A.2): Q_0 = 1, Q_1 = −(5 − 6x),
+        // Q_2 = 15 − 14x(3 − 2x), Q_3 = −{35 − 12x[14 − x(21 − 10x)]}.
+        let q = qcon_chebyshev(3);
+        for x in [0.0, 0.3, 0.77, 1.0] {
+            let want = [
+                1.0,
+                -(5.0 - 6.0 * x),
+                15.0 - 14.0 * x * (3.0 - 2.0 * x),
+                -(35.0 - 12.0 * x * (14.0 - x * (21.0 - 10.0 * x))),
+            ];
+            for (m, w) in want.iter().enumerate() {
+                let got = eval_chebyshev(&q[m], x);
+                assert!(
+                    (got - w).abs() <= 1e-13 * w.abs().max(1.0),
+                    "Q{m}({x}) = {got} vs {w}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn qcon_polynomials_are_orthogonal_with_their_weight() {
+        // ∫₀¹ Q_m Q_n x⁴ dx = δ_mn / (2m + 5) (Jacobi (0, 4) on 2x − 1).
+        let q = qcon_chebyshev(MAX_ORDER);
+        let n = 40_000;
+        for a in [0, 3, 11, 20] {
+            for b in [0, 3, 11, 20] {
+                let mut sum = 0.0;
+                // The midpoint rule on 40 000 cells: error ~h² f''/24,
+                // below 1e-8 here.
+                for i in 0..n {
+                    let x = (i as f64 + 0.5) / n as f64;
+                    sum += eval_chebyshev(&q[a], x) * eval_chebyshev(&q[b], x) * x.powi(4);
+                }
+                sum /= n as f64;
+                let want = if a == b {
+                    1.0 / (2 * a + 5) as f64
+                } else {
+                    0.0
+                };
+                assert!((sum - want).abs() < 1e-6, "<{a},{b}> = {sum}, want {want}");
+            }
         }
     }
 
