@@ -6,7 +6,7 @@ use std::path::Path;
 
 use lensc_grammar::{Diagnostic, FileId, Span};
 use lensc_runtime::program::{self, ProgramError, Provenance};
-use lensc_runtime::toolpath::{self, PlanError, Toolpath};
+use lensc_runtime::toolpath::{self, PlanError, ToolLocation, Toolpath};
 
 use crate::check::{self, trim_num};
 use crate::codes;
@@ -109,6 +109,34 @@ pub fn plan_and_emit(
                 continue;
             }
         };
+        if let Some(deepest) = path.seams.iter().max_by(|a, b| a.depth.total_cmp(&b.depth)) {
+            let (first, last) = (&path.seams[0], &path.seams[path.seams.len() - 1]);
+            let where_ = if path.seams.len() == 1 {
+                format!("the concave corner at r = {} mm", trim_num(first.at_radius))
+            } else {
+                format!(
+                    "{} concave corners between r = {} and {} mm",
+                    path.seams.len(),
+                    trim_num(first.at_radius),
+                    trim_num(last.at_radius)
+                )
+            };
+            diags.push(
+                Diagnostic::warning(
+                    codes::SEAM_LEFT_UNCUT,
+                    format!(
+                        "the {} mm nose cannot reach into {where_}: up to {} um of material is left above the design (at r = {} mm)",
+                        trim_num(lowered.tool.nose_radius),
+                        trim_num(deepest.depth * 1000.0),
+                        trim_num(deepest.at_radius)
+                    ),
+                    file,
+                    span,
+                )
+                .with_label("this job")
+                .with_help("the program cuts the gouge-free envelope; the report lists every corner and its depth; a smaller nose follows them closer"),
+            );
+        }
         match program::emit(&lowered, &path, &prov) {
             Ok(text) => {
                 let program_name =
@@ -168,6 +196,16 @@ fn build_report(
             "chord_tolerance_mm": job.strategy.chord_tolerance,
             "max_profile_slope_deg": path.max_slope.0.to_degrees(),
             "min_concave_radius_mm": path.min_concave_radius.map(|(r, at)| json!({ "value": r, "at_radius_mm": at })),
+            "tool_location": match job.strategy.location {
+                ToolLocation::Exact => "exact",
+                ToolLocation::Sequential { .. } => "sequential",
+                ToolLocation::Binary { .. } => "binary",
+            },
+            "seams": path.seams.iter().map(|s| json!({
+                "at_radius_mm": s.at_radius,
+                "uncut_depth_mm": s.depth,
+                "corner_angle_deg": s.angle.to_degrees(),
+            })).collect::<Vec<_>>(),
         },
         "surface": surface,
     })

@@ -7,7 +7,7 @@ use lensc_runtime::Job;
 use lensc_runtime::machine::{Dialect, Lathe};
 use lensc_runtime::surface::SurfaceInfo;
 use lensc_runtime::tool::RoundNoseTool;
-use lensc_runtime::toolpath::{Feed, ProfileTurning};
+use lensc_runtime::toolpath::{Feed, ProfileTurning, ToolLocation};
 
 use crate::check::{CheckedJob, aperture_inner_radius, aperture_radius, trim_num};
 use crate::codes;
@@ -65,7 +65,7 @@ pub fn lower(job: &CheckedJob) -> Result<Job, Vec<Diagnostic>> {
                     "surface",
                     format!("this is a `{}`", surface.kind.name),
                 )
-                .with_help("sphere, conic, asphere, qbfs and qcon surfaces with a circle or annulus aperture can be turned"),
+                .with_help("sphere, conic, asphere, qbfs and qcon surfaces with a circle or annulus aperture can be turned, and any profile made a surface of revolution with `revolve`"),
             );
             None
         }
@@ -110,6 +110,7 @@ pub fn lower(job: &CheckedJob) -> Result<Job, Vec<Diagnostic>> {
             value::object(&surface.fields, "aperture").map_or(0.0, |a| aperture_inner_radius(a))
         }),
         retract: value::num(f, "retract").unwrap_or(1.0),
+        location: tool_location(f),
     };
     let m = &machine.fields;
     let travel = value::block(m, "travel").expect("required");
@@ -152,10 +153,39 @@ pub fn lower(job: &CheckedJob) -> Result<Job, Vec<Diagnostic>> {
     })
 }
 
+/// The `search` of a profile-turning strategy: exact unless the user asks
+/// for one of Lei et al.'s reference searches.
+fn tool_location(f: &[value::Field]) -> ToolLocation {
+    let spacing = value::num(f, "search_spacing").unwrap_or(1e-3);
+    match value::word(f, "search") {
+        Some("sequential") => ToolLocation::Sequential {
+            spacing,
+            step: value::num(f, "search_step").unwrap_or(1e-5),
+        },
+        Some("binary") => ToolLocation::Binary {
+            spacing,
+            tolerance: value::num(f, "search_step").unwrap_or(1e-6),
+        },
+        _ => ToolLocation::Exact,
+    }
+}
+
 /// What the program header says about a surface of revolution that can be
 /// turned (sphere, conic, asphere, Q-bfs, Q-con with a circular or annular
 /// aperture), or `None` if it is not one.
 fn surface_info(o: &Object) -> Option<SurfaceInfo> {
+    if o.kind.name == "revolve" {
+        let ap = value::object(&o.fields, "aperture")?;
+        let aperture_radius = aperture_radius(ap)?;
+        return Some(SurfaceInfo {
+            description: format!(
+                "{}, aperture radius {} mm; +Z out of the material",
+                describe(o),
+                trim_num(aperture_radius)
+            ),
+            aperture_radius,
+        });
+    }
     if !matches!(
         o.kind.name,
         "sphere" | "conic" | "asphere" | "qbfs" | "qcon"
@@ -209,6 +239,39 @@ fn surface_info(o: &Object) -> Option<SurfaceInfo> {
         ),
         aperture_radius,
     })
+}
+
+/// A surface in words: its kind and every parameter, nested surfaces in
+/// brackets, apertures included (a revolved profile's own aperture is what
+/// makes its seams).
+fn describe(o: &Object) -> String {
+    let mut words = vec![o.kind.name.to_string()];
+    for fl in &o.fields {
+        match &fl.value {
+            Value::Num(v, d) => {
+                let (unit, factor) = d.display_unit();
+                words.push(format!(
+                    "{} {}{}{unit}",
+                    fl.name,
+                    exact_num(v * factor),
+                    if unit.is_empty() { "" } else { " " }
+                ));
+            }
+            Value::Word(w) => words.push(format!("{} {w}", fl.name)),
+            Value::Object(inner) => words.push(format!("{} [{}]", fl.name, describe(inner))),
+            Value::Range(a, b, d) => {
+                let (unit, factor) = d.display_unit();
+                words.push(format!(
+                    "{} {} .. {} {unit}",
+                    fl.name,
+                    exact_num(a * factor),
+                    exact_num(b * factor)
+                ));
+            }
+            _ => {}
+        }
+    }
+    words.join(", ")
 }
 
 /// Where a plan error should point: the job's name.

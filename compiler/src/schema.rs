@@ -640,6 +640,29 @@ pub static KINDS: &[Kind] = &[
         doc: "an off-axis section of a parent surface, in coordinates centred on (x, y), its height zero there",
     },
     Kind {
+        name: "revolve",
+        category: Category::Surface,
+        params: &[
+            req(
+                "profile",
+                Ty::Object(Category::Surface),
+                Check::Any,
+                "the surface whose section along +x at y = 0 is turned about the z axis",
+            ),
+            opt(
+                "start",
+                LENGTH,
+                Check::Any,
+                "x on the profile that lies on the axis; default 0",
+            ),
+            APERTURE,
+        ],
+        family: None,
+        positional: &["profile"],
+        exclusive: &[],
+        doc: "a surface of revolution: z(x, y) = profile(start + sqrt(x² + y²), 0), what a 2-axis lathe makes of a profile",
+    },
+    Kind {
         name: "grid",
         category: Category::Surface,
         params: &[
@@ -915,6 +938,24 @@ pub static KINDS: &[Kind] = &[
                 LENGTH,
                 Check::Positive,
                 "clearance above the part for rapid moves; default 1 mm",
+            ),
+            opt(
+                "search",
+                Ty::Word(&["exact", "sequential", "binary"]),
+                Check::Any,
+                "how the nose-centre height is found: exact (default), or Lei et al.'s sequential or binary search over the discretised profile (reference methods)",
+            ),
+            opt(
+                "search_spacing",
+                LENGTH,
+                Check::Positive,
+                "profile discretisation of the sequential and binary searches; default 1 µm",
+            ),
+            opt(
+                "search_step",
+                LENGTH,
+                Check::Positive,
+                "descent step of the sequential search (default 10 nm) or final bracket of the binary search (default 1 nm)",
             ),
         ],
         family: None,

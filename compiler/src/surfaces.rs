@@ -450,6 +450,16 @@ pub fn height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError>
                 .ok_or(LowerError::Unsupported("wrap without a design"))?;
             height(g, design, x, y)?
         }
+        "revolve" => {
+            let profile = value::object(f, "profile")
+                .ok_or(LowerError::Unsupported("revolve without a profile"))?;
+            let start = g.constant_node(value::num(f, "start").unwrap_or(0.0));
+            let r2 = radius_squared(g, x, y);
+            let r = g.sqrt(r2);
+            let u = g.add(start, r);
+            let zero = g.constant_node(0.0);
+            height(g, profile, u, zero)?
+        }
         "off_axis" => {
             let parent = value::object(f, "parent")
                 .ok_or(LowerError::Unsupported("off_axis without a parent"))?;

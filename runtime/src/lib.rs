@@ -5,12 +5,16 @@
 //! Internal units: one per dimension — millimetres, radians, seconds.
 
 pub mod analysis;
+pub mod envelope;
 pub mod forbes;
 pub mod format;
+pub mod grinding;
 pub mod ir;
 pub mod job;
 pub mod machine;
 pub mod program;
+pub mod raster;
+pub mod servo;
 pub mod surface;
 pub mod tool;
 pub mod toolpath;

@@ -52,7 +52,28 @@ fn emit_linuxcnc_lathe(
                 c => c,
             })
             .collect();
-        let _ = writeln!(out, "({clean})");
+        // RS274NGC lines are limited (LinuxCNC: 256 characters): long
+        // text is folded at ", " into several comments.
+        const WIDTH: usize = 120;
+        let mut line = String::new();
+        let pieces = clean.split(", ").flat_map(|p| {
+            // A piece with no ", " in it longer than a line: cut by characters.
+            let chars: Vec<char> = p.chars().collect();
+            chars
+                .chunks(WIDTH)
+                .map(|c| c.iter().collect::<String>())
+                .collect::<Vec<_>>()
+        });
+        for (i, piece) in pieces.enumerate() {
+            if i > 0 && line.chars().count() + piece.chars().count() + 2 > WIDTH {
+                let _ = writeln!(out, "({line},)");
+                line = String::from("  ");
+            } else if i > 0 {
+                line.push_str(", ");
+            }
+            line.push_str(&piece);
+        }
+        let _ = writeln!(out, "({line})");
     };
     comment(
         &mut out,

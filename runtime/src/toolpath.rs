@@ -4,6 +4,7 @@
 
 use nalgebra::Vector2;
 
+use crate::envelope::{self, Pieces};
 use crate::job::Job;
 use crate::surface::Profile;
 
@@ -30,6 +31,34 @@ pub struct ProfileTurning {
     pub end_radius: f64,
     /// Height (mm) above the highest tool-centre point for rapid moves.
     pub retract: f64,
+    /// How the nose-centre height is found.
+    pub location: ToolLocation,
+}
+
+/// How profile turning finds the nose-centre height.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ToolLocation {
+    /// Exact: the normal offset on a smooth profile; where the profile has
+    /// corners, the envelope of nose circles, piece by piece by Newton.
+    Exact,
+    /// Lei et al.'s sequential search (reference): the profile discretised
+    /// every `spacing` mm, the nose lowered in steps of `step` mm.
+    Sequential { spacing: f64, step: f64 },
+    /// Lei et al.'s binary search (reference): the profile discretised every
+    /// `spacing` mm, the height halved down to `tolerance` mm.
+    Binary { spacing: f64, tolerance: f64 },
+}
+
+/// A concave corner of the profile the nose cannot reach into: the cut
+/// there is the envelope, and material is left above the design.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Seam {
+    /// Where (radius, mm).
+    pub at_radius: f64,
+    /// Material left above the design at the corner (mm).
+    pub depth: f64,
+    /// The angle the profile turns through at the corner (rad).
+    pub angle: f64,
 }
 
 /// One motion in the dialect-independent move stream.
@@ -55,6 +84,8 @@ pub struct Toolpath {
     pub min_concave_radius: Option<(f64, f64)>,
     /// Steepest profile slope (rad) and where (r, mm).
     pub max_slope: (f64, f64),
+    /// Concave corners the nose cannot follow, in radius order.
+    pub seams: Vec<Seam>,
 }
 
 impl Toolpath {
@@ -151,13 +182,15 @@ pub fn plan_profile_turning(job: &Job, profile: &dyn Profile) -> Result<Toolpath
         });
     }
 
-    let centre = |r: f64| tool_centre(profile, rho, r);
-    let cut = sample_offset_curve(&centre, start, end, strat.chord_tolerance);
-    if cut.iter().any(|c| !(c.x.is_finite() && c.y.is_finite())) {
-        errors.push(PlanError::Undefined { at_radius: start });
-        return Err(errors);
-    }
-
+    // The profile the nose can touch: the cut range and, at the centre,
+    // its mirror image across the axis.
+    let (lo, hi) = {
+        let (a, b) = (start.min(end), start.max(end));
+        (if a <= 0.0 { a - rho } else { a }, b)
+    };
+    let pieces = envelope::split_at_corners(profile, lo, hi);
+    let seams = seams(profile, &pieces, rho, start.min(end), hi);
+    let cut = cut_path(profile, &pieces, rho, strat, start, end);
     let top = cut.iter().map(|c| c.y).fold(f64::NEG_INFINITY, f64::max);
     let safe_z = top + strat.retract;
     let mut moves = Vec::with_capacity(cut.len() + 4);
@@ -213,7 +246,80 @@ pub fn plan_profile_turning(job: &Job, profile: &dyn Profile) -> Result<Toolpath
         feed_speed,
         min_concave_radius: min_concave,
         max_slope,
+        seams,
     })
+}
+
+/// The nose-centre points of the cut, within the chord tolerance of the
+/// curve the chosen tool location gives.
+fn cut_path(
+    profile: &dyn Profile,
+    pieces: &Pieces,
+    rho: f64,
+    strat: &ProfileTurning,
+    start: f64,
+    end: f64,
+) -> Vec<Vector2<f64>> {
+    let tol = strat.chord_tolerance;
+    // The ends of the cut in the tool's x: the normal offsets of its ends.
+    let (x0, x1) = (
+        tool_centre(profile, rho, start).x,
+        tool_centre(profile, rho, end).x,
+    );
+    let discretised = |spacing: f64| -> Vec<(f64, f64)> {
+        let (a, b) = (pieces.bounds[0], pieces.bounds[pieces.bounds.len() - 1]);
+        let n = (((b - a) / spacing).ceil() as usize).max(1);
+        (0..=n)
+            .map(|i| {
+                let u = a + (b - a) * i as f64 / n as f64;
+                (u, profile.point(u).z)
+            })
+            .collect()
+    };
+    match strat.location {
+        ToolLocation::Exact if pieces.corners.is_empty() => {
+            let centre = |r: f64| tool_centre(profile, rho, r);
+            sample_offset_curve(&centre, start, end, tol)
+        }
+        ToolLocation::Exact => {
+            let centre =
+                |x: f64| Vector2::new(x, envelope::centre_height(profile, pieces, rho, x).0);
+            sample_offset_curve(&centre, x0, x1, tol)
+        }
+        ToolLocation::Sequential { spacing, step } => {
+            let pts = discretised(spacing);
+            let top = pts.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max) + rho;
+            let centre =
+                |x: f64| Vector2::new(x, envelope::sequential_search(&pts, rho, x, top, step));
+            sample_offset_curve(&centre, x0, x1, tol)
+        }
+        ToolLocation::Binary { spacing, tolerance } => {
+            let pts = discretised(spacing);
+            let centre = |x: f64| {
+                let near = envelope::points_near(&pts, x, rho);
+                Vector2::new(x, envelope::binary_search(near, rho, x, tolerance))
+            };
+            sample_offset_curve(&centre, x0, x1, tol)
+        }
+    }
+}
+
+/// The concave corners on [a, b] where the nose leaves more than 1 nm of
+/// material above the design.
+fn seams(profile: &dyn Profile, pieces: &Pieces, rho: f64, a: f64, b: f64) -> Vec<Seam> {
+    pieces
+        .corners
+        .iter()
+        .filter(|c| c.is_concave() && c.at >= a && c.at <= b)
+        .filter_map(|c| {
+            let depth = envelope::cut_height(profile, pieces, rho, c.at) - profile.point(c.at).z;
+            (depth > 1e-6).then(|| Seam {
+                at_radius: c.at,
+                depth,
+                angle: c.angle(),
+            })
+        })
+        .collect()
 }
 
 /// The nose centre when the nose touches the profile at radius `r`: the

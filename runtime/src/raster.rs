@@ -1,0 +1,1 @@
+//! Raster (iso-plane) planning for 3-axis mills: being written.

@@ -1,0 +1,67 @@
+//! Toolpath figures reproduced from the seed papers, end to end through
+//! `lensc build`: each test builds an example and reads its report.
+
+mod common;
+
+use common::{lensc, root, text};
+
+/// Builds `example` into a temporary directory; the report of `job` and
+/// the diagnostics printed.
+fn build(example: &str, job: &str) -> (serde_json::Value, String) {
+    let dir = tempfile::tempdir().expect("tmp");
+    let out_dir = dir.path().to_str().expect("utf-8 path");
+    let out = lensc(&root(), &["build", example, "--out", out_dir]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let report =
+        std::fs::read_to_string(dir.path().join(format!("{job}.report.json"))).expect("report");
+    (
+        serde_json::from_str(&report).expect("json"),
+        text(&out.stderr),
+    )
+}
+
+#[test]
+fn seed_004_seams_are_found_with_the_half_millimetre_nose() {
+    // Lei et al. 2021: arcs R = 0.788 mm, T1 = 0.534 mm, T2 = 0.02 mm, ten
+    // periods, nose 0.5 mm (Table 1). Every arc edge is a concave corner
+    // the nose cannot reach. Near a seam centred at c the nose rides on the
+    // nearer arc: its centre at height sqrt((R + ρ)² − (x − x_arc)²) − rim
+    // (rim = sqrt(R² − (T1/2)²), the arc centres' depth below the land),
+    // and what it leaves at the corner u is the lowest of its lower arcs,
+    // min over x of h(x) − sqrt(ρ² − (u − x)²): found here by a dense scan.
+    let (report, stderr) = build("examples/lei2021_cylinder_array.lens", "cylinder_rings");
+    let seams = report["toolpath"]["seams"].as_array().expect("seams");
+    assert_eq!(seams.len(), 20, "two corners per seam, ten seams");
+    let (r, rho, p, t1) = (0.788f64, 0.5f64, 0.554f64, 0.534f64);
+    let rim = (r * r - t1 * t1 / 4.0).sqrt();
+    let depth = {
+        let (c, u) = (0.0, -0.01);
+        let h = |x: f64| {
+            let arc = if x < c { c - p / 2.0 } else { c + p / 2.0 };
+            ((r + rho).powi(2) - (x - arc).powi(2)).sqrt() - rim
+        };
+        (0..=200_000)
+            .map(|i| {
+                let x = u - 0.05 + 0.1 * i as f64 / 200_000.0;
+                h(x) - (rho * rho - (u - x).powi(2)).sqrt()
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    for (i, s) in seams.iter().enumerate() {
+        let at = s["at_radius_mm"].as_f64().expect("at");
+        let d = s["uncut_depth_mm"].as_f64().expect("depth");
+        // Corners at the arc edges: 0.01, 0.544, 0.564, 1.098, … mm.
+        let want_at = 0.01 + (i / 2) as f64 * p + if i % 2 == 1 { t1 } else { 0.0 };
+        let want_at = if i == 0 { 0.01 } else { want_at };
+        assert!(
+            (at - want_at).abs() < 1e-9,
+            "corner {i} at {at}, want {want_at}"
+        );
+        assert!(
+            (d - depth).abs() < 1e-9,
+            "corner {i}: {d} mm left, want {depth}"
+        );
+    }
+    assert!(stderr.contains("W0003"), "{stderr}");
+    assert_eq!(report["toolpath"]["tool_location"], "exact");
+}
