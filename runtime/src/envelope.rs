@@ -174,9 +174,11 @@ fn phi(profile: &dyn Profile, rho: f64, x: f64, u: f64) -> (f64, f64, f64) {
     (p.z + s, dphi, p.d2z - rho * rho / (s * s * s))
 }
 
-/// Maximum of φ over [a, b] within one smooth piece: an end, or the root of
-/// φ′ by Newton's method kept inside a shrinking bracket.
-fn piece_max(profile: &dyn Profile, rho: f64, x: f64, a: f64, b: f64) -> (f64, f64) {
+/// The highest φ(u) = z(u) + sqrt(ρ² − (u − x)²) over [a, b] and its u,
+/// where φ is unimodal there (a smooth piece with ρ below its concave
+/// radius, or one with convex corners only): an end, or the root of φ′ by
+/// Newton's method kept inside a shrinking bracket.
+pub fn piece_max(profile: &dyn Profile, rho: f64, x: f64, a: f64, b: f64) -> (f64, f64) {
     // A corner is located to 1e-13 mm, possibly just across it: the ends
     // are read 1e-10 mm inside the piece, on the piece's own side.
     let inset = (1e-10f64).min(0.25 * (b - a));

@@ -8,6 +8,7 @@ pub mod analysis;
 pub mod envelope;
 pub mod forbes;
 pub mod format;
+pub mod fts;
 pub mod grinding;
 pub mod ir;
 pub mod job;
