@@ -65,3 +65,30 @@ fn seed_004_seams_are_found_with_the_half_millimetre_nose() {
     assert!(stderr.contains("W0003"), "{stderr}");
     assert_eq!(report["toolpath"]["tool_location"], "exact");
 }
+
+#[test]
+fn seed_003_fts_array_reproduces_the_paper() {
+    // Hashimoto & Yan 2025: R = 20 mm lenslets, d = 1.7 mm, 5 m/min, settling
+    // time 1 ms: h_offset = 3.7 µm (eqs 6-7); 2 µm/rev over the 10 × 10
+    // array is about 12,500 revolutions; the fast axis stays within its
+    // 5 mm stroke and 25 G (the program was made, so the checks passed).
+    let (report, _) = build("examples/hashimoto2025_lens_array.lens", "lens_array_fts");
+    let tp = &report["toolpath"];
+    let h = tp["settling"]["h_offset_mm"].as_f64().expect("h_offset");
+    assert_eq!(format!("{:.1}", h * 1000.0), "3.7", "{h}");
+    let d_traj = tp["settling"]["d_traj_mm"].as_f64().expect("d_traj");
+    assert!((d_traj - 5000.0 / 60.0 * 1e-3).abs() < 1e-15);
+    let revs = tp["revolutions"].as_u64().expect("revolutions");
+    assert!((12_000..=12_600).contains(&revs), "{revs}");
+    // The servo model from the machine's 1367 Hz, +1 dB: ζ = 0.523.
+    let zeta = tp["servo"]["damping"].as_f64().expect("damping");
+    assert_eq!(format!("{zeta:.3}"), "0.523");
+    // The fast axis moves through the lenslet sag (18.07 µm) plus h_offset.
+    let fa = &tp["fast_axis"];
+    let used = fa["stroke_used_mm"].as_f64().expect("stroke");
+    let sag = 0.85f64.powi(2) / (20.0 + (400.0 - 0.85f64.powi(2)).sqrt());
+    assert!(used > sag && used < sag + h + 1e-6, "{used}");
+    assert!(fa["max_acceleration_m_per_s2"].as_f64().expect("acc") < 25.0 * 9.80665);
+    // Capped at 1000 rpm near the centre.
+    assert!((tp["max_spindle_rpm"].as_f64().expect("rpm") - 1000.0).abs() < 1e-9);
+}

@@ -1207,6 +1207,7 @@ impl<'a> Checker<'a> {
                     Check::Positive => *v > 0.0,
                     Check::NonNegative => *v >= 0.0,
                     Check::HalfOpen(lo, hi) => *v >= lo && *v < hi,
+                    Check::Open(lo, hi) => *v > lo && *v < hi,
                     Check::Count => v.fract() == 0.0 && (1.0..=100_000.0).contains(v),
                 };
                 if !ok {
@@ -1217,6 +1218,11 @@ impl<'a> Checker<'a> {
                         Check::NonNegative => "cannot be negative".to_string(),
                         Check::HalfOpen(lo, hi) => format!(
                             "must be at least {} and less than {} {unit}",
+                            trim_num(lo * factor),
+                            trim_num(hi * factor)
+                        ),
+                        Check::Open(lo, hi) => format!(
+                            "must be greater than {} and less than {} {unit}",
                             trim_num(lo * factor),
                             trim_num(hi * factor)
                         ),

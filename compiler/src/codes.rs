@@ -39,6 +39,9 @@ pub const OUT_OF_TRAVEL: &str = "E0141";
 pub const FEED_TOO_HIGH: &str = "E0142";
 pub const SPINDLE_TOO_FAST: &str = "E0143";
 pub const UNDEFINED_ON_PATH: &str = "E0144";
+pub const CLEARANCE_TOO_SMALL: &str = "E0145";
+pub const STROKE_EXCEEDED: &str = "E0146";
+pub const ACCELERATION_EXCEEDED: &str = "E0147";
 pub const NOT_PRINTABLE: &str = "E0150";
 pub const CANNOT_WRITE: &str = "E0151";
 
@@ -86,6 +89,9 @@ pub const ALL: &[&str] = &[
     FEED_TOO_HIGH,
     SPINDLE_TOO_FAST,
     UNDEFINED_ON_PATH,
+    CLEARANCE_TOO_SMALL,
+    STROKE_EXCEEDED,
+    ACCELERATION_EXCEEDED,
     NOT_PRINTABLE,
     CANNOT_WRITE,
     UNUSED,

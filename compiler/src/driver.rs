@@ -48,18 +48,67 @@ pub struct Built {
     /// File name of the program (`JOB.ngc`); the report is `JOB.report.json`.
     pub program_name: String,
     pub report_name: String,
-    pub program: String,
-    pub toolpath: Toolpath,
+    pub program: ProgramText,
+    /// Points of the cut and its estimated time (s), for the summary line.
+    pub cut_points: usize,
+    pub cutting_time: f64,
     /// The build report (fields documented in README.md, "Build report").
     pub report: serde_json::Value,
 }
 
+/// A program's text: in memory, or spooled as it was written to a
+/// temporary file in the output directory (the programs of fast-tool-servo
+/// jobs run to millions of lines).
+pub enum ProgramText {
+    Memory(String),
+    Spooled {
+        file: tempfile::NamedTempFile,
+        lines: usize,
+        bytes: u64,
+    },
+}
+
+impl ProgramText {
+    pub fn lines(&self) -> usize {
+        match self {
+            ProgramText::Memory(t) => t.lines().count(),
+            ProgramText::Spooled { lines, .. } => *lines,
+        }
+    }
+    pub fn bytes(&self) -> u64 {
+        match self {
+            ProgramText::Memory(t) => t.len() as u64,
+            ProgramText::Spooled { bytes, .. } => *bytes,
+        }
+    }
+    /// The whole text (read back from the spool file if need be).
+    pub fn text(&self) -> std::io::Result<String> {
+        match self {
+            ProgramText::Memory(t) => Ok(t.clone()),
+            ProgramText::Spooled { file, .. } => std::fs::read_to_string(file.path()),
+        }
+    }
+    /// Puts the program at `path` atomically (a spooled program is renamed
+    /// into place: it was written in the same directory).
+    pub fn write_to(self, path: &Path) -> std::io::Result<()> {
+        match self {
+            ProgramText::Memory(t) => write_atomic(path, &t),
+            ProgramText::Spooled { file, .. } => {
+                file.as_file().sync_all()?;
+                file.persist(path).map(|_| ()).map_err(|e| e.error)
+            }
+        }
+    }
+}
+
 /// Builds programs and reports (without writing them) for the checked
-/// jobs. Returns them and any further diagnostics.
+/// jobs. Returns them and any further diagnostics. Large programs are
+/// spooled into `spool_dir` (the output directory) when one is given.
 pub fn plan_and_emit(
     c: &Checked,
     only: Option<&str>,
     source_name: &str,
+    spool_dir: Option<&Path>,
 ) -> (Vec<Built>, Vec<Diagnostic>) {
     let mut diags = Vec::new();
     let mut out = Vec::new();
@@ -75,6 +124,14 @@ pub fn plan_and_emit(
         lensc_version: env!("CARGO_PKG_VERSION").to_string(),
     };
     for job in jobs {
+        let strategy = crate::value::object(&job.fields, "strategy").expect("checked job part");
+        if strategy.kind.name == "fts_spiral" {
+            match crate::fts_job::build(job, &prov, spool_dir) {
+                Ok(b) => out.push(b),
+                Err(mut d) => diags.append(&mut d),
+            }
+            continue;
+        }
         let lowered = match lower::lower(job) {
             Ok(j) => j,
             Err(mut d) => {
@@ -147,8 +204,9 @@ pub fn plan_and_emit(
                 out.push(Built {
                     report_name: format!("{}.report.json", lowered.name),
                     program_name,
-                    program: text,
-                    toolpath: path,
+                    program: ProgramText::Memory(text),
+                    cut_points: path.cut_points,
+                    cutting_time: path.cutting_time(),
                     report,
                 });
             }
@@ -314,7 +372,7 @@ pub type Sample = [f64; 7];
 /// The second value names the backend used (reports carry it).
 pub fn evaluator(
     tape: &lensc_runtime::ir::SurfaceTape,
-) -> (Box<dyn lensc_runtime::ir::SurfaceFn>, &'static str) {
+) -> (Box<dyn lensc_runtime::ir::SurfaceFn + Sync>, &'static str) {
     match crate::jit::JitSurface::compile(tape) {
         Ok(j) => (Box::new(j), "jit"),
         Err(_) => (

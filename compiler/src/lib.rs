@@ -5,6 +5,7 @@
 pub mod check;
 pub mod codes;
 pub mod driver;
+pub mod fts_job;
 pub mod jit;
 pub mod loader;
 pub mod lower;

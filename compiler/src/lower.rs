@@ -244,7 +244,7 @@ fn surface_info(o: &Object) -> Option<SurfaceInfo> {
 /// A surface in words: its kind and every parameter, nested surfaces in
 /// brackets, apertures included (a revolved profile's own aperture is what
 /// makes its seams).
-fn describe(o: &Object) -> String {
+pub fn describe(o: &Object) -> String {
     let mut words = vec![o.kind.name.to_string()];
     for fl in &o.fields {
         match &fl.value {

@@ -252,7 +252,7 @@ fn run(cli: Cli) -> u8 {
                 return 1;
             }
             let (programs, diags) =
-                driver::plan_and_emit(&c, job.as_deref(), &file.display().to_string());
+                driver::plan_and_emit(&c, job.as_deref(), &file.display().to_string(), Some(&dir));
             out.diagnostics(&c, &diags);
             if diags.iter().any(|d| d.is_error()) {
                 return 1;
@@ -261,25 +261,27 @@ fn run(cli: Cli) -> u8 {
                 let target = dir.join(&built.program_name);
                 let report_path = dir.join(&built.report_name);
                 let report = serde_json::to_string_pretty(&built.report).unwrap_or_default() + "\n";
+                let lines = built.program.lines();
                 // The report is written first: a program on disk always has
                 // its report beside it.
-                for (path, text) in [(&report_path, &report), (&target, &built.program)] {
-                    if let Err(e) = driver::write_atomic(path, text) {
-                        eprintln!(
-                            "error[{}]: cannot write {}: {}",
-                            lensc::codes::CANNOT_WRITE,
-                            path.display(),
-                            plain_io_error(&e)
-                        );
-                        return 1;
-                    }
+                let written = driver::write_atomic(&report_path, &report)
+                    .map_err(|e| (&report_path, e))
+                    .and_then(|()| built.program.write_to(&target).map_err(|e| (&target, e)));
+                if let Err((path, e)) = written {
+                    eprintln!(
+                        "error[{}]: cannot write {}: {}",
+                        lensc::codes::CANNOT_WRITE,
+                        path.display(),
+                        plain_io_error(&e)
+                    );
+                    return 1;
                 }
                 eprintln!(
                     "wrote {} ({} lines, {} cut points, estimated cutting time {:.1} s) and {}",
                     target.display(),
-                    built.program.lines().count(),
-                    built.toolpath.cut_points,
-                    built.toolpath.cutting_time(),
+                    lines,
+                    built.cut_points,
+                    built.cutting_time,
                     report_path.display()
                 );
             }

@@ -67,6 +67,8 @@ pub enum Check {
     NonNegative,
     /// lo ≤ v < hi
     HalfOpen(f64, f64),
+    /// lo < v < hi
+    Open(f64, f64),
     /// A whole number from 1 to 100 000.
     Count,
 }
@@ -282,6 +284,57 @@ fn power_dims(n: i8) -> &'static [Dim] {
     ];
     &DIMS[n.clamp(0, 20) as usize]
 }
+
+const DIALECT: Param = req(
+    "dialect",
+    Ty::Word(&["linuxcnc"]),
+    Check::Any,
+    "the controller's program dialect",
+);
+const RESOLUTION: Param = req(
+    "resolution",
+    LENGTH,
+    Check::Positive,
+    "smallest programmable step",
+);
+const MAX_FEED: Param = req(
+    "max_feed",
+    Ty::Quantity(&[Dim::SPEED]),
+    Check::Positive,
+    "fastest cutting feed",
+);
+const SPINDLE: Param = req(
+    "spindle",
+    Ty::Block(&[req(
+        "max_speed",
+        Ty::Quantity(&[Dim::ROTATIONAL_SPEED]),
+        Check::Positive,
+        "spindle speed limit",
+    )]),
+    Check::Any,
+    "the work spindle",
+);
+const LATHE_TRAVEL: Param = req(
+    "travel",
+    Ty::Block(&[
+        req("x", Ty::Range(Dim::LENGTH), Check::Any, "X (radius) travel"),
+        req("z", Ty::Range(Dim::LENGTH), Check::Any, "Z travel"),
+    ]),
+    Check::Any,
+    "axis travel",
+);
+const RETRACT: Param = opt(
+    "retract",
+    LENGTH,
+    Check::Positive,
+    "clearance above the part for rapid moves; default 1 mm",
+);
+const CHORD_TOLERANCE: Param = opt(
+    "chord_tolerance",
+    LENGTH,
+    Check::Positive,
+    "largest chord deviation from the exact tool-centre path; default 10 nm",
+);
 
 const LENSLET: Param = req(
     "lenslet",
@@ -898,6 +951,290 @@ pub static KINDS: &[Kind] = &[
         positional: &[],
         exclusive: &[],
         doc: "a 2-axis lathe: X (radius) and Z (spindle axis)",
+    },
+    Kind {
+        name: "microshaper",
+        category: Category::Tool,
+        params: &[
+            req(
+                "nose_radius",
+                LENGTH,
+                Check::Positive,
+                "radius of the knife's nose, in the plane of the cut",
+            ),
+            req(
+                "clearance",
+                ANGLE,
+                Check::HalfOpen(0.0, DEG90),
+                "clearance angle of the flank",
+            ),
+        ],
+        family: None,
+        positional: &[],
+        exclusive: &[],
+        doc: "Lin's microshaper knife: a nose arc in the plane of the path, scraping along it (seed 000)",
+    },
+    Kind {
+        name: "ball_end",
+        category: Category::Tool,
+        params: &[req(
+            "diameter",
+            LENGTH,
+            Check::Positive,
+            "diameter of the ball",
+        )],
+        family: None,
+        positional: &[],
+        exclusive: &[],
+        doc: "a ball-end mill, referenced at the ball's centre",
+    },
+    Kind {
+        name: "spherical_wheel",
+        category: Category::Tool,
+        params: &[req(
+            "diameter",
+            LENGTH,
+            Check::Positive,
+            "diameter D_t of the wheel's spherical tip",
+        )],
+        family: None,
+        positional: &[],
+        exclusive: &[],
+        doc: "a spherical grinding wheel, referenced at its centre (seed 001)",
+    },
+    Kind {
+        name: "fts_lathe",
+        category: Category::Machine,
+        params: &[
+            DIALECT,
+            RESOLUTION,
+            LATHE_TRAVEL,
+            MAX_FEED,
+            SPINDLE,
+            req(
+                "fast_axis",
+                Ty::Block(&[
+                    req("stroke", LENGTH, Check::Positive, "travel of the fast axis"),
+                    req(
+                        "max_acceleration",
+                        Ty::Quantity(&[Dim::ACCELERATION]),
+                        Check::Positive,
+                        "acceleration limit of the fast axis",
+                    ),
+                    req(
+                        "resonance",
+                        Ty::Quantity(&[Dim::FREQUENCY]),
+                        Check::Positive,
+                        "resonance frequency of the closed-loop servo",
+                    ),
+                    req(
+                        "resonant_peak",
+                        NUMBER,
+                        Check::Positive,
+                        "resonant peak of the closed-loop servo, in dB",
+                    ),
+                    opt(
+                        "data_rate",
+                        Ty::Quantity(&[Dim::FREQUENCY]),
+                        Check::Positive,
+                        "rate at which the servo takes positions; default 20 kHz",
+                    ),
+                    opt(
+                        "settling_band",
+                        NUMBER,
+                        Check::Positive,
+                        "settling band as a fraction of the step; default 0.002 (0.2 %)",
+                    ),
+                ]),
+                Check::Any,
+                "the fast tool servo (W axis) and its second-order model",
+            ),
+        ],
+        family: None,
+        positional: &[],
+        exclusive: &[],
+        doc: "a lathe with C-axis spindle and a fast tool servo W along Z",
+    },
+    Kind {
+        name: "mill_3axis",
+        category: Category::Machine,
+        params: &[
+            DIALECT,
+            RESOLUTION,
+            req(
+                "travel",
+                Ty::Block(&[
+                    req("x", Ty::Range(Dim::LENGTH), Check::Any, "X travel"),
+                    req("y", Ty::Range(Dim::LENGTH), Check::Any, "Y travel"),
+                    req("z", Ty::Range(Dim::LENGTH), Check::Any, "Z travel"),
+                ]),
+                Check::Any,
+                "axis travel",
+            ),
+            MAX_FEED,
+        ],
+        family: None,
+        positional: &[],
+        exclusive: &[],
+        doc: "a 3-axis mill: X, Y, Z",
+    },
+    Kind {
+        name: "grinder_2axis",
+        category: Category::Machine,
+        params: &[DIALECT, RESOLUTION, LATHE_TRAVEL, MAX_FEED],
+        family: None,
+        positional: &[],
+        exclusive: &[],
+        doc: "a 2-axis (X, Z) grinder with a spherical wheel",
+    },
+    Kind {
+        name: "fts_spiral",
+        category: Category::Strategy,
+        params: &[
+            req(
+                "feed",
+                Ty::Quantity(&[Dim::FEED_PER_REV]),
+                Check::Positive,
+                "radial feed per revolution",
+            ),
+            opt(
+                "spindle_speed",
+                Ty::Quantity(&[Dim::ROTATIONAL_SPEED]),
+                Check::Positive,
+                "constant spindle speed",
+            ),
+            opt(
+                "surface_speed",
+                Ty::Quantity(&[Dim::SPEED]),
+                Check::Positive,
+                "constant surface speed at the tool",
+            ),
+            opt(
+                "spindle_cap",
+                Ty::Quantity(&[Dim::ROTATIONAL_SPEED]),
+                Check::Positive,
+                "highest spindle speed under constant surface speed; default the machine's",
+            ),
+            CHORD_TOLERANCE,
+            opt(
+                "seed_arc",
+                LENGTH,
+                Check::Positive,
+                "largest arc between the samples the chord test starts from; default 0.1 mm",
+            ),
+            opt(
+                "settle",
+                Ty::Word(&["auto", "none"]),
+                Check::Any,
+                "`auto` (default): hold the tool h_offset above the land so the servo settles before each lenslet (Hashimoto & Yan eqs 6-7); `none`: follow the land",
+            ),
+            opt(
+                "settling_time",
+                Ty::Quantity(&[Dim::TIME]),
+                Check::Positive,
+                "the servo's settling time for h_offset; default from the machine's servo model",
+            ),
+            opt(
+                "from",
+                LENGTH,
+                Check::NonNegative,
+                "radius where the spiral starts; default the outermost point of the surface",
+            ),
+            RETRACT,
+        ],
+        family: None,
+        positional: &[],
+        exclusive: &[(&["spindle_speed", "surface_speed"], true)],
+        doc: "fast-tool-servo spiral turning: X and C on an Archimedean spiral, W carrying the surface",
+    },
+    Kind {
+        name: "raster",
+        category: Category::Strategy,
+        params: &[
+            req(
+                "along",
+                Ty::Word(&["x", "y"]),
+                Check::Any,
+                "the cutting direction",
+            ),
+            opt(
+                "direction",
+                Ty::Word(&["one_way", "zigzag"]),
+                Check::Any,
+                "one_way (default): every pass cut the same way; zigzag: alternate passes reversed",
+            ),
+            req(
+                "stepover",
+                LENGTH,
+                Check::Positive,
+                "distance between passes",
+            ),
+            CHORD_TOLERANCE,
+            opt(
+                "max_step",
+                LENGTH,
+                Check::Positive,
+                "longest step along a pass",
+            ),
+            opt(
+                "lin_angle",
+                ANGLE,
+                Check::HalfOpen(0.0, DEG90),
+                "Lin's angle α: steps no longer than eqs 2-3 allow (2ρ sin(α/2) cos θ)",
+            ),
+            req(
+                "feed",
+                Ty::Quantity(&[Dim::SPEED]),
+                Check::Positive,
+                "cutting feed",
+            ),
+            RETRACT,
+        ],
+        family: None,
+        positional: &[],
+        exclusive: &[],
+        doc: "iso-plane raster: passes along x or y at a fixed stepover, the tool centre exact",
+    },
+    Kind {
+        name: "profile_grinding",
+        category: Category::Strategy,
+        params: &[
+            req(
+                "interval",
+                LENGTH,
+                Check::Positive,
+                "distance interval δ along x between commanded points",
+            ),
+            req(
+                "feed",
+                Ty::Quantity(&[Dim::SPEED]),
+                Check::Positive,
+                "feed v_f along x",
+            ),
+            req(
+                "smoothness",
+                NUMBER,
+                Check::Open(0.0, 1.0),
+                "γ: the share of each interval spent accelerating (Kim et al. eqs 17-19)",
+            ),
+            opt(
+                "from",
+                LENGTH,
+                Check::Any,
+                "x where grinding starts; default the centre",
+            ),
+            opt(
+                "to",
+                LENGTH,
+                Check::Any,
+                "x where grinding ends; default the aperture edge",
+            ),
+            RETRACT,
+        ],
+        family: None,
+        positional: &[],
+        exclusive: &[],
+        doc: "profile grinding with a spherical wheel: position-based interpolation of Kim et al. (seed 001)",
     },
     Kind {
         name: "profile_turning",

@@ -615,12 +615,100 @@ fn cell_index(g: &mut Graph, t: Id, n: f64, offset: f64) -> Id {
 /// height) wins; outside every aperture, the land. Each point looks at its
 /// own cell and, where apertures reach past half a pitch, the neighbours.
 fn array_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError> {
+    array_height_settled(g, o, x, y, None)
+}
+
+/// The tool trajectory over an array for fast-tool-servo turning with a
+/// settling offset h (Hashimoto & Yan, fig. 16): each lenslet continued
+/// past its rim until it rises h above the land, the land itself at h.
+pub fn lower_trajectory(o: &Object, settle: f64) -> Result<LoweredSurface, LowerError> {
+    if !matches!(o.kind.name, "grid" | "hex_grid" | "linear_array") {
+        return Err(LowerError::Unsupported(
+            "a settling offset needs an array of lenslets",
+        ));
+    }
+    let domain = surface_domain(o).ok_or(LowerError::Aperture("no aperture or domain"))?;
+    let mut g = Graph::new();
+    let (x, y) = (g.x(), g.y());
+    let z = array_height_settled(&mut g, o, x, y, Some(settle))?;
+    Ok(LoweredSurface {
+        tape: SurfaceTape::new(g, z),
+        domain,
+    })
+}
+
+/// The centres of a rectangular grid's or a linear array's lenslets (mm);
+/// `None` for other surfaces.
+pub fn array_centres(o: &Object) -> Option<Vec<(f64, f64)>> {
+    let f = &o.fields;
+    let num = |name: &str| value::num(f, name);
+    let (px, py, nx, ny) = match o.kind.name {
+        "grid" => (
+            num("pitch_x")?,
+            num("pitch_y")?,
+            num("count_x")?,
+            num("count_y")?,
+        ),
+        "linear_array" if value::word(f, "axis") == Some("y") => {
+            (0.0, num("pitch")?, 1.0, num("count")?)
+        }
+        "linear_array" => (num("pitch")?, 0.0, num("count")?, 1.0),
+        _ => return None,
+    };
+    let (nx, ny) = (nx as usize, ny as usize);
+    let mut centres = Vec::with_capacity(nx * ny);
+    for j in 0..ny {
+        for i in 0..nx {
+            centres.push((
+                (i as f64 - (nx as f64 - 1.0) / 2.0) * px,
+                (j as f64 - (ny as f64 - 1.0) / 2.0) * py,
+            ));
+        }
+    }
+    Some(centres)
+}
+
+/// The lenslet of an array as its own surface, with the radius of its
+/// circular aperture: what the settling offset is measured on.
+pub fn array_lenslet(o: &Object) -> Option<(LoweredSurface, f64)> {
+    if !matches!(o.kind.name, "grid" | "hex_grid" | "linear_array") {
+        return None;
+    }
+    let lenslet = value::object(&o.fields, "lenslet")?;
+    let Domain::Circle { radius } = domain_of(region(lenslet)?).ok()? else {
+        return None;
+    };
+    let mut g = Graph::new();
+    let (x, y) = (g.x(), g.y());
+    let z = height(&mut g, lenslet, x, y).ok()?;
+    Some((
+        LoweredSurface {
+            tape: SurfaceTape::new(g, z),
+            domain: Domain::Circle { radius },
+        },
+        radius,
+    ))
+}
+
+fn array_height_settled(
+    g: &mut Graph,
+    o: &Object,
+    x: Id,
+    y: Id,
+    settle: Option<f64>,
+) -> Result<Id, LowerError> {
     let f = &o.fields;
     let lenslet =
         value::object(f, "lenslet").ok_or(LowerError::Unsupported("array without a lenslet"))?;
     let ap =
         domain_of(region(lenslet).ok_or(LowerError::Aperture("lenslet without an aperture"))?)?;
     let (hx, hy) = half_extent(&ap);
+    // Continued lenslets reach past their apertures: look at neighbours.
+    let (hx, hy) = if settle.is_some() {
+        (1.5 * hx, 1.5 * hy)
+    } else {
+        (hx, hy)
+    };
     // The rim height: the lenslet at the edge of its aperture along +x.
     let rim = {
         let mut h = Graph::new();
@@ -750,9 +838,17 @@ fn array_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerErro
         let v = g.sub(y, cy);
         let zl = height(g, lenslet, u, v)?;
         let z = g.sub(zl, rim_c);
+        if settle.is_some() {
+            best = g.binary(Binary::Min, best, z);
+            continue;
+        }
         let inside_test = inside(g, &ap, u, v);
         let h = g.select(inside_test, z, big);
         best = g.binary(Binary::Min, best, h);
+    }
+    if let Some(h) = settle {
+        let plateau = g.constant_node(h);
+        return Ok(g.binary(Binary::Min, best, plateau));
     }
     let half_big = g.constant_node(BIG / 2.0);
     let test = g.sub(best, half_big);

@@ -66,6 +66,10 @@ pub struct FtsSpiral {
     /// Largest arc (mm) between seeds; features shorter than this along
     /// the spiral may be missed by the sampling.
     pub seed_arc: f64,
+    /// The servo's data period (s): no two points closer in time. Where
+    /// the trajectory has a corner (in the air, at the settling plateau)
+    /// the chord tolerance gives way to it.
+    pub min_interval: f64,
     pub start_radius: f64,
     pub end_radius: f64,
 }
@@ -80,13 +84,17 @@ pub struct FastAxis {
 }
 
 /// What the planner knows of the trajectory surface beforehand.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct TrajectoryBounds {
     /// The highest the surface rises (mm): where it is this high, the nose
     /// rests there and no neighbour can lift it.
     pub z_max: f64,
     /// Its steepest slope (rad): the contact is within ρ·sin of this.
     pub max_slope: f64,
+    /// Discs (centre x, y and radius, mm) outside which the surface is
+    /// level at `z_max`, if known (the lenslets of an array): the spiral is
+    /// sampled only where it crosses them.
+    pub features: Option<Vec<(f64, f64, f64)>>,
 }
 
 /// One programmed point: tool-nose centre at radius `x` (mm), spindle angle
@@ -207,6 +215,27 @@ impl Planner<'_> {
             return here.z + rho;
         }
         let reach = rho * self.bounds.max_slope.sin() * 1.05 + 1e-9;
+        // Newton on φ′ from u = x, where the surface is already evaluated;
+        // should a step leave the reach or φ not be concave there (a
+        // corner of the trajectory), the bracketed search takes over.
+        let (mut u, mut p) = (x, here);
+        for _ in 0..8 {
+            let d = u - x;
+            let root = (rho * rho - d * d).sqrt();
+            let dphi = p.dz - d / root;
+            let ddphi = p.d2z - rho * rho / (root * root * root);
+            let step = -dphi / ddphi;
+            let next = u + step;
+            if !(ddphi < 0.0 && (next - x).abs() < reach) {
+                break;
+            }
+            if step.abs() <= 1e-9 {
+                // Converged: φ at u is exact to ~φ″·step², far below a pm.
+                return p.z + root;
+            }
+            u = next;
+            p = ray.point(u);
+        }
         envelope::piece_max(&ray, rho, x, x - reach, x + reach).0
     }
 
@@ -221,21 +250,60 @@ impl Planner<'_> {
         if c1 <= c0 {
             return Vec::new();
         }
-        let r = self.radius(c0).max(self.spiral.seed_arc);
-        let seeds = (((c1 - c0) * r / self.spiral.seed_arc).ceil() as usize).max(8);
+        let mut out = Vec::new();
+        match self.feature_spans(c0, c1) {
+            None => self.sample(c0, c1, &mut out),
+            Some(spans) => {
+                // Level between the spans: their ends are enough.
+                let level = self.bounds.z_max + self.nose_radius;
+                let mut at = c0;
+                for (a, b) in spans {
+                    if a > at {
+                        out.push((at, level));
+                    }
+                    self.sample(a.max(at), b, &mut out);
+                    at = b;
+                }
+                if at < c1 {
+                    out.push((at, level));
+                }
+            }
+        }
+        out.dedup_by(|b, a| b.0 == a.0);
+        // Where W stays level (the land, or the settling plateau), the
+        // spiral between the ends of the level stretch is one move.
+        let mut kept: Vec<(f64, f64)> = Vec::with_capacity(out.len() / 4 + 2);
+        for (i, p) in out.iter().enumerate() {
+            let level_before = kept.last().is_some_and(|q| q.1 == p.1);
+            let level_after = out.get(i + 1).is_some_and(|q| q.1 == p.1);
+            if !(level_before && level_after) {
+                kept.push(*p);
+            }
+        }
+        kept
+    }
+
+    /// Samples [c0, c1) into `out`: seeds a seed arc apart, each interval
+    /// halved until its W midpoint is on the chord (or down to the servo's
+    /// data period).
+    fn sample(&self, c0: f64, c1: f64, out: &mut Vec<(f64, f64)>) {
         let tol = self.spiral.chord_tolerance;
-        let mut out = Vec::with_capacity(seeds * 2);
+        let r = self.radius(c0).max(self.spiral.seed_arc);
+        let seeds = (((c1 - c0) * r / self.spiral.seed_arc).ceil() as usize).max(2);
         let mut prev = (c0, self.centre(c0));
         for i in 1..=seeds {
             let c = c0 + (c1 - c0) * i as f64 / seeds as f64;
             let next = (c, self.centre(c));
-            // Halve (prev, next) until every midpoint is on its chord.
+            // Halve (prev, next) until every midpoint is on its chord, or
+            // the interval is down to the servo's data period.
+            let shortest = self.spiral.speed.at(self.radius(c)) * self.spiral.min_interval;
             let mut stack = vec![(next, 0u32)];
             let mut left = prev;
             while let Some((right, depth)) = stack.pop() {
                 let m = 0.5 * (left.0 + right.0);
                 let wm = self.centre(m);
-                if depth < 30 && (wm - 0.5 * (left.1 + right.1)).abs() > tol {
+                let splittable = depth < 40 && right.0 - left.0 > 2.0 * shortest;
+                if splittable && (wm - 0.5 * (left.1 + right.1)).abs() > tol {
                     stack.push((right, depth + 1));
                     stack.push(((m, wm), depth + 1));
                 } else {
@@ -245,7 +313,55 @@ impl Planner<'_> {
             }
             prev = next;
         }
-        out
+    }
+
+    /// The spans of spindle angle in [c0, c1) where the spiral passes over
+    /// a feature disc (grown by the nose's reach and a seed arc), merged and
+    /// in order; `None` when the features are not known.
+    fn feature_spans(&self, c0: f64, c1: f64) -> Option<Vec<(f64, f64)>> {
+        let features = self.bounds.features.as_ref()?;
+        let two_pi = 2.0 * std::f64::consts::PI;
+        let (r_out, r_in) = (self.radius(c0), self.radius(c1));
+        let grow = self.nose_radius * self.bounds.max_slope.sin() + self.spiral.seed_arc;
+        let mut spans: Vec<(f64, f64)> = Vec::new();
+        for &(fx, fy, fr) in features {
+            let d = fx.hypot(fy);
+            let rr = fr + grow;
+            if d - rr > r_out || d + rr < r_in {
+                continue;
+            }
+            // Half-width in angle at the radius nearest the disc centre.
+            let r = d.clamp(r_in, r_out);
+            let half = if d <= rr || r <= rr {
+                std::f64::consts::PI
+            } else {
+                let cos = ((r * r + d * d - rr * rr) / (2.0 * r * d)).clamp(-1.0, 1.0);
+                cos.acos()
+            };
+            let centre = fy.atan2(fx);
+            // Every copy of [centre − half, centre + half] (mod 2π) in range.
+            let base = ((c0 - centre - half) / two_pi).floor();
+            let mut n = base;
+            loop {
+                let (a, b) = (centre - half + n * two_pi, centre + half + n * two_pi);
+                if a >= c1 {
+                    break;
+                }
+                if b > c0 {
+                    spans.push((a.max(c0), b.min(c1)));
+                }
+                n += 1.0;
+            }
+        }
+        spans.sort_by(|p, q| p.0.total_cmp(&q.0));
+        let mut merged: Vec<(f64, f64)> = Vec::with_capacity(spans.len());
+        for (a, b) in spans {
+            match merged.last_mut() {
+                Some(last) if a <= last.1 => last.1 = last.1.max(b),
+                _ => merged.push((a, b)),
+            }
+        }
+        Some(merged)
     }
 
     /// Plans the spiral, handing each revolution's points in order to
@@ -441,6 +557,7 @@ mod tests {
             bounds: TrajectoryBounds {
                 z_max: d.h,
                 max_slope: slope,
+                features: None,
             },
         }
     }
@@ -451,6 +568,7 @@ mod tests {
             speed: SpindleSpeed::Constant(2.0 * std::f64::consts::PI * 125.0 / 60.0),
             chord_tolerance: 10e-6,
             seed_arc: 0.1,
+            min_interval: 1.0 / 20e3,
             start_radius: 1.2,
             end_radius: 0.0,
         }

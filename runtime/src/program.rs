@@ -41,40 +41,7 @@ fn emit_linuxcnc_lathe(
 ) -> Result<String, ProgramError> {
     let d = decimals_for(job.machine.resolution);
     let mut out = String::with_capacity(64 * path.moves.len() + 1024);
-    let comment = |out: &mut String, text: &str| {
-        // RS274NGC comments cannot nest parentheses.
-        let clean: String = text
-            .chars()
-            .map(|c| match c {
-                '(' => '[',
-                ')' => ']',
-                c if c.is_control() => ' ',
-                c => c,
-            })
-            .collect();
-        // RS274NGC lines are limited (LinuxCNC: 256 characters): long
-        // text is folded at ", " into several comments.
-        const WIDTH: usize = 120;
-        let mut line = String::new();
-        let pieces = clean.split(", ").flat_map(|p| {
-            // A piece with no ", " in it longer than a line: cut by characters.
-            let chars: Vec<char> = p.chars().collect();
-            chars
-                .chunks(WIDTH)
-                .map(|c| c.iter().collect::<String>())
-                .collect::<Vec<_>>()
-        });
-        for (i, piece) in pieces.enumerate() {
-            if i > 0 && line.chars().count() + piece.chars().count() + 2 > WIDTH {
-                let _ = writeln!(out, "({line},)");
-                line = String::from("  ");
-            } else if i > 0 {
-                line.push_str(", ");
-            }
-            line.push_str(&piece);
-        }
-        let _ = writeln!(out, "({line})");
-    };
+    let comment = write_comment;
     comment(
         &mut out,
         &format!("lensc {}: job {}", prov.lensc_version, job.name),
@@ -177,6 +144,43 @@ fn emit_linuxcnc_lathe(
     Ok(out)
 }
 
+/// Writes `text` as RS274NGC comments: no nested parentheses or control
+/// characters, long text folded into several lines.
+pub fn write_comment(out: &mut String, text: &str) {
+    // RS274NGC comments cannot nest parentheses.
+    let clean: String = text
+        .chars()
+        .map(|c| match c {
+            '(' => '[',
+            ')' => ']',
+            c if c.is_control() => ' ',
+            c => c,
+        })
+        .collect();
+    // RS274NGC lines are limited (LinuxCNC: 256 characters): long
+    // text is folded at ", " into several comments.
+    const WIDTH: usize = 120;
+    let mut line = String::new();
+    let pieces = clean.split(", ").flat_map(|p| {
+        // A piece with no ", " in it longer than a line: cut by characters.
+        let chars: Vec<char> = p.chars().collect();
+        chars
+            .chunks(WIDTH)
+            .map(|c| c.iter().collect::<String>())
+            .collect::<Vec<_>>()
+    });
+    for (i, piece) in pieces.enumerate() {
+        if i > 0 && line.chars().count() + piece.chars().count() + 2 > WIDTH {
+            let _ = writeln!(out, "({line},)");
+            line = String::from("  ");
+        } else if i > 0 {
+            line.push_str(", ");
+        }
+        line.push_str(&piece);
+    }
+    let _ = writeln!(out, "({line})");
+}
+
 fn word(out: &mut String, letter: char, value: f64, decimals: u32) -> Result<(), ProgramError> {
     if push_fixed(out, value, decimals) {
         Ok(())
@@ -210,5 +214,98 @@ fn duration(secs: f64) -> String {
         format!("{m} min {s} s")
     } else {
         format!("{s} s")
+    }
+}
+
+/// A LinuxCNC program for a fast-tool-servo spiral, written as the planner
+/// hands over its points: X (radius, G8) and C (degrees, counted on from
+/// the start) on the spiral, the nose-centre height on Z, each move timed
+/// by inverse-time feed (G93: F = 1/minutes). LinuxCNC has no fast-axis
+/// word its interpreter accepts, so the fast tool servo's motion is
+/// programmed on Z (the form of a slow-tool-servo program); controllers
+/// with a W axis get their own dialect.
+pub struct FtsProgram {
+    text: String,
+    decimals: u32,
+    safe_w: f64,
+    /// The last point written (NaN before the first).
+    last: crate::fts::SpiralPoint,
+    pub moves: usize,
+}
+
+/// Decimals of C in degrees: 1e-5° is 4 nm of arc at 25 mm.
+const C_DECIMALS: u32 = 5;
+
+impl FtsProgram {
+    /// Starts a program: the header comments and the modal line.
+    pub fn new(header: &[String], resolution: f64, safe_w: f64) -> FtsProgram {
+        let mut text = String::new();
+        for line in header {
+            write_comment(&mut text, line);
+        }
+        text.push_str("G18 G21 G90 G8 G40 G49 G80 G93\n");
+        FtsProgram {
+            text,
+            decimals: decimals_for(resolution),
+            safe_w,
+            last: crate::fts::SpiralPoint {
+                x: f64::NAN,
+                c: f64::NAN,
+                w: f64::NAN,
+                t: f64::NAN,
+            },
+            moves: 0,
+        }
+    }
+
+    /// Appends points in spiral order; the first is reached by rapids
+    /// above the part and a plunge.
+    pub fn extend(&mut self, points: &[crate::fts::SpiralPoint]) -> Result<(), ProgramError> {
+        let d = self.decimals;
+        for p in points {
+            let line = &mut self.text;
+            if self.last.x.is_nan() {
+                line.push_str("G0 X");
+                word(line, 'X', p.x, d)?;
+                line.push_str(" C");
+                word(line, 'C', p.c.to_degrees(), C_DECIMALS)?;
+                line.push_str("\nG0 Z");
+                word(line, 'Z', self.safe_w, d)?;
+                // The plunge: one second at inverse-time F60.
+                line.push_str("\nG1 Z");
+                word(line, 'Z', p.w, d)?;
+                line.push_str(" F60.\n");
+                self.moves += 3;
+                self.last = *p;
+                continue;
+            }
+            let dt = p.t - self.last.t;
+            line.push_str("G1 X");
+            word(line, 'X', p.x, d)?;
+            line.push_str(" C");
+            word(line, 'C', p.c.to_degrees(), C_DECIMALS)?;
+            line.push_str(" Z");
+            word(line, 'Z', p.w, d)?;
+            line.push_str(" F");
+            word(line, 'F', 60.0 / dt, 3)?;
+            line.push('\n');
+            self.moves += 1;
+            self.last = *p;
+        }
+        Ok(())
+    }
+
+    /// The text written since the last call, for the caller to pass on
+    /// (a program of millions of moves need not be held whole).
+    pub fn take_text(&mut self) -> String {
+        std::mem::take(&mut self.text)
+    }
+
+    /// Retracts and ends the program; the text not yet taken.
+    pub fn finish(mut self) -> Result<String, ProgramError> {
+        self.text.push_str("G0 Z");
+        word(&mut self.text, 'Z', self.safe_w, self.decimals)?;
+        self.text.push_str("\nM2\n");
+        Ok(self.text)
     }
 }

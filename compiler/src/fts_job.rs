@@ -1,0 +1,620 @@
+//! Building a fast-tool-servo spiral job (seed 003): the checked job's
+//! parts read into the runtime's planner, the settling offset worked out
+//! from the servo model, the spiral planned and streamed into a LinuxCNC
+//! program, and the report of what it makes.
+
+use lensc_grammar::{Diagnostic, FileId, Span};
+use lensc_runtime::fts::{
+    FastAxis, FtsError, FtsSpiral, FtsSummary, Planner, SpindleSpeed, TrajectoryBounds,
+};
+use lensc_runtime::ir::SurfaceFn;
+use lensc_runtime::program::{FtsProgram, ProgramError, Provenance};
+use lensc_runtime::servo::SecondOrderServo;
+use serde_json::json;
+
+use crate::check::{CheckedJob, trim_num};
+use crate::codes;
+use std::path::Path;
+
+use crate::driver::{Built, ProgramText, evaluator};
+use crate::surfaces;
+use crate::value::{self, Object};
+
+/// The settling offset and how it was found.
+struct Settling {
+    time: f64,
+    band: Option<f64>,
+    surface_speed: f64,
+    d_traj: f64,
+    offset: f64,
+}
+
+/// Everything the spiral planner needs, read from a checked job.
+pub struct Prepared {
+    pub kernel: Box<dyn SurfaceFn + Sync>,
+    pub spiral: FtsSpiral,
+    pub bounds: TrajectoryBounds,
+    pub nose_radius: f64,
+    pub fast_axis: FastAxis,
+    lowered: surfaces::LoweredSurface,
+    servo: Option<SecondOrderServo>,
+    settling: Option<Settling>,
+    safe_w: f64,
+    resolution: f64,
+}
+
+impl Prepared {
+    pub fn planner(&self) -> Planner<'_> {
+        Planner {
+            spiral: &self.spiral,
+            surface: self.kernel.as_ref(),
+            nose_radius: self.nose_radius,
+            bounds: self.bounds.clone(),
+        }
+    }
+}
+
+/// Builds one `fts_spiral` job, or says why it cannot be built. With a
+/// `spool_dir` the program goes to a temporary file there as it is
+/// written, so memory stays bounded however long it is.
+pub fn build(
+    job: &CheckedJob,
+    prov: &Provenance,
+    spool_dir: Option<&Path>,
+) -> Result<Built, Vec<Diagnostic>> {
+    let p = prepare(job)?;
+    let part = |name: &str| value::object(&job.fields, name).expect("checked job part");
+    let (surface, tool, machine, strategy) = (
+        part("surface"),
+        part("tool"),
+        part("machine"),
+        part("strategy"),
+    );
+    let (file, span) = (job.file, job.name.span);
+    let err = |code: &'static str, msg: String| {
+        Diagnostic::error(code, msg, file, span).with_label("this job")
+    };
+    let names = |p: &str, o: &Object| {
+        job.part_names
+            .get(p)
+            .cloned()
+            .unwrap_or_else(|| o.kind.name.to_string())
+    };
+    let header = header_lines(
+        job,
+        prov,
+        &names("surface", surface),
+        &crate::lower::describe(surface),
+        &names("tool", tool),
+        &names("machine", machine),
+        &names("strategy", strategy),
+        p.nose_radius,
+        &p.spiral,
+        p.settling.as_ref(),
+    );
+    let mut program = FtsProgram::new(&header, p.resolution, p.safe_w);
+    let mut sink = Sink::new(spool_dir).map_err(|e| vec![cannot_spool(&e, file, span)])?;
+    let mut write_error: Option<ProgramError> = None;
+    let planned = p.planner().plan(&p.fast_axis, |pts| {
+        if write_error.is_none()
+            && let Err(e) = program.extend(pts)
+        {
+            write_error = Some(e);
+        }
+        sink.push(program.take_text());
+    });
+    let summary = planned.map_err(|e| vec![fts_diagnostic(e, &p.spiral.speed, file, span)])?;
+    if let Some(ProgramError::NotPrintable { word, value }) = write_error {
+        return Err(vec![err(
+            codes::NOT_PRINTABLE,
+            format!("the program would contain {word}{value}, which no controller accepts"),
+        )]);
+    }
+    let rest = program.finish().map_err(|_| {
+        vec![err(
+            codes::NOT_PRINTABLE,
+            "the program's retract height cannot be written".into(),
+        )]
+    })?;
+    sink.push(rest);
+    let text = sink
+        .finish()
+        .map_err(|e| vec![cannot_spool(&e, file, span)])?;
+    let program_name = format!("{}.ngc", job.name.name);
+    let surface_name = names("surface", surface);
+    let report = json!({
+        "job": job.name.name,
+        "lensc_version": prov.lensc_version,
+        "source": prov.source,
+        "source_fnv1a64": format!("{:016x}", prov.source_hash),
+        "program": {
+            "file": program_name,
+            "dialect": "linuxcnc",
+            "lines": text.lines(),
+            "bytes": text.bytes(),
+        },
+        "toolpath": toolpath_json(&summary, &p.spiral, p.settling.as_ref(), &p.servo, p.nose_radius),
+        "surface": crate::driver::analysis_json(&surface_name, surface.kind.name, &p.lowered, 201),
+    });
+    Ok(Built {
+        report_name: format!("{}.report.json", job.name.name),
+        program_name,
+        program: text,
+        report,
+        cut_points: summary.points,
+        cutting_time: summary.time,
+    })
+}
+
+/// Reads and checks a job's parts into what the planner needs.
+pub fn prepare(job: &CheckedJob) -> Result<Prepared, Vec<Diagnostic>> {
+    let part = |name: &str| value::object(&job.fields, name).expect("checked job part");
+    let (surface, tool, machine, strategy) = (
+        part("surface"),
+        part("tool"),
+        part("machine"),
+        part("strategy"),
+    );
+    let (file, span) = (job.file, job.name.span);
+    let err = |code: &'static str, msg: String| {
+        Diagnostic::error(code, msg, file, span).with_label("this job")
+    };
+    let mut errors = Vec::new();
+    if machine.kind.name != "fts_lathe" {
+        errors.push(err(
+            codes::UNSUPPORTED_COMBINATION,
+            format!(
+                "fast-tool-servo turning needs an `fts_lathe`; this machine is a `{}`",
+                machine.kind.name
+            ),
+        ));
+    }
+    if tool.kind.name != "round_nose" {
+        errors.push(err(
+            codes::UNSUPPORTED_COMBINATION,
+            format!(
+                "fast-tool-servo turning needs a `round_nose` tool; this is a `{}`",
+                tool.kind.name
+            ),
+        ));
+    }
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+    let (m, t, st) = (&machine.fields, &tool.fields, &strategy.fields);
+    let fast = value::block(m, "fast_axis").expect("required");
+    let spindle = value::block(m, "spindle").expect("required");
+    let max_spindle = value::num(spindle, "max_speed").expect("required");
+    let rho = value::num(t, "nose_radius").expect("required");
+    let clearance = value::num(t, "clearance").expect("required");
+    let servo = SecondOrderServo::from_resonance(
+        value::num(fast, "resonance").expect("required"),
+        value::num(fast, "resonant_peak").expect("required"),
+    );
+    let fast_axis = FastAxis {
+        stroke: value::num(fast, "stroke").expect("required"),
+        max_acceleration: value::num(fast, "max_acceleration").expect("required"),
+    };
+    let speed = match value::num(st, "surface_speed") {
+        Some(v) => SpindleSpeed::SurfaceSpeed {
+            speed: v,
+            max: value::num(st, "spindle_cap").unwrap_or(max_spindle),
+        },
+        None => SpindleSpeed::Constant(value::num(st, "spindle_speed").expect("one of them")),
+    };
+
+    let lowered = surfaces::lower_surface(surface).map_err(|e| {
+        vec![err(
+            codes::UNSUPPORTED_COMBINATION,
+            format!("this surface cannot be evaluated yet: {e:?}"),
+        )]
+    })?;
+    let ((x0, x1), (y0, y1)) = lowered.domain.bounds();
+    let outer = [x0, x1]
+        .iter()
+        .flat_map(|x| [y0, y1].map(|y| x.hypot(y)))
+        .fold(0.0, f64::max);
+    let start = value::num(st, "from").unwrap_or(outer);
+    // The fastest surface speed the job reaches: what d_traj is made of.
+    let fastest = match speed {
+        SpindleSpeed::SurfaceSpeed { speed, .. } => speed,
+        SpindleSpeed::Constant(w) => w * start,
+    };
+
+    // The settling offset, where the surface is an array of dimples.
+    let settle_word = value::word(st, "settle");
+    let settling = if settle_word == Some("none") {
+        None
+    } else {
+        settling(surface, st, servo, fast, fastest)
+    };
+    if settle_word == Some("auto") && settling.is_none() {
+        errors.push(
+            err(
+                codes::UNSUPPORTED_COMBINATION,
+                "`settle: auto` needs an array of concave lenslets with circular apertures, whose continuation rises above the land".into(),
+            )
+            .with_help("use `settle: none` to follow the surface as it is"),
+        );
+        return Err(errors);
+    }
+    let trajectory = match &settling {
+        Some(s) => surfaces::lower_trajectory(surface, s.offset).map_err(|e| {
+            vec![err(
+                codes::UNSUPPORTED_COMBINATION,
+                format!("the tool trajectory cannot be built: {e:?}"),
+            )]
+        })?,
+        None => surfaces::lower_surface(surface).expect("lowered above"),
+    };
+    let (kernel, _) = evaluator(&trajectory.tape);
+    let analysis = lensc_runtime::analysis::analyse(kernel.as_ref(), &lowered.domain, 201);
+    let design = {
+        let (k, _) = evaluator(&lowered.tape);
+        lensc_runtime::analysis::analyse(k.as_ref(), &lowered.domain, 201)
+    };
+
+    // Tool checks on the design surface.
+    if let Some(r) = [design.min_radius_concave_x, design.min_radius_concave_y]
+        .into_iter()
+        .flatten()
+        .min_by(|a, b| a.value.total_cmp(&b.value))
+        && rho > r.value
+    {
+        errors.push(err(
+            codes::NOSE_TOO_LARGE,
+            format!(
+                "the tool's nose radius ({} um) is larger than the surface's smallest concave radius of curvature ({} um, at ({}, {}) mm): the tool would gouge",
+                trim_num(rho * 1000.0),
+                trim_num(r.value * 1000.0),
+                trim_num(r.x),
+                trim_num(r.y)
+            ),
+        ));
+    }
+    if clearance <= design.max_slope.value {
+        errors.push(err(
+            codes::CLEARANCE_TOO_SMALL,
+            format!(
+                "the clearance angle ({}°) is not above the surface's steepest slope in the cutting direction ({}°, at ({}, {}) mm): the flank would rub",
+                trim_num(clearance.to_degrees()),
+                trim_num(design.max_slope.value.to_degrees()),
+                trim_num(design.max_slope.x),
+                trim_num(design.max_slope.y)
+            ),
+        ));
+    }
+
+    let spiral = FtsSpiral {
+        feed_per_rev: value::num(st, "feed").expect("required") * 2.0 * std::f64::consts::PI,
+        speed,
+        chord_tolerance: value::num(st, "chord_tolerance").unwrap_or(10e-6),
+        seed_arc: value::num(st, "seed_arc").unwrap_or(0.1),
+        min_interval: 1.0 / value::num(fast, "data_rate").unwrap_or(20e3),
+        start_radius: start,
+        end_radius: 0.0,
+    };
+    // With a settling offset, the trajectory is level outside each
+    // lenslet's continuation, which meets the plateau d_traj past the rim.
+    let features = settling.as_ref().and_then(|s| {
+        let (_, rim) = surfaces::array_lenslet(surface)?;
+        let centres = surfaces::array_centres(surface)?;
+        Some(
+            centres
+                .into_iter()
+                .map(|(x, y)| (x, y, rim + s.d_traj))
+                .collect(),
+        )
+    });
+    let bounds = TrajectoryBounds {
+        z_max: analysis.sag_max.value,
+        // Margin over the sampled steepest slope: the contact search
+        // window must contain the contact.
+        max_slope: (analysis.max_slope.value * 1.1).min(1.5),
+        features,
+    };
+    let spin_max = match speed {
+        SpindleSpeed::Constant(w) => w,
+        // The spiral runs in to the axis, where the cap is reached.
+        SpindleSpeed::SurfaceSpeed { max, .. } => max,
+    };
+    if spin_max > max_spindle {
+        errors.push(err(
+            codes::SPINDLE_TOO_FAST,
+            format!(
+                "the spindle speed ({} rpm) is above the machine's maximum ({} rpm)",
+                trim_num(rpm(spin_max)),
+                trim_num(rpm(max_spindle))
+            ),
+        ));
+    }
+    let travel = value::block(m, "travel").expect("required");
+    let (tx0, tx1) = value::range(travel, "x").expect("required");
+    if start > tx1 || tx0 > 0.0 {
+        errors.push(err(
+            codes::OUT_OF_TRAVEL,
+            format!(
+                "the spiral moves X from {} mm to 0, outside the machine's travel {} .. {} mm",
+                trim_num(start),
+                trim_num(tx0),
+                trim_num(tx1)
+            ),
+        ));
+    }
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+
+    let retract = value::num(st, "retract").unwrap_or(1.0);
+    Ok(Prepared {
+        kernel,
+        spiral,
+        bounds,
+        nose_radius: rho,
+        fast_axis,
+        safe_w: analysis.sag_max.value + rho + retract,
+        resolution: value::num(m, "resolution").expect("required"),
+        lowered,
+        servo,
+        settling,
+    })
+}
+
+/// Where the program text goes as it is written: memory, or a spool file.
+enum Sink {
+    Memory(String),
+    File {
+        writer: std::io::BufWriter<tempfile::NamedTempFile>,
+        lines: usize,
+        bytes: u64,
+        error: Option<std::io::Error>,
+    },
+}
+
+impl Sink {
+    fn new(spool_dir: Option<&Path>) -> std::io::Result<Sink> {
+        Ok(match spool_dir {
+            None => Sink::Memory(String::new()),
+            Some(dir) => {
+                std::fs::create_dir_all(dir)?;
+                let file = tempfile::Builder::new()
+                    .prefix(".lensc-")
+                    .suffix(".tmp")
+                    .tempfile_in(dir)?;
+                Sink::File {
+                    writer: std::io::BufWriter::with_capacity(1 << 20, file),
+                    lines: 0,
+                    bytes: 0,
+                    error: None,
+                }
+            }
+        })
+    }
+
+    fn push(&mut self, text: String) {
+        match self {
+            Sink::Memory(all) => all.push_str(&text),
+            Sink::File {
+                writer,
+                lines,
+                bytes,
+                error,
+            } => {
+                if error.is_none() {
+                    use std::io::Write;
+                    *lines += text.bytes().filter(|&b| b == b'\n').count();
+                    *bytes += text.len() as u64;
+                    if let Err(e) = writer.write_all(text.as_bytes()) {
+                        *error = Some(e);
+                    }
+                }
+            }
+        }
+    }
+
+    fn finish(self) -> std::io::Result<ProgramText> {
+        match self {
+            Sink::Memory(text) => Ok(ProgramText::Memory(text)),
+            Sink::File {
+                writer,
+                lines,
+                bytes,
+                error,
+            } => {
+                if let Some(e) = error {
+                    return Err(e);
+                }
+                let file = writer.into_inner().map_err(|e| e.into_error())?;
+                Ok(ProgramText::Spooled { file, lines, bytes })
+            }
+        }
+    }
+}
+
+fn cannot_spool(e: &std::io::Error, file: FileId, span: Span) -> Diagnostic {
+    Diagnostic::error(
+        codes::CANNOT_WRITE,
+        format!("cannot write the program: {e}"),
+        file,
+        span,
+    )
+    .with_label("this job")
+}
+
+fn rpm(w: f64) -> f64 {
+    w * 60.0 / (2.0 * std::f64::consts::PI)
+}
+
+/// The settling offset for an array of concave lenslets: the servo's
+/// settling time (the strategy's, or the model's at its band), the path
+/// covered meanwhile at the fastest surface speed, and how far the
+/// lenslet's own surface rises over that path past its rim.
+fn settling(
+    surface: &Object,
+    st: &[value::Field],
+    servo: Option<SecondOrderServo>,
+    fast: &[value::Field],
+    surface_speed: f64,
+) -> Option<Settling> {
+    let (lenslet, rim) = surfaces::array_lenslet(surface)?;
+    let band = value::num(fast, "settling_band").unwrap_or(0.002);
+    let (time, band) = match value::num(st, "settling_time") {
+        Some(t) => (t, None),
+        None => (servo?.settling_time(band)?, Some(band)),
+    };
+    let f = lensc_runtime::ir::Interpreter::new(&lenslet.tape);
+    let along = |u: f64| f.eval(u, 0.0)[0];
+    let offset = lensc_runtime::fts::settling_offset(along, rim, surface_speed, time);
+    (offset.is_finite() && offset > 0.0).then_some(Settling {
+        time,
+        band,
+        surface_speed,
+        d_traj: surface_speed * time,
+        offset,
+    })
+}
+
+#[allow(clippy::too_many_arguments)]
+fn header_lines(
+    job: &CheckedJob,
+    prov: &Provenance,
+    surface: &str,
+    surface_words: &str,
+    tool: &str,
+    machine: &str,
+    strategy: &str,
+    rho: f64,
+    spiral: &FtsSpiral,
+    settling: Option<&Settling>,
+) -> Vec<String> {
+    let speed = match spiral.speed {
+        SpindleSpeed::Constant(w) => format!("constant spindle speed {} rpm", trim_num(rpm(w))),
+        SpindleSpeed::SurfaceSpeed { speed, max } => format!(
+            "constant surface speed {} m/min capped at {} rpm",
+            trim_num(speed * 60.0 / 1000.0),
+            trim_num(rpm(max))
+        ),
+    };
+    let mut lines = vec![
+        format!("lensc {}: job {}", prov.lensc_version, job.name.name),
+        format!("source {} fnv1a64 {:016x}", prov.source, prov.source_hash),
+        "units mm; X is the radius [G8], C the spindle angle in degrees counted on from the start, Z the fast tool servo's axis [LinuxCNC has no fast-axis word], +Z out of the material".into(),
+        "coordinates are the centre of the tool nose; feed in inverse time [G93, F = 1/min per move]".into(),
+        format!("surface {surface}: {surface_words}"),
+        format!("tool {tool}: round nose, nose radius {} mm", trim_num(rho)),
+        format!(
+            "strategy {strategy}: fast-tool-servo spiral from r = {} mm, feed {} um/rev, {speed}, chord tolerance {} nm",
+            trim_num(spiral.start_radius),
+            trim_num(spiral.feed_per_rev * 1000.0),
+            trim_num(spiral.chord_tolerance * 1e6)
+        ),
+        format!("machine {machine}: linuxcnc fast-tool-servo lathe"),
+    ];
+    match settling {
+        Some(s) => lines.push(format!(
+            "settling: tool held {} um above the land, lenslets continued {} um past their rims [settling time {} ms at {} m/min]",
+            trim_num(s.offset * 1000.0),
+            trim_num(s.d_traj * 1000.0),
+            trim_num(s.time * 1000.0),
+            trim_num(s.surface_speed * 0.06)
+        )),
+        None => lines.push("settling: none, the tool follows the surface".into()),
+    }
+    lines
+}
+
+fn toolpath_json(
+    s: &FtsSummary,
+    spiral: &FtsSpiral,
+    settling: Option<&Settling>,
+    servo: &Option<SecondOrderServo>,
+    rho: f64,
+) -> serde_json::Value {
+    let (speed_kind, allowed) = match spiral.speed {
+        SpindleSpeed::Constant(_) => ("spindle_rpm", rpm(s.highest_allowed_speed)),
+        SpindleSpeed::SurfaceSpeed { .. } => ("surface_m_per_min", s.highest_allowed_speed * 0.06),
+    };
+    json!({
+        "strategy": "fts_spiral",
+        "revolutions": s.revolutions,
+        "cut_points": s.points,
+        "cutting_time_s": s.time,
+        "chord_tolerance_mm": spiral.chord_tolerance,
+        "nose_radius_mm": rho,
+        "fast_axis": {
+            "w_min_mm": s.w_min,
+            "w_max_mm": s.w_max,
+            "stroke_used_mm": s.w_max - s.w_min,
+            "max_acceleration_m_per_s2": s.max_acceleration / 1000.0,
+            "max_acceleration_at_radius_mm": s.max_acceleration_at,
+            "highest_allowed_speed": { "unit": speed_kind, "value": allowed },
+        },
+        "max_spindle_rpm": rpm(s.max_spindle_speed),
+        "servo": servo.map(|m| json!({
+            "natural_frequency_hz": m.natural_frequency_hz,
+            "damping": m.damping,
+            "overshoot": m.overshoot(),
+            "settling_time_0_2_percent_s": m.settling_time(0.002),
+        })),
+        "settling": settling.map(|st| json!({
+            "settling_time_s": st.time,
+            "band": st.band,
+            "surface_speed_m_per_min": st.surface_speed * 0.06,
+            "d_traj_mm": st.d_traj,
+            "h_offset_mm": st.offset,
+        })),
+        "fingerprint_fnv1a64": format!("{:016x}", s.fingerprint),
+    })
+}
+
+fn fts_diagnostic(e: FtsError, speed: &SpindleSpeed, file: FileId, span: Span) -> Diagnostic {
+    let d = |code, msg: String| Diagnostic::error(code, msg, file, span).with_label("this job");
+    match e {
+        FtsError::Undefined { x, c } => d(
+            codes::UNDEFINED_ON_PATH,
+            format!(
+                "the surface is undefined where the nose must go (r = {} mm, C = {}°)",
+                trim_num(x),
+                trim_num(c.to_degrees() % 360.0)
+            ),
+        ),
+        FtsError::StrokeExceeded { range, stroke } => d(
+            codes::STROKE_EXCEEDED,
+            format!(
+                "the fast axis must travel {} um, more than its {} um stroke",
+                trim_num(range * 1000.0),
+                trim_num(stroke * 1000.0)
+            ),
+        ),
+        FtsError::AccelerationExceeded {
+            acceleration,
+            max,
+            at_radius,
+            highest_allowed_speed,
+        } => {
+            let allowed = match speed {
+                SpindleSpeed::Constant(_) => {
+                    format!(
+                        "a spindle speed of {} rpm",
+                        trim_num(rpm(highest_allowed_speed))
+                    )
+                }
+                SpindleSpeed::SurfaceSpeed { .. } => format!(
+                    "a surface speed of {} m/min",
+                    trim_num(highest_allowed_speed * 0.06)
+                ),
+            };
+            d(
+                codes::ACCELERATION_EXCEEDED,
+                format!(
+                    "the fast axis would accelerate at {} m/s² (at r = {} mm), above its {} m/s² limit",
+                    trim_num(acceleration / 1000.0),
+                    trim_num(at_radius),
+                    trim_num(max / 1000.0)
+                ),
+            )
+            .with_help(format!("the highest speed that respects it is {allowed}"))
+        }
+        FtsError::Invalid(why) => d(codes::UNSUPPORTED_COMBINATION, why.to_string()),
+    }
+}
