@@ -135,7 +135,7 @@ fn build_writes_program_to_out_dir() {
     let dir = tempfile::tempdir().expect("tmp");
     std::fs::copy(root().join(GOOD), dir.path().join("job.lens")).expect("copy");
     // Default output directory: out/ in the working directory.
-    let out = lensc(dir.path(), &["build", "job.lens"]);
+    let out = lensc(dir.path(), &["build", "job.lens", "--job", "kim_convex"]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     let program = std::fs::read_to_string(dir.path().join("out/kim_convex.ngc")).expect("program");
     assert!(program.starts_with("(lensc "));
@@ -175,10 +175,8 @@ fn failed_build_leaves_earlier_output_untouched() {
     let dir = tempfile::tempdir().expect("tmp");
     let src = std::fs::read_to_string(root().join(GOOD)).expect("read");
     std::fs::write(dir.path().join("job.lens"), &src).expect("write");
-    assert_eq!(
-        lensc(dir.path(), &["build", "job.lens"]).status.code(),
-        Some(0)
-    );
+    let build = |dir: &std::path::Path| lensc(dir, &["build", "job.lens", "--job", "kim_convex"]);
+    assert_eq!(build(dir.path()).status.code(), Some(0));
     let before = std::fs::read(dir.path().join("out/kim_convex.ngc")).expect("program");
 
     // Same job, now with a nose larger than any concave radius… on a convex
@@ -186,7 +184,7 @@ fn failed_build_leaves_earlier_output_untouched() {
     let broken = src.replace("spindle_speed: 1000 rpm", "spindle_speed: 9000 rpm");
     assert_ne!(broken, src);
     std::fs::write(dir.path().join("job.lens"), broken).expect("write");
-    let out = lensc(dir.path(), &["build", "job.lens"]);
+    let out = build(dir.path());
     assert_eq!(out.status.code(), Some(1));
     assert!(text(&out.stderr).contains("E0143"), "{}", text(&out.stderr));
     assert_eq!(

@@ -92,3 +92,80 @@ fn seed_003_fts_array_reproduces_the_paper() {
     // Capped at 1000 rpm near the centre.
     assert!((tp["max_spindle_rpm"].as_f64().expect("rpm") - 1000.0).abs() < 1e-9);
 }
+
+#[test]
+fn seed_001_grinding_follows_table_2() {
+    // Kim, Yang & Kim 2008, Table 2: δ = 1 µm, v_f = 20 µm/s over the convex
+    // lens's 1.6 mm radius (1600 intervals, 80 s); δ = 2 µm, v_f = 10 µm/s
+    // over the concave lens's 1.5 mm (750 intervals, 150 s). Every wheel
+    // centre is D_t/2 = 2 mm from its contact point along the normal.
+    for (example, job, segments, time, radius, conic, sign) in [
+        (
+            "examples/kim2008_convex_asphere.lens",
+            "kim_convex_grinding",
+            1600,
+            80.0,
+            22.405,
+            43.098,
+            -1.0,
+        ),
+        (
+            "examples/kim2008_concave_asphere.lens",
+            "kim_concave_grinding",
+            750,
+            150.0,
+            4.254,
+            -3.359,
+            1.0,
+        ),
+    ] {
+        let (report, _) = build(example, job);
+        let tp = &report["toolpath"];
+        assert_eq!(tp["segments"].as_u64(), Some(segments), "{job}");
+        assert!(
+            (tp["cutting_time_s"].as_f64().expect("time") - time).abs() < 1e-9,
+            "{job}"
+        );
+        let rows = tp["intervals"]["rows"].as_array().expect("table");
+        assert_eq!(rows.len() as u64, segments);
+        let c = 1.0 / radius;
+        let conic_z = |x: f64| {
+            let s = 1.0 - (1.0 + conic) * c * c * x * x;
+            sign * c * x * x / (1.0 + s.sqrt())
+        };
+        let slope = |x: f64| {
+            let s = 1.0 - (1.0 + conic) * c * c * x * x;
+            sign * c * x / s.sqrt()
+        };
+        for row in rows.iter().step_by(37) {
+            let v: Vec<f64> = row
+                .as_array()
+                .expect("row")
+                .iter()
+                .map(|x| x.as_f64().expect("n"))
+                .collect();
+            let (u, wx, wz) = (v[0], v[1], v[2]);
+            let n = (1.0 + slope(u).powi(2)).sqrt();
+            let (ex, ez) = (u - 2.0 * slope(u) / n, conic_z(u) + 2.0 / n);
+            assert!(
+                (wx - ex).abs() < 1e-12 && (wz - ez).abs() < 1e-12,
+                "{job} at {u}: ({wx}, {wz}) vs ({ex}, {ez})"
+            );
+        }
+    }
+}
+
+#[test]
+fn seed_000_scraping_covers_the_lens_exactly() {
+    // Lin 2022: hyperboloid R = 1 mm, k = -20 over 1.6 mm, 85 µm knife. The
+    // steepest slope along the cut is at the rim, atan(c r / sqrt(1 − (1+k)
+    // c² r²)) at r = 0.8 mm; passes every 10 µm across the 1.6 mm aperture.
+    let (report, _) = build("examples/lin2022_scraping.lens", "lin_hyperboloid");
+    let tp = &report["toolpath"];
+    let slope = (0.8f64 / (1.0f64 + 19.0 * 0.64).sqrt()).atan().to_degrees();
+    let along = tp["max_slope_along_deg"]["value"].as_f64().expect("slope");
+    assert!((along - slope).abs() < 1e-6, "{along} vs {slope}");
+    let passes = tp["passes"].as_u64().expect("passes");
+    assert!((159..=161).contains(&passes), "{passes}");
+    assert!(tp["cut_points"].as_u64().expect("points") > 10 * passes);
+}

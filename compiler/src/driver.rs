@@ -125,12 +125,22 @@ pub fn plan_and_emit(
     };
     for job in jobs {
         let strategy = crate::value::object(&job.fields, "strategy").expect("checked job part");
-        if strategy.kind.name == "fts_spiral" {
-            match crate::fts_job::build(job, &prov, spool_dir) {
-                Ok(b) => out.push(b),
-                Err(mut d) => diags.append(&mut d),
+        let other = match strategy.kind.name {
+            "fts_spiral" => Some(crate::fts_job::build(job, &prov, spool_dir)),
+            "raster" => Some(crate::mill_job::build_raster(job, &prov)),
+            "profile_grinding" => Some(crate::mill_job::build_grinding(job, &prov)),
+            _ => None,
+        };
+        match other {
+            Some(Ok(b)) => {
+                out.push(b);
+                continue;
             }
-            continue;
+            Some(Err(mut d)) => {
+                diags.append(&mut d);
+                continue;
+            }
+            None => {}
         }
         let lowered = match lower::lower(job) {
             Ok(j) => j,

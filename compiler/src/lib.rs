@@ -9,6 +9,7 @@ pub mod fts_job;
 pub mod jit;
 pub mod loader;
 pub mod lower;
+pub mod mill_job;
 pub mod render;
 pub mod schema;
 pub mod source;

@@ -962,11 +962,11 @@ pub static KINDS: &[Kind] = &[
                 Check::Positive,
                 "radius of the knife's nose, in the plane of the cut",
             ),
-            req(
+            opt(
                 "clearance",
                 ANGLE,
                 Check::HalfOpen(0.0, DEG90),
-                "clearance angle of the flank",
+                "clearance angle of the flank; when given, checked against the steepest slope along the cut",
             ),
         ],
         family: None,

@@ -309,3 +309,142 @@ impl FtsProgram {
         Ok(self.text)
     }
 }
+
+/// Writes moves word by word, leaving out words whose printed value has
+/// not changed (modal axes), refusing any value that cannot be printed.
+pub struct MoveWriter {
+    pub text: String,
+    decimals: u32,
+    /// The last value printed per axis letter, by index in `axes`.
+    last: Vec<f64>,
+    axes: &'static [char],
+    pub moves: usize,
+}
+
+impl MoveWriter {
+    /// A writer for `axes` (e.g. `['X', 'Y', 'Z']`) at the machine's
+    /// resolution, after the header comments and the modal line.
+    pub fn new(header: &[String], modal: &str, axes: &'static [char], resolution: f64) -> Self {
+        let mut text = String::new();
+        for line in header {
+            write_comment(&mut text, line);
+        }
+        text.push_str(modal);
+        text.push('\n');
+        MoveWriter {
+            text,
+            decimals: decimals_for(resolution),
+            last: vec![f64::NAN; axes.len()],
+            axes,
+            moves: 0,
+        }
+    }
+
+    /// One move: `G0` or `G1`, a value per axis (NaN: leave the axis
+    /// where it is), and a feed word if given.
+    pub fn motion(
+        &mut self,
+        g: &str,
+        at: &[f64],
+        feed: Option<(f64, u32)>,
+    ) -> Result<(), ProgramError> {
+        let d = self.decimals;
+        let mut line = String::from(g);
+        let before = line.len();
+        for (i, (&v, &letter)) in at.iter().zip(self.axes).enumerate() {
+            if v.is_nan() || rounded_eq(self.last[i], v, d) {
+                continue;
+            }
+            line.push(' ');
+            line.push(letter);
+            word(&mut line, letter, v, d)?;
+            self.last[i] = v;
+        }
+        if line.len() == before {
+            return Ok(());
+        }
+        if let Some((f, decimals)) = feed {
+            line.push_str(" F");
+            word(&mut line, 'F', f, decimals)?;
+        }
+        line.push('\n');
+        self.text.push_str(&line);
+        self.moves += 1;
+        Ok(())
+    }
+
+    /// A line as it is (spindle, modal changes).
+    pub fn raw(&mut self, line: &str) {
+        self.text.push_str(line);
+        self.text.push('\n');
+    }
+
+    pub fn finish(mut self) -> String {
+        self.text.push_str("M2\n");
+        self.text
+    }
+}
+
+/// A LinuxCNC program for a raster on a 3-axis mill: each pass reached by
+/// rapids at the safe height, a plunge, the cut, a retract.
+pub fn emit_mill_raster(
+    header: &[String],
+    path: &crate::raster::RasterPath,
+    feed: f64,
+    resolution: f64,
+) -> Result<String, ProgramError> {
+    let mut w = MoveWriter::new(
+        header,
+        "G17 G21 G90 G40 G49 G80 G94",
+        &['X', 'Y', 'Z'],
+        resolution,
+    );
+    let f = Some((feed * 60.0, 3));
+    let nan = f64::NAN;
+    w.motion("G0", &[nan, nan, path.safe_z], None)?;
+    for pass in &path.passes {
+        let Some(first) = pass.first() else { continue };
+        w.motion("G0", &[first[0], first[1], nan], None)?;
+        w.motion("G1", &[nan, nan, first[2]], f)?;
+        for p in &pass[1..] {
+            w.motion("G1", p, None)?;
+        }
+        w.motion("G0", &[nan, nan, path.safe_z], None)?;
+    }
+    Ok(w.finish())
+}
+
+/// A LinuxCNC program for a grinding pass: X (radius, G8) and Z of the
+/// wheel centre, each interval at its own feed so that the contact point
+/// advances at v_f (the interval takes δ/v_f).
+pub fn emit_grinding(
+    header: &[String],
+    path: &crate::grinding::GrindingPath,
+    feed: f64,
+    safe_z: f64,
+    resolution: f64,
+) -> Result<String, ProgramError> {
+    let mut w = MoveWriter::new(
+        header,
+        "G18 G21 G90 G8 G40 G49 G80 G94",
+        &['X', 'Z'],
+        resolution,
+    );
+    let Some(first) = path.points.first() else {
+        return Ok(w.finish());
+    };
+    w.raw("M3");
+    w.motion("G0", &[first.x, safe_z], None)?;
+    // The approach at the grinding feed.
+    w.motion("G1", &[first.x, first.z], Some((feed * 60.0, 6)))?;
+    for pair in path.points.windows(2) {
+        let (a, b) = (pair[0], pair[1]);
+        let step = ((b.x - a.x).powi(2) + (b.z - a.z).powi(2)).sqrt();
+        // The interval's time: its contact-x length at v_f.
+        let dt = (b.contact_x - a.contact_x).abs() / feed;
+        w.motion("G1", &[b.x, b.z], Some((step / dt * 60.0, 6)))?;
+    }
+    w.motion("G0", &[f64::NAN, safe_z], None)?;
+    w.raw("M5");
+    Ok(w.finish())
+}

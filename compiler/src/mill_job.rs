@@ -1,0 +1,473 @@
+//! Building the jobs of 2- and 3-axis machines beyond the lathe: iso-plane
+//! raster on a mill (seed 000) and profile grinding with a spherical wheel
+//! (seed 001). Each reads the checked job into its runtime planner, checks
+//! the tool against the surface, and writes a LinuxCNC program and report.
+
+use lensc_grammar::{Diagnostic, FileId, Span};
+use lensc_runtime::analysis::Domain;
+use lensc_runtime::grinding::{GrindingError, ProfileGrinding};
+use lensc_runtime::program::{ProgramError, Provenance};
+use lensc_runtime::raster::{Axis, Raster, RasterError, RasterTool};
+use lensc_runtime::surface::SectionAlongX;
+use serde_json::json;
+
+use crate::check::{CheckedJob, trim_num};
+use crate::codes;
+use crate::driver::{Built, ProgramText, analysis_json, evaluator};
+use crate::surfaces;
+use crate::value::{self, Object};
+
+/// The four parts of a checked job, their names, and where errors point.
+struct Parts<'a> {
+    job: &'a CheckedJob,
+    surface: &'a Object,
+    tool: &'a Object,
+    machine: &'a Object,
+    strategy: &'a Object,
+}
+
+impl<'a> Parts<'a> {
+    fn of(job: &'a CheckedJob) -> Parts<'a> {
+        let part = |name: &str| -> &'a Object {
+            value::object(&job.fields, name).expect("checked job part")
+        };
+        Parts {
+            job,
+            surface: part("surface"),
+            tool: part("tool"),
+            machine: part("machine"),
+            strategy: part("strategy"),
+        }
+    }
+    fn name(&self, part: &str, o: &Object) -> String {
+        self.job
+            .part_names
+            .get(part)
+            .cloned()
+            .unwrap_or_else(|| o.kind.name.to_string())
+    }
+    fn site(&self) -> (FileId, Span) {
+        (self.job.file, self.job.name.span)
+    }
+    fn error(&self, code: &'static str, msg: String) -> Diagnostic {
+        let (file, span) = self.site();
+        Diagnostic::error(code, msg, file, span).with_label("this job")
+    }
+    /// The lines every header starts with.
+    fn header(&self, prov: &Provenance, units: &str) -> Vec<String> {
+        vec![
+            format!("lensc {}: job {}", prov.lensc_version, self.job.name.name),
+            format!("source {} fnv1a64 {:016x}", prov.source, prov.source_hash),
+            units.to_string(),
+            format!(
+                "surface {}: {}",
+                self.name("surface", self.surface),
+                crate::lower::describe(self.surface)
+            ),
+        ]
+    }
+    fn report(
+        &self,
+        prov: &Provenance,
+        program_name: &str,
+        text: &str,
+        toolpath: serde_json::Value,
+        lowered: &surfaces::LoweredSurface,
+    ) -> serde_json::Value {
+        json!({
+            "job": self.job.name.name,
+            "lensc_version": prov.lensc_version,
+            "source": prov.source,
+            "source_fnv1a64": format!("{:016x}", prov.source_hash),
+            "program": {
+                "file": program_name,
+                "dialect": "linuxcnc",
+                "lines": text.lines().count(),
+                "bytes": text.len(),
+            },
+            "toolpath": toolpath,
+            "surface": analysis_json(&self.name("surface", self.surface), self.surface.kind.name, lowered, 201),
+        })
+    }
+    fn not_printable(&self, e: ProgramError) -> Diagnostic {
+        let ProgramError::NotPrintable { word, value } = e;
+        self.error(
+            codes::NOT_PRINTABLE,
+            format!("the program would contain {word}{value}, which no controller accepts"),
+        )
+    }
+    fn lowered(&self) -> Result<surfaces::LoweredSurface, Vec<Diagnostic>> {
+        surfaces::lower_surface(self.surface).map_err(|e| {
+            vec![self.error(
+                codes::UNSUPPORTED_COMBINATION,
+                format!("this surface cannot be evaluated yet: {e:?}"),
+            )]
+        })
+    }
+    fn needs(&self, part: &str, o: &Object, kinds: &[&str], what: &str) -> Option<Diagnostic> {
+        (!kinds.contains(&o.kind.name)).then(|| {
+            self.error(
+                codes::UNSUPPORTED_COMBINATION,
+                format!(
+                    "{what} needs {}; this {part} is a `{}`",
+                    kinds
+                        .iter()
+                        .map(|k| format!("`{k}`"))
+                        .collect::<Vec<_>>()
+                        .join(" or "),
+                    o.kind.name
+                ),
+            )
+        })
+    }
+}
+
+/// Builds a `raster` job on a `mill_3axis`.
+pub fn build_raster(job: &CheckedJob, prov: &Provenance) -> Result<Built, Vec<Diagnostic>> {
+    let p = Parts::of(job);
+    let errors: Vec<Diagnostic> = [
+        p.needs("machine", p.machine, &["mill_3axis"], "raster"),
+        p.needs("tool", p.tool, &["microshaper", "ball_end"], "raster"),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+    let (st, t, m) = (&p.strategy.fields, &p.tool.fields, &p.machine.fields);
+    let raster = Raster {
+        along: if value::word(st, "along") == Some("y") {
+            Axis::Y
+        } else {
+            Axis::X
+        },
+        zigzag: value::word(st, "direction") == Some("zigzag"),
+        stepover: value::num(st, "stepover").expect("required"),
+        chord_tolerance: value::num(st, "chord_tolerance").unwrap_or(10e-6),
+        max_step: value::num(st, "max_step"),
+        lin_angle: value::num(st, "lin_angle"),
+        retract: value::num(st, "retract").unwrap_or(1.0),
+    };
+    let (tool, tool_words) = match p.tool.kind.name {
+        "ball_end" => {
+            let d = value::num(t, "diameter").expect("required");
+            (
+                RasterTool::Ball { radius: d / 2.0 },
+                format!(
+                    "ball-end mill, diameter {} mm, referenced at the ball centre",
+                    trim_num(d)
+                ),
+            )
+        }
+        _ => {
+            let r = value::num(t, "nose_radius").expect("required");
+            (
+                RasterTool::Knife { nose_radius: r },
+                format!(
+                    "microshaper knife, nose radius {} mm in the plane of the cut, referenced at the nose centre",
+                    trim_num(r)
+                ),
+            )
+        }
+    };
+    let lowered = p.lowered()?;
+    let (kernel, _) = evaluator(&lowered.tape);
+    let path = lensc_runtime::raster::plan_raster(&raster, &tool, kernel.as_ref(), &lowered.domain)
+        .map_err(|e| vec![raster_diagnostic(&p, e)])?;
+    let mut errors = Vec::new();
+    // The knife's flank must clear the steepest slope along the cut.
+    if let Some(clearance) = value::num(t, "clearance")
+        && clearance <= path.max_slope_along.value
+    {
+        errors.push(p.error(
+            codes::CLEARANCE_TOO_SMALL,
+            format!(
+                "the clearance angle ({}°) is not above the surface's steepest slope along the cut ({}°, at ({}, {}) mm): the flank would rub",
+                trim_num(clearance.to_degrees()),
+                trim_num(path.max_slope_along.value.to_degrees()),
+                trim_num(path.max_slope_along.x),
+                trim_num(path.max_slope_along.y)
+            ),
+        ));
+    }
+    let feed = value::num(st, "feed").expect("required");
+    let max_feed = value::num(m, "max_feed").expect("required");
+    if feed > max_feed {
+        errors.push(p.error(
+            codes::FEED_TOO_HIGH,
+            format!(
+                "the cutting feed ({} mm/min) is above the machine's maximum ({} mm/min)",
+                trim_num(feed * 60.0),
+                trim_num(max_feed * 60.0)
+            ),
+        ));
+    }
+    let travel = value::block(m, "travel").expect("required");
+    for (i, axis) in ["x", "y", "z"].iter().enumerate() {
+        let (lo, hi) = value::range(travel, axis).expect("required");
+        let outside = path
+            .passes
+            .iter()
+            .flatten()
+            .map(|q| q[i])
+            .chain((i == 2).then_some(path.safe_z))
+            .find(|&v| v < lo || v > hi);
+        if let Some(v) = outside {
+            errors.push(p.error(
+                codes::OUT_OF_TRAVEL,
+                format!(
+                    "the path moves {} to {} mm, outside the machine's travel {} .. {} mm",
+                    axis.to_uppercase(),
+                    trim_num(v),
+                    trim_num(lo),
+                    trim_num(hi)
+                ),
+            ));
+        }
+    }
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+    let mut header = p.header(
+        prov,
+        "units mm; X Y Z of the tool centre, +Z out of the material; no cutter compensation",
+    );
+    header.push(format!("tool {}: {tool_words}", p.name("tool", p.tool)));
+    header.push(format!(
+        "strategy {}: raster along {}, {}, stepover {} um, chord tolerance {} nm, {} passes, {} points",
+        p.name("strategy", p.strategy),
+        if raster.along == Axis::X { "x" } else { "y" },
+        if raster.zigzag { "zigzag" } else { "one way" },
+        trim_num(raster.stepover * 1000.0),
+        trim_num(raster.chord_tolerance * 1e6),
+        path.pass_count,
+        path.point_count
+    ));
+    header.push(format!(
+        "machine {}: linuxcnc 3-axis mill",
+        p.name("machine", p.machine)
+    ));
+    let resolution = value::num(m, "resolution").expect("required");
+    let text = lensc_runtime::program::emit_mill_raster(&header, &path, feed, resolution)
+        .map_err(|e| vec![p.not_printable(e)])?;
+    let deg = 180.0 / std::f64::consts::PI;
+    let at = |e: &lensc_runtime::analysis::Extremum, s: f64| json!({ "value": e.value * s, "x_mm": e.x, "y_mm": e.y });
+    let time = path.cut_length / feed;
+    let toolpath = json!({
+        "strategy": "raster",
+        "passes": path.pass_count,
+        "cut_points": path.point_count,
+        "cut_length_mm": path.cut_length,
+        "feed_mm_per_min": feed * 60.0,
+        "cutting_time_s": time,
+        "chord_tolerance_mm": raster.chord_tolerance,
+        "stepover_mm": raster.stepover,
+        "max_slope_along_deg": at(&path.max_slope_along, deg),
+        "max_slope_across_deg": at(&path.max_slope_across, deg),
+        "min_concave_radius_along_mm": path.min_concave_radius_along.as_ref().map(|e| at(e, 1.0)),
+    });
+    let program_name = format!("{}.ngc", job.name.name);
+    let report = p.report(prov, &program_name, &text, toolpath, &lowered);
+    Ok(Built {
+        report_name: format!("{}.report.json", job.name.name),
+        program_name,
+        program: ProgramText::Memory(text),
+        report,
+        cut_points: path.point_count,
+        cutting_time: time,
+    })
+}
+
+fn raster_diagnostic(p: &Parts, e: RasterError) -> Diagnostic {
+    match e {
+        RasterError::ToolTooLarge {
+            tool_radius,
+            min_radius,
+            x,
+            y,
+        } => p
+            .error(
+                codes::NOSE_TOO_LARGE,
+                format!(
+                    "the tool's radius ({} um) is larger than the surface's smallest concave radius of curvature ({} um, at ({}, {}) mm): the tool would gouge",
+                    trim_num(tool_radius * 1000.0),
+                    trim_num(min_radius * 1000.0),
+                    trim_num(x),
+                    trim_num(y)
+                ),
+            )
+            .with_help("use a tool whose radius is below the smallest concave radius of curvature"),
+        RasterError::Undefined { x, y } | RasterError::NoContact { x, y } => p.error(
+            codes::UNDEFINED_ON_PATH,
+            format!(
+                "the surface or the tool path is undefined at ({}, {}) mm",
+                trim_num(x),
+                trim_num(y)
+            ),
+        ),
+        other => p.error(codes::UNSUPPORTED_COMBINATION, other.to_string()),
+    }
+}
+
+/// Builds a `profile_grinding` job on a `grinder_2axis`.
+pub fn build_grinding(job: &CheckedJob, prov: &Provenance) -> Result<Built, Vec<Diagnostic>> {
+    let p = Parts::of(job);
+    let errors: Vec<Diagnostic> = [
+        p.needs("machine", p.machine, &["grinder_2axis"], "profile grinding"),
+        p.needs("tool", p.tool, &["spherical_wheel"], "profile grinding"),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+    let (st, t, m) = (&p.strategy.fields, &p.tool.fields, &p.machine.fields);
+    let lowered = p.lowered()?;
+    let edge = match lowered.domain {
+        Domain::Circle { radius } | Domain::Annulus { outer: radius, .. } => radius,
+        Domain::Rect { x, .. } => x.1,
+    };
+    let feed = value::num(st, "feed").expect("required");
+    let grinding = ProfileGrinding {
+        wheel_diameter: value::num(t, "diameter").expect("required"),
+        interval: value::num(st, "interval").expect("required"),
+        feed,
+        smoothness: value::num(st, "smoothness").expect("required"),
+        start: value::num(st, "from").unwrap_or(0.0),
+        end: value::num(st, "to").unwrap_or(edge),
+    };
+    let (kernel, _) = evaluator(&lowered.tape);
+    let profile = SectionAlongX(kernel.as_ref());
+    let path = lensc_runtime::grinding::plan_profile_grinding(&grinding, &profile)
+        .map_err(|e| vec![grinding_diagnostic(&p, e)])?;
+    let mut errors = Vec::new();
+    let travel = value::block(m, "travel").expect("required");
+    let retract = value::num(st, "retract").unwrap_or(1.0);
+    let top = path
+        .points
+        .iter()
+        .map(|q| q.z)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let safe_z = top + retract;
+    for (i, axis) in ["x", "z"].iter().enumerate() {
+        let (lo, hi) = value::range(travel, axis).expect("required");
+        let outside = path
+            .points
+            .iter()
+            .map(|q| if i == 0 { q.x } else { q.z })
+            .chain((i == 1).then_some(safe_z))
+            .find(|&v| v < lo || v > hi);
+        if let Some(v) = outside {
+            errors.push(p.error(
+                codes::OUT_OF_TRAVEL,
+                format!(
+                    "the path moves {} to {} mm, outside the machine's travel {} .. {} mm",
+                    axis.to_uppercase(),
+                    trim_num(v),
+                    trim_num(lo),
+                    trim_num(hi)
+                ),
+            ));
+        }
+    }
+    let max_feed = value::num(m, "max_feed").expect("required");
+    if feed > max_feed {
+        errors.push(p.error(
+            codes::FEED_TOO_HIGH,
+            format!(
+                "the grinding feed ({} mm/min) is above the machine's maximum ({} mm/min)",
+                trim_num(feed * 60.0),
+                trim_num(max_feed * 60.0)
+            ),
+        ));
+    }
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+    let mut header = p.header(
+        prov,
+        "units mm; X is the radius [G8], Z along the spindle axis, +Z out of the material",
+    );
+    header.push(format!(
+        "tool {}: spherical wheel, diameter {} mm; coordinates are the wheel centre",
+        p.name("tool", p.tool),
+        trim_num(grinding.wheel_diameter)
+    ));
+    header.push(format!(
+        "strategy {}: profile grinding from x = {} to {} mm, interval {} um, feed {} um/s, smoothness {}; {} intervals, each at its own feed",
+        p.name("strategy", p.strategy),
+        trim_num(grinding.start),
+        trim_num(grinding.end),
+        trim_num(grinding.interval * 1000.0),
+        trim_num(feed * 1000.0),
+        trim_num(grinding.smoothness),
+        path.segments
+    ));
+    header.push(format!(
+        "machine {}: linuxcnc 2-axis grinder",
+        p.name("machine", p.machine)
+    ));
+    let resolution = value::num(m, "resolution").expect("required");
+    let text = lensc_runtime::program::emit_grinding(&header, &path, feed, safe_z, resolution)
+        .map_err(|e| vec![p.not_printable(e)])?;
+    // The table of eqs 18-19: every interval's commanded z velocity and
+    // acceleration, as the paper's position-based interpolation gives them.
+    let table: Vec<serde_json::Value> = path
+        .points
+        .iter()
+        .skip(1)
+        .map(|q| json!([q.contact_x, q.x, q.z, q.velocity, q.acceleration]))
+        .collect();
+    let toolpath = json!({
+        "strategy": "profile_grinding",
+        "segments": path.segments,
+        "cut_points": path.points.len(),
+        "interval_time_s": path.interval_time,
+        "cutting_time_s": path.total_time,
+        "max_z_speed_mm_per_s": path.max_speed,
+        "max_z_acceleration_mm_per_s2": path.max_acceleration,
+        "open_loop_drift_mm": path.open_loop_drift,
+        "min_concave_radius_mm": path.min_concave_radius.map(|(r, x)| json!({ "value": r, "at_x_mm": x })),
+        "intervals": {
+            "columns": ["contact_x_mm", "wheel_x_mm", "wheel_z_mm", "v_mm_per_s", "a_mm_per_s2"],
+            "rows": table,
+        },
+    });
+    let program_name = format!("{}.ngc", job.name.name);
+    let report = p.report(prov, &program_name, &text, toolpath, &lowered);
+    Ok(Built {
+        report_name: format!("{}.report.json", job.name.name),
+        program_name,
+        program: ProgramText::Memory(text),
+        report,
+        cut_points: path.points.len(),
+        cutting_time: path.total_time,
+    })
+}
+
+fn grinding_diagnostic(p: &Parts, e: GrindingError) -> Diagnostic {
+    match e {
+        GrindingError::WheelTooLarge {
+            x,
+            wheel_radius,
+            curvature_radius,
+        } => p
+            .error(
+                codes::NOSE_TOO_LARGE,
+                format!(
+                    "the wheel's radius ({} um) is larger than the surface's smallest concave radius of curvature ({} um, at x = {} mm): the wheel would gouge",
+                    trim_num(wheel_radius * 1000.0),
+                    trim_num(curvature_radius * 1000.0),
+                    trim_num(x)
+                ),
+            )
+            .with_help("use a smaller wheel"),
+        GrindingError::NonFiniteSurface { x } => p.error(
+            codes::UNDEFINED_ON_PATH,
+            format!("the surface is undefined at x = {} mm", trim_num(x)),
+        ),
+        other => p.error(codes::UNSUPPORTED_COMBINATION, other.to_string()),
+    }
+}
