@@ -1220,12 +1220,16 @@ impl<'a> Checker<'a> {
                             "must be at least {} and less than {} {unit}",
                             trim_num(lo * factor),
                             trim_num(hi * factor)
-                        ),
+                        )
+                        .trim_end()
+                        .to_string(),
                         Check::Open(lo, hi) => format!(
                             "must be greater than {} and less than {} {unit}",
                             trim_num(lo * factor),
                             trim_num(hi * factor)
-                        ),
+                        )
+                        .trim_end()
+                        .to_string(),
                         Check::Count => "must be a whole number from 1 to 100000".to_string(),
                         Check::Any => unreachable!(),
                     };
