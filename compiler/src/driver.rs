@@ -126,7 +126,7 @@ pub fn plan_and_emit(
     for job in jobs {
         let strategy = crate::value::object(&job.fields, "strategy").expect("checked job part");
         let other = match strategy.kind.name {
-            "fts_spiral" => Some(crate::fts_job::build(job, &prov, spool_dir)),
+            "fts_spiral" | "spiral_turning" => Some(crate::fts_job::build(job, &prov, spool_dir)),
             "raster" => Some(crate::mill_job::build_raster(job, &prov)),
             "profile_grinding" => Some(crate::mill_job::build_grinding(job, &prov)),
             _ => None,

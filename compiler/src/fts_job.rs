@@ -1,4 +1,6 @@
-//! Building a fast-tool-servo spiral job (seed 003): the checked job's
+//! Building a spiral turning job, with a fast tool servo (`fts_spiral` on
+//! an `fts_lathe`, seed 003) or a slow one (`spiral_turning` on an
+//! `sts_lathe`, Z carrying the surface): the checked job's
 //! parts read into the runtime's planner, the settling offset worked out
 //! from the servo model, the spiral planned and streamed into a LinuxCNC
 //! program, and the report of what it makes.
@@ -41,6 +43,8 @@ pub struct Prepared {
     settling: Option<Settling>,
     safe_w: f64,
     resolution: f64,
+    /// Slow tool servo: Z itself carries the surface.
+    slow: bool,
 }
 
 impl Prepared {
@@ -91,6 +95,7 @@ pub fn build(
         p.nose_radius,
         &p.spiral,
         p.settling.as_ref(),
+        p.slow,
     );
     let mut program = FtsProgram::new(&header, p.resolution, p.safe_w);
     let mut sink = Sink::new(spool_dir).map_err(|e| vec![cannot_spool(&e, file, span)])?;
@@ -103,7 +108,9 @@ pub fn build(
         }
         sink.push(program.take_text());
     });
-    let summary = planned.map_err(|e| vec![fts_diagnostic(e, &p.spiral.speed, file, span)])?;
+    let axis = if p.slow { "Z" } else { "the fast axis" };
+    let summary =
+        planned.map_err(|e| vec![fts_diagnostic(e, &p.spiral.speed, axis, file, span)])?;
     if let Some(ProgramError::NotPrintable { word, value }) = write_error {
         return Err(vec![err(
             codes::NOT_PRINTABLE,
@@ -122,6 +129,16 @@ pub fn build(
         .map_err(|e| vec![cannot_spool(&e, file, span)])?;
     let program_name = format!("{}.ngc", job.name.name);
     let surface_name = names("surface", surface);
+    let mut toolpath = toolpath_json(
+        &summary,
+        &p.spiral,
+        p.settling.as_ref(),
+        &p.servo,
+        p.nose_radius,
+    );
+    if p.slow {
+        toolpath["strategy"] = json!("spiral_turning");
+    }
     let report = json!({
         "job": job.name.name,
         "lensc_version": prov.lensc_version,
@@ -133,7 +150,7 @@ pub fn build(
             "lines": text.lines(),
             "bytes": text.bytes(),
         },
-        "toolpath": toolpath_json(&summary, &p.spiral, p.settling.as_ref(), &p.servo, p.nose_radius),
+        "toolpath": toolpath,
         "surface": crate::driver::analysis_json(&surface_name, surface.kind.name, &p.lowered, 201),
     });
     Ok(Built {
@@ -160,11 +177,17 @@ pub fn prepare(job: &CheckedJob) -> Result<Prepared, Vec<Diagnostic>> {
         Diagnostic::error(code, msg, file, span).with_label("this job")
     };
     let mut errors = Vec::new();
-    if machine.kind.name != "fts_lathe" {
+    let slow = strategy.kind.name == "spiral_turning";
+    let (want, what) = if slow {
+        ("sts_lathe", "slow-tool-servo spiral turning")
+    } else {
+        ("fts_lathe", "fast-tool-servo turning")
+    };
+    if machine.kind.name != want {
         errors.push(err(
             codes::UNSUPPORTED_COMBINATION,
             format!(
-                "fast-tool-servo turning needs an `fts_lathe`; this machine is a `{}`",
+                "{what} needs an `{want}`; this machine is a `{}`",
                 machine.kind.name
             ),
         ));
@@ -173,7 +196,7 @@ pub fn prepare(job: &CheckedJob) -> Result<Prepared, Vec<Diagnostic>> {
         errors.push(err(
             codes::UNSUPPORTED_COMBINATION,
             format!(
-                "fast-tool-servo turning needs a `round_nose` tool; this is a `{}`",
+                "{what} needs a `round_nose` tool; this is a `{}`",
                 tool.kind.name
             ),
         ));
@@ -182,17 +205,28 @@ pub fn prepare(job: &CheckedJob) -> Result<Prepared, Vec<Diagnostic>> {
         return Err(errors);
     }
     let (m, t, st) = (&machine.fields, &tool.fields, &strategy.fields);
-    let fast = value::block(m, "fast_axis").expect("required");
+    let travel = value::block(m, "travel").expect("required");
+    // The axis that carries the surface: the servo, or Z itself.
+    let fast = value::block(m, if slow { "z_axis" } else { "fast_axis" }).expect("required");
     let spindle = value::block(m, "spindle").expect("required");
     let max_spindle = value::num(spindle, "max_speed").expect("required");
     let rho = value::num(t, "nose_radius").expect("required");
     let clearance = value::num(t, "clearance").expect("required");
-    let servo = SecondOrderServo::from_resonance(
-        value::num(fast, "resonance").expect("required"),
-        value::num(fast, "resonant_peak").expect("required"),
-    );
+    let servo = if slow {
+        None
+    } else {
+        SecondOrderServo::from_resonance(
+            value::num(fast, "resonance").expect("required"),
+            value::num(fast, "resonant_peak").expect("required"),
+        )
+    };
     let fast_axis = FastAxis {
-        stroke: value::num(fast, "stroke").expect("required"),
+        stroke: if slow {
+            let (lo, hi) = value::range(travel, "z").expect("required");
+            hi - lo
+        } else {
+            value::num(fast, "stroke").expect("required")
+        },
         max_acceleration: value::num(fast, "max_acceleration").expect("required"),
     };
     let speed = match value::num(st, "surface_speed") {
@@ -209,11 +243,15 @@ pub fn prepare(job: &CheckedJob) -> Result<Prepared, Vec<Diagnostic>> {
             format!("this surface cannot be evaluated yet: {e:?}"),
         )]
     })?;
-    let ((x0, x1), (y0, y1)) = lowered.domain.bounds();
-    let outer = [x0, x1]
-        .iter()
-        .flat_map(|x| [y0, y1].map(|y| x.hypot(y)))
-        .fold(0.0, f64::max);
+    // The spiral starts where the surface's farthest point from the axis is.
+    let outer = match lowered.domain {
+        lensc_runtime::analysis::Domain::Circle { radius }
+        | lensc_runtime::analysis::Domain::Annulus { outer: radius, .. } => radius,
+        lensc_runtime::analysis::Domain::Rect { x, y } => [x.0, x.1]
+            .iter()
+            .flat_map(|a| [y.0, y.1].map(|b| a.hypot(b)))
+            .fold(0.0, f64::max),
+    };
     let start = value::num(st, "from").unwrap_or(outer);
     // The fastest surface speed the job reaches: what d_traj is made of.
     let fastest = match speed {
@@ -223,7 +261,7 @@ pub fn prepare(job: &CheckedJob) -> Result<Prepared, Vec<Diagnostic>> {
 
     // The settling offset, where the surface is an array of dimples.
     let settle_word = value::word(st, "settle");
-    let settling = if settle_word == Some("none") {
+    let settling = if slow || settle_word == Some("none") {
         None
     } else {
         settling(surface, st, servo, fast, fastest)
@@ -272,15 +310,36 @@ pub fn prepare(job: &CheckedJob) -> Result<Prepared, Vec<Diagnostic>> {
             ),
         ));
     }
-    if clearance <= design.max_slope.value {
+    // The flank follows the cut around the spindle: the clearance angle
+    // must exceed the steepest slope around (circumferential); the edge
+    // meets the slope across (radial): half its included angle must exceed it.
+    let (around, across) = {
+        let (k, _) = evaluator(&lowered.tape);
+        polar_slopes(k.as_ref(), &lowered.domain, 201)
+    };
+    if clearance <= around.0 {
         errors.push(err(
             codes::CLEARANCE_TOO_SMALL,
             format!(
-                "the clearance angle ({}°) is not above the surface's steepest slope in the cutting direction ({}°, at ({}, {}) mm): the flank would rub",
+                "the clearance angle ({}°) is not above the surface's steepest slope in the cutting direction, around the spindle ({}°, at ({}, {}) mm): the flank would rub",
                 trim_num(clearance.to_degrees()),
-                trim_num(design.max_slope.value.to_degrees()),
-                trim_num(design.max_slope.x),
-                trim_num(design.max_slope.y)
+                trim_num(around.0.to_degrees()),
+                trim_num(around.1),
+                trim_num(around.2)
+            ),
+        ));
+    }
+    if let Some(included) = value::num(t, "included_angle")
+        && included / 2.0 <= across.0
+    {
+        errors.push(err(
+            codes::CLEARANCE_TOO_SMALL,
+            format!(
+                "half the tool's included angle ({}°) is not above the surface's steepest slope across the cut, along the radius ({}°, at ({}, {}) mm): the edge's side would cut",
+                trim_num(included.to_degrees() / 2.0),
+                trim_num(across.0.to_degrees()),
+                trim_num(across.1),
+                trim_num(across.2)
             ),
         ));
     }
@@ -290,7 +349,7 @@ pub fn prepare(job: &CheckedJob) -> Result<Prepared, Vec<Diagnostic>> {
         speed,
         chord_tolerance: value::num(st, "chord_tolerance").unwrap_or(10e-6),
         seed_arc: value::num(st, "seed_arc").unwrap_or(0.1),
-        min_interval: 1.0 / value::num(fast, "data_rate").unwrap_or(20e3),
+        min_interval: 1.0 / value::num(fast, "data_rate").unwrap_or(if slow { 1e3 } else { 20e3 }),
         start_radius: start,
         end_radius: 0.0,
     };
@@ -328,7 +387,6 @@ pub fn prepare(job: &CheckedJob) -> Result<Prepared, Vec<Diagnostic>> {
             ),
         ));
     }
-    let travel = value::block(m, "travel").expect("required");
     let (tx0, tx1) = value::range(travel, "x").expect("required");
     if start > tx1 || tx0 > 0.0 {
         errors.push(err(
@@ -357,7 +415,36 @@ pub fn prepare(job: &CheckedJob) -> Result<Prepared, Vec<Diagnostic>> {
         lowered,
         servo,
         settling,
+        slow,
     })
+}
+
+/// The steepest slopes (rad) around the spindle axis and along the radius,
+/// each with where (x, y), over an n × n grid of the domain.
+fn polar_slopes(
+    f: &dyn SurfaceFn,
+    domain: &lensc_runtime::analysis::Domain,
+    n: usize,
+) -> ((f64, f64, f64), (f64, f64, f64)) {
+    let (xs, ys, out) = lensc_runtime::analysis::grid(f, domain, n);
+    let mut around = (0.0, 0.0, 0.0);
+    let mut across = (0.0, 0.0, 0.0);
+    for (i, (&x, &y)) in xs.iter().zip(&ys).enumerate() {
+        let r = x.hypot(y);
+        let (zx, zy) = (out[6 * i + 1], out[6 * i + 2]);
+        if r == 0.0 || !(zx.is_finite() && zy.is_finite()) {
+            continue;
+        }
+        let tangential = ((x * zy - y * zx) / r).abs().atan();
+        let radial = ((x * zx + y * zy) / r).abs().atan();
+        if tangential > around.0 {
+            around = (tangential, x, y);
+        }
+        if radial > across.0 {
+            across = (radial, x, y);
+        }
+    }
+    (around, across)
 }
 
 /// Where the program text goes as it is written: memory, or a spool file.
@@ -486,7 +573,16 @@ fn header_lines(
     rho: f64,
     spiral: &FtsSpiral,
     settling: Option<&Settling>,
+    slow: bool,
 ) -> Vec<String> {
+    let (servo_words, axis_words) = if slow {
+        ("slow-tool-servo", "Z carries the surface")
+    } else {
+        (
+            "fast-tool-servo",
+            "Z the fast tool servo's axis [LinuxCNC has no fast-axis word]",
+        )
+    };
     let speed = match spiral.speed {
         SpindleSpeed::Constant(w) => format!("constant spindle speed {} rpm", trim_num(rpm(w))),
         SpindleSpeed::SurfaceSpeed { speed, max } => format!(
@@ -498,19 +594,20 @@ fn header_lines(
     let mut lines = vec![
         format!("lensc {}: job {}", prov.lensc_version, job.name.name),
         format!("source {} fnv1a64 {:016x}", prov.source, prov.source_hash),
-        "units mm; X is the radius [G8], C the spindle angle in degrees counted on from the start, Z the fast tool servo's axis [LinuxCNC has no fast-axis word], +Z out of the material".into(),
+        format!("units mm; X is the radius [G8], C the spindle angle in degrees counted on from the start, {axis_words}, +Z out of the material"),
         "coordinates are the centre of the tool nose; feed in inverse time [G93, F = 1/min per move]".into(),
         format!("surface {surface}: {surface_words}"),
         format!("tool {tool}: round nose, nose radius {} mm", trim_num(rho)),
         format!(
-            "strategy {strategy}: fast-tool-servo spiral from r = {} mm, feed {} um/rev, {speed}, chord tolerance {} nm",
+            "strategy {strategy}: {servo_words} spiral from r = {} mm, feed {} um/rev, {speed}, chord tolerance {} nm",
             trim_num(spiral.start_radius),
             trim_num(spiral.feed_per_rev * 1000.0),
             trim_num(spiral.chord_tolerance * 1e6)
         ),
-        format!("machine {machine}: linuxcnc fast-tool-servo lathe"),
+        format!("machine {machine}: linuxcnc {servo_words} lathe"),
     ];
     match settling {
+        None if slow => {}
         Some(s) => lines.push(format!(
             "settling: tool held {} um above the land, lenslets continued {} um past their rims [settling time {} ms at {} m/min]",
             trim_num(s.offset * 1000.0),
@@ -567,7 +664,13 @@ fn toolpath_json(
     })
 }
 
-fn fts_diagnostic(e: FtsError, speed: &SpindleSpeed, file: FileId, span: Span) -> Diagnostic {
+fn fts_diagnostic(
+    e: FtsError,
+    speed: &SpindleSpeed,
+    axis: &str,
+    file: FileId,
+    span: Span,
+) -> Diagnostic {
     let d = |code, msg: String| Diagnostic::error(code, msg, file, span).with_label("this job");
     match e {
         FtsError::Undefined { x, c } => d(
@@ -581,7 +684,7 @@ fn fts_diagnostic(e: FtsError, speed: &SpindleSpeed, file: FileId, span: Span) -
         FtsError::StrokeExceeded { range, stroke } => d(
             codes::STROKE_EXCEEDED,
             format!(
-                "the fast axis must travel {} um, more than its {} um stroke",
+                "{axis} must travel {} um, more than its {} um stroke",
                 trim_num(range * 1000.0),
                 trim_num(stroke * 1000.0)
             ),
@@ -607,7 +710,7 @@ fn fts_diagnostic(e: FtsError, speed: &SpindleSpeed, file: FileId, span: Span) -
             d(
                 codes::ACCELERATION_EXCEEDED,
                 format!(
-                    "the fast axis would accelerate at {} m/s² (at r = {} mm), above its {} m/s² limit",
+                    "{axis} would accelerate at {} m/s² (at r = {} mm), above its {} m/s² limit",
                     trim_num(acceleration / 1000.0),
                     trim_num(at_radius),
                     trim_num(max / 1000.0)

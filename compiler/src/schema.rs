@@ -1056,6 +1056,40 @@ pub static KINDS: &[Kind] = &[
         doc: "a lathe with C-axis spindle and a fast tool servo W along Z",
     },
     Kind {
+        name: "sts_lathe",
+        category: Category::Machine,
+        params: &[
+            DIALECT,
+            RESOLUTION,
+            LATHE_TRAVEL,
+            MAX_FEED,
+            SPINDLE,
+            req(
+                "z_axis",
+                Ty::Block(&[
+                    req(
+                        "max_acceleration",
+                        Ty::Quantity(&[Dim::ACCELERATION]),
+                        Check::Positive,
+                        "acceleration limit of Z",
+                    ),
+                    opt(
+                        "data_rate",
+                        Ty::Quantity(&[Dim::FREQUENCY]),
+                        Check::Positive,
+                        "rate at which the controller takes positions; default 1 kHz",
+                    ),
+                ]),
+                Check::Any,
+                "Z, which follows the surface as the spindle turns",
+            ),
+        ],
+        family: None,
+        positional: &[],
+        exclusive: &[],
+        doc: "a lathe whose spindle is a C axis and whose Z follows the surface: slow-tool-servo turning",
+    },
+    Kind {
         name: "mill_3axis",
         category: Category::Machine,
         params: &[
@@ -1146,6 +1180,54 @@ pub static KINDS: &[Kind] = &[
         positional: &[],
         exclusive: &[(&["spindle_speed", "surface_speed"], true)],
         doc: "fast-tool-servo spiral turning: X and C on an Archimedean spiral, W carrying the surface",
+    },
+    Kind {
+        name: "spiral_turning",
+        category: Category::Strategy,
+        params: &[
+            req(
+                "feed",
+                Ty::Quantity(&[Dim::FEED_PER_REV]),
+                Check::Positive,
+                "radial feed per revolution",
+            ),
+            opt(
+                "spindle_speed",
+                Ty::Quantity(&[Dim::ROTATIONAL_SPEED]),
+                Check::Positive,
+                "constant spindle speed",
+            ),
+            opt(
+                "surface_speed",
+                Ty::Quantity(&[Dim::SPEED]),
+                Check::Positive,
+                "constant surface speed at the tool",
+            ),
+            opt(
+                "spindle_cap",
+                Ty::Quantity(&[Dim::ROTATIONAL_SPEED]),
+                Check::Positive,
+                "highest spindle speed under constant surface speed; default the machine's",
+            ),
+            CHORD_TOLERANCE,
+            opt(
+                "seed_arc",
+                LENGTH,
+                Check::Positive,
+                "largest arc between the samples the chord test starts from; default 0.1 mm",
+            ),
+            opt(
+                "from",
+                LENGTH,
+                Check::NonNegative,
+                "radius where the spiral starts; default the outermost point of the surface",
+            ),
+            RETRACT,
+        ],
+        family: None,
+        positional: &[],
+        exclusive: &[(&["spindle_speed", "surface_speed"], true)],
+        doc: "spiral turning with a slow tool servo: X and C on an Archimedean spiral, Z following the surface",
     },
     Kind {
         name: "raster",

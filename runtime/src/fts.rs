@@ -594,6 +594,29 @@ mod tests {
     }
 
     #[test]
+    fn off_the_axis_the_centre_is_on_the_section_circle() {
+        // A concave sphere R centred at (cx, 0, R): the plane of the ray at
+        // angle c cuts it in a circle of radius sqrt(R² − d²), d = cx·sin c,
+        // centred at u0 = cx·cos c; the nose centre is on the concentric
+        // circle ρ smaller (the exact offset, to 1e-12 mm).
+        let d = Dimple {
+            r: 20.0,
+            h: 0.1,
+            cx: 0.6,
+        };
+        let s = spiral();
+        let p = planner(&s, &d, 0.496);
+        for c in [0.3, 2.0, 10.0, 41.0, 77.7] {
+            let x = p.radius(c);
+            let w = p.centre(c);
+            let (dist, u0) = (0.6 * c.sin(), 0.6 * c.cos());
+            let rs = (400.0 - dist * dist).sqrt();
+            let want = 20.0 - ((rs - 0.496).powi(2) - (x - u0).powi(2)).sqrt();
+            assert!((w - want).abs() < 1e-12, "c {c}: {w} vs {want}");
+        }
+    }
+
+    #[test]
     fn on_the_plateau_the_centre_is_a_nose_radius_above_it() {
         let d = Dimple {
             r: 20.0,
