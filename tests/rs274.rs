@@ -252,3 +252,38 @@ fn fts_program_passes_rs274() {
         "{hi}"
     );
 }
+
+#[test]
+fn roller_program_passes_rs274() {
+    // Seed 002's pattern on a coarse helix: rs274 reads every move; Z
+    // advances by the pitch per turn of C within each pass.
+    let dir = tempfile::tempdir().expect("tmp");
+    let out = lensc(
+        &root(),
+        &[
+            "build",
+            "tests/jobs/roller_small.lens",
+            "--out",
+            dir.path().to_str().expect("utf8"),
+        ],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let canon = interpret(&dir.path().join("roller_small.ngc"));
+    let moves: Vec<Vec<f64>> = canon
+        .lines()
+        .filter_map(|l| l.split_once("STRAIGHT_FEED(").map(|(_, rest)| rest))
+        .map(|args| {
+            args.trim_end_matches(')')
+                .split(',')
+                .map(|s| s.trim().parse().expect("number"))
+                .collect()
+        })
+        .collect();
+    // Rough: 5 turns of 180 points + the end; finish: 20 turns of 360 + 1.
+    assert_eq!(moves.len(), 5 * 180 + 1 + 20 * 360 + 1);
+    let finish = &moves[5 * 180 + 1..];
+    for w in finish[1..].windows(2) {
+        let (dz, dc) = (w[1][2] - w[0][2], w[1][5] - w[0][5]);
+        assert!((dz - 0.05 * dc / 360.0).abs() < 2e-4, "dz {dz} for dc {dc}");
+    }
+}

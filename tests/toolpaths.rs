@@ -169,3 +169,45 @@ fn seed_000_scraping_covers_the_lens_exactly() {
     assert!((159..=161).contains(&passes), "{passes}");
     assert!(tp["cut_points"].as_u64().expect("points") > 10 * passes);
 }
+
+#[test]
+fn seed_002_roller_helix_reproduces_the_paper() {
+    // Liu et al.: the tool checks of section 4 with the paper's figures
+    // (minimum radius of curvature 2 mm; steepest slope 3.81° around the
+    // roller and 5.71° along it) pass with its tool (1.417567 mm, 12.5°
+    // clearance, 100° included); rough pass 1° / 0.1 mm and finish pass
+    // 0.1° / 5 µm over 5.5 mm: 55 and 1100 revolutions, 360 and 3600
+    // points per turn, plus the end point.
+    let (report, _) = build("examples/liu_roller_pattern.lens", "roller_pattern_helix");
+    let tp = &report["toolpath"];
+    let check = &tp["tool_check"];
+    let v = |k: &str| check[k].as_f64().expect(k);
+    assert_eq!(
+        format!("{:.3}", v("min_radius_of_curvature_cutting_plane_mm")),
+        "2.000"
+    );
+    assert_eq!(format!("{:.2}", v("max_slope_cutting_deg")), "3.81");
+    assert_eq!(format!("{:.2}", v("max_slope_axial_deg")), "5.71");
+    assert!(
+        v("nose_radius_mm") < 2.0
+            && v("clearance_deg") > 3.81
+            && v("half_included_angle_deg") > 5.71
+    );
+    let passes = tp["passes"].as_array().expect("passes");
+    let counts: Vec<u64> = passes
+        .iter()
+        .map(|p| p["points"].as_u64().expect("points"))
+        .collect();
+    assert_eq!(counts, [55 * 360 + 1, 1100 * 3600 + 1]);
+    // The finish pass's nose centres lie between the roller's radius plus
+    // the design's lowest and highest points, plus the nose radius.
+    let f = &passes[1];
+    let (lo, hi) = (
+        f["x_min_mm"].as_f64().expect("x"),
+        f["x_max_mm"].as_f64().expect("x"),
+    );
+    assert!(
+        lo >= 3.0 - 0.08 + 1.417567 - 1e-9 && hi <= 3.0 + 1.417567 + 1e-9,
+        "{lo} {hi}"
+    );
+}

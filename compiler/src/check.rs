@@ -1515,6 +1515,23 @@ impl<'a> Checker<'a> {
                 true
             }
             "profile_turning" => {
+                let f = &o.fields;
+                let stock = value::field(f, "stock_top").or(value::field(f, "stock_allowance"));
+                if let Some(at) = stock
+                    && value::num(f, "depth_of_cut").is_none()
+                {
+                    self.err(
+                        Diagnostic::error(
+                            codes::MISSING_PARAMETER,
+                            format!("`{}` gives the stock, but no `depth_of_cut` says how much each roughing pass removes", at.name),
+                            at.file,
+                            at.span,
+                        )
+                        .with_label("the stock")
+                        .with_help("add `depth_of_cut: …`, a length"),
+                    );
+                    return false;
+                }
                 if let (Some(from), Some(to)) =
                     (value::num(&o.fields, "from"), value::num(&o.fields, "to"))
                     && from <= to

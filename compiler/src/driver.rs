@@ -128,6 +128,7 @@ pub fn plan_and_emit(
         let other = match strategy.kind.name {
             "fts_spiral" | "spiral_turning" => Some(crate::fts_job::build(job, &prov, spool_dir)),
             "raster" => Some(crate::mill_job::build_raster(job, &prov)),
+            "roller_helix" => Some(crate::roller_job::build(job, &prov, spool_dir)),
             "profile_grinding" => Some(crate::mill_job::build_grinding(job, &prov)),
             _ => None,
         };
@@ -264,6 +265,7 @@ fn build_report(
             "chord_tolerance_mm": job.strategy.chord_tolerance,
             "max_profile_slope_deg": path.max_slope.0.to_degrees(),
             "min_concave_radius_mm": path.min_concave_radius.map(|(r, at)| json!({ "value": r, "at_radius_mm": at })),
+            "roughing_passes": path.roughing_passes,
             "tool_location": match job.strategy.location {
                 ToolLocation::Exact => "exact",
                 ToolLocation::Sequential { .. } => "sequential",

@@ -448,7 +448,7 @@ fn polar_slopes(
 }
 
 /// Where the program text goes as it is written: memory, or a spool file.
-enum Sink {
+pub(crate) enum Sink {
     Memory(String),
     File {
         writer: std::io::BufWriter<tempfile::NamedTempFile>,
@@ -459,7 +459,7 @@ enum Sink {
 }
 
 impl Sink {
-    fn new(spool_dir: Option<&Path>) -> std::io::Result<Sink> {
+    pub(crate) fn new(spool_dir: Option<&Path>) -> std::io::Result<Sink> {
         Ok(match spool_dir {
             None => Sink::Memory(String::new()),
             Some(dir) => {
@@ -478,7 +478,7 @@ impl Sink {
         })
     }
 
-    fn push(&mut self, text: String) {
+    pub(crate) fn push(&mut self, text: String) {
         match self {
             Sink::Memory(all) => all.push_str(&text),
             Sink::File {
@@ -499,7 +499,7 @@ impl Sink {
         }
     }
 
-    fn finish(self) -> std::io::Result<ProgramText> {
+    pub(crate) fn finish(self) -> std::io::Result<ProgramText> {
         match self {
             Sink::Memory(text) => Ok(ProgramText::Memory(text)),
             Sink::File {
@@ -518,7 +518,7 @@ impl Sink {
     }
 }
 
-fn cannot_spool(e: &std::io::Error, file: FileId, span: Span) -> Diagnostic {
+pub(crate) fn cannot_spool(e: &std::io::Error, file: FileId, span: Span) -> Diagnostic {
     Diagnostic::error(
         codes::CANNOT_WRITE,
         format!("cannot write the program: {e}"),

@@ -11,6 +11,7 @@ pub mod loader;
 pub mod lower;
 pub mod mill_job;
 pub mod render;
+pub mod roller_job;
 pub mod schema;
 pub mod source;
 pub mod surfaces;

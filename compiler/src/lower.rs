@@ -7,7 +7,7 @@ use lensc_runtime::Job;
 use lensc_runtime::machine::{Dialect, Lathe};
 use lensc_runtime::surface::SurfaceInfo;
 use lensc_runtime::tool::RoundNoseTool;
-use lensc_runtime::toolpath::{Feed, ProfileTurning, ToolLocation};
+use lensc_runtime::toolpath::{Feed, ProfileTurning, Roughing, Stock, ToolLocation};
 
 use crate::check::{CheckedJob, aperture_inner_radius, aperture_radius, trim_num};
 use crate::codes;
@@ -111,6 +111,7 @@ pub fn lower(job: &CheckedJob) -> Result<Job, Vec<Diagnostic>> {
         }),
         retract: value::num(f, "retract").unwrap_or(1.0),
         location: tool_location(f),
+        roughing: roughing(f),
     };
     let m = &machine.fields;
     let travel = value::block(m, "travel").expect("required");
@@ -150,6 +151,20 @@ pub fn lower(job: &CheckedJob) -> Result<Job, Vec<Diagnostic>> {
         tool: cutter,
         machine: lathe,
         strategy: strat,
+    })
+}
+
+/// Roughing passes, when the strategy states the stock and a depth of cut.
+fn roughing(f: &[value::Field]) -> Option<Roughing> {
+    let stock = match (value::num(f, "stock_top"), value::num(f, "stock_allowance")) {
+        (Some(top), _) => Stock::Flat { top },
+        (None, Some(allowance)) => Stock::Offset { allowance },
+        (None, None) => return None,
+    };
+    Some(Roughing {
+        stock,
+        depth_of_cut: value::num(f, "depth_of_cut")?,
+        finish_allowance: value::num(f, "finish_allowance").unwrap_or(0.0),
     })
 }
 

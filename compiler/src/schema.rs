@@ -1230,6 +1230,79 @@ pub static KINDS: &[Kind] = &[
         doc: "spiral turning with a slow tool servo: X and C on an Archimedean spiral, Z following the surface",
     },
     Kind {
+        name: "roller_helix",
+        category: Category::Strategy,
+        params: &[
+            opt(
+                "rough",
+                Ty::Block(&[
+                    req(
+                        "c_step",
+                        ANGLE,
+                        Check::Positive,
+                        "spindle angle between points",
+                    ),
+                    req(
+                        "pitch",
+                        LENGTH,
+                        Check::Positive,
+                        "axial feed per revolution",
+                    ),
+                    req(
+                        "finish_allowance",
+                        LENGTH,
+                        Check::NonNegative,
+                        "radial stock left for the finish pass",
+                    ),
+                ]),
+                Check::Any,
+                "the rough pass (Liu et al.: 1° and 0.1 mm)",
+            ),
+            req(
+                "finish",
+                Ty::Block(&[
+                    req(
+                        "c_step",
+                        ANGLE,
+                        Check::Positive,
+                        "spindle angle between points",
+                    ),
+                    req(
+                        "pitch",
+                        LENGTH,
+                        Check::Positive,
+                        "axial feed per revolution",
+                    ),
+                ]),
+                Check::Any,
+                "the finish pass (Liu et al.: 0.1° and 5 µm)",
+            ),
+            opt(
+                "z",
+                Ty::Range(Dim::LENGTH),
+                Check::Any,
+                "axial range of the cut, in the design's x; default the whole design",
+            ),
+            req(
+                "spindle_speed",
+                Ty::Quantity(&[Dim::ROTATIONAL_SPEED]),
+                Check::Positive,
+                "spindle speed",
+            ),
+            opt(
+                "blank_radius",
+                LENGTH,
+                Check::Positive,
+                "radius of the roller blank; default the top of the design",
+            ),
+            RETRACT,
+        ],
+        family: None,
+        positional: &[],
+        exclusive: &[],
+        doc: "roller helix turning (Liu et al., seed 002): the wrapped design cut along a helix z = P·c/360, rough then finish",
+    },
+    Kind {
         name: "raster",
         category: Category::Strategy,
         params: &[
@@ -1376,10 +1449,34 @@ pub static KINDS: &[Kind] = &[
                 Check::Positive,
                 "descent step of the sequential search (default 10 nm) or final bracket of the binary search (default 1 nm)",
             ),
+            opt(
+                "stock_top",
+                LENGTH,
+                Check::Any,
+                "the stock is flat, its face at this height: roughing passes take it down `depth_of_cut` at a time",
+            ),
+            opt(
+                "stock_allowance",
+                LENGTH,
+                Check::Positive,
+                "the stock is the design offset by this much along its normal: roughing passes take it down `depth_of_cut` at a time",
+            ),
+            opt(
+                "depth_of_cut",
+                LENGTH,
+                Check::Positive,
+                "most material one roughing pass removes; needed with a stock",
+            ),
+            opt(
+                "finish_allowance",
+                LENGTH,
+                Check::NonNegative,
+                "material the roughing passes leave for the finish pass; default 0",
+            ),
         ],
         family: None,
         positional: &[],
-        exclusive: &[],
+        exclusive: &[(&["stock_top", "stock_allowance"], false)],
         doc: "one facing pass along the profile with the nose centre offset along the normal",
     },
 ];

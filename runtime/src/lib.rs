@@ -15,6 +15,7 @@ pub mod job;
 pub mod machine;
 pub mod program;
 pub mod raster;
+pub mod roller;
 pub mod servo;
 pub mod surface;
 pub mod tool;

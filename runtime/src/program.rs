@@ -71,10 +71,11 @@ fn emit_linuxcnc_lathe(
     comment(
         &mut out,
         &format!(
-            "strategy {}: profile turning, {} points, chord tolerance {} nm",
+            "strategy {}: profile turning, {} points, chord tolerance {} nm{}",
             job.strategy_name,
             path.cut_points,
-            num(job.strategy.chord_tolerance * 1e6)
+            num(job.strategy.chord_tolerance * 1e6),
+            roughing_words(job, path)
         ),
     );
     comment(
@@ -179,6 +180,24 @@ pub fn write_comment(out: &mut String, text: &str) {
         line.push_str(&piece);
     }
     let _ = writeln!(out, "({line})");
+}
+
+/// ", after N roughing passes from …" for a job with stock, else "".
+fn roughing_words(job: &Job, path: &Toolpath) -> String {
+    use crate::toolpath::Stock;
+    let Some(r) = job.strategy.roughing else {
+        return String::new();
+    };
+    let stock = match r.stock {
+        Stock::Flat { top } => format!("flat stock at Z{}", num(top)),
+        Stock::Offset { allowance } => format!("stock {} mm over the surface", num(allowance)),
+    };
+    format!(
+        ", after {} roughing passes from {stock}, at most {} mm each, {} mm left for the finish",
+        path.roughing_passes,
+        num(r.depth_of_cut),
+        num(r.finish_allowance)
+    )
 }
 
 fn word(out: &mut String, letter: char, value: f64, decimals: u32) -> Result<(), ProgramError> {
@@ -447,4 +466,103 @@ pub fn emit_grinding(
     w.motion("G0", &[f64::NAN, safe_z], None)?;
     w.raw("M5");
     Ok(w.finish())
+}
+
+/// A LinuxCNC program for roller helix turning: X (the nose centre's
+/// distance from the roller axis, G8), Z along the roller, C the spindle
+/// angle in degrees counted on from the first pass; each pass starts on a
+/// whole turn after the last, moves timed by inverse-time feed (G93).
+pub struct RollerProgram {
+    text: String,
+    decimals: u32,
+    safe_x: f64,
+    spindle_speed: f64,
+    /// C (degrees) where the current pass started, and the last point.
+    c_base: f64,
+    last: Option<crate::roller::RollerPoint>,
+    pass: usize,
+    pub moves: usize,
+}
+
+impl RollerProgram {
+    pub fn new(header: &[String], resolution: f64, safe_x: f64, spindle_speed: f64) -> Self {
+        let mut text = String::new();
+        for line in header {
+            write_comment(&mut text, line);
+        }
+        text.push_str("G18 G21 G90 G8 G40 G49 G80 G93\n");
+        RollerProgram {
+            text,
+            decimals: decimals_for(resolution),
+            safe_x,
+            spindle_speed,
+            c_base: 0.0,
+            last: None,
+            pass: usize::MAX,
+            moves: 0,
+        }
+    }
+
+    /// Appends points of pass `pass`; a new pass retracts X, moves to its
+    /// start on the next whole turn of C, and plunges.
+    pub fn extend(
+        &mut self,
+        pass: usize,
+        points: &[crate::roller::RollerPoint],
+    ) -> Result<(), ProgramError> {
+        let d = self.decimals;
+        for p in points {
+            let line = &mut self.text;
+            if pass != self.pass {
+                if let Some(last) = self.last {
+                    let c_end = self.c_base + last.c.to_degrees();
+                    self.c_base = (c_end / 360.0).floor() * 360.0 + 360.0;
+                    line.push_str("G0 X");
+                    word(line, 'X', self.safe_x, d)?;
+                    line.push('\n');
+                }
+                self.pass = pass;
+                line.push_str("G0 X");
+                word(line, 'X', self.safe_x, d)?;
+                line.push_str(" Z");
+                word(line, 'Z', p.z, d)?;
+                line.push_str(" C");
+                word(line, 'C', self.c_base + p.c.to_degrees(), C_DECIMALS)?;
+                // The plunge: one second.
+                line.push_str("\nG1 X");
+                word(line, 'X', p.x, d)?;
+                line.push_str(" F60.\n");
+                self.moves += 2;
+                self.last = Some(*p);
+                continue;
+            }
+            let last = self.last.expect("a pass has begun");
+            let dt = (p.c - last.c) / self.spindle_speed;
+            line.push_str("G1 X");
+            word(line, 'X', p.x, d)?;
+            line.push_str(" Z");
+            word(line, 'Z', p.z, d)?;
+            line.push_str(" C");
+            word(line, 'C', self.c_base + p.c.to_degrees(), C_DECIMALS)?;
+            line.push_str(" F");
+            word(line, 'F', 60.0 / dt, 3)?;
+            line.push('\n');
+            self.moves += 1;
+            self.last = Some(*p);
+        }
+        Ok(())
+    }
+
+    /// The text written since the last call.
+    pub fn take_text(&mut self) -> String {
+        std::mem::take(&mut self.text)
+    }
+
+    /// Retracts and ends the program; the text not yet taken.
+    pub fn finish(mut self) -> Result<String, ProgramError> {
+        self.text.push_str("G0 X");
+        word(&mut self.text, 'X', self.safe_x, self.decimals)?;
+        self.text.push_str("\nM2\n");
+        Ok(self.text)
+    }
 }

@@ -33,6 +33,29 @@ pub struct ProfileTurning {
     pub retract: f64,
     /// How the nose-centre height is found.
     pub location: ToolLocation,
+    /// Roughing passes before the finish pass, if the stock is given.
+    pub roughing: Option<Roughing>,
+}
+
+/// What the part is before cutting, and how much each pass removes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Roughing {
+    pub stock: Stock,
+    /// Most material (mm) one roughing pass removes.
+    pub depth_of_cut: f64,
+    /// Material (mm, along the normal) the last roughing pass leaves for
+    /// the finish pass.
+    pub finish_allowance: f64,
+}
+
+/// The stock a job starts from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Stock {
+    /// A flat face at height `top` (mm).
+    Flat { top: f64 },
+    /// The design surface offset by `allowance` (mm) along its normal (a
+    /// moulded or pre-ground blank).
+    Offset { allowance: f64 },
 }
 
 /// How profile turning finds the nose-centre height.
@@ -86,6 +109,8 @@ pub struct Toolpath {
     pub max_slope: (f64, f64),
     /// Concave corners the nose cannot follow, in radius order.
     pub seams: Vec<Seam>,
+    /// Roughing passes before the finish pass.
+    pub roughing_passes: usize,
 }
 
 impl Toolpath {
@@ -191,27 +216,38 @@ pub fn plan_profile_turning(job: &Job, profile: &dyn Profile) -> Result<Toolpath
     let pieces = envelope::split_at_corners(profile, lo, hi);
     let seams = seams(profile, &pieces, rho, start.min(end), hi);
     let cut = cut_path(profile, &pieces, rho, strat, start, end);
-    let top = cut.iter().map(|c| c.y).fold(f64::NEG_INFINITY, f64::max);
+    let mut passes = roughing_passes(profile, &pieces, rho, strat, start, end, &cut);
+    let roughing_count = passes.len();
+    passes.push(cut);
+    let top = passes
+        .iter()
+        .flatten()
+        .map(|c| c.y)
+        .fold(f64::NEG_INFINITY, f64::max);
     let safe_z = top + strat.retract;
-    let mut moves = Vec::with_capacity(cut.len() + 4);
-    moves.push(Move::Rapid {
-        x: cut[0].x,
-        z: safe_z,
-    });
-    moves.push(Move::Feed {
-        x: cut[0].x,
-        z: cut[0].y,
-    });
-    let mut cut_length = (safe_z - cut[0].y).abs();
-    for w in cut.windows(2) {
-        cut_length += (w[1] - w[0]).norm();
+    let mut moves = Vec::with_capacity(passes.iter().map(|p| p.len() + 3).sum());
+    let mut cut_length = 0.0;
+    for cut in &passes {
+        moves.push(Move::Rapid {
+            x: cut[0].x,
+            z: safe_z,
+        });
+        moves.push(Move::Feed {
+            x: cut[0].x,
+            z: cut[0].y,
+        });
+        cut_length += (safe_z - cut[0].y).abs();
+        for w in cut.windows(2) {
+            cut_length += (w[1] - w[0]).norm();
+        }
+        moves.extend(cut.iter().skip(1).map(|c| Move::Feed { x: c.x, z: c.y }));
+        let last = cut[cut.len() - 1];
+        moves.push(Move::Rapid {
+            x: last.x,
+            z: safe_z,
+        });
     }
-    moves.extend(cut.iter().skip(1).map(|c| Move::Feed { x: c.x, z: c.y }));
-    let last = cut[cut.len() - 1];
-    moves.push(Move::Rapid {
-        x: last.x,
-        z: safe_z,
-    });
+    let cut = passes.pop().expect("the finish pass");
 
     let (lo_x, hi_x) = job.machine.travel_x;
     let (lo_z, hi_z) = job.machine.travel_z;
@@ -247,7 +283,73 @@ pub fn plan_profile_turning(job: &Job, profile: &dyn Profile) -> Result<Toolpath
         min_concave_radius: min_concave,
         max_slope,
         seams,
+        roughing_passes: roughing_count,
     })
+}
+
+/// The roughing passes, outermost first: each the exact nose-centre path
+/// for the design offset by that pass's allowance (a nose of radius
+/// ρ + allowance), and with flat stock never deeper than its level below
+/// the stock's top.
+fn roughing_passes(
+    profile: &dyn Profile,
+    pieces: &Pieces,
+    rho: f64,
+    strat: &ProfileTurning,
+    start: f64,
+    end: f64,
+    finish: &[Vector2<f64>],
+) -> Vec<Vec<Vector2<f64>>> {
+    let Some(r) = strat.roughing else {
+        return Vec::new();
+    };
+    let doc = r.depth_of_cut;
+    let f = r.finish_allowance;
+    let offset = |allowance: f64| -> Vec<Vector2<f64>> {
+        if allowance == 0.0 {
+            return finish.to_vec();
+        }
+        let exact = ProfileTurning {
+            location: ToolLocation::Exact,
+            ..strat.clone()
+        };
+        cut_path(profile, pieces, rho + allowance, &exact, start, end)
+    };
+    let mut passes = Vec::new();
+    match r.stock {
+        Stock::Offset { allowance } => {
+            let mut k = 1.0;
+            while allowance - k * doc > f + 1e-12 && passes.len() < 10_000 {
+                passes.push(offset(allowance - k * doc));
+                k += 1.0;
+            }
+            if f > 0.0 && allowance > f {
+                passes.push(offset(f));
+            }
+        }
+        Stock::Flat { top } => {
+            let last = offset(f);
+            let lowest = last.iter().map(|c| c.y).fold(f64::INFINITY, f64::min);
+            let mut k = 1.0;
+            loop {
+                // The nose's bottom at this level: its centre ρ above.
+                let level = top - k * doc + rho;
+                if level <= lowest || passes.len() >= 10_000 {
+                    break;
+                }
+                passes.push(
+                    last.iter()
+                        .map(|c| Vector2::new(c.x, c.y.max(level)))
+                        .collect(),
+                );
+                k += 1.0;
+            }
+            if f > 0.0 {
+                passes.push(last);
+            }
+        }
+    }
+    passes
 }
 
 /// The nose-centre points of the cut, within the chord tolerance of the
@@ -423,5 +525,136 @@ mod tests {
         assert!(pts.len() > 10);
         assert_eq!(pts[0].x, f(2.0).x);
         assert_eq!(pts.last().unwrap().x, 0.0);
+    }
+}
+
+#[cfg(test)]
+mod roughing_tests {
+    use super::*;
+    use crate::job::Job;
+    use crate::machine::{Dialect, Lathe};
+    use crate::surface::{RotationalSurface, Sense, SurfaceInfo};
+    use crate::tool::RoundNoseTool;
+
+    fn job(roughing: Roughing) -> (Job, RotationalSurface) {
+        let s = RotationalSurface {
+            radius: 10.0,
+            conic: 0.0,
+            sense: Sense::Convex,
+            terms: vec![],
+            aperture_radius: 3.0,
+        };
+        let job = Job {
+            name: "r".into(),
+            surface_name: "s".into(),
+            tool_name: "t".into(),
+            machine_name: "m".into(),
+            strategy_name: "p".into(),
+            surface: SurfaceInfo {
+                description: "sphere".into(),
+                aperture_radius: 3.0,
+            },
+            tool: RoundNoseTool {
+                nose_radius: 0.5,
+                clearance_angle: 0.1,
+                rake_angle: 0.0,
+            },
+            machine: Lathe {
+                dialect: Dialect::LinuxCnc,
+                resolution: 1e-6,
+                travel_x: (-10.0, 100.0),
+                travel_z: (-100.0, 100.0),
+                max_feed: 100.0,
+                max_spindle_speed: 1000.0,
+            },
+            strategy: ProfileTurning {
+                feed: Feed::PerRevolution(0.002 / (2.0 * std::f64::consts::PI)),
+                spindle_speed: 50.0,
+                chord_tolerance: 1e-5,
+                start_radius: None,
+                end_radius: 0.0,
+                retract: 1.0,
+                location: ToolLocation::Exact,
+                roughing: Some(roughing),
+            },
+        };
+        (job, s)
+    }
+
+    /// The cutting passes of a plan, split at its rapids.
+    fn passes(path: &Toolpath) -> Vec<Vec<(f64, f64)>> {
+        let mut out: Vec<Vec<(f64, f64)>> = Vec::new();
+        for m in &path.moves {
+            match *m {
+                Move::Rapid { .. } => {
+                    if out.last().is_none_or(|p| !p.is_empty()) {
+                        out.push(Vec::new());
+                    }
+                }
+                Move::Feed { x, z } => out.last_mut().expect("a rapid first").push((x, z)),
+            }
+        }
+        out.retain(|p| !p.is_empty());
+        out
+    }
+
+    #[test]
+    fn offset_stock_passes_are_exact_offsets_of_the_sphere() {
+        // A convex sphere R = 10 mm about (0, −10); stock 0.25 mm thick,
+        // 0.1 mm per pass, 0.02 mm left: passes at 0.15, 0.05, 0.02, then
+        // the finish at 0: each nose centre at R + ρ + allowance.
+        let (j, s) = job(Roughing {
+            stock: Stock::Offset { allowance: 0.25 },
+            depth_of_cut: 0.1,
+            finish_allowance: 0.02,
+        });
+        let path = plan_profile_turning(&j, &s).expect("plans");
+        assert_eq!(path.roughing_passes, 3);
+        let ps = passes(&path);
+        assert_eq!(ps.len(), 4);
+        for (pass, allowance) in ps.iter().zip([0.15, 0.05, 0.02, 0.0]) {
+            // Skip the plunge point (the first feed is the descent).
+            for &(x, z) in &pass[1..] {
+                let d = (x * x + (z + 10.0).powi(2)).sqrt();
+                assert!((d - (10.5 + allowance)).abs() < 1e-12, "{allowance}: {d}");
+            }
+        }
+    }
+
+    #[test]
+    fn flat_stock_passes_remove_at_most_the_depth_of_cut() {
+        let (j, s) = job(Roughing {
+            stock: Stock::Flat { top: 0.05 },
+            depth_of_cut: 0.1,
+            finish_allowance: 0.01,
+        });
+        let path = plan_profile_turning(&j, &s).expect("plans");
+        let ps = passes(&path);
+        assert_eq!(ps.len(), path.roughing_passes + 1);
+        // The sphere's sag over 3 mm is 0.4606 mm, plus the allowance: the
+        // levels 0.05 − k·0.1 reach below it after 5 passes, then the
+        // allowance pass and the finish.
+        assert_eq!(path.roughing_passes, 6);
+        let nose_bottom = |pass: &[(f64, f64)], x: f64| -> f64 {
+            // Linear interpolation of the centre height at x, less ρ.
+            let i = pass.partition_point(|p| p.0 > x).clamp(1, pass.len() - 1);
+            let (a, b) = (pass[i - 1], pass[i]);
+            let t = if a.0 == b.0 {
+                0.0
+            } else {
+                (x - a.0) / (b.0 - a.0)
+            };
+            a.1 + t * (b.1 - a.1) - 0.5
+        };
+        let mut previous: Option<&Vec<(f64, f64)>> = None;
+        for pass in &ps {
+            for i in 0..=60 {
+                let x = 3.0 * i as f64 / 60.0;
+                let now = nose_bottom(&pass[1..], x);
+                let before = previous.map_or(0.05, |p| nose_bottom(&p[1..], x));
+                assert!(before - now <= 0.1 + 1e-9, "x {x}: {before} to {now}");
+            }
+            previous = Some(pass);
+        }
     }
 }
