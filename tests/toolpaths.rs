@@ -211,3 +211,57 @@ fn seed_002_roller_helix_reproduces_the_paper() {
         "{lo} {hi}"
     );
 }
+
+#[test]
+fn a_tool_set_off_centre_is_corrected_in_x() {
+    // The edge 20 µm above the spindle axis cuts radius sqrt(X² + h²): the
+    // program's X is sqrt(r² − h²) of the nose-centre radius r the on-centre
+    // program gives, point for point, and the centre (r < h) is out of reach.
+    let src = std::fs::read_to_string(root().join("examples/kim2008_convex_asphere.lens"))
+        .expect("example");
+    let dir = tempfile::tempdir().expect("tmp");
+    let on = dir.path().join("on.lens");
+    let off = dir.path().join("off.lens");
+    std::fs::write(&on, &src).expect("write");
+    let shifted = src.replace(
+        "tool wheel = round_nose { nose_radius: 2 mm, clearance: 10° }",
+        "tool wheel = round_nose { nose_radius: 2 mm, clearance: 10°, centre_height: 20 um }",
+    );
+    assert_ne!(shifted, src);
+    std::fs::write(&off, shifted).expect("write");
+    let program = |file: &std::path::Path, out: &str| {
+        let o = lensc(
+            dir.path(),
+            &[
+                "build",
+                file.to_str().expect("utf-8"),
+                "--job",
+                "kim_convex",
+                "--out",
+                out,
+            ],
+        );
+        assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+        (
+            std::fs::read_to_string(dir.path().join(out).join("kim_convex.ngc")).expect("program"),
+            text(&o.stderr),
+        )
+    };
+    let (a, _) = program(&on, "a");
+    let (b, warnings) = program(&off, "b");
+    assert!(warnings.contains("W0004"), "{warnings}");
+    let xs = |p: &str| -> Vec<f64> {
+        p.lines()
+            .filter(|l| l.starts_with("G1") || l.starts_with("G0") || l.starts_with("G95"))
+            .filter_map(|l| l.split_whitespace().find_map(|w| w.strip_prefix('X')))
+            .map(|v| v.parse().expect("number"))
+            .collect()
+    };
+    let (xa, xb) = (xs(&a), xs(&b));
+    assert_eq!(xa.len(), xb.len());
+    for (r, x) in xa.iter().zip(&xb) {
+        let want = (r * r - 0.02f64 * 0.02).max(0.0).sqrt();
+        // Both printed to the machine's 10 nm: half a step each way.
+        assert!((x - want).abs() <= 1.01e-5, "{r} → {x}, want {want}");
+    }
+}

@@ -48,6 +48,7 @@ pub const CANNOT_WRITE: &str = "E0151";
 pub const UNUSED: &str = "W0001";
 pub const WRAP_GAP: &str = "W0002";
 pub const SEAM_LEFT_UNCUT: &str = "W0003";
+pub const CENTRE_LEFT_UNCUT: &str = "W0004";
 
 /// All codes, for the uniqueness test and the reference in README.
 pub const ALL: &[&str] = &[
@@ -96,6 +97,7 @@ pub const ALL: &[&str] = &[
     CANNOT_WRITE,
     UNUSED,
     SEAM_LEFT_UNCUT,
+    CENTRE_LEFT_UNCUT,
 ];
 
 #[cfg(test)]

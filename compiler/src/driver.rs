@@ -177,6 +177,30 @@ pub fn plan_and_emit(
                 continue;
             }
         };
+        let h = lowered.tool.centre_height.abs();
+        let inmost = path
+            .moves
+            .iter()
+            .filter_map(|m| match *m {
+                lensc_runtime::toolpath::Move::Feed { x, .. } => Some(x.abs()),
+                lensc_runtime::toolpath::Move::Rapid { .. } => None,
+            })
+            .fold(f64::INFINITY, f64::min);
+        if h > 0.0 && inmost < h {
+            diags.push(
+                Diagnostic::warning(
+                    codes::CENTRE_LEFT_UNCUT,
+                    format!(
+                        "the tool's edge is {} mm off the spindle axis: it cannot reach radii below that, and a pip is left at the centre",
+                        trim_num(h)
+                    ),
+                    file,
+                    span,
+                )
+                .with_label("this job")
+                .with_help("set the tool on centre; the program corrects X for the height given"),
+            );
+        }
         if let Some(deepest) = path.seams.iter().max_by(|a, b| a.depth.total_cmp(&b.depth)) {
             let (first, last) = (&path.seams[0], &path.seams[path.seams.len() - 1]);
             let where_ = if path.seams.len() == 1 {

@@ -215,10 +215,22 @@ pub fn prepare(job: &CheckedJob) -> Result<Prepared, Vec<Diagnostic>> {
     let servo = if slow {
         None
     } else {
-        SecondOrderServo::from_resonance(
-            value::num(fast, "resonance").expect("required"),
-            value::num(fast, "resonant_peak").expect("required"),
-        )
+        let num = |k: &str| value::num(fast, k);
+        match (
+            num("resonance"),
+            num("resonant_peak"),
+            num("natural_frequency"),
+            num("damping"),
+        ) {
+            (Some(f), Some(peak), None, None) => SecondOrderServo::from_resonance(f, peak),
+            (None, None, Some(f), Some(zeta)) => SecondOrderServo::from_natural(f, zeta),
+            _ => {
+                return Err(vec![err(
+                    codes::MISSING_PARAMETER,
+                    "the fast axis's servo model needs either `resonance` and `resonant_peak`, or `natural_frequency` and `damping`".into(),
+                )]);
+            }
+        }
     };
     let fast_axis = FastAxis {
         stroke: if slow {

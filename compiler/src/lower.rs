@@ -130,6 +130,7 @@ pub fn lower(job: &CheckedJob) -> Result<Job, Vec<Diagnostic>> {
     let cutter = RoundNoseTool {
         nose_radius: value::num(t, "nose_radius").expect("required"),
         clearance_angle: value::num(t, "clearance").expect("required"),
+        centre_height: value::num(t, "centre_height").unwrap_or(0.0),
         rake_angle: value::num(t, "rake").unwrap_or(0.0),
     };
     if !errors.is_empty() {

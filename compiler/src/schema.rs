@@ -898,6 +898,12 @@ pub static KINDS: &[Kind] = &[
                 Check::HalfOpen(0.0, std::f64::consts::PI),
                 "opening angle of the cutting edge",
             ),
+            opt(
+                "centre_height",
+                LENGTH,
+                Check::Any,
+                "height of the edge above the spindle axis as set (below: negative); profile turning corrects X for it; default 0",
+            ),
         ],
         family: None,
         positional: &[],
@@ -1021,17 +1027,29 @@ pub static KINDS: &[Kind] = &[
                         Check::Positive,
                         "acceleration limit of the fast axis",
                     ),
-                    req(
+                    opt(
                         "resonance",
                         Ty::Quantity(&[Dim::FREQUENCY]),
                         Check::Positive,
-                        "resonance frequency of the closed-loop servo",
+                        "resonance frequency of the closed-loop servo (with `resonant_peak`)",
                     ),
-                    req(
+                    opt(
                         "resonant_peak",
                         NUMBER,
                         Check::Positive,
-                        "resonant peak of the closed-loop servo, in dB",
+                        "resonant peak of the closed-loop servo, in dB (with `resonance`)",
+                    ),
+                    opt(
+                        "natural_frequency",
+                        Ty::Quantity(&[Dim::FREQUENCY]),
+                        Check::Positive,
+                        "natural frequency of the servo model (with `damping`, instead of the resonance)",
+                    ),
+                    opt(
+                        "damping",
+                        NUMBER,
+                        Check::Open(0.0, 1.0),
+                        "damping ratio of the servo model (with `natural_frequency`)",
                     ),
                     opt(
                         "data_rate",

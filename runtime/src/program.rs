@@ -63,9 +63,17 @@ fn emit_linuxcnc_lathe(
     comment(
         &mut out,
         &format!(
-            "tool {}: round nose, nose radius {} mm",
+            "tool {}: round nose, nose radius {} mm{}",
             job.tool_name,
-            num(job.tool.nose_radius)
+            num(job.tool.nose_radius),
+            if job.tool.centre_height == 0.0 {
+                String::new()
+            } else {
+                format!(
+                    ", edge {} mm off the spindle axis: X = sqrt[r² − h²] of the nose-centre radius r",
+                    num(job.tool.centre_height)
+                )
+            }
         ),
     );
     comment(
@@ -107,6 +115,13 @@ fn emit_linuxcnc_lathe(
         let (g, x, z) = match *m {
             Move::Rapid { x, z } => ("G0", x, z),
             Move::Feed { x, z } => ("G1", x, z),
+        };
+        // An edge set h off the axis cuts radius sqrt(X² + h²).
+        let h = job.tool.centre_height;
+        let x = if h == 0.0 {
+            x
+        } else {
+            x.signum() * (x * x - h * h).max(0.0).sqrt()
         };
         let mut line = String::with_capacity(40);
         if g == "G1" && !feed_set {

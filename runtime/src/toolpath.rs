@@ -557,6 +557,7 @@ mod roughing_tests {
             tool: RoundNoseTool {
                 nose_radius: 0.5,
                 clearance_angle: 0.1,
+                centre_height: 0.0,
                 rake_angle: 0.0,
             },
             machine: Lathe {
