@@ -165,7 +165,15 @@ pub fn build(
         passes,
         z_start,
         z_end,
-        blank_radius: value::num(st, "blank_radius").unwrap_or(roller_radius + check.z_max),
+        // By default the blank just covers the design: its highest point,
+        // found on the tool check's grid and by the refined analysis, or
+        // the roller's own radius (an array's land, z = 0, around it).
+        blank_radius: value::num(st, "blank_radius").unwrap_or_else(|| {
+            let top = lensc_runtime::analysis::analyse(kernel.as_ref(), &lowered.domain, 201)
+                .sag_max
+                .value;
+            roller_radius + check.z_max.max(top).max(0.0) + 1e-6
+        }),
         depth_of_cut: None,
         design_length_around: Some(design_y.1 - design_y.0),
         spindle_speed: Some(spindle_speed),

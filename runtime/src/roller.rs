@@ -539,10 +539,14 @@ fn survey_row(design: &dyn SurfaceFn, xs: &[f64], y: f64, roller_radius: f64) ->
         if let Some((x0, o0)) = prev {
             let h = x - x0;
             let slope_rise = (p - o0[1]) - 0.5 * (r + o0[3]) * h;
-            let z_jump = (z - o0[0]) - 0.5 * (p + o0[1]) * h;
-            if slope_rise > 1e-4 + 0.1 * (p - o0[1]).abs()
-                || z_jump.abs() > 1e-6 + 0.1 * (z - o0[0]).abs()
-            {
+            // A continuous section rises between the two end slopes times
+            // h (whatever kink lies between), give or take its curvature:
+            // only a rise outside that is a step. A convex kink (a ridge
+            // where neighbouring dimples meet) is neither.
+            let dz = z - o0[0];
+            let bend = 0.5 * r.abs().max(o0[3].abs()) * h * h + 1e-9;
+            let step = dz < p.min(o0[1]) * h - bend || dz > p.max(o0[1]) * h + bend;
+            if slope_rise > 1e-4 + 0.1 * (p - o0[1]).abs() || step {
                 s.corners += 1;
             }
         }
