@@ -13,6 +13,7 @@ pub mod grinding;
 pub mod ir;
 pub mod job;
 pub mod machine;
+pub mod moves;
 pub mod program;
 pub mod raster;
 pub mod roller;

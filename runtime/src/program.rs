@@ -1,6 +1,7 @@
-//! Dialect emitters: the dialect-independent move stream to program text.
-//! Every number goes through `format::push_fixed`; a program with a value
-//! that cannot be written is refused whole.
+//! Post-processors: the dialect-independent move stream (`moves.rs`) to
+//! program text, and each strategy's points to that stream. Every number
+//! goes through `format::push_fixed`; a program with a value that cannot
+//! be written is refused whole.
 
 use std::f64::consts::PI;
 use std::fmt::Write as _;
@@ -8,6 +9,7 @@ use std::fmt::Write as _;
 use crate::format::{decimals_for, push_fixed};
 use crate::job::Job;
 use crate::machine::Dialect;
+use crate::moves::{self, Position};
 use crate::toolpath::{Feed, Move, Toolpath};
 
 /// What the program header states about where the job came from.
@@ -39,125 +41,76 @@ fn emit_linuxcnc_lathe(
     path: &Toolpath,
     prov: &Provenance,
 ) -> Result<String, ProgramError> {
-    let d = decimals_for(job.machine.resolution);
-    let mut out = String::with_capacity(64 * path.moves.len() + 1024);
-    let comment = write_comment;
-    comment(
-        &mut out,
-        &format!("lensc {}: job {}", prov.lensc_version, job.name),
-    );
-    comment(
-        &mut out,
-        &format!("source {} fnv1a64 {:016x}", prov.source, prov.source_hash),
-    );
-    comment(
-        &mut out,
-        "units mm; X is the radius [G8], Z along the spindle axis, +Z out of the material",
-    );
-    comment(
-        &mut out,
-        "coordinates are the centre of the tool nose; no cutter compensation",
-    );
-    let surf = format!("surface {}: {}", job.surface_name, job.surface.description);
-    comment(&mut out, &surf);
-    comment(
-        &mut out,
-        &format!(
-            "tool {}: round nose, nose radius {} mm{}",
+    let centre_height = if job.tool.centre_height == 0.0 {
+        String::new()
+    } else {
+        format!(
+            ", edge {} mm off the spindle axis: X = sqrt[r² − h²] of the nose-centre radius r",
+            num(job.tool.centre_height)
+        )
+    };
+    let header = [
+        format!("lensc {}: job {}", prov.lensc_version, job.name),
+        format!("source {} fnv1a64 {:016x}", prov.source, prov.source_hash),
+        "units mm; X is the radius [G8], Z along the spindle axis, +Z out of the material".into(),
+        "coordinates are the centre of the tool nose; no cutter compensation".into(),
+        format!("surface {}: {}", job.surface_name, job.surface.description),
+        format!(
+            "tool {}: round nose, nose radius {} mm{centre_height}",
             job.tool_name,
-            num(job.tool.nose_radius),
-            if job.tool.centre_height == 0.0 {
-                String::new()
-            } else {
-                format!(
-                    ", edge {} mm off the spindle axis: X = sqrt[r² − h²] of the nose-centre radius r",
-                    num(job.tool.centre_height)
-                )
-            }
+            num(job.tool.nose_radius)
         ),
-    );
-    comment(
-        &mut out,
-        &format!(
+        format!(
             "strategy {}: profile turning, {} points, chord tolerance {} nm{}",
             job.strategy_name,
             path.cut_points,
             num(job.strategy.chord_tolerance * 1e6),
             roughing_words(job, path)
         ),
-    );
-    comment(
-        &mut out,
-        &format!(
+        format!(
             "machine {}: {} lathe",
             job.machine_name,
             job.machine.dialect.name()
         ),
+        format!("estimated cutting time {}", duration(path.cutting_time())),
+    ];
+    let mut w = LinuxCncWriter::new(
+        &header,
+        "G18 G21 G90 G8 G40 G49 G80 G94",
+        "XZ",
+        job.machine.resolution,
     );
-    comment(
-        &mut out,
-        &format!("estimated cutting time {}", duration(path.cutting_time())),
-    );
-    out.push_str("G18 G21 G90 G8 G40 G49 G80 G94\n");
+    w.write_all(&turning_moves(job, path))?;
+    Ok(w.finish())
+}
 
-    let rpm = job.strategy.spindle_speed * 60.0 / (2.0 * PI);
-    out.push('S');
-    word(&mut out, 'S', rpm, 3)?;
-    out.push_str(" M3\n");
-
-    let (feed_mode, feed_value) = match job.strategy.feed {
-        Feed::PerRevolution(f) => ("G95", f * 2.0 * PI),
-        Feed::PerTime(v) => ("G94", v * 60.0),
+/// The move stream of a profile-turning path: spindle on, the planner's
+/// moves (X corrected for an edge set off centre), spindle off.
+pub fn turning_moves(job: &Job, path: &Toolpath) -> Vec<moves::Move> {
+    let feed = match job.strategy.feed {
+        Feed::PerRevolution(f) => moves::Feed::PerRevolution(f),
+        Feed::PerTime(v) => moves::Feed::PerTime(v),
     };
-    let (mut cx, mut cz) = (f64::NAN, f64::NAN);
-    let mut feed_set = false;
-    for m in &path.moves {
-        let (g, x, z) = match *m {
-            Move::Rapid { x, z } => ("G0", x, z),
-            Move::Feed { x, z } => ("G1", x, z),
-        };
-        // An edge set h off the axis cuts radius sqrt(X² + h²).
-        let h = job.tool.centre_height;
-        let x = if h == 0.0 {
+    // An edge set h off the axis cuts radius sqrt(X² + h²).
+    let h = job.tool.centre_height;
+    let corrected = |x: f64| {
+        if h == 0.0 {
             x
         } else {
             x.signum() * (x * x - h * h).max(0.0).sqrt()
-        };
-        let mut line = String::with_capacity(40);
-        if g == "G1" && !feed_set {
-            line.push_str(feed_mode);
-            line.push(' ');
         }
-        line.push_str(g);
-        let before = line.len();
-        let mut xs = String::new();
-        word(&mut xs, 'X', x, d)?;
-        let mut zs = String::new();
-        word(&mut zs, 'Z', z, d)?;
-        // Words whose printed value has not changed are left out.
-        if !rounded_eq(cx, x, d) {
-            line.push_str(" X");
-            line.push_str(&xs);
-        }
-        if !rounded_eq(cz, z, d) {
-            line.push_str(" Z");
-            line.push_str(&zs);
-        }
-        if line.len() == before {
-            continue;
-        }
-        if g == "G1" && !feed_set {
-            line.push_str(" F");
-            word(&mut line, 'F', feed_value, 6)?;
-            feed_set = true;
-        }
-        cx = x;
-        cz = z;
-        out.push_str(&line);
-        out.push('\n');
-    }
-    out.push_str("M5\nM2\n");
-    Ok(out)
+    };
+    let mut out = Vec::with_capacity(path.moves.len() + 2);
+    out.push(moves::Move::SpindleOn(Some(job.strategy.spindle_speed)));
+    out.extend(path.moves.iter().map(|m| match *m {
+        Move::Rapid { x, z } => moves::Move::Rapid(Position::xz(corrected(x), z)),
+        Move::Feed { x, z } => moves::Move::Linear {
+            to: Position::xz(corrected(x), z),
+            feed: Some(feed),
+        },
+    }));
+    out.push(moves::Move::SpindleOff);
+    out
 }
 
 /// Writes `text` as RS274NGC comments: no nested parentheses or control
@@ -251,20 +204,18 @@ fn duration(secs: f64) -> String {
     }
 }
 
-/// A LinuxCNC program for a fast-tool-servo spiral, written as the planner
-/// hands over its points: X (radius, G8) and C (degrees, counted on from
-/// the start) on the spiral, the nose-centre height on Z, each move timed
-/// by inverse-time feed (G93: F = 1/minutes). LinuxCNC has no fast-axis
-/// word its interpreter accepts, so the fast tool servo's motion is
-/// programmed on Z (the form of a slow-tool-servo program); controllers
-/// with a W axis get their own dialect.
+/// A LinuxCNC program for a spiral (fast or slow tool servo), written as
+/// the planner hands over its points: X (radius, G8) and C (degrees,
+/// counted on from the start) on the spiral, the nose-centre height on Z,
+/// each move timed by inverse-time feed (G93: F = 1/minutes). LinuxCNC has
+/// no fast-axis word its interpreter accepts, so a fast tool servo's
+/// motion is programmed on Z (the form of a slow-tool-servo program);
+/// controllers with a W axis get their own dialect.
 pub struct FtsProgram {
-    text: String,
-    decimals: u32,
+    writer: LinuxCncWriter,
     safe_w: f64,
-    /// The last point written (NaN before the first).
-    last: crate::fts::SpiralPoint,
-    pub moves: usize,
+    /// The last point written (None before the first).
+    last: Option<crate::fts::SpiralPoint>,
 }
 
 /// Decimals of C in degrees: 1e-5° is 4 nm of arc at 25 mm.
@@ -273,184 +224,163 @@ const C_DECIMALS: u32 = 5;
 impl FtsProgram {
     /// Starts a program: the header comments and the modal line.
     pub fn new(header: &[String], resolution: f64, safe_w: f64) -> FtsProgram {
-        let mut text = String::new();
-        for line in header {
-            write_comment(&mut text, line);
-        }
-        text.push_str("G18 G21 G90 G8 G40 G49 G80 G93\n");
         FtsProgram {
-            text,
-            decimals: decimals_for(resolution),
+            writer: LinuxCncWriter::new(
+                header,
+                "G18 G21 G90 G8 G40 G49 G80 G93",
+                "XZC",
+                resolution,
+            ),
             safe_w,
-            last: crate::fts::SpiralPoint {
-                x: f64::NAN,
-                c: f64::NAN,
-                w: f64::NAN,
-                t: f64::NAN,
-            },
-            moves: 0,
+            last: None,
         }
     }
 
-    /// Appends points in spiral order; the first is reached by rapids
-    /// above the part and a plunge.
-    pub fn extend(&mut self, points: &[crate::fts::SpiralPoint]) -> Result<(), ProgramError> {
-        let d = self.decimals;
+    /// The move stream of spiral points: the first is reached by rapids
+    /// above the part and a one-second plunge.
+    pub fn moves(
+        last: Option<crate::fts::SpiralPoint>,
+        safe_w: f64,
+        points: &[crate::fts::SpiralPoint],
+    ) -> Vec<moves::Move> {
+        let mut out = Vec::with_capacity(points.len() + 3);
+        let mut last = last;
         for p in points {
-            let line = &mut self.text;
-            if self.last.x.is_nan() {
-                line.push_str("G0 X");
-                word(line, 'X', p.x, d)?;
-                line.push_str(" C");
-                word(line, 'C', p.c.to_degrees(), C_DECIMALS)?;
-                line.push_str("\nG0 Z");
-                word(line, 'Z', self.safe_w, d)?;
-                // The plunge: one second at inverse-time F60.
-                line.push_str("\nG1 Z");
-                word(line, 'Z', p.w, d)?;
-                line.push_str(" F60.\n");
-                self.moves += 3;
-                self.last = *p;
-                continue;
+            match last {
+                None => {
+                    out.push(moves::Move::Rapid(Position {
+                        x: p.x,
+                        c: p.c,
+                        ..Position::KEEP
+                    }));
+                    out.push(moves::Move::Rapid(Position {
+                        z: safe_w,
+                        ..Position::KEEP
+                    }));
+                    out.push(moves::Move::Linear {
+                        to: Position {
+                            z: p.w,
+                            ..Position::KEEP
+                        },
+                        feed: Some(moves::Feed::InverseTime(1.0)),
+                    });
+                }
+                Some(q) => out.push(moves::Move::Linear {
+                    to: Position::xzc(p.x, p.w, p.c),
+                    feed: Some(moves::Feed::InverseTime(p.t - q.t)),
+                }),
             }
-            let dt = p.t - self.last.t;
-            line.push_str("G1 X");
-            word(line, 'X', p.x, d)?;
-            line.push_str(" C");
-            word(line, 'C', p.c.to_degrees(), C_DECIMALS)?;
-            line.push_str(" Z");
-            word(line, 'Z', p.w, d)?;
-            line.push_str(" F");
-            word(line, 'F', 60.0 / dt, 3)?;
-            line.push('\n');
-            self.moves += 1;
-            self.last = *p;
+            last = Some(*p);
         }
-        Ok(())
+        out
+    }
+
+    /// Appends points in spiral order.
+    pub fn extend(&mut self, points: &[crate::fts::SpiralPoint]) -> Result<(), ProgramError> {
+        let stream = Self::moves(self.last, self.safe_w, points);
+        if let Some(p) = points.last() {
+            self.last = Some(*p);
+        }
+        self.writer.write_all(&stream)
     }
 
     /// The text written since the last call, for the caller to pass on
     /// (a program of millions of moves need not be held whole).
     pub fn take_text(&mut self) -> String {
-        std::mem::take(&mut self.text)
+        self.writer.take_text()
     }
 
     /// Retracts and ends the program; the text not yet taken.
     pub fn finish(mut self) -> Result<String, ProgramError> {
-        self.text.push_str("G0 Z");
-        word(&mut self.text, 'Z', self.safe_w, self.decimals)?;
-        self.text.push_str("\nM2\n");
-        Ok(self.text)
+        self.writer.write(&moves::Move::Rapid(Position {
+            z: self.safe_w,
+            ..Position::KEEP
+        }))?;
+        Ok(self.writer.finish())
     }
 }
 
-/// Writes moves word by word, leaving out words whose printed value has
-/// not changed (modal axes), refusing any value that cannot be printed.
-pub struct MoveWriter {
-    pub text: String,
-    decimals: u32,
-    /// The last value printed per axis letter, by index in `axes`.
-    last: Vec<f64>,
-    axes: &'static [char],
-    pub moves: usize,
+/// The move stream of a raster: each pass reached by rapids at the safe
+/// height, a plunge at the feed, the cut, a retract.
+pub fn raster_moves(path: &crate::raster::RasterPath, feed: f64) -> Vec<moves::Move> {
+    let safe = Position {
+        z: path.safe_z,
+        ..Position::KEEP
+    };
+    let mut out = vec![moves::Move::Rapid(safe)];
+    for pass in &path.passes {
+        let Some(first) = pass.first() else { continue };
+        out.push(moves::Move::Rapid(Position {
+            x: first[0],
+            y: first[1],
+            ..Position::KEEP
+        }));
+        out.push(moves::Move::Linear {
+            to: Position {
+                z: first[2],
+                ..Position::KEEP
+            },
+            feed: Some(moves::Feed::PerTime(feed)),
+        });
+        out.extend(pass[1..].iter().map(|p| moves::Move::Linear {
+            to: Position::xyz(p[0], p[1], p[2]),
+            feed: None,
+        }));
+        out.push(moves::Move::Rapid(safe));
+    }
+    out
 }
 
-impl MoveWriter {
-    /// A writer for `axes` (e.g. `['X', 'Y', 'Z']`) at the machine's
-    /// resolution, after the header comments and the modal line.
-    pub fn new(header: &[String], modal: &str, axes: &'static [char], resolution: f64) -> Self {
-        let mut text = String::new();
-        for line in header {
-            write_comment(&mut text, line);
-        }
-        text.push_str(modal);
-        text.push('\n');
-        MoveWriter {
-            text,
-            decimals: decimals_for(resolution),
-            last: vec![f64::NAN; axes.len()],
-            axes,
-            moves: 0,
-        }
-    }
-
-    /// One move: `G0` or `G1`, a value per axis (NaN: leave the axis
-    /// where it is), and a feed word if given.
-    pub fn motion(
-        &mut self,
-        g: &str,
-        at: &[f64],
-        feed: Option<(f64, u32)>,
-    ) -> Result<(), ProgramError> {
-        let d = self.decimals;
-        let mut line = String::from(g);
-        let before = line.len();
-        for (i, (&v, &letter)) in at.iter().zip(self.axes).enumerate() {
-            if v.is_nan() || rounded_eq(self.last[i], v, d) {
-                continue;
-            }
-            line.push(' ');
-            line.push(letter);
-            word(&mut line, letter, v, d)?;
-            self.last[i] = v;
-        }
-        if line.len() == before {
-            return Ok(());
-        }
-        if let Some((f, decimals)) = feed {
-            line.push_str(" F");
-            word(&mut line, 'F', f, decimals)?;
-        }
-        line.push('\n');
-        self.text.push_str(&line);
-        self.moves += 1;
-        Ok(())
-    }
-
-    /// A line as it is (spindle, modal changes).
-    pub fn raw(&mut self, line: &str) {
-        self.text.push_str(line);
-        self.text.push('\n');
-    }
-
-    pub fn finish(mut self) -> String {
-        self.text.push_str("M2\n");
-        self.text
-    }
-}
-
-/// A LinuxCNC program for a raster on a 3-axis mill: each pass reached by
-/// rapids at the safe height, a plunge, the cut, a retract.
+/// A LinuxCNC program for a raster on a 3-axis mill.
 pub fn emit_mill_raster(
     header: &[String],
     path: &crate::raster::RasterPath,
     feed: f64,
     resolution: f64,
 ) -> Result<String, ProgramError> {
-    let mut w = MoveWriter::new(
-        header,
-        "G17 G21 G90 G40 G49 G80 G94",
-        &['X', 'Y', 'Z'],
-        resolution,
-    );
-    let f = Some((feed * 60.0, 3));
-    let nan = f64::NAN;
-    w.motion("G0", &[nan, nan, path.safe_z], None)?;
-    for pass in &path.passes {
-        let Some(first) = pass.first() else { continue };
-        w.motion("G0", &[first[0], first[1], nan], None)?;
-        w.motion("G1", &[nan, nan, first[2]], f)?;
-        for p in &pass[1..] {
-            w.motion("G1", p, None)?;
-        }
-        w.motion("G0", &[nan, nan, path.safe_z], None)?;
-    }
+    let mut w = LinuxCncWriter::new(header, "G17 G21 G90 G40 G49 G80 G94", "XYZ", resolution);
+    w.write_all(&raster_moves(path, feed))?;
     Ok(w.finish())
 }
 
+/// The move stream of a grinding pass: the wheel centre's X and Z, each
+/// interval at the feed that moves the contact point at v_f (the interval
+/// takes its contact-x length over v_f).
+pub fn grinding_moves(
+    path: &crate::grinding::GrindingPath,
+    feed: f64,
+    safe_z: f64,
+) -> Vec<moves::Move> {
+    let Some(first) = path.points.first() else {
+        return Vec::new();
+    };
+    let mut out = vec![
+        moves::Move::SpindleOn(None),
+        moves::Move::Rapid(Position::xz(first.x, safe_z)),
+        moves::Move::Linear {
+            to: Position::xz(first.x, first.z),
+            feed: Some(moves::Feed::PerTime(feed)),
+        },
+    ];
+    for pair in path.points.windows(2) {
+        let (a, b) = (pair[0], pair[1]);
+        let step = ((b.x - a.x).powi(2) + (b.z - a.z).powi(2)).sqrt();
+        let dt = (b.contact_x - a.contact_x).abs() / feed;
+        out.push(moves::Move::Linear {
+            to: Position::xz(b.x, b.z),
+            feed: Some(moves::Feed::PerTime(step / dt)),
+        });
+    }
+    out.push(moves::Move::Rapid(Position {
+        z: safe_z,
+        ..Position::KEEP
+    }));
+    out.push(moves::Move::SpindleOff);
+    out
+}
+
 /// A LinuxCNC program for a grinding pass: X (radius, G8) and Z of the
-/// wheel centre, each interval at its own feed so that the contact point
-/// advances at v_f (the interval takes δ/v_f).
+/// wheel centre.
 pub fn emit_grinding(
     header: &[String],
     path: &crate::grinding::GrindingPath,
@@ -458,28 +388,8 @@ pub fn emit_grinding(
     safe_z: f64,
     resolution: f64,
 ) -> Result<String, ProgramError> {
-    let mut w = MoveWriter::new(
-        header,
-        "G18 G21 G90 G8 G40 G49 G80 G94",
-        &['X', 'Z'],
-        resolution,
-    );
-    let Some(first) = path.points.first() else {
-        return Ok(w.finish());
-    };
-    w.raw("M3");
-    w.motion("G0", &[first.x, safe_z], None)?;
-    // The approach at the grinding feed.
-    w.motion("G1", &[first.x, first.z], Some((feed * 60.0, 6)))?;
-    for pair in path.points.windows(2) {
-        let (a, b) = (pair[0], pair[1]);
-        let step = ((b.x - a.x).powi(2) + (b.z - a.z).powi(2)).sqrt();
-        // The interval's time: its contact-x length at v_f.
-        let dt = (b.contact_x - a.contact_x).abs() / feed;
-        w.motion("G1", &[b.x, b.z], Some((step / dt * 60.0, 6)))?;
-    }
-    w.motion("G0", &[f64::NAN, safe_z], None)?;
-    w.raw("M5");
+    let mut w = LinuxCncWriter::new(header, "G18 G21 G90 G8 G40 G49 G80 G94", "XZ", resolution);
+    w.write_all(&grinding_moves(path, feed, safe_z))?;
     Ok(w.finish())
 }
 
@@ -488,96 +398,327 @@ pub fn emit_grinding(
 /// angle in degrees counted on from the first pass; each pass starts on a
 /// whole turn after the last, moves timed by inverse-time feed (G93).
 pub struct RollerProgram {
-    text: String,
-    decimals: u32,
+    writer: LinuxCncWriter,
     safe_x: f64,
     spindle_speed: f64,
-    /// C (degrees) where the current pass started, and the last point.
+    /// C (rad) where the current pass started, and the last point.
     c_base: f64,
     last: Option<crate::roller::RollerPoint>,
     pass: usize,
-    pub moves: usize,
 }
 
 impl RollerProgram {
     pub fn new(header: &[String], resolution: f64, safe_x: f64, spindle_speed: f64) -> Self {
-        let mut text = String::new();
-        for line in header {
-            write_comment(&mut text, line);
-        }
-        text.push_str("G18 G21 G90 G8 G40 G49 G80 G93\n");
         RollerProgram {
-            text,
-            decimals: decimals_for(resolution),
+            writer: LinuxCncWriter::new(
+                header,
+                "G18 G21 G90 G8 G40 G49 G80 G93",
+                "XZC",
+                resolution,
+            ),
             safe_x,
             spindle_speed,
             c_base: 0.0,
             last: None,
             pass: usize::MAX,
-            moves: 0,
         }
     }
 
     /// Appends points of pass `pass`; a new pass retracts X, moves to its
-    /// start on the next whole turn of C, and plunges.
+    /// start on the next whole turn of C, and plunges in one second.
     pub fn extend(
         &mut self,
         pass: usize,
         points: &[crate::roller::RollerPoint],
     ) -> Result<(), ProgramError> {
-        let d = self.decimals;
+        let tau = 2.0 * PI;
+        let mut stream = Vec::with_capacity(points.len() + 3);
         for p in points {
-            let line = &mut self.text;
             if pass != self.pass {
                 if let Some(last) = self.last {
-                    let c_end = self.c_base + last.c.to_degrees();
-                    self.c_base = (c_end / 360.0).floor() * 360.0 + 360.0;
-                    line.push_str("G0 X");
-                    word(line, 'X', self.safe_x, d)?;
-                    line.push('\n');
+                    let c_end = self.c_base + last.c;
+                    self.c_base = ((c_end / tau).floor() + 1.0) * tau;
+                    stream.push(moves::Move::Rapid(Position {
+                        x: self.safe_x,
+                        ..Position::KEEP
+                    }));
                 }
                 self.pass = pass;
-                line.push_str("G0 X");
-                word(line, 'X', self.safe_x, d)?;
-                line.push_str(" Z");
-                word(line, 'Z', p.z, d)?;
-                line.push_str(" C");
-                word(line, 'C', self.c_base + p.c.to_degrees(), C_DECIMALS)?;
-                // The plunge: one second.
-                line.push_str("\nG1 X");
-                word(line, 'X', p.x, d)?;
-                line.push_str(" F60.\n");
-                self.moves += 2;
-                self.last = Some(*p);
-                continue;
+                stream.push(moves::Move::Rapid(Position::xzc(
+                    self.safe_x,
+                    p.z,
+                    self.c_base + p.c,
+                )));
+                stream.push(moves::Move::Linear {
+                    to: Position {
+                        x: p.x,
+                        ..Position::KEEP
+                    },
+                    feed: Some(moves::Feed::InverseTime(1.0)),
+                });
+            } else {
+                let last = self.last.expect("a pass has begun");
+                stream.push(moves::Move::Linear {
+                    to: Position::xzc(p.x, p.z, self.c_base + p.c),
+                    feed: Some(moves::Feed::InverseTime(
+                        (p.c - last.c) / self.spindle_speed,
+                    )),
+                });
             }
-            let last = self.last.expect("a pass has begun");
-            let dt = (p.c - last.c) / self.spindle_speed;
-            line.push_str("G1 X");
-            word(line, 'X', p.x, d)?;
-            line.push_str(" Z");
-            word(line, 'Z', p.z, d)?;
-            line.push_str(" C");
-            word(line, 'C', self.c_base + p.c.to_degrees(), C_DECIMALS)?;
-            line.push_str(" F");
-            word(line, 'F', 60.0 / dt, 3)?;
-            line.push('\n');
-            self.moves += 1;
             self.last = Some(*p);
         }
-        Ok(())
+        self.writer.write_all(&stream)
     }
 
     /// The text written since the last call.
     pub fn take_text(&mut self) -> String {
-        std::mem::take(&mut self.text)
+        self.writer.take_text()
     }
 
     /// Retracts and ends the program; the text not yet taken.
     pub fn finish(mut self) -> Result<String, ProgramError> {
-        self.text.push_str("G0 X");
-        word(&mut self.text, 'X', self.safe_x, self.decimals)?;
-        self.text.push_str("\nM2\n");
-        Ok(self.text)
+        self.writer.write(&moves::Move::Rapid(Position {
+            x: self.safe_x,
+            ..Position::KEEP
+        }))?;
+        Ok(self.writer.finish())
+    }
+}
+
+/// The LinuxCNC (RS274NGC) post-processor: header comments, a modal line,
+/// then the move stream, word by word. A word whose printed value has not
+/// changed is left out (axes are modal); a feed is written when it or its
+/// mode changes, and on every move in inverse time (G93 requires it); a
+/// move that changes no printed axis is left out whole.
+pub struct LinuxCncWriter {
+    text: String,
+    decimals: u32,
+    /// Letters of the machine's axes among X, Y, Z, C (others are refused).
+    letters: [Option<char>; 4],
+    /// The last value printed per axis (NaN: none yet).
+    last: [f64; 4],
+    mode: Option<FeedMode>,
+    last_feed: Option<String>,
+    pub moves: usize,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum FeedMode {
+    PerMinute,
+    PerRevolution,
+    InverseTime,
+}
+
+impl LinuxCncWriter {
+    /// `modal` is the program's line of G words after the header; `axes`
+    /// the machine's axis letters among "XYZC".
+    pub fn new(header: &[String], modal: &str, axes: &str, resolution: f64) -> Self {
+        let mut text = String::new();
+        for line in header {
+            write_comment(&mut text, line);
+        }
+        text.push_str(modal);
+        text.push('\n');
+        let has = |c: char| axes.contains(c).then_some(c);
+        LinuxCncWriter {
+            text,
+            decimals: decimals_for(resolution),
+            letters: [has('X'), has('Y'), has('Z'), has('C')],
+            last: [f64::NAN; 4],
+            // The first feed states its mode, whatever the modal line says.
+            mode: None,
+            last_feed: None,
+            moves: 0,
+        }
+    }
+
+    /// Writes one move.
+    pub fn write(&mut self, m: &crate::moves::Move) -> Result<(), ProgramError> {
+        use crate::moves::{Feed as F, Move as M};
+        let (g, to, feed) = match *m {
+            M::Rapid(to) => ("G0", to, None),
+            M::Linear { to, feed } => ("G1", to, feed),
+            M::SpindleOn(Some(w)) => {
+                self.text.push('S');
+                word(&mut self.text, 'S', w * 60.0 / (2.0 * PI), 3)?;
+                self.text.push_str(" M3\n");
+                return Ok(());
+            }
+            M::SpindleOn(None) => {
+                self.text.push_str("M3\n");
+                return Ok(());
+            }
+            M::SpindleOff => {
+                self.text.push_str("M5\n");
+                return Ok(());
+            }
+        };
+        let mut axes = String::with_capacity(48);
+        let mut printed = self.last;
+        for (i, v) in to.axes().into_iter().enumerate() {
+            if v.is_nan() {
+                continue;
+            }
+            let Some(letter) = self.letters[i] else {
+                return Err(ProgramError::NotPrintable {
+                    word: "XYZC".as_bytes()[i] as char,
+                    value: v,
+                });
+            };
+            let (value, d) = if letter == 'C' {
+                (v.to_degrees(), C_DECIMALS)
+            } else {
+                (v, self.decimals)
+            };
+            if rounded_eq(self.last[i], value, d) {
+                continue;
+            }
+            axes.push(' ');
+            axes.push(letter);
+            word(&mut axes, letter, value, d)?;
+            printed[i] = value;
+        }
+        if axes.is_empty() {
+            return Ok(());
+        }
+        let mut line = String::with_capacity(64);
+        let mut feed_word = None;
+        if let Some(f) = feed {
+            let (mode, value, d) = match f {
+                F::PerTime(v) => (FeedMode::PerMinute, v * 60.0, 6),
+                F::PerRevolution(v) => (FeedMode::PerRevolution, v * 2.0 * PI, 6),
+                F::InverseTime(t) => (FeedMode::InverseTime, 60.0 / t, 3),
+            };
+            let mut fw = String::new();
+            word(&mut fw, 'F', value, d)?;
+            let changed_mode = self.mode != Some(mode);
+            if changed_mode {
+                line.push_str(match mode {
+                    FeedMode::PerMinute => "G94 ",
+                    FeedMode::PerRevolution => "G95 ",
+                    FeedMode::InverseTime => "G93 ",
+                });
+                self.mode = Some(mode);
+            }
+            if changed_mode
+                || mode == FeedMode::InverseTime
+                || self.last_feed.as_deref() != Some(fw.as_str())
+            {
+                feed_word = Some(fw.clone());
+            }
+            self.last_feed = Some(fw);
+        }
+        line.push_str(g);
+        line.push_str(&axes);
+        if let Some(fw) = feed_word {
+            line.push_str(" F");
+            line.push_str(&fw);
+        }
+        line.push('\n');
+        self.text.push_str(&line);
+        self.last = printed;
+        self.moves += 1;
+        Ok(())
+    }
+
+    /// Writes every move of a stream.
+    pub fn write_all<'a>(
+        &mut self,
+        moves: impl IntoIterator<Item = &'a crate::moves::Move>,
+    ) -> Result<(), ProgramError> {
+        moves.into_iter().try_for_each(|m| self.write(m))
+    }
+
+    /// The text written since the last call (for streaming to a file).
+    pub fn take_text(&mut self) -> String {
+        std::mem::take(&mut self.text)
+    }
+
+    /// Ends the program; the text not yet taken.
+    pub fn finish(mut self) -> String {
+        self.text.push_str("M2\n");
+        self.text
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::moves::{Feed as F, Move as M, Position as P};
+
+    fn written(axes: &str, stream: &[M]) -> Result<String, ProgramError> {
+        let mut w = LinuxCncWriter::new(&["t".into()], "G17", axes, 1e-3);
+        w.write_all(stream)?;
+        Ok(w.finish())
+    }
+
+    #[test]
+    fn unchanged_words_and_feeds_are_left_out() {
+        let text = written(
+            "XYZ",
+            &[
+                M::Rapid(P::xyz(1.0, 2.0, 5.0)),
+                M::Linear {
+                    to: P::xyz(1.0, 2.0, 0.5),
+                    feed: Some(F::PerTime(1.0)),
+                },
+                M::Linear {
+                    to: P::xyz(1.5, 2.0, 0.5),
+                    feed: Some(F::PerTime(1.0)),
+                },
+                // Rounds to the same printed position: no line at all.
+                M::Linear {
+                    to: P::xyz(1.5001, 2.0, 0.5),
+                    feed: None,
+                },
+                M::Linear {
+                    to: P::xyz(1.5, 2.5, 0.5),
+                    feed: Some(F::PerTime(2.0)),
+                },
+            ],
+        )
+        .expect("writes");
+        assert_eq!(
+            text,
+            "(t)\nG17\nG0 X1. Y2. Z5.\nG94 G1 Z0.5 F60.\nG1 X1.5\nG1 Y2.5 F120.\nM2\n"
+        );
+    }
+
+    #[test]
+    fn inverse_time_writes_a_feed_on_every_move_and_c_in_degrees() {
+        let text = written(
+            "XZC",
+            &[
+                M::Linear {
+                    to: P::xzc(1.0, 0.0, std::f64::consts::FRAC_PI_2),
+                    feed: Some(F::InverseTime(0.5)),
+                },
+                M::Linear {
+                    to: P::xzc(0.9, 0.0, std::f64::consts::PI),
+                    feed: Some(F::InverseTime(0.5)),
+                },
+                M::Linear {
+                    to: P::xz(0.8, 0.1),
+                    feed: Some(F::PerRevolution(0.001)),
+                },
+            ],
+        )
+        .expect("writes");
+        assert_eq!(
+            text,
+            "(t)\nG17\nG93 G1 X1. Z0. C90. F120.\nG1 X0.9 C180. F120.\nG95 G1 X0.8 Z0.1 F0.006283\nM2\n"
+        );
+    }
+
+    #[test]
+    fn axes_the_machine_lacks_and_values_that_cannot_print_are_refused() {
+        assert!(matches!(
+            written("XZ", &[M::Rapid(P::xyz(1.0, 2.0, 3.0))]),
+            Err(ProgramError::NotPrintable { word: 'Y', .. })
+        ));
+        assert!(matches!(
+            written("XZ", &[M::Rapid(P::xz(f64::INFINITY, 0.0))]),
+            Err(ProgramError::NotPrintable { word: 'X', .. })
+        ));
     }
 }

@@ -1,0 +1,78 @@
+//! The dialect-independent move stream: what every planner hands the
+//! post-processors. A move says where the axes go (machine coordinates of
+//! the tool's reference point, mm; C in radians), how fast (a feed in one
+//! of the controller's feed modes), and the spindle's state; it knows
+//! nothing of words, letters or decimals. Planners that run to millions
+//! of points produce it in chunks, so a program streams in bounded memory.
+
+/// Where a move takes the axes; NaN leaves an axis where it is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Position {
+    pub x: f64,
+    pub y: f64,
+    pub z: f64,
+    /// Spindle (C axis) angle in radians, counted on (not wrapped).
+    pub c: f64,
+}
+
+impl Position {
+    /// No axis moves.
+    pub const KEEP: Position = Position {
+        x: f64::NAN,
+        y: f64::NAN,
+        z: f64::NAN,
+        c: f64::NAN,
+    };
+
+    /// X and Z of a lathe.
+    pub fn xz(x: f64, z: f64) -> Position {
+        Position { x, z, ..Self::KEEP }
+    }
+    pub fn xyz(x: f64, y: f64, z: f64) -> Position {
+        Position {
+            x,
+            y,
+            z,
+            c: f64::NAN,
+        }
+    }
+    pub fn xzc(x: f64, z: f64, c: f64) -> Position {
+        Position {
+            x,
+            z,
+            c,
+            y: f64::NAN,
+        }
+    }
+    /// The axes in the order X, Y, Z, C.
+    pub fn axes(&self) -> [f64; 4] {
+        [self.x, self.y, self.z, self.c]
+    }
+}
+
+/// How fast a cutting move goes, in the feed mode it is given in.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Feed {
+    /// Path speed (mm/s).
+    PerTime(f64),
+    /// mm per radian of spindle rotation.
+    PerRevolution(f64),
+    /// The time (s) the move takes: for moves that mix rotary and linear
+    /// axes, where no path speed means anything.
+    InverseTime(f64),
+}
+
+/// One step of a program.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Move {
+    /// Positioning at rapid rate, out of the material.
+    Rapid(Position),
+    /// A straight cutting move; `feed: None` keeps the feed in force.
+    Linear {
+        to: Position,
+        feed: Option<Feed>,
+    },
+    /// Spindle on, at a speed (rad/s) if it is not a C axis.
+    SpindleOn(Option<f64>),
+    SpindleOff,
+}
