@@ -19,6 +19,7 @@ use crate::codes;
 use std::path::Path;
 
 use crate::driver::{Built, ProgramText, evaluator};
+use crate::parts::Parts;
 use crate::surfaces;
 use crate::value::{self, Object};
 
@@ -67,23 +68,12 @@ pub fn build(
     spool_dir: Option<&Path>,
 ) -> Result<Built, Vec<Diagnostic>> {
     let p = prepare(job)?;
-    let part = |name: &str| value::object(&job.fields, name).expect("checked job part");
-    let (surface, tool, machine, strategy) = (
-        part("surface"),
-        part("tool"),
-        part("machine"),
-        part("strategy"),
-    );
-    let (file, span) = (job.file, job.name.span);
-    let err = |code: &'static str, msg: String| {
-        Diagnostic::error(code, msg, file, span).with_label("this job")
-    };
-    let names = |p: &str, o: &Object| {
-        job.part_names
-            .get(p)
-            .cloned()
-            .unwrap_or_else(|| o.kind.name.to_string())
-    };
+    let parts = Parts::of(job);
+    let (surface, tool, machine, strategy) =
+        (parts.surface, parts.tool, parts.machine, parts.strategy);
+    let (file, span) = parts.site();
+    let err = |code: &'static str, msg: String| parts.error(code, msg);
+    let names = |p: &str, o: &Object| parts.name(p, o);
     let header = header_lines(
         job,
         prov,
@@ -128,7 +118,6 @@ pub fn build(
         .finish()
         .map_err(|e| vec![cannot_spool(&e, file, span)])?;
     let program_name = format!("{}.ngc", job.name.name);
-    let surface_name = names("surface", surface);
     let mut toolpath = toolpath_json(
         &summary,
         &p.spiral,
@@ -139,20 +128,7 @@ pub fn build(
     if p.slow {
         toolpath["strategy"] = json!("spiral_turning");
     }
-    let report = json!({
-        "job": job.name.name,
-        "lensc_version": prov.lensc_version,
-        "source": prov.source,
-        "source_fnv1a64": format!("{:016x}", prov.source_hash),
-        "program": {
-            "file": program_name,
-            "dialect": "linuxcnc",
-            "lines": text.lines(),
-            "bytes": text.bytes(),
-        },
-        "toolpath": toolpath,
-        "surface": crate::driver::analysis_json(&surface_name, surface.kind.name, &p.lowered, 201),
-    });
+    let report = parts.report(prov, &program_name, &text, toolpath, &p.lowered);
     Ok(Built {
         report_name: format!("{}.report.json", job.name.name),
         program_name,

@@ -10,6 +10,7 @@ pub mod jit;
 pub mod loader;
 pub mod lower;
 pub mod mill_job;
+pub mod parts;
 pub mod render;
 pub mod roller_job;
 pub mod schema;

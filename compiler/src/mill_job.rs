@@ -3,124 +3,19 @@
 //! (seed 001). Each reads the checked job into its runtime planner, checks
 //! the tool against the surface, and writes a LinuxCNC program and report.
 
-use lensc_grammar::{Diagnostic, FileId, Span};
+use lensc_grammar::Diagnostic;
 use lensc_runtime::analysis::Domain;
 use lensc_runtime::grinding::{GrindingError, ProfileGrinding};
-use lensc_runtime::program::{ProgramError, Provenance};
+use lensc_runtime::program::Provenance;
 use lensc_runtime::raster::{Axis, Raster, RasterError, RasterTool};
 use lensc_runtime::surface::SectionAlongX;
 use serde_json::json;
 
 use crate::check::{CheckedJob, trim_num};
 use crate::codes;
-use crate::driver::{Built, ProgramText, analysis_json, evaluator};
-use crate::surfaces;
-use crate::value::{self, Object};
-
-/// The four parts of a checked job, their names, and where errors point.
-struct Parts<'a> {
-    job: &'a CheckedJob,
-    surface: &'a Object,
-    tool: &'a Object,
-    machine: &'a Object,
-    strategy: &'a Object,
-}
-
-impl<'a> Parts<'a> {
-    fn of(job: &'a CheckedJob) -> Parts<'a> {
-        let part = |name: &str| -> &'a Object {
-            value::object(&job.fields, name).expect("checked job part")
-        };
-        Parts {
-            job,
-            surface: part("surface"),
-            tool: part("tool"),
-            machine: part("machine"),
-            strategy: part("strategy"),
-        }
-    }
-    fn name(&self, part: &str, o: &Object) -> String {
-        self.job
-            .part_names
-            .get(part)
-            .cloned()
-            .unwrap_or_else(|| o.kind.name.to_string())
-    }
-    fn site(&self) -> (FileId, Span) {
-        (self.job.file, self.job.name.span)
-    }
-    fn error(&self, code: &'static str, msg: String) -> Diagnostic {
-        let (file, span) = self.site();
-        Diagnostic::error(code, msg, file, span).with_label("this job")
-    }
-    /// The lines every header starts with.
-    fn header(&self, prov: &Provenance, units: &str) -> Vec<String> {
-        vec![
-            format!("lensc {}: job {}", prov.lensc_version, self.job.name.name),
-            format!("source {} fnv1a64 {:016x}", prov.source, prov.source_hash),
-            units.to_string(),
-            format!(
-                "surface {}: {}",
-                self.name("surface", self.surface),
-                crate::lower::describe(self.surface)
-            ),
-        ]
-    }
-    fn report(
-        &self,
-        prov: &Provenance,
-        program_name: &str,
-        text: &str,
-        toolpath: serde_json::Value,
-        lowered: &surfaces::LoweredSurface,
-    ) -> serde_json::Value {
-        json!({
-            "job": self.job.name.name,
-            "lensc_version": prov.lensc_version,
-            "source": prov.source,
-            "source_fnv1a64": format!("{:016x}", prov.source_hash),
-            "program": {
-                "file": program_name,
-                "dialect": "linuxcnc",
-                "lines": text.lines().count(),
-                "bytes": text.len(),
-            },
-            "toolpath": toolpath,
-            "surface": analysis_json(&self.name("surface", self.surface), self.surface.kind.name, lowered, 201),
-        })
-    }
-    fn not_printable(&self, e: ProgramError) -> Diagnostic {
-        let ProgramError::NotPrintable { word, value } = e;
-        self.error(
-            codes::NOT_PRINTABLE,
-            format!("the program would contain {word}{value}, which no controller accepts"),
-        )
-    }
-    fn lowered(&self) -> Result<surfaces::LoweredSurface, Vec<Diagnostic>> {
-        surfaces::lower_surface(self.surface).map_err(|e| {
-            vec![self.error(
-                codes::UNSUPPORTED_COMBINATION,
-                format!("this surface cannot be evaluated yet: {e:?}"),
-            )]
-        })
-    }
-    fn needs(&self, part: &str, o: &Object, kinds: &[&str], what: &str) -> Option<Diagnostic> {
-        (!kinds.contains(&o.kind.name)).then(|| {
-            self.error(
-                codes::UNSUPPORTED_COMBINATION,
-                format!(
-                    "{what} needs {}; this {part} is a `{}`",
-                    kinds
-                        .iter()
-                        .map(|k| format!("`{k}`"))
-                        .collect::<Vec<_>>()
-                        .join(" or "),
-                    o.kind.name
-                ),
-            )
-        })
-    }
-}
+use crate::driver::{Built, ProgramText, evaluator};
+use crate::parts::Parts;
+use crate::value;
 
 /// Builds a `raster` job on a `mill_3axis`.
 pub fn build_raster(job: &CheckedJob, prov: &Provenance) -> Result<Built, Vec<Diagnostic>> {
@@ -268,11 +163,12 @@ pub fn build_raster(job: &CheckedJob, prov: &Provenance) -> Result<Built, Vec<Di
         "min_concave_radius_along_mm": path.min_concave_radius_along.as_ref().map(|e| at(e, 1.0)),
     });
     let program_name = format!("{}.ngc", job.name.name);
+    let text = ProgramText::Memory(text);
     let report = p.report(prov, &program_name, &text, toolpath, &lowered);
     Ok(Built {
         report_name: format!("{}.report.json", job.name.name),
         program_name,
-        program: ProgramText::Memory(text),
+        program: text,
         report,
         cut_points: path.point_count,
         cutting_time: time,
@@ -436,11 +332,12 @@ pub fn build_grinding(job: &CheckedJob, prov: &Provenance) -> Result<Built, Vec<
         },
     });
     let program_name = format!("{}.ngc", job.name.name);
+    let text = ProgramText::Memory(text);
     let report = p.report(prov, &program_name, &text, toolpath, &lowered);
     Ok(Built {
         report_name: format!("{}.report.json", job.name.name),
         program_name,
-        program: ProgramText::Memory(text),
+        program: text,
         report,
         cut_points: path.points.len(),
         cutting_time: path.total_time,

@@ -16,8 +16,9 @@ use serde_json::json;
 
 use crate::check::{CheckedJob, trim_num};
 use crate::codes;
-use crate::driver::{Built, analysis_json, evaluator};
+use crate::driver::{Built, evaluator};
 use crate::fts_job::{Sink, cannot_spool};
+use crate::parts::Parts;
 use crate::surfaces;
 use crate::value::{self, Object};
 
@@ -27,17 +28,11 @@ pub fn build(
     prov: &Provenance,
     spool_dir: Option<&Path>,
 ) -> Result<Built, Vec<Diagnostic>> {
-    let part = |name: &str| value::object(&job.fields, name).expect("checked job part");
-    let (surface, tool, machine, strategy) = (
-        part("surface"),
-        part("tool"),
-        part("machine"),
-        part("strategy"),
-    );
-    let (file, span) = (job.file, job.name.span);
-    let err = |code: &'static str, msg: String| {
-        Diagnostic::error(code, msg, file, span).with_label("this job")
-    };
+    let parts = Parts::of(job);
+    let (surface, tool, machine, strategy) =
+        (parts.surface, parts.tool, parts.machine, parts.strategy);
+    let (file, span) = parts.site();
+    let err = |code: &'static str, msg: String| parts.error(code, msg);
     let mut errors = Vec::new();
     if machine.kind.name != "sts_lathe" {
         errors.push(err(
@@ -193,12 +188,7 @@ pub fn build(
     }
     let retract = value::num(st, "retract").unwrap_or(1.0);
     let safe_x = helix.blank_radius + rho + retract;
-    let names = |p: &str, o: &Object| {
-        job.part_names
-            .get(p)
-            .cloned()
-            .unwrap_or_else(|| o.kind.name.to_string())
-    };
+    let names = |p: &str, o: &Object| parts.name(p, o);
     let pass_words: Vec<String> = helix
         .passes
         .iter()
@@ -271,47 +261,35 @@ pub fn build(
     let points: usize = path.passes.iter().map(|p| p.points).sum();
     let time: f64 = path.passes.iter().filter_map(|p| p.time).sum();
     let program_name = format!("{}.ngc", job.name.name);
-    let report = json!({
-        "job": job.name.name,
-        "lensc_version": prov.lensc_version,
-        "source": prov.source,
-        "source_fnv1a64": format!("{:016x}", prov.source_hash),
-        "program": {
-            "file": program_name,
-            "dialect": "linuxcnc",
-            "lines": text.lines(),
-            "bytes": text.bytes(),
+    let toolpath = json!({
+        "strategy": "roller_helix",
+        "cut_points": points,
+        "cutting_time_s": time,
+        "roller_radius_mm": roller_radius,
+        "passes": path.passes.iter().map(|p| json!({
+            "c_step_deg": p.c_step.to_degrees(),
+            "pitch_mm": p.pitch,
+            "finish_allowance_mm": p.finish_allowance,
+            "points": p.points,
+            "revolutions": p.revolutions,
+            "x_min_mm": p.x_min,
+            "x_max_mm": p.x_max,
+            "cutting_time_s": p.time,
+            "fingerprint_fnv1a64": format!("{:016x}", p.fingerprint),
+        })).collect::<Vec<_>>(),
+        "tool_check": {
+            "min_radius_of_curvature_cutting_plane_mm": check.min_radius_axial,
+            "min_radius_of_curvature_mm": check.min_radius_overall,
+            "max_slope_cutting_deg": check.max_slope_cutting.to_degrees(),
+            "max_slope_cutting_on_roller_deg": check.max_slope_cutting_on_roller.to_degrees(),
+            "max_slope_axial_deg": check.max_slope_axial.to_degrees(),
+            "nose_radius_mm": rho,
+            "clearance_deg": rt.clearance_angle.to_degrees(),
+            "half_included_angle_deg": rt.opening_angle.to_degrees() / 2.0,
         },
-        "toolpath": {
-            "strategy": "roller_helix",
-            "cut_points": points,
-            "cutting_time_s": time,
-            "roller_radius_mm": roller_radius,
-            "passes": path.passes.iter().map(|p| json!({
-                "c_step_deg": p.c_step.to_degrees(),
-                "pitch_mm": p.pitch,
-                "finish_allowance_mm": p.finish_allowance,
-                "points": p.points,
-                "revolutions": p.revolutions,
-                "x_min_mm": p.x_min,
-                "x_max_mm": p.x_max,
-                "cutting_time_s": p.time,
-                "fingerprint_fnv1a64": format!("{:016x}", p.fingerprint),
-            })).collect::<Vec<_>>(),
-            "tool_check": {
-                "min_radius_of_curvature_cutting_plane_mm": check.min_radius_axial,
-                "min_radius_of_curvature_mm": check.min_radius_overall,
-                "max_slope_cutting_deg": check.max_slope_cutting.to_degrees(),
-                "max_slope_cutting_on_roller_deg": check.max_slope_cutting_on_roller.to_degrees(),
-                "max_slope_axial_deg": check.max_slope_axial.to_degrees(),
-                "nose_radius_mm": rho,
-                "clearance_deg": rt.clearance_angle.to_degrees(),
-                "half_included_angle_deg": rt.opening_angle.to_degrees() / 2.0,
-            },
-            "wrap_gap_mm": path.wrap.map(|w| w.gap),
-        },
-        "surface": analysis_json(&names("surface", surface), surface.kind.name, &lowered, 201),
+        "wrap_gap_mm": path.wrap.map(|w| w.gap),
     });
+    let report = parts.report(prov, &program_name, &text, toolpath, &lowered);
     Ok(Built {
         report_name: format!("{}.report.json", job.name.name),
         program_name,

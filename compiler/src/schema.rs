@@ -336,6 +336,44 @@ const CHORD_TOLERANCE: Param = opt(
     "largest chord deviation from the exact tool-centre path; default 10 nm",
 );
 
+// The parameters both spiral strategies share.
+const SPIRAL_FEED: Param = req(
+    "feed",
+    Ty::Quantity(&[Dim::FEED_PER_REV]),
+    Check::Positive,
+    "radial feed per revolution",
+);
+const SPIRAL_SPINDLE_SPEED: Param = opt(
+    "spindle_speed",
+    Ty::Quantity(&[Dim::ROTATIONAL_SPEED]),
+    Check::Positive,
+    "constant spindle speed",
+);
+const SURFACE_SPEED: Param = opt(
+    "surface_speed",
+    Ty::Quantity(&[Dim::SPEED]),
+    Check::Positive,
+    "constant surface speed at the tool",
+);
+const SPINDLE_CAP: Param = opt(
+    "spindle_cap",
+    Ty::Quantity(&[Dim::ROTATIONAL_SPEED]),
+    Check::Positive,
+    "highest spindle speed under constant surface speed; default the machine's",
+);
+const SEED_ARC: Param = opt(
+    "seed_arc",
+    LENGTH,
+    Check::Positive,
+    "largest arc between the samples the chord test starts from; default 0.1 mm",
+);
+const SPIRAL_FROM: Param = opt(
+    "from",
+    LENGTH,
+    Check::NonNegative,
+    "radius where the spiral starts; default the outermost point of the surface",
+);
+
 const LENSLET: Param = req(
     "lenslet",
     Ty::Object(Category::Surface),
@@ -1143,37 +1181,12 @@ pub static KINDS: &[Kind] = &[
         name: "fts_spiral",
         category: Category::Strategy,
         params: &[
-            req(
-                "feed",
-                Ty::Quantity(&[Dim::FEED_PER_REV]),
-                Check::Positive,
-                "radial feed per revolution",
-            ),
-            opt(
-                "spindle_speed",
-                Ty::Quantity(&[Dim::ROTATIONAL_SPEED]),
-                Check::Positive,
-                "constant spindle speed",
-            ),
-            opt(
-                "surface_speed",
-                Ty::Quantity(&[Dim::SPEED]),
-                Check::Positive,
-                "constant surface speed at the tool",
-            ),
-            opt(
-                "spindle_cap",
-                Ty::Quantity(&[Dim::ROTATIONAL_SPEED]),
-                Check::Positive,
-                "highest spindle speed under constant surface speed; default the machine's",
-            ),
+            SPIRAL_FEED,
+            SPIRAL_SPINDLE_SPEED,
+            SURFACE_SPEED,
+            SPINDLE_CAP,
             CHORD_TOLERANCE,
-            opt(
-                "seed_arc",
-                LENGTH,
-                Check::Positive,
-                "largest arc between the samples the chord test starts from; default 0.1 mm",
-            ),
+            SEED_ARC,
             opt(
                 "settle",
                 Ty::Word(&["auto", "none"]),
@@ -1186,12 +1199,7 @@ pub static KINDS: &[Kind] = &[
                 Check::Positive,
                 "the servo's settling time for h_offset; default from the machine's servo model",
             ),
-            opt(
-                "from",
-                LENGTH,
-                Check::NonNegative,
-                "radius where the spiral starts; default the outermost point of the surface",
-            ),
+            SPIRAL_FROM,
             RETRACT,
         ],
         family: None,
@@ -1203,43 +1211,13 @@ pub static KINDS: &[Kind] = &[
         name: "spiral_turning",
         category: Category::Strategy,
         params: &[
-            req(
-                "feed",
-                Ty::Quantity(&[Dim::FEED_PER_REV]),
-                Check::Positive,
-                "radial feed per revolution",
-            ),
-            opt(
-                "spindle_speed",
-                Ty::Quantity(&[Dim::ROTATIONAL_SPEED]),
-                Check::Positive,
-                "constant spindle speed",
-            ),
-            opt(
-                "surface_speed",
-                Ty::Quantity(&[Dim::SPEED]),
-                Check::Positive,
-                "constant surface speed at the tool",
-            ),
-            opt(
-                "spindle_cap",
-                Ty::Quantity(&[Dim::ROTATIONAL_SPEED]),
-                Check::Positive,
-                "highest spindle speed under constant surface speed; default the machine's",
-            ),
+            SPIRAL_FEED,
+            SPIRAL_SPINDLE_SPEED,
+            SURFACE_SPEED,
+            SPINDLE_CAP,
             CHORD_TOLERANCE,
-            opt(
-                "seed_arc",
-                LENGTH,
-                Check::Positive,
-                "largest arc between the samples the chord test starts from; default 0.1 mm",
-            ),
-            opt(
-                "from",
-                LENGTH,
-                Check::NonNegative,
-                "radius where the spiral starts; default the outermost point of the surface",
-            ),
+            SEED_ARC,
+            SPIRAL_FROM,
             RETRACT,
         ],
         family: None,

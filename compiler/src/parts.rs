@@ -1,0 +1,125 @@
+//! The four parts of a checked job (surface, tool, machine, strategy) as
+//! every job builder reads them: their declared names, where a job's errors
+//! point, the provenance lines every program header starts with, and the
+//! report every program has beside it.
+
+use lensc_grammar::{Diagnostic, FileId, Span};
+use lensc_runtime::program::{ProgramError, Provenance};
+use serde_json::json;
+
+use crate::check::CheckedJob;
+use crate::codes;
+use crate::driver::{ProgramText, analysis_json};
+use crate::surfaces;
+use crate::value::{self, Object};
+
+/// The four parts of a checked job, their names, and where errors point.
+pub(crate) struct Parts<'a> {
+    pub job: &'a CheckedJob,
+    pub surface: &'a Object,
+    pub tool: &'a Object,
+    pub machine: &'a Object,
+    pub strategy: &'a Object,
+}
+
+impl<'a> Parts<'a> {
+    pub(crate) fn of(job: &'a CheckedJob) -> Parts<'a> {
+        let part = |name: &str| -> &'a Object {
+            value::object(&job.fields, name).expect("checked job part")
+        };
+        Parts {
+            job,
+            surface: part("surface"),
+            tool: part("tool"),
+            machine: part("machine"),
+            strategy: part("strategy"),
+        }
+    }
+    pub(crate) fn name(&self, part: &str, o: &Object) -> String {
+        self.job
+            .part_names
+            .get(part)
+            .cloned()
+            .unwrap_or_else(|| o.kind.name.to_string())
+    }
+    pub(crate) fn site(&self) -> (FileId, Span) {
+        (self.job.file, self.job.name.span)
+    }
+    pub(crate) fn error(&self, code: &'static str, msg: String) -> Diagnostic {
+        let (file, span) = self.site();
+        Diagnostic::error(code, msg, file, span).with_label("this job")
+    }
+    /// The lines every header starts with.
+    pub(crate) fn header(&self, prov: &Provenance, units: &str) -> Vec<String> {
+        vec![
+            format!("lensc {}: job {}", prov.lensc_version, self.job.name.name),
+            format!("source {} fnv1a64 {:016x}", prov.source, prov.source_hash),
+            units.to_string(),
+            format!(
+                "surface {}: {}",
+                self.name("surface", self.surface),
+                crate::lower::describe(self.surface)
+            ),
+        ]
+    }
+    pub(crate) fn report(
+        &self,
+        prov: &Provenance,
+        program_name: &str,
+        program: &ProgramText,
+        toolpath: serde_json::Value,
+        lowered: &surfaces::LoweredSurface,
+    ) -> serde_json::Value {
+        json!({
+            "job": self.job.name.name,
+            "lensc_version": prov.lensc_version,
+            "source": prov.source,
+            "source_fnv1a64": format!("{:016x}", prov.source_hash),
+            "program": {
+                "file": program_name,
+                "dialect": "linuxcnc",
+                "lines": program.lines(),
+                "bytes": program.bytes(),
+            },
+            "toolpath": toolpath,
+            "surface": analysis_json(&self.name("surface", self.surface), self.surface.kind.name, lowered, 201),
+        })
+    }
+    pub(crate) fn not_printable(&self, e: ProgramError) -> Diagnostic {
+        let ProgramError::NotPrintable { word, value } = e;
+        self.error(
+            codes::NOT_PRINTABLE,
+            format!("the program would contain {word}{value}, which no controller accepts"),
+        )
+    }
+    pub(crate) fn lowered(&self) -> Result<surfaces::LoweredSurface, Vec<Diagnostic>> {
+        surfaces::lower_surface(self.surface).map_err(|e| {
+            vec![self.error(
+                codes::UNSUPPORTED_COMBINATION,
+                format!("this surface cannot be evaluated yet: {e:?}"),
+            )]
+        })
+    }
+    pub(crate) fn needs(
+        &self,
+        part: &str,
+        o: &Object,
+        kinds: &[&str],
+        what: &str,
+    ) -> Option<Diagnostic> {
+        (!kinds.contains(&o.kind.name)).then(|| {
+            self.error(
+                codes::UNSUPPORTED_COMBINATION,
+                format!(
+                    "{what} needs {}; this {part} is a `{}`",
+                    kinds
+                        .iter()
+                        .map(|k| format!("`{k}`"))
+                        .collect::<Vec<_>>()
+                        .join(" or "),
+                    o.kind.name
+                ),
+            )
+        })
+    }
+}
