@@ -45,16 +45,20 @@ fn interpret(program: &Path) -> String {
 
 /// (x, z) of every STRAIGHT_FEED in rs274's canonical output.
 fn feeds(canon: &str) -> Vec<(f64, f64)> {
+    feed_axes(canon).iter().map(|v| (v[0], v[2])).collect()
+}
+
+/// All six axes (x, y, z, a, b, c) of every STRAIGHT_FEED in rs274's
+/// canonical output.
+fn feed_axes(canon: &str) -> Vec<Vec<f64>> {
     canon
         .lines()
         .filter_map(|l| l.split_once("STRAIGHT_FEED(").map(|(_, rest)| rest))
         .map(|args| {
-            let v: Vec<f64> = args
-                .trim_end_matches(')')
+            args.trim_end_matches(')')
                 .split(',')
                 .map(|s| s.trim().parse().expect("number"))
-                .collect();
-            (v[0], v[2])
+                .collect()
         })
         .collect()
 }
@@ -214,16 +218,7 @@ fn fts_program_passes_rs274() {
     );
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     let canon = interpret(&dir.path().join("corner_fts.ngc"));
-    let moves: Vec<Vec<f64>> = canon
-        .lines()
-        .filter_map(|l| l.split_once("STRAIGHT_FEED(").map(|(_, rest)| rest))
-        .map(|args| {
-            args.trim_end_matches(')')
-                .split(',')
-                .map(|s| s.trim().parse().expect("number"))
-                .collect()
-        })
-        .collect();
+    let moves = feed_axes(&canon);
     let report: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(dir.path().join("corner_fts.report.json")).expect("report"),
     )
@@ -269,16 +264,7 @@ fn roller_program_passes_rs274() {
     );
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     let canon = interpret(&dir.path().join("roller_small.ngc"));
-    let moves: Vec<Vec<f64>> = canon
-        .lines()
-        .filter_map(|l| l.split_once("STRAIGHT_FEED(").map(|(_, rest)| rest))
-        .map(|args| {
-            args.trim_end_matches(')')
-                .split(',')
-                .map(|s| s.trim().parse().expect("number"))
-                .collect()
-        })
-        .collect();
+    let moves = feed_axes(&canon);
     // Rough: 5 turns of 180 points + the end; finish: 20 turns of 360 + 1.
     assert_eq!(moves.len(), 5 * 180 + 1 + 20 * 360 + 1);
     let finish = &moves[5 * 180 + 1..];

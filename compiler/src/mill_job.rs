@@ -98,29 +98,8 @@ pub fn build_raster(job: &CheckedJob, prov: &Provenance) -> Result<Built, Vec<Di
             ),
         ));
     }
-    let travel = value::block(m, "travel").expect("required");
-    for (i, axis) in ["x", "y", "z"].iter().enumerate() {
-        let (lo, hi) = value::range(travel, axis).expect("required");
-        let outside = path
-            .passes
-            .iter()
-            .flatten()
-            .map(|q| q[i])
-            .chain((i == 2).then_some(path.safe_z))
-            .find(|&v| v < lo || v > hi);
-        if let Some(v) = outside {
-            errors.push(p.error(
-                codes::OUT_OF_TRAVEL,
-                format!(
-                    "the path moves {} to {} mm, outside the machine's travel {} .. {} mm",
-                    axis.to_uppercase(),
-                    trim_num(v),
-                    trim_num(lo),
-                    trim_num(hi)
-                ),
-            ));
-        }
-    }
+    let moves = lensc_runtime::program::raster_moves(&path, feed);
+    errors.extend(p.travel_error(&moves));
     if !errors.is_empty() {
         return Err(errors);
     }
@@ -239,7 +218,6 @@ pub fn build_grinding(job: &CheckedJob, prov: &Provenance) -> Result<Built, Vec<
     let path = lensc_runtime::grinding::plan_profile_grinding(&grinding, &profile)
         .map_err(|e| vec![grinding_diagnostic(&p, e)])?;
     let mut errors = Vec::new();
-    let travel = value::block(m, "travel").expect("required");
     let retract = value::num(st, "retract").unwrap_or(1.0);
     let top = path
         .points
@@ -247,27 +225,7 @@ pub fn build_grinding(job: &CheckedJob, prov: &Provenance) -> Result<Built, Vec<
         .map(|q| q.z)
         .fold(f64::NEG_INFINITY, f64::max);
     let safe_z = top + retract;
-    for (i, axis) in ["x", "z"].iter().enumerate() {
-        let (lo, hi) = value::range(travel, axis).expect("required");
-        let outside = path
-            .points
-            .iter()
-            .map(|q| if i == 0 { q.x } else { q.z })
-            .chain((i == 1).then_some(safe_z))
-            .find(|&v| v < lo || v > hi);
-        if let Some(v) = outside {
-            errors.push(p.error(
-                codes::OUT_OF_TRAVEL,
-                format!(
-                    "the path moves {} to {} mm, outside the machine's travel {} .. {} mm",
-                    axis.to_uppercase(),
-                    trim_num(v),
-                    trim_num(lo),
-                    trim_num(hi)
-                ),
-            ));
-        }
-    }
+    errors.extend(p.travel_error(&lensc_runtime::program::grinding_moves(&path, feed, safe_z)));
     let max_feed = value::num(m, "max_feed").expect("required");
     if feed > max_feed {
         errors.push(p.error(

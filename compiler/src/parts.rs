@@ -85,6 +85,22 @@ impl<'a> Parts<'a> {
             "surface": analysis_json(&self.name("surface", self.surface), self.surface.kind.name, lowered, 201),
         })
     }
+    /// E0141 if a move of the stream leaves the machine's `travel` block.
+    pub(crate) fn travel_error(&self, moves: &[lensc_runtime::moves::Move]) -> Option<Diagnostic> {
+        let travel = value::block(&self.machine.fields, "travel")?;
+        let limits = ["x", "y", "z", "c"].map(|a| value::range(travel, a));
+        let (axis, v, (lo, hi)) = lensc_runtime::moves::outside_travel(moves, limits)?;
+        Some(self.error(
+            codes::OUT_OF_TRAVEL,
+            format!(
+                "the path moves {axis} to {} mm, outside the machine's travel {} .. {} mm",
+                crate::check::trim_num(v),
+                crate::check::trim_num(lo),
+                crate::check::trim_num(hi)
+            ),
+        ))
+    }
+
     pub(crate) fn not_printable(&self, e: ProgramError) -> Diagnostic {
         let ProgramError::NotPrintable { word, value } = e;
         self.error(

@@ -182,22 +182,7 @@ fn radial_tape(o: &Object) -> Option<SurfaceTape> {
 /// u² = s/ρ_max², the sum evaluated as one Chebyshev series by Clenshaw's
 /// recurrence.
 fn qbfs_departure(h: &mut Graph, s: Id, c: f64, f: &[value::Field]) -> Option<Id> {
-    let norm = value::num(f, "norm_radius")?;
-    let coeffs: Vec<(usize, f64)> = (0..=lensc_runtime::forbes::MAX_ORDER)
-        .filter_map(|m| value::num(f, &format!("Q{m}")).map(|a| (m, a)))
-        .collect();
-    let top = coeffs.iter().map(|t| t.0).max().unwrap_or(0);
-    let q = lensc_runtime::forbes::qbfs_chebyshev(top);
-    // b_k = Σ_m a_m c_mk: the whole sum in the Chebyshev basis.
-    let mut b = vec![0.0; top + 1];
-    for &(m, a) in &coeffs {
-        for (bk, ck) in b.iter_mut().zip(&q[m]) {
-            *bk += a * ck;
-        }
-    }
-    let inv = h.constant_node(1.0 / (norm * norm));
-    let x = h.mul(s, inv);
-    let series = chebyshev_series(h, x, &b);
+    let (x, series) = forbes_series(h, s, f, lensc_runtime::forbes::qbfs_chebyshev)?;
     let one = h.constant_node(1.0);
     // u²(1 − u²) / sqrt(1 − c² s)
     let omx = h.sub(one, x);
@@ -214,12 +199,26 @@ fn qbfs_departure(h: &mut Graph, s: Id, c: f64, f: &[value::Field]) -> Option<Id
 /// u² = s/ρ_max², with Q_m^con(x) = P_m^(0,4)(2x − 1); the sum evaluated
 /// as one Chebyshev series.
 fn qcon_departure(h: &mut Graph, s: Id, f: &[value::Field]) -> Option<Id> {
+    let (x, series) = forbes_series(h, s, f, lensc_runtime::forbes::qcon_chebyshev)?;
+    let x2 = h.powi(x, 2);
+    Some(h.mul(x2, series))
+}
+
+/// u² = s/ρ_max² and Σ a_m Q_m(u²) for the coefficients `Q0` … `Q20` of a
+/// Forbes surface, `basis(top)` giving each Q_m in the Chebyshev basis:
+/// b_k = Σ_m a_m c_mk, the whole sum one Chebyshev series.
+fn forbes_series(
+    h: &mut Graph,
+    s: Id,
+    f: &[value::Field],
+    basis: fn(usize) -> Vec<Vec<f64>>,
+) -> Option<(Id, Id)> {
     let norm = value::num(f, "norm_radius")?;
     let coeffs: Vec<(usize, f64)> = (0..=lensc_runtime::forbes::MAX_ORDER)
         .filter_map(|m| value::num(f, &format!("Q{m}")).map(|a| (m, a)))
         .collect();
     let top = coeffs.iter().map(|t| t.0).max().unwrap_or(0);
-    let q = lensc_runtime::forbes::qcon_chebyshev(top);
+    let q = basis(top);
     let mut b = vec![0.0; top + 1];
     for &(m, a) in &coeffs {
         for (bk, ck) in b.iter_mut().zip(&q[m]) {
@@ -229,8 +228,7 @@ fn qcon_departure(h: &mut Graph, s: Id, f: &[value::Field]) -> Option<Id> {
     let inv = h.constant_node(1.0 / (norm * norm));
     let x = h.mul(s, inv);
     let series = chebyshev_series(h, x, &b);
-    let x2 = h.powi(x, 2);
-    Some(h.mul(x2, series))
+    Some((x, series))
 }
 
 /// Σ_k b_k T_k(2x − 1) by Clenshaw's recurrence:

@@ -76,3 +76,25 @@ pub enum Move {
     SpindleOn(Option<f64>),
     SpindleOff,
 }
+
+/// The first position in `moves` outside the machine's travel, given per
+/// axis X, Y, Z, C as (min, max) where limited: the axis letter, the
+/// value, and its travel.
+pub fn outside_travel(
+    moves: &[Move],
+    travel: [Option<(f64, f64)>; 4],
+) -> Option<(char, f64, (f64, f64))> {
+    moves.iter().find_map(|m| {
+        let (Move::Rapid(to) | Move::Linear { to, .. }) = m else {
+            return None;
+        };
+        to.axes()
+            .into_iter()
+            .zip(travel)
+            .zip(['X', 'Y', 'Z', 'C'])
+            .find_map(|((v, range), letter)| {
+                let (lo, hi) = range?;
+                (!v.is_nan() && (v < lo || v > hi)).then_some((letter, v, (lo, hi)))
+            })
+    })
+}
