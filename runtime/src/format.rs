@@ -17,17 +17,41 @@ pub fn decimals_for(resolution: f64) -> u32 {
 /// dropped. Returns false (and appends nothing) if the value is not
 /// finite or does not fit in 18 digits.
 pub fn push_fixed(out: &mut String, value: f64, decimals: u32) -> bool {
-    let scale = 10f64.powi(decimals as i32);
-    let scaled = (value * scale).round();
-    if !scaled.is_finite() || scaled.abs() >= 1e18 {
-        return false;
+    match fixed_units(value, decimals) {
+        Some(n) => {
+            push_units(out, n, decimals);
+            true
+        }
+        None => false,
     }
-    let n = scaled as i64;
+}
+
+/// Powers of ten, exactly, for up to 18 decimals.
+const POW10: [u64; 19] = {
+    let mut t = [1u64; 19];
+    let mut i = 1;
+    while i < 19 {
+        t[i] = t[i - 1] * 10;
+        i += 1;
+    }
+    t
+};
+
+/// `value` in units of 10^−decimals, rounded (what `push_fixed` prints);
+/// `None` if it is not finite or does not fit in 18 digits. Two values
+/// print the same exactly when their units are equal.
+pub fn fixed_units(value: f64, decimals: u32) -> Option<i64> {
+    let scaled = (value * POW10[decimals.min(18) as usize] as f64).round();
+    (scaled.is_finite() && scaled.abs() < 1e18).then_some(scaled as i64)
+}
+
+/// Appends `n` units of 10^−decimals as `push_fixed` does.
+pub fn push_units(out: &mut String, n: i64, decimals: u32) {
     if n < 0 {
         out.push('-');
     }
     let mag = n.unsigned_abs();
-    let pow = 10u64.pow(decimals);
+    let pow = POW10[decimals.min(18) as usize];
     let mut ib = itoa::Buffer::new();
     out.push_str(ib.format(mag / pow));
     out.push('.');
@@ -41,7 +65,6 @@ pub fn push_fixed(out: &mut String, value: f64, decimals: u32) -> bool {
             out.push_str(digits.trim_end_matches('0'));
         }
     }
-    true
 }
 
 #[cfg(test)]

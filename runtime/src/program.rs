@@ -6,7 +6,7 @@
 use std::f64::consts::PI;
 use std::fmt::Write as _;
 
-use crate::format::{decimals_for, push_fixed};
+use crate::format::{decimals_for, fixed_units, push_fixed, push_units};
 use crate::job::Job;
 use crate::machine::Dialect;
 use crate::moves::{self, Position};
@@ -177,11 +177,6 @@ fn word(out: &mut String, letter: char, value: f64, decimals: u32) -> Result<(),
             value,
         })
     }
-}
-
-fn rounded_eq(a: f64, b: f64, d: u32) -> bool {
-    let s = 10f64.powi(d as i32);
-    a.is_finite() && (a * s).round() == (b * s).round()
 }
 
 /// A header figure to 10 decimals (0.1 pm in mm), trailing zeros trimmed:
@@ -495,10 +490,11 @@ pub struct LinuxCncWriter {
     decimals: u32,
     /// Letters of the machine's axes among X, Y, Z, C (others are refused).
     letters: [Option<char>; 4],
-    /// The last value printed per axis (NaN: none yet).
-    last: [f64; 4],
+    /// The last value printed per axis, in units of its last decimal.
+    last: [Option<i64>; 4],
     mode: Option<FeedMode>,
-    last_feed: Option<String>,
+    /// The last feed printed, in units of its last decimal.
+    last_feed: Option<i64>,
     pub moves: usize,
 }
 
@@ -524,7 +520,7 @@ impl LinuxCncWriter {
             text,
             decimals: decimals_for(resolution),
             letters: [has('X'), has('Y'), has('Z'), has('C')],
-            last: [f64::NAN; 4],
+            last: [None; 4],
             // The first feed states its mode, whatever the modal line says.
             mode: None,
             last_feed: None,
@@ -532,7 +528,8 @@ impl LinuxCncWriter {
         }
     }
 
-    /// Writes one move.
+    /// Writes one move, straight into the text (no allocation per move:
+    /// a move that changes no printed axis is written and then cut off).
     pub fn write(&mut self, m: &crate::moves::Move) -> Result<(), ProgramError> {
         use crate::moves::{Feed as F, Move as M};
         let (g, to, feed) = match *m {
@@ -553,69 +550,69 @@ impl LinuxCncWriter {
                 return Ok(());
             }
         };
-        let mut axes = String::with_capacity(48);
+        let start = self.text.len();
+        let mode = feed.map(|f| match f {
+            F::PerTime(v) => (FeedMode::PerMinute, v * 60.0, 6),
+            F::PerRevolution(v) => (FeedMode::PerRevolution, v * 2.0 * PI, 6),
+            F::InverseTime(t) => (FeedMode::InverseTime, 60.0 / t, 3),
+        });
+        let mode_changes = mode.is_some_and(|(m, _, _)| self.mode != Some(m));
+        if let Some((m, _, _)) = mode
+            && mode_changes
+        {
+            self.text.push_str(match m {
+                FeedMode::PerMinute => "G94 ",
+                FeedMode::PerRevolution => "G95 ",
+                FeedMode::InverseTime => "G93 ",
+            });
+        }
+        self.text.push_str(g);
         let mut printed = self.last;
+        let mut any = false;
         for (i, v) in to.axes().into_iter().enumerate() {
             if v.is_nan() {
                 continue;
             }
-            let Some(letter) = self.letters[i] else {
-                return Err(ProgramError::NotPrintable {
-                    word: "XYZC".as_bytes()[i] as char,
-                    value: v,
-                });
-            };
-            let (value, d) = if letter == 'C' {
+            let letter = self.letters[i];
+            let (value, d) = if letter == Some('C') {
                 (v.to_degrees(), C_DECIMALS)
             } else {
                 (v, self.decimals)
             };
-            if rounded_eq(self.last[i], value, d) {
+            let (Some(letter), Some(n)) = (letter, fixed_units(value, d)) else {
+                self.text.truncate(start);
+                return Err(ProgramError::NotPrintable {
+                    word: self.letters[i].unwrap_or("XYZC".as_bytes()[i] as char),
+                    value: v,
+                });
+            };
+            // Modal: a word whose printed value has not changed is left out.
+            if printed[i] == Some(n) {
                 continue;
             }
-            axes.push(' ');
-            axes.push(letter);
-            word(&mut axes, letter, value, d)?;
-            printed[i] = value;
+            self.text.push(' ');
+            self.text.push(letter);
+            push_units(&mut self.text, n, d);
+            printed[i] = Some(n);
+            any = true;
         }
-        if axes.is_empty() {
+        if !any {
+            self.text.truncate(start);
             return Ok(());
         }
-        let mut line = String::with_capacity(64);
-        let mut feed_word = None;
-        if let Some(f) = feed {
-            let (mode, value, d) = match f {
-                F::PerTime(v) => (FeedMode::PerMinute, v * 60.0, 6),
-                F::PerRevolution(v) => (FeedMode::PerRevolution, v * 2.0 * PI, 6),
-                F::InverseTime(t) => (FeedMode::InverseTime, 60.0 / t, 3),
+        if let Some((m, value, d)) = mode {
+            let Some(n) = fixed_units(value, d) else {
+                self.text.truncate(start);
+                return Err(ProgramError::NotPrintable { word: 'F', value });
             };
-            let mut fw = String::new();
-            word(&mut fw, 'F', value, d)?;
-            let changed_mode = self.mode != Some(mode);
-            if changed_mode {
-                line.push_str(match mode {
-                    FeedMode::PerMinute => "G94 ",
-                    FeedMode::PerRevolution => "G95 ",
-                    FeedMode::InverseTime => "G93 ",
-                });
-                self.mode = Some(mode);
+            if mode_changes || m == FeedMode::InverseTime || self.last_feed != Some(n) {
+                self.text.push_str(" F");
+                push_units(&mut self.text, n, d);
             }
-            if changed_mode
-                || mode == FeedMode::InverseTime
-                || self.last_feed.as_deref() != Some(fw.as_str())
-            {
-                feed_word = Some(fw.clone());
-            }
-            self.last_feed = Some(fw);
+            self.last_feed = Some(n);
+            self.mode = Some(m);
         }
-        line.push_str(g);
-        line.push_str(&axes);
-        if let Some(fw) = feed_word {
-            line.push_str(" F");
-            line.push_str(&fw);
-        }
-        line.push('\n');
-        self.text.push_str(&line);
+        self.text.push('\n');
         self.last = printed;
         self.moves += 1;
         Ok(())
@@ -629,9 +626,11 @@ impl LinuxCncWriter {
         moves.into_iter().try_for_each(|m| self.write(m))
     }
 
-    /// The text written since the last call (for streaming to a file).
+    /// The text written since the last call (for streaming to a file); the
+    /// next chunk starts with room for as much again.
     pub fn take_text(&mut self) -> String {
-        std::mem::take(&mut self.text)
+        let room = self.text.len();
+        std::mem::replace(&mut self.text, String::with_capacity(room))
     }
 
     /// Ends the program; the text not yet taken.

@@ -1,0 +1,112 @@
+//! Program emission throughput: the LinuxCNC writer (`program.rs`) turning
+//! a move stream into text, against a baseline in the same run that writes
+//! the same numbers with `write!` and `{:.6}` formatting to a `BufWriter`.
+//! The stream is a fast-tool-servo spiral's: X, Z and C changing on every
+//! move, inverse-time feed on every line (the longest lines lensc writes).
+//!
+//! Goal (issue #5): at least 3× the baseline. Run:
+//!     cargo bench -p lensc-runtime --bench emission
+
+use std::hint::black_box;
+use std::io::Write as _;
+use std::time::{Duration, Instant};
+
+use lensc_runtime::moves::{Feed, Move, Position};
+use lensc_runtime::program::LinuxCncWriter;
+
+const MOVES: usize = 1_000_000;
+
+fn best_of(runs: usize, mut f: impl FnMut() -> usize) -> (Duration, usize) {
+    let mut best = (Duration::MAX, 0);
+    for _ in 0..runs {
+        let t = Instant::now();
+        let bytes = f();
+        let e = t.elapsed();
+        if e < best.0 {
+            best = (e, bytes);
+        }
+    }
+    best
+}
+
+fn main() {
+    let stream: Vec<Move> = (0..MOVES)
+        .map(|i| {
+            let c = i as f64 * 0.0021;
+            let x = 24.0 - 0.002 * c / std::f64::consts::TAU;
+            let z = 0.4997 + 0.018 * (7.0 * c).sin().powi(2);
+            Move::Linear {
+                to: Position::xzc(x, z, c),
+                feed: Some(Feed::InverseTime(0.00058 + 1e-7 * (i % 13) as f64)),
+            }
+        })
+        .collect();
+    let (ours, ours_bytes) = best_of(5, || {
+        let mut w = LinuxCncWriter::new(&[], "G18 G21 G90 G8 G93", "XZC", 1e-6);
+        let mut sink = std::io::BufWriter::new(std::io::sink());
+        let mut bytes = 0;
+        for chunk in stream.chunks(4096) {
+            w.write_all(chunk).expect("printable");
+            let t = w.take_text();
+            bytes += t.len();
+            sink.write_all(t.as_bytes()).expect("sink");
+        }
+        bytes + w.finish().len()
+    });
+    let (base, base_bytes) = best_of(5, || {
+        let mut sink = std::io::BufWriter::new(CountingSink(0));
+        for m in &stream {
+            if let Move::Linear {
+                to,
+                feed: Some(Feed::InverseTime(t)),
+            } = m
+            {
+                writeln!(
+                    sink,
+                    "G1 X{:.6} Z{:.6} C{:.5} F{:.3}",
+                    to.x,
+                    to.z,
+                    to.c.to_degrees(),
+                    60.0 / t
+                )
+                .expect("sink");
+            }
+        }
+        sink.flush().expect("flush");
+        black_box(sink.get_ref().0)
+    });
+    let rate = |d: Duration, bytes: usize| {
+        (
+            MOVES as f64 / d.as_secs_f64(),
+            bytes as f64 / d.as_secs_f64() / 1e6,
+        )
+    };
+    let (ol, om) = rate(ours, ours_bytes);
+    let (bl, bm) = rate(base, base_bytes);
+    println!("program emission, {MOVES} X Z C F moves");
+    println!(
+        "  LinuxCNC writer:         {:>12.0} lines/s {:>8.1} MB/s",
+        ol, om
+    );
+    println!(
+        "  write! + BufWriter:      {:>12.0} lines/s {:>8.1} MB/s",
+        bl, bm
+    );
+    println!(
+        "  ratio:                   {:>12.2}×",
+        base.as_secs_f64() / ours.as_secs_f64()
+    );
+}
+
+/// Counts the bytes written, like a file would take them.
+struct CountingSink(usize);
+
+impl std::io::Write for CountingSink {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0 += buf.len();
+        Ok(buf.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
