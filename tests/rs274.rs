@@ -113,6 +113,20 @@ fn every_example_program_passes_rs274() {
         if p.extension().is_some_and(|e| e == "ngc") && !big {
             let canon = interpret(&p);
             assert!(!feeds(&canon).is_empty(), "{} cuts nothing", p.display());
+            // Blending is on and held to the tolerance the program states.
+            let program = std::fs::read_to_string(&p).expect("program");
+            let stated: f64 = program
+                .split_once(" G64 P")
+                .and_then(|(_, rest)| rest.split_whitespace().next())
+                .and_then(|v| v.parse().ok())
+                .unwrap_or_else(|| panic!("{}: no G64 P", p.display()));
+            let mode = canon
+                .lines()
+                .find_map(|l| l.split_once("SET_MOTION_CONTROL_MODE(CANON_CONTINUOUS, "))
+                .map(|(_, v)| v.trim_end_matches(')').parse::<f64>().expect("number"))
+                .unwrap_or_else(|| panic!("{}: not in continuous mode", p.display()));
+            assert!((mode - stated).abs() < 1e-6, "{}: {mode} vs {stated}", p.display());
+            assert!(stated > 0.0 && stated <= 1e-4, "{}: P{stated}", p.display());
             n += 1;
         }
     }

@@ -87,7 +87,7 @@ pub fn build(
         p.settling.as_ref(),
         p.slow,
     );
-    let mut program = FtsProgram::new(&header, p.resolution, p.safe_w);
+    let mut program = FtsProgram::new(&header, p.resolution, p.spiral.chord_tolerance, p.safe_w);
     let mut sink = Sink::new(spool_dir).map_err(|e| vec![cannot_spool(&e, file, span)])?;
     let mut write_error: Option<ProgramError> = None;
     let planned = p.planner().plan(&p.fast_axis, |pts| {

@@ -123,8 +123,14 @@ pub fn build_raster(job: &CheckedJob, prov: &Provenance) -> Result<Built, Vec<Di
         p.name("machine", p.machine)
     ));
     let resolution = value::num(m, "resolution").expect("required");
-    let text = lensc_runtime::program::emit_mill_raster(&header, &path, feed, resolution)
-        .map_err(|e| vec![p.not_printable(e)])?;
+    let text = lensc_runtime::program::emit_mill_raster(
+        &header,
+        &path,
+        feed,
+        resolution,
+        raster.chord_tolerance,
+    )
+    .map_err(|e| vec![p.not_printable(e)])?;
     let deg = 180.0 / std::f64::consts::PI;
     let at = |e: &lensc_runtime::analysis::Extremum, s: f64| json!({ "value": e.value * s, "x_mm": e.x, "y_mm": e.y });
     let time = path.cut_length / feed;

@@ -42,7 +42,7 @@ fn main() {
         })
         .collect();
     let (ours, ours_bytes) = best_of(5, || {
-        let mut w = LinuxCncWriter::new(&[], "G18 G21 G90 G8 G93", "XZC", 1e-6);
+        let mut w = LinuxCncWriter::new(&[], "G18 G21 G90 G8 G93", "XZC", 1e-6, 1e-5);
         let mut sink = std::io::BufWriter::new(std::io::sink());
         let mut bytes = 0;
         for chunk in stream.chunks(4096) {

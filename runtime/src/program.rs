@@ -79,6 +79,7 @@ fn emit_linuxcnc_lathe(
         "G18 G21 G90 G8 G40 G49 G80 G94",
         "XZ",
         job.machine.resolution,
+        job.strategy.chord_tolerance,
     );
     w.write_all(&turning_moves(job, path))?;
     Ok(w.finish())
@@ -217,14 +218,21 @@ pub struct FtsProgram {
 const C_DECIMALS: u32 = 5;
 
 impl FtsProgram {
-    /// Starts a program: the header comments and the modal line.
-    pub fn new(header: &[String], resolution: f64, safe_w: f64) -> FtsProgram {
+    /// Starts a program: the header comments and the modal line, the
+    /// controller's blending held to the chord tolerance.
+    pub fn new(
+        header: &[String],
+        resolution: f64,
+        chord_tolerance: f64,
+        safe_w: f64,
+    ) -> FtsProgram {
         FtsProgram {
             writer: LinuxCncWriter::new(
                 header,
                 "G18 G21 G90 G8 G40 G49 G80 G93",
                 "XZC",
                 resolution,
+                chord_tolerance,
             ),
             safe_w,
             last: None,
@@ -332,8 +340,15 @@ pub fn emit_mill_raster(
     path: &crate::raster::RasterPath,
     feed: f64,
     resolution: f64,
+    chord_tolerance: f64,
 ) -> Result<String, ProgramError> {
-    let mut w = LinuxCncWriter::new(header, "G17 G21 G90 G40 G49 G80 G94", "XYZ", resolution);
+    let mut w = LinuxCncWriter::new(
+        header,
+        "G17 G21 G90 G40 G49 G80 G94",
+        "XYZ",
+        resolution,
+        chord_tolerance,
+    );
     w.write_all(&raster_moves(path, feed))?;
     Ok(w.finish())
 }
@@ -383,7 +398,15 @@ pub fn emit_grinding(
     safe_z: f64,
     resolution: f64,
 ) -> Result<String, ProgramError> {
-    let mut w = LinuxCncWriter::new(header, "G18 G21 G90 G8 G40 G49 G80 G94", "XZ", resolution);
+    // Wheel centres are exact at each interval: blending held to the
+    // machine's resolution.
+    let mut w = LinuxCncWriter::new(
+        header,
+        "G18 G21 G90 G8 G40 G49 G80 G94",
+        "XZ",
+        resolution,
+        resolution,
+    );
     w.write_all(&grinding_moves(path, feed, safe_z))?;
     Ok(w.finish())
 }
@@ -403,12 +426,15 @@ pub struct RollerProgram {
 }
 
 impl RollerProgram {
+    /// The roller's points are the exact nose centres at each C step:
+    /// blending is held to the machine's resolution.
     pub fn new(header: &[String], resolution: f64, safe_x: f64, spindle_speed: f64) -> Self {
         RollerProgram {
             writer: LinuxCncWriter::new(
                 header,
                 "G18 G21 G90 G8 G40 G49 G80 G93",
                 "XZC",
+                resolution,
                 resolution,
             ),
             safe_x,
@@ -507,13 +533,27 @@ enum FeedMode {
 
 impl LinuxCncWriter {
     /// `modal` is the program's line of G words after the header; `axes`
-    /// the machine's axis letters among "XYZC".
-    pub fn new(header: &[String], modal: &str, axes: &str, resolution: f64) -> Self {
+    /// the machine's axis letters among "XYZC"; `path_tolerance` (mm), the
+    /// most the controller may blend corners away from the programmed path
+    /// (`G64 P`), is the strategy's own tolerance so the two never add up
+    /// beyond it.
+    pub fn new(
+        header: &[String],
+        modal: &str,
+        axes: &str,
+        resolution: f64,
+        path_tolerance: f64,
+    ) -> Self {
         let mut text = String::new();
         for line in header {
             write_comment(&mut text, line);
         }
         text.push_str(modal);
+        text.push_str(" G64 P");
+        let d = decimals_for(path_tolerance).max(decimals_for(resolution));
+        if !push_fixed(&mut text, path_tolerance, d) {
+            text.push('0');
+        }
         text.push('\n');
         let has = |c: char| axes.contains(c).then_some(c);
         LinuxCncWriter {
@@ -646,7 +686,7 @@ mod tests {
     use crate::moves::{Feed as F, Move as M, Position as P};
 
     fn written(axes: &str, stream: &[M]) -> Result<String, ProgramError> {
-        let mut w = LinuxCncWriter::new(&["t".into()], "G17", axes, 1e-3);
+        let mut w = LinuxCncWriter::new(&["t".into()], "G17", axes, 1e-3, 1e-3);
         w.write_all(stream)?;
         Ok(w.finish())
     }
@@ -679,7 +719,7 @@ mod tests {
         .expect("writes");
         assert_eq!(
             text,
-            "(t)\nG17\nG0 X1. Y2. Z5.\nG94 G1 Z0.5 F60.\nG1 X1.5\nG1 Y2.5 F120.\nM2\n"
+            "(t)\nG17 G64 P0.001\nG0 X1. Y2. Z5.\nG94 G1 Z0.5 F60.\nG1 X1.5\nG1 Y2.5 F120.\nM2\n"
         );
     }
 
@@ -705,7 +745,7 @@ mod tests {
         .expect("writes");
         assert_eq!(
             text,
-            "(t)\nG17\nG93 G1 X1. Z0. C90. F120.\nG1 X0.9 C180. F120.\nG95 G1 X0.8 Z0.1 F0.006283\nM2\n"
+            "(t)\nG17 G64 P0.001\nG93 G1 X1. Z0. C90. F120.\nG1 X0.9 C180. F120.\nG95 G1 X0.8 Z0.1 F0.006283\nM2\n"
         );
     }
 
