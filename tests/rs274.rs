@@ -125,7 +125,11 @@ fn every_example_program_passes_rs274() {
                 .find_map(|l| l.split_once("SET_MOTION_CONTROL_MODE(CANON_CONTINUOUS, "))
                 .map(|(_, v)| v.trim_end_matches(')').parse::<f64>().expect("number"))
                 .unwrap_or_else(|| panic!("{}: not in continuous mode", p.display()));
-            assert!((mode - stated).abs() < 1e-6, "{}: {mode} vs {stated}", p.display());
+            assert!(
+                (mode - stated).abs() < 1e-6,
+                "{}: {mode} vs {stated}",
+                p.display()
+            );
             assert!(stated > 0.0 && stated <= 1e-4, "{}: P{stated}", p.display());
             n += 1;
         }
