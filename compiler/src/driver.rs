@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use lensc_grammar::{Diagnostic, FileId, Span};
-use lensc_runtime::program::{self, ProgramError, Provenance};
+use lensc_runtime::program::{self, Provenance};
 use lensc_runtime::toolpath::{self, PlanError, ToolLocation, Toolpath};
 
 use crate::check::{self, trim_num};
@@ -245,10 +245,10 @@ pub fn plan_and_emit(
                     report,
                 });
             }
-            Err(ProgramError::NotPrintable { word, value }) => diags.push(
+            Err(e) => diags.push(
                 Diagnostic::error(
                     codes::NOT_PRINTABLE,
-                    format!("the program would contain {word}{value}, which no controller accepts"),
+                    e.message(),
                     file,
                     span,
                 )

@@ -102,11 +102,7 @@ impl<'a> Parts<'a> {
     }
 
     pub(crate) fn not_printable(&self, e: ProgramError) -> Diagnostic {
-        let ProgramError::NotPrintable { word, value } = e;
-        self.error(
-            codes::NOT_PRINTABLE,
-            format!("the program would contain {word}{value}, which no controller accepts"),
-        )
+        self.error(codes::NOT_PRINTABLE, e.message())
     }
     pub(crate) fn lowered(&self) -> Result<surfaces::LoweredSurface, Vec<Diagnostic>> {
         surfaces::lower_surface(self.surface).map_err(|e| {

@@ -62,6 +62,35 @@ pub enum Feed {
     InverseTime(f64),
 }
 
+/// A plane of circular interpolation. Its two axes are named in the
+/// right-handed order that defines counter-clockwise, seen from the
+/// positive end of the third axis: G17 (X, Y), G18 (Z, X), G19 (Y, Z).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Plane {
+    Xy,
+    Zx,
+    Yz,
+}
+
+impl Plane {
+    /// Indices into `Position::axes()` of the plane's first and second axis.
+    pub fn axes(self) -> (usize, usize) {
+        match self {
+            Plane::Xy => (0, 1),
+            Plane::Zx => (2, 0),
+            Plane::Yz => (1, 2),
+        }
+    }
+    /// The plane's name in the language and dialect files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Plane::Xy => "xy",
+            Plane::Zx => "zx",
+            Plane::Yz => "yz",
+        }
+    }
+}
+
 /// One step of a program.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Move {
@@ -70,6 +99,17 @@ pub enum Move {
     /// A straight cutting move; `feed: None` keeps the feed in force.
     Linear {
         to: Position,
+        feed: Option<Feed>,
+    },
+    /// A circular cutting move in `plane` from where the axes are to `to`
+    /// about `centre` (absolute; only the plane's two axes are read),
+    /// counter-clockwise in the plane's order if `ccw`; less than a half
+    /// turn, and the axes off the plane do not move.
+    Arc {
+        to: Position,
+        centre: Position,
+        plane: Plane,
+        ccw: bool,
         feed: Option<Feed>,
     },
     /// Spindle on, at a speed (rad/s) if it is not a C axis.
@@ -85,7 +125,7 @@ pub fn outside_travel(
     travel: [Option<(f64, f64)>; 4],
 ) -> Option<(char, f64, (f64, f64))> {
     moves.iter().find_map(|m| {
-        let (Move::Rapid(to) | Move::Linear { to, .. }) = m else {
+        let (Move::Rapid(to) | Move::Linear { to, .. } | Move::Arc { to, .. }) = m else {
             return None;
         };
         to.axes()

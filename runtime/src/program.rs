@@ -27,6 +27,22 @@ pub struct Provenance {
 pub enum ProgramError {
     /// A coordinate or feed is NaN, infinite or too large to print.
     NotPrintable { word: char, value: f64 },
+    /// The dialect cannot express this move.
+    Unsupported(String),
+}
+
+impl ProgramError {
+    /// What is wrong, in plain words.
+    pub fn message(&self) -> String {
+        match self {
+            ProgramError::NotPrintable { word, value } => {
+                format!("the program would contain {word}{value}, which no controller accepts")
+            }
+            ProgramError::Unsupported(what) => {
+                format!("the machine's dialect cannot express {what}")
+            }
+        }
+    }
 }
 
 /// Writes a LinuxCNC (RS274NGC) lathe program for a profile-turning path.
@@ -581,6 +597,7 @@ impl LinuxCncWriter {
                 self.text.push_str(" M3\n");
                 return Ok(());
             }
+            M::Arc { .. } => return Err(ProgramError::Unsupported("arcs".into())),
             M::SpindleOn(None) => {
                 self.text.push_str("M3\n");
                 return Ok(());
