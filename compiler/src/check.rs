@@ -281,6 +281,14 @@ impl<'a> Checker<'a> {
         let mut v = self.eval(file, expr, &[]);
         if let Some(kind) = kind {
             v = self.expect_category(file, expr.span, v, Category::of(kind), Some((kind, name)));
+            // A declared object is known by its name (a dialect is chosen by it).
+            if let Value::Object(o) = &v
+                && o.name.is_none()
+            {
+                let mut named = (**o).clone();
+                named.name = Some(name.name.clone());
+                v = Value::Object(std::rc::Rc::new(named));
+            }
         }
         if let State::Done(prev) = &self.state[i] {
             // A cycle was reported while evaluating; keep the error value.
@@ -1054,6 +1062,7 @@ impl<'a> Checker<'a> {
             fields,
             head,
             file,
+            name: None,
         };
         // The sign rule reads only fields it checks itself, so it runs even
         // when another parameter is wrong: every error is reported.
@@ -1265,6 +1274,38 @@ impl<'a> Checker<'a> {
             (Ty::Object(cat), Value::Object(o)) if o.kind.category == *cat => {}
             (Ty::Object(cat), v @ Value::Word(_)) => {
                 self.expect_category(file, span, v.clone(), *cat, None);
+            }
+            (Ty::Text, Value::Str(_)) => {}
+            (Ty::Texts, Value::List(items)) => {
+                for (v, s) in items {
+                    if !matches!(v, Value::Str(_) | Value::Error) {
+                        self.err(
+                            Diagnostic::error(
+                                codes::WRONG_VALUE,
+                                format!(
+                                    "`{}` is a list of strings, but this is {}",
+                                    f.name,
+                                    v.describe()
+                                ),
+                                file,
+                                *s,
+                            )
+                            .with_label("expected a string `\"…\"`")
+                            .with_help(format!("`{}`: {}", f.name, p.doc)),
+                        );
+                    }
+                }
+            }
+            (Ty::Objects(cat), Value::List(items)) => {
+                for (v, s) in items {
+                    match v {
+                        Value::Object(o) if o.kind.category == *cat => {}
+                        Value::Error => {}
+                        v => {
+                            self.expect_category(file, *s, v.clone(), *cat, None);
+                        }
+                    }
+                }
             }
             (Ty::Block(sub), Value::Block(fields)) => {
                 let owner = format!("`{}` of {owner}", f.name);
@@ -1770,6 +1811,9 @@ fn ty_words(ty: &Ty) -> String {
             .join(" or "),
         Ty::Word(words) => one_of(words),
         Ty::Object(c) => c.noun().to_string(),
+        Ty::Objects(c) => format!("a list of {}s", c.noun().trim_start_matches("a ").trim_start_matches("an ")),
+        Ty::Text => "a string `\"…\"`".into(),
+        Ty::Texts => "a list of strings `[\"…\"]`".into(),
         Ty::Block(_) => "a block `{ … }`".into(),
         Ty::Range(d) => format!("a range `from .. to` of {d}"),
         Ty::Formula { coords, .. } => format!("a formula of {}", quoted(coords)),

@@ -42,6 +42,7 @@ pub const UNDEFINED_ON_PATH: &str = "E0144";
 pub const CLEARANCE_TOO_SMALL: &str = "E0145";
 pub const STROKE_EXCEEDED: &str = "E0146";
 pub const ACCELERATION_EXCEEDED: &str = "E0147";
+pub const DIALECT_NOT_OFFERED: &str = "E0148";
 pub const NOT_PRINTABLE: &str = "E0150";
 pub const CANNOT_WRITE: &str = "E0151";
 
@@ -93,6 +94,7 @@ pub const ALL: &[&str] = &[
     CLEARANCE_TOO_SMALL,
     STROKE_EXCEEDED,
     ACCELERATION_EXCEEDED,
+    DIALECT_NOT_OFFERED,
     NOT_PRINTABLE,
     CANNOT_WRITE,
     UNUSED,

@@ -101,15 +101,25 @@ impl ProgramText {
     }
 }
 
+/// What `lensc build` was asked for beyond the file.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Request<'a> {
+    /// Only this job.
+    pub job: Option<&'a str>,
+    /// This dialect instead of each machine's own (it must offer it).
+    pub dialect: Option<&'a str>,
+}
+
 /// Builds programs and reports (without writing them) for the checked
 /// jobs. Returns them and any further diagnostics. Large programs are
 /// spooled into `spool_dir` (the output directory) when one is given.
 pub fn plan_and_emit(
     c: &Checked,
-    only: Option<&str>,
+    request: Request,
     source_name: &str,
     spool_dir: Option<&Path>,
 ) -> (Vec<Built>, Vec<Diagnostic>) {
+    let only = request.job;
     let mut diags = Vec::new();
     let mut out = Vec::new();
     let jobs: Vec<&check::CheckedJob> = c
@@ -125,11 +135,22 @@ pub fn plan_and_emit(
     };
     for job in jobs {
         let strategy = crate::value::object(&job.fields, "strategy").expect("checked job part");
+        let dialect = match lower::dialect(job, request.dialect) {
+            Ok(d) => d,
+            Err(d) => {
+                diags.push(d);
+                continue;
+            }
+        };
         let other = match strategy.kind.name {
-            "fts_spiral" | "spiral_turning" => Some(crate::fts_job::build(job, &prov, spool_dir)),
-            "raster" => Some(crate::mill_job::build_raster(job, &prov)),
-            "roller_helix" => Some(crate::roller_job::build(job, &prov, spool_dir)),
-            "profile_grinding" => Some(crate::mill_job::build_grinding(job, &prov)),
+            "fts_spiral" | "spiral_turning" => Some(crate::fts_job::build(
+                job, &prov, &dialect, spool_dir,
+            )),
+            "raster" => Some(crate::mill_job::build_raster(job, &prov, &dialect)),
+            "roller_helix" => Some(crate::roller_job::build(
+                job, &prov, &dialect, spool_dir,
+            )),
+            "profile_grinding" => Some(crate::mill_job::build_grinding(job, &prov, &dialect)),
             _ => None,
         };
         match other {
@@ -143,7 +164,7 @@ pub fn plan_and_emit(
             }
             None => {}
         }
-        let lowered = match lower::lower(job) {
+        let lowered = match lower::lower(job, dialect) {
             Ok(j) => j,
             Err(mut d) => {
                 diags.append(&mut d);
@@ -232,7 +253,7 @@ pub fn plan_and_emit(
         match program::emit(&lowered, &path, &prov) {
             Ok(text) => {
                 let program_name =
-                    format!("{}.{}", lowered.name, lowered.machine.dialect.extension());
+                    format!("{}.{}", lowered.name, lowered.machine.dialect.extension);
                 let name = job.part_names.get("surface").cloned().unwrap_or_default();
                 let analysis = analysis_json(&name, surface.kind.name, &lowered_surface, 201);
                 let report = build_report(&lowered, &prov, &program_name, &text, &path, analysis);
@@ -276,7 +297,7 @@ fn build_report(
         "source_fnv1a64": format!("{:016x}", prov.source_hash),
         "program": {
             "file": program_name,
-            "dialect": job.machine.dialect.name(),
+            "dialect": job.machine.dialect.name,
             "lines": text.lines().count(),
             "bytes": text.len(),
         },

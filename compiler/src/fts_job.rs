@@ -5,6 +5,7 @@
 //! from the servo model, the spiral planned and streamed into a LinuxCNC
 //! program, and the report of what it makes.
 
+use lensc_runtime::machine::Dialect;
 use lensc_grammar::{Diagnostic, FileId, Span};
 use lensc_runtime::fts::{
     FastAxis, FtsError, FtsSpiral, FtsSummary, Planner, SpindleSpeed, TrajectoryBounds,
@@ -65,14 +66,14 @@ impl Prepared {
 pub fn build(
     job: &CheckedJob,
     prov: &Provenance,
+    dialect: &Dialect,
     spool_dir: Option<&Path>,
 ) -> Result<Built, Vec<Diagnostic>> {
     let p = prepare(job)?;
-    let parts = Parts::of(job);
+    let parts = Parts::of(job, dialect);
     let (surface, tool, machine, strategy) =
         (parts.surface, parts.tool, parts.machine, parts.strategy);
     let (file, span) = parts.site();
-    let err = |code: &'static str, msg: String| parts.error(code, msg);
     let names = |p: &str, o: &Object| parts.name(p, o);
     let header = header_lines(
         job,
@@ -86,8 +87,17 @@ pub fn build(
         &p.spiral,
         p.settling.as_ref(),
         p.slow,
+        &parts,
     );
-    let mut program = FtsProgram::new(&header, p.resolution, p.spiral.chord_tolerance, p.safe_w);
+    let mut program = FtsProgram::new(
+        dialect,
+        &job.name.name,
+        &header,
+        p.resolution,
+        p.spiral.chord_tolerance,
+        p.safe_w,
+    )
+    .map_err(|e| vec![parts.not_printable(e)])?;
     let mut sink = Sink::new(spool_dir).map_err(|e| vec![cannot_spool(&e, file, span)])?;
     let mut write_error: Option<ProgramError> = None;
     let planned = p.planner().plan(&p.fast_axis, |pts| {
@@ -96,28 +106,23 @@ pub fn build(
         {
             write_error = Some(e);
         }
-        sink.push(program.take_text());
+        match program.take_text() {
+            Ok(t) => sink.push(t),
+            Err(e) => write_error = write_error.take().or(Some(e)),
+        }
     });
     let axis = if p.slow { "Z" } else { "the fast axis" };
     let summary =
         planned.map_err(|e| vec![fts_diagnostic(e, &p.spiral.speed, axis, file, span)])?;
-    if let Some(ProgramError::NotPrintable { word, value }) = write_error {
-        return Err(vec![err(
-            codes::NOT_PRINTABLE,
-            format!("the program would contain {word}{value}, which no controller accepts"),
-        )]);
+    if let Some(e) = write_error {
+        return Err(vec![parts.not_printable(e)]);
     }
-    let rest = program.finish().map_err(|_| {
-        vec![err(
-            codes::NOT_PRINTABLE,
-            "the program's retract height cannot be written".into(),
-        )]
-    })?;
+    let rest = program.finish().map_err(|e| vec![parts.not_printable(e)])?;
     sink.push(rest);
     let text = sink
         .finish()
         .map_err(|e| vec![cannot_spool(&e, file, span)])?;
-    let program_name = format!("{}.ngc", job.name.name);
+    let program_name = parts.program_name();
     let mut toolpath = toolpath_json(
         &summary,
         &p.spiral,
@@ -562,13 +567,14 @@ fn header_lines(
     spiral: &FtsSpiral,
     settling: Option<&Settling>,
     slow: bool,
+    parts: &Parts,
 ) -> Vec<String> {
     let (servo_words, axis_words) = if slow {
         ("slow-tool-servo", "Z carries the surface")
     } else {
         (
             "fast-tool-servo",
-            "Z the fast tool servo's axis [LinuxCNC has no fast-axis word]",
+            "Z the fast tool servo's axis",
         )
     };
     let speed = match spiral.speed {
@@ -582,8 +588,8 @@ fn header_lines(
     let mut lines = vec![
         format!("lensc {}: job {}", prov.lensc_version, job.name.name),
         format!("source {} fnv1a64 {:016x}", prov.source, prov.source_hash),
-        format!("units mm; X is the radius [G8], C the spindle angle in degrees counted on from the start, {axis_words}, +Z out of the material"),
-        "coordinates are the centre of the tool nose; feed in inverse time [G93, F = 1/min per move]".into(),
+        format!("units mm; X is {}, C the spindle angle in degrees counted on from the start, {axis_words}, +Z out of the material", lensc_runtime::program::x_word(parts.dialect)),
+        format!("coordinates are the centre of the tool nose; {}", parts.inverse_time_words()),
         format!("surface {surface}: {surface_words}"),
         format!("tool {tool}: round nose, nose radius {} mm", trim_num(rho)),
         format!(
@@ -592,7 +598,7 @@ fn header_lines(
             trim_num(spiral.feed_per_rev * 1000.0),
             trim_num(spiral.chord_tolerance * 1e6)
         ),
-        format!("machine {machine}: linuxcnc {servo_words} lathe"),
+        format!("machine {machine}: {} {servo_words} lathe", parts.dialect.name),
     ];
     match settling {
         None if slow => {}

@@ -19,7 +19,14 @@ pub const STDLIB: &[(&str, &str)] = &[
     ("machines", include_str!("../../stdlib/machines.lens")),
     ("tools", include_str!("../../stdlib/tools.lens")),
     ("strategies", include_str!("../../stdlib/strategies.lens")),
+    ("dialects", include_str!("../../stdlib/dialects.lens")),
 ];
+
+/// The module every file sees without a `use`: the controller dialects,
+/// so a machine anywhere can say `dialect: fanuc_0i_lathe`. Its names come
+/// after every other name in scope: a file's own `dialect` of the same name
+/// wins.
+pub const PRELUDE: &str = "dialects";
 
 pub trait FileSystem {
     fn read(&self, path: &Path) -> std::io::Result<Vec<u8>>;
@@ -149,18 +156,38 @@ impl Loader<'_> {
         }
         let (ast, mut diags) = lensc_grammar::parse(&self.loaded.sources.get(id).text, id);
         self.loaded.diags.append(&mut diags);
-        self.stack.push((key, id));
+        self.stack.push((key.clone(), id));
         let mut imports = Vec::new();
         for item in &ast.items {
             if let ItemKind::Use(target) = &item.kind {
                 self.resolve_use(id, path.as_deref(), target, item.span, &mut imports);
             }
         }
+        if key != Key::Std(PRELUDE.to_string()) {
+            imports.push(Import::All {
+                file: self.std_module(PRELUDE),
+                span: Span::new(0, 0),
+            });
+        }
         self.stack.pop();
         let slot = &mut self.loaded.files[id.0 as usize];
         slot.ast = ast;
         slot.imports = imports;
         id
+    }
+
+    /// The standard-library module `name`, loaded once.
+    fn std_module(&mut self, name: &str) -> FileId {
+        let key = Key::Std(name.to_string());
+        if let Some(&f) = self.keys.get(&key) {
+            return f;
+        }
+        let text = STDLIB
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, t)| *t)
+            .expect("a standard-library module");
+        self.add(key, format!("std/{name}.lens"), None, text.as_bytes().to_vec())
     }
 
     fn resolve_use(
@@ -187,7 +214,7 @@ impl Loader<'_> {
                     return;
                 }
                 let Some(module) = segs.get(1) else { return };
-                let Some(&(mname, text)) = STDLIB.iter().find(|(n, _)| *n == module.name) else {
+                let Some(&(mname, _)) = STDLIB.iter().find(|(n, _)| *n == module.name) else {
                     let names: Vec<&str> = STDLIB.iter().map(|(n, _)| *n).collect();
                     let mut d = Diagnostic::error(
                         codes::UNKNOWN_MODULE,
@@ -214,16 +241,7 @@ impl Loader<'_> {
                         .with_label("remove this"),
                     );
                 }
-                let key = Key::Std(mname.to_string());
-                let file = match self.keys.get(&key) {
-                    Some(&f) => f,
-                    None => self.add(
-                        key,
-                        format!("std/{mname}.lens"),
-                        None,
-                        text.as_bytes().to_vec(),
-                    ),
-                };
+                let file = self.std_module(mname);
                 match segs.get(2) {
                     Some(name) => imports.push(Import::One {
                         file,

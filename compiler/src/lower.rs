@@ -15,7 +15,7 @@ use crate::units::Dim;
 use crate::value::{self, Object, Value};
 
 /// Lowers one checked job, or says why it cannot be built.
-pub fn lower(job: &CheckedJob) -> Result<Job, Vec<Diagnostic>> {
+pub fn lower(job: &CheckedJob, dialect: Dialect) -> Result<Job, Vec<Diagnostic>> {
     let part = |name: &str| value::object(&job.fields, name).expect("checked job part");
     let (surface, tool, machine, strategy) = (
         part("surface"),
@@ -117,9 +117,7 @@ pub fn lower(job: &CheckedJob) -> Result<Job, Vec<Diagnostic>> {
     let travel = value::block(m, "travel").expect("required");
     let spindle = value::block(m, "spindle").expect("required");
     let lathe = Lathe {
-        dialect: value::word(m, "dialect")
-            .and_then(Dialect::from_name)
-            .expect("the schema admits only known dialects"),
+        dialect,
         resolution: value::num(m, "resolution").expect("required"),
         travel_x: value::range(travel, "x").expect("required"),
         travel_z: value::range(travel, "z").expect("required"),
@@ -288,6 +286,117 @@ pub fn describe(o: &Object) -> String {
         }
     }
     words.join(", ")
+}
+
+/// The dialect a job's program is written in: the machine's `dialect`, or
+/// the one `requested` (by `lensc build --dialect`) among it and its
+/// `other_dialects`; E0148 if the machine offers no dialect of that name.
+pub fn dialect(job: &CheckedJob, requested: Option<&str>) -> Result<Dialect, Diagnostic> {
+    let machine = value::object(&job.fields, "machine").expect("checked job part");
+    let mut offered: Vec<&Object> = value::object(&machine.fields, "dialect")
+        .map(|o| o.as_ref())
+        .into_iter()
+        .collect();
+    if let Some(Value::List(items)) = value::field(&machine.fields, "other_dialects").map(|f| &f.value) {
+        offered.extend(items.iter().filter_map(|(v, _)| match v {
+            Value::Object(o) => Some(o.as_ref()),
+            _ => None,
+        }));
+    }
+    let name = |o: &Object| o.name.clone().unwrap_or_else(|| o.kind.name.to_string());
+    let chosen = match requested {
+        None => offered.first().copied(),
+        Some(r) => offered.iter().copied().find(|o| name(o) == r),
+    };
+    let Some(o) = chosen else {
+        let (file, span) = job_site(job);
+        let names: Vec<String> = offered.iter().map(|o| format!("`{}`", name(o))).collect();
+        return Err(Diagnostic::error(
+            codes::DIALECT_NOT_OFFERED,
+            format!(
+                "the machine of this job is not programmed in `{}`",
+                requested.unwrap_or("")
+            ),
+            file,
+            span,
+        )
+        .with_label("this job")
+        .with_help(format!(
+            "its machine offers {}; add the dialect to the machine's `other_dialects` if its controller reads it",
+            names.join(", ")
+        )));
+    };
+    Ok(dialect_of(o, name(o)))
+}
+
+/// A checked `gcode { … }` dialect as the post-processor reads it.
+fn dialect_of(o: &Object, name: String) -> Dialect {
+    let f = &o.fields;
+    let text = |n: &str, default: &str| match value::field(f, n).map(|x| &x.value) {
+        Some(Value::Str(s)) => s.clone(),
+        _ => default.to_string(),
+    };
+    let opt_text = |n: &str| match value::field(f, n).map(|x| &x.value) {
+        Some(Value::Str(s)) => Some(s.clone()),
+        _ => None,
+    };
+    let lines = |n: &str| match value::field(f, n).map(|x| &x.value) {
+        Some(Value::List(items)) => items
+            .iter()
+            .filter_map(|(v, _)| match v {
+                Value::Str(s) => Some(s.clone()),
+                _ => None,
+            })
+            .collect(),
+        _ => Vec::new(),
+    };
+    let count = |n: &str| value::num(f, n).map(|v| v as u64);
+    use lensc_runtime::moves::Plane;
+    Dialect {
+        name,
+        extension: text("extension", "nc"),
+        comment: match value::word(f, "comment") {
+            Some("semicolon") => lensc_runtime::machine::CommentStyle::Semicolon,
+            _ => lensc_runtime::machine::CommentStyle::Parentheses,
+        },
+        start: lines("start"),
+        program_number: count("program_number").unwrap_or(1) as u32,
+        lathe_setup: lines("lathe_setup"),
+        mill_setup: lines("mill_setup"),
+        path_tolerance: lines("path_tolerance"),
+        c_axis_on: lines("c_axis_on"),
+        c_axis_off: lines("c_axis_off"),
+        end: lines("end"),
+        trailer: lines("trailer"),
+        lathe_x_diameter: value::word(f, "lathe_x") == Some("diameter"),
+        rapid: text("rapid", "G0"),
+        linear: text("linear", "G1"),
+        arc_cw: text("arc_cw", "G2"),
+        arc_ccw: text("arc_ccw", "G3"),
+        arc_planes: lines("arc_planes")
+            .iter()
+            .filter_map(|p| match p.as_str() {
+                "xy" => Some(Plane::Xy),
+                "zx" => Some(Plane::Zx),
+                "yz" => Some(Plane::Yz),
+                _ => None,
+            })
+            .collect(),
+        arc_centre_absolute: value::word(f, "arc_centre") == Some("absolute"),
+        per_minute: opt_text("per_minute"),
+        per_revolution: opt_text("per_revolution"),
+        inverse_time: opt_text("inverse_time"),
+        spindle_on: text("spindle_on", "M3"),
+        spindle_off: text("spindle_off", "M5"),
+        c_letter: text("c_letter", "C").chars().next().unwrap_or('C'),
+        c_decimals: count("c_decimals").unwrap_or(5) as u32,
+        max_decimals: count("max_decimals").map(|v| v as u32),
+        max_digits: count("max_digits").map(|v| v as u32),
+        max_line_length: count("max_line_length").map(|v| v as usize),
+        line_numbers: count("line_numbers"),
+        max_line_number: count("max_line_number"),
+        block_end: text("block_end", ""),
+    }
 }
 
 /// Where a plan error should point: the job's name.

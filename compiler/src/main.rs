@@ -212,7 +212,7 @@ fn run(cli: Cli) -> u8 {
         Command::Build {
             file,
             job,
-            dialect: _,
+            dialect,
             out: dir,
         } => {
             let Some(c) = load(&out, &file) else { return 1 };
@@ -252,7 +252,15 @@ fn run(cli: Cli) -> u8 {
                 return 1;
             }
             let (programs, diags) =
-                driver::plan_and_emit(&c, job.as_deref(), &file.display().to_string(), Some(&dir));
+                driver::plan_and_emit(
+                    &c,
+                    driver::Request {
+                        job: job.as_deref(),
+                        dialect: dialect.as_deref(),
+                    },
+                    &file.display().to_string(),
+                    Some(&dir),
+                );
             out.diagnostics(&c, &diags);
             if diags.iter().any(|d| d.is_error()) {
                 return 1;

@@ -3,6 +3,7 @@
 //! (seed 001). Each reads the checked job into its runtime planner, checks
 //! the tool against the surface, and writes a LinuxCNC program and report.
 
+use lensc_runtime::machine::Dialect;
 use lensc_grammar::Diagnostic;
 use lensc_runtime::analysis::Domain;
 use lensc_runtime::grinding::{GrindingError, ProfileGrinding};
@@ -18,8 +19,12 @@ use crate::parts::Parts;
 use crate::value;
 
 /// Builds a `raster` job on a `mill_3axis`.
-pub fn build_raster(job: &CheckedJob, prov: &Provenance) -> Result<Built, Vec<Diagnostic>> {
-    let p = Parts::of(job);
+pub fn build_raster(
+    job: &CheckedJob,
+    prov: &Provenance,
+    dialect: &Dialect,
+) -> Result<Built, Vec<Diagnostic>> {
+    let p = Parts::of(job, dialect);
     let errors: Vec<Diagnostic> = [
         p.needs("machine", p.machine, &["mill_3axis"], "raster"),
         p.needs("tool", p.tool, &["microshaper", "ball_end"], "raster"),
@@ -119,14 +124,16 @@ pub fn build_raster(job: &CheckedJob, prov: &Provenance) -> Result<Built, Vec<Di
         path.point_count
     ));
     header.push(format!(
-        "machine {}: linuxcnc 3-axis mill",
-        p.name("machine", p.machine)
+        "machine {}: {} 3-axis mill",
+        p.name("machine", p.machine),
+        dialect.name
     ));
     let resolution = value::num(m, "resolution").expect("required");
-    let text = lensc_runtime::program::emit_mill_raster(
+    let text = lensc_runtime::program::emit_mill(
+        dialect,
+        &job.name.name,
         &header,
-        &path,
-        feed,
+        &moves,
         resolution,
         raster.chord_tolerance,
     )
@@ -147,7 +154,7 @@ pub fn build_raster(job: &CheckedJob, prov: &Provenance) -> Result<Built, Vec<Di
         "max_slope_across_deg": at(&path.max_slope_across, deg),
         "min_concave_radius_along_mm": path.min_concave_radius_along.as_ref().map(|e| at(e, 1.0)),
     });
-    let program_name = format!("{}.ngc", job.name.name);
+    let program_name = p.program_name();
     let text = ProgramText::Memory(text);
     let report = p.report(prov, &program_name, &text, toolpath, &lowered);
     Ok(Built {
@@ -192,8 +199,12 @@ fn raster_diagnostic(p: &Parts, e: RasterError) -> Diagnostic {
 }
 
 /// Builds a `profile_grinding` job on a `grinder_2axis`.
-pub fn build_grinding(job: &CheckedJob, prov: &Provenance) -> Result<Built, Vec<Diagnostic>> {
-    let p = Parts::of(job);
+pub fn build_grinding(
+    job: &CheckedJob,
+    prov: &Provenance,
+    dialect: &Dialect,
+) -> Result<Built, Vec<Diagnostic>> {
+    let p = Parts::of(job, dialect);
     let errors: Vec<Diagnostic> = [
         p.needs("machine", p.machine, &["grinder_2axis"], "profile grinding"),
         p.needs("tool", p.tool, &["spherical_wheel"], "profile grinding"),
@@ -246,10 +257,11 @@ pub fn build_grinding(job: &CheckedJob, prov: &Provenance) -> Result<Built, Vec<
     if !errors.is_empty() {
         return Err(errors);
     }
-    let mut header = p.header(
-        prov,
-        "units mm; X is the radius [G8], Z along the spindle axis, +Z out of the material",
+    let units = format!(
+        "units mm; X is {}, Z along the spindle axis, +Z out of the material",
+        lensc_runtime::program::x_word(dialect)
     );
+    let mut header = p.header(prov, &units);
     header.push(format!(
         "tool {}: spherical wheel, diameter {} mm; coordinates are the wheel centre",
         p.name("tool", p.tool),
@@ -266,11 +278,20 @@ pub fn build_grinding(job: &CheckedJob, prov: &Provenance) -> Result<Built, Vec<
         path.segments
     ));
     header.push(format!(
-        "machine {}: linuxcnc 2-axis grinder",
-        p.name("machine", p.machine)
+        "machine {}: {} 2-axis grinder",
+        p.name("machine", p.machine),
+        dialect.name
     ));
     let resolution = value::num(m, "resolution").expect("required");
-    let text = lensc_runtime::program::emit_grinding(&header, &path, feed, safe_z, resolution)
+    let text = lensc_runtime::program::emit_grinding(
+        dialect,
+        &job.name.name,
+        &header,
+        &path,
+        feed,
+        safe_z,
+        resolution,
+    )
         .map_err(|e| vec![p.not_printable(e)])?;
     // The table of eqs 18-19: every interval's commanded z velocity and
     // acceleration, as the paper's position-based interpolation gives them.
@@ -295,7 +316,7 @@ pub fn build_grinding(job: &CheckedJob, prov: &Provenance) -> Result<Built, Vec<
             "rows": table,
         },
     });
-    let program_name = format!("{}.ngc", job.name.name);
+    let program_name = p.program_name();
     let text = ProgramText::Memory(text);
     let report = p.report(prov, &program_name, &text, toolpath, &lowered);
     Ok(Built {

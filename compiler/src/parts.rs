@@ -4,6 +4,7 @@
 //! report every program has beside it.
 
 use lensc_grammar::{Diagnostic, FileId, Span};
+use lensc_runtime::machine::Dialect;
 use lensc_runtime::program::{ProgramError, Provenance};
 use serde_json::json;
 
@@ -20,10 +21,12 @@ pub(crate) struct Parts<'a> {
     pub tool: &'a Object,
     pub machine: &'a Object,
     pub strategy: &'a Object,
+    /// The dialect the program is written in.
+    pub dialect: &'a Dialect,
 }
 
 impl<'a> Parts<'a> {
-    pub(crate) fn of(job: &'a CheckedJob) -> Parts<'a> {
+    pub(crate) fn of(job: &'a CheckedJob, dialect: &'a Dialect) -> Parts<'a> {
         let part = |name: &str| -> &'a Object {
             value::object(&job.fields, name).expect("checked job part")
         };
@@ -33,6 +36,7 @@ impl<'a> Parts<'a> {
             tool: part("tool"),
             machine: part("machine"),
             strategy: part("strategy"),
+            dialect,
         }
     }
     pub(crate) fn name(&self, part: &str, o: &Object) -> String {
@@ -48,6 +52,17 @@ impl<'a> Parts<'a> {
     pub(crate) fn error(&self, code: &'static str, msg: String) -> Diagnostic {
         let (file, span) = self.site();
         Diagnostic::error(code, msg, file, span).with_label("this job")
+    }
+    /// The program's file name: the job's name and the dialect's extension.
+    pub(crate) fn program_name(&self) -> String {
+        format!("{}.{}", self.job.name.name, self.dialect.extension)
+    }
+    /// The header words for the feed in inverse time.
+    pub(crate) fn inverse_time_words(&self) -> String {
+        format!(
+            "feed in inverse time [{}, F = 1/min per move]",
+            self.dialect.inverse_time.as_deref().unwrap_or("none")
+        )
     }
     /// The lines every header starts with.
     pub(crate) fn header(&self, prov: &Provenance, units: &str) -> Vec<String> {
@@ -77,7 +92,7 @@ impl<'a> Parts<'a> {
             "source_fnv1a64": format!("{:016x}", prov.source_hash),
             "program": {
                 "file": program_name,
-                "dialect": "linuxcnc",
+                "dialect": self.dialect.name,
                 "lines": program.lines(),
                 "bytes": program.bytes(),
             },

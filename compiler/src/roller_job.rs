@@ -3,6 +3,7 @@
 //! rough then finish, the nose centre exact in the cutting plane; the
 //! section-4 tool checks; the program streamed like the spiral's.
 
+use lensc_runtime::machine::Dialect;
 use std::path::Path;
 
 use lensc_grammar::Diagnostic;
@@ -26,9 +27,10 @@ use crate::value::{self, Object};
 pub fn build(
     job: &CheckedJob,
     prov: &Provenance,
+    dialect: &Dialect,
     spool_dir: Option<&Path>,
 ) -> Result<Built, Vec<Diagnostic>> {
-    let parts = Parts::of(job);
+    let parts = Parts::of(job, dialect);
     let (surface, tool, machine, strategy) =
         (parts.surface, parts.tool, parts.machine, parts.strategy);
     let (file, span) = parts.site();
@@ -204,8 +206,8 @@ pub fn build(
     let header = vec![
         format!("lensc {}: job {}", prov.lensc_version, job.name.name),
         format!("source {} fnv1a64 {:016x}", prov.source, prov.source_hash),
-        "units mm; X the nose centre's distance from the roller axis [G8], Z along the roller, C the spindle angle in degrees counted on from the start".into(),
-        "coordinates are the centre of the tool nose; feed in inverse time [G93, F = 1/min per move]".into(),
+        format!("units mm; X is {} of the nose centre about the roller axis, Z along the roller, C the spindle angle in degrees counted on from the start", lensc_runtime::program::x_word(dialect)),
+        format!("coordinates are the centre of the tool nose; {}", parts.inverse_time_words()),
         format!(
             "surface {}: {}",
             names("surface", surface),
@@ -225,12 +227,21 @@ pub fn build(
             pass_words.join("; ")
         ),
         format!(
-            "machine {}: linuxcnc slow-tool-servo lathe",
-            names("machine", machine)
+            "machine {}: {} slow-tool-servo lathe",
+            names("machine", machine),
+            dialect.name
         ),
     ];
     let resolution = value::num(m, "resolution").expect("required");
-    let mut program = RollerProgram::new(&header, resolution, safe_x, spindle_speed);
+    let mut program = RollerProgram::new(
+        dialect,
+        &job.name.name,
+        &header,
+        resolution,
+        safe_x,
+        spindle_speed,
+    )
+    .map_err(|e| vec![parts.not_printable(e)])?;
     let mut sink = Sink::new(spool_dir).map_err(|e| vec![cannot_spool(&e, file, span)])?;
     let mut write_error: Option<ProgramError> = None;
     let planned = plan_roller_helix_into(&helix, rho, kernel.as_ref(), |pass, pts| {
@@ -239,28 +250,23 @@ pub fn build(
         {
             write_error = Some(e);
         }
-        sink.push(program.take_text());
+        match program.take_text() {
+            Ok(t) => sink.push(t),
+            Err(e) => write_error = write_error.take().or(Some(e)),
+        }
     });
     let path = planned.map_err(|e| vec![roller_diagnostic(e, job)])?;
-    if let Some(ProgramError::NotPrintable { word, value }) = write_error {
-        return Err(vec![err(
-            codes::NOT_PRINTABLE,
-            format!("the program would contain {word}{value}, which no controller accepts"),
-        )]);
+    if let Some(e) = write_error {
+        return Err(vec![parts.not_printable(e)]);
     }
-    let rest = program.finish().map_err(|_| {
-        vec![err(
-            codes::NOT_PRINTABLE,
-            "the program's retract cannot be written".into(),
-        )]
-    })?;
+    let rest = program.finish().map_err(|e| vec![parts.not_printable(e)])?;
     sink.push(rest);
     let text = sink
         .finish()
         .map_err(|e| vec![cannot_spool(&e, file, span)])?;
     let points: usize = path.passes.iter().map(|p| p.points).sum();
     let time: f64 = path.passes.iter().filter_map(|p| p.time).sum();
-    let program_name = format!("{}.ngc", job.name.name);
+    let program_name = parts.program_name();
     let toolpath = json!({
         "strategy": "roller_helix",
         "cut_points": points,

@@ -16,6 +16,7 @@ pub enum Category {
     Strategy,
     Aperture,
     Roller,
+    Dialect,
 }
 
 impl Category {
@@ -25,6 +26,7 @@ impl Category {
             DeclKind::Tool => Category::Tool,
             DeclKind::Machine => Category::Machine,
             DeclKind::Strategy => Category::Strategy,
+            DeclKind::Dialect => Category::Dialect,
         }
     }
     pub fn noun(self) -> &'static str {
@@ -35,6 +37,7 @@ impl Category {
             Category::Strategy => "a strategy",
             Category::Aperture => "an aperture",
             Category::Roller => "a roller",
+            Category::Dialect => "a dialect",
         }
     }
 }
@@ -48,6 +51,12 @@ pub enum Ty {
     Word(&'static [&'static str]),
     /// A value constructed by a kind of this category.
     Object(Category),
+    /// A list `[a, b]` of values of this category.
+    Objects(Category),
+    /// A string `"…"`.
+    Text,
+    /// A list of strings `["…", "…"]`.
+    Texts,
     /// A nested block with its own parameters.
     Block(&'static [Param]),
     /// `lo .. hi`, both of this dimension.
@@ -287,9 +296,15 @@ fn power_dims(n: i8) -> &'static [Dim] {
 
 const DIALECT: Param = req(
     "dialect",
-    Ty::Word(&["linuxcnc"]),
+    Ty::Object(Category::Dialect),
     Check::Any,
-    "the controller's program dialect",
+    "the controller's program dialect (see `std::dialects`): programs are written in it unless `lensc build --dialect` names one of `other_dialects`",
+);
+const OTHER_DIALECTS: Param = opt(
+    "other_dialects",
+    Ty::Objects(Category::Dialect),
+    Check::Any,
+    "further dialects the controller accepts, chosen with `lensc build --dialect NAME`",
 );
 const RESOLUTION: Param = req(
     "resolution",
@@ -394,7 +409,143 @@ const AXIS: Param = req(
     "the direction the profile is extruded along; the profile varies across it",
 );
 
+const fn text(name: &'static str, doc: &'static str) -> Param {
+    opt(name, Ty::Text, Check::Any, doc)
+}
+const fn texts(name: &'static str, doc: &'static str) -> Param {
+    opt(name, Ty::Texts, Check::Any, doc)
+}
+
+/// A G-code dialect: everything a post-processor needs to know about a
+/// controller, so a shop adds one in a `.lens` file without rebuilding
+/// lensc. Lines may hold `{job}`, `{JOB}` (upper case), `{number}` and
+/// `{tolerance}` (mm, to the machine's decimals).
+const GCODE_PARAMS: &[Param] = &[
+    req(
+        "extension",
+        Ty::Text,
+        Check::Any,
+        "the program file's extension, without the dot",
+    ),
+    req(
+        "comment",
+        Ty::Word(&["parentheses", "semicolon"]),
+        Check::Any,
+        "comment syntax: `(text)` or `; text`",
+    ),
+    texts(
+        "start",
+        "lines before the header comments (`%`, `O{number}`, a program name line)",
+    ),
+    opt(
+        "program_number",
+        NUMBER,
+        Check::Count,
+        "the program number `{number}` stands for; default 1",
+    ),
+    texts(
+        "lathe_setup",
+        "the safe-start lines of a lathe program (plane, units, absolute, radius or diameter mode, cancels)",
+    ),
+    texts("mill_setup", "the safe-start lines of a mill program"),
+    texts(
+        "path_tolerance",
+        "lines that hold the controller's blending to `{tolerance}`; left out if absent",
+    ),
+    texts(
+        "c_axis_on",
+        "lines that switch the spindle to a position-controlled C axis before a C move",
+    ),
+    texts("c_axis_off", "lines that give the spindle back after C moves"),
+    texts("end", "the blocks that end the program (`M2`, `M30`)"),
+    texts(
+        "trailer",
+        "lines after the last block, written as they are (`%`)",
+    ),
+    req(
+        "lathe_x",
+        Ty::Word(&["radius", "diameter"]),
+        Check::Any,
+        "whether a lathe's X word is the radius or the diameter (the setup lines must select the same)",
+    ),
+    text("rapid", "the rapid-move word; default `G0`"),
+    text("linear", "the linear-move word; default `G1`"),
+    text("arc_cw", "the clockwise-arc word; default `G2`"),
+    text("arc_ccw", "the counter-clockwise-arc word; default `G3`"),
+    texts(
+        "arc_planes",
+        "planes the controller interpolates arcs in, of \"xy\" (G17), \"zx\" (G18), \"yz\" (G19); none: no arcs",
+    ),
+    req(
+        "arc_centre",
+        Ty::Word(&["incremental", "absolute"]),
+        Check::Any,
+        "arc centres I J K from the arc's start (`incremental`) or in work coordinates",
+    ),
+    text("per_minute", "the word for feeds per minute; absent: not available"),
+    text(
+        "per_revolution",
+        "the word for feeds per revolution; absent: not available",
+    ),
+    text(
+        "inverse_time",
+        "the word for inverse-time feeds (F = 1/minutes of the move); absent: moves that turn the C axis cannot be timed",
+    ),
+    text("spindle_on", "the spindle-on word; default `M3`"),
+    text("spindle_off", "the spindle-off word; default `M5`"),
+    text("c_letter", "the spindle's C-axis letter; default `C`"),
+    opt(
+        "c_decimals",
+        NUMBER,
+        Check::Count,
+        "decimals of C in degrees; default 5 (4 nm of arc at 25 mm)",
+    ),
+    opt(
+        "max_decimals",
+        NUMBER,
+        Check::Count,
+        "the most decimals a linear axis takes; a machine whose resolution needs more is refused",
+    ),
+    opt(
+        "max_digits",
+        NUMBER,
+        Check::Count,
+        "the most digits in one value (Fanuc: 8); a program needing more is refused",
+    ),
+    opt(
+        "max_line_length",
+        NUMBER,
+        Check::Count,
+        "the longest line the controller reads, in characters",
+    ),
+    opt(
+        "line_numbers",
+        NUMBER,
+        Check::Count,
+        "number each block `N…` in steps of this; absent: no numbers",
+    ),
+    opt(
+        "max_line_number",
+        NUMBER,
+        Check::Count,
+        "block numbers start again from the step after this",
+    ),
+    text(
+        "block_end",
+        "text closing every block (Heidenhain ISO: ` *`); default none",
+    ),
+];
+
 pub static KINDS: &[Kind] = &[
+    Kind {
+        name: "gcode",
+        category: Category::Dialect,
+        params: GCODE_PARAMS,
+        family: None,
+        positional: &[],
+        exclusive: &[],
+        doc: "a G-code (ISO 6983 family) program dialect: how one controller wants its programs written",
+    },
     Kind {
         name: "plane",
         category: Category::Surface,
@@ -952,12 +1103,8 @@ pub static KINDS: &[Kind] = &[
         name: "lathe",
         category: Category::Machine,
         params: &[
-            req(
-                "dialect",
-                Ty::Word(&["linuxcnc"]),
-                Check::Any,
-                "the controller's program dialect",
-            ),
+            DIALECT,
+            OTHER_DIALECTS,
             req(
                 "resolution",
                 LENGTH,
@@ -1051,6 +1198,7 @@ pub static KINDS: &[Kind] = &[
         category: Category::Machine,
         params: &[
             DIALECT,
+            OTHER_DIALECTS,
             RESOLUTION,
             LATHE_TRAVEL,
             MAX_FEED,
@@ -1116,6 +1264,7 @@ pub static KINDS: &[Kind] = &[
         category: Category::Machine,
         params: &[
             DIALECT,
+            OTHER_DIALECTS,
             RESOLUTION,
             LATHE_TRAVEL,
             MAX_FEED,
@@ -1150,6 +1299,7 @@ pub static KINDS: &[Kind] = &[
         category: Category::Machine,
         params: &[
             DIALECT,
+            OTHER_DIALECTS,
             RESOLUTION,
             req(
                 "travel",
@@ -1171,7 +1321,7 @@ pub static KINDS: &[Kind] = &[
     Kind {
         name: "grinder_2axis",
         category: Category::Machine,
-        params: &[DIALECT, RESOLUTION, LATHE_TRAVEL, MAX_FEED],
+        params: &[DIALECT, OTHER_DIALECTS, RESOLUTION, LATHE_TRAVEL, MAX_FEED],
         family: None,
         positional: &[],
         exclusive: &[],

@@ -68,6 +68,8 @@ pub struct Object {
     /// Where the kind's name was written (or the copied declaration's).
     pub head: Span,
     pub file: FileId,
+    /// The name it was declared under (`dialect fanuc_0i_lathe = …`), if any.
+    pub name: Option<String>,
 }
 
 #[derive(Debug)]

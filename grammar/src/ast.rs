@@ -75,6 +75,7 @@ pub enum DeclKind {
     Tool,
     Machine,
     Strategy,
+    Dialect,
 }
 
 impl DeclKind {
@@ -84,6 +85,7 @@ impl DeclKind {
             DeclKind::Tool => "tool",
             DeclKind::Machine => "machine",
             DeclKind::Strategy => "strategy",
+            DeclKind::Dialect => "dialect",
         }
     }
 }

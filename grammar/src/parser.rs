@@ -323,6 +323,7 @@ impl Builder<'_> {
                     "surface" => DeclKind::Surface,
                     "tool" => DeclKind::Tool,
                     "machine" => DeclKind::Machine,
+                    "dialect" => DeclKind::Dialect,
                     _ => DeclKind::Strategy,
                 };
                 let name = self.ident(inner.next().expect("decl name"));

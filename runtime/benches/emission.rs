@@ -12,7 +12,8 @@ use std::io::Write as _;
 use std::time::{Duration, Instant};
 
 use lensc_runtime::moves::{Feed, Move, Position};
-use lensc_runtime::program::LinuxCncWriter;
+use lensc_runtime::machine::Dialect;
+use lensc_runtime::program::{ProgramWriter, Setup};
 
 const MOVES: usize = 1_000_000;
 
@@ -42,16 +43,25 @@ fn main() {
         })
         .collect();
     let (ours, ours_bytes) = best_of(5, || {
-        let mut w = LinuxCncWriter::new(&[], "G18 G21 G90 G8 G93", "XZC", 1e-6, 1e-5);
+        let mut w = ProgramWriter::new(
+            &Dialect::linuxcnc(),
+            Setup::Lathe,
+            "bench",
+            &[],
+            "XZC",
+            1e-6,
+            1e-5,
+        )
+        .expect("a LinuxCNC lathe program");
         let mut sink = std::io::BufWriter::new(std::io::sink());
         let mut bytes = 0;
         for chunk in stream.chunks(4096) {
             w.write_all(chunk).expect("printable");
-            let t = w.take_text();
+            let t = w.take_text().expect("checked");
             bytes += t.len();
             sink.write_all(t.as_bytes()).expect("sink");
         }
-        bytes + w.finish().len()
+        bytes + w.finish().expect("checked").len()
     });
     let (base, base_bytes) = best_of(5, || {
         let mut sink = std::io::BufWriter::new(CountingSink(0));

@@ -1,28 +1,102 @@
 //! Machines: their kinematics, limits and the dialect they speak.
 
-/// The controller dialect a program is written in.
+use crate::moves::Plane;
+
+/// How a dialect writes comments.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Dialect {
-    /// LinuxCNC RS274NGC, validated with `rs274 -g`.
-    LinuxCnc,
+pub enum CommentStyle {
+    /// `(text)`: RS274NGC, Fanuc, most ISO controllers.
+    Parentheses,
+    /// `; text`: Siemens, Heidenhain.
+    Semicolon,
+}
+
+/// A controller's G-code dialect, as data (declared in `stdlib/dialects.lens`
+/// or a shop's own file): the lines around the moves, the words, the
+/// limits of its number format. Lines may hold `{job}`, `{JOB}`,
+/// `{number}` and `{tolerance}`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Dialect {
+    pub name: String,
+    /// Program file extension, without the dot.
+    pub extension: String,
+    pub comment: CommentStyle,
+    /// Lines before the header comments.
+    pub start: Vec<String>,
+    pub program_number: u32,
+    pub lathe_setup: Vec<String>,
+    pub mill_setup: Vec<String>,
+    /// Lines holding the controller's blending to `{tolerance}`.
+    pub path_tolerance: Vec<String>,
+    pub c_axis_on: Vec<String>,
+    pub c_axis_off: Vec<String>,
+    /// Blocks that end the program (`M30`).
+    pub end: Vec<String>,
+    /// Lines after the last block, as written (`%`).
+    pub trailer: Vec<String>,
+    /// A lathe's X word is the diameter (arc centres stay radii).
+    pub lathe_x_diameter: bool,
+    pub rapid: String,
+    pub linear: String,
+    pub arc_cw: String,
+    pub arc_ccw: String,
+    pub arc_planes: Vec<Plane>,
+    /// Arc centres in work coordinates rather than from the arc's start.
+    pub arc_centre_absolute: bool,
+    pub per_minute: Option<String>,
+    pub per_revolution: Option<String>,
+    pub inverse_time: Option<String>,
+    pub spindle_on: String,
+    pub spindle_off: String,
+    pub c_letter: char,
+    pub c_decimals: u32,
+    pub max_decimals: Option<u32>,
+    pub max_digits: Option<u32>,
+    pub max_line_length: Option<usize>,
+    /// Block numbers `N…` in steps of this.
+    pub line_numbers: Option<u64>,
+    pub max_line_number: Option<u64>,
+    pub block_end: String,
 }
 
 impl Dialect {
-    pub fn name(self) -> &'static str {
-        match self {
-            Dialect::LinuxCnc => "linuxcnc",
-        }
-    }
-    pub fn from_name(name: &str) -> Option<Dialect> {
-        match name {
-            "linuxcnc" => Some(Dialect::LinuxCnc),
-            _ => None,
-        }
-    }
-    /// Program file extension.
-    pub fn extension(self) -> &'static str {
-        match self {
-            Dialect::LinuxCnc => "ngc",
+    /// LinuxCNC's RS274NGC as `stdlib/dialects.lens` declares it, for the
+    /// runtime's own tests and benchmarks.
+    pub fn linuxcnc() -> Dialect {
+        let lines = |l: &[&str]| l.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        Dialect {
+            name: "linuxcnc".into(),
+            extension: "ngc".into(),
+            comment: CommentStyle::Parentheses,
+            start: Vec::new(),
+            program_number: 1,
+            lathe_setup: lines(&["G18 G21 G90 G8 G40 G49 G80"]),
+            mill_setup: lines(&["G17 G21 G90 G40 G49 G80"]),
+            path_tolerance: lines(&["G64 P{tolerance}"]),
+            c_axis_on: Vec::new(),
+            c_axis_off: Vec::new(),
+            end: lines(&["M2"]),
+            trailer: Vec::new(),
+            lathe_x_diameter: false,
+            rapid: "G0".into(),
+            linear: "G1".into(),
+            arc_cw: "G2".into(),
+            arc_ccw: "G3".into(),
+            arc_planes: vec![Plane::Xy, Plane::Zx, Plane::Yz],
+            arc_centre_absolute: false,
+            per_minute: Some("G94".into()),
+            per_revolution: Some("G95".into()),
+            inverse_time: Some("G93".into()),
+            spindle_on: "M3".into(),
+            spindle_off: "M5".into(),
+            c_letter: 'C',
+            c_decimals: 5,
+            max_decimals: None,
+            max_digits: None,
+            max_line_length: Some(255),
+            line_numbers: None,
+            max_line_number: None,
+            block_end: String::new(),
         }
     }
 }

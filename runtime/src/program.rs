@@ -8,8 +8,8 @@ use std::fmt::Write as _;
 
 use crate::format::{decimals_for, fixed_units, push_fixed, push_units};
 use crate::job::Job;
-use crate::machine::Dialect;
-use crate::moves::{self, Position};
+use crate::machine::{CommentStyle, Dialect};
+use crate::moves::{self, Plane, Position};
 use crate::toolpath::{Feed, Move, Toolpath};
 
 /// What the program header states about where the job came from.
@@ -45,18 +45,9 @@ impl ProgramError {
     }
 }
 
-/// Writes a LinuxCNC (RS274NGC) lathe program for a profile-turning path.
+/// Writes a lathe program for a profile-turning path in the machine's
+/// dialect.
 pub fn emit(job: &Job, path: &Toolpath, prov: &Provenance) -> Result<String, ProgramError> {
-    match job.machine.dialect {
-        Dialect::LinuxCnc => emit_linuxcnc_lathe(job, path, prov),
-    }
-}
-
-fn emit_linuxcnc_lathe(
-    job: &Job,
-    path: &Toolpath,
-    prov: &Provenance,
-) -> Result<String, ProgramError> {
     let centre_height = if job.tool.centre_height == 0.0 {
         String::new()
     } else {
@@ -68,7 +59,10 @@ fn emit_linuxcnc_lathe(
     let header = [
         format!("lensc {}: job {}", prov.lensc_version, job.name),
         format!("source {} fnv1a64 {:016x}", prov.source, prov.source_hash),
-        "units mm; X is the radius [G8], Z along the spindle axis, +Z out of the material".into(),
+        format!(
+            "units mm; X is {}, Z along the spindle axis, +Z out of the material",
+            x_word(&job.machine.dialect)
+        ),
         "coordinates are the centre of the tool nose; no cutter compensation".into(),
         format!("surface {}: {}", job.surface_name, job.surface.description),
         format!(
@@ -86,19 +80,30 @@ fn emit_linuxcnc_lathe(
         format!(
             "machine {}: {} lathe",
             job.machine_name,
-            job.machine.dialect.name()
+            job.machine.dialect.name
         ),
         format!("estimated cutting time {}", duration(path.cutting_time())),
     ];
-    let mut w = LinuxCncWriter::new(
+    let mut w = ProgramWriter::new(
+        &job.machine.dialect,
+        Setup::Lathe,
+        &job.name,
         &header,
-        "G18 G21 G90 G8 G40 G49 G80 G94",
         "XZ",
         job.machine.resolution,
         job.strategy.chord_tolerance,
-    );
+    )?;
     w.write_all(&turning_moves(job, path))?;
-    Ok(w.finish())
+    w.finish()
+}
+
+/// What a lathe program's X word is in `dialect`, for its header.
+pub fn x_word(dialect: &Dialect) -> &'static str {
+    if dialect.lathe_x_diameter {
+        "the diameter"
+    } else {
+        "the radius"
+    }
 }
 
 /// The move stream of a profile-turning path: spindle on, the planner's
@@ -185,17 +190,6 @@ fn roughing_words(job: &Job, path: &Toolpath) -> String {
     )
 }
 
-fn word(out: &mut String, letter: char, value: f64, decimals: u32) -> Result<(), ProgramError> {
-    if push_fixed(out, value, decimals) {
-        Ok(())
-    } else {
-        Err(ProgramError::NotPrintable {
-            word: letter,
-            value,
-        })
-    }
-}
-
 /// A header figure to 10 decimals (0.1 pm in mm), trailing zeros trimmed:
 /// no exponent, and `1e-5` shows as `0.00001`, not `0.000009999…`.
 fn num(v: f64) -> String {
@@ -224,35 +218,36 @@ fn duration(secs: f64) -> String {
 /// motion is programmed on Z (the form of a slow-tool-servo program);
 /// controllers with a W axis get their own dialect.
 pub struct FtsProgram {
-    writer: LinuxCncWriter,
+    writer: ProgramWriter,
     safe_w: f64,
     /// The last point written (None before the first).
     last: Option<crate::fts::SpiralPoint>,
 }
 
-/// Decimals of C in degrees: 1e-5° is 4 nm of arc at 25 mm.
-const C_DECIMALS: u32 = 5;
-
 impl FtsProgram {
     /// Starts a program: the header comments and the modal line, the
     /// controller's blending held to the chord tolerance.
     pub fn new(
+        dialect: &Dialect,
+        job: &str,
         header: &[String],
         resolution: f64,
         chord_tolerance: f64,
         safe_w: f64,
-    ) -> FtsProgram {
-        FtsProgram {
-            writer: LinuxCncWriter::new(
+    ) -> Result<FtsProgram, ProgramError> {
+        Ok(FtsProgram {
+            writer: ProgramWriter::new(
+                dialect,
+                Setup::Lathe,
+                job,
                 header,
-                "G18 G21 G90 G8 G40 G49 G80 G93",
                 "XZC",
                 resolution,
                 chord_tolerance,
-            ),
+            )?,
             safe_w,
             last: None,
-        }
+        })
     }
 
     /// The move stream of spiral points: the first is reached by rapids
@@ -305,7 +300,7 @@ impl FtsProgram {
 
     /// The text written since the last call, for the caller to pass on
     /// (a program of millions of moves need not be held whole).
-    pub fn take_text(&mut self) -> String {
+    pub fn take_text(&mut self) -> Result<String, ProgramError> {
         self.writer.take_text()
     }
 
@@ -315,7 +310,7 @@ impl FtsProgram {
             z: self.safe_w,
             ..Position::KEEP
         }))?;
-        Ok(self.writer.finish())
+        self.writer.finish()
     }
 }
 
@@ -350,23 +345,26 @@ pub fn raster_moves(path: &crate::raster::RasterPath, feed: f64) -> Vec<moves::M
     out
 }
 
-/// A LinuxCNC program for a raster on a 3-axis mill.
-pub fn emit_mill_raster(
+/// A program for a move stream on a 3-axis mill.
+pub fn emit_mill(
+    dialect: &Dialect,
+    job: &str,
     header: &[String],
-    path: &crate::raster::RasterPath,
-    feed: f64,
+    stream: &[moves::Move],
     resolution: f64,
     chord_tolerance: f64,
 ) -> Result<String, ProgramError> {
-    let mut w = LinuxCncWriter::new(
+    let mut w = ProgramWriter::new(
+        dialect,
+        Setup::Mill,
+        job,
         header,
-        "G17 G21 G90 G40 G49 G80 G94",
         "XYZ",
         resolution,
         chord_tolerance,
-    );
-    w.write_all(&raster_moves(path, feed))?;
-    Ok(w.finish())
+    )?;
+    w.write_all(stream)?;
+    w.finish()
 }
 
 /// The move stream of a grinding pass: the wheel centre's X and Z, each
@@ -405,9 +403,10 @@ pub fn grinding_moves(
     out
 }
 
-/// A LinuxCNC program for a grinding pass: X (radius, G8) and Z of the
-/// wheel centre.
+/// A program for a grinding pass: X and Z of the wheel centre.
 pub fn emit_grinding(
+    dialect: &Dialect,
+    job: &str,
     header: &[String],
     path: &crate::grinding::GrindingPath,
     feed: f64,
@@ -416,15 +415,17 @@ pub fn emit_grinding(
 ) -> Result<String, ProgramError> {
     // Wheel centres are exact at each interval: blending held to the
     // machine's resolution.
-    let mut w = LinuxCncWriter::new(
+    let mut w = ProgramWriter::new(
+        dialect,
+        Setup::Lathe,
+        job,
         header,
-        "G18 G21 G90 G8 G40 G49 G80 G94",
         "XZ",
         resolution,
         resolution,
-    );
+    )?;
     w.write_all(&grinding_moves(path, feed, safe_z))?;
-    Ok(w.finish())
+    w.finish()
 }
 
 /// A LinuxCNC program for roller helix turning: X (the nose centre's
@@ -432,7 +433,7 @@ pub fn emit_grinding(
 /// angle in degrees counted on from the first pass; each pass starts on a
 /// whole turn after the last, moves timed by inverse-time feed (G93).
 pub struct RollerProgram {
-    writer: LinuxCncWriter,
+    writer: ProgramWriter,
     safe_x: f64,
     spindle_speed: f64,
     /// C (rad) where the current pass started, and the last point.
@@ -444,21 +445,30 @@ pub struct RollerProgram {
 impl RollerProgram {
     /// The roller's points are the exact nose centres at each C step:
     /// blending is held to the machine's resolution.
-    pub fn new(header: &[String], resolution: f64, safe_x: f64, spindle_speed: f64) -> Self {
-        RollerProgram {
-            writer: LinuxCncWriter::new(
+    pub fn new(
+        dialect: &Dialect,
+        job: &str,
+        header: &[String],
+        resolution: f64,
+        safe_x: f64,
+        spindle_speed: f64,
+    ) -> Result<Self, ProgramError> {
+        Ok(RollerProgram {
+            writer: ProgramWriter::new(
+                dialect,
+                Setup::Lathe,
+                job,
                 header,
-                "G18 G21 G90 G8 G40 G49 G80 G93",
                 "XZC",
                 resolution,
                 resolution,
-            ),
+            )?,
             safe_x,
             spindle_speed,
             c_base: 0.0,
             last: None,
             pass: usize::MAX,
-        }
+        })
     }
 
     /// Appends points of pass `pass`; a new pass retracts X, moves to its
@@ -508,7 +518,7 @@ impl RollerProgram {
     }
 
     /// The text written since the last call.
-    pub fn take_text(&mut self) -> String {
+    pub fn take_text(&mut self) -> Result<String, ProgramError> {
         self.writer.take_text()
     }
 
@@ -518,25 +528,47 @@ impl RollerProgram {
             x: self.safe_x,
             ..Position::KEEP
         }))?;
-        Ok(self.writer.finish())
+        self.writer.finish()
     }
 }
 
-/// The LinuxCNC (RS274NGC) post-processor: header comments, a modal line,
-/// then the move stream, word by word. A word whose printed value has not
+/// Which safe-start lines a program uses, and the arc plane they select.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Setup {
+    /// `lathe_setup`, G18 (Z, X): X is the radius or the diameter.
+    Lathe,
+    /// `mill_setup`, G17 (X, Y).
+    Mill,
+}
+
+/// The post-processor: a move stream to a program in a dialect given as
+/// data. The start lines, header comments, setup and path-tolerance
+/// lines, then the moves word by word: a word whose printed value has not
 /// changed is left out (axes are modal); a feed is written when it or its
-/// mode changes, and on every move in inverse time (G93 requires it); a
-/// move that changes no printed axis is left out whole.
-pub struct LinuxCncWriter {
+/// mode changes, and on every move in inverse time; a move that changes no
+/// printed axis is left out whole. Every value goes through the one
+/// fixed-point formatter and the dialect's digit limit; every chunk of
+/// text handed out has passed `check_numbers`.
+pub struct ProgramWriter {
     text: String,
+    dialect: Dialect,
     decimals: u32,
     /// Letters of the machine's axes among X, Y, Z, C (others are refused).
     letters: [Option<char>; 4],
+    /// Factor from the move stream's X to the printed X (2 in diameter mode).
+    x_scale: f64,
     /// The last value printed per axis, in units of its last decimal.
     last: [Option<i64>; 4],
+    /// Where the axes are (mm, rad; the stream's values).
+    at: [f64; 4],
+    plane: Plane,
     mode: Option<FeedMode>,
     /// The last feed printed, in units of its last decimal.
     last_feed: Option<i64>,
+    /// The next block number.
+    block: u64,
+    c_axis_on: bool,
+    job: String,
     pub moves: usize,
 }
 
@@ -547,83 +579,313 @@ enum FeedMode {
     InverseTime,
 }
 
-impl LinuxCncWriter {
-    /// `modal` is the program's line of G words after the header; `axes`
-    /// the machine's axis letters among "XYZC"; `path_tolerance` (mm), the
-    /// most the controller may blend corners away from the programmed path
-    /// (`G64 P`), is the strategy's own tolerance so the two never add up
-    /// beyond it.
+/// Decimals of feeds per minute and per revolution, and of inverse time.
+const FEED_DECIMALS: u32 = 6;
+const INVERSE_TIME_DECIMALS: u32 = 3;
+
+impl ProgramWriter {
+    /// Starts a program for job `job`: `axes` are the machine's axis
+    /// letters among "XYZC"; `path_tolerance` (mm), the most the controller
+    /// may blend corners away from the programmed path, is the strategy's
+    /// own tolerance so the two never add up beyond it. Refused if the
+    /// machine's resolution needs more decimals than the dialect writes.
     pub fn new(
+        dialect: &Dialect,
+        setup: Setup,
+        job: &str,
         header: &[String],
-        modal: &str,
         axes: &str,
         resolution: f64,
         path_tolerance: f64,
-    ) -> Self {
-        let mut text = String::new();
-        for line in header {
-            write_comment(&mut text, line);
+    ) -> Result<Self, ProgramError> {
+        let decimals = decimals_for(resolution);
+        if let Some(max) = dialect.max_decimals
+            && decimals > max
+        {
+            return Err(ProgramError::Unsupported(format!(
+                "the machine's resolution ({resolution} mm needs {decimals} decimals; {} writes at most {max})",
+                dialect.name
+            )));
         }
-        text.push_str(modal);
-        text.push_str(" G64 P");
-        let d = decimals_for(path_tolerance).max(decimals_for(resolution));
-        if !push_fixed(&mut text, path_tolerance, d) {
-            text.push('0');
+        let setup_lines = match setup {
+            Setup::Lathe => &dialect.lathe_setup,
+            Setup::Mill => &dialect.mill_setup,
+        };
+        if setup_lines.is_empty() {
+            return Err(ProgramError::Unsupported(format!(
+                "{} programs ({} has no `{}_setup`)",
+                match setup {
+                    Setup::Lathe => "lathe",
+                    Setup::Mill => "mill",
+                },
+                dialect.name,
+                match setup {
+                    Setup::Lathe => "lathe",
+                    Setup::Mill => "mill",
+                },
+            )));
         }
-        text.push('\n');
         let has = |c: char| axes.contains(c).then_some(c);
-        LinuxCncWriter {
-            text,
-            decimals: decimals_for(resolution),
-            letters: [has('X'), has('Y'), has('Z'), has('C')],
+        let mut w = ProgramWriter {
+            text: String::new(),
+            dialect: dialect.clone(),
+            decimals,
+            letters: [
+                has('X'),
+                has('Y'),
+                has('Z'),
+                has('C').map(|_| dialect.c_letter),
+            ],
+            x_scale: if setup == Setup::Lathe && dialect.lathe_x_diameter {
+                2.0
+            } else {
+                1.0
+            },
             last: [None; 4],
-            // The first feed states its mode, whatever the modal line says.
+            at: [f64::NAN; 4],
+            plane: match setup {
+                Setup::Lathe => Plane::Zx,
+                Setup::Mill => Plane::Xy,
+            },
+            // The first feed states its mode, whatever the setup says.
             mode: None,
             last_feed: None,
+            block: dialect.line_numbers.unwrap_or(0),
+            c_axis_on: false,
+            job: job.to_string(),
             moves: 0,
+        };
+        for line in &dialect.start {
+            let l = w.fill(line, path_tolerance);
+            w.text.push_str(&l);
+            w.text.push('\n');
         }
+        for line in header {
+            w.comment(line);
+        }
+        for line in setup_lines.iter().chain(&dialect.path_tolerance) {
+            let l = w.fill(line, path_tolerance);
+            w.block_line(&l)?;
+        }
+        Ok(w)
+    }
+
+    /// A line with its placeholders filled in.
+    fn fill(&self, line: &str, tolerance: f64) -> String {
+        let d = decimals_for(tolerance).max(self.decimals);
+        let mut tol = String::new();
+        if !push_fixed(&mut tol, tolerance, d) {
+            tol.push('0');
+        }
+        line.replace("{job}", &self.job)
+            .replace("{JOB}", &self.job.to_uppercase())
+            .replace("{number}", &self.dialect.program_number.to_string())
+            .replace("{tolerance}", &tol)
+    }
+
+    /// Starts a block: its number, if the dialect numbers blocks.
+    fn begin_block(&mut self) {
+        if self.dialect.line_numbers.is_some() {
+            self.text.push('N');
+            self.text.push_str(itoa::Buffer::new().format(self.block));
+            self.text.push(' ');
+        }
+    }
+
+    /// Ends the block begun at byte `start`: the dialect's block end, the
+    /// line-length limit, the next block number.
+    fn end_block(&mut self, start: usize) -> Result<(), ProgramError> {
+        self.text.push_str(&self.dialect.block_end);
+        if let Some(max) = self.dialect.max_line_length
+            && self.text.len() - start > max
+        {
+            let line = self.text[start..].to_string();
+            self.text.truncate(start);
+            return Err(ProgramError::Unsupported(format!(
+                "a line of {} characters ({} reads at most {max}): {line}",
+                line.len(),
+                self.dialect.name
+            )));
+        }
+        self.text.push('\n');
+        if let Some(step) = self.dialect.line_numbers {
+            self.block += step;
+            if self.dialect.max_line_number.is_some_and(|m| self.block > m) {
+                self.block = step;
+            }
+        }
+        Ok(())
+    }
+
+    fn block_line(&mut self, words: &str) -> Result<(), ProgramError> {
+        let start = self.text.len();
+        self.begin_block();
+        self.text.push_str(words);
+        self.end_block(start)
+    }
+
+    /// Writes `text` as comments in the dialect's syntax: no nested
+    /// parentheses or control characters, long text folded at ", ".
+    pub fn comment(&mut self, text: &str) {
+        let mut lines = String::new();
+        write_comment(&mut lines, text);
+        for line in lines.lines() {
+            let body = &line[1..line.len() - 1];
+            let start = self.text.len();
+            self.begin_block();
+            match self.dialect.comment {
+                CommentStyle::Parentheses => {
+                    self.text.push('(');
+                    self.text.push_str(body);
+                    self.text.push(')');
+                }
+                CommentStyle::Semicolon => {
+                    self.text.push_str("; ");
+                    self.text.push_str(body);
+                }
+            }
+            // Comments are folded to 120 characters: within every limit.
+            let _ = self.end_block(start);
+        }
+    }
+
+    /// Appends a value's digits, refusing more than the dialect's limit.
+    fn value(&mut self, letter: char, v: f64, n: i64, d: u32) -> Result<(), ProgramError> {
+        let before = self.text.len();
+        push_units(&mut self.text, n, d);
+        if let Some(max) = self.dialect.max_digits {
+            let digits = self.text.as_bytes()[before..]
+                .iter()
+                .filter(|b| b.is_ascii_digit())
+                .count();
+            if digits > max as usize {
+                return Err(ProgramError::Unsupported(format!(
+                    "{letter}{v} in {} digits ({} takes at most {max})",
+                    digits, self.dialect.name
+                )));
+            }
+        }
+        Ok(())
     }
 
     /// Writes one move, straight into the text (no allocation per move:
     /// a move that changes no printed axis is written and then cut off).
     pub fn write(&mut self, m: &crate::moves::Move) -> Result<(), ProgramError> {
-        use crate::moves::{Feed as F, Move as M};
-        let (g, to, feed) = match *m {
-            M::Rapid(to) => ("G0", to, None),
-            M::Linear { to, feed } => ("G1", to, feed),
-            M::SpindleOn(Some(w)) => {
-                self.text.push('S');
-                word(&mut self.text, 'S', w * 60.0 / (2.0 * PI), 3)?;
-                self.text.push_str(" M3\n");
-                return Ok(());
+        use crate::moves::Move as M;
+        let start = self.text.len();
+        let r = match *m {
+            M::Rapid(to) => self.motion(Word::Rapid, to, None, None),
+            M::Linear { to, feed } => self.motion(Word::Linear, to, feed, None),
+            M::Arc {
+                to,
+                centre,
+                plane,
+                ccw,
+                feed,
+            } => {
+                let w = if ccw { Word::ArcCcw } else { Word::ArcCw };
+                self.motion(w, to, feed, Some((plane, centre)))
             }
-            M::Arc { .. } => return Err(ProgramError::Unsupported("arcs".into())),
-            M::SpindleOn(None) => {
-                self.text.push_str("M3\n");
-                return Ok(());
+            M::SpindleOn(speed) => {
+                self.begin_block();
+                if let Some(w) = speed {
+                    let rpm = w * 60.0 / (2.0 * PI);
+                    self.text.push('S');
+                    match fixed_units(rpm, 3) {
+                        Some(n) => self.value('S', rpm, n, 3)?,
+                        None => {
+                            return Err(ProgramError::NotPrintable {
+                                word: 'S',
+                                value: rpm,
+                            });
+                        }
+                    }
+                    self.text.push(' ');
+                }
+                let on = self.dialect.spindle_on.clone();
+                self.text.push_str(&on);
+                self.end_block(start)
             }
             M::SpindleOff => {
-                self.text.push_str("M5\n");
-                return Ok(());
+                let off = self.dialect.spindle_off.clone();
+                self.block_line(&off)
             }
         };
+        if r.is_err() {
+            self.text.truncate(start);
+        }
+        r
+    }
+
+    fn motion(
+        &mut self,
+        word: Word,
+        to: Position,
+        feed: Option<crate::moves::Feed>,
+        arc: Option<(Plane, Position)>,
+    ) -> Result<(), ProgramError> {
+        use crate::moves::Feed as F;
+        if !to.c.is_nan() && !self.c_axis_on && self.letters[3].is_some() {
+            self.c_axis_on = true;
+            for line in self.dialect.c_axis_on.clone() {
+                self.block_line(&line)?;
+            }
+        }
         let start = self.text.len();
+        self.begin_block();
         let mode = feed.map(|f| match f {
-            F::PerTime(v) => (FeedMode::PerMinute, v * 60.0, 6),
-            F::PerRevolution(v) => (FeedMode::PerRevolution, v * 2.0 * PI, 6),
-            F::InverseTime(t) => (FeedMode::InverseTime, 60.0 / t, 3),
+            F::PerTime(v) => (FeedMode::PerMinute, v * 60.0, FEED_DECIMALS),
+            F::PerRevolution(v) => (FeedMode::PerRevolution, v * 2.0 * PI, FEED_DECIMALS),
+            F::InverseTime(t) => (FeedMode::InverseTime, 60.0 / t, INVERSE_TIME_DECIMALS),
         });
         let mode_changes = mode.is_some_and(|(m, _, _)| self.mode != Some(m));
         if let Some((m, _, _)) = mode
             && mode_changes
         {
-            self.text.push_str(match m {
-                FeedMode::PerMinute => "G94 ",
-                FeedMode::PerRevolution => "G95 ",
-                FeedMode::InverseTime => "G93 ",
-            });
+            let w = match m {
+                FeedMode::PerMinute => &self.dialect.per_minute,
+                FeedMode::PerRevolution => &self.dialect.per_revolution,
+                FeedMode::InverseTime => &self.dialect.inverse_time,
+            };
+            let Some(w) = w else {
+                return Err(ProgramError::Unsupported(format!(
+                    "feeds {} ({} has no word for them)",
+                    match m {
+                        FeedMode::PerMinute => "per minute",
+                        FeedMode::PerRevolution => "per revolution",
+                        FeedMode::InverseTime => "in inverse time",
+                    },
+                    self.dialect.name
+                )));
+            };
+            let w = w.clone();
+            self.text.push_str(&w);
+            self.text.push(' ');
         }
-        self.text.push_str(g);
+        if let Some((plane, _)) = arc {
+            if !self.dialect.arc_planes.contains(&plane) {
+                return Err(ProgramError::Unsupported(format!(
+                    "arcs in the {} plane",
+                    plane.name()
+                )));
+            }
+            if plane != self.plane {
+                self.text.push_str(match plane {
+                    Plane::Xy => "G17 ",
+                    Plane::Zx => "G18 ",
+                    Plane::Yz => "G19 ",
+                });
+                self.plane = plane;
+            }
+        }
+        let w = match word {
+            Word::Rapid => &self.dialect.rapid,
+            Word::Linear => &self.dialect.linear,
+            Word::ArcCw => &self.dialect.arc_cw,
+            Word::ArcCcw => &self.dialect.arc_ccw,
+        };
+        let w = w.clone();
+        self.text.push_str(&w);
         let mut printed = self.last;
         let mut any = false;
         for (i, v) in to.axes().into_iter().enumerate() {
@@ -631,13 +893,14 @@ impl LinuxCncWriter {
                 continue;
             }
             let letter = self.letters[i];
-            let (value, d) = if letter == Some('C') {
-                (v.to_degrees(), C_DECIMALS)
+            let (value, d) = if i == 3 {
+                (v.to_degrees(), self.dialect.c_decimals)
+            } else if i == 0 {
+                (v * self.x_scale, self.decimals)
             } else {
                 (v, self.decimals)
             };
             let (Some(letter), Some(n)) = (letter, fixed_units(value, d)) else {
-                self.text.truncate(start);
                 return Err(ProgramError::NotPrintable {
                     word: self.letters[i].unwrap_or("XYZC".as_bytes()[i] as char),
                     value: v,
@@ -649,7 +912,7 @@ impl LinuxCncWriter {
             }
             self.text.push(' ');
             self.text.push(letter);
-            push_units(&mut self.text, n, d);
+            self.value(letter, value, n, d)?;
             printed[i] = Some(n);
             any = true;
         }
@@ -657,20 +920,49 @@ impl LinuxCncWriter {
             self.text.truncate(start);
             return Ok(());
         }
+        if let Some((plane, centre)) = arc {
+            // I J K in that order, whatever the plane's orientation.
+            let (a, b) = plane.axes();
+            for i in [a.min(b), a.max(b)] {
+                let c = centre.axes()[i];
+                let from = if self.dialect.arc_centre_absolute {
+                    0.0
+                } else {
+                    self.at[i]
+                };
+                let (Some(cu), Some(fu)) = (
+                    fixed_units(c, self.decimals),
+                    fixed_units(from, self.decimals),
+                ) else {
+                    return Err(ProgramError::NotPrintable {
+                        word: ['I', 'J', 'K'][i],
+                        value: c,
+                    });
+                };
+                let letter = ['I', 'J', 'K'][i];
+                self.text.push(' ');
+                self.text.push(letter);
+                self.value(letter, c - from, cu - fu, self.decimals)?;
+            }
+        }
         if let Some((m, value, d)) = mode {
             let Some(n) = fixed_units(value, d) else {
-                self.text.truncate(start);
                 return Err(ProgramError::NotPrintable { word: 'F', value });
             };
             if mode_changes || m == FeedMode::InverseTime || self.last_feed != Some(n) {
                 self.text.push_str(" F");
-                push_units(&mut self.text, n, d);
+                self.value('F', value, n, d)?;
             }
             self.last_feed = Some(n);
             self.mode = Some(m);
         }
-        self.text.push('\n');
+        self.end_block(start)?;
         self.last = printed;
+        for (i, v) in to.axes().into_iter().enumerate() {
+            if !v.is_nan() {
+                self.at[i] = v;
+            }
+        }
         self.moves += 1;
         Ok(())
     }
@@ -683,18 +975,88 @@ impl LinuxCncWriter {
         moves.into_iter().try_for_each(|m| self.write(m))
     }
 
-    /// The text written since the last call (for streaming to a file); the
-    /// next chunk starts with room for as much again.
-    pub fn take_text(&mut self) -> String {
+    /// The text written since the last call (for streaming to a file),
+    /// checked by `check_numbers`; the next chunk starts with room for as
+    /// much again.
+    pub fn take_text(&mut self) -> Result<String, ProgramError> {
         let room = self.text.len();
-        std::mem::replace(&mut self.text, String::with_capacity(room))
+        let text = std::mem::replace(&mut self.text, String::with_capacity(room));
+        check_numbers(&text, self.dialect.comment)?;
+        Ok(text)
     }
 
-    /// Ends the program; the text not yet taken.
-    pub fn finish(mut self) -> String {
-        self.text.push_str("M2\n");
-        self.text
+    /// Ends the program; the text not yet taken, checked.
+    pub fn finish(mut self) -> Result<String, ProgramError> {
+        if self.c_axis_on {
+            for line in self.dialect.c_axis_off.clone() {
+                self.block_line(&line)?;
+            }
+        }
+        for line in self.dialect.end.clone() {
+            let l = self.fill(&line, 0.0);
+            self.block_line(&l)?;
+        }
+        for line in self.dialect.trailer.clone() {
+            let l = self.fill(&line, 0.0);
+            self.text.push_str(&l);
+            self.text.push('\n');
+        }
+        check_numbers(&self.text, self.dialect.comment)?;
+        Ok(self.text)
     }
+}
+
+#[derive(Clone, Copy)]
+enum Word {
+    Rapid,
+    Linear,
+    ArcCw,
+    ArcCcw,
+}
+
+/// The final check on program text: outside comments, no word's number
+/// is `-0`, has an exponent, or is not finite (`NaN`, `inf`), and no
+/// digit runs straight into a letter. The writer cannot produce these; this
+/// check makes sure no path around it does.
+pub fn check_numbers(text: &str, comments: CommentStyle) -> Result<(), ProgramError> {
+    for line in text.lines() {
+        let code = match comments {
+            CommentStyle::Parentheses => line.split('(').next().unwrap_or(""),
+            CommentStyle::Semicolon => line.split(';').next().unwrap_or(""),
+        };
+        for token in code.split_ascii_whitespace() {
+            let bad = |why: &str| {
+                Err(ProgramError::Unsupported(format!(
+                    "the word `{token}` ({why}) in the line `{line}`"
+                )))
+            };
+            let lower = token.to_ascii_lowercase();
+            if lower.contains("nan") || lower.contains("inf") {
+                return bad("not a finite number");
+            }
+            let b = token.as_bytes();
+            if b.len() < 2 || !b[0].is_ascii_alphabetic() {
+                continue;
+            }
+            let num = &token[1..];
+            if !num.starts_with(|c: char| c.is_ascii_digit() || c == '-' || c == '.') {
+                continue;
+            }
+            if num
+                .trim_start_matches('-')
+                .bytes()
+                .any(|c| !(c.is_ascii_digit() || c == b'.'))
+            {
+                // `G05.1`-style words are digits and points only; anything
+                // else after a number is an exponent or a run-on word.
+                return bad("a number with letters in it");
+            }
+            if num.starts_with('-') && num.bytes().all(|c| matches!(c, b'-' | b'0' | b'.')) {
+                return bad("minus zero");
+            }
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -703,9 +1065,18 @@ mod tests {
     use crate::moves::{Feed as F, Move as M, Position as P};
 
     fn written(axes: &str, stream: &[M]) -> Result<String, ProgramError> {
-        let mut w = LinuxCncWriter::new(&["t".into()], "G17", axes, 1e-3, 1e-3);
+        written_in(&Dialect::linuxcnc(), Setup::Mill, axes, stream)
+    }
+
+    fn written_in(
+        d: &Dialect,
+        setup: Setup,
+        axes: &str,
+        stream: &[M],
+    ) -> Result<String, ProgramError> {
+        let mut w = ProgramWriter::new(d, setup, "t1", &["t".into()], axes, 1e-3, 1e-3)?;
         w.write_all(stream)?;
-        Ok(w.finish())
+        w.finish()
     }
 
     #[test]
@@ -736,7 +1107,7 @@ mod tests {
         .expect("writes");
         assert_eq!(
             text,
-            "(t)\nG17 G64 P0.001\nG0 X1. Y2. Z5.\nG94 G1 Z0.5 F60.\nG1 X1.5\nG1 Y2.5 F120.\nM2\n"
+            "(t)\nG17 G21 G90 G40 G49 G80\nG64 P0.001\nG0 X1. Y2. Z5.\nG94 G1 Z0.5 F60.\nG1 X1.5\nG1 Y2.5 F120.\nM2\n"
         );
     }
 
@@ -762,8 +1133,105 @@ mod tests {
         .expect("writes");
         assert_eq!(
             text,
-            "(t)\nG17 G64 P0.001\nG93 G1 X1. Z0. C90. F120.\nG1 X0.9 C180. F120.\nG95 G1 X0.8 Z0.1 F0.006283\nM2\n"
+            "(t)\nG17 G21 G90 G40 G49 G80\nG64 P0.001\nG93 G1 X1. Z0. C90. F120.\nG1 X0.9 C180. F120.\nG95 G1 X0.8 Z0.1 F0.006283\nM2\n"
         );
+    }
+
+    #[test]
+    fn a_dialect_given_as_data_shapes_every_line() {
+        let mut d = Dialect::linuxcnc();
+        d.name = "heidenhain_like".into();
+        d.comment = CommentStyle::Semicolon;
+        d.start = vec!["%{JOB} G71 *".into()];
+        d.mill_setup = vec!["G17 G90".into()];
+        d.path_tolerance = Vec::new();
+        d.end = vec!["M30".into()];
+        d.trailer = vec!["N99999999 %{JOB} G71 *".into()];
+        d.line_numbers = Some(1);
+        d.block_end = " *".into();
+        d.arc_centre_absolute = true;
+        let text = written_in(
+            &d,
+            Setup::Mill,
+            "XYZ",
+            &[
+                M::Rapid(P::xyz(1.0, 0.0, 0.0)),
+                M::Arc {
+                    to: P::xyz(0.0, 1.0, 0.0),
+                    centre: P::xyz(0.0, 0.0, f64::NAN),
+                    plane: Plane::Xy,
+                    ccw: true,
+                    feed: Some(F::PerTime(1.0)),
+                },
+            ],
+        )
+        .expect("writes");
+        assert_eq!(
+            text,
+            "%T1 G71 *\nN1 ; t *\nN2 G17 G90 *\nN3 G0 X1. Y0. Z0. *\nN4 G94 G3 X0. Y1. I0. J0. F60. *\nN5 M30 *\nN99999999 %T1 G71 *\n"
+        );
+    }
+
+    #[test]
+    fn arcs_have_incremental_centres_and_select_their_plane() {
+        let text = written(
+            "XYZ",
+            &[
+                M::Rapid(P::xyz(1.0, 0.0, 2.0)),
+                M::Arc {
+                    to: P::xyz(3.0, 0.0, 2.0),
+                    centre: P::xyz(2.0, f64::NAN, 2.0),
+                    plane: Plane::Zx,
+                    ccw: false,
+                    feed: Some(F::PerTime(1.0)),
+                },
+            ],
+        )
+        .expect("writes");
+        assert!(text.contains("G94 G18 G2 X3. I1. K0. F60.\n"), "{text}");
+    }
+
+    #[test]
+    fn diameter_mode_doubles_x_and_limits_are_enforced() {
+        let mut d = Dialect::linuxcnc();
+        d.lathe_x_diameter = true;
+        d.max_digits = Some(4);
+        let text = written_in(&d, Setup::Lathe, "XZ", &[M::Rapid(P::xz(1.25, 0.0))])
+            .expect("writes");
+        assert!(text.contains("G0 X2.5 Z0.\n"), "{text}");
+        assert!(matches!(
+            written_in(&d, Setup::Lathe, "XZ", &[M::Rapid(P::xz(12.3455, 0.0))]),
+            Err(ProgramError::Unsupported(_))
+        ));
+        d.per_revolution = None;
+        assert!(matches!(
+            written_in(
+                &d,
+                Setup::Lathe,
+                "XZ",
+                &[M::Linear {
+                    to: P::xz(1.0, 0.0),
+                    feed: Some(F::PerRevolution(0.001))
+                }]
+            ),
+            Err(ProgramError::Unsupported(_))
+        ));
+        d.max_decimals = Some(2);
+        assert!(written_in(&d, Setup::Lathe, "XZ", &[]).is_err());
+        assert!(written_in(&Dialect::linuxcnc(), Setup::Lathe, "XZ", &[]).is_ok());
+    }
+
+    #[test]
+    fn the_final_check_refuses_bad_numbers_outside_comments() {
+        let ok = "(X-0. in a comment, 1e5 too)\nG1 X-0.5 Z0. F60.\nG05.1 Q1\n";
+        assert!(check_numbers(ok, CommentStyle::Parentheses).is_ok());
+        for bad in ["G1 X-0.", "G1 X-0.000", "G1 X1.5e-3", "G1 XNaN", "G1 Z-inf", "G1 X1.0Y2."] {
+            assert!(
+                check_numbers(bad, CommentStyle::Parentheses).is_err(),
+                "{bad} passed"
+            );
+        }
+        assert!(check_numbers("; X-0. here", CommentStyle::Semicolon).is_ok());
     }
 
     #[test]

@@ -561,7 +561,7 @@ mod roughing_tests {
                 rake_angle: 0.0,
             },
             machine: Lathe {
-                dialect: Dialect::LinuxCnc,
+                dialect: Dialect::linuxcnc(),
                 resolution: 1e-6,
                 travel_x: (-10.0, 100.0),
                 travel_z: (-100.0, 100.0),
