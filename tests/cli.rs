@@ -53,12 +53,20 @@ fn missing_file_is_a_user_error() {
 fn usage_errors_exit_two() {
     assert_eq!(lensc(&root(), &["check"]).status.code(), Some(2));
     assert_eq!(lensc(&root(), &["frobnicate"]).status.code(), Some(2));
-    assert_eq!(
-        lensc(&root(), &["build", GOOD, "--dialect", "klingon"])
-            .status
-            .code(),
-        Some(2)
+    // A dialect the machine does not offer is the user's error, E0148.
+    let out = lensc(
+        &root(),
+        &[
+            "build",
+            GOOD,
+            "--dialect",
+            "klingon",
+            "--out",
+            "/tmp/lensc-cli-klingon",
+        ],
     );
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out.stderr).contains("E0148"), "{}", text(&out.stderr));
     assert_eq!(
         lensc(&root(), &["check", "--message-format", "xml", GOOD])
             .status

@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{buildable_examples, examples, lensc, root, surface_names, text};
+use common::{abridged, buildable_examples, examples, lensc, root, surface_names, text};
 
 #[test]
 fn every_example_checks_clean() {
@@ -26,14 +26,9 @@ fn every_example_checks_clean() {
     }
 }
 
-/// Programs above this size are snapshotted by their head, their tail,
-/// their length and a hash of the whole (which still pins every byte): the
-/// raster programs run to hundreds of kilobytes, the fast-tool-servo one
-/// to hundreds of megabytes.
-const WHOLE_SNAPSHOT_LIMIT: usize = 256 << 10;
-
 /// Builds every example (they must all build) and compares each program
-/// with its reviewed snapshot.
+/// with its reviewed snapshot; programs above `WHOLE_SNAPSHOT_LIMIT` are
+/// snapshot abridged (see `common::abridged`).
 #[test]
 fn example_programs_match_their_snapshots() {
     let dir = tempfile::tempdir().expect("tmp");
@@ -59,7 +54,7 @@ fn example_programs_match_their_snapshots() {
     for p in programs {
         let name = p.file_name().expect("name").to_string_lossy().to_string();
         let program = std::fs::read_to_string(&p).expect("program");
-        let program = if program.len() > WHOLE_SNAPSHOT_LIMIT {
+        let program = if program.len() > common::WHOLE_SNAPSHOT_LIMIT {
             abridged(&program)
         } else {
             program
@@ -72,24 +67,6 @@ fn example_programs_match_their_snapshots() {
 
 /// The first 40 lines, the number of lines and bytes with the FNV-1a 64
 /// hash of the whole text, and the last 3 lines.
-fn abridged(program: &str) -> String {
-    let lines: Vec<&str> = program.lines().collect();
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in program.bytes() {
-        h ^= u64::from(b);
-        h = h.wrapping_mul(0x0100_0000_01b3);
-    }
-    let mut out = lines[..40.min(lines.len())].join("\n");
-    out.push_str(&format!(
-        "\n… {} lines, {} bytes, fnv1a64 {h:016x} …\n",
-        lines.len(),
-        program.len()
-    ));
-    out.push_str(&lines[lines.len().saturating_sub(3)..].join("\n"));
-    out.push('\n');
-    out
-}
-
 #[test]
 fn every_surface_of_every_example_samples() {
     for ex in examples() {

@@ -116,7 +116,8 @@ fn every_example_program_passes_rs274() {
             // Blending is on and held to the tolerance the program states.
             let program = std::fs::read_to_string(&p).expect("program");
             let stated: f64 = program
-                .split_once(" G64 P")
+                .lines()
+                .find_map(|l| l.split_once("G64 P"))
                 .and_then(|(_, rest)| rest.split_whitespace().next())
                 .and_then(|v| v.parse().ok())
                 .unwrap_or_else(|| panic!("{}: no G64 P", p.display()));

@@ -1811,7 +1811,10 @@ fn ty_words(ty: &Ty) -> String {
             .join(" or "),
         Ty::Word(words) => one_of(words),
         Ty::Object(c) => c.noun().to_string(),
-        Ty::Objects(c) => format!("a list of {}s", c.noun().trim_start_matches("a ").trim_start_matches("an ")),
+        Ty::Objects(c) => format!(
+            "a list of {}s",
+            c.noun().trim_start_matches("a ").trim_start_matches("an ")
+        ),
         Ty::Text => "a string `\"…\"`".into(),
         Ty::Texts => "a list of strings `[\"…\"]`".into(),
         Ty::Block(_) => "a block `{ … }`".into(),

@@ -143,13 +143,11 @@ pub fn plan_and_emit(
             }
         };
         let other = match strategy.kind.name {
-            "fts_spiral" | "spiral_turning" => Some(crate::fts_job::build(
-                job, &prov, &dialect, spool_dir,
-            )),
+            "fts_spiral" | "spiral_turning" => {
+                Some(crate::fts_job::build(job, &prov, &dialect, spool_dir))
+            }
             "raster" => Some(crate::mill_job::build_raster(job, &prov, &dialect)),
-            "roller_helix" => Some(crate::roller_job::build(
-                job, &prov, &dialect, spool_dir,
-            )),
+            "roller_helix" => Some(crate::roller_job::build(job, &prov, &dialect, spool_dir)),
             "profile_grinding" => Some(crate::mill_job::build_grinding(job, &prov, &dialect)),
             _ => None,
         };
@@ -267,13 +265,8 @@ pub fn plan_and_emit(
                 });
             }
             Err(e) => diags.push(
-                Diagnostic::error(
-                    codes::NOT_PRINTABLE,
-                    e.message(),
-                    file,
-                    span,
-                )
-                .with_label("no program was written for this job"),
+                Diagnostic::error(codes::NOT_PRINTABLE, e.message(), file, span)
+                    .with_label("no program was written for this job"),
             ),
         }
     }

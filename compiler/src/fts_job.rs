@@ -5,12 +5,12 @@
 //! from the servo model, the spiral planned and streamed into a LinuxCNC
 //! program, and the report of what it makes.
 
-use lensc_runtime::machine::Dialect;
 use lensc_grammar::{Diagnostic, FileId, Span};
 use lensc_runtime::fts::{
     FastAxis, FtsError, FtsSpiral, FtsSummary, Planner, SpindleSpeed, TrajectoryBounds,
 };
 use lensc_runtime::ir::SurfaceFn;
+use lensc_runtime::machine::Dialect;
 use lensc_runtime::program::{FtsProgram, ProgramError, Provenance};
 use lensc_runtime::servo::SecondOrderServo;
 use serde_json::json;
@@ -572,10 +572,7 @@ fn header_lines(
     let (servo_words, axis_words) = if slow {
         ("slow-tool-servo", "Z carries the surface")
     } else {
-        (
-            "fast-tool-servo",
-            "Z the fast tool servo's axis",
-        )
+        ("fast-tool-servo", "Z the fast tool servo's axis")
     };
     let speed = match spiral.speed {
         SpindleSpeed::Constant(w) => format!("constant spindle speed {} rpm", trim_num(rpm(w))),
@@ -588,8 +585,14 @@ fn header_lines(
     let mut lines = vec![
         format!("lensc {}: job {}", prov.lensc_version, job.name.name),
         format!("source {} fnv1a64 {:016x}", prov.source, prov.source_hash),
-        format!("units mm; X is {}, C the spindle angle in degrees counted on from the start, {axis_words}, +Z out of the material", lensc_runtime::program::x_word(parts.dialect)),
-        format!("coordinates are the centre of the tool nose; {}", parts.inverse_time_words()),
+        format!(
+            "units mm; X is {}, C the spindle angle in degrees counted on from the start, {axis_words}, +Z out of the material",
+            lensc_runtime::program::x_word(parts.dialect)
+        ),
+        format!(
+            "coordinates are the centre of the tool nose; {}",
+            parts.inverse_time_words()
+        ),
         format!("surface {surface}: {surface_words}"),
         format!("tool {tool}: round nose, nose radius {} mm", trim_num(rho)),
         format!(
@@ -598,7 +601,10 @@ fn header_lines(
             trim_num(spiral.feed_per_rev * 1000.0),
             trim_num(spiral.chord_tolerance * 1e6)
         ),
-        format!("machine {machine}: {} {servo_words} lathe", parts.dialect.name),
+        format!(
+            "machine {machine}: {} {servo_words} lathe",
+            parts.dialect.name
+        ),
     ];
     match settling {
         None if slow => {}

@@ -187,7 +187,12 @@ impl Loader<'_> {
             .find(|(n, _)| *n == name)
             .map(|(_, t)| *t)
             .expect("a standard-library module");
-        self.add(key, format!("std/{name}.lens"), None, text.as_bytes().to_vec())
+        self.add(
+            key,
+            format!("std/{name}.lens"),
+            None,
+            text.as_bytes().to_vec(),
+        )
     }
 
     fn resolve_use(

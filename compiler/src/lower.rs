@@ -292,25 +292,17 @@ pub fn describe(o: &Object) -> String {
 /// the one `requested` (by `lensc build --dialect`) among it and its
 /// `other_dialects`; E0148 if the machine offers no dialect of that name.
 pub fn dialect(job: &CheckedJob, requested: Option<&str>) -> Result<Dialect, Diagnostic> {
-    let machine = value::object(&job.fields, "machine").expect("checked job part");
-    let mut offered: Vec<&Object> = value::object(&machine.fields, "dialect")
-        .map(|o| o.as_ref())
-        .into_iter()
-        .collect();
-    if let Some(Value::List(items)) = value::field(&machine.fields, "other_dialects").map(|f| &f.value) {
-        offered.extend(items.iter().filter_map(|(v, _)| match v {
-            Value::Object(o) => Some(o.as_ref()),
-            _ => None,
-        }));
-    }
-    let name = |o: &Object| o.name.clone().unwrap_or_else(|| o.kind.name.to_string());
+    let offered = offered(job);
     let chosen = match requested {
         None => offered.first().copied(),
-        Some(r) => offered.iter().copied().find(|o| name(o) == r),
+        Some(r) => offered.iter().copied().find(|o| dialect_name(o) == r),
     };
     let Some(o) = chosen else {
         let (file, span) = job_site(job);
-        let names: Vec<String> = offered.iter().map(|o| format!("`{}`", name(o))).collect();
+        let names: Vec<String> = offered
+            .iter()
+            .map(|o| format!("`{}`", dialect_name(o)))
+            .collect();
         return Err(Diagnostic::error(
             codes::DIALECT_NOT_OFFERED,
             format!(
@@ -326,7 +318,34 @@ pub fn dialect(job: &CheckedJob, requested: Option<&str>) -> Result<Dialect, Dia
             names.join(", ")
         )));
     };
-    Ok(dialect_of(o, name(o)))
+    Ok(dialect_of(o, dialect_name(o)))
+}
+
+/// The names of the dialects a job's machine offers, its own first.
+pub fn offered_dialects(job: &CheckedJob) -> Vec<String> {
+    offered(job).into_iter().map(dialect_name).collect()
+}
+
+fn dialect_name(o: &Object) -> String {
+    o.name.clone().unwrap_or_else(|| o.kind.name.to_string())
+}
+
+/// The machine's `dialect` and then its `other_dialects`.
+fn offered(job: &CheckedJob) -> Vec<&Object> {
+    let machine = value::object(&job.fields, "machine").expect("checked job part");
+    let mut offered: Vec<&Object> = value::object(&machine.fields, "dialect")
+        .map(|o| o.as_ref())
+        .into_iter()
+        .collect();
+    if let Some(Value::List(items)) =
+        value::field(&machine.fields, "other_dialects").map(|f| &f.value)
+    {
+        offered.extend(items.iter().filter_map(|(v, _)| match v {
+            Value::Object(o) => Some(o.as_ref()),
+            _ => None,
+        }));
+    }
+    offered
 }
 
 /// A checked `gcode { … }` dialect as the post-processor reads it.

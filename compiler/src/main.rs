@@ -43,8 +43,9 @@ enum Command {
         /// Build only this job.
         #[arg(long)]
         job: Option<String>,
-        /// Write the program in this dialect (the machine must support it).
-        #[arg(long, value_parser = ["linuxcnc"])]
+        /// Write the program in this dialect, one the machine offers (its
+        /// `dialect` or one of its `other_dialects`).
+        #[arg(long)]
         dialect: Option<String>,
         /// Directory for the programs.
         #[arg(long, default_value = "out")]
@@ -251,16 +252,15 @@ fn run(cli: Cli) -> u8 {
                 out.diagnostics(&c, &[d]);
                 return 1;
             }
-            let (programs, diags) =
-                driver::plan_and_emit(
-                    &c,
-                    driver::Request {
-                        job: job.as_deref(),
-                        dialect: dialect.as_deref(),
-                    },
-                    &file.display().to_string(),
-                    Some(&dir),
-                );
+            let (programs, diags) = driver::plan_and_emit(
+                &c,
+                driver::Request {
+                    job: job.as_deref(),
+                    dialect: dialect.as_deref(),
+                },
+                &file.display().to_string(),
+                Some(&dir),
+            );
             out.diagnostics(&c, &diags);
             if diags.iter().any(|d| d.is_error()) {
                 return 1;

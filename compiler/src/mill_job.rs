@@ -3,10 +3,10 @@
 //! (seed 001). Each reads the checked job into its runtime planner, checks
 //! the tool against the surface, and writes a LinuxCNC program and report.
 
-use lensc_runtime::machine::Dialect;
 use lensc_grammar::Diagnostic;
 use lensc_runtime::analysis::Domain;
 use lensc_runtime::grinding::{GrindingError, ProfileGrinding};
+use lensc_runtime::machine::Dialect;
 use lensc_runtime::program::Provenance;
 use lensc_runtime::raster::{Axis, Raster, RasterError, RasterTool};
 use lensc_runtime::surface::SectionAlongX;
@@ -292,7 +292,7 @@ pub fn build_grinding(
         safe_z,
         resolution,
     )
-        .map_err(|e| vec![p.not_printable(e)])?;
+    .map_err(|e| vec![p.not_printable(e)])?;
     // The table of eqs 18-19: every interval's commanded z velocity and
     // acceleration, as the paper's position-based interpolation gives them.
     let table: Vec<serde_json::Value> = path

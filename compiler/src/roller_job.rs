@@ -206,8 +206,14 @@ pub fn build(
     let header = vec![
         format!("lensc {}: job {}", prov.lensc_version, job.name.name),
         format!("source {} fnv1a64 {:016x}", prov.source, prov.source_hash),
-        format!("units mm; X is {} of the nose centre about the roller axis, Z along the roller, C the spindle angle in degrees counted on from the start", lensc_runtime::program::x_word(dialect)),
-        format!("coordinates are the centre of the tool nose; {}", parts.inverse_time_words()),
+        format!(
+            "units mm; X is {} of the nose centre about the roller axis, Z along the roller, C the spindle angle in degrees counted on from the start",
+            lensc_runtime::program::x_word(dialect)
+        ),
+        format!(
+            "coordinates are the centre of the tool nose; {}",
+            parts.inverse_time_words()
+        ),
         format!(
             "surface {}: {}",
             names("surface", surface),

@@ -456,7 +456,10 @@ const GCODE_PARAMS: &[Param] = &[
         "c_axis_on",
         "lines that switch the spindle to a position-controlled C axis before a C move",
     ),
-    texts("c_axis_off", "lines that give the spindle back after C moves"),
+    texts(
+        "c_axis_off",
+        "lines that give the spindle back after C moves",
+    ),
     texts("end", "the blocks that end the program (`M2`, `M30`)"),
     texts(
         "trailer",
@@ -482,7 +485,10 @@ const GCODE_PARAMS: &[Param] = &[
         Check::Any,
         "arc centres I J K from the arc's start (`incremental`) or in work coordinates",
     ),
-    text("per_minute", "the word for feeds per minute; absent: not available"),
+    text(
+        "per_minute",
+        "the word for feeds per minute; absent: not available",
+    ),
     text(
         "per_revolution",
         "the word for feeds per revolution; absent: not available",

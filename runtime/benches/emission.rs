@@ -11,8 +11,8 @@ use std::hint::black_box;
 use std::io::Write as _;
 use std::time::{Duration, Instant};
 
-use lensc_runtime::moves::{Feed, Move, Position};
 use lensc_runtime::machine::Dialect;
+use lensc_runtime::moves::{Feed, Move, Position};
 use lensc_runtime::program::{ProgramWriter, Setup};
 
 const MOVES: usize = 1_000_000;

@@ -79,8 +79,7 @@ pub fn emit(job: &Job, path: &Toolpath, prov: &Provenance) -> Result<String, Pro
         ),
         format!(
             "machine {}: {} lathe",
-            job.machine_name,
-            job.machine.dialect.name
+            job.machine_name, job.machine.dialect.name
         ),
         format!("estimated cutting time {}", duration(path.cutting_time())),
     ];
@@ -603,8 +602,8 @@ impl ProgramWriter {
             && decimals > max
         {
             return Err(ProgramError::Unsupported(format!(
-                "the machine's resolution ({resolution} mm needs {decimals} decimals; {} writes at most {max})",
-                dialect.name
+                "the machine's resolution ({:.*} mm needs {decimals} decimals; {} writes at most {max})",
+                decimals as usize, resolution, dialect.name
             )));
         }
         let setup_lines = match setup {
@@ -1196,8 +1195,8 @@ mod tests {
         let mut d = Dialect::linuxcnc();
         d.lathe_x_diameter = true;
         d.max_digits = Some(4);
-        let text = written_in(&d, Setup::Lathe, "XZ", &[M::Rapid(P::xz(1.25, 0.0))])
-            .expect("writes");
+        let text =
+            written_in(&d, Setup::Lathe, "XZ", &[M::Rapid(P::xz(1.25, 0.0))]).expect("writes");
         assert!(text.contains("G0 X2.5 Z0.\n"), "{text}");
         assert!(matches!(
             written_in(&d, Setup::Lathe, "XZ", &[M::Rapid(P::xz(12.3455, 0.0))]),
@@ -1225,7 +1224,14 @@ mod tests {
     fn the_final_check_refuses_bad_numbers_outside_comments() {
         let ok = "(X-0. in a comment, 1e5 too)\nG1 X-0.5 Z0. F60.\nG05.1 Q1\n";
         assert!(check_numbers(ok, CommentStyle::Parentheses).is_ok());
-        for bad in ["G1 X-0.", "G1 X-0.000", "G1 X1.5e-3", "G1 XNaN", "G1 Z-inf", "G1 X1.0Y2."] {
+        for bad in [
+            "G1 X-0.",
+            "G1 X-0.000",
+            "G1 X1.5e-3",
+            "G1 XNaN",
+            "G1 Z-inf",
+            "G1 X1.0Y2.",
+        ] {
             assert!(
                 check_numbers(bad, CommentStyle::Parentheses).is_err(),
                 "{bad} passed"

@@ -60,3 +60,29 @@ pub fn surface_names(path: &Path) -> Vec<String> {
         .filter_map(|l| l.split_whitespace().next().map(str::to_string))
         .collect()
 }
+
+/// Programs longer than this are snapshot by their head, their tail, their
+/// length and a hash of the whole (which still pins every byte): the raster
+/// programs run to hundreds of kilobytes, the fast-tool-servo one to
+/// hundreds of megabytes.
+pub const WHOLE_SNAPSHOT_LIMIT: usize = 256 << 10;
+
+/// A long program as its snapshot holds it: the first 40 lines, the
+/// counts and an FNV-1a 64 hash of the whole, the last 3 lines.
+pub fn abridged(program: &str) -> String {
+    let lines: Vec<&str> = program.lines().collect();
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in program.bytes() {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    }
+    let mut out = lines[..40.min(lines.len())].join("\n");
+    out.push_str(&format!(
+        "\n… {} lines, {} bytes, fnv1a64 {h:016x} …\n",
+        lines.len(),
+        program.len()
+    ));
+    out.push_str(&lines[lines.len().saturating_sub(3)..].join("\n"));
+    out.push('\n');
+    out
+}

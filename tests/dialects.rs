@@ -1,0 +1,140 @@
+//! Every example job built in every dialect its machine offers besides its
+//! own (the own dialect's programs are `examples.rs`'s snapshots): each
+//! program is snapshot (abridged past 256 KB, with counts and a hash), and
+//! each obeys its dialect's rules as written in `stdlib/dialects.lens`.
+
+mod common;
+
+use common::{abridged, buildable_examples, root};
+use lensc::driver::{Request, check_path, plan_and_emit};
+use lensc::loader::RealFs;
+
+/// The rules a reader of each dialect would check first.
+fn obeys(dialect: &str, program: &str) -> Result<(), String> {
+    let lines: Vec<&str> = program.lines().collect();
+    let code = |l: &&&str| !l.starts_with('(') && !l.starts_with(';') && !l.contains(" ; ");
+    match dialect {
+        "fanuc_0i_lathe" | "fanuc_0i_mill" => {
+            if lines.first() != Some(&"%") || lines.last() != Some(&"%") {
+                return Err("a Fanuc program starts and ends with %".into());
+            }
+            if !lines[1].starts_with('O') {
+                return Err("the O number follows the first %".into());
+            }
+            for l in lines.iter().filter(code) {
+                for w in l.split_whitespace() {
+                    let digits = w[1..].bytes().filter(u8::is_ascii_digit).count();
+                    if digits > 8 {
+                        return Err(format!("more than 8 digits: {l}"));
+                    }
+                }
+            }
+        }
+        "siemens_840d_lathe" | "siemens_840d_mill" => {
+            if !lines[0].starts_with("%_N_") || !lines[0].ends_with("_MPF") {
+                return Err(format!("not a Sinumerik main program name: {}", lines[0]));
+            }
+            if lines.iter().any(|l| l.contains('(')) {
+                return Err("Sinumerik comments are `;`".into());
+            }
+            if lines.last() != Some(&"M30") {
+                return Err("a Sinumerik main program ends with M30".into());
+            }
+        }
+        "heidenhain_iso" => {
+            let body = &lines[1..lines.len() - 1];
+            let mut last = 0u64;
+            for l in body {
+                let Some(n) = l
+                    .strip_prefix('N')
+                    .and_then(|r| r.split(' ').next())
+                    .and_then(|n| n.parse::<u64>().ok())
+                else {
+                    return Err(format!("an unnumbered block: {l}"));
+                };
+                if n <= last && n != 1 {
+                    return Err(format!("block numbers go back: {l}"));
+                }
+                last = n;
+                if !l.ends_with(" *") {
+                    return Err(format!("a block without its end: {l}"));
+                }
+            }
+        }
+        "ultra_precision_lathe_gcode" => {
+            if lines.iter().any(|l| l.contains("G8") || l.contains("G64")) {
+                return Err("LinuxCNC words in an ultra-precision lathe program".into());
+            }
+        }
+        other => return Err(format!("no rules for {other}")),
+    }
+    Ok(())
+}
+
+#[test]
+fn every_example_builds_in_every_dialect_its_machine_offers() {
+    let spool = tempfile::tempdir().expect("tmp");
+    let mut built = 0;
+    for ex in buildable_examples() {
+        let rel = ex.strip_prefix(root()).expect("inside repo").to_path_buf();
+        let checked = check_path(&RealFs, &ex).expect("readable");
+        assert!(!checked.has_errors(), "{}", rel.display());
+        for job in &checked.checked.jobs {
+            for dialect in lensc::lower::offered_dialects(job).iter().skip(1) {
+                let request = Request {
+                    job: Some(&job.name.name),
+                    dialect: Some(dialect),
+                };
+                let (programs, diags) = plan_and_emit(
+                    &checked,
+                    request,
+                    &rel.display().to_string(),
+                    Some(spool.path()),
+                );
+                assert!(
+                    !diags.iter().any(|d| d.is_error()),
+                    "{} {} in {dialect}: {diags:?}",
+                    rel.display(),
+                    job.name.name
+                );
+                for p in programs {
+                    let text = p.program.text().expect("program text");
+                    obeys(dialect, &text)
+                        .unwrap_or_else(|e| panic!("{} in {dialect}: {e}", p.program_name));
+                    assert_eq!(p.report["program"]["dialect"], dialect.as_str());
+                    let shown = if text.len() > common::WHOLE_SNAPSHOT_LIMIT {
+                        abridged(&text)
+                    } else {
+                        text
+                    };
+                    let name = format!("{dialect}__{}", p.program_name);
+                    insta::with_settings!({ snapshot_path => "snapshots/dialects", prepend_module_to_snapshot => false, omit_expression => true }, {
+                        insta::assert_snapshot!(name, shown);
+                    });
+                    built += 1;
+                }
+            }
+        }
+    }
+    assert!(built >= 10, "only {built} programs in other dialects");
+}
+
+#[test]
+fn a_dialect_the_machine_does_not_offer_is_refused_with_what_it_offers() {
+    let ex = root().join("examples/lin2022_scraping.lens");
+    let checked = check_path(&RealFs, &ex).expect("readable");
+    let (programs, diags) = plan_and_emit(
+        &checked,
+        Request {
+            job: Some("lin_oblate"),
+            dialect: Some("fanuc_0i_lathe"),
+        },
+        "x.lens",
+        None,
+    );
+    assert!(programs.is_empty());
+    assert_eq!(diags.len(), 1);
+    assert_eq!(diags[0].code, "E0148");
+    let help = format!("{:?}", diags[0]);
+    assert!(help.contains("heidenhain_iso"), "{help}");
+}
