@@ -138,3 +138,49 @@ fn a_dialect_the_machine_does_not_offer_is_refused_with_what_it_offers() {
     let help = format!("{:?}", diags[0]);
     assert!(help.contains("heidenhain_iso"), "{help}");
 }
+
+#[test]
+fn a_fanuc_lathe_program_is_in_diameter_with_radius_arc_centres() {
+    // No example's machine runs a Fanuc 0i lathe (their resolutions are
+    // finer than its 0.1 um): a mould insert on the 0.1 um stock lathe.
+    let dir = tempfile::tempdir().expect("tmp");
+    let file = dir.path().join("fanuc_lathe.lens");
+    std::fs::write(
+        &file,
+        "use std::machines::linuxcnc_lathe\n\
+         use std::tools::diamond_r496um\n\
+         surface insert = conic { radius: 12 mm, conic: -0.6, sense: concave, aperture: circle(radius: 3 mm) }\n\
+         strategy finish = profile_turning { feed: 2 um/rev, spindle_speed: 1000 rpm, chord_tolerance: 50 nm }\n\
+         job fanuc_insert { surface: insert, tool: diamond_r496um, machine: linuxcnc_lathe, strategy: finish }\n",
+    )
+    .expect("write");
+    let checked = check_path(&RealFs, &file).expect("readable");
+    assert!(!checked.has_errors());
+    let (programs, diags) = plan_and_emit(
+        &checked,
+        Request {
+            job: None,
+            dialect: Some("fanuc_0i_lathe"),
+        },
+        "fanuc_lathe.lens",
+        None,
+    );
+    assert!(diags.is_empty(), "{diags:?}");
+    let text = programs[0].program.text().expect("text");
+    obeys("fanuc_0i_lathe", &text).expect("Fanuc rules");
+    // X is the diameter: the first position is twice the nose centre's
+    // radius at the rim; the arcs' I stays a radius (the centre of the
+    // last arc, which ends on the axis, is within its radius of it).
+    let first_x: f64 = text
+        .lines()
+        .find_map(|l| l.strip_prefix("G0 X"))
+        .and_then(|r| r.split(' ').next())
+        .and_then(|v| v.parse().ok())
+        .expect("a rapid to X");
+    assert!(first_x > 2.0 * 2.8 && first_x < 2.0 * 3.0, "{first_x}");
+    assert!(text.contains("\nG95 G1 "), "{text}");
+    assert!(text.contains("\nG3 X0. "), "{text}");
+    insta::with_settings!({ snapshot_path => "snapshots/dialects", prepend_module_to_snapshot => false, omit_expression => true }, {
+        insta::assert_snapshot!("fanuc_0i_lathe__fanuc_insert.nc", text);
+    });
+}

@@ -265,3 +265,34 @@ fn a_tool_set_off_centre_is_corrected_in_x() {
         assert!((x - want).abs() <= 1.01e-5, "{r} → {x}, want {want}");
     }
 }
+
+#[test]
+fn arc_fitting_shortens_seed_000_and_seed_004_programs_within_the_budget() {
+    // Issue #5's figure: the line-count reduction from merging and arc
+    // fitting, with the largest deviation held to the fitting share of
+    // the 10 nm path tolerance. The seed 004 cylinders are circles, and
+    // seed 000's raster passes are sections of conics: both fall to arcs.
+    for (example, job, at_least) in [
+        ("examples/lei2021_cylinder_array.lens", "cylinder_rings", 20),
+        ("examples/lin2022_scraping.lens", "lin_hyperboloid", 5),
+        ("examples/lin2022_scraping.lens", "lin_imaging_sphere", 20),
+    ] {
+        let (report, _) = build(example, job);
+        let o = &report["toolpath"]["optimisation"];
+        let before = o["blocks_before"].as_u64().expect("before");
+        let after = o["blocks_after"].as_u64().expect("after");
+        let deviation = o["max_deviation_mm"].as_f64().expect("deviation");
+        let tolerance = o["tolerance_mm"].as_f64().expect("tolerance");
+        println!(
+            "{job}: {before} -> {after} blocks, {} arcs, deviation {deviation:e} of {tolerance:e} mm",
+            o["arcs"]
+        );
+        assert!(o["arcs"].as_u64().expect("arcs") > 0, "{job}");
+        assert!(after * at_least <= before, "{job}: {before} -> {after}");
+        assert!(
+            deviation > 0.0 && deviation <= tolerance,
+            "{job}: {deviation}"
+        );
+        assert!((tolerance - 5e-6).abs() < 1e-12, "{job}: {tolerance}");
+    }
+}

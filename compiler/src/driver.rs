@@ -249,12 +249,14 @@ pub fn plan_and_emit(
             );
         }
         match program::emit(&lowered, &path, &prov) {
-            Ok(text) => {
+            Ok((text, optimised)) => {
                 let program_name =
                     format!("{}.{}", lowered.name, lowered.machine.dialect.extension);
                 let name = job.part_names.get("surface").cloned().unwrap_or_default();
                 let analysis = analysis_json(&name, surface.kind.name, &lowered_surface, 201);
-                let report = build_report(&lowered, &prov, &program_name, &text, &path, analysis);
+                let mut report =
+                    build_report(&lowered, &prov, &program_name, &text, &path, analysis);
+                report["toolpath"]["optimisation"] = optimisation_json(&optimised);
                 out.push(Built {
                     report_name: format!("{}.report.json", lowered.name),
                     program_name,
@@ -271,6 +273,21 @@ pub fn plan_and_emit(
         }
     }
     (out, diags)
+}
+
+/// What optimisation did to a program, for its report: motion blocks
+/// before and after, arcs written, straight moves that absorbed collinear
+/// points, and the largest deviation from the planned polyline against the
+/// tolerance it was held to.
+pub fn optimisation_json(s: &lensc_runtime::optimise::Summary) -> serde_json::Value {
+    serde_json::json!({
+        "blocks_before": s.moves_before,
+        "blocks_after": s.moves_after,
+        "arcs": s.arcs,
+        "merged_lines": s.merged_lines,
+        "max_deviation_mm": s.max_deviation,
+        "tolerance_mm": s.tolerance,
+    })
 }
 
 /// The report written beside a program.

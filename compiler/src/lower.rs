@@ -402,6 +402,7 @@ fn dialect_of(o: &Object, name: String) -> Dialect {
             })
             .collect(),
         arc_centre_absolute: value::word(f, "arc_centre") == Some("absolute"),
+        arc_radius_tolerance: value::num(f, "arc_radius_tolerance").unwrap_or(0.001),
         per_minute: opt_text("per_minute"),
         per_revolution: opt_text("per_revolution"),
         inverse_time: opt_text("inverse_time"),

@@ -114,15 +114,21 @@ pub fn build_raster(
     );
     header.push(format!("tool {}: {tool_words}", p.name("tool", p.tool)));
     header.push(format!(
-        "strategy {}: raster along {}, {}, stepover {} um, chord tolerance {} nm, {} passes, {} points",
+        "strategy {}: raster along {}, {}, stepover {} um, {}, {} passes, {} points",
         p.name("strategy", p.strategy),
         if raster.along == Axis::X { "x" } else { "y" },
         if raster.zigzag { "zigzag" } else { "one way" },
         trim_num(raster.stepover * 1000.0),
-        trim_num(raster.chord_tolerance * 1e6),
+        lensc_runtime::program::tolerance_words(raster.chord_tolerance),
         path.pass_count,
         path.point_count
     ));
+    let (moves, optimised) = lensc_runtime::optimise::optimise(
+        &moves,
+        raster.chord_tolerance * lensc_runtime::optimise::FIT_SHARE,
+        &dialect.arc_planes,
+    );
+    header.push(lensc_runtime::program::optimisation_words(&optimised));
     header.push(format!(
         "machine {}: {} 3-axis mill",
         p.name("machine", p.machine),
@@ -150,6 +156,7 @@ pub fn build_raster(
         "cutting_time_s": time,
         "chord_tolerance_mm": raster.chord_tolerance,
         "stepover_mm": raster.stepover,
+        "optimisation": crate::driver::optimisation_json(&optimised),
         "max_slope_along_deg": at(&path.max_slope_along, deg),
         "max_slope_across_deg": at(&path.max_slope_across, deg),
         "min_concave_radius_along_mm": path.min_concave_radius_along.as_ref().map(|e| at(e, 1.0)),

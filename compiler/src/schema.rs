@@ -485,6 +485,12 @@ const GCODE_PARAMS: &[Param] = &[
         Check::Any,
         "arc centres I J K from the arc's start (`incremental`) or in work coordinates",
     ),
+    opt(
+        "arc_radius_tolerance",
+        LENGTH,
+        Check::Positive,
+        "the most an arc's end radius may differ from its start radius before the controller refuses it; default 0.001 mm (LinuxCNC allows about 0.025 mm, Beckhoff 0.005 mm); arcs are checked after rounding",
+    ),
     text(
         "per_minute",
         "the word for feeds per minute; absent: not available",

@@ -14,6 +14,7 @@ pub mod ir;
 pub mod job;
 pub mod machine;
 pub mod moves;
+pub mod optimise;
 pub mod program;
 pub mod raster;
 pub mod roller;

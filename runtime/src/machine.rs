@@ -43,6 +43,9 @@ pub struct Dialect {
     pub arc_planes: Vec<Plane>,
     /// Arc centres in work coordinates rather than from the arc's start.
     pub arc_centre_absolute: bool,
+    /// The most (mm) an arc's end radius may differ from its start radius,
+    /// as the controller checks it after rounding.
+    pub arc_radius_tolerance: f64,
     pub per_minute: Option<String>,
     pub per_revolution: Option<String>,
     pub inverse_time: Option<String>,
@@ -84,6 +87,7 @@ impl Dialect {
             arc_ccw: "G3".into(),
             arc_planes: vec![Plane::Xy, Plane::Zx, Plane::Yz],
             arc_centre_absolute: false,
+            arc_radius_tolerance: 0.001,
             per_minute: Some("G94".into()),
             per_revolution: Some("G95".into()),
             inverse_time: Some("G93".into()),

@@ -10,6 +10,7 @@ use crate::format::{decimals_for, fixed_units, push_fixed, push_units};
 use crate::job::Job;
 use crate::machine::{CommentStyle, Dialect};
 use crate::moves::{self, Plane, Position};
+use crate::optimise::{self, optimise};
 use crate::toolpath::{Feed, Move, Toolpath};
 
 /// What the program header states about where the job came from.
@@ -46,8 +47,13 @@ impl ProgramError {
 }
 
 /// Writes a lathe program for a profile-turning path in the machine's
-/// dialect.
-pub fn emit(job: &Job, path: &Toolpath, prov: &Provenance) -> Result<String, ProgramError> {
+/// dialect, optimised (lines merged, arcs fitted) within the fitting share
+/// of the strategy's tolerance; with what optimisation did.
+pub fn emit(
+    job: &Job,
+    path: &Toolpath,
+    prov: &Provenance,
+) -> Result<(String, optimise::Summary), ProgramError> {
     let centre_height = if job.tool.centre_height == 0.0 {
         String::new()
     } else {
@@ -71,10 +77,10 @@ pub fn emit(job: &Job, path: &Toolpath, prov: &Provenance) -> Result<String, Pro
             num(job.tool.nose_radius)
         ),
         format!(
-            "strategy {}: profile turning, {} points, chord tolerance {} nm{}",
+            "strategy {}: profile turning, {} points, {}{}",
             job.strategy_name,
             path.cut_points,
-            num(job.strategy.chord_tolerance * 1e6),
+            tolerance_words(job.strategy.chord_tolerance),
             roughing_words(job, path)
         ),
         format!(
@@ -83,6 +89,14 @@ pub fn emit(job: &Job, path: &Toolpath, prov: &Provenance) -> Result<String, Pro
         ),
         format!("estimated cutting time {}", duration(path.cutting_time())),
     ];
+    let tolerance = job.strategy.chord_tolerance;
+    let (stream, summary) = optimise(
+        &turning_moves(job, path),
+        tolerance * optimise::FIT_SHARE,
+        &job.machine.dialect.arc_planes,
+    );
+    let mut header = header.to_vec();
+    header.push(optimisation_words(&summary));
     let mut w = ProgramWriter::new(
         &job.machine.dialect,
         Setup::Lathe,
@@ -90,10 +104,33 @@ pub fn emit(job: &Job, path: &Toolpath, prov: &Provenance) -> Result<String, Pro
         &header,
         "XZ",
         job.machine.resolution,
-        job.strategy.chord_tolerance,
+        tolerance * optimise::BLEND_SHARE,
     )?;
-    w.write_all(&turning_moves(job, path))?;
-    w.finish()
+    w.write_all(&stream)?;
+    Ok((w.finish()?, summary))
+}
+
+/// How a path's tolerance T is stated in a header, with its shares.
+pub fn tolerance_words(t: f64) -> String {
+    format!(
+        "path tolerance {} nm [chords {}, fitting {}, blending {} nm]",
+        num(t * 1e6),
+        num(t * optimise::CHORD_SHARE * 1e6),
+        num(t * optimise::FIT_SHARE * 1e6),
+        num(t * optimise::BLEND_SHARE * 1e6)
+    )
+}
+
+/// What optimisation did, for a header.
+pub fn optimisation_words(s: &optimise::Summary) -> String {
+    format!(
+        "optimised from {} to {} moves: {} arcs, {} merged lines, largest deviation {} nm",
+        s.moves_before,
+        s.moves_after,
+        s.arcs,
+        s.merged_lines,
+        num((s.max_deviation * 1e9).round() / 1e3)
+    )
 }
 
 /// What a lathe program's X word is in `dialect`, for its header.
@@ -344,14 +381,15 @@ pub fn raster_moves(path: &crate::raster::RasterPath, feed: f64) -> Vec<moves::M
     out
 }
 
-/// A program for a move stream on a 3-axis mill.
+/// A program for a (optimised) move stream on a 3-axis mill, blending
+/// held to the blending share of the path's tolerance `tolerance`.
 pub fn emit_mill(
     dialect: &Dialect,
     job: &str,
     header: &[String],
     stream: &[moves::Move],
     resolution: f64,
-    chord_tolerance: f64,
+    tolerance: f64,
 ) -> Result<String, ProgramError> {
     let mut w = ProgramWriter::new(
         dialect,
@@ -360,7 +398,7 @@ pub fn emit_mill(
         header,
         "XYZ",
         resolution,
-        chord_tolerance,
+        tolerance * optimise::BLEND_SHARE,
     )?;
     w.write_all(stream)?;
     w.finish()
@@ -920,8 +958,30 @@ impl ProgramWriter {
             return Ok(());
         }
         if let Some((plane, centre)) = arc {
-            // I J K in that order, whatever the plane's orientation.
+            // The controller measures the radius from the rounded centre
+            // to the rounded start and end, and refuses a mismatch.
             let (a, b) = plane.axes();
+            let scale = 10f64.powi(self.decimals as i32);
+            let round = |v: f64| (v * scale).round() / scale;
+            let end = to.axes();
+            let radius = |p: [f64; 4]| {
+                (round(p[a]) - round(centre.axes()[a])).hypot(round(p[b]) - round(centre.axes()[b]))
+            };
+            let mut end_at = self.at;
+            for (e, v) in end_at.iter_mut().zip(end) {
+                if !v.is_nan() {
+                    *e = v;
+                }
+            }
+            let mismatch = (radius(self.at) - radius(end_at)).abs();
+            if mismatch.is_nan() || mismatch > self.dialect.arc_radius_tolerance {
+                return Err(ProgramError::Unsupported(format!(
+                    "an arc whose end radius differs from its start radius by {} mm (it allows {} mm)",
+                    num(mismatch),
+                    num(self.dialect.arc_radius_tolerance)
+                )));
+            }
+            // I J K in that order, whatever the plane's orientation.
             for i in [a.min(b), a.max(b)] {
                 let c = centre.axes()[i];
                 let from = if self.dialect.arc_centre_absolute {
@@ -1188,6 +1248,30 @@ mod tests {
         )
         .expect("writes");
         assert!(text.contains("G94 G18 G2 X3. I1. K0. F60.\n"), "{text}");
+    }
+
+    #[test]
+    fn an_arc_whose_radii_disagree_after_rounding_is_refused() {
+        let arc = |end_x: f64| {
+            written(
+                "XZ",
+                &[
+                    M::Rapid(P::xz(1.0, 0.0)),
+                    M::Arc {
+                        to: P::xz(end_x, 0.0),
+                        centre: P::xz(0.0, 0.0),
+                        plane: Plane::Zx,
+                        ccw: true,
+                        feed: Some(F::PerTime(1.0)),
+                    },
+                ],
+            )
+        };
+        assert!(arc(-1.0005).is_ok());
+        let Err(ProgramError::Unsupported(why)) = arc(-1.002) else {
+            panic!("a 2 um mismatch written")
+        };
+        assert!(why.contains("0.002 mm"), "{why}");
     }
 
     #[test]

@@ -23,7 +23,9 @@ pub struct ProfileTurning {
     pub feed: Feed,
     /// Spindle speed (rad/s), constant.
     pub spindle_speed: f64,
-    /// Largest distance (mm) between the exact tool-centre curve and the chords.
+    /// The path's tolerance T (mm): the most the program, as the machine
+    /// runs it, may stray from the exact tool-centre curve. The chords take
+    /// `optimise::CHORD_SHARE` of it, arc fitting and blending the rest.
     pub chord_tolerance: f64,
     /// Radius (mm) where the cut starts; the aperture edge if `None`.
     pub start_radius: Option<f64>,
@@ -362,7 +364,7 @@ fn cut_path(
     start: f64,
     end: f64,
 ) -> Vec<Vector2<f64>> {
-    let tol = strat.chord_tolerance;
+    let tol = strat.chord_tolerance * crate::optimise::CHORD_SHARE;
     // The ends of the cut in the tool's x: the normal offsets of its ends.
     let (x0, x1) = (
         tool_centre(profile, rho, start).x,

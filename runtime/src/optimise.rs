@@ -1,0 +1,607 @@
+//! Program optimisation on the move stream: runs of straight cutting moves
+//! are replaced by fewer straight moves (points collinear within a
+//! tolerance dropped) and by circular arcs (G2/G3) in the planes the
+//! dialect can arc in. Every replacement is measured, not assumed: the new
+//! line or arc stays within the fitting tolerance of the polyline it
+//! replaces, both ways (every replaced point and every replaced chord is
+//! within it, and the points run monotonically along the new geometry).
+//!
+//! The deviation budget of a path is stated once, as the strategy's
+//! tolerance T, and shared: the planner's chords take `CHORD_SHARE` of it,
+//! fitting `FIT_SHARE` and the controller's corner blending (`G64 P`) the
+//! rest, so the program as the machine runs it stays within T of the exact
+//! tool-centre path.
+
+use crate::moves::{Feed, Move, Plane, Position};
+use std::f64::consts::PI;
+
+/// The planner's share of a path's tolerance (its chords' sag).
+pub const CHORD_SHARE: f64 = 0.125;
+/// The optimiser's share: how far a fitted line or arc may leave the
+/// planned polyline.
+pub const FIT_SHARE: f64 = 0.5;
+/// The controller's share: the blending tolerance the program asks for.
+pub const BLEND_SHARE: f64 = 0.375;
+
+/// The smallest arc radius fitted (mm). LinuxCNC refuses arcs under
+/// 0.00127 mm (its centre-arc radius tolerance) as zero-radius; a tool
+/// centre turning that tightly (round a seam's corner) is left as lines.
+pub const MIN_ARC_RADIUS: f64 = 0.01;
+
+/// What optimisation did to a stream.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Summary {
+    /// Moves before and after (one program block each).
+    pub moves_before: usize,
+    pub moves_after: usize,
+    /// Arcs written, and straight moves that absorbed collinear points.
+    pub arcs: usize,
+    pub merged_lines: usize,
+    /// The largest distance (mm) between a fitted line or arc and the
+    /// polyline it replaced.
+    pub max_deviation: f64,
+    /// The tolerance the fits were held to (mm).
+    pub tolerance: f64,
+}
+
+/// Optimises `stream` with fits held to `tolerance` (mm), arcs only in
+/// `arc_planes`. Rapids, spindle moves, moves with C, inverse-time moves
+/// and feed changes are kept as they are and break runs.
+pub fn optimise(stream: &[Move], tolerance: f64, arc_planes: &[Plane]) -> (Vec<Move>, Summary) {
+    let mut out = Vec::with_capacity(stream.len());
+    let mut summary = Summary {
+        moves_before: stream.len(),
+        tolerance,
+        ..Summary::default()
+    };
+    let mut at = [f64::NAN; 4];
+    let mut feed_in_force: Option<Feed> = None;
+    let mut i = 0;
+    while i < stream.len() {
+        // A run: straight moves from a known point, on the same axes, at
+        // the feed in force.
+        let run_end = run_length(stream, i, &at, feed_in_force);
+        if run_end - i >= 2 {
+            let start = at;
+            let points: Vec<[f64; 3]> = std::iter::once([start[0], start[1], start[2]])
+                .chain(stream[i..run_end].iter().map(|m| {
+                    let to = target(m).expect("a straight move");
+                    [to.x, to.y, to.z]
+                }))
+                .collect();
+            let feed = match stream[i] {
+                Move::Linear { feed, .. } => feed.or(feed_in_force),
+                _ => None,
+            };
+            if let Some(f) = feed {
+                feed_in_force = Some(f);
+            }
+            let template = target(&stream[i]).expect("a straight move");
+            let first_feed = match stream[i] {
+                Move::Linear { feed, .. } => feed,
+                _ => None,
+            };
+            // The turning planner gives every move its feed; keep its habit.
+            let rest_feed = if every_move_has_feed(&stream[i..run_end]) {
+                feed
+            } else {
+                None
+            };
+            fit_run(
+                &points,
+                template.c,
+                (first_feed, rest_feed),
+                arc_planes,
+                tolerance,
+                &mut out,
+                &mut summary,
+            );
+            let last = points[points.len() - 1];
+            at = [last[0], last[1], last[2], at[3]];
+            i = run_end;
+            continue;
+        }
+        let m = stream[i];
+        if let Move::Linear { feed: Some(f), .. } | Move::Arc { feed: Some(f), .. } = m {
+            feed_in_force = Some(f);
+        }
+        if let Some(to) = target(&m) {
+            for (a, v) in at.iter_mut().zip(to.axes()) {
+                if !v.is_nan() {
+                    *a = v;
+                }
+            }
+        }
+        out.push(m);
+        i += 1;
+    }
+    summary.moves_after = out.len();
+    (out, summary)
+}
+
+/// Whether the moves of a run carry their feed on every move or only on
+/// the first.
+fn every_move_has_feed(run: &[Move]) -> bool {
+    run.iter()
+        .skip(1)
+        .all(|m| matches!(m, Move::Linear { feed: Some(_), .. }))
+}
+
+fn target(m: &Move) -> Option<Position> {
+    match *m {
+        Move::Rapid(to) | Move::Linear { to, .. } | Move::Arc { to, .. } => Some(to),
+        _ => None,
+    }
+}
+
+/// The end (exclusive) of the run of straight moves starting at `i`.
+fn run_length(stream: &[Move], i: usize, at: &[f64; 4], feed_in_force: Option<Feed>) -> usize {
+    let Move::Linear { to, feed } = stream[i] else {
+        return i;
+    };
+    if !to.c.is_nan() || matches!(feed.or(feed_in_force), None | Some(Feed::InverseTime(_))) {
+        return i;
+    }
+    let present = [!to.x.is_nan(), !to.y.is_nan(), !to.z.is_nan()];
+    // The run's start must be known on every axis it moves.
+    if (0..3).any(|k| present[k] && at[k].is_nan()) || present.iter().filter(|p| **p).count() < 2 {
+        return i;
+    }
+    let run_feed = feed.or(feed_in_force);
+    let mut j = i + 1;
+    while j < stream.len() {
+        let Move::Linear { to, feed } = stream[j] else {
+            break;
+        };
+        let same_axes = [!to.x.is_nan(), !to.y.is_nan(), !to.z.is_nan()] == present;
+        if !same_axes || !to.c.is_nan() || feed.is_some_and(|f| Some(f) != run_feed) {
+            break;
+        }
+        j += 1;
+    }
+    j
+}
+
+/// Fits lines and arcs to the polyline `points` (X, Y, Z; NaN on axes the
+/// run does not move; C held at `c`) and appends the moves that replace
+/// it, the first with `feeds.0`, the others with `feeds.1`.
+fn fit_run(
+    points: &[[f64; 3]],
+    c: f64,
+    feeds: (Option<Feed>, Option<Feed>),
+    arc_planes: &[Plane],
+    tol: f64,
+    out: &mut Vec<Move>,
+    summary: &mut Summary,
+) {
+    // The plane of the run: the axis off it does not change.
+    let plane = [Plane::Zx, Plane::Xy, Plane::Yz].into_iter().find(|p| {
+        let (a, b) = p.axes();
+        let off = 3 - a - b;
+        arc_planes.contains(p)
+            && points
+                .iter()
+                .all(|q| !q[a].is_nan() && !q[b].is_nan() && same(q[off], points[0][off]))
+    });
+    let position = |q: [f64; 3]| Position {
+        x: q[0],
+        y: q[1],
+        z: q[2],
+        c,
+    };
+    let n = points.len() - 1;
+    let mut i = 0;
+    while i < n {
+        let feed = if i == 0 { feeds.0 } else { feeds.1 };
+        let line_to = longest(i, n, |j| line_fits(&points[i..=j], tol));
+        let arc = plane.and_then(|p| {
+            let j = longest(i, n, |j| {
+                j >= i + 2 && arc_fit(&points[i..=j], p, tol).is_some()
+            });
+            (j >= i + 2 && j > line_to)
+                .then(|| arc_fit(&points[i..=j], p, tol).map(|fit| (j, p, fit)))
+                .flatten()
+        });
+        match arc {
+            Some((j, plane, fit)) => {
+                out.push(Move::Arc {
+                    to: position(points[j]),
+                    centre: position(fit.centre),
+                    plane,
+                    ccw: fit.ccw,
+                    feed,
+                });
+                summary.arcs += 1;
+                summary.max_deviation = summary.max_deviation.max(fit.deviation);
+                i = j;
+            }
+            None => {
+                let j = line_to;
+                out.push(Move::Linear {
+                    to: position(points[j]),
+                    feed,
+                });
+                if j > i + 1 {
+                    summary.merged_lines += 1;
+                    let d = line_deviation(&points[i..=j]).unwrap_or(0.0);
+                    summary.max_deviation = summary.max_deviation.max(d);
+                }
+                i = j;
+            }
+        }
+    }
+}
+
+fn same(a: f64, b: f64) -> bool {
+    (a.is_nan() && b.is_nan()) || (a - b).abs() <= 1e-12
+}
+
+/// The largest `j` in (i, n] for which `fits(j)` holds, searched by
+/// doubling the span and then bisecting (`fits(i + 1)` is taken to hold).
+fn longest(i: usize, n: usize, fits: impl Fn(usize) -> bool) -> usize {
+    let mut good = i + 1;
+    let mut step = 1;
+    let mut bad = None;
+    while good < n {
+        let j = (i + 2 * step).min(n);
+        if fits(j) {
+            good = j;
+            step *= 2;
+        } else {
+            bad = Some(j);
+            break;
+        }
+    }
+    let Some(mut bad) = bad else { return good };
+    while bad - good > 1 {
+        let mid = (good + bad) / 2;
+        if fits(mid) {
+            good = mid;
+        } else {
+            bad = mid;
+        }
+    }
+    good
+}
+
+fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    let d = |k: usize| {
+        let v = a[k] - b[k];
+        if v.is_nan() { 0.0 } else { v }
+    };
+    [d(0), d(1), d(2)]
+}
+
+fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// The largest distance of the polyline's inner points from the straight
+/// line between its ends, or None if they do not run monotonically along
+/// it.
+fn line_deviation(pts: &[[f64; 3]]) -> Option<f64> {
+    let (a, b) = (&pts[0], &pts[pts.len() - 1]);
+    let ab = sub(b, a);
+    let len2 = dot(&ab, &ab);
+    if len2 == 0.0 {
+        return None;
+    }
+    let mut last_t = 0.0;
+    let mut worst: f64 = 0.0;
+    for p in &pts[1..pts.len() - 1] {
+        let ap = sub(p, a);
+        let t = dot(&ap, &ab) / len2;
+        if t < last_t || t > 1.0 {
+            return None;
+        }
+        last_t = t;
+        let d2 = (dot(&ap, &ap) - t * t * len2).max(0.0);
+        worst = worst.max(d2.sqrt());
+    }
+    Some(worst)
+}
+
+fn line_fits(pts: &[[f64; 3]], tol: f64) -> bool {
+    pts.len() <= 2 || line_deviation(pts).is_some_and(|d| d <= tol)
+}
+
+/// A circle fitted to a run of points.
+#[derive(Clone, Copy, Debug)]
+struct ArcFit {
+    /// Centre, with the off-plane axis copied from the points.
+    centre: [f64; 3],
+    ccw: bool,
+    /// The largest distance between the arc and the polyline.
+    deviation: f64,
+}
+
+/// The circle through the first, middle and last of `pts` in `plane`, if
+/// every point and every chord between them lies within `tol` of it, the
+/// points advance monotonically around it and it turns less than half a
+/// revolution.
+fn arc_fit(pts: &[[f64; 3]], plane: Plane, tol: f64) -> Option<ArcFit> {
+    let (ia, ib) = plane.axes();
+    let p2 = |q: &[f64; 3]| (q[ia], q[ib]);
+    let (a, m, b) = (
+        p2(&pts[0]),
+        p2(&pts[pts.len() / 2]),
+        p2(&pts[pts.len() - 1]),
+    );
+    // Circumcentre of a, m, b.
+    let (bx, by) = (m.0 - a.0, m.1 - a.1);
+    let (cx, cy) = (b.0 - a.0, b.1 - a.1);
+    let d = 2.0 * (bx * cy - by * cx);
+    let scale = (bx * bx + by * by).max(cx * cx + cy * cy);
+    if d.abs() <= 1e-12 * scale {
+        return None;
+    }
+    let ux = (cy * (bx * bx + by * by) - by * (cx * cx + cy * cy)) / d;
+    let uy = (bx * (cx * cx + cy * cy) - cx * (bx * bx + by * by)) / d;
+    let centre = (a.0 + ux, a.1 + uy);
+    let r = (ux * ux + uy * uy).sqrt();
+    if !r.is_finite() || !(MIN_ARC_RADIUS..=1e4).contains(&r) {
+        return None;
+    }
+    let ccw = d > 0.0;
+    let angle = |p: (f64, f64)| (p.1 - centre.1).atan2(p.0 - centre.0);
+    let a0 = angle(a);
+    // Angle travelled from the start in the arc's direction, in [0, 2π).
+    let swept = |p: (f64, f64)| {
+        let mut t = angle(p) - a0;
+        if !ccw {
+            t = -t;
+        }
+        t.rem_euclid(2.0 * PI)
+    };
+    let total = swept(b);
+    if total >= PI - 1e-9 {
+        return None;
+    }
+    let dist = |p: (f64, f64)| ((p.0 - centre.0).powi(2) + (p.1 - centre.1).powi(2)).sqrt();
+    let mut last = 0.0;
+    let mut worst: f64 = 0.0;
+    for w in pts.windows(2) {
+        let (p, q) = (p2(&w[0]), p2(&w[1]));
+        let t = swept(q);
+        if t < last || t > total + 1e-12 {
+            return None;
+        }
+        last = t;
+        // Distance from the centre along the chord p→q is convex: its
+        // extremes are the ends and the foot of the perpendicular.
+        let (dx, dy) = (q.0 - p.0, q.1 - p.1);
+        let len2 = dx * dx + dy * dy;
+        let mut dev = (dist(p) - r).abs().max((dist(q) - r).abs());
+        if len2 > 0.0 {
+            let s = (((centre.0 - p.0) * dx + (centre.1 - p.1) * dy) / len2).clamp(0.0, 1.0);
+            dev = dev.max((dist((p.0 + s * dx, p.1 + s * dy)) - r).abs());
+        }
+        worst = worst.max(dev);
+        if worst > tol {
+            return None;
+        }
+    }
+    let mut c3 = pts[0];
+    c3[ia] = centre.0;
+    c3[ib] = centre.1;
+    Some(ArcFit {
+        centre: c3,
+        ccw,
+        deviation: worst,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TOL: f64 = 2.5e-6;
+
+    /// A lathe-like stream: spindle on, rapid to the start, cutting moves
+    /// through `pts` (X, Z) with the feed on every move, spindle off.
+    fn lathe_stream(pts: &[(f64, f64)]) -> Vec<Move> {
+        let feed = Some(Feed::PerRevolution(0.001));
+        let mut s = vec![
+            Move::SpindleOn(Some(100.0)),
+            Move::Rapid(Position::xz(pts[0].0, pts[0].1 + 1.0)),
+            Move::Linear {
+                to: Position::xz(pts[0].0, pts[0].1),
+                feed,
+            },
+        ];
+        s.extend(pts[1..].iter().map(|&(x, z)| Move::Linear {
+            to: Position::xz(x, z),
+            feed,
+        }));
+        s.push(Move::SpindleOff);
+        s
+    }
+
+    /// Where a move's path is after the fraction `t` of it, in X and Z.
+    fn along(from: (f64, f64), m: &Move, t: f64) -> (f64, f64) {
+        match *m {
+            Move::Linear { to, .. } => (from.0 + t * (to.x - from.0), from.1 + t * (to.z - from.1)),
+            Move::Arc {
+                to, centre, ccw, ..
+            } => {
+                // Plane ZX: first axis Z, second X.
+                let (cz, cx) = (centre.z, centre.x);
+                let a0 = (from.0 - cx).atan2(from.1 - cz);
+                let a1 = (to.x - cx).atan2(to.z - cz);
+                let mut sweep = a1 - a0;
+                if ccw {
+                    sweep = sweep.rem_euclid(2.0 * PI);
+                } else {
+                    sweep = -(-sweep).rem_euclid(2.0 * PI);
+                }
+                let r = ((from.0 - cx).powi(2) + (from.1 - cz).powi(2)).sqrt();
+                let a = a0 + t * sweep;
+                (cx + r * a.sin(), cz + r * a.cos())
+            }
+            _ => from,
+        }
+    }
+
+    /// The largest distance from any of `pts` to the optimised path, and
+    /// from the optimised path (sampled) to the polyline through `pts`.
+    fn hausdorff(pts: &[(f64, f64)], out: &[Move]) -> f64 {
+        let mut path = vec![pts[0]];
+        let mut from = pts[0];
+        for m in out
+            .iter()
+            .skip_while(|m| !matches!(m, Move::Linear { .. }))
+            .skip(1)
+        {
+            if let Move::Linear { .. } | Move::Arc { .. } = m {
+                // Fine enough that the samples' own chords sag far below
+                // the tolerance (1 mm at radius 2 mm: 0.3 nm).
+                for k in 1..=2048 {
+                    path.push(along(from, m, k as f64 / 2048.0));
+                }
+                from = along(from, m, 1.0);
+            }
+        }
+        let seg_dist = |p: (f64, f64), a: (f64, f64), b: (f64, f64)| {
+            let (dx, dz) = (b.0 - a.0, b.1 - a.1);
+            let l2 = dx * dx + dz * dz;
+            let t = if l2 == 0.0 {
+                0.0
+            } else {
+                (((p.0 - a.0) * dx + (p.1 - a.1) * dz) / l2).clamp(0.0, 1.0)
+            };
+            ((p.0 - a.0 - t * dx).powi(2) + (p.1 - a.1 - t * dz).powi(2)).sqrt()
+        };
+        let to_poly = |p: (f64, f64), poly: &[(f64, f64)]| {
+            poly.windows(2)
+                .map(|w| seg_dist(p, w[0], w[1]))
+                .fold(f64::INFINITY, f64::min)
+        };
+        let a = pts.iter().map(|&p| to_poly(p, &path)).fold(0.0, f64::max);
+        let b = path.iter().map(|&p| to_poly(p, pts)).fold(0.0, f64::max);
+        a.max(b)
+    }
+
+    #[test]
+    fn points_on_a_circle_become_one_arc_in_the_right_direction() {
+        // A convex cap of radius 2 mm: z = sqrt(R² − x²) − R, cut from the
+        // rim to the centre (X decreasing).
+        let r = 2.0;
+        let pts: Vec<(f64, f64)> = (0..=200)
+            .map(|k| {
+                let x = 1.0 - k as f64 / 200.0;
+                (x, (r * r - x * x).sqrt() - r)
+            })
+            .collect();
+        let stream = lathe_stream(&pts);
+        let (out, s) = optimise(&stream, TOL, &[Plane::Zx]);
+        assert_eq!(s.arcs, 1, "{out:?}");
+        assert_eq!(s.moves_before, stream.len());
+        assert_eq!(s.moves_after, out.len());
+        assert_eq!(out.len(), 5);
+        let Move::Arc { centre, to, .. } = out[3] else {
+            panic!("{out:?}")
+        };
+        assert!(
+            (centre.x).abs() < 1e-9 && (centre.z + r).abs() < 1e-9,
+            "{centre:?}"
+        );
+        assert_eq!((to.x, to.z), pts[200]);
+        assert!(s.max_deviation <= TOL);
+        let d = hausdorff(&pts, &out);
+        assert!(d <= TOL, "{d} {out:?}");
+        // The arc's middle lies on the cap, not on the other side.
+        let mid = along(pts[0], &out[3], 0.5);
+        assert!(
+            (mid.1 - ((r * r - mid.0 * mid.0).sqrt() - r)).abs() < 1e-9,
+            "{mid:?}"
+        );
+    }
+
+    #[test]
+    fn concave_arcs_turn_the_other_way() {
+        let r = 3.0;
+        let pts: Vec<(f64, f64)> = (0..=1000)
+            .map(|k| {
+                let x = 1.5 * k as f64 / 1000.0;
+                (x, r - (r * r - x * x).sqrt())
+            })
+            .collect();
+        let (out, s) = optimise(&lathe_stream(&pts), TOL, &[Plane::Zx]);
+        assert_eq!(s.arcs, 1);
+        let arc = out.iter().find(|m| matches!(m, Move::Arc { .. })).unwrap();
+        let mid = along(pts[0], arc, 0.5);
+        assert!(
+            (mid.1 - (r - (r * r - mid.0 * mid.0).sqrt())).abs() < 1e-9,
+            "{mid:?}"
+        );
+        assert!(hausdorff(&pts, &out) <= TOL);
+    }
+
+    #[test]
+    fn collinear_points_merge_and_corners_stay() {
+        // Two straight legs with wobble below the tolerance.
+        let mut pts: Vec<(f64, f64)> = (0..=50)
+            .map(|k| {
+                let x = k as f64 * 0.01;
+                (x, 1e-6 * ((k * 7 % 5) as f64 / 4.0 - 0.5))
+            })
+            .collect();
+        pts.extend((1..=50).map(|k| (0.5, -(k as f64) * 0.01)));
+        let (out, s) = optimise(&lathe_stream(&pts), TOL, &[]);
+        assert_eq!(s.arcs, 0);
+        let lines = out
+            .iter()
+            .filter(|m| matches!(m, Move::Linear { .. }))
+            .count();
+        assert_eq!(lines, 3, "{out:?}"); // the plunge and one line per leg
+        assert!(hausdorff(&pts, &out) <= TOL);
+        assert!(s.max_deviation > 0.0 && s.max_deviation <= TOL);
+    }
+
+    #[test]
+    fn any_profile_stays_within_tolerance_of_the_polyline() {
+        // Sampled sines and steps of many sizes, some far coarser than the
+        // tolerance, some finer: whatever is fitted, nothing strays.
+        for (amp, freq, n) in [
+            (0.01, 3.0, 400),
+            (1e-6, 40.0, 300),
+            (0.2, 1.0, 50),
+            (2e-6, 1.0, 999),
+        ] {
+            let pts: Vec<(f64, f64)> = (0..=n)
+                .map(|k| {
+                    let x = 2.0 - 2.0 * k as f64 / n as f64;
+                    (x, amp * (freq * x).sin() + 0.01 * x * x)
+                })
+                .collect();
+            let (out, s) = optimise(&lathe_stream(&pts), TOL, &[Plane::Zx]);
+            let d = hausdorff(&pts, &out);
+            assert!(d <= TOL * 1.001, "amp {amp} freq {freq}: {d}");
+            assert!(s.max_deviation <= TOL);
+            assert!(s.moves_after <= s.moves_before);
+        }
+    }
+
+    #[test]
+    fn rapids_spindle_and_inverse_time_moves_are_kept() {
+        let stream = vec![
+            Move::Rapid(Position::xzc(1.0, 1.0, 0.0)),
+            Move::Linear {
+                to: Position::xzc(0.9, 0.0, 1.0),
+                feed: Some(Feed::InverseTime(0.1)),
+            },
+            Move::Linear {
+                to: Position::xzc(0.8, 0.0, 2.0),
+                feed: Some(Feed::InverseTime(0.1)),
+            },
+            Move::Linear {
+                to: Position::xzc(0.7, 0.0, 3.0),
+                feed: Some(Feed::InverseTime(0.1)),
+            },
+            Move::SpindleOff,
+        ];
+        let (out, s) = optimise(&stream, TOL, &[Plane::Zx]);
+        assert_eq!(format!("{out:?}"), format!("{stream:?}"));
+        assert_eq!(s.arcs + s.merged_lines, 0);
+    }
+}
