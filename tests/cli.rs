@@ -158,6 +158,16 @@ fn build_writes_program_to_out_dir() {
         ["kim_convex.ngc", "kim_convex.report.json"],
         "temporary files left"
     );
+    // Put in place readable by all, not with the temporary file's 0600.
+    #[cfg(unix)]
+    for f in &leftovers {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(dir.path().join("out").join(f))
+            .expect("meta")
+            .permissions()
+            .mode();
+        assert_eq!(mode & 0o777, 0o644, "{f}");
+    }
     // The report: provenance, the program, the toolpath and the surface.
     let report: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(dir.path().join("out/kim_convex.report.json")).expect("report"),

@@ -184,3 +184,104 @@ fn a_fanuc_lathe_program_is_in_diameter_with_radius_arc_centres() {
         insta::assert_snapshot!("fanuc_0i_lathe__fanuc_insert.nc", text);
     });
 }
+
+/// Every word of a program's motion blocks, modal: (X, Z, C) after each
+/// block that moves at a feed (G1), in the order written.
+fn modal_feeds(program: &str) -> Vec<[f64; 3]> {
+    let mut at = [f64::NAN; 3];
+    let mut feeding = false;
+    let mut out = Vec::new();
+    for line in program.lines().filter(|l| !l.starts_with('(')) {
+        let mut moved = false;
+        for w in line.split_whitespace() {
+            match w {
+                "G0" => feeding = false,
+                "G1" => feeding = true,
+                _ => {}
+            }
+            for (k, letter) in ['X', 'Z', 'C'].into_iter().enumerate() {
+                if let Some(v) = w.strip_prefix(letter) {
+                    at[k] = v.parse().expect("number");
+                    moved = true;
+                }
+            }
+        }
+        if moved && feeding {
+            out.push(at);
+        }
+    }
+    out
+}
+
+#[test]
+fn a_fast_tool_servo_table_holds_the_same_points_as_the_linuxcnc_program() {
+    let file = root().join("tests/jobs/fts_small_array.lens");
+    let checked = check_path(&RealFs, &file).expect("readable");
+    let build = |dialect: &str| {
+        let (mut programs, diags) = plan_and_emit(
+            &checked,
+            Request {
+                job: None,
+                dialect: Some(dialect),
+            },
+            "fts_small_array.lens",
+            None,
+        );
+        assert!(diags.is_empty(), "{diags:?}");
+        programs.remove(0)
+    };
+    let linuxcnc = build("linuxcnc");
+    let table_built = build("ultra_precision_lathe_gcode");
+    assert!(linuxcnc.beside.is_empty());
+    assert_eq!(table_built.beside.len(), 1);
+    let (name, table) = &table_built.beside[0];
+    assert_eq!(name, "corner_fts.fts");
+    let table = table.text().expect("table");
+    let rows: Vec<[f64; 3]> = table
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| {
+            let v: Vec<f64> = l.split(' ').map(|v| v.parse().expect("number")).collect();
+            assert_eq!(v.len(), 3, "{l}");
+            [v[0], v[1], v[2]]
+        })
+        .collect();
+    // LinuxCNC's program carries W on Z: after its plunge, the same points
+    // as the table's rows, X Z C against C X W.
+    let lin = modal_feeds(&linuxcnc.program.text().expect("text"));
+    let points = linuxcnc.report["toolpath"]["cut_points"]
+        .as_u64()
+        .expect("n") as usize;
+    assert_eq!(rows.len(), points);
+    assert_eq!(lin.len(), points, "the plunge and a move per later point");
+    assert_eq!(
+        table_built.report["program"]["fts_table"]["rows"].as_u64(),
+        Some(points as u64)
+    );
+    for (row, m) in rows.iter().zip(&lin).skip(1) {
+        assert_eq!([row[1], row[2], row[0]], *m);
+    }
+    // The table's program moves X and C a revolution a block and the table
+    // has a row at each end.
+    let program = table_built.program.text().expect("text");
+    obeys("ultra_precision_lathe_gcode", &program).expect("rules");
+    assert!(
+        program.contains("\nM70 (FTS TABLE corner_fts.fts)\nG93 G1 Z0. F60.\n"),
+        "{program}"
+    );
+    let blocks = modal_feeds(&program);
+    let revolutions = (rows[rows.len() - 1][0] / 360.0).ceil() as usize;
+    assert_eq!(
+        blocks.len(),
+        revolutions + 1,
+        "the plunge, then a block per turn"
+    );
+    for b in &blocks[1..] {
+        assert!(
+            rows.iter().any(|r| r[0] == b[2] && r[1] == b[0]),
+            "block X{} C{} is not a table row",
+            b[0],
+            b[2]
+        );
+    }
+}

@@ -54,6 +54,9 @@ pub struct Built {
     pub cutting_time: f64,
     /// The build report (fields documented in README.md, "Build report").
     pub report: serde_json::Value,
+    /// Files the program reads, written beside it (a fast-tool-servo
+    /// table): name and text.
+    pub beside: Vec<(String, ProgramText)>,
 }
 
 /// A program's text: in memory, or spooled as it was written to a
@@ -94,6 +97,7 @@ impl ProgramText {
         match self {
             ProgramText::Memory(t) => write_atomic(path, &t),
             ProgramText::Spooled { file, .. } => {
+                readable_by_all(file.as_file())?;
                 file.as_file().sync_all()?;
                 file.persist(path).map(|_| ()).map_err(|e| e.error)
             }
@@ -264,6 +268,7 @@ pub fn plan_and_emit(
                     cut_points: path.cut_points,
                     cutting_time: path.cutting_time(),
                     report,
+                    beside: Vec::new(),
                 });
             }
             Err(e) => diags.push(
@@ -288,6 +293,18 @@ pub fn optimisation_json(s: &lensc_runtime::optimise::Summary) -> serde_json::Va
         "max_deviation_mm": s.max_deviation,
         "tolerance_mm": s.tolerance,
     })
+}
+
+/// Makes a finished output file readable by all and writable by its owner.
+fn readable_by_all(file: &std::fs::File) -> std::io::Result<()> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        file.set_permissions(std::fs::Permissions::from_mode(0o644))?;
+    }
+    #[cfg(not(unix))]
+    let _ = file;
+    Ok(())
 }
 
 /// The report written beside a program.
@@ -403,6 +420,9 @@ fn plan_diagnostic(e: PlanError, file: FileId, span: Span) -> Diagnostic {
 /// Writes `text` to `path` atomically: a temporary file in the same
 /// directory, flushed, then renamed over the target. On failure the
 /// target is untouched and no temporary file is left behind.
+/// Temporary files are created private (0600); a program and its report
+/// are put in place readable by all (0644), as any other written file, so
+/// they can be copied to the controller's share.
 pub fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {
     use std::io::Write;
     let dir = path
@@ -415,6 +435,7 @@ pub fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {
         .suffix(".tmp")
         .tempfile_in(dir)?;
     tmp.write_all(text.as_bytes())?;
+    readable_by_all(tmp.as_file())?;
     tmp.as_file().sync_all()?;
     tmp.persist(path).map_err(|e| e.error)?;
     Ok(())

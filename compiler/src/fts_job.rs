@@ -75,6 +75,12 @@ pub fn build(
         (parts.surface, parts.tool, parts.machine, parts.strategy);
     let (file, span) = parts.site();
     let names = |p: &str, o: &Object| parts.name(p, o);
+    // A fast tool servo whose controller takes a table: its motion goes
+    // there, and the program moves X and C a revolution a block.
+    let table_name = match &dialect.fts_table {
+        Some(ext) if !p.slow => Some(format!("{}.{ext}", job.name.name)),
+        _ => None,
+    };
     let header = header_lines(
         job,
         prov,
@@ -87,6 +93,7 @@ pub fn build(
         &p.spiral,
         p.settling.as_ref(),
         p.slow,
+        table_name.as_deref(),
         &parts,
     );
     let mut program = FtsProgram::new(
@@ -96,9 +103,14 @@ pub fn build(
         p.resolution,
         p.spiral.chord_tolerance,
         p.safe_w,
+        table_name.as_deref(),
     )
     .map_err(|e| vec![parts.not_printable(e)])?;
     let mut sink = Sink::new(spool_dir).map_err(|e| vec![cannot_spool(&e, file, span)])?;
+    let mut table_sink = match table_name {
+        Some(_) => Some(Sink::new(spool_dir).map_err(|e| vec![cannot_spool(&e, file, span)])?),
+        None => None,
+    };
     let mut write_error: Option<ProgramError> = None;
     let planned = p.planner().plan(&p.fast_axis, |pts| {
         if write_error.is_none()
@@ -110,6 +122,9 @@ pub fn build(
             Ok(t) => sink.push(t),
             Err(e) => write_error = write_error.take().or(Some(e)),
         }
+        if let Some(t) = table_sink.as_mut() {
+            t.push(program.take_table_text());
+        }
     });
     let axis = if p.slow { "Z" } else { "the fast axis" };
     let summary =
@@ -117,8 +132,16 @@ pub fn build(
     if let Some(e) = write_error {
         return Err(vec![parts.not_printable(e)]);
     }
+    if let Some(t) = table_sink.as_mut() {
+        t.push(program.take_table_text());
+    }
     let rest = program.finish().map_err(|e| vec![parts.not_printable(e)])?;
     sink.push(rest);
+    let mut beside = Vec::new();
+    if let (Some(name), Some(t)) = (table_name, table_sink) {
+        let table = t.finish().map_err(|e| vec![cannot_spool(&e, file, span)])?;
+        beside.push((name, table));
+    }
     let text = sink
         .finish()
         .map_err(|e| vec![cannot_spool(&e, file, span)])?;
@@ -133,12 +156,17 @@ pub fn build(
     if p.slow {
         toolpath["strategy"] = json!("spiral_turning");
     }
-    let report = parts.report(prov, &program_name, &text, toolpath, &p.lowered);
+    let mut report = parts.report(prov, &program_name, &text, toolpath, &p.lowered);
+    if let Some((name, table)) = beside.first() {
+        report["program"]["fts_table"] =
+            json!({ "file": name, "rows": table.lines().saturating_sub(2) });
+    }
     Ok(Built {
         report_name: format!("{}.report.json", job.name.name),
         program_name,
         program: text,
         report,
+        beside,
         cut_points: summary.points,
         cutting_time: summary.time,
     })
@@ -567,10 +595,17 @@ fn header_lines(
     spiral: &FtsSpiral,
     settling: Option<&Settling>,
     slow: bool,
+    table: Option<&str>,
     parts: &Parts,
 ) -> Vec<String> {
+    let table_words;
     let (servo_words, axis_words) = if slow {
         ("slow-tool-servo", "Z carries the surface")
+    } else if let Some(table) = table {
+        table_words = format!(
+            "Z held at 0 while the fast tool servo follows the table {table} [rows C X W, one per point]"
+        );
+        ("fast-tool-servo", table_words.as_str())
     } else {
         ("fast-tool-servo", "Z the fast tool servo's axis")
     };
@@ -596,10 +631,14 @@ fn header_lines(
         format!("surface {surface}: {surface_words}"),
         format!("tool {tool}: round nose, nose radius {} mm", trim_num(rho)),
         format!(
-            "strategy {strategy}: {servo_words} spiral from r = {} mm, feed {} um/rev, {speed}, chord tolerance {} nm",
+            "strategy {strategy}: {servo_words} spiral from r = {} mm, feed {} um/rev, {speed}, path tolerance {} nm [chords {}, blending {} nm]",
             trim_num(spiral.start_radius),
             trim_num(spiral.feed_per_rev * 1000.0),
-            trim_num(spiral.chord_tolerance * 1e6)
+            trim_num(spiral.chord_tolerance * 1e6),
+            trim_num(
+                spiral.chord_tolerance * lensc_runtime::optimise::UNOPTIMISED_CHORD_SHARE * 1e6
+            ),
+            trim_num(spiral.chord_tolerance * lensc_runtime::optimise::BLEND_SHARE * 1e6)
         ),
         format!(
             "machine {machine}: {} {servo_words} lathe",

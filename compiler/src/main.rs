@@ -270,11 +270,28 @@ fn run(cli: Cli) -> u8 {
                 let report_path = dir.join(&built.report_name);
                 let report = serde_json::to_string_pretty(&built.report).unwrap_or_default() + "\n";
                 let lines = built.program.lines();
+                let beside: Vec<String> = built
+                    .beside
+                    .iter()
+                    .map(|(name, text)| {
+                        format!(", {} ({} lines)", dir.join(name).display(), text.lines())
+                    })
+                    .collect();
                 // The report is written first: a program on disk always has
                 // its report beside it.
-                let written = driver::write_atomic(&report_path, &report)
-                    .map_err(|e| (&report_path, e))
-                    .and_then(|()| built.program.write_to(&target).map_err(|e| (&target, e)));
+                let mut written = driver::write_atomic(&report_path, &report)
+                    .map_err(|e| (report_path.clone(), e));
+                // Then what the program reads, then the program.
+                for (name, text) in built.beside {
+                    let path = dir.join(&name);
+                    written = written.and_then(|()| text.write_to(&path).map_err(|e| (path, e)));
+                }
+                let written = written.and_then(|()| {
+                    built
+                        .program
+                        .write_to(&target)
+                        .map_err(|e| (target.clone(), e))
+                });
                 if let Err((path, e)) = written {
                     eprintln!(
                         "error[{}]: cannot write {}: {}",
@@ -285,11 +302,12 @@ fn run(cli: Cli) -> u8 {
                     return 1;
                 }
                 eprintln!(
-                    "wrote {} ({} lines, {} cut points, estimated cutting time {:.1} s) and {}",
+                    "wrote {} ({} lines, {} cut points, estimated cutting time {:.1} s){} and {}",
                     target.display(),
                     lines,
                     built.cut_points,
                     built.cutting_time,
+                    beside.concat(),
                     report_path.display()
                 );
             }

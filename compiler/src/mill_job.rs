@@ -169,6 +169,7 @@ pub fn build_raster(
         program_name,
         program: text,
         report,
+        beside: Vec::new(),
         cut_points: path.point_count,
         cutting_time: time,
     })
@@ -331,6 +332,7 @@ pub fn build_grinding(
         program_name,
         program: text,
         report,
+        beside: Vec::new(),
         cut_points: path.points.len(),
         cutting_time: path.total_time,
     })

@@ -307,6 +307,7 @@ pub fn build(
         program_name,
         program: text,
         report,
+        beside: Vec::new(),
         cut_points: points,
         cutting_time: time,
     })

@@ -485,6 +485,18 @@ const GCODE_PARAMS: &[Param] = &[
         Check::Any,
         "arc centres I J K from the arc's start (`incremental`) or in work coordinates",
     ),
+    text(
+        "fts_table",
+        "the extension of a fast-tool-servo table file (rows `C X W`: degrees, mm, mm) written beside the program; absent: the fast axis's motion is programmed on Z",
+    ),
+    texts(
+        "fts_on",
+        "blocks that arm the servo to follow its table, before the plunge (`{table}`: the table's file name)",
+    ),
+    texts(
+        "fts_off",
+        "blocks that release the servo after the last revolution",
+    ),
     opt(
         "arc_radius_tolerance",
         LENGTH,

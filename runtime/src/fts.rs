@@ -61,7 +61,8 @@ pub struct FtsSpiral {
     /// Radial feed per revolution (mm).
     pub feed_per_rev: f64,
     pub speed: SpindleSpeed,
-    /// Largest deviation (mm) of W from its chords in (C, W).
+    /// The path's tolerance T (mm); W's chords in (C, W) take
+    /// `optimise::UNOPTIMISED_CHORD_SHARE` of it, blending the rest.
     pub chord_tolerance: f64,
     /// Largest arc (mm) between seeds; features shorter than this along
     /// the spiral may be missed by the sampling.
@@ -287,7 +288,7 @@ impl Planner<'_> {
     /// halved until its W midpoint is on the chord (or down to the servo's
     /// data period).
     fn sample(&self, c0: f64, c1: f64, out: &mut Vec<(f64, f64)>) {
-        let tol = self.spiral.chord_tolerance;
+        let tol = self.spiral.chord_tolerance * crate::optimise::UNOPTIMISED_CHORD_SHARE;
         let r = self.radius(c0).max(self.spiral.seed_arc);
         let seeds = (((c1 - c0) * r / self.spiral.seed_arc).ceil() as usize).max(2);
         let mut prev = (c0, self.centre(c0));

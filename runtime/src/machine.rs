@@ -30,6 +30,12 @@ pub struct Dialect {
     pub path_tolerance: Vec<String>,
     pub c_axis_on: Vec<String>,
     pub c_axis_off: Vec<String>,
+    /// The extension of a fast-tool-servo table file, if the controller
+    /// takes the fast axis's motion as a table beside the program.
+    pub fts_table: Option<String>,
+    /// Blocks arming and releasing the servo's table (`{table}`: its file).
+    pub fts_on: Vec<String>,
+    pub fts_off: Vec<String>,
     /// Blocks that end the program (`M30`).
     pub end: Vec<String>,
     /// Lines after the last block, as written (`%`).
@@ -78,6 +84,9 @@ impl Dialect {
             path_tolerance: lines(&["G64 P{tolerance}"]),
             c_axis_on: Vec::new(),
             c_axis_off: Vec::new(),
+            fts_table: None,
+            fts_on: Vec::new(),
+            fts_off: Vec::new(),
             end: lines(&["M2"]),
             trailer: Vec::new(),
             lathe_x_diameter: false,

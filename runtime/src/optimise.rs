@@ -22,6 +22,9 @@ pub const CHORD_SHARE: f64 = 0.125;
 pub const FIT_SHARE: f64 = 0.5;
 /// The controller's share: the blending tolerance the program asks for.
 pub const BLEND_SHARE: f64 = 0.375;
+/// The chords' share where a path is written as planned, not optimised
+/// (fast- and slow-tool-servo spirals): all but the blending.
+pub const UNOPTIMISED_CHORD_SHARE: f64 = 1.0 - BLEND_SHARE;
 
 /// The smallest arc radius fitted (mm). LinuxCNC refuses arcs under
 /// 0.00127 mm (its centre-arc radius tolerance) as zero-radius; a tool
