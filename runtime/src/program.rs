@@ -815,8 +815,29 @@ impl ProgramWriter {
             job: job.to_string(),
             moves: 0,
         };
+        // The dialect's own words, checked once: every number the writer
+        // prints itself is checked as it is printed (`value`), and every
+        // line taken from the dialect as it is written, so no text leaves
+        // the writer unchecked.
+        let words = [
+            &dialect.rapid,
+            &dialect.linear,
+            &dialect.arc_cw,
+            &dialect.arc_ccw,
+            &dialect.spindle_on,
+            &dialect.spindle_off,
+            &dialect.block_end,
+        ]
+        .into_iter()
+        .chain(dialect.per_minute.iter())
+        .chain(dialect.per_revolution.iter())
+        .chain(dialect.inverse_time.iter());
+        for word in words {
+            check_numbers(word, dialect.comment)?;
+        }
         for line in &dialect.start {
             let l = w.fill(line, path_tolerance);
+            check_numbers(&l, dialect.comment)?;
             w.text.push_str(&l);
             w.text.push('\n');
         }
@@ -878,6 +899,7 @@ impl ProgramWriter {
     }
 
     fn block_line(&mut self, words: &str) -> Result<(), ProgramError> {
+        check_numbers(words, self.dialect.comment)?;
         let start = self.text.len();
         self.begin_block();
         self.text.push_str(words);
@@ -913,6 +935,12 @@ impl ProgramWriter {
     fn value(&mut self, letter: char, v: f64, n: i64, d: u32) -> Result<(), ProgramError> {
         let before = self.text.len();
         push_units(&mut self.text, n, d);
+        if let Err(why) = check_number(&self.text.as_bytes()[before..]) {
+            return Err(ProgramError::Unsupported(format!(
+                "the word `{letter}{}` ({why})",
+                &self.text[before..]
+            )));
+        }
         if let Some(max) = self.dialect.max_digits {
             let digits = self.text.as_bytes()[before..]
                 .iter()
@@ -1038,14 +1066,12 @@ impl ProgramWriter {
                 self.plane = plane;
             }
         }
-        let w = match word {
+        self.text.push_str(match word {
             Word::Rapid => &self.dialect.rapid,
             Word::Linear => &self.dialect.linear,
             Word::ArcCw => &self.dialect.arc_cw,
             Word::ArcCcw => &self.dialect.arc_ccw,
-        };
-        let w = w.clone();
-        self.text.push_str(&w);
+        });
         let mut printed = self.last;
         let mut any = false;
         for (i, v) in to.axes().into_iter().enumerate() {
@@ -1158,13 +1184,14 @@ impl ProgramWriter {
     }
 
     /// The text written since the last call (for streaming to a file),
-    /// checked by `check_numbers`; the next chunk starts with room for as
-    /// much again.
+    /// every number and dialect line in it checked as it was written; the
+    /// next chunk starts with room for as much again.
     pub fn take_text(&mut self) -> Result<String, ProgramError> {
         let room = self.text.len();
-        let text = std::mem::replace(&mut self.text, String::with_capacity(room));
-        check_numbers(&text, self.dialect.comment)?;
-        Ok(text)
+        Ok(std::mem::replace(
+            &mut self.text,
+            String::with_capacity(room),
+        ))
     }
 
     /// Ends the program; the text not yet taken, checked.
@@ -1180,10 +1207,10 @@ impl ProgramWriter {
         }
         for line in self.dialect.trailer.clone() {
             let l = self.fill(&line, 0.0);
+            check_numbers(&l, self.dialect.comment)?;
             self.text.push_str(&l);
             self.text.push('\n');
         }
-        check_numbers(&self.text, self.dialect.comment)?;
         Ok(self.text)
     }
 }
@@ -1201,42 +1228,62 @@ enum Word {
 /// digit runs straight into a letter. The writer cannot produce these; this
 /// check makes sure no path around it does.
 pub fn check_numbers(text: &str, comments: CommentStyle) -> Result<(), ProgramError> {
-    for line in text.lines() {
-        let code = match comments {
-            CommentStyle::Parentheses => line.split('(').next().unwrap_or(""),
-            CommentStyle::Semicolon => line.split(';').next().unwrap_or(""),
-        };
-        for token in code.split_ascii_whitespace() {
-            let bad = |why: &str| {
-                Err(ProgramError::Unsupported(format!(
-                    "the word `{token}` ({why}) in the line `{line}`"
-                )))
-            };
-            let lower = token.to_ascii_lowercase();
-            if lower.contains("nan") || lower.contains("inf") {
-                return bad("not a finite number");
-            }
-            let b = token.as_bytes();
-            if b.len() < 2 || !b[0].is_ascii_alphabetic() {
+    let opens = match comments {
+        CommentStyle::Parentheses => b'(',
+        CommentStyle::Semicolon => b';',
+    };
+    for line in text.split('\n') {
+        let b = line.as_bytes();
+        let code = &b[..b.iter().position(|&c| c == opens).unwrap_or(b.len())];
+        let mut j = 0;
+        while j < code.len() {
+            if code[j].is_ascii_whitespace() {
+                j += 1;
                 continue;
             }
-            let num = &token[1..];
-            if !num.starts_with(|c: char| c.is_ascii_digit() || c == '-' || c == '.') {
-                continue;
+            let start = j;
+            while j < code.len() && !code[j].is_ascii_whitespace() {
+                j += 1;
             }
-            if num
-                .trim_start_matches('-')
-                .bytes()
-                .any(|c| !(c.is_ascii_digit() || c == b'.'))
-            {
-                // `G05.1`-style words are digits and points only; anything
-                // else after a number is an exponent or a run-on word.
-                return bad("a number with letters in it");
-            }
-            if num.starts_with('-') && num.bytes().all(|c| matches!(c, b'-' | b'0' | b'.')) {
-                return bad("minus zero");
+            if let Err(why) = check_word(&code[start..j]) {
+                return Err(ProgramError::Unsupported(format!(
+                    "the word `{}` ({why}) in the line `{line}`",
+                    &line[start..j]
+                )));
             }
         }
+    }
+    Ok(())
+}
+
+/// One word of code: a letter and a number (digits and points, perhaps a
+/// leading minus that is not on a zero) or a word that spells no
+/// non-finite number.
+fn check_word(w: &[u8]) -> Result<(), &'static str> {
+    let numeric =
+        w.len() >= 2 && w[0].is_ascii_alphabetic() && matches!(w[1], b'0'..=b'9' | b'-' | b'.');
+    if !numeric {
+        let spells = |s: &[u8]| w.windows(3).any(|x| x.eq_ignore_ascii_case(s));
+        return if spells(b"nan") || spells(b"inf") {
+            Err("not a finite number")
+        } else {
+            Ok(())
+        };
+    }
+    check_number(&w[1..])
+}
+
+/// A printed number: digits and points after an optional minus, and not
+/// a minus zero.
+fn check_number(num: &[u8]) -> Result<(), &'static str> {
+    let digits = num.strip_prefix(b"-").unwrap_or(num);
+    if !digits.iter().all(|&c| c.is_ascii_digit() || c == b'.') {
+        // `G05.1`-style words are digits and points only; anything else
+        // after a number is an exponent or a run-on word.
+        return Err("a number with letters in it");
+    }
+    if digits.len() < num.len() && digits.iter().all(|&c| c == b'0' || c == b'.') {
+        return Err("minus zero");
     }
     Ok(())
 }
