@@ -253,7 +253,11 @@ pub fn plan_and_emit(
             );
         }
         match program::emit(&lowered, &path, &prov) {
-            Ok((text, optimised)) => {
+            Ok(program::Emitted {
+                text,
+                stream,
+                optimised,
+            }) => {
                 let program_name =
                     format!("{}.{}", lowered.name, lowered.machine.dialect.extension);
                 let name = job.part_names.get("surface").cloned().unwrap_or_default();
@@ -261,6 +265,30 @@ pub fn plan_and_emit(
                 let mut report =
                     build_report(&lowered, &prov, &program_name, &text, &path, analysis);
                 report["toolpath"]["optimisation"] = optimisation_json(&optimised);
+                report["simulation"] = if lowered.tool.centre_height == 0.0 {
+                    use lensc_runtime::surface::Profile as _;
+                    let design = |x: f64| profile.point(x).z;
+                    let range = (
+                        lowered.strategy.end_radius,
+                        lowered
+                            .strategy
+                            .start_radius
+                            .unwrap_or(lowered.surface.aperture_radius),
+                    );
+                    let cut = lensc_runtime::simulate::profile_cut(
+                        &stream,
+                        lowered.tool.nose_radius,
+                        lowered.machine.resolution,
+                        &design,
+                        range,
+                        PROFILE_SAMPLES,
+                    );
+                    profile_cut_json(&cut)
+                } else {
+                    serde_json::json!({
+                        "skipped": "the edge is set off the spindle axis: the program's X is not the nose centre's radius"
+                    })
+                };
                 out.push(Built {
                     report_name: format!("{}.report.json", lowered.name),
                     program_name,
@@ -278,6 +306,24 @@ pub fn plan_and_emit(
         }
     }
     (out, diags)
+}
+
+/// Radii sampled by a profile's cut simulation.
+pub const PROFILE_SAMPLES: usize = 20_001;
+
+/// A profile's simulated cut, for its report: the form error (design to
+/// cut, positive where material is left) over the radii the cut reaches.
+pub fn profile_cut_json(cut: &lensc_runtime::simulate::ProfileCut) -> serde_json::Value {
+    serde_json::json!({
+        "kind": "profile envelope of the nose along the program's moves, as printed",
+        "samples": cut.samples.len(),
+        "from_radius_mm": cut.samples.first().map(|s| s.0),
+        "to_radius_mm": cut.samples.last().map(|s| s.0),
+        "form_error_pv_nm": cut.pv * 1e6,
+        "form_error_rms_nm": cut.rms * 1e6,
+        "max_residual_nm": { "value": cut.max_residual.0 * 1e6, "at_radius_mm": cut.max_residual.1 },
+        "max_gouge_nm": { "value": cut.max_gouge.0 * 1e6, "at_radius_mm": cut.max_gouge.1 },
+    })
 }
 
 /// What optimisation did to a program, for its report: motion blocks

@@ -326,7 +326,20 @@ pub fn build_grinding(
     });
     let program_name = p.program_name();
     let text = ProgramText::Memory(text);
-    let report = p.report(prov, &program_name, &text, toolpath, &lowered);
+    let mut report = p.report(prov, &program_name, &text, toolpath, &lowered);
+    // What the wheel's section (a circle of its radius about the centre)
+    // leaves along the programmed centres.
+    use lensc_runtime::surface::Profile as _;
+    let stream = lensc_runtime::program::grinding_moves(&path, feed, safe_z);
+    let cut = lensc_runtime::simulate::profile_cut(
+        &stream,
+        grinding.wheel_diameter / 2.0,
+        resolution,
+        &|x: f64| profile.point(x).z,
+        (grinding.start, grinding.end),
+        crate::driver::PROFILE_SAMPLES,
+    );
+    report["simulation"] = crate::driver::profile_cut_json(&cut);
     Ok(Built {
         report_name: format!("{}.report.json", job.name.name),
         program_name,

@@ -19,6 +19,7 @@ pub mod program;
 pub mod raster;
 pub mod roller;
 pub mod servo;
+pub mod simulate;
 pub mod surface;
 pub mod tool;
 pub mod toolpath;

@@ -46,14 +46,18 @@ impl ProgramError {
     }
 }
 
+/// A program, the move stream it was written from, and what
+/// optimisation did to that stream.
+pub struct Emitted {
+    pub text: String,
+    pub stream: Vec<moves::Move>,
+    pub optimised: optimise::Summary,
+}
+
 /// Writes a lathe program for a profile-turning path in the machine's
 /// dialect, optimised (lines merged, arcs fitted) within the fitting share
-/// of the strategy's tolerance; with what optimisation did.
-pub fn emit(
-    job: &Job,
-    path: &Toolpath,
-    prov: &Provenance,
-) -> Result<(String, optimise::Summary), ProgramError> {
+/// of the strategy's tolerance.
+pub fn emit(job: &Job, path: &Toolpath, prov: &Provenance) -> Result<Emitted, ProgramError> {
     let centre_height = if job.tool.centre_height == 0.0 {
         String::new()
     } else {
@@ -107,7 +111,11 @@ pub fn emit(
         tolerance * optimise::BLEND_SHARE,
     )?;
     w.write_all(&stream)?;
-    Ok((w.finish()?, summary))
+    Ok(Emitted {
+        text: w.finish()?,
+        stream,
+        optimised: summary,
+    })
 }
 
 /// How a path's tolerance T is stated in a header, with its shares.
@@ -853,9 +861,20 @@ impl ProgramWriter {
 
     /// A line with its placeholders filled in.
     fn fill(&self, line: &str, tolerance: f64) -> String {
-        let d = decimals_for(tolerance).max(self.decimals);
+        // A tolerance is a bound: printed exactly if a few more decimals
+        // do it (2.5 nm as 0.0000025), else rounded down, never up.
+        let first = decimals_for(tolerance).max(self.decimals);
+        let exact = (first..=9).find(|&d| {
+            let scaled = tolerance * 10f64.powi(d as i32);
+            (scaled - scaled.round()).abs() < 1e-6
+        });
+        let d = exact.unwrap_or(first);
+        let shown = match exact {
+            Some(_) => tolerance,
+            None => (tolerance * 10f64.powi(d as i32)).floor() / 10f64.powi(d as i32),
+        };
         let mut tol = String::new();
-        if !push_fixed(&mut tol, tolerance, d) {
+        if !push_fixed(&mut tol, shown, d) {
             tol.push('0');
         }
         line.replace("{job}", &self.job)
