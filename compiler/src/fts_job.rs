@@ -111,8 +111,29 @@ pub fn build(
         Some(_) => Some(Sink::new(spool_dir).map_err(|e| vec![cannot_spool(&e, file, span)])?),
         None => None,
     };
+    // The fast axis's servo, run on the commands as printed as they are
+    // planned (a slow tool servo's Z has no servo model here).
+    let data_rate = 1.0 / p.spiral.min_interval;
+    let features = p.bounds.features.clone().unwrap_or_default();
+    let mut following = match (&p.servo, p.slow) {
+        (Some(servo), false) => {
+            lensc_runtime::follow::FollowingSimulation::new(servo, data_rate, &features, 20_000)
+        }
+        _ => None,
+    };
+    let mut printed = Vec::new();
     let mut write_error: Option<ProgramError> = None;
     let planned = p.planner().plan(&p.fast_axis, |pts| {
+        if let Some(sim) = following.as_mut() {
+            let as_printed = |v: f64| lensc_runtime::simulate::as_printed(v, p.resolution);
+            printed.clear();
+            printed.extend(pts.iter().map(|q| lensc_runtime::fts::SpiralPoint {
+                x: as_printed(q.x),
+                w: as_printed(q.w),
+                ..*q
+            }));
+            sim.extend(&printed);
+        }
         if write_error.is_none()
             && let Err(e) = program.extend(pts)
         {
@@ -157,6 +178,13 @@ pub fn build(
         toolpath["strategy"] = json!("spiral_turning");
     }
     let mut report = parts.report(prov, &program_name, &text, toolpath, &p.lowered);
+    report["simulation"] = match following {
+        Some(sim) => following_json(&sim.finish(), data_rate),
+        None if p.slow => {
+            json!({ "skipped": "slow tool servo: Z is a machine axis, with no servo model here" })
+        }
+        None => json!({ "skipped": "the fast axis has no servo model" }),
+    };
     if let Some((name, table)) = beside.first() {
         report["program"]["fts_table"] =
             json!({ "file": name, "rows": table.lines().saturating_sub(2) });
@@ -169,6 +197,26 @@ pub fn build(
         beside,
         cut_points: summary.points,
         cutting_time: summary.time,
+    })
+}
+
+/// The fast axis's following, for the report: over the whole spiral and
+/// per lenslet (in the planner's feature order), errors in nm and the
+/// waviness (RMS slope of the error along the cut) in µrad.
+fn following_json(f: &lensc_runtime::follow::Following, data_rate: f64) -> serde_json::Value {
+    json!({
+        "kind": "fast-tool-servo following: the machine's servo model driven by the commanded positions, as printed, at its data rate",
+        "data_rate_hz": data_rate,
+        "servo_samples": f.samples,
+        "max_following_error_nm": { "value": f.max_error * 1e6, "at_radius_mm": f.max_error_at },
+        "lenslets": f.lenslets.iter().map(|l| json!({
+            "centre_mm": [l.centre.0, l.centre.1],
+            "radius_mm": l.radius,
+            "samples": l.samples,
+            "max_error_nm": l.max_error * 1e6,
+            "rms_error_nm": l.rms_error * 1e6,
+            "waviness_urad": l.waviness * 1e6,
+        })).collect::<Vec<_>>(),
     })
 }
 

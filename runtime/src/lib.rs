@@ -6,6 +6,7 @@
 
 pub mod analysis;
 pub mod envelope;
+pub mod follow;
 pub mod forbes;
 pub mod format;
 pub mod fts;

@@ -224,6 +224,13 @@ impl SecondOrderServo {
         Some(positions)
     }
 
+    /// Φ and Γ of one step of `dt` (s) of the exact zero-order-hold
+    /// discretisation (see [`simulate`](Self::simulate)), for running the
+    /// servo as commands arrive; `None` for an invalid model or step.
+    pub fn zero_order_hold_step(&self, dt: f64) -> Option<(Matrix2<f64>, Vector2<f64>)> {
+        (self.is_valid() && dt.is_finite() && dt > 0.0).then(|| self.zero_order_hold(dt))
+    }
+
     /// Φ = e^(A dt) and Γ of the zero-order-hold discretisation (see
     /// [`simulate`](Self::simulate)).
     fn zero_order_hold(&self, dt: f64) -> (Matrix2<f64>, Vector2<f64>) {
