@@ -379,6 +379,8 @@ fn build_report(
             "cut_points": path.cut_points,
             "cut_length_mm": path.cut_length,
             "feed_mm_per_min": path.feed_speed * 60.0,
+            "surface_speed_m_per_min": job.strategy.surface_speed.map(|v| v * 0.06),
+            "max_spindle_rpm": job.strategy.spindle_speed * 60.0 / std::f64::consts::TAU,
             "cutting_time_s": path.cutting_time(),
             "chord_tolerance_mm": job.strategy.chord_tolerance,
             "max_profile_slope_deg": path.max_slope.0.to_degrees(),

@@ -102,7 +102,15 @@ pub fn lower(job: &CheckedJob, dialect: Dialect) -> Result<Job, Vec<Diagnostic>>
     };
     let strat = ProfileTurning {
         feed,
-        spindle_speed: value::num(f, "spindle_speed").expect("required"),
+        // Under constant surface speed the spindle speed is its cap.
+        spindle_speed: value::num(f, "spindle_speed")
+            .or_else(|| value::num(f, "spindle_cap"))
+            .unwrap_or_else(|| {
+                value::block(&machine.fields, "spindle")
+                    .and_then(|s| value::num(s, "max_speed"))
+                    .expect("required")
+            }),
+        surface_speed: value::num(f, "surface_speed"),
         chord_tolerance: value::num(f, "chord_tolerance").unwrap_or(10e-6),
         start_radius: from,
         // An annular aperture's cut ends at its inner edge.
@@ -385,6 +393,7 @@ fn dialect_of(o: &Object, name: String) -> Dialect {
         path_tolerance: lines("path_tolerance"),
         c_axis_on: lines("c_axis_on"),
         c_axis_off: lines("c_axis_off"),
+        surface_speed: lines("surface_speed"),
         fts_table: opt_text("fts_table"),
         fts_on: lines("fts_on"),
         fts_off: lines("fts_off"),

@@ -485,6 +485,10 @@ const GCODE_PARAMS: &[Param] = &[
         Check::Any,
         "arc centres I J K from the arc's start (`incremental`) or in work coordinates",
     ),
+    texts(
+        "surface_speed",
+        "blocks that set constant surface speed before the spindle-on word (`{speed}` m/min, `{cap}` rpm); none: the controller cannot",
+    ),
     text(
         "fts_table",
         "the extension of a fast-tool-servo table file (rows `C X W`: degrees, mm, mm) written beside the program; absent: the fast axis's motion is programmed on Z",
@@ -1571,17 +1575,14 @@ pub static KINDS: &[Kind] = &[
                 Check::Positive,
                 "feed per revolution or feed speed",
             ),
-            req(
-                "spindle_speed",
-                Ty::Quantity(&[Dim::ROTATIONAL_SPEED]),
-                Check::Positive,
-                "constant spindle speed",
-            ),
+            SPIRAL_SPINDLE_SPEED,
+            SURFACE_SPEED,
+            SPINDLE_CAP,
             opt(
                 "chord_tolerance",
                 LENGTH,
                 Check::Positive,
-                "largest chord deviation from the exact tool-centre path; default 10 nm",
+                "the path's tolerance: the most the program, as the machine runs it, may stray from the exact tool-centre path; default 10 nm",
             ),
             opt(
                 "from",
@@ -1646,7 +1647,10 @@ pub static KINDS: &[Kind] = &[
         ],
         family: None,
         positional: &[],
-        exclusive: &[(&["stock_top", "stock_allowance"], false)],
+        exclusive: &[
+            (&["stock_top", "stock_allowance"], false),
+            (&["spindle_speed", "surface_speed"], true),
+        ],
         doc: "one facing pass along the profile with the nose centre offset along the normal",
     },
 ];

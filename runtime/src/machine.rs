@@ -30,6 +30,10 @@ pub struct Dialect {
     pub path_tolerance: Vec<String>,
     pub c_axis_on: Vec<String>,
     pub c_axis_off: Vec<String>,
+    /// Blocks that set constant surface speed (`{speed}` in m/min,
+    /// `{cap}` the spindle's limit in rpm), before the spindle-on word;
+    /// none: the controller cannot.
+    pub surface_speed: Vec<String>,
     /// The extension of a fast-tool-servo table file, if the controller
     /// takes the fast axis's motion as a table beside the program.
     pub fts_table: Option<String>,
@@ -84,6 +88,7 @@ impl Dialect {
             path_tolerance: lines(&["G64 P{tolerance}"]),
             c_axis_on: Vec::new(),
             c_axis_off: Vec::new(),
+            surface_speed: vec!["G96 D{cap} S{speed}".into()],
             fts_table: None,
             fts_on: Vec::new(),
             fts_off: Vec::new(),

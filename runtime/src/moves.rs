@@ -114,6 +114,12 @@ pub enum Move {
     },
     /// Spindle on, at a speed (rad/s) if it is not a C axis.
     SpindleOn(Option<f64>),
+    /// Spindle on at constant surface speed (mm/s at the tool's radius),
+    /// turning no faster than `cap` (rad/s).
+    SpindleSurfaceSpeed {
+        surface_speed: f64,
+        cap: f64,
+    },
     SpindleOff,
 }
 

@@ -81,10 +81,18 @@ pub fn emit(job: &Job, path: &Toolpath, prov: &Provenance) -> Result<Emitted, Pr
             num(job.tool.nose_radius)
         ),
         format!(
-            "strategy {}: profile turning, {} points, {}{}",
+            "strategy {}: profile turning, {} points, {}{}{}",
             job.strategy_name,
             path.cut_points,
             tolerance_words(job.strategy.chord_tolerance),
+            match job.strategy.surface_speed {
+                Some(v) => format!(
+                    ", constant surface speed {} m/min capped at {} rpm",
+                    num(v * 0.06),
+                    num((job.strategy.spindle_speed * 60.0 / (2.0 * PI)).floor())
+                ),
+                None => String::new(),
+            },
             roughing_words(job, path)
         ),
         format!(
@@ -167,7 +175,13 @@ pub fn turning_moves(job: &Job, path: &Toolpath) -> Vec<moves::Move> {
         }
     };
     let mut out = Vec::with_capacity(path.moves.len() + 2);
-    out.push(moves::Move::SpindleOn(Some(job.strategy.spindle_speed)));
+    out.push(match job.strategy.surface_speed {
+        Some(v) => moves::Move::SpindleSurfaceSpeed {
+            surface_speed: v,
+            cap: job.strategy.spindle_speed,
+        },
+        None => moves::Move::SpindleOn(Some(job.strategy.spindle_speed)),
+    });
     out.extend(path.moves.iter().map(|m| match *m {
         Move::Rapid { x, z } => moves::Move::Rapid(Position::xz(corrected(x), z)),
         Move::Feed { x, z } => moves::Move::Linear {
@@ -1012,6 +1026,33 @@ impl ProgramWriter {
                 let on = self.dialect.spindle_on.clone();
                 self.text.push_str(&on);
                 self.end_block(start)
+            }
+            M::SpindleSurfaceSpeed { surface_speed, cap } => {
+                let lines = self.dialect.surface_speed.clone();
+                if lines.is_empty() {
+                    return Err(ProgramError::Unsupported(format!(
+                        "constant surface speed ({} has no `surface_speed` lines)",
+                        self.dialect.name
+                    )));
+                }
+                let mut speed = String::new();
+                let mut rpm = String::new();
+                let m_per_min = surface_speed * 60.0 / 1000.0;
+                let cap_rpm = cap * 60.0 / (2.0 * PI);
+                if !(push_fixed(&mut speed, m_per_min, 3)
+                    && push_fixed(&mut rpm, cap_rpm.floor(), 0))
+                {
+                    return Err(ProgramError::NotPrintable {
+                        word: 'S',
+                        value: m_per_min,
+                    });
+                }
+                for line in lines {
+                    let l = line.replace("{speed}", &speed).replace("{cap}", &rpm);
+                    self.block_line(&l)?;
+                }
+                let on = self.dialect.spindle_on.clone();
+                self.block_line(&on)
             }
             M::SpindleOff => {
                 let off = self.dialect.spindle_off.clone();

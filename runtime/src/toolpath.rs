@@ -21,8 +21,12 @@ pub enum Feed {
 #[derive(Clone, Debug, PartialEq)]
 pub struct ProfileTurning {
     pub feed: Feed,
-    /// Spindle speed (rad/s), constant.
+    /// Spindle speed (rad/s): constant, or the cap under constant surface
+    /// speed.
     pub spindle_speed: f64,
+    /// Constant surface speed at the tool (mm/s), the spindle turning at
+    /// v/r up to `spindle_speed`.
+    pub surface_speed: Option<f64>,
     /// The path's tolerance T (mm): the most the program, as the machine
     /// runs it, may stray from the exact tool-centre curve. The chords take
     /// `optimise::CHORD_SHARE` of it, arc fitting and blending the rest.
@@ -103,8 +107,11 @@ pub struct Toolpath {
     pub cut_points: usize,
     /// Length (mm) of the cutting moves.
     pub cut_length: f64,
-    /// Cutting feed as a speed (mm/s).
+    /// Cutting feed as a speed (mm/s), at the spindle's highest speed.
     pub feed_speed: f64,
+    /// Time (s) of the cutting moves, the spindle's speed at each move's
+    /// radius under constant surface speed.
+    pub cutting_time: f64,
     /// Smallest concave radius of curvature on the profile and where (r, mm).
     pub min_concave_radius: Option<(f64, f64)>,
     /// Steepest profile slope (rad) and where (r, mm).
@@ -118,7 +125,7 @@ pub struct Toolpath {
 impl Toolpath {
     /// Estimated cutting time (s), rapids excluded.
     pub fn cutting_time(&self) -> f64 {
-        self.cut_length / self.feed_speed
+        self.cutting_time
     }
 }
 
@@ -229,6 +236,19 @@ pub fn plan_profile_turning(job: &Job, profile: &dyn Profile) -> Result<Toolpath
     let safe_z = top + strat.retract;
     let mut moves = Vec::with_capacity(passes.iter().map(|p| p.len() + 3).sum());
     let mut cut_length = 0.0;
+    let mut cutting_time = 0.0;
+    // The feed speed (mm/s) at radius r.
+    let speed_at = |r: f64| match (strat.feed, strat.surface_speed) {
+        (Feed::PerTime(v), _) => v,
+        (Feed::PerRevolution(f), None) => f * strat.spindle_speed,
+        (Feed::PerRevolution(f), Some(v)) => {
+            f * if r.abs() * strat.spindle_speed > v {
+                v / r.abs()
+            } else {
+                strat.spindle_speed
+            }
+        }
+    };
     for cut in &passes {
         moves.push(Move::Rapid {
             x: cut[0].x,
@@ -239,8 +259,11 @@ pub fn plan_profile_turning(job: &Job, profile: &dyn Profile) -> Result<Toolpath
             z: cut[0].y,
         });
         cut_length += (safe_z - cut[0].y).abs();
+        cutting_time += (safe_z - cut[0].y).abs() / speed_at(cut[0].x);
         for w in cut.windows(2) {
-            cut_length += (w[1] - w[0]).norm();
+            let len = (w[1] - w[0]).norm();
+            cut_length += len;
+            cutting_time += len / speed_at(0.5 * (w[0].x + w[1].x));
         }
         moves.extend(cut.iter().skip(1).map(|c| Move::Feed { x: c.x, z: c.y }));
         let last = cut[cut.len() - 1];
@@ -282,6 +305,7 @@ pub fn plan_profile_turning(job: &Job, profile: &dyn Profile) -> Result<Toolpath
         moves,
         cut_length,
         feed_speed,
+        cutting_time,
         min_concave_radius: min_concave,
         max_slope,
         seams,
@@ -573,6 +597,7 @@ mod roughing_tests {
             strategy: ProfileTurning {
                 feed: Feed::PerRevolution(0.002 / (2.0 * std::f64::consts::PI)),
                 spindle_speed: 50.0,
+                surface_speed: None,
                 chord_tolerance: 1e-5,
                 start_radius: None,
                 end_radius: 0.0,
