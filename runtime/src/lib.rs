@@ -11,6 +11,7 @@ pub mod forbes;
 pub mod format;
 pub mod fts;
 pub mod grinding;
+pub mod heightmap;
 pub mod ir;
 pub mod job;
 pub mod machine;

@@ -1,0 +1,764 @@
+//! Height-map cut simulation of surfaces: what a raster, spiral or helix
+//! program leaves on a window of the part, from the tool positions it
+//! commands (as printed), against the design.
+//!
+//! Every surface strategy here cuts with a round nose whose edge lies in
+//! the plane across the cut: the microshaper knife's nose in the plane
+//! normal to its stroke, a lathe's or roller lathe's diamond in the plane
+//! through the spindle axis. So at each position `s` along the cut (x for
+//! a raster, the spindle angle for a lathe or roller), every pass that
+//! crosses `s` leaves a circle of the nose radius about its centre in the
+//! (u, h) plane across it (u the step-over coordinate: y, the radius, the
+//! axial z; h the height, material below), and the surface cut there is
+//! the lower envelope of those circles. Between programmed points the
+//! controller interpolates linearly (or along a printed arc), and so does
+//! this simulation. The envelope of equal circles is exact: any two cross
+//! once, so the envelope takes them in order of u, and its corners are the
+//! scallop cusps, found exactly, whatever the grid.
+//!
+//! The grid's columns are positions along the cut and its rows positions
+//! across; on a lathe they are angles and radii (a polar grid), masked to
+//! the window the user asked for.
+
+use rayon::prelude::*;
+
+/// The simulation grid: columns along the cut, rows across it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Grid {
+    /// First column (mm, or rad when `period` is set), spacing, count.
+    pub s0: f64,
+    pub ds: f64,
+    pub ns: usize,
+    /// First row (mm), spacing, count.
+    pub u0: f64,
+    pub du: f64,
+    pub nu: usize,
+    /// Columns are spindle angles repeating every `period` (2π); the
+    /// columns must span less than one period.
+    pub period: Option<f64>,
+}
+
+impl Grid {
+    pub fn s(&self, j: usize) -> f64 {
+        self.s0 + j as f64 * self.ds
+    }
+    pub fn u(&self, i: usize) -> f64 {
+        self.u0 + i as f64 * self.du
+    }
+    fn u_end(&self) -> f64 {
+        self.u(self.nu.saturating_sub(1))
+    }
+}
+
+/// How grid coordinates sit on the part, and the design there. The job
+/// that plans the path supplies it.
+pub trait Frame: Sync {
+    /// Design heights h at the (s, u) points (same units and sense as the
+    /// tool-centre heights: material below).
+    fn design(&self, points: &[(f64, f64)], out: &mut [f64]);
+    /// The part's (x, y) (mm) at (s, u).
+    fn xy(&self, s: f64, u: f64) -> (f64, f64);
+    /// Whether (x, y) is in the window the user asked for.
+    fn inside(&self, x: f64, y: f64) -> bool;
+    /// Discs (centre x, y, radius) reported one by one (lenslets), if any;
+    /// when there are some, only cells inside them count in the totals.
+    fn features(&self) -> &[(f64, f64, f64)] {
+        &[]
+    }
+}
+
+/// Tool-centre positions gathered column by column as the path streams.
+pub struct Sweep {
+    grid: Grid,
+    radius: f64,
+    /// The band of u whose circles can reach the rows.
+    band: (f64, f64),
+    /// Per column, the (u, h) of every pass crossing it.
+    columns: Vec<Vec<(f64, f64)>>,
+    /// The previous point of the current pass.
+    last: Option<(f64, f64, f64)>,
+    /// Columns' range of s (non-periodic), for a quick reject.
+    s_range: (f64, f64),
+}
+
+impl Sweep {
+    pub fn new(grid: Grid, nose_radius: f64) -> Sweep {
+        let margin = nose_radius + grid.du;
+        Sweep {
+            grid,
+            radius: nose_radius,
+            band: (grid.u0 - margin, grid.u_end() + margin),
+            columns: vec![Vec::new(); grid.ns],
+            last: None,
+            s_range: (grid.s0, grid.s(grid.ns.saturating_sub(1))),
+        }
+    }
+
+    /// The tool leaves the part: the next point starts a new pass.
+    pub fn lift(&mut self) {
+        self.last = None;
+    }
+
+    /// The next commanded point of the current pass: cutting coordinate
+    /// `s` (unwrapped angle for a lathe), step-over coordinate `u`,
+    /// height `h` of the nose centre, reached along a straight line.
+    pub fn point(&mut self, s: f64, u: f64, h: f64) {
+        if let Some((sa, ua, ha)) = self.last.replace((s, u, h))
+            && !(ua.max(u) < self.band.0 || ua.min(u) > self.band.1)
+        {
+            self.segment((sa, ua, ha), (s, u, h), None);
+        }
+    }
+
+    /// The next point reached along a circular arc in the (s, h) plane
+    /// (u constant) about `centre`; the arc is the minor one.
+    pub fn arc(&mut self, s: f64, u: f64, h: f64, centre: (f64, f64)) {
+        if let Some((sa, ua, ha)) = self.last.replace((s, u, h))
+            && !(ua.max(u) < self.band.0 || ua.min(u) > self.band.1)
+        {
+            self.segment((sa, ua, ha), (s, u, h), Some(centre));
+        }
+    }
+
+    fn segment(&mut self, a: (f64, f64, f64), b: (f64, f64, f64), arc: Option<(f64, f64)>) {
+        let (lo, hi) = (a.0.min(b.0), a.0.max(b.0));
+        let g = self.grid;
+        let bases: Vec<f64> = match g.period {
+            None => {
+                if hi < self.s_range.0 || lo > self.s_range.1 {
+                    return;
+                }
+                vec![g.s0]
+            }
+            Some(p) => {
+                let m0 = ((lo - g.s(g.ns - 1)) / p).ceil() as i64;
+                let m1 = ((hi - g.s0) / p).floor() as i64;
+                (m0..=m1).map(|m| g.s0 + m as f64 * p).collect()
+            }
+        };
+        for base in bases {
+            let j_lo = ((lo - base) / g.ds).ceil().max(0.0) as usize;
+            let j_hi = ((hi - base) / g.ds).floor();
+            if j_hi < 0.0 {
+                continue;
+            }
+            let j_hi = (j_hi as usize).min(g.ns - 1);
+            for j in j_lo..=j_hi {
+                let s = base + j as f64 * g.ds;
+                let t = if b.0 == a.0 {
+                    0.0
+                } else {
+                    (s - a.0) / (b.0 - a.0)
+                };
+                let u = a.1 + t * (b.1 - a.1);
+                if u < self.band.0 || u > self.band.1 {
+                    continue;
+                }
+                match arc {
+                    None => self.columns[j].push((u, a.2 + t * (b.2 - a.2))),
+                    Some(o) => {
+                        if let Some(h) = minor_arc_height((a.0, a.2), (b.0, b.2), o, s) {
+                            self.columns[j].push((u, h));
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// The envelope in every column, against the design.
+    pub fn finish(self, frame: &dyn Frame) -> HeightMap {
+        let g = self.grid;
+        let r = self.radius;
+        let columns: Vec<Column> = self
+            .columns
+            .into_par_iter()
+            .enumerate()
+            .map(|(j, centres)| column(&g, r, j, centres, frame))
+            .collect();
+        HeightMap::gather(g, r, columns, frame)
+    }
+}
+
+/// The height on the minor arc from `a` to `b` about `o` at `s`, if the
+/// arc passes over `s`.
+fn minor_arc_height(a: (f64, f64), b: (f64, f64), o: (f64, f64), s: f64) -> Option<f64> {
+    let radius = ((a.0 - o.0).hypot(a.1 - o.1) + (b.0 - o.0).hypot(b.1 - o.1)) / 2.0;
+    let dh = (radius * radius - (s - o.0) * (s - o.0)).max(0.0).sqrt();
+    // A point is on the minor arc when it is on the far side of the chord
+    // from the centre.
+    let side = |p: (f64, f64)| (b.0 - a.0) * (p.1 - a.1) - (b.1 - a.1) * (p.0 - a.0);
+    let far = -side(o).signum();
+    [o.1 - dh, o.1 + dh]
+        .into_iter()
+        .find(|&h| side((s, h)) * far >= -1e-18)
+}
+
+/// One column's result.
+struct Column {
+    /// Error (cut − design, mm) per row; NaN where no pass reaches or the
+    /// cell is outside the window.
+    errors: Vec<f64>,
+    /// Per pass on the envelope inside the window: where its contact
+    /// (least error) is and that error.
+    valleys: Vec<(f64, f64)>,
+    /// Per cusp between neighbouring passes: where and the scallop height
+    /// above the neighbours' contacts.
+    cusps: Vec<(f64, f64)>,
+}
+
+/// The lower envelope of the circles of radius `r` about `centres` (sorted
+/// by u, distinct): per piece, the circle's index and where it starts.
+fn envelope(centres: &[(f64, f64)], r: f64) -> Vec<(usize, f64)> {
+    let circle = |k: usize, u: f64| {
+        let (cu, ch) = centres[k];
+        ch - (r * r - (u - cu) * (u - cu)).max(0.0).sqrt()
+    };
+    // Where k (right of j) starts to be lower than j.
+    let crossing = |j: usize, k: usize| -> f64 {
+        let ((uj, hj), (uk, hk)) = (centres[j], centres[k]);
+        let (from, to) = (uk - r, uj + r);
+        if from >= to || hk <= circle(j, from) {
+            return from;
+        }
+        if circle(k, to) >= hj {
+            return to;
+        }
+        // The lower crossing of two equal circles.
+        let (du, dh) = (uk - uj, hk - hj);
+        let d = du.hypot(dh);
+        let q = (r * r - d * d / 4.0).max(0.0).sqrt();
+        let u = (uj + uk) / 2.0 + q * dh / d;
+        if u > from && u < to {
+            return u;
+        }
+        let (mut a, mut b) = (from, to);
+        for _ in 0..80 {
+            let m = (a + b) / 2.0;
+            if circle(k, m) < circle(j, m) {
+                b = m;
+            } else {
+                a = m;
+            }
+        }
+        (a + b) / 2.0
+    };
+    let mut stack: Vec<(usize, f64)> = Vec::new();
+    for k in 0..centres.len() {
+        loop {
+            match stack.last() {
+                None => {
+                    stack.push((k, centres[k].0 - r));
+                    break;
+                }
+                Some(&(j, start)) => {
+                    let x = crossing(j, k);
+                    if x <= start {
+                        stack.pop();
+                    } else {
+                        stack.push((k, x));
+                        break;
+                    }
+                }
+            }
+        }
+    }
+    stack
+}
+
+fn column(g: &Grid, r: f64, j: usize, mut centres: Vec<(f64, f64)>, frame: &dyn Frame) -> Column {
+    let s = g.s(j);
+    centres.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    centres.dedup_by(|later, kept| (later.0 - kept.0).abs() < 1e-12);
+    let pieces = envelope(&centres, r);
+    let height = |p: usize, u: f64| {
+        let (cu, ch) = centres[pieces[p].0];
+        let d = u - cu;
+        if d.abs() > r {
+            f64::NAN
+        } else {
+            ch - (r * r - d * d).sqrt()
+        }
+    };
+    let end = |p: usize| pieces.get(p + 1).map_or(f64::INFINITY, |q| q.1);
+    let in_window = |u: f64| {
+        let (x, y) = frame.xy(s, u);
+        frame.inside(x, y) && in_features(frame.features(), x, y)
+    };
+    // Rows.
+    let mut cut = vec![f64::NAN; g.nu];
+    let mut p = 0;
+    for (i, c) in cut.iter_mut().enumerate() {
+        let u = g.u(i);
+        while p < pieces.len() && end(p) <= u {
+            p += 1;
+        }
+        if p < pieces.len() && pieces[p].1 <= u && in_window(u) {
+            *c = height(p, u);
+        }
+    }
+    let points: Vec<(f64, f64)> = (0..g.nu).map(|i| (s, g.u(i))).collect();
+    let mut design = vec![0.0; g.nu];
+    frame.design(&points, &mut design);
+    let errors: Vec<f64> = cut.iter().zip(&design).map(|(c, d)| c - d).collect();
+    // Contacts: the least error over each piece inside the rows, from
+    // five samples and a parabola through the least and its neighbours.
+    let (u_lo, u_hi) = (g.u0, g.u_end());
+    let mut valleys: Vec<(f64, f64)> = vec![(f64::NAN, f64::NAN); pieces.len()];
+    let mut probe = Vec::with_capacity(6);
+    let mut probe_design = [0.0; 6];
+    for (q, v) in valleys.iter_mut().enumerate() {
+        let (cu, _) = centres[pieces[q].0];
+        let a = pieces[q].1.max(cu - r).max(u_lo);
+        let b = end(q).min(cu + r).min(u_hi);
+        if !(b > a) {
+            continue;
+        }
+        probe.clear();
+        probe.extend((0..5).map(|k| (s, a + (b - a) * k as f64 / 4.0)));
+        frame.design(&probe, &mut probe_design[..5]);
+        let e: Vec<f64> = (0..5)
+            .map(|k| height(q, probe[k].1) - probe_design[k])
+            .collect();
+        let m = (1..4).min_by(|&x, &y| e[x].total_cmp(&e[y])).unwrap_or(2);
+        let (mut best_u, mut best) = (probe[m].1, e[m]);
+        for k in [0, 4] {
+            if e[k] < best {
+                (best_u, best) = (probe[k].1, e[k]);
+            }
+        }
+        let h = (b - a) / 4.0;
+        let curv = e[m - 1] - 2.0 * e[m] + e[m + 1];
+        if curv > 0.0 {
+            let t = 0.5 * (e[m - 1] - e[m + 1]) / curv;
+            if t.abs() <= 1.0 {
+                let u = probe[m].1 + t * h;
+                let mut dz = [0.0];
+                frame.design(&[(s, u)], &mut dz);
+                let eu = height(q, u) - dz[0];
+                if eu < best {
+                    (best_u, best) = (u, eu);
+                }
+            }
+        }
+        // A piece cut short by the window's edge has its contact outside
+        // when its least error is at that edge.
+        let clipped =
+            (best_u == a && a > pieces[q].1.max(cu - r)) || (best_u == b && b < end(q).min(cu + r));
+        let (x, y) = frame.xy(s, best_u);
+        if !clipped && frame.inside(x, y) && in_features(frame.features(), x, y) {
+            *v = (best_u, best);
+        }
+    }
+    // Cusps between neighbouring pieces whose circles meet there.
+    let mut cusps = Vec::new();
+    for q in 1..pieces.len() {
+        let u = pieces[q].1;
+        let (cu_a, cu_b) = (centres[pieces[q - 1].0].0, centres[pieces[q].0].0);
+        if u < u_lo || u > u_hi || (u - cu_a).abs() > r || (u - cu_b).abs() > r {
+            continue;
+        }
+        let (va, vb) = (valleys[q - 1].1, valleys[q].1);
+        if va.is_nan() || vb.is_nan() {
+            continue;
+        }
+        let (x, y) = frame.xy(s, u);
+        if !(frame.inside(x, y) && in_features(frame.features(), x, y)) {
+            continue;
+        }
+        let mut dz = [0.0];
+        frame.design(&[(s, u)], &mut dz);
+        let e = height(q, u) - dz[0];
+        cusps.push((u, e - (va + vb) / 2.0));
+    }
+    Column {
+        errors,
+        valleys: valleys.into_iter().filter(|v| !v.1.is_nan()).collect(),
+        cusps,
+    }
+}
+
+fn in_features(features: &[(f64, f64, f64)], x: f64, y: f64) -> bool {
+    features.is_empty()
+        || features
+            .iter()
+            .any(|&(cx, cy, r)| (x - cx).hypot(y - cy) <= r)
+}
+
+/// PV, RMS and extremes of a set of errors, with where they are.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ErrorFigures {
+    pub count: usize,
+    pub pv: f64,
+    pub rms: f64,
+    /// Most material left (mm, ≥ 0) and where (x, y).
+    pub max_residual: (f64, (f64, f64)),
+    /// Deepest cut below the design (mm, ≥ 0) and where.
+    pub max_gouge: (f64, (f64, f64)),
+}
+
+#[derive(Default)]
+struct Tally {
+    n: usize,
+    sum2: f64,
+    min: (f64, (f64, f64)),
+    max: (f64, (f64, f64)),
+}
+
+impl Tally {
+    fn new() -> Tally {
+        Tally {
+            n: 0,
+            sum2: 0.0,
+            min: (f64::INFINITY, (0.0, 0.0)),
+            max: (f64::NEG_INFINITY, (0.0, 0.0)),
+        }
+    }
+    fn add(&mut self, e: f64, at: (f64, f64)) {
+        self.n += 1;
+        self.sum2 += e * e;
+        if e < self.min.0 {
+            self.min = (e, at);
+        }
+        if e > self.max.0 {
+            self.max = (e, at);
+        }
+    }
+    fn figures(&self) -> Option<ErrorFigures> {
+        (self.n > 0).then(|| ErrorFigures {
+            count: self.n,
+            pv: self.max.0 - self.min.0,
+            rms: (self.sum2 / self.n as f64).sqrt(),
+            max_residual: (self.max.0.max(0.0), self.max.1),
+            max_gouge: ((-self.min.0).max(0.0), self.min.1),
+        })
+    }
+}
+
+/// Scallop heights between neighbouring passes (mm).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scallops {
+    pub count: usize,
+    pub max: f64,
+    pub mean: f64,
+}
+
+/// The figures of one lenslet (a feature disc) in the window.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FeatureFigures {
+    pub centre: (f64, f64),
+    /// Over every cell of the aperture (scallops included).
+    pub surface: Option<ErrorFigures>,
+    /// At the passes' contacts (scallops excluded).
+    pub contact: Option<ErrorFigures>,
+    pub scallops: Option<Scallops>,
+}
+
+/// What the program cuts on the window.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeightMap {
+    pub grid: Grid,
+    pub nose_radius: f64,
+    /// Error (cut − design, mm) per cell, column by column (`ns` columns
+    /// of `nu` rows); NaN where uncut or outside the window.
+    pub errors: Vec<f64>,
+    /// Over every cut cell: the surface as cut, scallops included.
+    pub surface: Option<ErrorFigures>,
+    /// At the passes' contacts: the path's own form error.
+    pub contact: Option<ErrorFigures>,
+    pub scallops: Option<Scallops>,
+    /// Cells in the window that no pass reached.
+    pub uncut: usize,
+    /// RMS about the mean of the error along each row (the cutting
+    /// direction) and along each column (the step-over direction),
+    /// averaged over rows and columns (mm).
+    pub rq_cutting: f64,
+    pub rq_stepover: f64,
+    pub features: Vec<FeatureFigures>,
+}
+
+fn rq(values: impl Iterator<Item = f64>) -> Option<f64> {
+    let v: Vec<f64> = values.filter(|e| !e.is_nan()).collect();
+    if v.len() < 2 {
+        return None;
+    }
+    let mean = v.iter().sum::<f64>() / v.len() as f64;
+    Some((v.iter().map(|e| (e - mean) * (e - mean)).sum::<f64>() / v.len() as f64).sqrt())
+}
+
+fn mean(values: impl Iterator<Item = f64>) -> f64 {
+    let (mut n, mut sum) = (0usize, 0.0);
+    for v in values {
+        n += 1;
+        sum += v;
+    }
+    if n == 0 { f64::NAN } else { sum / n as f64 }
+}
+
+impl HeightMap {
+    fn gather(g: Grid, r: f64, columns: Vec<Column>, frame: &dyn Frame) -> HeightMap {
+        let features = frame.features();
+        let which = |x: f64, y: f64| {
+            features
+                .iter()
+                .position(|&(cx, cy, fr)| (x - cx).hypot(y - cy) <= fr)
+        };
+        let mut surface = Tally::new();
+        let mut contact = Tally::new();
+        let mut per: Vec<(Tally, Tally, Vec<f64>)> = features
+            .iter()
+            .map(|_| (Tally::new(), Tally::new(), Vec::new()))
+            .collect();
+        let mut all_cusps = Vec::new();
+        let mut uncut = 0;
+        let mut errors = Vec::with_capacity(g.ns * g.nu);
+        for (j, c) in columns.iter().enumerate() {
+            let s = g.s(j);
+            for (i, &e) in c.errors.iter().enumerate() {
+                let (x, y) = frame.xy(s, g.u(i));
+                if e.is_nan() {
+                    if frame.inside(x, y) && in_features(features, x, y) {
+                        uncut += 1;
+                    }
+                    continue;
+                }
+                surface.add(e, (x, y));
+                if let Some(f) = which(x, y) {
+                    per[f].0.add(e, (x, y));
+                }
+            }
+            for &(u, e) in &c.valleys {
+                let (x, y) = frame.xy(s, u);
+                contact.add(e, (x, y));
+                if let Some(f) = which(x, y) {
+                    per[f].1.add(e, (x, y));
+                }
+            }
+            for &(u, h) in &c.cusps {
+                all_cusps.push(h);
+                let (x, y) = frame.xy(s, u);
+                if let Some(f) = which(x, y) {
+                    per[f].2.push(h);
+                }
+            }
+            errors.extend_from_slice(&c.errors);
+        }
+        let scallops = |h: &[f64]| {
+            (!h.is_empty()).then(|| Scallops {
+                count: h.len(),
+                max: h.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b)),
+                mean: mean(h.iter().copied()),
+            })
+        };
+        let rq_stepover = mean(columns.iter().filter_map(|c| rq(c.errors.iter().copied())));
+        let rq_cutting = mean((0..g.nu).filter_map(|i| rq(columns.iter().map(|c| c.errors[i]))));
+        HeightMap {
+            grid: g,
+            nose_radius: r,
+            surface: surface.figures(),
+            contact: contact.figures(),
+            scallops: scallops(&all_cusps),
+            uncut,
+            rq_cutting,
+            rq_stepover,
+            features: features
+                .iter()
+                .zip(&per)
+                .filter(|(_, t)| t.0.n > 0)
+                .map(|(&(cx, cy, _), t)| FeatureFigures {
+                    centre: (cx, cy),
+                    surface: t.0.figures(),
+                    contact: t.1.figures(),
+                    scallops: scallops(&t.2),
+                })
+                .collect(),
+            errors,
+        }
+    }
+
+    /// The scallop a round nose of radius `r` leaves between passes `step`
+    /// apart on a flat (mm).
+    pub fn flat_scallop(r: f64, step: f64) -> f64 {
+        r - (r * r - step * step / 4.0).max(0.0).sqrt()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A plane or sphere design on a Cartesian window.
+    struct Flat<F: Fn(f64, f64) -> f64 + Sync> {
+        z: F,
+        window: (f64, f64, f64, f64),
+    }
+    impl<F: Fn(f64, f64) -> f64 + Sync> Frame for Flat<F> {
+        fn design(&self, points: &[(f64, f64)], out: &mut [f64]) {
+            for (o, &(s, u)) in out.iter_mut().zip(points) {
+                *o = (self.z)(s, u);
+            }
+        }
+        fn xy(&self, s: f64, u: f64) -> (f64, f64) {
+            (s, u)
+        }
+        fn inside(&self, x: f64, y: f64) -> bool {
+            let w = self.window;
+            x >= w.0 && x <= w.1 && y >= w.2 && y <= w.3
+        }
+    }
+
+    fn grid(n: usize, spacing: f64) -> Grid {
+        Grid {
+            s0: 0.0,
+            ds: spacing,
+            ns: n,
+            u0: 0.0,
+            du: spacing,
+            nu: n,
+            period: None,
+        }
+    }
+
+    #[test]
+    fn flat_raster_leaves_the_textbook_scallop() {
+        // Passes 10 µm apart along s over a plane, nose 85 µm: scallops
+        // r − sqrt(r² − (f/2)²) = 147.1 nm, contacts on the design.
+        let (r, f) = (0.085, 0.010);
+        let g = grid(101, 0.001);
+        let mut sweep = Sweep::new(g, r);
+        for k in -12..=22 {
+            let u = k as f64 * f;
+            sweep.lift();
+            sweep.point(-0.01, u, r);
+            sweep.point(0.2, u, r);
+        }
+        let frame = Flat {
+            z: |_, _| 0.0,
+            window: (0.0, 0.1, 0.0, 0.1),
+        };
+        let map = sweep.finish(&frame);
+        let want = HeightMap::flat_scallop(r, f);
+        let sc = map.scallops.unwrap();
+        assert!((want - 147.1e-6).abs() < 0.1e-6);
+        assert!((sc.max - want).abs() < 1e-12, "{} vs {want}", sc.max);
+        assert!((sc.mean - want).abs() < 1e-12);
+        let contact = map.contact.unwrap();
+        assert!(contact.pv < 1e-12 && contact.rms < 1e-12);
+        // The cells sample the scallop: PV of the map is the scallop (rows
+        // fall on cusps every 10 µm) and nothing is uncut.
+        let surface = map.surface.unwrap();
+        assert!((surface.pv - want).abs() < 1e-12);
+        assert_eq!(map.uncut, 0);
+        // Scallops run across the passes, not along them.
+        assert!(map.rq_stepover > 10.0 * map.rq_cutting.max(1e-15));
+    }
+
+    #[test]
+    fn a_pass_too_high_leaves_material_and_one_too_low_gouges() {
+        let r = 0.1;
+        let g = grid(21, 0.005);
+        let mut sweep = Sweep::new(g, r);
+        for k in -5..=25 {
+            let u = k as f64 * 0.005;
+            let h = r + if k == 10 { -2e-6 } else { 0.0 };
+            sweep.lift();
+            sweep.point(-0.01, u, h);
+            sweep.point(0.11, u, h);
+        }
+        let frame = Flat {
+            z: |_, _| 0.0,
+            window: (0.0, 0.1, 0.0, 0.1),
+        };
+        let map = sweep.finish(&frame);
+        let contact = map.contact.unwrap();
+        assert!((contact.max_gouge.0 - 2e-6).abs() < 1e-12);
+        assert!((contact.max_gouge.1.1 - 0.05).abs() < 1e-9);
+        assert!((map.surface.unwrap().max_gouge.0 - 2e-6).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_sphere_cut_by_exact_offsets_has_its_contacts_on_the_design() {
+        // A convex sphere of radius R under a knife whose nose centres lie
+        // on the offset of each section x = const (a circle of radius
+        // sqrt(R² − x²)) by r: every contact is exact, and between points
+        // the chords leave material (the feed marks).
+        let (big, r, f, step) = (2.0, 0.05, 0.004, 0.02);
+        let z = move |x: f64, y: f64| (big * big - x * x - y * y).sqrt() - big;
+        let g = grid(201, 0.0005);
+        let mut sweep = Sweep::new(g, r);
+        for k in -20..=45 {
+            let y = k as f64 * f;
+            sweep.lift();
+            for m in -3..=8 {
+                let x = m as f64 * step;
+                let rr = (big * big - x * x).sqrt() + r;
+                let zc = (rr * rr - y * y).sqrt() - big;
+                sweep.point(x, y, zc);
+            }
+        }
+        let frame = Flat {
+            z,
+            window: (0.0, 0.1, 0.0, 0.1),
+        };
+        let map = sweep.finish(&frame);
+        let contact = map.contact.unwrap();
+        // Chords 20 µm long on a 2 mm dome sag into it by L²/8R = 25 nm
+        // midway; at the points the contact is exact.
+        let chord = step * step / (8.0 * big);
+        assert!(contact.max_gouge.0 <= chord * 1.01, "{contact:?}");
+        assert!(contact.max_gouge.0 >= chord * 0.9, "{contact:?}");
+        assert!(contact.max_residual.0 < 1e-11, "{contact:?}");
+        let sc = map.scallops.unwrap();
+        // On a convex sphere the scallop is below the flat one's.
+        let flat = HeightMap::flat_scallop(r, f);
+        assert!(
+            sc.max < flat * 1.01 + chord && sc.max > 0.5 * flat,
+            "{sc:?} {flat}"
+        );
+    }
+
+    #[test]
+    fn angles_wrap_and_arcs_are_followed() {
+        // A lathe facing a flat: rings of radius u at every angle, the
+        // columns straddling angle 0.
+        let r = 0.2;
+        let g = Grid {
+            s0: -0.05,
+            ds: 0.01,
+            ns: 11,
+            u0: 1.0,
+            du: 0.001,
+            nu: 11,
+            period: Some(std::f64::consts::TAU),
+        };
+        let mut sweep = Sweep::new(g, r);
+        for k in 0..40 {
+            let u = 1.05 - k as f64 * 0.005;
+            for m in 0..=36 {
+                // Unwrapped angle, 10° a step, one revolution per ring.
+                let c = (k * 36 + m) as f64 * std::f64::consts::TAU / 36.0;
+                sweep.point(c, u - m as f64 * 0.005 / 36.0, r);
+            }
+        }
+        struct Polar;
+        impl Frame for Polar {
+            fn design(&self, _: &[(f64, f64)], out: &mut [f64]) {
+                out.fill(0.0);
+            }
+            fn xy(&self, s: f64, u: f64) -> (f64, f64) {
+                (u * s.cos(), u * s.sin())
+            }
+            fn inside(&self, _: f64, _: f64) -> bool {
+                true
+            }
+        }
+        let map = sweep.finish(&Polar);
+        assert_eq!(map.uncut, 0);
+        assert!((map.scallops.unwrap().max - HeightMap::flat_scallop(r, 0.005)).abs() < 1e-9);
+        // An arc in (s, h): the minor arc's height is on its circle.
+        let h = minor_arc_height((0.0, 0.0), (2.0, 0.0), (1.0, 10.0), 1.0).unwrap();
+        assert!((h - (10.0 - 101f64.sqrt())).abs() < 1e-12);
+        let h = minor_arc_height((0.0, 0.0), (2.0, 0.0), (1.0, -10.0), 1.0).unwrap();
+        assert!((h - (-10.0 + 101f64.sqrt())).abs() < 1e-12);
+    }
+}
