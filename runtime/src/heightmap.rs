@@ -244,11 +244,11 @@ fn envelope(centres: &[(f64, f64)], r: f64) -> Vec<(usize, f64)> {
         (a + b) / 2.0
     };
     let mut stack: Vec<(usize, f64)> = Vec::new();
-    for k in 0..centres.len() {
+    for (k, &(centre_u, _)) in centres.iter().enumerate() {
         loop {
             match stack.last() {
                 None => {
-                    stack.push((k, centres[k].0 - r));
+                    stack.push((k, centre_u - r));
                     break;
                 }
                 Some(&(j, start)) => {
@@ -311,7 +311,7 @@ fn column(g: &Grid, r: f64, j: usize, mut centres: Vec<(f64, f64)>, frame: &dyn 
         let (cu, _) = centres[pieces[q].0];
         let a = pieces[q].1.max(cu - r).max(u_lo);
         let b = end(q).min(cu + r).min(u_hi);
-        if !(b > a) {
+        if b.partial_cmp(&a) != Some(std::cmp::Ordering::Greater) {
             continue;
         }
         probe.clear();
