@@ -43,6 +43,7 @@ pub const CLEARANCE_TOO_SMALL: &str = "E0145";
 pub const STROKE_EXCEEDED: &str = "E0146";
 pub const ACCELERATION_EXCEEDED: &str = "E0147";
 pub const DIALECT_NOT_OFFERED: &str = "E0148";
+pub const SIMULATION_TOO_LARGE: &str = "E0149";
 pub const NOT_PRINTABLE: &str = "E0150";
 pub const CANNOT_WRITE: &str = "E0151";
 
@@ -95,6 +96,7 @@ pub const ALL: &[&str] = &[
     STROKE_EXCEEDED,
     ACCELERATION_EXCEEDED,
     DIALECT_NOT_OFFERED,
+    SIMULATION_TOO_LARGE,
     NOT_PRINTABLE,
     CANNOT_WRITE,
     UNUSED,

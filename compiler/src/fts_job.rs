@@ -20,9 +20,11 @@ use crate::codes;
 use std::path::Path;
 
 use crate::driver::{Built, ProgramText, evaluator};
+use crate::height_map::{self, LatheFrame, Window};
 use crate::parts::Parts;
 use crate::surfaces;
 use crate::value::{self, Object};
+use lensc_runtime::heightmap::Sweep;
 
 /// The settling offset and how it was found.
 struct Settling {
@@ -121,17 +123,27 @@ pub fn build(
         }
         _ => None,
     };
+    // The height map over the window, from the same printed points.
+    let design = evaluator(&p.lowered.tape).0;
+    let window = Window::of(job, height_map::lathe_centre(&p.lowered.domain, &features))
+        .map_err(|d| vec![d])?;
+    let grid = window.polar();
+    window.check_size(job, &grid).map_err(|d| vec![d])?;
+    let mut sweep = Sweep::new(grid, p.nose_radius);
     let mut printed = Vec::new();
     let mut write_error: Option<ProgramError> = None;
     let planned = p.planner().plan(&p.fast_axis, |pts| {
+        let as_printed = |v: f64| lensc_runtime::simulate::as_printed(v, p.resolution);
+        printed.clear();
+        printed.extend(pts.iter().map(|q| lensc_runtime::fts::SpiralPoint {
+            x: as_printed(q.x),
+            w: as_printed(q.w),
+            ..*q
+        }));
+        for q in &printed {
+            sweep.point(q.c, q.x, q.w);
+        }
         if let Some(sim) = following.as_mut() {
-            let as_printed = |v: f64| lensc_runtime::simulate::as_printed(v, p.resolution);
-            printed.clear();
-            printed.extend(pts.iter().map(|q| lensc_runtime::fts::SpiralPoint {
-                x: as_printed(q.x),
-                w: as_printed(q.w),
-                ..*q
-            }));
             sim.extend(&printed);
         }
         if write_error.is_none()
@@ -185,6 +197,14 @@ pub fn build(
         }
         None => json!({ "skipped": "the fast axis has no servo model" }),
     };
+    let frame = LatheFrame::new(design.as_ref(), window, p.lowered.domain, &features);
+    let map = sweep.finish(&frame);
+    report["simulation"]["height_map"] = height_map::json(
+        &map,
+        &window,
+        "columns at spindle angles (column step in rad), rows at radii",
+        p.spiral.feed_per_rev,
+    );
     if let Some((name, table)) = beside.first() {
         report["program"]["fts_table"] =
             json!({ "file": name, "rows": table.lines().saturating_sub(2) });

@@ -6,6 +6,7 @@ pub mod check;
 pub mod codes;
 pub mod driver;
 pub mod fts_job;
+pub mod height_map;
 pub mod jit;
 pub mod loader;
 pub mod lower;

@@ -6,6 +6,7 @@
 use lensc_grammar::Diagnostic;
 use lensc_runtime::analysis::Domain;
 use lensc_runtime::grinding::{GrindingError, ProfileGrinding};
+use lensc_runtime::heightmap::Sweep;
 use lensc_runtime::machine::Dialect;
 use lensc_runtime::program::Provenance;
 use lensc_runtime::raster::{Axis, Raster, RasterError, RasterTool};
@@ -15,6 +16,7 @@ use serde_json::json;
 use crate::check::{CheckedJob, trim_num};
 use crate::codes;
 use crate::driver::{Built, ProgramText, evaluator};
+use crate::height_map::{self, Window, domain_centre};
 use crate::parts::Parts;
 use crate::value;
 
@@ -163,7 +165,37 @@ pub fn build_raster(
     });
     let program_name = p.program_name();
     let text = ProgramText::Memory(text);
-    let report = p.report(prov, &program_name, &text, toolpath, &lowered);
+    let mut report = p.report(prov, &program_name, &text, toolpath, &lowered);
+    report["simulation"] = match tool {
+        RasterTool::Knife { nose_radius } => {
+            let along_x = raster.along == Axis::X;
+            let window = Window::of(job, domain_centre(&lowered.domain)).map_err(|d| vec![d])?;
+            let grid = window.cartesian(along_x);
+            window.check_size(job, &grid).map_err(|d| vec![d])?;
+            let mut sweep = Sweep::new(grid, nose_radius);
+            height_map::sweep_mill_moves(&mut sweep, &moves, along_x, resolution);
+            let frame = height_map::RasterFrame {
+                kernel: kernel.as_ref(),
+                along_x,
+                window,
+                domain: lowered.domain,
+            };
+            let map = sweep.finish(&frame);
+            let coordinates = if along_x {
+                "columns along x, rows along y"
+            } else {
+                "columns along y, rows along x"
+            };
+            let mut j = height_map::json(&map, &window, coordinates, raster.stepover);
+            j["edge"] = json!(
+                "the knife's edge taken in its rake face, across the cut (the clearance-angle check's geometry): the planner offsets it in the plane of the path (Lin's model), which leaves about r(1/cos θ − 1) where the path slopes by θ"
+            );
+            json!({ "height_map": j })
+        }
+        RasterTool::Ball { .. } => json!({
+            "skipped": "a ball's cut reaches a radius along the path as well as across it; the height map sweeps edges that lie across the cut"
+        }),
+    };
     Ok(Built {
         report_name: format!("{}.report.json", job.name.name),
         program_name,

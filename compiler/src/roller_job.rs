@@ -19,9 +19,11 @@ use crate::check::{CheckedJob, trim_num};
 use crate::codes;
 use crate::driver::{Built, evaluator};
 use crate::fts_job::{Sink, cannot_spool};
+use crate::height_map::{self, RollerFrame, Window};
 use crate::parts::Parts;
 use crate::surfaces;
 use crate::value::{self, Object};
+use lensc_runtime::heightmap::Sweep;
 
 /// Builds one `roller_helix` job, or says why it cannot be built.
 pub fn build(
@@ -249,8 +251,27 @@ pub fn build(
     )
     .map_err(|e| vec![parts.not_printable(e)])?;
     let mut sink = Sink::new(spool_dir).map_err(|e| vec![cannot_spool(&e, file, span)])?;
+    // The height map over the window, from the printed points of every
+    // pass (the finish pass's envelope lies below the rough one's).
+    let window = Window::of(
+        job,
+        ((z_start + z_end) / 2.0, (design_y.0 + design_y.1) / 2.0),
+    )
+    .map_err(|d| vec![d])?;
+    let grid = window.roller(roller_radius);
+    window.check_size(job, &grid).map_err(|d| vec![d])?;
+    let mut sweep = Sweep::new(grid, rho);
+    let mut current_pass = usize::MAX;
     let mut write_error: Option<ProgramError> = None;
     let planned = plan_roller_helix_into(&helix, rho, kernel.as_ref(), |pass, pts| {
+        if pass != current_pass {
+            sweep.lift();
+            current_pass = pass;
+        }
+        let printed = |v: f64| lensc_runtime::simulate::as_printed(v, resolution);
+        for q in pts {
+            sweep.point(q.c, printed(q.z), printed(q.x));
+        }
         if write_error.is_none()
             && let Err(e) = program.extend(pass, pts)
         {
@@ -301,7 +322,23 @@ pub fn build(
         },
         "wrap_gap_mm": path.wrap.map(|w| w.gap),
     });
-    let report = parts.report(prov, &program_name, &text, toolpath, &lowered);
+    let mut report = parts.report(prov, &program_name, &text, toolpath, &lowered);
+    let frame = RollerFrame {
+        kernel: kernel.as_ref(),
+        window,
+        roller_radius,
+        domain: lowered.domain,
+    };
+    let map = sweep.finish(&frame);
+    let finish_pitch = helix.passes.last().map_or(0.0, |p| p.pitch);
+    report["simulation"] = json!({
+        "height_map": height_map::json(
+            &map,
+            &window,
+            "columns at spindle angles (column step in rad; design y = roller radius × angle), rows along the roller axis (design x)",
+            finish_pitch,
+        )
+    });
     Ok(Built {
         report_name: format!("{}.report.json", job.name.name),
         program_name,

@@ -1681,6 +1681,31 @@ pub static JOB_PARAMS: &[Param] = &[
         Check::Any,
         "how the path is planned",
     ),
+    opt(
+        "simulate",
+        Ty::Block(&[
+            req(
+                "x",
+                Ty::Range(Dim::LENGTH),
+                Check::Any,
+                "the window's extent in x",
+            ),
+            req(
+                "y",
+                Ty::Range(Dim::LENGTH),
+                Check::Any,
+                "the window's extent in y",
+            ),
+            opt(
+                "spacing",
+                LENGTH,
+                Check::Positive,
+                "the grid's spacing; default 1 um",
+            ),
+        ]),
+        Check::Any,
+        "the window of a surface job's height-map simulation (design x, y); default a 0.2 mm square where the surface is representative",
+    ),
 ];
 
 pub fn kind(name: &str) -> Option<&'static Kind> {

@@ -180,18 +180,25 @@ impl Sweep {
     }
 }
 
-/// The height on the minor arc from `a` to `b` about `o` at `s`, if the
-/// arc passes over `s`.
+/// The height on the minor arc from `a` to `b` about `o` at `s` (between
+/// them): of the circle's two heights there, the one nearer the chord (a
+/// minor arc stays within its sagitta of it; printed centres and ends
+/// disagree by the resolution, so no exact side test is safe).
 fn minor_arc_height(a: (f64, f64), b: (f64, f64), o: (f64, f64), s: f64) -> Option<f64> {
     let radius = ((a.0 - o.0).hypot(a.1 - o.1) + (b.0 - o.0).hypot(b.1 - o.1)) / 2.0;
     let dh = (radius * radius - (s - o.0) * (s - o.0)).max(0.0).sqrt();
-    // A point is on the minor arc when it is on the far side of the chord
-    // from the centre.
-    let side = |p: (f64, f64)| (b.0 - a.0) * (p.1 - a.1) - (b.1 - a.1) * (p.0 - a.0);
-    let far = -side(o).signum();
-    [o.1 - dh, o.1 + dh]
-        .into_iter()
-        .find(|&h| side((s, h)) * far >= -1e-18)
+    let chord = if b.0 == a.0 {
+        (a.1 + b.1) / 2.0
+    } else {
+        a.1 + (s - a.0) / (b.0 - a.0) * (b.1 - a.1)
+    };
+    let (lo, hi) = (o.1 - dh, o.1 + dh);
+    let h = if (lo - chord).abs() <= (hi - chord).abs() {
+        lo
+    } else {
+        hi
+    };
+    h.is_finite().then_some(h)
 }
 
 /// One column's result.
@@ -469,21 +476,73 @@ pub struct HeightMap {
     pub scallops: Option<Scallops>,
     /// Cells in the window that no pass reached.
     pub uncut: usize,
-    /// RMS about the mean of the error along each row (the cutting
-    /// direction) and along each column (the step-over direction),
-    /// averaged over rows and columns (mm).
+    /// RMS of the error along each row (the cutting direction) and along
+    /// each column (the step-over direction) about its least-squares
+    /// quadratic (the form's trend), averaged over rows and columns (mm).
     pub rq_cutting: f64,
     pub rq_stepover: f64,
     pub features: Vec<FeatureFigures>,
 }
 
+/// The RMS roughness of a line of errors: about their least-squares
+/// quadratic, so the form error's trend across the window is left out and
+/// what remains is the scallops and the chords' ripple.
 fn rq(values: impl Iterator<Item = f64>) -> Option<f64> {
-    let v: Vec<f64> = values.filter(|e| !e.is_nan()).collect();
-    if v.len() < 2 {
+    let v: Vec<(f64, f64)> = values
+        .enumerate()
+        .filter(|(_, e)| !e.is_nan())
+        .map(|(i, e)| (i as f64, e))
+        .collect();
+    if v.len() < 4 {
         return None;
     }
-    let mean = v.iter().sum::<f64>() / v.len() as f64;
-    Some((v.iter().map(|e| (e - mean) * (e - mean)).sum::<f64>() / v.len() as f64).sqrt())
+    // Fit on t in [−1, 1] for a well-conditioned system.
+    let (t0, t1) = (v[0].0, v[v.len() - 1].0);
+    let (mid, half) = ((t0 + t1) / 2.0, ((t1 - t0) / 2.0).max(1.0));
+    let mut m = [[0.0; 3]; 3];
+    let mut rhs = [0.0; 3];
+    for &(i, e) in &v {
+        let t = (i - mid) / half;
+        let p = [1.0, t, t * t];
+        for a in 0..3 {
+            rhs[a] += p[a] * e;
+            for b in 0..3 {
+                m[a][b] += p[a] * p[b];
+            }
+        }
+    }
+    let c = solve3(m, rhs)?;
+    let sum2: f64 = v
+        .iter()
+        .map(|&(i, e)| {
+            let t = (i - mid) / half;
+            let r = e - (c[0] + c[1] * t + c[2] * t * t);
+            r * r
+        })
+        .sum();
+    Some((sum2 / v.len() as f64).sqrt())
+}
+
+/// Solves a 3 × 3 system by Cramer's rule; None when it is singular.
+fn solve3(m: [[f64; 3]; 3], r: [f64; 3]) -> Option<[f64; 3]> {
+    let det = |m: &[[f64; 3]; 3]| {
+        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+    };
+    let d = det(&m);
+    if d.abs() < 1e-300 || !d.is_finite() {
+        return None;
+    }
+    let mut out = [0.0; 3];
+    for (k, o) in out.iter_mut().enumerate() {
+        let mut mk = m;
+        for (row, &rv) in mk.iter_mut().zip(&r) {
+            row[k] = rv;
+        }
+        *o = det(&mk) / d;
+    }
+    Some(out)
 }
 
 fn mean(values: impl Iterator<Item = f64>) -> f64 {
