@@ -200,3 +200,196 @@ fn at_constant_rpm_the_outer_lenslets_wave_more_and_constant_surface_speed_evens
         "{css:?}"
     );
 }
+
+/// Builds a job file written here and returns its one report.
+fn report_of(source: &str, job: &str) -> serde_json::Value {
+    let dir = tempfile::tempdir().expect("tmp");
+    std::fs::write(dir.path().join("job.lens"), source).expect("write");
+    let out = lensc(
+        dir.path(),
+        &[
+            "build",
+            "job.lens",
+            "--out",
+            dir.path().to_str().expect("utf8"),
+        ],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join(format!("{job}.report.json"))).expect("report"),
+    )
+    .expect("json")
+}
+
+fn num(v: &serde_json::Value) -> f64 {
+    v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
+}
+
+/// The scallop a nose of radius r leaves between passes whose centres are
+/// `step` apart, on a surface of radius of curvature R across them (R > 0
+/// convex, < 0 concave): the contacts are step · R / (R + r) apart, and
+/// h = step² / 8 · R / (r (R + r)) (to second order in the step).
+fn scallop(r: f64, step: f64, big_r: f64) -> f64 {
+    step * step / 8.0 / (r * (1.0 + r / big_r))
+}
+
+#[test]
+fn seed_000_raster_scallops_across_the_cut_outweigh_the_marks_along_it() {
+    // Lin's imaging sphere (R 4 mm, 85 um knife, 10 um stepover): the
+    // height map shows the anisotropy the paper measured (Ra 346 nm across
+    // vs 143 nm along): scallops across, only chords and rounding along.
+    let r = reports("examples/lin2022_scraping.lens")
+        .into_iter()
+        .find(|r| r["job"] == "lin_imaging_sphere")
+        .expect("job");
+    let h = &r["simulation"]["height_map"];
+    assert_eq!(h["uncut_cells"], 0);
+    assert_eq!(h["window"]["given"], false);
+    let expected = scallop(0.085, 0.01, 4.0) * 1e6;
+    let mean = num(&h["scallops"]["simulated"]["mean_nm"]);
+    let flat = num(&h["scallops"]["flat_theory_nm"]);
+    assert!((flat - 147.186).abs() < 1e-3, "{flat}");
+    assert!(
+        (mean - expected).abs() < 0.01 * expected,
+        "{mean} vs {expected}"
+    );
+    let (across, along) = (
+        num(&h["rq_stepover_direction_nm"]),
+        num(&h["rq_cutting_direction_nm"]),
+    );
+    assert!(
+        across > 30.0 && across > 10.0 * along,
+        "{across} vs {along}"
+    );
+    // The knife's edge lies in its rake face, across the cut; the planner
+    // puts Lin's nose circle in the plane of the path, so where the path
+    // slopes by θ the edge stands r (1/cos θ − 1) above the surface. The
+    // simulation finds just that, largest where the window is steepest.
+    let worst = &h["contact"]["max_residual_nm"];
+    let (x, y) = (num(&worst["x_mm"]), num(&worst["y_mm"]));
+    let theta = (x / (16.0 - x * x - y * y).sqrt()).atan();
+    let offset = 0.085e6 * (1.0 / theta.cos() - 1.0);
+    let got = num(&worst["value"]);
+    assert!((got - offset).abs() < 0.02 * offset, "{got} vs {offset}");
+    assert!(num(&h["contact"]["max_gouge_nm"]["value"]) < 1.0);
+}
+
+#[test]
+fn fts_height_map_of_a_lenslet_window_gives_its_scallops_and_contacts() {
+    // Seed 003's lenslet (R 20 mm concave, 0.496 mm nose), here at a coarse
+    // 50 um/rev so the scallop stands well above the chords: over a window
+    // on the corner lenslet, the scallop is the concave-surface figure and
+    // the contacts sit on the design within the chord tolerance.
+    let r = report_of(
+        "surface lenslet = sphere { radius: 20 mm, sense: concave, aperture: circle(diameter: 1.7 mm) }\n\
+         surface corner = grid(lenslet, pitch_x: 3.5 mm, pitch_y: 3.5 mm, count_x: 2, count_y: 2)\n\
+         use std::machines::nanoform_x_fts5000\n\
+         use std::tools::diamond_r496um\n\
+         strategy s = fts_spiral { feed: 50 um/rev, surface_speed: 5 m/min, spindle_cap: 1000 rpm, settling_time: 1 ms, chord_tolerance: 20 nm }\n\
+         job corner { surface: corner, tool: diamond_r496um, machine: nanoform_x_fts5000, strategy: s,\n\
+             simulate: { x: 1.4 mm .. 2.1 mm, y: 1.5 mm .. 2 mm, spacing: 2 um } }\n",
+        "corner",
+    );
+    let h = &r["simulation"]["height_map"];
+    assert_eq!(h["window"]["given"], true);
+    assert_eq!(h["uncut_cells"], 0);
+    let lenslets = h["lenslets"].as_array().expect("lenslets");
+    assert_eq!(lenslets.len(), 1, "{lenslets:?}");
+    assert_eq!(lenslets[0]["centre_mm"], serde_json::json!([1.75, 1.75]));
+    let expected = scallop(0.496, 0.05, -20.0) * 1e6;
+    let mean = num(&h["scallops"]["simulated"]["mean_nm"]);
+    assert!(
+        (mean - expected).abs() < 0.01 * expected,
+        "{mean} vs {expected}"
+    );
+    let contact = &h["contact"];
+    assert!(num(&contact["rms_nm"]) < 20.0, "{contact}");
+    assert!(num(&contact["max_gouge_nm"]["value"]) < 20.0, "{contact}");
+    assert!(
+        num(&contact["max_residual_nm"]["value"]) < 20.0,
+        "{contact}"
+    );
+    // The servo's following is still reported beside the height map.
+    assert!(r["simulation"]["servo_samples"].as_u64().expect("samples") > 1000);
+}
+
+#[test]
+fn roller_height_map_gives_the_scallop_and_the_chords_of_the_c_step() {
+    // Seed 002's pattern on its 3 mm roller (nose 1.417567 mm), finished
+    // at a coarse 50 um pitch and 0.25° c step over a window on the crest
+    // of cos(10 y / 3 mm) around the roller and of sin(5 x) along it (x =
+    // π/2 mm): there the axial section is convex with radius 2 mm, which
+    // sets the scallop; along the cut the 13 um chords between printed
+    // points dip below the crest by their sagitta L² κ / 8, κ = 0.02 mm ·
+    // (10/3 mm)². (In the hollows, where the radius comes as close as 2 mm
+    // to the nose's, the contacts spread far from the passes' centres and
+    // the scallops grow: the height map shows that too.)
+    let r = report_of(
+        "surface pattern = freeform {\n\
+             z(x, y) = 0.02 mm * (sin(5 rad/mm * x) + cos(10 rad/(3 mm) * y)) - 0.04 mm\n\
+             domain: rect(x: 0 mm .. 6.283185307179586 mm, y: 0 mm .. 18.84955592153876 mm)\n\
+         }\n\
+         surface on_roller = wrap(pattern, onto: roller(radius: 3 mm))\n\
+         use std::machines::moore_nanotech_450fg\n\
+         tool diamond = round_nose { nose_radius: 1.417567 mm, clearance: 12.5 deg, included_angle: 100 deg }\n\
+         strategy s = roller_helix {\n\
+             finish: { c_step: 0.25 deg, pitch: 0.05 mm }\n\
+             z: 1.2 mm .. 1.9 mm\n\
+             spindle_speed: 60 rpm\n\
+         }\n\
+         job crest { surface: on_roller, tool: diamond, machine: moore_nanotech_450fg, strategy: s,\n\
+             simulate: { x: 1.53 mm .. 1.61 mm, y: 9.38 mm .. 9.47 mm } }\n",
+        "crest",
+    );
+    let h = &r["simulation"]["height_map"];
+    assert_eq!(h["uncut_cells"], 0);
+    let expected = scallop(1.417567, 0.05, 2.0) * 1e6;
+    let mean = num(&h["scallops"]["simulated"]["mean_nm"]);
+    assert!(
+        (mean - expected).abs() < 0.03 * expected,
+        "{mean} vs {expected}"
+    );
+    let flat = scallop(1.417567, 0.05, f64::INFINITY) * 1e6;
+    assert!((num(&h["scallops"]["flat_theory_nm"]) - flat).abs() < 1e-3 * flat);
+    let chord = 3.0 * 0.25f64.to_radians();
+    let sagitta = chord * chord * 0.02 * (10.0f64 / 3.0).powi(2) / 8.0 * 1e6;
+    let contact = &h["contact"];
+    let gouge = num(&contact["max_gouge_nm"]["value"]);
+    // Plus up to half the machine's 1 nm resolution, as printed.
+    assert!(
+        gouge < sagitta + 0.5 && gouge > 0.7 * sagitta,
+        "{gouge} vs {sagitta}"
+    );
+    assert!(num(&contact["max_residual_nm"]["value"]) < 1.0, "{contact}");
+}
+
+#[test]
+fn a_simulation_window_too_fine_is_refused_with_its_size() {
+    let dir = tempfile::tempdir().expect("tmp");
+    std::fs::write(
+        dir.path().join("job.lens"),
+        "surface s = sphere { radius: 4 mm, sense: convex, aperture: circle(diameter: 2 mm) }\n\
+         use std::machines::generic_3axis_mill\n\
+         use std::tools::microshaper_r85um\n\
+         strategy scrape = raster { along: x, direction: one_way, stepover: 50 um, chord_tolerance: 1 um, feed: 100 mm/min }\n\
+         job j { surface: s, tool: microshaper_r85um, machine: generic_3axis_mill, strategy: scrape,\n\
+             simulate: { x: -1 mm .. 1 mm, y: -1 mm .. 1 mm, spacing: 0.5 um } }\n",
+    )
+    .expect("write");
+    let out = lensc(
+        dir.path(),
+        &[
+            "build",
+            "job.lens",
+            "--out",
+            dir.path().to_str().expect("utf8"),
+        ],
+    );
+    assert_eq!(out.status.code(), Some(1));
+    let err = text(&out.stderr);
+    assert!(
+        err.contains("E0149") && err.contains("16008001 cells"),
+        "{err}"
+    );
+    assert!(!dir.path().join("j.ngc").exists());
+}
