@@ -125,7 +125,13 @@ pub fn build(
     };
     // The height map over the window, from the same printed points.
     let design = evaluator(&p.lowered.tape).0;
-    let window = Window::of(job, height_map::lathe_centre(&p.lowered.domain, &features))
+    // The lenslets' own apertures (the planner's features reach on to
+    // where the trajectory meets the settling plateau).
+    let apertures: Vec<(f64, f64, f64)> = surfaces::array_lenslet(surface)
+        .zip(surfaces::array_centres(surface))
+        .map(|((_, rim), centres)| centres.into_iter().map(|(x, y)| (x, y, rim)).collect())
+        .unwrap_or_default();
+    let window = Window::of(job, height_map::lathe_centre(&p.lowered.domain, &apertures))
         .map_err(|d| vec![d])?;
     let grid = window.polar();
     window.check_size(job, &grid).map_err(|d| vec![d])?;
@@ -197,7 +203,7 @@ pub fn build(
         }
         None => json!({ "skipped": "the fast axis has no servo model" }),
     };
-    let frame = LatheFrame::new(design.as_ref(), window, p.lowered.domain, &features);
+    let frame = LatheFrame::new(design.as_ref(), window, p.lowered.domain, &apertures);
     let map = sweep.finish(&frame);
     report["simulation"]["height_map"] = height_map::json(
         &map,
