@@ -393,3 +393,33 @@ fn a_simulation_window_too_fine_is_refused_with_its_size() {
     );
     assert!(!dir.path().join("j.ngc").exists());
 }
+
+#[test]
+fn a_profile_job_refuses_a_simulation_window() {
+    let dir = tempfile::tempdir().expect("tmp");
+    std::fs::write(
+        dir.path().join("job.lens"),
+        "surface s = sphere { radius: 10 mm, sense: convex, aperture: circle(diameter: 4 mm) }\n\
+         use std::machines::linuxcnc_lathe\n\
+         tool t = round_nose { nose_radius: 0.5 mm, clearance: 10 deg }\n\
+         strategy face = profile_turning { feed: 5 um/rev, spindle_speed: 1000 rpm }\n\
+         job j { surface: s, tool: t, machine: linuxcnc_lathe, strategy: face,\n\
+             simulate: { x: 0 mm .. 1 mm, y: 0 mm .. 1 mm } }\n",
+    )
+    .expect("write");
+    let out = lensc(
+        dir.path(),
+        &[
+            "build",
+            "job.lens",
+            "--out",
+            dir.path().to_str().expect("utf8"),
+        ],
+    );
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("E0131") && err.contains("whole profile"),
+        "{err}"
+    );
+}

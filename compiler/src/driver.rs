@@ -146,6 +146,27 @@ pub fn plan_and_emit(
                 continue;
             }
         };
+        // Profile jobs are simulated along their whole profile: a window
+        // means nothing to them.
+        if let ("profile_turning" | "profile_grinding", Some(f)) = (
+            strategy.kind.name,
+            crate::value::field(&job.fields, "simulate"),
+        ) {
+            diags.push(
+                Diagnostic::error(
+                    codes::UNSUPPORTED_COMBINATION,
+                    format!(
+                        "`simulate` sets the window of a surface's height map; this `{}` job is simulated along its whole profile",
+                        strategy.kind.name
+                    ),
+                    f.file,
+                    f.span,
+                )
+                .with_label("not for a profile job")
+                .with_help("remove the `simulate` block"),
+            );
+            continue;
+        }
         let other = match strategy.kind.name {
             "fts_spiral" | "spiral_turning" => {
                 Some(crate::fts_job::build(job, &prov, &dialect, spool_dir))
