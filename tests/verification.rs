@@ -261,17 +261,42 @@ fn seed_000_raster_scallops_across_the_cut_outweigh_the_marks_along_it() {
         across > 30.0 && across > 10.0 * along,
         "{across} vs {along}"
     );
-    // The knife's edge lies in its rake face, across the cut; the planner
-    // puts Lin's nose circle in the plane of the path, so where the path
-    // slopes by θ the edge stands r (1/cos θ − 1) above the surface. The
-    // simulation finds just that, largest where the window is steepest.
-    let worst = &h["contact"]["max_residual_nm"];
-    let (x, y) = (num(&worst["x_mm"]), num(&worst["y_mm"]));
-    let theta = (x / (16.0 - x * x - y * y).sqrt()).atan();
-    let offset = 0.085e6 * (1.0 / theta.cos() - 1.0);
-    let got = num(&worst["value"]);
-    assert!((got - offset).abs() < 0.02 * offset, "{got} vs {offset}");
-    assert!(num(&h["contact"]["max_gouge_nm"]["value"]) < 1.0);
+    // The generic mill prints to 0.1 um: its rounding (of arc centres
+    // millimetres away, too) is what the contacts show, nothing else.
+    let contact = &h["contact"];
+    for k in ["max_residual_nm", "max_gouge_nm"] {
+        let v = num(&contact[k]["value"]);
+        assert!(v < 100.0, "{k} {v}");
+    }
+}
+
+#[test]
+fn seed_000_knife_contacts_sit_on_the_design() {
+    // The same imaging sphere on a mill printing to 1 nm: the planner puts
+    // the knife's edge (its nose arc across the cut, in the rake face) on
+    // the design exactly, and the height map, sweeping that edge along the
+    // printed arcs, finds every pass's contact on it within the chords'
+    // and the fitting's shares of the 10 nm tolerance and the rounding.
+    // (Lin's in-plane nose model, which lensc planned by before, left
+    // r (1/cos θ − 1) here: 0.98 um at 8.6°.)
+    let r = report_of(
+        "surface imaging_sphere = sphere { radius: 4 mm, sense: convex, aperture: circle(diameter: 2 mm) }\n\
+         use std::machines::generic_3axis_mill\n\
+         use std::tools::microshaper_r85um\n\
+         machine fine = generic_3axis_mill { resolution: 1 nm }\n\
+         strategy scrape = raster { along: x, direction: one_way, stepover: 10 um, chord_tolerance: 10 nm, lin_angle: 5 deg, feed: 100 mm/min, retract: 0.5 mm }\n\
+         job s1 { surface: imaging_sphere, tool: microshaper_r85um, machine: fine, strategy: scrape,\n\
+             simulate: { x: 0.75 mm .. 0.85 mm, y: -0.1 mm .. 0.1 mm } }\n",
+        "s1",
+    );
+    let h = &r["simulation"]["height_map"];
+    assert_eq!(h["uncut_cells"], 0);
+    let contact = &h["contact"];
+    assert!(num(&contact["cells"]) > 1000.0, "{contact}");
+    let (rms, pv) = (num(&contact["rms_nm"]), num(&contact["pv_nm"]));
+    assert!(rms < 1.0 && pv < 5.0, "{contact}");
+    assert!(num(&contact["max_residual_nm"]["value"]) < 2.5, "{contact}");
+    assert!(num(&contact["max_gouge_nm"]["value"]) < 2.5, "{contact}");
 }
 
 #[test]

@@ -67,7 +67,7 @@ pub fn build_raster(
             (
                 RasterTool::Knife { nose_radius: r },
                 format!(
-                    "microshaper knife, nose radius {} mm in the plane of the cut, referenced at the nose centre",
+                    "microshaper knife, nose radius {} mm, its edge across the cut, referenced at the nose centre",
                     trim_num(r)
                 ),
             )
@@ -188,7 +188,7 @@ pub fn build_raster(
             };
             let mut j = height_map::json(&map, &window, coordinates, raster.stepover);
             j["edge"] = json!(
-                "the knife's edge taken in its rake face, across the cut (the clearance-angle check's geometry): the planner offsets it in the plane of the path (Lin's model), which leaves about r(1/cos θ − 1) where the path slopes by θ"
+                "the knife's edge in its rake face, across the cut, as the planner places it"
             );
             json!({ "height_map": j })
         }

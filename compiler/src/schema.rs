@@ -1179,7 +1179,7 @@ pub static KINDS: &[Kind] = &[
                 "nose_radius",
                 LENGTH,
                 Check::Positive,
-                "radius of the knife's nose, in the plane of the cut",
+                "radius of the knife's nose, the arc of its cutting edge in the rake face (across the cut)",
             ),
             opt(
                 "clearance",
@@ -1191,7 +1191,7 @@ pub static KINDS: &[Kind] = &[
         family: None,
         positional: &[],
         exclusive: &[],
-        doc: "Lin's microshaper knife: a nose arc in the plane of the path, scraping along it (seed 000)",
+        doc: "Lin's microshaper knife (seed 000): scrapes along the cut, rake face forward, its edge a nose arc across the cut",
     },
     Kind {
         name: "ball_end",

@@ -4,9 +4,16 @@
 //!
 //! Every tool-centre point is exact, computed from the surface's exact
 //! derivatives:
-//! - the microshaper knife's nose is a circle in the plane of the path, so
-//!   its centre is the contact point moved by the nose radius along the unit
-//!   normal of the section curve in that plane (a closed form);
+//! - the microshaper knife scrapes along the cut with its rake face
+//!   facing the motion, so its cutting edge, the nose arc, lies in the
+//!   plane across the cut: at each position along the cut the nose centre
+//!   is the offset of the surface's cross-section (the section across the
+//!   cut) by the nose radius, its contact solved (Newton on the exact
+//!   derivatives) so that the centre lies on the path plane. The cut this
+//!   leaves is what the height-map simulation sweeps (`heightmap.rs`), the
+//!   geometry the clearance-angle check assumes, and what gives Lin's
+//!   step-over scallops. Lin's own model (the nose circle in the plane of
+//!   the path, his Fig. 5 and eq 4) is kept as reference functions;
 //! - the ball-end mill's centre is the contact point moved by the radius
 //!   along the 3-D surface normal; the contact point is solved (Newton on
 //!   the exact derivatives) so that the centre lies on the path plane.
@@ -57,9 +64,10 @@ pub struct Raster {
 /// The cutter, referenced at the centre of its nose circle or ball.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum RasterTool {
-    /// The microshaper: its nose is a circle in the cutting plane (the plane
-    /// of the path), so the tool-centre is the 2-D offset of the section
-    /// curve in that plane. The tip is `nose_radius` below the centre.
+    /// The microshaper: its edge, the nose arc, lies in its rake face,
+    /// across the cut, so the tool-centre is the 2-D offset of the section
+    /// across the cut, with the centre on the path plane. The tip is
+    /// `nose_radius` below the centre.
     Knife { nose_radius: f64 },
     /// Ball-end mill: 3-D offset along the surface normal, with the centre
     /// kept on the path plane.
@@ -107,7 +115,7 @@ pub enum RasterError {
     /// must be).
     InvalidParameter { name: &'static str, value: f64 },
     /// The tool is larger than the smallest concave radius of curvature it
-    /// must fit: the section along the cut for the knife, the larger
+    /// must fit: the section across the cut for the knife, the larger
     /// principal curvature for the ball. It would cut the sides of the
     /// hollow before reaching its bottom.
     ToolTooLarge {
@@ -119,7 +127,7 @@ pub enum RasterError {
     /// The surface (or its derivatives) is not finite at this point of the
     /// aperture.
     Undefined { x: f64, y: f64 },
-    /// No ball contact point puts the ball centre on the path plane here.
+    /// No contact point puts the tool centre on the path plane here.
     NoContact { x: f64, y: f64 },
     /// The chord tolerance cannot be met in floating point near this point.
     ToleranceUnreachable { x: f64, y: f64, tolerance: f64 },
@@ -149,7 +157,7 @@ impl std::fmt::Display for RasterError {
             ),
             RasterError::Undefined { x, y } => write!(f, "surface undefined at ({x}, {y})"),
             RasterError::NoContact { x, y } => {
-                write!(f, "no ball contact on the path plane near ({x}, {y})")
+                write!(f, "no tool contact on the path plane near ({x}, {y})")
             }
             RasterError::ToleranceUnreachable { x, y, tolerance } => write!(
                 f,
@@ -232,10 +240,10 @@ pub fn lin_boundary_offset(nose_radius: f64, slope: f64) -> f64 {
 
 /// The exact contact and tool-centre of `tool` for the path plane at
 /// `plane` (y for cuts along x, x for cuts along y) at position `u` along
-/// the cut. For the knife, u is the contact point's coordinate along the
-/// cut (the contact is on the plane); for the ball, it is the contact
-/// point's coordinate along the cut, and the contact's other coordinate is
-/// solved so that the centre lies on the plane.
+/// the cut: u is the contact point's coordinate along the cut, and the
+/// contact's other coordinate is solved so that the centre lies on the
+/// plane. The knife's centre is at u too (its edge is across the cut); the
+/// ball's is moved along the cut by the normal's component there.
 pub fn tool_contact(
     tool: &RasterTool,
     surface: &dyn SurfaceFn,
@@ -275,14 +283,10 @@ pub fn plan_raster(
         Axis::X => ((x0, x1), (y0, y1)),
         Axis::Y => ((y0, y1), (x0, x1)),
     };
-    // The ball's contact lies off its plane by up to its radius, so its
+    // The contact lies off its plane by up to the tool's radius, so the
     // planes reach a radius beyond the aperture on either side.
     let last = ((v1 - v0) / r.stepover + 1e-9).floor();
-    let extra = if cutter.ball {
-        (cutter.radius / r.stepover).ceil()
-    } else {
-        0.0
-    };
+    let extra = (cutter.radius / r.stepover).ceil();
     let paths = last + 1.0 + 2.0 * extra;
     if paths > MAX_PATHS as f64 {
         return Err(RasterError::TooManyPaths {
@@ -300,11 +304,7 @@ pub fn plan_raster(
         if k == last {
             v = v.min(v1);
         }
-        let spans = if cutter.ball {
-            cutter.ball_spans(aperture, v, (u0, u1), &mut summary)?
-        } else {
-            cutter.knife_spans(aperture, v, &mut summary)?
-        };
+        let spans = cutter.spans(aperture, v, (u0, u1), &mut summary)?;
         if !spans.is_empty() {
             lines.push((v, spans));
         }
@@ -365,10 +365,12 @@ const MAX_PATHS: usize = 1_000_000;
 const MAX_POINTS: usize = 5_000_000;
 /// Deepest bisection of one pass.
 const MAX_DEPTH: u32 = 48;
-/// Points at which each knife pass is scanned before it is sampled.
-const SCAN: usize = 256;
-/// Points at which each ball plane is scanned for its contact spans.
-const BALL_SCAN: usize = 512;
+/// Shortest span (mm) of contacts a plane cuts, a nanometre: shorter ones
+/// are a plane touching the aperture's edge, widened by rounding (a tangent
+/// touch in f64 gives a chord of about √ε times the radius).
+const MIN_SPAN: f64 = 1e-6;
+/// Points at which each plane is scanned for its contact spans.
+const SCAN: usize = 512;
 /// Chords are checked against the exact curve at i/PROBES, 0 < i < PROBES.
 const PROBES: usize = 8;
 
@@ -482,6 +484,12 @@ impl Local {
         self.zuu / (1.0 + self.zu * self.zu).powf(1.5)
     }
 
+    /// Curvature (1/mm) of the section across the cut, positive where
+    /// concave.
+    fn curvature_across(&self) -> f64 {
+        self.zvv / (1.0 + self.zv * self.zv).powf(1.5)
+    }
+
     /// The larger principal curvature (1/mm), positive where concave.
     fn max_principal_curvature(&self) -> f64 {
         let w2 = 1.0 + self.zu * self.zu + self.zv * self.zv;
@@ -550,29 +558,19 @@ impl<'a> Cutter<'a> {
     }
 
     /// The contact at `t` along the cut for the plane at `plane`; `guess`
-    /// starts the ball's solve for the contact's v.
+    /// starts the solve for the contact's v.
     fn contact(&self, plane: f64, t: f64, guess: f64) -> Result<Contact, RasterError> {
         let rho = self.radius;
-        if !self.ball {
-            // Knife: centre = section point + ρ n2, n2 = (−z_u, 1)/√(1 + z_u²).
-            let l = Local::at(self.surface, self.along, t, plane);
-            if !l.is_finite() {
-                return Err(self.error_at(t, plane, false));
-            }
-            let w = (1.0 + l.zu * l.zu).sqrt();
-            return Ok(Contact {
-                u: t,
-                v: plane,
-                l,
-                c: [t - rho * l.zu / w, l.z + rho / w],
-            });
-        }
-        // Ball: find v with g(v) = v − ρ z_v/W − plane = 0 (the centre's v
-        // on the plane), W = √(1 + z_u² + z_v²), by damped Newton with
-        // g'(v) = 1 − ρ ∂(z_v/W)/∂v.
+        // The slope along the cut that tilts the tool's normal: the ball's
+        // contact normal is the surface's; the knife's edge, across the cut,
+        // sees only the cross-section (its normal in the plane u = t).
+        let zu = |l: &Local| if self.ball { l.zu } else { 0.0 };
+        // Find v with g(v) = v − ρ z_v/W − plane = 0 (the centre's v on
+        // the plane), W = √(1 + z_u² + z_v²) (z_u = 0 for the knife), by
+        // damped Newton with g'(v) = 1 − ρ ∂(z_v/W)/∂v.
         let scale = 1.0 + plane.abs() + rho;
         let resid = |v: f64, l: &Local| {
-            let w = (1.0 + l.zu * l.zu + l.zv * l.zv).sqrt();
+            let w = (1.0 + zu(l) * zu(l) + l.zv * l.zv).sqrt();
             v - rho * l.zv / w - plane
         };
         let mut v = if guess.is_finite() { guess } else { plane };
@@ -585,14 +583,14 @@ impl<'a> Cutter<'a> {
             if g.abs() <= 1e-16 * scale {
                 break;
             }
-            let w2 = 1.0 + l.zu * l.zu + l.zv * l.zv;
+            let w2 = 1.0 + zu(&l) * zu(&l) + l.zv * l.zv;
             let w = w2.sqrt();
-            let dq = l.zvv / w - l.zv * (l.zu * l.zuv + l.zv * l.zvv) / (w2 * w);
+            let dq = l.zvv / w - l.zv * (zu(&l) * l.zuv + l.zv * l.zvv) / (w2 * w);
             let jac = 1.0 - rho * dq;
             if jac.is_nan() || jac <= 0.0 {
-                // The plane's offset folds over: the ball is too large for
+                // The plane's offset folds over: the tool is too large for
                 // the hollow here, or no contact lies on this plane.
-                let min_radius = 1.0 / l.max_principal_curvature();
+                let min_radius = self.limiting_radius(&l);
                 if min_radius > 0.0 && rho > min_radius {
                     let (x, y) = xy(self.along, t, v);
                     return Err(RasterError::ToolTooLarge {
@@ -626,93 +624,85 @@ impl<'a> Cutter<'a> {
         if g.is_nan() || g.abs() > 1e-13 * scale {
             return Err(self.error_at(t, v, true));
         }
-        let w = (1.0 + l.zu * l.zu + l.zv * l.zv).sqrt();
+        let w = (1.0 + zu(&l) * zu(&l) + l.zv * l.zv).sqrt();
         Ok(Contact {
             u: t,
             v,
             l,
-            c: [t - rho * l.zu / w, l.z + rho / w],
+            c: [t - rho * zu(&l) / w, l.z + rho / w],
         })
     }
 
-    /// The knife's spans on the plane at v: the aperture's chord, exactly,
-    /// scanned for an undefined surface and recorded in the summary.
-    fn knife_spans(
-        &self,
-        aperture: &Domain,
-        v: f64,
-        summary: &mut Summary,
-    ) -> Result<Vec<(Contact, Contact)>, RasterError> {
-        let mut spans = Vec::new();
-        for (a, b) in chord_intervals(aperture, self.along, v) {
-            if b <= a {
-                continue;
-            }
-            let at = |i: usize| {
-                if i == SCAN {
-                    b
+    /// Where the surface stops being defined on the plane at v, between
+    /// `ok` (defined, if a defined point was seen) and `bad` (undefined), by
+    /// bisection: the point a diagnostic names.
+    fn edge_of_definition(&self, v: f64, ok: Option<f64>, mut bad: f64) -> RasterError {
+        let defined = |t: f64| Local::at(self.surface, self.along, t, v).is_finite();
+        if let Some(mut ok) = ok {
+            for _ in 0..64 {
+                let mid = 0.5 * (ok + bad);
+                if mid == ok || mid == bad {
+                    break;
+                }
+                if defined(mid) {
+                    ok = mid;
                 } else {
-                    a + (b - a) * i as f64 / SCAN as f64
+                    bad = mid;
                 }
-            };
-            let scan: Vec<_> = (0..=SCAN).map(|i| self.contact(v, at(i), v)).collect();
-            if let Some(bad) = scan.iter().position(Result::is_err) {
-                // Locate the edge of definition between a defined and an
-                // undefined scan point, if the scan straddles one.
-                let good = scan.iter().position(Result::is_ok);
-                let (mut ok, mut nok) = match good {
-                    Some(g) if g < bad => (at(bad - 1), at(bad)),
-                    Some(g) => (at(g), at(g - 1)),
-                    None => return Err(self.error_at(at(bad), v, false)),
-                };
-                for _ in 0..64 {
-                    let mid = 0.5 * (ok + nok);
-                    if mid == ok || mid == nok {
-                        break;
-                    }
-                    if self.contact(v, mid, v).is_ok() {
-                        ok = mid;
-                    } else {
-                        nok = mid;
-                    }
-                }
-                return Err(self.error_at(nok, v, false));
             }
-            let scan: Vec<Contact> = scan.into_iter().flatten().collect();
-            for c in &scan {
-                summary.see(c, self.ball);
-            }
-            spans.push((scan[0], scan[SCAN]));
         }
-        Ok(spans)
+        self.error_at(bad, v, false)
     }
 
-    /// The ball's spans on the plane at v: runs of contact positions whose
-    /// contact point lies in the aperture, their ends refined to the edge.
-    fn ball_spans(
+    /// The smallest concave radius (mm) the tool must fit at a contact:
+    /// the cross-section's for the knife (its edge), the smaller principal
+    /// radius for the ball; infinite or negative where nothing is concave.
+    fn limiting_radius(&self, l: &Local) -> f64 {
+        if self.ball {
+            1.0 / l.max_principal_curvature()
+        } else {
+            1.0 / l.curvature_across()
+        }
+    }
+
+    /// The spans of the plane at v: runs of contact positions whose contact
+    /// point lies in the aperture, their ends refined to the edge.
+    fn spans(
         &self,
         aperture: &Domain,
         v: f64,
         (u0, u1): (f64, f64),
         summary: &mut Summary,
     ) -> Result<Vec<(Contact, Contact)>, RasterError> {
-        let (a, b) = (u0 - self.radius, u1 + self.radius);
-        let at = |i: usize| a + (b - a) * i as f64 / BALL_SCAN as f64;
+        // The ball's centre is up to a radius along the cut from its
+        // contact; the knife's is at the contact's u.
+        let margin = if self.ball { self.radius } else { 0.0 };
+        let (a, b) = (u0 - margin, u1 + margin);
+        let at = |i: usize| a + (b - a) * i as f64 / SCAN as f64;
         let inside = |c: &Contact| {
             let (x, y) = xy(self.along, c.u, c.v);
             aperture.contains(x, y)
         };
         // The surface must be defined wherever the plane crosses the
-        // aperture. A ball whose solve fails has no contact on this plane
+        // aperture. A tool whose solve fails has no contact on this plane
         // there (its contact would lie off the surface's domain) unless the
-        // ball is too large for the hollow inside the aperture.
-        let mut scan: Vec<Probe> = Vec::with_capacity(BALL_SCAN + 1);
+        // tool is too large for the hollow inside the aperture.
+        let mut scan: Vec<Probe> = Vec::with_capacity(SCAN + 1);
         let mut guess = v;
-        for i in 0..=BALL_SCAN {
+        for i in 0..=SCAN {
             let t = at(i);
             let (x, y) = xy(self.along, t, v);
             if aperture.contains(x, y) && !Local::at(self.surface, self.along, t, v).is_finite() {
-                return Err(RasterError::Undefined { x, y });
+                // The edge of definition lies between this point and the
+                // defined scan point next to it (before it, or else the
+                // first one after it).
+                let defined = |t: f64| Local::at(self.surface, self.along, t, v).is_finite();
+                let ok = if i > 0 && defined(at(i - 1)) {
+                    Some(at(i - 1))
+                } else {
+                    (i + 1..=SCAN).map(at).find(|&t| defined(t))
+                };
+                return Err(self.edge_of_definition(v, ok, t));
             }
             let probe = match self.contact(v, t, guess) {
                 Ok(c) if inside(&c) => Probe::In(c),
@@ -774,17 +764,17 @@ impl<'a> Cutter<'a> {
         };
         let mut spans = Vec::new();
         let mut i = 0;
-        while i <= BALL_SCAN {
+        while i <= SCAN {
             let Some(first) = scan[i] else {
                 i += 1;
                 continue;
             };
             let mut j = i;
-            while j < BALL_SCAN && scan[j + 1].is_some() {
+            while j < SCAN && scan[j + 1].is_some() {
                 j += 1;
             }
             for c in scan[i..=j].iter().flatten() {
-                summary.see(c, self.ball);
+                summary.see(c, self);
             }
             let start = if i > 0 {
                 refine(first, at(i - 1))
@@ -792,14 +782,16 @@ impl<'a> Cutter<'a> {
                 first
             };
             let last = scan[j].unwrap_or(first);
-            let end = if j < BALL_SCAN {
+            let end = if j < SCAN {
                 refine(last, at(j + 1))
             } else {
                 last
             };
-            summary.see(&start, self.ball);
-            summary.see(&end, self.ball);
-            if end.u > start.u {
+            summary.see(&start, self);
+            summary.see(&end, self);
+            // A plane that only grazes the aperture (its contacts meeting
+            // the edge at one point, to rounding) has nothing to cut.
+            if end.u - start.u > MIN_SPAN {
                 spans.push((start, end));
             }
             i = j + 1;
@@ -832,7 +824,7 @@ impl<'a> Cutter<'a> {
                     });
                 }
                 let mid = self.contact(plane, 0.5 * (c0.u + c1.u), 0.5 * (c0.v + c1.v))?;
-                summary.see(&mid, self.ball);
+                summary.see(&mid, self);
                 stack.push((mid, c1, depth + 1));
                 stack.push((c0, mid, depth + 1));
             } else {
@@ -874,7 +866,7 @@ impl<'a> Cutter<'a> {
         for (i, di) in d.iter_mut().enumerate().take(PROBES).skip(1) {
             let s = i as f64 / PROBES as f64;
             let q = self.contact(plane, c0.u + s * (c1.u - c0.u), c0.v + s * (c1.v - c0.v))?;
-            summary.see(&q, self.ball);
+            summary.see(&q, self);
             *di = distance_to_segment(q.c, p0, p1);
         }
         let m = (1..PROBES)
@@ -891,40 +883,13 @@ impl<'a> Cutter<'a> {
     }
 }
 
-/// The exact intervals of u where the plane at v crosses the aperture.
-fn chord_intervals(aperture: &Domain, along: Axis, v: f64) -> Vec<(f64, f64)> {
-    let half = |radius: f64| {
-        let h2 = radius * radius - v * v;
-        (h2 > 0.0).then(|| h2.sqrt())
-    };
-    match *aperture {
-        Domain::Circle { radius } => half(radius).map(|h| vec![(-h, h)]).unwrap_or_default(),
-        Domain::Annulus { inner, outer } => match (half(outer), half(inner)) {
-            (None, _) => vec![],
-            (Some(ho), None) => vec![(-ho, ho)],
-            (Some(ho), Some(hi)) => vec![(-ho, -hi), (hi, ho)],
-        },
-        Domain::Rect { x, y } => {
-            let (ur, vr) = match along {
-                Axis::X => (x, y),
-                Axis::Y => (y, x),
-            };
-            if v >= vr.0 && v <= vr.1 {
-                vec![ur]
-            } else {
-                vec![]
-            }
-        }
-    }
-}
-
 /// Figures gathered over every contact point the planner evaluates.
 struct Summary {
     along: Axis,
     slope_along: Extremum,
     slope_across: Extremum,
     concave_along: Option<Extremum>,
-    /// The smallest concave radius the tool must fit (along the section for
+    /// The smallest concave radius the tool must fit (across the cut for
     /// the knife, principal for the ball).
     tool_limit: Option<Extremum>,
 }
@@ -945,7 +910,7 @@ impl Summary {
         }
     }
 
-    fn see(&mut self, c: &Contact, ball: bool) {
+    fn see(&mut self, c: &Contact, cutter: &Cutter) {
         let (x, y) = xy(self.along, c.u, c.v);
         let at = |value: f64| Extremum { value, x, y };
         let along = c.l.zu.abs().atan();
@@ -963,11 +928,7 @@ impl Summary {
         if smaller(&self.concave_along, r_along) {
             self.concave_along = Some(at(r_along));
         }
-        let r_tool = if ball {
-            1.0 / c.l.max_principal_curvature()
-        } else {
-            r_along
-        };
+        let r_tool = cutter.limiting_radius(&c.l);
         if smaller(&self.tool_limit, r_tool) {
             self.tool_limit = Some(at(r_tool));
         }
@@ -1098,11 +1059,13 @@ mod tests {
         }
     }
 
-    /// Knife centres over a sphere of radius R lie on the section circle of
-    /// radius √(R² − v²) offset by ρ (outward on the dome, inward in the
-    /// bowl), about (0, ∓R) in the plane — a closed form, so exact.
+    /// Knife centres over a sphere of radius R: at u along the cut the
+    /// edge sees the cross-section, a circle of radius √(R² − u²) about the
+    /// sphere's axis, offset by ρ (outward on the dome, inward in the bowl);
+    /// the centre lies on that offset circle and on its plane — a closed
+    /// form, so exact.
     #[test]
-    fn knife_centres_on_a_sphere_lie_on_the_offset_section_circle() {
+    fn knife_centres_on_a_sphere_lie_on_the_offset_cross_section() {
         for (s, along) in [(-1.0, Axis::X), (-1.0, Axis::Y), (1.0, Axis::X)] {
             let sphere = Conic {
                 radius: 1.0,
@@ -1114,10 +1077,10 @@ mod tests {
             let mut worst = 0.0f64;
             for pass in &path.passes {
                 let v = plane_of(along, pass[0]);
-                let rs = (1.0 - v * v).sqrt();
                 for &p in pass {
                     assert_eq!(plane_of(along, p), v);
-                    let d = u_of(along, p).hypot(p[2] - s);
+                    let rs = (1.0 - u_of(along, p).powi(2)).sqrt();
+                    let d = v.hypot(p[2] - s);
                     worst = worst.max((d - (rs - s * LIN_NOSE)).abs());
                 }
             }
@@ -1167,13 +1130,24 @@ mod tests {
             let mut worst = 0.0f64;
             for pass in &path.passes {
                 let v = pass[0][1];
-                let rc = match tool {
-                    RasterTool::Knife { nose_radius } => (1.0 - v * v).sqrt() + nose_radius,
-                    RasterTool::Ball { radius } => ((1.0 + radius).powi(2) - v * v).sqrt(),
+                // The exact centre height at u on this plane: on the offset
+                // cross-section (knife) or the offset sphere (ball).
+                let exact = |u: f64| {
+                    match tool {
+                        RasterTool::Knife { nose_radius } => {
+                            ((1.0 - u * u).sqrt() + nose_radius).powi(2) - v * v
+                        }
+                        RasterTool::Ball { radius } => (1.0 + radius).powi(2) - v * v - u * u,
+                    }
+                    .sqrt()
+                        - 1.0
                 };
                 for w in pass.windows(2) {
+                    let (du, dz) = (w[1][0] - w[0][0], w[1][2] - w[0][2]);
                     let m = [0.5 * (w[0][0] + w[1][0]), 0.5 * (w[0][2] + w[1][2])];
-                    let dev = rc - m[0].hypot(m[1] + 1.0);
+                    // Vertical gap times the cosine of the chord's slope:
+                    // the distance to the (locally straight) curve.
+                    let dev = (exact(m[0]) - m[1]) * du.abs() / du.hypot(dz);
                     assert!(dev > -1e-12, "chord outside the curve by {dev:e}");
                     worst = worst.max(dev);
                 }
@@ -1186,12 +1160,28 @@ mod tests {
         }
     }
 
-    /// The exact knife-centre curve of the plane at y = `v` at centre
-    /// position x = `xc`: the contact whose centre is at xc, found by
-    /// bisection (the centre's x rises with the contact's x where the nose
-    /// fits the section).
+    /// Lin's model of the knife (his Fig. 5): the nose circle in the plane
+    /// of the path (y = `v`), touching the section at x = `t`; its centre is
+    /// the contact moved by the nose radius along the section's normal.
+    /// Returns (contact, centre).
+    fn lin_plane_contact(surface: &dyn SurfaceFn, v: f64, t: f64) -> ([f64; 3], [f64; 3]) {
+        let o = surface.eval(t, v);
+        let w = (1.0 + o[1] * o[1]).sqrt();
+        (
+            [t, v, o[0]],
+            [t - LIN_NOSE * o[1] / w, v, o[0] + LIN_NOSE / w],
+        )
+    }
+
+    /// The exact centre curve of Lin's in-plane model on the plane at y =
+    /// `v` at centre position x = `xc`: the contact whose centre is at xc,
+    /// found by bisection (the centre's x rises with the contact's x where
+    /// the nose fits the section).
     fn knife_centre_at(surface: &dyn SurfaceFn, v: f64, xc: f64) -> ([f64; 3], [f64; 3]) {
-        let at = |t: f64| tool_contact(&KNIFE, surface, Axis::X, v, t).unwrap();
+        let at = |t: f64| {
+            let (contact, centre) = lin_plane_contact(surface, v, t);
+            ToolContact { contact, centre }
+        };
         let (mut lo, mut hi) = (xc - LIN_NOSE, xc + LIN_NOSE);
         for _ in 0..200 {
             let mid = 0.5 * (lo + hi);
@@ -1209,9 +1199,9 @@ mod tests {
     }
 
     /// Lin's hyperboloid job (R = 1 mm, k = −20): chord midpoints against
-    /// the exact centre curve, and no surface point ever inside the nose at
-    /// a planned centre (and inside it by at most the chord tolerance along
-    /// a chord).
+    /// the exact centre curve, and no surface point ever inside the knife's
+    /// edge (the nose arc across the cut) at a planned centre, and inside it
+    /// by at most the chord tolerance along a chord.
     #[test]
     fn hyperboloid_chords_and_gouge() {
         let surf = convex(1.0, -20.0);
@@ -1226,9 +1216,9 @@ mod tests {
             let clearance = |c: [f64; 3]| {
                 (0..=400)
                     .map(|i| {
-                        let x = c[0] - LIN_NOSE + 2.0 * LIN_NOSE * i as f64 / 400.0;
-                        let z = surf.eval(x, v)[0];
-                        LIN_NOSE - (x - c[0]).hypot(z - c[2])
+                        let y = c[1] - LIN_NOSE + 2.0 * LIN_NOSE * i as f64 / 400.0;
+                        let z = surf.eval(c[0], y)[0];
+                        LIN_NOSE - (y - c[1]).hypot(z - c[2])
                     })
                     .fold(f64::NEG_INFINITY, f64::max)
             };
@@ -1236,7 +1226,10 @@ mod tests {
                 worst_gouge = worst_gouge.max(clearance(w[0]));
                 let m = [0.5 * (w[0][0] + w[1][0]), v, 0.5 * (w[0][2] + w[1][2])];
                 worst_chord_gouge = worst_chord_gouge.max(clearance(m));
-                let (_, exact) = knife_centre_at(&surf, v, m[0]);
+                let exact = tool_contact(&KNIFE, &surf, Axis::X, v, m[0])
+                    .unwrap()
+                    .centre;
+                assert_eq!(exact[0], m[0]);
                 let (du, dz) = (w[1][0] - w[0][0], w[1][2] - w[0][2]);
                 // Vertical gap times cos of the chord's inclination: the
                 // distance to the (locally straight) curve.
@@ -1304,9 +1297,18 @@ mod tests {
                 path.max_slope_across.value.to_degrees(),
                 path.safe_z
             );
-            // Planes at −0.8 + 0.01 k; the two touching the edge are empty.
-            assert_eq!(path.pass_count, 159);
-            assert_eq!(path.passes.len(), 159);
+            // Planes at −0.8 + 0.01 k. The knife's contact on the plane
+            // at v lies ρ sin φ nearer the axis, φ the slope across, so
+            // planes out to 0.8 mm + ρ sin φ(0.8 mm) cut (φ at the edge on
+            // the y axis, where the contact is nearest the axis).
+            let phi = (0.8 / (radius * radius - (1.0 + k) * 0.64f64).sqrt()).atan();
+            let reach = 0.8 + LIN_NOSE * phi.sin();
+            let planes = (-9..=169)
+                .filter(|&j| (-0.8 + 0.01 * f64::from(j)).abs() < reach)
+                .count();
+            eprintln!("  {planes} planes reach {reach:.5} mm");
+            assert_eq!(path.pass_count, planes);
+            assert_eq!(path.passes.len(), planes);
             // A convex lens has no concave section.
             assert_eq!(path.min_concave_radius_along, None);
             // Steepest along the cut at the aperture edge on y ≈ 0:
@@ -1488,18 +1490,25 @@ mod tests {
             ),
             Err(RasterError::ToleranceUnreachable { .. })
         ));
-        // The one plane of a tiny aperture only touches its edge.
+        // The one plane of a tiny aperture only touches its edge (on a
+        // surface level across the cut, the contact is on the plane).
         assert_eq!(
-            err(KNIFE, Domain::Circle { radius: 0.001 }),
+            plan_raster(
+                &base,
+                &KNIFE,
+                &Ramp { a: 0.1, b: 0.0 },
+                &Domain::Circle { radius: 0.001 }
+            )
+            .unwrap_err(),
             RasterError::NothingToCut
         );
     }
 
-    /// A concave sphere R = 1 mm: the section at y = v is a circle of
-    /// radius √(1 − v²), smallest on the outermost plane (v = ±0.79 for
-    /// stepover 10 µm and aperture 0.8 mm, radius 0.6131 mm). A 0.7 mm
-    /// knife does not fit; a 0.7 mm ball does (principal radius 1 mm);
-    /// a 1.2 mm ball does not.
+    /// A concave sphere R = 1 mm: the cross-section at x = u, the knife
+    /// edge's, is a circle of radius √(1 − u²), down to 0.6 mm at the
+    /// aperture's edge (0.8 mm). A 0.7 mm knife does not fit there (it is
+    /// refused where it first meets a cross-section tighter than itself); a
+    /// 0.7 mm ball does (principal radius 1 mm); a 1.2 mm ball does not.
     #[test]
     fn tool_larger_than_the_hollow_is_refused() {
         let bowl = Conic {
@@ -1518,13 +1527,14 @@ mod tests {
             Err(RasterError::ToolTooLarge {
                 tool_radius,
                 min_radius,
+                x,
                 y,
-                ..
             }) => {
                 assert_eq!(tool_radius, 0.7);
-                let want = (1.0f64 - 0.79 * 0.79).sqrt();
-                assert!((min_radius - want).abs() < 1e-9, "{min_radius}");
-                assert!((y.abs() - 0.79).abs() < 1e-9, "{y}");
+                assert!(min_radius < 0.7 && min_radius > 0.6 - 1e-9, "{min_radius}");
+                let want = (1.0 - x * x).sqrt();
+                assert!((min_radius - want).abs() < 1e-9, "{min_radius} at x {x}");
+                assert!(x.hypot(y) <= 0.8 + 1e-12, "({x}, {y})");
             }
             other => panic!("{other:?}"),
         }
@@ -1546,12 +1556,15 @@ mod tests {
         let r = raster(Axis::X, 0.05, 1e-5);
         let path = plan_raster(&r, &KNIFE, &surf, &Domain::Circle { radius: 0.8 }).unwrap();
         for pass in &path.passes {
-            let v = pass[0][1];
-            let h = (0.64 - v * v).sqrt();
-            let start = tool_contact(&KNIFE, &surf, Axis::X, v, -h).unwrap();
-            let end = tool_contact(&KNIFE, &surf, Axis::X, v, h).unwrap();
-            assert!(distance3(pass[0], start.centre) < 1e-15);
-            assert!(distance3(*pass.last().unwrap(), end.centre) < 1e-15);
+            for p in [pass[0], *pass.last().unwrap()] {
+                // The knife's contact is at the centre's x.
+                let c = tool_contact(&KNIFE, &surf, Axis::X, p[1], p[0]).unwrap();
+                assert!(distance3(p, c.centre) < 1e-15);
+                assert!(
+                    (c.contact[0].hypot(c.contact[1]) - 0.8).abs() < 1e-9,
+                    "{c:?}"
+                );
+            }
         }
         let ball = RasterTool::Ball { radius: 0.1 };
         let path = plan_raster(&r, &ball, &surf, &Domain::Circle { radius: 0.8 }).unwrap();
@@ -1582,12 +1595,24 @@ mod tests {
         centre[2] - LIN_NOSE - surface.eval(xs, 0.0)[0]
     }
 
-    /// Eq 4 is exact where the section is straight (δ2 = 0, δ1 exact), and
-    /// close on a curved one: on a circle of signed radius ρ the exact raise
-    /// is ρ cos θ − r − sgn ρ √((ρ − r)² − ρ² sin² θ), which eq 4 matches to
-    /// first order in r/ρ.
+    /// Eq 4 (for Lin's in-plane nose) is exact where the section is
+    /// straight (δ2 = 0, δ1 exact), and close on a curved one: on a circle
+    /// of signed radius ρ the exact raise is
+    /// ρ cos θ − r − sgn ρ √((ρ − r)² − ρ² sin² θ), which eq 4 matches to
+    /// first order in r/ρ. lensc's knife, its edge across the cut, needs no
+    /// raise where the cross-section is level: its tip is on S.
     #[test]
     fn eq4_against_the_exact_centre() {
+        for (surf, xs) in [
+            (convex(1.0, -20.0), 0.8),
+            (convex(1.0, 0.0), 0.5),
+            (convex(3.0, 10.0), -0.7),
+        ] {
+            let c = tool_contact(&KNIFE, &surf, Axis::X, 0.0, xs).unwrap();
+            assert_eq!(c.centre[0], xs);
+            let raise = c.centre[2] - LIN_NOSE - surf.eval(xs, 0.0)[0];
+            assert!(raise.abs() < 1e-15, "{raise:e}");
+        }
         // Straight: a ramp of slope 0.3 along x.
         let ramp = Ramp { a: -0.3, b: 0.0 };
         for xs in [-0.5, 0.0, 0.7] {
@@ -1649,12 +1674,7 @@ mod tests {
     /// contact must stop for the knife tip to stay at the edge's height.
     fn exact_inset(surface: &dyn SurfaceFn, edge: f64) -> f64 {
         let z_edge = surface.eval(edge, 0.0)[0];
-        let tip = |t: f64| {
-            tool_contact(&KNIFE, surface, Axis::X, 0.0, t)
-                .unwrap()
-                .centre[2]
-                - LIN_NOSE
-        };
+        let tip = |t: f64| lin_plane_contact(surface, 0.0, t).1[2] - LIN_NOSE;
         // The tip falls towards the edge of the dome (edge > 0).
         let (mut lo, mut hi) = (0.0, edge);
         for _ in 0..200 {
@@ -1668,10 +1688,11 @@ mod tests {
         edge - 0.5 * (lo + hi)
     }
 
-    /// Eqs 5–6 are exact for a straight section; on Lin's curved sections
-    /// they differ from the exact inset. The planner instead lets the
-    /// contact reach the edge: its tool-centre then lies r sin θ beyond the
-    /// edge, the tip r (1 − cos θ) below the edge's height.
+    /// Eqs 5–6 (for Lin's in-plane nose) are exact for a straight section;
+    /// on Lin's curved sections they differ from the exact inset. lensc's
+    /// knife, its edge across the cut, needs none: the pass ends with the
+    /// contact on the edge, the centre straight above it and the tip at the
+    /// edge's height.
     #[test]
     fn eqs5_6_against_the_exact_centre() {
         let ramp = Ramp { a: -0.3, b: 0.0 };
@@ -1690,15 +1711,15 @@ mod tests {
             let lin = lin_boundary_offset(LIN_NOSE, o[1]).abs();
             let c = tool_contact(&KNIFE, &surf, Axis::X, 0.0, 0.8).unwrap();
             let theta = o[1].atan();
-            assert!((c.centre[0] - 0.8 - LIN_NOSE * theta.sin().abs()).abs() < 1e-15);
+            assert_eq!(c.centre[0], 0.8);
+            assert!((c.centre[2] - LIN_NOSE - o[0]).abs() < 1e-15);
             eprintln!(
                 "eqs 5-6, {name} at 0.8 mm (θ {:.3}°): exact inset {:.4} µm, eq 6 {:.4} µm, \
-                 differ {:.4} µm; planner's centre {:.4} µm beyond the edge",
+                 differ {:.4} µm",
                 theta.to_degrees().abs(),
                 exact * 1e3,
                 lin * 1e3,
                 (lin - exact) * 1e3,
-                (c.centre[0] - 0.8) * 1e3
             );
             // On a dome the surface falls faster than its tangent, so the
             // exact inset is shorter than the straight-line estimate.
@@ -1792,8 +1813,12 @@ mod tests {
             outer: 0.8,
         };
         let path = plan_raster(&r, &KNIFE, &surf, &ap).unwrap();
-        // Planes −0.7 … 0.7 (15), of which −0.2 … 0.2 (5) are split.
-        assert_eq!(path.pass_count, 20);
+        // Planes −0.8 … 0.8 (17): on the paraboloid z = −q²/2 the contact
+        // lies ρ q/√(1 + q²) nearer the axis than its plane (0.747 mm for the
+        // plane at 0.8, 0.843 mm for 0.9, outside). Of them −0.2 … 0.2 (5)
+        // are split: the plane at 0.3 has its contacts at 0.276 mm, outside
+        // the 0.25 mm hole.
+        assert_eq!(path.pass_count, 22);
     }
 
     /// Seed 000 appendix eq A1 as printed gives dz/dq = s q (2Q² − (1+k) q²)/Q³
