@@ -322,3 +322,35 @@ fn arc_fitting_shortens_seed_000_and_seed_004_programs_within_the_budget() {
         assert!((tolerance - 1.5e-6).abs() < 1e-12, "{job}: {tolerance}");
     }
 }
+
+#[test]
+fn machining_time_is_given_per_pass_and_in_total() {
+    // Profile turning from a blank: each roughing pass and the finish pass
+    // has its cutting time, and they add up to the job's.
+    let (report, _) = build("examples/forbes_qcon_asphere.lens", "condenser_from_blank");
+    let tp = &report["toolpath"];
+    let passes = tp["passes"].as_array().expect("passes");
+    let roughing = tp["roughing_passes"].as_u64().expect("roughing") as usize;
+    assert!(roughing >= 1, "{roughing}");
+    assert_eq!(passes.len(), roughing + 1);
+    for (i, p) in passes.iter().enumerate() {
+        let want = if i < roughing { "roughing" } else { "finish" };
+        assert_eq!(p["pass"], want);
+        assert!(p["cutting_time_s"].as_f64().expect("time") > 0.0);
+    }
+    let sum: f64 = passes
+        .iter()
+        .map(|p| p["cutting_time_s"].as_f64().expect("time"))
+        .sum();
+    let total = tp["cutting_time_s"].as_f64().expect("total");
+    assert!((sum - total).abs() <= 1e-9 * total, "{sum} vs {total}");
+
+    // A raster: one time per pass, the same total.
+    let (report, _) = build("examples/lin2022_scraping.lens", "lin_hyperboloid");
+    let tp = &report["toolpath"];
+    let times = tp["pass_cutting_times_s"].as_array().expect("times");
+    assert_eq!(times.len() as u64, tp["passes"].as_u64().expect("passes"));
+    let sum: f64 = times.iter().map(|t| t.as_f64().expect("time")).sum();
+    let total = tp["cutting_time_s"].as_f64().expect("total");
+    assert!((sum - total).abs() <= 1e-9 * total, "{sum} vs {total}");
+}

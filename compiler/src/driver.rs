@@ -403,6 +403,10 @@ fn build_report(
             "surface_speed_m_per_min": job.strategy.surface_speed.map(|v| v * 0.06),
             "max_spindle_rpm": job.strategy.spindle_speed * 60.0 / std::f64::consts::TAU,
             "cutting_time_s": path.cutting_time(),
+            "passes": path.pass_times.iter().enumerate().map(|(i, t)| serde_json::json!({
+                "pass": if i < path.roughing_passes { "roughing" } else { "finish" },
+                "cutting_time_s": t,
+            })).collect::<Vec<_>>(),
             "chord_tolerance_mm": job.strategy.chord_tolerance,
             "max_profile_slope_deg": path.max_slope.0.to_degrees(),
             "min_concave_radius_mm": path.min_concave_radius.map(|(r, at)| json!({ "value": r, "at_radius_mm": at })),

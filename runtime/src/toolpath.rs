@@ -112,6 +112,9 @@ pub struct Toolpath {
     /// Time (s) of the cutting moves, the spindle's speed at each move's
     /// radius under constant surface speed.
     pub cutting_time: f64,
+    /// Cutting time (s) of each pass, roughing passes first, the finish
+    /// pass last; they sum to `cutting_time`.
+    pub pass_times: Vec<f64>,
     /// Smallest concave radius of curvature on the profile and where (r, mm).
     pub min_concave_radius: Option<(f64, f64)>,
     /// Steepest profile slope (rad) and where (r, mm).
@@ -236,7 +239,7 @@ pub fn plan_profile_turning(job: &Job, profile: &dyn Profile) -> Result<Toolpath
     let safe_z = top + strat.retract;
     let mut moves = Vec::with_capacity(passes.iter().map(|p| p.len() + 3).sum());
     let mut cut_length = 0.0;
-    let mut cutting_time = 0.0;
+    let mut pass_times = Vec::with_capacity(passes.len());
     // The feed speed (mm/s) at radius r.
     let speed_at = |r: f64| match (strat.feed, strat.surface_speed) {
         (Feed::PerTime(v), _) => v,
@@ -259,12 +262,13 @@ pub fn plan_profile_turning(job: &Job, profile: &dyn Profile) -> Result<Toolpath
             z: cut[0].y,
         });
         cut_length += (safe_z - cut[0].y).abs();
-        cutting_time += (safe_z - cut[0].y).abs() / speed_at(cut[0].x);
+        let mut time = (safe_z - cut[0].y).abs() / speed_at(cut[0].x);
         for w in cut.windows(2) {
             let len = (w[1] - w[0]).norm();
             cut_length += len;
-            cutting_time += len / speed_at(0.5 * (w[0].x + w[1].x));
+            time += len / speed_at(0.5 * (w[0].x + w[1].x));
         }
+        pass_times.push(time);
         moves.extend(cut.iter().skip(1).map(|c| Move::Feed { x: c.x, z: c.y }));
         let last = cut[cut.len() - 1];
         moves.push(Move::Rapid {
@@ -273,6 +277,7 @@ pub fn plan_profile_turning(job: &Job, profile: &dyn Profile) -> Result<Toolpath
         });
     }
     let cut = passes.pop().expect("the finish pass");
+    let cutting_time = pass_times.iter().sum();
 
     let (lo_x, hi_x) = job.machine.travel_x;
     let (lo_z, hi_z) = job.machine.travel_z;
@@ -306,6 +311,7 @@ pub fn plan_profile_turning(job: &Job, profile: &dyn Profile) -> Result<Toolpath
         cut_length,
         feed_speed,
         cutting_time,
+        pass_times,
         min_concave_radius: min_concave,
         max_slope,
         seams,
