@@ -685,7 +685,9 @@ mod roughing_tests {
     /// with a 2 mm wheel radius and a 0.1 mm nose.
     #[test]
     fn planned_centres_are_the_exact_offset_of_aspheres() {
-        let cases: [(f64, f64, Sense, Vec<(u32, f64)>, f64, f64); 3] = [
+        // (R, k, sense, A_j terms, aperture radius, nose radius)
+        type Case = (f64, f64, Sense, Vec<(u32, f64)>, f64, f64);
+        let cases: [Case; 3] = [
             (
                 22.405,
                 43.098,
