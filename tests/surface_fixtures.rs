@@ -166,8 +166,8 @@ fn expect(label: &str, source: &str, what: &str, at: (f64, f64), got: f64, want:
 // ---------------------------------------------------------------------------
 
 /// The conic section's sag at r² = s: c s / (1 + sqrt(1 − (1+k) c² s)),
-/// c = 1/R (ISO 10110-12:2019 eq. 1 without its polynomial; the "standard"
-/// surface of Zemax OpticStudio and Code V).
+/// c = 1/R (ISO 10110-12's aspheric equation without its polynomial; the
+/// "standard" surface of Zemax OpticStudio and Code V).
 fn conic_sag(c: f64, k: f64, s: f64) -> f64 {
     c * s / (1.0 + (1.0 - (1.0 + k) * c * c * s).sqrt())
 }
@@ -177,7 +177,7 @@ fn conic_slope(c: f64, k: f64, r: f64) -> f64 {
     c * r / (1.0 - (1.0 + k) * c * c * r * r).sqrt()
 }
 
-/// The rotationally symmetric asphere of ISO 10110-12 / Kim 2008 eq. 1,
+/// The rotationally symmetric asphere of ISO 10110-12 and Kim 2008 eq. 1,
 /// z = conic + Σ A_j |r|^j, with slopes (x, y) · z'(r)/r; `sign` multiplies all.
 fn asphere(sign: f64, c: f64, k: f64, terms: &[(i32, f64)], x: f64, y: f64) -> Want {
     let r = x.hypot(y);
@@ -239,7 +239,7 @@ fn sphere_and_conic_are_the_conic_sections() {
         "paraboloid r²/(2R)",
     );
     // Every conic satisfies its section's equation r² − 2Rz + (1+k)z² = 0
-    // (Born & Wolf §4.10; ISO 10110-12): z = (R − sqrt(R² − (1+k) r²))/(1+k)
+    // (the conic section about its vertex): z = (R − sqrt(R² − (1+k) r²))/(1+k)
     // for k ≠ −1 (the nearer root), a hyperboloid, an oblate and a prolate
     // ellipsoid.
     for k in [-2.5f64, 0.6, -0.4, 43.098] {
@@ -424,8 +424,8 @@ fn toroid_is_a_swept_profile() {
 #[test]
 fn ellipsoid_cap() {
     // The ellipsoid x²/a² + y²/b² + (z − c)²/c² = 1 through the vertex:
-    // z = c (1 − sqrt(1 − x²/a² − y²/b²)) (Liu et al., seed 002, the
-    // microlens); convex is its mirror image.
+    // z = c (1 − sqrt(1 − x²/a² − y²/b²)) (Liu et al., seed 002, eq. 11, the
+    // microlens, moved to its vertex); convex is its mirror image.
     for (sense, s) in [("concave", 1.0), ("convex", -1.0)] {
         let src = format!(
             "surface e = ellipsoid {{ a: 2.5 mm, b: 1.8 mm, c: 3.2 mm, sense: {sense}, aperture: circle(radius: 1.5 mm) }}"
@@ -505,9 +505,9 @@ fn xy_polynomial_on_a_conic_and_on_a_plane() {
 
 /// The 37-term fringe (University of Arizona) Zernike set, as tabulated by
 /// Wyant & Creath, "Basic wavefront aberration theory for optical
-/// metrology" (Applied Optics and Optical Engineering XI, 1992), Table 2,
-/// and the Zemax OpticStudio manual ("Fringe Zernike"): (radial polynomial
-/// in ρ, m), m > 0 cos mθ, m < 0 sin |m|θ.
+/// metrology" (Applied Optics and Optical Engineering XI, 1992), and the
+/// Zemax OpticStudio manual ("Fringe Zernike Sag"): (radial polynomial in
+/// ρ, m), m > 0 cos mθ, m < 0 sin |m|θ.
 fn fringe_table(j: usize, rho: f64) -> (f64, i32) {
     let p = |c: &[f64]| c.iter().fold(0.0, |acc, &a| acc * rho + a);
     let r = rho;
@@ -677,8 +677,7 @@ fn zernike_ansi_is_normalised_and_numbered_from_zero() {
 }
 
 /// Forbes 2007 ("Shape specification for axially symmetric optical
-/// surfaces", Opt. Express 15, 5218), eq. 3.x: Q_0 … Q_3 of Q-bfs in
-/// x = u².
+/// surfaces", Opt. Express 15, 5218): his Q_0 … Q_3 of Q-bfs in x = u².
 fn forbes_qbfs(m: usize, x: f64) -> f64 {
     match m {
         0 => 1.0,
@@ -709,12 +708,12 @@ fn qbfs_is_forbes_2007() {
             let sum: f64 = (0..4).map(|m| a[m] * forbes_qbfs(m, u2)).sum();
             z_only(-(conic_sag(c, 0.0, s) + u2 * (1.0 - u2) / (1.0 - c * c * s).sqrt() * sum))
         },
-        "−(sphere + u²(1−u²)/sqrt(1−c²ρ²) Σ a_m Q_m) (Forbes 2007 eq. 2.2)",
+        "−(sphere + u²(1−u²)/sqrt(1−c²ρ²) Σ a_m Q_m) (Forbes 2007)",
     );
 }
 
 /// The Jacobi polynomial P_n^(α,β)(t) from its explicit sum (Abramowitz &
-/// Stegun 22.3.1; DLMF 18.5.8):
+/// Stegun 22.3; DLMF §18.5):
 /// Σ_s C(n+α, n−s) C(n+β, s) ((t−1)/2)^s ((t+1)/2)^(n−s).
 fn jacobi(n: usize, alpha: usize, beta: usize, t: f64) -> f64 {
     let binom = |a: usize, b: usize| -> f64 {
@@ -732,8 +731,8 @@ fn jacobi(n: usize, alpha: usize, beta: usize, t: f64) -> f64 {
 
 #[test]
 fn qcon_is_the_conic_plus_jacobi_polynomials() {
-    // Forbes 2007 eq. 2.5: z = conic + u⁴ Σ a_m Q_m^con(u²), with
-    // Q_m^con(x) = P_m^(0,4)(2x − 1) (his eq. 2.6); his closed forms
+    // Forbes 2007: z = conic + u⁴ Σ a_m Q_m^con(u²), with
+    // Q_m^con(x) = P_m^(0,4)(2x − 1); his closed forms
     // Q_0 = 1, Q_1 = −(5 − 6x), Q_2 = 15 − 14x(3 − 2x),
     // Q_3 = −(35 − 12x(14 − x(21 − 10x))) hold for the sum above.
     for x in [0.0, 0.13, 0.5, 0.77, 1.0] {
@@ -777,7 +776,7 @@ fn qcon_is_the_conic_plus_jacobi_polynomials() {
                 .enumerate()
                 .map(|(m, am)| am * jacobi(m, 0, 4, t))
                 .sum();
-            // d/dt P_m^(0,4)(t) = (m + 5)/2 · P_{m−1}^(1,5)(t) (DLMF 18.9.15)
+            // d/dt P_m^(0,4)(t) = (m + 5)/2 · P_{m−1}^(1,5)(t) (DLMF §18.9)
             let dsum: f64 = a
                 .iter()
                 .enumerate()
@@ -797,7 +796,7 @@ fn qcon_is_the_conic_plus_jacobi_polynomials() {
 
 #[test]
 fn freeform_is_its_formula() {
-    // Seed 002's pattern (DESIGN.md's example): 0.02 mm (sin 5x + cos 10y/3) − 0.04 mm.
+    // DESIGN.md's roller pattern: 0.02 mm (sin 5x + cos 10y/3) − 0.04 mm.
     surface(
         "surface f = freeform { z(x, y) = 0.02 mm * (sin(5 rad/mm * x) + cos(10 rad/(3 mm) * y)) - 0.04 mm, domain: rect(x: 0 mm .. 6.283 mm, y: 0 mm .. 18.85 mm) }",
         "f",
@@ -1285,7 +1284,8 @@ fn seed_003_lenslet_sag_and_settling_offset() {
     let at_075 = o[2][1].atan().to_degrees();
     assert!((at_075 - 2.15).abs() < 5e-3, "{at_075}°");
     // Eq. 6, h_offset = sqrt(R² − (d/2)²) − sqrt(R² − (d/2 + d_traj)²) with
-    // eq. 7, d_traj = v T_s: "5 m/min … 0.001 s … 3.7 µm" (§3.4). On the
+    // eq. 7, d_traj = v T_s: "5 m/min … 0.001 s … 3.7 µm" (the text after
+    // eq. 7). On the
     // lenslet it is the rise from the rim to d/2 + d_traj.
     let d_traj = 5000.0 / 60.0 * 0.001;
     let h = s.at(&[(0.85 + d_traj, 0.0)])[0][0] - o[0][0];
@@ -1300,7 +1300,7 @@ fn seed_003_lenslet_sag_and_settling_offset() {
 
 #[test]
 fn seed_002_microlens_depth() {
-    // Liu et al. (seed 002), §4.2: ellipsoids a = b = 0.505 mm, c = 1.01 mm,
+    // Liu et al. (seed 002), §3.2, eq. 11: ellipsoids a = b = 0.505 mm, c = 1.01 mm,
     // 100 µm apart along the roller's axis and 3.75° (on R = 3 mm) around
     // it, overlapping into ~100 × 200 µm cells, "the depth of the
     // microlens was approximately 5 µm". As examples/liu_roller_microlens.lens
