@@ -445,3 +445,44 @@ job ring_cut { surface: ring, tool: t, machine: linuxcnc_lathe, strategy: finish
     assert_eq!(out.status.code(), Some(1));
     assert!(text(&out.stderr).contains("inner radius"));
 }
+
+#[test]
+fn sample_works_on_every_example_surface() {
+    // Issue #3: `lensc sample` on every surface of every example, through
+    // the real binary: a 5 × 5 grid over the aperture, every value finite.
+    let mut sampled = 0;
+    for ex in common::examples() {
+        let path = ex.to_str().expect("utf8").to_string();
+        for name in common::surface_names(&ex) {
+            let out = lensc(
+                &root(),
+                &["sample", &path, "--surface", &name, "--grid", "5"],
+            );
+            assert_eq!(
+                out.status.code(),
+                Some(0),
+                "{path} {name}: {}",
+                text(&out.stderr)
+            );
+            let csv = text(&out.stdout);
+            let mut lines = csv.lines();
+            assert_eq!(
+                lines.next(),
+                Some("x,y,z,dzdx,dzdy,curvature_x,curvature_y"),
+                "{path} {name}"
+            );
+            let rows: Vec<&str> = lines.collect();
+            assert!(!rows.is_empty(), "{path} {name}: no point inside");
+            for row in rows {
+                let values: Vec<f64> = row
+                    .split(',')
+                    .map(|v| v.parse().unwrap_or_else(|_| panic!("{path} {name}: {row}")))
+                    .collect();
+                assert_eq!(values.len(), 7, "{row}");
+                assert!(values.iter().all(|v| v.is_finite()), "{path} {name}: {row}");
+            }
+            sampled += 1;
+        }
+    }
+    assert!(sampled >= 15, "only {sampled} surfaces");
+}
