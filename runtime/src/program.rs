@@ -6,7 +6,7 @@
 use std::f64::consts::PI;
 use std::fmt::Write as _;
 
-use crate::format::{decimals_for, fixed_units, push_fixed, push_units};
+use crate::format::{decimals_for, fixed_units, print_units, push_fixed};
 use crate::job::Job;
 use crate::machine::{CommentStyle, Dialect};
 use crate::moves::{self, Plane, Position};
@@ -732,11 +732,20 @@ pub enum Setup {
 /// fixed-point formatter and the dialect's digit limit; every chunk of
 /// text handed out has passed `check_numbers`.
 pub struct ProgramWriter {
-    text: String,
+    /// Program text not yet taken (UTF-8: only `str`s and ASCII go in).
+    text: Vec<u8>,
     dialect: Dialect,
     decimals: u32,
     /// Letters of the machine's axes among X, Y, Z, C (others are refused).
     letters: [Option<char>; 4],
+    /// What goes before each axis's number: a space and its letter.
+    axis_words: [Snippet; 4],
+    /// Decimals of each axis: the resolution's, C's own for C.
+    axis_decimals: [u32; 4],
+    /// The motion words: rapid, linear, clockwise and counter-clockwise arc.
+    motion_words: [Snippet; 4],
+    /// The dialect's block end and the newline.
+    line_end: Snippet,
     /// Factor from the move stream's X to the printed X (2 in diameter mode).
     x_scale: f64,
     /// The last value printed per axis, in units of its last decimal.
@@ -808,16 +817,27 @@ impl ProgramWriter {
             )));
         }
         let has = |c: char| axes.contains(c).then_some(c);
+        let letters = [
+            has('X'),
+            has('Y'),
+            has('Z'),
+            has('C').map(|_| dialect.c_letter),
+        ];
         let mut w = ProgramWriter {
-            text: String::new(),
+            text: Vec::new(),
             dialect: dialect.clone(),
             decimals,
-            letters: [
-                has('X'),
-                has('Y'),
-                has('Z'),
-                has('C').map(|_| dialect.c_letter),
-            ],
+            letters,
+            axis_words: letters.map(|l| Snippet::new(&format!(" {}", l.unwrap_or(' ')))),
+            axis_decimals: [decimals, decimals, decimals, dialect.c_decimals],
+            motion_words: [
+                &dialect.rapid,
+                &dialect.linear,
+                &dialect.arc_cw,
+                &dialect.arc_ccw,
+            ]
+            .map(|w| Snippet::new(w)),
+            line_end: Snippet::new(&format!("{}\n", dialect.block_end)),
             x_scale: if setup == Setup::Lathe && dialect.lathe_x_diameter {
                 2.0
             } else {
@@ -860,8 +880,8 @@ impl ProgramWriter {
         for line in &dialect.start {
             let l = w.fill(line, path_tolerance);
             check_numbers(&l, dialect.comment)?;
-            w.text.push_str(&l);
-            w.text.push('\n');
+            w.text.extend_from_slice(l.as_bytes());
+            w.text.push(b'\n');
         }
         for line in header {
             w.comment(line);
@@ -897,23 +917,34 @@ impl ProgramWriter {
             .replace("{tolerance}", &tol)
     }
 
+    /// A space and a word's letter.
+    #[inline]
+    fn push_letter(&mut self, letter: char) {
+        self.text.push(b' ');
+        let mut utf8 = [0; 4];
+        self.text
+            .extend_from_slice(letter.encode_utf8(&mut utf8).as_bytes());
+    }
+
     /// Starts a block: its number, if the dialect numbers blocks.
     fn begin_block(&mut self) {
         if self.dialect.line_numbers.is_some() {
-            self.text.push('N');
-            self.text.push_str(itoa::Buffer::new().format(self.block));
-            self.text.push(' ');
+            self.text.push(b'N');
+            self.text
+                .extend_from_slice(itoa::Buffer::new().format(self.block).as_bytes());
+            self.text.push(b' ');
         }
     }
 
     /// Ends the block begun at byte `start`: the dialect's block end, the
     /// line-length limit, the next block number.
     fn end_block(&mut self, start: usize) -> Result<(), ProgramError> {
-        self.text.push_str(&self.dialect.block_end);
+        // The line's length is where the text ends now: nothing rescanned.
         if let Some(max) = self.dialect.max_line_length
-            && self.text.len() - start > max
+            && self.text.len() - start + self.dialect.block_end.len() > max
         {
-            let line = self.text[start..].to_string();
+            let mut line = String::from_utf8_lossy(&self.text[start..]).into_owned();
+            line.push_str(&self.dialect.block_end);
             self.text.truncate(start);
             return Err(ProgramError::Unsupported(format!(
                 "a line of {} characters ({} reads at most {max}): {line}",
@@ -921,7 +952,7 @@ impl ProgramWriter {
                 self.dialect.name
             )));
         }
-        self.text.push('\n');
+        self.line_end.push_to(&mut self.text);
         if let Some(step) = self.dialect.line_numbers {
             self.block += step;
             if self.dialect.max_line_number.is_some_and(|m| self.block > m) {
@@ -935,7 +966,7 @@ impl ProgramWriter {
         check_numbers(words, self.dialect.comment)?;
         let start = self.text.len();
         self.begin_block();
-        self.text.push_str(words);
+        self.text.extend_from_slice(words.as_bytes());
         self.end_block(start)
     }
 
@@ -950,13 +981,13 @@ impl ProgramWriter {
             self.begin_block();
             match self.dialect.comment {
                 CommentStyle::Parentheses => {
-                    self.text.push('(');
-                    self.text.push_str(body);
-                    self.text.push(')');
+                    self.text.push(b'(');
+                    self.text.extend_from_slice(body.as_bytes());
+                    self.text.push(b')');
                 }
                 CommentStyle::Semicolon => {
-                    self.text.push_str("; ");
-                    self.text.push_str(body);
+                    self.text.extend_from_slice(b"; ");
+                    self.text.extend_from_slice(body.as_bytes());
                 }
             }
             // Comments are folded to 120 characters: within every limit.
@@ -965,27 +996,26 @@ impl ProgramWriter {
     }
 
     /// Appends a value's digits, refusing more than the dialect's limit.
+    /// The digits come from an integer count of units (`print_units`), so
+    /// they cannot spell an exponent, NaN or `-0`: `check_number` holds
+    /// of them by construction (the format module's tests hold it to
+    /// that), and is asserted again in debug builds.
+    #[inline]
     fn value(&mut self, letter: char, v: f64, n: i64, d: u32) -> Result<(), ProgramError> {
-        let before = self.text.len();
-        push_units(&mut self.text, n, d);
-        if let Err(why) = check_number(&self.text.as_bytes()[before..]) {
+        let printed = print_units(n, d);
+        debug_assert!(check_number(printed.as_bytes()).is_ok());
+        if let Some(max) = self.dialect.max_digits
+            && printed.digits > max as usize
+        {
             return Err(ProgramError::Unsupported(format!(
-                "the word `{letter}{}` ({why})",
-                &self.text[before..]
+                "{letter}{v} in {} digits ({} takes at most {max})",
+                printed.digits, self.dialect.name
             )));
         }
-        if let Some(max) = self.dialect.max_digits {
-            let digits = self.text.as_bytes()[before..]
-                .iter()
-                .filter(|b| b.is_ascii_digit())
-                .count();
-            if digits > max as usize {
-                return Err(ProgramError::Unsupported(format!(
-                    "{letter}{v} in {} digits ({} takes at most {max})",
-                    digits, self.dialect.name
-                )));
-            }
-        }
+        // The whole room copied (a fixed size: no call), then cut back.
+        let at = self.text.len();
+        self.text.extend_from_slice(&printed.room);
+        self.text.truncate(at + printed.len);
         Ok(())
     }
 
@@ -1011,7 +1041,7 @@ impl ProgramWriter {
                 self.begin_block();
                 if let Some(w) = speed {
                     let rpm = w * 60.0 / (2.0 * PI);
-                    self.text.push('S');
+                    self.text.push(b'S');
                     match fixed_units(rpm, 3) {
                         Some(n) => self.value('S', rpm, n, 3)?,
                         None => {
@@ -1021,10 +1051,10 @@ impl ProgramWriter {
                             });
                         }
                     }
-                    self.text.push(' ');
+                    self.text.push(b' ');
                 }
                 let on = self.dialect.spindle_on.clone();
-                self.text.push_str(&on);
+                self.text.extend_from_slice(on.as_bytes());
                 self.end_block(start)
             }
             M::SpindleSurfaceSpeed { surface_speed, cap } => {
@@ -1107,8 +1137,8 @@ impl ProgramWriter {
                 )));
             };
             let w = w.clone();
-            self.text.push_str(&w);
-            self.text.push(' ');
+            self.text.extend_from_slice(w.as_bytes());
+            self.text.push(b' ');
         }
         if let Some((plane, _)) = arc {
             if !self.dialect.arc_planes.contains(&plane) {
@@ -1118,20 +1148,15 @@ impl ProgramWriter {
                 )));
             }
             if plane != self.plane {
-                self.text.push_str(match plane {
-                    Plane::Xy => "G17 ",
-                    Plane::Zx => "G18 ",
-                    Plane::Yz => "G19 ",
+                self.text.extend_from_slice(match plane {
+                    Plane::Xy => b"G17 ",
+                    Plane::Zx => b"G18 ",
+                    Plane::Yz => b"G19 ",
                 });
                 self.plane = plane;
             }
         }
-        self.text.push_str(match word {
-            Word::Rapid => &self.dialect.rapid,
-            Word::Linear => &self.dialect.linear,
-            Word::ArcCw => &self.dialect.arc_cw,
-            Word::ArcCcw => &self.dialect.arc_ccw,
-        });
+        self.motion_words[word as usize].push_to(&mut self.text);
         let mut printed = self.last;
         let mut any = false;
         for (i, v) in to.axes().into_iter().enumerate() {
@@ -1139,13 +1164,12 @@ impl ProgramWriter {
                 continue;
             }
             let letter = self.letters[i];
-            let (value, d) = if i == 3 {
-                (v.to_degrees(), self.dialect.c_decimals)
-            } else if i == 0 {
-                (v * self.x_scale, self.decimals)
-            } else {
-                (v, self.decimals)
+            let value = match i {
+                0 => v * self.x_scale,
+                3 => v.to_degrees(),
+                _ => v,
             };
+            let d = self.axis_decimals[i];
             let (Some(letter), Some(n)) = (letter, fixed_units(value, d)) else {
                 return Err(ProgramError::NotPrintable {
                     word: self.letters[i].unwrap_or("XYZC".as_bytes()[i] as char),
@@ -1156,8 +1180,7 @@ impl ProgramWriter {
             if printed[i] == Some(n) {
                 continue;
             }
-            self.text.push(' ');
-            self.text.push(letter);
+            self.axis_words[i].push_to(&mut self.text);
             self.value(letter, value, n, d)?;
             printed[i] = Some(n);
             any = true;
@@ -1208,8 +1231,7 @@ impl ProgramWriter {
                     });
                 };
                 let letter = ['I', 'J', 'K'][i];
-                self.text.push(' ');
-                self.text.push(letter);
+                self.push_letter(letter);
                 self.value(letter, c - from, cu - fu, self.decimals)?;
             }
         }
@@ -1218,7 +1240,7 @@ impl ProgramWriter {
                 return Err(ProgramError::NotPrintable { word: 'F', value });
             };
             if mode_changes || m == FeedMode::InverseTime || self.last_feed != Some(n) {
-                self.text.push_str(" F");
+                self.text.extend_from_slice(b" F");
                 self.value('F', value, n, d)?;
             }
             self.last_feed = Some(n);
@@ -1248,10 +1270,7 @@ impl ProgramWriter {
     /// next chunk starts with room for as much again.
     pub fn take_text(&mut self) -> Result<String, ProgramError> {
         let room = self.text.len();
-        Ok(std::mem::replace(
-            &mut self.text,
-            String::with_capacity(room),
-        ))
+        utf8(std::mem::replace(&mut self.text, Vec::with_capacity(room)))
     }
 
     /// Ends the program; the text not yet taken, checked.
@@ -1268,10 +1287,59 @@ impl ProgramWriter {
         for line in self.dialect.trailer.clone() {
             let l = self.fill(&line, 0.0);
             check_numbers(&l, self.dialect.comment)?;
-            self.text.push_str(&l);
-            self.text.push('\n');
+            self.text.extend_from_slice(l.as_bytes());
+            self.text.push(b'\n');
         }
-        Ok(self.text)
+        utf8(self.text)
+    }
+}
+
+/// The writer's text as a `String`: it only ever appends `str`s and
+/// ASCII, so this holds; were it ever not so, the text is refused, not
+/// handed out.
+fn utf8(text: Vec<u8>) -> Result<String, ProgramError> {
+    String::from_utf8(text)
+        .map_err(|_| ProgramError::Unsupported("program text that is not UTF-8".into()))
+}
+
+/// A short piece of program text (a word's letter, a motion word, a
+/// block end), kept in a fixed array so appending it is a copy of fixed
+/// size and a cut back (no call to `memcpy`); longer pieces as they are.
+struct Snippet {
+    room: [u8; SNIPPET_ROOM],
+    len: usize,
+    long: Box<[u8]>,
+}
+
+const SNIPPET_ROOM: usize = 16;
+
+impl Snippet {
+    fn new(text: &str) -> Snippet {
+        let b = text.as_bytes();
+        let mut room = [0; SNIPPET_ROOM];
+        if b.len() <= SNIPPET_ROOM {
+            room[..b.len()].copy_from_slice(b);
+        }
+        Snippet {
+            room,
+            len: b.len(),
+            long: if b.len() > SNIPPET_ROOM {
+                b.into()
+            } else {
+                Box::default()
+            },
+        }
+    }
+
+    #[inline]
+    fn push_to(&self, text: &mut Vec<u8>) {
+        if self.len <= SNIPPET_ROOM {
+            let at = text.len();
+            text.extend_from_slice(&self.room);
+            text.truncate(at + self.len);
+        } else {
+            text.extend_from_slice(&self.long);
+        }
     }
 }
 
@@ -1335,7 +1403,7 @@ fn check_word(w: &[u8]) -> Result<(), &'static str> {
 
 /// A printed number: digits and points after an optional minus, and not
 /// a minus zero.
-fn check_number(num: &[u8]) -> Result<(), &'static str> {
+pub(crate) fn check_number(num: &[u8]) -> Result<(), &'static str> {
     let digits = num.strip_prefix(b"-").unwrap_or(num);
     if !digits.iter().all(|&c| c.is_ascii_digit() || c == b'.') {
         // `G05.1`-style words are digits and points only; anything else
