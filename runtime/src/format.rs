@@ -37,12 +37,23 @@ const POW10: [u64; 19] = {
     t
 };
 
+/// The same as doubles (all exact: 10^18 = 2^18 · 5^18 and 5^18 < 2^53).
+const POW10_F64: [f64; 19] = {
+    let mut t = [1f64; 19];
+    let mut i = 1;
+    while i < 19 {
+        t[i] = POW10[i] as f64;
+        i += 1;
+    }
+    t
+};
+
 /// `value` in units of 10^−decimals, rounded half away from zero (what
 /// `push_fixed` prints); `None` if it is not finite or does not fit in 18
 /// digits. Two values print the same exactly when their units are equal.
 #[inline]
 pub fn fixed_units(value: f64, decimals: u32) -> Option<i64> {
-    let scaled = value * POW10[decimals.min(18) as usize] as f64;
+    let scaled = value * POW10_F64[decimals.min(18) as usize];
     // NaN fails the comparison. Rounding cannot cross 1e18: doubles that
     // large are spaced 128 apart, so they are whole numbers already.
     if !(scaled.abs() < 1e18) {
@@ -51,24 +62,16 @@ pub fn fixed_units(value: f64, decimals: u32) -> Option<i64> {
     Some(round_half_away(scaled))
 }
 
-/// `scaled.round() as i64` for |scaled| < 1e18, without the library call:
-/// below 2^52 a double's distance from its truncation is exact, so the
-/// comparison with one half is too; above, every double is whole.
+/// `scaled.round() as i64` for |scaled| < 1e18, without the library call
+/// and without a branch on the digits (which way a value rounds is a coin
+/// toss a branch predictor loses): below 2^52 a double's distance from its
+/// truncation is exact, so the comparison with one half is too; from 2^52
+/// on, every double is whole and the distance is zero.
 #[inline]
 fn round_half_away(scaled: f64) -> i64 {
-    const WHOLE: f64 = 4_503_599_627_370_496.0; // 2^52
     let t = scaled as i64;
-    if scaled.abs() >= WHOLE {
-        return t;
-    }
     let rest = scaled - t as f64;
-    if rest >= 0.5 {
-        t + 1
-    } else if rest <= -0.5 {
-        t - 1
-    } else {
-        t
-    }
+    t + (rest >= 0.5) as i64 - (rest <= -0.5) as i64
 }
 
 /// Room for the longest number `print_units` writes: a minus, 19 integer
@@ -105,10 +108,54 @@ impl Printed {
     }
 }
 
+/// `n` units of 10^−decimals (at most 18) printed as `push_units` writes
+/// them: the integer part (at least `0`), the point, the decimals with
+/// trailing zeros trimmed.
+pub fn print_units(n: i64, decimals: u32) -> Printed {
+    let mut room = [b'0'; PRINTED_ROOM];
+    let (len, digits) = print_into(&mut room, n, decimals);
+    Printed { room, len, digits }
+}
+
+/// Appends `n` units of 10^−decimals as `print_units` prints them to
+/// `text`, printing in place (room for the longest number is added and
+/// cut back: the digits are stored once, never copied or read back);
+/// returns how many digits it has (what a dialect's digit limit counts).
+#[inline(always)]
+pub fn push_units_to(text: &mut Vec<u8>, n: i64, decimals: u32) -> usize {
+    let at = text.len();
+    text.extend_from_slice(&[b'0'; PRINTED_ROOM]);
+    let (len, digits) = print_into(&mut text[at..], n, decimals);
+    text.truncate(at + len);
+    digits
+}
+
+/// Prints into `room` (at least `PRINTED_ROOM` long, all `'0'`); returns
+/// the number's length and its count of digits.
+#[inline(always)]
+fn print_into(room: &mut [u8], n: i64, decimals: u32) -> (usize, usize) {
+    let d = decimals.min(18) as usize;
+    let mag = n.unsigned_abs();
+    if d <= 8 && mag < POW10[8 + d] {
+        // At most 8 digits either side of the point: scaled to 8 decimals
+        // it splits at a constant (a multiply, where 10^d would divide).
+        let m8 = mag * POW10[8 - d];
+        print_short(
+            room,
+            n < 0,
+            (m8 / 100_000_000) as u32,
+            (m8 % 100_000_000) as u32,
+        )
+    } else {
+        let p = POW10[d];
+        print_long(room, n < 0, mag / p, mag % p, d)
+    }
+}
+
 /// Writes `v`'s digits right-aligned to end at `end`, two at a time.
 /// Zero writes nothing.
 #[inline]
-fn digits_before(buf: &mut [u8; PRINTED_ROOM], end: usize, mut v: u64) {
+fn digits_before(buf: &mut [u8], end: usize, mut v: u64) {
     let mut pos = end;
     while v >= 100 {
         let pair = (v % 100) as usize * 2;
@@ -121,20 +168,6 @@ fn digits_before(buf: &mut [u8; PRINTED_ROOM], end: usize, mut v: u64) {
         buf[pos - 2..pos].copy_from_slice(&PAIRS[pair..pair + 2]);
     } else if v > 0 {
         buf[pos - 1] = b'0' + v as u8;
-    }
-}
-
-/// `n` units of 10^−decimals (at most 18) printed as `push_units` writes
-/// them: the integer part (at least `0`), the point, the decimals with
-/// trailing zeros trimmed.
-#[inline]
-pub fn print_units(n: i64, decimals: u32) -> Printed {
-    let d = decimals.min(18) as usize;
-    let (whole, frac) = split_units(n.unsigned_abs(), d);
-    if d <= 8 && whole < 100_000_000 {
-        print_short(n < 0, whole as u32, frac as u32 * POW10[8 - d] as u32)
-    } else {
-        print_long(n < 0, whole, frac, d)
     }
 }
 
@@ -156,39 +189,36 @@ fn eight_digits(v: u32) -> u64 {
 /// A number with at most 8 integer digits and 8 decimals: each part
 /// printed as one 8-byte word, its zeros counted from the word's bits.
 /// `frac8` is the decimals scaled to eight places.
-#[inline]
-fn print_short(negative: bool, whole: u32, frac8: u32) -> Printed {
+#[inline(always)]
+fn print_short(room: &mut [u8], negative: bool, whole: u32, frac8: u32) -> (usize, usize) {
     const ZEROS: u64 = 0x3030_3030_3030_3030;
     let w = eight_digits(whole);
-    // Leading zeros are the low bytes; a zero integer part keeps one digit.
-    let whole_digits = if w == 0 {
-        1
-    } else {
-        8 - w.trailing_zeros() as usize / 8
-    };
+    // Leading zeros are the low bytes; the last digit is always shown
+    // (marked, so a zero integer part counts as one digit).
+    let whole_digits = 8 - (w | 1 << 56).trailing_zeros() as usize / 8;
     let f = eight_digits(frac8);
     // Trailing zeros are the high bytes; all zero: no decimals at all.
-    let shown = if f == 0 {
-        0
-    } else {
-        8 - f.leading_zeros() as usize / 8
-    };
+    let shown = 8 - f.leading_zeros() as usize / 8;
     let minus = negative as usize;
     let point = minus + whole_digits;
-    let mut room = [b'-'; PRINTED_ROOM];
+    // A positive number's digits overwrite the '0' put where a minus goes.
+    room[0] = if negative { b'-' } else { b'0' };
     room[minus..minus + 8]
         .copy_from_slice(&((w >> (8 * (8 - whole_digits))) | ZEROS).to_le_bytes());
     room[point] = b'.';
     room[point + 1..point + 9].copy_from_slice(&(f | ZEROS).to_le_bytes());
-    Printed {
-        room,
-        len: point + 1 + shown,
-        digits: whole_digits + shown,
-    }
+    (point + 1 + shown, whole_digits + shown)
 }
 
 /// Any other number: digits two at a time from a table.
-fn print_long(negative: bool, whole: u64, mut frac: u64, d: usize) -> Printed {
+#[inline(never)]
+fn print_long(
+    room: &mut [u8],
+    negative: bool,
+    whole: u64,
+    mut frac: u64,
+    d: usize,
+) -> (usize, usize) {
     let mut shown = 0;
     if frac != 0 {
         shown = d;
@@ -203,43 +233,13 @@ fn print_long(negative: bool, whole: u64, mut frac: u64, d: usize) -> Printed {
     let len = point + 1 + shown;
     // Zeros the digits do not overwrite are the number's own: a zero
     // integer part, the decimals' leading zeros.
-    let mut room = [b'0'; PRINTED_ROOM];
     if negative {
         room[0] = b'-';
     }
-    digits_before(&mut room, point, whole);
+    digits_before(room, point, whole);
     room[point] = b'.';
-    digits_before(&mut room, len, frac);
-    Printed {
-        room,
-        len,
-        digits: whole_digits + shown,
-    }
-}
-
-/// `mag` split at the point of `d` decimals into whole units and the
-/// decimals' digits; the common decimals divide by a constant (a multiply)
-/// rather than by a looked-up power (a division).
-#[inline]
-fn split_units(mag: u64, d: usize) -> (u64, u64) {
-    macro_rules! by {
-        ($p:expr) => {
-            (mag / $p, mag % $p)
-        };
-    }
-    match d {
-        0 => (mag, 0),
-        1 => by!(10),
-        2 => by!(100),
-        3 => by!(1_000),
-        4 => by!(10_000),
-        5 => by!(100_000),
-        6 => by!(1_000_000),
-        7 => by!(10_000_000),
-        8 => by!(100_000_000),
-        9 => by!(1_000_000_000),
-        _ => (mag / POW10[d], mag % POW10[d]),
-    }
+    digits_before(room, len, frac);
+    (len, whole_digits + shown)
 }
 
 /// Appends `n` units of 10^−decimals as `push_fixed` does.

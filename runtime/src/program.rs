@@ -6,7 +6,7 @@
 use std::f64::consts::PI;
 use std::fmt::Write as _;
 
-use crate::format::{decimals_for, fixed_units, print_units, push_fixed};
+use crate::format::{decimals_for, fixed_units, push_fixed, push_units_to};
 use crate::job::Job;
 use crate::machine::{CommentStyle, Dialect};
 use crate::moves::{self, Plane, Position};
@@ -746,6 +746,8 @@ pub struct ProgramWriter {
     motion_words: [Snippet; 4],
     /// The dialect's block end and the newline.
     line_end: Snippet,
+    /// The dialect's digit limit (none: `usize::MAX`).
+    max_digits: usize,
     /// Factor from the move stream's X to the printed X (2 in diameter mode).
     x_scale: f64,
     /// The last value printed per axis, in units of its last decimal.
@@ -838,6 +840,7 @@ impl ProgramWriter {
             ]
             .map(|w| Snippet::new(w)),
             line_end: Snippet::new(&format!("{}\n", dialect.block_end)),
+            max_digits: dialect.max_digits.map_or(usize::MAX, |m| m as usize),
             x_scale: if setup == Setup::Lathe && dialect.lathe_x_diameter {
                 2.0
             } else {
@@ -917,16 +920,8 @@ impl ProgramWriter {
             .replace("{tolerance}", &tol)
     }
 
-    /// A space and a word's letter.
-    #[inline]
-    fn push_letter(&mut self, letter: char) {
-        self.text.push(b' ');
-        let mut utf8 = [0; 4];
-        self.text
-            .extend_from_slice(letter.encode_utf8(&mut utf8).as_bytes());
-    }
-
     /// Starts a block: its number, if the dialect numbers blocks.
+    #[inline]
     fn begin_block(&mut self) {
         if self.dialect.line_numbers.is_some() {
             self.text.push(b'N');
@@ -938,6 +933,7 @@ impl ProgramWriter {
 
     /// Ends the block begun at byte `start`: the dialect's block end, the
     /// line-length limit, the next block number.
+    #[inline]
     fn end_block(&mut self, start: usize) -> Result<(), ProgramError> {
         // The line's length is where the text ends now: nothing rescanned.
         if let Some(max) = self.dialect.max_line_length
@@ -995,28 +991,34 @@ impl ProgramWriter {
         }
     }
 
-    /// Appends a value's digits, refusing more than the dialect's limit.
-    /// The digits come from an integer count of units (`print_units`), so
-    /// they cannot spell an exponent, NaN or `-0`: `check_number` holds
-    /// of them by construction (the format module's tests hold it to
-    /// that), and is asserted again in debug builds.
-    #[inline]
-    fn value(&mut self, letter: char, v: f64, n: i64, d: u32) -> Result<(), ProgramError> {
-        let printed = print_units(n, d);
-        debug_assert!(check_number(printed.as_bytes()).is_ok());
-        if let Some(max) = self.dialect.max_digits
-            && printed.digits > max as usize
-        {
-            return Err(ProgramError::Unsupported(format!(
-                "{letter}{v} in {} digits ({} takes at most {max})",
-                printed.digits, self.dialect.name
-            )));
-        }
-        // The whole room copied (a fixed size: no call), then cut back.
+    /// Appends a value's digits (`push_units_to`), refused if more than
+    /// the dialect's limit (the caller cuts the block off). The digits
+    /// come from an integer count of units, so they cannot spell an
+    /// exponent, NaN or `-0`: `check_number` holds of them by construction
+    /// (the format module's tests hold the printer to that), and is
+    /// asserted again in debug builds.
+    #[inline(always)]
+    fn number(&mut self, letter: char, v: f64, n: i64, d: u32) -> Result<(), ProgramError> {
         let at = self.text.len();
-        self.text.extend_from_slice(&printed.room);
-        self.text.truncate(at + printed.len);
+        let digits = push_units_to(&mut self.text, n, d);
+        debug_assert!(check_number(&self.text[at..]).is_ok());
+        if digits > self.max_digits {
+            return Err(self.too_many_digits(letter, v, digits));
+        }
         Ok(())
+    }
+
+    #[cold]
+    fn too_many_digits(&self, letter: char, v: f64, digits: usize) -> ProgramError {
+        ProgramError::Unsupported(format!(
+            "{letter}{v} in {digits} digits ({} takes at most {})",
+            self.dialect.name, self.max_digits
+        ))
+    }
+
+    /// Appends a value's digits, refusing more than the dialect's limit.
+    fn value(&mut self, letter: char, v: f64, n: i64, d: u32) -> Result<(), ProgramError> {
+        self.number(letter, v, n, d)
     }
 
     /// Writes one move, straight into the text (no allocation per move:
@@ -1095,7 +1097,27 @@ impl ProgramWriter {
         r
     }
 
+    /// A motion block; a block refused leaves the modal state as it was.
     fn motion(
+        &mut self,
+        word: Word,
+        to: Position,
+        feed: Option<crate::moves::Feed>,
+        arc: Option<(Plane, Position)>,
+    ) -> Result<(), ProgramError> {
+        let last = self.last;
+        let r = self.motion_words_into_text(word, to, feed, arc);
+        if r.is_err() {
+            self.last = last;
+        }
+        r
+    }
+
+    /// A motion block: its words straight into the text, each a copy of
+    /// fixed size (a snippet's room, a number's room) cut back to length.
+    /// The last printed values are updated in place, word by word.
+    #[inline(always)]
+    fn motion_words_into_text(
         &mut self,
         word: Word,
         to: Position,
@@ -1104,10 +1126,7 @@ impl ProgramWriter {
     ) -> Result<(), ProgramError> {
         use crate::moves::Feed as F;
         if !to.c.is_nan() && !self.c_axis_on && self.letters[3].is_some() {
-            self.c_axis_on = true;
-            for line in self.dialect.c_axis_on.clone() {
-                self.block_line(&line)?;
-            }
+            self.c_axis_on_lines()?;
         }
         let start = self.text.len();
         self.begin_block();
@@ -1120,23 +1139,7 @@ impl ProgramWriter {
         if let Some((m, _, _)) = mode
             && mode_changes
         {
-            let w = match m {
-                FeedMode::PerMinute => &self.dialect.per_minute,
-                FeedMode::PerRevolution => &self.dialect.per_revolution,
-                FeedMode::InverseTime => &self.dialect.inverse_time,
-            };
-            let Some(w) = w else {
-                return Err(ProgramError::Unsupported(format!(
-                    "feeds {} ({} has no word for them)",
-                    match m {
-                        FeedMode::PerMinute => "per minute",
-                        FeedMode::PerRevolution => "per revolution",
-                        FeedMode::InverseTime => "in inverse time",
-                    },
-                    self.dialect.name
-                )));
-            };
-            let w = w.clone();
+            let w = self.feed_mode_word(m)?.to_string();
             self.text.extend_from_slice(w.as_bytes());
             self.text.push(b' ');
         }
@@ -1157,32 +1160,29 @@ impl ProgramWriter {
             }
         }
         self.motion_words[word as usize].push_to(&mut self.text);
-        let mut printed = self.last;
         let mut any = false;
-        for (i, v) in to.axes().into_iter().enumerate() {
+        let axes = to.axes();
+        for i in 0..4 {
+            let v = axes[i];
             if v.is_nan() {
                 continue;
             }
-            let letter = self.letters[i];
             let value = match i {
                 0 => v * self.x_scale,
                 3 => v.to_degrees(),
                 _ => v,
             };
             let d = self.axis_decimals[i];
-            let (Some(letter), Some(n)) = (letter, fixed_units(value, d)) else {
-                return Err(ProgramError::NotPrintable {
-                    word: self.letters[i].unwrap_or("XYZC".as_bytes()[i] as char),
-                    value: v,
-                });
+            let (Some(letter), Some(n)) = (self.letters[i], fixed_units(value, d)) else {
+                return Err(self.not_printable(i, v));
             };
             // Modal: a word whose printed value has not changed is left out.
-            if printed[i] == Some(n) {
+            if self.last[i] == Some(n) {
                 continue;
             }
             self.axis_words[i].push_to(&mut self.text);
-            self.value(letter, value, n, d)?;
-            printed[i] = Some(n);
+            self.number(letter, value, n, d)?;
+            self.last[i] = Some(n);
             any = true;
         }
         if !any {
@@ -1190,50 +1190,7 @@ impl ProgramWriter {
             return Ok(());
         }
         if let Some((plane, centre)) = arc {
-            // The controller measures the radius from the rounded centre
-            // to the rounded start and end, and refuses a mismatch.
-            let (a, b) = plane.axes();
-            let scale = 10f64.powi(self.decimals as i32);
-            let round = |v: f64| (v * scale).round() / scale;
-            let end = to.axes();
-            let radius = |p: [f64; 4]| {
-                (round(p[a]) - round(centre.axes()[a])).hypot(round(p[b]) - round(centre.axes()[b]))
-            };
-            let mut end_at = self.at;
-            for (e, v) in end_at.iter_mut().zip(end) {
-                if !v.is_nan() {
-                    *e = v;
-                }
-            }
-            let mismatch = (radius(self.at) - radius(end_at)).abs();
-            if mismatch.is_nan() || mismatch > self.dialect.arc_radius_tolerance {
-                return Err(ProgramError::Unsupported(format!(
-                    "an arc whose end radius differs from its start radius by {} mm (it allows {} mm)",
-                    num(mismatch),
-                    num(self.dialect.arc_radius_tolerance)
-                )));
-            }
-            // I J K in that order, whatever the plane's orientation.
-            for i in [a.min(b), a.max(b)] {
-                let c = centre.axes()[i];
-                let from = if self.dialect.arc_centre_absolute {
-                    0.0
-                } else {
-                    self.at[i]
-                };
-                let (Some(cu), Some(fu)) = (
-                    fixed_units(c, self.decimals),
-                    fixed_units(from, self.decimals),
-                ) else {
-                    return Err(ProgramError::NotPrintable {
-                        word: ['I', 'J', 'K'][i],
-                        value: c,
-                    });
-                };
-                let letter = ['I', 'J', 'K'][i];
-                self.push_letter(letter);
-                self.value(letter, c - from, cu - fu, self.decimals)?;
-            }
+            self.arc_centre(plane, to, centre)?;
         }
         if let Some((m, value, d)) = mode {
             let Some(n) = fixed_units(value, d) else {
@@ -1241,19 +1198,114 @@ impl ProgramWriter {
             };
             if mode_changes || m == FeedMode::InverseTime || self.last_feed != Some(n) {
                 self.text.extend_from_slice(b" F");
-                self.value('F', value, n, d)?;
+                self.number('F', value, n, d)?;
             }
             self.last_feed = Some(n);
             self.mode = Some(m);
         }
         self.end_block(start)?;
-        self.last = printed;
-        for (i, v) in to.axes().into_iter().enumerate() {
+        for (at, v) in self.at.iter_mut().zip(axes) {
             if !v.is_nan() {
-                self.at[i] = v;
+                *at = v;
             }
         }
         self.moves += 1;
+        Ok(())
+    }
+
+    /// The dialect's lines that switch the C axis on, before its first move.
+    #[cold]
+    fn c_axis_on_lines(&mut self) -> Result<(), ProgramError> {
+        self.c_axis_on = true;
+        for line in self.dialect.c_axis_on.clone() {
+            self.block_line(&line)?;
+        }
+        Ok(())
+    }
+
+    /// The word that switches the controller to feed mode `m`.
+    #[cold]
+    fn feed_mode_word(&self, m: FeedMode) -> Result<&str, ProgramError> {
+        let w = match m {
+            FeedMode::PerMinute => &self.dialect.per_minute,
+            FeedMode::PerRevolution => &self.dialect.per_revolution,
+            FeedMode::InverseTime => &self.dialect.inverse_time,
+        };
+        w.as_deref().ok_or_else(|| {
+            ProgramError::Unsupported(format!(
+                "feeds {} ({} has no word for them)",
+                match m {
+                    FeedMode::PerMinute => "per minute",
+                    FeedMode::PerRevolution => "per revolution",
+                    FeedMode::InverseTime => "in inverse time",
+                },
+                self.dialect.name
+            ))
+        })
+    }
+
+    /// Axis `i` has no letter on this machine, or `v` cannot be printed.
+    #[cold]
+    fn not_printable(&self, i: usize, v: f64) -> ProgramError {
+        ProgramError::NotPrintable {
+            word: self.letters[i].unwrap_or("XYZC".as_bytes()[i] as char),
+            value: v,
+        }
+    }
+
+    /// An arc's centre words, once its radii are checked as the
+    /// controller checks them.
+    #[inline(never)]
+    fn arc_centre(
+        &mut self,
+        plane: Plane,
+        to: Position,
+        centre: Position,
+    ) -> Result<(), ProgramError> {
+        // The controller measures the radius from the rounded centre
+        // to the rounded start and end, and refuses a mismatch.
+        let (a, b) = plane.axes();
+        let scale = 10f64.powi(self.decimals as i32);
+        let round = |v: f64| (v * scale).round() / scale;
+        let end = to.axes();
+        let radius = |p: [f64; 4]| {
+            (round(p[a]) - round(centre.axes()[a])).hypot(round(p[b]) - round(centre.axes()[b]))
+        };
+        let mut end_at = self.at;
+        for (e, v) in end_at.iter_mut().zip(end) {
+            if !v.is_nan() {
+                *e = v;
+            }
+        }
+        let mismatch = (radius(self.at) - radius(end_at)).abs();
+        if mismatch.is_nan() || mismatch > self.dialect.arc_radius_tolerance {
+            return Err(ProgramError::Unsupported(format!(
+                "an arc whose end radius differs from its start radius by {} mm (it allows {} mm)",
+                num(mismatch),
+                num(self.dialect.arc_radius_tolerance)
+            )));
+        }
+        // I J K in that order, whatever the plane's orientation.
+        for i in [a.min(b), a.max(b)] {
+            let c = centre.axes()[i];
+            let from = if self.dialect.arc_centre_absolute {
+                0.0
+            } else {
+                self.at[i]
+            };
+            let (Some(cu), Some(fu)) = (
+                fixed_units(c, self.decimals),
+                fixed_units(from, self.decimals),
+            ) else {
+                return Err(ProgramError::NotPrintable {
+                    word: ['I', 'J', 'K'][i],
+                    value: c,
+                });
+            };
+            let letter = ['I', 'J', 'K'][i];
+            self.text.extend_from_slice(&[b' ', letter as u8]);
+            self.number(letter, c - from, cu - fu, self.decimals)?;
+        }
         Ok(())
     }
 
