@@ -125,7 +125,10 @@ pub fn print_units(n: i64, decimals: u32) -> Printed {
 pub fn push_units_to(text: &mut Vec<u8>, n: i64, decimals: u32) -> usize {
     let at = text.len();
     text.extend_from_slice(&[b'0'; PRINTED_ROOM]);
-    let (len, digits) = print_into(&mut text[at..], n, decimals);
+    let (len, digits) = match text.split_last_chunk_mut::<PRINTED_ROOM>() {
+        Some((_, room)) => print_into(room, n, decimals),
+        None => unreachable!("the room was just added"),
+    };
     text.truncate(at + len);
     digits
 }
@@ -133,7 +136,7 @@ pub fn push_units_to(text: &mut Vec<u8>, n: i64, decimals: u32) -> usize {
 /// Prints into `room` (at least `PRINTED_ROOM` long, all `'0'`); returns
 /// the number's length and its count of digits.
 #[inline(always)]
-fn print_into(room: &mut [u8], n: i64, decimals: u32) -> (usize, usize) {
+fn print_into(room: &mut [u8; PRINTED_ROOM], n: i64, decimals: u32) -> (usize, usize) {
     let d = decimals.min(18) as usize;
     let mag = n.unsigned_abs();
     if d <= 8 && mag < POW10[8 + d] {
@@ -190,7 +193,12 @@ fn eight_digits(v: u32) -> u64 {
 /// printed as one 8-byte word, its zeros counted from the word's bits.
 /// `frac8` is the decimals scaled to eight places.
 #[inline(always)]
-fn print_short(room: &mut [u8], negative: bool, whole: u32, frac8: u32) -> (usize, usize) {
+fn print_short(
+    room: &mut [u8; PRINTED_ROOM],
+    negative: bool,
+    whole: u32,
+    frac8: u32,
+) -> (usize, usize) {
     const ZEROS: u64 = 0x3030_3030_3030_3030;
     let w = eight_digits(whole);
     // Leading zeros are the low bytes; the last digit is always shown
@@ -213,7 +221,7 @@ fn print_short(room: &mut [u8], negative: bool, whole: u32, frac8: u32) -> (usiz
 /// Any other number: digits two at a time from a table.
 #[inline(never)]
 fn print_long(
-    room: &mut [u8],
+    room: &mut [u8; PRINTED_ROOM],
     negative: bool,
     whole: u64,
     mut frac: u64,

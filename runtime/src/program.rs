@@ -748,6 +748,8 @@ pub struct ProgramWriter {
     line_end: Snippet,
     /// The dialect's digit limit (none: `usize::MAX`).
     max_digits: usize,
+    /// The dialect's line-length limit (none: `usize::MAX`).
+    max_line_length: usize,
     /// Factor from the move stream's X to the printed X (2 in diameter mode).
     x_scale: f64,
     /// The last value printed per axis, in units of its last decimal.
@@ -841,6 +843,7 @@ impl ProgramWriter {
             .map(|w| Snippet::new(w)),
             line_end: Snippet::new(&format!("{}\n", dialect.block_end)),
             max_digits: dialect.max_digits.map_or(usize::MAX, |m| m as usize),
+            max_line_length: dialect.max_line_length.unwrap_or(usize::MAX),
             x_scale: if setup == Setup::Lathe && dialect.lathe_x_diameter {
                 2.0
             } else {
@@ -933,20 +936,11 @@ impl ProgramWriter {
 
     /// Ends the block begun at byte `start`: the dialect's block end, the
     /// line-length limit, the next block number.
-    #[inline]
+    #[inline(always)]
     fn end_block(&mut self, start: usize) -> Result<(), ProgramError> {
         // The line's length is where the text ends now: nothing rescanned.
-        if let Some(max) = self.dialect.max_line_length
-            && self.text.len() - start + self.dialect.block_end.len() > max
-        {
-            let mut line = String::from_utf8_lossy(&self.text[start..]).into_owned();
-            line.push_str(&self.dialect.block_end);
-            self.text.truncate(start);
-            return Err(ProgramError::Unsupported(format!(
-                "a line of {} characters ({} reads at most {max}): {line}",
-                line.len(),
-                self.dialect.name
-            )));
+        if self.text.len() - start + self.dialect.block_end.len() > self.max_line_length {
+            return Err(self.line_too_long(start));
         }
         self.line_end.push_to(&mut self.text);
         if let Some(step) = self.dialect.line_numbers {
@@ -956,6 +950,20 @@ impl ProgramWriter {
             }
         }
         Ok(())
+    }
+
+    /// Refuses the block begun at byte `start` for its length.
+    #[cold]
+    fn line_too_long(&mut self, start: usize) -> ProgramError {
+        let mut line = String::from_utf8_lossy(&self.text[start..]).into_owned();
+        line.push_str(&self.dialect.block_end);
+        self.text.truncate(start);
+        ProgramError::Unsupported(format!(
+            "a line of {} characters ({} reads at most {}): {line}",
+            line.len(),
+            self.dialect.name,
+            self.max_line_length
+        ))
     }
 
     fn block_line(&mut self, words: &str) -> Result<(), ProgramError> {
