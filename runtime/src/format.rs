@@ -200,10 +200,19 @@ fn print_short(
     frac8: u32,
 ) -> (usize, usize) {
     const ZEROS: u64 = 0x3030_3030_3030_3030;
-    let w = eight_digits(whole);
-    // Leading zeros are the low bytes; the last digit is always shown
-    // (marked, so a zero integer part counts as one digit).
-    let whole_digits = 8 - (w | 1 << 56).trailing_zeros() as usize / 8;
+    // Most integer parts are short (a radius, a height): up to two
+    // digits come straight from the table.
+    let (w, whole_digits) = if whole < 100 {
+        let pair = whole as usize * 2;
+        let short = (whole >= 10) as usize;
+        let word = u16::from_le_bytes([PAIRS[pair], PAIRS[pair + 1]]) as u64 & !ZEROS;
+        (word >> (8 * (1 - short)), 1 + short)
+    } else {
+        let w = eight_digits(whole);
+        // Leading zeros are the low bytes; the last digit is always shown.
+        let digits = 8 - w.trailing_zeros() as usize / 8;
+        (w >> (8 * (8 - digits)), digits)
+    };
     let f = eight_digits(frac8);
     // Trailing zeros are the high bytes; all zero: no decimals at all.
     let shown = 8 - f.leading_zeros() as usize / 8;
@@ -211,8 +220,7 @@ fn print_short(
     let point = minus + whole_digits;
     // A positive number's digits overwrite the '0' put where a minus goes.
     room[0] = if negative { b'-' } else { b'0' };
-    room[minus..minus + 8]
-        .copy_from_slice(&((w >> (8 * (8 - whole_digits))) | ZEROS).to_le_bytes());
+    room[minus..minus + 8].copy_from_slice(&(w | ZEROS).to_le_bytes());
     room[point] = b'.';
     room[point + 1..point + 9].copy_from_slice(&(f | ZEROS).to_le_bytes());
     (point + 1 + shown, whole_digits + shown)

@@ -1105,7 +1105,7 @@ impl ProgramWriter {
         r
     }
 
-    /// A motion block; a block refused leaves the modal state as it was.
+    /// A motion block.
     fn motion(
         &mut self,
         word: Word,
@@ -1113,17 +1113,14 @@ impl ProgramWriter {
         feed: Option<crate::moves::Feed>,
         arc: Option<(Plane, Position)>,
     ) -> Result<(), ProgramError> {
-        let last = self.last;
-        let r = self.motion_words_into_text(word, to, feed, arc);
-        if r.is_err() {
-            self.last = last;
-        }
-        r
+        self.motion_words_into_text(word, to, feed, arc)
     }
 
     /// A motion block: its words straight into the text, each a copy of
     /// fixed size (a snippet's room, a number's room) cut back to length.
-    /// The last printed values are updated in place, word by word.
+    /// The values printed are kept word by word and become the last
+    /// printed values only when the block is written (a block refused
+    /// leaves them as they were).
     #[inline(always)]
     fn motion_words_into_text(
         &mut self,
@@ -1168,7 +1165,8 @@ impl ProgramWriter {
             }
         }
         self.motion_words[word as usize].push_to(&mut self.text);
-        let mut any = false;
+        let mut printed = [0i64; 4];
+        let mut changed = 0u8;
         let axes = to.axes();
         for i in 0..4 {
             let v = axes[i];
@@ -1190,10 +1188,10 @@ impl ProgramWriter {
             }
             self.axis_words[i].push_to(&mut self.text);
             self.number(letter, value, n, d)?;
-            self.last[i] = Some(n);
-            any = true;
+            printed[i] = n;
+            changed |= 1 << i;
         }
-        if !any {
+        if changed == 0 {
             self.text.truncate(start);
             return Ok(());
         }
@@ -1212,6 +1210,11 @@ impl ProgramWriter {
             self.mode = Some(m);
         }
         self.end_block(start)?;
+        for (i, n) in printed.into_iter().enumerate() {
+            if changed & 1 << i != 0 {
+                self.last[i] = Some(n);
+            }
+        }
         for (at, v) in self.at.iter_mut().zip(axes) {
             if !v.is_nan() {
                 *at = v;
