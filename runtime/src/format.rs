@@ -1,6 +1,8 @@
 //! The one canonical number formatter every dialect uses: round to a fixed
-//! number of decimals as an integer, print it with `itoa`. It never prints
-//! an exponent, `-0`, NaN or infinity (those are refused before this point).
+//! number of decimals as an integer count of units, print that count's
+//! digits (eight at a time, in place). It never prints an exponent, `-0`,
+//! NaN or infinity (those are refused before this point), and prints
+//! exactly what `{:.N}` prints of the rounded value, trailing zeros trimmed.
 
 /// Decimals needed to express `resolution` (mm), e.g. 0.1 µm → 4.
 pub fn decimals_for(resolution: f64) -> u32 {

@@ -1,7 +1,8 @@
 //! Post-processors: the dialect-independent move stream (`moves.rs`) to
 //! program text, and each strategy's points to that stream. Every number
-//! goes through `format::push_fixed`; a program with a value that cannot
-//! be written is refused whole.
+//! goes through the one formatter (`format.rs`: rounded to integer units,
+//! printed from them); a program with a value that cannot be written is
+//! refused whole.
 
 use std::f64::consts::PI;
 use std::fmt::Write as _;
@@ -1695,5 +1696,79 @@ mod tests {
             written("XZ", &[M::Rapid(P::xz(f64::INFINITY, 0.0))]),
             Err(ProgramError::NotPrintable { word: 'X', .. })
         ));
+    }
+
+    /// `{:.N}` of `n` units of 10^−N, trailing zeros trimmed, the point
+    /// kept: the reference every printed word is held to.
+    fn std_word(n: i64, d: u32) -> String {
+        let s = format!("{:.*}", d as usize, n as f64 / 10f64.powi(d as i32));
+        if d == 0 {
+            s + "."
+        } else {
+            s.trim_end_matches('0').to_string()
+        }
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(300))]
+
+        /// A spiral-like stream through the writer against a model of it
+        /// built from `f64::round` and `{:.N}`: the same lines, word for
+        /// word, unchanged words left out, a feed on every block, no block
+        /// for a move that changes no printed axis.
+        #[test]
+        fn the_writer_prints_what_a_plain_model_of_it_prints(
+            resolution in proptest::sample::select(vec![1e-3, 1e-4, 1e-6]),
+            moves in proptest::collection::vec(
+                (-100.0f64..100.0, -50.0f64..50.0, -1000.0f64..1000.0, 1e-5f64..1.0, 0u8..4),
+                1..200,
+            ),
+        ) {
+            let d = decimals_for(resolution);
+            let mut stream = Vec::new();
+            let mut at = (0.0, 0.0, 0.0);
+            for &(x, z, c, t, keep) in &moves {
+                // Some moves repeat a coordinate, or come within a unit of it.
+                let x = if keep & 1 == 1 { at.0 + resolution * 0.3 } else { x };
+                let z = if keep & 2 == 2 { at.1 } else { z };
+                at = (x, z, c);
+                stream.push(M::Linear { to: P::xzc(x, z, c), feed: Some(F::InverseTime(t)) });
+            }
+            let dialect = Dialect::linuxcnc();
+            let mut w = ProgramWriter::new(&dialect, Setup::Lathe, "t", &[], "XZC", resolution, 1e-5)
+                .expect("a lathe program");
+            w.write_all(&stream).expect("printable");
+            let text = w.finish().expect("checked");
+            proptest::prop_assert!(check_numbers(&text, CommentStyle::Parentheses).is_ok());
+            let units = |v: f64, d: u32| (v * 10f64.powi(d as i32)).round() as i64;
+            let mut last: [Option<i64>; 3] = [None; 3];
+            let mut expected = Vec::new();
+            for m in &stream {
+                let M::Linear { to, feed: Some(F::InverseTime(t)) } = m else { unreachable!() };
+                let mut line = String::from(if expected.is_empty() { "G93 G1" } else { "G1" });
+                let mut any = false;
+                for (k, (letter, v, dk)) in
+                    [('X', to.x, d), ('Z', to.z, d), ('C', to.c.to_degrees(), 5)].into_iter().enumerate()
+                {
+                    let n = units(v, dk);
+                    if last[k] != Some(n) {
+                        line += &format!(" {letter}{}", std_word(n, dk));
+                        last[k] = Some(n);
+                        any = true;
+                    }
+                }
+                if any {
+                    line += &format!(" F{}", std_word(units(60.0 / t, 3), 3));
+                    expected.push(line);
+                }
+            }
+            let written: Vec<&str> = text
+                .lines()
+                .skip_while(|l| !l.starts_with("G93"))
+                .take_while(|l| *l != "M2")
+                .collect();
+            proptest::prop_assert_eq!(written, expected);
+            proptest::prop_assert!(text.lines().all(|l| l.len() <= 255));
+        }
     }
 }
