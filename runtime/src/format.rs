@@ -58,10 +58,11 @@ pub fn fixed_units(value: f64, decimals: u32) -> Option<i64> {
     let scaled = value * POW10_F64[decimals.min(18) as usize];
     // NaN fails the comparison. Rounding cannot cross 1e18: doubles that
     // large are spaced 128 apart, so they are whole numbers already.
-    if !(scaled.abs() < 1e18) {
-        return None;
+    if scaled.abs() < 1e18 {
+        Some(round_half_away(scaled))
+    } else {
+        None
     }
-    Some(round_half_away(scaled))
 }
 
 /// `scaled.round() as i64` for |scaled| < 1e18, without the library call
@@ -240,7 +241,7 @@ fn print_long(
     let mut shown = 0;
     if frac != 0 {
         shown = d;
-        while frac % 10 == 0 {
+        while frac.is_multiple_of(10) {
             frac /= 10;
             shown -= 1;
         }
@@ -371,10 +372,10 @@ mod tests {
             99_999_999_999_999_999,
             100_000_000_000_000_000,
             9_999_999_999_999_999,
-            99_999_999_99,
-            100_000_000_00,
-            -99_999_999_00,
-            -100_000_000_00,
+            99_999_999 * 100 + 99,
+            100_000_000 * 100,
+            -99_999_999 * 100,
+            -100_000_000 * 100,
             123_456_789,
             1,
             -1,
