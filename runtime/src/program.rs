@@ -1034,10 +1034,9 @@ impl ProgramWriter {
     /// a move that changes no printed axis is written and then cut off).
     pub fn write(&mut self, m: &crate::moves::Move) -> Result<(), ProgramError> {
         use crate::moves::Move as M;
-        let start = self.text.len();
-        let r = match *m {
-            M::Rapid(to) => self.motion(Word::Rapid, to, None, None),
-            M::Linear { to, feed } => self.motion(Word::Linear, to, feed, None),
+        let (word, to, feed, arc) = match *m {
+            M::Rapid(to) => (Word::Rapid, to, None, None),
+            M::Linear { to, feed } => (Word::Linear, to, feed, None),
             M::Arc {
                 to,
                 centre,
@@ -1046,8 +1045,24 @@ impl ProgramWriter {
                 feed,
             } => {
                 let w = if ccw { Word::ArcCcw } else { Word::ArcCw };
-                self.motion(w, to, feed, Some((plane, centre)))
+                (w, to, feed, Some((plane, centre)))
             }
+            _ => return self.write_spindle(m),
+        };
+        let start = self.text.len();
+        let r = self.motion(word, to, feed, arc);
+        if r.is_err() {
+            self.text.truncate(start);
+        }
+        r
+    }
+
+    /// Writes a move that is not a motion: the spindle's.
+    fn write_spindle(&mut self, m: &crate::moves::Move) -> Result<(), ProgramError> {
+        use crate::moves::Move as M;
+        let start = self.text.len();
+        let r = match *m {
+            M::Rapid(_) | M::Linear { .. } | M::Arc { .. } => self.write(m),
             M::SpindleOn(speed) => {
                 self.begin_block();
                 if let Some(w) = speed {
@@ -1107,6 +1122,7 @@ impl ProgramWriter {
     }
 
     /// A motion block.
+    #[inline(always)]
     fn motion(
         &mut self,
         word: Word,
