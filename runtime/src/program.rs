@@ -1610,6 +1610,55 @@ mod tests {
     }
 
     #[test]
+    fn long_words_and_letters_beyond_ascii_are_written_whole() {
+        // Words longer than a snippet's fixed room, and a C letter of two
+        // bytes, take the writer's other paths.
+        let mut d = Dialect::linuxcnc();
+        d.linear = "G1 G90 G94 G17 G21 G40".into();
+        d.block_end = " ; the end of a long block".into();
+        d.c_letter = 'Ç';
+        // The longest line is 77 bytes (the limit counts bytes, as before).
+        d.max_line_length = Some(77);
+        let text = written_in(
+            &d,
+            Setup::Lathe,
+            "XZC",
+            &[
+                M::Linear {
+                    to: P::xzc(1.5, -0.25, std::f64::consts::PI),
+                    feed: Some(F::InverseTime(0.5)),
+                },
+                M::Linear {
+                    to: P::xzc(1.5, -0.25, std::f64::consts::FRAC_PI_2),
+                    feed: Some(F::InverseTime(0.25)),
+                },
+            ],
+        )
+        .expect("writes");
+        assert!(
+            text.contains(
+                "G93 G1 G90 G94 G17 G21 G40 X1.5 Z-0.25 Ç180. F120. ; the end of a long block\n\
+                 G1 G90 G94 G17 G21 G40 Ç90. F240. ; the end of a long block\n"
+            ),
+            "{text}"
+        );
+        // One byte over the limit, the block end counted.
+        d.max_line_length = Some(76);
+        let Err(ProgramError::Unsupported(why)) = written_in(
+            &d,
+            Setup::Lathe,
+            "XZC",
+            &[M::Linear {
+                to: P::xzc(1.5, -0.25, std::f64::consts::PI),
+                feed: Some(F::InverseTime(0.5)),
+            }],
+        ) else {
+            panic!("a line over the limit written")
+        };
+        assert!(why.contains("a line of 77 characters"), "{why}");
+    }
+
+    #[test]
     fn arcs_have_incremental_centres_and_select_their_plane() {
         let text = written(
             "XYZ",
