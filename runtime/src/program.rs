@@ -730,8 +730,11 @@ pub enum Setup {
 /// changed is left out (axes are modal); a feed is written when it or its
 /// mode changes, and on every move in inverse time; a move that changes no
 /// printed axis is left out whole. Every value goes through the one
-/// fixed-point formatter and the dialect's digit limit; every chunk of
-/// text handed out has passed `check_numbers`.
+/// fixed-point formatter (refused if not finite or too large) and the
+/// dialect's digit limit, every block through its line-length limit;
+/// numbers printed from integer units pass `check_numbers` by
+/// construction (asserted in debug builds, held to it by the tests), and
+/// every line taken from the dialect is checked with it as it is written.
 pub struct ProgramWriter {
     /// Program text not yet taken (UTF-8: only `str`s and ASCII go in).
     text: Vec<u8>,
@@ -865,9 +868,9 @@ impl ProgramWriter {
             moves: 0,
         };
         // The dialect's own words, checked once: every number the writer
-        // prints itself is checked as it is printed (`value`), and every
-        // line taken from the dialect as it is written, so no text leaves
-        // the writer unchecked.
+        // prints itself is well formed by construction (`number`), and
+        // every line taken from the dialect is checked as it is written,
+        // so no text leaves the writer unchecked.
         let words = [
             &dialect.rapid,
             &dialect.linear,
@@ -1346,7 +1349,8 @@ impl ProgramWriter {
     }
 
     /// The text written since the last call (for streaming to a file),
-    /// every number and dialect line in it checked as it was written; the
+    /// every number and dialect line in it checked as it was written (see
+    /// `ProgramWriter`); the
     /// next chunk starts with room for as much again.
     pub fn take_text(&mut self) -> Result<String, ProgramError> {
         let room = self.text.len();
