@@ -1,12 +1,13 @@
 //! Post-processors: the dialect-independent move stream (`moves.rs`) to
 //! program text, and each strategy's points to that stream. Every number
-//! goes through `format::push_fixed`; a program with a value that cannot
-//! be written is refused whole.
+//! goes through the one formatter (`format.rs`: rounded to integer units,
+//! printed from them); a program with a value that cannot be written is
+//! refused whole.
 
 use std::f64::consts::PI;
 use std::fmt::Write as _;
 
-use crate::format::{decimals_for, fixed_units, push_fixed, push_units};
+use crate::format::{decimals_for, fixed_units, push_fixed, push_units_to};
 use crate::job::Job;
 use crate::machine::{CommentStyle, Dialect};
 use crate::moves::{self, Plane, Position};
@@ -729,14 +730,30 @@ pub enum Setup {
 /// changed is left out (axes are modal); a feed is written when it or its
 /// mode changes, and on every move in inverse time; a move that changes no
 /// printed axis is left out whole. Every value goes through the one
-/// fixed-point formatter and the dialect's digit limit; every chunk of
-/// text handed out has passed `check_numbers`.
+/// fixed-point formatter (refused if not finite or too large) and the
+/// dialect's digit limit, every block through its line-length limit;
+/// numbers printed from integer units pass `check_numbers` by
+/// construction (asserted in debug builds, held to it by the tests), and
+/// every line taken from the dialect is checked with it as it is written.
 pub struct ProgramWriter {
-    text: String,
+    /// Program text not yet taken (UTF-8: only `str`s and ASCII go in).
+    text: Vec<u8>,
     dialect: Dialect,
     decimals: u32,
     /// Letters of the machine's axes among X, Y, Z, C (others are refused).
     letters: [Option<char>; 4],
+    /// What goes before each axis's number: a space and its letter.
+    axis_words: [Snippet; 4],
+    /// Decimals of each axis: the resolution's, C's own for C.
+    axis_decimals: [u32; 4],
+    /// The motion words: rapid, linear, clockwise and counter-clockwise arc.
+    motion_words: [Snippet; 4],
+    /// The dialect's block end and the newline.
+    line_end: Snippet,
+    /// The dialect's digit limit (none: `usize::MAX`).
+    max_digits: usize,
+    /// The dialect's line-length limit (none: `usize::MAX`).
+    max_line_length: usize,
     /// Factor from the move stream's X to the printed X (2 in diameter mode).
     x_scale: f64,
     /// The last value printed per axis, in units of its last decimal.
@@ -808,16 +825,29 @@ impl ProgramWriter {
             )));
         }
         let has = |c: char| axes.contains(c).then_some(c);
+        let letters = [
+            has('X'),
+            has('Y'),
+            has('Z'),
+            has('C').map(|_| dialect.c_letter),
+        ];
         let mut w = ProgramWriter {
-            text: String::new(),
+            text: Vec::new(),
             dialect: dialect.clone(),
             decimals,
-            letters: [
-                has('X'),
-                has('Y'),
-                has('Z'),
-                has('C').map(|_| dialect.c_letter),
-            ],
+            letters,
+            axis_words: letters.map(|l| Snippet::new(&format!(" {}", l.unwrap_or(' ')))),
+            axis_decimals: [decimals, decimals, decimals, dialect.c_decimals],
+            motion_words: [
+                &dialect.rapid,
+                &dialect.linear,
+                &dialect.arc_cw,
+                &dialect.arc_ccw,
+            ]
+            .map(|w| Snippet::new(w)),
+            line_end: Snippet::new(&format!("{}\n", dialect.block_end)),
+            max_digits: dialect.max_digits.map_or(usize::MAX, |m| m as usize),
+            max_line_length: dialect.max_line_length.unwrap_or(usize::MAX),
             x_scale: if setup == Setup::Lathe && dialect.lathe_x_diameter {
                 2.0
             } else {
@@ -838,9 +868,9 @@ impl ProgramWriter {
             moves: 0,
         };
         // The dialect's own words, checked once: every number the writer
-        // prints itself is checked as it is printed (`value`), and every
-        // line taken from the dialect as it is written, so no text leaves
-        // the writer unchecked.
+        // prints itself is well formed by construction (`number`), and
+        // every line taken from the dialect is checked as it is written,
+        // so no text leaves the writer unchecked.
         let words = [
             &dialect.rapid,
             &dialect.linear,
@@ -860,8 +890,8 @@ impl ProgramWriter {
         for line in &dialect.start {
             let l = w.fill(line, path_tolerance);
             check_numbers(&l, dialect.comment)?;
-            w.text.push_str(&l);
-            w.text.push('\n');
+            w.text.extend_from_slice(l.as_bytes());
+            w.text.push(b'\n');
         }
         for line in header {
             w.comment(line);
@@ -898,30 +928,25 @@ impl ProgramWriter {
     }
 
     /// Starts a block: its number, if the dialect numbers blocks.
+    #[inline]
     fn begin_block(&mut self) {
         if self.dialect.line_numbers.is_some() {
-            self.text.push('N');
-            self.text.push_str(itoa::Buffer::new().format(self.block));
-            self.text.push(' ');
+            self.text.push(b'N');
+            self.text
+                .extend_from_slice(itoa::Buffer::new().format(self.block).as_bytes());
+            self.text.push(b' ');
         }
     }
 
     /// Ends the block begun at byte `start`: the dialect's block end, the
     /// line-length limit, the next block number.
+    #[inline(always)]
     fn end_block(&mut self, start: usize) -> Result<(), ProgramError> {
-        self.text.push_str(&self.dialect.block_end);
-        if let Some(max) = self.dialect.max_line_length
-            && self.text.len() - start > max
-        {
-            let line = self.text[start..].to_string();
-            self.text.truncate(start);
-            return Err(ProgramError::Unsupported(format!(
-                "a line of {} characters ({} reads at most {max}): {line}",
-                line.len(),
-                self.dialect.name
-            )));
+        // The line's length is where the text ends now: nothing rescanned.
+        if self.text.len() - start + self.dialect.block_end.len() > self.max_line_length {
+            return Err(self.line_too_long(start));
         }
-        self.text.push('\n');
+        self.line_end.push_to(&mut self.text);
         if let Some(step) = self.dialect.line_numbers {
             self.block += step;
             if self.dialect.max_line_number.is_some_and(|m| self.block > m) {
@@ -931,11 +956,25 @@ impl ProgramWriter {
         Ok(())
     }
 
+    /// Refuses the block begun at byte `start` for its length.
+    #[cold]
+    fn line_too_long(&mut self, start: usize) -> ProgramError {
+        let mut line = String::from_utf8_lossy(&self.text[start..]).into_owned();
+        line.push_str(&self.dialect.block_end);
+        self.text.truncate(start);
+        ProgramError::Unsupported(format!(
+            "a line of {} characters ({} reads at most {}): {line}",
+            line.len(),
+            self.dialect.name,
+            self.max_line_length
+        ))
+    }
+
     fn block_line(&mut self, words: &str) -> Result<(), ProgramError> {
         check_numbers(words, self.dialect.comment)?;
         let start = self.text.len();
         self.begin_block();
-        self.text.push_str(words);
+        self.text.extend_from_slice(words.as_bytes());
         self.end_block(start)
     }
 
@@ -950,13 +989,13 @@ impl ProgramWriter {
             self.begin_block();
             match self.dialect.comment {
                 CommentStyle::Parentheses => {
-                    self.text.push('(');
-                    self.text.push_str(body);
-                    self.text.push(')');
+                    self.text.push(b'(');
+                    self.text.extend_from_slice(body.as_bytes());
+                    self.text.push(b')');
                 }
                 CommentStyle::Semicolon => {
-                    self.text.push_str("; ");
-                    self.text.push_str(body);
+                    self.text.extend_from_slice(b"; ");
+                    self.text.extend_from_slice(body.as_bytes());
                 }
             }
             // Comments are folded to 120 characters: within every limit.
@@ -964,39 +1003,43 @@ impl ProgramWriter {
         }
     }
 
-    /// Appends a value's digits, refusing more than the dialect's limit.
-    fn value(&mut self, letter: char, v: f64, n: i64, d: u32) -> Result<(), ProgramError> {
-        let before = self.text.len();
-        push_units(&mut self.text, n, d);
-        if let Err(why) = check_number(&self.text.as_bytes()[before..]) {
-            return Err(ProgramError::Unsupported(format!(
-                "the word `{letter}{}` ({why})",
-                &self.text[before..]
-            )));
-        }
-        if let Some(max) = self.dialect.max_digits {
-            let digits = self.text.as_bytes()[before..]
-                .iter()
-                .filter(|b| b.is_ascii_digit())
-                .count();
-            if digits > max as usize {
-                return Err(ProgramError::Unsupported(format!(
-                    "{letter}{v} in {} digits ({} takes at most {max})",
-                    digits, self.dialect.name
-                )));
-            }
+    /// Appends a value's digits (`push_units_to`), refused if more than
+    /// the dialect's limit (the caller cuts the block off). The digits
+    /// come from an integer count of units, so they cannot spell an
+    /// exponent, NaN or `-0`: `check_number` holds of them by construction
+    /// (the format module's tests hold the printer to that), and is
+    /// asserted again in debug builds.
+    #[inline(always)]
+    fn number(&mut self, letter: char, v: f64, n: i64, d: u32) -> Result<(), ProgramError> {
+        let at = self.text.len();
+        let digits = push_units_to(&mut self.text, n, d);
+        debug_assert!(check_number(&self.text[at..]).is_ok());
+        if digits > self.max_digits {
+            return Err(self.too_many_digits(letter, v, digits));
         }
         Ok(())
+    }
+
+    #[cold]
+    fn too_many_digits(&self, letter: char, v: f64, digits: usize) -> ProgramError {
+        ProgramError::Unsupported(format!(
+            "{letter}{v} in {digits} digits ({} takes at most {})",
+            self.dialect.name, self.max_digits
+        ))
+    }
+
+    /// Appends a value's digits, refusing more than the dialect's limit.
+    fn value(&mut self, letter: char, v: f64, n: i64, d: u32) -> Result<(), ProgramError> {
+        self.number(letter, v, n, d)
     }
 
     /// Writes one move, straight into the text (no allocation per move:
     /// a move that changes no printed axis is written and then cut off).
     pub fn write(&mut self, m: &crate::moves::Move) -> Result<(), ProgramError> {
         use crate::moves::Move as M;
-        let start = self.text.len();
-        let r = match *m {
-            M::Rapid(to) => self.motion(Word::Rapid, to, None, None),
-            M::Linear { to, feed } => self.motion(Word::Linear, to, feed, None),
+        let (word, to, feed, arc) = match *m {
+            M::Rapid(to) => (Word::Rapid, to, None, None),
+            M::Linear { to, feed } => (Word::Linear, to, feed, None),
             M::Arc {
                 to,
                 centre,
@@ -1005,13 +1048,29 @@ impl ProgramWriter {
                 feed,
             } => {
                 let w = if ccw { Word::ArcCcw } else { Word::ArcCw };
-                self.motion(w, to, feed, Some((plane, centre)))
+                (w, to, feed, Some((plane, centre)))
             }
+            _ => return self.write_spindle(m),
+        };
+        let start = self.text.len();
+        let r = self.motion(word, to, feed, arc);
+        if r.is_err() {
+            self.text.truncate(start);
+        }
+        r
+    }
+
+    /// Writes a move that is not a motion: the spindle's.
+    fn write_spindle(&mut self, m: &crate::moves::Move) -> Result<(), ProgramError> {
+        use crate::moves::Move as M;
+        let start = self.text.len();
+        let r = match *m {
+            M::Rapid(_) | M::Linear { .. } | M::Arc { .. } => self.write(m),
             M::SpindleOn(speed) => {
                 self.begin_block();
                 if let Some(w) = speed {
                     let rpm = w * 60.0 / (2.0 * PI);
-                    self.text.push('S');
+                    self.text.push(b'S');
                     match fixed_units(rpm, 3) {
                         Some(n) => self.value('S', rpm, n, 3)?,
                         None => {
@@ -1021,10 +1080,10 @@ impl ProgramWriter {
                             });
                         }
                     }
-                    self.text.push(' ');
+                    self.text.push(b' ');
                 }
                 let on = self.dialect.spindle_on.clone();
-                self.text.push_str(&on);
+                self.text.extend_from_slice(on.as_bytes());
                 self.end_block(start)
             }
             M::SpindleSurfaceSpeed { surface_speed, cap } => {
@@ -1065,7 +1124,25 @@ impl ProgramWriter {
         r
     }
 
+    /// A motion block.
+    #[inline(always)]
     fn motion(
+        &mut self,
+        word: Word,
+        to: Position,
+        feed: Option<crate::moves::Feed>,
+        arc: Option<(Plane, Position)>,
+    ) -> Result<(), ProgramError> {
+        self.motion_words_into_text(word, to, feed, arc)
+    }
+
+    /// A motion block: its words straight into the text, each a copy of
+    /// fixed size (a snippet's room, a number's room) cut back to length.
+    /// The values printed are kept word by word and become the last
+    /// printed values only when the block is written (a block refused
+    /// leaves them as they were).
+    #[inline(always)]
+    fn motion_words_into_text(
         &mut self,
         word: Word,
         to: Position,
@@ -1074,10 +1151,7 @@ impl ProgramWriter {
     ) -> Result<(), ProgramError> {
         use crate::moves::Feed as F;
         if !to.c.is_nan() && !self.c_axis_on && self.letters[3].is_some() {
-            self.c_axis_on = true;
-            for line in self.dialect.c_axis_on.clone() {
-                self.block_line(&line)?;
-            }
+            self.c_axis_on_lines()?;
         }
         let start = self.text.len();
         self.begin_block();
@@ -1090,25 +1164,9 @@ impl ProgramWriter {
         if let Some((m, _, _)) = mode
             && mode_changes
         {
-            let w = match m {
-                FeedMode::PerMinute => &self.dialect.per_minute,
-                FeedMode::PerRevolution => &self.dialect.per_revolution,
-                FeedMode::InverseTime => &self.dialect.inverse_time,
-            };
-            let Some(w) = w else {
-                return Err(ProgramError::Unsupported(format!(
-                    "feeds {} ({} has no word for them)",
-                    match m {
-                        FeedMode::PerMinute => "per minute",
-                        FeedMode::PerRevolution => "per revolution",
-                        FeedMode::InverseTime => "in inverse time",
-                    },
-                    self.dialect.name
-                )));
-            };
-            let w = w.clone();
-            self.text.push_str(&w);
-            self.text.push(' ');
+            let w = self.feed_mode_word(m)?.to_string();
+            self.text.extend_from_slice(w.as_bytes());
+            self.text.push(b' ');
         }
         if let Some((plane, _)) = arc {
             if !self.dialect.arc_planes.contains(&plane) {
@@ -1118,120 +1176,167 @@ impl ProgramWriter {
                 )));
             }
             if plane != self.plane {
-                self.text.push_str(match plane {
-                    Plane::Xy => "G17 ",
-                    Plane::Zx => "G18 ",
-                    Plane::Yz => "G19 ",
+                self.text.extend_from_slice(match plane {
+                    Plane::Xy => b"G17 ",
+                    Plane::Zx => b"G18 ",
+                    Plane::Yz => b"G19 ",
                 });
                 self.plane = plane;
             }
         }
-        self.text.push_str(match word {
-            Word::Rapid => &self.dialect.rapid,
-            Word::Linear => &self.dialect.linear,
-            Word::ArcCw => &self.dialect.arc_cw,
-            Word::ArcCcw => &self.dialect.arc_ccw,
-        });
-        let mut printed = self.last;
-        let mut any = false;
-        for (i, v) in to.axes().into_iter().enumerate() {
+        self.motion_words[word as usize].push_to(&mut self.text);
+        let mut printed = [0i64; 4];
+        let mut changed = 0u8;
+        let axes = to.axes();
+        for i in 0..4 {
+            let v = axes[i];
             if v.is_nan() {
                 continue;
             }
-            let letter = self.letters[i];
-            let (value, d) = if i == 3 {
-                (v.to_degrees(), self.dialect.c_decimals)
-            } else if i == 0 {
-                (v * self.x_scale, self.decimals)
-            } else {
-                (v, self.decimals)
+            let value = match i {
+                0 => v * self.x_scale,
+                3 => v.to_degrees(),
+                _ => v,
             };
-            let (Some(letter), Some(n)) = (letter, fixed_units(value, d)) else {
-                return Err(ProgramError::NotPrintable {
-                    word: self.letters[i].unwrap_or("XYZC".as_bytes()[i] as char),
-                    value: v,
-                });
+            let d = self.axis_decimals[i];
+            let (Some(letter), Some(n)) = (self.letters[i], fixed_units(value, d)) else {
+                return Err(self.not_printable(i, v));
             };
             // Modal: a word whose printed value has not changed is left out.
-            if printed[i] == Some(n) {
+            if self.last[i] == Some(n) {
                 continue;
             }
-            self.text.push(' ');
-            self.text.push(letter);
-            self.value(letter, value, n, d)?;
-            printed[i] = Some(n);
-            any = true;
+            self.axis_words[i].push_to(&mut self.text);
+            self.number(letter, value, n, d)?;
+            printed[i] = n;
+            changed |= 1 << i;
         }
-        if !any {
+        if changed == 0 {
             self.text.truncate(start);
             return Ok(());
         }
         if let Some((plane, centre)) = arc {
-            // The controller measures the radius from the rounded centre
-            // to the rounded start and end, and refuses a mismatch.
-            let (a, b) = plane.axes();
-            let scale = 10f64.powi(self.decimals as i32);
-            let round = |v: f64| (v * scale).round() / scale;
-            let end = to.axes();
-            let radius = |p: [f64; 4]| {
-                (round(p[a]) - round(centre.axes()[a])).hypot(round(p[b]) - round(centre.axes()[b]))
-            };
-            let mut end_at = self.at;
-            for (e, v) in end_at.iter_mut().zip(end) {
-                if !v.is_nan() {
-                    *e = v;
-                }
-            }
-            let mismatch = (radius(self.at) - radius(end_at)).abs();
-            if mismatch.is_nan() || mismatch > self.dialect.arc_radius_tolerance {
-                return Err(ProgramError::Unsupported(format!(
-                    "an arc whose end radius differs from its start radius by {} mm (it allows {} mm)",
-                    num(mismatch),
-                    num(self.dialect.arc_radius_tolerance)
-                )));
-            }
-            // I J K in that order, whatever the plane's orientation.
-            for i in [a.min(b), a.max(b)] {
-                let c = centre.axes()[i];
-                let from = if self.dialect.arc_centre_absolute {
-                    0.0
-                } else {
-                    self.at[i]
-                };
-                let (Some(cu), Some(fu)) = (
-                    fixed_units(c, self.decimals),
-                    fixed_units(from, self.decimals),
-                ) else {
-                    return Err(ProgramError::NotPrintable {
-                        word: ['I', 'J', 'K'][i],
-                        value: c,
-                    });
-                };
-                let letter = ['I', 'J', 'K'][i];
-                self.text.push(' ');
-                self.text.push(letter);
-                self.value(letter, c - from, cu - fu, self.decimals)?;
-            }
+            self.arc_centre(plane, to, centre)?;
         }
         if let Some((m, value, d)) = mode {
             let Some(n) = fixed_units(value, d) else {
                 return Err(ProgramError::NotPrintable { word: 'F', value });
             };
             if mode_changes || m == FeedMode::InverseTime || self.last_feed != Some(n) {
-                self.text.push_str(" F");
-                self.value('F', value, n, d)?;
+                self.text.extend_from_slice(b" F");
+                self.number('F', value, n, d)?;
             }
             self.last_feed = Some(n);
             self.mode = Some(m);
         }
         self.end_block(start)?;
-        self.last = printed;
-        for (i, v) in to.axes().into_iter().enumerate() {
+        for (i, n) in printed.into_iter().enumerate() {
+            if changed & 1 << i != 0 {
+                self.last[i] = Some(n);
+            }
+        }
+        for (at, v) in self.at.iter_mut().zip(axes) {
             if !v.is_nan() {
-                self.at[i] = v;
+                *at = v;
             }
         }
         self.moves += 1;
+        Ok(())
+    }
+
+    /// The dialect's lines that switch the C axis on, before its first move.
+    #[cold]
+    fn c_axis_on_lines(&mut self) -> Result<(), ProgramError> {
+        self.c_axis_on = true;
+        for line in self.dialect.c_axis_on.clone() {
+            self.block_line(&line)?;
+        }
+        Ok(())
+    }
+
+    /// The word that switches the controller to feed mode `m`.
+    #[cold]
+    fn feed_mode_word(&self, m: FeedMode) -> Result<&str, ProgramError> {
+        let w = match m {
+            FeedMode::PerMinute => &self.dialect.per_minute,
+            FeedMode::PerRevolution => &self.dialect.per_revolution,
+            FeedMode::InverseTime => &self.dialect.inverse_time,
+        };
+        w.as_deref().ok_or_else(|| {
+            ProgramError::Unsupported(format!(
+                "feeds {} ({} has no word for them)",
+                match m {
+                    FeedMode::PerMinute => "per minute",
+                    FeedMode::PerRevolution => "per revolution",
+                    FeedMode::InverseTime => "in inverse time",
+                },
+                self.dialect.name
+            ))
+        })
+    }
+
+    /// Axis `i` has no letter on this machine, or `v` cannot be printed.
+    #[cold]
+    fn not_printable(&self, i: usize, v: f64) -> ProgramError {
+        ProgramError::NotPrintable {
+            word: self.letters[i].unwrap_or("XYZC".as_bytes()[i] as char),
+            value: v,
+        }
+    }
+
+    /// An arc's centre words, once its radii are checked as the
+    /// controller checks them.
+    #[inline(never)]
+    fn arc_centre(
+        &mut self,
+        plane: Plane,
+        to: Position,
+        centre: Position,
+    ) -> Result<(), ProgramError> {
+        // The controller measures the radius from the rounded centre
+        // to the rounded start and end, and refuses a mismatch.
+        let (a, b) = plane.axes();
+        let scale = 10f64.powi(self.decimals as i32);
+        let round = |v: f64| (v * scale).round() / scale;
+        let end = to.axes();
+        let radius = |p: [f64; 4]| {
+            (round(p[a]) - round(centre.axes()[a])).hypot(round(p[b]) - round(centre.axes()[b]))
+        };
+        let mut end_at = self.at;
+        for (e, v) in end_at.iter_mut().zip(end) {
+            if !v.is_nan() {
+                *e = v;
+            }
+        }
+        let mismatch = (radius(self.at) - radius(end_at)).abs();
+        if mismatch.is_nan() || mismatch > self.dialect.arc_radius_tolerance {
+            return Err(ProgramError::Unsupported(format!(
+                "an arc whose end radius differs from its start radius by {} mm (it allows {} mm)",
+                num(mismatch),
+                num(self.dialect.arc_radius_tolerance)
+            )));
+        }
+        // I J K in that order, whatever the plane's orientation.
+        for i in [a.min(b), a.max(b)] {
+            let c = centre.axes()[i];
+            let from = if self.dialect.arc_centre_absolute {
+                0.0
+            } else {
+                self.at[i]
+            };
+            let (Some(cu), Some(fu)) = (
+                fixed_units(c, self.decimals),
+                fixed_units(from, self.decimals),
+            ) else {
+                return Err(ProgramError::NotPrintable {
+                    word: ['I', 'J', 'K'][i],
+                    value: c,
+                });
+            };
+            let letter = ['I', 'J', 'K'][i];
+            self.text.extend_from_slice(&[b' ', letter as u8]);
+            self.number(letter, c - from, cu - fu, self.decimals)?;
+        }
         Ok(())
     }
 
@@ -1244,14 +1349,12 @@ impl ProgramWriter {
     }
 
     /// The text written since the last call (for streaming to a file),
-    /// every number and dialect line in it checked as it was written; the
+    /// every number and dialect line in it checked as it was written (see
+    /// `ProgramWriter`); the
     /// next chunk starts with room for as much again.
     pub fn take_text(&mut self) -> Result<String, ProgramError> {
         let room = self.text.len();
-        Ok(std::mem::replace(
-            &mut self.text,
-            String::with_capacity(room),
-        ))
+        utf8(std::mem::replace(&mut self.text, Vec::with_capacity(room)))
     }
 
     /// Ends the program; the text not yet taken, checked.
@@ -1268,10 +1371,59 @@ impl ProgramWriter {
         for line in self.dialect.trailer.clone() {
             let l = self.fill(&line, 0.0);
             check_numbers(&l, self.dialect.comment)?;
-            self.text.push_str(&l);
-            self.text.push('\n');
+            self.text.extend_from_slice(l.as_bytes());
+            self.text.push(b'\n');
         }
-        Ok(self.text)
+        utf8(self.text)
+    }
+}
+
+/// The writer's text as a `String`: it only ever appends `str`s and
+/// ASCII, so this holds; were it ever not so, the text is refused, not
+/// handed out.
+fn utf8(text: Vec<u8>) -> Result<String, ProgramError> {
+    String::from_utf8(text)
+        .map_err(|_| ProgramError::Unsupported("program text that is not UTF-8".into()))
+}
+
+/// A short piece of program text (a word's letter, a motion word, a
+/// block end), kept in a fixed array so appending it is a copy of fixed
+/// size and a cut back (no call to `memcpy`); longer pieces as they are.
+struct Snippet {
+    room: [u8; SNIPPET_ROOM],
+    len: usize,
+    long: Box<[u8]>,
+}
+
+const SNIPPET_ROOM: usize = 16;
+
+impl Snippet {
+    fn new(text: &str) -> Snippet {
+        let b = text.as_bytes();
+        let mut room = [0; SNIPPET_ROOM];
+        if b.len() <= SNIPPET_ROOM {
+            room[..b.len()].copy_from_slice(b);
+        }
+        Snippet {
+            room,
+            len: b.len(),
+            long: if b.len() > SNIPPET_ROOM {
+                b.into()
+            } else {
+                Box::default()
+            },
+        }
+    }
+
+    #[inline]
+    fn push_to(&self, text: &mut Vec<u8>) {
+        if self.len <= SNIPPET_ROOM {
+            let at = text.len();
+            text.extend_from_slice(&self.room);
+            text.truncate(at + self.len);
+        } else {
+            text.extend_from_slice(&self.long);
+        }
     }
 }
 
@@ -1335,7 +1487,7 @@ fn check_word(w: &[u8]) -> Result<(), &'static str> {
 
 /// A printed number: digits and points after an optional minus, and not
 /// a minus zero.
-fn check_number(num: &[u8]) -> Result<(), &'static str> {
+pub(crate) fn check_number(num: &[u8]) -> Result<(), &'static str> {
     let digits = num.strip_prefix(b"-").unwrap_or(num);
     if !digits.iter().all(|&c| c.is_ascii_digit() || c == b'.') {
         // `G05.1`-style words are digits and points only; anything else
@@ -1462,6 +1614,55 @@ mod tests {
     }
 
     #[test]
+    fn long_words_and_letters_beyond_ascii_are_written_whole() {
+        // Words longer than a snippet's fixed room, and a C letter of two
+        // bytes, take the writer's other paths.
+        let mut d = Dialect::linuxcnc();
+        d.linear = "G1 G90 G94 G17 G21 G40".into();
+        d.block_end = " ; the end of a long block".into();
+        d.c_letter = 'Ç';
+        // The longest line is 77 bytes (the limit counts bytes, as before).
+        d.max_line_length = Some(77);
+        let text = written_in(
+            &d,
+            Setup::Lathe,
+            "XZC",
+            &[
+                M::Linear {
+                    to: P::xzc(1.5, -0.25, std::f64::consts::PI),
+                    feed: Some(F::InverseTime(0.5)),
+                },
+                M::Linear {
+                    to: P::xzc(1.5, -0.25, std::f64::consts::FRAC_PI_2),
+                    feed: Some(F::InverseTime(0.25)),
+                },
+            ],
+        )
+        .expect("writes");
+        assert!(
+            text.contains(
+                "G93 G1 G90 G94 G17 G21 G40 X1.5 Z-0.25 Ç180. F120. ; the end of a long block\n\
+                 G1 G90 G94 G17 G21 G40 Ç90. F240. ; the end of a long block\n"
+            ),
+            "{text}"
+        );
+        // One byte over the limit, the block end counted.
+        d.max_line_length = Some(76);
+        let Err(ProgramError::Unsupported(why)) = written_in(
+            &d,
+            Setup::Lathe,
+            "XZC",
+            &[M::Linear {
+                to: P::xzc(1.5, -0.25, std::f64::consts::PI),
+                feed: Some(F::InverseTime(0.5)),
+            }],
+        ) else {
+            panic!("a line over the limit written")
+        };
+        assert!(why.contains("a line of 77 characters"), "{why}");
+    }
+
+    #[test]
     fn arcs_have_incremental_centres_and_select_their_plane() {
         let text = written(
             "XYZ",
@@ -1564,5 +1765,79 @@ mod tests {
             written("XZ", &[M::Rapid(P::xz(f64::INFINITY, 0.0))]),
             Err(ProgramError::NotPrintable { word: 'X', .. })
         ));
+    }
+
+    /// `{:.N}` of `n` units of 10^−N, trailing zeros trimmed, the point
+    /// kept: the reference every printed word is held to.
+    fn std_word(n: i64, d: u32) -> String {
+        let s = format!("{:.*}", d as usize, n as f64 / 10f64.powi(d as i32));
+        if d == 0 {
+            s + "."
+        } else {
+            s.trim_end_matches('0').to_string()
+        }
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(300))]
+
+        /// A spiral-like stream through the writer against a model of it
+        /// built from `f64::round` and `{:.N}`: the same lines, word for
+        /// word, unchanged words left out, a feed on every block, no block
+        /// for a move that changes no printed axis.
+        #[test]
+        fn the_writer_prints_what_a_plain_model_of_it_prints(
+            resolution in proptest::sample::select(vec![1e-3, 1e-4, 1e-6]),
+            moves in proptest::collection::vec(
+                (-100.0f64..100.0, -50.0f64..50.0, -1000.0f64..1000.0, 1e-5f64..1.0, 0u8..4),
+                1..200,
+            ),
+        ) {
+            let d = decimals_for(resolution);
+            let mut stream = Vec::new();
+            let mut at = (0.0, 0.0, 0.0);
+            for &(x, z, c, t, keep) in &moves {
+                // Some moves repeat a coordinate, or come within a unit of it.
+                let x = if keep & 1 == 1 { at.0 + resolution * 0.3 } else { x };
+                let z = if keep & 2 == 2 { at.1 } else { z };
+                at = (x, z, c);
+                stream.push(M::Linear { to: P::xzc(x, z, c), feed: Some(F::InverseTime(t)) });
+            }
+            let dialect = Dialect::linuxcnc();
+            let mut w = ProgramWriter::new(&dialect, Setup::Lathe, "t", &[], "XZC", resolution, 1e-5)
+                .expect("a lathe program");
+            w.write_all(&stream).expect("printable");
+            let text = w.finish().expect("checked");
+            proptest::prop_assert!(check_numbers(&text, CommentStyle::Parentheses).is_ok());
+            let units = |v: f64, d: u32| (v * 10f64.powi(d as i32)).round() as i64;
+            let mut last: [Option<i64>; 3] = [None; 3];
+            let mut expected = Vec::new();
+            for m in &stream {
+                let M::Linear { to, feed: Some(F::InverseTime(t)) } = m else { unreachable!() };
+                let mut line = String::from(if expected.is_empty() { "G93 G1" } else { "G1" });
+                let mut any = false;
+                for (k, (letter, v, dk)) in
+                    [('X', to.x, d), ('Z', to.z, d), ('C', to.c.to_degrees(), 5)].into_iter().enumerate()
+                {
+                    let n = units(v, dk);
+                    if last[k] != Some(n) {
+                        line += &format!(" {letter}{}", std_word(n, dk));
+                        last[k] = Some(n);
+                        any = true;
+                    }
+                }
+                if any {
+                    line += &format!(" F{}", std_word(units(60.0 / t, 3), 3));
+                    expected.push(line);
+                }
+            }
+            let written: Vec<&str> = text
+                .lines()
+                .skip_while(|l| !l.starts_with("G93"))
+                .take_while(|l| *l != "M2")
+                .collect();
+            proptest::prop_assert_eq!(written, expected);
+            proptest::prop_assert!(text.lines().all(|l| l.len() <= 255));
+        }
     }
 }
