@@ -118,9 +118,16 @@ pub fn build(
     let data_rate = 1.0 / p.spiral.min_interval;
     let features = p.bounds.features.clone().unwrap_or_default();
     let mut following = match (&p.servo, p.slow) {
-        (Some(servo), false) => {
-            lensc_runtime::follow::FollowingSimulation::new(servo, data_rate, &features, 20_000)
-        }
+        (Some(servo), false) => lensc_runtime::follow::FollowingSimulation::new(
+            servo,
+            data_rate,
+            &features,
+            lensc_runtime::follow::RadialBins::new(
+                p.spiral.start_radius.abs().min(p.spiral.end_radius.abs()),
+                p.spiral.start_radius.abs().max(p.spiral.end_radius.abs()),
+                1000,
+            ),
+        ),
         _ => None,
     };
     // The height map over the window, from the same printed points.
