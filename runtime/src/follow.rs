@@ -106,11 +106,15 @@ impl RadialBins {
 
     /// Counts an error `e` (mm) at radius `r` (mm).
     pub fn add(&mut self, r: f64, e: f64) {
-        let i = self.index(r);
+        self.add_many(self.index(r), 1, e, e);
+    }
+
+    /// Counts `n` errors from `min` to `max` (mm) in bin `i`.
+    pub fn add_many(&mut self, i: usize, n: u64, min: f64, max: f64) {
         let b = &mut self.bins[i];
-        b.samples += 1;
-        b.min = b.min.min(e);
-        b.max = b.max.max(e);
+        b.samples += n;
+        b.min = b.min.min(min);
+        b.max = b.max.max(max);
     }
 }
 
@@ -250,16 +254,29 @@ impl FollowingSimulation {
                 let per_second = 1.0 / span;
                 let dw = p.w - q.w;
                 let mut acc = lenslet.map(|i| (i, 0usize, 0.0f64, 0.0f64, 0.0f64));
+                // A move whose ends lie in one bin of radius (on one side
+                // of the axis, the radius runs straight between them) has
+                // every sample there: its extremes are gathered here and
+                // counted once.
+                let bin = self.by_radius.index(q.x.abs());
+                let one_bin = q.x * p.x >= 0.0 && self.by_radius.index(p.x.abs()) == bin;
+                let (mut n, mut lo, mut hi) = (0u64, f64::INFINITY, f64::NEG_INFINITY);
                 while self.next < p.t {
                     let f = (self.next - q.t) * per_second;
                     let command = q.w + f * dw;
                     let error = pos - command;
-                    let radius = (q.x + f * (p.x - q.x)).abs();
+                    let radius = || (q.x + f * (p.x - q.x)).abs();
                     if error.abs() > self.max_error {
                         self.max_error = error.abs();
-                        self.max_error_at = radius;
+                        self.max_error_at = radius();
                     }
-                    self.by_radius.add(radius, error);
+                    if one_bin {
+                        n += 1;
+                        lo = lo.min(error);
+                        hi = hi.max(error);
+                    } else {
+                        self.by_radius.add(radius(), error);
+                    }
                     if let Some((_, n, max, sum2, slope2)) = acc.as_mut() {
                         *n += 1;
                         *max = max.max(error.abs());
@@ -276,6 +293,9 @@ impl FollowingSimulation {
                     );
                     self.k += 1;
                     self.next = self.t0 + self.k as f64 * self.dt;
+                }
+                if n > 0 {
+                    self.by_radius.add_many(bin, n, lo, hi);
                 }
                 if let Some((i, n, max, sum2, slope2)) = acc {
                     let a = &mut self.acc[i];
