@@ -57,6 +57,8 @@ pub struct Built {
     /// Files the program reads, written beside it (a fast-tool-servo
     /// table): name and text.
     pub beside: Vec<(String, ProgramText)>,
+    /// The series behind the plots of `lensc report`.
+    pub plots: crate::plots::PlotSeries,
 }
 
 /// A program's text: in memory, or spooled as it was written to a
@@ -286,6 +288,7 @@ pub fn plan_and_emit(
                 let mut report =
                     build_report(&lowered, &prov, &program_name, &text, &path, analysis);
                 report["toolpath"]["optimisation"] = optimisation_json(&optimised);
+                let mut plots = crate::plots::PlotSeries::default();
                 report["simulation"] = if lowered.tool.centre_height == 0.0 {
                     use lensc_runtime::surface::Profile as _;
                     let design = |x: f64| profile.point(x).z;
@@ -304,6 +307,14 @@ pub fn plan_and_emit(
                         range,
                         PROFILE_SAMPLES,
                     );
+                    plots.profile = Some(profile_series(
+                        &cut,
+                        &design,
+                        &stream,
+                        ("nose", lowered.tool.nose_radius),
+                        lowered.machine.resolution,
+                        path.seams.iter().map(|s| s.at_radius).collect(),
+                    ));
                     profile_cut_json(&cut)
                 } else {
                     serde_json::json!({
@@ -318,6 +329,7 @@ pub fn plan_and_emit(
                     cutting_time: path.cutting_time(),
                     report,
                     beside: Vec::new(),
+                    plots,
                 });
             }
             Err(e) => diags.push(
@@ -331,6 +343,33 @@ pub fn plan_and_emit(
 
 /// Radii sampled by a profile's cut simulation.
 pub const PROFILE_SAMPLES: usize = 20_001;
+
+/// A profile's simulated cut as the series of its plot: the design and
+/// the error at every simulated radius, the tool centre's path as printed
+/// (the cutting moves of `stream`), the seams' radii. `tool` names the
+/// tool ("nose", "wheel") and gives its radius (mm).
+pub fn profile_series(
+    cut: &lensc_runtime::simulate::ProfileCut,
+    design: &dyn Fn(f64) -> f64,
+    stream: &[lensc_runtime::moves::Move],
+    tool: (&'static str, f64),
+    resolution: f64,
+    seams: Vec<f64>,
+) -> crate::plots::ProfileSeries {
+    crate::plots::ProfileSeries {
+        tool: tool.0,
+        tool_radius: tool.1,
+        samples: cut
+            .samples
+            .iter()
+            .map(|&(x, e)| (x, design(x), e))
+            .collect(),
+        centre_path: lensc_runtime::simulate::centre_path(stream, resolution),
+        seams,
+        pv: cut.pv,
+        rms: cut.rms,
+    }
+}
 
 /// A profile's simulated cut, for its report: the form error (design to
 /// cut, positive where material is left) over the radii the cut reaches.

@@ -118,9 +118,16 @@ pub fn build(
     let data_rate = 1.0 / p.spiral.min_interval;
     let features = p.bounds.features.clone().unwrap_or_default();
     let mut following = match (&p.servo, p.slow) {
-        (Some(servo), false) => {
-            lensc_runtime::follow::FollowingSimulation::new(servo, data_rate, &features, 20_000)
-        }
+        (Some(servo), false) => lensc_runtime::follow::FollowingSimulation::new(
+            servo,
+            data_rate,
+            &features,
+            lensc_runtime::follow::RadialBins::new(
+                p.spiral.start_radius.abs().min(p.spiral.end_radius.abs()),
+                p.spiral.start_radius.abs().max(p.spiral.end_radius.abs()),
+                crate::plots::FOLLOWING_BINS,
+            ),
+        ),
         _ => None,
     };
     // The height map over the window, from the same printed points.
@@ -196,8 +203,19 @@ pub fn build(
         toolpath["strategy"] = json!("spiral_turning");
     }
     let mut report = parts.report(prov, &program_name, &text, toolpath, &p.lowered);
+    let mut plots = crate::plots::PlotSeries::default();
     report["simulation"] = match following {
-        Some(sim) => following_json(&sim.finish(), data_rate),
+        Some(sim) => {
+            let f = sim.finish();
+            let j = following_json(&f, data_rate);
+            plots.following = Some(crate::plots::FollowingSeries {
+                by_radius: f.by_radius,
+                samples: f.samples,
+                data_rate_hz: data_rate,
+                max_error: (f.max_error, f.max_error_at),
+            });
+            j
+        }
         None if p.slow => {
             json!({ "skipped": "slow tool servo: Z is a machine axis, with no servo model here" })
         }
@@ -205,6 +223,15 @@ pub fn build(
     };
     let frame = LatheFrame::new(design.as_ref(), window, p.lowered.domain, &apertures);
     let map = sweep.finish(&frame);
+    plots.form_error = Some(height_map::form_error_series(
+        &map,
+        &frame,
+        &window,
+        // A polar grid's cells lie askew to the raster's blocks: √2 times
+        // the spacing puts a cell in every block (1.5 for margin).
+        1.5 * window.spacing,
+        ("x (mm)", "y (mm)"),
+    ));
     report["simulation"]["height_map"] = height_map::json(
         &map,
         &window,
@@ -223,6 +250,7 @@ pub fn build(
         beside,
         cut_points: summary.points,
         cutting_time: summary.time,
+        plots,
     })
 }
 

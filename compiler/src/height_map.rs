@@ -410,6 +410,31 @@ fn finite(v: f64) -> Value {
     if v.is_finite() { json!(v) } else { Value::Null }
 }
 
+/// A height map as the series of its plot: the error on a raster of at
+/// most `plots::RASTER_SIDE` blocks a side over the window, blocks no
+/// finer than `min_block` (mm).
+pub fn form_error_series(
+    map: &HeightMap,
+    frame: &dyn Frame,
+    window: &Window,
+    min_block: f64,
+    axes: (&'static str, &'static str),
+) -> crate::plots::FormErrorSeries {
+    crate::plots::FormErrorSeries {
+        raster: map.raster(
+            frame,
+            window.x,
+            window.y,
+            min_block,
+            crate::plots::RASTER_SIDE,
+        ),
+        window: (window.x, window.y),
+        spacing: window.spacing,
+        x_axis: axes.0,
+        y_axis: axes.1,
+    }
+}
+
 /// One line for the build summary.
 pub fn summary(map: &HeightMap) -> Option<String> {
     let c = map.contact.as_ref()?;

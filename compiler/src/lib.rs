@@ -12,6 +12,7 @@ pub mod loader;
 pub mod lower;
 pub mod mill_job;
 pub mod parts;
+pub mod plots;
 pub mod render;
 pub mod roller_job;
 pub mod schema;

@@ -1,6 +1,6 @@
-//! The `lensc` command line: `check` and `build`. Exit codes: 0 success
-//! (warnings allowed), 1 errors in the input, 2 usage errors, 101 an
-//! internal error.
+//! The `lensc` command line: `check`, `build`, `report`, `analyse` and
+//! `sample`. Exit codes: 0 success (warnings allowed), 1 errors in the
+//! input, 2 usage errors, 101 an internal error.
 
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
@@ -48,6 +48,24 @@ enum Command {
         #[arg(long)]
         dialect: Option<String>,
         /// Directory for the programs.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+    },
+    /// Plan and simulate a file's jobs as `build` does and write SVG plots
+    /// of what each program will cut: `JOB.profile.svg` (profile jobs: the
+    /// design, the tool-centre path and the simulated cut, with the form
+    /// error in nm beneath), `JOB.form_error.svg` (raster, spiral and
+    /// roller jobs: the form error over the simulation window as a colour
+    /// map) and `JOB.following.svg` (fast-tool-servo jobs: the servo's
+    /// following error against radius). Writes no program or report (use
+    /// `build`); nothing is written if any job fails.
+    Report {
+        /// The .lens file to plot.
+        file: PathBuf,
+        /// Plot only this job.
+        #[arg(long)]
+        job: Option<String>,
+        /// Directory for the plots.
         #[arg(long, default_value = "out")]
         out: PathBuf,
     },
@@ -210,6 +228,67 @@ fn run(cli: Cli) -> u8 {
                 }
             }
         }
+        Command::Report {
+            file,
+            job,
+            out: dir,
+        } => {
+            let Some(c) = load(&out, &file) else { return 1 };
+            out.diagnostics(&c, c.diags());
+            if c.has_errors() {
+                return 1;
+            }
+            if let Err(code) = has_jobs(&out, &c, &file, job.as_deref()) {
+                return code;
+            }
+            // The programs are built as `build` builds them (spooled into
+            // the output directory and dropped: only the plots are kept).
+            let (built, diags) = driver::plan_and_emit(
+                &c,
+                driver::Request {
+                    job: job.as_deref(),
+                    dialect: None,
+                },
+                &file.display().to_string(),
+                Some(&dir),
+            );
+            out.diagnostics(&c, &diags);
+            if diags.iter().any(|d| d.is_error()) {
+                return 1;
+            }
+            // Every plot is drawn before any is written.
+            let mut plots = Vec::new();
+            for b in built {
+                let name = b.report["job"].as_str().unwrap_or_default().to_string();
+                match lensc::plots::render(&name, &b.plots) {
+                    Ok(files) if files.is_empty() => eprintln!(
+                        "note: job `{name}` has nothing to plot: its simulation was skipped ({})",
+                        b.report["simulation"]["skipped"]
+                            .as_str()
+                            .unwrap_or("no simulation")
+                    ),
+                    Ok(files) => plots.extend(files),
+                    Err(e) => {
+                        eprintln!("error: job `{name}`: {e}");
+                        return 101;
+                    }
+                }
+            }
+            for (name, svg) in plots {
+                let path = dir.join(&name);
+                if let Err(e) = driver::write_atomic(&path, &svg) {
+                    eprintln!(
+                        "error[{}]: cannot write {}: {}",
+                        lensc::codes::CANNOT_WRITE,
+                        path.display(),
+                        plain_io_error(&e)
+                    );
+                    return 1;
+                }
+                eprintln!("wrote {} ({} bytes)", path.display(), svg.len());
+            }
+            0
+        }
         Command::Build {
             file,
             job,
@@ -221,36 +300,8 @@ fn run(cli: Cli) -> u8 {
             if c.has_errors() {
                 return 1;
             }
-            if let Some(name) = &job
-                && !c.checked.jobs.iter().any(|j| &j.name.name == name)
-            {
-                let names: Vec<&str> = c
-                    .checked
-                    .jobs
-                    .iter()
-                    .map(|j| j.name.name.as_str())
-                    .collect();
-                eprintln!(
-                    "error: {} has no job `{name}` (its jobs: {})",
-                    file.display(),
-                    if names.is_empty() {
-                        "none".into()
-                    } else {
-                        names.join(", ")
-                    }
-                );
-                return 2;
-            }
-            if c.checked.jobs.is_empty() {
-                let d = lensc_grammar::Diagnostic::error(
-                    lensc::codes::NO_JOB,
-                    "this file has no job to build",
-                    lensc_grammar::FileId(0),
-                    lensc_grammar::Span::new(0, 0),
-                )
-                .with_help("add `job NAME { surface: …, tool: …, machine: …, strategy: … }`");
-                out.diagnostics(&c, &[d]);
-                return 1;
+            if let Err(code) = has_jobs(&out, &c, &file, job.as_deref()) {
+                return code;
             }
             let (programs, diags) = driver::plan_and_emit(
                 &c,
@@ -338,6 +389,43 @@ impl Output {
         let _ = result;
         let _ = std::io::stdout().flush();
     }
+}
+
+/// Whether the checked file has the job asked for (exit 2 if not) and any
+/// job at all (exit 1, E-code NO_JOB, if not).
+fn has_jobs(out: &Output, c: &Checked, file: &Path, job: Option<&str>) -> Result<(), u8> {
+    if let Some(name) = job
+        && !c.checked.jobs.iter().any(|j| j.name.name == name)
+    {
+        let names: Vec<&str> = c
+            .checked
+            .jobs
+            .iter()
+            .map(|j| j.name.name.as_str())
+            .collect();
+        eprintln!(
+            "error: {} has no job `{name}` (its jobs: {})",
+            file.display(),
+            if names.is_empty() {
+                "none".into()
+            } else {
+                names.join(", ")
+            }
+        );
+        return Err(2);
+    }
+    if c.checked.jobs.is_empty() {
+        let d = lensc_grammar::Diagnostic::error(
+            lensc::codes::NO_JOB,
+            "this file has no job to build",
+            lensc_grammar::FileId(0),
+            lensc_grammar::Span::new(0, 0),
+        )
+        .with_help("add `job NAME { surface: …, tool: …, machine: …, strategy: … }`");
+        out.diagnostics(c, &[d]);
+        return Err(1);
+    }
+    Ok(())
 }
 
 /// Loads and checks a root file; reports an unreadable file itself.

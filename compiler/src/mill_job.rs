@@ -171,6 +171,7 @@ pub fn build_raster(
     let program_name = p.program_name();
     let text = ProgramText::Memory(text);
     let mut report = p.report(prov, &program_name, &text, toolpath, &lowered);
+    let mut plots = crate::plots::PlotSeries::default();
     report["simulation"] = match tool {
         RasterTool::Knife { nose_radius } => {
             let along_x = raster.along == Axis::X;
@@ -186,6 +187,13 @@ pub fn build_raster(
                 domain: lowered.domain,
             };
             let map = sweep.finish(&frame);
+            plots.form_error = Some(height_map::form_error_series(
+                &map,
+                &frame,
+                &window,
+                window.spacing,
+                ("x (mm)", "y (mm)"),
+            ));
             let coordinates = if along_x {
                 "columns along x, rows along y"
             } else {
@@ -209,6 +217,7 @@ pub fn build_raster(
         beside: Vec::new(),
         cut_points: path.point_count,
         cutting_time: time,
+        plots,
     })
 }
 
@@ -377,6 +386,17 @@ pub fn build_grinding(
         crate::driver::PROFILE_SAMPLES,
     );
     report["simulation"] = crate::driver::profile_cut_json(&cut);
+    let plots = crate::plots::PlotSeries {
+        profile: Some(crate::driver::profile_series(
+            &cut,
+            &|x: f64| profile.point(x).z,
+            &stream,
+            ("wheel", grinding.wheel_diameter / 2.0),
+            resolution,
+            Vec::new(),
+        )),
+        ..Default::default()
+    };
     Ok(Built {
         report_name: format!("{}.report.json", job.name.name),
         program_name,
@@ -385,6 +405,7 @@ pub fn build_grinding(
         beside: Vec::new(),
         cut_points: path.points.len(),
         cutting_time: path.total_time,
+        plots,
     })
 }
 

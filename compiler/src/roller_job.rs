@@ -330,6 +330,19 @@ pub fn build(
         domain: lowered.domain,
     };
     let map = sweep.finish(&frame);
+    let plots = crate::plots::PlotSeries {
+        form_error: Some(height_map::form_error_series(
+            &map,
+            &frame,
+            &window,
+            window.spacing,
+            (
+                "along the roller axis, design x (mm)",
+                "around the roller, design y (mm)",
+            ),
+        )),
+        ..Default::default()
+    };
     let finish_pitch = helix.passes.last().map_or(0.0, |p| p.pitch);
     report["simulation"] = json!({
         "height_map": height_map::json(
@@ -347,6 +360,7 @@ pub fn build(
         beside: Vec::new(),
         cut_points: points,
         cutting_time: time,
+        plots,
     })
 }
 

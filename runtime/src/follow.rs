@@ -39,9 +39,83 @@ pub struct Following {
     pub max_error: f64,
     pub max_error_at: f64,
     pub lenslets: Vec<LensletFollowing>,
-    /// The error every `trace_every` samples: time (s), radius (mm),
-    /// commanded W (mm), error (mm), for plots.
-    pub trace: Vec<[f64; 4]>,
+    /// Every sample's error gathered in bins of radius, for plots.
+    pub by_radius: RadialBins,
+}
+
+/// The following error of every sample gathered in a fixed number of
+/// bins of radius: per bin, the count and the least and largest error, so
+/// a plot of them keeps every peak however many samples fall in a bin,
+/// and memory stays fixed however long the spiral.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RadialBins {
+    /// The radii (mm) the bins cover, `from < to`, in equal widths.
+    pub from: f64,
+    pub to: f64,
+    pub bins: Vec<ErrorBin>,
+}
+
+/// One bin of [`RadialBins`]: samples, least and largest error (mm); the
+/// extremes are ±infinity while it is empty.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ErrorBin {
+    pub samples: u64,
+    pub min: f64,
+    pub max: f64,
+}
+
+impl RadialBins {
+    /// `count` (at least 1) empty bins over the radii `from..to` (mm);
+    /// an empty or reversed range is taken as one 1 µm wide.
+    pub fn new(from: f64, to: f64, count: usize) -> RadialBins {
+        let (from, to) = if to > from && (to - from).is_finite() {
+            (from, to)
+        } else {
+            (from, from + 1e-3)
+        };
+        RadialBins {
+            from,
+            to,
+            bins: vec![
+                ErrorBin {
+                    samples: 0,
+                    min: f64::INFINITY,
+                    max: f64::NEG_INFINITY,
+                };
+                count.max(1)
+            ],
+        }
+    }
+
+    /// The bin of radius `r` (mm); radii beyond the range fall in the end
+    /// bins.
+    pub fn index(&self, r: f64) -> usize {
+        let n = self.bins.len();
+        let t = (r - self.from) / (self.to - self.from) * n as f64;
+        if t.is_nan() {
+            return 0;
+        }
+        (t.floor().max(0.0) as usize).min(n - 1)
+    }
+
+    /// The radii (mm) bin `i` covers.
+    pub fn span(&self, i: usize) -> (f64, f64) {
+        let w = (self.to - self.from) / self.bins.len() as f64;
+        (self.from + i as f64 * w, self.from + (i + 1) as f64 * w)
+    }
+
+    /// Counts an error `e` (mm) at radius `r` (mm).
+    pub fn add(&mut self, r: f64, e: f64) {
+        self.add_many(self.index(r), 1, e, e);
+    }
+
+    /// Counts `n` errors from `min` to `max` (mm) in bin `i`.
+    pub fn add_many(&mut self, i: usize, n: u64, min: f64, max: f64) {
+        let b = &mut self.bins[i];
+        b.samples += n;
+        b.min = b.min.min(min);
+        b.max = b.max.max(max);
+    }
 }
 
 struct Acc {
@@ -71,21 +145,18 @@ pub struct FollowingSimulation {
     acc: Vec<Acc>,
     max_error: f64,
     max_error_at: f64,
-    trace_every: u64,
-    /// Samples until the next trace row.
-    until_trace: u64,
-    trace: Vec<[f64; 4]>,
+    by_radius: RadialBins,
 }
 
 impl FollowingSimulation {
     /// A servo sampled at `data_rate_hz` over lenslets `features` (centre
-    /// x, y and radius, mm); a trace sample is kept every `trace_every`
-    /// servo samples. `None` for an invalid servo or rate.
+    /// x, y and radius, mm); every sample's error is also gathered in
+    /// `by_radius`. `None` for an invalid servo or rate.
     pub fn new(
         servo: &SecondOrderServo,
         data_rate_hz: f64,
         features: &[(f64, f64, f64)],
-        trace_every: u64,
+        by_radius: RadialBins,
     ) -> Option<FollowingSimulation> {
         let dt = 1.0 / data_rate_hz;
         let (phi, gamma) = servo.zero_order_hold_step(dt)?;
@@ -134,9 +205,7 @@ impl FollowingSimulation {
                 .collect(),
             max_error: 0.0,
             max_error_at: f64::NAN,
-            trace_every: trace_every.max(1),
-            until_trace: 0,
-            trace: Vec::new(),
+            by_radius,
         })
     }
 
@@ -185,13 +254,28 @@ impl FollowingSimulation {
                 let per_second = 1.0 / span;
                 let dw = p.w - q.w;
                 let mut acc = lenslet.map(|i| (i, 0usize, 0.0f64, 0.0f64, 0.0f64));
+                // A move whose ends lie in one bin of radius (on one side
+                // of the axis, the radius runs straight between them) has
+                // every sample there: its extremes are gathered here and
+                // counted once.
+                let bin = self.by_radius.index(q.x.abs());
+                let one_bin = q.x * p.x >= 0.0 && self.by_radius.index(p.x.abs()) == bin;
+                let (mut n, mut lo, mut hi) = (0u64, f64::INFINITY, f64::NEG_INFINITY);
                 while self.next < p.t {
                     let f = (self.next - q.t) * per_second;
                     let command = q.w + f * dw;
                     let error = pos - command;
+                    let radius = || (q.x + f * (p.x - q.x)).abs();
                     if error.abs() > self.max_error {
                         self.max_error = error.abs();
-                        self.max_error_at = (q.x + f * (p.x - q.x)).abs();
+                        self.max_error_at = radius();
+                    }
+                    if one_bin {
+                        n += 1;
+                        lo = lo.min(error);
+                        hi = hi.max(error);
+                    } else {
+                        self.by_radius.add(radius(), error);
                     }
                     if let Some((_, n, max, sum2, slope2)) = acc.as_mut() {
                         *n += 1;
@@ -202,12 +286,6 @@ impl FollowingSimulation {
                             *slope2 += slope * slope;
                         }
                     }
-                    if self.until_trace == 0 {
-                        self.trace
-                            .push([self.next, (q.x + f * (p.x - q.x)).abs(), command, error]);
-                        self.until_trace = self.trace_every;
-                    }
-                    self.until_trace -= 1;
                     self.last_error = Some(error);
                     (pos, vel) = (
                         p00 * pos + p01 * vel + g0 * command,
@@ -215,6 +293,9 @@ impl FollowingSimulation {
                     );
                     self.k += 1;
                     self.next = self.t0 + self.k as f64 * self.dt;
+                }
+                if n > 0 {
+                    self.by_radius.add_many(bin, n, lo, hi);
                 }
                 if let Some((i, n, max, sum2, slope2)) = acc {
                     let a = &mut self.acc[i];
@@ -253,7 +334,7 @@ impl FollowingSimulation {
             max_error: self.max_error,
             max_error_at: self.max_error_at,
             lenslets,
-            trace: self.trace,
+            by_radius: self.by_radius,
         }
     }
 }
@@ -285,7 +366,8 @@ mod tests {
 
     #[test]
     fn a_held_command_is_followed_exactly() {
-        let mut sim = FollowingSimulation::new(&servo(), 20e3, &[], 1).expect("valid");
+        let mut sim = FollowingSimulation::new(&servo(), 20e3, &[], RadialBins::new(0.0, 10.0, 4))
+            .expect("valid");
         sim.extend(&circle(5.0, 100.0, 1e-3, 200, |_| 0.25));
         let f = sim.finish();
         assert!(f.samples > 3900);
@@ -294,26 +376,81 @@ mod tests {
 
     #[test]
     fn streaming_matches_the_batch_servo_response() {
-        // Points exactly on the servo's samples: the streamed errors are the
-        // batch simulation's response minus the command, sample for sample,
-        // however the points are split into chunks.
+        // Points exactly on the servo's samples, the radius falling from 5
+        // to 3 mm: the streamed errors are the batch simulation's response
+        // minus the command, sample for sample, however the points are
+        // split into chunks; each radial bin holds the least and largest
+        // of the errors at its radii.
         let dt = 1.0 / 20e3;
         let w = |t: f64| 0.002 * (2.0 * std::f64::consts::PI * 300.0 * t).sin();
-        let pts = circle(5.0, 100.0, dt, 2000, w);
-        let mut sim = FollowingSimulation::new(&servo(), 20e3, &[], 1).expect("valid");
+        let mut pts = circle(5.0, 100.0, dt, 2000, w);
+        for (k, p) in pts.iter_mut().enumerate() {
+            p.x = 5.0 - 2.0 * k as f64 / 2000.0;
+        }
+        let bins = RadialBins::new(2.55, 5.55, 30);
+        let mut sim = FollowingSimulation::new(&servo(), 20e3, &[], bins.clone()).expect("valid");
         for chunk in pts.chunks(37) {
             sim.extend(chunk);
         }
         let f = sim.finish();
         let commands: Vec<f64> = pts.iter().map(|p| p.w).collect();
         let batch = servo().simulate(&commands, dt).expect("valid");
-        assert_eq!(f.trace.len(), pts.len() - 1);
-        for (k, row) in f.trace.iter().enumerate() {
-            let want = batch[k] - commands[k];
-            assert!((row[3] - want).abs() < 1e-15, "{k}: {} vs {want}", row[3]);
+        let mut want = bins;
+        for k in 0..pts.len() - 1 {
+            want.add(pts[k].x, batch[k] - commands[k]);
         }
+        assert_eq!(f.samples, pts.len() - 1);
+        let used = want.bins.iter().filter(|b| b.samples > 0).count();
+        assert_eq!(used, 21, "radii 3.001 to 5 mm: bins 4 to 24");
+        for (k, (got, want)) in f.by_radius.bins.iter().zip(&want.bins).enumerate() {
+            assert_eq!(got.samples, want.samples, "bin {k}");
+            if want.samples > 0 {
+                assert!(
+                    (got.min - want.min).abs() < 1e-15,
+                    "bin {k}: {got:?} {want:?}"
+                );
+                assert!(
+                    (got.max - want.max).abs() < 1e-15,
+                    "bin {k}: {got:?} {want:?}"
+                );
+            }
+        }
+        let peak = f
+            .by_radius
+            .bins
+            .iter()
+            .map(|b| b.max.max(-b.min))
+            .fold(0.0, f64::max);
+        assert_eq!(peak, f.max_error, "the bins keep the largest error");
         // 300 Hz on a 1367 Hz servo: a real, visible lag.
         assert!(f.max_error > 1e-5, "{}", f.max_error);
+    }
+
+    #[test]
+    fn radial_bins_cover_their_range_and_clamp_beyond_it() {
+        let mut b = RadialBins::new(1.0, 3.0, 4);
+        assert_eq!(b.index(1.0), 0);
+        assert_eq!(b.index(1.49), 0);
+        assert_eq!(b.index(1.5), 1);
+        assert_eq!(b.index(2.99), 3);
+        assert_eq!(b.index(3.0), 3);
+        assert_eq!(b.index(-7.0), 0);
+        assert_eq!(b.index(f64::NAN), 0);
+        assert_eq!(b.span(1), (1.5, 2.0));
+        b.add(2.2, 4e-6);
+        b.add(2.3, -1e-6);
+        assert_eq!(
+            b.bins[2],
+            ErrorBin {
+                samples: 2,
+                min: -1e-6,
+                max: 4e-6
+            }
+        );
+        assert_eq!(b.bins[0].samples, 0);
+        let empty = RadialBins::new(2.0, 2.0, 0);
+        assert_eq!(empty.bins.len(), 1);
+        assert!(empty.to > empty.from);
     }
 
     #[test]
@@ -331,7 +468,9 @@ mod tests {
                 0.0
             }
         };
-        let mut sim = FollowingSimulation::new(&servo(), 20e3, &feats, 100).expect("valid");
+        let mut sim =
+            FollowingSimulation::new(&servo(), 20e3, &feats, RadialBins::new(4.0, 6.0, 10))
+                .expect("valid");
         sim.extend(&circle(r, 100.0, 1e-5, 60_000, w));
         let f = sim.finish();
         let (a, b) = (&f.lenslets[0], &f.lenslets[1]);
@@ -345,6 +484,8 @@ mod tests {
         assert!(a.max_error < 1e-12, "{}", a.max_error);
         assert!(b.max_error > 1e-5 && b.waviness > 0.0);
         assert!((b.radius - r).abs() < 1e-12);
-        assert_eq!(f.trace.len(), f.samples.div_ceil(100));
+        let binned: u64 = f.by_radius.bins.iter().map(|b| b.samples).sum();
+        assert_eq!(binned as usize, f.samples);
+        assert_eq!(f.by_radius.bins[5].samples, binned, "all at r = 5 mm");
     }
 }

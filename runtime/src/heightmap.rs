@@ -461,6 +461,32 @@ pub struct FeatureFigures {
     pub scallops: Option<Scallops>,
 }
 
+/// A height map's error on square blocks of the part's x–y plane (see
+/// [`HeightMap::raster`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ErrorRaster {
+    /// The plane covered (mm): blocks from `x.0`, `y.0` on, `block` (mm)
+    /// wide, `nx` along x and `ny` along y (the last ones may reach past
+    /// `x.1`, `y.1`).
+    pub x: (f64, f64),
+    pub y: (f64, f64),
+    pub block: f64,
+    pub nx: usize,
+    pub ny: usize,
+    /// Row by row from `y.0`: the error (mm) of the largest magnitude in
+    /// each block; NaN where no cut cell falls.
+    pub cells: Vec<f64>,
+}
+
+impl ErrorRaster {
+    /// The least and largest error over the blocks, if any holds one.
+    pub fn range(&self) -> Option<(f64, f64)> {
+        let mut it = self.cells.iter().copied().filter(|e| !e.is_nan());
+        let first = it.next()?;
+        Some(it.fold((first, first), |(lo, hi), e| (lo.min(e), hi.max(e))))
+    }
+}
+
 /// What the program cuts on the window.
 #[derive(Clone, Debug, PartialEq)]
 pub struct HeightMap {
@@ -635,6 +661,73 @@ impl HeightMap {
         }
     }
 
+    /// The map on an x–y raster over `x` × `y` (mm), for a plot: square
+    /// blocks no smaller than `min_block` (mm) and no more than `max_side`
+    /// to a side; each block holds, of the cut cells whose (x, y) falls in
+    /// it, the error with the largest magnitude (sign kept), so no peak is
+    /// lost however many cells a block gathers; NaN where none falls.
+    /// `min_block` keeps blocks from being finer than the grid (on a
+    /// polar grid, √2 times its spacing puts a cell in every block). The
+    /// raster reaches half of `min_block` beyond the window on every side,
+    /// so cells on a grid of that spacing fall in the middle of blocks.
+    pub fn raster(
+        &self,
+        frame: &dyn Frame,
+        x: (f64, f64),
+        y: (f64, f64),
+        min_block: f64,
+        max_side: usize,
+    ) -> ErrorRaster {
+        let half = (min_block / 2.0).max(0.0);
+        let (x, y) = ((x.0 - half, x.1 + half), (y.0 - half, y.1 + half));
+        let (w, h) = ((x.1 - x.0).max(0.0), (y.1 - y.0).max(0.0));
+        let max_side = max_side.max(1);
+        let block = (w.max(h) / max_side as f64).max(min_block);
+        let count = |extent: f64| {
+            if block > 0.0 && block.is_finite() {
+                ((extent / block - 1e-9).ceil().max(1.0) as usize).min(max_side)
+            } else {
+                1
+            }
+        };
+        let (nx, ny) = (count(w), count(h));
+        let mut cells = vec![f64::NAN; nx * ny];
+        let g = &self.grid;
+        for j in 0..g.ns {
+            let s = g.s(j);
+            for i in 0..g.nu {
+                let e = self.errors[j * g.nu + i];
+                if e.is_nan() {
+                    continue;
+                }
+                let (px, py) = frame.xy(s, g.u(i));
+                let bx = ((px - x.0) / block).floor();
+                let by = ((py - y.0) / block).floor();
+                if !(bx >= 0.0 && by >= 0.0) {
+                    continue;
+                }
+                // Cells on the far edges belong to the last blocks.
+                let edge = 1e-9 * block;
+                if px > x.1 + edge || py > y.1 + edge {
+                    continue;
+                }
+                let (bx, by) = ((bx as usize).min(nx - 1), (by as usize).min(ny - 1));
+                let c = &mut cells[by * nx + bx];
+                if c.is_nan() || e.abs() > c.abs() {
+                    *c = e;
+                }
+            }
+        }
+        ErrorRaster {
+            x,
+            y,
+            block,
+            nx,
+            ny,
+            cells,
+        }
+    }
+
     /// The scallop a round nose of radius `r` leaves between passes `step`
     /// apart on a flat (mm).
     pub fn flat_scallop(r: f64, step: f64) -> f64 {
@@ -710,6 +803,87 @@ mod tests {
         assert_eq!(map.uncut, 0);
         // Scallops run across the passes, not along them.
         assert!(map.rq_stepover > 10.0 * map.rq_cutting.max(1e-15));
+    }
+
+    #[test]
+    fn a_raster_keeps_each_blocks_worst_error_and_its_sign() {
+        // A 100 × 100 map of known errors on 1 µm cells (centred at 0.5,
+        // 1.5, … µm), gathered into blocks of 10 µm (at most 10 a side;
+        // `min_block` 0 so the raster starts on the window): each block's
+        // value is the error of largest magnitude of the cells in it.
+        let g = Grid {
+            s0: 0.0005,
+            u0: 0.0005,
+            ..grid(100, 0.001)
+        };
+        let frame = Flat {
+            z: |_, _| 0.0,
+            window: (0.0, 0.1, 0.0, 0.1),
+        };
+        let mut errors = vec![f64::NAN; 100 * 100];
+        for j in 0..100 {
+            for i in 0..100 {
+                // Columns are x (s), rows y (u).
+                errors[j * 100 + i] = 1e-6 * (j as f64 - 2.0 * i as f64);
+            }
+        }
+        errors[55 * 100 + 33] = -5e-3; // one deep cell
+        errors[0] = f64::NAN; // one uncut
+        let map = HeightMap {
+            grid: g,
+            nose_radius: 0.1,
+            errors,
+            surface: None,
+            contact: None,
+            scallops: None,
+            uncut: 1,
+            rq_cutting: 0.0,
+            rq_stepover: 0.0,
+            features: Vec::new(),
+        };
+        let r = map.raster(&frame, (0.0, 0.1), (0.0, 0.1), 0.0, 10);
+        assert_eq!((r.nx, r.ny), (10, 10));
+        assert!((r.block - 0.01).abs() < 1e-15);
+        // Block (5, 3) holds the deep cell at x = 55 µm, y = 33 µm.
+        assert_eq!(r.cells[3 * 10 + 5], -5e-3);
+        // Elsewhere the worst of j − 2i over the block's cells: block
+        // (bx, by) spans j in 10bx..10bx+9 (x), i in 10by..10by+9 (y).
+        for by in 0..10 {
+            for bx in 0..10 {
+                if (bx, by) == (5, 3) {
+                    continue;
+                }
+                let mut want = f64::NAN;
+                for j in 10 * bx..10 * bx + 10 {
+                    for i in 10 * by..10 * by + 10 {
+                        let e = map.errors[j * 100 + i];
+                        if !e.is_nan() && (want.is_nan() || e.abs() > want.abs()) {
+                            want = e;
+                        }
+                    }
+                }
+                assert_eq!(r.cells[by * 10 + bx], want, "block {bx} {by}");
+            }
+        }
+        assert_eq!(r.range().map(|r| r.0), Some(-5e-3));
+        // Cells on the far edge of the raster fall in its last blocks.
+        let edge = map.raster(&frame, (0.0, 0.0995), (0.0, 0.0995), 0.0, 10);
+        assert_eq!((edge.nx, edge.ny), (10, 10));
+        assert_eq!(edge.cells[99], r.cells[99]);
+        // Blocks are never finer than asked: the 100 µm side and 10 µm
+        // beyond each edge at 20 µm.
+        let coarse = map.raster(&frame, (0.0, 0.1), (0.0, 0.1), 0.02, 600);
+        assert_eq!((coarse.nx, coarse.ny), (6, 6));
+        assert_eq!(coarse.x.0, -0.01);
+        // Blocks as fine as the grid, centred on its cells: one cell each.
+        let fine = map.raster(&frame, (0.0005, 0.0995), (0.0005, 0.0995), 0.001, 600);
+        assert_eq!((fine.nx, fine.ny), (100, 100));
+        for j in 0..100 {
+            for i in 0..100 {
+                let (got, want) = (fine.cells[i * 100 + j], map.errors[j * 100 + i]);
+                assert!(got == want || (got.is_nan() && want.is_nan()), "{j} {i}");
+            }
+        }
     }
 
     #[test]

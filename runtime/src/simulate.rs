@@ -109,6 +109,36 @@ fn pieces(stream: &[Move], resolution: f64) -> Vec<Piece> {
     out
 }
 
+/// The nose centre's path along the cutting moves of a lathe `stream`, as
+/// printed (coordinates rounded to `resolution`): one polyline of (X, Z)
+/// (mm) per run of cutting moves, an arc drawn through points at most
+/// 1° of its sweep apart. For plots.
+pub fn centre_path(stream: &[Move], resolution: f64) -> Vec<Vec<(f64, f64)>> {
+    let mut runs: Vec<Vec<(f64, f64)>> = Vec::new();
+    for piece in pieces(stream, resolution) {
+        let (a, b) = match piece {
+            Piece::Line { a, b } | Piece::Arc { a, b, .. } => (a, b),
+        };
+        let continues = runs.last().and_then(|r| r.last()) == Some(&a);
+        if !continues {
+            runs.push(vec![a]);
+        }
+        let run = runs.last_mut().expect("pushed");
+        if let Piece::Arc {
+            o, r, start, sweep, ..
+        } = piece
+        {
+            let steps = (sweep.abs().to_degrees().ceil() as usize).max(1);
+            for k in 1..steps {
+                let ang = start + sweep * k as f64 / steps as f64;
+                run.push((o.0 + r * ang.sin(), o.1 + r * ang.cos()));
+            }
+        }
+        run.push(b);
+    }
+    runs
+}
+
 /// The lowest point at abscissa `x` of a disc of radius `rho` centred at
 /// `c`, if the disc reaches `x`.
 fn disc_bottom(c: (f64, f64), rho: f64, x: f64) -> Option<f64> {
@@ -297,6 +327,37 @@ mod tests {
         let cut = profile_cut(&stream, RHO, 1e-9, &convex(r), (0.0, 1.5), 301);
         assert_eq!(cut.samples.len(), 301);
         assert!(cut.pv < 1e-9 && cut.rms < 1e-9, "{} {}", cut.pv, cut.rms);
+    }
+
+    #[test]
+    fn the_centre_path_follows_the_printed_moves_and_breaks_at_rapids() {
+        let stream = [
+            Move::Rapid(Position::xz(2.0, 5.0)),
+            linear(2.0, 0.0004),
+            Move::Arc {
+                to: Position::xz(0.0, 2.0),
+                centre: Position::xz(0.0, 0.0),
+                plane: Plane::Zx,
+                ccw: false,
+                feed: None,
+            },
+            Move::Rapid(Position::xz(3.0, 5.0)),
+            linear(3.0, 1.0),
+            linear(2.5, 1.0),
+        ];
+        let runs = centre_path(&stream, 1e-3);
+        assert_eq!(runs.len(), 2);
+        // The plunge's end as printed to 1 µm, then the quarter arc up to
+        // the axis at 1° steps, every point on its circle.
+        assert_eq!(runs[0][0], (2.0, 5.0));
+        assert_eq!(runs[0][1], (2.0, 0.0));
+        let arc = &runs[0][1..];
+        assert_eq!(arc.len(), 91);
+        for p in arc {
+            assert!((p.0.hypot(p.1) - 2.0).abs() < 1e-12, "{p:?}");
+        }
+        assert!(arc.windows(2).all(|w| w[1].0 < w[0].0 && w[1].1 > w[0].1));
+        assert_eq!(runs[1], vec![(3.0, 5.0), (3.0, 1.0), (2.5, 1.0)]);
     }
 
     #[test]
