@@ -346,7 +346,8 @@ pub fn domain_centre(domain: &Domain) -> (f64, f64) {
     }
 }
 
-fn figures_json(f: &Option<ErrorFigures>) -> Value {
+/// PV, RMS and extremes of a set of errors as the report gives them (nm).
+pub fn figures_json(f: &Option<ErrorFigures>) -> Value {
     match f {
         None => Value::Null,
         Some(f) => json!({

@@ -203,6 +203,11 @@ pub fn build_raster(
             j["edge"] = json!(
                 "the knife's edge in its rake face, across the cut, as the planner places it"
             );
+            // The path's own error apart from the machine's resolution: the
+            // same moves swept as computed (rounded to a picometre only).
+            let mut unrounded = Sweep::new(grid, nose_radius);
+            height_map::sweep_mill_moves(&mut unrounded, &moves, along_x, 1e-9);
+            j["contact_unrounded"] = height_map::figures_json(&unrounded.finish(&frame).contact);
             json!({ "height_map": j })
         }
         RasterTool::Ball { .. } => json!({
