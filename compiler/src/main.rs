@@ -233,14 +233,10 @@ fn run(cli: Cli) -> u8 {
             job,
             out: dir,
         } => {
-            let Some(c) = load(&out, &file) else { return 1 };
-            out.diagnostics(&c, c.diags());
-            if c.has_errors() {
-                return 1;
-            }
-            if let Err(code) = has_jobs(&out, &c, &file, job.as_deref()) {
-                return code;
-            }
+            let c = match load_jobs(&out, &file, job.as_deref()) {
+                Ok(c) => c,
+                Err(code) => return code,
+            };
             // The programs are built as `build` builds them (spooled into
             // the output directory and dropped: only the plots are kept).
             let (built, diags) = driver::plan_and_emit(
@@ -295,14 +291,10 @@ fn run(cli: Cli) -> u8 {
             dialect,
             out: dir,
         } => {
-            let Some(c) = load(&out, &file) else { return 1 };
-            out.diagnostics(&c, c.diags());
-            if c.has_errors() {
-                return 1;
-            }
-            if let Err(code) = has_jobs(&out, &c, &file, job.as_deref()) {
-                return code;
-            }
+            let c = match load_jobs(&out, &file, job.as_deref()) {
+                Ok(c) => c,
+                Err(code) => return code,
+            };
             let (programs, diags) = driver::plan_and_emit(
                 &c,
                 driver::Request {
@@ -393,6 +385,21 @@ impl Output {
 
 /// Whether the checked file has the job asked for (exit 2 if not) and any
 /// job at all (exit 1, E-code NO_JOB, if not).
+/// Loads and checks `file` for `build` and `report`, printing its
+/// diagnostics: the checked file if it has the job(s) asked for, or the
+/// exit code (1 for errors in the input, 2 for a `--job` naming no job).
+fn load_jobs(out: &Output, file: &Path, job: Option<&str>) -> Result<Checked, u8> {
+    let Some(c) = load(out, file) else {
+        return Err(1);
+    };
+    out.diagnostics(&c, c.diags());
+    if c.has_errors() {
+        return Err(1);
+    }
+    has_jobs(out, &c, file, job)?;
+    Ok(c)
+}
+
 fn has_jobs(out: &Output, c: &Checked, file: &Path, job: Option<&str>) -> Result<(), u8> {
     if let Some(name) = job
         && !c.checked.jobs.iter().any(|j| j.name.name == name)

@@ -247,6 +247,21 @@ fn legend_line(c: RGBColor) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
     move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], c.stroke_width(2))
 }
 
+/// Draws a chart's legend box, the same on every plot: upper right, on a
+/// translucent white ground with a black border.
+fn legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font((FONT, 14))
+        .draw()
+        .map_err(err)
+}
+
 fn profile_svg(job: &str, p: &ProfileSeries) -> Result<String, String> {
     let design: Vec<(f64, f64)> = p.samples.iter().map(|s| (s.0, s.1)).collect();
     let cut: Vec<(f64, f64)> = p.samples.iter().map(|s| (s.0, s.1 + s.2)).collect();
@@ -369,14 +384,7 @@ fn profile_svg(job: &str, p: &ProfileSeries) -> Result<String, String> {
             .map_err(err)?
             .label("simulated cut")
             .legend(legend_line(CUT));
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font((FONT, 14))
-            .draw()
-            .map_err(err)?;
+        legend(&mut chart)?;
         let mut chart = ChartBuilder::on(&lower)
             .margin(10)
             .margin_right(100)
@@ -412,14 +420,7 @@ fn profile_svg(job: &str, p: &ProfileSeries) -> Result<String, String> {
             .map_err(err)?
             .label("form error")
             .legend(legend_line(ERROR));
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font((FONT, 14))
-            .draw()
-            .map_err(err)?;
+        legend(&mut chart)?;
         caption(&below, &lines)?;
         root.present().map_err(err)?;
     }
@@ -632,14 +633,7 @@ fn following_svg(job: &str, f: &FollowingSeries) -> Result<String, String> {
             .map_err(err)?
             .label("least and largest error per bin")
             .legend(legend_line(CENTRE));
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font((FONT, 14))
-            .draw()
-            .map_err(err)?;
+        legend(&mut chart)?;
         caption(&below, &lines)?;
         root.present().map_err(err)?;
     }
