@@ -474,3 +474,28 @@ fn seed_000_paths_cut_within_the_figure_before_the_machines_rounding() {
         assert!(num(&printed["max_gouge_nm"]["value"]) < 100.0, "{printed}");
     }
 }
+
+#[test]
+fn seed_003_contacts_meet_the_figure_at_the_default_tolerance() {
+    // Issue #6's figure for seed 003: its lenslet at the paper's 2 um/rev,
+    // 5 m/min capped at 1000 rpm, with the default path tolerance (10 nm;
+    // the W chords take T/4), the corner lenslet of a 2 × 2 array simulated
+    // over a 0.3 mm square on its slope: the contacts within 1 nm RMS and
+    // 5 nm PV of the design.
+    let r = report_of(
+        "surface lenslet = sphere { radius: 20 mm, sense: concave, aperture: circle(diameter: 1.7 mm) }\n\
+         surface corner = grid(lenslet, pitch_x: 3.5 mm, pitch_y: 3.5 mm, count_x: 2, count_y: 2)\n\
+         use std::machines::nanoform_x_fts5000\n\
+         use std::tools::diamond_r496um\n\
+         strategy s = fts_spiral { feed: 2 um/rev, surface_speed: 5 m/min, spindle_cap: 1000 rpm, settling_time: 1 ms }\n\
+         job corner { surface: corner, tool: diamond_r496um, machine: nanoform_x_fts5000, strategy: s,\n\
+             simulate: { x: 2.0 mm .. 2.3 mm, y: 1.6 mm .. 1.9 mm, spacing: 1 um } }\n",
+        "corner",
+    );
+    let h = &r["simulation"]["height_map"];
+    assert_eq!(h["uncut_cells"], 0);
+    let contact = &h["contact"];
+    assert!(num(&contact["cells"]) > 10_000.0, "{contact}");
+    let (rms, pv) = (num(&contact["rms_nm"]), num(&contact["pv_nm"]));
+    assert!(rms < 1.0 && pv < 5.0, "{contact}");
+}
