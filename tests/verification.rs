@@ -499,3 +499,22 @@ fn seed_003_contacts_meet_the_figure_at_the_default_tolerance() {
     let (rms, pv) = (num(&contact["rms_nm"]), num(&contact["pv_nm"]));
     assert!(rms < 1.0 && pv < 5.0, "{contact}");
 }
+
+#[test]
+fn seed_002_rollers_cut_within_the_figure() {
+    // Issue #6's figure for both of seed 002's jobs as their examples state
+    // them: the pattern at the paper's 0.1° finish step, the microlenses at
+    // 0.025° (the example says why): contacts within 1 nm RMS, 5 nm PV over
+    // the default window.
+    for example in [
+        "examples/liu_roller_pattern.lens",
+        "examples/liu_roller_microlens.lens",
+    ] {
+        for r in reports(example) {
+            let c = &r["simulation"]["height_map"]["contact"];
+            assert!(num(&c["cells"]) > 1000.0, "{}: {c}", r["job"]);
+            let (rms, pv) = (num(&c["rms_nm"]), num(&c["pv_nm"]));
+            assert!(rms < 1.0 && pv < 5.0, "{}: {c}", r["job"]);
+        }
+    }
+}
