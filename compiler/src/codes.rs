@@ -51,6 +51,9 @@ pub const UNUSED: &str = "W0001";
 pub const WRAP_GAP: &str = "W0002";
 pub const SEAM_LEFT_UNCUT: &str = "W0003";
 pub const CENTRE_LEFT_UNCUT: &str = "W0004";
+/// A servo's data period keeps a spiral's chords from meeting their share
+/// of the path tolerance.
+pub const CHORDS_OVER_TOLERANCE: &str = "W0005";
 
 /// All codes, for the uniqueness test and the reference in README.
 pub const ALL: &[&str] = &[
@@ -102,6 +105,7 @@ pub const ALL: &[&str] = &[
     UNUSED,
     SEAM_LEFT_UNCUT,
     CENTRE_LEFT_UNCUT,
+    CHORDS_OVER_TOLERANCE,
 ];
 
 #[cfg(test)]

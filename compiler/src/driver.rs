@@ -59,6 +59,8 @@ pub struct Built {
     pub beside: Vec<(String, ProgramText)>,
     /// The series behind the plots of `lensc report`.
     pub plots: crate::plots::PlotSeries,
+    /// Warnings the build found (the job still built).
+    pub warnings: Vec<Diagnostic>,
 }
 
 /// A program's text: in memory, or spooled as it was written to a
@@ -179,7 +181,8 @@ pub fn plan_and_emit(
             _ => None,
         };
         match other {
-            Some(Ok(b)) => {
+            Some(Ok(mut b)) => {
+                diags.append(&mut b.warnings);
                 out.push(b);
                 continue;
             }
@@ -330,6 +333,7 @@ pub fn plan_and_emit(
                     report,
                     beside: Vec::new(),
                     plots,
+                    warnings: Vec::new(),
                 });
             }
             Err(e) => diags.push(

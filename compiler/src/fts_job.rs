@@ -242,6 +242,30 @@ pub fn build(
         report["program"]["fts_table"] =
             json!({ "file": name, "rows": table.lines().saturating_sub(2) });
     }
+    // Chords the data period kept from their share of the tolerance.
+    let share = p.spiral.chord_tolerance * lensc_runtime::optimise::UNOPTIMISED_CHORD_SHARE;
+    let warnings = summary
+        .chords_over_tolerance
+        .map(|o| {
+            Diagnostic::warning(
+                codes::CHORDS_OVER_TOLERANCE,
+                format!(
+                    "{} chords of the spiral stray up to {} nm from the exact path (their share of the tolerance is {} nm), the worst at r = {} mm: {} may not be commanded faster than its data rate ({} Hz) allows",
+                    o.count,
+                    trim_num(o.deviation * 1e6),
+                    trim_num(share * 1e6),
+                    trim_num(o.at_radius),
+                    axis,
+                    trim_num(data_rate)
+                ),
+                file,
+                span,
+            )
+            .with_label("this job")
+            .with_help("lower the spindle or surface speed, or give the axis a higher `data_rate`; the report's `chords_over_tolerance` says how many and where")
+        })
+        .into_iter()
+        .collect();
     Ok(Built {
         report_name: format!("{}.report.json", job.name.name),
         program_name,
@@ -251,6 +275,7 @@ pub fn build(
         cut_points: summary.points,
         cutting_time: summary.time,
         plots,
+        warnings,
     })
 }
 
@@ -494,6 +519,7 @@ pub fn prepare(job: &CheckedJob) -> Result<Prepared, Vec<Diagnostic>> {
         // window must contain the contact.
         max_slope: (analysis.max_slope.value * 1.1).min(1.5),
         features,
+        part_top: design.sag_max.value,
     };
     let spin_max = match speed {
         SpindleSpeed::Constant(w) => w,
@@ -778,6 +804,11 @@ fn toolpath_json(
         "cut_points": s.points,
         "cutting_time_s": s.time,
         "chord_tolerance_mm": spiral.chord_tolerance,
+        "chords_over_tolerance": s.chords_over_tolerance.map(|o| json!({
+            "count": o.count,
+            "max_deviation_nm": o.deviation * 1e6,
+            "at_radius_mm": o.at_radius,
+        })),
         "nose_radius_mm": rho,
         "fast_axis": {
             "w_min_mm": s.w_min,

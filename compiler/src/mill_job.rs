@@ -223,6 +223,7 @@ pub fn build_raster(
         cut_points: path.point_count,
         cutting_time: time,
         plots,
+        warnings: Vec::new(),
     })
 }
 
@@ -411,6 +412,7 @@ pub fn build_grinding(
         cut_points: path.points.len(),
         cutting_time: path.total_time,
         plots,
+        warnings: Vec::new(),
     })
 }
 

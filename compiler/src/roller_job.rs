@@ -361,6 +361,7 @@ pub fn build(
         cut_points: points,
         cutting_time: time,
         plots,
+        warnings: Vec::new(),
     })
 }
 

@@ -96,6 +96,10 @@ pub struct TrajectoryBounds {
     /// level at `z_max`, if known (the lenslets of an array): the spiral is
     /// sampled only where it crosses them.
     pub features: Option<Vec<(f64, f64, f64)>>,
+    /// The highest level (mm) of the part itself: where the trajectory is
+    /// above it (a settling plateau, a lenslet's continuation over the
+    /// land) the nose cuts air. Equal to `z_max` without settling.
+    pub part_top: f64,
 }
 
 /// One programmed point: tool-nose centre at radius `x` (mm), spindle angle
@@ -152,6 +156,42 @@ pub struct FtsSummary {
     /// FNV-1a 64 over the bits of every point, in order: equal for any
     /// thread count.
     pub fingerprint: u64,
+    /// Chords left further from the exact path than their share of the
+    /// tolerance because the servo's data period stopped their splitting.
+    pub chords_over_tolerance: Option<ChordShortfall>,
+}
+
+/// One revolution's points (spindle angle, nose-centre height) and the
+/// chords among them that could not meet the chord tolerance.
+pub type Revolution = (Vec<(f64, f64)>, Option<ChordShortfall>);
+
+/// Chords the sampler could not split down to the chord tolerance: two
+/// points may not be closer in time than the servo's data period, and
+/// between those the exact path strays further than the chords' share.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ChordShortfall {
+    /// How many chords.
+    pub count: usize,
+    /// The largest deviation (mm) of a chord's midpoint from the exact
+    /// path, and the radius (mm) where it is.
+    pub deviation: f64,
+    pub at_radius: f64,
+}
+
+impl ChordShortfall {
+    fn merge(into: &mut Option<ChordShortfall>, other: Option<ChordShortfall>) {
+        match (into.as_mut(), other) {
+            (_, None) => {}
+            (None, Some(o)) => *into = Some(o),
+            (Some(a), Some(o)) => {
+                a.count += o.count;
+                if o.deviation > a.deviation {
+                    a.deviation = o.deviation;
+                    a.at_radius = o.at_radius;
+                }
+            }
+        }
+    }
 }
 
 /// The section of a surface along the ray at angle θ: z, dz/du, d²z/du².
@@ -256,19 +296,21 @@ impl Planner<'_> {
     }
 
     /// Points of revolution `k` (its first point, not its last: the next
-    /// revolution starts there), sampled to the chord tolerance.
-    pub fn revolution(&self, k: usize) -> Vec<(f64, f64)> {
+    /// revolution starts there), sampled to the chord tolerance, and the
+    /// chords that could not meet it.
+    pub fn revolution(&self, k: usize) -> Revolution {
         let two_pi = 2.0 * std::f64::consts::PI;
         let (c0, c1) = (
             two_pi * k as f64,
             (two_pi * (k + 1) as f64).min(self.total_angle()),
         );
         if c1 <= c0 {
-            return Vec::new();
+            return (Vec::new(), None);
         }
         let mut out = Vec::new();
+        let mut over = None;
         match self.feature_spans(c0, c1) {
-            None => self.sample(c0, c1, &mut out),
+            None => self.sample(c0, c1, &mut out, &mut over),
             Some(spans) => {
                 // Level between the spans: their ends are enough.
                 let level = self.bounds.z_max + self.nose_radius;
@@ -277,7 +319,7 @@ impl Planner<'_> {
                     if a > at {
                         out.push((at, level));
                     }
-                    self.sample(a.max(at), b, &mut out);
+                    self.sample(a.max(at), b, &mut out, &mut over);
                     at = b;
                 }
                 if at < c1 {
@@ -296,13 +338,19 @@ impl Planner<'_> {
                 kept.push(*p);
             }
         }
-        kept
+        (kept, over)
     }
 
     /// Samples [c0, c1) into `out`: seeds a seed arc apart, each interval
     /// halved until its W midpoint is on the chord (or down to the servo's
     /// data period).
-    fn sample(&self, c0: f64, c1: f64, out: &mut Vec<(f64, f64)>) {
+    fn sample(
+        &self,
+        c0: f64,
+        c1: f64,
+        out: &mut Vec<(f64, f64)>,
+        over: &mut Option<ChordShortfall>,
+    ) {
         let tol = self.spiral.chord_tolerance * crate::optimise::UNOPTIMISED_CHORD_SHARE;
         let r = self.radius(c0).max(self.spiral.seed_arc);
         let seeds = (((c1 - c0) * r / self.spiral.seed_arc).ceil() as usize).max(2);
@@ -325,10 +373,25 @@ impl Planner<'_> {
                 let (wm, h) = self.centre_near(m, Some(hint));
                 hint = h;
                 let splittable = depth < 40 && right.0 - left.0 > 2.0 * shortest;
-                if splittable && (wm - 0.5 * (left.1 + right.1)).abs() > tol {
+                let deviation = (wm - 0.5 * (left.1 + right.1)).abs();
+                if splittable && deviation > tol {
                     stack.push((right, depth + 1));
                     stack.push(((m, wm), depth + 1));
                 } else {
+                    // Only where the nose reaches the part: a chord wholly
+                    // above its top (a settling plateau, a lenslet's
+                    // continuation over the land) cuts air.
+                    let low = left.1.min(right.1).min(wm);
+                    if deviation > tol && low < self.bounds.part_top + self.nose_radius - 1e-9 {
+                        ChordShortfall::merge(
+                            over,
+                            Some(ChordShortfall {
+                                count: 1,
+                                deviation,
+                                at_radius: self.radius(m),
+                            }),
+                        );
+                    }
                     out.push(left);
                     left = right;
                 }
@@ -418,6 +481,7 @@ impl Planner<'_> {
             highest_allowed_speed: f64::INFINITY,
             max_spindle_speed: 0.0,
             fingerprint: 0xcbf2_9ce4_8422_2325,
+            chords_over_tolerance: None,
         };
         let batch = 64;
         // The last two points, for the acceleration across batches.
@@ -427,18 +491,19 @@ impl Planner<'_> {
         let mut k = 0;
         while k <= revs {
             let hi = (k + batch).min(revs + 1);
-            let chunks: Vec<Vec<(f64, f64)>> = (k..hi)
+            let chunks: Vec<Revolution> = (k..hi)
                 .into_par_iter()
                 .map(|j| {
                     if j == revs {
                         // The end point of the spiral.
-                        vec![(total, self.centre(total))]
+                        (vec![(total, self.centre(total))], None)
                     } else {
                         self.revolution(j)
                     }
                 })
                 .collect();
-            for pts in chunks {
+            for (pts, over) in chunks {
+                ChordShortfall::merge(&mut summary.chords_over_tolerance, over);
                 buffer.clear();
                 for (c, w) in pts {
                     let x = self.radius(c);
@@ -580,6 +645,7 @@ mod tests {
                 z_max: d.h,
                 max_slope: slope,
                 features: None,
+                part_top: d.h,
             },
         }
     }
