@@ -156,11 +156,7 @@ pub fn build_raster(
         "cut_length_mm": path.cut_length,
         "feed_mm_per_min": feed * 60.0,
         "cutting_time_s": time,
-        "pass_cutting_times_s": path.passes.iter().map(|p| {
-            p.windows(2).map(|w| {
-                ((w[1][0] - w[0][0]).powi(2) + (w[1][1] - w[0][1]).powi(2) + (w[1][2] - w[0][2]).powi(2)).sqrt()
-            }).sum::<f64>() / feed
-        }).collect::<Vec<_>>(),
+        "pass_cutting_times_s": path.pass_lengths.iter().map(|l| l / feed).collect::<Vec<_>>(),
         "chord_tolerance_mm": raster.chord_tolerance,
         "stepover_mm": raster.stepover,
         "optimisation": crate::driver::optimisation_json(&optimised),

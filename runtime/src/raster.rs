@@ -98,6 +98,8 @@ pub struct RasterPath {
     pub point_count: usize,
     /// Length (mm) of the cutting moves (rapids, plunges and retracts excluded).
     pub cut_length: f64,
+    /// Length (mm) of each pass's cutting moves, in cutting order.
+    pub pass_lengths: Vec<f64>,
     /// Steepest slope along the cut, atan |∂z/∂u| (rad), at a contact point.
     pub max_slope_along: Extremum,
     /// Steepest slope across the cut, atan |∂z/∂v| (rad), at a contact point.
@@ -347,11 +349,16 @@ pub fn plan_raster(
         .flat_map(|p| p.windows(2))
         .map(|w| distance3(w[0], w[1]))
         .sum();
+    let pass_lengths = passes
+        .iter()
+        .map(|p| p.windows(2).map(|w| distance3(w[0], w[1])).sum())
+        .collect();
     Ok(RasterPath {
         safe_z: top + r.retract,
         pass_count: passes.len(),
         point_count: passes.iter().map(Vec::len).sum(),
         cut_length,
+        pass_lengths,
         max_slope_along: summary.slope_along,
         max_slope_across: summary.slope_across,
         min_concave_radius_along: summary.concave_along,
