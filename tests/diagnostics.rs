@@ -4,9 +4,9 @@
 
 use std::path::Path;
 
-use lensc::driver;
-use lensc::loader::RealFs;
 use lensc::render;
+use lensc_build::driver;
+use lensc_lang::loader::RealFs;
 
 fn corpus() -> Vec<std::path::PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/bad");
@@ -134,7 +134,7 @@ fn labels_after_multibyte_characters_point_at_the_right_bytes() {
     let d = c
         .diags()
         .iter()
-        .find(|d| d.code == lensc::codes::PARAMETER_DIMENSION)
+        .find(|d| d.code == lensc_lang::codes::PARAMETER_DIMENSION)
         .expect("rake error");
     assert_eq!(&text[d.primary().span.range()], "3 mm");
     let (human, _, _) = render_file(&path);

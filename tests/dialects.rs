@@ -6,8 +6,8 @@
 mod common;
 
 use common::{abridged, buildable_examples, root};
-use lensc::driver::{Request, check_path, plan_and_emit};
-use lensc::loader::RealFs;
+use lensc_build::driver::{Request, check_path, plan_and_emit};
+use lensc_lang::loader::RealFs;
 
 /// The rules a reader of each dialect would check first.
 fn obeys(dialect: &str, program: &str) -> Result<(), String> {
@@ -80,7 +80,7 @@ fn every_example_builds_in_every_dialect_its_machine_offers() {
         let checked = check_path(&RealFs, &ex).expect("readable");
         assert!(!checked.has_errors(), "{}", rel.display());
         for job in &checked.checked.jobs {
-            for dialect in lensc::lower::offered_dialects(job).iter().skip(1) {
+            for dialect in lensc_lang::lower::offered_dialects(job).iter().skip(1) {
                 let request = Request {
                     job: Some(&job.name.name),
                     dialect: Some(dialect),

@@ -5,9 +5,9 @@
 
 mod common;
 
-use lensc::driver::{self, Checked};
-use lensc::loader::RealFs;
 use lensc::render;
+use lensc_build::driver::{self, Checked};
+use lensc_lang::loader::RealFs;
 use proptest::prelude::*;
 
 fn check(bytes: &[u8]) -> Checked {

@@ -1,11 +1,11 @@
-//! Conformance of the cranelift surface JIT (`lensc::jit`) to the reference
-//! interpreter (`lensc_runtime::ir::Interpreter`): every operation, whole
+//! Conformance of the cranelift surface JIT (`lensc_runtime::surface::jit`) to the reference
+//! interpreter (`lensc_runtime::surface::ir::Interpreter`): every operation, whole
 //! powers, steps, deep and wide tapes, realistic surfaces and random tapes
 //! must give the same six outputs (to 1e-13 relative, NaN equal to NaN) on
 //! batches of every length.
 
-use lensc::jit::JitSurface;
-use lensc_runtime::ir::{Binary, Graph, Id, Interpreter, SurfaceFn, SurfaceTape, Unary};
+use lensc_runtime::surface::ir::{Binary, Graph, Id, Interpreter, SurfaceFn, SurfaceTape, Unary};
+use lensc_runtime::surface::jit::JitSurface;
 use proptest::prelude::*;
 
 const TOL: f64 = 1e-13;

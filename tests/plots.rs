@@ -5,9 +5,9 @@
 mod common;
 
 use common::{lensc, root, text};
-use lensc::driver::{self, Request};
-use lensc::loader::RealFs;
-use lensc::plots::{self, PlotSeries};
+use lensc_build::driver::{self, Request};
+use lensc_build::plots::{self, PlotSeries};
+use lensc_lang::loader::RealFs;
 
 /// Runs `lensc report` into a fresh directory; returns it and the output.
 fn report(args: &[&str]) -> (tempfile::TempDir, std::process::Output) {

@@ -1,5 +1,5 @@
 //! Sag fixtures for every surface kind (issue #3): each surface is written
-//! as `.lens` text, checked and lowered by `lensc::driver`, evaluated by both
+//! as `.lens` text, checked and lowered by `lensc_build::driver`, evaluated by both
 //! backends (the interpreter and the JIT, which must agree to 1e-13), and
 //! compared with values whose source is written beside them:
 //!
@@ -56,10 +56,10 @@
 //!   signs the rotation radius on its own; lensc's `rotation_radius` is a
 //!   magnitude on the profile's side (no saddle toroids).
 
-use lensc::driver;
-use lensc::jit::JitSurface;
-use lensc::loader::RealFs;
-use lensc_runtime::ir::{Interpreter, SurfaceFn};
+use lensc_build::driver;
+use lensc_lang::loader::RealFs;
+use lensc_runtime::surface::ir::{Interpreter, SurfaceFn};
+use lensc_runtime::surface::jit::JitSurface;
 
 /// Agreement with a reference: 1e-12 (mm, or dimensionless slope), relative
 /// above 1.

@@ -4,17 +4,17 @@
 
 mod common;
 
-use lensc::driver;
-use lensc::jit::JitSurface;
-use lensc::loader::RealFs;
-use lensc_runtime::ir::{Interpreter, SurfaceFn};
+use lensc_build::driver;
+use lensc_lang::loader::RealFs;
+use lensc_runtime::surface::ir::{Interpreter, SurfaceFn};
+use lensc_runtime::surface::jit::JitSurface;
 
 fn agree(a: f64, b: f64) -> bool {
     (a.is_nan() && b.is_nan()) || a == b || (a - b).abs() <= 1e-13 * a.abs().max(b.abs()).max(1.0)
 }
 
 /// (file, surface name, lowered surface) for every example surface.
-fn example_surfaces() -> Vec<(String, String, lensc::surfaces::LoweredSurface)> {
+fn example_surfaces() -> Vec<(String, String, lensc_lang::lower::surface::LoweredSurface)> {
     let mut all = Vec::new();
     for ex in common::examples() {
         let c = driver::check_path(&RealFs, &ex).expect("read");
@@ -30,7 +30,7 @@ fn example_surfaces() -> Vec<(String, String, lensc::surfaces::LoweredSurface)> 
 }
 
 /// An n × n grid over the domain's bounding box, inside the domain.
-fn grid(l: &lensc::surfaces::LoweredSurface, n: usize) -> (Vec<f64>, Vec<f64>) {
+fn grid(l: &lensc_lang::lower::surface::LoweredSurface, n: usize) -> (Vec<f64>, Vec<f64>) {
     let ((x0, x1), (y0, y1)) = l.domain.bounds();
     let mut xs = Vec::new();
     let mut ys = Vec::new();

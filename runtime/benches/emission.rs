@@ -11,9 +11,10 @@ use std::hint::black_box;
 use std::io::Write as _;
 use std::time::{Duration, Instant};
 
-use lensc_runtime::machine::Dialect;
 use lensc_runtime::moves::{Feed, Move, Position};
-use lensc_runtime::program::{ProgramWriter, Setup};
+use lensc_runtime::post::Dialect;
+use lensc_runtime::post::ProgramWriter;
+use lensc_runtime::post::Setup;
 
 const MOVES: usize = 1_000_000;
 

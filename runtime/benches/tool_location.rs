@@ -16,7 +16,7 @@
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
-use lensc_runtime::envelope::{binary_search, centre_height, points_near, split_at_corners};
+use lensc_runtime::plan::envelope::{binary_search, centre_height, points_near, split_at_corners};
 use lensc_runtime::surface::{Profile, ProfilePoint};
 
 struct Arcs {

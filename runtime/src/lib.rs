@@ -1,29 +1,23 @@
-//! Everything that executes a lens-machining job, usable as a Rust library
-//! without the language: surfaces, tools, machines, toolpath strategies and
-//! the dialect emitters that turn a move stream into a program.
+//! lensc-runtime: a CAM library with no language in it. The pipeline runs
+//! through its folders in order:
+//!
+//! - `surface/`: the surface IR, its interpreter and (feature `jit`, on by
+//!   default) its cranelift compiler, Forbes polynomials, profiles and
+//!   analysis (curvature, slopes);
+//! - `machine/`: machines, tools and the servo model;
+//! - `plan/`: one planner per strategy, giving neutral tool-centre points;
+//! - `emit/`: each planner's output to the dialect-independent move stream
+//!   (`moves`) and a program;
+//! - `post/`: the move stream to program text in a dialect given as data;
+//! - `verify/`: what the program will cut (simulation, height maps,
+//!   following error).
 //!
 //! Internal units: one per dimension — millimetres, radians, seconds.
 
-pub mod analysis;
-pub mod envelope;
-pub mod follow;
-pub mod forbes;
-pub mod format;
-pub mod fts;
-pub mod grinding;
-pub mod heightmap;
-pub mod ir;
-pub mod job;
+pub mod emit;
 pub mod machine;
 pub mod moves;
-pub mod optimise;
-pub mod program;
-pub mod raster;
-pub mod roller;
-pub mod servo;
-pub mod simulate;
+pub mod plan;
+pub mod post;
 pub mod surface;
-pub mod tool;
-pub mod toolpath;
-
-pub use job::Job;
+pub mod verify;

@@ -1,0 +1,319 @@
+//! Loads a job file and everything it `use`s: standard-library modules
+//! embedded in the binary (shown as `std/NAME.lens`) and other `.lens`
+//! files by path relative to the file that uses them. File access goes
+//! through the `FileSystem` trait so the compiler core stays pure.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use lensc_grammar::ast::{self, Ident, ItemKind, Span, UseTarget};
+use lensc_grammar::diagnostic::codes as syntax_codes;
+use lensc_grammar::{Diagnostic, FileId};
+
+use crate::codes;
+use crate::source::SourceMap;
+use lensc_grammar::suggest::did_you_mean;
+
+/// The standard library: module name and its text.
+pub const STDLIB: &[(&str, &str)] = &[
+    ("machines", include_str!("../../../stdlib/machines.lens")),
+    ("tools", include_str!("../../../stdlib/tools.lens")),
+    (
+        "strategies",
+        include_str!("../../../stdlib/strategies.lens"),
+    ),
+    ("dialects", include_str!("../../../stdlib/dialects.lens")),
+];
+
+/// The module every file sees without a `use`: the controller dialects,
+/// so a machine anywhere can say `dialect: fanuc_0i_lathe`. Its names come
+/// after every other name in scope: a file's own `dialect` of the same name
+/// wins.
+pub const PRELUDE: &str = "dialects";
+
+pub trait FileSystem {
+    fn read(&self, path: &Path) -> std::io::Result<Vec<u8>>;
+    /// A key that is equal for two paths naming the same file.
+    fn canonical(&self, path: &Path) -> PathBuf;
+}
+
+/// The real file system.
+pub struct RealFs;
+
+impl FileSystem for RealFs {
+    fn read(&self, path: &Path) -> std::io::Result<Vec<u8>> {
+        std::fs::read(path)
+    }
+    fn canonical(&self, path: &Path) -> PathBuf {
+        std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf())
+    }
+}
+
+/// What one `use` brings into a file's scope.
+#[derive(Clone, Debug)]
+pub enum Import {
+    /// Every top-level `let` and declaration of the file.
+    All { file: FileId, span: Span },
+    /// One named item of the file.
+    One { file: FileId, name: Ident },
+}
+
+pub struct ParsedFile {
+    pub id: FileId,
+    pub ast: ast::File,
+    pub imports: Vec<Import>,
+}
+
+pub struct Loaded {
+    pub sources: SourceMap,
+    /// Indexed by `FileId`; the first is the root file.
+    pub files: Vec<ParsedFile>,
+    pub diags: Vec<Diagnostic>,
+}
+
+impl Loaded {
+    pub fn file(&self, id: FileId) -> &ParsedFile {
+        &self.files[id.0 as usize]
+    }
+}
+
+/// Loads `root` (as the user named it) and the closure of its `use`s.
+pub fn load(fs: &dyn FileSystem, root: &Path) -> Result<Loaded, std::io::Error> {
+    let bytes = fs.read(root)?;
+    Ok(load_bytes(fs, Key::Path(fs.canonical(root)), root, bytes))
+}
+
+/// Loads source text given directly (tests, benchmarks); `use` of a path
+/// is resolved relative to the working directory.
+pub fn load_text(fs: &dyn FileSystem, name: &str, text: &[u8]) -> Loaded {
+    load_bytes(
+        fs,
+        Key::Path(PathBuf::from(name)),
+        Path::new(name),
+        text.to_vec(),
+    )
+}
+
+fn load_bytes(fs: &dyn FileSystem, key: Key, path: &Path, bytes: Vec<u8>) -> Loaded {
+    let mut l = Loader {
+        fs,
+        loaded: Loaded {
+            sources: SourceMap::default(),
+            files: Vec::new(),
+            diags: Vec::new(),
+        },
+        keys: HashMap::new(),
+        stack: Vec::new(),
+    };
+    l.add(
+        key,
+        path.display().to_string(),
+        Some(path.to_path_buf()),
+        bytes,
+    );
+    l.loaded
+}
+
+#[derive(Clone, PartialEq, Eq, Hash)]
+enum Key {
+    Path(PathBuf),
+    Std(String),
+}
+
+struct Loader<'f> {
+    fs: &'f dyn FileSystem,
+    loaded: Loaded,
+    keys: HashMap<Key, FileId>,
+    /// Files being loaded, outermost first, to detect import cycles.
+    stack: Vec<(Key, FileId)>,
+}
+
+impl Loader<'_> {
+    fn add(&mut self, key: Key, name: String, path: Option<PathBuf>, bytes: Vec<u8>) -> FileId {
+        let (text, utf8_error) = match String::from_utf8(bytes) {
+            Ok(t) => (t, None),
+            Err(e) => {
+                let at = e.utf8_error().valid_up_to();
+                (String::from_utf8_lossy(e.as_bytes()).into_owned(), Some(at))
+            }
+        };
+        let id = self.loaded.sources.add(name, path.clone(), text);
+        self.keys.insert(key.clone(), id);
+        self.loaded.files.push(ParsedFile {
+            id,
+            ast: ast::File::default(),
+            imports: Vec::new(),
+        });
+        if let Some(at) = utf8_error {
+            self.loaded.diags.push(
+                Diagnostic::error(
+                    syntax_codes::NOT_UTF8,
+                    "this file is not valid UTF-8",
+                    id,
+                    Span::new(at, at + 3),
+                )
+                .with_label("the first byte that is not UTF-8")
+                .with_help("save the file as UTF-8; units like µm and ° need it"),
+            );
+            return id;
+        }
+        let (ast, mut diags) = lensc_grammar::parse(&self.loaded.sources.get(id).text, id);
+        self.loaded.diags.append(&mut diags);
+        self.stack.push((key.clone(), id));
+        let mut imports = Vec::new();
+        for item in &ast.items {
+            if let ItemKind::Use(target) = &item.kind {
+                self.resolve_use(id, path.as_deref(), target, item.span, &mut imports);
+            }
+        }
+        if key != Key::Std(PRELUDE.to_string()) {
+            imports.push(Import::All {
+                file: self.std_module(PRELUDE),
+                span: Span::new(0, 0),
+            });
+        }
+        self.stack.pop();
+        let slot = &mut self.loaded.files[id.0 as usize];
+        slot.ast = ast;
+        slot.imports = imports;
+        id
+    }
+
+    /// The standard-library module `name`, loaded once.
+    fn std_module(&mut self, name: &str) -> FileId {
+        let key = Key::Std(name.to_string());
+        if let Some(&f) = self.keys.get(&key) {
+            return f;
+        }
+        let text = STDLIB
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, t)| *t)
+            .expect("a standard-library module");
+        self.add(
+            key,
+            format!("std/{name}.lens"),
+            None,
+            text.as_bytes().to_vec(),
+        )
+    }
+
+    fn resolve_use(
+        &mut self,
+        from: FileId,
+        from_path: Option<&Path>,
+        target: &UseTarget,
+        span: Span,
+        imports: &mut Vec<Import>,
+    ) {
+        match target {
+            UseTarget::Std(segs) => {
+                if segs[0].name != "std" {
+                    self.loaded.diags.push(
+                        Diagnostic::error(
+                            codes::UNKNOWN_MODULE,
+                            format!("unknown module `{}`", segs[0].name),
+                            from,
+                            segs[0].span,
+                        )
+                        .with_label("only `std` modules are named this way")
+                        .with_help("use another file by its path in quotes: use \"common.lens\""),
+                    );
+                    return;
+                }
+                let Some(module) = segs.get(1) else { return };
+                let Some(&(mname, _)) = STDLIB.iter().find(|(n, _)| *n == module.name) else {
+                    let names: Vec<&str> = STDLIB.iter().map(|(n, _)| *n).collect();
+                    let mut d = Diagnostic::error(
+                        codes::UNKNOWN_MODULE,
+                        format!("the standard library has no module `{}`", module.name),
+                        from,
+                        module.span,
+                    )
+                    .with_label("no such module");
+                    d = d.with_help(match did_you_mean(&module.name, names.iter().copied()) {
+                        Some(s) => format!("did you mean `{s}`?"),
+                        None => format!("the modules are: {}", names.join(", ")),
+                    });
+                    self.loaded.diags.push(d);
+                    return;
+                };
+                if segs.len() > 3 {
+                    self.loaded.diags.push(
+                        Diagnostic::error(
+                            codes::UNKNOWN_MODULE,
+                            "a `use` path names a module and at most one item",
+                            from,
+                            segs[3].span.to(segs[segs.len() - 1].span),
+                        )
+                        .with_label("remove this"),
+                    );
+                }
+                let file = self.std_module(mname);
+                match segs.get(2) {
+                    Some(name) => imports.push(Import::One {
+                        file,
+                        name: name.clone(),
+                    }),
+                    None => imports.push(Import::All { file, span }),
+                }
+            }
+            UseTarget::File { path, span: pspan } => {
+                let base = from_path.and_then(Path::parent).unwrap_or(Path::new(""));
+                let full = base.join(path);
+                let key = Key::Path(self.fs.canonical(&full));
+                if let Some(pos) = self.stack.iter().position(|(k, _)| *k == key) {
+                    let mut chain: Vec<String> = self.stack[pos..]
+                        .iter()
+                        .map(|(_, f)| self.loaded.sources.get(*f).name.clone())
+                        .collect();
+                    chain.push(self.loaded.sources.get(self.stack[pos].1).name.clone());
+                    self.loaded.diags.push(
+                        Diagnostic::error(codes::IMPORT_CYCLE, "import cycle", from, *pspan)
+                            .with_label(
+                                "this `use` leads back to a file that is still being loaded",
+                            )
+                            .with_help(format!(
+                                "the cycle is {}; move what both files need into a third file",
+                                chain.join(" → ")
+                            )),
+                    );
+                    return;
+                }
+                if let Some(&f) = self.keys.get(&key) {
+                    imports.push(Import::All { file: f, span });
+                    return;
+                }
+                match self.fs.read(&full) {
+                    Ok(bytes) => {
+                        let f = self.add(key, full.display().to_string(), Some(full), bytes);
+                        imports.push(Import::All { file: f, span });
+                    }
+                    Err(e) => self.loaded.diags.push(
+                        Diagnostic::error(
+                            codes::CANNOT_READ,
+                            format!("cannot read `{}`: {}", full.display(), plain_io_error(&e)),
+                            from,
+                            *pspan,
+                        )
+                        .with_label("used here")
+                        .with_help("paths are relative to the file that uses them"),
+                    ),
+                }
+            }
+        }
+    }
+}
+
+/// The OS error without its "(os error 2)" tail.
+pub fn plain_io_error(e: &std::io::Error) -> String {
+    match e.kind() {
+        std::io::ErrorKind::NotFound => "no such file".into(),
+        std::io::ErrorKind::PermissionDenied => "permission denied".into(),
+        std::io::ErrorKind::IsADirectory => "it is a directory".into(),
+        _ => {
+            let s = e.to_string();
+            s.split(" (os error").next().unwrap_or(&s).to_lowercase()
+        }
+    }
+}

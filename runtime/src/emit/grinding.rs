@@ -1,0 +1,66 @@
+//! Profile grinding: the wheel-centre path to a lathe program.
+
+use crate::moves::{self, Position};
+use crate::post::dialect::Dialect;
+use crate::post::{ProgramError, ProgramWriter, Setup};
+
+/// The move stream of a grinding pass: the wheel centre's X and Z, each
+/// interval at the feed that moves the contact point at v_f (the interval
+/// takes its contact-x length over v_f).
+pub fn grinding_moves(
+    path: &crate::plan::grinding::GrindingPath,
+    feed: f64,
+    safe_z: f64,
+) -> Vec<moves::Move> {
+    let Some(first) = path.points.first() else {
+        return Vec::new();
+    };
+    let mut out = vec![
+        moves::Move::SpindleOn(None),
+        moves::Move::Rapid(Position::xz(first.x, safe_z)),
+        moves::Move::Linear {
+            to: Position::xz(first.x, first.z),
+            feed: Some(moves::Feed::PerTime(feed)),
+        },
+    ];
+    for pair in path.points.windows(2) {
+        let (a, b) = (pair[0], pair[1]);
+        let step = ((b.x - a.x).powi(2) + (b.z - a.z).powi(2)).sqrt();
+        let dt = (b.contact_x - a.contact_x).abs() / feed;
+        out.push(moves::Move::Linear {
+            to: Position::xz(b.x, b.z),
+            feed: Some(moves::Feed::PerTime(step / dt)),
+        });
+    }
+    out.push(moves::Move::Rapid(Position {
+        z: safe_z,
+        ..Position::KEEP
+    }));
+    out.push(moves::Move::SpindleOff);
+    out
+}
+
+/// A program for a grinding pass: X and Z of the wheel centre.
+pub fn emit_grinding(
+    dialect: &Dialect,
+    job: &str,
+    header: &[String],
+    path: &crate::plan::grinding::GrindingPath,
+    feed: f64,
+    safe_z: f64,
+    resolution: f64,
+) -> Result<String, ProgramError> {
+    // Wheel centres are exact at each interval: blending held to the
+    // machine's resolution.
+    let mut w = ProgramWriter::new(
+        dialect,
+        Setup::Lathe,
+        job,
+        header,
+        "XZ",
+        resolution,
+        resolution,
+    )?;
+    w.write_all(&grinding_moves(path, feed, safe_z))?;
+    w.finish()
+}

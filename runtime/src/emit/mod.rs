@@ -1,0 +1,54 @@
+//! Each strategy's planned path to the dialect-independent move stream and
+//! a program: the adapters between `plan/` and `post/`, one file per
+//! strategy, and the header words they share.
+
+pub mod fts;
+pub mod grinding;
+pub mod raster;
+pub mod roller;
+pub mod turning;
+
+use crate::moves;
+use crate::plan::optimise;
+use crate::post::dialect::Dialect;
+use crate::post::header::num;
+
+/// A program, the move stream it was written from, and what
+/// optimisation did to that stream.
+pub struct Emitted {
+    pub text: String,
+    pub stream: Vec<moves::Move>,
+    pub optimised: optimise::Summary,
+}
+
+/// How a path's tolerance T is stated in a header, with its shares.
+pub fn tolerance_words(t: f64) -> String {
+    format!(
+        "path tolerance {} nm [chords {}, fitting {}, blending {} nm]",
+        num(t * 1e6),
+        num(t * optimise::CHORD_SHARE * 1e6),
+        num(t * optimise::FIT_SHARE * 1e6),
+        num(t * optimise::BLEND_SHARE * 1e6)
+    )
+}
+
+/// What optimisation did, for a header.
+pub fn optimisation_words(s: &optimise::Summary) -> String {
+    format!(
+        "optimised from {} to {} moves: {} arcs, {} merged lines, largest deviation {} nm",
+        s.moves_before,
+        s.moves_after,
+        s.arcs,
+        s.merged_lines,
+        num((s.max_deviation * 1e9).round() / 1e3)
+    )
+}
+
+/// What a lathe program's X word is in `dialect`, for its header.
+pub fn x_word(dialect: &Dialect) -> &'static str {
+    if dialect.lathe_x_diameter {
+        "the diameter"
+    } else {
+        "the radius"
+    }
+}

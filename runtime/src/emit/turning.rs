@@ -1,0 +1,134 @@
+//! Profile turning: the planned profile path to a lathe program.
+
+use super::{Emitted, optimisation_words, tolerance_words, x_word};
+use crate::moves::{self, Position};
+use crate::plan::optimise::{self, optimise};
+use crate::plan::turning::{Feed, Move, Toolpath, TurningJob};
+use crate::post::header::{Provenance, duration, num};
+use crate::post::{ProgramError, ProgramWriter, Setup};
+use std::f64::consts::PI;
+
+/// Writes a lathe program for a profile-turning path in the machine's
+/// dialect, optimised (lines merged, arcs fitted) within the fitting share
+/// of the strategy's tolerance.
+pub fn emit(job: &TurningJob, path: &Toolpath, prov: &Provenance) -> Result<Emitted, ProgramError> {
+    let centre_height = if job.tool.centre_height == 0.0 {
+        String::new()
+    } else {
+        format!(
+            ", edge {} mm off the spindle axis: X = sqrt[r² − h²] of the nose-centre radius r",
+            num(job.tool.centre_height)
+        )
+    };
+    let header = [
+        format!("lensc {}: job {}", prov.lensc_version, job.name),
+        format!("source {} fnv1a64 {:016x}", prov.source, prov.source_hash),
+        format!(
+            "units mm; X is {}, Z along the spindle axis, +Z out of the material",
+            x_word(&job.machine.dialect)
+        ),
+        "coordinates are the centre of the tool nose; no cutter compensation".into(),
+        format!("surface {}: {}", job.surface_name, job.surface.description),
+        format!(
+            "tool {}: round nose, nose radius {} mm{centre_height}",
+            job.tool_name,
+            num(job.tool.nose_radius)
+        ),
+        format!(
+            "strategy {}: profile turning, {} points, {}{}{}",
+            job.strategy_name,
+            path.cut_points,
+            tolerance_words(job.strategy.chord_tolerance),
+            match job.strategy.surface_speed {
+                Some(v) => format!(
+                    ", constant surface speed {} m/min capped at {} rpm",
+                    num(v * 0.06),
+                    num((job.strategy.spindle_speed * 60.0 / (2.0 * PI)).floor())
+                ),
+                None => String::new(),
+            },
+            roughing_words(job, path)
+        ),
+        format!(
+            "machine {}: {} lathe",
+            job.machine_name, job.machine.dialect.name
+        ),
+        format!("estimated cutting time {}", duration(path.cutting_time())),
+    ];
+    let tolerance = job.strategy.chord_tolerance;
+    let (stream, summary) = optimise(
+        &turning_moves(job, path),
+        tolerance * optimise::FIT_SHARE,
+        &job.machine.dialect.arc_planes,
+    );
+    let mut header = header.to_vec();
+    header.push(optimisation_words(&summary));
+    let mut w = ProgramWriter::new(
+        &job.machine.dialect,
+        Setup::Lathe,
+        &job.name,
+        &header,
+        "XZ",
+        job.machine.resolution,
+        tolerance * optimise::BLEND_SHARE,
+    )?;
+    w.write_all(&stream)?;
+    Ok(Emitted {
+        text: w.finish()?,
+        stream,
+        optimised: summary,
+    })
+}
+
+/// The move stream of a profile-turning path: spindle on, the planner's
+/// moves (X corrected for an edge set off centre), spindle off.
+pub fn turning_moves(job: &TurningJob, path: &Toolpath) -> Vec<moves::Move> {
+    let feed = match job.strategy.feed {
+        Feed::PerRevolution(f) => moves::Feed::PerRevolution(f),
+        Feed::PerTime(v) => moves::Feed::PerTime(v),
+    };
+    // An edge set h off the axis cuts radius sqrt(X² + h²).
+    let h = job.tool.centre_height;
+    let corrected = |x: f64| {
+        if h == 0.0 {
+            x
+        } else {
+            x.signum() * (x * x - h * h).max(0.0).sqrt()
+        }
+    };
+    let mut out = Vec::with_capacity(path.moves.len() + 2);
+    out.push(match job.strategy.surface_speed {
+        Some(v) => moves::Move::SpindleSurfaceSpeed {
+            surface_speed: v,
+            cap: job.strategy.spindle_speed,
+        },
+        None => moves::Move::SpindleOn(Some(job.strategy.spindle_speed)),
+    });
+    out.extend(path.moves.iter().map(|m| match *m {
+        Move::Rapid { x, z } => moves::Move::Rapid(Position::xz(corrected(x), z)),
+        Move::Feed { x, z } => moves::Move::Linear {
+            to: Position::xz(corrected(x), z),
+            feed: Some(feed),
+        },
+    }));
+    out.push(moves::Move::SpindleOff);
+    out
+}
+
+/// ", after N roughing passes from …" for a job with stock, else "".
+fn roughing_words(job: &TurningJob, path: &Toolpath) -> String {
+    use crate::plan::turning::Stock;
+    let Some(r) = job.strategy.roughing else {
+        return String::new();
+    };
+    let stock = match r.stock {
+        Stock::Flat { top } => format!("flat stock at Z{}", num(top)),
+        Stock::Offset { allowance } => format!("stock {} mm over the surface", num(allowance)),
+    };
+    format!(
+        ", after {} roughing passes from {stock}, at most {} mm each, {} mm left for the finish",
+        path.roughing_passes,
+        num(r.depth_of_cut),
+        num(r.finish_allowance)
+    )
+}

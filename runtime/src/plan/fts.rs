@@ -1,0 +1,835 @@
+//! Spiral turning with a fast tool servo (Hashimoto & Yan 2025, seed 003):
+//! an Archimedean spiral in X (radius) and C (spindle angle) with the fast
+//! axis W carrying the height of the tool-nose centre, revolution by
+//! revolution, lazily and in parallel, identical for any thread count.
+//!
+//! Geometry. At spindle angle θ the nose sits over the part's ray at polar
+//! angle θ, its centre at radius x(θ) = r₀ − f θ / 2π. The nose's cutting
+//! edge is a circle of radius ρ in the plane of that ray and the spindle
+//! axis, so the centre height is the envelope of the section along the ray:
+//!   w = max over u of  z(u) + sqrt(ρ² − (u − x)²),
+//! found by Newton's method on the exact derivatives (`envelope::piece_max`),
+//! within the reach ρ·sin(steepest slope) of x. The surface the planner
+//! follows is the tool trajectory: for lens arrays, each lenslet continued
+//! past its rim up to the settling offset h above the land (eqs 6–7), the
+//! land itself at h, so the servo has settled before the cut begins.
+//!
+//! Sampling. X and C move together linearly in the program, which is the
+//! Archimedean spiral itself, so only W needs sampling: from seeds a fixed
+//! arc apart, each interval is halved until the W midpoint lies within the
+//! chord tolerance of the chord in (C, W).
+//!
+//! Speed. Constant spindle speed, or constant surface speed with a cap.
+//! Each point's time follows from the speed at its radius; the fast axis's
+//! acceleration is the second divided difference of W in time, checked
+//! against the machine's limit.
+
+use rayon::prelude::*;
+
+use crate::plan::envelope;
+use crate::surface::ir::SurfaceFn;
+use crate::surface::{Profile, ProfilePoint};
+
+/// How fast the spindle turns.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SpindleSpeed {
+    /// Constant (rad/s).
+    Constant(f64),
+    /// Constant surface speed (mm/s) at the tool, capped (rad/s).
+    SurfaceSpeed { speed: f64, max: f64 },
+}
+
+impl SpindleSpeed {
+    /// Spindle speed (rad/s) with the tool at radius `r` (mm).
+    pub fn at(self, r: f64) -> f64 {
+        match self {
+            SpindleSpeed::Constant(w) => w,
+            SpindleSpeed::SurfaceSpeed { speed, max } => {
+                if r * max <= speed {
+                    max
+                } else {
+                    speed / r
+                }
+            }
+        }
+    }
+}
+
+/// A fast-tool-servo spiral, from `start_radius` in to `end_radius`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FtsSpiral {
+    /// Radial feed per revolution (mm).
+    pub feed_per_rev: f64,
+    pub speed: SpindleSpeed,
+    /// The path's tolerance T (mm); W's chords in (C, W) take
+    /// `optimise::UNOPTIMISED_CHORD_SHARE` of it, blending the rest.
+    pub chord_tolerance: f64,
+    /// Largest arc (mm) between seeds; features shorter than this along
+    /// the spiral may be missed by the sampling.
+    pub seed_arc: f64,
+    /// The servo's data period (s): no two points closer in time. Where
+    /// the trajectory has a corner (in the air, at the settling plateau)
+    /// the chord tolerance gives way to it.
+    pub min_interval: f64,
+    pub start_radius: f64,
+    pub end_radius: f64,
+}
+
+/// The fast axis's limits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FastAxis {
+    /// Travel (mm).
+    pub stroke: f64,
+    /// Largest acceleration (mm/s²).
+    pub max_acceleration: f64,
+}
+
+/// What the planner knows of the trajectory surface beforehand.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TrajectoryBounds {
+    /// The highest the surface rises (mm): where it is this high, the nose
+    /// rests there and no neighbour can lift it.
+    pub z_max: f64,
+    /// Its steepest slope (rad): the contact is within ρ·sin of this.
+    pub max_slope: f64,
+    /// Discs (centre x, y and radius, mm) outside which the surface is
+    /// level at `z_max`, if known (the lenslets of an array): the spiral is
+    /// sampled only where it crosses them.
+    pub features: Option<Vec<(f64, f64, f64)>>,
+    /// The highest level (mm) of the part itself: where the trajectory is
+    /// above it (a settling plateau, a lenslet's continuation over the
+    /// land) the nose cuts air. Equal to `z_max` without settling.
+    pub part_top: f64,
+}
+
+/// One programmed point: tool-nose centre at radius `x` (mm), spindle angle
+/// `c` (rad, counted from the start), fast-axis height `w` (mm), and the
+/// time (s) since the start of the spiral.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpiralPoint {
+    pub x: f64,
+    pub c: f64,
+    pub w: f64,
+    pub t: f64,
+}
+
+/// Why a spiral cannot be planned.
+#[derive(Clone, Debug, PartialEq)]
+pub enum FtsError {
+    /// The surface is undefined where the nose must go.
+    Undefined { x: f64, c: f64 },
+    /// The fast axis would travel further than its stroke.
+    StrokeExceeded { range: f64, stroke: f64 },
+    /// The fast axis would accelerate beyond its limit; the highest speed
+    /// that respects it (rad/s for constant speed, mm/s for constant
+    /// surface speed).
+    AccelerationExceeded {
+        acceleration: f64,
+        max: f64,
+        at_radius: f64,
+        highest_allowed_speed: f64,
+    },
+    /// Parameters that cannot make a spiral.
+    Invalid(&'static str),
+}
+
+/// The figures of a planned spiral.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FtsSummary {
+    pub revolutions: usize,
+    pub points: usize,
+    /// Cutting time (s).
+    pub time: f64,
+    /// W range (mm): lowest and highest.
+    pub w_min: f64,
+    pub w_max: f64,
+    /// Largest |acceleration| of W (mm/s²) and the radius where it occurs.
+    pub max_acceleration: f64,
+    pub max_acceleration_at: f64,
+    /// The highest spindle speed (constant speed, rad/s) or surface speed
+    /// (constant surface speed, mm/s) at which every point's acceleration
+    /// stays within the limit.
+    pub highest_allowed_speed: f64,
+    /// Highest spindle speed used (rad/s) and the surface speed (mm/s) at
+    /// the outermost point.
+    pub max_spindle_speed: f64,
+    /// FNV-1a 64 over the bits of every point, in order: equal for any
+    /// thread count.
+    pub fingerprint: u64,
+    /// Chords left further from the exact path than their share of the
+    /// tolerance because the servo's data period stopped their splitting.
+    pub chords_over_tolerance: Option<ChordShortfall>,
+}
+
+/// One revolution's points (spindle angle, nose-centre height) and the
+/// chords among them that could not meet the chord tolerance.
+pub type Revolution = (Vec<(f64, f64)>, Option<ChordShortfall>);
+
+/// Chords the sampler could not split down to the chord tolerance: two
+/// points may not be closer in time than the servo's data period, and
+/// between those the exact path strays further than the chords' share.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ChordShortfall {
+    /// How many chords.
+    pub count: usize,
+    /// The largest deviation (mm) of a chord's midpoint from the exact
+    /// path, and the radius (mm) where it is.
+    pub deviation: f64,
+    pub at_radius: f64,
+}
+
+impl ChordShortfall {
+    fn merge(into: &mut Option<ChordShortfall>, other: Option<ChordShortfall>) {
+        match (into.as_mut(), other) {
+            (_, None) => {}
+            (None, Some(o)) => *into = Some(o),
+            (Some(a), Some(o)) => {
+                a.count += o.count;
+                if o.deviation > a.deviation {
+                    a.deviation = o.deviation;
+                    a.at_radius = o.at_radius;
+                }
+            }
+        }
+    }
+}
+
+/// The section of a surface along the ray at angle θ: z, dz/du, d²z/du².
+struct Ray<'a> {
+    surface: &'a dyn SurfaceFn,
+    cos: f64,
+    sin: f64,
+}
+
+impl Profile for Ray<'_> {
+    fn point(&self, u: f64) -> ProfilePoint {
+        let o = self.surface.eval(u * self.cos, u * self.sin);
+        let (c, s) = (self.cos, self.sin);
+        ProfilePoint {
+            z: o[0],
+            dz: o[1] * c + o[2] * s,
+            d2z: o[3] * c * c + 2.0 * o[4] * c * s + o[5] * s * s,
+        }
+    }
+}
+
+/// The planner: the spiral's geometry and how to find each point.
+pub struct Planner<'a> {
+    pub spiral: &'a FtsSpiral,
+    pub surface: &'a (dyn SurfaceFn + Sync),
+    pub nose_radius: f64,
+    pub bounds: TrajectoryBounds,
+}
+
+impl Planner<'_> {
+    /// Number of revolutions from the start radius in to the end radius.
+    pub fn revolutions(&self) -> usize {
+        let s = self.spiral;
+        ((s.start_radius - s.end_radius) / s.feed_per_rev)
+            .ceil()
+            .max(0.0) as usize
+    }
+
+    /// Total spindle angle (rad) of the spiral.
+    fn total_angle(&self) -> f64 {
+        let s = self.spiral;
+        2.0 * std::f64::consts::PI * (s.start_radius - s.end_radius) / s.feed_per_rev
+    }
+
+    /// Tool radius at spindle angle c.
+    fn radius(&self, c: f64) -> f64 {
+        self.spiral.start_radius - self.spiral.feed_per_rev * c / (2.0 * std::f64::consts::PI)
+    }
+
+    /// The nose-centre height at spindle angle c (exact, see module doc).
+    pub fn centre(&self, c: f64) -> f64 {
+        self.centre_near(c, None).0
+    }
+
+    /// The nose-centre height at spindle angle c and the contact's offset
+    /// along the ray from the nose's radius; `hint`, a neighbouring point's
+    /// offset, starts Newton's method nearer the contact than the nose's
+    /// own radius does. The height is the same to far below a picometre
+    /// from any start (seed 003's programs came out byte for byte the same).
+    fn centre_near(&self, c: f64, hint: Option<f64>) -> (f64, f64) {
+        let x = self.radius(c);
+        let ray = Ray {
+            surface: self.surface,
+            cos: c.cos(),
+            sin: c.sin(),
+        };
+        let rho = self.nose_radius;
+        let reach = rho * self.bounds.max_slope.sin() * 1.05 + 1e-9;
+        let start = match hint {
+            Some(h) if h != 0.0 && h.abs() < reach => x + h,
+            _ => x,
+        };
+        let here = ray.point(start);
+        if start == x && here.z >= self.bounds.z_max && here.dz == 0.0 {
+            // Nothing within reach can rise above the highest level.
+            return (here.z + rho, 0.0);
+        }
+        // Newton on φ′ from u = start, where the surface is already
+        // evaluated; should a step leave the reach or φ not be concave
+        // there (a corner of the trajectory), the bracketed search takes
+        // over.
+        let (mut u, mut p) = (start, here);
+        for _ in 0..8 {
+            let d = u - x;
+            let root = (rho * rho - d * d).sqrt();
+            let dphi = p.dz - d / root;
+            let ddphi = p.d2z - rho * rho / (root * root * root);
+            let step = -dphi / ddphi;
+            let next = u + step;
+            if !(ddphi < 0.0 && (next - x).abs() < reach) {
+                break;
+            }
+            if step.abs() <= 1e-9 {
+                // Converged: φ at u is exact to ~φ″·step², far below a pm.
+                return (p.z + root, u - x);
+            }
+            u = next;
+            p = ray.point(u);
+        }
+        let (w, at) = envelope::piece_max(&ray, rho, x, x - reach, x + reach);
+        (w, at - x)
+    }
+
+    /// Points of revolution `k` (its first point, not its last: the next
+    /// revolution starts there), sampled to the chord tolerance, and the
+    /// chords that could not meet it.
+    pub fn revolution(&self, k: usize) -> Revolution {
+        let two_pi = 2.0 * std::f64::consts::PI;
+        let (c0, c1) = (
+            two_pi * k as f64,
+            (two_pi * (k + 1) as f64).min(self.total_angle()),
+        );
+        if c1 <= c0 {
+            return (Vec::new(), None);
+        }
+        let mut out = Vec::new();
+        let mut over = None;
+        match self.feature_spans(c0, c1) {
+            None => self.sample(c0, c1, &mut out, &mut over),
+            Some(spans) => {
+                // Level between the spans: their ends are enough.
+                let level = self.bounds.z_max + self.nose_radius;
+                let mut at = c0;
+                for (a, b) in spans {
+                    if a > at {
+                        out.push((at, level));
+                    }
+                    self.sample(a.max(at), b, &mut out, &mut over);
+                    at = b;
+                }
+                if at < c1 {
+                    out.push((at, level));
+                }
+            }
+        }
+        out.dedup_by(|b, a| b.0 == a.0);
+        // Where W stays level (the land, or the settling plateau), the
+        // spiral between the ends of the level stretch is one move.
+        let mut kept: Vec<(f64, f64)> = Vec::with_capacity(out.len() / 4 + 2);
+        for (i, p) in out.iter().enumerate() {
+            let level_before = kept.last().is_some_and(|q| q.1 == p.1);
+            let level_after = out.get(i + 1).is_some_and(|q| q.1 == p.1);
+            if !(level_before && level_after) {
+                kept.push(*p);
+            }
+        }
+        (kept, over)
+    }
+
+    /// Samples [c0, c1) into `out`: seeds a seed arc apart, each interval
+    /// halved until its W midpoint is on the chord (or down to the servo's
+    /// data period).
+    fn sample(
+        &self,
+        c0: f64,
+        c1: f64,
+        out: &mut Vec<(f64, f64)>,
+        over: &mut Option<ChordShortfall>,
+    ) {
+        let tol = self.spiral.chord_tolerance * crate::plan::optimise::UNOPTIMISED_CHORD_SHARE;
+        let r = self.radius(c0).max(self.spiral.seed_arc);
+        let seeds = (((c1 - c0) * r / self.spiral.seed_arc).ceil() as usize).max(2);
+        // The contact's offset along the ray at the last point computed:
+        // each solve starts from its neighbour's.
+        let (w0, mut hint) = self.centre_near(c0, None);
+        let mut prev = (c0, w0);
+        for i in 1..=seeds {
+            let c = c0 + (c1 - c0) * i as f64 / seeds as f64;
+            let (w, h) = self.centre_near(c, Some(hint));
+            hint = h;
+            let next = (c, w);
+            // Halve (prev, next) until every midpoint is on its chord, or
+            // the interval is down to the servo's data period.
+            let shortest = self.spiral.speed.at(self.radius(c)) * self.spiral.min_interval;
+            let mut stack = vec![(next, 0u32)];
+            let mut left = prev;
+            while let Some((right, depth)) = stack.pop() {
+                let m = 0.5 * (left.0 + right.0);
+                let (wm, h) = self.centre_near(m, Some(hint));
+                hint = h;
+                let splittable = depth < 40 && right.0 - left.0 > 2.0 * shortest;
+                let deviation = (wm - 0.5 * (left.1 + right.1)).abs();
+                if splittable && deviation > tol {
+                    stack.push((right, depth + 1));
+                    stack.push(((m, wm), depth + 1));
+                } else {
+                    // Only where the nose reaches the part: a chord wholly
+                    // above its top (a settling plateau, a lenslet's
+                    // continuation over the land) cuts air.
+                    let low = left.1.min(right.1).min(wm);
+                    if deviation > tol && low < self.bounds.part_top + self.nose_radius - 1e-9 {
+                        ChordShortfall::merge(
+                            over,
+                            Some(ChordShortfall {
+                                count: 1,
+                                deviation,
+                                at_radius: self.radius(m),
+                            }),
+                        );
+                    }
+                    out.push(left);
+                    left = right;
+                }
+            }
+            prev = next;
+        }
+    }
+
+    /// The spans of spindle angle in [c0, c1) where the spiral passes over
+    /// a feature disc (grown by the nose's reach and a seed arc), merged and
+    /// in order; `None` when the features are not known.
+    fn feature_spans(&self, c0: f64, c1: f64) -> Option<Vec<(f64, f64)>> {
+        let features = self.bounds.features.as_ref()?;
+        let two_pi = 2.0 * std::f64::consts::PI;
+        let (r_out, r_in) = (self.radius(c0), self.radius(c1));
+        let grow = self.nose_radius * self.bounds.max_slope.sin() + self.spiral.seed_arc;
+        let mut spans: Vec<(f64, f64)> = Vec::new();
+        for &(fx, fy, fr) in features {
+            let d = fx.hypot(fy);
+            let rr = fr + grow;
+            if d - rr > r_out || d + rr < r_in {
+                continue;
+            }
+            // Half-width in angle at the radius nearest the disc centre.
+            let r = d.clamp(r_in, r_out);
+            let half = if d <= rr || r <= rr {
+                std::f64::consts::PI
+            } else {
+                let cos = ((r * r + d * d - rr * rr) / (2.0 * r * d)).clamp(-1.0, 1.0);
+                cos.acos()
+            };
+            let centre = fy.atan2(fx);
+            // Every copy of [centre − half, centre + half] (mod 2π) in range.
+            let base = ((c0 - centre - half) / two_pi).floor();
+            let mut n = base;
+            loop {
+                let (a, b) = (centre - half + n * two_pi, centre + half + n * two_pi);
+                if a >= c1 {
+                    break;
+                }
+                if b > c0 {
+                    spans.push((a.max(c0), b.min(c1)));
+                }
+                n += 1.0;
+            }
+        }
+        spans.sort_by(|p, q| p.0.total_cmp(&q.0));
+        let mut merged: Vec<(f64, f64)> = Vec::with_capacity(spans.len());
+        for (a, b) in spans {
+            match merged.last_mut() {
+                Some(last) if a <= last.1 => last.1 = last.1.max(b),
+                _ => merged.push((a, b)),
+            }
+        }
+        Some(merged)
+    }
+
+    /// Plans the spiral, handing each revolution's points in order to
+    /// `sink`; revolutions are computed `batch` at a time in parallel.
+    pub fn plan(
+        &self,
+        fast_axis: &FastAxis,
+        mut sink: impl FnMut(&[SpiralPoint]),
+    ) -> Result<FtsSummary, FtsError> {
+        let s = self.spiral;
+        let ok = |v: f64| v.is_finite() && v > 0.0;
+        if !(ok(s.feed_per_rev) && ok(s.chord_tolerance) && ok(s.seed_arc) && ok(self.nose_radius))
+        {
+            return Err(FtsError::Invalid(
+                "feed, tolerance, seed arc and nose radius must be positive",
+            ));
+        }
+        if !(s.start_radius.is_finite() && s.end_radius >= 0.0 && s.start_radius > s.end_radius) {
+            return Err(FtsError::Invalid(
+                "the spiral must run inwards from its start radius",
+            ));
+        }
+        let revs = self.revolutions();
+        let mut summary = FtsSummary {
+            revolutions: revs,
+            points: 0,
+            time: 0.0,
+            w_min: f64::INFINITY,
+            w_max: f64::NEG_INFINITY,
+            max_acceleration: 0.0,
+            max_acceleration_at: s.start_radius,
+            highest_allowed_speed: f64::INFINITY,
+            max_spindle_speed: 0.0,
+            fingerprint: 0xcbf2_9ce4_8422_2325,
+            chords_over_tolerance: None,
+        };
+        let batch = 64;
+        // The last two points, for the acceleration across batches.
+        let mut last: Vec<SpiralPoint> = Vec::with_capacity(2);
+        let mut buffer: Vec<SpiralPoint> = Vec::new();
+        let total = self.total_angle();
+        let mut k = 0;
+        while k <= revs {
+            let hi = (k + batch).min(revs + 1);
+            let chunks: Vec<Revolution> = (k..hi)
+                .into_par_iter()
+                .map(|j| {
+                    if j == revs {
+                        // The end point of the spiral.
+                        (vec![(total, self.centre(total))], None)
+                    } else {
+                        self.revolution(j)
+                    }
+                })
+                .collect();
+            for (pts, over) in chunks {
+                ChordShortfall::merge(&mut summary.chords_over_tolerance, over);
+                buffer.clear();
+                for (c, w) in pts {
+                    let x = self.radius(c);
+                    if !(w.is_finite() && x.is_finite()) {
+                        return Err(FtsError::Undefined { x, c });
+                    }
+                    let t = match last.last() {
+                        None => 0.0,
+                        Some(p) => {
+                            let spin = s.speed.at(0.5 * (p.x + x));
+                            p.t + (c - p.c) / spin
+                        }
+                    };
+                    let point = SpiralPoint { x, c, w, t };
+                    self.account(&mut summary, &last, point, fast_axis);
+                    if last.len() == 2 {
+                        last.remove(0);
+                    }
+                    last.push(point);
+                    buffer.push(point);
+                }
+                sink(&buffer);
+            }
+            k = hi;
+        }
+        summary.time = last.last().map_or(0.0, |p| p.t);
+        let range = summary.w_max - summary.w_min;
+        if range > fast_axis.stroke {
+            return Err(FtsError::StrokeExceeded {
+                range,
+                stroke: fast_axis.stroke,
+            });
+        }
+        if summary.max_acceleration > fast_axis.max_acceleration {
+            return Err(FtsError::AccelerationExceeded {
+                acceleration: summary.max_acceleration,
+                max: fast_axis.max_acceleration,
+                at_radius: summary.max_acceleration_at,
+                highest_allowed_speed: summary.highest_allowed_speed,
+            });
+        }
+        Ok(summary)
+    }
+
+    /// Folds one point into the summary: counts, W range, spindle speed,
+    /// acceleration (second divided difference with the two before it).
+    fn account(&self, sum: &mut FtsSummary, last: &[SpiralPoint], p: SpiralPoint, fa: &FastAxis) {
+        sum.points += 1;
+        sum.w_min = sum.w_min.min(p.w);
+        sum.w_max = sum.w_max.max(p.w);
+        let spin = self.spiral.speed.at(p.x);
+        sum.max_spindle_speed = sum.max_spindle_speed.max(spin);
+        for v in [p.x, p.c, p.w] {
+            for b in v.to_bits().to_le_bytes() {
+                sum.fingerprint ^= u64::from(b);
+                sum.fingerprint = sum.fingerprint.wrapping_mul(0x0100_0000_01b3);
+            }
+        }
+        if let [a, b] = last {
+            let (d1, d2) = (b.t - a.t, p.t - b.t);
+            if d1 > 0.0 && d2 > 0.0 {
+                let acc = 2.0 * ((p.w - b.w) / d2 - (b.w - a.w) / d1) / (d1 + d2);
+                if acc.abs() > sum.max_acceleration {
+                    sum.max_acceleration = acc.abs();
+                    sum.max_acceleration_at = b.x;
+                }
+                if acc != 0.0 {
+                    // Acceleration scales with the square of the speed.
+                    let scale = (fa.max_acceleration / acc.abs()).sqrt();
+                    let now = match self.spiral.speed {
+                        SpindleSpeed::Constant(w) => w,
+                        SpindleSpeed::SurfaceSpeed { speed, .. } => speed,
+                    };
+                    sum.highest_allowed_speed = sum.highest_allowed_speed.min(now * scale);
+                }
+            }
+        }
+    }
+}
+
+/// The settling offset h (mm) for a lenslet whose height along its radius
+/// is `lenslet(u)` (rim at `rim_radius`): how far the lenslet's own surface,
+/// continued past its rim, rises above the rim while the tool covers
+/// d_traj = v·T_s (eqs 6–7 for a sphere; any lenslet here).
+pub fn settling_offset(
+    lenslet: impl Fn(f64) -> f64,
+    rim_radius: f64,
+    surface_speed: f64,
+    settling_time: f64,
+) -> f64 {
+    let d_traj = surface_speed * settling_time;
+    lenslet(rim_radius + d_traj) - lenslet(rim_radius)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A concave sphere R about the origin (z = R − sqrt(R² − r²)), as a
+    /// SurfaceFn, with a plateau at height h: z = min(sphere, h).
+    struct Dimple {
+        r: f64,
+        h: f64,
+        /// Centre on the x axis.
+        cx: f64,
+    }
+
+    impl SurfaceFn for Dimple {
+        fn eval_batch(&self, xs: &[f64], ys: &[f64], out: &mut [f64]) {
+            for (i, (&x, &y)) in xs.iter().zip(ys).enumerate() {
+                let x = x - self.cx;
+                let q = (self.r * self.r - x * x - y * y).sqrt();
+                let z = self.r - q;
+                let o = if z >= self.h {
+                    [self.h, 0.0, 0.0, 0.0, 0.0, 0.0]
+                } else {
+                    let q3 = q * q * q;
+                    [
+                        z,
+                        x / q,
+                        y / q,
+                        (self.r * self.r - y * y) / q3,
+                        x * y / q3,
+                        (self.r * self.r - x * x) / q3,
+                    ]
+                };
+                out[6 * i..6 * i + 6].copy_from_slice(&o);
+            }
+        }
+    }
+
+    fn planner<'a>(spiral: &'a FtsSpiral, d: &'a Dimple, rho: f64) -> Planner<'a> {
+        let slope = ((2.0 * d.r * d.h - d.h * d.h).sqrt() / (d.r - d.h)).atan();
+        Planner {
+            spiral,
+            surface: d,
+            nose_radius: rho,
+            bounds: TrajectoryBounds {
+                z_max: d.h,
+                max_slope: slope,
+                features: None,
+                part_top: d.h,
+            },
+        }
+    }
+
+    fn spiral() -> FtsSpiral {
+        FtsSpiral {
+            feed_per_rev: 0.01,
+            speed: SpindleSpeed::Constant(2.0 * std::f64::consts::PI * 125.0 / 60.0),
+            chord_tolerance: 10e-6,
+            seed_arc: 0.1,
+            min_interval: 1.0 / 20e3,
+            start_radius: 1.2,
+            end_radius: 0.0,
+        }
+    }
+
+    #[test]
+    fn inside_the_dimple_the_centre_is_on_the_smaller_sphere() {
+        // Concave sphere R: the nose centre lies on the sphere R − ρ about
+        // the same centre (0, 0, R).
+        let d = Dimple {
+            r: 20.0,
+            h: 0.1,
+            cx: 0.0,
+        };
+        let s = spiral();
+        let p = planner(&s, &d, 0.496);
+        for c in [0.3, 10.0, 50.0] {
+            let x = p.radius(c);
+            let w = p.centre(c);
+            let want = 20.0 - ((20.0f64 - 0.496).powi(2) - x * x).sqrt();
+            assert!((w - want).abs() < 1e-12, "c {c}: {w} vs {want}");
+        }
+    }
+
+    #[test]
+    fn off_the_axis_the_centre_is_on_the_section_circle() {
+        // A concave sphere R centred at (cx, 0, R): the plane of the ray at
+        // angle c cuts it in a circle of radius sqrt(R² − d²), d = cx·sin c,
+        // centred at u0 = cx·cos c; the nose centre is on the concentric
+        // circle ρ smaller (the exact offset, to 1e-12 mm).
+        let d = Dimple {
+            r: 20.0,
+            h: 0.1,
+            cx: 0.6,
+        };
+        let s = spiral();
+        let p = planner(&s, &d, 0.496);
+        for c in [0.3, 2.0, 10.0, 41.0, 77.7] {
+            let x = p.radius(c);
+            let w = p.centre(c);
+            let (dist, u0) = (0.6 * c.sin(), 0.6 * c.cos());
+            let rs = (400.0 - dist * dist).sqrt();
+            let want = 20.0 - ((rs - 0.496).powi(2) - (x - u0).powi(2)).sqrt();
+            assert!((w - want).abs() < 1e-12, "c {c}: {w} vs {want}");
+        }
+    }
+
+    #[test]
+    fn on_the_plateau_the_centre_is_a_nose_radius_above_it() {
+        let d = Dimple {
+            r: 20.0,
+            h: 0.005,
+            cx: 0.0,
+        };
+        let s = FtsSpiral {
+            start_radius: 2.0,
+            ..spiral()
+        };
+        let p = planner(&s, &d, 0.496);
+        // Plateau where 20 − sqrt(400 − r²) ≥ 0.005: r ≥ 0.447 mm; the nose
+        // reaches past the edge by ρ sin(slope), so well outside it rests flat.
+        assert!((p.centre(0.0) - (0.005 + 0.496)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn samples_stay_on_their_chords_and_the_plan_is_thread_independent() {
+        let d = Dimple {
+            r: 20.0,
+            h: 0.004,
+            cx: 0.6,
+        };
+        let s = spiral();
+        let p = planner(&s, &d, 0.496);
+        let fa = FastAxis {
+            stroke: 5.0,
+            max_acceleration: 25.0 * 9806.65,
+        };
+        let mut pts = Vec::new();
+        let sum = p.plan(&fa, |b| pts.extend_from_slice(b)).expect("plans");
+        assert_eq!(sum.points, pts.len());
+        assert_eq!(sum.revolutions, 120);
+        // Midpoints of chords against the exact centre height.
+        for w in pts.windows(2).step_by(7) {
+            let m = 0.5 * (w[0].c + w[1].c);
+            let exact = p.centre(m);
+            assert!((exact - 0.5 * (w[0].w + w[1].w)).abs() <= 10e-6 * 1.0001);
+        }
+        // X follows the spiral and C increases.
+        assert!(pts.windows(2).all(|w| w[1].c > w[0].c && w[1].x < w[0].x));
+        assert_eq!(pts.last().expect("end").x, 0.0);
+        // One thread gives the same bits.
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .expect("pool");
+        let single = one.install(|| p.plan(&fa, |_| {}).expect("plans"));
+        assert_eq!(single.fingerprint, sum.fingerprint);
+    }
+
+    #[test]
+    fn too_little_stroke_or_acceleration_is_refused() {
+        // Off the spindle axis the dimple makes W move every revolution.
+        let d = Dimple {
+            r: 20.0,
+            h: 0.004,
+            cx: 0.6,
+        };
+        let s = spiral();
+        let p = planner(&s, &d, 0.496);
+        let e = p
+            .plan(
+                &FastAxis {
+                    stroke: 0.001,
+                    max_acceleration: 1e9,
+                },
+                |_| {},
+            )
+            .expect_err("stroke");
+        assert!(matches!(e, FtsError::StrokeExceeded { .. }), "{e:?}");
+        let e = p
+            .plan(
+                &FastAxis {
+                    stroke: 5.0,
+                    max_acceleration: 1.0,
+                },
+                |_| {},
+            )
+            .expect_err("acceleration");
+        let FtsError::AccelerationExceeded {
+            highest_allowed_speed,
+            ..
+        } = e
+        else {
+            panic!("{e:?}")
+        };
+        // Replanned at that speed, it passes (just).
+        let slower = FtsSpiral {
+            speed: SpindleSpeed::Constant(highest_allowed_speed * 0.999),
+            ..s.clone()
+        };
+        let p2 = planner(&slower, &d, 0.496);
+        p2.plan(
+            &FastAxis {
+                stroke: 5.0,
+                max_acceleration: 1.0,
+            },
+            |_| {},
+        )
+        .expect("slow enough");
+    }
+
+    #[test]
+    fn settling_offset_of_seed_003() {
+        // R = 20 mm, d = 1.7 mm, 5 m/min, T_s = 1 ms: 3.7 µm (eqs 6–7).
+        let sphere = |u: f64| 20.0 - (400.0 - u * u).sqrt();
+        let h = settling_offset(sphere, 0.85, 5000.0 / 60.0, 1e-3);
+        assert_eq!(format!("{:.1}", h * 1000.0), "3.7", "{h}");
+        let paper =
+            crate::machine::servo::settling_offset(20.0, 1.7, 5000.0 / 60.0, 1e-3).expect("h");
+        assert!((h - paper).abs() < 1e-15 + 1e-12 * paper, "{h} vs {paper}");
+    }
+
+    #[test]
+    fn surface_speed_is_capped_near_the_centre() {
+        // 5 m/min capped at 1000 rpm: the cap holds inside r = v/ω_max.
+        let s = SpindleSpeed::SurfaceSpeed {
+            speed: 5000.0 / 60.0,
+            max: 1000.0 * 2.0 * std::f64::consts::PI / 60.0,
+        };
+        assert_eq!(s.at(0.1), 1000.0 * 2.0 * std::f64::consts::PI / 60.0);
+        assert!((s.at(10.0) * 10.0 - 5000.0 / 60.0).abs() < 1e-12);
+        // Seed 003: the corner lenslet at 22.7 mm at 125 rpm sees 17.8 m/min.
+        let v = 22.7 * 125.0 * 2.0 * std::f64::consts::PI / 60.0 * 60.0 / 1000.0;
+        assert_eq!(format!("{v:.1}"), "17.8");
+    }
+}

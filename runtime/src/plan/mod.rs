@@ -1,0 +1,11 @@
+//! Planners: one file per strategy, each turning a surface and a machine's
+//! limits into neutral tool-centre points and moves. No program text here:
+//! `emit/` turns their output into the move stream.
+
+pub mod envelope;
+pub mod fts;
+pub mod grinding;
+pub mod optimise;
+pub mod raster;
+pub mod roller;
+pub mod turning;

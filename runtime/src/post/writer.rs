@@ -1,0 +1,1147 @@
+//! The program writer: a move stream to the text of a program, word by
+//! word, with every number through the one fixed-point formatter.
+
+use super::ProgramError;
+use super::dialect::{CommentStyle, Dialect};
+use super::format::{decimals_for, fixed_units, push_fixed, push_units_to};
+use super::header::{num, write_comment};
+use crate::moves::{Plane, Position};
+use std::f64::consts::PI;
+
+/// Which safe-start lines a program uses, and the arc plane they select.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Setup {
+    /// `lathe_setup`, G18 (Z, X): X is the radius or the diameter.
+    Lathe,
+    /// `mill_setup`, G17 (X, Y).
+    Mill,
+}
+
+/// The post-processor: a move stream to a program in a dialect given as
+/// data. The start lines, header comments, setup and path-tolerance
+/// lines, then the moves word by word: a word whose printed value has not
+/// changed is left out (axes are modal); a feed is written when it or its
+/// mode changes, and on every move in inverse time; a move that changes no
+/// printed axis is left out whole. Every value goes through the one
+/// fixed-point formatter (refused if not finite or too large) and the
+/// dialect's digit limit, every block through its line-length limit;
+/// numbers printed from integer units pass `check_numbers` by
+/// construction (asserted in debug builds, held to it by the tests), and
+/// every line taken from the dialect is checked with it as it is written.
+pub struct ProgramWriter {
+    /// Program text not yet taken (UTF-8: only `str`s and ASCII go in).
+    text: Vec<u8>,
+    dialect: Dialect,
+    decimals: u32,
+    /// Letters of the machine's axes among X, Y, Z, C (others are refused).
+    letters: [Option<char>; 4],
+    /// What goes before each axis's number: a space and its letter.
+    axis_words: [Snippet; 4],
+    /// Decimals of each axis: the resolution's, C's own for C.
+    axis_decimals: [u32; 4],
+    /// The motion words: rapid, linear, clockwise and counter-clockwise arc.
+    motion_words: [Snippet; 4],
+    /// The dialect's block end and the newline.
+    line_end: Snippet,
+    /// The dialect's digit limit (none: `usize::MAX`).
+    max_digits: usize,
+    /// The dialect's line-length limit (none: `usize::MAX`).
+    max_line_length: usize,
+    /// Factor from the move stream's X to the printed X (2 in diameter mode).
+    x_scale: f64,
+    /// The last value printed per axis, in units of its last decimal.
+    last: [Option<i64>; 4],
+    /// Where the axes are (mm, rad; the stream's values).
+    at: [f64; 4],
+    plane: Plane,
+    mode: Option<FeedMode>,
+    /// The last feed printed, in units of its last decimal.
+    last_feed: Option<i64>,
+    /// The next block number.
+    block: u64,
+    c_axis_on: bool,
+    job: String,
+    pub moves: usize,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum FeedMode {
+    PerMinute,
+    PerRevolution,
+    InverseTime,
+}
+
+/// Decimals of feeds per minute and per revolution, and of inverse time.
+const FEED_DECIMALS: u32 = 6;
+const INVERSE_TIME_DECIMALS: u32 = 3;
+
+impl ProgramWriter {
+    /// Starts a program for job `job`: `axes` are the machine's axis
+    /// letters among "XYZC"; `path_tolerance` (mm), the most the controller
+    /// may blend corners away from the programmed path, is the strategy's
+    /// own tolerance so the two never add up beyond it. Refused if the
+    /// machine's resolution needs more decimals than the dialect writes.
+    pub fn new(
+        dialect: &Dialect,
+        setup: Setup,
+        job: &str,
+        header: &[String],
+        axes: &str,
+        resolution: f64,
+        path_tolerance: f64,
+    ) -> Result<Self, ProgramError> {
+        let decimals = decimals_for(resolution);
+        if let Some(max) = dialect.max_decimals
+            && decimals > max
+        {
+            return Err(ProgramError::Unsupported(format!(
+                "the machine's resolution ({:.*} mm needs {decimals} decimals; {} writes at most {max})",
+                decimals as usize, resolution, dialect.name
+            )));
+        }
+        let setup_lines = match setup {
+            Setup::Lathe => &dialect.lathe_setup,
+            Setup::Mill => &dialect.mill_setup,
+        };
+        if setup_lines.is_empty() {
+            return Err(ProgramError::Unsupported(format!(
+                "{} programs ({} has no `{}_setup`)",
+                match setup {
+                    Setup::Lathe => "lathe",
+                    Setup::Mill => "mill",
+                },
+                dialect.name,
+                match setup {
+                    Setup::Lathe => "lathe",
+                    Setup::Mill => "mill",
+                },
+            )));
+        }
+        let has = |c: char| axes.contains(c).then_some(c);
+        let letters = [
+            has('X'),
+            has('Y'),
+            has('Z'),
+            has('C').map(|_| dialect.c_letter),
+        ];
+        let mut w = ProgramWriter {
+            text: Vec::new(),
+            dialect: dialect.clone(),
+            decimals,
+            letters,
+            axis_words: letters.map(|l| Snippet::new(&format!(" {}", l.unwrap_or(' ')))),
+            axis_decimals: [decimals, decimals, decimals, dialect.c_decimals],
+            motion_words: [
+                &dialect.rapid,
+                &dialect.linear,
+                &dialect.arc_cw,
+                &dialect.arc_ccw,
+            ]
+            .map(|w| Snippet::new(w)),
+            line_end: Snippet::new(&format!("{}\n", dialect.block_end)),
+            max_digits: dialect.max_digits.map_or(usize::MAX, |m| m as usize),
+            max_line_length: dialect.max_line_length.unwrap_or(usize::MAX),
+            x_scale: if setup == Setup::Lathe && dialect.lathe_x_diameter {
+                2.0
+            } else {
+                1.0
+            },
+            last: [None; 4],
+            at: [f64::NAN; 4],
+            plane: match setup {
+                Setup::Lathe => Plane::Zx,
+                Setup::Mill => Plane::Xy,
+            },
+            // The first feed states its mode, whatever the setup says.
+            mode: None,
+            last_feed: None,
+            block: dialect.line_numbers.unwrap_or(0),
+            c_axis_on: false,
+            job: job.to_string(),
+            moves: 0,
+        };
+        // The dialect's own words, checked once: every number the writer
+        // prints itself is well formed by construction (`number`), and
+        // every line taken from the dialect is checked as it is written,
+        // so no text leaves the writer unchecked.
+        let words = [
+            &dialect.rapid,
+            &dialect.linear,
+            &dialect.arc_cw,
+            &dialect.arc_ccw,
+            &dialect.spindle_on,
+            &dialect.spindle_off,
+            &dialect.block_end,
+        ]
+        .into_iter()
+        .chain(dialect.per_minute.iter())
+        .chain(dialect.per_revolution.iter())
+        .chain(dialect.inverse_time.iter());
+        for word in words {
+            check_numbers(word, dialect.comment)?;
+        }
+        for line in &dialect.start {
+            let l = w.fill(line, path_tolerance);
+            check_numbers(&l, dialect.comment)?;
+            w.text.extend_from_slice(l.as_bytes());
+            w.text.push(b'\n');
+        }
+        for line in header {
+            w.comment(line);
+        }
+        for line in setup_lines.iter().chain(&dialect.path_tolerance) {
+            let l = w.fill(line, path_tolerance);
+            w.block_line(&l)?;
+        }
+        Ok(w)
+    }
+
+    /// A line with its placeholders filled in.
+    fn fill(&self, line: &str, tolerance: f64) -> String {
+        // A tolerance is a bound: printed exactly if a few more decimals
+        // do it (2.5 nm as 0.0000025), else rounded down, never up.
+        let first = decimals_for(tolerance).max(self.decimals);
+        let exact = (first..=9).find(|&d| {
+            let scaled = tolerance * 10f64.powi(d as i32);
+            (scaled - scaled.round()).abs() < 1e-6
+        });
+        let d = exact.unwrap_or(first);
+        let shown = match exact {
+            Some(_) => tolerance,
+            None => (tolerance * 10f64.powi(d as i32)).floor() / 10f64.powi(d as i32),
+        };
+        let mut tol = String::new();
+        if !push_fixed(&mut tol, shown, d) {
+            tol.push('0');
+        }
+        line.replace("{job}", &self.job)
+            .replace("{JOB}", &self.job.to_uppercase())
+            .replace("{number}", &self.dialect.program_number.to_string())
+            .replace("{tolerance}", &tol)
+    }
+
+    /// Starts a block: its number, if the dialect numbers blocks.
+    #[inline]
+    fn begin_block(&mut self) {
+        if self.dialect.line_numbers.is_some() {
+            self.text.push(b'N');
+            self.text
+                .extend_from_slice(itoa::Buffer::new().format(self.block).as_bytes());
+            self.text.push(b' ');
+        }
+    }
+
+    /// Ends the block begun at byte `start`: the dialect's block end, the
+    /// line-length limit, the next block number.
+    #[inline(always)]
+    fn end_block(&mut self, start: usize) -> Result<(), ProgramError> {
+        // The line's length is where the text ends now: nothing rescanned.
+        if self.text.len() - start + self.dialect.block_end.len() > self.max_line_length {
+            return Err(self.line_too_long(start));
+        }
+        self.line_end.push_to(&mut self.text);
+        if let Some(step) = self.dialect.line_numbers {
+            self.block += step;
+            if self.dialect.max_line_number.is_some_and(|m| self.block > m) {
+                self.block = step;
+            }
+        }
+        Ok(())
+    }
+
+    /// Refuses the block begun at byte `start` for its length.
+    #[cold]
+    fn line_too_long(&mut self, start: usize) -> ProgramError {
+        let mut line = String::from_utf8_lossy(&self.text[start..]).into_owned();
+        line.push_str(&self.dialect.block_end);
+        self.text.truncate(start);
+        ProgramError::Unsupported(format!(
+            "a line of {} characters ({} reads at most {}): {line}",
+            line.len(),
+            self.dialect.name,
+            self.max_line_length
+        ))
+    }
+
+    /// The decimals of the machine's linear axes.
+    pub fn decimals(&self) -> u32 {
+        self.decimals
+    }
+
+    /// The dialect the program is written in.
+    pub fn dialect(&self) -> &Dialect {
+        &self.dialect
+    }
+
+    /// Writes one block of the dialect's own words, checked as it is written.
+    pub fn block_line(&mut self, words: &str) -> Result<(), ProgramError> {
+        check_numbers(words, self.dialect.comment)?;
+        let start = self.text.len();
+        self.begin_block();
+        self.text.extend_from_slice(words.as_bytes());
+        self.end_block(start)
+    }
+
+    /// Writes `text` as comments in the dialect's syntax: no nested
+    /// parentheses or control characters, long text folded at ", ".
+    pub fn comment(&mut self, text: &str) {
+        let mut lines = String::new();
+        write_comment(&mut lines, text);
+        for line in lines.lines() {
+            let body = &line[1..line.len() - 1];
+            let start = self.text.len();
+            self.begin_block();
+            match self.dialect.comment {
+                CommentStyle::Parentheses => {
+                    self.text.push(b'(');
+                    self.text.extend_from_slice(body.as_bytes());
+                    self.text.push(b')');
+                }
+                CommentStyle::Semicolon => {
+                    self.text.extend_from_slice(b"; ");
+                    self.text.extend_from_slice(body.as_bytes());
+                }
+            }
+            // Comments are folded to 120 characters: within every limit.
+            let _ = self.end_block(start);
+        }
+    }
+
+    /// Appends a value's digits (`push_units_to`), refused if more than
+    /// the dialect's limit (the caller cuts the block off). The digits
+    /// come from an integer count of units, so they cannot spell an
+    /// exponent, NaN or `-0`: `check_number` holds of them by construction
+    /// (the format module's tests hold the printer to that), and is
+    /// asserted again in debug builds.
+    #[inline(always)]
+    fn number(&mut self, letter: char, v: f64, n: i64, d: u32) -> Result<(), ProgramError> {
+        let at = self.text.len();
+        let digits = push_units_to(&mut self.text, n, d);
+        debug_assert!(check_number(&self.text[at..]).is_ok());
+        if digits > self.max_digits {
+            return Err(self.too_many_digits(letter, v, digits));
+        }
+        Ok(())
+    }
+
+    #[cold]
+    fn too_many_digits(&self, letter: char, v: f64, digits: usize) -> ProgramError {
+        ProgramError::Unsupported(format!(
+            "{letter}{v} in {digits} digits ({} takes at most {})",
+            self.dialect.name, self.max_digits
+        ))
+    }
+
+    /// Appends a value's digits, refusing more than the dialect's limit.
+    fn value(&mut self, letter: char, v: f64, n: i64, d: u32) -> Result<(), ProgramError> {
+        self.number(letter, v, n, d)
+    }
+
+    /// Writes one move, straight into the text (no allocation per move:
+    /// a move that changes no printed axis is written and then cut off).
+    pub fn write(&mut self, m: &crate::moves::Move) -> Result<(), ProgramError> {
+        use crate::moves::Move as M;
+        let (word, to, feed, arc) = match *m {
+            M::Rapid(to) => (Word::Rapid, to, None, None),
+            M::Linear { to, feed } => (Word::Linear, to, feed, None),
+            M::Arc {
+                to,
+                centre,
+                plane,
+                ccw,
+                feed,
+            } => {
+                let w = if ccw { Word::ArcCcw } else { Word::ArcCw };
+                (w, to, feed, Some((plane, centre)))
+            }
+            _ => return self.write_spindle(m),
+        };
+        let start = self.text.len();
+        let r = self.motion(word, to, feed, arc);
+        if r.is_err() {
+            self.text.truncate(start);
+        }
+        r
+    }
+
+    /// Writes a move that is not a motion: the spindle's.
+    fn write_spindle(&mut self, m: &crate::moves::Move) -> Result<(), ProgramError> {
+        use crate::moves::Move as M;
+        let start = self.text.len();
+        let r = match *m {
+            M::Rapid(_) | M::Linear { .. } | M::Arc { .. } => self.write(m),
+            M::SpindleOn(speed) => {
+                self.begin_block();
+                if let Some(w) = speed {
+                    let rpm = w * 60.0 / (2.0 * PI);
+                    self.text.push(b'S');
+                    match fixed_units(rpm, 3) {
+                        Some(n) => self.value('S', rpm, n, 3)?,
+                        None => {
+                            return Err(ProgramError::NotPrintable {
+                                word: 'S',
+                                value: rpm,
+                            });
+                        }
+                    }
+                    self.text.push(b' ');
+                }
+                let on = self.dialect.spindle_on.clone();
+                self.text.extend_from_slice(on.as_bytes());
+                self.end_block(start)
+            }
+            M::SpindleSurfaceSpeed { surface_speed, cap } => {
+                let lines = self.dialect.surface_speed.clone();
+                if lines.is_empty() {
+                    return Err(ProgramError::Unsupported(format!(
+                        "constant surface speed ({} has no `surface_speed` lines)",
+                        self.dialect.name
+                    )));
+                }
+                let mut speed = String::new();
+                let mut rpm = String::new();
+                let m_per_min = surface_speed * 60.0 / 1000.0;
+                let cap_rpm = cap * 60.0 / (2.0 * PI);
+                if !(push_fixed(&mut speed, m_per_min, 3)
+                    && push_fixed(&mut rpm, cap_rpm.floor(), 0))
+                {
+                    return Err(ProgramError::NotPrintable {
+                        word: 'S',
+                        value: m_per_min,
+                    });
+                }
+                for line in lines {
+                    let l = line.replace("{speed}", &speed).replace("{cap}", &rpm);
+                    self.block_line(&l)?;
+                }
+                let on = self.dialect.spindle_on.clone();
+                self.block_line(&on)
+            }
+            M::SpindleOff => {
+                let off = self.dialect.spindle_off.clone();
+                self.block_line(&off)
+            }
+        };
+        if r.is_err() {
+            self.text.truncate(start);
+        }
+        r
+    }
+
+    /// A motion block.
+    #[inline(always)]
+    fn motion(
+        &mut self,
+        word: Word,
+        to: Position,
+        feed: Option<crate::moves::Feed>,
+        arc: Option<(Plane, Position)>,
+    ) -> Result<(), ProgramError> {
+        self.motion_words_into_text(word, to, feed, arc)
+    }
+
+    /// A motion block: its words straight into the text, each a copy of
+    /// fixed size (a snippet's room, a number's room) cut back to length.
+    /// The values printed are kept word by word and become the last
+    /// printed values only when the block is written (a block refused
+    /// leaves them as they were).
+    #[inline(always)]
+    fn motion_words_into_text(
+        &mut self,
+        word: Word,
+        to: Position,
+        feed: Option<crate::moves::Feed>,
+        arc: Option<(Plane, Position)>,
+    ) -> Result<(), ProgramError> {
+        use crate::moves::Feed as F;
+        if !to.c.is_nan() && !self.c_axis_on && self.letters[3].is_some() {
+            self.c_axis_on_lines()?;
+        }
+        let start = self.text.len();
+        self.begin_block();
+        let mode = feed.map(|f| match f {
+            F::PerTime(v) => (FeedMode::PerMinute, v * 60.0, FEED_DECIMALS),
+            F::PerRevolution(v) => (FeedMode::PerRevolution, v * 2.0 * PI, FEED_DECIMALS),
+            F::InverseTime(t) => (FeedMode::InverseTime, 60.0 / t, INVERSE_TIME_DECIMALS),
+        });
+        let mode_changes = mode.is_some_and(|(m, _, _)| self.mode != Some(m));
+        if let Some((m, _, _)) = mode
+            && mode_changes
+        {
+            let w = self.feed_mode_word(m)?.to_string();
+            self.text.extend_from_slice(w.as_bytes());
+            self.text.push(b' ');
+        }
+        if let Some((plane, _)) = arc {
+            if !self.dialect.arc_planes.contains(&plane) {
+                return Err(ProgramError::Unsupported(format!(
+                    "arcs in the {} plane",
+                    plane.name()
+                )));
+            }
+            if plane != self.plane {
+                self.text.extend_from_slice(match plane {
+                    Plane::Xy => b"G17 ",
+                    Plane::Zx => b"G18 ",
+                    Plane::Yz => b"G19 ",
+                });
+                self.plane = plane;
+            }
+        }
+        self.motion_words[word as usize].push_to(&mut self.text);
+        let mut printed = [0i64; 4];
+        let mut changed = 0u8;
+        let axes = to.axes();
+        for i in 0..4 {
+            let v = axes[i];
+            if v.is_nan() {
+                continue;
+            }
+            let value = match i {
+                0 => v * self.x_scale,
+                3 => v.to_degrees(),
+                _ => v,
+            };
+            let d = self.axis_decimals[i];
+            let (Some(letter), Some(n)) = (self.letters[i], fixed_units(value, d)) else {
+                return Err(self.not_printable(i, v));
+            };
+            // Modal: a word whose printed value has not changed is left out.
+            if self.last[i] == Some(n) {
+                continue;
+            }
+            self.axis_words[i].push_to(&mut self.text);
+            self.number(letter, value, n, d)?;
+            printed[i] = n;
+            changed |= 1 << i;
+        }
+        if changed == 0 {
+            self.text.truncate(start);
+            return Ok(());
+        }
+        if let Some((plane, centre)) = arc {
+            self.arc_centre(plane, to, centre)?;
+        }
+        if let Some((m, value, d)) = mode {
+            let Some(n) = fixed_units(value, d) else {
+                return Err(ProgramError::NotPrintable { word: 'F', value });
+            };
+            if mode_changes || m == FeedMode::InverseTime || self.last_feed != Some(n) {
+                self.text.extend_from_slice(b" F");
+                self.number('F', value, n, d)?;
+            }
+            self.last_feed = Some(n);
+            self.mode = Some(m);
+        }
+        self.end_block(start)?;
+        for (i, n) in printed.into_iter().enumerate() {
+            if changed & 1 << i != 0 {
+                self.last[i] = Some(n);
+            }
+        }
+        for (at, v) in self.at.iter_mut().zip(axes) {
+            if !v.is_nan() {
+                *at = v;
+            }
+        }
+        self.moves += 1;
+        Ok(())
+    }
+
+    /// The dialect's lines that switch the C axis on, before its first move.
+    #[cold]
+    fn c_axis_on_lines(&mut self) -> Result<(), ProgramError> {
+        self.c_axis_on = true;
+        for line in self.dialect.c_axis_on.clone() {
+            self.block_line(&line)?;
+        }
+        Ok(())
+    }
+
+    /// The word that switches the controller to feed mode `m`.
+    #[cold]
+    fn feed_mode_word(&self, m: FeedMode) -> Result<&str, ProgramError> {
+        let w = match m {
+            FeedMode::PerMinute => &self.dialect.per_minute,
+            FeedMode::PerRevolution => &self.dialect.per_revolution,
+            FeedMode::InverseTime => &self.dialect.inverse_time,
+        };
+        w.as_deref().ok_or_else(|| {
+            ProgramError::Unsupported(format!(
+                "feeds {} ({} has no word for them)",
+                match m {
+                    FeedMode::PerMinute => "per minute",
+                    FeedMode::PerRevolution => "per revolution",
+                    FeedMode::InverseTime => "in inverse time",
+                },
+                self.dialect.name
+            ))
+        })
+    }
+
+    /// Axis `i` has no letter on this machine, or `v` cannot be printed.
+    #[cold]
+    fn not_printable(&self, i: usize, v: f64) -> ProgramError {
+        ProgramError::NotPrintable {
+            word: self.letters[i].unwrap_or("XYZC".as_bytes()[i] as char),
+            value: v,
+        }
+    }
+
+    /// An arc's centre words, once its radii are checked as the
+    /// controller checks them.
+    #[inline(never)]
+    fn arc_centre(
+        &mut self,
+        plane: Plane,
+        to: Position,
+        centre: Position,
+    ) -> Result<(), ProgramError> {
+        // The controller measures the radius from the rounded centre
+        // to the rounded start and end, and refuses a mismatch.
+        let (a, b) = plane.axes();
+        let scale = 10f64.powi(self.decimals as i32);
+        let round = |v: f64| (v * scale).round() / scale;
+        let end = to.axes();
+        let radius = |p: [f64; 4]| {
+            (round(p[a]) - round(centre.axes()[a])).hypot(round(p[b]) - round(centre.axes()[b]))
+        };
+        let mut end_at = self.at;
+        for (e, v) in end_at.iter_mut().zip(end) {
+            if !v.is_nan() {
+                *e = v;
+            }
+        }
+        let mismatch = (radius(self.at) - radius(end_at)).abs();
+        if mismatch.is_nan() || mismatch > self.dialect.arc_radius_tolerance {
+            return Err(ProgramError::Unsupported(format!(
+                "an arc whose end radius differs from its start radius by {} mm (it allows {} mm)",
+                num(mismatch),
+                num(self.dialect.arc_radius_tolerance)
+            )));
+        }
+        // I J K in that order, whatever the plane's orientation.
+        for i in [a.min(b), a.max(b)] {
+            let c = centre.axes()[i];
+            let from = if self.dialect.arc_centre_absolute {
+                0.0
+            } else {
+                self.at[i]
+            };
+            let (Some(cu), Some(fu)) = (
+                fixed_units(c, self.decimals),
+                fixed_units(from, self.decimals),
+            ) else {
+                return Err(ProgramError::NotPrintable {
+                    word: ['I', 'J', 'K'][i],
+                    value: c,
+                });
+            };
+            let letter = ['I', 'J', 'K'][i];
+            self.text.extend_from_slice(&[b' ', letter as u8]);
+            self.number(letter, c - from, cu - fu, self.decimals)?;
+        }
+        Ok(())
+    }
+
+    /// Writes every move of a stream.
+    pub fn write_all<'a>(
+        &mut self,
+        moves: impl IntoIterator<Item = &'a crate::moves::Move>,
+    ) -> Result<(), ProgramError> {
+        moves.into_iter().try_for_each(|m| self.write(m))
+    }
+
+    /// The text written since the last call (for streaming to a file),
+    /// every number and dialect line in it checked as it was written (see
+    /// `ProgramWriter`); the
+    /// next chunk starts with room for as much again.
+    pub fn take_text(&mut self) -> Result<String, ProgramError> {
+        let room = self.text.len();
+        utf8(std::mem::replace(&mut self.text, Vec::with_capacity(room)))
+    }
+
+    /// Ends the program; the text not yet taken, checked.
+    pub fn finish(mut self) -> Result<String, ProgramError> {
+        if self.c_axis_on {
+            for line in self.dialect.c_axis_off.clone() {
+                self.block_line(&line)?;
+            }
+        }
+        for line in self.dialect.end.clone() {
+            let l = self.fill(&line, 0.0);
+            self.block_line(&l)?;
+        }
+        for line in self.dialect.trailer.clone() {
+            let l = self.fill(&line, 0.0);
+            check_numbers(&l, self.dialect.comment)?;
+            self.text.extend_from_slice(l.as_bytes());
+            self.text.push(b'\n');
+        }
+        utf8(self.text)
+    }
+}
+
+/// The writer's text as a `String`: it only ever appends `str`s and
+/// ASCII, so this holds; were it ever not so, the text is refused, not
+/// handed out.
+fn utf8(text: Vec<u8>) -> Result<String, ProgramError> {
+    String::from_utf8(text)
+        .map_err(|_| ProgramError::Unsupported("program text that is not UTF-8".into()))
+}
+
+/// A short piece of program text (a word's letter, a motion word, a
+/// block end), kept in a fixed array so appending it is a copy of fixed
+/// size and a cut back (no call to `memcpy`); longer pieces as they are.
+struct Snippet {
+    room: [u8; SNIPPET_ROOM],
+    len: usize,
+    long: Box<[u8]>,
+}
+
+const SNIPPET_ROOM: usize = 16;
+
+impl Snippet {
+    fn new(text: &str) -> Snippet {
+        let b = text.as_bytes();
+        let mut room = [0; SNIPPET_ROOM];
+        if b.len() <= SNIPPET_ROOM {
+            room[..b.len()].copy_from_slice(b);
+        }
+        Snippet {
+            room,
+            len: b.len(),
+            long: if b.len() > SNIPPET_ROOM {
+                b.into()
+            } else {
+                Box::default()
+            },
+        }
+    }
+
+    #[inline]
+    fn push_to(&self, text: &mut Vec<u8>) {
+        if self.len <= SNIPPET_ROOM {
+            let at = text.len();
+            text.extend_from_slice(&self.room);
+            text.truncate(at + self.len);
+        } else {
+            text.extend_from_slice(&self.long);
+        }
+    }
+}
+
+#[derive(Clone, Copy)]
+enum Word {
+    Rapid,
+    Linear,
+    ArcCw,
+    ArcCcw,
+}
+
+/// The final check on program text: outside comments, no word's number
+/// is `-0`, has an exponent, or is not finite (`NaN`, `inf`), and no
+/// digit runs straight into a letter. The writer cannot produce these; this
+/// check makes sure no path around it does.
+pub fn check_numbers(text: &str, comments: CommentStyle) -> Result<(), ProgramError> {
+    let opens = match comments {
+        CommentStyle::Parentheses => b'(',
+        CommentStyle::Semicolon => b';',
+    };
+    for line in text.split('\n') {
+        let b = line.as_bytes();
+        let code = &b[..b.iter().position(|&c| c == opens).unwrap_or(b.len())];
+        let mut j = 0;
+        while j < code.len() {
+            if code[j].is_ascii_whitespace() {
+                j += 1;
+                continue;
+            }
+            let start = j;
+            while j < code.len() && !code[j].is_ascii_whitespace() {
+                j += 1;
+            }
+            if let Err(why) = check_word(&code[start..j]) {
+                return Err(ProgramError::Unsupported(format!(
+                    "the word `{}` ({why}) in the line `{line}`",
+                    &line[start..j]
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// One word of code: a letter and a number (digits and points, perhaps a
+/// leading minus that is not on a zero) or a word that spells no
+/// non-finite number.
+fn check_word(w: &[u8]) -> Result<(), &'static str> {
+    let numeric =
+        w.len() >= 2 && w[0].is_ascii_alphabetic() && matches!(w[1], b'0'..=b'9' | b'-' | b'.');
+    if !numeric {
+        let spells = |s: &[u8]| w.windows(3).any(|x| x.eq_ignore_ascii_case(s));
+        return if spells(b"nan") || spells(b"inf") {
+            Err("not a finite number")
+        } else {
+            Ok(())
+        };
+    }
+    check_number(&w[1..])
+}
+
+/// A printed number: digits and points after an optional minus, and not
+/// a minus zero.
+pub(crate) fn check_number(num: &[u8]) -> Result<(), &'static str> {
+    let digits = num.strip_prefix(b"-").unwrap_or(num);
+    if !digits.iter().all(|&c| c.is_ascii_digit() || c == b'.') {
+        // `G05.1`-style words are digits and points only; anything else
+        // after a number is an exponent or a run-on word.
+        return Err("a number with letters in it");
+    }
+    if digits.len() < num.len() && digits.iter().all(|&c| c == b'0' || c == b'.') {
+        return Err("minus zero");
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::moves::{Feed as F, Move as M, Position as P};
+
+    fn written(axes: &str, stream: &[M]) -> Result<String, ProgramError> {
+        written_in(&Dialect::linuxcnc(), Setup::Mill, axes, stream)
+    }
+
+    fn written_in(
+        d: &Dialect,
+        setup: Setup,
+        axes: &str,
+        stream: &[M],
+    ) -> Result<String, ProgramError> {
+        let mut w = ProgramWriter::new(d, setup, "t1", &["t".into()], axes, 1e-3, 1e-3)?;
+        w.write_all(stream)?;
+        w.finish()
+    }
+
+    #[test]
+    fn unchanged_words_and_feeds_are_left_out() {
+        let text = written(
+            "XYZ",
+            &[
+                M::Rapid(P::xyz(1.0, 2.0, 5.0)),
+                M::Linear {
+                    to: P::xyz(1.0, 2.0, 0.5),
+                    feed: Some(F::PerTime(1.0)),
+                },
+                M::Linear {
+                    to: P::xyz(1.5, 2.0, 0.5),
+                    feed: Some(F::PerTime(1.0)),
+                },
+                // Rounds to the same printed position: no line at all.
+                M::Linear {
+                    to: P::xyz(1.5001, 2.0, 0.5),
+                    feed: None,
+                },
+                M::Linear {
+                    to: P::xyz(1.5, 2.5, 0.5),
+                    feed: Some(F::PerTime(2.0)),
+                },
+            ],
+        )
+        .expect("writes");
+        assert_eq!(
+            text,
+            "(t)\nG17 G21 G90 G40 G49 G80\nG64 P0.001\nG0 X1. Y2. Z5.\nG94 G1 Z0.5 F60.\nG1 X1.5\nG1 Y2.5 F120.\nM2\n"
+        );
+    }
+
+    #[test]
+    fn inverse_time_writes_a_feed_on_every_move_and_c_in_degrees() {
+        let text = written(
+            "XZC",
+            &[
+                M::Linear {
+                    to: P::xzc(1.0, 0.0, std::f64::consts::FRAC_PI_2),
+                    feed: Some(F::InverseTime(0.5)),
+                },
+                M::Linear {
+                    to: P::xzc(0.9, 0.0, std::f64::consts::PI),
+                    feed: Some(F::InverseTime(0.5)),
+                },
+                M::Linear {
+                    to: P::xz(0.8, 0.1),
+                    feed: Some(F::PerRevolution(0.001)),
+                },
+            ],
+        )
+        .expect("writes");
+        assert_eq!(
+            text,
+            "(t)\nG17 G21 G90 G40 G49 G80\nG64 P0.001\nG93 G1 X1. Z0. C90. F120.\nG1 X0.9 C180. F120.\nG95 G1 X0.8 Z0.1 F0.006283\nM2\n"
+        );
+    }
+
+    #[test]
+    fn a_dialect_given_as_data_shapes_every_line() {
+        let mut d = Dialect::linuxcnc();
+        d.name = "heidenhain_like".into();
+        d.comment = CommentStyle::Semicolon;
+        d.start = vec!["%{JOB} G71 *".into()];
+        d.mill_setup = vec!["G17 G90".into()];
+        d.path_tolerance = Vec::new();
+        d.end = vec!["M30".into()];
+        d.trailer = vec!["N99999999 %{JOB} G71 *".into()];
+        d.line_numbers = Some(1);
+        d.block_end = " *".into();
+        d.arc_centre_absolute = true;
+        let text = written_in(
+            &d,
+            Setup::Mill,
+            "XYZ",
+            &[
+                M::Rapid(P::xyz(1.0, 0.0, 0.0)),
+                M::Arc {
+                    to: P::xyz(0.0, 1.0, 0.0),
+                    centre: P::xyz(0.0, 0.0, f64::NAN),
+                    plane: Plane::Xy,
+                    ccw: true,
+                    feed: Some(F::PerTime(1.0)),
+                },
+            ],
+        )
+        .expect("writes");
+        assert_eq!(
+            text,
+            "%T1 G71 *\nN1 ; t *\nN2 G17 G90 *\nN3 G0 X1. Y0. Z0. *\nN4 G94 G3 X0. Y1. I0. J0. F60. *\nN5 M30 *\nN99999999 %T1 G71 *\n"
+        );
+    }
+
+    #[test]
+    fn long_words_and_letters_beyond_ascii_are_written_whole() {
+        // Words longer than a snippet's fixed room, and a C letter of two
+        // bytes, take the writer's other paths.
+        let mut d = Dialect::linuxcnc();
+        d.linear = "G1 G90 G94 G17 G21 G40".into();
+        d.block_end = " ; the end of a long block".into();
+        d.c_letter = 'Ç';
+        // The longest line is 77 bytes (the limit counts bytes, as before).
+        d.max_line_length = Some(77);
+        let text = written_in(
+            &d,
+            Setup::Lathe,
+            "XZC",
+            &[
+                M::Linear {
+                    to: P::xzc(1.5, -0.25, std::f64::consts::PI),
+                    feed: Some(F::InverseTime(0.5)),
+                },
+                M::Linear {
+                    to: P::xzc(1.5, -0.25, std::f64::consts::FRAC_PI_2),
+                    feed: Some(F::InverseTime(0.25)),
+                },
+            ],
+        )
+        .expect("writes");
+        assert!(
+            text.contains(
+                "G93 G1 G90 G94 G17 G21 G40 X1.5 Z-0.25 Ç180. F120. ; the end of a long block\n\
+                 G1 G90 G94 G17 G21 G40 Ç90. F240. ; the end of a long block\n"
+            ),
+            "{text}"
+        );
+        // One byte over the limit, the block end counted.
+        d.max_line_length = Some(76);
+        let Err(ProgramError::Unsupported(why)) = written_in(
+            &d,
+            Setup::Lathe,
+            "XZC",
+            &[M::Linear {
+                to: P::xzc(1.5, -0.25, std::f64::consts::PI),
+                feed: Some(F::InverseTime(0.5)),
+            }],
+        ) else {
+            panic!("a line over the limit written")
+        };
+        assert!(why.contains("a line of 77 characters"), "{why}");
+    }
+
+    #[test]
+    fn arcs_have_incremental_centres_and_select_their_plane() {
+        let text = written(
+            "XYZ",
+            &[
+                M::Rapid(P::xyz(1.0, 0.0, 2.0)),
+                M::Arc {
+                    to: P::xyz(3.0, 0.0, 2.0),
+                    centre: P::xyz(2.0, f64::NAN, 2.0),
+                    plane: Plane::Zx,
+                    ccw: false,
+                    feed: Some(F::PerTime(1.0)),
+                },
+            ],
+        )
+        .expect("writes");
+        assert!(text.contains("G94 G18 G2 X3. I1. K0. F60.\n"), "{text}");
+    }
+
+    #[test]
+    fn an_arc_whose_radii_disagree_after_rounding_is_refused() {
+        let arc = |end_x: f64| {
+            written(
+                "XZ",
+                &[
+                    M::Rapid(P::xz(1.0, 0.0)),
+                    M::Arc {
+                        to: P::xz(end_x, 0.0),
+                        centre: P::xz(0.0, 0.0),
+                        plane: Plane::Zx,
+                        ccw: true,
+                        feed: Some(F::PerTime(1.0)),
+                    },
+                ],
+            )
+        };
+        assert!(arc(-1.0005).is_ok());
+        let Err(ProgramError::Unsupported(why)) = arc(-1.002) else {
+            panic!("a 2 um mismatch written")
+        };
+        assert!(why.contains("0.002 mm"), "{why}");
+    }
+
+    #[test]
+    fn diameter_mode_doubles_x_and_limits_are_enforced() {
+        let mut d = Dialect::linuxcnc();
+        d.lathe_x_diameter = true;
+        d.max_digits = Some(4);
+        let text =
+            written_in(&d, Setup::Lathe, "XZ", &[M::Rapid(P::xz(1.25, 0.0))]).expect("writes");
+        assert!(text.contains("G0 X2.5 Z0.\n"), "{text}");
+        assert!(matches!(
+            written_in(&d, Setup::Lathe, "XZ", &[M::Rapid(P::xz(12.3455, 0.0))]),
+            Err(ProgramError::Unsupported(_))
+        ));
+        d.per_revolution = None;
+        assert!(matches!(
+            written_in(
+                &d,
+                Setup::Lathe,
+                "XZ",
+                &[M::Linear {
+                    to: P::xz(1.0, 0.0),
+                    feed: Some(F::PerRevolution(0.001))
+                }]
+            ),
+            Err(ProgramError::Unsupported(_))
+        ));
+        d.max_decimals = Some(2);
+        assert!(written_in(&d, Setup::Lathe, "XZ", &[]).is_err());
+        assert!(written_in(&Dialect::linuxcnc(), Setup::Lathe, "XZ", &[]).is_ok());
+    }
+
+    #[test]
+    fn the_final_check_refuses_bad_numbers_outside_comments() {
+        let ok = "(X-0. in a comment, 1e5 too)\nG1 X-0.5 Z0. F60.\nG05.1 Q1\n";
+        assert!(check_numbers(ok, CommentStyle::Parentheses).is_ok());
+        for bad in [
+            "G1 X-0.",
+            "G1 X-0.000",
+            "G1 X1.5e-3",
+            "G1 XNaN",
+            "G1 Z-inf",
+            "G1 X1.0Y2.",
+        ] {
+            assert!(
+                check_numbers(bad, CommentStyle::Parentheses).is_err(),
+                "{bad} passed"
+            );
+        }
+        assert!(check_numbers("; X-0. here", CommentStyle::Semicolon).is_ok());
+    }
+
+    #[test]
+    fn axes_the_machine_lacks_and_values_that_cannot_print_are_refused() {
+        assert!(matches!(
+            written("XZ", &[M::Rapid(P::xyz(1.0, 2.0, 3.0))]),
+            Err(ProgramError::NotPrintable { word: 'Y', .. })
+        ));
+        assert!(matches!(
+            written("XZ", &[M::Rapid(P::xz(f64::INFINITY, 0.0))]),
+            Err(ProgramError::NotPrintable { word: 'X', .. })
+        ));
+    }
+
+    /// `{:.N}` of `n` units of 10^−N, trailing zeros trimmed, the point
+    /// kept: the reference every printed word is held to.
+    fn std_word(n: i64, d: u32) -> String {
+        let s = format!("{:.*}", d as usize, n as f64 / 10f64.powi(d as i32));
+        if d == 0 {
+            s + "."
+        } else {
+            s.trim_end_matches('0').to_string()
+        }
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(300))]
+
+        /// A spiral-like stream through the writer against a model of it
+        /// built from `f64::round` and `{:.N}`: the same lines, word for
+        /// word, unchanged words left out, a feed on every block, no block
+        /// for a move that changes no printed axis.
+        #[test]
+        fn the_writer_prints_what_a_plain_model_of_it_prints(
+            resolution in proptest::sample::select(vec![1e-3, 1e-4, 1e-6]),
+            moves in proptest::collection::vec(
+                (-100.0f64..100.0, -50.0f64..50.0, -1000.0f64..1000.0, 1e-5f64..1.0, 0u8..4),
+                1..200,
+            ),
+        ) {
+            let d = decimals_for(resolution);
+            let mut stream = Vec::new();
+            let mut at = (0.0, 0.0, 0.0);
+            for &(x, z, c, t, keep) in &moves {
+                // Some moves repeat a coordinate, or come within a unit of it.
+                let x = if keep & 1 == 1 { at.0 + resolution * 0.3 } else { x };
+                let z = if keep & 2 == 2 { at.1 } else { z };
+                at = (x, z, c);
+                stream.push(M::Linear { to: P::xzc(x, z, c), feed: Some(F::InverseTime(t)) });
+            }
+            let dialect = Dialect::linuxcnc();
+            let mut w = ProgramWriter::new(&dialect, Setup::Lathe, "t", &[], "XZC", resolution, 1e-5)
+                .expect("a lathe program");
+            w.write_all(&stream).expect("printable");
+            let text = w.finish().expect("checked");
+            proptest::prop_assert!(check_numbers(&text, CommentStyle::Parentheses).is_ok());
+            let units = |v: f64, d: u32| (v * 10f64.powi(d as i32)).round() as i64;
+            let mut last: [Option<i64>; 3] = [None; 3];
+            let mut expected = Vec::new();
+            for m in &stream {
+                let M::Linear { to, feed: Some(F::InverseTime(t)) } = m else { unreachable!() };
+                let mut line = String::from(if expected.is_empty() { "G93 G1" } else { "G1" });
+                let mut any = false;
+                for (k, (letter, v, dk)) in
+                    [('X', to.x, d), ('Z', to.z, d), ('C', to.c.to_degrees(), 5)].into_iter().enumerate()
+                {
+                    let n = units(v, dk);
+                    if last[k] != Some(n) {
+                        line += &format!(" {letter}{}", std_word(n, dk));
+                        last[k] = Some(n);
+                        any = true;
+                    }
+                }
+                if any {
+                    line += &format!(" F{}", std_word(units(60.0 / t, 3), 3));
+                    expected.push(line);
+                }
+            }
+            let written: Vec<&str> = text
+                .lines()
+                .skip_while(|l| !l.starts_with("G93"))
+                .take_while(|l| *l != "M2")
+                .collect();
+            proptest::prop_assert_eq!(written, expected);
+            proptest::prop_assert!(text.lines().all(|l| l.len() <= 255));
+        }
+    }
+}

@@ -1,0 +1,603 @@
+//! Compiles a surface tape (`crate::surface::ir::SurfaceTape`) to native
+//! code with cranelift: one kernel per tape that evaluates the six outputs
+//! (z and its first and second derivatives) for a whole batch of points,
+//! computing exactly what the reference `Interpreter` computes.
+//!
+//! The kernel is `extern "C" fn(xs, ys, out, n)`: the loop over the points
+//! is inside the generated code, so a batch costs one call. The loop takes
+//! two points per pass in the lanes of an `F64X2` (about twice the
+//! throughput of one lane on arithmetic-heavy tapes, as measured by
+//! `benches/surface_eval.rs`) and an odd last point in a scalar pass.
+//!
+//! Arithmetic, `sqrt`, `abs` and negation are native instructions
+//! (IEEE-exact, as in Rust); `min`/`max` are a select sequence with Rust's
+//! `f64::min`/`max` behaviour (the non-NaN operand wins, ties return the
+//! first operand); whole powers are expanded by repeated squaring in the
+//! order compiler-rt's `__powidf2` (Rust's `f64::powi`) multiplies;
+//! everything else (sin … ln, pow, atan2) calls the interpreter's own
+//! `apply_unary`/`apply_binary` through `extern "C"` wrappers registered as
+//! JIT symbols, once per lane.
+
+use std::collections::HashMap;
+use std::fmt;
+use std::sync::OnceLock;
+
+use crate::surface::ir::{
+    Binary, Id, Node, SurfaceFn, SurfaceTape, Unary, Var, apply_binary, apply_unary,
+};
+use cranelift_codegen::Context;
+use cranelift_codegen::ir::condcodes::{FloatCC, IntCC};
+use cranelift_codegen::ir::immediates::Ieee64;
+use cranelift_codegen::ir::{
+    AbiParam, FuncRef, InstBuilder, MemFlagsData, Type, UserFuncName, Value, types,
+};
+use cranelift_codegen::isa::OwnedTargetIsa;
+use cranelift_codegen::settings::{self, Configurable};
+use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
+use cranelift_jit::{JITBuilder, JITModule};
+use cranelift_module::{FuncId, Linkage, Module, default_libcall_names};
+
+/// Why a tape could not be compiled (a cranelift or host error, never a
+/// user error: every valid tape compiles).
+#[derive(Debug)]
+pub struct JitError(pub String);
+
+impl fmt::Display for JitError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "surface JIT: {}", self.0)
+    }
+}
+
+impl std::error::Error for JitError {}
+
+/// The generated kernel: for i in 0..n, writes the six outputs at
+/// (xs[i], ys[i]) to out[6i .. 6i + 6].
+type Kernel = unsafe extern "C" fn(xs: *const f64, ys: *const f64, out: *mut f64, n: usize);
+
+/// A surface tape compiled to native code.
+pub struct JitSurface {
+    kernel: Kernel,
+    /// Owns the executable memory `kernel` points into; freed on drop.
+    module: ModuleGuard,
+}
+
+// `JitSurface` is `Send` without help: `JITModule` is `Send` and a function
+// pointer is `Send`. Checked here so a cranelift change cannot silently
+// take it away.
+const _: fn() = || {
+    fn send<T: Send>() {}
+    send::<JitSurface>();
+};
+
+// SAFETY: through `&JitSurface` the only thing reachable is `kernel`, a
+// function pointer to finalized, read-only code that touches nothing but
+// its arguments (and calls pure, thread-safe libm wrappers). The module's
+// interior state (a `RefCell` symbol cache) is never touched after
+// `compile` returns: `ModuleGuard` exposes it to no `&self` method, only
+// to its own `Drop`, which has exclusive access.
+unsafe impl Sync for JitSurface {}
+
+/// Keeps the `JITModule` alive as long as its code can be called and frees
+/// its memory when dropped (cranelift's own `Drop` leaks it on purpose).
+struct ModuleGuard(Option<JITModule>);
+
+impl Drop for ModuleGuard {
+    fn drop(&mut self) {
+        if let Some(module) = self.0.take() {
+            // SAFETY: the guard is dropped with (or instead of) the
+            // `JitSurface` that holds the only copy of the kernel pointer,
+            // so no code of this module runs or can be called afterwards.
+            unsafe { module.free_memory() };
+        }
+    }
+}
+
+impl JitSurface {
+    /// Compiles the live part of `tape` into one batch kernel.
+    pub fn compile(tape: &SurfaceTape) -> Result<JitSurface, JitError> {
+        let mut jb = JITBuilder::with_isa(host_isa()?, default_libcall_names());
+        for f in Libm::ALL {
+            jb.symbol(f.symbol(), f.address());
+        }
+        // From here on, an early return frees whatever was allocated.
+        let mut guard = ModuleGuard(Some(JITModule::new(jb)));
+        let module = guard.0.as_mut().expect("module is present until drop");
+        let id = define_kernel(module, tape)?;
+        module
+            .finalize_definitions()
+            .map_err(|e| JitError(format!("finalizing the kernel: {e}")))?;
+        let code = module.get_finalized_function(id);
+        // SAFETY: `code` is the finalized kernel, declared with the
+        // signature built in `define_kernel`: four pointer-sized integer
+        // parameters and no return value, in the host's default (C)
+        // calling convention — exactly `Kernel`.
+        let kernel = unsafe { std::mem::transmute::<*const u8, Kernel>(code) };
+        Ok(JitSurface {
+            kernel,
+            module: guard,
+        })
+    }
+}
+
+impl SurfaceFn for JitSurface {
+    fn eval_batch(&self, xs: &[f64], ys: &[f64], out: &mut [f64]) {
+        // Hard asserts: the kernel trusts these lengths with raw pointers.
+        assert_eq!(xs.len(), ys.len(), "xs and ys differ in length");
+        assert_eq!(
+            out.len(),
+            6 * xs.len(),
+            "out must hold six values per point"
+        );
+        debug_assert!(self.module.0.is_some());
+        // SAFETY: the kernel reads xs[0..n], ys[0..n] and writes
+        // out[0..6n], all in bounds by the asserts above; its code lives as
+        // long as `self.module`.
+        unsafe { (self.kernel)(xs.as_ptr(), ys.as_ptr(), out.as_mut_ptr(), xs.len()) }
+    }
+}
+
+/// The host ISA, detected once per process (`OwnedTargetIsa` is an `Arc`).
+fn host_isa() -> Result<OwnedTargetIsa, JitError> {
+    static ISA: OnceLock<Result<OwnedTargetIsa, String>> = OnceLock::new();
+    ISA.get_or_init(|| {
+        let mut flags = settings::builder();
+        let set = |fb: &mut settings::Builder, k: &str, v: &str| {
+            fb.set(k, v).map_err(|e| format!("setting {k}={v}: {e}"))
+        };
+        // cranelift-jit requires both: absolute calls to the wrappers.
+        set(&mut flags, "use_colocated_libcalls", "false")?;
+        set(&mut flags, "is_pic", "false")?;
+        // The tape reaching the JIT is already deduplicated and folded
+        // (`ir::Graph`), so cranelift's e-graph pass finds nothing to gain:
+        // measured with `benches/surface_eval.rs`, "none" compiles 25–35 %
+        // faster (the 10 × 10 array 0.95 → 0.75 ms) and runs as fast or
+        // faster (conic + A4…A16 batch 6.8 → 6.2 ns/point) than "speed".
+        // The single-pass register allocator would halve compile time again
+        // but doubles run time; the default (backtracking) is kept.
+        set(&mut flags, "opt_level", "none")?;
+        // The verifier costs compile time; keep it for debug builds.
+        let verify = if cfg!(debug_assertions) {
+            "true"
+        } else {
+            "false"
+        };
+        set(&mut flags, "enable_verifier", verify)?;
+        let isa =
+            cranelift_native::builder().map_err(|e| format!("host machine not supported: {e}"))?;
+        isa.finish(settings::Flags::new(flags))
+            .map_err(|e| format!("building the host ISA: {e}"))
+    })
+    .clone()
+    .map_err(JitError)
+}
+
+/// How many points one pass of the tape evaluates: two side by side in
+/// the lanes of an `F64X2` (cranelift has no 4-lane f64 on x86-64) in the
+/// main loop, one (`F64`) for the odd point left at the end.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Lanes {
+    One,
+    Two,
+}
+
+impl Lanes {
+    fn ty(self) -> Type {
+        match self {
+            Lanes::One => types::F64,
+            Lanes::Two => types::F64X2,
+        }
+    }
+}
+
+/// Builds and defines the kernel function in `module`.
+///
+/// ```text
+/// entry: end = xs + 8·(n & !1); if n < 2 goto tail
+/// main:  the tape on F64X2 for points (px[0], py[0]) and (px[1], py[1]);
+///        advance the cursors by two points; loop until px == end
+/// tail:  if n is odd: the tape on F64 for the last point
+/// exit:  return
+/// ```
+fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, JitError> {
+    let ptr = module.target_config().pointer_type();
+    let mut sig = module.make_signature();
+    for _ in 0..4 {
+        sig.params.push(AbiParam::new(ptr));
+    }
+    let id = module
+        .declare_function("lensc_surface_kernel", Linkage::Local, &sig)
+        .map_err(|e| JitError(format!("declaring the kernel: {e}")))?;
+
+    let mut ctx: Context = module.make_context();
+    ctx.func.signature = sig;
+    ctx.func.name = UserFuncName::user(0, id.as_u32());
+    let mut fctx = FunctionBuilderContext::new();
+    let mut b = FunctionBuilder::new(&mut ctx.func, &mut fctx);
+    let mut emit = Emitter {
+        module,
+        imports: HashMap::new(),
+    };
+
+    let entry = b.create_block();
+    let main = b.create_block();
+    let tail = b.create_block();
+    let last = b.create_block();
+    let exit = b.create_block();
+
+    b.append_block_params_for_function_params(entry);
+    b.switch_to_block(entry);
+    let &[xs, ys, out, n] = b.block_params(entry) else {
+        unreachable!("the kernel has four parameters")
+    };
+    let [px, py, po] = [(); 3].map(|_| b.declare_var(ptr));
+    b.def_var(px, xs);
+    b.def_var(py, ys);
+    b.def_var(po, out);
+    let even = b.ins().band_imm_s(n, -2);
+    let bytes = b.ins().ishl_imm_u(even, 3);
+    let end = b.ins().iadd(xs, bytes);
+    b.ins().brif(even, main, &[], tail, &[]);
+
+    b.switch_to_block(main);
+    let (cx, cy, co) = (b.use_var(px), b.use_var(py), b.use_var(po));
+    emit.pass(&mut b, tape, Lanes::Two, cx, cy, co)?;
+    let nx = b.ins().iadd_imm_u(cx, 16);
+    let ny = b.ins().iadd_imm_u(cy, 16);
+    let no = b.ins().iadd_imm_u(co, 96);
+    b.def_var(px, nx);
+    b.def_var(py, ny);
+    b.def_var(po, no);
+    let more = b.ins().icmp(IntCC::NotEqual, nx, end);
+    b.ins().brif(more, main, &[], tail, &[]);
+
+    b.switch_to_block(tail);
+    let odd = b.ins().band_imm_u(n, 1);
+    b.ins().brif(odd, last, &[], exit, &[]);
+
+    b.switch_to_block(last);
+    let (cx, cy, co) = (b.use_var(px), b.use_var(py), b.use_var(po));
+    emit.pass(&mut b, tape, Lanes::One, cx, cy, co)?;
+    b.ins().jump(exit, &[]);
+
+    b.switch_to_block(exit);
+    b.ins().return_(&[]);
+    b.seal_all_blocks();
+    let frontend = emit.module.target_config();
+    b.finalize(frontend);
+
+    module
+        .define_function(id, &mut ctx)
+        .map_err(|e| JitError(format!("compiling the kernel: {e:?}")))?;
+    Ok(id)
+}
+
+/// Emits operations, importing each libm wrapper at most once.
+struct Emitter<'m> {
+    module: &'m mut JITModule,
+    imports: HashMap<Libm, FuncRef>,
+}
+
+impl Emitter<'_> {
+    /// One pass of the live tape for the point(s) at the cursors: loads x
+    /// and y, evaluates every node, stores the six outputs of each point.
+    fn pass(
+        &mut self,
+        b: &mut FunctionBuilder,
+        tape: &SurfaceTape,
+        lanes: Lanes,
+        cx: Value,
+        cy: Value,
+        co: Value,
+    ) -> Result<(), JitError> {
+        // Slices of f64 are 8-aligned, so a pair is not always 16-aligned.
+        let load = match lanes {
+            Lanes::One => MemFlagsData::trusted(),
+            Lanes::Two => MemFlagsData::new().with_notrap(),
+        };
+        let x = b.ins().load(lanes.ty(), load, cx, 0);
+        let y = b.ins().load(lanes.ty(), load, cy, 0);
+        let mut val: Vec<Option<Value>> = vec![None; tape.graph.len()];
+        for id in tape.live_nodes() {
+            let get =
+                |i: Id| val[i.0 as usize].expect("operands come before their node in the tape");
+            let v = match tape.graph.node(id) {
+                Node::Const(bits) => constant(b, lanes, bits),
+                Node::Var(Var::X) => x,
+                Node::Var(Var::Y) => y,
+                Node::Unary(op, a) => self.unary(b, lanes, op, get(a))?,
+                Node::Binary(op, a, c) => self.binary(b, lanes, op, get(a), get(c))?,
+                Node::PowI(a, k) => powi(b, lanes, get(a), k),
+                Node::Step(a) => {
+                    // 1 where a < 0 (false for NaN), else 0.
+                    let zero = constant(b, lanes, 0f64.to_bits());
+                    let one = constant(b, lanes, 1f64.to_bits());
+                    let neg = b.ins().fcmp(FloatCC::LessThan, get(a), zero);
+                    select(b, lanes, neg, one, zero)
+                }
+                Node::Select(c, t, f) => {
+                    // t where c < 0 (false for NaN), else f.
+                    let zero = constant(b, lanes, 0f64.to_bits());
+                    let neg = b.ins().fcmp(FloatCC::LessThan, get(c), zero);
+                    select(b, lanes, neg, get(t), get(f))
+                }
+            };
+            val[id.0 as usize] = Some(v);
+        }
+        let mem = MemFlagsData::trusted();
+        for (k, o) in tape.outputs.iter().enumerate() {
+            let v = val[o.0 as usize].expect("outputs are live");
+            let off = 8 * k as i32;
+            match lanes {
+                Lanes::One => {
+                    b.ins().store(mem, v, co, off);
+                }
+                Lanes::Two => {
+                    let lo = b.ins().extractlane(v, 0);
+                    let hi = b.ins().extractlane(v, 1);
+                    b.ins().store(mem, lo, co, off);
+                    b.ins().store(mem, hi, co, off + 48);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn unary(
+        &mut self,
+        b: &mut FunctionBuilder,
+        lanes: Lanes,
+        op: Unary,
+        a: Value,
+    ) -> Result<Value, JitError> {
+        Ok(match op {
+            Unary::Neg => b.ins().fneg(a),
+            Unary::Sqrt => b.ins().sqrt(a),
+            Unary::Abs => b.ins().fabs(a),
+            Unary::Floor => b.ins().floor(a),
+            Unary::Sin => self.call(b, lanes, Libm::Sin, &[a])?,
+            Unary::Cos => self.call(b, lanes, Libm::Cos, &[a])?,
+            Unary::Tan => self.call(b, lanes, Libm::Tan, &[a])?,
+            Unary::Asin => self.call(b, lanes, Libm::Asin, &[a])?,
+            Unary::Acos => self.call(b, lanes, Libm::Acos, &[a])?,
+            Unary::Atan => self.call(b, lanes, Libm::Atan, &[a])?,
+            Unary::Exp => self.call(b, lanes, Libm::Exp, &[a])?,
+            Unary::Ln => self.call(b, lanes, Libm::Ln, &[a])?,
+        })
+    }
+
+    fn binary(
+        &mut self,
+        b: &mut FunctionBuilder,
+        lanes: Lanes,
+        op: Binary,
+        l: Value,
+        r: Value,
+    ) -> Result<Value, JitError> {
+        Ok(match op {
+            Binary::Add => b.ins().fadd(l, r),
+            Binary::Sub => b.ins().fsub(l, r),
+            Binary::Mul => b.ins().fmul(l, r),
+            Binary::Div => b.ins().fdiv(l, r),
+            Binary::Pow => self.call(b, lanes, Libm::Pow, &[l, r])?,
+            Binary::Atan2 => self.call(b, lanes, Libm::Atan2, &[l, r])?,
+            // Rust's f64::min/max (LLVM minnum/maxnum on x86-64):
+            // l is NaN → r; else r if r is strictly smaller (greater), else l.
+            // So a NaN r yields l, and equal operands (±0) yield l.
+            // cranelift's fmin/fmax propagate NaN and order −0 < +0 instead.
+            Binary::Min | Binary::Max => {
+                let cc = if op == Binary::Min {
+                    FloatCC::LessThan
+                } else {
+                    FloatCC::GreaterThan
+                };
+                let r_wins = b.ins().fcmp(cc, r, l);
+                let m = select(b, lanes, r_wins, r, l);
+                let l_nan = b.ins().fcmp(FloatCC::Unordered, l, l);
+                select(b, lanes, l_nan, r, m)
+            }
+        })
+    }
+
+    /// Calls a scalar wrapper, once per lane.
+    fn call(
+        &mut self,
+        b: &mut FunctionBuilder,
+        lanes: Lanes,
+        f: Libm,
+        args: &[Value],
+    ) -> Result<Value, JitError> {
+        let fref = match self.imports.get(&f) {
+            Some(&r) => r,
+            None => {
+                let mut sig = self.module.make_signature();
+                for _ in 0..f.arity() {
+                    sig.params.push(AbiParam::new(types::F64));
+                }
+                sig.returns.push(AbiParam::new(types::F64));
+                let fid = self
+                    .module
+                    .declare_function(f.symbol(), Linkage::Import, &sig)
+                    .map_err(|e| JitError(format!("declaring {}: {e}", f.symbol())))?;
+                let r = self.module.declare_func_in_func(fid, b.func);
+                self.imports.insert(f, r);
+                r
+            }
+        };
+        let call = |b: &mut FunctionBuilder, args: &[Value]| {
+            let inst = b.ins().call(fref, args);
+            b.inst_results(inst)[0]
+        };
+        Ok(match lanes {
+            Lanes::One => call(b, args),
+            Lanes::Two => {
+                let lane = |b: &mut FunctionBuilder, i: u8| {
+                    let a: Vec<Value> = args.iter().map(|&a| b.ins().extractlane(a, i)).collect();
+                    call(b, &a)
+                };
+                let lo = lane(b, 0);
+                let hi = lane(b, 1);
+                let v = b.ins().scalar_to_vector(types::F64X2, lo);
+                b.ins().insertlane(v, hi, 1)
+            }
+        })
+    }
+}
+
+/// A constant, in every lane.
+fn constant(b: &mut FunctionBuilder, lanes: Lanes, bits: u64) -> Value {
+    match lanes {
+        Lanes::One => b.ins().f64const(Ieee64::with_bits(bits)),
+        Lanes::Two => {
+            let mut bytes = bits.to_le_bytes().to_vec();
+            bytes.extend_from_slice(&bits.to_le_bytes());
+            let c = b.func.dfg.constants.insert(bytes.into());
+            b.ins().vconst(types::F64X2, c)
+        }
+    }
+}
+
+/// `cond ? t : f` lane by lane, for a condition from `fcmp`: a flag with
+/// one lane, a lane mask with two.
+fn select(b: &mut FunctionBuilder, lanes: Lanes, cond: Value, t: Value, f: Value) -> Value {
+    match lanes {
+        Lanes::One => b.ins().select(cond, t, f),
+        Lanes::Two => {
+            let mask = b.ins().bitcast(types::F64X2, MemFlagsData::new(), cond);
+            b.ins().bitselect(mask, t, f)
+        }
+    }
+}
+
+/// a^n by repeated squaring, multiplying in the order of compiler-rt's
+/// `__powidf2`, which Rust's `f64::powi` is: r = 1; for each bit of |n|
+/// from the lowest, r *= a if set, then a *= a; 1/r for negative n. (The
+/// leading `1 · a` is exact and left out.)
+fn powi(b: &mut FunctionBuilder, lanes: Lanes, a: Value, n: i32) -> Value {
+    let mut e = n.unsigned_abs();
+    let mut square = a;
+    let mut acc: Option<Value> = None;
+    while e != 0 {
+        if e & 1 == 1 {
+            acc = Some(match acc {
+                None => square,
+                Some(r) => b.ins().fmul(r, square),
+            });
+        }
+        e >>= 1;
+        if e != 0 {
+            square = b.ins().fmul(square, square);
+        }
+    }
+    let r = match acc {
+        Some(r) => r,
+        None => constant(b, lanes, 1f64.to_bits()),
+    };
+    if n < 0 {
+        let one = constant(b, lanes, 1f64.to_bits());
+        b.ins().fdiv(one, r)
+    } else {
+        r
+    }
+}
+
+/// The functions the kernel calls rather than inlines.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum Libm {
+    Sin,
+    Cos,
+    Tan,
+    Asin,
+    Acos,
+    Atan,
+    Exp,
+    Ln,
+    Pow,
+    Atan2,
+}
+
+impl Libm {
+    const ALL: [Libm; 10] = [
+        Libm::Sin,
+        Libm::Cos,
+        Libm::Tan,
+        Libm::Asin,
+        Libm::Acos,
+        Libm::Atan,
+        Libm::Exp,
+        Libm::Ln,
+        Libm::Pow,
+        Libm::Atan2,
+    ];
+
+    fn symbol(self) -> &'static str {
+        match self {
+            Libm::Sin => "lensc_jit_sin",
+            Libm::Cos => "lensc_jit_cos",
+            Libm::Tan => "lensc_jit_tan",
+            Libm::Asin => "lensc_jit_asin",
+            Libm::Acos => "lensc_jit_acos",
+            Libm::Atan => "lensc_jit_atan",
+            Libm::Exp => "lensc_jit_exp",
+            Libm::Ln => "lensc_jit_ln",
+            Libm::Pow => "lensc_jit_pow",
+            Libm::Atan2 => "lensc_jit_atan2",
+        }
+    }
+
+    fn arity(self) -> usize {
+        match self {
+            Libm::Pow | Libm::Atan2 => 2,
+            _ => 1,
+        }
+    }
+
+    fn address(self) -> *const u8 {
+        type F1 = extern "C" fn(f64) -> f64;
+        type F2 = extern "C" fn(f64, f64) -> f64;
+        match self {
+            Libm::Sin => lensc_jit_sin as F1 as *const u8,
+            Libm::Cos => lensc_jit_cos as F1 as *const u8,
+            Libm::Tan => lensc_jit_tan as F1 as *const u8,
+            Libm::Asin => lensc_jit_asin as F1 as *const u8,
+            Libm::Acos => lensc_jit_acos as F1 as *const u8,
+            Libm::Atan => lensc_jit_atan as F1 as *const u8,
+            Libm::Exp => lensc_jit_exp as F1 as *const u8,
+            Libm::Ln => lensc_jit_ln as F1 as *const u8,
+            Libm::Pow => lensc_jit_pow as F2 as *const u8,
+            Libm::Atan2 => lensc_jit_atan2 as F2 as *const u8,
+        }
+    }
+}
+
+// The C-ABI entry points the kernel calls. Each is the interpreter's own
+// function for that operation, so both backends share one implementation.
+extern "C" fn lensc_jit_sin(a: f64) -> f64 {
+    apply_unary(Unary::Sin, a)
+}
+extern "C" fn lensc_jit_cos(a: f64) -> f64 {
+    apply_unary(Unary::Cos, a)
+}
+extern "C" fn lensc_jit_tan(a: f64) -> f64 {
+    apply_unary(Unary::Tan, a)
+}
+extern "C" fn lensc_jit_asin(a: f64) -> f64 {
+    apply_unary(Unary::Asin, a)
+}
+extern "C" fn lensc_jit_acos(a: f64) -> f64 {
+    apply_unary(Unary::Acos, a)
+}
+extern "C" fn lensc_jit_atan(a: f64) -> f64 {
+    apply_unary(Unary::Atan, a)
+}
+extern "C" fn lensc_jit_exp(a: f64) -> f64 {
+    apply_unary(Unary::Exp, a)
+}
+extern "C" fn lensc_jit_ln(a: f64) -> f64 {
+    apply_unary(Unary::Ln, a)
+}
+extern "C" fn lensc_jit_pow(a: f64, b: f64) -> f64 {
+    apply_binary(Binary::Pow, a, b)
+}
+extern "C" fn lensc_jit_atan2(a: f64, b: f64) -> f64 {
+    apply_binary(Binary::Atan2, a, b)
+}

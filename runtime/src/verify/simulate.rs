@@ -1,0 +1,417 @@
+//! Cut simulation of profiles: the surface a lathe or grinder program
+//! leaves, from the moves the program actually commands (after
+//! optimisation, with every coordinate rounded to the machine's
+//! resolution as the writer prints it), compared with the design.
+//!
+//! The tool is a round nose (or a wheel's section) of radius ρ whose
+//! centre follows the moves; the material is on the −Z side, so the cut
+//! surface is the lower envelope of the disc swept along every cutting
+//! move. The envelope is exact: a disc swept along a straight move is
+//! bounded below by its end discs and the move offset by ρ; along an arc
+//! of radius R, by its end discs and the arcs of radius R ± ρ.
+
+use crate::moves::{Move, Plane};
+use crate::post::format::{decimals_for, fixed_units};
+use std::f64::consts::PI;
+
+/// What a profile program cuts, against the design.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProfileCut {
+    /// Radii (mm) where the cut was sampled, and the error there: the cut
+    /// surface's height minus the design's (mm; positive where material is
+    /// left, negative where the cut went below the design).
+    pub samples: Vec<(f64, f64)>,
+    /// Peak to valley and RMS of the error (mm).
+    pub pv: f64,
+    pub rms: f64,
+    /// The most material left above the design (mm, ≥ 0) and where.
+    pub max_residual: (f64, f64),
+    /// The deepest cut below the design (mm, ≥ 0) and where.
+    pub max_gouge: (f64, f64),
+}
+
+/// One cutting move of the nose centre in the X–Z plane.
+#[derive(Clone, Copy, Debug)]
+enum Piece {
+    Line {
+        a: (f64, f64),
+        b: (f64, f64),
+    },
+    /// Centre, radius, and the arc's start angle and signed sweep, angles
+    /// measured from +Z towards +X (the G18 sense).
+    Arc {
+        o: (f64, f64),
+        r: f64,
+        start: f64,
+        sweep: f64,
+        a: (f64, f64),
+        b: (f64, f64),
+    },
+}
+
+/// Rounds `v` (mm) as a writer with `resolution` prints it.
+pub fn as_printed(v: f64, resolution: f64) -> f64 {
+    let d = decimals_for(resolution);
+    match fixed_units(v, d) {
+        Some(n) => n as f64 / 10f64.powi(d as i32),
+        None => v,
+    }
+}
+
+/// The cutting moves of a lathe stream (X, Z; arcs in G18) as printed.
+fn pieces(stream: &[Move], resolution: f64) -> Vec<Piece> {
+    let p = |v: f64| as_printed(v, resolution);
+    let mut at = (f64::NAN, f64::NAN);
+    let mut out = Vec::new();
+    for m in stream {
+        let (to, arc) = match *m {
+            Move::Rapid(to) => (to, None),
+            Move::Linear { to, .. } => (to, Some(None)),
+            Move::Arc {
+                to,
+                centre,
+                plane: Plane::Zx,
+                ccw,
+                ..
+            } => (to, Some(Some((centre, ccw)))),
+            _ => continue,
+        };
+        let next = (
+            if to.x.is_nan() { at.0 } else { p(to.x) },
+            if to.z.is_nan() { at.1 } else { p(to.z) },
+        );
+        let known = !(at.0.is_nan() || at.1.is_nan());
+        match arc {
+            Some(None) if known => out.push(Piece::Line { a: at, b: next }),
+            Some(Some((c, ccw))) if known => {
+                let o = (p(c.x), p(c.z));
+                let angle = |q: (f64, f64)| (q.0 - o.0).atan2(q.1 - o.1);
+                let (a0, a1) = (angle(at), angle(next));
+                let sweep = if ccw {
+                    (a1 - a0).rem_euclid(2.0 * PI)
+                } else {
+                    -(a0 - a1).rem_euclid(2.0 * PI)
+                };
+                let r = (at.0 - o.0).hypot(at.1 - o.1);
+                out.push(Piece::Arc {
+                    o,
+                    r,
+                    start: a0,
+                    sweep,
+                    a: at,
+                    b: next,
+                });
+            }
+            _ => {}
+        }
+        at = next;
+    }
+    out
+}
+
+/// The nose centre's path along the cutting moves of a lathe `stream`, as
+/// printed (coordinates rounded to `resolution`): one polyline of (X, Z)
+/// (mm) per run of cutting moves, an arc drawn through points at most
+/// 1° of its sweep apart. For plots.
+pub fn centre_path(stream: &[Move], resolution: f64) -> Vec<Vec<(f64, f64)>> {
+    let mut runs: Vec<Vec<(f64, f64)>> = Vec::new();
+    for piece in pieces(stream, resolution) {
+        let (a, b) = match piece {
+            Piece::Line { a, b } | Piece::Arc { a, b, .. } => (a, b),
+        };
+        let continues = runs.last().and_then(|r| r.last()) == Some(&a);
+        if !continues {
+            runs.push(vec![a]);
+        }
+        let run = runs.last_mut().expect("pushed");
+        if let Piece::Arc {
+            o, r, start, sweep, ..
+        } = piece
+        {
+            let steps = (sweep.abs().to_degrees().ceil() as usize).max(1);
+            for k in 1..steps {
+                let ang = start + sweep * k as f64 / steps as f64;
+                run.push((o.0 + r * ang.sin(), o.1 + r * ang.cos()));
+            }
+        }
+        run.push(b);
+    }
+    runs
+}
+
+/// The lowest point at abscissa `x` of a disc of radius `rho` centred at
+/// `c`, if the disc reaches `x`.
+fn disc_bottom(c: (f64, f64), rho: f64, x: f64) -> Option<f64> {
+    let dx = x - c.0;
+    (dx.abs() <= rho).then(|| c.1 - (rho * rho - dx * dx).sqrt())
+}
+
+impl Piece {
+    /// The radii the disc swept along the piece reaches.
+    fn reach(&self, rho: f64) -> (f64, f64) {
+        match *self {
+            Piece::Line { a, b } => (a.0.min(b.0) - rho, a.0.max(b.0) + rho),
+            Piece::Arc { o, r, .. } => (o.0 - r - rho, o.0 + r + rho),
+        }
+    }
+
+    /// The lowest point at `x` of the disc of radius `rho` swept along the
+    /// piece, if the swept region reaches `x`.
+    fn bottom(&self, rho: f64, x: f64) -> Option<f64> {
+        let (a, b) = match *self {
+            Piece::Line { a, b } | Piece::Arc { a, b, .. } => (a, b),
+        };
+        let mut low = disc_bottom(a, rho, x);
+        let mut see = |z: Option<f64>| {
+            if let Some(z) = z {
+                low = Some(low.map_or(z, |l: f64| l.min(z)));
+            }
+        };
+        see(disc_bottom(b, rho, x));
+        match *self {
+            Piece::Line { a, b } => {
+                let (dx, dz) = (b.0 - a.0, b.1 - a.1);
+                let len = dx.hypot(dz);
+                if len > 0.0 && dx != 0.0 {
+                    // The normal pointing down (−Z).
+                    let (nx, nz) = if dx > 0.0 {
+                        (dz / len, -dx / len)
+                    } else {
+                        (-dz / len, dx / len)
+                    };
+                    let (a2, b2) = (
+                        (a.0 + rho * nx, a.1 + rho * nz),
+                        (b.0 + rho * nx, b.1 + rho * nz),
+                    );
+                    let t = (x - a2.0) / (b2.0 - a2.0);
+                    if (0.0..=1.0).contains(&t) {
+                        see(Some(a2.1 + t * (b2.1 - a2.1)));
+                    }
+                }
+            }
+            Piece::Arc {
+                o, r, start, sweep, ..
+            } => {
+                for rr in [r + rho, r - rho] {
+                    if rr <= 0.0 {
+                        continue;
+                    }
+                    let s = (x - o.0) / rr;
+                    if s.abs() > 1.0 {
+                        continue;
+                    }
+                    let base = s.asin();
+                    for ang in [base, PI - base] {
+                        // Within the arc's sweep from its start?
+                        let mut t = ang - start;
+                        if sweep >= 0.0 {
+                            t = t.rem_euclid(2.0 * PI);
+                            if t > sweep {
+                                continue;
+                            }
+                        } else {
+                            t = (-t).rem_euclid(2.0 * PI);
+                            if t > -sweep {
+                                continue;
+                            }
+                        }
+                        see(Some(o.1 + rr * ang.cos()));
+                    }
+                }
+            }
+        }
+        low
+    }
+}
+
+/// Simulates the cut of a lathe `stream` (nose radius `rho`, coordinates
+/// rounded to `resolution`) on `samples` radii evenly over `from..=to`
+/// and compares it with `design` (the profile's height at a radius).
+/// Radii the cut does not reach are left out.
+pub fn profile_cut(
+    stream: &[Move],
+    rho: f64,
+    resolution: f64,
+    design: &dyn Fn(f64) -> f64,
+    (from, to): (f64, f64),
+    samples: usize,
+) -> ProfileCut {
+    let pieces = pieces(stream, resolution);
+    let n = samples.max(2);
+    // Each piece listed in the bins of radii its swept disc can reach.
+    let bins = 1024usize;
+    let width = (to - from) / bins as f64;
+    let bin = |x: f64| (((x - from) / width).floor().max(0.0) as usize).min(bins - 1);
+    let mut in_bin: Vec<Vec<usize>> = vec![Vec::new(); bins];
+    for (i, p) in pieces.iter().enumerate() {
+        let (lo, hi) = p.reach(rho);
+        if hi < from || lo > to || !(lo.is_finite() && hi.is_finite()) {
+            continue;
+        }
+        for b in &mut in_bin[bin(lo)..=bin(hi)] {
+            b.push(i);
+        }
+    }
+    let mut out = Vec::with_capacity(n);
+    for k in 0..n {
+        let x = from + (to - from) * k as f64 / (n - 1) as f64;
+        let cut = in_bin[bin(x)]
+            .iter()
+            .filter_map(|&i| pieces[i].bottom(rho, x))
+            .fold(f64::INFINITY, f64::min);
+        if cut.is_finite() {
+            out.push((x, cut - design(x)));
+        }
+    }
+    let (mut hi, mut lo) = ((f64::NAN, f64::NEG_INFINITY), (f64::NAN, f64::INFINITY));
+    let mut sum2 = 0.0;
+    for &(x, e) in &out {
+        if e > hi.1 {
+            hi = (x, e);
+        }
+        if e < lo.1 {
+            lo = (x, e);
+        }
+        sum2 += e * e;
+    }
+    let rms = if out.is_empty() {
+        0.0
+    } else {
+        (sum2 / out.len() as f64).sqrt()
+    };
+    ProfileCut {
+        pv: if out.is_empty() { 0.0 } else { hi.1 - lo.1 },
+        rms,
+        max_residual: (hi.1.max(0.0), hi.0),
+        max_gouge: ((-lo.1).max(0.0), lo.0),
+        samples: out,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::moves::{Feed, Position};
+
+    const RHO: f64 = 0.5;
+
+    /// A sphere of radius `r` (convex, vertex at 0): the nose centre runs
+    /// on the sphere of radius r + ρ.
+    fn convex(r: f64) -> impl Fn(f64) -> f64 {
+        move |x: f64| (r * r - x * x).sqrt() - r
+    }
+
+    fn linear(x: f64, z: f64) -> Move {
+        Move::Linear {
+            to: Position::xz(x, z),
+            feed: Some(Feed::PerTime(1.0)),
+        }
+    }
+
+    #[test]
+    fn one_exact_arc_cuts_the_sphere_it_offsets() {
+        let r = 10.0;
+        let rc = r + RHO;
+        let start = (2.0f64, (rc * rc - 4.0).sqrt() - r);
+        let stream = [
+            Move::Rapid(Position::xz(start.0, 5.0)),
+            linear(start.0, start.1),
+            Move::Arc {
+                to: Position::xz(0.0, RHO),
+                centre: Position::xz(0.0, -r),
+                plane: Plane::Zx,
+                ccw: false,
+                feed: None,
+            },
+        ];
+        let cut = profile_cut(&stream, RHO, 1e-9, &convex(r), (0.0, 1.5), 301);
+        assert_eq!(cut.samples.len(), 301);
+        assert!(cut.pv < 1e-9 && cut.rms < 1e-9, "{} {}", cut.pv, cut.rms);
+    }
+
+    #[test]
+    fn the_centre_path_follows_the_printed_moves_and_breaks_at_rapids() {
+        let stream = [
+            Move::Rapid(Position::xz(2.0, 5.0)),
+            linear(2.0, 0.0004),
+            Move::Arc {
+                to: Position::xz(0.0, 2.0),
+                centre: Position::xz(0.0, 0.0),
+                plane: Plane::Zx,
+                ccw: false,
+                feed: None,
+            },
+            Move::Rapid(Position::xz(3.0, 5.0)),
+            linear(3.0, 1.0),
+            linear(2.5, 1.0),
+        ];
+        let runs = centre_path(&stream, 1e-3);
+        assert_eq!(runs.len(), 2);
+        // The plunge's end as printed to 1 µm, then the quarter arc up to
+        // the axis at 1° steps, every point on its circle.
+        assert_eq!(runs[0][0], (2.0, 5.0));
+        assert_eq!(runs[0][1], (2.0, 0.0));
+        let arc = &runs[0][1..];
+        assert_eq!(arc.len(), 91);
+        for p in arc {
+            assert!((p.0.hypot(p.1) - 2.0).abs() < 1e-12, "{p:?}");
+        }
+        assert!(arc.windows(2).all(|w| w[1].0 < w[0].0 && w[1].1 > w[0].1));
+        assert_eq!(runs[1], vec![(3.0, 5.0), (3.0, 1.0), (2.5, 1.0)]);
+    }
+
+    #[test]
+    fn chords_cut_a_convex_part_by_their_sag_and_rounding_shows() {
+        // Lines through points on the nose-centre sphere lie inside it, on
+        // the material's side: the cut dips below the design between points
+        // by the chord's sag, L²/(8 Rc).
+        let r = 10.0;
+        let rc = r + RHO;
+        let step = 0.1;
+        let mut stream = vec![Move::Rapid(Position::xz(2.0, 5.0))];
+        let mut x = 2.0f64;
+        while x > -1e-12 {
+            stream.push(linear(x.max(0.0), (rc * rc - x * x).sqrt() - r));
+            x -= step;
+        }
+        let cut = profile_cut(&stream, RHO, 1e-9, &convex(r), (0.0, 1.5), 3001);
+        // The chord of length ≈ 0.1 on radius rc, offset by the nose.
+        let sag = step * step / (8.0 * rc);
+        assert!(cut.max_residual.0 < 1e-9, "{:?}", cut.max_residual);
+        assert!(
+            (cut.max_gouge.0 - sag).abs() < 0.1 * sag,
+            "{:?} vs {sag}",
+            cut.max_gouge
+        );
+        // Rounded to 1 µm, the same path is off by up to half of it.
+        let coarse = profile_cut(&stream, RHO, 1e-3, &convex(r), (0.0, 1.5), 3001);
+        assert!(coarse.pv > cut.pv + 1e-4, "{} vs {}", coarse.pv, cut.pv);
+    }
+
+    #[test]
+    fn a_path_dropped_too_low_is_a_gouge_where_it_drops() {
+        let r = 10.0;
+        let rc = r + RHO;
+        let z = |x: f64| (rc * rc - x * x).sqrt() - r;
+        // Points every 10 µm (chord sag 5 pm), one of them 1 µm low.
+        let mut stream = vec![Move::Rapid(Position::xz(1.0, 5.0))];
+        for k in 0..=100 {
+            let x = 1.0 - 0.01 * k as f64;
+            let low = if k == 20 { 0.001 } else { 0.0 };
+            stream.push(linear(x, z(x) - low));
+        }
+        let cut = profile_cut(&stream, RHO, 1e-9, &convex(r), (0.0, 1.0), 2001);
+        assert!(
+            (cut.max_gouge.0 - 0.001).abs() < 2e-5,
+            "{:?}",
+            cut.max_gouge
+        );
+        // Seen through the nose, the dip is where the nose below (0.8, …)
+        // touches the design: at about x = 0.8 · r / rc.
+        assert!(
+            (cut.max_gouge.1 - 0.8 * r / rc).abs() < 0.01,
+            "{:?}",
+            cut.max_gouge
+        );
+    }
+}
