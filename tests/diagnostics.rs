@@ -9,7 +9,7 @@ use lensc_build::driver;
 use lensc_lang::loader::RealFs;
 
 fn corpus() -> Vec<std::path::PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/bad");
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/bad");
     let mut files: Vec<_> = std::fs::read_dir(&dir)
         .expect("tests/bad")
         .map(|e| e.expect("entry").path())
@@ -21,7 +21,7 @@ fn corpus() -> Vec<std::path::PathBuf> {
 
 /// Renders the diagnostics of one corpus file with a stable, relative name.
 fn render_file(path: &Path) -> (String, String, usize) {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let rel = path.strip_prefix(&root).unwrap_or(path);
     // Check with the working directory at the repository root so file names
     // in the output do not depend on where the tests run.
@@ -117,18 +117,19 @@ fn json_lines_have_every_field() {
 #[test]
 fn checker_reports_every_error_not_the_first() {
     let (_, _, errors) = render_file(
-        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/bad/many_errors_at_once.lens"),
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/bad/many_errors_at_once.lens"),
     );
     assert!(errors >= 6, "only {errors} errors");
     let (_, _, errors) = render_file(
-        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/bad/syntax_two_errors.lens"),
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/bad/syntax_two_errors.lens"),
     );
     assert!(errors >= 2, "a syntax error hid the next one");
 }
 
 #[test]
 fn labels_after_multibyte_characters_point_at_the_right_bytes() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/bad/unicode_before_error.lens");
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/bad/unicode_before_error.lens");
     let c = driver::check_path(&RealFs, &path).expect("read");
     let text = &c.loaded.sources.get(lensc_grammar::FileId(0)).text;
     let d = c

@@ -5,7 +5,7 @@ use std::path::Path;
 
 #[test]
 fn every_seed_sketch_parses() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/seed_sketches");
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/seed_sketches");
     let mut n = 0;
     for entry in std::fs::read_dir(dir).expect("seed_sketches/") {
         let path = entry.expect("entry").path();

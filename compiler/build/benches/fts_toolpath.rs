@@ -22,7 +22,7 @@ fn peak_rss_mb() -> f64 {
 }
 
 fn main() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let path = root.join("examples/hashimoto2025_lens_array.lens");
     let c = lensc_build::driver::check_path(&lensc_lang::loader::RealFs, &path).expect("example");
     assert!(!c.has_errors(), "the example checks");

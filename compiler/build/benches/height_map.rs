@@ -68,7 +68,7 @@ fn compare(name: &str, big: &str, small: &str) {
 }
 
 fn main() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let roller = std::fs::read_to_string(root.join("examples/liu_roller_pattern.lens"))
         .expect("seed 002 example");
     let job_end = "strategy: helix }";
