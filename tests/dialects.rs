@@ -101,7 +101,7 @@ fn every_example_builds_in_every_dialect_its_machine_offers() {
                     let text = p.program.text().expect("program text");
                     obeys(dialect, &text)
                         .unwrap_or_else(|e| panic!("{} in {dialect}: {e}", p.program_name));
-                    assert_eq!(p.report["program"]["dialect"], dialect.as_str());
+                    assert_eq!(p.report.program.dialect, dialect.as_str());
                     let shown = if text.len() > common::WHOLE_SNAPSHOT_LIMIT {
                         abridged(&text)
                     } else {
@@ -249,14 +249,14 @@ fn a_fast_tool_servo_table_holds_the_same_points_as_the_linuxcnc_program() {
     // LinuxCNC's program carries W on Z: after its plunge, the same points
     // as the table's rows, X Z C against C X W.
     let lin = modal_feeds(&linuxcnc.program.text().expect("text"));
-    let points = linuxcnc.report["toolpath"]["cut_points"]
+    let points = linuxcnc.report.to_json()["toolpath"]["cut_points"]
         .as_u64()
         .expect("n") as usize;
     assert_eq!(rows.len(), points);
     assert_eq!(lin.len(), points, "the plunge and a move per later point");
     assert_eq!(
-        table_built.report["program"]["fts_table"]["rows"].as_u64(),
-        Some(points as u64)
+        table_built.report.program.fts_table.map(|t| t.rows),
+        Some(points)
     );
     for (row, m) in rows.iter().zip(&lin).skip(1) {
         assert_eq!([row[1], row[2], row[0]], *m);

@@ -28,7 +28,8 @@ fn every_example_checks_clean() {
 
 /// Builds every example (they must all build) and compares each program
 /// with its reviewed snapshot; programs above `WHOLE_SNAPSHOT_LIMIT` are
-/// snapshot abridged (see `common::abridged`).
+/// snapshot abridged (see `common::abridged`). Every report written must
+/// validate against the committed schema, `docs/report.schema.json`.
 #[test]
 fn example_programs_match_their_snapshots() {
     let dir = tempfile::tempdir().expect("tmp");
@@ -45,6 +46,7 @@ fn example_programs_match_their_snapshots() {
         );
         assert_eq!(out.status.code(), Some(0), "{rel}: {}", text(&out.stderr));
     }
+    reports_follow_the_schema(dir.path());
     let mut programs: Vec<_> = std::fs::read_dir(dir.path())
         .expect("out")
         .map(|e| e.expect("e").path())
@@ -63,6 +65,47 @@ fn example_programs_match_their_snapshots() {
             insta::assert_snapshot!(name, program);
         });
     }
+}
+
+/// Validates every `*.report.json` in `dir` against the committed schema.
+fn reports_follow_the_schema(dir: &std::path::Path) {
+    let schema_path = root().join("docs/report.schema.json");
+    let schema: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&schema_path).expect("schema"))
+            .expect("the schema is JSON");
+    let mut schemas = boon::Schemas::new();
+    let mut compiler = boon::Compiler::new();
+    compiler
+        .add_resource("report.schema.json", schema)
+        .expect("schema resource");
+    let index = compiler
+        .compile("report.schema.json", &mut schemas)
+        .unwrap_or_else(|e| panic!("the report schema compiles: {e}"));
+    let mut checked = 0;
+    for entry in std::fs::read_dir(dir).expect("out") {
+        let path = entry.expect("entry").path();
+        if !path.to_string_lossy().ends_with(".report.json") {
+            continue;
+        }
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&path).expect("report"))
+                .expect("a report is JSON");
+        if let Err(e) = schemas.validate(&report, index) {
+            panic!("{} does not follow the schema: {e:#}", path.display());
+        }
+        // The schema bites: a report with a key it does not document, or
+        // without one it requires, fails.
+        if checked == 0 {
+            let mut extra = report.clone();
+            extra["toolpath"]["undocumented"] = serde_json::json!(1);
+            assert!(schemas.validate(&extra, index).is_err());
+            let mut missing = report.clone();
+            missing.as_object_mut().expect("object").remove("job");
+            assert!(schemas.validate(&missing, index).is_err());
+        }
+        checked += 1;
+    }
+    assert!(checked >= 10, "only {checked} reports");
 }
 
 /// The first 40 lines, the number of lines and bytes with the FNV-1a 64

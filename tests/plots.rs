@@ -68,10 +68,7 @@ fn series(file: &str) -> Vec<(String, PlotSeries, serde_json::Value)> {
     assert!(!diags.iter().any(|d| d.is_error()), "{file}");
     built
         .into_iter()
-        .map(|b| {
-            let job = b.report["job"].as_str().expect("job").to_string();
-            (job, b.plots, b.report)
-        })
+        .map(|b| (b.report.job.clone(), b.plots, b.report.to_json()))
         .collect()
 }
 

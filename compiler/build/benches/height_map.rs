@@ -33,7 +33,7 @@ fn build(src: &str) -> (Duration, serde_json::Value) {
         diags.iter().all(|d| !d.is_error()),
         "the bench's job builds"
     );
-    let report = built.into_iter().next().expect("one job").report;
+    let report = built.into_iter().next().expect("one job").report.to_json();
     (e, report)
 }
 

@@ -13,6 +13,8 @@ use lensc_lang::codes;
 use lensc_lang::loader::Loaded;
 use lensc_lang::lower;
 
+use crate::report;
+
 pub use lensc_lang::{Checked, check_path, check_text};
 
 /// One job's output, not yet written.
@@ -24,8 +26,9 @@ pub struct Built {
     /// Points of the cut and its estimated time (s), for the summary line.
     pub cut_points: usize,
     pub cutting_time: f64,
-    /// The build report (fields documented in README.md, "Build report").
-    pub report: serde_json::Value,
+    /// The build report (its fields are documented in
+    /// docs/report.schema.json, generated from `crate::report`).
+    pub report: crate::report::Report,
     /// Files the program reads, written beside it (a fast-tool-servo
     /// table): name and text.
     pub beside: Vec<(String, ProgramText)>,
@@ -260,12 +263,9 @@ pub fn plan_and_emit(
                 let program_name =
                     format!("{}.{}", lowered.name, lowered.machine.dialect.extension);
                 let name = job.part_names.get("surface").cloned().unwrap_or_default();
-                let analysis = analysis_json(&name, surface.kind.name, &lowered_surface, 201);
-                let mut report =
-                    build_report(&lowered, &prov, &program_name, &text, &path, analysis);
-                report["toolpath"]["optimisation"] = optimisation_json(&optimised);
+                let analysis = surface_analysis(&name, surface.kind.name, &lowered_surface, 201);
                 let mut plots = crate::plots::PlotSeries::default();
-                report["simulation"] = if lowered.tool.centre_height == 0.0 {
+                let simulation = if lowered.tool.centre_height == 0.0 {
                     use lensc_runtime::surface::Profile as _;
                     let design = |x: f64| profile.point(x).z;
                     let range = (
@@ -291,12 +291,23 @@ pub fn plan_and_emit(
                         lowered.machine.resolution,
                         path.seams.iter().map(|s| s.at_radius).collect(),
                     ));
-                    profile_cut_json(&cut)
+                    report::Simulation::Profile((&cut).into())
                 } else {
-                    serde_json::json!({
-                        "skipped": "the edge is set off the spindle axis: the program's X is not the nose centre's radius"
+                    report::Simulation::Skipped(report::Skipped {
+                        skipped: "the edge is set off the spindle axis: the program's X is not the nose centre's radius",
+                        height_map: None,
                     })
                 };
+                let report = build_report(
+                    &lowered,
+                    &prov,
+                    &program_name,
+                    &text,
+                    &path,
+                    &optimised,
+                    simulation,
+                    analysis,
+                );
                 out.push(Built {
                     report_name: format!("{}.report.json", lowered.name),
                     program_name,
@@ -348,36 +359,6 @@ pub fn profile_series(
     }
 }
 
-/// A profile's simulated cut, for its report: the form error (design to
-/// cut, positive where material is left) over the radii the cut reaches.
-pub fn profile_cut_json(cut: &lensc_runtime::verify::simulate::ProfileCut) -> serde_json::Value {
-    serde_json::json!({
-        "kind": "profile envelope of the nose along the program's moves, as printed",
-        "samples": cut.samples.len(),
-        "from_radius_mm": cut.samples.first().map(|s| s.0),
-        "to_radius_mm": cut.samples.last().map(|s| s.0),
-        "form_error_pv_nm": cut.pv * 1e6,
-        "form_error_rms_nm": cut.rms * 1e6,
-        "max_residual_nm": { "value": cut.max_residual.0 * 1e6, "at_radius_mm": cut.max_residual.1 },
-        "max_gouge_nm": { "value": cut.max_gouge.0 * 1e6, "at_radius_mm": cut.max_gouge.1 },
-    })
-}
-
-/// What optimisation did to a program, for its report: motion blocks
-/// before and after, arcs written, straight moves that absorbed collinear
-/// points, and the largest deviation from the planned polyline against the
-/// tolerance it was held to.
-pub fn optimisation_json(s: &lensc_runtime::plan::optimise::Summary) -> serde_json::Value {
-    serde_json::json!({
-        "blocks_before": s.moves_before,
-        "blocks_after": s.moves_after,
-        "arcs": s.arcs,
-        "merged_lines": s.merged_lines,
-        "max_deviation_mm": s.max_deviation,
-        "tolerance_mm": s.tolerance,
-    })
-}
-
 /// Makes a finished output file readable by all and writable by its owner.
 fn readable_by_all(file: &std::fs::File) -> std::io::Result<()> {
     #[cfg(unix)]
@@ -390,56 +371,77 @@ fn readable_by_all(file: &std::fs::File) -> std::io::Result<()> {
     Ok(())
 }
 
-/// The report written beside a program.
+/// The report written beside a profile-turning program.
+#[allow(clippy::too_many_arguments)]
 fn build_report(
     job: &lensc_runtime::plan::turning::TurningJob,
     prov: &Provenance,
     program_name: &str,
     text: &str,
     path: &Toolpath,
-    surface: serde_json::Value,
-) -> serde_json::Value {
-    use serde_json::json;
-    json!({
-        "job": job.name,
-        "lensc_version": prov.lensc_version,
-        "source": prov.source,
-        "source_fnv1a64": format!("{:016x}", prov.source_hash),
-        "program": {
-            "file": program_name,
-            "dialect": job.machine.dialect.name,
-            "lines": text.lines().count(),
-            "bytes": text.len(),
+    optimised: &lensc_runtime::plan::optimise::Summary,
+    simulation: report::Simulation,
+    surface: report::SurfaceAnalysis,
+) -> report::Report {
+    let toolpath = report::ProfileTurning {
+        cut_points: path.cut_points,
+        cut_length_mm: path.cut_length,
+        feed_mm_per_min: path.feed_speed * 60.0,
+        surface_speed_m_per_min: job.strategy.surface_speed.map(|v| v * 0.06),
+        max_spindle_rpm: job.strategy.spindle_speed * 60.0 / std::f64::consts::TAU,
+        cutting_time_s: path.cutting_time(),
+        passes: path
+            .pass_times
+            .iter()
+            .enumerate()
+            .map(|(i, &t)| report::TurningPass {
+                pass: if i < path.roughing_passes {
+                    report::PassKind::Roughing
+                } else {
+                    report::PassKind::Finish
+                },
+                cutting_time_s: t,
+            })
+            .collect(),
+        chord_tolerance_mm: job.strategy.chord_tolerance,
+        max_profile_slope_deg: path.max_slope.0.to_degrees(),
+        min_concave_radius_mm: path.min_concave_radius.map(|(r, at)| report::AtRadius {
+            value: r,
+            at_radius_mm: at,
+        }),
+        roughing_passes: path.roughing_passes,
+        tool_location: match job.strategy.location {
+            ToolLocation::Exact => report::ToolLocation::Exact,
+            ToolLocation::Sequential { .. } => report::ToolLocation::Sequential,
+            ToolLocation::Binary { .. } => report::ToolLocation::Binary,
         },
-        "toolpath": {
-            "strategy": "profile_turning",
-            "cut_points": path.cut_points,
-            "cut_length_mm": path.cut_length,
-            "feed_mm_per_min": path.feed_speed * 60.0,
-            "surface_speed_m_per_min": job.strategy.surface_speed.map(|v| v * 0.06),
-            "max_spindle_rpm": job.strategy.spindle_speed * 60.0 / std::f64::consts::TAU,
-            "cutting_time_s": path.cutting_time(),
-            "passes": path.pass_times.iter().enumerate().map(|(i, t)| serde_json::json!({
-                "pass": if i < path.roughing_passes { "roughing" } else { "finish" },
-                "cutting_time_s": t,
-            })).collect::<Vec<_>>(),
-            "chord_tolerance_mm": job.strategy.chord_tolerance,
-            "max_profile_slope_deg": path.max_slope.0.to_degrees(),
-            "min_concave_radius_mm": path.min_concave_radius.map(|(r, at)| json!({ "value": r, "at_radius_mm": at })),
-            "roughing_passes": path.roughing_passes,
-            "tool_location": match job.strategy.location {
-                ToolLocation::Exact => "exact",
-                ToolLocation::Sequential { .. } => "sequential",
-                ToolLocation::Binary { .. } => "binary",
-            },
-            "seams": path.seams.iter().map(|s| json!({
-                "at_radius_mm": s.at_radius,
-                "uncut_depth_mm": s.depth,
-                "corner_angle_deg": s.angle.to_degrees(),
-            })).collect::<Vec<_>>(),
+        seams: path
+            .seams
+            .iter()
+            .map(|s| report::Seam {
+                at_radius_mm: s.at_radius,
+                uncut_depth_mm: s.depth,
+                corner_angle_deg: s.angle.to_degrees(),
+            })
+            .collect(),
+        optimisation: optimised.into(),
+    };
+    report::Report {
+        job: job.name.clone(),
+        lensc_version: prov.lensc_version.clone(),
+        source: prov.source.clone(),
+        source_fnv1a64: format!("{:016x}", prov.source_hash),
+        program: report::Program {
+            file: program_name.to_string(),
+            dialect: job.machine.dialect.name.clone(),
+            lines: text.lines().count(),
+            bytes: text.len() as u64,
+            fts_table: None,
         },
-        "surface": surface,
-    })
+        toolpath: report::Toolpath::ProfileTurning(toolpath),
+        simulation,
+        surface,
+    }
 }
 
 /// FNV-1a 64 over every loaded source, in load order.
@@ -551,13 +553,13 @@ pub fn evaluator(
     tape: &lensc_runtime::surface::ir::SurfaceTape,
 ) -> (
     Box<dyn lensc_runtime::surface::ir::SurfaceFn + Sync>,
-    &'static str,
+    report::Backend,
 ) {
     match lensc_runtime::surface::jit::JitSurface::compile(tape) {
-        Ok(j) => (Box::new(j), "jit"),
+        Ok(j) => (Box::new(j), report::Backend::Jit),
         Err(_) => (
             Box::new(lensc_runtime::surface::ir::Interpreter::new(tape)),
-            "interpreter",
+            report::Backend::Interpreter,
         ),
     }
 }
@@ -595,46 +597,17 @@ pub fn declared_surface(
         .map_err(|e| format!("`{name}` cannot be evaluated yet: {e:?}"))
 }
 
-/// The analysis of a surface as the JSON object the reports carry (its
-/// fields are documented in README.md, "Surface analysis").
-pub fn analysis_json(
+/// The analysis of a surface as the reports carry it (and `lensc
+/// analyse` prints it), on a `grid` per side.
+pub fn surface_analysis(
     name: &str,
     kind: &str,
     l: &lensc_lang::lower::surface::LoweredSurface,
     grid: usize,
-) -> serde_json::Value {
-    use lensc_runtime::surface::analysis::{Domain, Extremum, analyse};
-    use serde_json::json;
+) -> report::SurfaceAnalysis {
     let (f, backend) = evaluator(&l.tape);
-    let a = analyse(f.as_ref(), &l.domain, grid);
-    let at =
-        |e: &Extremum, scale: f64| json!({ "value": e.value * scale, "x_mm": e.x, "y_mm": e.y });
-    let deg = 180.0 / std::f64::consts::PI;
-    let radius = |e: &Option<Extremum>| e.as_ref().map_or(serde_json::Value::Null, |e| at(e, 1.0));
-    let domain = match l.domain {
-        Domain::Circle { radius } => json!({ "circle": { "radius_mm": radius } }),
-        Domain::Annulus { inner, outer } => {
-            json!({ "annulus": { "inner_mm": inner, "outer_mm": outer } })
-        }
-        Domain::Rect { x, y } => json!({ "rect": { "x_mm": [x.0, x.1], "y_mm": [y.0, y.1] } }),
-    };
-    json!({
-        "surface": name,
-        "kind": kind,
-        "domain": domain,
-        "grid": grid,
-        "backend": backend,
-        "sag_mm": { "min": at(&a.sag_min, 1.0), "max": at(&a.sag_max, 1.0), "pv": a.pv() },
-        "max_slope_deg": at(&a.max_slope, deg),
-        "max_slope_x_deg": at(&a.max_slope_x, deg),
-        "max_slope_y_deg": at(&a.max_slope_y, deg),
-        "min_radius_of_curvature_mm": {
-            "concave_x": radius(&a.min_radius_concave_x),
-            "convex_x": radius(&a.min_radius_convex_x),
-            "concave_y": radius(&a.min_radius_concave_y),
-            "convex_y": radius(&a.min_radius_convex_y),
-        },
-    })
+    let a = lensc_runtime::surface::analysis::analyse(f.as_ref(), &l.domain, grid);
+    report::SurfaceAnalysis::new(name, kind, &l.domain, grid, backend, &a)
 }
 
 /// Evaluates a declared surface at the requested points.

@@ -15,7 +15,6 @@ use lensc_runtime::post::Dialect;
 use lensc_runtime::post::ProgramError;
 use lensc_runtime::post::Provenance;
 use lensc_runtime::surface::ir::SurfaceFn;
-use serde_json::json;
 
 use lensc_lang::check::{CheckedJob, trim_num};
 use lensc_lang::codes;
@@ -24,6 +23,7 @@ use std::path::Path;
 use crate::driver::{Built, ProgramText, evaluator};
 use crate::height_map::{self, LatheFrame, Window};
 use crate::parts::Parts;
+use crate::report;
 use lensc_lang::value::{self, Object};
 use lensc_runtime::verify::heightmap::Sweep;
 
@@ -193,35 +193,19 @@ pub fn build(
         .finish()
         .map_err(|e| vec![cannot_spool(&e, file, span)])?;
     let program_name = parts.program_name();
-    let mut toolpath = toolpath_json(
+    let spiral = spiral_report(
         &summary,
         &p.spiral,
         p.settling.as_ref(),
         &p.servo,
         p.nose_radius,
     );
-    if p.slow {
-        toolpath["strategy"] = json!("spiral_turning");
-    }
-    let mut report = parts.report(prov, &program_name, &text, toolpath, &p.lowered);
-    let mut plots = crate::plots::PlotSeries::default();
-    report["simulation"] = match following {
-        Some(sim) => {
-            let f = sim.finish();
-            let j = following_json(&f, data_rate);
-            plots.following = Some(crate::plots::FollowingSeries {
-                by_radius: f.by_radius,
-                samples: f.samples,
-                data_rate_hz: data_rate,
-                max_error: (f.max_error, f.max_error_at),
-            });
-            j
-        }
-        None if p.slow => {
-            json!({ "skipped": "slow tool servo: Z is a machine axis, with no servo model here" })
-        }
-        None => json!({ "skipped": "the fast axis has no servo model" }),
+    let toolpath = if p.slow {
+        report::Toolpath::SpiralTurning(spiral)
+    } else {
+        report::Toolpath::FtsSpiral(spiral)
     };
+    let mut plots = crate::plots::PlotSeries::default();
     let frame = LatheFrame::new(design.as_ref(), window, p.lowered.domain, &apertures);
     let map = sweep.finish(&frame);
     plots.form_error = Some(height_map::form_error_series(
@@ -233,15 +217,39 @@ pub fn build(
         1.5 * window.spacing,
         ("x (mm)", "y (mm)"),
     ));
-    report["simulation"]["height_map"] = height_map::json(
+    let height_map = report::HeightMap::new(
         &map,
         &window,
         "columns at spindle angles (column step in rad), rows at radii",
         p.spiral.feed_per_rev,
     );
+    let simulation = match following {
+        Some(sim) => {
+            let f = sim.finish();
+            let following = report::Following::new(&f, data_rate, height_map);
+            plots.following = Some(crate::plots::FollowingSeries {
+                by_radius: f.by_radius,
+                samples: f.samples,
+                data_rate_hz: data_rate,
+                max_error: (f.max_error, f.max_error_at),
+            });
+            report::Simulation::Following(following)
+        }
+        None => report::Simulation::Skipped(report::Skipped {
+            skipped: if p.slow {
+                "slow tool servo: Z is a machine axis, with no servo model here"
+            } else {
+                "the fast axis has no servo model"
+            },
+            height_map: Some(height_map),
+        }),
+    };
+    let mut report = parts.report(prov, &program_name, &text, toolpath, simulation, &p.lowered);
     if let Some((name, table)) = beside.first() {
-        report["program"]["fts_table"] =
-            json!({ "file": name, "rows": table.lines().saturating_sub(2) });
+        report.program.fts_table = Some(report::FtsTable {
+            file: name.clone(),
+            rows: table.lines().saturating_sub(2),
+        });
     }
     // Chords the data period kept from their share of the tolerance.
     let share = p.spiral.chord_tolerance * lensc_runtime::plan::optimise::UNOPTIMISED_CHORD_SHARE;
@@ -277,29 +285,6 @@ pub fn build(
         cutting_time: summary.time,
         plots,
         warnings,
-    })
-}
-
-/// The fast axis's following, for the report: over the whole spiral and
-/// per lenslet (in the planner's feature order), errors in nm and the
-/// waviness (RMS slope of the error along the cut) in µrad.
-fn following_json(
-    f: &lensc_runtime::verify::follow::Following,
-    data_rate: f64,
-) -> serde_json::Value {
-    json!({
-        "kind": "fast-tool-servo following: the machine's servo model driven by the commanded positions, as printed, at its data rate",
-        "data_rate_hz": data_rate,
-        "servo_samples": f.samples,
-        "max_following_error_nm": { "value": f.max_error * 1e6, "at_radius_mm": f.max_error_at },
-        "lenslets": f.lenslets.iter().map(|l| json!({
-            "centre_mm": [l.centre.0, l.centre.1],
-            "radius_mm": l.radius,
-            "samples": l.samples,
-            "max_error_nm": l.max_error * 1e6,
-            "rms_error_nm": l.rms_error * 1e6,
-            "waviness_urad": l.waviness * 1e6,
-        })).collect::<Vec<_>>(),
     })
 }
 
@@ -795,53 +780,61 @@ fn header_lines(
     lines
 }
 
-fn toolpath_json(
+/// The report's toolpath section of a spiral.
+fn spiral_report(
     s: &FtsSummary,
     spiral: &FtsSpiral,
     settling: Option<&Settling>,
     servo: &Option<SecondOrderServo>,
     rho: f64,
-) -> serde_json::Value {
-    let (speed_kind, allowed) = match spiral.speed {
-        SpindleSpeed::Constant(_) => ("spindle_rpm", rpm(s.highest_allowed_speed)),
-        SpindleSpeed::SurfaceSpeed { .. } => ("surface_m_per_min", s.highest_allowed_speed * 0.06),
-    };
-    json!({
-        "strategy": "fts_spiral",
-        "revolutions": s.revolutions,
-        "cut_points": s.points,
-        "cutting_time_s": s.time,
-        "chord_tolerance_mm": spiral.chord_tolerance,
-        "chords_over_tolerance": s.chords_over_tolerance.map(|o| json!({
-            "count": o.count,
-            "max_deviation_nm": o.deviation * 1e6,
-            "at_radius_mm": o.at_radius,
-        })),
-        "nose_radius_mm": rho,
-        "fast_axis": {
-            "w_min_mm": s.w_min,
-            "w_max_mm": s.w_max,
-            "stroke_used_mm": s.w_max - s.w_min,
-            "max_acceleration_m_per_s2": s.max_acceleration / 1000.0,
-            "max_acceleration_at_radius_mm": s.max_acceleration_at,
-            "highest_allowed_speed": { "unit": speed_kind, "value": allowed },
+) -> report::Spiral {
+    let highest_allowed_speed = match spiral.speed {
+        SpindleSpeed::Constant(_) => report::AllowedSpeed {
+            unit: report::SpeedUnit::SpindleRpm,
+            value: rpm(s.highest_allowed_speed),
         },
-        "max_spindle_rpm": rpm(s.max_spindle_speed),
-        "servo": servo.map(|m| json!({
-            "natural_frequency_hz": m.natural_frequency_hz,
-            "damping": m.damping,
-            "overshoot": m.overshoot(),
-            "settling_time_0_2_percent_s": m.settling_time(0.002),
-        })),
-        "settling": settling.map(|st| json!({
-            "settling_time_s": st.time,
-            "band": st.band,
-            "surface_speed_m_per_min": st.surface_speed * 0.06,
-            "d_traj_mm": st.d_traj,
-            "h_offset_mm": st.offset,
-        })),
-        "fingerprint_fnv1a64": format!("{:016x}", s.fingerprint),
-    })
+        SpindleSpeed::SurfaceSpeed { .. } => report::AllowedSpeed {
+            unit: report::SpeedUnit::SurfaceMPerMin,
+            value: s.highest_allowed_speed * 0.06,
+        },
+    };
+    report::Spiral {
+        revolutions: s.revolutions,
+        cut_points: s.points,
+        cutting_time_s: s.time,
+        chord_tolerance_mm: spiral.chord_tolerance,
+        chords_over_tolerance: s
+            .chords_over_tolerance
+            .map(|o| report::ChordsOverTolerance {
+                count: o.count,
+                max_deviation_nm: o.deviation * 1e6,
+                at_radius_mm: o.at_radius,
+            }),
+        nose_radius_mm: rho,
+        fast_axis: report::FastAxis {
+            w_min_mm: s.w_min,
+            w_max_mm: s.w_max,
+            stroke_used_mm: s.w_max - s.w_min,
+            max_acceleration_m_per_s2: s.max_acceleration / 1000.0,
+            max_acceleration_at_radius_mm: s.max_acceleration_at,
+            highest_allowed_speed,
+        },
+        max_spindle_rpm: rpm(s.max_spindle_speed),
+        servo: servo.map(|m| report::Servo {
+            natural_frequency_hz: m.natural_frequency_hz,
+            damping: m.damping,
+            overshoot: m.overshoot(),
+            settling_time_0_2_percent_s: m.settling_time(0.002),
+        }),
+        settling: settling.map(|st| report::Settling {
+            settling_time_s: st.time,
+            band: st.band,
+            surface_speed_m_per_min: st.surface_speed * 0.06,
+            d_traj_mm: st.d_traj,
+            h_offset_mm: st.offset,
+        }),
+        fingerprint_fnv1a64: format!("{:016x}", s.fingerprint),
+    }
 }
 
 fn fts_diagnostic(

@@ -3,14 +3,14 @@
 //! the surface is representative), the grid over it in the coordinates of
 //! the cut (Cartesian for a raster, polar for a lathe, angle and axial
 //! position for a roller), the frames that tie those coordinates to the
-//! design, and the report's `simulation.height_map` section.
+//! design (the report's `simulation.height_map` section is
+//! `crate::report::HeightMap`).
 
 use lensc_grammar::Diagnostic;
 use lensc_runtime::moves::{Move, Plane};
 use lensc_runtime::surface::analysis::Domain;
 use lensc_runtime::surface::ir::SurfaceFn;
-use lensc_runtime::verify::heightmap::{ErrorFigures, Frame, Grid, HeightMap, Scallops, Sweep};
-use serde_json::{Value, json};
+use lensc_runtime::verify::heightmap::{Frame, Grid, HeightMap, Sweep};
 use std::f64::consts::TAU;
 
 use lensc_lang::check::{CheckedJob, trim_num};
@@ -344,71 +344,6 @@ pub fn domain_centre(domain: &Domain) -> (f64, f64) {
         Domain::Annulus { inner, outer } => ((inner + outer) / 2.0, 0.0),
         Domain::Rect { x, y } => ((x.0 + x.1) / 2.0, (y.0 + y.1) / 2.0),
     }
-}
-
-/// PV, RMS and extremes of a set of errors as the report gives them (nm).
-pub fn figures_json(f: &Option<ErrorFigures>) -> Value {
-    match f {
-        None => Value::Null,
-        Some(f) => json!({
-            "cells": f.count,
-            "pv_nm": f.pv * 1e6,
-            "rms_nm": f.rms * 1e6,
-            "max_residual_nm": { "value": f.max_residual.0 * 1e6, "x_mm": f.max_residual.1.0, "y_mm": f.max_residual.1.1 },
-            "max_gouge_nm": { "value": f.max_gouge.0 * 1e6, "x_mm": f.max_gouge.1.0, "y_mm": f.max_gouge.1.1 },
-        }),
-    }
-}
-
-fn scallops_json(s: &Option<Scallops>) -> Value {
-    match s {
-        None => Value::Null,
-        Some(s) => json!({ "count": s.count, "max_nm": s.max * 1e6, "mean_nm": s.mean * 1e6 }),
-    }
-}
-
-/// The report's `simulation.height_map`: the window, the grid, the form
-/// error over the cut surface and at the passes' contacts, the scallops
-/// beside the flat-surface figure for `stepover`, the roughness along and
-/// across the cut, and the same per lenslet.
-pub fn json(map: &HeightMap, window: &Window, coordinates: &str, stepover: f64) -> Value {
-    let g = &map.grid;
-    json!({
-        "kind": "height map of the nose swept along the program's moves, as printed, against the design",
-        "window": {
-            "x_mm": [window.x.0, window.x.1],
-            "y_mm": [window.y.0, window.y.1],
-            "spacing_mm": window.spacing,
-            "given": window.given,
-        },
-        "grid": {
-            "coordinates": coordinates,
-            "columns": g.ns,
-            "rows": g.nu,
-            "column_step": g.ds,
-            "row_step_mm": g.du,
-        },
-        "uncut_cells": map.uncut,
-        "surface": figures_json(&map.surface),
-        "contact": figures_json(&map.contact),
-        "scallops": {
-            "stepover_mm": stepover,
-            "flat_theory_nm": HeightMap::flat_scallop(map.nose_radius, stepover) * 1e6,
-            "simulated": scallops_json(&map.scallops),
-        },
-        "rq_cutting_direction_nm": finite(map.rq_cutting * 1e6),
-        "rq_stepover_direction_nm": finite(map.rq_stepover * 1e6),
-        "lenslets": map.features.iter().map(|f| json!({
-            "centre_mm": [f.centre.0, f.centre.1],
-            "surface": figures_json(&f.surface),
-            "contact": figures_json(&f.contact),
-            "scallops": scallops_json(&f.scallops),
-        })).collect::<Vec<_>>(),
-    })
-}
-
-fn finite(v: f64) -> Value {
-    if v.is_finite() { json!(v) } else { Value::Null }
 }
 
 /// A height map as the series of its plot: the error on a raster of at

@@ -10,4 +10,5 @@ pub mod height_map;
 pub mod mill_job;
 pub mod parts;
 pub mod plots;
+pub mod report;
 pub mod roller_job;

@@ -11,11 +11,11 @@ use lensc_runtime::post::Provenance;
 use lensc_runtime::surface::SectionAlongX;
 use lensc_runtime::surface::analysis::Domain;
 use lensc_runtime::verify::heightmap::Sweep;
-use serde_json::json;
 
 use crate::driver::{Built, ProgramText, evaluator};
 use crate::height_map::{self, Window, domain_centre};
 use crate::parts::Parts;
+use crate::report;
 use lensc_lang::check::{CheckedJob, trim_num};
 use lensc_lang::codes;
 use lensc_lang::value;
@@ -148,28 +148,26 @@ pub fn build_raster(
     )
     .map_err(|e| vec![p.not_printable(e)])?;
     let deg = 180.0 / std::f64::consts::PI;
-    let at = |e: &lensc_runtime::surface::analysis::Extremum, s: f64| json!({ "value": e.value * s, "x_mm": e.x, "y_mm": e.y });
+    let at = |e: &lensc_runtime::surface::analysis::Extremum, s: f64| report::AtPoint::of(e, s);
     let time = path.cut_length / feed;
-    let toolpath = json!({
-        "strategy": "raster",
-        "passes": path.pass_count,
-        "cut_points": path.point_count,
-        "cut_length_mm": path.cut_length,
-        "feed_mm_per_min": feed * 60.0,
-        "cutting_time_s": time,
-        "pass_cutting_times_s": path.pass_lengths.iter().map(|l| l / feed).collect::<Vec<_>>(),
-        "chord_tolerance_mm": raster.chord_tolerance,
-        "stepover_mm": raster.stepover,
-        "optimisation": crate::driver::optimisation_json(&optimised),
-        "max_slope_along_deg": at(&path.max_slope_along, deg),
-        "max_slope_across_deg": at(&path.max_slope_across, deg),
-        "min_concave_radius_along_mm": path.min_concave_radius_along.as_ref().map(|e| at(e, 1.0)),
+    let toolpath = report::Toolpath::Raster(report::Raster {
+        passes: path.pass_count,
+        cut_points: path.point_count,
+        cut_length_mm: path.cut_length,
+        feed_mm_per_min: feed * 60.0,
+        cutting_time_s: time,
+        pass_cutting_times_s: path.pass_lengths.iter().map(|l| l / feed).collect(),
+        chord_tolerance_mm: raster.chord_tolerance,
+        stepover_mm: raster.stepover,
+        optimisation: (&optimised).into(),
+        max_slope_along_deg: at(&path.max_slope_along, deg),
+        max_slope_across_deg: at(&path.max_slope_across, deg),
+        min_concave_radius_along_mm: path.min_concave_radius_along.as_ref().map(|e| at(e, 1.0)),
     });
     let program_name = p.program_name();
     let text = ProgramText::Memory(text);
-    let mut report = p.report(prov, &program_name, &text, toolpath, &lowered);
     let mut plots = crate::plots::PlotSeries::default();
-    report["simulation"] = match tool {
+    let simulation = match tool {
         RasterTool::Knife { nose_radius } => {
             let along_x = raster.along == Axis::X;
             let window = Window::of(job, domain_centre(&lowered.domain)).map_err(|d| vec![d])?;
@@ -196,21 +194,28 @@ pub fn build_raster(
             } else {
                 "columns along y, rows along x"
             };
-            let mut j = height_map::json(&map, &window, coordinates, raster.stepover);
-            j["edge"] = json!(
-                "the knife's edge in its rake face, across the cut, as the planner places it"
-            );
+            let mut height_map =
+                report::HeightMap::new(&map, &window, coordinates, raster.stepover);
             // The path's own error apart from the machine's resolution: the
             // same moves swept as computed (rounded to a picometre only).
             let mut unrounded = Sweep::new(grid, nose_radius);
             height_map::sweep_mill_moves(&mut unrounded, &moves, along_x, 1e-9);
-            j["contact_unrounded"] = height_map::figures_json(&unrounded.finish(&frame).contact);
-            json!({ "height_map": j })
+            height_map.raster = Some(report::RasterEdge {
+                edge: "the knife's edge in its rake face, across the cut, as the planner places it",
+                contact_unrounded: unrounded
+                    .finish(&frame)
+                    .contact
+                    .as_ref()
+                    .map(report::Figures::from),
+            });
+            report::Simulation::HeightMap(report::HeightMapOnly { height_map })
         }
-        RasterTool::Ball { .. } => json!({
-            "skipped": "a ball's cut reaches a radius along the path as well as across it; the height map sweeps edges that lie across the cut"
+        RasterTool::Ball { .. } => report::Simulation::Skipped(report::Skipped {
+            skipped: "a ball's cut reaches a radius along the path as well as across it; the height map sweeps edges that lie across the cut",
+            height_map: None,
         }),
     };
+    let report = p.report(prov, &program_name, &text, toolpath, simulation, &lowered);
     Ok(Built {
         report_name: format!("{}.report.json", job.name.name),
         program_name,
@@ -356,30 +361,31 @@ pub fn build_grinding(
     .map_err(|e| vec![p.not_printable(e)])?;
     // The table of eqs 18-19: every interval's commanded z velocity and
     // acceleration, as the paper's position-based interpolation gives them.
-    let table: Vec<serde_json::Value> = path
+    let rows = path
         .points
         .iter()
         .skip(1)
-        .map(|q| json!([q.contact_x, q.x, q.z, q.velocity, q.acceleration]))
+        .map(|q| [q.contact_x, q.x, q.z, q.velocity, q.acceleration])
         .collect();
-    let toolpath = json!({
-        "strategy": "profile_grinding",
-        "segments": path.segments,
-        "cut_points": path.points.len(),
-        "interval_time_s": path.interval_time,
-        "cutting_time_s": path.total_time,
-        "max_z_speed_mm_per_s": path.max_speed,
-        "max_z_acceleration_mm_per_s2": path.max_acceleration,
-        "open_loop_drift_mm": path.open_loop_drift,
-        "min_concave_radius_mm": path.min_concave_radius.map(|(r, x)| json!({ "value": r, "at_x_mm": x })),
-        "intervals": {
-            "columns": ["contact_x_mm", "wheel_x_mm", "wheel_z_mm", "v_mm_per_s", "a_mm_per_s2"],
-            "rows": table,
+    let toolpath = report::Toolpath::ProfileGrinding(report::ProfileGrinding {
+        segments: path.segments,
+        cut_points: path.points.len(),
+        interval_time_s: path.interval_time,
+        cutting_time_s: path.total_time,
+        max_z_speed_mm_per_s: path.max_speed,
+        max_z_acceleration_mm_per_s2: path.max_acceleration,
+        open_loop_drift_mm: path.open_loop_drift,
+        min_concave_radius_mm: path.min_concave_radius.map(|(r, x)| report::AtX {
+            value: r,
+            at_x_mm: x,
+        }),
+        intervals: report::Intervals {
+            columns: report::INTERVAL_COLUMNS,
+            rows,
         },
     });
     let program_name = p.program_name();
     let text = ProgramText::Memory(text);
-    let mut report = p.report(prov, &program_name, &text, toolpath, &lowered);
     // What the wheel's section (a circle of its radius about the centre)
     // leaves along the programmed centres.
     use lensc_runtime::surface::Profile as _;
@@ -392,7 +398,14 @@ pub fn build_grinding(
         (grinding.start, grinding.end),
         crate::driver::PROFILE_SAMPLES,
     );
-    report["simulation"] = crate::driver::profile_cut_json(&cut);
+    let report = p.report(
+        prov,
+        &program_name,
+        &text,
+        toolpath,
+        report::Simulation::Profile((&cut).into()),
+        &lowered,
+    );
     let plots = crate::plots::PlotSeries {
         profile: Some(crate::driver::profile_series(
             &cut,

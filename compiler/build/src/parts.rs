@@ -3,16 +3,15 @@
 //! point, the provenance lines every program header starts with, and the
 //! report every program has beside it.
 
+use crate::driver::{ProgramText, surface_analysis};
+use crate::report;
 use lensc_grammar::{Diagnostic, FileId, Span};
-use lensc_runtime::post::Dialect;
-use lensc_runtime::post::ProgramError;
-use lensc_runtime::post::Provenance;
-use serde_json::json;
-
-use crate::driver::{ProgramText, analysis_json};
 use lensc_lang::check::CheckedJob;
 use lensc_lang::codes;
 use lensc_lang::value::{self, Object};
+use lensc_runtime::post::Dialect;
+use lensc_runtime::post::ProgramError;
+use lensc_runtime::post::Provenance;
 
 /// The four parts of a checked job, their names, and where errors point.
 pub(crate) struct Parts<'a> {
@@ -77,28 +76,38 @@ impl<'a> Parts<'a> {
             ),
         ]
     }
+    /// The report of the job's program, its toolpath and simulation, with
+    /// the analysis of the surface.
     pub(crate) fn report(
         &self,
         prov: &Provenance,
         program_name: &str,
         program: &ProgramText,
-        toolpath: serde_json::Value,
+        toolpath: report::Toolpath,
+        simulation: report::Simulation,
         lowered: &lensc_lang::lower::surface::LoweredSurface,
-    ) -> serde_json::Value {
-        json!({
-            "job": self.job.name.name,
-            "lensc_version": prov.lensc_version,
-            "source": prov.source,
-            "source_fnv1a64": format!("{:016x}", prov.source_hash),
-            "program": {
-                "file": program_name,
-                "dialect": self.dialect.name,
-                "lines": program.lines(),
-                "bytes": program.bytes(),
+    ) -> report::Report {
+        report::Report {
+            job: self.job.name.name.to_string(),
+            lensc_version: prov.lensc_version.clone(),
+            source: prov.source.clone(),
+            source_fnv1a64: format!("{:016x}", prov.source_hash),
+            program: report::Program {
+                file: program_name.to_string(),
+                dialect: self.dialect.name.clone(),
+                lines: program.lines(),
+                bytes: program.bytes(),
+                fts_table: None,
             },
-            "toolpath": toolpath,
-            "surface": analysis_json(&self.name("surface", self.surface), self.surface.kind.name, lowered, 201),
-        })
+            toolpath,
+            simulation,
+            surface: surface_analysis(
+                &self.name("surface", self.surface),
+                self.surface.kind.name,
+                lowered,
+                201,
+            ),
+        }
     }
     /// E0141 if a move of the stream leaves the machine's `travel` block.
     pub(crate) fn travel_error(&self, moves: &[lensc_runtime::moves::Move]) -> Option<Diagnostic> {

@@ -15,12 +15,12 @@ use lensc_runtime::plan::roller::{
 use lensc_runtime::post::ProgramError;
 use lensc_runtime::post::Provenance;
 use lensc_runtime::surface::analysis::Domain;
-use serde_json::json;
 
 use crate::driver::{Built, evaluator};
 use crate::fts_job::{Sink, cannot_spool};
 use crate::height_map::{self, RollerFrame, Window};
 use crate::parts::Parts;
+use crate::report;
 use lensc_lang::check::{CheckedJob, trim_num};
 use lensc_lang::codes;
 use lensc_lang::value::{self, Object};
@@ -296,35 +296,37 @@ pub fn build(
     let points: usize = path.passes.iter().map(|p| p.points).sum();
     let time: f64 = path.passes.iter().filter_map(|p| p.time).sum();
     let program_name = parts.program_name();
-    let toolpath = json!({
-        "strategy": "roller_helix",
-        "cut_points": points,
-        "cutting_time_s": time,
-        "roller_radius_mm": roller_radius,
-        "passes": path.passes.iter().map(|p| json!({
-            "c_step_deg": p.c_step.to_degrees(),
-            "pitch_mm": p.pitch,
-            "finish_allowance_mm": p.finish_allowance,
-            "points": p.points,
-            "revolutions": p.revolutions,
-            "x_min_mm": p.x_min,
-            "x_max_mm": p.x_max,
-            "cutting_time_s": p.time,
-            "fingerprint_fnv1a64": format!("{:016x}", p.fingerprint),
-        })).collect::<Vec<_>>(),
-        "tool_check": {
-            "min_radius_of_curvature_cutting_plane_mm": check.min_radius_axial,
-            "min_radius_of_curvature_mm": check.min_radius_overall,
-            "max_slope_cutting_deg": check.max_slope_cutting.to_degrees(),
-            "max_slope_cutting_on_roller_deg": check.max_slope_cutting_on_roller.to_degrees(),
-            "max_slope_axial_deg": check.max_slope_axial.to_degrees(),
-            "nose_radius_mm": rho,
-            "clearance_deg": rt.clearance_angle.to_degrees(),
-            "half_included_angle_deg": rt.opening_angle.to_degrees() / 2.0,
+    let toolpath = report::Toolpath::RollerHelix(report::RollerHelix {
+        cut_points: points,
+        cutting_time_s: time,
+        roller_radius_mm: roller_radius,
+        passes: path
+            .passes
+            .iter()
+            .map(|p| report::HelixPass {
+                c_step_deg: p.c_step.to_degrees(),
+                pitch_mm: p.pitch,
+                finish_allowance_mm: p.finish_allowance,
+                points: p.points,
+                revolutions: p.revolutions,
+                x_min_mm: p.x_min,
+                x_max_mm: p.x_max,
+                cutting_time_s: p.time,
+                fingerprint_fnv1a64: format!("{:016x}", p.fingerprint),
+            })
+            .collect(),
+        tool_check: report::RollerToolCheck {
+            min_radius_of_curvature_cutting_plane_mm: check.min_radius_axial,
+            min_radius_of_curvature_mm: check.min_radius_overall,
+            max_slope_cutting_deg: check.max_slope_cutting.to_degrees(),
+            max_slope_cutting_on_roller_deg: check.max_slope_cutting_on_roller.to_degrees(),
+            max_slope_axial_deg: check.max_slope_axial.to_degrees(),
+            nose_radius_mm: rho,
+            clearance_deg: rt.clearance_angle.to_degrees(),
+            half_included_angle_deg: rt.opening_angle.to_degrees() / 2.0,
         },
-        "wrap_gap_mm": path.wrap.map(|w| w.gap),
+        wrap_gap_mm: path.wrap.map(|w| w.gap),
     });
-    let mut report = parts.report(prov, &program_name, &text, toolpath, &lowered);
     let frame = RollerFrame {
         kernel: kernel.as_ref(),
         window,
@@ -346,14 +348,20 @@ pub fn build(
         ..Default::default()
     };
     let finish_pitch = helix.passes.last().map_or(0.0, |p| p.pitch);
-    report["simulation"] = json!({
-        "height_map": height_map::json(
-            &map,
-            &window,
-            "columns at spindle angles (column step in rad; design y = roller radius × angle), rows along the roller axis (design x)",
-            finish_pitch,
-        )
-    });
+    let height_map = report::HeightMap::new(
+        &map,
+        &window,
+        "columns at spindle angles (column step in rad; design y = roller radius × angle), rows along the roller axis (design x)",
+        finish_pitch,
+    );
+    let report = parts.report(
+        prov,
+        &program_name,
+        &text,
+        toolpath,
+        report::Simulation::HeightMap(report::HeightMapOnly { height_map }),
+        &lowered,
+    );
     Ok(Built {
         report_name: format!("{}.report.json", job.name.name),
         program_name,

@@ -172,12 +172,12 @@ fn run(cli: Cli) -> u8 {
                         .declarations
                         .get(&surface)
                         .map_or("", |o| o.kind.name);
-                    let v = driver::analysis_json(&surface, kind, &l, grid.max(2));
+                    let v = driver::surface_analysis(&surface, kind, &l, grid.max(2));
                     // A closed pipe (`| head`) is not an error.
-                    let _ = writeln!(
+                    let _ = write!(
                         std::io::stdout().lock(),
                         "{}",
-                        serde_json::to_string_pretty(&v).unwrap_or_default()
+                        lensc_build::report::json_text(&v)
                     );
                     0
                 }
@@ -255,13 +255,14 @@ fn run(cli: Cli) -> u8 {
             // Every plot is drawn before any is written.
             let mut plots = Vec::new();
             for b in built {
-                let name = b.report["job"].as_str().unwrap_or_default().to_string();
+                let name = b.report.job.clone();
                 match lensc_build::plots::render(&name, &b.plots) {
                     Ok(files) if files.is_empty() => eprintln!(
                         "note: job `{name}` has nothing to plot: its simulation was skipped ({})",
-                        b.report["simulation"]["skipped"]
-                            .as_str()
-                            .unwrap_or("no simulation")
+                        match &b.report.simulation {
+                            lensc_build::report::Simulation::Skipped(s) => s.skipped,
+                            _ => "no simulation",
+                        }
                     ),
                     Ok(files) => plots.extend(files),
                     Err(e) => {
@@ -311,7 +312,7 @@ fn run(cli: Cli) -> u8 {
             for built in programs {
                 let target = dir.join(&built.program_name);
                 let report_path = dir.join(&built.report_name);
-                let report = serde_json::to_string_pretty(&built.report).unwrap_or_default() + "\n";
+                let report = built.report.to_json_text();
                 let lines = built.program.lines();
                 let beside: Vec<String> = built
                     .beside
