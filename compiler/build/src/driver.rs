@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use lensc_grammar::{Diagnostic, FileId, Span};
-use lensc_runtime::plan::turning::{PlanError, ToolLocation, Toolpath};
+use lensc_grammar::Diagnostic;
+use lensc_runtime::plan::turning::{ToolLocation, Toolpath};
 use lensc_runtime::post::Provenance;
 
 use lensc_lang::check::{self, trim_num};
@@ -13,6 +13,7 @@ use lensc_lang::codes;
 use lensc_lang::loader::Loaded;
 use lensc_lang::lower;
 
+use crate::diagnostics::RuntimeError;
 use crate::report;
 
 pub use lensc_lang::{Checked, check_path, check_text};
@@ -181,15 +182,7 @@ pub fn plan_and_emit(
         let lowered_surface = match lensc_lang::lower::surface::lower_surface(surface) {
             Ok(l) => l,
             Err(e) => {
-                diags.push(
-                    Diagnostic::error(
-                        codes::UNSUPPORTED_COMBINATION,
-                        format!("this surface cannot be evaluated yet: {e:?}"),
-                        file,
-                        span,
-                    )
-                    .with_label("this job"),
-                );
+                diags.push(RuntimeError::Surface(e).at(file, span));
                 continue;
             }
         };
@@ -198,7 +191,10 @@ pub fn plan_and_emit(
         let path = match lensc_runtime::plan::turning::plan_profile_turning(&lowered, &profile) {
             Ok(p) => p,
             Err(errs) => {
-                diags.extend(errs.into_iter().map(|e| plan_diagnostic(e, file, span)));
+                diags.extend(
+                    errs.into_iter()
+                        .map(|e| RuntimeError::Turning(e).at(file, span)),
+                );
                 continue;
             }
         };
@@ -320,10 +316,7 @@ pub fn plan_and_emit(
                     warnings: Vec::new(),
                 });
             }
-            Err(e) => diags.push(
-                Diagnostic::error(codes::NOT_PRINTABLE, e.message(), file, span)
-                    .with_label("no program was written for this job"),
-            ),
+            Err(e) => diags.push(RuntimeError::Program(e).at(file, span)),
         }
     }
     (out, diags)
@@ -456,58 +449,6 @@ pub fn source_hash(l: &Loaded) -> u64 {
     h
 }
 
-fn plan_diagnostic(e: PlanError, file: FileId, span: Span) -> Diagnostic {
-    let um = |mm: f64| trim_num(mm * 1000.0);
-    match e {
-        PlanError::NoseTooLarge { nose_radius, min_radius, at_radius } => Diagnostic::error(
-            codes::NOSE_TOO_LARGE,
-            format!(
-                "the tool's nose radius ({} um) is larger than the surface's smallest concave radius of curvature ({} um, at r = {} mm): the tool would gouge",
-                um(nose_radius),
-                um(min_radius),
-                trim_num(at_radius)
-            ),
-            file,
-            span,
-        )
-        .with_label("this job")
-        .with_help("use a tool whose nose radius is below the smallest concave radius of curvature"),
-        PlanError::OutOfTravel { axis, value, min, max } => Diagnostic::error(
-            codes::OUT_OF_TRAVEL,
-            format!("the path moves {axis} to {} mm, outside the machine's travel {} .. {} mm", trim_num(value), trim_num(min), trim_num(max)),
-            file,
-            span,
-        )
-        .with_label("this job")
-        .with_help("check the machine's travel, the aperture and the retract height"),
-        PlanError::FeedTooHigh { feed, max } => Diagnostic::error(
-            codes::FEED_TOO_HIGH,
-            format!("the cutting feed ({} mm/min) is above the machine's maximum ({} mm/min)", trim_num(feed * 60.0), trim_num(max * 60.0)),
-            file,
-            span,
-        )
-        .with_label("this job")
-        .with_help("lower the feed or the spindle speed"),
-        PlanError::SpindleTooFast { speed, max } => {
-            let rpm = |w: f64| trim_num(w * 60.0 / (2.0 * std::f64::consts::PI));
-            Diagnostic::error(
-                codes::SPINDLE_TOO_FAST,
-                format!("the spindle speed ({} rpm) is above the machine's maximum ({} rpm)", rpm(speed), rpm(max)),
-                file,
-                span,
-            )
-            .with_label("this job")
-        }
-        PlanError::Undefined { at_radius } => Diagnostic::error(
-            codes::UNDEFINED_ON_PATH,
-            format!("the surface or the tool path is undefined at r = {} mm", trim_num(at_radius)),
-            file,
-            span,
-        )
-        .with_label("this job"),
-    }
-}
-
 /// Writes `text` to `path` atomically: a temporary file in the same
 /// directory, flushed, then renamed over the target. On failure the
 /// target is untouched and no temporary file is left behind.
@@ -593,8 +534,12 @@ pub fn declared_surface(
             obj.kind.category.noun()
         ));
     }
-    lensc_lang::lower::surface::lower_surface(obj)
-        .map_err(|e| format!("`{name}` cannot be evaluated yet: {e:?}"))
+    lensc_lang::lower::surface::lower_surface(obj).map_err(|e| {
+        format!(
+            "`{name}` cannot be evaluated yet: {}",
+            crate::diagnostics::lowering_words(&e)
+        )
+    })
 }
 
 /// The analysis of a surface as the reports carry it (and `lensc

@@ -9,7 +9,7 @@ use lensc_grammar::{Diagnostic, FileId, Span};
 use lensc_runtime::emit::fts::FtsProgram;
 use lensc_runtime::machine::servo::SecondOrderServo;
 use lensc_runtime::plan::fts::{
-    FastAxis, FtsError, FtsSpiral, FtsSummary, Planner, SpindleSpeed, TrajectoryBounds,
+    FastAxis, FtsSpiral, FtsSummary, Planner, SpindleSpeed, TrajectoryBounds,
 };
 use lensc_runtime::post::Dialect;
 use lensc_runtime::post::ProgramError;
@@ -20,6 +20,7 @@ use lensc_lang::check::{CheckedJob, trim_num};
 use lensc_lang::codes;
 use std::path::Path;
 
+use crate::diagnostics::RuntimeError;
 use crate::driver::{Built, ProgramText, evaluator};
 use crate::height_map::{self, LatheFrame, Window};
 use crate::parts::Parts;
@@ -174,8 +175,16 @@ pub fn build(
         }
     });
     let axis = if p.slow { "Z" } else { "the fast axis" };
-    let summary =
-        planned.map_err(|e| vec![fts_diagnostic(e, &p.spiral.speed, axis, file, span)])?;
+    let summary = planned.map_err(|error| {
+        vec![
+            RuntimeError::Spiral {
+                error,
+                speed: &p.spiral.speed,
+                axis,
+            }
+            .at(file, span),
+        ]
+    })?;
     if let Some(e) = write_error {
         return Err(vec![parts.not_printable(e)]);
     }
@@ -374,12 +383,8 @@ pub fn prepare(job: &CheckedJob) -> Result<Prepared, Vec<Diagnostic>> {
         None => SpindleSpeed::Constant(value::num(st, "spindle_speed").expect("one of them")),
     };
 
-    let lowered = lensc_lang::lower::surface::lower_surface(surface).map_err(|e| {
-        vec![err(
-            codes::UNSUPPORTED_COMBINATION,
-            format!("this surface cannot be evaluated yet: {e:?}"),
-        )]
-    })?;
+    let lowered = lensc_lang::lower::surface::lower_surface(surface)
+        .map_err(|e| vec![RuntimeError::Surface(e).at(file, span)])?;
     // The spiral starts where the surface's farthest point from the axis is.
     let outer = match lowered.domain {
         lensc_runtime::surface::analysis::Domain::Circle { radius }
@@ -414,14 +419,8 @@ pub fn prepare(job: &CheckedJob) -> Result<Prepared, Vec<Diagnostic>> {
         return Err(errors);
     }
     let trajectory = match &settling {
-        Some(s) => {
-            lensc_lang::lower::surface::lower_trajectory(surface, s.offset).map_err(|e| {
-                vec![err(
-                    codes::UNSUPPORTED_COMBINATION,
-                    format!("the tool trajectory cannot be built: {e:?}"),
-                )]
-            })?
-        }
+        Some(s) => lensc_lang::lower::surface::lower_trajectory(surface, s.offset)
+            .map_err(|e| vec![RuntimeError::Trajectory(e).at(file, span)])?,
         None => lensc_lang::lower::surface::lower_surface(surface).expect("lowered above"),
     };
     let (kernel, _) = evaluator(&trajectory.tape);
@@ -659,13 +658,7 @@ impl Sink {
 }
 
 pub(crate) fn cannot_spool(e: &std::io::Error, file: FileId, span: Span) -> Diagnostic {
-    Diagnostic::error(
-        codes::CANNOT_WRITE,
-        format!("cannot write the program: {e}"),
-        file,
-        span,
-    )
-    .with_label("this job")
+    RuntimeError::Spool(e).at(file, span)
 }
 
 fn rpm(w: f64) -> f64 {
@@ -834,63 +827,5 @@ fn spiral_report(
             h_offset_mm: st.offset,
         }),
         fingerprint_fnv1a64: format!("{:016x}", s.fingerprint),
-    }
-}
-
-fn fts_diagnostic(
-    e: FtsError,
-    speed: &SpindleSpeed,
-    axis: &str,
-    file: FileId,
-    span: Span,
-) -> Diagnostic {
-    let d = |code, msg: String| Diagnostic::error(code, msg, file, span).with_label("this job");
-    match e {
-        FtsError::Undefined { x, c } => d(
-            codes::UNDEFINED_ON_PATH,
-            format!(
-                "the surface is undefined where the nose must go (r = {} mm, C = {}°)",
-                trim_num(x),
-                trim_num(c.to_degrees() % 360.0)
-            ),
-        ),
-        FtsError::StrokeExceeded { range, stroke } => d(
-            codes::STROKE_EXCEEDED,
-            format!(
-                "{axis} must travel {} um, more than its {} um stroke",
-                trim_num(range * 1000.0),
-                trim_num(stroke * 1000.0)
-            ),
-        ),
-        FtsError::AccelerationExceeded {
-            acceleration,
-            max,
-            at_radius,
-            highest_allowed_speed,
-        } => {
-            let allowed = match speed {
-                SpindleSpeed::Constant(_) => {
-                    format!(
-                        "a spindle speed of {} rpm",
-                        trim_num(rpm(highest_allowed_speed))
-                    )
-                }
-                SpindleSpeed::SurfaceSpeed { .. } => format!(
-                    "a surface speed of {} m/min",
-                    trim_num(highest_allowed_speed * 0.06)
-                ),
-            };
-            d(
-                codes::ACCELERATION_EXCEEDED,
-                format!(
-                    "{axis} would accelerate at {} m/s² (at r = {} mm), above its {} m/s² limit",
-                    trim_num(acceleration / 1000.0),
-                    trim_num(at_radius),
-                    trim_num(max / 1000.0)
-                ),
-            )
-            .with_help(format!("the highest speed that respects it is {allowed}"))
-        }
-        FtsError::Invalid(why) => d(codes::UNSUPPORTED_COMBINATION, why.to_string()),
     }
 }

@@ -4,6 +4,7 @@
 //! (spooled and written atomically), simulates what it will cut and fills
 //! the build report; plots draw that report.
 
+pub mod diagnostics;
 pub mod driver;
 pub mod fts_job;
 pub mod height_map;

@@ -4,14 +4,15 @@
 //! the tool against the surface, and writes a LinuxCNC program and report.
 
 use lensc_grammar::Diagnostic;
-use lensc_runtime::plan::grinding::{GrindingError, ProfileGrinding};
-use lensc_runtime::plan::raster::{Axis, Raster, RasterError, RasterTool};
+use lensc_runtime::plan::grinding::ProfileGrinding;
+use lensc_runtime::plan::raster::{Axis, Raster, RasterTool};
 use lensc_runtime::post::Dialect;
 use lensc_runtime::post::Provenance;
 use lensc_runtime::surface::SectionAlongX;
 use lensc_runtime::surface::analysis::Domain;
 use lensc_runtime::verify::heightmap::Sweep;
 
+use crate::diagnostics::RuntimeError;
 use crate::driver::{Built, ProgramText, evaluator};
 use crate::height_map::{self, Window, domain_centre};
 use crate::parts::Parts;
@@ -77,7 +78,7 @@ pub fn build_raster(
     let (kernel, _) = evaluator(&lowered.tape);
     let path =
         lensc_runtime::plan::raster::plan_raster(&raster, &tool, kernel.as_ref(), &lowered.domain)
-            .map_err(|e| vec![raster_diagnostic(&p, e)])?;
+            .map_err(|e| vec![p.failed(RuntimeError::Raster(e))])?;
     let mut errors = Vec::new();
     // The knife's flank must clear the steepest slope along the cut.
     if let Some(clearance) = value::num(t, "clearance")
@@ -229,37 +230,6 @@ pub fn build_raster(
     })
 }
 
-fn raster_diagnostic(p: &Parts, e: RasterError) -> Diagnostic {
-    match e {
-        RasterError::ToolTooLarge {
-            tool_radius,
-            min_radius,
-            x,
-            y,
-        } => p
-            .error(
-                codes::NOSE_TOO_LARGE,
-                format!(
-                    "the tool's radius ({} um) is larger than the surface's smallest concave radius of curvature ({} um, at ({}, {}) mm): the tool would gouge",
-                    trim_num(tool_radius * 1000.0),
-                    trim_num(min_radius * 1000.0),
-                    trim_num(x),
-                    trim_num(y)
-                ),
-            )
-            .with_help("use a tool whose radius is below the smallest concave radius of curvature"),
-        RasterError::Undefined { x, y } | RasterError::NoContact { x, y } => p.error(
-            codes::UNDEFINED_ON_PATH,
-            format!(
-                "the surface or the tool path is undefined at ({}, {}) mm",
-                trim_num(x),
-                trim_num(y)
-            ),
-        ),
-        other => p.error(codes::UNSUPPORTED_COMBINATION, other.to_string()),
-    }
-}
-
 /// Builds a `profile_grinding` job on a `grinder_2axis`.
 pub fn build_grinding(
     job: &CheckedJob,
@@ -295,7 +265,7 @@ pub fn build_grinding(
     let (kernel, _) = evaluator(&lowered.tape);
     let profile = SectionAlongX(kernel.as_ref());
     let path = lensc_runtime::plan::grinding::plan_profile_grinding(&grinding, &profile)
-        .map_err(|e| vec![grinding_diagnostic(&p, e)])?;
+        .map_err(|e| vec![p.failed(RuntimeError::Grinding(e))])?;
     let mut errors = Vec::new();
     let retract = value::num(st, "retract").unwrap_or(1.0);
     let top = path
@@ -428,29 +398,4 @@ pub fn build_grinding(
         plots,
         warnings: Vec::new(),
     })
-}
-
-fn grinding_diagnostic(p: &Parts, e: GrindingError) -> Diagnostic {
-    match e {
-        GrindingError::WheelTooLarge {
-            x,
-            wheel_radius,
-            curvature_radius,
-        } => p
-            .error(
-                codes::NOSE_TOO_LARGE,
-                format!(
-                    "the wheel's radius ({} um) is larger than the surface's smallest concave radius of curvature ({} um, at x = {} mm): the wheel would gouge",
-                    trim_num(wheel_radius * 1000.0),
-                    trim_num(curvature_radius * 1000.0),
-                    trim_num(x)
-                ),
-            )
-            .with_help("use a smaller wheel"),
-        GrindingError::NonFiniteSurface { x } => p.error(
-            codes::UNDEFINED_ON_PATH,
-            format!("the surface is undefined at x = {} mm", trim_num(x)),
-        ),
-        other => p.error(codes::UNSUPPORTED_COMBINATION, other.to_string()),
-    }
 }

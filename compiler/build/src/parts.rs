@@ -3,6 +3,7 @@
 //! point, the provenance lines every program header starts with, and the
 //! report every program has beside it.
 
+use crate::diagnostics::RuntimeError;
 use crate::driver::{ProgramText, surface_analysis};
 use crate::report;
 use lensc_grammar::{Diagnostic, FileId, Span};
@@ -125,18 +126,19 @@ impl<'a> Parts<'a> {
         ))
     }
 
+    /// A runtime error of this job as its diagnostic.
+    pub(crate) fn failed(&self, e: RuntimeError) -> Diagnostic {
+        let (file, span) = self.site();
+        e.at(file, span)
+    }
     pub(crate) fn not_printable(&self, e: ProgramError) -> Diagnostic {
-        self.error(codes::NOT_PRINTABLE, e.message())
+        self.failed(RuntimeError::Program(e))
     }
     pub(crate) fn lowered(
         &self,
     ) -> Result<lensc_lang::lower::surface::LoweredSurface, Vec<Diagnostic>> {
-        lensc_lang::lower::surface::lower_surface(self.surface).map_err(|e| {
-            vec![self.error(
-                codes::UNSUPPORTED_COMBINATION,
-                format!("this surface cannot be evaluated yet: {e:?}"),
-            )]
-        })
+        lensc_lang::lower::surface::lower_surface(self.surface)
+            .map_err(|e| vec![self.failed(RuntimeError::Surface(e))])
     }
     pub(crate) fn needs(
         &self,

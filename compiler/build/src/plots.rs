@@ -124,8 +124,8 @@ const WIDTH: u32 = 1000;
 /// Pixels of caption text per character, for wrapping (14 px type).
 const CAPTION_CHAR: f64 = 7.0;
 
-fn err<E: std::fmt::Debug>(e: E) -> String {
-    format!("cannot draw the plot: {e:?}")
+fn err<E: std::fmt::Display>(e: E) -> String {
+    format!("cannot draw the plot: {e}")
 }
 
 /// A number with `d` decimals and no minus sign on zero.

@@ -9,13 +9,13 @@ use std::path::Path;
 use lensc_grammar::Diagnostic;
 use lensc_runtime::emit::roller::RollerProgram;
 use lensc_runtime::plan::roller::{
-    DesignRegion, HelixPass, RollerError, RollerHelix, RollerTool, check_roller_tool,
-    plan_roller_helix_into,
+    DesignRegion, HelixPass, RollerHelix, RollerTool, check_roller_tool, plan_roller_helix_into,
 };
 use lensc_runtime::post::ProgramError;
 use lensc_runtime::post::Provenance;
 use lensc_runtime::surface::analysis::Domain;
 
+use crate::diagnostics::RuntimeError;
 use crate::driver::{Built, evaluator};
 use crate::fts_job::{Sink, cannot_spool};
 use crate::height_map::{self, RollerFrame, Window};
@@ -78,12 +78,7 @@ pub fn build(
     }
     let roller_radius = roller.expect("checked above");
     let (m, t, st) = (&machine.fields, &tool.fields, &strategy.fields);
-    let lowered = lensc_lang::lower::surface::lower_surface(surface).map_err(|e| {
-        vec![err(
-            codes::UNSUPPORTED_COMBINATION,
-            format!("this surface cannot be evaluated yet: {e:?}"),
-        )]
-    })?;
+    let lowered = parts.lowered()?;
     let Domain::Rect {
         x: design_x,
         y: design_y,
@@ -107,7 +102,7 @@ pub fn build(
         samples: (401, 401),
     };
     let check = check_roller_tool(kernel.as_ref(), &region, roller_radius, &rt)
-        .map_err(|e| vec![roller_diagnostic(e, job)])?;
+        .map_err(|e| vec![parts.failed(RuntimeError::Roller(e))])?;
     let deg = |a: f64| trim_num(a.to_degrees());
     if !check.radius_ok {
         errors.push(err(
@@ -284,7 +279,7 @@ pub fn build(
             Err(e) => write_error = write_error.take().or(Some(e)),
         }
     });
-    let path = planned.map_err(|e| vec![roller_diagnostic(e, job)])?;
+    let path = planned.map_err(|e| vec![parts.failed(RuntimeError::Roller(e))])?;
     if let Some(e) = write_error {
         return Err(vec![parts.not_printable(e)]);
     }
@@ -373,58 +368,4 @@ pub fn build(
         plots,
         warnings: Vec::new(),
     })
-}
-
-fn roller_diagnostic(e: RollerError, job: &CheckedJob) -> Diagnostic {
-    let d = |code, msg: String| {
-        Diagnostic::error(code, msg, job.file, job.name.span).with_label("this job")
-    };
-    match e {
-        RollerError::NoseTooLarge {
-            nose_radius,
-            min_radius,
-            x,
-            y,
-        } => d(
-            codes::NOSE_TOO_LARGE,
-            format!(
-                "the tool's nose radius ({} mm) is not below the design's smallest concave radius of curvature ({} mm, at ({}, {}) mm)",
-                trim_num(nose_radius),
-                trim_num(min_radius),
-                trim_num(x),
-                trim_num(y)
-            ),
-        ),
-        RollerError::Overlap {
-            circumference,
-            design_length,
-        } => d(
-            codes::WRAP_OVERLAP,
-            format!(
-                "the design is {} mm around, longer than the roller's {} mm circumference",
-                trim_num(design_length),
-                trim_num(circumference)
-            ),
-        ),
-        RollerError::Undefined { c, z, .. } => d(
-            codes::UNDEFINED_ON_PATH,
-            format!(
-                "the design is undefined where the nose must go (z = {} mm, C = {}°)",
-                trim_num(z),
-                trim_num(c.to_degrees() % 360.0)
-            ),
-        ),
-        RollerError::BlankBelowDesign {
-            blank_radius,
-            design_top,
-        } => d(
-            codes::OUT_OF_RANGE,
-            format!(
-                "the blank's radius ({} mm) is below the top of the design ({} mm)",
-                trim_num(blank_radius),
-                trim_num(design_top)
-            ),
-        ),
-        other => d(codes::UNSUPPORTED_COMBINATION, format!("{other:?}")),
-    }
 }
