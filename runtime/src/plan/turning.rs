@@ -180,12 +180,29 @@ pub enum PlanError {
 /// Number of radii at which the profile is scanned for curvature and slope.
 const SCAN_POINTS: usize = 4096;
 
-/// Plans the profile-turning path of `job` along `profile` (the surface's
-/// section, from the JIT kernel in a build), or says every reason it cannot.
-pub fn plan_profile_turning(
+/// What the scan of a profile over the cut finds before any path is
+/// planned: its smallest concave radius of curvature and its steepest
+/// slope, each with the radius (mm) where it occurs, and the feed speed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProfileScan {
+    /// (radius of curvature, at radius), mm.
+    pub min_concave: Option<(f64, f64)>,
+    /// (slope in rad, at radius mm).
+    pub max_slope: (f64, f64),
+    /// The cutting feed (mm/s).
+    pub feed_speed: f64,
+}
+
+/// Checks a turning job against its profile before planning: the profile
+/// is defined over the cut, the nose fits its smallest concave radius of
+/// curvature, the feed and the spindle speed are within the machine's
+/// limits. The compiler's lowering runs it so `lensc check` reports these;
+/// the planner runs it again as its precondition. Every reason found, or
+/// the scan.
+pub fn check_profile_turning(
     job: &TurningJob,
     profile: &dyn Profile,
-) -> Result<Toolpath, Vec<PlanError>> {
+) -> Result<ProfileScan, Vec<PlanError>> {
     let surf = &job.surface;
     let strat = &job.strategy;
     let rho = job.tool.nose_radius;
@@ -240,6 +257,33 @@ pub fn plan_profile_turning(
             max: job.machine.max_spindle_speed,
         });
     }
+    if errors.is_empty() {
+        Ok(ProfileScan {
+            min_concave,
+            max_slope,
+            feed_speed,
+        })
+    } else {
+        Err(errors)
+    }
+}
+
+/// Plans the profile-turning path of `job` along `profile` (the surface's
+/// section, from the JIT kernel in a build), or says every reason it cannot.
+pub fn plan_profile_turning(
+    job: &TurningJob,
+    profile: &dyn Profile,
+) -> Result<Toolpath, Vec<PlanError>> {
+    let ProfileScan {
+        min_concave,
+        max_slope,
+        feed_speed,
+    } = check_profile_turning(job, profile)?;
+    let strat = &job.strategy;
+    let rho = job.tool.nose_radius;
+    let start = strat.start_radius.unwrap_or(job.surface.aperture_radius);
+    let end = strat.end_radius;
+    let mut errors = Vec::new();
 
     // The profile the nose can touch: the cut range and, at the centre,
     // its mirror image across the axis.

@@ -1464,32 +1464,38 @@ impl<'a> Checker<'a> {
                     }
                 });
                 let Some(length) = length else { return true };
-                let circumference = 2.0 * std::f64::consts::PI * radius;
                 let at = value::field(f, "onto").expect("onto");
-                // Within 1 µm the design closes on itself.
-                if length > circumference + 1e-3 {
-                    self.err(
-                        Diagnostic::error(
-                            codes::WRAP_OVERLAP,
-                            format!("the design is {} mm long around the roller, more than its circumference 2π·{} = {} mm: it would overlap itself", trim_num(length), trim_num(radius), trim_num(circumference)),
-                            at.file,
-                            at.span,
-                        )
-                        .with_label("this roller is too small for the design")
-                        .with_help(format!("a roller for this design has radius L/2π = {} mm", trim_num(length / (2.0 * std::f64::consts::PI)))),
-                    );
-                    return false;
-                }
-                if length < circumference - 1e-3 {
-                    self.diags.push(
-                        Diagnostic::warning(
-                            codes::WRAP_GAP,
-                            format!("the design is {} mm long around the roller, shorter than its circumference {} mm: a {} mm gap is left", trim_num(length), trim_num(circumference), trim_num(circumference - length)),
-                            at.file,
-                            at.span,
-                        )
-                        .with_label("the design does not close around this roller"),
-                    );
+                // The rule and its 1 µm tolerance live with the planner's
+                // precondition, so the two cannot disagree.
+                use lensc_runtime::plan::roller::{RollerError, check_wrap};
+                match check_wrap(radius, length) {
+                    Err(RollerError::Overlap { circumference, .. }) => {
+                        self.err(
+                            Diagnostic::error(
+                                codes::WRAP_OVERLAP,
+                                format!("the design is {} mm long around the roller, more than its circumference 2π·{} = {} mm: it would overlap itself", trim_num(length), trim_num(radius), trim_num(circumference)),
+                                at.file,
+                                at.span,
+                            )
+                            .with_label("this roller is too small for the design")
+                            .with_help(format!("a roller for this design has radius L/2π = {} mm", trim_num(length / (2.0 * std::f64::consts::PI)))),
+                        );
+                        return false;
+                    }
+                    Ok(fit) if fit.gap > 0.0 => {
+                        self.diags.push(
+                            Diagnostic::warning(
+                                codes::WRAP_GAP,
+                                format!("the design is {} mm long around the roller, shorter than its circumference {} mm: a {} mm gap is left", trim_num(length), trim_num(fit.circumference), trim_num(fit.gap)),
+                                at.file,
+                                at.span,
+                            )
+                            .with_label("the design does not close around this roller"),
+                        );
+                    }
+                    // Other errors (a length or radius not positive) are
+                    // the range checks' to report.
+                    _ => {}
                 }
                 true
             }
