@@ -148,8 +148,21 @@ fn run(cli: Cli) -> u8 {
                     code = 1;
                     continue;
                 };
-                out.diagnostics(&c, c.diags());
-                if c.has_errors() {
+                // Everything knowable without planning: each job lowered
+                // as `build` lowers it (in its machine's own dialect), once
+                // the file checks.
+                let mut diags = c.diags().to_vec();
+                if !c.has_errors() {
+                    diags.extend(
+                        c.checked
+                            .jobs
+                            .iter()
+                            .filter_map(|j| lensc_build::pipeline::lower(j, None).err())
+                            .flatten(),
+                    );
+                }
+                out.diagnostics(&c, &diags);
+                if diags.iter().any(|d| d.is_error()) {
                     code = 1;
                 }
             }

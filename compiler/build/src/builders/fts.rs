@@ -1,64 +1,49 @@
 //! Building a spiral turning job, with a fast tool servo (`fts_spiral` on
 //! an `fts_lathe`, seed 003) or a slow one (`spiral_turning` on an
-//! `sts_lathe`, Z carrying the surface): the checked job's
-//! parts read into the runtime's planner, the settling offset worked out
-//! from the servo model, the spiral planned and streamed into a LinuxCNC
-//! program, and the report of what it makes.
+//! `sts_lathe`, Z carrying the surface): the lowered spiral (its settling
+//! offset and tool checks were made in lowering) planned and streamed into
+//! the program, the servo's following and the cut simulated as it is
+//! written, and the report of what it makes.
 
 use lensc_grammar::{Diagnostic, FileId, Span};
+use lensc_lang::check::trim_num;
+use lensc_lang::codes;
+use lensc_lang::lower::job::{Settling, SpiralSpec};
 use lensc_runtime::emit::fts::FtsProgram;
 use lensc_runtime::machine::servo::SecondOrderServo;
-use lensc_runtime::plan::fts::{
-    FastAxis, FtsError, FtsSpiral, FtsSummary, Planner, SpindleSpeed, TrajectoryBounds,
-};
-use lensc_runtime::post::Dialect;
+use lensc_runtime::plan::fts::{FtsError, FtsSpiral, FtsSummary, Planner, SpindleSpeed};
 use lensc_runtime::post::ProgramError;
 use lensc_runtime::post::Provenance;
 use lensc_runtime::surface::ir::SurfaceFn;
+use lensc_runtime::verify::heightmap::Sweep;
 use serde_json::json;
-
-use lensc_lang::check::{CheckedJob, trim_num};
-use lensc_lang::codes;
 use std::path::Path;
 
-use crate::driver::{Built, ProgramText, evaluator};
+use crate::driver::{Built, evaluator};
 use crate::height_map::{self, LatheFrame, Window};
-use crate::parts::Parts;
-use lensc_lang::value::{self, Object};
-use lensc_runtime::verify::heightmap::Sweep;
+use crate::parts;
+use crate::spool::{Sink, cannot_spool};
 
-/// The settling offset and how it was found.
-struct Settling {
-    time: f64,
-    band: Option<f64>,
-    surface_speed: f64,
-    d_traj: f64,
-    offset: f64,
-}
-
-/// Everything the spiral planner needs, read from a checked job.
-pub struct Prepared {
+/// A spiral job ready to plan: its spec and the trajectory's kernel.
+pub struct Prepared<'s> {
+    pub spec: &'s SpiralSpec,
     pub kernel: Box<dyn SurfaceFn + Sync>,
-    pub spiral: FtsSpiral,
-    pub bounds: TrajectoryBounds,
-    pub nose_radius: f64,
-    pub fast_axis: FastAxis,
-    lowered: lensc_lang::lower::surface::LoweredSurface,
-    servo: Option<SecondOrderServo>,
-    settling: Option<Settling>,
-    safe_w: f64,
-    resolution: f64,
-    /// Slow tool servo: Z itself carries the surface.
-    slow: bool,
 }
 
-impl Prepared {
+impl<'s> Prepared<'s> {
+    /// Compiles the trajectory the nose centre follows.
+    pub fn of(spec: &'s SpiralSpec) -> Prepared<'s> {
+        Prepared {
+            spec,
+            kernel: evaluator(&spec.trajectory.tape).0,
+        }
+    }
     pub fn planner(&self) -> Planner<'_> {
         Planner {
-            spiral: &self.spiral,
+            spiral: &self.spec.spiral,
             surface: self.kernel.as_ref(),
-            nose_radius: self.nose_radius,
-            bounds: self.bounds.clone(),
+            nose_radius: self.spec.nose_radius,
+            bounds: self.spec.bounds.clone(),
         }
     }
 }
@@ -67,51 +52,35 @@ impl Prepared {
 /// `spool_dir` the program goes to a temporary file there as it is
 /// written, so memory stays bounded however long it is.
 pub fn build(
-    job: &CheckedJob,
+    spec: &SpiralSpec,
     prov: &Provenance,
-    dialect: &Dialect,
     spool_dir: Option<&Path>,
 ) -> Result<Built, Vec<Diagnostic>> {
-    let p = prepare(job)?;
-    let parts = Parts::of(job, dialect);
-    let (surface, tool, machine, strategy) =
-        (parts.surface, parts.tool, parts.machine, parts.strategy);
-    let (file, span) = parts.site();
-    let names = |p: &str, o: &Object| parts.name(p, o);
+    let prepared = Prepared::of(spec);
+    let (p, head) = (spec, &spec.head);
+    let dialect = &head.dialect;
+    let site = head.site;
+    let not_printable = |e| vec![parts::not_printable(head, e)];
     // A fast tool servo whose controller takes a table: its motion goes
     // there, and the program moves X and C a revolution a block.
     let table_name = match &dialect.fts_table {
-        Some(ext) if !p.slow => Some(format!("{}.{ext}", job.name.name)),
+        Some(ext) if !p.slow => Some(format!("{}.{ext}", head.name)),
         _ => None,
     };
-    let header = header_lines(
-        job,
-        prov,
-        &names("surface", surface),
-        &lensc_lang::lower::describe(surface),
-        &names("tool", tool),
-        &names("machine", machine),
-        &names("strategy", strategy),
-        p.nose_radius,
-        &p.spiral,
-        p.settling.as_ref(),
-        p.slow,
-        table_name.as_deref(),
-        &parts,
-    );
+    let header = header_lines(spec, prov, table_name.as_deref());
     let mut program = FtsProgram::new(
         dialect,
-        &job.name.name,
+        &head.name,
         &header,
-        p.resolution,
+        head.resolution,
         p.spiral.chord_tolerance,
         p.safe_w,
         table_name.as_deref(),
     )
-    .map_err(|e| vec![parts.not_printable(e)])?;
-    let mut sink = Sink::new(spool_dir).map_err(|e| vec![cannot_spool(&e, file, span)])?;
+    .map_err(not_printable)?;
+    let mut sink = Sink::new(spool_dir).map_err(|e| vec![cannot_spool(&e, site)])?;
     let mut table_sink = match table_name {
-        Some(_) => Some(Sink::new(spool_dir).map_err(|e| vec![cannot_spool(&e, file, span)])?),
+        Some(_) => Some(Sink::new(spool_dir).map_err(|e| vec![cannot_spool(&e, site)])?),
         None => None,
     };
     // The fast axis's servo, run on the commands as printed as they are
@@ -132,22 +101,17 @@ pub fn build(
         _ => None,
     };
     // The height map over the window, from the same printed points.
-    let design = evaluator(&p.lowered.tape).0;
-    // The lenslets' own apertures (the planner's features reach on to
-    // where the trajectory meets the settling plateau).
-    let apertures: Vec<(f64, f64, f64)> = lensc_lang::lower::surface::array_lenslet(surface)
-        .zip(lensc_lang::lower::surface::array_centres(surface))
-        .map(|((_, rim), centres)| centres.into_iter().map(|(x, y)| (x, y, rim)).collect())
-        .unwrap_or_default();
-    let window = Window::of(job, height_map::lathe_centre(&p.lowered.domain, &apertures))
-        .map_err(|d| vec![d])?;
+    let lowered = &head.surface.lowered;
+    let design = evaluator(&lowered.tape).0;
+    let apertures = &p.lenslets;
+    let window = Window::of(head, height_map::lathe_centre(&lowered.domain, apertures));
     let grid = window.polar();
-    window.check_size(job, &grid).map_err(|d| vec![d])?;
+    window.check_size(head, &grid).map_err(|d| vec![d])?;
     let mut sweep = Sweep::new(grid, p.nose_radius);
     let mut printed = Vec::new();
     let mut write_error: Option<ProgramError> = None;
-    let planned = p.planner().plan(&p.fast_axis, |pts| {
-        let as_printed = |v: f64| lensc_runtime::verify::simulate::as_printed(v, p.resolution);
+    let planned = prepared.planner().plan(&p.fast_axis, |pts| {
+        let as_printed = |v: f64| lensc_runtime::verify::simulate::as_printed(v, head.resolution);
         printed.clear();
         printed.extend(pts.iter().map(|q| lensc_runtime::plan::fts::SpiralPoint {
             x: as_printed(q.x),
@@ -174,25 +138,22 @@ pub fn build(
         }
     });
     let axis = if p.slow { "Z" } else { "the fast axis" };
-    let summary =
-        planned.map_err(|e| vec![fts_diagnostic(e, &p.spiral.speed, axis, file, span)])?;
+    let summary = planned.map_err(|e| vec![fts_diagnostic(e, &p.spiral.speed, axis, site)])?;
     if let Some(e) = write_error {
-        return Err(vec![parts.not_printable(e)]);
+        return Err(not_printable(e));
     }
     if let Some(t) = table_sink.as_mut() {
         t.push(program.take_table_text());
     }
-    let rest = program.finish().map_err(|e| vec![parts.not_printable(e)])?;
+    let rest = program.finish().map_err(not_printable)?;
     sink.push(rest);
     let mut beside = Vec::new();
     if let (Some(name), Some(t)) = (table_name, table_sink) {
-        let table = t.finish().map_err(|e| vec![cannot_spool(&e, file, span)])?;
+        let table = t.finish().map_err(|e| vec![cannot_spool(&e, site)])?;
         beside.push((name, table));
     }
-    let text = sink
-        .finish()
-        .map_err(|e| vec![cannot_spool(&e, file, span)])?;
-    let program_name = parts.program_name();
+    let text = sink.finish().map_err(|e| vec![cannot_spool(&e, site)])?;
+    let program_name = head.program_name();
     let mut toolpath = toolpath_json(
         &summary,
         &p.spiral,
@@ -203,7 +164,7 @@ pub fn build(
     if p.slow {
         toolpath["strategy"] = json!("spiral_turning");
     }
-    let mut report = parts.report(prov, &program_name, &text, toolpath, &p.lowered);
+    let mut report = parts::report(head, prov, &program_name, &text, toolpath);
     let mut plots = crate::plots::PlotSeries::default();
     report["simulation"] = match following {
         Some(sim) => {
@@ -222,7 +183,7 @@ pub fn build(
         }
         None => json!({ "skipped": "the fast axis has no servo model" }),
     };
-    let frame = LatheFrame::new(design.as_ref(), window, p.lowered.domain, &apertures);
+    let frame = LatheFrame::new(design.as_ref(), window, lowered.domain, apertures);
     let map = sweep.finish(&frame);
     plots.form_error = Some(height_map::form_error_series(
         &map,
@@ -259,8 +220,8 @@ pub fn build(
                     axis,
                     trim_num(data_rate)
                 ),
-                file,
-                span,
+                site.0,
+                site.1,
             )
             .with_label("this job")
             .with_help("lower the spindle or surface speed, or give the axis a higher `data_rate`; the report's `chords_over_tolerance` says how many and where")
@@ -268,7 +229,7 @@ pub fn build(
         .into_iter()
         .collect();
     Ok(Built {
-        report_name: format!("{}.report.json", job.name.name),
+        report_name: format!("{}.report.json", head.name),
         program_name,
         program: text,
         report,
@@ -303,435 +264,15 @@ fn following_json(
     })
 }
 
-/// Reads and checks a job's parts into what the planner needs.
-pub fn prepare(job: &CheckedJob) -> Result<Prepared, Vec<Diagnostic>> {
-    let part = |name: &str| value::object(&job.fields, name).expect("checked job part");
-    let (surface, tool, machine, strategy) = (
-        part("surface"),
-        part("tool"),
-        part("machine"),
-        part("strategy"),
-    );
-    let (file, span) = (job.file, job.name.span);
-    let err = |code: &'static str, msg: String| {
-        Diagnostic::error(code, msg, file, span).with_label("this job")
-    };
-    let mut errors = Vec::new();
-    let slow = strategy.kind.name == "spiral_turning";
-    let (want, what) = if slow {
-        ("sts_lathe", "slow-tool-servo spiral turning")
-    } else {
-        ("fts_lathe", "fast-tool-servo turning")
-    };
-    if machine.kind.name != want {
-        errors.push(err(
-            codes::UNSUPPORTED_COMBINATION,
-            format!(
-                "{what} needs an `{want}`; this machine is a `{}`",
-                machine.kind.name
-            ),
-        ));
-    }
-    if tool.kind.name != "round_nose" {
-        errors.push(err(
-            codes::UNSUPPORTED_COMBINATION,
-            format!(
-                "{what} needs a `round_nose` tool; this is a `{}`",
-                tool.kind.name
-            ),
-        ));
-    }
-    if !errors.is_empty() {
-        return Err(errors);
-    }
-    let (m, t, st) = (&machine.fields, &tool.fields, &strategy.fields);
-    let travel = value::block(m, "travel").expect("required");
-    // The axis that carries the surface: the servo, or Z itself.
-    let fast = value::block(m, if slow { "z_axis" } else { "fast_axis" }).expect("required");
-    let spindle = value::block(m, "spindle").expect("required");
-    let max_spindle = value::num(spindle, "max_speed").expect("required");
-    let rho = value::num(t, "nose_radius").expect("required");
-    let clearance = value::num(t, "clearance").expect("required");
-    let servo = if slow {
-        None
-    } else {
-        let num = |k: &str| value::num(fast, k);
-        match (
-            num("resonance"),
-            num("resonant_peak"),
-            num("natural_frequency"),
-            num("damping"),
-        ) {
-            (Some(f), Some(peak), None, None) => SecondOrderServo::from_resonance(f, peak),
-            (None, None, Some(f), Some(zeta)) => SecondOrderServo::from_natural(f, zeta),
-            _ => {
-                return Err(vec![err(
-                    codes::MISSING_PARAMETER,
-                    "the fast axis's servo model needs either `resonance` and `resonant_peak`, or `natural_frequency` and `damping`".into(),
-                )]);
-            }
-        }
-    };
-    let fast_axis = FastAxis {
-        stroke: if slow {
-            let (lo, hi) = value::range(travel, "z").expect("required");
-            hi - lo
-        } else {
-            value::num(fast, "stroke").expect("required")
-        },
-        max_acceleration: value::num(fast, "max_acceleration").expect("required"),
-    };
-    let speed = match value::num(st, "surface_speed") {
-        Some(v) => SpindleSpeed::SurfaceSpeed {
-            speed: v,
-            max: value::num(st, "spindle_cap").unwrap_or(max_spindle),
-        },
-        None => SpindleSpeed::Constant(value::num(st, "spindle_speed").expect("one of them")),
-    };
-
-    let lowered = lensc_lang::lower::surface::lower_surface(surface).map_err(|e| {
-        vec![err(
-            codes::UNSUPPORTED_COMBINATION,
-            format!("this surface cannot be evaluated yet: {e:?}"),
-        )]
-    })?;
-    // The spiral starts where the surface's farthest point from the axis is.
-    let outer = match lowered.domain {
-        lensc_runtime::surface::analysis::Domain::Circle { radius }
-        | lensc_runtime::surface::analysis::Domain::Annulus { outer: radius, .. } => radius,
-        lensc_runtime::surface::analysis::Domain::Rect { x, y } => [x.0, x.1]
-            .iter()
-            .flat_map(|a| [y.0, y.1].map(|b| a.hypot(b)))
-            .fold(0.0, f64::max),
-    };
-    let start = value::num(st, "from").unwrap_or(outer);
-    // The fastest surface speed the job reaches: what d_traj is made of.
-    let fastest = match speed {
-        SpindleSpeed::SurfaceSpeed { speed, .. } => speed,
-        SpindleSpeed::Constant(w) => w * start,
-    };
-
-    // The settling offset, where the surface is an array of dimples.
-    let settle_word = value::word(st, "settle");
-    let settling = if slow || settle_word == Some("none") {
-        None
-    } else {
-        settling(surface, st, servo, fast, fastest)
-    };
-    if settle_word == Some("auto") && settling.is_none() {
-        errors.push(
-            err(
-                codes::UNSUPPORTED_COMBINATION,
-                "`settle: auto` needs an array of concave lenslets with circular apertures, whose continuation rises above the land".into(),
-            )
-            .with_help("use `settle: none` to follow the surface as it is"),
-        );
-        return Err(errors);
-    }
-    let trajectory = match &settling {
-        Some(s) => {
-            lensc_lang::lower::surface::lower_trajectory(surface, s.offset).map_err(|e| {
-                vec![err(
-                    codes::UNSUPPORTED_COMBINATION,
-                    format!("the tool trajectory cannot be built: {e:?}"),
-                )]
-            })?
-        }
-        None => lensc_lang::lower::surface::lower_surface(surface).expect("lowered above"),
-    };
-    let (kernel, _) = evaluator(&trajectory.tape);
-    let analysis = lensc_runtime::surface::analysis::analyse(kernel.as_ref(), &lowered.domain, 201);
-    let design = {
-        let (k, _) = evaluator(&lowered.tape);
-        lensc_runtime::surface::analysis::analyse(k.as_ref(), &lowered.domain, 201)
-    };
-
-    // Tool checks on the design surface.
-    if let Some(r) = [design.min_radius_concave_x, design.min_radius_concave_y]
-        .into_iter()
-        .flatten()
-        .min_by(|a, b| a.value.total_cmp(&b.value))
-        && rho > r.value
-    {
-        errors.push(err(
-            codes::NOSE_TOO_LARGE,
-            format!(
-                "the tool's nose radius ({} um) is larger than the surface's smallest concave radius of curvature ({} um, at ({}, {}) mm): the tool would gouge",
-                trim_num(rho * 1000.0),
-                trim_num(r.value * 1000.0),
-                trim_num(r.x),
-                trim_num(r.y)
-            ),
-        ));
-    }
-    // The flank follows the cut around the spindle: the clearance angle
-    // must exceed the steepest slope around (circumferential); the edge
-    // meets the slope across (radial): half its included angle must exceed it.
-    let (around, across) = {
-        let (k, _) = evaluator(&lowered.tape);
-        polar_slopes(k.as_ref(), &lowered.domain, 201)
-    };
-    if clearance <= around.0 {
-        errors.push(err(
-            codes::CLEARANCE_TOO_SMALL,
-            format!(
-                "the clearance angle ({}°) is not above the surface's steepest slope in the cutting direction, around the spindle ({}°, at ({}, {}) mm): the flank would rub",
-                trim_num(clearance.to_degrees()),
-                trim_num(around.0.to_degrees()),
-                trim_num(around.1),
-                trim_num(around.2)
-            ),
-        ));
-    }
-    if let Some(included) = value::num(t, "included_angle")
-        && included / 2.0 <= across.0
-    {
-        errors.push(err(
-            codes::CLEARANCE_TOO_SMALL,
-            format!(
-                "half the tool's included angle ({}°) is not above the surface's steepest slope across the cut, along the radius ({}°, at ({}, {}) mm): the edge's side would cut",
-                trim_num(included.to_degrees() / 2.0),
-                trim_num(across.0.to_degrees()),
-                trim_num(across.1),
-                trim_num(across.2)
-            ),
-        ));
-    }
-
-    let spiral = FtsSpiral {
-        feed_per_rev: value::num(st, "feed").expect("required") * 2.0 * std::f64::consts::PI,
-        speed,
-        chord_tolerance: value::num(st, "chord_tolerance").unwrap_or(10e-6),
-        seed_arc: value::num(st, "seed_arc").unwrap_or(0.1),
-        min_interval: 1.0 / value::num(fast, "data_rate").unwrap_or(if slow { 1e3 } else { 20e3 }),
-        start_radius: start,
-        end_radius: 0.0,
-    };
-    // With a settling offset, the trajectory is level outside each
-    // lenslet's continuation, which meets the plateau d_traj past the rim.
-    let features = settling.as_ref().and_then(|s| {
-        let (_, rim) = lensc_lang::lower::surface::array_lenslet(surface)?;
-        let centres = lensc_lang::lower::surface::array_centres(surface)?;
-        Some(
-            centres
-                .into_iter()
-                .map(|(x, y)| (x, y, rim + s.d_traj))
-                .collect(),
-        )
-    });
-    let bounds = TrajectoryBounds {
-        z_max: analysis.sag_max.value,
-        // Margin over the sampled steepest slope: the contact search
-        // window must contain the contact.
-        max_slope: (analysis.max_slope.value * 1.1).min(1.5),
-        features,
-        part_top: design.sag_max.value,
-    };
-    let spin_max = match speed {
-        SpindleSpeed::Constant(w) => w,
-        // The spiral runs in to the axis, where the cap is reached.
-        SpindleSpeed::SurfaceSpeed { max, .. } => max,
-    };
-    if spin_max > max_spindle {
-        errors.push(err(
-            codes::SPINDLE_TOO_FAST,
-            format!(
-                "the spindle speed ({} rpm) is above the machine's maximum ({} rpm)",
-                trim_num(rpm(spin_max)),
-                trim_num(rpm(max_spindle))
-            ),
-        ));
-    }
-    let (tx0, tx1) = value::range(travel, "x").expect("required");
-    if start > tx1 || tx0 > 0.0 {
-        errors.push(err(
-            codes::OUT_OF_TRAVEL,
-            format!(
-                "the spiral moves X from {} mm to 0, outside the machine's travel {} .. {} mm",
-                trim_num(start),
-                trim_num(tx0),
-                trim_num(tx1)
-            ),
-        ));
-    }
-    if !errors.is_empty() {
-        return Err(errors);
-    }
-
-    let retract = value::num(st, "retract").unwrap_or(1.0);
-    Ok(Prepared {
-        kernel,
-        spiral,
-        bounds,
-        nose_radius: rho,
-        fast_axis,
-        safe_w: analysis.sag_max.value + rho + retract,
-        resolution: value::num(m, "resolution").expect("required"),
-        lowered,
-        servo,
-        settling,
-        slow,
-    })
-}
-
-/// The steepest slopes (rad) around the spindle axis and along the radius,
-/// each with where (x, y), over an n × n grid of the domain.
-fn polar_slopes(
-    f: &dyn SurfaceFn,
-    domain: &lensc_runtime::surface::analysis::Domain,
-    n: usize,
-) -> ((f64, f64, f64), (f64, f64, f64)) {
-    let (xs, ys, out) = lensc_runtime::surface::analysis::grid(f, domain, n);
-    let mut around = (0.0, 0.0, 0.0);
-    let mut across = (0.0, 0.0, 0.0);
-    for (i, (&x, &y)) in xs.iter().zip(&ys).enumerate() {
-        let r = x.hypot(y);
-        let (zx, zy) = (out[6 * i + 1], out[6 * i + 2]);
-        if r == 0.0 || !(zx.is_finite() && zy.is_finite()) {
-            continue;
-        }
-        let tangential = ((x * zy - y * zx) / r).abs().atan();
-        let radial = ((x * zx + y * zy) / r).abs().atan();
-        if tangential > around.0 {
-            around = (tangential, x, y);
-        }
-        if radial > across.0 {
-            across = (radial, x, y);
-        }
-    }
-    (around, across)
-}
-
-/// Where the program text goes as it is written: memory, or a spool file.
-pub(crate) enum Sink {
-    Memory(String),
-    File {
-        writer: std::io::BufWriter<tempfile::NamedTempFile>,
-        lines: usize,
-        bytes: u64,
-        error: Option<std::io::Error>,
-    },
-}
-
-impl Sink {
-    pub(crate) fn new(spool_dir: Option<&Path>) -> std::io::Result<Sink> {
-        Ok(match spool_dir {
-            None => Sink::Memory(String::new()),
-            Some(dir) => {
-                std::fs::create_dir_all(dir)?;
-                let file = tempfile::Builder::new()
-                    .prefix(".lensc-")
-                    .suffix(".tmp")
-                    .tempfile_in(dir)?;
-                Sink::File {
-                    writer: std::io::BufWriter::with_capacity(1 << 20, file),
-                    lines: 0,
-                    bytes: 0,
-                    error: None,
-                }
-            }
-        })
-    }
-
-    pub(crate) fn push(&mut self, text: String) {
-        match self {
-            Sink::Memory(all) => all.push_str(&text),
-            Sink::File {
-                writer,
-                lines,
-                bytes,
-                error,
-            } => {
-                if error.is_none() {
-                    use std::io::Write;
-                    *lines += text.bytes().filter(|&b| b == b'\n').count();
-                    *bytes += text.len() as u64;
-                    if let Err(e) = writer.write_all(text.as_bytes()) {
-                        *error = Some(e);
-                    }
-                }
-            }
-        }
-    }
-
-    pub(crate) fn finish(self) -> std::io::Result<ProgramText> {
-        match self {
-            Sink::Memory(text) => Ok(ProgramText::Memory(text)),
-            Sink::File {
-                writer,
-                lines,
-                bytes,
-                error,
-            } => {
-                if let Some(e) = error {
-                    return Err(e);
-                }
-                let file = writer.into_inner().map_err(|e| e.into_error())?;
-                Ok(ProgramText::Spooled { file, lines, bytes })
-            }
-        }
-    }
-}
-
-pub(crate) fn cannot_spool(e: &std::io::Error, file: FileId, span: Span) -> Diagnostic {
-    Diagnostic::error(
-        codes::CANNOT_WRITE,
-        format!("cannot write the program: {e}"),
-        file,
-        span,
-    )
-    .with_label("this job")
-}
-
 fn rpm(w: f64) -> f64 {
     w * 60.0 / (2.0 * std::f64::consts::PI)
 }
 
-/// The settling offset for an array of concave lenslets: the servo's
-/// settling time (the strategy's, or the model's at its band), the path
-/// covered meanwhile at the fastest surface speed, and how far the
-/// lenslet's own surface rises over that path past its rim.
-fn settling(
-    surface: &Object,
-    st: &[value::Field],
-    servo: Option<SecondOrderServo>,
-    fast: &[value::Field],
-    surface_speed: f64,
-) -> Option<Settling> {
-    let (lenslet, rim) = lensc_lang::lower::surface::array_lenslet(surface)?;
-    let band = value::num(fast, "settling_band").unwrap_or(0.002);
-    let (time, band) = match value::num(st, "settling_time") {
-        Some(t) => (t, None),
-        None => (servo?.settling_time(band)?, Some(band)),
-    };
-    let f = lensc_runtime::surface::ir::Interpreter::new(&lenslet.tape);
-    let along = |u: f64| f.eval(u, 0.0)[0];
-    let offset = lensc_runtime::plan::fts::settling_offset(along, rim, surface_speed, time);
-    (offset.is_finite() && offset > 0.0).then_some(Settling {
-        time,
-        band,
-        surface_speed,
-        d_traj: surface_speed * time,
-        offset,
-    })
-}
-
-#[allow(clippy::too_many_arguments)]
-fn header_lines(
-    job: &CheckedJob,
-    prov: &Provenance,
-    surface: &str,
-    surface_words: &str,
-    tool: &str,
-    machine: &str,
-    strategy: &str,
-    rho: f64,
-    spiral: &FtsSpiral,
-    settling: Option<&Settling>,
-    slow: bool,
-    table: Option<&str>,
-    parts: &Parts,
-) -> Vec<String> {
+/// The program's header: provenance, units, the surface, tool, spiral
+/// and machine in words, and the settling offset.
+fn header_lines(spec: &SpiralSpec, prov: &Provenance, table: Option<&str>) -> Vec<String> {
+    let (head, spiral, slow, rho) = (&spec.head, &spec.spiral, spec.slow, spec.nose_radius);
+    let settling = spec.settling.as_ref();
     let table_words;
     let (servo_words, axis_words) = if slow {
         ("slow-tool-servo", "Z carries the surface")
@@ -752,20 +293,25 @@ fn header_lines(
         ),
     };
     let mut lines = vec![
-        format!("lensc {}: job {}", prov.lensc_version, job.name.name),
+        format!("lensc {}: job {}", prov.lensc_version, head.name),
         format!("source {} fnv1a64 {:016x}", prov.source, prov.source_hash),
         format!(
             "units mm; X is {}, C the spindle angle in degrees counted on from the start, {axis_words}, +Z out of the material",
-            lensc_runtime::emit::x_word(parts.dialect)
+            lensc_runtime::emit::x_word(&head.dialect)
         ),
         format!(
             "coordinates are the centre of the tool nose; {}",
-            parts.inverse_time_words()
+            parts::inverse_time_words(head)
         ),
-        format!("surface {surface}: {surface_words}"),
-        format!("tool {tool}: round nose, nose radius {} mm", trim_num(rho)),
+        format!("surface {}: {}", head.names.surface, head.surface.words),
         format!(
-            "strategy {strategy}: {servo_words} spiral from r = {} mm, feed {} um/rev, {speed}, path tolerance {} nm [chords {}, blending {} nm]",
+            "tool {}: round nose, nose radius {} mm",
+            head.names.tool,
+            trim_num(rho)
+        ),
+        format!(
+            "strategy {}: {servo_words} spiral from r = {} mm, feed {} um/rev, {speed}, path tolerance {} nm [chords {}, blending {} nm]",
+            head.names.strategy,
             trim_num(spiral.start_radius),
             trim_num(spiral.feed_per_rev * 1000.0),
             trim_num(spiral.chord_tolerance * 1e6),
@@ -777,8 +323,8 @@ fn header_lines(
             trim_num(spiral.chord_tolerance * lensc_runtime::plan::optimise::BLEND_SHARE * 1e6)
         ),
         format!(
-            "machine {machine}: {} {servo_words} lathe",
-            parts.dialect.name
+            "machine {}: {} {servo_words} lathe",
+            head.names.machine, head.dialect.name
         ),
     ];
     match settling {
@@ -848,8 +394,7 @@ fn fts_diagnostic(
     e: FtsError,
     speed: &SpindleSpeed,
     axis: &str,
-    file: FileId,
-    span: Span,
+    (file, span): (FileId, Span),
 ) -> Diagnostic {
     let d = |code, msg: String| Diagnostic::error(code, msg, file, span).with_label("this job");
     match e {
