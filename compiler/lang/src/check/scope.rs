@@ -10,131 +10,179 @@ use lensc_grammar::{Diagnostic, FileId};
 
 use super::{COORDINATES, Checker, Decl, FUNCTIONS, State};
 use crate::codes;
-use crate::loader::Import;
+use crate::loader::{Import, ParsedFile};
 use crate::schema::{self, Category};
-use crate::units::{self};
+use crate::units;
 use crate::value::Value;
 
 impl<'a> Checker<'a> {
+    /// Builds every file's scope: its own items first, then its imports.
     pub(super) fn build_scopes(&mut self) {
         let loaded = self.loaded;
-        // Pass 1: every file's own items.
-        let mut locals: Vec<HashMap<&'a str, usize>> = Vec::new();
+        let locals: Vec<HashMap<&'a str, usize>> = loaded
+            .files
+            .iter()
+            .map(|pf| self.declare_items(pf))
+            .collect();
         for pf in &loaded.files {
-            let mut scope: HashMap<&'a str, usize> = HashMap::new();
-            for item in &pf.ast.items {
-                let (name, kind, value) = match &item.kind {
-                    ItemKind::Let { name, value } => (name, None, value),
-                    ItemKind::Decl { kind, name, value } => (name, Some(*kind), value),
-                    _ => continue,
-                };
-                if let Some(&prev) = scope.get(name.name.as_str()) {
-                    let first = self.decls[prev].name.span;
-                    self.err(
-                        Diagnostic::error(
-                            codes::DUPLICATE_NAME,
-                            format!("`{}` is defined twice", name.name),
-                            pf.id,
-                            name.span,
-                        )
-                        .with_label("second definition")
-                        .with_note(pf.id, first, "first defined here")
-                        .with_help("rename one of them"),
-                    );
-                    continue;
-                }
-                if schema::is_word(&name.name) {
-                    self.err(
-                        Diagnostic::error(codes::DUPLICATE_NAME, format!("`{}` is a word lensc uses as a value", name.name), pf.id, name.span)
-                            .with_label("this name would hide the word")
-                            .with_help(format!("`{}` is the value of a parameter (as in `sense: convex`); choose another name", name.name)),
-                    );
-                    continue;
-                }
-                if FUNCTIONS.contains(&name.name.as_str())
-                    || schema::kind(&name.name).is_some()
-                    || COORDINATES.contains(&name.name.as_str())
-                {
-                    self.err(
-                        Diagnostic::error(
-                            codes::DUPLICATE_NAME,
-                            format!("`{}` is a built-in name", name.name),
-                            pf.id,
-                            name.span,
-                        )
-                        .with_label("this would hide the built-in")
-                        .with_help("choose another name"),
-                    );
-                    continue;
-                }
-                scope.insert(name.name.as_str(), self.decls.len());
-                self.decls.push(Decl {
-                    file: pf.id,
-                    name,
-                    kind,
-                    value,
-                });
-                self.state.push(State::Todo);
-                self.used.push(false);
-            }
-            locals.push(scope);
-        }
-        // Pass 2: imports.
-        for pf in &loaded.files {
-            let mut scope = locals[pf.id.0 as usize].clone();
-            for imp in &pf.imports {
-                match imp {
-                    Import::One { file, name } => {
-                        let source = &locals[file.0 as usize];
-                        match source.get(name.name.as_str()) {
-                            Some(&i) => {
-                                if let Some(&prev) = scope.get(name.name.as_str()) {
-                                    let prev_span = self.decls[prev].name.span;
-                                    let prev_file = self.decls[prev].file;
-                                    self.err(
-                                        Diagnostic::error(
-                                            codes::DUPLICATE_NAME,
-                                            format!("`{}` is already defined", name.name),
-                                            pf.id,
-                                            name.span,
-                                        )
-                                        .with_label("imported here")
-                                        .with_note(prev_file, prev_span, "also defined here")
-                                        .with_help("rename the local definition"),
-                                    );
-                                } else {
-                                    scope.insert(name.name.as_str(), i);
-                                    self.used[i] = true;
-                                }
-                            }
-                            None => {
-                                let module = loaded.sources.get(*file).name.clone();
-                                let mut d = Diagnostic::error(
-                                    codes::NOT_IN_MODULE,
-                                    format!("`{module}` has no item `{}`", name.name),
-                                    pf.id,
-                                    name.span,
-                                )
-                                .with_label("not found");
-                                let names: Vec<&str> = source.keys().copied().collect();
-                                let mut sorted = names.clone();
-                                sorted.sort_unstable();
-                                d = d.with_help(match did_you_mean(&name.name, names) {
-                                    Some(s) => format!("did you mean `{s}`?"),
-                                    None => format!("it has: {}", sorted.join(", ")),
-                                });
-                                self.err(d);
-                            }
-                        }
-                    }
-                    Import::All { file, .. } => {
-                        for (&n, &i) in &locals[file.0 as usize] {
-                            scope.entry(n).or_insert(i);
-                        }
-                    }
-                }
-            }
+            let scope = self.resolve_imports(pf, &locals);
             self.scopes.push(scope);
+        }
+    }
+
+    /// A file's own `let`s and declarations, by name.
+    fn declare_items(&mut self, pf: &'a ParsedFile) -> HashMap<&'a str, usize> {
+        let mut scope: HashMap<&'a str, usize> = HashMap::new();
+        for item in &pf.ast.items {
+            let (name, kind, value) = match &item.kind {
+                ItemKind::Let { name, value } => (name, None, value),
+                ItemKind::Decl { kind, name, value } => (name, Some(*kind), value),
+                _ => continue,
+            };
+            if !self.name_is_free(pf.id, &scope, name) {
+                continue;
+            }
+            scope.insert(name.name.as_str(), self.decls.len());
+            self.decls.push(Decl {
+                file: pf.id,
+                name,
+                kind,
+                value,
+            });
+            self.state.push(State::Todo);
+            self.used.push(false);
+        }
+        scope
+    }
+
+    /// Whether `name` may be defined in a file: not twice, and not a word,
+    /// function, kind or coordinate lensc already gives a meaning.
+    fn name_is_free(
+        &mut self,
+        file: FileId,
+        scope: &HashMap<&'a str, usize>,
+        name: &Ident,
+    ) -> bool {
+        if let Some(&prev) = scope.get(name.name.as_str()) {
+            let first = self.decls[prev].name.span;
+            self.err(
+                Diagnostic::error(
+                    codes::DUPLICATE_NAME,
+                    format!("`{}` is defined twice", name.name),
+                    file,
+                    name.span,
+                )
+                .with_label("second definition")
+                .with_note(file, first, "first defined here")
+                .with_help("rename one of them"),
+            );
+            return false;
+        }
+        if schema::is_word(&name.name) {
+            self.err(
+                Diagnostic::error(
+                    codes::DUPLICATE_NAME,
+                    format!("`{}` is a word lensc uses as a value", name.name),
+                    file,
+                    name.span,
+                )
+                .with_label("this name would hide the word")
+                .with_help(format!(
+                    "`{}` is the value of a parameter (as in `sense: convex`); choose another name",
+                    name.name
+                )),
+            );
+            return false;
+        }
+        if FUNCTIONS.contains(&name.name.as_str())
+            || schema::kind(&name.name).is_some()
+            || COORDINATES.contains(&name.name.as_str())
+        {
+            self.err(
+                Diagnostic::error(
+                    codes::DUPLICATE_NAME,
+                    format!("`{}` is a built-in name", name.name),
+                    file,
+                    name.span,
+                )
+                .with_label("this would hide the built-in")
+                .with_help("choose another name"),
+            );
+            return false;
+        }
+        true
+    }
+
+    /// A file's scope: its own items and those it imports.
+    fn resolve_imports(
+        &mut self,
+        pf: &'a ParsedFile,
+        locals: &[HashMap<&'a str, usize>],
+    ) -> HashMap<&'a str, usize> {
+        let mut scope = locals[pf.id.0 as usize].clone();
+        for imp in &pf.imports {
+            match imp {
+                Import::One { file, name } => {
+                    self.import_one(pf.id, &mut scope, &locals[file.0 as usize], *file, name)
+                }
+                Import::All { file, .. } => {
+                    for (&n, &i) in &locals[file.0 as usize] {
+                        scope.entry(n).or_insert(i);
+                    }
+                }
+            }
+        }
+        scope
+    }
+
+    /// `use module::name`: the item joins the scope unless the name is taken.
+    fn import_one(
+        &mut self,
+        here: FileId,
+        scope: &mut HashMap<&'a str, usize>,
+        source: &HashMap<&'a str, usize>,
+        file: FileId,
+        name: &'a Ident,
+    ) {
+        match source.get(name.name.as_str()) {
+            Some(&i) => {
+                if let Some(&prev) = scope.get(name.name.as_str()) {
+                    let prev_span = self.decls[prev].name.span;
+                    let prev_file = self.decls[prev].file;
+                    self.err(
+                        Diagnostic::error(
+                            codes::DUPLICATE_NAME,
+                            format!("`{}` is already defined", name.name),
+                            here,
+                            name.span,
+                        )
+                        .with_label("imported here")
+                        .with_note(prev_file, prev_span, "also defined here")
+                        .with_help("rename the local definition"),
+                    );
+                } else {
+                    scope.insert(name.name.as_str(), i);
+                    self.used[i] = true;
+                }
+            }
+            None => {
+                let module = self.loaded.sources.get(file).name.clone();
+                let mut d = Diagnostic::error(
+                    codes::NOT_IN_MODULE,
+                    format!("`{module}` has no item `{}`", name.name),
+                    here,
+                    name.span,
+                )
+                .with_label("not found");
+                let names: Vec<&str> = source.keys().copied().collect();
+                let mut sorted = names.clone();
+                sorted.sort_unstable();
+                d = d.with_help(match did_you_mean(&name.name, names) {
+                    Some(s) => format!("did you mean `{s}`?"),
+                    None => format!("it has: {}", sorted.join(", ")),
+                });
+                self.err(d);
+            }
         }
     }
 

@@ -108,125 +108,12 @@ fn array_height_settled(
     } else {
         (hx, hy)
     };
-    // The rim height: the lenslet at the edge of its aperture along +x.
-    let rim = {
-        let mut h = Graph::new();
-        let (u, v) = (h.x(), h.y());
-        let z = height(&mut h, lenslet, u, v)?;
-        let f = lensc_runtime::surface::ir::Interpreter::new(&SurfaceTape::new(h, z));
-        let at = match ap {
-            Domain::Circle { radius } | Domain::Annulus { outer: radius, .. } => (radius, 0.0),
-            Domain::Rect { x, y } => (x.1, 0.5 * (y.0 + y.1)),
-        };
-        lensc_runtime::surface::ir::SurfaceFn::eval(&f, at.0, at.1)[0]
-    };
+    let rim = rim_height(lenslet, &ap)?;
     // Cell centres: (i, j) → (cx, cy) as nodes; candidate cells per point.
-    let mut candidates: Vec<(Id, Id)> = Vec::new();
-    let num = |name: &str| value::num(f, name).unwrap_or(1.0);
-    match o.kind.name {
-        "grid" | "linear_array" => {
-            let along_y = value::word(f, "axis") == Some("y");
-            let (px, py, nx, ny) = match o.kind.name {
-                "grid" => (
-                    num("pitch_x"),
-                    num("pitch_y"),
-                    num("count_x"),
-                    num("count_y"),
-                ),
-                _ if along_y => (f64::INFINITY, num("pitch"), 1.0, num("count")),
-                _ => (num("pitch"), f64::INFINITY, num("count"), 1.0),
-            };
-            let reach = |half: f64, pitch: f64| {
-                if half > 1.5 * pitch {
-                    None
-                } else if half > 0.5 * pitch {
-                    Some(1)
-                } else {
-                    Some(0)
-                }
-            };
-            let (kx, ky) = match (reach(hx, px), reach(hy, py)) {
-                (Some(a), Some(b)) => (a, b),
-                _ => {
-                    return Err(LowerError::Aperture(
-                        "lenslet apertures reach past their neighbours",
-                    ));
-                }
-            };
-            let axis_cells = |g: &mut Graph, t: Id, pitch: f64, n: f64, k: i32| -> Vec<Id> {
-                if n <= 1.0 {
-                    return vec![g.constant_node(0.0)];
-                }
-                let inv = g.constant_node(1.0 / pitch);
-                let q = g.mul(t, inv);
-                let half = g.constant_node(n / 2.0);
-                let qt = g.add(q, half);
-                (-k..=k)
-                    .map(|d| {
-                        let i = cell_index(g, qt, n, f64::from(d));
-                        // centre = (i − (n − 1)/2) · pitch
-                        let mid = g.constant_node((n - 1.0) / 2.0);
-                        let off = g.sub(i, mid);
-                        let p = g.constant_node(pitch);
-                        g.mul(off, p)
-                    })
-                    .collect()
-            };
-            let xs = axis_cells(g, x, px, nx, kx);
-            let ys = axis_cells(g, y, py, ny, ky);
-            for &cx in &xs {
-                for &cy in &ys {
-                    candidates.push((cx, cy));
-                }
-            }
-        }
-        _ => {
-            // Hexagonal: rows of spacing p·√3/2, odd rows shifted by p/2.
-            let (p, nx, ny) = (num("pitch"), num("count_x"), num("count_y"));
-            if hx.max(hy) > 1.5 * p {
-                return Err(LowerError::Aperture(
-                    "lenslet apertures reach past their neighbours",
-                ));
-            }
-            let row = p * 3f64.sqrt() / 2.0;
-            let inv = g.constant_node(1.0 / row);
-            let q = g.mul(y, inv);
-            let half = g.constant_node(ny / 2.0);
-            let qt = g.add(q, half);
-            for dj in -1..=1 {
-                let j = cell_index(g, qt, ny, f64::from(dj));
-                let mid = g.constant_node((ny - 1.0) / 2.0);
-                let joff = g.sub(j, mid);
-                let rc = g.constant_node(row);
-                let cy = g.mul(joff, rc);
-                // parity of j: j − 2 floor(j/2), shifting the row by ±p/4.
-                let h = g.constant_node(0.5);
-                let jh = g.mul(j, h);
-                let fl = g.floor(jh);
-                let two = g.constant_node(2.0);
-                let tf = g.mul(two, fl);
-                let parity = g.sub(j, tf);
-                let quarter = g.constant_node(p / 2.0);
-                let pq = g.mul(parity, quarter);
-                let back = g.constant_node(p / 4.0);
-                let shift = g.sub(pq, back);
-                let xl = g.sub(x, shift);
-                let pinv = g.constant_node(1.0 / p);
-                let xq = g.mul(xl, pinv);
-                let nh = g.constant_node(nx / 2.0);
-                let xt = g.add(xq, nh);
-                for di in -1..=1 {
-                    let i = cell_index(g, xt, nx, f64::from(di));
-                    let mid = g.constant_node((nx - 1.0) / 2.0);
-                    let ioff = g.sub(i, mid);
-                    let pc = g.constant_node(p);
-                    let cx0 = g.mul(ioff, pc);
-                    let cx = g.add(cx0, shift);
-                    candidates.push((cx, cy));
-                }
-            }
-        }
-    }
+    let candidates = match o.kind.name {
+        "grid" | "linear_array" => grid_cells(g, o, (x, y), (hx, hy))?,
+        _ => hex_cells(g, o, (x, y), (hx, hy))?,
+    };
     // min over the candidates that contain the point; +BIG where none do.
     const BIG: f64 = 1e6;
     let big = g.constant_node(BIG);
@@ -253,6 +140,146 @@ fn array_height_settled(
     let test = g.sub(best, half_big);
     let land = g.constant_node(0.0);
     Ok(g.select(test, best, land))
+}
+
+/// The lenslet's height at the edge of its aperture along +x: the height
+/// the land is cut at.
+fn rim_height(lenslet: &Object, ap: &Domain) -> Result<f64, LowerError> {
+    let mut h = Graph::new();
+    let (u, v) = (h.x(), h.y());
+    let z = height(&mut h, lenslet, u, v)?;
+    let f = lensc_runtime::surface::ir::Interpreter::new(&SurfaceTape::new(h, z));
+    let at = match *ap {
+        Domain::Circle { radius } | Domain::Annulus { outer: radius, .. } => (radius, 0.0),
+        Domain::Rect { x, y } => (x.1, 0.5 * (y.0 + y.1)),
+    };
+    Ok(lensc_runtime::surface::ir::SurfaceFn::eval(&f, at.0, at.1)[0])
+}
+
+/// The centres of the cells of a rectangular grid or a linear array a
+/// point may lie in: its own and, where apertures reach past half a
+/// pitch, its neighbours.
+fn grid_cells(
+    g: &mut Graph,
+    o: &Object,
+    (x, y): (Id, Id),
+    (hx, hy): (f64, f64),
+) -> Result<Vec<(Id, Id)>, LowerError> {
+    let f = &o.fields;
+    let num = |name: &str| value::num(f, name).unwrap_or(1.0);
+    let mut candidates: Vec<(Id, Id)> = Vec::new();
+    let along_y = value::word(f, "axis") == Some("y");
+    let (px, py, nx, ny) = match o.kind.name {
+        "grid" => (
+            num("pitch_x"),
+            num("pitch_y"),
+            num("count_x"),
+            num("count_y"),
+        ),
+        _ if along_y => (f64::INFINITY, num("pitch"), 1.0, num("count")),
+        _ => (num("pitch"), f64::INFINITY, num("count"), 1.0),
+    };
+    let reach = |half: f64, pitch: f64| {
+        if half > 1.5 * pitch {
+            None
+        } else if half > 0.5 * pitch {
+            Some(1)
+        } else {
+            Some(0)
+        }
+    };
+    let (kx, ky) = match (reach(hx, px), reach(hy, py)) {
+        (Some(a), Some(b)) => (a, b),
+        _ => {
+            return Err(LowerError::Aperture(
+                "lenslet apertures reach past their neighbours",
+            ));
+        }
+    };
+    let axis_cells = |g: &mut Graph, t: Id, pitch: f64, n: f64, k: i32| -> Vec<Id> {
+        if n <= 1.0 {
+            return vec![g.constant_node(0.0)];
+        }
+        let inv = g.constant_node(1.0 / pitch);
+        let q = g.mul(t, inv);
+        let half = g.constant_node(n / 2.0);
+        let qt = g.add(q, half);
+        (-k..=k)
+            .map(|d| {
+                let i = cell_index(g, qt, n, f64::from(d));
+                // centre = (i − (n − 1)/2) · pitch
+                let mid = g.constant_node((n - 1.0) / 2.0);
+                let off = g.sub(i, mid);
+                let p = g.constant_node(pitch);
+                g.mul(off, p)
+            })
+            .collect()
+    };
+    let xs = axis_cells(g, x, px, nx, kx);
+    let ys = axis_cells(g, y, py, ny, ky);
+    for &cx in &xs {
+        for &cy in &ys {
+            candidates.push((cx, cy));
+        }
+    }
+    Ok(candidates)
+}
+
+/// The centres of the cells of a hexagonal grid a point may lie in: three
+/// rows of three.
+fn hex_cells(
+    g: &mut Graph,
+    o: &Object,
+    (x, y): (Id, Id),
+    (hx, hy): (f64, f64),
+) -> Result<Vec<(Id, Id)>, LowerError> {
+    let num = |name: &str| value::num(&o.fields, name).unwrap_or(1.0);
+    let mut candidates: Vec<(Id, Id)> = Vec::new();
+    // Hexagonal: rows of spacing p·√3/2, odd rows shifted by p/2.
+    let (p, nx, ny) = (num("pitch"), num("count_x"), num("count_y"));
+    if hx.max(hy) > 1.5 * p {
+        return Err(LowerError::Aperture(
+            "lenslet apertures reach past their neighbours",
+        ));
+    }
+    let row = p * 3f64.sqrt() / 2.0;
+    let inv = g.constant_node(1.0 / row);
+    let q = g.mul(y, inv);
+    let half = g.constant_node(ny / 2.0);
+    let qt = g.add(q, half);
+    for dj in -1..=1 {
+        let j = cell_index(g, qt, ny, f64::from(dj));
+        let mid = g.constant_node((ny - 1.0) / 2.0);
+        let joff = g.sub(j, mid);
+        let rc = g.constant_node(row);
+        let cy = g.mul(joff, rc);
+        // parity of j: j − 2 floor(j/2), shifting the row by ±p/4.
+        let h = g.constant_node(0.5);
+        let jh = g.mul(j, h);
+        let fl = g.floor(jh);
+        let two = g.constant_node(2.0);
+        let tf = g.mul(two, fl);
+        let parity = g.sub(j, tf);
+        let quarter = g.constant_node(p / 2.0);
+        let pq = g.mul(parity, quarter);
+        let back = g.constant_node(p / 4.0);
+        let shift = g.sub(pq, back);
+        let xl = g.sub(x, shift);
+        let pinv = g.constant_node(1.0 / p);
+        let xq = g.mul(xl, pinv);
+        let nh = g.constant_node(nx / 2.0);
+        let xt = g.add(xq, nh);
+        for di in -1..=1 {
+            let i = cell_index(g, xt, nx, f64::from(di));
+            let mid = g.constant_node((nx - 1.0) / 2.0);
+            let ioff = g.sub(i, mid);
+            let pc = g.constant_node(p);
+            let cx0 = g.mul(ioff, pc);
+            let cx = g.add(cx0, shift);
+            candidates.push((cx, cy));
+        }
+    }
+    Ok(candidates)
 }
 
 /// The rectangle of every cell of an array (count × pitch), centred on
