@@ -37,47 +37,39 @@ pub static XY_COEFFICIENTS: Family = Family {
 /// `Z1`, `Z2`, …: Zernike coefficients (lengths), in the surface's ordering.
 pub static ZERNIKE_COEFFICIENTS: Family = Family {
     describe: "Zernike coefficients (lengths) numbered in the chosen `ordering`: `Z1` … `Z37` fringe, `Z0` … `Z230` ansi",
-    param: |name| {
-        let j: u32 = name.strip_prefix('Z')?.parse().ok()?;
-        (0..=230).contains(&j).then_some(Param {
-            name: "Zj",
-            ty: LENGTH,
-            required: false,
-            check: Check::Any,
-            doc: "Zernike coefficient, a length",
-        })
-    },
+    param: |name| numbered_length(name, 'Z', 230, "Zj", "Zernike coefficient, a length"),
 };
 
 /// `Q0` … `Q20`: Forbes Q-bfs coefficients (lengths).
 pub static QBFS_COEFFICIENTS: Family = Family {
     describe: "Forbes Q-bfs coefficients `Q0` … `Q20` (lengths)",
-    param: |name| {
-        let m: usize = name.strip_prefix('Q')?.parse().ok()?;
-        (m <= 20).then_some(Param {
-            name: "Qm",
-            ty: LENGTH,
-            required: false,
-            check: Check::Any,
-            doc: "Q-bfs coefficient a_m, a length",
-        })
-    },
+    param: |name| numbered_length(name, 'Q', 20, "Qm", "Q-bfs coefficient a_m, a length"),
 };
 
 /// `Q0` … `Q20`: Forbes Q-con coefficients (lengths).
 pub static QCON_COEFFICIENTS: Family = Family {
     describe: "Forbes Q-con coefficients `Q0` … `Q20` (lengths)",
-    param: |name| {
-        let m: usize = name.strip_prefix('Q')?.parse().ok()?;
-        (m <= 20).then_some(Param {
-            name: "Qm",
-            ty: LENGTH,
-            required: false,
-            check: Check::Any,
-            doc: "Q-con coefficient a_m, a length",
-        })
-    },
+    param: |name| numbered_length(name, 'Q', 20, "Qm", "Q-con coefficient a_m, a length"),
 };
+
+/// The parameter a name `<prefix>n` stands for, if n is at most `top`:
+/// a coefficient that is a length.
+fn numbered_length(
+    name: &str,
+    prefix: char,
+    top: u32,
+    pname: &'static str,
+    doc: &'static str,
+) -> Option<Param> {
+    let n: u32 = name.strip_prefix(prefix)?.parse().ok()?;
+    (n <= top).then_some(Param {
+        name: pname,
+        ty: LENGTH,
+        required: false,
+        check: Check::Any,
+        doc,
+    })
+}
 
 /// The (i, j) of a name `XiYj`, if it is one with 1 ≤ i + j ≤ 20.
 pub fn xy_powers(name: &str) -> Option<(u32, u32)> {

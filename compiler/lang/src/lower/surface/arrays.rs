@@ -200,18 +200,11 @@ fn grid_cells(
         if n <= 1.0 {
             return vec![g.constant_node(0.0)];
         }
-        let inv = g.constant_node(1.0 / pitch);
-        let q = g.mul(t, inv);
-        let half = g.constant_node(n / 2.0);
-        let qt = g.add(q, half);
+        let qt = cell_coordinate(g, t, pitch, n);
         (-k..=k)
             .map(|d| {
                 let i = cell_index(g, qt, n, f64::from(d));
-                // centre = (i − (n − 1)/2) · pitch
-                let mid = g.constant_node((n - 1.0) / 2.0);
-                let off = g.sub(i, mid);
-                let p = g.constant_node(pitch);
-                g.mul(off, p)
+                cell_centre(g, i, n, pitch)
             })
             .collect()
     };
@@ -243,16 +236,10 @@ fn hex_cells(
         ));
     }
     let row = p * 3f64.sqrt() / 2.0;
-    let inv = g.constant_node(1.0 / row);
-    let q = g.mul(y, inv);
-    let half = g.constant_node(ny / 2.0);
-    let qt = g.add(q, half);
+    let qt = cell_coordinate(g, y, row, ny);
     for dj in -1..=1 {
         let j = cell_index(g, qt, ny, f64::from(dj));
-        let mid = g.constant_node((ny - 1.0) / 2.0);
-        let joff = g.sub(j, mid);
-        let rc = g.constant_node(row);
-        let cy = g.mul(joff, rc);
+        let cy = cell_centre(g, j, ny, row);
         // parity of j: j − 2 floor(j/2), shifting the row by ±p/4.
         let h = g.constant_node(0.5);
         let jh = g.mul(j, h);
@@ -265,16 +252,10 @@ fn hex_cells(
         let back = g.constant_node(p / 4.0);
         let shift = g.sub(pq, back);
         let xl = g.sub(x, shift);
-        let pinv = g.constant_node(1.0 / p);
-        let xq = g.mul(xl, pinv);
-        let nh = g.constant_node(nx / 2.0);
-        let xt = g.add(xq, nh);
+        let xt = cell_coordinate(g, xl, p, nx);
         for di in -1..=1 {
             let i = cell_index(g, xt, nx, f64::from(di));
-            let mid = g.constant_node((nx - 1.0) / 2.0);
-            let ioff = g.sub(i, mid);
-            let pc = g.constant_node(p);
-            let cx0 = g.mul(ioff, pc);
+            let cx0 = cell_centre(g, i, nx, p);
             let cx = g.add(cx0, shift);
             candidates.push((cx, cy));
         }
@@ -314,6 +295,23 @@ fn half_extent(d: &Domain) -> (f64, f64) {
         Domain::Circle { radius } | Domain::Annulus { outer: radius, .. } => (radius, radius),
         Domain::Rect { x, y } => (x.0.abs().max(x.1.abs()), y.0.abs().max(y.1.abs())),
     }
+}
+
+/// t/pitch + n/2, as a node: the coordinate in cells from the edge of a
+/// row of n cells centred on the origin.
+fn cell_coordinate(g: &mut Graph, t: Id, pitch: f64, n: f64) -> Id {
+    let inv = g.constant_node(1.0 / pitch);
+    let q = g.mul(t, inv);
+    let half = g.constant_node(n / 2.0);
+    g.add(q, half)
+}
+
+/// (i − (n − 1)/2) · pitch, as a node: the centre of cell i of a row of n.
+fn cell_centre(g: &mut Graph, i: Id, n: f64, pitch: f64) -> Id {
+    let mid = g.constant_node((n - 1.0) / 2.0);
+    let off = g.sub(i, mid);
+    let p = g.constant_node(pitch);
+    g.mul(off, p)
 }
 
 /// clamp(floor(t), 0, n − 1) + offset, as a node: a cell index.

@@ -15,12 +15,7 @@ pub(super) fn xy_polynomial_height(
 ) -> Result<Id, LowerError> {
     let f = &o.fields;
     let side = Side::of(f);
-    let k = value::num(f, "conic").unwrap_or(0.0);
-    let r2 = radius_squared(g, x, y);
-    let mut sag = match value::num(f, "radius") {
-        Some(radius) => conic_sag(g, side.curvature(radius), k, r2),
-        None => g.constant_node(0.0),
-    };
+    let mut sag = base_conic(g, f, side, x, y);
     let mut terms: Vec<(u32, u32, f64)> = f
         .iter()
         .filter_map(|fl| {
@@ -43,17 +38,23 @@ pub(super) fn xy_polynomial_height(
     Ok(side.apply(g, sag))
 }
 
+/// The base conic of a polynomial surface in r² = x² + y²: zero when no
+/// `radius` is given.
+fn base_conic(g: &mut Graph, f: &[value::Field], side: Side, x: Id, y: Id) -> Id {
+    let k = value::num(f, "conic").unwrap_or(0.0);
+    let r2 = radius_squared(g, x, y);
+    match value::num(f, "radius") {
+        Some(radius) => conic_sag(g, side.curvature(radius), k, r2),
+        None => g.constant_node(0.0),
+    }
+}
+
 /// A Zernike surface: the base conic (if a radius is given) plus the terms
 /// over ρ = r / `norm_radius`, in the fringe or ANSI numbering.
 pub(super) fn zernike_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError> {
     let f = &o.fields;
     let side = Side::of(f);
-    let k = value::num(f, "conic").unwrap_or(0.0);
-    let r2 = radius_squared(g, x, y);
-    let mut sag = match value::num(f, "radius") {
-        Some(radius) => conic_sag(g, side.curvature(radius), k, r2),
-        None => g.constant_node(0.0),
-    };
+    let mut sag = base_conic(g, f, side, x, y);
     let norm = value::num(f, "norm_radius").ok_or(LowerError::Unsupported("norm_radius"))?;
     let ansi = value::word(f, "ordering") == Some("ansi");
     let mut terms: Vec<(u32, f64)> = f
