@@ -3,11 +3,9 @@
 //! which the parallel planners use), and every program and report must be
 //! byte-identical.
 
-mod common;
-
 use std::process::Command;
 
-use common::{buildable_examples, root, text};
+use crate::common::{buildable_examples, root, text};
 
 fn build_all(threads: Option<&str>) -> tempfile::TempDir {
     let dir = tempfile::tempdir().expect("tmp");

@@ -2,9 +2,7 @@
 //! meets them (files, titles, axes, exit codes, nothing written on
 //! failure) and the series behind them (their sizes, from the driver).
 
-mod common;
-
-use common::{lensc, root, text};
+use crate::common::{lensc, root, text};
 use lensc_build::driver::{self, Request};
 use lensc_build::plots::{self, PlotSeries};
 use lensc_lang::loader::RealFs;

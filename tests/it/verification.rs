@@ -2,9 +2,7 @@
 //! optimisation, rounded to the machine's resolution), against the
 //! design: issue #6's figures, read from the build reports.
 
-mod common;
-
-use common::{lensc, root, text};
+use crate::common::{lensc, root, text};
 
 /// Builds `example` and returns every report it wrote.
 fn reports(example: &str) -> Vec<serde_json::Value> {

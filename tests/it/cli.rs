@@ -1,9 +1,9 @@
 //! The `lensc` binary as a user and a CI pipeline meet it: exit codes,
 //! JSON diagnostics, `--help`, atomic output.
 
-mod common;
+use crate::common;
 
-use common::{lensc, root, text};
+use crate::common::{lensc, root, text};
 
 const GOOD: &str = "examples/kim2008_convex_asphere.lens";
 

@@ -1,8 +1,8 @@
 //! Every example checks clean (no errors, no warnings) and builds.
 
-mod common;
+use crate::common;
 
-use common::{abridged, buildable_examples, examples, lensc, root, surface_names, text};
+use crate::common::{abridged, buildable_examples, examples, lensc, root, surface_names, text};
 
 #[test]
 fn every_example_checks_clean() {
@@ -59,7 +59,7 @@ fn example_programs_match_their_snapshots() {
         } else {
             program
         };
-        insta::with_settings!({ snapshot_path => "snapshots/programs", prepend_module_to_snapshot => false, omit_expression => true }, {
+        insta::with_settings!({ snapshot_path => "../snapshots/programs", prepend_module_to_snapshot => false, omit_expression => true }, {
             insta::assert_snapshot!(name, program);
         });
     }

@@ -2,7 +2,7 @@
 //! with the interpreter to 1e-13 relative, and the interpreter's exact
 //! derivatives agree with central differences of its own heights.
 
-mod common;
+use crate::common;
 
 use lensc_build::driver;
 use lensc_lang::loader::RealFs;

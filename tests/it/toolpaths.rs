@@ -1,9 +1,7 @@
 //! Toolpath figures reproduced from the seed papers, end to end through
 //! `lensc build`: each test builds an example and reads its report.
 
-mod common;
-
-use common::{lensc, root, text};
+use crate::common::{lensc, root, text};
 
 /// Builds `example` into a temporary directory; the report of `job` and
 /// the diagnostics printed.

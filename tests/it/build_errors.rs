@@ -4,9 +4,7 @@
 //! findings are warnings builds (exit 0); any error means exit 1 and no
 //! program.
 
-mod common;
-
-use common::{lensc, root, text};
+use crate::common::{lensc, root, text};
 
 #[test]
 fn every_bad_build_is_reported_and_snapshotted() {
@@ -51,7 +49,7 @@ fn every_bad_build_is_reported_and_snapshotted() {
             .expect("stem")
             .to_string_lossy()
             .to_string();
-        insta::with_settings!({ snapshot_path => "snapshots/bad_builds", prepend_module_to_snapshot => false, omit_expression => true }, {
+        insta::with_settings!({ snapshot_path => "../snapshots/bad_builds", prepend_module_to_snapshot => false, omit_expression => true }, {
             insta::assert_snapshot!(name, stderr);
         });
     }

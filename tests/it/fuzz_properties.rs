@@ -3,7 +3,7 @@
 //! diagnostics, and through the real binary exit 1 exactly when an error
 //! is reported (never 101).
 
-mod common;
+use crate::common;
 
 use lensc::render;
 use lensc_build::driver::{self, Checked};

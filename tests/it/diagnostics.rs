@@ -89,7 +89,7 @@ fn every_bad_file_is_reported_and_snapshotted() {
             failures.push(name.clone());
         }
         let shown = format!("{human}\n--- json ---\n{json}");
-        insta::with_settings!({ snapshot_path => "snapshots/bad", prepend_module_to_snapshot => false, omit_expression => true }, {
+        insta::with_settings!({ snapshot_path => "../snapshots/bad", prepend_module_to_snapshot => false, omit_expression => true }, {
             insta::assert_snapshot!(name, shown);
         });
     }

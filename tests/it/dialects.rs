@@ -3,9 +3,9 @@
 //! program is snapshot (abridged past 256 KB, with counts and a hash), and
 //! each obeys its dialect's rules as written in `stdlib/dialects.lens`.
 
-mod common;
+use crate::common;
 
-use common::{abridged, buildable_examples, root};
+use crate::common::{abridged, buildable_examples, root};
 use lensc_build::driver::{Request, check_path, plan_and_emit};
 use lensc_lang::loader::RealFs;
 
@@ -108,7 +108,7 @@ fn every_example_builds_in_every_dialect_its_machine_offers() {
                         text
                     };
                     let name = format!("{dialect}__{}", p.program_name);
-                    insta::with_settings!({ snapshot_path => "snapshots/dialects", prepend_module_to_snapshot => false, omit_expression => true }, {
+                    insta::with_settings!({ snapshot_path => "../snapshots/dialects", prepend_module_to_snapshot => false, omit_expression => true }, {
                         insta::assert_snapshot!(name, shown);
                     });
                     built += 1;
@@ -180,7 +180,7 @@ fn a_fanuc_lathe_program_is_in_diameter_with_radius_arc_centres() {
     assert!(first_x > 2.0 * 2.8 && first_x < 2.0 * 3.0, "{first_x}");
     assert!(text.contains("\nG95 G1 "), "{text}");
     assert!(text.contains("\nG3 X0. "), "{text}");
-    insta::with_settings!({ snapshot_path => "snapshots/dialects", prepend_module_to_snapshot => false, omit_expression => true }, {
+    insta::with_settings!({ snapshot_path => "../snapshots/dialects", prepend_module_to_snapshot => false, omit_expression => true }, {
         insta::assert_snapshot!("fanuc_0i_lathe__fanuc_insert.nc", text);
     });
 }

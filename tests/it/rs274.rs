@@ -4,12 +4,10 @@
 //! it prints must lie on the tool-centre curve computed here independently
 //! of lensc's runtime.
 
-mod common;
-
 use std::path::Path;
 use std::process::Command;
 
-use common::{buildable_examples, lensc, root, text};
+use crate::common::{buildable_examples, lensc, root, text};
 
 fn rs274() -> Command {
     assert!(
