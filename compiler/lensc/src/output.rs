@@ -108,3 +108,13 @@ pub fn load(out: &Output, path: &Path) -> Option<Checked> {
         }
     }
 }
+
+/// Reports a file that could not be written (E-code CANNOT_WRITE).
+pub fn cannot_write(path: &Path, e: &std::io::Error) {
+    eprintln!(
+        "error[{}]: cannot write {}: {}",
+        lensc_lang::codes::CANNOT_WRITE,
+        path.display(),
+        plain_io_error(e)
+    );
+}

@@ -3,9 +3,8 @@
 use std::path::Path;
 
 use lensc_build::driver;
-use lensc_lang::loader::plain_io_error;
 
-use crate::output::{Output, load_jobs};
+use crate::output::{Output, cannot_write, load_jobs};
 
 /// Runs the subcommand; returns the exit code.
 pub fn run(out: &Output, file: &Path, job: Option<&str>, dialect: Option<&str>, dir: &Path) -> u8 {
@@ -49,12 +48,7 @@ pub fn run(out: &Output, file: &Path, job: Option<&str>, dialect: Option<&str>, 
                 .map_err(|e| (target.clone(), e))
         });
         if let Err((path, e)) = written {
-            eprintln!(
-                "error[{}]: cannot write {}: {}",
-                lensc_lang::codes::CANNOT_WRITE,
-                path.display(),
-                plain_io_error(&e)
-            );
+            cannot_write(&path, &e);
             return 1;
         }
         eprintln!(

@@ -3,9 +3,8 @@
 use std::path::Path;
 
 use lensc_build::driver;
-use lensc_lang::loader::plain_io_error;
 
-use crate::output::{Output, load_jobs};
+use crate::output::{Output, cannot_write, load_jobs};
 
 /// Runs the subcommand; returns the exit code.
 pub fn run(out: &Output, file: &Path, job: Option<&str>, dir: &Path) -> u8 {
@@ -46,12 +45,7 @@ pub fn run(out: &Output, file: &Path, job: Option<&str>, dir: &Path) -> u8 {
     for (name, svg) in plots {
         let path = dir.join(&name);
         if let Err(e) = driver::write_atomic(&path, &svg) {
-            eprintln!(
-                "error[{}]: cannot write {}: {}",
-                lensc_lang::codes::CANNOT_WRITE,
-                path.display(),
-                plain_io_error(&e)
-            );
+            cannot_write(&path, &e);
             return 1;
         }
         eprintln!("wrote {} ({} bytes)", path.display(), svg.len());
