@@ -14,6 +14,7 @@
 
 pub mod check;
 pub mod codes;
+pub mod domain;
 pub mod loader;
 pub mod lower;
 pub mod schema;

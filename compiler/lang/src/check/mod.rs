@@ -26,7 +26,7 @@ mod params;
 mod rules;
 mod scope;
 
-pub use rules::{aperture_inner_radius, aperture_radius};
+pub use crate::domain::{aperture_inner_radius, aperture_radius};
 
 /// Built-in math functions.
 pub const FUNCTIONS: &[&str] = &[

@@ -5,6 +5,7 @@ use lensc_grammar::Diagnostic;
 
 use super::{Checker, trim_num};
 use crate::codes;
+use crate::domain::aperture_radius;
 use crate::value::{self, Field, Object, Value};
 
 impl<'a> Checker<'a> {
@@ -95,7 +96,7 @@ impl<'a> Checker<'a> {
         let Some(radius) = value::num(&roller.fields, "radius") else {
             return true;
         };
-        let length = crate::lower::surface::surface_domain(design).map(|d| match d {
+        let length = crate::domain::surface_domain(design).map(|d| match d {
             lensc_runtime::surface::analysis::Domain::Rect { y, .. } => y.1 - y.0,
             lensc_runtime::surface::analysis::Domain::Circle { radius }
             | lensc_runtime::surface::analysis::Domain::Annulus { outer: radius, .. } => {
@@ -308,25 +309,5 @@ impl<'a> Checker<'a> {
             }
         }
         ok
-    }
-}
-
-/// The radius of a circular aperture, if it is one.
-/// The outer radius of a circular or annular aperture.
-pub fn aperture_radius(ap: &Object) -> Option<f64> {
-    match ap.kind.name {
-        "circle" => value::num(&ap.fields, "radius")
-            .or_else(|| value::num(&ap.fields, "diameter").map(|d| d / 2.0)),
-        "annulus" => value::num(&ap.fields, "outer"),
-        _ => None,
-    }
-}
-
-/// The inner radius of an annular aperture (0 for a circle).
-pub fn aperture_inner_radius(ap: &Object) -> f64 {
-    if ap.kind.name == "annulus" {
-        value::num(&ap.fields, "inner").unwrap_or(0.0)
-    } else {
-        0.0
     }
 }

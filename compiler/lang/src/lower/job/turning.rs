@@ -12,8 +12,9 @@ use lensc_runtime::post::Dialect;
 use lensc_runtime::surface::{SectionAlongX, SurfaceInfo};
 
 use super::{Evaluate, JobHead, Parts};
-use crate::check::{aperture_inner_radius, aperture_radius, trim_num};
+use crate::check::trim_num;
 use crate::codes;
+use crate::domain::{aperture_inner_radius, aperture_radius};
 use crate::units::Dim;
 use crate::value::{self, Field, Object, Value};
 

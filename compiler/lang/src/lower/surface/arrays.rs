@@ -4,9 +4,8 @@
 use lensc_runtime::surface::analysis::Domain;
 use lensc_runtime::surface::ir::{Binary, Graph, Id, SurfaceTape};
 
-use super::{
-    LowerError, LoweredSurface, domain_of, height, radius_squared, region, surface_domain,
-};
+use super::{LowerError, LoweredSurface, height, radius_squared};
+use crate::domain::{domain_of, half_extent, region, surface_domain};
 use crate::value::{self, Object};
 
 /// Arrays: each lenslet clipped to its own aperture with its rim at the
@@ -99,8 +98,8 @@ fn array_height_settled(
     let f = &o.fields;
     let lenslet =
         value::object(f, "lenslet").ok_or(LowerError::Unsupported("array without a lenslet"))?;
-    let ap =
-        domain_of(region(lenslet).ok_or(LowerError::Aperture("lenslet without an aperture"))?)?;
+    let ap = domain_of(region(lenslet).ok_or(LowerError::Aperture("lenslet without an aperture"))?)
+        .map_err(LowerError::Aperture)?;
     let (hx, hy) = half_extent(&ap);
     // Continued lenslets reach past their apertures: look at neighbours.
     let (hx, hy) = if settle.is_some() {
@@ -261,40 +260,6 @@ fn hex_cells(
         }
     }
     Ok(candidates)
-}
-
-/// The rectangle of every cell of an array (count × pitch), centred on
-/// the origin: a wrapped array closes on itself when its cells do.
-pub(super) fn array_domain(o: &Object) -> Option<Domain> {
-    let f = &o.fields;
-    let lenslet = value::object(f, "lenslet")?;
-    let ap = domain_of(region(lenslet)?).ok()?;
-    let (hx, hy) = half_extent(&ap);
-    let num = |name: &str| value::num(f, name).unwrap_or(1.0);
-    let (ex, ey) = match o.kind.name {
-        "grid" => (
-            num("count_x") * num("pitch_x") / 2.0,
-            num("count_y") * num("pitch_y") / 2.0,
-        ),
-        "hex_grid" => (
-            num("count_x") * num("pitch") / 2.0 + num("pitch") / 4.0,
-            num("count_y") * num("pitch") * 3f64.sqrt() / 4.0,
-        ),
-        _ if value::word(f, "axis") == Some("y") => (hx, num("count") * num("pitch") / 2.0),
-        _ => (num("count") * num("pitch") / 2.0, hy),
-    };
-    Some(Domain::Rect {
-        x: (-ex, ex),
-        y: (-ey, ey),
-    })
-}
-
-/// Half the extent of a lenslet's aperture along x and y.
-fn half_extent(d: &Domain) -> (f64, f64) {
-    match *d {
-        Domain::Circle { radius } | Domain::Annulus { outer: radius, .. } => (radius, radius),
-        Domain::Rect { x, y } => (x.0.abs().max(x.1.abs()), y.0.abs().max(y.1.abs())),
-    }
 }
 
 /// t/pitch + n/2, as a node: the coordinate in cells from the edge of a

@@ -24,7 +24,7 @@ pub use rotational::rotational_sag;
 use lensc_runtime::surface::analysis::Domain;
 use lensc_runtime::surface::ir::{Binary, Graph, Id, SurfaceTape};
 
-use crate::check::aperture_radius;
+use crate::domain::surface_domain;
 use crate::value::{self, Object};
 
 /// A surface ready to evaluate.
@@ -129,24 +129,6 @@ pub fn height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError>
     }
 }
 
-/// The region a surface is defined on: its aperture, or its domain.
-fn region(o: &Object) -> Option<&Object> {
-    value::object(&o.fields, "aperture")
-        .or_else(|| value::object(&o.fields, "domain"))
-        .map(|r| &**r)
-}
-
-/// The domain a checked surface is evaluated over, if it can be lowered.
-pub fn surface_domain(o: &Object) -> Option<Domain> {
-    match region(o) {
-        Some(r) => domain_of(r).ok(),
-        None if matches!(o.kind.name, "grid" | "hex_grid" | "linear_array") => {
-            arrays::array_domain(o)
-        }
-        None => value::object(&o.fields, "surface").and_then(|s| surface_domain(s)),
-    }
-}
-
 /// x² + y².
 fn radius_squared(g: &mut Graph, x: Id, y: Id) -> Id {
     let x2 = g.powi(x, 2);
@@ -207,24 +189,4 @@ fn add_power_terms(g: &mut Graph, mut sag: Id, s: Id, terms: &[(u32, f64)]) -> I
         sag = g.add(sag, term);
     }
     sag
-}
-
-fn domain_of(ap: &Object) -> Result<Domain, LowerError> {
-    match ap.kind.name {
-        "circle" => aperture_radius(ap)
-            .map(|radius| Domain::Circle { radius })
-            .ok_or(LowerError::Aperture("circle")),
-        "annulus" => match (
-            value::num(&ap.fields, "inner"),
-            value::num(&ap.fields, "outer"),
-        ) {
-            (Some(inner), Some(outer)) => Ok(Domain::Annulus { inner, outer }),
-            _ => Err(LowerError::Aperture("annulus")),
-        },
-        "rect" => match (value::range(&ap.fields, "x"), value::range(&ap.fields, "y")) {
-            (Some(x), Some(y)) => Ok(Domain::Rect { x, y }),
-            _ => Err(LowerError::Aperture("rect")),
-        },
-        _ => Err(LowerError::Aperture("unknown aperture")),
-    }
 }
