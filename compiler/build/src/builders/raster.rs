@@ -1,0 +1,167 @@
+//! Building an iso-plane raster job on a 3-axis mill (seed 000): the
+//! raster planned over the surface, the knife's clearance checked against
+//! the planner's steepest slope along the cut, the moves kept within the
+//! travel, the program written, and the cut simulated as a height map.
+
+use lensc_grammar::Diagnostic;
+use lensc_lang::check::trim_num;
+use lensc_lang::codes;
+use lensc_lang::diagnostics::RuntimeError;
+use lensc_lang::lower::job::RasterSpec;
+use lensc_runtime::plan::raster::{Axis, RasterTool};
+use lensc_runtime::post::Provenance;
+use lensc_runtime::verify::heightmap::Sweep;
+
+use crate::driver::{Built, ProgramText, evaluator};
+use crate::height_map::{self, Window, domain_centre};
+use crate::parts;
+use crate::report;
+
+/// Builds a `raster` job on a `mill_3axis`.
+pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnostic>> {
+    let (head, raster, tool) = (&spec.head, &spec.raster, spec.tool);
+    let dialect = &head.dialect;
+    let lowered = &head.surface.lowered;
+    let (kernel, _) = evaluator(&lowered.tape);
+    let path =
+        lensc_runtime::plan::raster::plan_raster(raster, &tool, kernel.as_ref(), &lowered.domain)
+            .map_err(|e| vec![parts::failed(head, RuntimeError::Raster(e))])?;
+    let mut errors = Vec::new();
+    // The knife's flank must clear the steepest slope along the cut.
+    if let Some(clearance) = spec.clearance
+        && clearance <= path.max_slope_along.value
+    {
+        errors.push(head.error(
+            codes::CLEARANCE_TOO_SMALL,
+            format!(
+                "the clearance angle ({}°) is not above the surface's steepest slope along the cut ({}°, at ({}, {}) mm): the flank would rub",
+                trim_num(clearance.to_degrees()),
+                trim_num(path.max_slope_along.value.to_degrees()),
+                trim_num(path.max_slope_along.x),
+                trim_num(path.max_slope_along.y)
+            ),
+        ));
+    }
+    let feed = spec.feed;
+    let moves = lensc_runtime::emit::raster::raster_moves(&path, feed);
+    errors.extend(parts::travel_error(head, &moves));
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+    let mut header = parts::header(
+        head,
+        prov,
+        "units mm; X Y Z of the tool centre, +Z out of the material; no cutter compensation",
+    );
+    header.push(format!("tool {}: {}", head.names.tool, spec.tool_words));
+    header.push(format!(
+        "strategy {}: raster along {}, {}, stepover {} um, {}, {} passes, {} points",
+        head.names.strategy,
+        if raster.along == Axis::X { "x" } else { "y" },
+        if raster.zigzag { "zigzag" } else { "one way" },
+        trim_num(raster.stepover * 1000.0),
+        lensc_runtime::emit::tolerance_words(raster.chord_tolerance),
+        path.pass_count,
+        path.point_count
+    ));
+    let (moves, optimised) = lensc_runtime::plan::optimise::optimise(
+        &moves,
+        raster.chord_tolerance * lensc_runtime::plan::optimise::FIT_SHARE,
+        &dialect.arc_planes,
+    );
+    header.push(lensc_runtime::emit::optimisation_words(&optimised));
+    header.push(format!(
+        "machine {}: {} 3-axis mill",
+        head.names.machine, dialect.name
+    ));
+    let resolution = head.resolution;
+    let text = lensc_runtime::emit::raster::emit_mill(
+        dialect,
+        &head.name,
+        &header,
+        &moves,
+        resolution,
+        raster.chord_tolerance,
+    )
+    .map_err(|e| vec![parts::not_printable(head, e)])?;
+    let deg = 180.0 / std::f64::consts::PI;
+    let at = |e: &lensc_runtime::surface::analysis::Extremum, s: f64| report::AtPoint::of(e, s);
+    let time = path.cut_length / feed;
+    let toolpath = report::Toolpath::Raster(report::Raster {
+        passes: path.pass_count,
+        cut_points: path.point_count,
+        cut_length_mm: path.cut_length,
+        feed_mm_per_min: feed * 60.0,
+        cutting_time_s: time,
+        pass_cutting_times_s: path.pass_lengths.iter().map(|l| l / feed).collect(),
+        chord_tolerance_mm: raster.chord_tolerance,
+        stepover_mm: raster.stepover,
+        optimisation: (&optimised).into(),
+        max_slope_along_deg: at(&path.max_slope_along, deg),
+        max_slope_across_deg: at(&path.max_slope_across, deg),
+        min_concave_radius_along_mm: path.min_concave_radius_along.as_ref().map(|e| at(e, 1.0)),
+    });
+    let program_name = head.program_name();
+    let text = ProgramText::Memory(text);
+    let mut plots = crate::plots::PlotSeries::default();
+    let simulation = match tool {
+        RasterTool::Knife { nose_radius } => {
+            let along_x = raster.along == Axis::X;
+            let window = Window::of(head, domain_centre(&lowered.domain));
+            let grid = window.cartesian(along_x);
+            window.check_size(head, &grid).map_err(|d| vec![d])?;
+            let mut sweep = Sweep::new(grid, nose_radius);
+            height_map::sweep_mill_moves(&mut sweep, &moves, along_x, resolution);
+            let frame = height_map::RasterFrame {
+                kernel: kernel.as_ref(),
+                along_x,
+                window,
+                domain: lowered.domain,
+            };
+            let map = sweep.finish(&frame);
+            plots.form_error = Some(height_map::form_error_series(
+                &map,
+                &frame,
+                &window,
+                window.spacing,
+                ("x (mm)", "y (mm)"),
+            ));
+            let coordinates = if along_x {
+                "columns along x, rows along y"
+            } else {
+                "columns along y, rows along x"
+            };
+            let mut height_map =
+                report::HeightMap::new(&map, &window, coordinates, raster.stepover);
+            // The path's own error apart from the machine's resolution: the
+            // same moves swept as computed (rounded to a picometre only).
+            let mut unrounded = Sweep::new(grid, nose_radius);
+            height_map::sweep_mill_moves(&mut unrounded, &moves, along_x, 1e-9);
+            height_map.raster = Some(report::RasterEdge {
+                edge: "the knife's edge in its rake face, across the cut, as the planner places it",
+                contact_unrounded: unrounded
+                    .finish(&frame)
+                    .contact
+                    .as_ref()
+                    .map(report::Figures::from),
+            });
+            report::Simulation::HeightMap(report::HeightMapOnly { height_map })
+        }
+        RasterTool::Ball { .. } => report::Simulation::Skipped(report::Skipped {
+            skipped: "a ball's cut reaches a radius along the path as well as across it; the height map sweeps edges that lie across the cut",
+            height_map: None,
+        }),
+    };
+    let report = parts::report(head, prov, &program_name, &text, toolpath, simulation);
+    Ok(Built {
+        report_name: format!("{}.report.json", head.name),
+        program_name,
+        program: text,
+        report,
+        beside: Vec::new(),
+        cut_points: path.point_count,
+        cutting_time: time,
+        plots,
+        warnings: Vec::new(),
+    })
+}

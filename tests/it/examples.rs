@@ -1,0 +1,152 @@
+//! Every example checks clean (no errors, no warnings) and builds.
+
+use crate::common;
+
+use crate::common::{abridged, buildable_examples, examples, lensc, root, surface_names, text};
+
+#[test]
+fn every_example_checks_clean() {
+    let list = examples();
+    assert!(!list.is_empty());
+    for ex in list {
+        let out = lensc(&root(), &["check", ex.to_str().expect("utf8")]);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}: {}",
+            ex.display(),
+            text(&out.stderr)
+        );
+        assert!(
+            out.stderr.is_empty(),
+            "{} has warnings: {}",
+            ex.display(),
+            text(&out.stderr)
+        );
+    }
+}
+
+/// Builds every example (they must all build) and compares each program
+/// with its reviewed snapshot; programs above `WHOLE_SNAPSHOT_LIMIT` are
+/// snapshot abridged (see `common::abridged`). Every report written must
+/// validate against the committed schema, `docs/report.schema.json`.
+#[test]
+fn example_programs_match_their_snapshots() {
+    let dir = tempfile::tempdir().expect("tmp");
+    for ex in buildable_examples() {
+        let rel = ex
+            .strip_prefix(root())
+            .expect("inside repo")
+            .to_str()
+            .expect("utf8")
+            .to_string();
+        let out = lensc(
+            &root(),
+            &["build", &rel, "--out", dir.path().to_str().expect("utf8")],
+        );
+        assert_eq!(out.status.code(), Some(0), "{rel}: {}", text(&out.stderr));
+    }
+    reports_follow_the_schema(dir.path());
+    let mut programs: Vec<_> = std::fs::read_dir(dir.path())
+        .expect("out")
+        .map(|e| e.expect("e").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ngc"))
+        .collect();
+    programs.sort();
+    for p in programs {
+        let name = p.file_name().expect("name").to_string_lossy().to_string();
+        let program = std::fs::read_to_string(&p).expect("program");
+        let program = if program.len() > common::WHOLE_SNAPSHOT_LIMIT {
+            abridged(&program)
+        } else {
+            program
+        };
+        insta::with_settings!({ snapshot_path => "../snapshots/programs", prepend_module_to_snapshot => false, omit_expression => true }, {
+            insta::assert_snapshot!(name, program);
+        });
+    }
+}
+
+/// Validates every `*.report.json` in `dir` against the committed schema.
+fn reports_follow_the_schema(dir: &std::path::Path) {
+    let schema_path = root().join("docs/report.schema.json");
+    let schema: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&schema_path).expect("schema"))
+            .expect("the schema is JSON");
+    let mut schemas = boon::Schemas::new();
+    let mut compiler = boon::Compiler::new();
+    compiler
+        .add_resource("report.schema.json", schema)
+        .expect("schema resource");
+    let index = compiler
+        .compile("report.schema.json", &mut schemas)
+        .unwrap_or_else(|e| panic!("the report schema compiles: {e}"));
+    let mut checked = 0;
+    for entry in std::fs::read_dir(dir).expect("out") {
+        let path = entry.expect("entry").path();
+        if !path.to_string_lossy().ends_with(".report.json") {
+            continue;
+        }
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&path).expect("report"))
+                .expect("a report is JSON");
+        if let Err(e) = schemas.validate(&report, index) {
+            panic!("{} does not follow the schema: {e:#}", path.display());
+        }
+        // The schema bites: a report with a key it does not document, or
+        // without one it requires, fails.
+        if checked == 0 {
+            let mut extra = report.clone();
+            extra["toolpath"]["undocumented"] = serde_json::json!(1);
+            assert!(schemas.validate(&extra, index).is_err());
+            let mut missing = report.clone();
+            missing.as_object_mut().expect("object").remove("job");
+            assert!(schemas.validate(&missing, index).is_err());
+        }
+        checked += 1;
+    }
+    assert!(checked >= 10, "only {checked} reports");
+}
+
+/// The first 40 lines, the number of lines and bytes with the FNV-1a 64
+/// hash of the whole text, and the last 3 lines.
+#[test]
+fn every_surface_of_every_example_samples() {
+    for ex in examples() {
+        for name in surface_names(&ex) {
+            let out = lensc(
+                &root(),
+                &[
+                    "sample",
+                    ex.to_str().expect("utf8"),
+                    "--surface",
+                    &name,
+                    "--grid",
+                    "5",
+                ],
+            );
+            assert_eq!(
+                out.status.code(),
+                Some(0),
+                "{} {name}: {}",
+                ex.display(),
+                text(&out.stderr)
+            );
+            let csv = text(&out.stdout);
+            let mut lines = csv.lines();
+            assert_eq!(
+                lines.next(),
+                Some("x,y,z,dzdx,dzdy,curvature_x,curvature_y")
+            );
+            let rows: Vec<Vec<f64>> = lines
+                .map(|l| l.split(',').map(|c| c.parse().expect("number")).collect())
+                .collect();
+            assert!(!rows.is_empty(), "{} {name}: no points", ex.display());
+            assert!(
+                rows.iter().flatten().all(|v| v.is_finite()),
+                "{} {name}: {csv}",
+                ex.display()
+            );
+        }
+    }
+}
