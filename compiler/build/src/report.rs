@@ -9,7 +9,13 @@
 //! angles in degrees where the name ends in `_deg`; times in s. A number
 //! that was not finite (an empty set's PV, say) is written as `null`.
 
+use lensc_runtime::machine::servo::SecondOrderServo;
+use lensc_runtime::plan::fts::{FtsSpiral, FtsSummary, SpindleSpeed};
+use lensc_runtime::plan::grinding::GrindingPath;
 use lensc_runtime::plan::optimise::Summary;
+use lensc_runtime::plan::raster::RasterPath;
+use lensc_runtime::plan::roller::{RollerPath, RollerTool, ToolCheck};
+use lensc_runtime::plan::turning::{Toolpath as TurningPath, TurningJob};
 use lensc_runtime::surface::analysis::{Extremum, SurfaceAnalysis as Analysis};
 use lensc_runtime::verify::heightmap::{ErrorFigures, FeatureFigures, HeightMap as Map};
 use schemars::JsonSchema;
@@ -135,6 +141,11 @@ impl AtPoint {
 /// Degrees per radian.
 const DEG: f64 = 180.0 / std::f64::consts::PI;
 
+/// rpm of an angular speed in rad/s.
+fn rpm(w: f64) -> f64 {
+    w * 60.0 / (2.0 * std::f64::consts::PI)
+}
+
 /// The toolpath as planned; its fields depend on the strategy, named by
 /// `strategy`.
 #[derive(Clone, Debug, Serialize, JsonSchema)]
@@ -190,6 +201,57 @@ pub struct ProfileTurning {
     pub seams: Vec<Seam>,
     /// What optimisation (arcs, merged lines) did to the program.
     pub optimisation: Optimisation,
+}
+
+impl ProfileTurning {
+    /// The section of `path`, planned for `job`, optimised as `optimised`
+    /// says.
+    pub fn new(job: &TurningJob, path: &TurningPath, optimised: &Summary) -> ProfileTurning {
+        use lensc_runtime::plan::turning::ToolLocation as L;
+        ProfileTurning {
+            cut_points: path.cut_points,
+            cut_length_mm: path.cut_length,
+            feed_mm_per_min: path.feed_speed * 60.0,
+            surface_speed_m_per_min: job.strategy.surface_speed.map(|v| v * 0.06),
+            max_spindle_rpm: rpm(job.strategy.spindle_speed),
+            cutting_time_s: path.cutting_time(),
+            passes: path
+                .pass_times
+                .iter()
+                .enumerate()
+                .map(|(i, &t)| TurningPass {
+                    pass: if i < path.roughing_passes {
+                        PassKind::Roughing
+                    } else {
+                        PassKind::Finish
+                    },
+                    cutting_time_s: t,
+                })
+                .collect(),
+            chord_tolerance_mm: job.strategy.chord_tolerance,
+            max_profile_slope_deg: path.max_slope.0.to_degrees(),
+            min_concave_radius_mm: path.min_concave_radius.map(|(r, at)| AtRadius {
+                value: r,
+                at_radius_mm: at,
+            }),
+            roughing_passes: path.roughing_passes,
+            tool_location: match job.strategy.location {
+                L::Exact => ToolLocation::Exact,
+                L::Sequential { .. } => ToolLocation::Sequential,
+                L::Binary { .. } => ToolLocation::Binary,
+            },
+            seams: path
+                .seams
+                .iter()
+                .map(|s| Seam {
+                    at_radius_mm: s.at_radius,
+                    uncut_depth_mm: s.depth,
+                    corner_angle_deg: s.angle.to_degrees(),
+                })
+                .collect(),
+            optimisation: optimised.into(),
+        }
+    }
 }
 
 /// One pass of a profile-turning job.
@@ -298,6 +360,64 @@ pub struct Spiral {
     pub settling: Option<Settling>,
     /// FNV-1a 64 of every point of the spiral, 16 hex digits.
     pub fingerprint_fnv1a64: String,
+}
+
+impl Spiral {
+    /// The section of the spiral `s` planned as `spiral` asks, with the
+    /// settling offset, the servo model and the nose radius `rho` (mm).
+    pub fn new(
+        s: &FtsSummary,
+        spiral: &FtsSpiral,
+        settling: Option<&lensc_lang::lower::job::Settling>,
+        servo: Option<&SecondOrderServo>,
+        rho: f64,
+    ) -> Spiral {
+        let highest_allowed_speed = match spiral.speed {
+            SpindleSpeed::Constant(_) => AllowedSpeed {
+                unit: SpeedUnit::SpindleRpm,
+                value: rpm(s.highest_allowed_speed),
+            },
+            SpindleSpeed::SurfaceSpeed { .. } => AllowedSpeed {
+                unit: SpeedUnit::SurfaceMPerMin,
+                value: s.highest_allowed_speed * 0.06,
+            },
+        };
+        Spiral {
+            revolutions: s.revolutions,
+            cut_points: s.points,
+            cutting_time_s: s.time,
+            chord_tolerance_mm: spiral.chord_tolerance,
+            chords_over_tolerance: s.chords_over_tolerance.map(|o| ChordsOverTolerance {
+                count: o.count,
+                max_deviation_nm: o.deviation * 1e6,
+                at_radius_mm: o.at_radius,
+            }),
+            nose_radius_mm: rho,
+            fast_axis: FastAxis {
+                w_min_mm: s.w_min,
+                w_max_mm: s.w_max,
+                stroke_used_mm: s.w_max - s.w_min,
+                max_acceleration_m_per_s2: s.max_acceleration / 1000.0,
+                max_acceleration_at_radius_mm: s.max_acceleration_at,
+                highest_allowed_speed,
+            },
+            max_spindle_rpm: rpm(s.max_spindle_speed),
+            servo: servo.map(|m| Servo {
+                natural_frequency_hz: m.natural_frequency_hz,
+                damping: m.damping,
+                overshoot: m.overshoot(),
+                settling_time_0_2_percent_s: m.settling_time(0.002),
+            }),
+            settling: settling.map(|st| Settling {
+                settling_time_s: st.time,
+                band: st.band,
+                surface_speed_m_per_min: st.surface_speed * 0.06,
+                d_traj_mm: st.d_traj,
+                h_offset_mm: st.offset,
+            }),
+            fingerprint_fnv1a64: format!("{:016x}", s.fingerprint),
+        }
+    }
 }
 
 /// Chords of a spiral that stray beyond their share of the tolerance.
@@ -415,6 +535,35 @@ pub struct Raster {
     pub min_concave_radius_along_mm: Option<AtPoint>,
 }
 
+impl Raster {
+    /// The section of `path`, planned as `raster` asks, cut at `feed`
+    /// (mm/s), optimised as `optimised` says.
+    pub fn new(
+        path: &RasterPath,
+        raster: &lensc_runtime::plan::raster::Raster,
+        feed: f64,
+        optimised: &Summary,
+    ) -> Raster {
+        Raster {
+            passes: path.pass_count,
+            cut_points: path.point_count,
+            cut_length_mm: path.cut_length,
+            feed_mm_per_min: feed * 60.0,
+            cutting_time_s: path.cut_length / feed,
+            pass_cutting_times_s: path.pass_lengths.iter().map(|l| l / feed).collect(),
+            chord_tolerance_mm: raster.chord_tolerance,
+            stepover_mm: raster.stepover,
+            optimisation: optimised.into(),
+            max_slope_along_deg: AtPoint::of(&path.max_slope_along, DEG),
+            max_slope_across_deg: AtPoint::of(&path.max_slope_across, DEG),
+            min_concave_radius_along_mm: path
+                .min_concave_radius_along
+                .as_ref()
+                .map(|e| AtPoint::of(e, 1.0)),
+        }
+    }
+}
+
 /// The toolpath of a profile-grinding job.
 #[derive(Clone, Debug, Serialize, JsonSchema)]
 #[schemars(deny_unknown_fields)]
@@ -439,6 +588,36 @@ pub struct ProfileGrinding {
     pub min_concave_radius_mm: Option<AtX>,
     /// Every interval's commanded z velocity and acceleration (eqs 18–19).
     pub intervals: Intervals,
+}
+
+impl From<&GrindingPath> for ProfileGrinding {
+    fn from(path: &GrindingPath) -> ProfileGrinding {
+        ProfileGrinding {
+            segments: path.segments,
+            cut_points: path.points.len(),
+            interval_time_s: path.interval_time,
+            cutting_time_s: path.total_time,
+            max_z_speed_mm_per_s: path.max_speed,
+            max_z_acceleration_mm_per_s2: path.max_acceleration,
+            open_loop_drift_mm: path.open_loop_drift,
+            min_concave_radius_mm: path.min_concave_radius.map(|(r, x)| AtX {
+                value: r,
+                at_x_mm: x,
+            }),
+            // The table of eqs 18-19: every interval's commanded z
+            // velocity and acceleration, as the paper's position-based
+            // interpolation gives them.
+            intervals: Intervals {
+                columns: INTERVAL_COLUMNS,
+                rows: path
+                    .points
+                    .iter()
+                    .skip(1)
+                    .map(|q| [q.contact_x, q.x, q.z, q.velocity, q.acceleration])
+                    .collect(),
+            },
+        }
+    }
 }
 
 /// The intervals of a grinding path as a table.
@@ -478,6 +657,49 @@ pub struct RollerHelix {
     /// Arc (mm) around the roller left undesigned where the design wraps,
     /// or null if the design does not wrap.
     pub wrap_gap_mm: Option<f64>,
+}
+
+impl RollerHelix {
+    /// The section of `path` on a roller of `roller_radius` (mm), cut by
+    /// `tool`, which passed `check`.
+    pub fn new(
+        path: &RollerPath,
+        check: &ToolCheck,
+        tool: &RollerTool,
+        roller_radius: f64,
+    ) -> RollerHelix {
+        RollerHelix {
+            cut_points: path.passes.iter().map(|p| p.points).sum(),
+            cutting_time_s: path.passes.iter().filter_map(|p| p.time).sum(),
+            roller_radius_mm: roller_radius,
+            passes: path
+                .passes
+                .iter()
+                .map(|p| HelixPass {
+                    c_step_deg: p.c_step.to_degrees(),
+                    pitch_mm: p.pitch,
+                    finish_allowance_mm: p.finish_allowance,
+                    points: p.points,
+                    revolutions: p.revolutions,
+                    x_min_mm: p.x_min,
+                    x_max_mm: p.x_max,
+                    cutting_time_s: p.time,
+                    fingerprint_fnv1a64: format!("{:016x}", p.fingerprint),
+                })
+                .collect(),
+            tool_check: RollerToolCheck {
+                min_radius_of_curvature_cutting_plane_mm: check.min_radius_axial,
+                min_radius_of_curvature_mm: check.min_radius_overall,
+                max_slope_cutting_deg: check.max_slope_cutting.to_degrees(),
+                max_slope_cutting_on_roller_deg: check.max_slope_cutting_on_roller.to_degrees(),
+                max_slope_axial_deg: check.max_slope_axial.to_degrees(),
+                nose_radius_mm: tool.nose_radius,
+                clearance_deg: tool.clearance_angle.to_degrees(),
+                half_included_angle_deg: tool.opening_angle.to_degrees() / 2.0,
+            },
+            wrap_gap_mm: path.wrap.map(|w| w.gap),
+        }
+    }
 }
 
 /// One pass of a roller helix.

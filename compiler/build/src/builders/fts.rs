@@ -9,10 +9,9 @@ use lensc_grammar::Diagnostic;
 use lensc_lang::check::trim_num;
 use lensc_lang::codes;
 use lensc_lang::diagnostics::RuntimeError;
-use lensc_lang::lower::job::{Settling, SpiralSpec};
+use lensc_lang::lower::job::SpiralSpec;
 use lensc_runtime::emit::fts::FtsProgram;
-use lensc_runtime::machine::servo::SecondOrderServo;
-use lensc_runtime::plan::fts::{FtsSpiral, FtsSummary, Planner, SpindleSpeed};
+use lensc_runtime::plan::fts::{Planner, SpindleSpeed};
 use lensc_runtime::post::ProgramError;
 use lensc_runtime::post::Provenance;
 use lensc_runtime::surface::ir::SurfaceFn;
@@ -164,11 +163,11 @@ pub fn build(
     }
     let text = sink.finish().map_err(|e| vec![cannot_spool(&e, site)])?;
     let program_name = head.program_name();
-    let spiral = spiral_report(
+    let spiral = report::Spiral::new(
         &summary,
         &p.spiral,
         p.settling.as_ref(),
-        &p.servo,
+        p.servo.as_ref(),
         p.nose_radius,
     );
     let toolpath = if p.slow {
@@ -194,27 +193,7 @@ pub fn build(
         "columns at spindle angles (column step in rad), rows at radii",
         p.spiral.feed_per_rev,
     );
-    let simulation = match following {
-        Some(sim) => {
-            let f = sim.finish();
-            let following = report::Following::new(&f, data_rate, height_map);
-            plots.following = Some(crate::plots::FollowingSeries {
-                by_radius: f.by_radius,
-                samples: f.samples,
-                data_rate_hz: data_rate,
-                max_error: (f.max_error, f.max_error_at),
-            });
-            report::Simulation::Following(following)
-        }
-        None => report::Simulation::Skipped(report::Skipped {
-            skipped: if p.slow {
-                "slow tool servo: Z is a machine axis, with no servo model here"
-            } else {
-                "the fast axis has no servo model"
-            },
-            height_map: Some(height_map),
-        }),
-    };
+    let simulation = simulation(following, height_map, data_rate, p.slow, &mut plots);
     let mut report = parts::report(head, prov, &program_name, &text, toolpath, simulation);
     if let Some((name, table)) = beside.first() {
         report.program.fts_table = Some(report::FtsTable {
@@ -257,6 +236,37 @@ pub fn build(
         plots,
         warnings,
     })
+}
+
+/// A spiral's simulation for its report: the fast axis's following where
+/// it has a servo model (at `data_rate`, Hz; its series go into `plots`),
+/// and the height map either way.
+fn simulation(
+    following: Option<lensc_runtime::verify::follow::FollowingSimulation>,
+    height_map: report::HeightMap,
+    data_rate: f64,
+    slow: bool,
+    plots: &mut crate::plots::PlotSeries,
+) -> report::Simulation {
+    let Some(sim) = following else {
+        return report::Simulation::Skipped(report::Skipped {
+            skipped: if slow {
+                "slow tool servo: Z is a machine axis, with no servo model here"
+            } else {
+                "the fast axis has no servo model"
+            },
+            height_map: Some(height_map),
+        });
+    };
+    let f = sim.finish();
+    let following = report::Following::new(&f, data_rate, height_map);
+    plots.following = Some(crate::plots::FollowingSeries {
+        by_radius: f.by_radius,
+        samples: f.samples,
+        data_rate_hz: data_rate,
+        max_error: (f.max_error, f.max_error_at),
+    });
+    report::Simulation::Following(following)
 }
 
 fn rpm(w: f64) -> f64 {
@@ -334,61 +344,4 @@ fn header_lines(spec: &SpiralSpec, prov: &Provenance, table: Option<&str>) -> Ve
         None => lines.push("settling: none, the tool follows the surface".into()),
     }
     lines
-}
-
-/// The report's toolpath section of a spiral.
-fn spiral_report(
-    s: &FtsSummary,
-    spiral: &FtsSpiral,
-    settling: Option<&Settling>,
-    servo: &Option<SecondOrderServo>,
-    rho: f64,
-) -> report::Spiral {
-    let highest_allowed_speed = match spiral.speed {
-        SpindleSpeed::Constant(_) => report::AllowedSpeed {
-            unit: report::SpeedUnit::SpindleRpm,
-            value: rpm(s.highest_allowed_speed),
-        },
-        SpindleSpeed::SurfaceSpeed { .. } => report::AllowedSpeed {
-            unit: report::SpeedUnit::SurfaceMPerMin,
-            value: s.highest_allowed_speed * 0.06,
-        },
-    };
-    report::Spiral {
-        revolutions: s.revolutions,
-        cut_points: s.points,
-        cutting_time_s: s.time,
-        chord_tolerance_mm: spiral.chord_tolerance,
-        chords_over_tolerance: s
-            .chords_over_tolerance
-            .map(|o| report::ChordsOverTolerance {
-                count: o.count,
-                max_deviation_nm: o.deviation * 1e6,
-                at_radius_mm: o.at_radius,
-            }),
-        nose_radius_mm: rho,
-        fast_axis: report::FastAxis {
-            w_min_mm: s.w_min,
-            w_max_mm: s.w_max,
-            stroke_used_mm: s.w_max - s.w_min,
-            max_acceleration_m_per_s2: s.max_acceleration / 1000.0,
-            max_acceleration_at_radius_mm: s.max_acceleration_at,
-            highest_allowed_speed,
-        },
-        max_spindle_rpm: rpm(s.max_spindle_speed),
-        servo: servo.map(|m| report::Servo {
-            natural_frequency_hz: m.natural_frequency_hz,
-            damping: m.damping,
-            overshoot: m.overshoot(),
-            settling_time_0_2_percent_s: m.settling_time(0.002),
-        }),
-        settling: settling.map(|st| report::Settling {
-            settling_time_s: st.time,
-            band: st.band,
-            surface_speed_m_per_min: st.surface_speed * 0.06,
-            d_traj_mm: st.d_traj,
-            h_offset_mm: st.offset,
-        }),
-        fingerprint_fnv1a64: format!("{:016x}", s.fingerprint),
-    }
 }

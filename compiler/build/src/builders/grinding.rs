@@ -66,31 +66,7 @@ pub fn build(spec: &GrindingSpec, prov: &Provenance) -> Result<Built, Vec<Diagno
         dialect, &head.name, &header, &path, feed, safe_z, resolution,
     )
     .map_err(|e| vec![parts::not_printable(head, e)])?;
-    // The table of eqs 18-19: every interval's commanded z velocity and
-    // acceleration, as the paper's position-based interpolation gives them.
-    let rows = path
-        .points
-        .iter()
-        .skip(1)
-        .map(|q| [q.contact_x, q.x, q.z, q.velocity, q.acceleration])
-        .collect();
-    let toolpath = report::Toolpath::ProfileGrinding(report::ProfileGrinding {
-        segments: path.segments,
-        cut_points: path.points.len(),
-        interval_time_s: path.interval_time,
-        cutting_time_s: path.total_time,
-        max_z_speed_mm_per_s: path.max_speed,
-        max_z_acceleration_mm_per_s2: path.max_acceleration,
-        open_loop_drift_mm: path.open_loop_drift,
-        min_concave_radius_mm: path.min_concave_radius.map(|(r, x)| report::AtX {
-            value: r,
-            at_x_mm: x,
-        }),
-        intervals: report::Intervals {
-            columns: report::INTERVAL_COLUMNS,
-            rows,
-        },
-    });
+    let toolpath = report::Toolpath::ProfileGrinding((&path).into());
     let program_name = head.program_name();
     let text = ProgramText::Memory(text);
     // What the wheel's section (a circle of its radius about the centre)

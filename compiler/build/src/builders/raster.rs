@@ -84,23 +84,9 @@ pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnost
         raster.chord_tolerance,
     )
     .map_err(|e| vec![parts::not_printable(head, e)])?;
-    let deg = 180.0 / std::f64::consts::PI;
-    let at = |e: &lensc_runtime::surface::analysis::Extremum, s: f64| report::AtPoint::of(e, s);
-    let time = path.cut_length / feed;
-    let toolpath = report::Toolpath::Raster(report::Raster {
-        passes: path.pass_count,
-        cut_points: path.point_count,
-        cut_length_mm: path.cut_length,
-        feed_mm_per_min: feed * 60.0,
-        cutting_time_s: time,
-        pass_cutting_times_s: path.pass_lengths.iter().map(|l| l / feed).collect(),
-        chord_tolerance_mm: raster.chord_tolerance,
-        stepover_mm: raster.stepover,
-        optimisation: (&optimised).into(),
-        max_slope_along_deg: at(&path.max_slope_along, deg),
-        max_slope_across_deg: at(&path.max_slope_across, deg),
-        min_concave_radius_along_mm: path.min_concave_radius_along.as_ref().map(|e| at(e, 1.0)),
-    });
+    let section = report::Raster::new(&path, raster, feed, &optimised);
+    let time = section.cutting_time_s;
+    let toolpath = report::Toolpath::Raster(section);
     let program_name = head.program_name();
     let text = ProgramText::Memory(text);
     let mut plots = crate::plots::PlotSeries::default();

@@ -128,40 +128,10 @@ pub fn build(
     let rest = program.finish().map_err(not_printable)?;
     sink.push(rest);
     let text = sink.finish().map_err(|e| vec![cannot_spool(&e, site)])?;
-    let points: usize = path.passes.iter().map(|p| p.points).sum();
-    let time: f64 = path.passes.iter().filter_map(|p| p.time).sum();
     let program_name = head.program_name();
-    let toolpath = report::Toolpath::RollerHelix(report::RollerHelix {
-        cut_points: points,
-        cutting_time_s: time,
-        roller_radius_mm: roller_radius,
-        passes: path
-            .passes
-            .iter()
-            .map(|p| report::HelixPass {
-                c_step_deg: p.c_step.to_degrees(),
-                pitch_mm: p.pitch,
-                finish_allowance_mm: p.finish_allowance,
-                points: p.points,
-                revolutions: p.revolutions,
-                x_min_mm: p.x_min,
-                x_max_mm: p.x_max,
-                cutting_time_s: p.time,
-                fingerprint_fnv1a64: format!("{:016x}", p.fingerprint),
-            })
-            .collect(),
-        tool_check: report::RollerToolCheck {
-            min_radius_of_curvature_cutting_plane_mm: check.min_radius_axial,
-            min_radius_of_curvature_mm: check.min_radius_overall,
-            max_slope_cutting_deg: check.max_slope_cutting.to_degrees(),
-            max_slope_cutting_on_roller_deg: check.max_slope_cutting_on_roller.to_degrees(),
-            max_slope_axial_deg: check.max_slope_axial.to_degrees(),
-            nose_radius_mm: rho,
-            clearance_deg: rt.clearance_angle.to_degrees(),
-            half_included_angle_deg: rt.opening_angle.to_degrees() / 2.0,
-        },
-        wrap_gap_mm: path.wrap.map(|w| w.gap),
-    });
+    let section = report::RollerHelix::new(&path, check, rt, roller_radius);
+    let (points, time) = (section.cut_points, section.cutting_time_s);
+    let toolpath = report::Toolpath::RollerHelix(section);
     let frame = RollerFrame {
         kernel: kernel.as_ref(),
         window,

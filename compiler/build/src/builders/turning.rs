@@ -8,13 +8,11 @@ use lensc_lang::check::trim_num;
 use lensc_lang::codes;
 use lensc_lang::diagnostics::RuntimeError;
 use lensc_lang::lower::job::TurningSpec;
-use lensc_runtime::plan::turning::{Move, ToolLocation, Toolpath, TurningJob};
+use lensc_runtime::plan::turning::{Move, Toolpath};
 use lensc_runtime::post::Provenance;
 use lensc_runtime::surface::SectionAlongX;
 
-use crate::driver::{
-    Built, PROFILE_SAMPLES, ProgramText, evaluator, profile_series, surface_analysis,
-};
+use crate::driver::{Built, PROFILE_SAMPLES, ProgramText, evaluator, profile_series};
 use crate::report;
 
 /// Builds one profile-turning job, or says why it cannot be built.
@@ -45,12 +43,6 @@ pub fn build(spec: &TurningSpec, prov: &Provenance) -> Result<Built, Vec<Diagnos
         optimised,
     } = emitted;
     let program_name = format!("{}.{}", job.name, job.machine.dialect.extension);
-    let analysis = surface_analysis(
-        &head.names.surface_declared,
-        head.surface.kind,
-        lowered,
-        201,
-    );
     let mut plots = crate::plots::PlotSeries::default();
     let simulation = if job.tool.centre_height == 0.0 {
         use lensc_runtime::surface::Profile as _;
@@ -84,26 +76,23 @@ pub fn build(spec: &TurningSpec, prov: &Provenance) -> Result<Built, Vec<Diagnos
             height_map: None,
         })
     };
-    let report = report::Report {
-        job: job.name.clone(),
-        lensc_version: prov.lensc_version.clone(),
-        source: prov.source.clone(),
-        source_fnv1a64: format!("{:016x}", prov.source_hash),
-        program: report::Program {
-            file: program_name.clone(),
-            dialect: job.machine.dialect.name.clone(),
-            lines: text.lines().count(),
-            bytes: text.len() as u64,
-            fts_table: None,
-        },
-        toolpath: report::Toolpath::ProfileTurning(toolpath_report(job, &path, &optimised)),
+    let toolpath = report::ProfileTurning::new(job, &path, &optimised);
+    let text = ProgramText::Memory(text);
+    let mut report = crate::parts::report(
+        head,
+        prov,
+        &program_name,
+        &text,
+        report::Toolpath::ProfileTurning(toolpath),
         simulation,
-        surface: analysis,
-    };
+    );
+    // A profile-turning report names a surface written in place "" (the
+    // other strategies give its kind), as it always has.
+    report.surface.surface = head.names.surface_declared.clone();
     Ok(Built {
         report_name: format!("{}.report.json", job.name),
         program_name,
-        program: ProgramText::Memory(text),
+        program: text,
         cut_points: path.cut_points,
         cutting_time: path.cutting_time(),
         report,
@@ -173,55 +162,4 @@ fn warnings(spec: &TurningSpec, path: &Toolpath) -> Vec<Diagnostic> {
         );
     }
     out
-}
-
-/// The report's toolpath section of a profile-turning job.
-fn toolpath_report(
-    job: &TurningJob,
-    path: &Toolpath,
-    optimised: &lensc_runtime::plan::optimise::Summary,
-) -> report::ProfileTurning {
-    report::ProfileTurning {
-        cut_points: path.cut_points,
-        cut_length_mm: path.cut_length,
-        feed_mm_per_min: path.feed_speed * 60.0,
-        surface_speed_m_per_min: job.strategy.surface_speed.map(|v| v * 0.06),
-        max_spindle_rpm: job.strategy.spindle_speed * 60.0 / std::f64::consts::TAU,
-        cutting_time_s: path.cutting_time(),
-        passes: path
-            .pass_times
-            .iter()
-            .enumerate()
-            .map(|(i, &t)| report::TurningPass {
-                pass: if i < path.roughing_passes {
-                    report::PassKind::Roughing
-                } else {
-                    report::PassKind::Finish
-                },
-                cutting_time_s: t,
-            })
-            .collect(),
-        chord_tolerance_mm: job.strategy.chord_tolerance,
-        max_profile_slope_deg: path.max_slope.0.to_degrees(),
-        min_concave_radius_mm: path.min_concave_radius.map(|(r, at)| report::AtRadius {
-            value: r,
-            at_radius_mm: at,
-        }),
-        roughing_passes: path.roughing_passes,
-        tool_location: match job.strategy.location {
-            ToolLocation::Exact => report::ToolLocation::Exact,
-            ToolLocation::Sequential { .. } => report::ToolLocation::Sequential,
-            ToolLocation::Binary { .. } => report::ToolLocation::Binary,
-        },
-        seams: path
-            .seams
-            .iter()
-            .map(|s| report::Seam {
-                at_radius_mm: s.at_radius,
-                uncut_depth_mm: s.depth,
-                corner_angle_deg: s.angle.to_degrees(),
-            })
-            .collect(),
-        optimisation: optimised.into(),
-    }
 }
