@@ -191,30 +191,9 @@ pub fn plan_profile_turning(
     let rho = job.tool.nose_radius;
     let start = strat.start_radius.unwrap_or(surf.aperture_radius);
     let end = strat.end_radius;
+    let scan = scan_profile(profile, start, end).map_err(|e| vec![e])?;
     let mut errors = Vec::new();
-
-    // Scan the profile: curvature and slope over the cut.
-    let mut min_concave: Option<(f64, f64)> = None;
-    let mut max_slope = (0.0f64, 0.0f64);
-    for i in 0..=SCAN_POINTS {
-        let r = end + (start - end) * i as f64 / SCAN_POINTS as f64;
-        let p = profile.point(r);
-        if !(p.z.is_finite() && p.dz.is_finite() && p.d2z.is_finite()) {
-            errors.push(PlanError::Undefined { at_radius: r });
-            return Err(errors);
-        }
-        let slope = p.dz.atan().abs();
-        if slope > max_slope.0 {
-            max_slope = (slope, r);
-        }
-        if p.d2z > 0.0 {
-            let radius = (1.0 + p.dz * p.dz).powf(1.5) / p.d2z;
-            if min_concave.is_none_or(|(m, _)| radius < m) {
-                min_concave = Some((radius, r));
-            }
-        }
-    }
-    if let Some((min_radius, at_radius)) = min_concave
+    if let Some((min_radius, at_radius)) = scan.min_concave
         && rho > min_radius
     {
         errors.push(PlanError::NoseTooLarge {
@@ -223,23 +202,11 @@ pub fn plan_profile_turning(
             at_radius,
         });
     }
-
     let feed_speed = match strat.feed {
         Feed::PerRevolution(f) => f * strat.spindle_speed,
         Feed::PerTime(v) => v,
     };
-    if feed_speed > job.machine.max_feed {
-        errors.push(PlanError::FeedTooHigh {
-            feed: feed_speed,
-            max: job.machine.max_feed,
-        });
-    }
-    if strat.spindle_speed > job.machine.max_spindle_speed {
-        errors.push(PlanError::SpindleTooFast {
-            speed: strat.spindle_speed,
-            max: job.machine.max_spindle_speed,
-        });
-    }
+    errors.extend(rate_errors(&job.machine, strat, feed_speed));
 
     // The profile the nose can touch: the cut range and, at the centre,
     // its mirror image across the axis.
@@ -253,6 +220,95 @@ pub fn plan_profile_turning(
     let mut passes = roughing_passes(profile, &pieces, rho, strat, start, end, &cut);
     let roughing_count = passes.len();
     passes.push(cut);
+    let linked = link_passes(&passes, strat);
+    let cut = passes.pop().expect("the finish pass");
+    let cutting_time = linked.pass_times.iter().sum();
+
+    errors.extend(travel_error(&job.machine, &linked.moves));
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+    Ok(Toolpath {
+        cut_points: cut.len(),
+        moves: linked.moves,
+        cut_length: linked.cut_length,
+        feed_speed,
+        cutting_time,
+        pass_times: linked.pass_times,
+        min_concave_radius: scan.min_concave,
+        max_slope: scan.max_slope,
+        seams,
+        roughing_passes: roughing_count,
+    })
+}
+
+/// What a scan of the profile over the cut finds.
+struct ProfileScan {
+    /// Smallest concave radius of curvature and where (r, mm).
+    min_concave: Option<(f64, f64)>,
+    /// Steepest slope (rad) and where (r, mm).
+    max_slope: (f64, f64),
+}
+
+/// Scans the profile at `SCAN_POINTS` radii from `end` to `start` for its
+/// curvature and slope, or says where it is undefined.
+fn scan_profile(profile: &dyn Profile, start: f64, end: f64) -> Result<ProfileScan, PlanError> {
+    let mut min_concave: Option<(f64, f64)> = None;
+    let mut max_slope = (0.0f64, 0.0f64);
+    for i in 0..=SCAN_POINTS {
+        let r = end + (start - end) * i as f64 / SCAN_POINTS as f64;
+        let p = profile.point(r);
+        if !(p.z.is_finite() && p.dz.is_finite() && p.d2z.is_finite()) {
+            return Err(PlanError::Undefined { at_radius: r });
+        }
+        let slope = p.dz.atan().abs();
+        if slope > max_slope.0 {
+            max_slope = (slope, r);
+        }
+        if p.d2z > 0.0 {
+            let radius = (1.0 + p.dz * p.dz).powf(1.5) / p.d2z;
+            if min_concave.is_none_or(|(m, _)| radius < m) {
+                min_concave = Some((radius, r));
+            }
+        }
+    }
+    Ok(ProfileScan {
+        min_concave,
+        max_slope,
+    })
+}
+
+/// The feed and spindle speed the machine cannot give.
+fn rate_errors(machine: &Lathe, strat: &ProfileTurning, feed_speed: f64) -> Vec<PlanError> {
+    let mut errors = Vec::new();
+    if feed_speed > machine.max_feed {
+        errors.push(PlanError::FeedTooHigh {
+            feed: feed_speed,
+            max: machine.max_feed,
+        });
+    }
+    if strat.spindle_speed > machine.max_spindle_speed {
+        errors.push(PlanError::SpindleTooFast {
+            speed: strat.spindle_speed,
+            max: machine.max_spindle_speed,
+        });
+    }
+    errors
+}
+
+/// The passes joined into one move stream, with what it costs.
+struct LinkedPasses {
+    moves: Vec<Move>,
+    /// Length (mm) of the feed moves, the plunges included.
+    cut_length: f64,
+    /// Cutting time (s) of each pass.
+    pass_times: Vec<f64>,
+}
+
+/// Each pass in turn: a rapid above its first point at the safe height
+/// (the retract above the highest point of any pass), a feed down to it,
+/// the pass, and a rapid back up.
+fn link_passes(passes: &[Vec<Vector2<f64>>], strat: &ProfileTurning) -> LinkedPasses {
     let top = passes
         .iter()
         .flatten()
@@ -274,7 +330,7 @@ pub fn plan_profile_turning(
             }
         }
     };
-    for cut in &passes {
+    for cut in passes {
         moves.push(Move::Rapid {
             x: cut[0].x,
             z: safe_z,
@@ -298,46 +354,27 @@ pub fn plan_profile_turning(
             z: safe_z,
         });
     }
-    let cut = passes.pop().expect("the finish pass");
-    let cutting_time = pass_times.iter().sum();
-
-    let (lo_x, hi_x) = job.machine.travel_x;
-    let (lo_z, hi_z) = job.machine.travel_z;
-    for m in &moves {
-        let (Move::Rapid { x, z } | Move::Feed { x, z }) = *m;
-        if x < lo_x || x > hi_x {
-            errors.push(PlanError::OutOfTravel {
-                axis: 'X',
-                value: x,
-                min: lo_x,
-                max: hi_x,
-            });
-            break;
-        }
-        if z < lo_z || z > hi_z {
-            errors.push(PlanError::OutOfTravel {
-                axis: 'Z',
-                value: z,
-                min: lo_z,
-                max: hi_z,
-            });
-            break;
-        }
-    }
-    if !errors.is_empty() {
-        return Err(errors);
-    }
-    Ok(Toolpath {
-        cut_points: cut.len(),
+    LinkedPasses {
         moves,
         cut_length,
-        feed_speed,
-        cutting_time,
         pass_times,
-        min_concave_radius: min_concave,
-        max_slope,
-        seams,
-        roughing_passes: roughing_count,
+    }
+}
+
+/// The first move, X before Z, that leaves the machine's travel.
+fn travel_error(machine: &Lathe, moves: &[Move]) -> Option<PlanError> {
+    moves.iter().find_map(|m| {
+        let (Move::Rapid { x, z } | Move::Feed { x, z }) = *m;
+        [('X', x, machine.travel_x), ('Z', z, machine.travel_z)]
+            .into_iter()
+            .find_map(|(axis, value, (min, max))| {
+                (value < min || value > max).then_some(PlanError::OutOfTravel {
+                    axis,
+                    value,
+                    min,
+                    max,
+                })
+            })
     })
 }
 

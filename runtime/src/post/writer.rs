@@ -17,6 +17,40 @@ pub enum Setup {
     Mill,
 }
 
+impl Setup {
+    /// The kind of program, as the dialect's `<name>_setup` key has it.
+    fn name(self) -> &'static str {
+        match self {
+            Setup::Lathe => "lathe",
+            Setup::Mill => "mill",
+        }
+    }
+}
+
+/// The dialect's own words, checked once: every number the writer prints
+/// itself is well formed by construction (`number`), and every line taken
+/// from the dialect is checked as it is written, so no text leaves the
+/// writer unchecked.
+fn check_dialect_words(dialect: &Dialect) -> Result<(), ProgramError> {
+    let words = [
+        &dialect.rapid,
+        &dialect.linear,
+        &dialect.arc_cw,
+        &dialect.arc_ccw,
+        &dialect.spindle_on,
+        &dialect.spindle_off,
+        &dialect.block_end,
+    ]
+    .into_iter()
+    .chain(dialect.per_minute.iter())
+    .chain(dialect.per_revolution.iter())
+    .chain(dialect.inverse_time.iter());
+    for word in words {
+        check_numbers(word, dialect.comment)?;
+    }
+    Ok(())
+}
+
 /// The post-processor: a move stream to a program in a dialect given as
 /// data. The start lines, header comments, setup and path-tolerance
 /// lines, then the moves word by word: a word whose printed value has not
@@ -106,17 +140,32 @@ impl ProgramWriter {
         if setup_lines.is_empty() {
             return Err(ProgramError::Unsupported(format!(
                 "{} programs ({} has no `{}_setup`)",
-                match setup {
-                    Setup::Lathe => "lathe",
-                    Setup::Mill => "mill",
-                },
+                setup.name(),
                 dialect.name,
-                match setup {
-                    Setup::Lathe => "lathe",
-                    Setup::Mill => "mill",
-                },
+                setup.name(),
             )));
         }
+        let mut w = ProgramWriter::blank(dialect, setup, job, axes, decimals);
+        check_dialect_words(dialect)?;
+        for line in &dialect.start {
+            let l = w.fill(line, path_tolerance);
+            check_numbers(&l, dialect.comment)?;
+            w.text.extend_from_slice(l.as_bytes());
+            w.text.push(b'\n');
+        }
+        for line in header {
+            w.comment(line);
+        }
+        for line in setup_lines.iter().chain(&dialect.path_tolerance) {
+            let l = w.fill(line, path_tolerance);
+            w.block_line(&l)?;
+        }
+        Ok(w)
+    }
+
+    /// A writer with nothing written yet, every word of the dialect
+    /// prepared and no axis position known.
+    fn blank(dialect: &Dialect, setup: Setup, job: &str, axes: &str, decimals: u32) -> Self {
         let has = |c: char| axes.contains(c).then_some(c);
         let letters = [
             has('X'),
@@ -124,7 +173,7 @@ impl ProgramWriter {
             has('Z'),
             has('C').map(|_| dialect.c_letter),
         ];
-        let mut w = ProgramWriter {
+        ProgramWriter {
             text: Vec::new(),
             dialect: dialect.clone(),
             decimals,
@@ -159,41 +208,7 @@ impl ProgramWriter {
             c_axis_on: false,
             job: job.to_string(),
             moves: 0,
-        };
-        // The dialect's own words, checked once: every number the writer
-        // prints itself is well formed by construction (`number`), and
-        // every line taken from the dialect is checked as it is written,
-        // so no text leaves the writer unchecked.
-        let words = [
-            &dialect.rapid,
-            &dialect.linear,
-            &dialect.arc_cw,
-            &dialect.arc_ccw,
-            &dialect.spindle_on,
-            &dialect.spindle_off,
-            &dialect.block_end,
-        ]
-        .into_iter()
-        .chain(dialect.per_minute.iter())
-        .chain(dialect.per_revolution.iter())
-        .chain(dialect.inverse_time.iter());
-        for word in words {
-            check_numbers(word, dialect.comment)?;
         }
-        for line in &dialect.start {
-            let l = w.fill(line, path_tolerance);
-            check_numbers(&l, dialect.comment)?;
-            w.text.extend_from_slice(l.as_bytes());
-            w.text.push(b'\n');
-        }
-        for line in header {
-            w.comment(line);
-        }
-        for line in setup_lines.iter().chain(&dialect.path_tolerance) {
-            let l = w.fill(line, path_tolerance);
-            w.block_line(&l)?;
-        }
-        Ok(w)
     }
 
     /// A line with its placeholders filled in.
@@ -428,25 +443,13 @@ impl ProgramWriter {
         r
     }
 
-    /// A motion block.
-    #[inline(always)]
-    fn motion(
-        &mut self,
-        word: Word,
-        to: Position,
-        feed: Option<crate::moves::Feed>,
-        arc: Option<(Plane, Position)>,
-    ) -> Result<(), ProgramError> {
-        self.motion_words_into_text(word, to, feed, arc)
-    }
-
     /// A motion block: its words straight into the text, each a copy of
     /// fixed size (a snippet's room, a number's room) cut back to length.
     /// The values printed are kept word by word and become the last
     /// printed values only when the block is written (a block refused
     /// leaves them as they were).
     #[inline(always)]
-    fn motion_words_into_text(
+    fn motion(
         &mut self,
         word: Word,
         to: Position,
@@ -489,9 +492,40 @@ impl ProgramWriter {
             }
         }
         self.motion_words[word as usize].push_to(&mut self.text);
+        let axes = to.axes();
+        let (printed, changed) = self.write_axes(axes)?;
+        if changed == 0 {
+            self.text.truncate(start);
+            return Ok(());
+        }
+        if let Some((plane, centre)) = arc {
+            self.arc_centre(plane, to, centre)?;
+        }
+        if let Some(mode) = mode {
+            self.feed_word(mode, mode_changes)?;
+        }
+        self.end_block(start)?;
+        for (i, n) in printed.into_iter().enumerate() {
+            if changed & 1 << i != 0 {
+                self.last[i] = Some(n);
+            }
+        }
+        for (at, v) in self.at.iter_mut().zip(axes) {
+            if !v.is_nan() {
+                *at = v;
+            }
+        }
+        self.moves += 1;
+        Ok(())
+    }
+
+    /// The words of the axes that move (a NaN axis stays where it is),
+    /// each printed only if its printed value changes; returns the
+    /// printed values and a bit per axis written.
+    #[inline(always)]
+    fn write_axes(&mut self, axes: [f64; 4]) -> Result<([i64; 4], u8), ProgramError> {
         let mut printed = [0i64; 4];
         let mut changed = 0u8;
-        let axes = to.axes();
         for i in 0..4 {
             let v = axes[i];
             if v.is_nan() {
@@ -515,36 +549,26 @@ impl ProgramWriter {
             printed[i] = n;
             changed |= 1 << i;
         }
-        if changed == 0 {
-            self.text.truncate(start);
-            return Ok(());
+        Ok((printed, changed))
+    }
+
+    /// The feed word: written when the mode or the printed feed changes,
+    /// and on every move in inverse time.
+    #[inline(always)]
+    fn feed_word(
+        &mut self,
+        (m, value, d): (FeedMode, f64, u32),
+        mode_changes: bool,
+    ) -> Result<(), ProgramError> {
+        let Some(n) = fixed_units(value, d) else {
+            return Err(ProgramError::NotPrintable { word: 'F', value });
+        };
+        if mode_changes || m == FeedMode::InverseTime || self.last_feed != Some(n) {
+            self.text.extend_from_slice(b" F");
+            self.number('F', value, n, d)?;
         }
-        if let Some((plane, centre)) = arc {
-            self.arc_centre(plane, to, centre)?;
-        }
-        if let Some((m, value, d)) = mode {
-            let Some(n) = fixed_units(value, d) else {
-                return Err(ProgramError::NotPrintable { word: 'F', value });
-            };
-            if mode_changes || m == FeedMode::InverseTime || self.last_feed != Some(n) {
-                self.text.extend_from_slice(b" F");
-                self.number('F', value, n, d)?;
-            }
-            self.last_feed = Some(n);
-            self.mode = Some(m);
-        }
-        self.end_block(start)?;
-        for (i, n) in printed.into_iter().enumerate() {
-            if changed & 1 << i != 0 {
-                self.last[i] = Some(n);
-            }
-        }
-        for (at, v) in self.at.iter_mut().zip(axes) {
-            if !v.is_nan() {
-                *at = v;
-            }
-        }
-        self.moves += 1;
+        self.last_feed = Some(n);
+        self.mode = Some(m);
         Ok(())
     }
 
