@@ -259,6 +259,9 @@ fn segment_count(length: f64, interval: f64) -> Result<usize, GrindingError> {
 /// A contact x and the profile there.
 type Contact = (f64, ProfilePoint);
 
+/// The smallest concave radius of curvature (mm) and its x, if any.
+type MinConcave = Option<(f64, f64)>;
+
 /// The contact points, one per station, and the smallest concave radius
 /// of curvature (and its x) over the contact points, interval midpoints
 /// and an even scan; or the first x where the profile is undefined.
@@ -266,7 +269,7 @@ fn contact_points(
     p: &ProfileGrinding,
     profile: &dyn Profile,
     segments: usize,
-) -> Result<(Vec<Contact>, Option<(f64, f64)>), GrindingError> {
+) -> Result<(Vec<Contact>, MinConcave), GrindingError> {
     let dir = (p.end - p.start).signum();
     let station = |i: usize| {
         if i >= segments {
@@ -275,7 +278,7 @@ fn contact_points(
             p.start + dir * i as f64 * p.interval
         }
     };
-    let mut min_concave: Option<(f64, f64)> = None;
+    let mut min_concave: MinConcave = None;
     let mut check = |x: f64| -> Result<ProfilePoint, GrindingError> {
         let pt = profile.point(x);
         if !(pt.z.is_finite() && pt.dz.is_finite() && pt.d2z.is_finite()) {
