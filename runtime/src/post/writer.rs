@@ -493,37 +493,6 @@ impl ProgramWriter {
         }
         self.motion_words[word as usize].push_to(&mut self.text);
         let axes = to.axes();
-        let (printed, changed) = self.write_axes(axes)?;
-        if changed == 0 {
-            self.text.truncate(start);
-            return Ok(());
-        }
-        if let Some((plane, centre)) = arc {
-            self.arc_centre(plane, to, centre)?;
-        }
-        if let Some(mode) = mode {
-            self.feed_word(mode, mode_changes)?;
-        }
-        self.end_block(start)?;
-        for (i, n) in printed.into_iter().enumerate() {
-            if changed & 1 << i != 0 {
-                self.last[i] = Some(n);
-            }
-        }
-        for (at, v) in self.at.iter_mut().zip(axes) {
-            if !v.is_nan() {
-                *at = v;
-            }
-        }
-        self.moves += 1;
-        Ok(())
-    }
-
-    /// The words of the axes that move (a NaN axis stays where it is),
-    /// each printed only if its printed value changes; returns the
-    /// printed values and a bit per axis written.
-    #[inline(always)]
-    fn write_axes(&mut self, axes: [f64; 4]) -> Result<([i64; 4], u8), ProgramError> {
         let mut printed = [0i64; 4];
         let mut changed = 0u8;
         for i in 0..4 {
@@ -549,7 +518,29 @@ impl ProgramWriter {
             printed[i] = n;
             changed |= 1 << i;
         }
-        Ok((printed, changed))
+        if changed == 0 {
+            self.text.truncate(start);
+            return Ok(());
+        }
+        if let Some((plane, centre)) = arc {
+            self.arc_centre(plane, to, centre)?;
+        }
+        if let Some(mode) = mode {
+            self.feed_word(mode, mode_changes)?;
+        }
+        self.end_block(start)?;
+        for (i, n) in printed.into_iter().enumerate() {
+            if changed & 1 << i != 0 {
+                self.last[i] = Some(n);
+            }
+        }
+        for (at, v) in self.at.iter_mut().zip(axes) {
+            if !v.is_nan() {
+                *at = v;
+            }
+        }
+        self.moves += 1;
+        Ok(())
     }
 
     /// The feed word: written when the mode or the printed feed changes,
