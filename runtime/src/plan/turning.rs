@@ -216,8 +216,14 @@ pub fn plan_profile_turning(
     };
     let pieces = envelope::split_at_corners(profile, lo, hi);
     let seams = seams(profile, &pieces, rho, start.min(end), hi);
-    let cut = cut_path(profile, &pieces, rho, strat, start, end);
-    let mut passes = roughing_passes(profile, &pieces, rho, strat, start, end, &cut);
+    let section = Section {
+        profile,
+        pieces: &pieces,
+        start,
+        end,
+    };
+    let cut = cut_path(&section, rho, strat);
+    let mut passes = roughing_passes(&section, rho, strat, &cut);
     let roughing_count = passes.len();
     passes.push(cut);
     let linked = link_passes(&passes, strat);
@@ -383,12 +389,9 @@ fn travel_error(machine: &Lathe, moves: &[Move]) -> Option<PlanError> {
 /// ρ + allowance), and with flat stock never deeper than its level below
 /// the stock's top.
 fn roughing_passes(
-    profile: &dyn Profile,
-    pieces: &Pieces,
+    section: &Section,
     rho: f64,
     strat: &ProfileTurning,
-    start: f64,
-    end: f64,
     finish: &[Vector2<f64>],
 ) -> Vec<Vec<Vector2<f64>>> {
     let Some(r) = strat.roughing else {
@@ -404,7 +407,7 @@ fn roughing_passes(
             location: ToolLocation::Exact,
             ..strat.clone()
         };
-        cut_path(profile, pieces, rho + allowance, &exact, start, end)
+        cut_path(section, rho + allowance, &exact)
     };
     let mut passes = Vec::new();
     match r.stock {
@@ -443,16 +446,24 @@ fn roughing_passes(
     passes
 }
 
-/// The nose-centre points of the cut, within the chord tolerance of the
-/// curve the chosen tool location gives.
-fn cut_path(
-    profile: &dyn Profile,
-    pieces: &Pieces,
-    rho: f64,
-    strat: &ProfileTurning,
+/// The part of the profile a cut runs over: its smooth pieces, from
+/// radius `start` to `end`.
+struct Section<'a> {
+    profile: &'a dyn Profile,
+    pieces: &'a Pieces,
     start: f64,
     end: f64,
-) -> Vec<Vector2<f64>> {
+}
+
+/// The nose-centre points of the cut, within the chord tolerance of the
+/// curve the chosen tool location gives.
+fn cut_path(section: &Section, rho: f64, strat: &ProfileTurning) -> Vec<Vector2<f64>> {
+    let Section {
+        profile,
+        pieces,
+        start,
+        end,
+    } = *section;
     let tol = strat.chord_tolerance * crate::plan::optimise::CHORD_SHARE;
     // The ends of the cut in the tool's x: the normal offsets of its ends.
     let (x0, x1) = (
