@@ -596,5 +596,14 @@ libm_entries! {
 
 #[cfg(test)]
 mod tests {
-    crate::surface::conformance::surface_fn_tests!(super::JitSurface);
+    use super::JitSurface;
+    use crate::surface::ir::SurfaceTape;
+
+    impl crate::surface::conformance::Backend for JitSurface {
+        fn build(tape: &SurfaceTape) -> Self {
+            JitSurface::compile(tape).expect("the tape compiles")
+        }
+    }
+
+    crate::surface::conformance::surface_fn_tests!(JitSurface);
 }
