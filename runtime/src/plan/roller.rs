@@ -200,14 +200,21 @@ pub struct WrapFit {
     pub gap: f64,
 }
 
+/// How far (mm) a design's length around may differ from the roller's
+/// circumference and still close on itself: 1 µm.
+pub const WRAP_TOLERANCE: f64 = 1e-3;
+
 /// Checks a design's length around against the roller's circumference
-/// (section 2.1): a longer design overlaps itself (an error), a shorter
-/// one leaves a gap (reported). Lengths within 1e-9 relative are equal.
+/// (section 2.1): a design longer by over `WRAP_TOLERANCE` overlaps itself
+/// (E0134, an error), one shorter by over it leaves a gap (reported);
+/// within it the design closes. This is the rule's one statement: the
+/// compiler's checker reports it, and the planner runs it again as its
+/// precondition.
 pub fn check_wrap(roller_radius: f64, design_length_around: f64) -> Result<WrapFit, RollerError> {
     positive("roller radius", roller_radius)?;
     positive("design length around", design_length_around)?;
     let circumference = TAU * roller_radius;
-    let slack = 1e-9 * circumference;
+    let slack = WRAP_TOLERANCE;
     if design_length_around > circumference + slack {
         return Err(RollerError::Overlap {
             circumference,

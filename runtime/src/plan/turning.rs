@@ -180,18 +180,37 @@ pub enum PlanError {
 /// Number of radii at which the profile is scanned for curvature and slope.
 const SCAN_POINTS: usize = 4096;
 
-/// Plans the profile-turning path of `job` along `profile` (the surface's
-/// section, from the JIT kernel in a build), or says every reason it cannot.
-pub fn plan_profile_turning(
+/// What the scan of a profile over the cut finds before any path is
+/// planned: its smallest concave radius of curvature and its steepest
+/// slope, each with the radius (mm) where it occurs, and the feed speed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProfileScan {
+    /// (radius of curvature, at radius), mm.
+    pub min_concave: Option<(f64, f64)>,
+    /// (slope in rad, at radius mm).
+    pub max_slope: (f64, f64),
+    /// The cutting feed (mm/s).
+    pub feed_speed: f64,
+}
+
+/// Checks a turning job against its profile before planning: the profile
+/// is defined over the cut, the nose fits its smallest concave radius of
+/// curvature, the feed and the spindle speed are within the machine's
+/// limits. The compiler's lowering runs it so `lensc check` reports these;
+/// the planner runs it again as its precondition. Every reason found, or
+/// the scan.
+pub fn check_profile_turning(
     job: &TurningJob,
     profile: &dyn Profile,
-) -> Result<Toolpath, Vec<PlanError>> {
-    let surf = &job.surface;
+) -> Result<ProfileScan, Vec<PlanError>> {
     let strat = &job.strategy;
     let rho = job.tool.nose_radius;
-    let start = strat.start_radius.unwrap_or(surf.aperture_radius);
-    let end = strat.end_radius;
-    let scan = scan_profile(profile, start, end).map_err(|e| vec![e])?;
+    let start = strat.start_radius.unwrap_or(job.surface.aperture_radius);
+    let feed_speed = match strat.feed {
+        Feed::PerRevolution(f) => f * strat.spindle_speed,
+        Feed::PerTime(v) => v,
+    };
+    let scan = scan_profile(profile, start, strat.end_radius, feed_speed).map_err(|e| vec![e])?;
     let mut errors = Vec::new();
     if let Some((min_radius, at_radius)) = scan.min_concave
         && rho > min_radius
@@ -202,11 +221,25 @@ pub fn plan_profile_turning(
             at_radius,
         });
     }
-    let feed_speed = match strat.feed {
-        Feed::PerRevolution(f) => f * strat.spindle_speed,
-        Feed::PerTime(v) => v,
-    };
     errors.extend(rate_errors(&job.machine, strat, feed_speed));
+    if errors.is_empty() {
+        Ok(scan)
+    } else {
+        Err(errors)
+    }
+}
+
+/// Plans the profile-turning path of `job` along `profile` (the surface's
+/// section, from the JIT kernel in a build), or says every reason it cannot.
+pub fn plan_profile_turning(
+    job: &TurningJob,
+    profile: &dyn Profile,
+) -> Result<Toolpath, Vec<PlanError>> {
+    let scan = check_profile_turning(job, profile)?;
+    let strat = &job.strategy;
+    let rho = job.tool.nose_radius;
+    let start = strat.start_radius.unwrap_or(job.surface.aperture_radius);
+    let end = strat.end_radius;
 
     // The profile the nose can touch: the cut range and, at the centre,
     // its mirror image across the axis.
@@ -230,15 +263,14 @@ pub fn plan_profile_turning(
     let cut = passes.pop().expect("the finish pass");
     let cutting_time = linked.pass_times.iter().sum();
 
-    errors.extend(travel_error(&job.machine, &linked.moves));
-    if !errors.is_empty() {
-        return Err(errors);
+    if let Some(e) = travel_error(&job.machine, &linked.moves) {
+        return Err(vec![e]);
     }
     Ok(Toolpath {
         cut_points: cut.len(),
         moves: linked.moves,
         cut_length: linked.cut_length,
-        feed_speed,
+        feed_speed: scan.feed_speed,
         cutting_time,
         pass_times: linked.pass_times,
         min_concave_radius: scan.min_concave,
@@ -248,17 +280,14 @@ pub fn plan_profile_turning(
     })
 }
 
-/// What a scan of the profile over the cut finds.
-struct ProfileScan {
-    /// Smallest concave radius of curvature and where (r, mm).
-    min_concave: Option<(f64, f64)>,
-    /// Steepest slope (rad) and where (r, mm).
-    max_slope: (f64, f64),
-}
-
 /// Scans the profile at `SCAN_POINTS` radii from `end` to `start` for its
 /// curvature and slope, or says where it is undefined.
-fn scan_profile(profile: &dyn Profile, start: f64, end: f64) -> Result<ProfileScan, PlanError> {
+fn scan_profile(
+    profile: &dyn Profile,
+    start: f64,
+    end: f64,
+    feed_speed: f64,
+) -> Result<ProfileScan, PlanError> {
     let mut min_concave: Option<(f64, f64)> = None;
     let mut max_slope = (0.0f64, 0.0f64);
     for i in 0..=SCAN_POINTS {
@@ -281,6 +310,7 @@ fn scan_profile(profile: &dyn Profile, start: f64, end: f64) -> Result<ProfileSc
     Ok(ProfileScan {
         min_concave,
         max_slope,
+        feed_speed,
     })
 }
 

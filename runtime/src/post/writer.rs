@@ -124,27 +124,11 @@ impl ProgramWriter {
         resolution: f64,
         path_tolerance: f64,
     ) -> Result<Self, ProgramError> {
-        let decimals = decimals_for(resolution);
-        if let Some(max) = dialect.max_decimals
-            && decimals > max
-        {
-            return Err(ProgramError::Unsupported(format!(
-                "the machine's resolution ({:.*} mm needs {decimals} decimals; {} writes at most {max})",
-                decimals as usize, resolution, dialect.name
-            )));
-        }
+        let decimals = check_dialect(dialect, setup, resolution)?;
         let setup_lines = match setup {
             Setup::Lathe => &dialect.lathe_setup,
             Setup::Mill => &dialect.mill_setup,
         };
-        if setup_lines.is_empty() {
-            return Err(ProgramError::Unsupported(format!(
-                "{} programs ({} has no `{}_setup`)",
-                setup.name(),
-                dialect.name,
-                setup.name(),
-            )));
-        }
         let mut w = ProgramWriter::blank(dialect, setup, job, axes, decimals);
         check_dialect_words(dialect)?;
         for line in &dialect.start {
@@ -752,6 +736,40 @@ enum Word {
     Linear,
     ArcCw,
     ArcCcw,
+}
+
+/// Whether `dialect` can write a program of this `setup` for a machine of
+/// this resolution (mm): it has the setup's lines and prints as many
+/// decimals as the resolution needs. The decimals, or why not. Every
+/// writer checks it when it starts; the compiler's lowering checks it
+/// before planning.
+pub fn check_dialect(
+    dialect: &Dialect,
+    setup: Setup,
+    resolution: f64,
+) -> Result<u32, ProgramError> {
+    let decimals = decimals_for(resolution);
+    if let Some(max) = dialect.max_decimals
+        && decimals > max
+    {
+        return Err(ProgramError::Unsupported(format!(
+            "the machine's resolution ({:.*} mm needs {decimals} decimals; {} writes at most {max})",
+            decimals as usize, resolution, dialect.name
+        )));
+    }
+    let setup_lines = match setup {
+        Setup::Lathe => &dialect.lathe_setup,
+        Setup::Mill => &dialect.mill_setup,
+    };
+    if setup_lines.is_empty() {
+        return Err(ProgramError::Unsupported(format!(
+            "{} programs ({} has no `{}_setup`)",
+            setup.name(),
+            dialect.name,
+            setup.name(),
+        )));
+    }
+    Ok(decimals)
 }
 
 /// The final check on program text: outside comments, no word's number

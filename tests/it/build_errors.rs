@@ -1,0 +1,147 @@
+//! The plan-time checks fire on deliberately bad jobs: each file in
+//! tests/bad_builds/ is built, and what `lensc build` says is compared with
+//! its reviewed snapshot (tests/snapshots/bad_builds/). A file whose only
+//! findings are warnings builds (exit 0); any error means exit 1 and no
+//! program.
+
+use crate::common::{lensc, root, text};
+
+#[test]
+fn every_bad_build_is_reported_and_snapshotted() {
+    let mut files: Vec<_> = std::fs::read_dir(root().join("tests/bad_builds"))
+        .expect("tests/bad_builds")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "lens"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 10, "the corpus has {} files", files.len());
+    for path in files {
+        let dir = tempfile::tempdir().expect("tmp");
+        let rel = path
+            .strip_prefix(root())
+            .expect("inside the repo")
+            .to_str()
+            .expect("utf-8")
+            .to_string();
+        let out = lensc(
+            &root(),
+            &["build", &rel, "--out", dir.path().to_str().expect("utf-8")],
+        );
+        let stderr = text(&out.stderr).replace(dir.path().to_str().expect("utf-8"), "OUT");
+        let has_error = stderr.lines().any(|l| l.starts_with("[E"));
+        assert_eq!(
+            out.status.code(),
+            Some(if has_error { 1 } else { 0 }),
+            "{rel}: {stderr}"
+        );
+        assert!(
+            stderr
+                .lines()
+                .any(|l| l.starts_with("[E") || l.starts_with("[W")),
+            "{rel} reports nothing: {stderr}"
+        );
+        let written = std::fs::read_dir(dir.path()).map_or(0, |d| d.count());
+        if has_error {
+            assert_eq!(written, 0, "{rel}: output left behind");
+        }
+        let name = path
+            .file_stem()
+            .expect("stem")
+            .to_string_lossy()
+            .to_string();
+        insta::with_settings!({ snapshot_path => "../snapshots/bad_builds", prepend_module_to_snapshot => false, omit_expression => true }, {
+            insta::assert_snapshot!(name, stderr);
+        });
+    }
+}
+
+/// What only planning finds, and why: a code on its own holds for every
+/// file; a code with a file holds for that file's strategy alone (the same
+/// code is found before planning elsewhere).
+const PLANNING_ONLY: &[(&str, Option<&str>, &str)] = &[
+    (
+        "E0141",
+        None,
+        "the travel is checked against the planned moves",
+    ),
+    (
+        "E0146",
+        None,
+        "the stroke the spiral needs is known once it is planned",
+    ),
+    (
+        "E0147",
+        None,
+        "the fast axis's acceleration is known once the spiral is planned",
+    ),
+    ("W0003", None, "the seams are found on the planned envelope"),
+    (
+        "W0004",
+        None,
+        "the pip at the centre is found on the planned moves",
+    ),
+    (
+        "W0005",
+        None,
+        "the chords over tolerance are found on the planned spiral",
+    ),
+    (
+        "E0140",
+        Some("raster_knife_too_large"),
+        "the raster planner finds the limiting radius at the contacts of its planes",
+    ),
+    (
+        "E0145",
+        Some("raster_clearance_too_small"),
+        "the steepest slope along the cut is the raster planner's",
+    ),
+    (
+        "E0140",
+        Some("grinding_wheel_too_large"),
+        "the grinding planner finds the smallest radius at its own contact stations",
+    ),
+];
+
+#[test]
+fn check_reports_every_bad_build_error_that_needs_no_toolpath() {
+    let codes = |stderr: &str| -> Vec<String> {
+        stderr
+            .lines()
+            .filter(|l| l.starts_with("[E") || l.starts_with("[W"))
+            .filter_map(|l| l.get(1..6).map(str::to_string))
+            .collect()
+    };
+    let mut files: Vec<_> = std::fs::read_dir(root().join("tests/bad_builds"))
+        .expect("tests/bad_builds")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "lens"))
+        .collect();
+    files.sort();
+    for path in files {
+        let rel = path.strip_prefix(root()).expect("inside the repo");
+        let rel = rel.to_str().expect("utf-8");
+        let stem = path
+            .file_stem()
+            .expect("stem")
+            .to_string_lossy()
+            .to_string();
+        let dir = tempfile::tempdir().expect("tmp");
+        let out = dir.path().to_str().expect("utf-8");
+        let built = codes(&text(&lensc(&root(), &["build", rel, "--out", out]).stderr));
+        let checked = lensc(&root(), &["check", rel]);
+        let found = codes(&text(&checked.stderr));
+        for code in &built {
+            let planning = PLANNING_ONLY
+                .iter()
+                .any(|(c, f, _)| c == code && f.is_none_or(|f| f == stem));
+            if !planning {
+                assert!(
+                    found.contains(code),
+                    "{rel}: `check` misses {code}: {found:?}"
+                );
+            }
+        }
+        let errors = found.iter().any(|c| c.starts_with('E'));
+        assert_eq!(checked.status.code(), Some(i32::from(errors)), "{rel}");
+    }
+}

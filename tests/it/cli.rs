@@ -1,0 +1,488 @@
+//! The `lensc` binary as a user and a CI pipeline meet it: exit codes,
+//! JSON diagnostics, `--help`, atomic output.
+
+use crate::common;
+
+use crate::common::{lensc, root, text};
+
+const GOOD: &str = "examples/kim2008_convex_asphere.lens";
+
+#[test]
+fn check_clean_file_exits_zero() {
+    let out = lensc(&root(), &["check", GOOD]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+}
+
+#[test]
+fn check_bad_file_exits_one_with_diagnostics() {
+    let out = lensc(&root(), &["check", "tests/bad/many_errors_at_once.lens"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = text(&out.stderr);
+    assert!(err.contains("[E0123]") && err.contains("[E0120]"), "{err}");
+}
+
+#[test]
+fn check_reports_every_file_given() {
+    let out = lensc(
+        &root(),
+        &[
+            "check",
+            "--message-format",
+            "json",
+            "tests/bad/sin_of_length.lens",
+            GOOD,
+            "tests/bad/unknown_unit.lens",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(1));
+    let stdout = text(&out.stdout);
+    assert!(
+        stdout.contains("sin_of_length.lens") && stdout.contains("unknown_unit.lens"),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn missing_file_is_a_user_error() {
+    let out = lensc(&root(), &["check", "no/such/file.lens"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out.stderr).contains("no such file"));
+}
+
+#[test]
+fn usage_errors_exit_two() {
+    assert_eq!(lensc(&root(), &["check"]).status.code(), Some(2));
+    assert_eq!(lensc(&root(), &["frobnicate"]).status.code(), Some(2));
+    // A dialect the machine does not offer is the user's error, E0148.
+    let out = lensc(
+        &root(),
+        &[
+            "build",
+            GOOD,
+            "--dialect",
+            "klingon",
+            "--out",
+            "/tmp/lensc-cli-klingon",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out.stderr).contains("E0148"), "{}", text(&out.stderr));
+    assert_eq!(
+        lensc(&root(), &["check", "--message-format", "xml", GOOD])
+            .status
+            .code(),
+        Some(2)
+    );
+    let dir = tempfile::tempdir().expect("tmp");
+    let out_dir = dir.path().to_str().expect("utf8");
+    assert_eq!(
+        lensc(&root(), &["build", GOOD, "--job", "nope", "--out", out_dir])
+            .status
+            .code(),
+        Some(2)
+    );
+}
+
+#[test]
+fn help_on_every_subcommand() {
+    for args in [
+        &["--help"][..],
+        &["check", "--help"],
+        &["build", "--help"],
+        &["sample", "--help"],
+        &["help", "build"],
+    ] {
+        let out = lensc(&root(), args);
+        assert_eq!(out.status.code(), Some(0), "{args:?}");
+        assert!(text(&out.stdout).contains("Usage"), "{args:?}");
+    }
+    let build = text(&lensc(&root(), &["build", "--help"]).stdout);
+    for flag in ["--job", "--dialect", "--out", "--message-format", "--color"] {
+        assert!(build.contains(flag), "build --help lacks {flag}");
+    }
+}
+
+#[test]
+fn json_diagnostics_are_one_object_per_line_on_stdout() {
+    let out = lensc(
+        &root(),
+        &[
+            "check",
+            "--message-format",
+            "json",
+            "tests/bad/many_errors_at_once.lens",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(1));
+    let stdout = text(&out.stdout);
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert!(lines.len() >= 6);
+    for l in lines {
+        let v: serde_json::Value = serde_json::from_str(l).expect("json line");
+        assert_eq!(v["file"], "tests/bad/many_errors_at_once.lens");
+        assert!(v["code"].as_str().expect("code").starts_with('E') || v["severity"] == "warning");
+    }
+    assert!(
+        text(&out.stderr).is_empty(),
+        "human output leaked: {}",
+        text(&out.stderr)
+    );
+}
+
+#[test]
+fn color_always_and_never() {
+    let bad = "tests/bad/sin_of_length.lens";
+    let always = lensc(&root(), &["check", "--color", "always", bad]);
+    assert!(text(&always.stderr).contains('\u{1b}'));
+    let never = lensc(&root(), &["check", "--color", "never", bad]);
+    assert!(!text(&never.stderr).contains('\u{1b}'));
+}
+
+#[test]
+fn build_writes_program_to_out_dir() {
+    let dir = tempfile::tempdir().expect("tmp");
+    std::fs::copy(root().join(GOOD), dir.path().join("job.lens")).expect("copy");
+    // Default output directory: out/ in the working directory.
+    let out = lensc(dir.path(), &["build", "job.lens", "--job", "kim_convex"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let program = std::fs::read_to_string(dir.path().join("out/kim_convex.ngc")).expect("program");
+    assert!(program.starts_with("(lensc "));
+    assert!(program.trim_end().ends_with("M2"));
+    let mut leftovers: Vec<String> = std::fs::read_dir(dir.path().join("out"))
+        .expect("out")
+        .map(|e| e.expect("e").file_name().to_string_lossy().into_owned())
+        .collect();
+    leftovers.sort();
+    assert_eq!(
+        leftovers,
+        ["kim_convex.ngc", "kim_convex.report.json"],
+        "temporary files left"
+    );
+    // Put in place readable by all, not with the temporary file's 0600.
+    #[cfg(unix)]
+    for f in &leftovers {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(dir.path().join("out").join(f))
+            .expect("meta")
+            .permissions()
+            .mode();
+        assert_eq!(mode & 0o777, 0o644, "{f}");
+    }
+    // The report: provenance, the program, the toolpath and the surface.
+    let report: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("out/kim_convex.report.json")).expect("report"),
+    )
+    .expect("json");
+    assert_eq!(report["job"], "kim_convex");
+    assert_eq!(report["program"]["file"], "kim_convex.ngc");
+    assert_eq!(
+        report["program"]["lines"].as_u64(),
+        Some(program.lines().count() as u64)
+    );
+    assert_eq!(report["surface"]["kind"], "conic");
+    assert_eq!(report["surface"]["backend"], "jit");
+    let pv = report["surface"]["sag_mm"]["pv"].as_f64().expect("pv");
+    let c = 1.0 / 22.405;
+    let sag = c * 1.6 * 1.6 / (1.0 + (1.0f64 - 44.098 * c * c * 2.56).sqrt());
+    assert!((pv - sag).abs() < 1e-12, "{pv} vs {sag}");
+    assert!(report["toolpath"]["cutting_time_s"].as_f64().expect("time") > 0.0);
+}
+
+#[test]
+fn failed_build_leaves_earlier_output_untouched() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let src = std::fs::read_to_string(root().join(GOOD)).expect("read");
+    std::fs::write(dir.path().join("job.lens"), &src).expect("write");
+    let build = |dir: &std::path::Path| lensc(dir, &["build", "job.lens", "--job", "kim_convex"]);
+    assert_eq!(build(dir.path()).status.code(), Some(0));
+    let before = std::fs::read(dir.path().join("out/kim_convex.ngc")).expect("program");
+
+    // Same job, now with a nose larger than any concave radius… on a convex
+    // part there is none, so break it another way: a spindle over the limit.
+    let broken = src.replace("spindle_speed: 1000 rpm", "spindle_speed: 9000 rpm");
+    assert_ne!(broken, src);
+    std::fs::write(dir.path().join("job.lens"), broken).expect("write");
+    let out = build(dir.path());
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out.stderr).contains("E0143"), "{}", text(&out.stderr));
+    assert_eq!(
+        std::fs::read(dir.path().join("out/kim_convex.ngc")).expect("program"),
+        before
+    );
+    let names: Vec<_> = std::fs::read_dir(dir.path().join("out"))
+        .expect("out")
+        .map(|e| e.expect("e").file_name())
+        .collect();
+    assert_eq!(names.len(), 2, "partial files left: {names:?}");
+}
+
+#[test]
+fn plan_errors_name_their_location() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let src = "use std::machines::linuxcnc_lathe
+use std::strategies::finish_turning
+// A concave sphere of radius 0.3 mm cannot be cut with a 0.5 mm nose.
+surface bowl = sphere { radius: 0.3 mm, sense: concave, aperture: circle(radius: 0.2 mm) }
+tool big = round_nose { nose_radius: 0.5 mm, clearance: 7 deg }
+job gouge { surface: bowl, tool: big, machine: linuxcnc_lathe, strategy: finish_turning }
+";
+    std::fs::write(dir.path().join("gouge.lens"), src).expect("write");
+    let out = lensc(
+        dir.path(),
+        &["build", "gouge.lens", "--message-format", "json"],
+    );
+    assert_eq!(out.status.code(), Some(1));
+    let stdout = text(&out.stdout);
+    let v: serde_json::Value =
+        serde_json::from_str(stdout.lines().next().expect("a diagnostic")).expect("json");
+    assert_eq!(v["code"], "E0140");
+    assert!(
+        v["message"].as_str().expect("msg").contains("300 um"),
+        "{v}"
+    );
+    assert!(!dir.path().join("out/gouge.ngc").exists());
+}
+
+#[test]
+fn build_only_the_named_job() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let src = std::fs::read_to_string(root().join(GOOD)).expect("read")
+        + "\njob second { surface: convex_asphere, tool: wheel, machine: grinder, strategy: grind }\n";
+    std::fs::write(dir.path().join("two.lens"), src).expect("write");
+    let out = lensc(
+        dir.path(),
+        &["build", "two.lens", "--job", "second", "--out", "progs"],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert!(dir.path().join("progs/second.ngc").exists());
+    assert!(!dir.path().join("progs/kim_convex.ngc").exists());
+}
+
+/// Parses `lensc sample` CSV output into rows.
+fn csv_rows(out: &std::process::Output) -> Vec<Vec<f64>> {
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let csv = text(&out.stdout);
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next(),
+        Some("x,y,z,dzdx,dzdy,curvature_x,curvature_y")
+    );
+    lines
+        .map(|l| l.split(',').map(|c| c.parse().expect("number")).collect())
+        .collect()
+}
+
+#[test]
+fn sample_radial_matches_the_closed_form_conic() {
+    let rows = csv_rows(&lensc(
+        &root(),
+        &[
+            "sample",
+            GOOD,
+            "--surface",
+            "convex_asphere",
+            "--radial",
+            "9",
+        ],
+    ));
+    assert_eq!(rows.len(), 9);
+    let (c, k) = (1.0 / 22.405, 43.098);
+    for r in &rows {
+        let (x, y) = (r[0], r[1]);
+        assert_eq!(y, 0.0);
+        let u = 1.0 - (1.0 + k) * c * c * x * x;
+        let z = -(c * x * x / (1.0 + u.sqrt()));
+        let dz = -(c * x / u.sqrt());
+        let d2z = -(c / (u * u.sqrt()));
+        assert!((r[2] - z).abs() < 1e-15, "z at {x}: {} vs {z}", r[2]);
+        assert!((r[3] - dz).abs() < 1e-14, "dz/dx at {x}");
+        assert!(
+            (r[5] - d2z / (1.0 + dz * dz).powf(1.5)).abs() < 1e-13,
+            "curvature at {x}"
+        );
+    }
+    assert_eq!(
+        rows[8][0], 1.6,
+        "the radial samples end at the aperture edge"
+    );
+}
+
+#[test]
+fn sample_grid_and_points_on_the_seed_002_pattern() {
+    let ex = "examples/liu_roller_pattern.lens";
+    let grid = csv_rows(&lensc(
+        &root(),
+        &["sample", ex, "--surface", "pattern", "--grid", "3"],
+    ));
+    assert_eq!(grid.len(), 9);
+    let dir = tempfile::tempdir().expect("tmp");
+    let pts = dir.path().join("pts.csv");
+    std::fs::write(&pts, "x,y\n0,0\n0.3141592653589793,0\n").expect("write");
+    let rows = csv_rows(&lensc(
+        &root(),
+        &[
+            "sample",
+            ex,
+            "--surface",
+            "pattern",
+            "--points",
+            pts.to_str().expect("utf8"),
+        ],
+    ));
+    // z = 0.02 (sin 5x + cos(10y/3)) − 0.04: at the origin −0.02, dz/dx 0.1;
+    // at x = π/10 the top of the sine: z = 0, dz/dx = 0, curvature −0.5.
+    assert!((rows[0][2] + 0.02).abs() < 1e-15 && (rows[0][3] - 0.1).abs() < 1e-15);
+    assert!(
+        rows[1][2].abs() < 1e-15 && rows[1][3].abs() < 1e-15 && (rows[1][5] + 0.5).abs() < 1e-14,
+        "{:?}",
+        rows[1]
+    );
+}
+
+#[test]
+fn sample_usage_errors() {
+    assert_eq!(
+        lensc(&root(), &["sample", GOOD, "--surface", "convex_asphere"])
+            .status
+            .code(),
+        Some(2)
+    );
+    assert_eq!(
+        lensc(
+            &root(),
+            &["sample", GOOD, "--surface", "nope", "--grid", "3"]
+        )
+        .status
+        .code(),
+        Some(2)
+    );
+    assert_eq!(
+        lensc(
+            &root(),
+            &["sample", GOOD, "--surface", "wheel", "--grid", "3"]
+        )
+        .status
+        .code(),
+        Some(2)
+    );
+}
+
+fn analyse(file: &str, surface: &str) -> serde_json::Value {
+    let out = lensc(&root(), &["analyse", file, "--surface", surface]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    serde_json::from_slice(&out.stdout).expect("json")
+}
+
+#[test]
+fn analyse_reproduces_seed_002_figures() {
+    // Liu et al.: minimum radius of curvature 2 mm, maximum slope 3.81° in
+    // the cutting (circumferential, y) direction and 5.71° axially (x).
+    let a = analyse("examples/liu_roller_pattern.lens", "pattern");
+    let v = |p: &str| a.pointer(p).and_then(serde_json::Value::as_f64).expect(p);
+    assert_eq!(format!("{:.2}", v("/max_slope_y_deg/value")), "3.81");
+    assert_eq!(format!("{:.2}", v("/max_slope_x_deg/value")), "5.71");
+    let r = v("/min_radius_of_curvature_mm/convex_x/value")
+        .min(v("/min_radius_of_curvature_mm/concave_x/value"));
+    assert_eq!(format!("{r:.3}"), "2.000");
+    assert!((v("/sag_mm/pv") - 0.08).abs() < 1e-12);
+    assert_eq!(
+        a["backend"], "jit",
+        "surfaces are evaluated by JIT-compiled kernels"
+    );
+}
+
+#[test]
+fn analyse_seed_003_lenslet() {
+    // Sphere R = 20 mm over 1.7 mm: sag 18.07 µm (Table 1: 18 µm), edge
+    // slope asin(0.85/20) = 2.436°. The x–z section at y is a circle of
+    // radius sqrt(R² − y²): smallest at the rim, y = ±0.85 mm.
+    let a = analyse("examples/hashimoto2025_lenslet.lens", "lenslet");
+    let v = |p: &str| a.pointer(p).and_then(serde_json::Value::as_f64).expect(p);
+    let sag = 0.85f64.powi(2) / (20.0 + (400.0 - 0.85f64.powi(2)).sqrt());
+    assert!((v("/sag_mm/pv") - sag).abs() < 1e-12, "{}", v("/sag_mm/pv"));
+    assert!((v("/max_slope_deg/value") - (0.85f64 / 20.0).asin().to_degrees()).abs() < 1e-9);
+    assert!(
+        (v("/min_radius_of_curvature_mm/concave_x/value") - (400.0f64 - 0.7225).sqrt()).abs()
+            < 1e-9
+    );
+    assert!(
+        a.pointer("/min_radius_of_curvature_mm/convex_x")
+            .expect("key")
+            .is_null()
+    );
+}
+
+#[test]
+fn annular_aperture_cuts_from_outer_to_inner_edge() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let src = "use std::machines::linuxcnc_lathe
+use std::strategies::finish_turning
+// A concave sphere R = 10 mm cut only on the ring 1 mm <= r <= 2 mm.
+surface ring = sphere { radius: 10 mm, sense: concave, aperture: annulus(inner: 1 mm, outer: 2 mm) }
+tool t = round_nose { nose_radius: 0.5 mm, clearance: 7 deg }
+job ring_cut { surface: ring, tool: t, machine: linuxcnc_lathe, strategy: finish_turning }
+";
+    std::fs::write(dir.path().join("ring.lens"), src).expect("write");
+    let out = lensc(dir.path(), &["build", "ring.lens"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let program = std::fs::read_to_string(dir.path().join("out/ring_cut.ngc")).expect("program");
+    // Every X word, from the first rapid over the start to the last cut.
+    let xs: Vec<f64> = program
+        .lines()
+        .filter(|l| !l.starts_with('('))
+        .filter_map(|l| l.split_whitespace().find_map(|w| w.strip_prefix('X')))
+        .map(|v| v.parse().expect("X"))
+        .collect();
+    // The nose centre over a concave sphere sits on the sphere of radius
+    // R − ρ about the same centre: x_c = r (R − ρ)/R.
+    let (first, last) = (xs[0], *xs.last().expect("moves"));
+    // (The lathe's resolution is 0.1 µm: four decimals.)
+    assert!((first - 2.0 * 9.5 / 10.0).abs() < 1e-4, "starts at {first}");
+    assert!((last - 1.0 * 9.5 / 10.0).abs() < 1e-4, "ends at {last}");
+    let bad = "surface bad_ring = sphere { radius: 10 mm, sense: concave, aperture: annulus(inner: 2 mm, outer: 1 mm) }\n";
+    std::fs::write(dir.path().join("bad.lens"), bad).expect("write");
+    let out = lensc(dir.path(), &["check", "bad.lens"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out.stderr).contains("inner radius"));
+}
+
+#[test]
+fn sample_works_on_every_example_surface() {
+    // Issue #3: `lensc sample` on every surface of every example, through
+    // the real binary: a 5 × 5 grid over the aperture, every value finite.
+    let mut sampled = 0;
+    for ex in common::examples() {
+        let path = ex.to_str().expect("utf8").to_string();
+        for name in common::surface_names(&ex) {
+            let out = lensc(
+                &root(),
+                &["sample", &path, "--surface", &name, "--grid", "5"],
+            );
+            assert_eq!(
+                out.status.code(),
+                Some(0),
+                "{path} {name}: {}",
+                text(&out.stderr)
+            );
+            let csv = text(&out.stdout);
+            let mut lines = csv.lines();
+            assert_eq!(
+                lines.next(),
+                Some("x,y,z,dzdx,dzdy,curvature_x,curvature_y"),
+                "{path} {name}"
+            );
+            let rows: Vec<&str> = lines.collect();
+            assert!(!rows.is_empty(), "{path} {name}: no point inside");
+            for row in rows {
+                let values: Vec<f64> = row
+                    .split(',')
+                    .map(|v| v.parse().unwrap_or_else(|_| panic!("{path} {name}: {row}")))
+                    .collect();
+                assert_eq!(values.len(), 7, "{row}");
+                assert!(values.iter().all(|v| v.is_finite()), "{path} {name}: {row}");
+            }
+            sampled += 1;
+        }
+    }
+    assert!(sampled >= 15, "only {sampled} surfaces");
+}

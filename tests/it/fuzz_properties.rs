@@ -1,0 +1,237 @@
+//! Property tests: random bytes and random token sequences never panic
+//! the checker, never overflow its stack, always give well-formed
+//! diagnostics, and through the real binary exit 1 exactly when an error
+//! is reported (never 101).
+
+use crate::common;
+
+use lensc::render;
+use lensc_build::driver::{self, Checked};
+use lensc_lang::loader::RealFs;
+use proptest::prelude::*;
+
+fn check(bytes: &[u8]) -> Checked {
+    driver::check_text(&RealFs, "fuzz.lens", bytes)
+}
+
+/// Every span lies inside its file on character boundaries, and both
+/// renderers accept every diagnostic.
+fn assert_well_formed(c: &Checked) {
+    for d in c.diags() {
+        assert!(!d.message.is_empty());
+        for l in &d.labels {
+            let text = &c.loaded.sources.get(l.file).text;
+            assert!(
+                l.span.start <= l.span.end && (l.span.end as usize) <= text.len(),
+                "{:?} in {} bytes",
+                l.span,
+                text.len()
+            );
+            assert!(
+                text.is_char_boundary(l.span.start as usize)
+                    && text.is_char_boundary(l.span.end as usize)
+            );
+        }
+    }
+    let mut sink = Vec::new();
+    render::human(c.diags(), &c.loaded.sources, false, &mut sink).expect("render");
+    render::json_lines(c.diags(), &c.loaded.sources, &mut sink).expect("json");
+}
+
+const TOKENS: &[&str] = &[
+    "surface",
+    "tool",
+    "machine",
+    "strategy",
+    "job",
+    "let",
+    "use",
+    "s",
+    "t",
+    "m",
+    "x",
+    "y",
+    "z",
+    "r",
+    "conic",
+    "sphere",
+    "asphere",
+    "freeform",
+    "circle",
+    "rect",
+    "round_nose",
+    "lathe",
+    "profile_turning",
+    "radius",
+    "sense",
+    "convex",
+    "aperture",
+    "diameter",
+    "nose_radius",
+    "clearance",
+    "sin",
+    "sqrt",
+    "atan2",
+    "min",
+    "std",
+    "::",
+    "machines",
+    "linuxcnc_lathe",
+    "1",
+    "-20",
+    "0.5",
+    "1e3",
+    "1e999",
+    "85 um",
+    "7 deg",
+    "7°",
+    "3 µm",
+    "5 rad/mm",
+    "2 um/rev",
+    "1000 rpm",
+    "25 g",
+    "1 mm^-3",
+    "=",
+    ":",
+    ",",
+    "{",
+    "}",
+    "(",
+    ")",
+    "[",
+    "]",
+    "+",
+    "-",
+    "*",
+    "/",
+    "^",
+    "..",
+    "\"a.lens\"",
+    "\"",
+    "\n",
+    " ",
+    "//c\n",
+    "/*",
+    "*/",
+    "\\",
+    ";",
+    "é",
+    "\u{0}",
+];
+
+fn tokens() -> impl Strategy<Value = String> {
+    prop::collection::vec(prop::sample::select(TOKENS), 0..120).prop_map(|t| t.join(" "))
+}
+
+/// Fragments of valid files, recombined, reach deeper into the checker
+/// than uniform tokens do.
+fn fragments() -> impl Strategy<Value = String> {
+    const F: &[&str] = &[
+        "use std::machines::linuxcnc_lathe\n",
+        "use std::strategies::finish_turning\n",
+        "surface s = conic { radius: 22.405 mm, conic: 43.098, sense: convex, aperture: circle(radius: 1.6 mm) }\n",
+        "surface f = freeform { z(x, y) = 0.02 mm * sin(5 rad/mm * x), domain: rect(x: 0 mm .. 1 mm, y: 0 mm .. 1 mm) }\n",
+        "tool t = round_nose { nose_radius: 0.5 mm, clearance: 7 deg }\n",
+        "machine m = linuxcnc_lathe { resolution: 10 nm }\n",
+        "strategy g = profile_turning { feed: 2 um/rev, spindle_speed: 500 rpm }\n",
+        "job j { surface: s, tool: t, machine: m, strategy: g }\n",
+        "let a = b\n",
+        "let b = a\n",
+        "radius: -1 mm\n",
+        "}\n",
+        "{\n",
+        "sense: ",
+        "concave",
+        "(",
+        ")",
+    ];
+    prop::collection::vec(prop::sample::select(F), 0..12).prop_map(|t| t.concat())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 256, failure_persistence: None, ..ProptestConfig::default() })]
+
+    #[test]
+    fn random_bytes_never_panic(bytes in prop::collection::vec(any::<u8>(), 0..600)) {
+        let c = check(&bytes);
+        assert_well_formed(&c);
+        if std::str::from_utf8(&bytes).is_err() {
+            prop_assert!(c.has_errors(), "invalid UTF-8 accepted");
+        }
+    }
+
+    #[test]
+    fn random_tokens_never_panic(src in tokens()) {
+        let c = check(src.as_bytes());
+        assert_well_formed(&c);
+        // Whatever pest refuses must be reported.
+        let (_, syntax) = lensc_grammar::parse(&src, lensc_grammar::FileId(0));
+        if !syntax.is_empty() {
+            prop_assert!(c.has_errors());
+        }
+    }
+
+    #[test]
+    fn recombined_fragments_never_panic(src in fragments()) {
+        let c = check(src.as_bytes());
+        assert_well_formed(&c);
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// Through the binary: exit 1 exactly when an error is printed, 0
+    /// otherwise, never an internal error, JSON on every stdout line.
+    #[test]
+    fn binary_exit_code_matches_diagnostics(src in prop_oneof![tokens(), fragments()]) {
+        let dir = tempfile::tempdir().expect("tmp");
+        let path = dir.path().join("fuzz.lens");
+        std::fs::write(&path, &src).expect("write");
+        let out = common::lensc(dir.path(), &["check", "--message-format", "json", "fuzz.lens"]);
+        let stdout = common::text(&out.stdout);
+        let mut errors = 0;
+        for line in stdout.lines() {
+            let v: serde_json::Value = serde_json::from_str(line).expect("json line");
+            if v["severity"] == "error" { errors += 1; }
+        }
+        let code = out.status.code();
+        prop_assert!(code == Some(0) || code == Some(1), "exit {:?}: {}", code, common::text(&out.stderr));
+        prop_assert_eq!(code == Some(1), errors > 0, "exit {:?} with {} errors", code, errors);
+    }
+}
+
+#[test]
+fn pathological_nesting_is_refused_without_overflow() {
+    let deep = |open: &str, close: &str, n: usize| {
+        format!("let a = {}1 mm{}\n", open.repeat(n), close.repeat(n))
+    };
+    for src in [
+        deep("(", ")", 1_000_000),
+        deep("[", "]", 100_000),
+        deep("{", "}", 100_000),
+        deep("-", "", 100_000),
+        deep("sin(", ")", 100_000),
+        format!("let a = 1 mm{}\n", " + 1 mm".repeat(200_000)),
+        format!("let a = 2{}\n", " ^ 2".repeat(100_000)),
+        format!("let a = b{}\n", "(1)".repeat(100_000)),
+        format!("let a = 1{}\n", " * (2 + (3".repeat(30)),
+    ] {
+        let c = check(src.as_bytes());
+        assert!(
+            c.diags()
+                .iter()
+                .any(|d| d.code == "E0002" || d.code == "E0001"),
+            "{}",
+            &src[..60]
+        );
+        assert_well_formed(&c);
+    }
+}
+
+#[test]
+fn empty_and_whitespace_files_are_errors() {
+    for src in ["", "   \n\n", "// only a comment\n"] {
+        assert!(check(src.as_bytes()).has_errors(), "{src:?}");
+    }
+}

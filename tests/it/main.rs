@@ -1,0 +1,26 @@
+//! The integration tests, as one test binary (one link of cranelift,
+//! plotters and the whole compiler instead of fifteen): each module is one
+//! concern, run alone with `cargo test --test it -- MODULE::`.
+//!
+//! Data lives beside this folder: `tests/bad/` and `tests/bad_builds/` (the
+//! bad-input corpora), `tests/jobs/` (small jobs), `tests/fixtures/`,
+//! `tests/seed_sketches/` and `tests/snapshots/` (insta's, reached from
+//! here as `../snapshots/...`).
+
+mod common;
+
+mod build_errors;
+mod cli;
+mod determinism;
+mod diagnostics;
+mod dialects;
+mod examples;
+mod fuzz_properties;
+mod jit_conformance;
+mod plots;
+mod rs274;
+mod seed_sketches;
+mod surface_fixtures;
+mod surface_kinds;
+mod toolpaths;
+mod verification;
