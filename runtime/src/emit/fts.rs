@@ -5,7 +5,7 @@ use crate::moves::{self, Position};
 use crate::plan::optimise::{self};
 use crate::post::dialect::Dialect;
 use crate::post::format::push_fixed;
-use crate::post::{ProgramError, ProgramWriter, Setup};
+use crate::post::{ProgramError, ProgramWriter};
 use std::f64::consts::PI;
 use std::fmt::Write as _;
 
@@ -67,12 +67,10 @@ impl FtsProgram {
             }
         });
         Ok(FtsProgram {
-            writer: ProgramWriter::new(
+            writer: super::xzc_lathe_writer(
                 dialect,
-                Setup::Lathe,
                 job,
                 header,
-                "XZC",
                 resolution,
                 chord_tolerance * optimise::BLEND_SHARE,
             )?,

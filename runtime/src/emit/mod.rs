@@ -12,6 +12,7 @@ use crate::moves;
 use crate::plan::optimise;
 use crate::post::dialect::Dialect;
 use crate::post::header::num;
+use crate::post::{ProgramError, ProgramWriter, Setup};
 
 /// A program, the move stream it was written from, and what
 /// optimisation did to that stream.
@@ -51,4 +52,25 @@ pub fn x_word(dialect: &Dialect) -> &'static str {
     } else {
         "the radius"
     }
+}
+
+/// A lathe program on the X, Z and C axes (the spiral and helix
+/// strategies), its controller blending corners by at most
+/// `path_tolerance` (mm).
+fn xzc_lathe_writer(
+    dialect: &Dialect,
+    job: &str,
+    header: &[String],
+    resolution: f64,
+    path_tolerance: f64,
+) -> Result<ProgramWriter, ProgramError> {
+    ProgramWriter::new(
+        dialect,
+        Setup::Lathe,
+        job,
+        header,
+        "XZC",
+        resolution,
+        path_tolerance,
+    )
 }

@@ -2,7 +2,7 @@
 
 use crate::moves::{self, Position};
 use crate::post::dialect::Dialect;
-use crate::post::{ProgramError, ProgramWriter, Setup};
+use crate::post::{ProgramError, ProgramWriter};
 use std::f64::consts::PI;
 
 /// A LinuxCNC program for roller helix turning: X (the nose centre's
@@ -31,15 +31,7 @@ impl RollerProgram {
         spindle_speed: f64,
     ) -> Result<Self, ProgramError> {
         Ok(RollerProgram {
-            writer: ProgramWriter::new(
-                dialect,
-                Setup::Lathe,
-                job,
-                header,
-                "XZC",
-                resolution,
-                resolution,
-            )?,
+            writer: super::xzc_lathe_writer(dialect, job, header, resolution, resolution)?,
             safe_x,
             spindle_speed,
             c_base: 0.0,

@@ -195,11 +195,51 @@ pub fn plan_profile_grinding(
     check_parameters(p)?;
     let wheel_radius = 0.5 * p.wheel_diameter;
     let length = (p.end - p.start).abs();
-    let dir = (p.end - p.start).signum();
+    let segments = segment_count(length, p.interval)?;
+    let (contacts, min_concave) = contact_points(p, profile, segments)?;
+    if let Some((curvature_radius, x)) = min_concave
+        && wheel_radius > curvature_radius
+    {
+        return Err(GrindingError::WheelTooLarge {
+            x,
+            wheel_radius,
+            curvature_radius,
+        });
+    }
 
-    // Number of intervals: length/δ, rounded when it is an integer up to
-    // rounding (1.6 mm / 1 µm), else one more, shorter, last interval.
-    let ratio = length / p.interval;
+    // Wheel centres (eqs 5–6 in our frame) and the commands (eqs 17–19).
+    let centres: Vec<Vector2<f64>> = contacts
+        .iter()
+        .map(|&(x, pt)| wheel_centre(x, pt, wheel_radius))
+        .collect();
+    if let Some(i) = centres
+        .iter()
+        .position(|c| !(c.x.is_finite() && c.y.is_finite()))
+    {
+        return Err(GrindingError::NonFiniteSurface { x: contacts[i].0 });
+    }
+    let interval_time = p.interval / p.feed;
+    let commands = commands(p, &contacts, &centres, interval_time);
+    if !(commands.max_speed.is_finite() && commands.max_acceleration.is_finite()) {
+        return Err(GrindingError::NonFiniteSurface { x: p.start });
+    }
+
+    Ok(GrindingPath {
+        points: commands.points,
+        segments,
+        interval_time,
+        total_time: length / p.feed,
+        max_speed: commands.max_speed,
+        max_acceleration: commands.max_acceleration,
+        open_loop_drift: commands.open_loop_drift,
+        min_concave_radius: min_concave,
+    })
+}
+
+/// Number of intervals: length/δ, rounded when it is an integer up to
+/// rounding (1.6 mm / 1 µm), else one more, shorter, last interval.
+fn segment_count(length: f64, interval: f64) -> Result<usize, GrindingError> {
+    let ratio = length / interval;
     let nearest = ratio.round();
     let count = if (ratio - nearest).abs() <= 1e-9 * nearest.max(1.0) {
         nearest.max(1.0)
@@ -213,7 +253,24 @@ pub fn plan_profile_grinding(
             limit: MAX_SEGMENTS,
         });
     }
-    let segments = count as usize;
+    Ok(count as usize)
+}
+
+/// A contact x and the profile there.
+type Contact = (f64, ProfilePoint);
+
+/// The smallest concave radius of curvature (mm) and its x, if any.
+type MinConcave = Option<(f64, f64)>;
+
+/// The contact points, one per station, and the smallest concave radius
+/// of curvature (and its x) over the contact points, interval midpoints
+/// and an even scan; or the first x where the profile is undefined.
+fn contact_points(
+    p: &ProfileGrinding,
+    profile: &dyn Profile,
+    segments: usize,
+) -> Result<(Vec<Contact>, MinConcave), GrindingError> {
+    let dir = (p.end - p.start).signum();
     let station = |i: usize| {
         if i >= segments {
             p.end
@@ -221,9 +278,7 @@ pub fn plan_profile_grinding(
             p.start + dir * i as f64 * p.interval
         }
     };
-
-    // Curvature: contact points, interval midpoints and an even scan.
-    let mut min_concave: Option<(f64, f64)> = None;
+    let mut min_concave: MinConcave = None;
     let mut check = |x: f64| -> Result<ProfilePoint, GrindingError> {
         let pt = profile.point(x);
         if !(pt.z.is_finite() && pt.dz.is_finite() && pt.d2z.is_finite()) {
@@ -248,29 +303,27 @@ pub fn plan_profile_grinding(
     for i in 0..=SCAN_POINTS {
         check(p.start + (p.end - p.start) * i as f64 / SCAN_POINTS as f64)?;
     }
-    if let Some((curvature_radius, x)) = min_concave
-        && wheel_radius > curvature_radius
-    {
-        return Err(GrindingError::WheelTooLarge {
-            x,
-            wheel_radius,
-            curvature_radius,
-        });
-    }
+    Ok((contacts, min_concave))
+}
 
-    // Wheel centres (eqs 5–6 in our frame) and the commands (eqs 17–19).
-    let centres: Vec<Vector2<f64>> = contacts
-        .iter()
-        .map(|&(x, pt)| wheel_centre(x, pt, wheel_radius))
-        .collect();
-    if let Some(i) = centres
-        .iter()
-        .position(|c| !(c.x.is_finite() && c.y.is_finite()))
-    {
-        return Err(GrindingError::NonFiniteSurface { x: contacts[i].0 });
-    }
+/// The pass's points with each interval's commands, and their extremes.
+struct Commands {
+    points: Vec<GrindingPoint>,
+    max_speed: f64,
+    max_acceleration: f64,
+    open_loop_drift: f64,
+}
+
+/// Each interval's commanded z velocity (eq 18) and acceleration (eq 19),
+/// the axis starting at rest.
+fn commands(
+    p: &ProfileGrinding,
+    contacts: &[Contact],
+    centres: &[Vector2<f64>],
+    interval_time: f64,
+) -> Commands {
+    let segments = contacts.len() - 1;
     let gamma = p.smoothness;
-    let interval_time = p.interval / p.feed;
     let mut points = Vec::with_capacity(segments + 1);
     points.push(GrindingPoint {
         x: centres[0].x,
@@ -304,20 +357,12 @@ pub fn plan_profile_grinding(
         });
         v_prev = v;
     }
-    if !(max_speed.is_finite() && max_acceleration.is_finite()) {
-        return Err(GrindingError::NonFiniteSurface { x: p.start });
-    }
-
-    Ok(GrindingPath {
+    Commands {
         points,
-        segments,
-        interval_time,
-        total_time: length / p.feed,
         max_speed,
         max_acceleration,
         open_loop_drift,
-        min_concave_radius: min_concave,
-    })
+    }
 }
 
 /// The wheel centre when the wheel of radius `wheel_radius` touches the

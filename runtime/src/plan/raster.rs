@@ -690,63 +690,7 @@ impl<'a> Cutter<'a> {
             let (x, y) = xy(self.along, c.u, c.v);
             aperture.contains(x, y)
         };
-        // The surface must be defined wherever the plane crosses the
-        // aperture. A tool whose solve fails has no contact on this plane
-        // there (its contact would lie off the surface's domain) unless the
-        // tool is too large for the hollow inside the aperture.
-        let mut scan: Vec<Probe> = Vec::with_capacity(SCAN + 1);
-        let mut guess = v;
-        for i in 0..=SCAN {
-            let t = at(i);
-            let (x, y) = xy(self.along, t, v);
-            if aperture.contains(x, y) && !Local::at(self.surface, self.along, t, v).is_finite() {
-                // The edge of definition lies between this point and the
-                // defined scan point next to it (before it, or else the
-                // first one after it).
-                let defined = |t: f64| Local::at(self.surface, self.along, t, v).is_finite();
-                let ok = if i > 0 && defined(at(i - 1)) {
-                    Some(at(i - 1))
-                } else {
-                    (i + 1..=SCAN).map(at).find(|&t| defined(t))
-                };
-                return Err(self.edge_of_definition(v, ok, t));
-            }
-            let probe = match self.contact(v, t, guess) {
-                Ok(c) if inside(&c) => Probe::In(c),
-                Ok(_) => Probe::Out,
-                Err(RasterError::ToolTooLarge {
-                    tool_radius,
-                    min_radius,
-                    x,
-                    y,
-                }) if aperture.contains(x, y) => {
-                    return Err(RasterError::ToolTooLarge {
-                        tool_radius,
-                        min_radius,
-                        x,
-                        y,
-                    });
-                }
-                Err(e) => Probe::Fail(e),
-            };
-            guess = match probe {
-                Probe::In(c) => c.v,
-                _ => v,
-            };
-            scan.push(probe);
-        }
-        // A failed solve between contacts inside the aperture would leave
-        // a gap in the cut.
-        for (i, p) in scan.iter().enumerate() {
-            if let Probe::Fail(e) = p {
-                let solved = |p: &&Probe| !matches!(p, Probe::Fail(_));
-                let before = scan[..i].iter().rev().find(solved);
-                let after = scan[i + 1..].iter().find(solved);
-                if let (Some(Probe::In(_)), Some(Probe::In(_))) = (before, after) {
-                    return Err(e.clone());
-                }
-            }
-        }
+        let scan = self.probe_plane(aperture, v, &at, &inside)?;
         let scan: Vec<Option<Contact>> = scan
             .into_iter()
             .map(|p| match p {
@@ -804,6 +748,76 @@ impl<'a> Cutter<'a> {
             i = j + 1;
         }
         Ok(spans)
+    }
+
+    /// The contact at each of the `SCAN + 1` positions `at(i)` of the
+    /// plane at v: `In` inside the aperture, `Out` outside, `Fail` where
+    /// the solve failed; or the error that stops the plane.
+    fn probe_plane(
+        &self,
+        aperture: &Domain,
+        v: f64,
+        at: &dyn Fn(usize) -> f64,
+        inside: &dyn Fn(&Contact) -> bool,
+    ) -> Result<Vec<Probe>, RasterError> {
+        // The surface must be defined wherever the plane crosses the
+        // aperture. A tool whose solve fails has no contact on this plane
+        // there (its contact would lie off the surface's domain) unless the
+        // tool is too large for the hollow inside the aperture.
+        let mut scan: Vec<Probe> = Vec::with_capacity(SCAN + 1);
+        let mut guess = v;
+        for i in 0..=SCAN {
+            let t = at(i);
+            let (x, y) = xy(self.along, t, v);
+            if aperture.contains(x, y) && !Local::at(self.surface, self.along, t, v).is_finite() {
+                // The edge of definition lies between this point and the
+                // defined scan point next to it (before it, or else the
+                // first one after it).
+                let defined = |t: f64| Local::at(self.surface, self.along, t, v).is_finite();
+                let ok = if i > 0 && defined(at(i - 1)) {
+                    Some(at(i - 1))
+                } else {
+                    (i + 1..=SCAN).map(at).find(|&t| defined(t))
+                };
+                return Err(self.edge_of_definition(v, ok, t));
+            }
+            let probe = match self.contact(v, t, guess) {
+                Ok(c) if inside(&c) => Probe::In(c),
+                Ok(_) => Probe::Out,
+                Err(RasterError::ToolTooLarge {
+                    tool_radius,
+                    min_radius,
+                    x,
+                    y,
+                }) if aperture.contains(x, y) => {
+                    return Err(RasterError::ToolTooLarge {
+                        tool_radius,
+                        min_radius,
+                        x,
+                        y,
+                    });
+                }
+                Err(e) => Probe::Fail(e),
+            };
+            guess = match probe {
+                Probe::In(c) => c.v,
+                _ => v,
+            };
+            scan.push(probe);
+        }
+        // A failed solve between contacts inside the aperture would leave
+        // a gap in the cut.
+        for (i, p) in scan.iter().enumerate() {
+            if let Probe::Fail(e) = p {
+                let solved = |p: &&Probe| !matches!(p, Probe::Fail(_));
+                let before = scan[..i].iter().rev().find(solved);
+                let after = scan[i + 1..].iter().find(solved);
+                if let (Some(Probe::In(_)), Some(Probe::In(_))) = (before, after) {
+                    return Err(e.clone());
+                }
+            }
+        }
+        Ok(scan)
     }
 
     /// The contacts of one pass from `a` to `b` (increasing u): bisection

@@ -756,11 +756,54 @@ pub fn plan_roller_helix_into(
 ) -> Result<RollerPath, RollerError> {
     validate(h, nose_radius)?;
     let rho = nose_radius;
-    let r_r = h.roller_radius;
     let wrap = match h.design_length_around {
-        Some(l) => Some(check_wrap(r_r, l)?),
+        Some(l) => Some(check_wrap(h.roller_radius, l)?),
         None => None,
     };
+    let s = survey_reach(h, rho, design)?;
+    let scanned = s.corners > 0;
+    let centre = |y: f64, x: f64| {
+        let section = AxialSection { design, y };
+        if scanned {
+            centre_height_scanned(&section, rho, x)
+        } else {
+            centre_height(&section, rho, x)
+        }
+    };
+    let mut summaries = Vec::with_capacity(h.passes.len());
+    // The radial stock above the design's lowest point.
+    let mut stock = h.blank_radius - (h.roller_radius + s.z_min);
+    for (i, pass) in h.passes.iter().enumerate() {
+        let (steps, total) = pass_steps(h, pass)?;
+        let cycles = cycles(stock, pass.finish_allowance, h.depth_of_cut);
+        stock = pass.finish_allowance;
+        let plan = PassPlan {
+            h,
+            index: i,
+            pass,
+            steps,
+            total,
+        };
+        summaries.push(plan.run(&centre, cycles, &mut sink)?);
+    }
+    Ok(RollerPath {
+        passes: summaries,
+        points: Vec::new(),
+        design_z_min: s.z_min,
+        design_z_max: s.z_max,
+        concave_corners: s.corners,
+        wrap,
+    })
+}
+
+/// The design surveyed over the nose's reach (see
+/// `plan_roller_helix_into`), or why the nose or the blank cannot cut it.
+fn survey_reach(
+    h: &RollerHelix,
+    rho: f64,
+    design: &(dyn SurfaceFn + Sync),
+) -> Result<Survey, RollerError> {
+    let r_r = h.roller_radius;
     let step = SURVEY_STEP.min(rho / 16.0);
     let count = |len: f64| ((len / step).ceil() as usize + 1).clamp(2, SURVEY_MAX);
     let x_range = (h.z_start - rho, h.z_end + rho);
@@ -784,23 +827,31 @@ pub fn plan_roller_helix_into(
             design_top: r_r + s.z_max,
         });
     }
-    let scanned = s.corners > 0;
-    let centre = |y: f64, x: f64| {
-        let section = AxialSection { design, y };
-        if scanned {
-            centre_height_scanned(&section, rho, x)
-        } else {
-            centre_height(&section, rho, x)
-        }
-    };
-    let mut summaries = Vec::with_capacity(h.passes.len());
-    // The radial stock above the design's lowest point.
-    let mut stock = h.blank_radius - (r_r + s.z_min);
-    for (i, pass) in h.passes.iter().enumerate() {
-        let (steps, total) = pass_steps(h, pass)?;
-        let (cycle_offsets, max_depth_of_cut) =
-            cycles(stock, pass.finish_allowance, h.depth_of_cut);
-        stock = pass.finish_allowance;
+    Ok(s)
+}
+
+/// One pass of a helix: `steps` C steps to its end at C = `total` (rad).
+struct PassPlan<'a> {
+    h: &'a RollerHelix,
+    index: usize,
+    pass: &'a HelixPass,
+    steps: usize,
+    total: f64,
+}
+
+impl PassPlan<'_> {
+    /// Plans the pass's points, a revolution at a time in parallel
+    /// batches, hands them to `sink` in order, and sums them up.
+    /// `centre(y, x)` is the nose-centre height over the design;
+    /// `(cycle_offsets, max_depth_of_cut)` come from `cycles`.
+    fn run(
+        &self,
+        centre: &(impl Fn(f64, f64) -> f64 + Sync),
+        (cycle_offsets, max_depth_of_cut): (Vec<f64>, f64),
+        sink: &mut impl FnMut(usize, &[RollerPoint]),
+    ) -> Result<PassSummary, RollerError> {
+        let (h, pass, steps, total) = (self.h, self.pass, self.steps, self.total);
+        let r_r = h.roller_radius;
         let point = |k: usize| -> Result<RollerPoint, RollerError> {
             let (c, z) = if k == steps {
                 (total, h.z_end)
@@ -813,7 +864,12 @@ pub fn plan_roller_helix_into(
             if x.is_finite() {
                 Ok(RollerPoint { c, z, x })
             } else {
-                Err(RollerError::Undefined { pass: i, c, z, y })
+                Err(RollerError::Undefined {
+                    pass: self.index,
+                    c,
+                    z,
+                    y,
+                })
             }
         };
         // ⌈2π / Δc⌉, a whole number up to rounding being that number.
@@ -846,30 +902,30 @@ pub fn plan_roller_helix_into(
                 .collect();
             for pts in done {
                 let pts = pts?;
-                for p in &pts {
-                    sum.points += 1;
-                    sum.x_min = sum.x_min.min(p.x);
-                    sum.x_max = sum.x_max.max(p.x);
-                    for v in [p.c, p.z, p.x] {
-                        for b in v.to_bits().to_le_bytes() {
-                            sum.fingerprint ^= u64::from(b);
-                            sum.fingerprint = sum.fingerprint.wrapping_mul(0x0100_0000_01b3);
-                        }
-                    }
-                }
-                sink(i, &pts);
+                sum.tally(&pts);
+                sink(self.index, &pts);
             }
         }
-        summaries.push(sum);
+        Ok(sum)
     }
-    Ok(RollerPath {
-        passes: summaries,
-        points: Vec::new(),
-        design_z_min: s.z_min,
-        design_z_max: s.z_max,
-        concave_corners: s.corners,
-        wrap,
-    })
+}
+
+impl PassSummary {
+    /// Counts `pts`, widens the X range over them and folds their bits
+    /// into the fingerprint (FNV-1a over c, z, x of each point).
+    fn tally(&mut self, pts: &[RollerPoint]) {
+        for p in pts {
+            self.points += 1;
+            self.x_min = self.x_min.min(p.x);
+            self.x_max = self.x_max.max(p.x);
+            for v in [p.c, p.z, p.x] {
+                for b in v.to_bits().to_le_bytes() {
+                    self.fingerprint ^= u64::from(b);
+                    self.fingerprint = self.fingerprint.wrapping_mul(0x0100_0000_01b3);
+                }
+            }
+        }
+    }
 }
 
 #[cfg(test)]

@@ -203,22 +203,98 @@ pub fn check_profile_turning(
     job: &TurningJob,
     profile: &dyn Profile,
 ) -> Result<ProfileScan, Vec<PlanError>> {
-    let surf = &job.surface;
     let strat = &job.strategy;
     let rho = job.tool.nose_radius;
-    let start = strat.start_radius.unwrap_or(surf.aperture_radius);
-    let end = strat.end_radius;
+    let start = strat.start_radius.unwrap_or(job.surface.aperture_radius);
+    let feed_speed = match strat.feed {
+        Feed::PerRevolution(f) => f * strat.spindle_speed,
+        Feed::PerTime(v) => v,
+    };
+    let scan = scan_profile(profile, start, strat.end_radius, feed_speed).map_err(|e| vec![e])?;
     let mut errors = Vec::new();
+    if let Some((min_radius, at_radius)) = scan.min_concave
+        && rho > min_radius
+    {
+        errors.push(PlanError::NoseTooLarge {
+            nose_radius: rho,
+            min_radius,
+            at_radius,
+        });
+    }
+    errors.extend(rate_errors(&job.machine, strat, feed_speed));
+    if errors.is_empty() {
+        Ok(scan)
+    } else {
+        Err(errors)
+    }
+}
 
-    // Scan the profile: curvature and slope over the cut.
+/// Plans the profile-turning path of `job` along `profile` (the surface's
+/// section, from the JIT kernel in a build), or says every reason it cannot.
+pub fn plan_profile_turning(
+    job: &TurningJob,
+    profile: &dyn Profile,
+) -> Result<Toolpath, Vec<PlanError>> {
+    let scan = check_profile_turning(job, profile)?;
+    let strat = &job.strategy;
+    let rho = job.tool.nose_radius;
+    let start = strat.start_radius.unwrap_or(job.surface.aperture_radius);
+    let end = strat.end_radius;
+
+    // The profile the nose can touch: the cut range and, at the centre,
+    // its mirror image across the axis.
+    let (lo, hi) = {
+        let (a, b) = (start.min(end), start.max(end));
+        (if a <= 0.0 { a - rho } else { a }, b)
+    };
+    let pieces = envelope::split_at_corners(profile, lo, hi);
+    let seams = seams(profile, &pieces, rho, start.min(end), hi);
+    let section = Section {
+        profile,
+        pieces: &pieces,
+        start,
+        end,
+    };
+    let cut = cut_path(&section, rho, strat);
+    let mut passes = roughing_passes(&section, rho, strat, &cut);
+    let roughing_count = passes.len();
+    passes.push(cut);
+    let linked = link_passes(&passes, strat);
+    let cut = passes.pop().expect("the finish pass");
+    let cutting_time = linked.pass_times.iter().sum();
+
+    if let Some(e) = travel_error(&job.machine, &linked.moves) {
+        return Err(vec![e]);
+    }
+    Ok(Toolpath {
+        cut_points: cut.len(),
+        moves: linked.moves,
+        cut_length: linked.cut_length,
+        feed_speed: scan.feed_speed,
+        cutting_time,
+        pass_times: linked.pass_times,
+        min_concave_radius: scan.min_concave,
+        max_slope: scan.max_slope,
+        seams,
+        roughing_passes: roughing_count,
+    })
+}
+
+/// Scans the profile at `SCAN_POINTS` radii from `end` to `start` for its
+/// curvature and slope, or says where it is undefined.
+fn scan_profile(
+    profile: &dyn Profile,
+    start: f64,
+    end: f64,
+    feed_speed: f64,
+) -> Result<ProfileScan, PlanError> {
     let mut min_concave: Option<(f64, f64)> = None;
     let mut max_slope = (0.0f64, 0.0f64);
     for i in 0..=SCAN_POINTS {
         let r = end + (start - end) * i as f64 / SCAN_POINTS as f64;
         let p = profile.point(r);
         if !(p.z.is_finite() && p.dz.is_finite() && p.d2z.is_finite()) {
-            errors.push(PlanError::Undefined { at_radius: r });
-            return Err(errors);
+            return Err(PlanError::Undefined { at_radius: r });
         }
         let slope = p.dz.atan().abs();
         if slope > max_slope.0 {
@@ -231,72 +307,44 @@ pub fn check_profile_turning(
             }
         }
     }
-    if let Some((min_radius, at_radius)) = min_concave
-        && rho > min_radius
-    {
-        errors.push(PlanError::NoseTooLarge {
-            nose_radius: rho,
-            min_radius,
-            at_radius,
-        });
-    }
-
-    let feed_speed = match strat.feed {
-        Feed::PerRevolution(f) => f * strat.spindle_speed,
-        Feed::PerTime(v) => v,
-    };
-    if feed_speed > job.machine.max_feed {
-        errors.push(PlanError::FeedTooHigh {
-            feed: feed_speed,
-            max: job.machine.max_feed,
-        });
-    }
-    if strat.spindle_speed > job.machine.max_spindle_speed {
-        errors.push(PlanError::SpindleTooFast {
-            speed: strat.spindle_speed,
-            max: job.machine.max_spindle_speed,
-        });
-    }
-    if errors.is_empty() {
-        Ok(ProfileScan {
-            min_concave,
-            max_slope,
-            feed_speed,
-        })
-    } else {
-        Err(errors)
-    }
-}
-
-/// Plans the profile-turning path of `job` along `profile` (the surface's
-/// section, from the JIT kernel in a build), or says every reason it cannot.
-pub fn plan_profile_turning(
-    job: &TurningJob,
-    profile: &dyn Profile,
-) -> Result<Toolpath, Vec<PlanError>> {
-    let ProfileScan {
+    Ok(ProfileScan {
         min_concave,
         max_slope,
         feed_speed,
-    } = check_profile_turning(job, profile)?;
-    let strat = &job.strategy;
-    let rho = job.tool.nose_radius;
-    let start = strat.start_radius.unwrap_or(job.surface.aperture_radius);
-    let end = strat.end_radius;
-    let mut errors = Vec::new();
+    })
+}
 
-    // The profile the nose can touch: the cut range and, at the centre,
-    // its mirror image across the axis.
-    let (lo, hi) = {
-        let (a, b) = (start.min(end), start.max(end));
-        (if a <= 0.0 { a - rho } else { a }, b)
-    };
-    let pieces = envelope::split_at_corners(profile, lo, hi);
-    let seams = seams(profile, &pieces, rho, start.min(end), hi);
-    let cut = cut_path(profile, &pieces, rho, strat, start, end);
-    let mut passes = roughing_passes(profile, &pieces, rho, strat, start, end, &cut);
-    let roughing_count = passes.len();
-    passes.push(cut);
+/// The feed and spindle speed the machine cannot give.
+fn rate_errors(machine: &Lathe, strat: &ProfileTurning, feed_speed: f64) -> Vec<PlanError> {
+    let mut errors = Vec::new();
+    if feed_speed > machine.max_feed {
+        errors.push(PlanError::FeedTooHigh {
+            feed: feed_speed,
+            max: machine.max_feed,
+        });
+    }
+    if strat.spindle_speed > machine.max_spindle_speed {
+        errors.push(PlanError::SpindleTooFast {
+            speed: strat.spindle_speed,
+            max: machine.max_spindle_speed,
+        });
+    }
+    errors
+}
+
+/// The passes joined into one move stream, with what it costs.
+struct LinkedPasses {
+    moves: Vec<Move>,
+    /// Length (mm) of the feed moves, the plunges included.
+    cut_length: f64,
+    /// Cutting time (s) of each pass.
+    pass_times: Vec<f64>,
+}
+
+/// Each pass in turn: a rapid above its first point at the safe height
+/// (the retract above the highest point of any pass), a feed down to it,
+/// the pass, and a rapid back up.
+fn link_passes(passes: &[Vec<Vector2<f64>>], strat: &ProfileTurning) -> LinkedPasses {
     let top = passes
         .iter()
         .flatten()
@@ -318,7 +366,7 @@ pub fn plan_profile_turning(
             }
         }
     };
-    for cut in &passes {
+    for cut in passes {
         moves.push(Move::Rapid {
             x: cut[0].x,
             z: safe_z,
@@ -342,46 +390,27 @@ pub fn plan_profile_turning(
             z: safe_z,
         });
     }
-    let cut = passes.pop().expect("the finish pass");
-    let cutting_time = pass_times.iter().sum();
-
-    let (lo_x, hi_x) = job.machine.travel_x;
-    let (lo_z, hi_z) = job.machine.travel_z;
-    for m in &moves {
-        let (Move::Rapid { x, z } | Move::Feed { x, z }) = *m;
-        if x < lo_x || x > hi_x {
-            errors.push(PlanError::OutOfTravel {
-                axis: 'X',
-                value: x,
-                min: lo_x,
-                max: hi_x,
-            });
-            break;
-        }
-        if z < lo_z || z > hi_z {
-            errors.push(PlanError::OutOfTravel {
-                axis: 'Z',
-                value: z,
-                min: lo_z,
-                max: hi_z,
-            });
-            break;
-        }
-    }
-    if !errors.is_empty() {
-        return Err(errors);
-    }
-    Ok(Toolpath {
-        cut_points: cut.len(),
+    LinkedPasses {
         moves,
         cut_length,
-        feed_speed,
-        cutting_time,
         pass_times,
-        min_concave_radius: min_concave,
-        max_slope,
-        seams,
-        roughing_passes: roughing_count,
+    }
+}
+
+/// The first move, X before Z, that leaves the machine's travel.
+fn travel_error(machine: &Lathe, moves: &[Move]) -> Option<PlanError> {
+    moves.iter().find_map(|m| {
+        let (Move::Rapid { x, z } | Move::Feed { x, z }) = *m;
+        [('X', x, machine.travel_x), ('Z', z, machine.travel_z)]
+            .into_iter()
+            .find_map(|(axis, value, (min, max))| {
+                (value < min || value > max).then_some(PlanError::OutOfTravel {
+                    axis,
+                    value,
+                    min,
+                    max,
+                })
+            })
     })
 }
 
@@ -390,12 +419,9 @@ pub fn plan_profile_turning(
 /// ρ + allowance), and with flat stock never deeper than its level below
 /// the stock's top.
 fn roughing_passes(
-    profile: &dyn Profile,
-    pieces: &Pieces,
+    section: &Section,
     rho: f64,
     strat: &ProfileTurning,
-    start: f64,
-    end: f64,
     finish: &[Vector2<f64>],
 ) -> Vec<Vec<Vector2<f64>>> {
     let Some(r) = strat.roughing else {
@@ -411,7 +437,7 @@ fn roughing_passes(
             location: ToolLocation::Exact,
             ..strat.clone()
         };
-        cut_path(profile, pieces, rho + allowance, &exact, start, end)
+        cut_path(section, rho + allowance, &exact)
     };
     let mut passes = Vec::new();
     match r.stock {
@@ -450,16 +476,24 @@ fn roughing_passes(
     passes
 }
 
-/// The nose-centre points of the cut, within the chord tolerance of the
-/// curve the chosen tool location gives.
-fn cut_path(
-    profile: &dyn Profile,
-    pieces: &Pieces,
-    rho: f64,
-    strat: &ProfileTurning,
+/// The part of the profile a cut runs over: its smooth pieces, from
+/// radius `start` to `end`.
+struct Section<'a> {
+    profile: &'a dyn Profile,
+    pieces: &'a Pieces,
     start: f64,
     end: f64,
-) -> Vec<Vector2<f64>> {
+}
+
+/// The nose-centre points of the cut, within the chord tolerance of the
+/// curve the chosen tool location gives.
+fn cut_path(section: &Section, rho: f64, strat: &ProfileTurning) -> Vec<Vector2<f64>> {
+    let Section {
+        profile,
+        pieces,
+        start,
+        end,
+    } = *section;
     let tol = strat.chord_tolerance * crate::plan::optimise::CHORD_SHARE;
     // The ends of the cut in the tool's x: the normal offsets of its ends.
     let (x0, x1) = (

@@ -17,6 +17,40 @@ pub enum Setup {
     Mill,
 }
 
+impl Setup {
+    /// The kind of program, as the dialect's `<name>_setup` key has it.
+    fn name(self) -> &'static str {
+        match self {
+            Setup::Lathe => "lathe",
+            Setup::Mill => "mill",
+        }
+    }
+}
+
+/// The dialect's own words, checked once: every number the writer prints
+/// itself is well formed by construction (`number`), and every line taken
+/// from the dialect is checked as it is written, so no text leaves the
+/// writer unchecked.
+fn check_dialect_words(dialect: &Dialect) -> Result<(), ProgramError> {
+    let words = [
+        &dialect.rapid,
+        &dialect.linear,
+        &dialect.arc_cw,
+        &dialect.arc_ccw,
+        &dialect.spindle_on,
+        &dialect.spindle_off,
+        &dialect.block_end,
+    ]
+    .into_iter()
+    .chain(dialect.per_minute.iter())
+    .chain(dialect.per_revolution.iter())
+    .chain(dialect.inverse_time.iter());
+    for word in words {
+        check_numbers(word, dialect.comment)?;
+    }
+    Ok(())
+}
+
 /// The post-processor: a move stream to a program in a dialect given as
 /// data. The start lines, header comments, setup and path-tolerance
 /// lines, then the moves word by word: a word whose printed value has not
@@ -95,6 +129,27 @@ impl ProgramWriter {
             Setup::Lathe => &dialect.lathe_setup,
             Setup::Mill => &dialect.mill_setup,
         };
+        let mut w = ProgramWriter::blank(dialect, setup, job, axes, decimals);
+        check_dialect_words(dialect)?;
+        for line in &dialect.start {
+            let l = w.fill(line, path_tolerance);
+            check_numbers(&l, dialect.comment)?;
+            w.text.extend_from_slice(l.as_bytes());
+            w.text.push(b'\n');
+        }
+        for line in header {
+            w.comment(line);
+        }
+        for line in setup_lines.iter().chain(&dialect.path_tolerance) {
+            let l = w.fill(line, path_tolerance);
+            w.block_line(&l)?;
+        }
+        Ok(w)
+    }
+
+    /// A writer with nothing written yet, every word of the dialect
+    /// prepared and no axis position known.
+    fn blank(dialect: &Dialect, setup: Setup, job: &str, axes: &str, decimals: u32) -> Self {
         let has = |c: char| axes.contains(c).then_some(c);
         let letters = [
             has('X'),
@@ -102,7 +157,7 @@ impl ProgramWriter {
             has('Z'),
             has('C').map(|_| dialect.c_letter),
         ];
-        let mut w = ProgramWriter {
+        ProgramWriter {
             text: Vec::new(),
             dialect: dialect.clone(),
             decimals,
@@ -137,41 +192,7 @@ impl ProgramWriter {
             c_axis_on: false,
             job: job.to_string(),
             moves: 0,
-        };
-        // The dialect's own words, checked once: every number the writer
-        // prints itself is well formed by construction (`number`), and
-        // every line taken from the dialect is checked as it is written,
-        // so no text leaves the writer unchecked.
-        let words = [
-            &dialect.rapid,
-            &dialect.linear,
-            &dialect.arc_cw,
-            &dialect.arc_ccw,
-            &dialect.spindle_on,
-            &dialect.spindle_off,
-            &dialect.block_end,
-        ]
-        .into_iter()
-        .chain(dialect.per_minute.iter())
-        .chain(dialect.per_revolution.iter())
-        .chain(dialect.inverse_time.iter());
-        for word in words {
-            check_numbers(word, dialect.comment)?;
         }
-        for line in &dialect.start {
-            let l = w.fill(line, path_tolerance);
-            check_numbers(&l, dialect.comment)?;
-            w.text.extend_from_slice(l.as_bytes());
-            w.text.push(b'\n');
-        }
-        for line in header {
-            w.comment(line);
-        }
-        for line in setup_lines.iter().chain(&dialect.path_tolerance) {
-            let l = w.fill(line, path_tolerance);
-            w.block_line(&l)?;
-        }
-        Ok(w)
     }
 
     /// A line with its placeholders filled in.
@@ -406,25 +427,13 @@ impl ProgramWriter {
         r
     }
 
-    /// A motion block.
-    #[inline(always)]
-    fn motion(
-        &mut self,
-        word: Word,
-        to: Position,
-        feed: Option<crate::moves::Feed>,
-        arc: Option<(Plane, Position)>,
-    ) -> Result<(), ProgramError> {
-        self.motion_words_into_text(word, to, feed, arc)
-    }
-
     /// A motion block: its words straight into the text, each a copy of
     /// fixed size (a snippet's room, a number's room) cut back to length.
     /// The values printed are kept word by word and become the last
     /// printed values only when the block is written (a block refused
     /// leaves them as they were).
     #[inline(always)]
-    fn motion_words_into_text(
+    fn motion(
         &mut self,
         word: Word,
         to: Position,
@@ -467,9 +476,9 @@ impl ProgramWriter {
             }
         }
         self.motion_words[word as usize].push_to(&mut self.text);
+        let axes = to.axes();
         let mut printed = [0i64; 4];
         let mut changed = 0u8;
-        let axes = to.axes();
         for i in 0..4 {
             let v = axes[i];
             if v.is_nan() {
@@ -500,16 +509,8 @@ impl ProgramWriter {
         if let Some((plane, centre)) = arc {
             self.arc_centre(plane, to, centre)?;
         }
-        if let Some((m, value, d)) = mode {
-            let Some(n) = fixed_units(value, d) else {
-                return Err(ProgramError::NotPrintable { word: 'F', value });
-            };
-            if mode_changes || m == FeedMode::InverseTime || self.last_feed != Some(n) {
-                self.text.extend_from_slice(b" F");
-                self.number('F', value, n, d)?;
-            }
-            self.last_feed = Some(n);
-            self.mode = Some(m);
+        if let Some(mode) = mode {
+            self.feed_word(mode, mode_changes)?;
         }
         self.end_block(start)?;
         for (i, n) in printed.into_iter().enumerate() {
@@ -523,6 +524,26 @@ impl ProgramWriter {
             }
         }
         self.moves += 1;
+        Ok(())
+    }
+
+    /// The feed word: written when the mode or the printed feed changes,
+    /// and on every move in inverse time.
+    #[inline(always)]
+    fn feed_word(
+        &mut self,
+        (m, value, d): (FeedMode, f64, u32),
+        mode_changes: bool,
+    ) -> Result<(), ProgramError> {
+        let Some(n) = fixed_units(value, d) else {
+            return Err(ProgramError::NotPrintable { word: 'F', value });
+        };
+        if mode_changes || m == FeedMode::InverseTime || self.last_feed != Some(n) {
+            self.text.extend_from_slice(b" F");
+            self.number('F', value, n, d)?;
+        }
+        self.last_feed = Some(n);
+        self.mode = Some(m);
         Ok(())
     }
 
@@ -743,15 +764,9 @@ pub fn check_dialect(
     if setup_lines.is_empty() {
         return Err(ProgramError::Unsupported(format!(
             "{} programs ({} has no `{}_setup`)",
-            match setup {
-                Setup::Lathe => "lathe",
-                Setup::Mill => "mill",
-            },
+            setup.name(),
             dialect.name,
-            match setup {
-                Setup::Lathe => "lathe",
-                Setup::Mill => "mill",
-            },
+            setup.name(),
         )));
     }
     Ok(decimals)

@@ -12,24 +12,12 @@
 
 use std::marker::PhantomData;
 
-use super::ir::{Binary, Graph, Id, Interpreter, SurfaceFn, SurfaceTape, Unary};
+use super::ir::{Binary, Graph, Id, SurfaceFn, SurfaceTape, Unary};
 
-/// An evaluator under test: how it is made from a tape.
+/// An evaluator under test: how it is made from a tape. Each backend's
+/// own tests implement it and call `surface_fn_tests!`.
 pub trait Backend: SurfaceFn + Sized {
     fn build(tape: &SurfaceTape) -> Self;
-}
-
-impl Backend for Interpreter {
-    fn build(tape: &SurfaceTape) -> Self {
-        Interpreter::new(tape)
-    }
-}
-
-#[cfg(feature = "jit")]
-impl Backend for super::jit::JitSurface {
-    fn build(tape: &SurfaceTape) -> Self {
-        super::jit::JitSurface::compile(tape).expect("the tape compiles")
-    }
 }
 
 /// Closed forms and the backend agree to this, relative to the larger of

@@ -335,123 +335,141 @@ impl Graph {
                 let np = self.mul(n, p);
                 self.mul(np, da)
             }
+            Node::Unary(Unary::Neg, a) => {
+                let da = self.derivative(a, var);
+                self.neg(da)
+            }
             Node::Unary(op, a) => {
                 let da = self.derivative(a, var);
-                let outer = match op {
-                    Unary::Neg => {
-                        let n = self.neg(da);
-                        return self.memo(id, var, n);
-                    }
-                    // d sqrt(a) = da / (2 sqrt(a))
-                    Unary::Sqrt => {
-                        let two = self.constant_node(2.0);
-                        let t = self.mul(two, id);
-                        let one = self.constant_node(1.0);
-                        self.div(one, t)
-                    }
-                    // d |a| = sign(a) da, with sign = 1 − 2·step(a)
-                    Unary::Abs => {
-                        let s = self.step(a);
-                        let two = self.constant_node(2.0);
-                        let t = self.mul(two, s);
-                        let one = self.constant_node(1.0);
-                        self.sub(one, t)
-                    }
-                    Unary::Sin => self.unary(Unary::Cos, a),
-                    Unary::Cos => {
-                        let s = self.unary(Unary::Sin, a);
-                        self.neg(s)
-                    }
-                    // d tan(a) = (1 + tan²a) da
-                    Unary::Tan => {
-                        let t2 = self.powi(id, 2);
-                        let one = self.constant_node(1.0);
-                        self.add(one, t2)
-                    }
-                    // d asin(a) = da / sqrt(1 − a²); acos is its negative
-                    Unary::Asin | Unary::Acos => {
-                        let a2 = self.powi(a, 2);
-                        let one = self.constant_node(1.0);
-                        let r = self.sub(one, a2);
-                        let s = self.sqrt(r);
-                        let inv = self.div(one, s);
-                        if op == Unary::Asin {
-                            inv
-                        } else {
-                            self.neg(inv)
-                        }
-                    }
-                    // d atan(a) = da / (1 + a²)
-                    Unary::Atan => {
-                        let a2 = self.powi(a, 2);
-                        let one = self.constant_node(1.0);
-                        let r = self.add(one, a2);
-                        self.div(one, r)
-                    }
-                    Unary::Exp => id,
-                    Unary::Ln => {
-                        let one = self.constant_node(1.0);
-                        self.div(one, a)
-                    }
-                    Unary::Floor => unreachable!("handled above"),
-                };
+                let outer = self.unary_slope(op, id, a);
                 self.mul(outer, da)
             }
             Node::Binary(op, a, b) => {
                 let da = self.derivative(a, var);
                 let db = self.derivative(b, var);
-                match op {
-                    Binary::Add => self.add(da, db),
-                    Binary::Sub => self.sub(da, db),
-                    Binary::Mul => {
-                        let l = self.mul(da, b);
-                        let r = self.mul(a, db);
-                        self.add(l, r)
-                    }
-                    // d(a/b) = (da − (a/b) db) / b
-                    Binary::Div => {
-                        let q = self.mul(id, db);
-                        let num = self.sub(da, q);
-                        self.div(num, b)
-                    }
-                    // d(a^b) = a^b (db ln a + b da / a)
-                    Binary::Pow => {
-                        let ln = self.unary(Unary::Ln, a);
-                        let l = self.mul(db, ln);
-                        let ba = self.div(b, a);
-                        let r = self.mul(ba, da);
-                        let s = self.add(l, r);
-                        self.mul(id, s)
-                    }
-                    // atan2(a, b): d = (b da − a db) / (a² + b²)
-                    Binary::Atan2 => {
-                        let l = self.mul(b, da);
-                        let r = self.mul(a, db);
-                        let num = self.sub(l, r);
-                        let a2 = self.powi(a, 2);
-                        let b2 = self.powi(b, 2);
-                        let den = self.add(a2, b2);
-                        self.div(num, den)
-                    }
-                    // With s = step(a − b) (1 where a < b):
-                    // min(a, b) = b + s(a − b), d min = db + s(da − db);
-                    // max(a, b) = a + s(b − a), d max = da + s(db − da).
-                    Binary::Min | Binary::Max => {
-                        let diff = self.sub(a, b);
-                        let s = self.step(diff);
-                        let (lo, hi) = if op == Binary::Min {
-                            (da, db)
-                        } else {
-                            (db, da)
-                        };
-                        let dd = self.sub(lo, hi);
-                        let t = self.mul(s, dd);
-                        self.add(hi, t)
-                    }
-                }
+                self.binary_derivative(op, id, (a, da), (b, db))
             }
         };
         self.memo(id, var, d)
+    }
+
+    /// f′(a) of `id` = f(a), a function of one argument other than
+    /// negation (the chain rule's outer factor).
+    fn unary_slope(&mut self, op: Unary, id: Id, a: Id) -> Id {
+        match op {
+            // d sqrt(a) = da / (2 sqrt(a))
+            Unary::Sqrt => {
+                let two = self.constant_node(2.0);
+                let t = self.mul(two, id);
+                let one = self.constant_node(1.0);
+                self.div(one, t)
+            }
+            // d |a| = sign(a) da, with sign = 1 − 2·step(a)
+            Unary::Abs => {
+                let s = self.step(a);
+                let two = self.constant_node(2.0);
+                let t = self.mul(two, s);
+                let one = self.constant_node(1.0);
+                self.sub(one, t)
+            }
+            Unary::Sin => self.unary(Unary::Cos, a),
+            Unary::Cos => {
+                let s = self.unary(Unary::Sin, a);
+                self.neg(s)
+            }
+            // d tan(a) = (1 + tan²a) da
+            Unary::Tan => {
+                let t2 = self.powi(id, 2);
+                let one = self.constant_node(1.0);
+                self.add(one, t2)
+            }
+            // d asin(a) = da / sqrt(1 − a²); acos is its negative
+            Unary::Asin | Unary::Acos => {
+                let a2 = self.powi(a, 2);
+                let one = self.constant_node(1.0);
+                let r = self.sub(one, a2);
+                let s = self.sqrt(r);
+                let inv = self.div(one, s);
+                if op == Unary::Asin {
+                    inv
+                } else {
+                    self.neg(inv)
+                }
+            }
+            // d atan(a) = da / (1 + a²)
+            Unary::Atan => {
+                let a2 = self.powi(a, 2);
+                let one = self.constant_node(1.0);
+                let r = self.add(one, a2);
+                self.div(one, r)
+            }
+            Unary::Exp => id,
+            Unary::Ln => {
+                let one = self.constant_node(1.0);
+                self.div(one, a)
+            }
+            Unary::Neg | Unary::Floor => unreachable!("handled by `derivative`"),
+        }
+    }
+
+    /// d(a op b) from the operands and their derivatives; `id` is the node
+    /// a op b itself.
+    fn binary_derivative(
+        &mut self,
+        op: Binary,
+        id: Id,
+        (a, da): (Id, Id),
+        (b, db): (Id, Id),
+    ) -> Id {
+        match op {
+            Binary::Add => self.add(da, db),
+            Binary::Sub => self.sub(da, db),
+            Binary::Mul => {
+                let l = self.mul(da, b);
+                let r = self.mul(a, db);
+                self.add(l, r)
+            }
+            // d(a/b) = (da − (a/b) db) / b
+            Binary::Div => {
+                let q = self.mul(id, db);
+                let num = self.sub(da, q);
+                self.div(num, b)
+            }
+            // d(a^b) = a^b (db ln a + b da / a)
+            Binary::Pow => {
+                let ln = self.unary(Unary::Ln, a);
+                let l = self.mul(db, ln);
+                let ba = self.div(b, a);
+                let r = self.mul(ba, da);
+                let s = self.add(l, r);
+                self.mul(id, s)
+            }
+            // atan2(a, b): d = (b da − a db) / (a² + b²)
+            Binary::Atan2 => {
+                let l = self.mul(b, da);
+                let r = self.mul(a, db);
+                let num = self.sub(l, r);
+                let a2 = self.powi(a, 2);
+                let b2 = self.powi(b, 2);
+                let den = self.add(a2, b2);
+                self.div(num, den)
+            }
+            // With s = step(a − b) (1 where a < b):
+            // min(a, b) = b + s(a − b), d min = db + s(da − db);
+            // max(a, b) = a + s(b − a), d max = da + s(db − da).
+            Binary::Min | Binary::Max => {
+                let diff = self.sub(a, b);
+                let s = self.step(diff);
+                let (lo, hi) = if op == Binary::Min {
+                    (da, db)
+                } else {
+                    (db, da)
+                };
+                let dd = self.sub(lo, hi);
+                let t = self.mul(s, dd);
+                self.add(hi, t)
+            }
+        }
     }
 
     fn memo(&mut self, id: Id, var: Var, d: Id) -> Id {

@@ -571,38 +571,39 @@ impl Libm {
 
 // The C-ABI entry points the kernel calls. Each is the interpreter's own
 // function for that operation, so both backends share one implementation.
-extern "C" fn lensc_jit_sin(a: f64) -> f64 {
-    apply_unary(Unary::Sin, a)
+macro_rules! libm_entries {
+    ($($name:ident = $kind:ident::$op:ident ($($arg:ident),+);)*) => {
+        $(extern "C" fn $name($($arg: f64),+) -> f64 {
+            libm_entries!(@apply $kind::$op, $($arg),+)
+        })*
+    };
+    (@apply Unary::$op:ident, $a:ident) => { apply_unary(Unary::$op, $a) };
+    (@apply Binary::$op:ident, $a:ident, $b:ident) => { apply_binary(Binary::$op, $a, $b) };
 }
-extern "C" fn lensc_jit_cos(a: f64) -> f64 {
-    apply_unary(Unary::Cos, a)
-}
-extern "C" fn lensc_jit_tan(a: f64) -> f64 {
-    apply_unary(Unary::Tan, a)
-}
-extern "C" fn lensc_jit_asin(a: f64) -> f64 {
-    apply_unary(Unary::Asin, a)
-}
-extern "C" fn lensc_jit_acos(a: f64) -> f64 {
-    apply_unary(Unary::Acos, a)
-}
-extern "C" fn lensc_jit_atan(a: f64) -> f64 {
-    apply_unary(Unary::Atan, a)
-}
-extern "C" fn lensc_jit_exp(a: f64) -> f64 {
-    apply_unary(Unary::Exp, a)
-}
-extern "C" fn lensc_jit_ln(a: f64) -> f64 {
-    apply_unary(Unary::Ln, a)
-}
-extern "C" fn lensc_jit_pow(a: f64, b: f64) -> f64 {
-    apply_binary(Binary::Pow, a, b)
-}
-extern "C" fn lensc_jit_atan2(a: f64, b: f64) -> f64 {
-    apply_binary(Binary::Atan2, a, b)
+
+libm_entries! {
+    lensc_jit_sin = Unary::Sin(a);
+    lensc_jit_cos = Unary::Cos(a);
+    lensc_jit_tan = Unary::Tan(a);
+    lensc_jit_asin = Unary::Asin(a);
+    lensc_jit_acos = Unary::Acos(a);
+    lensc_jit_atan = Unary::Atan(a);
+    lensc_jit_exp = Unary::Exp(a);
+    lensc_jit_ln = Unary::Ln(a);
+    lensc_jit_pow = Binary::Pow(a, b);
+    lensc_jit_atan2 = Binary::Atan2(a, b);
 }
 
 #[cfg(test)]
 mod tests {
-    crate::surface::conformance::surface_fn_tests!(super::JitSurface);
+    use super::JitSurface;
+    use crate::surface::ir::SurfaceTape;
+
+    impl crate::surface::conformance::Backend for JitSurface {
+        fn build(tape: &SurfaceTape) -> Self {
+            JitSurface::compile(tape).expect("the tape compiles")
+        }
+    }
+
+    crate::surface::conformance::surface_fn_tests!(JitSurface);
 }

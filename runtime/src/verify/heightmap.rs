@@ -274,114 +274,163 @@ fn envelope(centres: &[(f64, f64)], r: f64) -> Vec<(usize, f64)> {
 }
 
 fn column(g: &Grid, r: f64, j: usize, mut centres: Vec<(f64, f64)>, frame: &dyn Frame) -> Column {
-    let s = g.s(j);
     centres.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
     centres.dedup_by(|later, kept| (later.0 - kept.0).abs() < 1e-12);
     let pieces = envelope(&centres, r);
-    let height = |p: usize, u: f64| {
-        let (cu, ch) = centres[pieces[p].0];
+    let cut = ColumnCut {
+        s: g.s(j),
+        r,
+        centres,
+        pieces,
+        frame,
+    };
+    let valleys = cut.valleys(g);
+    Column {
+        errors: cut.errors(g),
+        cusps: cut.cusps(g, &valleys),
+        valleys: valleys.into_iter().filter(|v| !v.1.is_nan()).collect(),
+    }
+}
+
+/// One column's cut: the lower envelope of the tool circles over it,
+/// piece `p` being circle `centres[pieces[p].0]` from u = `pieces[p].1`.
+struct ColumnCut<'a> {
+    /// The column (mm, or rad).
+    s: f64,
+    /// The tool radius (mm).
+    r: f64,
+    centres: Vec<(f64, f64)>,
+    pieces: Vec<(usize, f64)>,
+    frame: &'a dyn Frame,
+}
+
+impl ColumnCut<'_> {
+    /// The height piece `p`'s circle cuts at u (NaN beyond its reach).
+    fn height(&self, p: usize, u: f64) -> f64 {
+        let (cu, ch) = self.centres[self.pieces[p].0];
         let d = u - cu;
-        if d.abs() > r {
+        if d.abs() > self.r {
             f64::NAN
         } else {
-            ch - (r * r - d * d).sqrt()
-        }
-    };
-    let end = |p: usize| pieces.get(p + 1).map_or(f64::INFINITY, |q| q.1);
-    let in_window = |u: f64| {
-        let (x, y) = frame.xy(s, u);
-        frame.inside(x, y) && in_features(frame.features(), x, y)
-    };
-    // Rows.
-    let mut cut = vec![f64::NAN; g.nu];
-    let mut p = 0;
-    for (i, c) in cut.iter_mut().enumerate() {
-        let u = g.u(i);
-        while p < pieces.len() && end(p) <= u {
-            p += 1;
-        }
-        if p < pieces.len() && pieces[p].1 <= u && in_window(u) {
-            *c = height(p, u);
+            ch - (self.r * self.r - d * d).sqrt()
         }
     }
-    let points: Vec<(f64, f64)> = (0..g.nu).map(|i| (s, g.u(i))).collect();
-    let mut design = vec![0.0; g.nu];
-    frame.design(&points, &mut design);
-    let errors: Vec<f64> = cut.iter().zip(&design).map(|(c, d)| c - d).collect();
-    // Contacts: the least error over each piece inside the rows, from
-    // five samples and a parabola through the least and its neighbours.
-    let (u_lo, u_hi) = (g.u0, g.u_end());
-    let mut valleys: Vec<(f64, f64)> = vec![(f64::NAN, f64::NAN); pieces.len()];
-    let mut probe = Vec::with_capacity(6);
-    let mut probe_design = [0.0; 6];
-    for (q, v) in valleys.iter_mut().enumerate() {
-        let (cu, _) = centres[pieces[q].0];
-        let a = pieces[q].1.max(cu - r).max(u_lo);
-        let b = end(q).min(cu + r).min(u_hi);
-        if b.partial_cmp(&a) != Some(std::cmp::Ordering::Greater) {
-            continue;
-        }
-        probe.clear();
-        probe.extend((0..5).map(|k| (s, a + (b - a) * k as f64 / 4.0)));
-        frame.design(&probe, &mut probe_design[..5]);
-        let e: Vec<f64> = (0..5)
-            .map(|k| height(q, probe[k].1) - probe_design[k])
-            .collect();
-        let m = (1..4).min_by(|&x, &y| e[x].total_cmp(&e[y])).unwrap_or(2);
-        let (mut best_u, mut best) = (probe[m].1, e[m]);
-        for k in [0, 4] {
-            if e[k] < best {
-                (best_u, best) = (probe[k].1, e[k]);
+
+    /// Where piece `p` ends: where the next begins.
+    fn end(&self, p: usize) -> f64 {
+        self.pieces.get(p + 1).map_or(f64::INFINITY, |q| q.1)
+    }
+
+    /// Whether (s, u) lies in the window and its features.
+    fn in_window(&self, u: f64) -> bool {
+        let (x, y) = self.frame.xy(self.s, u);
+        self.frame.inside(x, y) && in_features(self.frame.features(), x, y)
+    }
+
+    /// The design's height at (s, u).
+    fn design_at(&self, u: f64) -> f64 {
+        let mut dz = [0.0];
+        self.frame.design(&[(self.s, u)], &mut dz);
+        dz[0]
+    }
+
+    /// Cut − design at every row (NaN where no piece reaches or outside
+    /// the window).
+    fn errors(&self, g: &Grid) -> Vec<f64> {
+        let mut cut = vec![f64::NAN; g.nu];
+        let mut p = 0;
+        for (i, c) in cut.iter_mut().enumerate() {
+            let u = g.u(i);
+            while p < self.pieces.len() && self.end(p) <= u {
+                p += 1;
+            }
+            if p < self.pieces.len() && self.pieces[p].1 <= u && self.in_window(u) {
+                *c = self.height(p, u);
             }
         }
-        let h = (b - a) / 4.0;
-        let curv = e[m - 1] - 2.0 * e[m] + e[m + 1];
-        if curv > 0.0 {
-            let t = 0.5 * (e[m - 1] - e[m + 1]) / curv;
-            if t.abs() <= 1.0 {
-                let u = probe[m].1 + t * h;
-                let mut dz = [0.0];
-                frame.design(&[(s, u)], &mut dz);
-                let eu = height(q, u) - dz[0];
-                if eu < best {
-                    (best_u, best) = (u, eu);
+        let points: Vec<(f64, f64)> = (0..g.nu).map(|i| (self.s, g.u(i))).collect();
+        let mut design = vec![0.0; g.nu];
+        self.frame.design(&points, &mut design);
+        cut.iter().zip(&design).map(|(c, d)| c - d).collect()
+    }
+
+    /// Contacts: the least error over each piece inside the rows, from
+    /// five samples and a parabola through the least and its neighbours;
+    /// (NaN, NaN) for a piece with none in the window.
+    fn valleys(&self, g: &Grid) -> Vec<(f64, f64)> {
+        let (s, r) = (self.s, self.r);
+        let (u_lo, u_hi) = (g.u0, g.u_end());
+        let mut valleys: Vec<(f64, f64)> = vec![(f64::NAN, f64::NAN); self.pieces.len()];
+        let mut probe = Vec::with_capacity(6);
+        let mut probe_design = [0.0; 6];
+        for (q, v) in valleys.iter_mut().enumerate() {
+            let (cu, _) = self.centres[self.pieces[q].0];
+            let a = self.pieces[q].1.max(cu - r).max(u_lo);
+            let b = self.end(q).min(cu + r).min(u_hi);
+            if b.partial_cmp(&a) != Some(std::cmp::Ordering::Greater) {
+                continue;
+            }
+            probe.clear();
+            probe.extend((0..5).map(|k| (s, a + (b - a) * k as f64 / 4.0)));
+            self.frame.design(&probe, &mut probe_design[..5]);
+            let e: Vec<f64> = (0..5)
+                .map(|k| self.height(q, probe[k].1) - probe_design[k])
+                .collect();
+            let m = (1..4).min_by(|&x, &y| e[x].total_cmp(&e[y])).unwrap_or(2);
+            let (mut best_u, mut best) = (probe[m].1, e[m]);
+            for k in [0, 4] {
+                if e[k] < best {
+                    (best_u, best) = (probe[k].1, e[k]);
                 }
             }
+            let h = (b - a) / 4.0;
+            let curv = e[m - 1] - 2.0 * e[m] + e[m + 1];
+            if curv > 0.0 {
+                let t = 0.5 * (e[m - 1] - e[m + 1]) / curv;
+                if t.abs() <= 1.0 {
+                    let u = probe[m].1 + t * h;
+                    let eu = self.height(q, u) - self.design_at(u);
+                    if eu < best {
+                        (best_u, best) = (u, eu);
+                    }
+                }
+            }
+            // A piece cut short by the window's edge has its contact outside
+            // when its least error is at that edge.
+            let clipped = (best_u == a && a > self.pieces[q].1.max(cu - r))
+                || (best_u == b && b < self.end(q).min(cu + r));
+            if !clipped && self.in_window(best_u) {
+                *v = (best_u, best);
+            }
         }
-        // A piece cut short by the window's edge has its contact outside
-        // when its least error is at that edge.
-        let clipped =
-            (best_u == a && a > pieces[q].1.max(cu - r)) || (best_u == b && b < end(q).min(cu + r));
-        let (x, y) = frame.xy(s, best_u);
-        if !clipped && frame.inside(x, y) && in_features(frame.features(), x, y) {
-            *v = (best_u, best);
-        }
+        valleys
     }
-    // Cusps between neighbouring pieces whose circles meet there.
-    let mut cusps = Vec::new();
-    for q in 1..pieces.len() {
-        let u = pieces[q].1;
-        let (cu_a, cu_b) = (centres[pieces[q - 1].0].0, centres[pieces[q].0].0);
-        if u < u_lo || u > u_hi || (u - cu_a).abs() > r || (u - cu_b).abs() > r {
-            continue;
+
+    /// Cusps between neighbouring pieces whose circles meet there: where
+    /// and how high above the mean of the two valleys.
+    fn cusps(&self, g: &Grid, valleys: &[(f64, f64)]) -> Vec<(f64, f64)> {
+        let (u_lo, u_hi) = (g.u0, g.u_end());
+        let mut cusps = Vec::new();
+        for q in 1..self.pieces.len() {
+            let u = self.pieces[q].1;
+            let (cu_a, cu_b) = (
+                self.centres[self.pieces[q - 1].0].0,
+                self.centres[self.pieces[q].0].0,
+            );
+            if u < u_lo || u > u_hi || (u - cu_a).abs() > self.r || (u - cu_b).abs() > self.r {
+                continue;
+            }
+            let (va, vb) = (valleys[q - 1].1, valleys[q].1);
+            if va.is_nan() || vb.is_nan() {
+                continue;
+            }
+            if !self.in_window(u) {
+                continue;
+            }
+            let e = self.height(q, u) - self.design_at(u);
+            cusps.push((u, e - (va + vb) / 2.0));
         }
-        let (va, vb) = (valleys[q - 1].1, valleys[q].1);
-        if va.is_nan() || vb.is_nan() {
-            continue;
-        }
-        let (x, y) = frame.xy(s, u);
-        if !(frame.inside(x, y) && in_features(frame.features(), x, y)) {
-            continue;
-        }
-        let mut dz = [0.0];
-        frame.design(&[(s, u)], &mut dz);
-        let e = height(q, u) - dz[0];
-        cusps.push((u, e - (va + vb) / 2.0));
-    }
-    Column {
-        errors,
-        valleys: valleys.into_iter().filter(|v| !v.1.is_nan()).collect(),
-        cusps,
+        cusps
     }
 }
 

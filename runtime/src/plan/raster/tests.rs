@@ -410,7 +410,7 @@ fn zigzag_reverses_alternate_passes() {
 }
 
 #[test]
-fn invalid_inputs_give_errors() {
+fn invalid_raster_parameters_give_errors() {
     let surf = convex(1.0, 0.0);
     let aperture = Domain::Circle { radius: 0.5 };
     let base = raster(Axis::X, 0.05, 1e-4);
@@ -455,6 +455,13 @@ fn invalid_inputs_give_errors() {
         },
         "retract",
     );
+}
+
+#[test]
+fn invalid_tools_and_apertures_give_errors() {
+    let surf = convex(1.0, 0.0);
+    let aperture = Domain::Circle { radius: 0.5 };
+    let base = raster(Axis::X, 0.05, 1e-4);
     let err = |tool: RasterTool, ap: Domain| plan_raster(&base, &tool, &surf, &ap).unwrap_err();
     assert!(matches!(
         err(RasterTool::Knife { nose_radius: 0.0 }, aperture),
@@ -497,6 +504,13 @@ fn invalid_inputs_give_errors() {
         ),
         RasterError::InvalidParameter { .. }
     ));
+}
+
+#[test]
+fn plans_beyond_reach_give_errors() {
+    let surf = convex(1.0, 0.0);
+    let aperture = Domain::Circle { radius: 0.5 };
+    let base = raster(Axis::X, 0.05, 1e-4);
     assert!(matches!(
         plan_raster(
             &Raster {

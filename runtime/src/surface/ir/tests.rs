@@ -22,4 +22,10 @@ fn builds_deduplicate_and_fold() {
     assert_eq!(g.neg(nx), x);
 }
 
+impl crate::surface::conformance::Backend for Interpreter {
+    fn build(tape: &SurfaceTape) -> Self {
+        Interpreter::new(tape)
+    }
+}
+
 crate::surface::conformance::surface_fn_tests!(Interpreter);
