@@ -95,8 +95,8 @@ fn a_profile_job_plots_design_path_cut_and_form_error() {
     // The form error (green): the 20,001 simulated radii in runs of 21,
     // each drawn by its least and largest value; the legend's sample is
     // the 2-point line.
-    let run = driver::PROFILE_SAMPLES.div_ceil(plots::PROFILE_POINTS / 2);
-    let want = 2 * driver::PROFILE_SAMPLES.div_ceil(run);
+    let run = plots::PROFILE_SAMPLES.div_ceil(plots::PROFILE_POINTS / 2);
+    let want = 2 * plots::PROFILE_SAMPLES.div_ceil(run);
     assert_eq!((run, want), (21, 1906));
     assert_eq!(polylines(&svg, "#2CA02C"), vec![want, 2]);
     assert!(svg.contains(&format!("runs of {run} consecutive ones")));
@@ -128,7 +128,7 @@ fn profile_series_agree_with_the_report() {
         let p = s.profile.expect("a profile job has a profile series");
         assert!(s.form_error.is_none() && s.following.is_none());
         let sim = &report["simulation"];
-        assert_eq!(p.samples.len(), driver::PROFILE_SAMPLES, "{job}");
+        assert_eq!(p.samples.len(), plots::PROFILE_SAMPLES, "{job}");
         let worst = p
             .samples
             .iter()

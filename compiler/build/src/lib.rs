@@ -7,7 +7,9 @@
 
 pub mod builders;
 pub mod driver;
+pub mod evaluate;
 pub mod height_map;
+pub mod output;
 pub(crate) mod parts;
 pub mod pipeline;
 pub mod plots;

@@ -8,10 +8,11 @@ use lensc_lang::lower::job::JobHead;
 use lensc_runtime::post::ProgramError;
 use lensc_runtime::post::Provenance;
 
-use crate::driver::{ProgramText, surface_analysis};
+use crate::evaluate::surface_analysis;
+use crate::output::ProgramText;
 use crate::report;
 use lensc_lang::codes;
-use lensc_lang::diagnostics::RuntimeError;
+use lensc_lang::lower::diagnostics::RuntimeError;
 
 /// The header words for the feed in inverse time.
 pub(crate) fn inverse_time_words(head: &JobHead) -> String {

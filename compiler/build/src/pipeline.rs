@@ -12,7 +12,8 @@ use lensc_runtime::post::Provenance;
 use lensc_runtime::surface::ir::{SurfaceFn, SurfaceTape};
 
 use crate::builders;
-use crate::driver::{Built, evaluator, source_hash};
+use crate::evaluate::evaluator;
+use crate::output::Built;
 
 /// What `lensc build` was asked for beyond the file.
 #[derive(Clone, Copy, Debug, Default)]
@@ -82,4 +83,16 @@ pub fn build(
         JobSpec::Grinding(s) => builders::grinding::build(s, prov),
         JobSpec::Roller(s) => builders::roller::build(s, prov, spool_dir),
     }
+}
+
+/// FNV-1a 64 over every loaded source, in load order.
+fn source_hash(l: &lensc_lang::loader::Loaded) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for (_, f) in l.sources.iter() {
+        for b in f.text.bytes().chain(std::iter::once(0u8)) {
+            h ^= u64::from(b);
+            h = h.wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    h
 }

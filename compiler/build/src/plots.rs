@@ -9,6 +9,36 @@ use lensc_runtime::verify::heightmap::ErrorRaster;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+/// Radii sampled by a profile's cut simulation.
+pub const PROFILE_SAMPLES: usize = 20_001;
+
+/// A profile's simulated cut as the series of its plot: the design and
+/// the error at every simulated radius, the tool centre's path as printed
+/// (the cutting moves of `stream`), the seams' radii. `tool` names the
+/// tool ("nose", "wheel") and gives its radius (mm).
+pub fn profile_series(
+    cut: &lensc_runtime::verify::simulate::ProfileCut,
+    design: &dyn Fn(f64) -> f64,
+    stream: &[lensc_runtime::moves::Move],
+    tool: (&'static str, f64),
+    resolution: f64,
+    seams: Vec<f64>,
+) -> ProfileSeries {
+    ProfileSeries {
+        tool: tool.0,
+        tool_radius: tool.1,
+        samples: cut
+            .samples
+            .iter()
+            .map(|&(x, e)| (x, design(x), e))
+            .collect(),
+        centre_path: lensc_runtime::verify::simulate::centre_path(stream, resolution),
+        seams,
+        pv: cut.pv,
+        rms: cut.rms,
+    }
+}
+
 /// The series behind a job's plots, kept by its build (each bounded in
 /// size whatever the job: see the constants below).
 #[derive(Clone, Debug, Default)]

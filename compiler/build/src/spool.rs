@@ -5,7 +5,7 @@
 use lensc_grammar::{Diagnostic, FileId, Span};
 use std::path::Path;
 
-use crate::driver::ProgramText;
+use crate::output::ProgramText;
 
 /// Where the program text goes as it is written: memory, or a spool file.
 pub(crate) enum Sink {
@@ -80,5 +80,5 @@ impl Sink {
 
 /// E0151: the spool file could not be written.
 pub(crate) fn cannot_spool(e: &std::io::Error, site: (FileId, Span)) -> Diagnostic {
-    lensc_lang::diagnostics::RuntimeError::Spool(e).at(site)
+    lensc_lang::lower::diagnostics::RuntimeError::Spool(e).at(site)
 }

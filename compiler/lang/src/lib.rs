@@ -8,13 +8,13 @@
 //! schema (`check`: `scope`, `expr`, `params`, `rules`; `schema`, one file
 //! per category of kind; `units`, `value`, `codes`); and checked jobs and
 //! surfaces are lowered to what the runtime plans (`lower`, with
-//! `lower::surface` one file per surface family). Errors are data
-//! (`Diagnostic`s with codes and spans; `diagnostics` maps every runtime
+//! `lower::surface` one file per surface family, `domain` the apertures both
+//! share). Errors are data
+//! (`Diagnostic`s with codes and spans; `lower::diagnostics` maps every runtime
 //! error to one); nothing here plans, writes or renders.
 
 pub mod check;
 pub mod codes;
-pub mod diagnostics;
 pub mod domain;
 pub mod loader;
 pub mod lower;

@@ -8,7 +8,7 @@
 use lensc_grammar::Diagnostic;
 use lensc_lang::check::trim_num;
 use lensc_lang::codes;
-use lensc_lang::diagnostics::RuntimeError;
+use lensc_lang::lower::diagnostics::RuntimeError;
 use lensc_lang::lower::job::SpiralSpec;
 use lensc_runtime::emit::fts::FtsProgram;
 use lensc_runtime::plan::fts::{Planner, SpindleSpeed};
@@ -18,8 +18,9 @@ use lensc_runtime::surface::ir::SurfaceFn;
 use lensc_runtime::verify::heightmap::Sweep;
 use std::path::Path;
 
-use crate::driver::{Built, evaluator};
+use crate::evaluate::evaluator;
 use crate::height_map::{self, LatheFrame, Window};
+use crate::output::Built;
 use crate::parts;
 use crate::report;
 use crate::spool::{Sink, cannot_spool};

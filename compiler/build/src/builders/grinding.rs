@@ -5,12 +5,13 @@
 
 use lensc_grammar::Diagnostic;
 use lensc_lang::check::trim_num;
-use lensc_lang::diagnostics::RuntimeError;
+use lensc_lang::lower::diagnostics::RuntimeError;
 use lensc_lang::lower::job::GrindingSpec;
 use lensc_runtime::post::Provenance;
 use lensc_runtime::surface::SectionAlongX;
 
-use crate::driver::{Built, ProgramText, evaluator};
+use crate::evaluate::evaluator;
+use crate::output::{Built, ProgramText};
 use crate::parts;
 use crate::report;
 
@@ -79,7 +80,7 @@ pub fn build(spec: &GrindingSpec, prov: &Provenance) -> Result<Built, Vec<Diagno
         resolution,
         &|x: f64| profile.point(x).z,
         (grinding.start, grinding.end),
-        crate::driver::PROFILE_SAMPLES,
+        crate::plots::PROFILE_SAMPLES,
     );
     let report = parts::report(
         head,
@@ -90,7 +91,7 @@ pub fn build(spec: &GrindingSpec, prov: &Provenance) -> Result<Built, Vec<Diagno
         report::Simulation::Profile((&cut).into()),
     );
     let plots = crate::plots::PlotSeries {
-        profile: Some(crate::driver::profile_series(
+        profile: Some(crate::plots::profile_series(
             &cut,
             &|x: f64| profile.point(x).z,
             &stream,

@@ -6,14 +6,15 @@
 use lensc_grammar::Diagnostic;
 use lensc_lang::check::trim_num;
 use lensc_lang::codes;
-use lensc_lang::diagnostics::RuntimeError;
+use lensc_lang::lower::diagnostics::RuntimeError;
 use lensc_lang::lower::job::RasterSpec;
 use lensc_runtime::plan::raster::{Axis, RasterTool};
 use lensc_runtime::post::Provenance;
 use lensc_runtime::verify::heightmap::Sweep;
 
-use crate::driver::{Built, ProgramText, evaluator};
+use crate::evaluate::evaluator;
 use crate::height_map::{self, Window, domain_centre};
+use crate::output::{Built, ProgramText};
 use crate::parts;
 use crate::report;
 

@@ -8,7 +8,7 @@ use std::path::Path;
 
 use lensc_grammar::Diagnostic;
 use lensc_lang::check::trim_num;
-use lensc_lang::diagnostics::RuntimeError;
+use lensc_lang::lower::diagnostics::RuntimeError;
 use lensc_lang::lower::job::RollerSpec;
 use lensc_runtime::emit::roller::RollerProgram;
 use lensc_runtime::plan::roller::plan_roller_helix_into;
@@ -16,8 +16,9 @@ use lensc_runtime::post::ProgramError;
 use lensc_runtime::post::Provenance;
 use lensc_runtime::verify::heightmap::Sweep;
 
-use crate::driver::{Built, evaluator};
+use crate::evaluate::evaluator;
 use crate::height_map::{self, RollerFrame, Window};
+use crate::output::Built;
 use crate::parts;
 use crate::report;
 use crate::spool::{Sink, cannot_spool};

@@ -6,13 +6,15 @@
 use lensc_grammar::Diagnostic;
 use lensc_lang::check::trim_num;
 use lensc_lang::codes;
-use lensc_lang::diagnostics::RuntimeError;
+use lensc_lang::lower::diagnostics::RuntimeError;
 use lensc_lang::lower::job::TurningSpec;
 use lensc_runtime::plan::turning::{Move, Toolpath};
 use lensc_runtime::post::Provenance;
 use lensc_runtime::surface::SectionAlongX;
 
-use crate::driver::{Built, PROFILE_SAMPLES, ProgramText, evaluator, profile_series};
+use crate::evaluate::evaluator;
+use crate::output::{Built, ProgramText};
+use crate::plots::{PROFILE_SAMPLES, profile_series};
 use crate::report;
 
 /// Builds one profile-turning job, or says why it cannot be built.

@@ -26,7 +26,7 @@ use lensc_runtime::surface::ir::{SurfaceFn, SurfaceTape};
 
 use crate::check::CheckedJob;
 use crate::codes;
-use crate::diagnostics::RuntimeError;
+use crate::lower::diagnostics::RuntimeError;
 use crate::lower::surface::LoweredSurface;
 use crate::value::{self, Object};
 

@@ -3,6 +3,7 @@
 //! several parts at once); `surface` turns a surface into IR. Here too:
 //! the dialect a job is written in, and a surface described in words.
 
+pub mod diagnostics;
 pub mod job;
 pub mod surface;
 

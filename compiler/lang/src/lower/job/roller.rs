@@ -14,7 +14,7 @@ use lensc_runtime::surface::analysis::Domain;
 use super::{Evaluate, JobHead, Parts};
 use crate::check::trim_num;
 use crate::codes;
-use crate::diagnostics::RuntimeError;
+use crate::lower::diagnostics::RuntimeError;
 use crate::value;
 
 /// A roller job, typed.

@@ -14,8 +14,8 @@ use lensc_runtime::surface::{SectionAlongX, SurfaceInfo};
 use super::{Evaluate, JobHead, Parts};
 use crate::check::trim_num;
 use crate::codes;
-use crate::diagnostics::RuntimeError;
 use crate::domain::{aperture_inner_radius, aperture_radius};
+use crate::lower::diagnostics::RuntimeError;
 use crate::units::Dim;
 use crate::value::{self, Field, Object, Value};
 

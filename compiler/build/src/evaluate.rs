@@ -1,0 +1,144 @@
+//! Surfaces evaluated for the build and for `lensc analyse` and `lensc
+//! sample`: the backend (the JIT, or the interpreter behind it), a
+//! declared surface lowered by name, its analysis, and samples of it.
+
+use lensc_lang::Checked;
+
+/// Where `lensc sample` evaluates a surface.
+pub enum SamplePoints {
+    /// n × n over the domain's bounding box, points inside the domain.
+    Grid(usize),
+    /// n points from the centre of the domain to its edge along +x.
+    Radial(usize),
+    /// Given points (mm).
+    Points(Vec<(f64, f64)>),
+}
+
+/// One sample: x, y, z (mm), dz/dx, dz/dy, curvature along x and y (1/mm).
+pub type Sample = [f64; 7];
+
+/// The backend that evaluates surfaces: a JIT kernel, or the reference
+/// interpreter should cranelift refuse the tape (they agree to 1e-13, see
+/// tests/jit_conformance.rs and tests/surface_kinds.rs).
+/// The second value names the backend used (reports carry it).
+pub fn evaluator(
+    tape: &lensc_runtime::surface::ir::SurfaceTape,
+) -> (
+    Box<dyn lensc_runtime::surface::ir::SurfaceFn + Sync>,
+    crate::report::Backend,
+) {
+    match lensc_runtime::surface::jit::JitSurface::compile(tape) {
+        Ok(j) => (Box::new(j), crate::report::Backend::Jit),
+        Err(_) => (
+            Box::new(lensc_runtime::surface::ir::Interpreter::new(tape)),
+            crate::report::Backend::Interpreter,
+        ),
+    }
+}
+
+/// The declared surface `name`, lowered to IR, or a message saying why not.
+pub fn declared_surface(
+    c: &Checked,
+    name: &str,
+) -> Result<lensc_lang::lower::surface::LoweredSurface, String> {
+    let Some(obj) = c.checked.declarations.get(name) else {
+        let mut names: Vec<&str> = c
+            .checked
+            .declarations
+            .iter()
+            .filter(|(_, o)| o.kind.category == lensc_lang::schema::Category::Surface)
+            .map(|(n, _)| n.as_str())
+            .collect();
+        names.sort_unstable();
+        return Err(format!(
+            "no surface `{name}` (surfaces: {})",
+            if names.is_empty() {
+                "none".into()
+            } else {
+                names.join(", ")
+            }
+        ));
+    };
+    if obj.kind.category != lensc_lang::schema::Category::Surface {
+        return Err(format!(
+            "`{name}` is {}, not a surface",
+            obj.kind.category.noun()
+        ));
+    }
+    lensc_lang::lower::surface::lower_surface(obj).map_err(|e| {
+        format!(
+            "`{name}` cannot be evaluated yet: {}",
+            lensc_lang::lower::diagnostics::lowering_words(&e)
+        )
+    })
+}
+
+/// The analysis of a surface as the reports carry it (and `lensc
+/// analyse` prints it), on a `grid` per side.
+pub fn surface_analysis(
+    name: &str,
+    kind: &str,
+    l: &lensc_lang::lower::surface::LoweredSurface,
+    grid: usize,
+) -> crate::report::SurfaceAnalysis {
+    let (f, backend) = evaluator(&l.tape);
+    let a = lensc_runtime::surface::analysis::analyse(f.as_ref(), &l.domain, grid);
+    crate::report::SurfaceAnalysis::new(name, kind, &l.domain, grid, backend, &a)
+}
+
+/// Evaluates a declared surface at the requested points.
+pub fn sample(c: &Checked, surface: &str, at: &SamplePoints) -> Result<Vec<Sample>, String> {
+    let lowered = declared_surface(c, surface)?;
+    let (f, _) = evaluator(&lowered.tape);
+    let domain = lowered.domain;
+    let ((x0, x1), (y0, y1)) = domain.bounds();
+    let (xs, ys): (Vec<f64>, Vec<f64>) = match at {
+        SamplePoints::Grid(n) => {
+            let n = (*n).max(1);
+            let step = |a: f64, b: f64, i: usize| {
+                if n == 1 {
+                    0.5 * (a + b)
+                } else {
+                    a + (b - a) * i as f64 / (n - 1) as f64
+                }
+            };
+            (0..n)
+                .flat_map(|j| (0..n).map(move |i| (step(x0, x1, i), step(y0, y1, j))))
+                .filter(|&(x, y)| domain.contains(x, y))
+                .unzip()
+        }
+        SamplePoints::Radial(n) => {
+            let n = (*n).max(1);
+            let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+            (0..n)
+                .map(|i| {
+                    (
+                        if n == 1 {
+                            cx
+                        } else {
+                            cx + (x1 - cx) * i as f64 / (n - 1) as f64
+                        },
+                        cy,
+                    )
+                })
+                .unzip()
+        }
+        SamplePoints::Points(p) => p.iter().copied().unzip(),
+    };
+    let mut out = vec![0.0; 6 * xs.len()];
+    f.eval_batch(&xs, &ys, &mut out);
+    Ok((0..xs.len())
+        .map(|i| {
+            let o = &out[6 * i..6 * i + 6];
+            [
+                xs[i],
+                ys[i],
+                o[0],
+                o[1],
+                o[2],
+                lensc_runtime::surface::analysis::curvature_x(o),
+                lensc_runtime::surface::analysis::curvature_y(o),
+            ]
+        })
+        .collect())
+}

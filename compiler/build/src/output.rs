@@ -1,0 +1,110 @@
+//! What a built job is before it reaches the disk (`Built`, the program's
+//! text in memory or spooled) and how every output file is put in place:
+//! atomically, readable by all, with no temporary file left on failure.
+
+use std::path::Path;
+
+use lensc_grammar::Diagnostic;
+
+/// One job's output, not yet written.
+pub struct Built {
+    /// File name of the program (`JOB.ngc`); the report is `JOB.report.json`.
+    pub program_name: String,
+    pub report_name: String,
+    pub program: ProgramText,
+    /// Points of the cut and its estimated time (s), for the summary line.
+    pub cut_points: usize,
+    pub cutting_time: f64,
+    /// The build report (its fields are documented in
+    /// docs/report.schema.json, generated from `crate::report`).
+    pub report: crate::report::Report,
+    /// Files the program reads, written beside it (a fast-tool-servo
+    /// table): name and text.
+    pub beside: Vec<(String, ProgramText)>,
+    /// The series behind the plots of `lensc report`.
+    pub plots: crate::plots::PlotSeries,
+    /// Warnings the build found (the job still built).
+    pub warnings: Vec<Diagnostic>,
+}
+
+/// A program's text: in memory, or spooled as it was written to a
+/// temporary file in the output directory (the programs of fast-tool-servo
+/// jobs run to millions of lines).
+pub enum ProgramText {
+    Memory(String),
+    Spooled {
+        file: tempfile::NamedTempFile,
+        lines: usize,
+        bytes: u64,
+    },
+}
+
+impl ProgramText {
+    pub fn lines(&self) -> usize {
+        match self {
+            ProgramText::Memory(t) => t.lines().count(),
+            ProgramText::Spooled { lines, .. } => *lines,
+        }
+    }
+    pub fn bytes(&self) -> u64 {
+        match self {
+            ProgramText::Memory(t) => t.len() as u64,
+            ProgramText::Spooled { bytes, .. } => *bytes,
+        }
+    }
+    /// The whole text (read back from the spool file if need be).
+    pub fn text(&self) -> std::io::Result<String> {
+        match self {
+            ProgramText::Memory(t) => Ok(t.clone()),
+            ProgramText::Spooled { file, .. } => std::fs::read_to_string(file.path()),
+        }
+    }
+    /// Puts the program at `path` atomically (a spooled program is renamed
+    /// into place: it was written in the same directory).
+    pub fn write_to(self, path: &Path) -> std::io::Result<()> {
+        match self {
+            ProgramText::Memory(t) => write_atomic(path, &t),
+            ProgramText::Spooled { file, .. } => {
+                readable_by_all(file.as_file())?;
+                file.as_file().sync_all()?;
+                file.persist(path).map(|_| ()).map_err(|e| e.error)
+            }
+        }
+    }
+}
+
+/// Makes a finished output file readable by all and writable by its owner.
+fn readable_by_all(file: &std::fs::File) -> std::io::Result<()> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        file.set_permissions(std::fs::Permissions::from_mode(0o644))?;
+    }
+    #[cfg(not(unix))]
+    let _ = file;
+    Ok(())
+}
+
+/// Writes `text` to `path` atomically: a temporary file in the same
+/// directory, flushed, then renamed over the target. On failure the
+/// target is untouched and no temporary file is left behind.
+/// Temporary files are created private (0600); a program and its report
+/// are put in place readable by all (0644), as any other written file, so
+/// they can be copied to the controller's share.
+pub fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {
+    use std::io::Write;
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir)?;
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".lensc-")
+        .suffix(".tmp")
+        .tempfile_in(dir)?;
+    tmp.write_all(text.as_bytes())?;
+    readable_by_all(tmp.as_file())?;
+    tmp.as_file().sync_all()?;
+    tmp.persist(path).map_err(|e| e.error)?;
+    Ok(())
+}
