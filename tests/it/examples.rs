@@ -1,8 +1,6 @@
 //! Every example checks clean (no errors, no warnings) and builds.
 
-use crate::common;
-
-use crate::common::{abridged, buildable_examples, examples, lensc, root, surface_names, text};
+use crate::common::{Written, built_examples, examples, lensc, root, surface_names, text};
 
 #[test]
 fn every_example_checks_clean() {
@@ -31,34 +29,15 @@ fn every_example_checks_clean() {
 /// snapshot abridged (see `common::abridged`).
 #[test]
 fn example_programs_match_their_snapshots() {
-    let dir = tempfile::tempdir().expect("tmp");
-    for ex in buildable_examples() {
-        let rel = ex
-            .strip_prefix(root())
-            .expect("inside repo")
-            .to_str()
-            .expect("utf8")
-            .to_string();
-        let out = lensc(
-            &root(),
-            &["build", &rel, "--out", dir.path().to_str().expect("utf8")],
-        );
-        assert_eq!(out.status.code(), Some(0), "{rel}: {}", text(&out.stderr));
-    }
-    let mut programs: Vec<_> = std::fs::read_dir(dir.path())
-        .expect("out")
-        .map(|e| e.expect("e").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "ngc"))
+    let mut programs: Vec<(&String, &Written)> = built_examples()
+        .iter()
+        .flat_map(|b| &b.files)
+        .filter(|(name, _)| name.ends_with(".ngc"))
         .collect();
-    programs.sort();
-    for p in programs {
-        let name = p.file_name().expect("name").to_string_lossy().to_string();
-        let program = std::fs::read_to_string(&p).expect("program");
-        let program = if program.len() > common::WHOLE_SNAPSHOT_LIMIT {
-            abridged(&program)
-        } else {
-            program
-        };
+    programs.sort_by_key(|(name, _)| *name);
+    assert!(programs.len() >= 20, "{} programs", programs.len());
+    for (name, file) in programs {
+        let (name, program) = (name.clone(), file.snapshot());
         insta::with_settings!({ snapshot_path => "../snapshots/programs", prepend_module_to_snapshot => false, omit_expression => true }, {
             insta::assert_snapshot!(name, program);
         });
