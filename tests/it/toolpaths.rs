@@ -1,5 +1,6 @@
 //! Toolpath figures reproduced from the seed papers, end to end through
-//! `lensc build`: each test builds an example and reads its report.
+//! `lensc build`: each test reads an example's report from its one build
+//! (`common::built_examples`).
 
 use crate::common::{built, lensc, root, text};
 
