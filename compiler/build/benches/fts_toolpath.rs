@@ -28,14 +28,18 @@ fn main() {
     assert!(!c.has_errors(), "the example checks");
     let job = &c.checked.jobs[0];
     let t = Instant::now();
-    let prepared = lensc_build::fts_job::prepare(job).unwrap_or_else(|_| panic!("prepares"));
+    let Ok(lensc_lang::lower::job::JobSpec::Spiral(spec)) = lensc_build::pipeline::lower(job, None)
+    else {
+        panic!("lowers to a spiral")
+    };
+    let prepared = lensc_build::builders::fts::Prepared::of(&spec);
     let prepare = t.elapsed();
     let planner = prepared.planner();
     let run = || {
         let mut points = 0usize;
         let t = Instant::now();
         let s = planner
-            .plan(&prepared.fast_axis, |p| points += p.len())
+            .plan(&spec.fast_axis, |p| points += p.len())
             .expect("plans");
         (t.elapsed(), s, points)
     };

@@ -13,9 +13,9 @@ use lensc_runtime::verify::heightmap::{ErrorFigures, Frame, Grid, HeightMap, Sca
 use serde_json::{Value, json};
 use std::f64::consts::TAU;
 
-use lensc_lang::check::{CheckedJob, trim_num};
+use lensc_lang::check::trim_num;
 use lensc_lang::codes;
-use lensc_lang::value;
+use lensc_lang::lower::job::JobHead;
 
 /// The most cells a window may have (8 bytes each in the map, plus the
 /// passes gathered per column).
@@ -36,35 +36,26 @@ pub struct Window {
 }
 
 impl Window {
-    /// The job's window, or the default one about `centre`; an error if
-    /// the window is empty.
-    pub fn of(job: &CheckedJob, centre: (f64, f64)) -> Result<Window, Diagnostic> {
-        let Some(field) = value::field(&job.fields, "simulate") else {
-            let h = DEFAULT_SIZE / 2.0;
-            return Ok(Window {
-                x: (centre.0 - h, centre.0 + h),
-                y: (centre.1 - h, centre.1 + h),
-                spacing: DEFAULT_SPACING,
-                given: false,
-            });
-        };
-        let b = value::block(&job.fields, "simulate").expect("checked block");
-        let w = Window {
-            x: value::range(b, "x").expect("required"),
-            y: value::range(b, "y").expect("required"),
-            spacing: value::num(b, "spacing").unwrap_or(DEFAULT_SPACING),
-            given: true,
-        };
-        if !(w.x.1 > w.x.0 && w.y.1 > w.y.0) {
-            return Err(Diagnostic::error(
-                codes::WRONG_VALUE,
-                "the simulation window is empty: each range must run from low to high",
-                field.file,
-                field.span,
-            )
-            .with_label("this window"));
+    /// The job's window (lowering checked it is not empty), or the
+    /// default one about `centre`.
+    pub fn of(head: &JobHead, centre: (f64, f64)) -> Window {
+        match head.simulate {
+            Some(s) => Window {
+                x: s.x,
+                y: s.y,
+                spacing: s.spacing.unwrap_or(DEFAULT_SPACING),
+                given: true,
+            },
+            None => {
+                let h = DEFAULT_SIZE / 2.0;
+                Window {
+                    x: (centre.0 - h, centre.0 + h),
+                    y: (centre.1 - h, centre.1 + h),
+                    spacing: DEFAULT_SPACING,
+                    given: false,
+                }
+            }
         }
-        Ok(w)
     }
 
     pub fn contains(&self, x: f64, y: f64) -> bool {
@@ -72,15 +63,12 @@ impl Window {
     }
 
     /// E0149 when `grid` has more cells than the simulation takes.
-    pub fn check_size(&self, job: &CheckedJob, grid: &Grid) -> Result<(), Diagnostic> {
+    pub fn check_size(&self, head: &JobHead, grid: &Grid) -> Result<(), Diagnostic> {
         let cells = grid.ns * grid.nu;
         if cells <= MAX_CELLS {
             return Ok(());
         }
-        let (file, span) = match value::field(&job.fields, "simulate") {
-            Some(f) => (f.file, f.span),
-            None => (job.file, job.name.span),
-        };
+        let (file, span) = head.simulate.map_or(head.site, |s| s.site);
         Err(Diagnostic::error(
             codes::SIMULATION_TOO_LARGE,
             format!(

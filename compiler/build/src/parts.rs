@@ -1,154 +1,78 @@
-//! The four parts of a checked job (surface, tool, machine, strategy) as
-//! every job builder reads them: their declared names, where a job's errors
-//! point, the provenance lines every program header starts with, and the
-//! report every program has beside it.
+//! What every job builder writes the same way from a job's head: the
+//! provenance lines every program header starts with, the feed words, the
+//! report every program has beside it, and the errors that point at the
+//! job.
 
-use lensc_grammar::{Diagnostic, FileId, Span};
-use lensc_runtime::post::Dialect;
+use lensc_grammar::Diagnostic;
+use lensc_lang::lower::job::JobHead;
 use lensc_runtime::post::ProgramError;
 use lensc_runtime::post::Provenance;
 use serde_json::json;
 
 use crate::driver::{ProgramText, analysis_json};
-use lensc_lang::check::CheckedJob;
 use lensc_lang::codes;
-use lensc_lang::value::{self, Object};
 
-/// The four parts of a checked job, their names, and where errors point.
-pub(crate) struct Parts<'a> {
-    pub job: &'a CheckedJob,
-    pub surface: &'a Object,
-    pub tool: &'a Object,
-    pub machine: &'a Object,
-    pub strategy: &'a Object,
-    /// The dialect the program is written in.
-    pub dialect: &'a Dialect,
+/// The header words for the feed in inverse time.
+pub(crate) fn inverse_time_words(head: &JobHead) -> String {
+    format!(
+        "feed in inverse time [{}, F = 1/min per move]",
+        head.dialect.inverse_time.as_deref().unwrap_or("none")
+    )
 }
 
-impl<'a> Parts<'a> {
-    pub(crate) fn of(job: &'a CheckedJob, dialect: &'a Dialect) -> Parts<'a> {
-        let part = |name: &str| -> &'a Object {
-            value::object(&job.fields, name).expect("checked job part")
-        };
-        Parts {
-            job,
-            surface: part("surface"),
-            tool: part("tool"),
-            machine: part("machine"),
-            strategy: part("strategy"),
-            dialect,
-        }
-    }
-    pub(crate) fn name(&self, part: &str, o: &Object) -> String {
-        self.job
-            .part_names
-            .get(part)
-            .cloned()
-            .unwrap_or_else(|| o.kind.name.to_string())
-    }
-    pub(crate) fn site(&self) -> (FileId, Span) {
-        (self.job.file, self.job.name.span)
-    }
-    pub(crate) fn error(&self, code: &'static str, msg: String) -> Diagnostic {
-        let (file, span) = self.site();
-        Diagnostic::error(code, msg, file, span).with_label("this job")
-    }
-    /// The program's file name: the job's name and the dialect's extension.
-    pub(crate) fn program_name(&self) -> String {
-        format!("{}.{}", self.job.name.name, self.dialect.extension)
-    }
-    /// The header words for the feed in inverse time.
-    pub(crate) fn inverse_time_words(&self) -> String {
-        format!(
-            "feed in inverse time [{}, F = 1/min per move]",
-            self.dialect.inverse_time.as_deref().unwrap_or("none")
-        )
-    }
-    /// The lines every header starts with.
-    pub(crate) fn header(&self, prov: &Provenance, units: &str) -> Vec<String> {
-        vec![
-            format!("lensc {}: job {}", prov.lensc_version, self.job.name.name),
-            format!("source {} fnv1a64 {:016x}", prov.source, prov.source_hash),
-            units.to_string(),
-            format!(
-                "surface {}: {}",
-                self.name("surface", self.surface),
-                lensc_lang::lower::describe(self.surface)
-            ),
-        ]
-    }
-    pub(crate) fn report(
-        &self,
-        prov: &Provenance,
-        program_name: &str,
-        program: &ProgramText,
-        toolpath: serde_json::Value,
-        lowered: &lensc_lang::lower::surface::LoweredSurface,
-    ) -> serde_json::Value {
-        json!({
-            "job": self.job.name.name,
-            "lensc_version": prov.lensc_version,
-            "source": prov.source,
-            "source_fnv1a64": format!("{:016x}", prov.source_hash),
-            "program": {
-                "file": program_name,
-                "dialect": self.dialect.name,
-                "lines": program.lines(),
-                "bytes": program.bytes(),
-            },
-            "toolpath": toolpath,
-            "surface": analysis_json(&self.name("surface", self.surface), self.surface.kind.name, lowered, 201),
-        })
-    }
-    /// E0141 if a move of the stream leaves the machine's `travel` block.
-    pub(crate) fn travel_error(&self, moves: &[lensc_runtime::moves::Move]) -> Option<Diagnostic> {
-        let travel = value::block(&self.machine.fields, "travel")?;
-        let limits = ["x", "y", "z", "c"].map(|a| value::range(travel, a));
-        let (axis, v, (lo, hi)) = lensc_runtime::moves::outside_travel(moves, limits)?;
-        Some(self.error(
-            codes::OUT_OF_TRAVEL,
-            format!(
-                "the path moves {axis} to {} mm, outside the machine's travel {} .. {} mm",
-                lensc_lang::check::trim_num(v),
-                lensc_lang::check::trim_num(lo),
-                lensc_lang::check::trim_num(hi)
-            ),
-        ))
-    }
+/// The lines every header starts with.
+pub(crate) fn header(head: &JobHead, prov: &Provenance, units: &str) -> Vec<String> {
+    vec![
+        format!("lensc {}: job {}", prov.lensc_version, head.name),
+        format!("source {} fnv1a64 {:016x}", prov.source, prov.source_hash),
+        units.to_string(),
+        format!("surface {}: {}", head.names.surface, head.surface.words),
+    ]
+}
 
-    pub(crate) fn not_printable(&self, e: ProgramError) -> Diagnostic {
-        self.error(codes::NOT_PRINTABLE, e.message())
-    }
-    pub(crate) fn lowered(
-        &self,
-    ) -> Result<lensc_lang::lower::surface::LoweredSurface, Vec<Diagnostic>> {
-        lensc_lang::lower::surface::lower_surface(self.surface).map_err(|e| {
-            vec![self.error(
-                codes::UNSUPPORTED_COMBINATION,
-                format!("this surface cannot be evaluated yet: {e:?}"),
-            )]
-        })
-    }
-    pub(crate) fn needs(
-        &self,
-        part: &str,
-        o: &Object,
-        kinds: &[&str],
-        what: &str,
-    ) -> Option<Diagnostic> {
-        (!kinds.contains(&o.kind.name)).then(|| {
-            self.error(
-                codes::UNSUPPORTED_COMBINATION,
-                format!(
-                    "{what} needs {}; this {part} is a `{}`",
-                    kinds
-                        .iter()
-                        .map(|k| format!("`{k}`"))
-                        .collect::<Vec<_>>()
-                        .join(" or "),
-                    o.kind.name
-                ),
-            )
-        })
-    }
+/// The report beside a program: provenance, the program, the toolpath's
+/// own section and the surface's analysis.
+pub(crate) fn report(
+    head: &JobHead,
+    prov: &Provenance,
+    program_name: &str,
+    program: &ProgramText,
+    toolpath: serde_json::Value,
+) -> serde_json::Value {
+    json!({
+        "job": head.name,
+        "lensc_version": prov.lensc_version,
+        "source": prov.source,
+        "source_fnv1a64": format!("{:016x}", prov.source_hash),
+        "program": {
+            "file": program_name,
+            "dialect": head.dialect.name,
+            "lines": program.lines(),
+            "bytes": program.bytes(),
+        },
+        "toolpath": toolpath,
+        "surface": analysis_json(&head.names.surface, head.surface.kind, &head.surface.lowered, 201),
+    })
+}
+
+/// E0141 if a move of the stream leaves the machine's travel.
+pub(crate) fn travel_error(
+    head: &JobHead,
+    moves: &[lensc_runtime::moves::Move],
+) -> Option<Diagnostic> {
+    let (axis, v, (lo, hi)) = lensc_runtime::moves::outside_travel(moves, head.travel)?;
+    Some(head.error(
+        codes::OUT_OF_TRAVEL,
+        format!(
+            "the path moves {axis} to {} mm, outside the machine's travel {} .. {} mm",
+            lensc_lang::check::trim_num(v),
+            lensc_lang::check::trim_num(lo),
+            lensc_lang::check::trim_num(hi)
+        ),
+    ))
+}
+
+/// E0150: the program cannot be written in the job's dialect.
+pub(crate) fn not_printable(head: &JobHead, e: ProgramError) -> Diagnostic {
+    head.error(codes::NOT_PRINTABLE, e.message())
 }

@@ -262,44 +262,74 @@ fn legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
         .map_err(err)
 }
 
-fn profile_svg(job: &str, p: &ProfileSeries) -> Result<String, String> {
-    let design: Vec<(f64, f64)> = p.samples.iter().map(|s| (s.0, s.1)).collect();
-    let cut: Vec<(f64, f64)> = p.samples.iter().map(|s| (s.0, s.1 + s.2)).collect();
-    let error_nm: Vec<(f64, f64)> = p.samples.iter().map(|s| (s.0, s.2 * 1e6)).collect();
-    let (design, _) = decimate(&design, PROFILE_POINTS);
-    let (cut, _) = decimate(&cut, PROFILE_POINTS);
-    let (error_nm, run) = decimate(&error_nm, PROFILE_POINTS);
-    let path: Vec<Vec<(f64, f64)>> = p
-        .centre_path
-        .iter()
-        .map(|r| {
-            let abs: Vec<(f64, f64)> = r.iter().map(|q| (q.0.abs(), q.1)).collect();
-            decimate(&abs, PROFILE_POINTS).0
+/// A profile's series thinned for drawing, with the ranges of its axes.
+struct ProfileView {
+    design: Vec<(f64, f64)>,
+    cut: Vec<(f64, f64)>,
+    error_nm: Vec<(f64, f64)>,
+    /// How many consecutive samples each drawn error point stands for.
+    run: usize,
+    path: Vec<Vec<(f64, f64)>>,
+    /// Radius, height, the centre path's height (right axis) and error.
+    r: (f64, f64),
+    z: (f64, f64),
+    centre_z: (f64, f64),
+    e: (f64, f64),
+}
+
+impl ProfileView {
+    fn of(p: &ProfileSeries) -> Result<ProfileView, String> {
+        let design: Vec<(f64, f64)> = p.samples.iter().map(|s| (s.0, s.1)).collect();
+        let cut: Vec<(f64, f64)> = p.samples.iter().map(|s| (s.0, s.1 + s.2)).collect();
+        let error_nm: Vec<(f64, f64)> = p.samples.iter().map(|s| (s.0, s.2 * 1e6)).collect();
+        let (design, _) = decimate(&design, PROFILE_POINTS);
+        let (cut, _) = decimate(&cut, PROFILE_POINTS);
+        let (error_nm, run) = decimate(&error_nm, PROFILE_POINTS);
+        let path: Vec<Vec<(f64, f64)>> = p
+            .centre_path
+            .iter()
+            .map(|r| {
+                let abs: Vec<(f64, f64)> = r.iter().map(|q| (q.0.abs(), q.1)).collect();
+                decimate(&abs, PROFILE_POINTS).0
+            })
+            .collect();
+        let (r0, r1) = range_of(p.samples.iter().map(|s| s.0));
+        let (z0, z1) = range_of(p.samples.iter().flat_map(|s| [s.1, s.1 + s.2]));
+        // The path's own scale (right axis): where it runs over the simulated
+        // radii, up to the tool radius above the design's top (an approach or
+        // retract from higher leaves the top of the plot).
+        let ceiling = z1 + 1.05 * p.tool_radius;
+        let (c0, c1) = range_of(
+            path.iter()
+                .flatten()
+                .filter(|q| q.0 >= r0 && q.0 <= r1 && q.1 <= ceiling)
+                .map(|q| q.1),
+        );
+        let centre_z = if c1 >= c0 {
+            padded(c0, c1, 0.3)
+        } else {
+            padded(z0, z1, 0.3)
+        };
+        let (e0, e1) = range_of(error_nm.iter().map(|e| e.1));
+        if !(r1 >= r0 && z1 >= z0 && e1 >= e0) {
+            return Err("the profile's simulation has no samples to plot".into());
+        }
+        Ok(ProfileView {
+            design,
+            cut,
+            error_nm,
+            run,
+            path,
+            r: (r0, r1),
+            z: padded(z0, z1, 0.3),
+            centre_z,
+            e: padded(e0.min(0.0), e1.max(0.0), 0.25),
         })
-        .collect();
-    let (r0, r1) = range_of(p.samples.iter().map(|s| s.0));
-    let (z0, z1) = range_of(p.samples.iter().flat_map(|s| [s.1, s.1 + s.2]));
-    // The path's own scale (right axis): where it runs over the simulated
-    // radii, up to the tool radius above the design's top (an approach or
-    // retract from higher leaves the top of the plot).
-    let ceiling = z1 + 1.05 * p.tool_radius;
-    let (c0, c1) = range_of(
-        path.iter()
-            .flatten()
-            .filter(|q| q.0 >= r0 && q.0 <= r1 && q.1 <= ceiling)
-            .map(|q| q.1),
-    );
-    let (c0, c1) = if c1 >= c0 {
-        padded(c0, c1, 0.3)
-    } else {
-        padded(z0, z1, 0.3)
-    };
-    let (e0, e1) = range_of(error_nm.iter().map(|e| e.1));
-    if !(r1 >= r0 && z1 >= z0 && e1 >= e0) {
-        return Err("the profile's simulation has no samples to plot".into());
     }
-    let (z0, z1) = padded(z0, z1, 0.3);
-    let (e0, e1) = padded(e0.min(0.0), e1.max(0.0), 0.25);
+}
+
+/// The caption under a profile plot: what each curve is, and the figures.
+fn profile_caption(p: &ProfileSeries, run: usize) -> String {
     let thinned = if run > 1 {
         format!(
             "The {} samples are drawn in runs of {run} consecutive ones, each by its least and largest value, so every peak is kept.",
@@ -318,7 +348,7 @@ fn profile_svg(job: &str, p: &ProfileSeries) -> Result<String, String> {
             p.tool
         )
     };
-    let text = format!(
+    format!(
         "Upper: the design profile and the cut the program leaves (left axis): the exact envelope of the {tool} ({tool} radius {rho} mm) swept along the printed moves, simulated on {n} radii; it lies on the design wherever the form error below is too small to see at this scale. The {tool} centre's path as the program prints it, on its own scale (right axis). \
          Lower: the form error, cut − design, in nm (positive where material is left, negative a gouge): PV {pv} nm, RMS {rms} nm.{seams}\n{thinned}",
         tool = p.tool,
@@ -326,8 +356,12 @@ fn profile_svg(job: &str, p: &ProfileSeries) -> Result<String, String> {
         n = p.samples.len(),
         pv = num(p.pv * 1e6, decimals(p.pv * 1e6)),
         rms = num(p.rms * 1e6, decimals(p.rms * 1e6)),
-    );
-    let lines = wrap(&text, f64::from(WIDTH) - 40.0);
+    )
+}
+
+fn profile_svg(job: &str, p: &ProfileSeries) -> Result<String, String> {
+    let view = ProfileView::of(p)?;
+    let lines = wrap(&profile_caption(p, view.run), f64::from(WIDTH) - 40.0);
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (WIDTH, 900)).into_drawing_area();
@@ -338,93 +372,112 @@ fn profile_svg(job: &str, p: &ProfileSeries) -> Result<String, String> {
         )?;
         let (_, h) = plot.dim_in_pixel();
         let (upper, lower) = plot.split_vertically(h * 11 / 20);
-        let mut chart = ChartBuilder::on(&upper)
-            .margin(10)
-            .x_label_area_size(45)
-            .y_label_area_size(90)
-            .right_y_label_area_size(90)
-            .build_cartesian_2d(r0..r1, z0..z1)
-            .map_err(err)?
-            .set_secondary_coord(r0..r1, c0..c1);
-        chart
-            .configure_mesh()
-            .x_desc("radius r (mm)")
-            .y_desc("height z (mm)")
-            .x_label_formatter(&ticks(r0, r1))
-            .y_label_formatter(&ticks(z0, z1))
-            .axis_desc_style((FONT, 16))
-            .label_style((FONT, 13))
-            .draw()
-            .map_err(err)?;
-        chart
-            .configure_secondary_axes()
-            .y_desc(format!("{} centre Z (mm)", p.tool))
-            .y_label_formatter(&ticks(c0, c1))
-            .axis_desc_style((FONT, 16).into_font().color(&CENTRE))
-            .label_style((FONT, 13))
-            .draw()
-            .map_err(err)?;
-        for (k, run) in path.iter().enumerate() {
-            let drawn = chart
-                .draw_secondary_series(LineSeries::new(run.iter().copied(), CENTRE.stroke_width(2)))
-                .map_err(err)?;
-            if k == 0 {
-                drawn
-                    .label(format!("{} centre path, as printed (right axis)", p.tool))
-                    .legend(legend_line(CENTRE));
-            }
-        }
-        chart
-            .draw_series(LineSeries::new(design, DESIGN.stroke_width(2)))
-            .map_err(err)?
-            .label("design")
-            .legend(legend_line(DESIGN));
-        chart
-            .draw_series(LineSeries::new(cut, CUT.stroke_width(1)))
-            .map_err(err)?
-            .label("simulated cut")
-            .legend(legend_line(CUT));
-        legend(&mut chart)?;
-        let mut chart = ChartBuilder::on(&lower)
-            .margin(10)
-            .margin_right(100)
-            .x_label_area_size(45)
-            .y_label_area_size(90)
-            .build_cartesian_2d(r0..r1, e0..e1)
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("radius r (mm)")
-            .y_desc("form error, cut − design (nm)")
-            .x_label_formatter(&ticks(r0, r1))
-            .y_label_formatter(&ticks(e0, e1))
-            .axis_desc_style((FONT, 16))
-            .label_style((FONT, 13))
-            .draw()
-            .map_err(err)?;
-        for (k, &r) in p.seams.iter().enumerate() {
-            let drawn = chart
-                .draw_series(DashedLineSeries::new(
-                    [(r, e0), (r, e1)],
-                    6,
-                    4,
-                    SEAM.stroke_width(1),
-                ))
-                .map_err(err)?;
-            if k == 0 {
-                drawn.label("seam").legend(legend_line(SEAM));
-            }
-        }
-        chart
-            .draw_series(LineSeries::new(error_nm, ERROR.stroke_width(1)))
-            .map_err(err)?
-            .label("form error")
-            .legend(legend_line(ERROR));
-        legend(&mut chart)?;
+        draw_profile_and_path(&upper, p, &view)?;
+        draw_profile_error(&lower, p, &view)?;
         caption(&below, &lines)?;
         root.present().map_err(err)?;
     }
     Ok(svg)
+}
+
+/// The upper half of a profile plot: design and cut (left axis), the
+/// tool centre's path on its own scale (right axis).
+fn draw_profile_and_path(area: &Area, p: &ProfileSeries, v: &ProfileView) -> Result<(), String> {
+    let ((r0, r1), (z0, z1), (c0, c1)) = (v.r, v.z, v.centre_z);
+    let mut chart = ChartBuilder::on(area)
+        .margin(10)
+        .x_label_area_size(45)
+        .y_label_area_size(90)
+        .right_y_label_area_size(90)
+        .build_cartesian_2d(r0..r1, z0..z1)
+        .map_err(err)?
+        .set_secondary_coord(r0..r1, c0..c1);
+    chart
+        .configure_mesh()
+        .x_desc("radius r (mm)")
+        .y_desc("height z (mm)")
+        .x_label_formatter(&ticks(r0, r1))
+        .y_label_formatter(&ticks(z0, z1))
+        .axis_desc_style((FONT, 16))
+        .label_style((FONT, 13))
+        .draw()
+        .map_err(err)?;
+    chart
+        .configure_secondary_axes()
+        .y_desc(format!("{} centre Z (mm)", p.tool))
+        .y_label_formatter(&ticks(c0, c1))
+        .axis_desc_style((FONT, 16).into_font().color(&CENTRE))
+        .label_style((FONT, 13))
+        .draw()
+        .map_err(err)?;
+    for (k, run) in v.path.iter().enumerate() {
+        let drawn = chart
+            .draw_secondary_series(LineSeries::new(run.iter().copied(), CENTRE.stroke_width(2)))
+            .map_err(err)?;
+        if k == 0 {
+            drawn
+                .label(format!("{} centre path, as printed (right axis)", p.tool))
+                .legend(legend_line(CENTRE));
+        }
+    }
+    chart
+        .draw_series(LineSeries::new(
+            v.design.iter().copied(),
+            DESIGN.stroke_width(2),
+        ))
+        .map_err(err)?
+        .label("design")
+        .legend(legend_line(DESIGN));
+    chart
+        .draw_series(LineSeries::new(v.cut.iter().copied(), CUT.stroke_width(1)))
+        .map_err(err)?
+        .label("simulated cut")
+        .legend(legend_line(CUT));
+    legend(&mut chart)
+}
+
+/// The lower half of a profile plot: the form error in nm, seams dashed.
+fn draw_profile_error(area: &Area, p: &ProfileSeries, v: &ProfileView) -> Result<(), String> {
+    let ((r0, r1), (e0, e1)) = (v.r, v.e);
+    let mut chart = ChartBuilder::on(area)
+        .margin(10)
+        .margin_right(100)
+        .x_label_area_size(45)
+        .y_label_area_size(90)
+        .build_cartesian_2d(r0..r1, e0..e1)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("radius r (mm)")
+        .y_desc("form error, cut − design (nm)")
+        .x_label_formatter(&ticks(r0, r1))
+        .y_label_formatter(&ticks(e0, e1))
+        .axis_desc_style((FONT, 16))
+        .label_style((FONT, 13))
+        .draw()
+        .map_err(err)?;
+    for (k, &r) in p.seams.iter().enumerate() {
+        let drawn = chart
+            .draw_series(DashedLineSeries::new(
+                [(r, e0), (r, e1)],
+                6,
+                4,
+                SEAM.stroke_width(1),
+            ))
+            .map_err(err)?;
+        if k == 0 {
+            drawn.label("seam").legend(legend_line(SEAM));
+        }
+    }
+    chart
+        .draw_series(LineSeries::new(
+            v.error_nm.iter().copied(),
+            ERROR.stroke_width(1),
+        ))
+        .map_err(err)?
+        .label("form error")
+        .legend(legend_line(ERROR));
+    legend(&mut chart)
 }
 
 /// The colour of level `k` of `COLOUR_LEVELS` (viridis, low to high).
@@ -439,20 +492,11 @@ fn level(e: f64, lo: f64, hi: f64) -> usize {
     (t.floor().max(0.0) as usize).min(COLOUR_LEVELS - 1)
 }
 
-fn form_error_svg(job: &str, f: &FormErrorSeries) -> Result<String, String> {
+/// The caption under a form-error map: what it shows and its scale.
+fn form_error_caption(f: &FormErrorSeries, lo: f64, hi: f64) -> String {
     let r = &f.raster;
-    let Some((lo, hi)) = r.range() else {
-        return Err("the height map has no cut cell in its window".into());
-    };
-    let (lo_nm, hi_nm) = if hi > lo {
-        (lo * 1e6, hi * 1e6)
-    } else {
-        (lo * 1e6 - 0.5, hi * 1e6 + 0.5)
-    };
-    let (w, h) = (r.nx as f64 * r.block, r.ny as f64 * r.block);
-    let (x0, y0) = (r.x.0, r.y.0);
     let cut_blocks = r.cells.iter().filter(|e| !e.is_nan()).count();
-    let text = format!(
+    format!(
         "The form error of the simulated cut, cut − design, in nm (positive where material is left, negative a gouge) over the simulation window x {wx0} .. {wx1} mm, y {wy0} .. {wy1} mm (grid spacing {sp} µm). \
          Shown on {nx} × {ny} blocks {b} µm square; each block holds the error of largest magnitude (sign kept) among the grid cells in it, so every peak is kept. \
          White: no cut cell (outside the window, the surface or its lenslets); {cut_blocks} blocks hold cut cells. Colours in {levels} steps from {lo} to {hi} nm, the least and largest block values.",
@@ -467,7 +511,93 @@ fn form_error_svg(job: &str, f: &FormErrorSeries) -> Result<String, String> {
         levels = COLOUR_LEVELS,
         lo = num(lo * 1e6, decimals(lo * 1e6).max(1)),
         hi = num(hi * 1e6, decimals(hi * 1e6).max(1)),
-    );
+    )
+}
+
+/// The map's blocks as rectangles: runs of equal level along each row of
+/// blocks, one rectangle each.
+fn level_runs(r: &ErrorRaster, lo_nm: f64, hi_nm: f64) -> Vec<Rectangle<(f64, f64)>> {
+    let (x0, y0) = (r.x.0, r.y.0);
+    let mut rects = Vec::new();
+    for by in 0..r.ny {
+        let row = &r.cells[by * r.nx..(by + 1) * r.nx];
+        let mut bx = 0;
+        while bx < r.nx {
+            let e = row[bx];
+            if e.is_nan() {
+                bx += 1;
+                continue;
+            }
+            let k = level(e * 1e6, lo_nm, hi_nm);
+            let mut end = bx + 1;
+            while end < r.nx && !row[end].is_nan() && level(row[end] * 1e6, lo_nm, hi_nm) == k {
+                end += 1;
+            }
+            let yb = y0 + by as f64 * r.block;
+            rects.push(Rectangle::new(
+                [
+                    (x0 + bx as f64 * r.block, yb),
+                    (x0 + end as f64 * r.block, yb + r.block),
+                ],
+                level_colour(k).filled(),
+            ));
+            bx = end;
+        }
+    }
+    rects
+}
+
+/// The colour scale beside a form-error map: every level, in nm.
+fn draw_colour_scale(
+    area: &Area,
+    lo_nm: f64,
+    hi_nm: f64,
+    (margin, bottom): (u32, u32),
+) -> Result<(), String> {
+    let mut bar = ChartBuilder::on(area)
+        .margin(margin)
+        .margin_left(0)
+        .x_label_area_size(bottom)
+        .y_label_area_size(90)
+        .build_cartesian_2d(0.0..1.0, lo_nm..hi_nm)
+        .map_err(err)?;
+    bar.configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_desc("form error, cut − design (nm)")
+        .y_label_formatter(&ticks(lo_nm, hi_nm))
+        .axis_desc_style((FONT, 16))
+        .label_style((FONT, 13))
+        .y_labels(8)
+        .draw()
+        .map_err(err)?;
+    let step = (hi_nm - lo_nm) / COLOUR_LEVELS as f64;
+    bar.draw_series((0..COLOUR_LEVELS).map(|k| {
+        Rectangle::new(
+            [
+                (0.0, lo_nm + k as f64 * step),
+                (1.0, lo_nm + (k + 1) as f64 * step),
+            ],
+            level_colour(k).filled(),
+        )
+    }))
+    .map_err(err)?;
+    Ok(())
+}
+
+fn form_error_svg(job: &str, f: &FormErrorSeries) -> Result<String, String> {
+    let r = &f.raster;
+    let Some((lo, hi)) = r.range() else {
+        return Err("the height map has no cut cell in its window".into());
+    };
+    let (lo_nm, hi_nm) = if hi > lo {
+        (lo * 1e6, hi * 1e6)
+    } else {
+        (lo * 1e6 - 0.5, hi * 1e6 + 0.5)
+    };
+    let (w, h) = (r.nx as f64 * r.block, r.ny as f64 * r.block);
+    let (x0, y0) = (r.x.0, r.y.0);
+    let text = form_error_caption(f, lo, hi);
     let lines = wrap(&text, f64::from(WIDTH) - 40.0);
     // The map's plotting area keeps the window's aspect (axes to scale).
     let side = 600.0;
@@ -508,64 +638,12 @@ fn form_error_svg(job: &str, f: &FormErrorSeries) -> Result<String, String> {
             .y_labels(6)
             .draw()
             .map_err(err)?;
-        // Runs of equal level along each row of blocks, one rectangle each.
-        let mut rects = Vec::new();
-        for by in 0..r.ny {
-            let row = &r.cells[by * r.nx..(by + 1) * r.nx];
-            let mut bx = 0;
-            while bx < r.nx {
-                let e = row[bx];
-                if e.is_nan() {
-                    bx += 1;
-                    continue;
-                }
-                let k = level(e * 1e6, lo_nm, hi_nm);
-                let mut end = bx + 1;
-                while end < r.nx && !row[end].is_nan() && level(row[end] * 1e6, lo_nm, hi_nm) == k {
-                    end += 1;
-                }
-                let yb = y0 + by as f64 * r.block;
-                rects.push(Rectangle::new(
-                    [
-                        (x0 + bx as f64 * r.block, yb),
-                        (x0 + end as f64 * r.block, yb + r.block),
-                    ],
-                    level_colour(k).filled(),
-                ));
-                bx = end;
-            }
-        }
-        chart.draw_series(rects).map_err(err)?;
+        chart
+            .draw_series(level_runs(r, lo_nm, hi_nm))
+            .map_err(err)?;
         // The scale: every level, labelled in nm.
         let bar_area = plot.clone().shrink((map_w + 10, 0), (170u32, map_h));
-        let mut bar = ChartBuilder::on(&bar_area)
-            .margin(margin)
-            .margin_left(0)
-            .x_label_area_size(bottom)
-            .y_label_area_size(90)
-            .build_cartesian_2d(0.0..1.0, lo_nm..hi_nm)
-            .map_err(err)?;
-        bar.configure_mesh()
-            .disable_mesh()
-            .disable_x_axis()
-            .y_desc("form error, cut − design (nm)")
-            .y_label_formatter(&ticks(lo_nm, hi_nm))
-            .axis_desc_style((FONT, 16))
-            .label_style((FONT, 13))
-            .y_labels(8)
-            .draw()
-            .map_err(err)?;
-        let step = (hi_nm - lo_nm) / COLOUR_LEVELS as f64;
-        bar.draw_series((0..COLOUR_LEVELS).map(|k| {
-            Rectangle::new(
-                [
-                    (0.0, lo_nm + k as f64 * step),
-                    (1.0, lo_nm + (k + 1) as f64 * step),
-                ],
-                level_colour(k).filled(),
-            )
-        }))
-        .map_err(err)?;
+        draw_colour_scale(&bar_area, lo_nm, hi_nm, (margin, bottom))?;
         caption(&below, &lines)?;
         root.present().map_err(err)?;
     }

@@ -1,12 +1,20 @@
-//! lensc-lang: the `.lens` front end. Text becomes a syntax tree in
-//! `lensc-grammar`; here files are loaded (`loader`), names resolved and
-//! every value checked for its unit and range against the schema
-//! (`check`, `schema`, `units`), and checked jobs lowered to what the
-//! runtime plans (`lower`). Errors are data (`Diagnostic`s with codes and
-//! spans); nothing here plans, writes or renders.
+//! lensc-lang: the `.lens` front end. The pipeline runs source text →
+//! syntax tree (`lensc-grammar`) → checked values (here) → typed jobs and
+//! surface IR (here) → toolpaths and programs (`lensc-build` driving
+//! `lensc-runtime`) → the `lensc` binary's output.
+//!
+//! Here files are loaded with their `use`s (`loader`, `source`); names are
+//! resolved and every value checked for its unit and range against the
+//! schema (`check`: `scope`, `expr`, `params`, `rules`; `schema`, one file
+//! per category of kind; `units`, `value`, `codes`); and checked jobs and
+//! surfaces are lowered to what the runtime plans (`lower`, with
+//! `lower::surface` one file per surface family). Errors are data
+//! (`Diagnostic`s with codes and spans); nothing here plans, writes or
+//! renders.
 
 pub mod check;
 pub mod codes;
+pub mod domain;
 pub mod loader;
 pub mod lower;
 pub mod schema;

@@ -207,100 +207,115 @@ impl Loader<'_> {
         imports: &mut Vec<Import>,
     ) {
         match target {
-            UseTarget::Std(segs) => {
-                if segs[0].name != "std" {
-                    self.loaded.diags.push(
-                        Diagnostic::error(
-                            codes::UNKNOWN_MODULE,
-                            format!("unknown module `{}`", segs[0].name),
-                            from,
-                            segs[0].span,
-                        )
-                        .with_label("only `std` modules are named this way")
-                        .with_help("use another file by its path in quotes: use \"common.lens\""),
-                    );
-                    return;
-                }
-                let Some(module) = segs.get(1) else { return };
-                let Some(&(mname, _)) = STDLIB.iter().find(|(n, _)| *n == module.name) else {
-                    let names: Vec<&str> = STDLIB.iter().map(|(n, _)| *n).collect();
-                    let mut d = Diagnostic::error(
-                        codes::UNKNOWN_MODULE,
-                        format!("the standard library has no module `{}`", module.name),
-                        from,
-                        module.span,
-                    )
-                    .with_label("no such module");
-                    d = d.with_help(match did_you_mean(&module.name, names.iter().copied()) {
-                        Some(s) => format!("did you mean `{s}`?"),
-                        None => format!("the modules are: {}", names.join(", ")),
-                    });
-                    self.loaded.diags.push(d);
-                    return;
-                };
-                if segs.len() > 3 {
-                    self.loaded.diags.push(
-                        Diagnostic::error(
-                            codes::UNKNOWN_MODULE,
-                            "a `use` path names a module and at most one item",
-                            from,
-                            segs[3].span.to(segs[segs.len() - 1].span),
-                        )
-                        .with_label("remove this"),
-                    );
-                }
-                let file = self.std_module(mname);
-                match segs.get(2) {
-                    Some(name) => imports.push(Import::One {
-                        file,
-                        name: name.clone(),
-                    }),
-                    None => imports.push(Import::All { file, span }),
-                }
-            }
+            UseTarget::Std(segs) => self.use_std(from, segs, span, imports),
             UseTarget::File { path, span: pspan } => {
-                let base = from_path.and_then(Path::parent).unwrap_or(Path::new(""));
-                let full = base.join(path);
-                let key = Key::Path(self.fs.canonical(&full));
-                if let Some(pos) = self.stack.iter().position(|(k, _)| *k == key) {
-                    let mut chain: Vec<String> = self.stack[pos..]
-                        .iter()
-                        .map(|(_, f)| self.loaded.sources.get(*f).name.clone())
-                        .collect();
-                    chain.push(self.loaded.sources.get(self.stack[pos].1).name.clone());
-                    self.loaded.diags.push(
-                        Diagnostic::error(codes::IMPORT_CYCLE, "import cycle", from, *pspan)
-                            .with_label(
-                                "this `use` leads back to a file that is still being loaded",
-                            )
-                            .with_help(format!(
-                                "the cycle is {}; move what both files need into a third file",
-                                chain.join(" → ")
-                            )),
-                    );
-                    return;
-                }
-                if let Some(&f) = self.keys.get(&key) {
-                    imports.push(Import::All { file: f, span });
-                    return;
-                }
-                match self.fs.read(&full) {
-                    Ok(bytes) => {
-                        let f = self.add(key, full.display().to_string(), Some(full), bytes);
-                        imports.push(Import::All { file: f, span });
-                    }
-                    Err(e) => self.loaded.diags.push(
-                        Diagnostic::error(
-                            codes::CANNOT_READ,
-                            format!("cannot read `{}`: {}", full.display(), plain_io_error(&e)),
-                            from,
-                            *pspan,
-                        )
-                        .with_label("used here")
-                        .with_help("paths are relative to the file that uses them"),
-                    ),
-                }
+                self.use_file(from, from_path, path, *pspan, span, imports)
             }
+        }
+    }
+
+    /// `use std::module` or `use std::module::item`.
+    fn use_std(&mut self, from: FileId, segs: &[Ident], span: Span, imports: &mut Vec<Import>) {
+        if segs[0].name != "std" {
+            self.loaded.diags.push(
+                Diagnostic::error(
+                    codes::UNKNOWN_MODULE,
+                    format!("unknown module `{}`", segs[0].name),
+                    from,
+                    segs[0].span,
+                )
+                .with_label("only `std` modules are named this way")
+                .with_help("use another file by its path in quotes: use \"common.lens\""),
+            );
+            return;
+        }
+        let Some(module) = segs.get(1) else { return };
+        let Some(&(mname, _)) = STDLIB.iter().find(|(n, _)| *n == module.name) else {
+            let names: Vec<&str> = STDLIB.iter().map(|(n, _)| *n).collect();
+            let mut d = Diagnostic::error(
+                codes::UNKNOWN_MODULE,
+                format!("the standard library has no module `{}`", module.name),
+                from,
+                module.span,
+            )
+            .with_label("no such module");
+            d = d.with_help(match did_you_mean(&module.name, names.iter().copied()) {
+                Some(s) => format!("did you mean `{s}`?"),
+                None => format!("the modules are: {}", names.join(", ")),
+            });
+            self.loaded.diags.push(d);
+            return;
+        };
+        if segs.len() > 3 {
+            self.loaded.diags.push(
+                Diagnostic::error(
+                    codes::UNKNOWN_MODULE,
+                    "a `use` path names a module and at most one item",
+                    from,
+                    segs[3].span.to(segs[segs.len() - 1].span),
+                )
+                .with_label("remove this"),
+            );
+        }
+        let file = self.std_module(mname);
+        match segs.get(2) {
+            Some(name) => imports.push(Import::One {
+                file,
+                name: name.clone(),
+            }),
+            None => imports.push(Import::All { file, span }),
+        }
+    }
+
+    /// `use "file.lens"`, relative to the file that uses it: read once,
+    /// and never while it is still being loaded (a cycle).
+    fn use_file(
+        &mut self,
+        from: FileId,
+        from_path: Option<&Path>,
+        path: &str,
+        pspan: Span,
+        span: Span,
+        imports: &mut Vec<Import>,
+    ) {
+        let base = from_path.and_then(Path::parent).unwrap_or(Path::new(""));
+        let full = base.join(path);
+        let key = Key::Path(self.fs.canonical(&full));
+        if let Some(pos) = self.stack.iter().position(|(k, _)| *k == key) {
+            let mut chain: Vec<String> = self.stack[pos..]
+                .iter()
+                .map(|(_, f)| self.loaded.sources.get(*f).name.clone())
+                .collect();
+            chain.push(self.loaded.sources.get(self.stack[pos].1).name.clone());
+            self.loaded.diags.push(
+                Diagnostic::error(codes::IMPORT_CYCLE, "import cycle", from, pspan)
+                    .with_label("this `use` leads back to a file that is still being loaded")
+                    .with_help(format!(
+                        "the cycle is {}; move what both files need into a third file",
+                        chain.join(" → ")
+                    )),
+            );
+            return;
+        }
+        if let Some(&f) = self.keys.get(&key) {
+            imports.push(Import::All { file: f, span });
+            return;
+        }
+        match self.fs.read(&full) {
+            Ok(bytes) => {
+                let f = self.add(key, full.display().to_string(), Some(full), bytes);
+                imports.push(Import::All { file: f, span });
+            }
+            Err(e) => self.loaded.diags.push(
+                Diagnostic::error(
+                    codes::CANNOT_READ,
+                    format!("cannot read `{}`: {}", full.display(), plain_io_error(&e)),
+                    from,
+                    pspan,
+                )
+                .with_label("used here")
+                .with_help("paths are relative to the file that uses them"),
+            ),
         }
     }
 }

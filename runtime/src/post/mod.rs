@@ -11,7 +11,7 @@ pub mod writer;
 
 pub use dialect::{CommentStyle, Dialect};
 pub use header::Provenance;
-pub use writer::{ProgramWriter, Setup, check_numbers};
+pub use writer::{ProgramWriter, Setup, check_dialect, check_numbers};
 
 /// A program could not be written.
 #[derive(Clone, Debug, PartialEq)]

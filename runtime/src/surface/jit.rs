@@ -601,3 +601,8 @@ extern "C" fn lensc_jit_pow(a: f64, b: f64) -> f64 {
 extern "C" fn lensc_jit_atan2(a: f64, b: f64) -> f64 {
     apply_binary(Binary::Atan2, a, b)
 }
+
+#[cfg(test)]
+mod tests {
+    crate::surface::conformance::surface_fn_tests!(super::JitSurface);
+}

@@ -1,0 +1,215 @@
+//! Building a profile-turning job: the profile planned along the surface's
+//! section as the JIT evaluates it, the seams and the centre the nose
+//! cannot reach reported, the program emitted, and the cut simulated along
+//! the whole profile for the report.
+
+use lensc_grammar::Diagnostic;
+use lensc_lang::check::trim_num;
+use lensc_lang::codes;
+use lensc_lang::lower::job::{TurningSpec, turning_diagnostic};
+use lensc_runtime::plan::turning::{Move, ToolLocation, Toolpath, TurningJob};
+use lensc_runtime::post::Provenance;
+use lensc_runtime::surface::SectionAlongX;
+
+use crate::driver::{
+    Built, PROFILE_SAMPLES, ProgramText, analysis_json, evaluator, optimisation_json,
+    profile_cut_json, profile_series,
+};
+
+/// Builds one profile-turning job, or says why it cannot be built.
+pub fn build(spec: &TurningSpec, prov: &Provenance) -> Result<Built, Vec<Diagnostic>> {
+    let (head, job) = (&spec.head, &spec.job);
+    let lowered = &head.surface.lowered;
+    // The planner follows the surface as the JIT evaluates it.
+    let (kernel, _) = evaluator(&lowered.tape);
+    let profile = SectionAlongX(kernel.as_ref());
+    let path =
+        lensc_runtime::plan::turning::plan_profile_turning(job, &profile).map_err(|errs| {
+            errs.into_iter()
+                .map(|e| turning_diagnostic(e, head.site))
+                .collect::<Vec<_>>()
+        })?;
+    let warnings = warnings(spec, &path);
+    let emitted = match lensc_runtime::emit::turning::emit(job, &path, prov) {
+        Ok(e) => e,
+        Err(e) => {
+            let mut all = warnings;
+            all.push(
+                Diagnostic::error(codes::NOT_PRINTABLE, e.message(), head.site.0, head.site.1)
+                    .with_label("no program was written for this job"),
+            );
+            return Err(all);
+        }
+    };
+    let lensc_runtime::emit::Emitted {
+        text,
+        stream,
+        optimised,
+    } = emitted;
+    let program_name = format!("{}.{}", job.name, job.machine.dialect.extension);
+    let analysis = analysis_json(
+        &head.names.surface_declared,
+        head.surface.kind,
+        lowered,
+        201,
+    );
+    let mut report = build_report(job, prov, &program_name, &text, &path, analysis);
+    report["toolpath"]["optimisation"] = optimisation_json(&optimised);
+    let mut plots = crate::plots::PlotSeries::default();
+    report["simulation"] = if job.tool.centre_height == 0.0 {
+        use lensc_runtime::surface::Profile as _;
+        let design = |x: f64| profile.point(x).z;
+        let range = (
+            job.strategy.end_radius,
+            job.strategy
+                .start_radius
+                .unwrap_or(job.surface.aperture_radius),
+        );
+        let cut = lensc_runtime::verify::simulate::profile_cut(
+            &stream,
+            job.tool.nose_radius,
+            job.machine.resolution,
+            &design,
+            range,
+            PROFILE_SAMPLES,
+        );
+        plots.profile = Some(profile_series(
+            &cut,
+            &design,
+            &stream,
+            ("nose", job.tool.nose_radius),
+            job.machine.resolution,
+            path.seams.iter().map(|s| s.at_radius).collect(),
+        ));
+        profile_cut_json(&cut)
+    } else {
+        serde_json::json!({
+            "skipped": "the edge is set off the spindle axis: the program's X is not the nose centre's radius"
+        })
+    };
+    Ok(Built {
+        report_name: format!("{}.report.json", job.name),
+        program_name,
+        program: ProgramText::Memory(text),
+        cut_points: path.cut_points,
+        cutting_time: path.cutting_time(),
+        report,
+        beside: Vec::new(),
+        plots,
+        warnings,
+    })
+}
+
+/// What the path leaves uncut: the centre, when the edge is set off the
+/// spindle axis (W0004), and the concave corners the nose cannot reach
+/// (W0003).
+fn warnings(spec: &TurningSpec, path: &Toolpath) -> Vec<Diagnostic> {
+    let (head, job) = (&spec.head, &spec.job);
+    let (file, span) = head.site;
+    let mut out = Vec::new();
+    let h = job.tool.centre_height.abs();
+    let inmost = path
+        .moves
+        .iter()
+        .filter_map(|m| match *m {
+            Move::Feed { x, .. } => Some(x.abs()),
+            Move::Rapid { .. } => None,
+        })
+        .fold(f64::INFINITY, f64::min);
+    if h > 0.0 && inmost < h {
+        out.push(
+            Diagnostic::warning(
+                codes::CENTRE_LEFT_UNCUT,
+                format!(
+                    "the tool's edge is {} mm off the spindle axis: it cannot reach radii below that, and a pip is left at the centre",
+                    trim_num(h)
+                ),
+                file,
+                span,
+            )
+            .with_label("this job")
+            .with_help("set the tool on centre; the program corrects X for the height given"),
+        );
+    }
+    if let Some(deepest) = path.seams.iter().max_by(|a, b| a.depth.total_cmp(&b.depth)) {
+        let (first, last) = (&path.seams[0], &path.seams[path.seams.len() - 1]);
+        let where_ = if path.seams.len() == 1 {
+            format!("the concave corner at r = {} mm", trim_num(first.at_radius))
+        } else {
+            format!(
+                "{} concave corners between r = {} and {} mm",
+                path.seams.len(),
+                trim_num(first.at_radius),
+                trim_num(last.at_radius)
+            )
+        };
+        out.push(
+            Diagnostic::warning(
+                codes::SEAM_LEFT_UNCUT,
+                format!(
+                    "the {} mm nose cannot reach into {where_}: up to {} um of material is left above the design (at r = {} mm)",
+                    trim_num(job.tool.nose_radius),
+                    trim_num(deepest.depth * 1000.0),
+                    trim_num(deepest.at_radius)
+                ),
+                file,
+                span,
+            )
+            .with_label("this job")
+            .with_help("the program cuts the gouge-free envelope; the report lists every corner and its depth; a smaller nose follows them closer"),
+        );
+    }
+    out
+}
+
+/// The report written beside a program.
+fn build_report(
+    job: &TurningJob,
+    prov: &Provenance,
+    program_name: &str,
+    text: &str,
+    path: &Toolpath,
+    surface: serde_json::Value,
+) -> serde_json::Value {
+    use serde_json::json;
+    json!({
+        "job": job.name,
+        "lensc_version": prov.lensc_version,
+        "source": prov.source,
+        "source_fnv1a64": format!("{:016x}", prov.source_hash),
+        "program": {
+            "file": program_name,
+            "dialect": job.machine.dialect.name,
+            "lines": text.lines().count(),
+            "bytes": text.len(),
+        },
+        "toolpath": {
+            "strategy": "profile_turning",
+            "cut_points": path.cut_points,
+            "cut_length_mm": path.cut_length,
+            "feed_mm_per_min": path.feed_speed * 60.0,
+            "surface_speed_m_per_min": job.strategy.surface_speed.map(|v| v * 0.06),
+            "max_spindle_rpm": job.strategy.spindle_speed * 60.0 / std::f64::consts::TAU,
+            "cutting_time_s": path.cutting_time(),
+            "passes": path.pass_times.iter().enumerate().map(|(i, t)| serde_json::json!({
+                "pass": if i < path.roughing_passes { "roughing" } else { "finish" },
+                "cutting_time_s": t,
+            })).collect::<Vec<_>>(),
+            "chord_tolerance_mm": job.strategy.chord_tolerance,
+            "max_profile_slope_deg": path.max_slope.0.to_degrees(),
+            "min_concave_radius_mm": path.min_concave_radius.map(|(r, at)| json!({ "value": r, "at_radius_mm": at })),
+            "roughing_passes": path.roughing_passes,
+            "tool_location": match job.strategy.location {
+                ToolLocation::Exact => "exact",
+                ToolLocation::Sequential { .. } => "sequential",
+                ToolLocation::Binary { .. } => "binary",
+            },
+            "seams": path.seams.iter().map(|s| json!({
+                "at_radius_mm": s.at_radius,
+                "uncut_depth_mm": s.depth,
+                "corner_angle_deg": s.angle.to_degrees(),
+            })).collect::<Vec<_>>(),
+        },
+        "surface": surface,
+    })
+}

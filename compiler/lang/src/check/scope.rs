@@ -1,0 +1,352 @@
+//! Names: declarations and `let`s of every file, `use` imports,
+//! evaluation of each declaration once (reporting cycles), unknown
+//! names with a suggestion, and unused definitions.
+
+use std::collections::HashMap;
+
+use lensc_grammar::ast::{DeclKind, Ident, ItemKind, Span};
+use lensc_grammar::suggest::did_you_mean;
+use lensc_grammar::{Diagnostic, FileId};
+
+use super::{COORDINATES, Checker, Decl, FUNCTIONS, State};
+use crate::codes;
+use crate::loader::{Import, ParsedFile};
+use crate::schema::{self, Category};
+use crate::units;
+use crate::value::Value;
+
+impl<'a> Checker<'a> {
+    /// Builds every file's scope: its own items first, then its imports.
+    pub(super) fn build_scopes(&mut self) {
+        let loaded = self.loaded;
+        let locals: Vec<HashMap<&'a str, usize>> = loaded
+            .files
+            .iter()
+            .map(|pf| self.declare_items(pf))
+            .collect();
+        for pf in &loaded.files {
+            let scope = self.resolve_imports(pf, &locals);
+            self.scopes.push(scope);
+        }
+    }
+
+    /// A file's own `let`s and declarations, by name.
+    fn declare_items(&mut self, pf: &'a ParsedFile) -> HashMap<&'a str, usize> {
+        let mut scope: HashMap<&'a str, usize> = HashMap::new();
+        for item in &pf.ast.items {
+            let (name, kind, value) = match &item.kind {
+                ItemKind::Let { name, value } => (name, None, value),
+                ItemKind::Decl { kind, name, value } => (name, Some(*kind), value),
+                _ => continue,
+            };
+            if !self.name_is_free(pf.id, &scope, name) {
+                continue;
+            }
+            scope.insert(name.name.as_str(), self.decls.len());
+            self.decls.push(Decl {
+                file: pf.id,
+                name,
+                kind,
+                value,
+            });
+            self.state.push(State::Todo);
+            self.used.push(false);
+        }
+        scope
+    }
+
+    /// Whether `name` may be defined in a file: not twice, and not a word,
+    /// function, kind or coordinate lensc already gives a meaning.
+    fn name_is_free(
+        &mut self,
+        file: FileId,
+        scope: &HashMap<&'a str, usize>,
+        name: &Ident,
+    ) -> bool {
+        if let Some(&prev) = scope.get(name.name.as_str()) {
+            let first = self.decls[prev].name.span;
+            self.err(
+                Diagnostic::error(
+                    codes::DUPLICATE_NAME,
+                    format!("`{}` is defined twice", name.name),
+                    file,
+                    name.span,
+                )
+                .with_label("second definition")
+                .with_note(file, first, "first defined here")
+                .with_help("rename one of them"),
+            );
+            return false;
+        }
+        if schema::is_word(&name.name) {
+            self.err(
+                Diagnostic::error(
+                    codes::DUPLICATE_NAME,
+                    format!("`{}` is a word lensc uses as a value", name.name),
+                    file,
+                    name.span,
+                )
+                .with_label("this name would hide the word")
+                .with_help(format!(
+                    "`{}` is the value of a parameter (as in `sense: convex`); choose another name",
+                    name.name
+                )),
+            );
+            return false;
+        }
+        if FUNCTIONS.contains(&name.name.as_str())
+            || schema::kind(&name.name).is_some()
+            || COORDINATES.contains(&name.name.as_str())
+        {
+            self.err(
+                Diagnostic::error(
+                    codes::DUPLICATE_NAME,
+                    format!("`{}` is a built-in name", name.name),
+                    file,
+                    name.span,
+                )
+                .with_label("this would hide the built-in")
+                .with_help("choose another name"),
+            );
+            return false;
+        }
+        true
+    }
+
+    /// A file's scope: its own items and those it imports.
+    fn resolve_imports(
+        &mut self,
+        pf: &'a ParsedFile,
+        locals: &[HashMap<&'a str, usize>],
+    ) -> HashMap<&'a str, usize> {
+        let mut scope = locals[pf.id.0 as usize].clone();
+        for imp in &pf.imports {
+            match imp {
+                Import::One { file, name } => {
+                    self.import_one(pf.id, &mut scope, &locals[file.0 as usize], *file, name)
+                }
+                Import::All { file, .. } => {
+                    for (&n, &i) in &locals[file.0 as usize] {
+                        scope.entry(n).or_insert(i);
+                    }
+                }
+            }
+        }
+        scope
+    }
+
+    /// `use module::name`: the item joins the scope unless the name is taken.
+    fn import_one(
+        &mut self,
+        here: FileId,
+        scope: &mut HashMap<&'a str, usize>,
+        source: &HashMap<&'a str, usize>,
+        file: FileId,
+        name: &'a Ident,
+    ) {
+        match source.get(name.name.as_str()) {
+            Some(&i) => {
+                if let Some(&prev) = scope.get(name.name.as_str()) {
+                    let prev_span = self.decls[prev].name.span;
+                    let prev_file = self.decls[prev].file;
+                    self.err(
+                        Diagnostic::error(
+                            codes::DUPLICATE_NAME,
+                            format!("`{}` is already defined", name.name),
+                            here,
+                            name.span,
+                        )
+                        .with_label("imported here")
+                        .with_note(prev_file, prev_span, "also defined here")
+                        .with_help("rename the local definition"),
+                    );
+                } else {
+                    scope.insert(name.name.as_str(), i);
+                    self.used[i] = true;
+                }
+            }
+            None => {
+                let module = self.loaded.sources.get(file).name.clone();
+                let mut d = Diagnostic::error(
+                    codes::NOT_IN_MODULE,
+                    format!("`{module}` has no item `{}`", name.name),
+                    here,
+                    name.span,
+                )
+                .with_label("not found");
+                let names: Vec<&str> = source.keys().copied().collect();
+                let mut sorted = names.clone();
+                sorted.sort_unstable();
+                d = d.with_help(match did_you_mean(&name.name, names) {
+                    Some(s) => format!("did you mean `{s}`?"),
+                    None => format!("it has: {}", sorted.join(", ")),
+                });
+                self.err(d);
+            }
+        }
+    }
+
+    pub(super) fn decl_value(&mut self, i: usize) -> Value {
+        match &self.state[i] {
+            State::Done(v) => return v.clone(),
+            State::Busy => {
+                let d = &self.decls[i];
+                let (file, span, name) = (d.file, d.name.span, d.name.name.clone());
+                self.err(
+                    Diagnostic::error(
+                        codes::SELF_REFERENCE,
+                        format!("`{name}` is defined in terms of itself"),
+                        file,
+                        span,
+                    )
+                    .with_label("this definition needs its own value")
+                    .with_help("break the cycle by giving one of the values directly"),
+                );
+                self.state[i] = State::Done(Value::Error);
+                return Value::Error;
+            }
+            State::Todo => {}
+        }
+        self.state[i] = State::Busy;
+        let (file, expr, kind, name) = (
+            self.decls[i].file,
+            self.decls[i].value,
+            self.decls[i].kind,
+            self.decls[i].name,
+        );
+        let mut v = self.eval(file, expr, &[]);
+        if let Some(kind) = kind {
+            v = self.expect_category(file, expr.span, v, Category::of(kind), Some((kind, name)));
+            // A declared object is known by its name (a dialect is chosen by it).
+            if let Value::Object(o) = &v
+                && o.name.is_none()
+            {
+                let mut named = (**o).clone();
+                named.name = Some(name.name.clone());
+                v = Value::Object(std::rc::Rc::new(named));
+            }
+        }
+        if let State::Done(prev) = &self.state[i] {
+            // A cycle was reported while evaluating; keep the error value.
+            return prev.clone();
+        }
+        self.state[i] = State::Done(v.clone());
+        v
+    }
+
+    /// Checks that a declaration's value was made by a kind of the category.
+    pub(super) fn expect_category(
+        &mut self,
+        file: FileId,
+        span: Span,
+        v: Value,
+        cat: Category,
+        decl: Option<(DeclKind, &Ident)>,
+    ) -> Value {
+        match &v {
+            Value::Object(o) if o.kind.category == cat => v,
+            Value::Error => v,
+            Value::Kind(k) if k.category == cat => {
+                self.err(
+                    Diagnostic::error(
+                        codes::WRONG_VALUE,
+                        format!("`{}` needs its parameters", k.name),
+                        file,
+                        span,
+                    )
+                    .with_label("a kind, not a value")
+                    .with_help(format!("write `{} {{ … }}` with its parameters", k.name)),
+                );
+                Value::Error
+            }
+            Value::Word(w) => {
+                self.unknown_name(file, span, w);
+                Value::Error
+            }
+            other => {
+                let what = other.describe();
+                let msg = match decl {
+                    Some((k, name)) => format!(
+                        "`{}` is declared as {} but its value is {what}",
+                        name.name,
+                        Category::of(k).noun()
+                    ),
+                    None => format!("expected {} but found {what}", cat.noun()),
+                };
+                let mut d = Diagnostic::error(codes::DECLARATION_KIND, msg, file, span)
+                    .with_label(format!("this is {what}"));
+                let kinds: Vec<&str> = schema::KINDS
+                    .iter()
+                    .filter(|k| k.category == cat)
+                    .map(|k| k.name)
+                    .collect();
+                d = d.with_help(format!(
+                    "{} is made by one of: {}",
+                    cat.noun(),
+                    kinds.join(", ")
+                ));
+                self.err(d);
+                Value::Error
+            }
+        }
+    }
+
+    pub(super) fn lookup(&mut self, file: FileId, name: &str) -> Option<usize> {
+        let i = *self.scopes[file.0 as usize].get(name)?;
+        self.used[i] = true;
+        Some(i)
+    }
+
+    pub(super) fn unknown_name(&mut self, file: FileId, span: Span, name: &str) {
+        let scope = &self.scopes[file.0 as usize];
+        let mut candidates: Vec<&str> = scope.keys().copied().collect();
+        candidates.extend(FUNCTIONS);
+        candidates.extend(schema::KINDS.iter().map(|k| k.name));
+        let mut d = Diagnostic::error(
+            codes::UNKNOWN_NAME,
+            format!("unknown name `{name}`"),
+            file,
+            span,
+        )
+        .with_label("not defined");
+        if COORDINATES.contains(&name) {
+            d = d.with_help(
+                "coordinates can only be used inside a surface formula such as `z(x, y) = …`",
+            );
+        } else if let Some(s) = did_you_mean(name, candidates) {
+            d = d.with_help(format!("did you mean `{s}`?"));
+        } else if units::lookup(name).is_some() {
+            d = d.with_help(format!(
+                "`{name}` is a unit: write it right after a number, as in `1 {name}`"
+            ));
+        }
+        self.err(d);
+    }
+
+    /// Unused definitions are worth a warning in a job file; a file with no
+    /// job (a library of surfaces or tools) is all definitions by design.
+    pub(super) fn warn_unused(&mut self) {
+        let has_jobs = self.loaded.files[0]
+            .ast
+            .items
+            .iter()
+            .any(|i| matches!(i.kind, ItemKind::Job { .. }));
+        for (i, d) in self.decls.iter().enumerate() {
+            if !has_jobs && d.kind.is_some() {
+                continue;
+            }
+            if d.file == FileId(0) && !self.used[i] {
+                self.diags.push(
+                    Diagnostic::warning(
+                        codes::UNUSED,
+                        format!("`{}` is never used", d.name.name),
+                        d.file,
+                        d.name.span,
+                    )
+                    .with_label("defined here")
+                    .with_help("remove it, or use it in a job"),
+                );
+            }
+        }
+    }
+}

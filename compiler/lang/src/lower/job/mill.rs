@@ -1,0 +1,150 @@
+//! Lowering the jobs of 2- and 3-axis machines beyond the lathe: iso-plane
+//! raster on a mill and profile grinding with a spherical wheel, each
+//! checked for its machine, its tool and its feed.
+
+use lensc_grammar::Diagnostic;
+use lensc_runtime::plan::grinding::ProfileGrinding;
+use lensc_runtime::plan::raster::{Axis, Raster, RasterTool};
+use lensc_runtime::post::Dialect;
+use lensc_runtime::surface::analysis::Domain;
+
+use super::{JobHead, Parts};
+use crate::check::trim_num;
+use crate::codes;
+use crate::value;
+
+/// A `raster` job on a `mill_3axis`, typed.
+pub struct RasterSpec {
+    pub head: JobHead,
+    pub raster: Raster,
+    pub tool: RasterTool,
+    /// The tool in the header's words.
+    pub tool_words: String,
+    /// The knife's clearance angle (rad), if it has one: the planner's
+    /// steepest slope along the cut must stay below it.
+    pub clearance: Option<f64>,
+    /// The cutting feed (mm/s).
+    pub feed: f64,
+}
+
+/// A `profile_grinding` job on a `grinder_2axis`, typed.
+pub struct GrindingSpec {
+    pub head: JobHead,
+    pub grinding: ProfileGrinding,
+    /// Height (mm) above the part's top for the rapid moves.
+    pub retract: f64,
+}
+
+pub(super) fn lower_raster(p: &Parts, dialect: Dialect) -> Result<RasterSpec, Vec<Diagnostic>> {
+    let errors: Vec<Diagnostic> = [
+        p.needs("machine", p.machine, &["mill_3axis"], "raster"),
+        p.needs("tool", p.tool, &["microshaper", "ball_end"], "raster"),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+    let (st, t, m) = (&p.strategy.fields, &p.tool.fields, &p.machine.fields);
+    let raster = Raster {
+        along: if value::word(st, "along") == Some("y") {
+            Axis::Y
+        } else {
+            Axis::X
+        },
+        zigzag: value::word(st, "direction") == Some("zigzag"),
+        stepover: value::num(st, "stepover").expect("required"),
+        chord_tolerance: value::num(st, "chord_tolerance").unwrap_or(10e-6),
+        max_step: value::num(st, "max_step"),
+        lin_angle: value::num(st, "lin_angle"),
+        retract: value::num(st, "retract").unwrap_or(1.0),
+    };
+    let (tool, tool_words) = match p.tool.kind.name {
+        "ball_end" => {
+            let d = value::num(t, "diameter").expect("required");
+            (
+                RasterTool::Ball { radius: d / 2.0 },
+                format!(
+                    "ball-end mill, diameter {} mm, referenced at the ball centre",
+                    trim_num(d)
+                ),
+            )
+        }
+        _ => {
+            let r = value::num(t, "nose_radius").expect("required");
+            (
+                RasterTool::Knife { nose_radius: r },
+                format!(
+                    "microshaper knife, nose radius {} mm, its edge across the cut, referenced at the nose centre",
+                    trim_num(r)
+                ),
+            )
+        }
+    };
+    let lowered = p.lowered().map_err(|d| vec![d])?;
+    let feed = value::num(st, "feed").expect("required");
+    let max_feed = value::num(m, "max_feed").expect("required");
+    if feed > max_feed {
+        return Err(vec![p.error(
+            codes::FEED_TOO_HIGH,
+            format!(
+                "the cutting feed ({} mm/min) is above the machine's maximum ({} mm/min)",
+                trim_num(feed * 60.0),
+                trim_num(max_feed * 60.0)
+            ),
+        )]);
+    }
+    Ok(RasterSpec {
+        head: p.head(dialect, lowered),
+        raster,
+        tool,
+        tool_words,
+        clearance: value::num(t, "clearance"),
+        feed,
+    })
+}
+
+pub(super) fn lower_grinding(p: &Parts, dialect: Dialect) -> Result<GrindingSpec, Vec<Diagnostic>> {
+    let errors: Vec<Diagnostic> = [
+        p.needs("machine", p.machine, &["grinder_2axis"], "profile grinding"),
+        p.needs("tool", p.tool, &["spherical_wheel"], "profile grinding"),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+    let (st, t, m) = (&p.strategy.fields, &p.tool.fields, &p.machine.fields);
+    let lowered = p.lowered().map_err(|d| vec![d])?;
+    let edge = match lowered.domain {
+        Domain::Circle { radius } | Domain::Annulus { outer: radius, .. } => radius,
+        Domain::Rect { x, .. } => x.1,
+    };
+    let feed = value::num(st, "feed").expect("required");
+    let grinding = ProfileGrinding {
+        wheel_diameter: value::num(t, "diameter").expect("required"),
+        interval: value::num(st, "interval").expect("required"),
+        feed,
+        smoothness: value::num(st, "smoothness").expect("required"),
+        start: value::num(st, "from").unwrap_or(0.0),
+        end: value::num(st, "to").unwrap_or(edge),
+    };
+    let max_feed = value::num(m, "max_feed").expect("required");
+    if feed > max_feed {
+        return Err(vec![p.error(
+            codes::FEED_TOO_HIGH,
+            format!(
+                "the grinding feed ({} mm/min) is above the machine's maximum ({} mm/min)",
+                trim_num(feed * 60.0),
+                trim_num(max_feed * 60.0)
+            ),
+        )]);
+    }
+    Ok(GrindingSpec {
+        head: p.head(dialect, lowered),
+        grinding,
+        retract: value::num(st, "retract").unwrap_or(1.0),
+    })
+}

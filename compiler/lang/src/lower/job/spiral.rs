@@ -1,0 +1,397 @@
+//! Lowering a spiral turning job, with a fast tool servo (`fts_spiral` on
+//! an `fts_lathe`) or a slow one (`spiral_turning` on an `sts_lathe`, Z
+//! carrying the surface): the servo model, the settling offset worked out
+//! from it, the tool trajectory, the spiral and its bounds, and the checks
+//! of the tool against the design (nose radius, clearance, included
+//! angle), the spindle and the travel, all before the spiral is planned.
+
+use lensc_grammar::Diagnostic;
+use lensc_runtime::machine::servo::SecondOrderServo;
+use lensc_runtime::plan::fts::{FastAxis, FtsSpiral, SpindleSpeed, TrajectoryBounds};
+use lensc_runtime::post::Dialect;
+use lensc_runtime::surface::ir::SurfaceFn;
+
+use super::{Evaluate, JobHead, Parts};
+use crate::check::trim_num;
+use crate::codes;
+use crate::lower::surface::LoweredSurface;
+use crate::value::{self, Object};
+
+/// A spiral job, typed: what the spiral planner needs.
+pub struct SpiralSpec {
+    pub head: JobHead,
+    /// Slow tool servo: Z itself carries the surface.
+    pub slow: bool,
+    pub spiral: FtsSpiral,
+    pub bounds: TrajectoryBounds,
+    pub nose_radius: f64,
+    pub fast_axis: FastAxis,
+    /// The surface the nose centre follows: the design, or with a
+    /// settling offset its lenslets continued and lifted over the land.
+    pub trajectory: LoweredSurface,
+    /// The fast axis's servo model (none for a slow tool servo).
+    pub servo: Option<SecondOrderServo>,
+    pub settling: Option<Settling>,
+    /// The fast axis's position (mm) clear of the part.
+    pub safe_w: f64,
+    /// The lenslets' own apertures (centre x, y and rim radius, mm), if
+    /// the surface is an array.
+    pub lenslets: Vec<(f64, f64, f64)>,
+}
+
+/// The settling offset and how it was found.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settling {
+    /// The servo's settling time (s).
+    pub time: f64,
+    /// The band it settles into, when the time came from the model.
+    pub band: Option<f64>,
+    /// The fastest surface speed (mm/s) the job reaches.
+    pub surface_speed: f64,
+    /// The path covered while settling (mm).
+    pub d_traj: f64,
+    /// How far the tool is held above the land (mm).
+    pub offset: f64,
+}
+
+pub(super) fn lower(
+    p: &Parts,
+    dialect: Dialect,
+    evaluate: Evaluate,
+) -> Result<SpiralSpec, Vec<Diagnostic>> {
+    let (surface, tool, machine, strategy) = (p.surface, p.tool, p.machine, p.strategy);
+    let err = |code: &'static str, msg: String| p.error(code, msg);
+    let mut errors = Vec::new();
+    let slow = strategy.kind.name == "spiral_turning";
+    let (want, what) = if slow {
+        ("sts_lathe", "slow-tool-servo spiral turning")
+    } else {
+        ("fts_lathe", "fast-tool-servo turning")
+    };
+    if machine.kind.name != want {
+        errors.push(err(
+            codes::UNSUPPORTED_COMBINATION,
+            format!(
+                "{what} needs an `{want}`; this machine is a `{}`",
+                machine.kind.name
+            ),
+        ));
+    }
+    if tool.kind.name != "round_nose" {
+        errors.push(err(
+            codes::UNSUPPORTED_COMBINATION,
+            format!(
+                "{what} needs a `round_nose` tool; this is a `{}`",
+                tool.kind.name
+            ),
+        ));
+    }
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+    let (m, t, st) = (&machine.fields, &tool.fields, &strategy.fields);
+    let travel = value::block(m, "travel").expect("required");
+    // The axis that carries the surface: the servo, or Z itself.
+    let fast = value::block(m, if slow { "z_axis" } else { "fast_axis" }).expect("required");
+    let max_spindle = p.max_spindle_speed();
+    let rho = value::num(t, "nose_radius").expect("required");
+    let servo = if slow {
+        None
+    } else {
+        servo_model(fast).map_err(|()| {
+            vec![err(
+                codes::MISSING_PARAMETER,
+                "the fast axis's servo model needs either `resonance` and `resonant_peak`, or `natural_frequency` and `damping`".into(),
+            )]
+        })?
+    };
+    let fast_axis = FastAxis {
+        stroke: if slow {
+            let (lo, hi) = value::range(travel, "z").expect("required");
+            hi - lo
+        } else {
+            value::num(fast, "stroke").expect("required")
+        },
+        max_acceleration: value::num(fast, "max_acceleration").expect("required"),
+    };
+    let speed = match value::num(st, "surface_speed") {
+        Some(v) => SpindleSpeed::SurfaceSpeed {
+            speed: v,
+            max: value::num(st, "spindle_cap").unwrap_or(max_spindle),
+        },
+        None => SpindleSpeed::Constant(value::num(st, "spindle_speed").expect("one of them")),
+    };
+
+    let lowered = p.lowered().map_err(|d| vec![d])?;
+    // The spiral starts where the surface's farthest point from the axis is.
+    let outer = match lowered.domain {
+        lensc_runtime::surface::analysis::Domain::Circle { radius }
+        | lensc_runtime::surface::analysis::Domain::Annulus { outer: radius, .. } => radius,
+        lensc_runtime::surface::analysis::Domain::Rect { x, y } => [x.0, x.1]
+            .iter()
+            .flat_map(|a| [y.0, y.1].map(|b| a.hypot(b)))
+            .fold(0.0, f64::max),
+    };
+    let start = value::num(st, "from").unwrap_or(outer);
+    // The fastest surface speed the job reaches: what d_traj is made of.
+    let fastest = match speed {
+        SpindleSpeed::SurfaceSpeed { speed, .. } => speed,
+        SpindleSpeed::Constant(w) => w * start,
+    };
+
+    // The settling offset, where the surface is an array of dimples.
+    let settle_word = value::word(st, "settle");
+    let settling = if slow || settle_word == Some("none") {
+        None
+    } else {
+        settling(surface, st, servo, fast, fastest)
+    };
+    if settle_word == Some("auto") && settling.is_none() {
+        return Err(vec![
+            err(
+                codes::UNSUPPORTED_COMBINATION,
+                "`settle: auto` needs an array of concave lenslets with circular apertures, whose continuation rises above the land".into(),
+            )
+            .with_help("use `settle: none` to follow the surface as it is"),
+        ]);
+    }
+    let trajectory = match &settling {
+        Some(s) => crate::lower::surface::lower_trajectory(surface, s.offset).map_err(|e| {
+            vec![err(
+                codes::UNSUPPORTED_COMBINATION,
+                format!("the tool trajectory cannot be built: {e:?}"),
+            )]
+        })?,
+        None => crate::lower::surface::lower_surface(surface).expect("lowered above"),
+    };
+    let analysis = {
+        let k = evaluate(&trajectory.tape);
+        lensc_runtime::surface::analysis::analyse(k.as_ref(), &lowered.domain, 201)
+    };
+    let design_kernel = evaluate(&lowered.tape);
+    let design =
+        lensc_runtime::surface::analysis::analyse(design_kernel.as_ref(), &lowered.domain, 201);
+    errors.extend(tool_checks(p, design_kernel.as_ref(), &lowered, &design));
+
+    let spiral = FtsSpiral {
+        feed_per_rev: value::num(st, "feed").expect("required") * 2.0 * std::f64::consts::PI,
+        speed,
+        chord_tolerance: value::num(st, "chord_tolerance").unwrap_or(10e-6),
+        seed_arc: value::num(st, "seed_arc").unwrap_or(0.1),
+        min_interval: 1.0 / value::num(fast, "data_rate").unwrap_or(if slow { 1e3 } else { 20e3 }),
+        start_radius: start,
+        end_radius: 0.0,
+    };
+    // With a settling offset, the trajectory is level outside each
+    // lenslet's continuation, which meets the plateau d_traj past the rim.
+    let features = settling.as_ref().and_then(|s| {
+        let (_, rim) = crate::lower::surface::array_lenslet(surface)?;
+        let centres = crate::lower::surface::array_centres(surface)?;
+        Some(
+            centres
+                .into_iter()
+                .map(|(x, y)| (x, y, rim + s.d_traj))
+                .collect(),
+        )
+    });
+    let bounds = TrajectoryBounds {
+        z_max: analysis.sag_max.value,
+        // Margin over the sampled steepest slope: the contact search
+        // window must contain the contact.
+        max_slope: (analysis.max_slope.value * 1.1).min(1.5),
+        features,
+        part_top: design.sag_max.value,
+    };
+    let spin_max = match speed {
+        SpindleSpeed::Constant(w) => w,
+        // The spiral runs in to the axis, where the cap is reached.
+        SpindleSpeed::SurfaceSpeed { max, .. } => max,
+    };
+    if spin_max > max_spindle {
+        errors.push(err(
+            codes::SPINDLE_TOO_FAST,
+            format!(
+                "the spindle speed ({} rpm) is above the machine's maximum ({} rpm)",
+                trim_num(rpm(spin_max)),
+                trim_num(rpm(max_spindle))
+            ),
+        ));
+    }
+    let (tx0, tx1) = value::range(travel, "x").expect("required");
+    if start > tx1 || tx0 > 0.0 {
+        errors.push(err(
+            codes::OUT_OF_TRAVEL,
+            format!(
+                "the spiral moves X from {} mm to 0, outside the machine's travel {} .. {} mm",
+                trim_num(start),
+                trim_num(tx0),
+                trim_num(tx1)
+            ),
+        ));
+    }
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+
+    let retract = value::num(st, "retract").unwrap_or(1.0);
+    // The lenslets' own apertures (the planner's features reach on to
+    // where the trajectory meets the settling plateau).
+    let lenslets = crate::lower::surface::array_lenslet(surface)
+        .zip(crate::lower::surface::array_centres(surface))
+        .map(|((_, rim), centres)| centres.into_iter().map(|(x, y)| (x, y, rim)).collect())
+        .unwrap_or_default();
+    Ok(SpiralSpec {
+        head: p.head(dialect, lowered),
+        slow,
+        spiral,
+        bounds,
+        nose_radius: rho,
+        fast_axis,
+        trajectory,
+        servo,
+        settling,
+        safe_w: analysis.sag_max.value + rho + retract,
+        lenslets,
+    })
+}
+
+/// The fast axis's second-order servo model, from its resonance and peak
+/// or its natural frequency and damping (`None` if those make no servo);
+/// an error if neither pair is given.
+fn servo_model(fast: &[value::Field]) -> Result<Option<SecondOrderServo>, ()> {
+    let num = |k: &str| value::num(fast, k);
+    match (
+        num("resonance"),
+        num("resonant_peak"),
+        num("natural_frequency"),
+        num("damping"),
+    ) {
+        (Some(f), Some(peak), None, None) => Ok(SecondOrderServo::from_resonance(f, peak)),
+        (None, None, Some(f), Some(zeta)) => Ok(SecondOrderServo::from_natural(f, zeta)),
+        _ => Err(()),
+    }
+}
+
+/// The tool against the design surface: the nose radius against the
+/// smallest concave radius of curvature; the flank follows the cut around
+/// the spindle, so the clearance angle must exceed the steepest slope
+/// around (circumferential); the edge meets the slope across (radial), so
+/// half its included angle must exceed it.
+fn tool_checks(
+    p: &Parts,
+    design_kernel: &dyn SurfaceFn,
+    lowered: &LoweredSurface,
+    design: &lensc_runtime::surface::analysis::SurfaceAnalysis,
+) -> Vec<Diagnostic> {
+    let t = &p.tool.fields;
+    let rho = value::num(t, "nose_radius").expect("required");
+    let clearance = value::num(t, "clearance").expect("required");
+    let err = |code: &'static str, msg: String| p.error(code, msg);
+    let mut errors = Vec::new();
+    if let Some(r) = [design.min_radius_concave_x, design.min_radius_concave_y]
+        .into_iter()
+        .flatten()
+        .min_by(|a, b| a.value.total_cmp(&b.value))
+        && rho > r.value
+    {
+        errors.push(err(
+            codes::NOSE_TOO_LARGE,
+            format!(
+                "the tool's nose radius ({} um) is larger than the surface's smallest concave radius of curvature ({} um, at ({}, {}) mm): the tool would gouge",
+                trim_num(rho * 1000.0),
+                trim_num(r.value * 1000.0),
+                trim_num(r.x),
+                trim_num(r.y)
+            ),
+        ));
+    }
+    let (around, across) = polar_slopes(design_kernel, &lowered.domain, 201);
+    if clearance <= around.0 {
+        errors.push(err(
+            codes::CLEARANCE_TOO_SMALL,
+            format!(
+                "the clearance angle ({}°) is not above the surface's steepest slope in the cutting direction, around the spindle ({}°, at ({}, {}) mm): the flank would rub",
+                trim_num(clearance.to_degrees()),
+                trim_num(around.0.to_degrees()),
+                trim_num(around.1),
+                trim_num(around.2)
+            ),
+        ));
+    }
+    if let Some(included) = value::num(t, "included_angle")
+        && included / 2.0 <= across.0
+    {
+        errors.push(err(
+            codes::CLEARANCE_TOO_SMALL,
+            format!(
+                "half the tool's included angle ({}°) is not above the surface's steepest slope across the cut, along the radius ({}°, at ({}, {}) mm): the edge's side would cut",
+                trim_num(included.to_degrees() / 2.0),
+                trim_num(across.0.to_degrees()),
+                trim_num(across.1),
+                trim_num(across.2)
+            ),
+        ));
+    }
+    errors
+}
+
+/// The steepest slopes (rad) around the spindle axis and along the radius,
+/// each with where (x, y), over an n × n grid of the domain.
+fn polar_slopes(
+    f: &dyn SurfaceFn,
+    domain: &lensc_runtime::surface::analysis::Domain,
+    n: usize,
+) -> ((f64, f64, f64), (f64, f64, f64)) {
+    let (xs, ys, out) = lensc_runtime::surface::analysis::grid(f, domain, n);
+    let mut around = (0.0, 0.0, 0.0);
+    let mut across = (0.0, 0.0, 0.0);
+    for (i, (&x, &y)) in xs.iter().zip(&ys).enumerate() {
+        let r = x.hypot(y);
+        let (zx, zy) = (out[6 * i + 1], out[6 * i + 2]);
+        if r == 0.0 || !(zx.is_finite() && zy.is_finite()) {
+            continue;
+        }
+        let tangential = ((x * zy - y * zx) / r).abs().atan();
+        let radial = ((x * zx + y * zy) / r).abs().atan();
+        if tangential > around.0 {
+            around = (tangential, x, y);
+        }
+        if radial > across.0 {
+            across = (radial, x, y);
+        }
+    }
+    (around, across)
+}
+
+/// The settling offset for an array of concave lenslets: the servo's
+/// settling time (the strategy's, or the model's at its band), the path
+/// covered meanwhile at the fastest surface speed, and how far the
+/// lenslet's own surface rises over that path past its rim.
+fn settling(
+    surface: &Object,
+    st: &[value::Field],
+    servo: Option<SecondOrderServo>,
+    fast: &[value::Field],
+    surface_speed: f64,
+) -> Option<Settling> {
+    let (lenslet, rim) = crate::lower::surface::array_lenslet(surface)?;
+    let band = value::num(fast, "settling_band").unwrap_or(0.002);
+    let (time, band) = match value::num(st, "settling_time") {
+        Some(t) => (t, None),
+        None => (servo?.settling_time(band)?, Some(band)),
+    };
+    let f = lensc_runtime::surface::ir::Interpreter::new(&lenslet.tape);
+    let along = |u: f64| f.eval(u, 0.0)[0];
+    let offset = lensc_runtime::plan::fts::settling_offset(along, rim, surface_speed, time);
+    (offset.is_finite() && offset > 0.0).then_some(Settling {
+        time,
+        band,
+        surface_speed,
+        d_traj: surface_speed * time,
+        offset,
+    })
+}
+
+fn rpm(w: f64) -> f64 {
+    w * 60.0 / (2.0 * std::f64::consts::PI)
+}

@@ -1,0 +1,328 @@
+//! Arrays of lenslets (grid, hex grid, linear array): each lenslet clipped
+//! to its aperture on a land, and the settled trajectory for a fast tool servo.
+
+use lensc_runtime::surface::analysis::Domain;
+use lensc_runtime::surface::ir::{Binary, Graph, Id, SurfaceTape};
+
+use super::{LowerError, LoweredSurface, height, radius_squared};
+use crate::domain::{domain_of, half_extent, region, surface_domain};
+use crate::value::{self, Object};
+
+/// Arrays: each lenslet clipped to its own aperture with its rim at the
+/// land (z = 0); where apertures overlap, the deepest cut (the lowest
+/// height) wins; outside every aperture, the land. Each point looks at its
+/// own cell and, where apertures reach past half a pitch, the neighbours.
+pub(super) fn array_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError> {
+    array_height_settled(g, o, x, y, None)
+}
+
+/// The tool trajectory over an array for fast-tool-servo turning with a
+/// settling offset h (Hashimoto & Yan, fig. 16): each lenslet continued
+/// past its rim until it rises h above the land, the land itself at h.
+pub fn lower_trajectory(o: &Object, settle: f64) -> Result<LoweredSurface, LowerError> {
+    if !matches!(o.kind.name, "grid" | "hex_grid" | "linear_array") {
+        return Err(LowerError::Unsupported(
+            "a settling offset needs an array of lenslets",
+        ));
+    }
+    let domain = surface_domain(o).ok_or(LowerError::Aperture("no aperture or domain"))?;
+    let mut g = Graph::new();
+    let (x, y) = (g.x(), g.y());
+    let z = array_height_settled(&mut g, o, x, y, Some(settle))?;
+    Ok(LoweredSurface {
+        tape: SurfaceTape::new(g, z),
+        domain,
+    })
+}
+
+/// The centres of a rectangular grid's or a linear array's lenslets (mm);
+/// `None` for other surfaces.
+pub fn array_centres(o: &Object) -> Option<Vec<(f64, f64)>> {
+    let f = &o.fields;
+    let num = |name: &str| value::num(f, name);
+    let (px, py, nx, ny) = match o.kind.name {
+        "grid" => (
+            num("pitch_x")?,
+            num("pitch_y")?,
+            num("count_x")?,
+            num("count_y")?,
+        ),
+        "linear_array" if value::word(f, "axis") == Some("y") => {
+            (0.0, num("pitch")?, 1.0, num("count")?)
+        }
+        "linear_array" => (num("pitch")?, 0.0, num("count")?, 1.0),
+        _ => return None,
+    };
+    let (nx, ny) = (nx as usize, ny as usize);
+    let mut centres = Vec::with_capacity(nx * ny);
+    for j in 0..ny {
+        for i in 0..nx {
+            centres.push((
+                (i as f64 - (nx as f64 - 1.0) / 2.0) * px,
+                (j as f64 - (ny as f64 - 1.0) / 2.0) * py,
+            ));
+        }
+    }
+    Some(centres)
+}
+
+/// The lenslet of an array as its own surface, with the radius of its
+/// circular aperture: what the settling offset is measured on.
+pub fn array_lenslet(o: &Object) -> Option<(LoweredSurface, f64)> {
+    if !matches!(o.kind.name, "grid" | "hex_grid" | "linear_array") {
+        return None;
+    }
+    let lenslet = value::object(&o.fields, "lenslet")?;
+    let Domain::Circle { radius } = domain_of(region(lenslet)?).ok()? else {
+        return None;
+    };
+    let mut g = Graph::new();
+    let (x, y) = (g.x(), g.y());
+    let z = height(&mut g, lenslet, x, y).ok()?;
+    Some((
+        LoweredSurface {
+            tape: SurfaceTape::new(g, z),
+            domain: Domain::Circle { radius },
+        },
+        radius,
+    ))
+}
+
+fn array_height_settled(
+    g: &mut Graph,
+    o: &Object,
+    x: Id,
+    y: Id,
+    settle: Option<f64>,
+) -> Result<Id, LowerError> {
+    let f = &o.fields;
+    let lenslet =
+        value::object(f, "lenslet").ok_or(LowerError::Unsupported("array without a lenslet"))?;
+    let ap = domain_of(region(lenslet).ok_or(LowerError::Aperture("lenslet without an aperture"))?)
+        .map_err(LowerError::Aperture)?;
+    let (hx, hy) = half_extent(&ap);
+    // Continued lenslets reach past their apertures: look at neighbours.
+    let (hx, hy) = if settle.is_some() {
+        (1.5 * hx, 1.5 * hy)
+    } else {
+        (hx, hy)
+    };
+    let rim = rim_height(lenslet, &ap)?;
+    // Cell centres: (i, j) → (cx, cy) as nodes; candidate cells per point.
+    let candidates = match o.kind.name {
+        "grid" | "linear_array" => grid_cells(g, o, (x, y), (hx, hy))?,
+        _ => hex_cells(g, o, (x, y), (hx, hy))?,
+    };
+    // min over the candidates that contain the point; +BIG where none do.
+    const BIG: f64 = 1e6;
+    let big = g.constant_node(BIG);
+    let rim_c = g.constant_node(rim);
+    let mut best = big;
+    for (cx, cy) in candidates {
+        let u = g.sub(x, cx);
+        let v = g.sub(y, cy);
+        let zl = height(g, lenslet, u, v)?;
+        let z = g.sub(zl, rim_c);
+        if settle.is_some() {
+            best = g.binary(Binary::Min, best, z);
+            continue;
+        }
+        let inside_test = inside(g, &ap, u, v);
+        let h = g.select(inside_test, z, big);
+        best = g.binary(Binary::Min, best, h);
+    }
+    if let Some(h) = settle {
+        let plateau = g.constant_node(h);
+        return Ok(g.binary(Binary::Min, best, plateau));
+    }
+    let half_big = g.constant_node(BIG / 2.0);
+    let test = g.sub(best, half_big);
+    let land = g.constant_node(0.0);
+    Ok(g.select(test, best, land))
+}
+
+/// The lenslet's height at the edge of its aperture along +x: the height
+/// the land is cut at.
+fn rim_height(lenslet: &Object, ap: &Domain) -> Result<f64, LowerError> {
+    let mut h = Graph::new();
+    let (u, v) = (h.x(), h.y());
+    let z = height(&mut h, lenslet, u, v)?;
+    let f = lensc_runtime::surface::ir::Interpreter::new(&SurfaceTape::new(h, z));
+    let at = match *ap {
+        Domain::Circle { radius } | Domain::Annulus { outer: radius, .. } => (radius, 0.0),
+        Domain::Rect { x, y } => (x.1, 0.5 * (y.0 + y.1)),
+    };
+    Ok(lensc_runtime::surface::ir::SurfaceFn::eval(&f, at.0, at.1)[0])
+}
+
+/// The centres of the cells of a rectangular grid or a linear array a
+/// point may lie in: its own and, where apertures reach past half a
+/// pitch, its neighbours.
+fn grid_cells(
+    g: &mut Graph,
+    o: &Object,
+    (x, y): (Id, Id),
+    (hx, hy): (f64, f64),
+) -> Result<Vec<(Id, Id)>, LowerError> {
+    let f = &o.fields;
+    let num = |name: &str| value::num(f, name).unwrap_or(1.0);
+    let mut candidates: Vec<(Id, Id)> = Vec::new();
+    let along_y = value::word(f, "axis") == Some("y");
+    let (px, py, nx, ny) = match o.kind.name {
+        "grid" => (
+            num("pitch_x"),
+            num("pitch_y"),
+            num("count_x"),
+            num("count_y"),
+        ),
+        _ if along_y => (f64::INFINITY, num("pitch"), 1.0, num("count")),
+        _ => (num("pitch"), f64::INFINITY, num("count"), 1.0),
+    };
+    let reach = |half: f64, pitch: f64| {
+        if half > 1.5 * pitch {
+            None
+        } else if half > 0.5 * pitch {
+            Some(1)
+        } else {
+            Some(0)
+        }
+    };
+    let (kx, ky) = match (reach(hx, px), reach(hy, py)) {
+        (Some(a), Some(b)) => (a, b),
+        _ => {
+            return Err(LowerError::Aperture(
+                "lenslet apertures reach past their neighbours",
+            ));
+        }
+    };
+    let axis_cells = |g: &mut Graph, t: Id, pitch: f64, n: f64, k: i32| -> Vec<Id> {
+        if n <= 1.0 {
+            return vec![g.constant_node(0.0)];
+        }
+        let qt = cell_coordinate(g, t, pitch, n);
+        (-k..=k)
+            .map(|d| {
+                let i = cell_index(g, qt, n, f64::from(d));
+                cell_centre(g, i, n, pitch)
+            })
+            .collect()
+    };
+    let xs = axis_cells(g, x, px, nx, kx);
+    let ys = axis_cells(g, y, py, ny, ky);
+    for &cx in &xs {
+        for &cy in &ys {
+            candidates.push((cx, cy));
+        }
+    }
+    Ok(candidates)
+}
+
+/// The centres of the cells of a hexagonal grid a point may lie in: three
+/// rows of three.
+fn hex_cells(
+    g: &mut Graph,
+    o: &Object,
+    (x, y): (Id, Id),
+    (hx, hy): (f64, f64),
+) -> Result<Vec<(Id, Id)>, LowerError> {
+    let num = |name: &str| value::num(&o.fields, name).unwrap_or(1.0);
+    let mut candidates: Vec<(Id, Id)> = Vec::new();
+    // Hexagonal: rows of spacing p·√3/2, odd rows shifted by p/2.
+    let (p, nx, ny) = (num("pitch"), num("count_x"), num("count_y"));
+    if hx.max(hy) > 1.5 * p {
+        return Err(LowerError::Aperture(
+            "lenslet apertures reach past their neighbours",
+        ));
+    }
+    let row = p * 3f64.sqrt() / 2.0;
+    let qt = cell_coordinate(g, y, row, ny);
+    for dj in -1..=1 {
+        let j = cell_index(g, qt, ny, f64::from(dj));
+        let cy = cell_centre(g, j, ny, row);
+        // parity of j: j − 2 floor(j/2), shifting the row by ±p/4.
+        let h = g.constant_node(0.5);
+        let jh = g.mul(j, h);
+        let fl = g.floor(jh);
+        let two = g.constant_node(2.0);
+        let tf = g.mul(two, fl);
+        let parity = g.sub(j, tf);
+        let quarter = g.constant_node(p / 2.0);
+        let pq = g.mul(parity, quarter);
+        let back = g.constant_node(p / 4.0);
+        let shift = g.sub(pq, back);
+        let xl = g.sub(x, shift);
+        let xt = cell_coordinate(g, xl, p, nx);
+        for di in -1..=1 {
+            let i = cell_index(g, xt, nx, f64::from(di));
+            let cx0 = cell_centre(g, i, nx, p);
+            let cx = g.add(cx0, shift);
+            candidates.push((cx, cy));
+        }
+    }
+    Ok(candidates)
+}
+
+/// t/pitch + n/2, as a node: the coordinate in cells from the edge of a
+/// row of n cells centred on the origin.
+fn cell_coordinate(g: &mut Graph, t: Id, pitch: f64, n: f64) -> Id {
+    let inv = g.constant_node(1.0 / pitch);
+    let q = g.mul(t, inv);
+    let half = g.constant_node(n / 2.0);
+    g.add(q, half)
+}
+
+/// (i − (n − 1)/2) · pitch, as a node: the centre of cell i of a row of n.
+fn cell_centre(g: &mut Graph, i: Id, n: f64, pitch: f64) -> Id {
+    let mid = g.constant_node((n - 1.0) / 2.0);
+    let off = g.sub(i, mid);
+    let p = g.constant_node(pitch);
+    g.mul(off, p)
+}
+
+/// clamp(floor(t), 0, n − 1) + offset, as a node: a cell index.
+fn cell_index(g: &mut Graph, t: Id, n: f64, offset: f64) -> Id {
+    let f = g.floor(t);
+    let zero = g.constant_node(0.0);
+    let top = g.constant_node(n - 1.0);
+    let lo = g.binary(Binary::Max, f, zero);
+    let i = g.binary(Binary::Min, lo, top);
+    let off = g.constant_node(offset);
+    let shifted = g.add(i, off);
+    let clamped_lo = g.binary(Binary::Max, shifted, zero);
+    g.binary(Binary::Min, clamped_lo, top)
+}
+
+/// A node that is negative exactly inside `domain` at (u, v).
+fn inside(g: &mut Graph, domain: &Domain, u: Id, v: Id) -> Id {
+    match *domain {
+        Domain::Circle { radius } => {
+            let r2 = radius_squared(g, u, v);
+            let a2 = g.constant_node(radius * radius);
+            g.sub(r2, a2)
+        }
+        Domain::Annulus { inner, outer } => {
+            // max(r² − outer², inner² − r²)
+            let r2 = radius_squared(g, u, v);
+            let o2 = g.constant_node(outer * outer);
+            let i2 = g.constant_node(inner * inner);
+            let a = g.sub(r2, o2);
+            let b = g.sub(i2, r2);
+            g.binary(Binary::Max, a, b)
+        }
+        Domain::Rect {
+            x: (x0, x1),
+            y: (y0, y1),
+        } => {
+            // max(x0 − u, u − x1, y0 − v, v − y1)
+            let c = |g: &mut Graph, k: f64| g.constant_node(k);
+            let (cx0, cx1, cy0, cy1) = (c(g, x0), c(g, x1), c(g, y0), c(g, y1));
+            let a = g.sub(cx0, u);
+            let b = g.sub(u, cx1);
+            let d = g.sub(cy0, v);
+            let e = g.sub(v, cy1);
+            let m1 = g.binary(Binary::Max, a, b);
+            let m2 = g.binary(Binary::Max, d, e);
+            g.binary(Binary::Max, m1, m2)
+        }
+    }
+}

@@ -1,0 +1,469 @@
+//! The surface lowering against closed forms and published tables.
+
+use super::*;
+use lensc_runtime::surface::ir::{Interpreter, SurfaceFn};
+use lensc_runtime::surface::{RotationalSurface, Sense};
+
+/// The IR sag (in r² form, differentiated symbolically) against the
+/// runtime's closed-form profile (differentiated by hand), along x and,
+/// by symmetry, along y.
+#[test]
+fn ir_sag_matches_closed_form_profile() {
+    let terms = vec![(3, 2e-4), (4, 1.5e-4), (6, -3e-6), (8, 2e-8), (16, 1e-14)];
+    for (radius, k, sense) in [
+        (22.405, 43.098, Sense::Convex),
+        (4.254, -3.359, Sense::Concave),
+        (8.5, -0.62, Sense::Convex),
+        (5.0, 0.0, Sense::Concave),
+    ] {
+        let closed = RotationalSurface {
+            radius,
+            conic: k,
+            sense,
+            terms: terms.clone(),
+            aperture_radius: 1.5,
+        };
+        let mut g = Graph::new();
+        let z = rotational_sag(&mut g, radius, k, &terms, sense.sign());
+        let f = Interpreter::new(&SurfaceTape::new(g, z));
+        for r in [0.05, 0.4, 0.9, 1.5] {
+            let p = closed.eval(r);
+            let ox = f.eval(r, 0.0);
+            let oy = f.eval(0.0, r);
+            let tol = |a: f64| 1e-13 * (1.0 + a.abs());
+            assert!(
+                (ox[0] - p.z).abs() <= tol(p.z),
+                "z R={radius} r={r}: {} vs {}",
+                ox[0],
+                p.z
+            );
+            assert!(
+                (ox[1] - p.dz).abs() <= tol(p.dz),
+                "dz/dx R={radius} r={r}: {} vs {}",
+                ox[1],
+                p.dz
+            );
+            assert!(
+                (ox[3] - p.d2z).abs() <= tol(p.d2z),
+                "d2z/dx2 R={radius} r={r}: {} vs {}",
+                ox[3],
+                p.d2z
+            );
+            assert!(
+                (oy[0] - p.z).abs() <= tol(p.z)
+                    && (oy[2] - p.dz).abs() <= tol(p.dz)
+                    && (oy[5] - p.d2z).abs() <= tol(p.d2z)
+            );
+            assert!(
+                ox[2].abs() < 1e-15 && ox[4].abs() < 1e-15,
+                "no slope across the section"
+            );
+        }
+    }
+}
+
+/// A sphere's sag against R − sqrt(R² − r²) in 2-D, off the axes
+/// (written r²/(R + sqrt(R² − r²)) to avoid cancellation).
+#[test]
+fn sphere_sag_off_axis() {
+    let mut g = Graph::new();
+    let z = rotational_sag(&mut g, 20.0, 0.0, &[], 1.0);
+    let f = Interpreter::new(&SurfaceTape::new(g, z));
+    for (x, y) in [(0.3, 0.4), (-0.6, 0.8), (0.85, -0.1)] {
+        let r2 = x * x + y * y;
+        let want = r2 / (20.0 + (400.0f64 - r2).sqrt());
+        let got = f.eval(x, y)[0];
+        assert!((got - want).abs() <= 4e-16 * want, "{got} vs {want}");
+    }
+}
+
+/// Checks `src` and lowers its surface `name`; evaluates at (x, y).
+fn eval_surface(src: &str, name: &str, x: f64, y: f64) -> [f64; 6] {
+    let c = crate::check_text(&crate::loader::RealFs, "t.lens", src.as_bytes());
+    assert!(!c.has_errors(), "{:?}", c.diags());
+    let o = c.checked.declarations.get(name).expect("surface");
+    let l = lower_surface(o).expect("lowers");
+    Interpreter::new(&l.tape).eval(x, y)
+}
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-14 * (1.0 + a.abs().max(b.abs()))
+}
+
+#[test]
+fn zernike_indices_follow_the_tables() {
+    // Fringe: Z1 piston, Z4 defocus, Z5/Z6 astigmatism, Z9 spherical,
+    // Z10 trefoil, Z16 5th-order spherical, Z36 (10,0), Z37 (12,0).
+    assert_eq!(zernike_fringe(1), Some((0, 0)));
+    assert_eq!(zernike_fringe(2), Some((1, 1)));
+    assert_eq!(zernike_fringe(3), Some((1, -1)));
+    assert_eq!(zernike_fringe(4), Some((2, 0)));
+    assert_eq!(zernike_fringe(6), Some((2, -2)));
+    assert_eq!(zernike_fringe(9), Some((4, 0)));
+    assert_eq!(zernike_fringe(10), Some((3, 3)));
+    assert_eq!(zernike_fringe(16), Some((6, 0)));
+    assert_eq!(zernike_fringe(36), Some((10, 0)));
+    assert_eq!(zernike_fringe(37), Some((12, 0)));
+    assert_eq!(zernike_fringe(38), None);
+    // ANSI Z80.28: j = (n(n+2) + m)/2.
+    for n in 0..12u32 {
+        for m in (-(n as i32)..=n as i32).step_by(2) {
+            let j = ((n * (n + 2)) as i32 + m) / 2;
+            assert_eq!(zernike_ansi(j as u32), (n, m), "j={j}");
+        }
+    }
+}
+
+#[test]
+fn zernike_terms_match_their_polynomials() {
+    let base = "surface w = zernike { norm_radius: 2 mm, ordering: ORD, aperture: circle(radius: 2 mm), TERM: 1 um }";
+    let at = |ord: &str, term: &str, x: f64, y: f64| {
+        eval_surface(&base.replace("ORD", ord).replace("TERM", term), "w", x, y)[0]
+    };
+    let (x, y): (f64, f64) = (0.7, -1.1);
+    let (rho, th) = ((x * x + y * y).sqrt() / 2.0, f64::atan2(y, x));
+    let um = 1e-3;
+    // Fringe Z9 = 6ρ⁴ − 6ρ² + 1; Z8 = (3ρ³ − 2ρ) sin θ; Z10 = ρ³ cos 3θ.
+    assert!(close(
+        at("fringe", "Z9", x, y),
+        um * (6.0 * rho.powi(4) - 6.0 * rho * rho + 1.0)
+    ));
+    assert!(close(
+        at("fringe", "Z8", x, y),
+        um * (3.0 * rho.powi(3) - 2.0 * rho) * th.sin()
+    ));
+    assert!(close(
+        at("fringe", "Z10", x, y),
+        um * rho.powi(3) * (3.0 * th).cos()
+    ));
+    // ANSI j = 12 is (4, 0) normalised by sqrt(5); j = 3 is (2, −2) by sqrt(6).
+    assert!(close(
+        at("ansi", "Z12", x, y),
+        um * 5f64.sqrt() * (6.0 * rho.powi(4) - 6.0 * rho * rho + 1.0)
+    ));
+    assert!(close(
+        at("ansi", "Z3", x, y),
+        um * 6f64.sqrt() * rho * rho * (2.0 * th).sin()
+    ));
+}
+
+#[test]
+fn cylinder_toroid_biconic_ellipsoid_and_xy_polynomial() {
+    let (x, y) = (0.3, -0.45);
+    // A cylinder along y varies only with x.
+    let cyl = eval_surface(
+        "surface c = cylinder { radius: 2 mm, axis: y, sense: concave, aperture: circle(radius: 1 mm) }",
+        "c",
+        x,
+        y,
+    );
+    assert!(close(cyl[0], x * x / (2.0 + (4.0 - x * x).sqrt())) && cyl[2] == 0.0 && cyl[5] == 0.0);
+    // A biconic with equal radii and conics is the conic of revolution.
+    let bic = eval_surface(
+        "surface b = biconic { radius_x: 3 mm, radius_y: 3 mm, conic_x: -0.5, conic_y: -0.5, sense: convex, aperture: circle(radius: 1 mm) }",
+        "b",
+        x,
+        y,
+    );
+    let con = eval_surface(
+        "surface b = conic { radius: 3 mm, conic: -0.5, sense: convex, aperture: circle(radius: 1 mm) }",
+        "b",
+        x,
+        y,
+    );
+    for k in 0..6 {
+        assert!(
+            close(bic[k], con[k]),
+            "output {k}: {} vs {}",
+            bic[k],
+            con[k]
+        );
+    }
+    // A toroid whose rotation radius equals its profile radius is a sphere.
+    let tor = eval_surface(
+        "surface t = toroid { radius: 4 mm, rotation_radius: 4 mm, sense: concave, aperture: circle(radius: 1 mm) }",
+        "t",
+        x,
+        y,
+    );
+    let sph = eval_surface(
+        "surface t = sphere { radius: 4 mm, sense: concave, aperture: circle(radius: 1 mm) }",
+        "t",
+        x,
+        y,
+    );
+    for k in 0..6 {
+        assert!(
+            close(tor[k], sph[k]),
+            "output {k}: {} vs {}",
+            tor[k],
+            sph[k]
+        );
+    }
+    // At x = 0 a toroid is its y–z profile; along x a circle of the rotation radius.
+    let tor = eval_surface(
+        "surface t = toroid { radius: 4 mm, rotation_radius: 10 mm, sense: concave, aperture: circle(radius: 1 mm) }",
+        "t",
+        0.0,
+        y,
+    );
+    assert!(close(tor[0], y * y / (4.0 + (16.0 - y * y).sqrt())));
+    let tor = eval_surface(
+        "surface t = toroid { radius: 4 mm, rotation_radius: 10 mm, sense: concave, aperture: circle(radius: 1 mm) }",
+        "t",
+        x,
+        0.0,
+    );
+    assert!(close(tor[0], x * x / (10.0 + (100.0 - x * x).sqrt())));
+    // Seed 002's lenslet: a = b = 0.505 mm, c = 1.01 mm, a dimple.
+    let e = eval_surface(
+        "surface e = ellipsoid { a: 0.505 mm, b: 0.505 mm, c: 1.01 mm, sense: concave, aperture: circle(diameter: 0.1 mm) }",
+        "e",
+        0.03,
+        0.04,
+    );
+    assert!(close(
+        e[0],
+        1.01 * (1.0 - (1.0f64 - 0.0025 / (0.505 * 0.505)).sqrt())
+    ));
+    // XY polynomial on a plane: 0.01 x²y − 0.002 y³ (coefficients in mm^-2).
+    let p = eval_surface(
+        "surface p = xy_polynomial { aperture: circle(radius: 1 mm), X2Y1: 0.01 mm^-2, X0Y3: -0.002 mm^-2 }",
+        "p",
+        x,
+        y,
+    );
+    assert!(close(p[0], 0.01 * x * x * y - 0.002 * y * y * y));
+    assert!(close(p[4], 0.02 * x));
+}
+
+#[test]
+fn optical_sign_convention_matches_sense() {
+    // Kim 2008's concave R = −4.254 mm, k = −3.359 in the optical
+    // convention is the same surface as |R| with `sense: concave`; a
+    // positive optical R is convex. Coefficients follow the sag's sign.
+    let (x, y) = (0.4, 0.9);
+    let opt = eval_surface(
+        "surface s = asphere { radius: -4.254 mm, conic: -3.359, convention: optical, A4: 1e-3 mm^-3, aperture: circle(radius: 1.5 mm) }",
+        "s",
+        x,
+        y,
+    );
+    let sen = eval_surface(
+        "surface s = asphere { radius: 4.254 mm, conic: -3.359, sense: concave, A4: -1e-3 mm^-3, aperture: circle(radius: 1.5 mm) }",
+        "s",
+        x,
+        y,
+    );
+    for k in 0..6 {
+        assert!(
+            close(opt[k], sen[k]),
+            "output {k}: {} vs {}",
+            opt[k],
+            sen[k]
+        );
+    }
+    let opt = eval_surface(
+        "surface s = conic { radius: 22.405 mm, conic: 43.098, convention: optical, aperture: circle(radius: 1.6 mm) }",
+        "s",
+        x,
+        y,
+    );
+    let sen = eval_surface(
+        "surface s = conic { radius: 22.405 mm, conic: 43.098, sense: convex, aperture: circle(radius: 1.6 mm) }",
+        "s",
+        x,
+        y,
+    );
+    assert!(close(opt[0], sen[0]) && opt[0] < 0.0);
+}
+
+#[test]
+fn off_axis_section_and_wrap() {
+    // An off-axis section of a paraboloid z = r²/(2R) centred at (3, 0):
+    // z(x, y) = ((x+3)² + y² − 9)/(2R); with the tilt removed, x²+y² over 2R.
+    let src = "surface p = conic { radius: 10 mm, conic: -1, sense: concave, aperture: circle(radius: 5 mm) }
+surface s = off_axis(p, x: 3 mm, y: 0 mm, aperture: circle(radius: 1 mm))
+surface t = off_axis(p, x: 3 mm, y: 0 mm, tilt: remove, aperture: circle(radius: 1 mm))";
+    let (x, y) = (0.4, -0.7);
+    let s = eval_surface(src, "s", x, y);
+    assert!(
+        close(s[0], ((x + 3.0) * (x + 3.0) + y * y - 9.0) / 20.0) && close(s[1], (x + 3.0) / 10.0)
+    );
+    let t = eval_surface(src, "t", x, y);
+    assert!(close(t[0], (x * x + y * y) / 20.0) && close(t[1], x / 10.0));
+    // A wrapped design evaluates as the flat design.
+    let w = eval_surface(
+        "surface f = freeform { z(x, y) = 0.02 mm * sin(5 rad/mm * x), domain: rect(x: 0 mm .. 6 mm, y: 0 mm .. 18.84955592153876 mm) }
+surface w = wrap(f, onto: roller(radius: 3 mm))",
+        "w",
+        0.3,
+        1.0,
+    );
+    assert!(close(w[0], 0.02 * 1.5f64.sin()));
+}
+
+/// sag of a sphere of radius R at r: r²/(R + sqrt(R² − r²)).
+fn sphere_sag(radius: f64, r: f64) -> f64 {
+    r * r / (radius + (radius * radius - r * r).sqrt())
+}
+
+#[test]
+fn grid_places_clips_and_lands() {
+    let src =
+        "surface l = sphere { radius: 2 mm, sense: concave, aperture: circle(radius: 0.3 mm) }
+surface a = grid(l, pitch_x: 1 mm, pitch_y: 1 mm, count_x: 2, count_y: 2)";
+    let rim = sphere_sag(2.0, 0.3);
+    // Centres at (±0.5, ±0.5); the rim sits on the land, z = 0.
+    assert!(close(eval_surface(src, "a", 0.5, 0.5)[0], -rim));
+    assert!(close(eval_surface(src, "a", -0.5, 0.5)[0], -rim));
+    assert!(close(
+        eval_surface(src, "a", 0.6, 0.5)[0],
+        sphere_sag(2.0, 0.1) - rim
+    ));
+    assert_eq!(
+        eval_surface(src, "a", 0.0, 0.0)[0],
+        0.0,
+        "land between the lenslets"
+    );
+    assert_eq!(
+        eval_surface(src, "a", 0.5, 0.85)[0],
+        0.0,
+        "outside the aperture"
+    );
+}
+
+#[test]
+fn overlapping_lenslets_keep_the_deepest_cut() {
+    // Convex bumps 1 mm apart whose apertures (0.8 mm) overlap: between
+    // them the lower of the two profiles is what is left.
+    let src = "surface l = sphere { radius: 2 mm, sense: convex, aperture: circle(radius: 0.8 mm) }
+surface a = grid(l, pitch_x: 1 mm, pitch_y: 1 mm, count_x: 2, count_y: 1)";
+    let rim = sphere_sag(2.0, 0.8);
+    let near = rim - sphere_sag(2.0, 0.4);
+    let far = rim - sphere_sag(2.0, 0.6);
+    let z = eval_surface(src, "a", 0.1, 0.0)[0];
+    assert!(
+        close(z, near.min(far)) && far < near,
+        "{z} vs {near} / {far}"
+    );
+    // Concave dimples: the nearer (deeper) one wins.
+    let src = src.replace("convex", "concave");
+    let z = eval_surface(&src, "a", 0.1, 0.0)[0];
+    assert!(close(
+        z,
+        (sphere_sag(2.0, 0.4) - rim).min(sphere_sag(2.0, 0.6) - rim)
+    ));
+}
+
+#[test]
+fn hex_rows_alternate_by_half_a_pitch() {
+    let src =
+        "surface l = sphere { radius: 2 mm, sense: concave, aperture: circle(radius: 0.2 mm) }
+surface h = hex_grid(l, pitch: 1 mm, count_x: 3, count_y: 2)";
+    let rim = sphere_sag(2.0, 0.2);
+    let row = 3f64.sqrt() / 2.0;
+    // Rows at y = ∓row/2; row 0 shifted by −1/4, row 1 by +1/4.
+    for (x, y) in [
+        (-1.25, -row / 2.0),
+        (-0.25, -row / 2.0),
+        (0.75, -row / 2.0),
+        (-0.75, row / 2.0),
+        (0.25, row / 2.0),
+        (1.25, row / 2.0),
+    ] {
+        assert!(
+            close(eval_surface(src, "h", x, y)[0], -rim),
+            "no lenslet centre at ({x}, {y})"
+        );
+    }
+    assert_eq!(eval_surface(src, "h", 0.25, -row / 2.0)[0], 0.0);
+}
+
+#[test]
+fn qbfs_is_the_sphere_plus_the_published_departure() {
+    // Best-fit sphere R = 25 mm, ρ_max = 4 mm, a_0 … a_3 in µm.
+    let src = "surface q = qbfs { radius: 25 mm, sense: concave, norm_radius: 4 mm, aperture: circle(radius: 4 mm), Q0: 2 um, Q1: -1 um, Q2: 0.5 um, Q3: 0.25 um }";
+    let (x, y): (f64, f64) = (1.3, -2.1);
+    let rho2 = x * x + y * y;
+    let u2 = rho2 / 16.0;
+    let q = [
+        1.0,
+        (13.0 - 16.0 * u2) / 19f64.sqrt(),
+        (2.0f64 / 95.0).sqrt() * (29.0 - 4.0 * u2 * (25.0 - 19.0 * u2)),
+        (2.0f64 / 2545.0).sqrt() * (207.0 - 4.0 * u2 * (315.0 - u2 * (577.0 - 320.0 * u2))),
+    ];
+    let a = [2e-3, -1e-3, 0.5e-3, 0.25e-3];
+    let c = 1.0 / 25.0;
+    let sum: f64 = a.iter().zip(q).map(|(a, q)| a * q).sum();
+    let want = c * rho2 / (1.0 + (1.0 - c * c * rho2).sqrt())
+        + u2 * (1.0 - u2) / (1.0 - c * c * rho2).sqrt() * sum;
+    let got = eval_surface(src, "q", x, y)[0];
+    assert!((got - want).abs() < 1e-15, "{got} vs {want}");
+    // At the edge (u = 1) the departure vanishes: the best-fit sphere.
+    let edge = eval_surface(src, "q", 4.0, 0.0)[0];
+    assert!((edge - c * 16.0 / (1.0 + (1.0f64 - c * c * 16.0).sqrt())).abs() < 1e-15);
+}
+
+#[test]
+fn qcon_is_the_conic_plus_the_published_departure() {
+    // Conic R = 12 mm, k = −0.8, ρ_max = 3 mm; Forbes 2007's closed forms
+    // Q_0 = 1, Q_1 = −(5 − 6x), Q_2 = 15 − 14x(3 − 2x).
+    let src = "surface q = qcon { radius: 12 mm, conic: -0.8, sense: convex, norm_radius: 3 mm, aperture: circle(radius: 3 mm), Q0: 1.5 um, Q1: -0.4 um, Q2: 0.2 um }
+surface l = qcon { radius: 12 mm, conic: -0.8, sense: convex, norm_radius: 0.4 mm, aperture: circle(radius: 0.4 mm), Q1: 1 um }
+surface a = grid(l, pitch_x: 1 mm, pitch_y: 1 mm, count_x: 2, count_y: 2)";
+    let (x, y): (f64, f64) = (0.9, -2.2);
+    let rho2 = x * x + y * y;
+    let u2 = rho2 / 9.0;
+    let (c, k) = (1.0 / 12.0, -0.8);
+    let q = [1.0, -(5.0 - 6.0 * u2), 15.0 - 14.0 * u2 * (3.0 - 2.0 * u2)];
+    let a = [1.5e-3, -0.4e-3, 0.2e-3];
+    let sum: f64 = a.iter().zip(q).map(|(a, q)| a * q).sum();
+    let sag = c * rho2 / (1.0 + (1.0 - (1.0 + k) * c * c * rho2).sqrt()) + u2 * u2 * sum;
+    let got = eval_surface(src, "q", x, y)[0];
+    assert!((got + sag).abs() < 1e-15, "{got} vs {}", -sag);
+    // In an array the lenslet is the same surface about its centre, its
+    // rim (ρ = 0.4 mm) at the land.
+    let lens = |r2: f64| {
+        let u2 = r2 / 0.16;
+        c * r2 / (1.0 + (1.0 - (1.0 + k) * c * c * r2).sqrt()) + u2 * u2 * 1e-3 * -(5.0 - 6.0 * u2)
+    };
+    let (dx, dy) = (0.1, -0.25);
+    let want = lens(0.16) - lens(dx * dx + dy * dy);
+    let got = eval_surface(src, "a", 0.5 + dx, 0.5 + dy)[0];
+    assert!(close(got, want), "{got} vs {want}");
+}
+
+#[test]
+fn tilted_sphere_is_the_sphere_with_its_centre_turned() {
+    // A concave sphere R = 5 mm (centre (0, 0, 5)) turned 10° about y has
+    // its centre at (5 sin θ, 0, 5 cos θ); its lower cap is the height.
+    let src = "surface s = sphere { radius: 5 mm, sense: concave, aperture: circle(radius: 2 mm) }
+surface t = tilt(s, about: y, angle: 10 deg, aperture: circle(radius: 1.5 mm))
+surface u = tilt(s, about: x, angle: -7 deg, aperture: circle(radius: 1.5 mm))";
+    let th = 10f64.to_radians();
+    let (xc, zc) = (5.0 * th.sin(), 5.0 * th.cos());
+    for (x, y) in [(0.0, 0.0), (0.7, -0.4), (-1.1, 0.9)] {
+        let o = eval_surface(src, "t", x, y);
+        let d = (25.0 - (x - xc) * (x - xc) - y * y).sqrt();
+        assert!(
+            close(o[0], zc - d),
+            "z at ({x}, {y}): {} vs {}",
+            o[0],
+            zc - d
+        );
+        assert!(
+            close(o[1], (x - xc) / d),
+            "dz/dx at ({x}, {y}): {} vs {}",
+            o[1],
+            (x - xc) / d
+        );
+        assert!(close(o[2], y / d), "dz/dy at ({x}, {y})");
+    }
+    // About x, right-handed: the centre (0, 0, 5) goes to (0, −5 sin φ, 5 cos φ).
+    let ph = (-7f64).to_radians();
+    let (yc, zc) = (-5.0 * ph.sin(), 5.0 * ph.cos());
+    let (x, y) = (0.3, 0.8);
+    let d = (25.0 - x * x - (y - yc) * (y - yc)).sqrt();
+    assert!(close(eval_surface(src, "u", x, y)[0], zc - d));
+}

@@ -1,0 +1,169 @@
+//! The `gcode` dialect kind: everything a post-processor needs to know
+//! about a controller, as data.
+
+use super::{Category, Check, Kind, LENGTH, NUMBER, Param, Ty, opt, req};
+
+const fn text(name: &'static str, doc: &'static str) -> Param {
+    opt(name, Ty::Text, Check::Any, doc)
+}
+const fn texts(name: &'static str, doc: &'static str) -> Param {
+    opt(name, Ty::Texts, Check::Any, doc)
+}
+
+/// A G-code dialect: everything a post-processor needs to know about a
+/// controller, so a shop adds one in a `.lens` file without rebuilding
+/// lensc. Lines may hold `{job}`, `{JOB}` (upper case), `{number}` and
+/// `{tolerance}` (mm, to the machine's decimals).
+const GCODE_PARAMS: &[Param] = &[
+    req(
+        "extension",
+        Ty::Text,
+        Check::Any,
+        "the program file's extension, without the dot",
+    ),
+    req(
+        "comment",
+        Ty::Word(&["parentheses", "semicolon"]),
+        Check::Any,
+        "comment syntax: `(text)` or `; text`",
+    ),
+    texts(
+        "start",
+        "lines before the header comments (`%`, `O{number}`, a program name line)",
+    ),
+    opt(
+        "program_number",
+        NUMBER,
+        Check::Count,
+        "the program number `{number}` stands for; default 1",
+    ),
+    texts(
+        "lathe_setup",
+        "the safe-start lines of a lathe program (plane, units, absolute, radius or diameter mode, cancels)",
+    ),
+    texts("mill_setup", "the safe-start lines of a mill program"),
+    texts(
+        "path_tolerance",
+        "lines that hold the controller's blending to `{tolerance}`; left out if absent",
+    ),
+    texts(
+        "c_axis_on",
+        "lines that switch the spindle to a position-controlled C axis before a C move",
+    ),
+    texts(
+        "c_axis_off",
+        "lines that give the spindle back after C moves",
+    ),
+    texts("end", "the blocks that end the program (`M2`, `M30`)"),
+    texts(
+        "trailer",
+        "lines after the last block, written as they are (`%`)",
+    ),
+    req(
+        "lathe_x",
+        Ty::Word(&["radius", "diameter"]),
+        Check::Any,
+        "whether a lathe's X word is the radius or the diameter (the setup lines must select the same)",
+    ),
+    text("rapid", "the rapid-move word; default `G0`"),
+    text("linear", "the linear-move word; default `G1`"),
+    text("arc_cw", "the clockwise-arc word; default `G2`"),
+    text("arc_ccw", "the counter-clockwise-arc word; default `G3`"),
+    texts(
+        "arc_planes",
+        "planes the controller interpolates arcs in, of \"xy\" (G17), \"zx\" (G18), \"yz\" (G19); none: no arcs",
+    ),
+    req(
+        "arc_centre",
+        Ty::Word(&["incremental", "absolute"]),
+        Check::Any,
+        "arc centres I J K from the arc's start (`incremental`) or in work coordinates",
+    ),
+    texts(
+        "surface_speed",
+        "blocks that set constant surface speed before the spindle-on word (`{speed}` m/min, `{cap}` rpm); none: the controller cannot",
+    ),
+    text(
+        "fts_table",
+        "the extension of a fast-tool-servo table file (rows `C X W`: degrees, mm, mm) written beside the program; absent: the fast axis's motion is programmed on Z",
+    ),
+    texts(
+        "fts_on",
+        "blocks that arm the servo to follow its table, before the plunge (`{table}`: the table's file name)",
+    ),
+    texts(
+        "fts_off",
+        "blocks that release the servo after the last revolution",
+    ),
+    opt(
+        "arc_radius_tolerance",
+        LENGTH,
+        Check::Positive,
+        "the most an arc's end radius may differ from its start radius before the controller refuses it; default 0.001 mm (LinuxCNC allows about 0.025 mm, Beckhoff 0.005 mm); arcs are checked after rounding",
+    ),
+    text(
+        "per_minute",
+        "the word for feeds per minute; absent: not available",
+    ),
+    text(
+        "per_revolution",
+        "the word for feeds per revolution; absent: not available",
+    ),
+    text(
+        "inverse_time",
+        "the word for inverse-time feeds (F = 1/minutes of the move); absent: moves that turn the C axis cannot be timed",
+    ),
+    text("spindle_on", "the spindle-on word; default `M3`"),
+    text("spindle_off", "the spindle-off word; default `M5`"),
+    text("c_letter", "the spindle's C-axis letter; default `C`"),
+    opt(
+        "c_decimals",
+        NUMBER,
+        Check::Count,
+        "decimals of C in degrees; default 5 (4 nm of arc at 25 mm)",
+    ),
+    opt(
+        "max_decimals",
+        NUMBER,
+        Check::Count,
+        "the most decimals a linear axis takes; a machine whose resolution needs more is refused",
+    ),
+    opt(
+        "max_digits",
+        NUMBER,
+        Check::Count,
+        "the most digits in one value (Fanuc: 8); a program needing more is refused",
+    ),
+    opt(
+        "max_line_length",
+        NUMBER,
+        Check::Count,
+        "the longest line the controller reads, in characters",
+    ),
+    opt(
+        "line_numbers",
+        NUMBER,
+        Check::Count,
+        "number each block `N…` in steps of this; absent: no numbers",
+    ),
+    opt(
+        "max_line_number",
+        NUMBER,
+        Check::Count,
+        "block numbers start again from the step after this",
+    ),
+    text(
+        "block_end",
+        "text closing every block (Heidenhain ISO: ` *`); default none",
+    ),
+];
+
+pub(super) const GCODE: Kind = Kind {
+    name: "gcode",
+    category: Category::Dialect,
+    params: GCODE_PARAMS,
+    family: None,
+    positional: &[],
+    exclusive: &[],
+    doc: "a G-code (ISO 6983 family) program dialect: how one controller wants its programs written",
+};

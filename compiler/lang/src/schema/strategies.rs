@@ -1,0 +1,360 @@
+//! The strategies: how a path is planned, with the parameters the spiral
+//! strategies share.
+
+use super::{ANGLE, Category, Check, DEG90, Kind, LENGTH, NUMBER, Param, Ty, opt, req};
+use crate::units::Dim;
+
+const RETRACT: Param = opt(
+    "retract",
+    LENGTH,
+    Check::Positive,
+    "clearance above the part for rapid moves; default 1 mm",
+);
+const CHORD_TOLERANCE: Param = opt(
+    "chord_tolerance",
+    LENGTH,
+    Check::Positive,
+    "largest chord deviation from the exact tool-centre path; default 10 nm",
+);
+
+// The parameters both spiral strategies share.
+const SPIRAL_FEED: Param = req(
+    "feed",
+    Ty::Quantity(&[Dim::FEED_PER_REV]),
+    Check::Positive,
+    "radial feed per revolution",
+);
+const SPIRAL_SPINDLE_SPEED: Param = opt(
+    "spindle_speed",
+    Ty::Quantity(&[Dim::ROTATIONAL_SPEED]),
+    Check::Positive,
+    "constant spindle speed",
+);
+const SURFACE_SPEED: Param = opt(
+    "surface_speed",
+    Ty::Quantity(&[Dim::SPEED]),
+    Check::Positive,
+    "constant surface speed at the tool",
+);
+const SPINDLE_CAP: Param = opt(
+    "spindle_cap",
+    Ty::Quantity(&[Dim::ROTATIONAL_SPEED]),
+    Check::Positive,
+    "highest spindle speed under constant surface speed; default the machine's",
+);
+const SEED_ARC: Param = opt(
+    "seed_arc",
+    LENGTH,
+    Check::Positive,
+    "largest arc between the samples the chord test starts from; default 0.1 mm",
+);
+const SPIRAL_FROM: Param = opt(
+    "from",
+    LENGTH,
+    Check::NonNegative,
+    "radius where the spiral starts; default the outermost point of the surface",
+);
+
+pub(super) const FTS_SPIRAL: Kind = Kind {
+    name: "fts_spiral",
+    category: Category::Strategy,
+    params: &[
+        SPIRAL_FEED,
+        SPIRAL_SPINDLE_SPEED,
+        SURFACE_SPEED,
+        SPINDLE_CAP,
+        CHORD_TOLERANCE,
+        SEED_ARC,
+        opt(
+            "settle",
+            Ty::Word(&["auto", "none"]),
+            Check::Any,
+            "`auto` (default): hold the tool h_offset above the land so the servo settles before each lenslet (Hashimoto & Yan eqs 6-7); `none`: follow the land",
+        ),
+        opt(
+            "settling_time",
+            Ty::Quantity(&[Dim::TIME]),
+            Check::Positive,
+            "the servo's settling time for h_offset; default from the machine's servo model",
+        ),
+        SPIRAL_FROM,
+        RETRACT,
+    ],
+    family: None,
+    positional: &[],
+    exclusive: &[(&["spindle_speed", "surface_speed"], true)],
+    doc: "fast-tool-servo spiral turning: X and C on an Archimedean spiral, W carrying the surface",
+};
+
+pub(super) const SPIRAL_TURNING: Kind = Kind {
+    name: "spiral_turning",
+    category: Category::Strategy,
+    params: &[
+        SPIRAL_FEED,
+        SPIRAL_SPINDLE_SPEED,
+        SURFACE_SPEED,
+        SPINDLE_CAP,
+        CHORD_TOLERANCE,
+        SEED_ARC,
+        SPIRAL_FROM,
+        RETRACT,
+    ],
+    family: None,
+    positional: &[],
+    exclusive: &[(&["spindle_speed", "surface_speed"], true)],
+    doc: "spiral turning with a slow tool servo: X and C on an Archimedean spiral, Z following the surface",
+};
+
+pub(super) const ROLLER_HELIX: Kind = Kind {
+    name: "roller_helix",
+    category: Category::Strategy,
+    params: &[
+        opt(
+            "rough",
+            Ty::Block(&[
+                req(
+                    "c_step",
+                    ANGLE,
+                    Check::Positive,
+                    "spindle angle between points",
+                ),
+                req(
+                    "pitch",
+                    LENGTH,
+                    Check::Positive,
+                    "axial feed per revolution",
+                ),
+                req(
+                    "finish_allowance",
+                    LENGTH,
+                    Check::NonNegative,
+                    "radial stock left for the finish pass",
+                ),
+            ]),
+            Check::Any,
+            "the rough pass (Liu et al.: 1° and 0.1 mm)",
+        ),
+        req(
+            "finish",
+            Ty::Block(&[
+                req(
+                    "c_step",
+                    ANGLE,
+                    Check::Positive,
+                    "spindle angle between points",
+                ),
+                req(
+                    "pitch",
+                    LENGTH,
+                    Check::Positive,
+                    "axial feed per revolution",
+                ),
+            ]),
+            Check::Any,
+            "the finish pass (Liu et al.: 0.1° and 5 µm)",
+        ),
+        opt(
+            "z",
+            Ty::Range(Dim::LENGTH),
+            Check::Any,
+            "axial range of the cut, in the design's x; default the whole design",
+        ),
+        req(
+            "spindle_speed",
+            Ty::Quantity(&[Dim::ROTATIONAL_SPEED]),
+            Check::Positive,
+            "spindle speed",
+        ),
+        opt(
+            "blank_radius",
+            LENGTH,
+            Check::Positive,
+            "radius of the roller blank; default the top of the design",
+        ),
+        RETRACT,
+    ],
+    family: None,
+    positional: &[],
+    exclusive: &[],
+    doc: "roller helix turning (Liu et al., seed 002): the wrapped design cut along a helix z = P·c/360, rough then finish",
+};
+
+pub(super) const RASTER: Kind = Kind {
+    name: "raster",
+    category: Category::Strategy,
+    params: &[
+        req(
+            "along",
+            Ty::Word(&["x", "y"]),
+            Check::Any,
+            "the cutting direction",
+        ),
+        opt(
+            "direction",
+            Ty::Word(&["one_way", "zigzag"]),
+            Check::Any,
+            "one_way (default): every pass cut the same way; zigzag: alternate passes reversed",
+        ),
+        req(
+            "stepover",
+            LENGTH,
+            Check::Positive,
+            "distance between passes",
+        ),
+        CHORD_TOLERANCE,
+        opt(
+            "max_step",
+            LENGTH,
+            Check::Positive,
+            "longest step along a pass",
+        ),
+        opt(
+            "lin_angle",
+            ANGLE,
+            Check::HalfOpen(0.0, DEG90),
+            "Lin's angle α: steps no longer than eqs 2-3 allow (2ρ sin(α/2) cos θ)",
+        ),
+        req(
+            "feed",
+            Ty::Quantity(&[Dim::SPEED]),
+            Check::Positive,
+            "cutting feed",
+        ),
+        RETRACT,
+    ],
+    family: None,
+    positional: &[],
+    exclusive: &[],
+    doc: "iso-plane raster: passes along x or y at a fixed stepover, the tool centre exact",
+};
+
+pub(super) const PROFILE_GRINDING: Kind = Kind {
+    name: "profile_grinding",
+    category: Category::Strategy,
+    params: &[
+        req(
+            "interval",
+            LENGTH,
+            Check::Positive,
+            "distance interval δ along x between commanded points",
+        ),
+        req(
+            "feed",
+            Ty::Quantity(&[Dim::SPEED]),
+            Check::Positive,
+            "feed v_f along x",
+        ),
+        req(
+            "smoothness",
+            NUMBER,
+            Check::Open(0.0, 1.0),
+            "γ: the share of each interval spent accelerating (Kim et al. eqs 17-19)",
+        ),
+        opt(
+            "from",
+            LENGTH,
+            Check::Any,
+            "x where grinding starts; default the centre",
+        ),
+        opt(
+            "to",
+            LENGTH,
+            Check::Any,
+            "x where grinding ends; default the aperture edge",
+        ),
+        RETRACT,
+    ],
+    family: None,
+    positional: &[],
+    exclusive: &[],
+    doc: "profile grinding with a spherical wheel: position-based interpolation of Kim et al. (seed 001)",
+};
+
+pub(super) const PROFILE_TURNING: Kind = Kind {
+    name: "profile_turning",
+    category: Category::Strategy,
+    params: &[
+        req(
+            "feed",
+            Ty::Quantity(&[Dim::FEED_PER_REV, Dim::SPEED]),
+            Check::Positive,
+            "feed per revolution or feed speed",
+        ),
+        SPIRAL_SPINDLE_SPEED,
+        SURFACE_SPEED,
+        SPINDLE_CAP,
+        opt(
+            "chord_tolerance",
+            LENGTH,
+            Check::Positive,
+            "the path's tolerance: the most the program, as the machine runs it, may stray from the exact tool-centre path; default 10 nm",
+        ),
+        opt(
+            "from",
+            LENGTH,
+            Check::NonNegative,
+            "radius where the cut starts; default the aperture edge",
+        ),
+        opt(
+            "to",
+            LENGTH,
+            Check::NonNegative,
+            "radius where the cut ends; default 0",
+        ),
+        opt(
+            "retract",
+            LENGTH,
+            Check::Positive,
+            "clearance above the part for rapid moves; default 1 mm",
+        ),
+        opt(
+            "search",
+            Ty::Word(&["exact", "sequential", "binary"]),
+            Check::Any,
+            "how the nose-centre height is found: exact (default), or Lei et al.'s sequential or binary search over the discretised profile (reference methods)",
+        ),
+        opt(
+            "search_spacing",
+            LENGTH,
+            Check::Positive,
+            "profile discretisation of the sequential and binary searches; default 1 µm",
+        ),
+        opt(
+            "search_step",
+            LENGTH,
+            Check::Positive,
+            "descent step of the sequential search (default 10 nm) or final bracket of the binary search (default 1 nm)",
+        ),
+        opt(
+            "stock_top",
+            LENGTH,
+            Check::Any,
+            "the stock is flat, its face at this height: roughing passes take it down `depth_of_cut` at a time",
+        ),
+        opt(
+            "stock_allowance",
+            LENGTH,
+            Check::Positive,
+            "the stock is the design offset by this much along its normal: roughing passes take it down `depth_of_cut` at a time",
+        ),
+        opt(
+            "depth_of_cut",
+            LENGTH,
+            Check::Positive,
+            "most material one roughing pass removes; needed with a stock",
+        ),
+        opt(
+            "finish_allowance",
+            LENGTH,
+            Check::NonNegative,
+            "material the roughing passes leave for the finish pass; default 0",
+        ),
+    ],
+    family: None,
+    positional: &[],
+    exclusive: &[
+        (&["stock_top", "stock_allowance"], false),
+        (&["spindle_speed", "surface_speed"], true),
+    ],
+    doc: "one facing pass along the profile with the nose centre offset along the normal",
+};

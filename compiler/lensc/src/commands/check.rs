@@ -1,0 +1,34 @@
+//! `lensc check`: check files for errors without building anything: the
+//! checker's findings and, once a file checks, every job lowered as `build`
+//! lowers it (everything knowable without planning).
+
+use crate::output::{Output, load};
+
+/// Runs the subcommand; returns the exit code.
+pub fn run(out: &Output, files: &[std::path::PathBuf]) -> u8 {
+    let mut code = 0;
+    for f in files {
+        let Some(c) = load(out, f) else {
+            code = 1;
+            continue;
+        };
+        // Everything knowable without planning: each job lowered as
+        // `build` lowers it (in its machine's own dialect), once the file
+        // checks.
+        let mut diags = c.diags().to_vec();
+        if !c.has_errors() {
+            diags.extend(
+                c.checked
+                    .jobs
+                    .iter()
+                    .filter_map(|j| lensc_build::pipeline::lower(j, None).err())
+                    .flatten(),
+            );
+        }
+        out.diagnostics(&c, &diags);
+        if diags.iter().any(|d| d.is_error()) {
+            code = 1;
+        }
+    }
+    code
+}

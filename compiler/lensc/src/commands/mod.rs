@@ -1,0 +1,8 @@
+//! One file per subcommand: each turns its arguments into calls on
+//! lensc-build and lensc-lang and returns the exit code.
+
+pub mod analyse;
+pub mod build;
+pub mod check;
+pub mod report;
+pub mod sample;

@@ -1,0 +1,233 @@
+//! Tests of the fast-tool-servo spiral planner.
+
+use super::*;
+
+/// A concave sphere R about the origin (z = R − sqrt(R² − r²)), as a
+/// SurfaceFn, with a plateau at height h: z = min(sphere, h).
+struct Dimple {
+    r: f64,
+    h: f64,
+    /// Centre on the x axis.
+    cx: f64,
+}
+
+impl SurfaceFn for Dimple {
+    fn eval_batch(&self, xs: &[f64], ys: &[f64], out: &mut [f64]) {
+        for (i, (&x, &y)) in xs.iter().zip(ys).enumerate() {
+            let x = x - self.cx;
+            let q = (self.r * self.r - x * x - y * y).sqrt();
+            let z = self.r - q;
+            let o = if z >= self.h {
+                [self.h, 0.0, 0.0, 0.0, 0.0, 0.0]
+            } else {
+                let q3 = q * q * q;
+                [
+                    z,
+                    x / q,
+                    y / q,
+                    (self.r * self.r - y * y) / q3,
+                    x * y / q3,
+                    (self.r * self.r - x * x) / q3,
+                ]
+            };
+            out[6 * i..6 * i + 6].copy_from_slice(&o);
+        }
+    }
+}
+
+fn planner<'a>(spiral: &'a FtsSpiral, d: &'a Dimple, rho: f64) -> Planner<'a> {
+    let slope = ((2.0 * d.r * d.h - d.h * d.h).sqrt() / (d.r - d.h)).atan();
+    Planner {
+        spiral,
+        surface: d,
+        nose_radius: rho,
+        bounds: TrajectoryBounds {
+            z_max: d.h,
+            max_slope: slope,
+            features: None,
+            part_top: d.h,
+        },
+    }
+}
+
+fn spiral() -> FtsSpiral {
+    FtsSpiral {
+        feed_per_rev: 0.01,
+        speed: SpindleSpeed::Constant(2.0 * std::f64::consts::PI * 125.0 / 60.0),
+        chord_tolerance: 10e-6,
+        seed_arc: 0.1,
+        min_interval: 1.0 / 20e3,
+        start_radius: 1.2,
+        end_radius: 0.0,
+    }
+}
+
+#[test]
+fn inside_the_dimple_the_centre_is_on_the_smaller_sphere() {
+    // Concave sphere R: the nose centre lies on the sphere R − ρ about
+    // the same centre (0, 0, R).
+    let d = Dimple {
+        r: 20.0,
+        h: 0.1,
+        cx: 0.0,
+    };
+    let s = spiral();
+    let p = planner(&s, &d, 0.496);
+    for c in [0.3, 10.0, 50.0] {
+        let x = p.radius(c);
+        let w = p.centre(c);
+        let want = 20.0 - ((20.0f64 - 0.496).powi(2) - x * x).sqrt();
+        assert!((w - want).abs() < 1e-12, "c {c}: {w} vs {want}");
+    }
+}
+
+#[test]
+fn off_the_axis_the_centre_is_on_the_section_circle() {
+    // A concave sphere R centred at (cx, 0, R): the plane of the ray at
+    // angle c cuts it in a circle of radius sqrt(R² − d²), d = cx·sin c,
+    // centred at u0 = cx·cos c; the nose centre is on the concentric
+    // circle ρ smaller (the exact offset, to 1e-12 mm).
+    let d = Dimple {
+        r: 20.0,
+        h: 0.1,
+        cx: 0.6,
+    };
+    let s = spiral();
+    let p = planner(&s, &d, 0.496);
+    for c in [0.3, 2.0, 10.0, 41.0, 77.7] {
+        let x = p.radius(c);
+        let w = p.centre(c);
+        let (dist, u0) = (0.6 * c.sin(), 0.6 * c.cos());
+        let rs = (400.0 - dist * dist).sqrt();
+        let want = 20.0 - ((rs - 0.496).powi(2) - (x - u0).powi(2)).sqrt();
+        assert!((w - want).abs() < 1e-12, "c {c}: {w} vs {want}");
+    }
+}
+
+#[test]
+fn on_the_plateau_the_centre_is_a_nose_radius_above_it() {
+    let d = Dimple {
+        r: 20.0,
+        h: 0.005,
+        cx: 0.0,
+    };
+    let s = FtsSpiral {
+        start_radius: 2.0,
+        ..spiral()
+    };
+    let p = planner(&s, &d, 0.496);
+    // Plateau where 20 − sqrt(400 − r²) ≥ 0.005: r ≥ 0.447 mm; the nose
+    // reaches past the edge by ρ sin(slope), so well outside it rests flat.
+    assert!((p.centre(0.0) - (0.005 + 0.496)).abs() < 1e-15);
+}
+
+#[test]
+fn samples_stay_on_their_chords_and_the_plan_is_thread_independent() {
+    let d = Dimple {
+        r: 20.0,
+        h: 0.004,
+        cx: 0.6,
+    };
+    let s = spiral();
+    let p = planner(&s, &d, 0.496);
+    let fa = FastAxis {
+        stroke: 5.0,
+        max_acceleration: 25.0 * 9806.65,
+    };
+    let mut pts = Vec::new();
+    let sum = p.plan(&fa, |b| pts.extend_from_slice(b)).expect("plans");
+    assert_eq!(sum.points, pts.len());
+    assert_eq!(sum.revolutions, 120);
+    // Midpoints of chords against the exact centre height.
+    for w in pts.windows(2).step_by(7) {
+        let m = 0.5 * (w[0].c + w[1].c);
+        let exact = p.centre(m);
+        assert!((exact - 0.5 * (w[0].w + w[1].w)).abs() <= 10e-6 * 1.0001);
+    }
+    // X follows the spiral and C increases.
+    assert!(pts.windows(2).all(|w| w[1].c > w[0].c && w[1].x < w[0].x));
+    assert_eq!(pts.last().expect("end").x, 0.0);
+    // One thread gives the same bits.
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("pool");
+    let single = one.install(|| p.plan(&fa, |_| {}).expect("plans"));
+    assert_eq!(single.fingerprint, sum.fingerprint);
+}
+
+#[test]
+fn too_little_stroke_or_acceleration_is_refused() {
+    // Off the spindle axis the dimple makes W move every revolution.
+    let d = Dimple {
+        r: 20.0,
+        h: 0.004,
+        cx: 0.6,
+    };
+    let s = spiral();
+    let p = planner(&s, &d, 0.496);
+    let e = p
+        .plan(
+            &FastAxis {
+                stroke: 0.001,
+                max_acceleration: 1e9,
+            },
+            |_| {},
+        )
+        .expect_err("stroke");
+    assert!(matches!(e, FtsError::StrokeExceeded { .. }), "{e:?}");
+    let e = p
+        .plan(
+            &FastAxis {
+                stroke: 5.0,
+                max_acceleration: 1.0,
+            },
+            |_| {},
+        )
+        .expect_err("acceleration");
+    let FtsError::AccelerationExceeded {
+        highest_allowed_speed,
+        ..
+    } = e
+    else {
+        panic!("{e:?}")
+    };
+    // Replanned at that speed, it passes (just).
+    let slower = FtsSpiral {
+        speed: SpindleSpeed::Constant(highest_allowed_speed * 0.999),
+        ..s.clone()
+    };
+    let p2 = planner(&slower, &d, 0.496);
+    p2.plan(
+        &FastAxis {
+            stroke: 5.0,
+            max_acceleration: 1.0,
+        },
+        |_| {},
+    )
+    .expect("slow enough");
+}
+
+#[test]
+fn settling_offset_of_seed_003() {
+    // R = 20 mm, d = 1.7 mm, 5 m/min, T_s = 1 ms: 3.7 µm (eqs 6–7).
+    let sphere = |u: f64| 20.0 - (400.0 - u * u).sqrt();
+    let h = settling_offset(sphere, 0.85, 5000.0 / 60.0, 1e-3);
+    assert_eq!(format!("{:.1}", h * 1000.0), "3.7", "{h}");
+    let paper = crate::machine::servo::settling_offset(20.0, 1.7, 5000.0 / 60.0, 1e-3).expect("h");
+    assert!((h - paper).abs() < 1e-15 + 1e-12 * paper, "{h} vs {paper}");
+}
+
+#[test]
+fn surface_speed_is_capped_near_the_centre() {
+    // 5 m/min capped at 1000 rpm: the cap holds inside r = v/ω_max.
+    let s = SpindleSpeed::SurfaceSpeed {
+        speed: 5000.0 / 60.0,
+        max: 1000.0 * 2.0 * std::f64::consts::PI / 60.0,
+    };
+    assert_eq!(s.at(0.1), 1000.0 * 2.0 * std::f64::consts::PI / 60.0);
+    assert!((s.at(10.0) * 10.0 - 5000.0 / 60.0).abs() < 1e-12);
+    // Seed 003: the corner lenslet at 22.7 mm at 125 rpm sees 17.8 m/min.
+    let v = 22.7 * 125.0 * 2.0 * std::f64::consts::PI / 60.0 * 60.0 / 1000.0;
+    assert_eq!(format!("{v:.1}"), "17.8");
+}

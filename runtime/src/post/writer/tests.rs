@@ -1,0 +1,334 @@
+//! Tests of the program writer: words, modal state, feeds and line text.
+
+use super::*;
+use crate::moves::{Feed as F, Move as M, Position as P};
+
+fn written(axes: &str, stream: &[M]) -> Result<String, ProgramError> {
+    written_in(&Dialect::linuxcnc(), Setup::Mill, axes, stream)
+}
+
+fn written_in(d: &Dialect, setup: Setup, axes: &str, stream: &[M]) -> Result<String, ProgramError> {
+    let mut w = ProgramWriter::new(d, setup, "t1", &["t".into()], axes, 1e-3, 1e-3)?;
+    w.write_all(stream)?;
+    w.finish()
+}
+
+#[test]
+fn unchanged_words_and_feeds_are_left_out() {
+    let text = written(
+        "XYZ",
+        &[
+            M::Rapid(P::xyz(1.0, 2.0, 5.0)),
+            M::Linear {
+                to: P::xyz(1.0, 2.0, 0.5),
+                feed: Some(F::PerTime(1.0)),
+            },
+            M::Linear {
+                to: P::xyz(1.5, 2.0, 0.5),
+                feed: Some(F::PerTime(1.0)),
+            },
+            // Rounds to the same printed position: no line at all.
+            M::Linear {
+                to: P::xyz(1.5001, 2.0, 0.5),
+                feed: None,
+            },
+            M::Linear {
+                to: P::xyz(1.5, 2.5, 0.5),
+                feed: Some(F::PerTime(2.0)),
+            },
+        ],
+    )
+    .expect("writes");
+    assert_eq!(
+        text,
+        "(t)\nG17 G21 G90 G40 G49 G80\nG64 P0.001\nG0 X1. Y2. Z5.\nG94 G1 Z0.5 F60.\nG1 X1.5\nG1 Y2.5 F120.\nM2\n"
+    );
+}
+
+#[test]
+fn inverse_time_writes_a_feed_on_every_move_and_c_in_degrees() {
+    let text = written(
+        "XZC",
+        &[
+            M::Linear {
+                to: P::xzc(1.0, 0.0, std::f64::consts::FRAC_PI_2),
+                feed: Some(F::InverseTime(0.5)),
+            },
+            M::Linear {
+                to: P::xzc(0.9, 0.0, std::f64::consts::PI),
+                feed: Some(F::InverseTime(0.5)),
+            },
+            M::Linear {
+                to: P::xz(0.8, 0.1),
+                feed: Some(F::PerRevolution(0.001)),
+            },
+        ],
+    )
+    .expect("writes");
+    assert_eq!(
+        text,
+        "(t)\nG17 G21 G90 G40 G49 G80\nG64 P0.001\nG93 G1 X1. Z0. C90. F120.\nG1 X0.9 C180. F120.\nG95 G1 X0.8 Z0.1 F0.006283\nM2\n"
+    );
+}
+
+#[test]
+fn a_dialect_given_as_data_shapes_every_line() {
+    let mut d = Dialect::linuxcnc();
+    d.name = "heidenhain_like".into();
+    d.comment = CommentStyle::Semicolon;
+    d.start = vec!["%{JOB} G71 *".into()];
+    d.mill_setup = vec!["G17 G90".into()];
+    d.path_tolerance = Vec::new();
+    d.end = vec!["M30".into()];
+    d.trailer = vec!["N99999999 %{JOB} G71 *".into()];
+    d.line_numbers = Some(1);
+    d.block_end = " *".into();
+    d.arc_centre_absolute = true;
+    let text = written_in(
+        &d,
+        Setup::Mill,
+        "XYZ",
+        &[
+            M::Rapid(P::xyz(1.0, 0.0, 0.0)),
+            M::Arc {
+                to: P::xyz(0.0, 1.0, 0.0),
+                centre: P::xyz(0.0, 0.0, f64::NAN),
+                plane: Plane::Xy,
+                ccw: true,
+                feed: Some(F::PerTime(1.0)),
+            },
+        ],
+    )
+    .expect("writes");
+    assert_eq!(
+        text,
+        "%T1 G71 *\nN1 ; t *\nN2 G17 G90 *\nN3 G0 X1. Y0. Z0. *\nN4 G94 G3 X0. Y1. I0. J0. F60. *\nN5 M30 *\nN99999999 %T1 G71 *\n"
+    );
+}
+
+#[test]
+fn long_words_and_letters_beyond_ascii_are_written_whole() {
+    // Words longer than a snippet's fixed room, and a C letter of two
+    // bytes, take the writer's other paths.
+    let mut d = Dialect::linuxcnc();
+    d.linear = "G1 G90 G94 G17 G21 G40".into();
+    d.block_end = " ; the end of a long block".into();
+    d.c_letter = 'Ç';
+    // The longest line is 77 bytes (the limit counts bytes, as before).
+    d.max_line_length = Some(77);
+    let text = written_in(
+        &d,
+        Setup::Lathe,
+        "XZC",
+        &[
+            M::Linear {
+                to: P::xzc(1.5, -0.25, std::f64::consts::PI),
+                feed: Some(F::InverseTime(0.5)),
+            },
+            M::Linear {
+                to: P::xzc(1.5, -0.25, std::f64::consts::FRAC_PI_2),
+                feed: Some(F::InverseTime(0.25)),
+            },
+        ],
+    )
+    .expect("writes");
+    assert!(
+        text.contains(
+            "G93 G1 G90 G94 G17 G21 G40 X1.5 Z-0.25 Ç180. F120. ; the end of a long block\n\
+             G1 G90 G94 G17 G21 G40 Ç90. F240. ; the end of a long block\n"
+        ),
+        "{text}"
+    );
+    // One byte over the limit, the block end counted.
+    d.max_line_length = Some(76);
+    let Err(ProgramError::Unsupported(why)) = written_in(
+        &d,
+        Setup::Lathe,
+        "XZC",
+        &[M::Linear {
+            to: P::xzc(1.5, -0.25, std::f64::consts::PI),
+            feed: Some(F::InverseTime(0.5)),
+        }],
+    ) else {
+        panic!("a line over the limit written")
+    };
+    assert!(why.contains("a line of 77 characters"), "{why}");
+}
+
+#[test]
+fn arcs_have_incremental_centres_and_select_their_plane() {
+    let text = written(
+        "XYZ",
+        &[
+            M::Rapid(P::xyz(1.0, 0.0, 2.0)),
+            M::Arc {
+                to: P::xyz(3.0, 0.0, 2.0),
+                centre: P::xyz(2.0, f64::NAN, 2.0),
+                plane: Plane::Zx,
+                ccw: false,
+                feed: Some(F::PerTime(1.0)),
+            },
+        ],
+    )
+    .expect("writes");
+    assert!(text.contains("G94 G18 G2 X3. I1. K0. F60.\n"), "{text}");
+}
+
+#[test]
+fn an_arc_whose_radii_disagree_after_rounding_is_refused() {
+    let arc = |end_x: f64| {
+        written(
+            "XZ",
+            &[
+                M::Rapid(P::xz(1.0, 0.0)),
+                M::Arc {
+                    to: P::xz(end_x, 0.0),
+                    centre: P::xz(0.0, 0.0),
+                    plane: Plane::Zx,
+                    ccw: true,
+                    feed: Some(F::PerTime(1.0)),
+                },
+            ],
+        )
+    };
+    assert!(arc(-1.0005).is_ok());
+    let Err(ProgramError::Unsupported(why)) = arc(-1.002) else {
+        panic!("a 2 um mismatch written")
+    };
+    assert!(why.contains("0.002 mm"), "{why}");
+}
+
+#[test]
+fn diameter_mode_doubles_x_and_limits_are_enforced() {
+    let mut d = Dialect::linuxcnc();
+    d.lathe_x_diameter = true;
+    d.max_digits = Some(4);
+    let text = written_in(&d, Setup::Lathe, "XZ", &[M::Rapid(P::xz(1.25, 0.0))]).expect("writes");
+    assert!(text.contains("G0 X2.5 Z0.\n"), "{text}");
+    assert!(matches!(
+        written_in(&d, Setup::Lathe, "XZ", &[M::Rapid(P::xz(12.3455, 0.0))]),
+        Err(ProgramError::Unsupported(_))
+    ));
+    d.per_revolution = None;
+    assert!(matches!(
+        written_in(
+            &d,
+            Setup::Lathe,
+            "XZ",
+            &[M::Linear {
+                to: P::xz(1.0, 0.0),
+                feed: Some(F::PerRevolution(0.001))
+            }]
+        ),
+        Err(ProgramError::Unsupported(_))
+    ));
+    d.max_decimals = Some(2);
+    assert!(written_in(&d, Setup::Lathe, "XZ", &[]).is_err());
+    assert!(written_in(&Dialect::linuxcnc(), Setup::Lathe, "XZ", &[]).is_ok());
+}
+
+#[test]
+fn the_final_check_refuses_bad_numbers_outside_comments() {
+    let ok = "(X-0. in a comment, 1e5 too)\nG1 X-0.5 Z0. F60.\nG05.1 Q1\n";
+    assert!(check_numbers(ok, CommentStyle::Parentheses).is_ok());
+    for bad in [
+        "G1 X-0.",
+        "G1 X-0.000",
+        "G1 X1.5e-3",
+        "G1 XNaN",
+        "G1 Z-inf",
+        "G1 X1.0Y2.",
+    ] {
+        assert!(
+            check_numbers(bad, CommentStyle::Parentheses).is_err(),
+            "{bad} passed"
+        );
+    }
+    assert!(check_numbers("; X-0. here", CommentStyle::Semicolon).is_ok());
+}
+
+#[test]
+fn axes_the_machine_lacks_and_values_that_cannot_print_are_refused() {
+    assert!(matches!(
+        written("XZ", &[M::Rapid(P::xyz(1.0, 2.0, 3.0))]),
+        Err(ProgramError::NotPrintable { word: 'Y', .. })
+    ));
+    assert!(matches!(
+        written("XZ", &[M::Rapid(P::xz(f64::INFINITY, 0.0))]),
+        Err(ProgramError::NotPrintable { word: 'X', .. })
+    ));
+}
+
+/// `{:.N}` of `n` units of 10^−N, trailing zeros trimmed, the point
+/// kept: the reference every printed word is held to.
+fn std_word(n: i64, d: u32) -> String {
+    let s = format!("{:.*}", d as usize, n as f64 / 10f64.powi(d as i32));
+    if d == 0 {
+        s + "."
+    } else {
+        s.trim_end_matches('0').to_string()
+    }
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(300))]
+
+    /// A spiral-like stream through the writer against a model of it
+    /// built from `f64::round` and `{:.N}`: the same lines, word for
+    /// word, unchanged words left out, a feed on every block, no block
+    /// for a move that changes no printed axis.
+    #[test]
+    fn the_writer_prints_what_a_plain_model_of_it_prints(
+        resolution in proptest::sample::select(vec![1e-3, 1e-4, 1e-6]),
+        moves in proptest::collection::vec(
+            (-100.0f64..100.0, -50.0f64..50.0, -1000.0f64..1000.0, 1e-5f64..1.0, 0u8..4),
+            1..200,
+        ),
+    ) {
+        let d = decimals_for(resolution);
+        let mut stream = Vec::new();
+        let mut at = (0.0, 0.0, 0.0);
+        for &(x, z, c, t, keep) in &moves {
+            // Some moves repeat a coordinate, or come within a unit of it.
+            let x = if keep & 1 == 1 { at.0 + resolution * 0.3 } else { x };
+            let z = if keep & 2 == 2 { at.1 } else { z };
+            at = (x, z, c);
+            stream.push(M::Linear { to: P::xzc(x, z, c), feed: Some(F::InverseTime(t)) });
+        }
+        let dialect = Dialect::linuxcnc();
+        let mut w = ProgramWriter::new(&dialect, Setup::Lathe, "t", &[], "XZC", resolution, 1e-5)
+            .expect("a lathe program");
+        w.write_all(&stream).expect("printable");
+        let text = w.finish().expect("checked");
+        proptest::prop_assert!(check_numbers(&text, CommentStyle::Parentheses).is_ok());
+        let units = |v: f64, d: u32| (v * 10f64.powi(d as i32)).round() as i64;
+        let mut last: [Option<i64>; 3] = [None; 3];
+        let mut expected = Vec::new();
+        for m in &stream {
+            let M::Linear { to, feed: Some(F::InverseTime(t)) } = m else { unreachable!() };
+            let mut line = String::from(if expected.is_empty() { "G93 G1" } else { "G1" });
+            let mut any = false;
+            for (k, (letter, v, dk)) in
+                [('X', to.x, d), ('Z', to.z, d), ('C', to.c.to_degrees(), 5)].into_iter().enumerate()
+            {
+                let n = units(v, dk);
+                if last[k] != Some(n) {
+                    line += &format!(" {letter}{}", std_word(n, dk));
+                    last[k] = Some(n);
+                    any = true;
+                }
+            }
+            if any {
+                line += &format!(" F{}", std_word(units(60.0 / t, 3), 3));
+                expected.push(line);
+            }
+        }
+        let written: Vec<&str> = text
+            .lines()
+            .skip_while(|l| !l.starts_with("G93"))
+            .take_while(|l| *l != "M2")
+            .collect();
+        proptest::prop_assert_eq!(written, expected);
+        proptest::prop_assert!(text.lines().all(|l| l.len() <= 255));
+    }
+}

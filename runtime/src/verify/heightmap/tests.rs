@@ -1,0 +1,259 @@
+//! Tests of height maps of what the program cuts.
+
+use super::*;
+
+/// A plane or sphere design on a Cartesian window.
+struct Flat<F: Fn(f64, f64) -> f64 + Sync> {
+    z: F,
+    window: (f64, f64, f64, f64),
+}
+impl<F: Fn(f64, f64) -> f64 + Sync> Frame for Flat<F> {
+    fn design(&self, points: &[(f64, f64)], out: &mut [f64]) {
+        for (o, &(s, u)) in out.iter_mut().zip(points) {
+            *o = (self.z)(s, u);
+        }
+    }
+    fn xy(&self, s: f64, u: f64) -> (f64, f64) {
+        (s, u)
+    }
+    fn inside(&self, x: f64, y: f64) -> bool {
+        let w = self.window;
+        x >= w.0 && x <= w.1 && y >= w.2 && y <= w.3
+    }
+}
+
+fn grid(n: usize, spacing: f64) -> Grid {
+    Grid {
+        s0: 0.0,
+        ds: spacing,
+        ns: n,
+        u0: 0.0,
+        du: spacing,
+        nu: n,
+        period: None,
+    }
+}
+
+#[test]
+fn flat_raster_leaves_the_textbook_scallop() {
+    // Passes 10 µm apart along s over a plane, nose 85 µm: scallops
+    // r − sqrt(r² − (f/2)²) = 147.1 nm, contacts on the design.
+    let (r, f) = (0.085, 0.010);
+    let g = grid(101, 0.001);
+    let mut sweep = Sweep::new(g, r);
+    for k in -12..=22 {
+        let u = k as f64 * f;
+        sweep.lift();
+        sweep.point(-0.01, u, r);
+        sweep.point(0.2, u, r);
+    }
+    let frame = Flat {
+        z: |_, _| 0.0,
+        window: (0.0, 0.1, 0.0, 0.1),
+    };
+    let map = sweep.finish(&frame);
+    let want = HeightMap::flat_scallop(r, f);
+    let sc = map.scallops.unwrap();
+    assert!((want - 147.1e-6).abs() < 0.1e-6);
+    assert!((sc.max - want).abs() < 1e-12, "{} vs {want}", sc.max);
+    assert!((sc.mean - want).abs() < 1e-12);
+    let contact = map.contact.unwrap();
+    assert!(contact.pv < 1e-12 && contact.rms < 1e-12);
+    // The cells sample the scallop: PV of the map is the scallop (rows
+    // fall on cusps every 10 µm) and nothing is uncut.
+    let surface = map.surface.unwrap();
+    assert!((surface.pv - want).abs() < 1e-12);
+    assert_eq!(map.uncut, 0);
+    // Scallops run across the passes, not along them.
+    assert!(map.rq_stepover > 10.0 * map.rq_cutting.max(1e-15));
+}
+
+#[test]
+fn a_raster_keeps_each_blocks_worst_error_and_its_sign() {
+    // A 100 × 100 map of known errors on 1 µm cells (centred at 0.5,
+    // 1.5, … µm), gathered into blocks of 10 µm (at most 10 a side;
+    // `min_block` 0 so the raster starts on the window): each block's
+    // value is the error of largest magnitude of the cells in it.
+    let g = Grid {
+        s0: 0.0005,
+        u0: 0.0005,
+        ..grid(100, 0.001)
+    };
+    let frame = Flat {
+        z: |_, _| 0.0,
+        window: (0.0, 0.1, 0.0, 0.1),
+    };
+    let mut errors = vec![f64::NAN; 100 * 100];
+    for j in 0..100 {
+        for i in 0..100 {
+            // Columns are x (s), rows y (u).
+            errors[j * 100 + i] = 1e-6 * (j as f64 - 2.0 * i as f64);
+        }
+    }
+    errors[55 * 100 + 33] = -5e-3; // one deep cell
+    errors[0] = f64::NAN; // one uncut
+    let map = HeightMap {
+        grid: g,
+        nose_radius: 0.1,
+        errors,
+        surface: None,
+        contact: None,
+        scallops: None,
+        uncut: 1,
+        rq_cutting: 0.0,
+        rq_stepover: 0.0,
+        features: Vec::new(),
+    };
+    let r = map.raster(&frame, (0.0, 0.1), (0.0, 0.1), 0.0, 10);
+    assert_eq!((r.nx, r.ny), (10, 10));
+    assert!((r.block - 0.01).abs() < 1e-15);
+    // Block (5, 3) holds the deep cell at x = 55 µm, y = 33 µm.
+    assert_eq!(r.cells[3 * 10 + 5], -5e-3);
+    // Elsewhere the worst of j − 2i over the block's cells: block
+    // (bx, by) spans j in 10bx..10bx+9 (x), i in 10by..10by+9 (y).
+    for by in 0..10 {
+        for bx in 0..10 {
+            if (bx, by) == (5, 3) {
+                continue;
+            }
+            let mut want = f64::NAN;
+            for j in 10 * bx..10 * bx + 10 {
+                for i in 10 * by..10 * by + 10 {
+                    let e = map.errors[j * 100 + i];
+                    if !e.is_nan() && (want.is_nan() || e.abs() > want.abs()) {
+                        want = e;
+                    }
+                }
+            }
+            assert_eq!(r.cells[by * 10 + bx], want, "block {bx} {by}");
+        }
+    }
+    assert_eq!(r.range().map(|r| r.0), Some(-5e-3));
+    // Cells on the far edge of the raster fall in its last blocks.
+    let edge = map.raster(&frame, (0.0, 0.0995), (0.0, 0.0995), 0.0, 10);
+    assert_eq!((edge.nx, edge.ny), (10, 10));
+    assert_eq!(edge.cells[99], r.cells[99]);
+    // Blocks are never finer than asked: the 100 µm side and 10 µm
+    // beyond each edge at 20 µm.
+    let coarse = map.raster(&frame, (0.0, 0.1), (0.0, 0.1), 0.02, 600);
+    assert_eq!((coarse.nx, coarse.ny), (6, 6));
+    assert_eq!(coarse.x.0, -0.01);
+    // Blocks as fine as the grid, centred on its cells: one cell each.
+    let fine = map.raster(&frame, (0.0005, 0.0995), (0.0005, 0.0995), 0.001, 600);
+    assert_eq!((fine.nx, fine.ny), (100, 100));
+    for j in 0..100 {
+        for i in 0..100 {
+            let (got, want) = (fine.cells[i * 100 + j], map.errors[j * 100 + i]);
+            assert!(got == want || (got.is_nan() && want.is_nan()), "{j} {i}");
+        }
+    }
+}
+
+#[test]
+fn a_pass_too_high_leaves_material_and_one_too_low_gouges() {
+    let r = 0.1;
+    let g = grid(21, 0.005);
+    let mut sweep = Sweep::new(g, r);
+    for k in -5..=25 {
+        let u = k as f64 * 0.005;
+        let h = r + if k == 10 { -2e-6 } else { 0.0 };
+        sweep.lift();
+        sweep.point(-0.01, u, h);
+        sweep.point(0.11, u, h);
+    }
+    let frame = Flat {
+        z: |_, _| 0.0,
+        window: (0.0, 0.1, 0.0, 0.1),
+    };
+    let map = sweep.finish(&frame);
+    let contact = map.contact.unwrap();
+    assert!((contact.max_gouge.0 - 2e-6).abs() < 1e-12);
+    assert!((contact.max_gouge.1.1 - 0.05).abs() < 1e-9);
+    assert!((map.surface.unwrap().max_gouge.0 - 2e-6).abs() < 1e-12);
+}
+
+#[test]
+fn a_sphere_cut_by_exact_offsets_has_its_contacts_on_the_design() {
+    // A convex sphere of radius R under a knife whose nose centres lie
+    // on the offset of each section x = const (a circle of radius
+    // sqrt(R² − x²)) by r: every contact is exact, and between points
+    // the chords leave material (the feed marks).
+    let (big, r, f, step) = (2.0, 0.05, 0.004, 0.02);
+    let z = move |x: f64, y: f64| (big * big - x * x - y * y).sqrt() - big;
+    let g = grid(201, 0.0005);
+    let mut sweep = Sweep::new(g, r);
+    for k in -20..=45 {
+        let y = k as f64 * f;
+        sweep.lift();
+        for m in -3..=8 {
+            let x = m as f64 * step;
+            let rr = (big * big - x * x).sqrt() + r;
+            let zc = (rr * rr - y * y).sqrt() - big;
+            sweep.point(x, y, zc);
+        }
+    }
+    let frame = Flat {
+        z,
+        window: (0.0, 0.1, 0.0, 0.1),
+    };
+    let map = sweep.finish(&frame);
+    let contact = map.contact.unwrap();
+    // Chords 20 µm long on a 2 mm dome sag into it by L²/8R = 25 nm
+    // midway; at the points the contact is exact.
+    let chord = step * step / (8.0 * big);
+    assert!(contact.max_gouge.0 <= chord * 1.01, "{contact:?}");
+    assert!(contact.max_gouge.0 >= chord * 0.9, "{contact:?}");
+    assert!(contact.max_residual.0 < 1e-11, "{contact:?}");
+    let sc = map.scallops.unwrap();
+    // On a convex sphere the scallop is below the flat one's.
+    let flat = HeightMap::flat_scallop(r, f);
+    assert!(
+        sc.max < flat * 1.01 + chord && sc.max > 0.5 * flat,
+        "{sc:?} {flat}"
+    );
+}
+
+#[test]
+fn angles_wrap_and_arcs_are_followed() {
+    // A lathe facing a flat: rings of radius u at every angle, the
+    // columns straddling angle 0.
+    let r = 0.2;
+    let g = Grid {
+        s0: -0.05,
+        ds: 0.01,
+        ns: 11,
+        u0: 1.0,
+        du: 0.001,
+        nu: 11,
+        period: Some(std::f64::consts::TAU),
+    };
+    let mut sweep = Sweep::new(g, r);
+    for k in 0..40 {
+        let u = 1.05 - k as f64 * 0.005;
+        for m in 0..=36 {
+            // Unwrapped angle, 10° a step, one revolution per ring.
+            let c = (k * 36 + m) as f64 * std::f64::consts::TAU / 36.0;
+            sweep.point(c, u - m as f64 * 0.005 / 36.0, r);
+        }
+    }
+    struct Polar;
+    impl Frame for Polar {
+        fn design(&self, _: &[(f64, f64)], out: &mut [f64]) {
+            out.fill(0.0);
+        }
+        fn xy(&self, s: f64, u: f64) -> (f64, f64) {
+            (u * s.cos(), u * s.sin())
+        }
+        fn inside(&self, _: f64, _: f64) -> bool {
+            true
+        }
+    }
+    let map = sweep.finish(&Polar);
+    assert_eq!(map.uncut, 0);
+    assert!((map.scallops.unwrap().max - HeightMap::flat_scallop(r, 0.005)).abs() < 1e-9);
+    // An arc in (s, h): the minor arc's height is on its circle.
+    let h = minor_arc_height((0.0, 0.0), (2.0, 0.0), (1.0, 10.0), 1.0).unwrap();
+    assert!((h - (10.0 - 101f64.sqrt())).abs() < 1e-12);
+    let h = minor_arc_height((0.0, 0.0), (2.0, 0.0), (1.0, -10.0), 1.0).unwrap();
+    assert!((h - (-10.0 + 101f64.sqrt())).abs() < 1e-12);
+}
