@@ -8,12 +8,14 @@
 //! - `plan/`: one planner per strategy, giving neutral tool-centre points;
 //! - `emit/`: each planner's output to the dialect-independent move stream
 //!   (`moves`) and a program;
-//! - `post/`: the move stream to program text in a dialect given as data;
+//! - `post/`: the move stream (`moves`) to program text in a dialect
+//!   given as data (`dialect`, which a machine also names);
 //! - `verify/`: what the program will cut (simulation, height maps,
 //!   following error).
 //!
 //! Internal units: one per dimension — millimetres, radians, seconds.
 
+pub mod dialect;
 pub mod emit;
 pub mod machine;
 pub mod moves;

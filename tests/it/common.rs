@@ -1,8 +1,10 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use std::sync::OnceLock;
 
 /// The repository root.
 pub fn root() -> PathBuf {
@@ -85,4 +87,138 @@ pub fn abridged(program: &str) -> String {
     out.push_str(&lines[lines.len().saturating_sub(3)..].join("\n"));
     out.push('\n');
     out
+}
+
+/// Files up to this size are kept whole by [`built_examples`]: every
+/// program but the three of tens of millions of points (rs274 takes about
+/// 15 µs a line, so these are the ones it reads too).
+pub const KEPT_WHOLE_LIMIT: usize = 8 << 20;
+
+/// A file `lensc build` wrote.
+pub enum Written {
+    /// Up to [`KEPT_WHOLE_LIMIT`]: every byte.
+    Whole(Vec<u8>),
+    /// A larger program: its snapshot form (see [`abridged`]) only.
+    Abridged(String),
+}
+
+impl Written {
+    /// The file as its program snapshot holds it.
+    pub fn snapshot(&self) -> String {
+        match self {
+            Written::Whole(bytes) if bytes.len() > WHOLE_SNAPSHOT_LIMIT => abridged(&text(bytes)),
+            Written::Whole(bytes) => text(bytes),
+            Written::Abridged(shown) => shown.clone(),
+        }
+    }
+}
+
+/// One example as `lensc build` made it, with the machine's number of
+/// threads, into an empty directory.
+pub struct Built {
+    /// The example, relative to the repository root (`examples/….lens`).
+    pub example: String,
+    /// What lensc printed on stderr: its warnings.
+    pub stderr: String,
+    /// Every file written (programs and reports), by name.
+    pub files: BTreeMap<String, Written>,
+}
+
+impl Built {
+    /// The report of `job`.
+    pub fn report(&self, job: &str) -> serde_json::Value {
+        match self.files.get(&format!("{job}.report.json")) {
+            Some(Written::Whole(bytes)) => serde_json::from_slice(bytes).expect("json"),
+            _ => panic!("{}: no report of {job}", self.example),
+        }
+    }
+
+    /// Every report, in the order of their file names.
+    pub fn reports(&self) -> Vec<serde_json::Value> {
+        self.files
+            .iter()
+            .filter(|(name, _)| name.ends_with(".report.json"))
+            .map(|(name, file)| match file {
+                Written::Whole(bytes) => serde_json::from_slice(bytes).expect("json"),
+                Written::Abridged(_) => panic!("{name} is too large"),
+            })
+            .collect()
+    }
+}
+
+/// Builds `file` (relative to the repository root) into a new directory
+/// with `RAYON_NUM_THREADS` as given (the parallel planners' threads) or
+/// unset; the exit status must be 0. Returns what lensc wrote and printed.
+pub fn build_into(file: &str, threads: Option<&str>) -> (tempfile::TempDir, String) {
+    let dir = tempfile::tempdir().expect("tmp");
+    let mut c = Command::new(env!("CARGO_BIN_EXE_lensc"));
+    c.current_dir(root())
+        .args(["build", file, "--out"])
+        .arg(dir.path())
+        .env("NO_COLOR", "1");
+    match threads {
+        Some(n) => c.env("RAYON_NUM_THREADS", n),
+        None => c.env_remove("RAYON_NUM_THREADS"),
+    };
+    let out = c.output().expect("run lensc");
+    assert_eq!(out.status.code(), Some(0), "{file}: {}", text(&out.stderr));
+    (dir, text(&out.stderr))
+}
+
+/// Every buildable example, built once for the whole test run (its largest
+/// programs take tens of seconds and hundreds of megabytes each): the
+/// program snapshots, rs274, the paper figures and the determinism check
+/// all read these. The files are read back and their directories removed.
+pub fn built_examples() -> &'static [Built] {
+    static BUILT: OnceLock<Vec<Built>> = OnceLock::new();
+    BUILT.get_or_init(|| {
+        buildable_examples()
+            .iter()
+            .map(|path| {
+                let example = path
+                    .strip_prefix(root())
+                    .expect("inside repo")
+                    .to_str()
+                    .expect("utf8")
+                    .to_string();
+                let (dir, stderr) = build_into(&example, None);
+                Built {
+                    example,
+                    stderr,
+                    files: read_written(dir.path()),
+                }
+            })
+            .collect()
+    })
+}
+
+/// The build of one example (`examples/….lens`) from [`built_examples`].
+pub fn built(example: &str) -> &'static Built {
+    built_examples()
+        .iter()
+        .find(|b| b.example == example)
+        .unwrap_or_else(|| panic!("{example} is not a buildable example"))
+}
+
+/// Every file in `dir`, by name: whole up to [`KEPT_WHOLE_LIMIT`],
+/// abridged past it.
+pub fn read_written(dir: &Path) -> BTreeMap<String, Written> {
+    std::fs::read_dir(dir)
+        .expect("out")
+        .map(|e| {
+            let path = e.expect("entry").path();
+            let name = path
+                .file_name()
+                .expect("name")
+                .to_string_lossy()
+                .into_owned();
+            let bytes = std::fs::read(&path).expect("read");
+            let file = if bytes.len() > KEPT_WHOLE_LIMIT {
+                Written::Abridged(abridged(std::str::from_utf8(&bytes).expect("utf-8")))
+            } else {
+                Written::Whole(bytes)
+            };
+            (name, file)
+        })
+        .collect()
 }

@@ -1,8 +1,6 @@
 //! Every example checks clean (no errors, no warnings) and builds.
 
-use crate::common;
-
-use crate::common::{abridged, buildable_examples, examples, lensc, root, surface_names, text};
+use crate::common::{Written, built_examples, examples, lensc, root, surface_names, text};
 
 #[test]
 fn every_example_checks_clean() {
@@ -32,35 +30,16 @@ fn every_example_checks_clean() {
 /// validate against the committed schema, `docs/report.schema.json`.
 #[test]
 fn example_programs_match_their_snapshots() {
-    let dir = tempfile::tempdir().expect("tmp");
-    for ex in buildable_examples() {
-        let rel = ex
-            .strip_prefix(root())
-            .expect("inside repo")
-            .to_str()
-            .expect("utf8")
-            .to_string();
-        let out = lensc(
-            &root(),
-            &["build", &rel, "--out", dir.path().to_str().expect("utf8")],
-        );
-        assert_eq!(out.status.code(), Some(0), "{rel}: {}", text(&out.stderr));
-    }
-    reports_follow_the_schema(dir.path());
-    let mut programs: Vec<_> = std::fs::read_dir(dir.path())
-        .expect("out")
-        .map(|e| e.expect("e").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "ngc"))
+    reports_follow_the_schema();
+    let mut programs: Vec<(&String, &Written)> = built_examples()
+        .iter()
+        .flat_map(|b| &b.files)
+        .filter(|(name, _)| name.ends_with(".ngc"))
         .collect();
-    programs.sort();
-    for p in programs {
-        let name = p.file_name().expect("name").to_string_lossy().to_string();
-        let program = std::fs::read_to_string(&p).expect("program");
-        let program = if program.len() > common::WHOLE_SNAPSHOT_LIMIT {
-            abridged(&program)
-        } else {
-            program
-        };
+    programs.sort_by_key(|(name, _)| *name);
+    assert!(programs.len() >= 20, "{} programs", programs.len());
+    for (name, file) in programs {
+        let (name, program) = (name.clone(), file.snapshot());
         insta::with_settings!({ snapshot_path => "../snapshots/programs", prepend_module_to_snapshot => false, omit_expression => true }, {
             insta::assert_snapshot!(name, program);
         });
@@ -68,7 +47,7 @@ fn example_programs_match_their_snapshots() {
 }
 
 /// Validates every `*.report.json` in `dir` against the committed schema.
-fn reports_follow_the_schema(dir: &std::path::Path) {
+fn reports_follow_the_schema() {
     let schema_path = root().join("docs/report.schema.json");
     let schema: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&schema_path).expect("schema"))
@@ -82,16 +61,15 @@ fn reports_follow_the_schema(dir: &std::path::Path) {
         .compile("report.schema.json", &mut schemas)
         .unwrap_or_else(|e| panic!("the report schema compiles: {e}"));
     let mut checked = 0;
-    for entry in std::fs::read_dir(dir).expect("out") {
-        let path = entry.expect("entry").path();
-        if !path.to_string_lossy().ends_with(".report.json") {
-            continue;
-        }
+    let reports = built_examples()
+        .iter()
+        .flat_map(|b| &b.files)
+        .filter(|(name, _)| name.ends_with(".report.json"));
+    for (name, file) in reports {
         let report: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(&path).expect("report"))
-                .expect("a report is JSON");
+            serde_json::from_str(&file.snapshot()).expect("a report is JSON");
         if let Err(e) = schemas.validate(&report, index) {
-            panic!("{} does not follow the schema: {e:#}", path.display());
+            panic!("{name} does not follow the schema: {e:#}");
         }
         // The schema bites: a report with a key it does not document, or
         // without one it requires, fails.

@@ -7,7 +7,7 @@
 use std::path::Path;
 use std::process::Command;
 
-use crate::common::{buildable_examples, lensc, root, text};
+use crate::common::{Written, built, built_examples, lensc, root, text};
 
 fn rs274() -> Command {
     assert!(
@@ -124,32 +124,33 @@ fn kim_centre_z_at(x: f64) -> f64 {
     kim_centre(0.5 * (lo + hi)).1
 }
 
+/// The seed 001 convex lens's turning program, from the one build of the
+/// examples.
+fn kim_convex_program() -> String {
+    match &built("examples/kim2008_convex_asphere.lens").files["kim_convex.ngc"] {
+        Written::Whole(bytes) => text(bytes),
+        Written::Abridged(_) => unreachable!("a program of kilobytes"),
+    }
+}
+
 #[test]
 fn every_example_program_passes_rs274() {
     let dir = tempfile::tempdir().expect("tmp");
-    for ex in buildable_examples() {
-        let out = lensc(
-            &root(),
-            &[
-                "build",
-                ex.to_str().expect("utf8"),
-                "--out",
-                dir.path().to_str().expect("utf8"),
-            ],
-        );
-        assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
-    }
     let mut n = 0;
-    for entry in std::fs::read_dir(dir.path()).expect("out") {
-        let p = entry.expect("entry").path();
-        // rs274 takes about 15 µs a line: the fast-tool-servo example's six
-        // million are left to `fts_program_passes_rs274`, on a smaller array.
-        let big = std::fs::metadata(&p).is_ok_and(|m| m.len() > 8 << 20);
-        if p.extension().is_some_and(|e| e == "ngc") && !big {
+    for (name, file) in built_examples().iter().flat_map(|b| &b.files) {
+        // rs274 takes about 15 µs a line: the programs of millions of
+        // points, not kept whole, are left to `fts_program_passes_rs274` and
+        // `roller_program_passes_rs274`, on smaller jobs.
+        let Written::Whole(bytes) = file else {
+            continue;
+        };
+        let p = dir.path().join(name);
+        if p.extension().is_some_and(|e| e == "ngc") {
+            std::fs::write(&p, bytes).expect("write program");
             let canon = interpret(&p);
             assert!(!feeds(&canon).is_empty(), "{} cuts nothing", p.display());
             // Blending is on and held to the tolerance the program states.
-            let program = std::fs::read_to_string(&p).expect("program");
+            let program = text(bytes);
             let stated: f64 = program
                 .lines()
                 .find_map(|l| l.split_once("G64 P"))
@@ -176,17 +177,8 @@ fn every_example_program_passes_rs274() {
 #[test]
 fn canonical_moves_lie_on_the_offset_curve() {
     let dir = tempfile::tempdir().expect("tmp");
-    let out = lensc(
-        &root(),
-        &[
-            "build",
-            "examples/kim2008_convex_asphere.lens",
-            "--out",
-            dir.path().to_str().expect("utf8"),
-        ],
-    );
-    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     let program = dir.path().join("kim_convex.ngc");
+    std::fs::write(&program, kim_convex_program()).expect("write program");
     let canon = interpret(&program);
     assert!(canon.contains("ARC_FEED("), "no arcs");
     let moves = cut_points_xz(&canon);
@@ -218,18 +210,7 @@ fn program_path_stays_within_the_path_tolerance() {
     // read back from their G2/G3 words and I K centres), must lie within
     // the strategy's 10 nm path tolerance of the exact wheel-centre curve,
     // plus rounding.
-    let dir = tempfile::tempdir().expect("tmp");
-    let out = lensc(
-        &root(),
-        &[
-            "build",
-            "examples/kim2008_convex_asphere.lens",
-            "--out",
-            dir.path().to_str().expect("utf8"),
-        ],
-    );
-    assert_eq!(out.status.code(), Some(0));
-    let program = std::fs::read_to_string(dir.path().join("kim_convex.ngc")).expect("program");
+    let program = kim_convex_program();
     let (mut x, mut z) = (f64::NAN, f64::NAN);
     let mut motion = "";
     // (start, end, arc centre and direction if an arc) of each cutting move.

@@ -1,21 +1,14 @@
 //! Toolpath figures reproduced from the seed papers, end to end through
-//! `lensc build`: each test builds an example and reads its report.
+//! `lensc build`: each test reads an example's report from its one build
+//! (`common::built_examples`).
 
-use crate::common::{lensc, root, text};
+use crate::common::{built, lensc, root, text};
 
-/// Builds `example` into a temporary directory; the report of `job` and
-/// the diagnostics printed.
+/// The report of `job` from the one build of `example`, and the
+/// diagnostics lensc printed.
 fn build(example: &str, job: &str) -> (serde_json::Value, String) {
-    let dir = tempfile::tempdir().expect("tmp");
-    let out_dir = dir.path().to_str().expect("utf-8 path");
-    let out = lensc(&root(), &["build", example, "--out", out_dir]);
-    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
-    let report =
-        std::fs::read_to_string(dir.path().join(format!("{job}.report.json"))).expect("report");
-    (
-        serde_json::from_str(&report).expect("json"),
-        text(&out.stderr),
-    )
+    let built = built(example);
+    (built.report(job), built.stderr.clone())
 }
 
 #[test]

@@ -2,31 +2,11 @@
 //! optimisation, rounded to the machine's resolution), against the
 //! design: issue #6's figures, read from the build reports.
 
-use crate::common::{lensc, root, text};
+use crate::common::{built, lensc, text};
 
-/// Builds `example` and returns every report it wrote.
+/// Every report of `example`, from its one build.
 fn reports(example: &str) -> Vec<serde_json::Value> {
-    let dir = tempfile::tempdir().expect("tmp");
-    let out = lensc(
-        &root(),
-        &[
-            "build",
-            example,
-            "--out",
-            dir.path().to_str().expect("utf8"),
-        ],
-    );
-    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
-    let mut found: Vec<_> = std::fs::read_dir(dir.path())
-        .expect("out")
-        .map(|e| e.expect("entry").path())
-        .filter(|p| p.to_string_lossy().ends_with(".report.json"))
-        .collect();
-    found.sort();
-    found
-        .iter()
-        .map(|p| serde_json::from_str(&std::fs::read_to_string(p).expect("report")).expect("json"))
-        .collect()
+    built(example).reports()
 }
 
 #[test]

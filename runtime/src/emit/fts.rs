@@ -1,9 +1,9 @@
 //! Spirals (fast and slow tool servo): planned points to a program, and
 //! to a servo table where the controller takes one.
 
+use crate::dialect::Dialect;
 use crate::moves::{self, Position};
 use crate::plan::optimise::{self};
-use crate::post::dialect::Dialect;
 use crate::post::format::push_fixed;
 use crate::post::{ProgramError, ProgramWriter};
 use std::f64::consts::PI;

@@ -1,7 +1,7 @@
 //! Profile grinding: the wheel-centre path to a lathe program.
 
+use crate::dialect::Dialect;
 use crate::moves::{self, Position};
-use crate::post::dialect::Dialect;
 use crate::post::{ProgramError, ProgramWriter, Setup};
 
 /// The move stream of a grinding pass: the wheel centre's X and Z, each

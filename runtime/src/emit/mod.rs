@@ -8,9 +8,9 @@ pub mod raster;
 pub mod roller;
 pub mod turning;
 
+use crate::dialect::Dialect;
 use crate::moves;
 use crate::plan::optimise;
-use crate::post::dialect::Dialect;
 use crate::post::header::num;
 use crate::post::{ProgramError, ProgramWriter, Setup};
 

@@ -1,8 +1,8 @@
 //! Rasters: a milling path to the move stream and a mill program.
 
+use crate::dialect::Dialect;
 use crate::moves::{self, Position};
 use crate::plan::optimise::{self};
-use crate::post::dialect::Dialect;
 use crate::post::{ProgramError, ProgramWriter, Setup};
 
 /// The move stream of a raster: each pass reached by rapids at the safe

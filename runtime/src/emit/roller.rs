@@ -1,7 +1,7 @@
 //! Roller helix turning: planned passes to a program.
 
+use crate::dialect::Dialect;
 use crate::moves::{self, Position};
-use crate::post::dialect::Dialect;
 use crate::post::{ProgramError, ProgramWriter};
 use std::f64::consts::PI;
 

@@ -3,7 +3,7 @@
 pub mod servo;
 pub mod tool;
 
-use crate::post::dialect::Dialect;
+use crate::dialect::Dialect;
 
 /// A 2-axis (X radius, Z along the spindle) turning machine.
 #[derive(Clone, Debug, PartialEq)]

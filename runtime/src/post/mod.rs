@@ -4,12 +4,11 @@
 //! them); a program with a value that cannot be written is refused whole.
 //! It knows nothing of planners: each strategy's adapter lives in `emit/`.
 
-pub mod dialect;
 pub mod format;
 pub mod header;
 pub mod writer;
 
-pub use dialect::{CommentStyle, Dialect};
+pub use crate::dialect::{CommentStyle, Dialect};
 pub use header::Provenance;
 pub use writer::{ProgramWriter, Setup, check_dialect, check_numbers};
 

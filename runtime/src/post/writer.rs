@@ -2,9 +2,9 @@
 //! word, with every number through the one fixed-point formatter.
 
 use super::ProgramError;
-use super::dialect::{CommentStyle, Dialect};
 use super::format::{decimals_for, fixed_units, push_fixed, push_units_to};
 use super::header::{num, write_comment};
+use crate::dialect::{CommentStyle, Dialect};
 use crate::moves::{Plane, Position};
 use std::f64::consts::PI;
 
