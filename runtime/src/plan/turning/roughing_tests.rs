@@ -3,7 +3,7 @@
 use super::*;
 use crate::machine::Lathe;
 use crate::machine::tool::RoundNoseTool;
-use crate::post::Dialect;
+use crate::dialect::Dialect;
 use crate::surface::{RotationalSurface, Sense, SurfaceInfo};
 
 fn job(roughing: Roughing) -> (TurningJob, RotationalSurface) {
