@@ -1,9 +1,9 @@
 //! Tests of roughing passes before the finishing pass.
 
 use super::*;
+use crate::dialect::Dialect;
 use crate::machine::Lathe;
 use crate::machine::tool::RoundNoseTool;
-use crate::dialect::Dialect;
 use crate::surface::{RotationalSurface, Sense, SurfaceInfo};
 
 fn job(roughing: Roughing) -> (TurningJob, RotationalSurface) {
