@@ -1,0 +1,172 @@
+//! One input through the compiler as `lensc check` and `lensc build` take
+//! it — check, render, lower, plan and emit, write — with the fuzzer's
+//! invariant checked at each step: every diagnostic has a code and a
+//! span inside its file. Panics are not caught here (`supervise` does).
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use lensc_build::driver;
+use lensc_grammar::Diagnostic;
+use lensc_lang::loader::FileSystem;
+use lensc_lang::source::SourceMap;
+
+/// How far an input went.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Reached {
+    /// It checked with no error.
+    pub clean: bool,
+    /// Jobs lowered to typed jobs (or rejected with coded diagnostics).
+    pub lowered: usize,
+    /// Jobs built (planned, emitted, simulated) and their files written.
+    pub built: usize,
+    pub written: usize,
+}
+
+/// What is wrong with an input's handling, beyond a panic.
+pub type Fault = String;
+
+/// An in-memory file system for `use "…"`: a few named files (the
+/// bad-input corpus's imports and a small part library); every other path
+/// is missing. The fuzzer never reads the disk on an input's behalf.
+pub struct MemFs {
+    files: HashMap<String, Vec<u8>>,
+}
+
+impl MemFs {
+    pub fn new(extra: &[(String, Vec<u8>)]) -> MemFs {
+        let mut files: HashMap<String, Vec<u8>> = extra.iter().cloned().collect();
+        files.insert(
+            "part.lens".into(),
+            b"surface part_surface = sphere { radius: 20 mm, sense: convex, aperture: circle(radius: 1 mm) }\nlet part_pitch = 0.5 mm\n".to_vec(),
+        );
+        files.insert("self.lens".into(), b"use \"self.lens\"\n".to_vec());
+        MemFs { files }
+    }
+}
+
+impl FileSystem for MemFs {
+    fn read(&self, path: &Path) -> std::io::Result<Vec<u8>> {
+        let name = path.file_name().map(|n| n.to_string_lossy().into_owned());
+        name.and_then(|n| self.files.get(&n).cloned())
+            .ok_or_else(|| std::io::Error::from(std::io::ErrorKind::NotFound))
+    }
+    fn canonical(&self, path: &Path) -> PathBuf {
+        path.to_path_buf()
+    }
+}
+
+/// What to do with an input beyond checking it.
+#[derive(Clone, Copy, Debug)]
+pub enum Depth {
+    /// Check and render.
+    Check,
+    /// Also lower every job of a clean file.
+    Lower,
+    /// Also build every job of a clean file and write its files.
+    Build,
+}
+
+/// Runs `bytes` as far as `depth` asks (and the checker lets it).
+pub fn run(fs: &MemFs, bytes: &[u8], depth: Depth, out_dir: &Path) -> Result<Reached, Fault> {
+    let c = driver::check_text(fs, "fuzz.lens", bytes);
+    let sources = &c.loaded.sources;
+    well_formed(c.diags(), sources)?;
+    render(c.diags(), sources)?;
+    let mut reached = Reached {
+        clean: !c.has_errors(),
+        ..Reached::default()
+    };
+    if !reached.clean {
+        return Ok(reached);
+    }
+    match depth {
+        Depth::Check => {}
+        Depth::Lower => {
+            for job in &c.checked.jobs {
+                if let Err(diags) = lensc_build::pipeline::lower(job, None) {
+                    well_formed(&diags, sources)?;
+                    render(&diags, sources)?;
+                }
+                reached.lowered += 1;
+            }
+        }
+        Depth::Build => {
+            let (built, diags) =
+                driver::plan_and_emit(&c, driver::Request::default(), "fuzz.lens", Some(out_dir));
+            well_formed(&diags, sources)?;
+            render(&diags, sources)?;
+            reached.lowered = c.checked.jobs.len();
+            reached.built = built.len();
+            for b in built {
+                write(b, out_dir).map_err(|e| format!("cannot write a built job: {e}"))?;
+                reached.written += 1;
+            }
+            clear(out_dir);
+        }
+    }
+    Ok(reached)
+}
+
+/// The invariant: every diagnostic has a code and a primary span lying in
+/// its file, on character boundaries.
+fn well_formed(diags: &[Diagnostic], sources: &SourceMap) -> Result<(), Fault> {
+    let files = sources.iter().count();
+    for d in diags {
+        let what = || format!("{} {:?}: {}", d.code, d.severity, d.message);
+        if d.code.is_empty() {
+            return Err(format!("uncoded diagnostic: {}", what()));
+        }
+        if d.message.is_empty() {
+            return Err(format!("diagnostic without a message: {}", what()));
+        }
+        if d.labels.is_empty() {
+            return Err(format!("diagnostic without a span: {}", what()));
+        }
+        for l in &d.labels {
+            if l.file.0 as usize >= files {
+                return Err(format!("span in no loaded file: {}", what()));
+            }
+            let text = &sources.get(l.file).text;
+            let (s, e) = (l.span.start as usize, l.span.end as usize);
+            if s > e || e > text.len() || !text.is_char_boundary(s) || !text.is_char_boundary(e) {
+                return Err(format!(
+                    "span {s}..{e} outside its file of {} bytes: {}",
+                    text.len(),
+                    what()
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Both renderers take every diagnostic.
+fn render(diags: &[Diagnostic], sources: &SourceMap) -> Result<(), Fault> {
+    if diags.is_empty() {
+        return Ok(());
+    }
+    let mut sink = Vec::new();
+    lensc::render::human(diags, sources, false, &mut sink)
+        .and_then(|()| lensc::render::json_lines(diags, sources, &mut sink))
+        .map_err(|e| format!("rendering failed: {e}"))
+}
+
+/// Writes a built job's files as `lensc build` does: report, the files
+/// beside the program, the program.
+fn write(b: driver::Built, dir: &Path) -> std::io::Result<()> {
+    driver::write_atomic(&dir.join(&b.report_name), &b.report.to_json_text())?;
+    for (name, text) in b.beside {
+        text.write_to(&dir.join(name))?;
+    }
+    b.program.write_to(&dir.join(&b.program_name))
+}
+
+/// Empties the output directory between builds.
+fn clear(dir: &Path) {
+    if let Ok(entries) = std::fs::read_dir(dir) {
+        for e in entries.flatten() {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
