@@ -13,14 +13,38 @@ use crate::rng::Rng;
 /// One file with one small job.
 pub fn file(rng: &mut Rng) -> String {
     let mut out = String::new();
-    match rng.below(6) {
+    match rng.below(7) {
         0 | 1 => turning(rng, &mut out),
         2 => grinding(rng, &mut out),
         3 => raster(rng, &mut out),
         4 => spiral(rng, &mut out),
-        _ => fts(rng, &mut out),
+        5 => fts(rng, &mut out),
+        _ => roller(rng, &mut out),
+    }
+    // Now and then one number of the file, whatever it sizes, becomes an
+    // extreme: the build must refuse it with a coded diagnostic or finish.
+    if rng.chance(0.03) {
+        out = extreme_somewhere(rng, &out);
     }
     out
+}
+
+/// `text` with one of its numbers replaced by an extreme.
+fn extreme_somewhere(rng: &mut Rng, text: &str) -> String {
+    let starts: Vec<usize> = text
+        .char_indices()
+        .filter(|&(i, c)| c.is_ascii_digit() && !text[..i].ends_with(|p: char| p.is_ascii_alphanumeric() || p == '.'))
+        .map(|(i, _)| i)
+        .collect();
+    if starts.is_empty() {
+        return text.to_string();
+    }
+    let at = *rng.pick(&starts);
+    let end = text[at..]
+        .find(|c: char| !(c.is_ascii_digit() || c == '.' || c == 'e' || c == '-'))
+        .map_or(text.len(), |n| at + n);
+    let new = rng.pick(&["0", "1e-300", "1e300", "5e-324", "1e-9", "100000", "0.000001"]);
+    format!("{}{new}{}", &text[..at], &text[end..])
 }
 
 /// A length in mm written with a random unit.
@@ -174,7 +198,11 @@ fn grinding(rng: &mut Rng, out: &mut String) {
 
 fn raster(rng: &mut Rng, out: &mut String) {
     let r = rng.log_uniform(0.03, 0.4);
-    rotational(rng, out, r);
+    if rng.chance(0.5) {
+        rotational(rng, out, r);
+    } else {
+        any_shape(rng, out, r);
+    }
     let _ = writeln!(out, "use std::machines::generic_3axis_mill");
     let _ = writeln!(
         out,
@@ -196,10 +224,70 @@ fn raster(rng: &mut Rng, out: &mut String) {
     );
 }
 
+/// A surface of any shape `s` over a circle of radius `r` mm.
+fn any_shape(rng: &mut Rng, out: &mut String, r: f64) {
+    let aperture = format!("circle(radius: {})", length(rng, r));
+    let _ = match rng.below(5) {
+        0 => writeln!(
+            out,
+            "surface s = toroid {{ radius: {}, rotation_radius: {}, sense: {}, aperture: {aperture} }}",
+            random_length(rng, 2.0, 100.0),
+            random_length(rng, 2.0, 100.0),
+            sense(rng)
+        ),
+        1 => writeln!(
+            out,
+            "surface s = xy_polynomial {{ X2Y0: {} mm^-1, X0Y2: {} mm^-1, X1Y1: {} mm^-1, aperture: {aperture} }}",
+            free_number(rng, -0.05, 0.05),
+            free_number(rng, -0.05, 0.05),
+            free_number(rng, -0.05, 0.05)
+        ),
+        2 => writeln!(
+            out,
+            "surface s = zernike {{ ordering: {}, norm_radius: {}, Z4: {} um, Z5: {} um, Z11: {} um, aperture: {aperture} }}",
+            ["fringe", "ansi"][rng.below(2)],
+            length(rng, r),
+            free_number(rng, -2.0, 2.0),
+            free_number(rng, -2.0, 2.0),
+            free_number(rng, -2.0, 2.0)
+        ),
+        3 => {
+            let _ = writeln!(
+                out,
+                "surface parent = conic {{ radius: {}, conic: -1, sense: concave, aperture: circle(radius: {}) }}",
+                random_length(rng, 20.0, 200.0),
+                length(rng, 4.0 * r + 1.0)
+            );
+            let x = 2.0 * r * rng.unit();
+            writeln!(
+                out,
+                "surface s = off_axis(parent, x: {}, y: 0 mm, aperture: {aperture})",
+                length(rng, x)
+            )
+        }
+        _ => {
+            let _ = writeln!(
+                out,
+                "surface flat = sphere {{ radius: {}, sense: convex, aperture: circle(radius: {}) }}",
+                random_length(rng, 5.0, 100.0),
+                length(rng, 2.0 * r)
+            );
+            writeln!(
+                out,
+                "surface s = tilt(flat, about: {}, angle: {} deg, aperture: {aperture})",
+                ["x", "y"][rng.below(2)],
+                free_number(rng, -10.0, 10.0)
+            )
+        }
+    };
+}
+
 fn spiral(rng: &mut Rng, out: &mut String) {
     let r = rng.log_uniform(0.05, 0.6);
-    if rng.chance(0.7) {
+    if rng.chance(0.4) {
         rotational(rng, out, r);
+    } else if rng.chance(0.6) {
+        any_shape(rng, out, r);
     } else {
         let _ = writeln!(
             out,
@@ -264,4 +352,41 @@ fn fts(rng: &mut Rng, out: &mut String) {
         out,
         "job j {{ surface: s, tool: diamond_r496um, machine: nanoform_x_fts5000, strategy: st }}"
     );
+}
+
+fn roller(rng: &mut Rng, out: &mut String) {
+    let radius = rng.log_uniform(1.0, 10.0);
+    let width = rng.log_uniform(0.3, 2.0);
+    let _ = writeln!(
+        out,
+        "surface pattern = freeform {{ z(x, y) = {} * sin(5 rad/mm * x) - 0.04 mm, domain: rect(x: 0 mm .. {}, y: 0 mm .. {}) }}",
+        ["0.02 mm", "0.01 mm", "1 um", "0 mm"][rng.below(4)],
+        length(rng, width),
+        length(rng, std::f64::consts::TAU * radius)
+    );
+    let _ = writeln!(out, "surface s = wrap(pattern, onto: roller(radius: {}))", length(rng, radius));
+    let _ = writeln!(out, "use std::machines::moore_nanotech_450fg");
+    let _ = writeln!(
+        out,
+        "tool t = round_nose {{ nose_radius: {}, clearance: 12.5 deg, included_angle: {} deg }}",
+        random_length(rng, 0.05, 2.0),
+        free_number(rng, 40.0, 120.0)
+    );
+    let rough = if rng.chance(0.5) {
+        format!(
+            "rough: {{ c_step: {} deg, pitch: {}, finish_allowance: {} }}, ",
+            rng.log_uniform(1.0, 5.0),
+            random_length(rng, 0.1, 0.5),
+            random_length(rng, 0.001, 0.02)
+        )
+    } else {
+        String::new()
+    };
+    let _ = writeln!(
+        out,
+        "strategy st = roller_helix {{ {rough}finish: {{ c_step: {} deg, pitch: {} }}, spindle_speed: 60 rpm }}",
+        rng.log_uniform(0.5, 5.0),
+        random_length(rng, 0.05, 0.3)
+    );
+    let _ = writeln!(out, "job j {{ surface: s, tool: t, machine: moore_nanotech_450fg, strategy: st }}");
 }
