@@ -170,3 +170,52 @@ fn clear(dir: &Path) {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lensc_grammar::{FileId, Span};
+
+    fn sources() -> SourceMap {
+        driver::check_text(&MemFs::new(&[]), "t.lens", b"let a = 1 mm\n")
+            .loaded
+            .sources
+    }
+
+    #[test]
+    fn a_diagnostic_without_a_code_or_outside_its_file_is_a_fault() {
+        let s = sources();
+        let ok = Diagnostic::error("E0001", "fine", FileId(0), Span { start: 0, end: 3 });
+        assert!(well_formed(std::slice::from_ref(&ok), &s).is_ok());
+        let uncoded = Diagnostic::error("", "no code", FileId(0), Span { start: 0, end: 3 });
+        assert!(well_formed(&[uncoded], &s).is_err());
+        let outside = Diagnostic::error(
+            "E0001",
+            "past the end",
+            FileId(0),
+            Span { start: 0, end: 99 },
+        );
+        assert!(well_formed(&[outside], &s).is_err());
+        let mut unspanned = ok.clone();
+        unspanned.labels.clear();
+        assert!(well_formed(&[unspanned], &s).is_err());
+    }
+
+    #[test]
+    fn a_small_job_is_checked_built_and_written() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let text = b"surface s = sphere { radius: 20 mm, sense: convex, aperture: circle(radius: 0.2 mm) }\n\
+            use std::machines::linuxcnc_lathe\n\
+            tool t = round_nose { nose_radius: 0.5 mm, clearance: 7 deg }\n\
+            strategy st = profile_turning { feed: 20 um/rev, spindle_speed: 1000 rpm, chord_tolerance: 1 um }\n\
+            job j { surface: s, tool: t, machine: linuxcnc_lathe, strategy: st }\n";
+        let r = run(&MemFs::new(&[]), text, Depth::Build, dir.path()).expect("no fault");
+        assert!(r.clean);
+        assert_eq!((r.built, r.written), (1, 1));
+        assert_eq!(
+            std::fs::read_dir(dir.path()).expect("dir").count(),
+            0,
+            "the directory is emptied"
+        );
+    }
+}

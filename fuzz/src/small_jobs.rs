@@ -33,7 +33,10 @@ pub fn file(rng: &mut Rng) -> String {
 fn extreme_somewhere(rng: &mut Rng, text: &str) -> String {
     let starts: Vec<usize> = text
         .char_indices()
-        .filter(|&(i, c)| c.is_ascii_digit() && !text[..i].ends_with(|p: char| p.is_ascii_alphanumeric() || p == '.'))
+        .filter(|&(i, c)| {
+            c.is_ascii_digit()
+                && !text[..i].ends_with(|p: char| p.is_ascii_alphanumeric() || p == '.')
+        })
         .map(|(i, _)| i)
         .collect();
     if starts.is_empty() {
@@ -43,7 +46,9 @@ fn extreme_somewhere(rng: &mut Rng, text: &str) -> String {
     let end = text[at..]
         .find(|c: char| !(c.is_ascii_digit() || c == '.' || c == 'e' || c == '-'))
         .map_or(text.len(), |n| at + n);
-    let new = rng.pick(&["0", "1e-300", "1e300", "5e-324", "1e-9", "100000", "0.000001"]);
+    let new = rng.pick(&[
+        "0", "1e-300", "1e300", "5e-324", "1e-9", "100000", "0.000001",
+    ]);
     format!("{}{new}{}", &text[..at], &text[end..])
 }
 
@@ -364,7 +369,11 @@ fn roller(rng: &mut Rng, out: &mut String) {
         length(rng, width),
         length(rng, std::f64::consts::TAU * radius)
     );
-    let _ = writeln!(out, "surface s = wrap(pattern, onto: roller(radius: {}))", length(rng, radius));
+    let _ = writeln!(
+        out,
+        "surface s = wrap(pattern, onto: roller(radius: {}))",
+        length(rng, radius)
+    );
     let _ = writeln!(out, "use std::machines::moore_nanotech_450fg");
     let _ = writeln!(
         out,
@@ -388,5 +397,8 @@ fn roller(rng: &mut Rng, out: &mut String) {
         rng.log_uniform(0.5, 5.0),
         random_length(rng, 0.05, 0.3)
     );
-    let _ = writeln!(out, "job j {{ surface: s, tool: t, machine: moore_nanotech_450fg, strategy: st }}");
+    let _ = writeln!(
+        out,
+        "job j {{ surface: s, tool: t, machine: moore_nanotech_450fg, strategy: st }}"
+    );
 }

@@ -28,6 +28,10 @@ pub enum Outcome {
     Hung,
 }
 
+/// What a worker does with an input: `harness::run`, or a stand-in in
+/// the tests.
+pub type Runner = fn(&MemFs, &[u8], Depth, &std::path::Path) -> Result<Reached, Fault>;
+
 struct Job {
     bytes: Vec<u8>,
     depth: Depth,
@@ -46,6 +50,7 @@ pub struct Supervisor {
     out_dir: PathBuf,
     timeout: Duration,
     worker: Option<Worker>,
+    runner: Runner,
 }
 
 thread_local! {
@@ -85,6 +90,7 @@ impl Supervisor {
             out_dir,
             timeout,
             worker: None,
+            runner: harness::run,
         }
     }
 
@@ -120,6 +126,7 @@ impl Supervisor {
         let (answer_tx, answers) = channel();
         let fs = Arc::clone(&self.fs);
         let dir = self.out_dir.clone();
+        let runner = self.runner;
         std::thread::Builder::new()
             .name(format!(
                 "{WORKER_PREFIX}{} inputs {from}..{until}",
@@ -129,7 +136,7 @@ impl Supervisor {
             .spawn(move || {
                 for job in job_rx {
                     let result = catch_unwind(AssertUnwindSafe(|| {
-                        harness::run(&fs, &job.bytes, job.depth, &dir)
+                        runner(&fs, &job.bytes, job.depth, &dir)
                     }));
                     let outcome = match result {
                         Ok(r) => Outcome::Done(r),
@@ -150,5 +157,62 @@ impl Supervisor {
             answers,
             until,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn supervisor(runner: Runner, timeout: Duration) -> Supervisor {
+        install_panic_hook();
+        let mut s = Supervisor::new(1, Arc::new(MemFs::new(&[])), std::env::temp_dir(), timeout);
+        s.runner = runner;
+        s
+    }
+
+    fn boom(_: &MemFs, bytes: &[u8], _: Depth, _: &std::path::Path) -> Result<Reached, Fault> {
+        if bytes == b"boom" {
+            panic!("boom went the checker");
+        }
+        Ok(Reached::default())
+    }
+
+    fn stuck(_: &MemFs, bytes: &[u8], _: Depth, _: &std::path::Path) -> Result<Reached, Fault> {
+        if bytes == b"stuck" {
+            std::thread::sleep(Duration::from_secs(5));
+        }
+        Ok(Reached::default())
+    }
+
+    #[test]
+    fn a_panic_is_caught_with_its_message_and_the_next_input_runs() {
+        let mut s = supervisor(boom, Duration::from_secs(10));
+        match s.run(0, b"boom".to_vec(), Depth::Check) {
+            Outcome::Panicked(m) => {
+                assert!(
+                    m.contains("boom went the checker") && m.contains("supervise.rs"),
+                    "{m}"
+                )
+            }
+            _ => panic!("the panic was not caught"),
+        }
+        assert!(matches!(
+            s.run(1, b"fine".to_vec(), Depth::Check),
+            Outcome::Done(Ok(_))
+        ));
+    }
+
+    #[test]
+    fn an_input_over_the_timeout_is_a_hang_and_a_new_worker_takes_over() {
+        let mut s = supervisor(stuck, Duration::from_millis(200));
+        assert!(matches!(
+            s.run(0, b"stuck".to_vec(), Depth::Check),
+            Outcome::Hung
+        ));
+        assert!(matches!(
+            s.run(1, b"fine".to_vec(), Depth::Check),
+            Outcome::Done(Ok(_))
+        ));
     }
 }
