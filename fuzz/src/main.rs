@@ -69,7 +69,9 @@ enum Source {
 /// Makes input `index` of the run seeded `seed`.
 fn input(seed: u64, index: u64, build_every: u64, corpus: &Corpus) -> (Source, Vec<u8>, Depth) {
     let mut rng = Rng::for_input(seed, index);
-    if build_every > 0 && index.is_multiple_of(build_every) {
+    // Drawn, not `index % K`: lanes take every J-th index, and a tier on a
+    // fixed stride would fall to one lane.
+    if build_every > 0 && rng.below(build_every as usize) == 0 {
         return (
             Source::SmallJob,
             small_jobs::file(&mut rng).into_bytes(),
@@ -77,7 +79,7 @@ fn input(seed: u64, index: u64, build_every: u64, corpus: &Corpus) -> (Source, V
         );
     }
     // Lowering JIT-compiles every surface: one clean input in eight.
-    let depth = if index % 8 == 1 {
+    let depth = if rng.below(8) == 0 {
         Depth::Lower
     } else {
         Depth::Check
@@ -102,6 +104,7 @@ struct Counts {
     build_inputs: u64,
     built: u64,
     written: u64,
+    unwritten: u64,
     panics: u64,
     hangs: u64,
     uncoded: u64,
@@ -256,7 +259,9 @@ impl Run<'_> {
         };
         if n <= 3 {
             let saved = save(&self.crashes, what, self.seed, index, bytes, message);
-            eprintln!(
+            // Not `eprintln!`, which panics if stderr cannot be written.
+            let _ = writeln!(
+                std::io::stderr(),
                 "fuzz: {what} on input {index} ({source:?}): {message}\n      saved as {saved}"
             );
         }
@@ -279,6 +284,7 @@ impl Counts {
                 self.lowered += r.lowered as u64;
                 self.built += r.built as u64;
                 self.written += r.written as u64;
+                self.unwritten += r.unwritten as u64;
                 if matches!(depth, Depth::Build) {
                     self.build_inputs += 1;
                     self.build_time += took;
@@ -313,6 +319,7 @@ impl Counts {
         self.build_inputs += o.build_inputs;
         self.built += o.built;
         self.written += o.written;
+        self.unwritten += o.unwritten;
         self.panics += o.panics;
         self.hangs += o.hangs;
         self.uncoded += o.uncoded;
@@ -347,6 +354,8 @@ fn save(dir: &Path, what: &str, seed: u64, index: u64, bytes: &[u8], message: &s
     }
 }
 
+/// The run's figures, on stdout (a full disk or a closed pipe loses them
+/// quietly rather than panicking).
 fn summary(c: &Counts, elapsed: Duration, distinct: usize, lanes: u64) {
     let secs = elapsed.as_secs_f64().max(1e-9);
     // Lanes run side by side: their build time is shared out among them.
@@ -355,31 +364,39 @@ fn summary(c: &Counts, elapsed: Duration, distinct: usize, lanes: u64) {
         .max(1e-9);
     let check_only = c.checked.saturating_sub(c.build_inputs);
     let get = |s| c.inputs.get(&s).copied().unwrap_or(0);
-    eprintln!("fuzz: {:.1} s", secs);
-    eprintln!(
-        "  inputs            {} ({} generated, {} mutated, {} small jobs)",
+    let mut out = std::io::stdout().lock();
+    let _ = writeln!(out, "fuzz: {secs:.1} s, {lanes} lane(s)");
+    let _ = writeln!(
+        out,
+        "  inputs            {} ({} generated, {} mutated, {} small jobs), {:.0}/s",
         get(Source::Generated) + get(Source::Mutated) + get(Source::SmallJob),
         get(Source::Generated),
         get(Source::Mutated),
-        get(Source::SmallJob)
+        get(Source::SmallJob),
+        c.checked as f64 / secs
     );
-    eprintln!(
+    let _ = writeln!(
+        out,
         "  through check     {} ({} clean), {:.0} inputs/s outside builds",
         c.checked,
         c.clean,
         check_only as f64 / check_secs
     );
-    eprintln!("  jobs lowered      {}", c.lowered);
-    eprintln!(
-        "  through build     {} jobs built and {} written from {} small-job inputs, {:.1} builds/s while building, slowest {:.2} s, {} over 1 s",
+    let _ = writeln!(out, "  jobs lowered      {}", c.lowered);
+    let _ = writeln!(
+        out,
+        "  through build     {} jobs built and {} written ({} not written: I/O) from {} small-job inputs, {:.2} builds/s over the run, {:.1} builds/s per lane while building, slowest {:.2} s, {} over 1 s",
         c.built,
         c.written,
+        c.unwritten,
         c.build_inputs,
+        c.built as f64 / secs,
         c.built as f64 * lanes as f64 / c.build_time.as_secs_f64().max(1e-9),
         c.slowest_build.as_secs_f64(),
         c.slow_builds
     );
-    eprintln!(
+    let _ = writeln!(
+        out,
         "  panics {}, hangs {}, uncoded rejections {} ({} distinct)",
         c.panics, c.hangs, c.uncoded, distinct
     );
