@@ -43,6 +43,10 @@ struct Cli {
     /// Every K-th input is a small whole job that is built and written.
     #[arg(long, default_value_t = 50)]
     build_every: u64,
+    /// Stop after inputs 0..N of the seed even if time is left (CI runs a
+    /// range of a fixed seed that a longer run has shown clean).
+    #[arg(long, value_name = "N")]
+    inputs: Option<u64>,
     /// Worker threads, each with its own share of the inputs.
     #[arg(long, default_value_t = 1)]
     jobs: u64,
@@ -148,7 +152,10 @@ fn main() -> ExitCode {
             eprintln!("fuzz: --replay takes A or A..B");
             return ExitCode::from(2);
         }
-        None => (0..u64::MAX, Some(Duration::from_secs(cli.seconds))),
+        None => (
+            0..cli.inputs.unwrap_or(u64::MAX),
+            Some(Duration::from_secs(cli.seconds)),
+        ),
     };
     let jobs = if cli.replay.is_some() {
         1
