@@ -5,7 +5,8 @@
 //! variant fails to compile until it has its words; no Rust value is ever
 //! printed with `{:?}`. It lives here, not in lensc-build, because
 //! lowering runs the planners' preconditions (turning's profile checks,
-//! the roller's tool check) and reports their errors as `build` does.
+//! the raster's plane scan and clearance, grinding's station scan, the
+//! roller's tool check) and reports their errors as `build` does.
 
 use crate::check::trim_num;
 use crate::codes;
@@ -246,6 +247,21 @@ fn raster(e: RasterError) -> Coded {
             ),
         )
         .help("use a tool whose radius is below the smallest concave radius of curvature"),
+        RasterError::ClearanceTooSmall {
+            clearance,
+            slope,
+            x,
+            y,
+        } => coded(
+            codes::CLEARANCE_TOO_SMALL,
+            format!(
+                "the clearance angle ({}°) is not above the surface's steepest slope along the cut ({}°, at ({}, {}) mm): the flank would rub",
+                trim_num(clearance.to_degrees()),
+                trim_num(slope.to_degrees()),
+                trim_num(x),
+                trim_num(y)
+            ),
+        ),
         RasterError::Undefined { x, y } | RasterError::NoContact { x, y } => coded(
             codes::UNDEFINED_ON_PATH,
             format!(

@@ -264,9 +264,12 @@ pub fn lower_job(
             spiral::lower(&p, d, evaluate).map(JobSpec::Spiral),
             Setup::Lathe,
         ),
-        "raster" => (mill::lower_raster(&p, d).map(JobSpec::Raster), Setup::Mill),
+        "raster" => (
+            mill::lower_raster(&p, d, evaluate).map(JobSpec::Raster),
+            Setup::Mill,
+        ),
         "profile_grinding" => (
-            mill::lower_grinding(&p, d).map(JobSpec::Grinding),
+            mill::lower_grinding(&p, d, evaluate).map(JobSpec::Grinding),
             Setup::Lathe,
         ),
         "roller_helix" => (
