@@ -12,7 +12,7 @@ use lensc_runtime::post::Provenance;
 use lensc_runtime::verify::heightmap::Sweep;
 
 use crate::evaluate::evaluator;
-use crate::height_map::{self, Window, domain_centre};
+use crate::height_map::{self, domain_centre};
 use crate::output::{Built, ProgramText};
 use crate::parts;
 use crate::report;
@@ -85,9 +85,8 @@ pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnost
     let simulation = match tool {
         RasterTool::Knife { nose_radius } => {
             let along_x = raster.along == Axis::X;
-            let window = Window::of(head, domain_centre(&lowered.domain));
+            let window = height_map::window(head, domain_centre(&lowered.domain));
             let grid = window.cartesian(along_x);
-            window.check_size(head, &grid).map_err(|d| vec![d])?;
             let mut sweep = Sweep::new(grid, nose_radius);
             height_map::sweep_mill_moves(&mut sweep, &moves, along_x, resolution);
             let frame = height_map::RasterFrame {

@@ -18,6 +18,7 @@ use lensc_runtime::plan::raster::RasterError;
 use lensc_runtime::plan::roller::RollerError;
 use lensc_runtime::plan::turning::PlanError;
 use lensc_runtime::post::ProgramError;
+use lensc_runtime::verify::window::TooManyCells;
 
 /// Every error a build can meet after checking, with what its message
 /// needs beyond the error itself.
@@ -39,6 +40,9 @@ pub enum RuntimeError<'a> {
     Grinding(GrindingError),
     /// A roller job could not be checked or planned.
     Roller(RollerError),
+    /// The job's simulation window makes too large a grid (the
+    /// diagnostic points at the window).
+    Simulation(TooManyCells),
     /// The program could not be written in the machine's dialect.
     Program(ProgramError),
     /// The surface could not be lowered to something that evaluates it.
@@ -82,6 +86,17 @@ impl RuntimeError<'_> {
             RuntimeError::Raster(e) => raster(e),
             RuntimeError::Grinding(e) => grinding(e),
             RuntimeError::Roller(e) => roller(e),
+            RuntimeError::Simulation(e) => Coded {
+                label: "this window",
+                ..coded(
+                    codes::SIMULATION_TOO_LARGE,
+                    format!(
+                        "the simulation grid would have {} cells ({} × {}), more than the {} it takes",
+                        e.cells, e.columns, e.rows, e.limit
+                    ),
+                )
+                .help("make the window smaller or its spacing coarser")
+            },
             RuntimeError::Program(e) => Coded {
                 label: "no program was written for this job",
                 ..coded(codes::NOT_PRINTABLE, e.message())
