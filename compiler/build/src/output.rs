@@ -1,6 +1,9 @@
 //! What a built job is before it reaches the disk (`Built`, the program's
 //! text in memory or spooled) and how every output file is put in place:
-//! atomically, readable by all, with no temporary file left on failure.
+//! atomically, readable by all, with no temporary file left on failure,
+//! and never in place of a symbolic link (`--out` itself may be one: the
+//! user chose it; a link planted at an output's name is refused, not
+//! followed or replaced).
 
 use std::path::Path;
 
@@ -65,11 +68,25 @@ impl ProgramText {
         match self {
             ProgramText::Memory(t) => write_atomic(path, &t),
             ProgramText::Spooled { file, .. } => {
+                not_a_link(path)?;
                 readable_by_all(file.as_file())?;
                 file.as_file().sync_all()?;
                 file.persist(path).map(|_| ()).map_err(|e| e.error)
             }
         }
+    }
+}
+
+/// Refuses a target that is a symbolic link: the rename would replace the
+/// link, not write where it points, but a link there means someone expects
+/// the output elsewhere — it is theirs to remove.
+fn not_a_link(path: &Path) -> std::io::Result<()> {
+    match std::fs::symlink_metadata(path) {
+        Ok(m) if m.file_type().is_symlink() => Err(std::io::Error::new(
+            std::io::ErrorKind::AlreadyExists,
+            "it is a symbolic link (lensc writes no output through or over one; remove it)",
+        )),
+        _ => Ok(()),
     }
 }
 
@@ -98,6 +115,7 @@ pub fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
     std::fs::create_dir_all(dir)?;
+    not_a_link(path)?;
     let mut tmp = tempfile::Builder::new()
         .prefix(".lensc-")
         .suffix(".tmp")
