@@ -77,6 +77,20 @@ impl ProgramText {
     }
 }
 
+/// Where the output `name` goes in `dir`: refused unless `name` is one plain
+/// file name (a dialect's table extension comes from the job file, and
+/// must not carry the file out of `--out`).
+pub fn output_path(dir: &Path, name: &str) -> std::io::Result<std::path::PathBuf> {
+    let mut parts = Path::new(name).components();
+    match (parts.next(), parts.next()) {
+        (Some(std::path::Component::Normal(n)), None) if n == name => Ok(dir.join(name)),
+        _ => Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!("`{name}` is not a plain file name: outputs are written only inside --out"),
+        )),
+    }
+}
+
 /// Refuses a target that is a symbolic link: the rename would replace the
 /// link, not write where it points, but a link there means someone expects
 /// the output elsewhere — it is theirs to remove.
@@ -125,4 +139,18 @@ pub fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {
     tmp.as_file().sync_all()?;
     tmp.persist(path).map_err(|e| e.error)?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn outputs_stay_inside_the_output_directory() {
+        let dir = Path::new("out");
+        assert_eq!(output_path(dir, "job.ngc").unwrap(), dir.join("job.ngc"));
+        for bad in ["job./../../x", "/etc/x", "..", "a/b", "", "job.ngc/"] {
+            assert!(output_path(dir, bad).is_err(), "{bad}");
+        }
+    }
 }
