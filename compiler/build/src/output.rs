@@ -36,7 +36,7 @@ pub struct Built {
 pub enum ProgramText {
     Memory(String),
     Spooled {
-        file: tempfile::NamedTempFile,
+        file: crate::temps::TempFile,
         lines: usize,
         bytes: u64,
     },
@@ -71,7 +71,7 @@ impl ProgramText {
                 not_a_link(path)?;
                 readable_by_all(file.as_file())?;
                 file.as_file().sync_all()?;
-                file.persist(path).map(|_| ()).map_err(|e| e.error)
+                file.persist(path)
             }
         }
     }
@@ -130,15 +130,11 @@ pub fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {
         .unwrap_or(Path::new("."));
     std::fs::create_dir_all(dir)?;
     not_a_link(path)?;
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".lensc-")
-        .suffix(".tmp")
-        .tempfile_in(dir)?;
+    let mut tmp = crate::temps::TempFile::create_in(dir)?;
     tmp.write_all(text.as_bytes())?;
     readable_by_all(tmp.as_file())?;
     tmp.as_file().sync_all()?;
-    tmp.persist(path).map_err(|e| e.error)?;
-    Ok(())
+    tmp.persist(path)
 }
 
 #[cfg(test)]
