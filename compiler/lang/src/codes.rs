@@ -9,6 +9,13 @@ pub const CANNOT_READ: &str = "E0103";
 pub const IMPORT_CYCLE: &str = "E0104";
 pub const NOT_IN_MODULE: &str = "E0105";
 pub const SELF_REFERENCE: &str = "E0106";
+/// A `use` (or the file given with `--root`) that resolves, after
+/// symlinks, outside the project root.
+pub const OUTSIDE_ROOT: &str = "E0107";
+/// A path that names a FIFO, device, socket or directory, not a regular file.
+pub const NOT_A_FILE: &str = "E0108";
+/// A file over the size limit of what lensc reads (16 MiB).
+pub const FILE_TOO_LARGE: &str = "E0109";
 pub const UNKNOWN_UNIT: &str = "E0110";
 pub const DIMENSION_MISMATCH: &str = "E0111";
 pub const BAD_ARGUMENT_DIMENSION: &str = "E0112";
@@ -64,6 +71,9 @@ pub const ALL: &[&str] = &[
     IMPORT_CYCLE,
     NOT_IN_MODULE,
     SELF_REFERENCE,
+    OUTSIDE_ROOT,
+    NOT_A_FILE,
+    FILE_TOO_LARGE,
     UNKNOWN_UNIT,
     DIMENSION_MISMATCH,
     BAD_ARGUMENT_DIMENSION,

@@ -30,6 +30,15 @@ struct Cli {
     /// Colour in human diagnostics.
     #[arg(long, global = true, value_enum, default_value_t = ColorChoice::Auto)]
     color: ColorChoice,
+    /// The project root: no file outside it is read on a job's behalf (a
+    /// `use` that resolves there is an error). Default: the directory of
+    /// the file given.
+    #[arg(long, global = true, value_name = "DIR")]
+    root: Option<PathBuf>,
+    /// Print every diagnostic: without it, after 100 of one code the rest
+    /// are counted in one summary line per code.
+    #[arg(long, global = true)]
+    all_diagnostics: bool,
 }
 
 #[derive(Subcommand)]
@@ -140,9 +149,17 @@ fn run(cli: Cli) -> u8 {
             std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none()
         }
     };
+    if let Some(root) = &cli.root
+        && !root.is_dir()
+    {
+        eprintln!("error: --root {}: no such directory", root.display());
+        return 2;
+    }
     let out = Output {
         format: cli.message_format,
         color,
+        root: cli.root,
+        all_diagnostics: cli.all_diagnostics,
     };
     match cli.command {
         Command::Check { files } => commands::check::run(&out, &files),

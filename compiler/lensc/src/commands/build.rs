@@ -24,6 +24,15 @@ pub fn run(out: &Output, file: &Path, job: Option<&str>, dialect: Option<&str>, 
         return 1;
     }
     for built in programs {
+        let names = std::iter::once(&built.program_name)
+            .chain([&built.report_name])
+            .chain(built.beside.iter().map(|(name, _)| name));
+        for name in names {
+            if let Err(e) = driver::output_path(dir, name) {
+                cannot_write(&dir.join(name), &e);
+                return 1;
+            }
+        }
         let target = dir.join(&built.program_name);
         let report_path = dir.join(&built.report_name);
         let report = built.report.to_json_text();

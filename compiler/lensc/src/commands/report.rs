@@ -46,7 +46,8 @@ pub fn run(out: &Output, file: &Path, job: Option<&str>, dir: &Path) -> u8 {
     }
     for (name, svg) in plots {
         let path = dir.join(&name);
-        if let Err(e) = driver::write_atomic(&path, &svg) {
+        if let Err(e) = driver::output_path(dir, &name).and_then(|p| driver::write_atomic(&p, &svg))
+        {
             cannot_write(&path, &e);
             return 1;
         }
