@@ -17,6 +17,7 @@ mod dialects;
 mod examples;
 mod fuzz_properties;
 mod jit_conformance;
+mod limits;
 mod plots;
 mod rs274;
 mod seed_sketches;
