@@ -19,6 +19,7 @@ mod floods;
 mod fuzz_properties;
 mod interrupt;
 mod jit_conformance;
+mod limits;
 mod plots;
 mod rs274;
 mod sandbox;

@@ -53,6 +53,10 @@ pub const DIALECT_NOT_OFFERED: &str = "E0148";
 pub const SIMULATION_TOO_LARGE: &str = "E0149";
 pub const NOT_PRINTABLE: &str = "E0150";
 pub const CANNOT_WRITE: &str = "E0151";
+/// A job asks for more points than lensc plans for one job.
+pub const TOO_MANY_POINTS: &str = "E0160";
+/// A job's program would be larger than `--max-program-size`.
+pub const PROGRAM_TOO_LARGE: &str = "E0161";
 
 pub const UNUSED: &str = "W0001";
 pub const WRAP_GAP: &str = "W0002";
@@ -112,6 +116,8 @@ pub const ALL: &[&str] = &[
     SIMULATION_TOO_LARGE,
     NOT_PRINTABLE,
     CANNOT_WRITE,
+    TOO_MANY_POINTS,
+    PROGRAM_TOO_LARGE,
     UNUSED,
     SEAM_LEFT_UNCUT,
     CENTRE_LEFT_UNCUT,

@@ -11,12 +11,14 @@
 //! window too fine (`window.rs`) — so `lensc check` reports it as `lensc
 //! build` does. Every error found is returned together.
 
+mod estimate;
 mod mill;
 mod roller;
 mod spiral;
 mod turning;
 mod window;
 
+pub use estimate::{DEFAULT_MAX_PROGRAM_SIZE, Estimate, Limits, MAX_POINTS, estimate, refusals};
 pub use mill::{GrindingSpec, RasterSpec};
 pub use roller::RollerSpec;
 pub use spiral::{Settling, SpiralSpec};
