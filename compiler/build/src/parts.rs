@@ -55,6 +55,8 @@ pub(crate) fn report(
             fts_table: None,
         },
         toolpath,
+        // Filled in by the pipeline, which made the estimate.
+        estimate: report::Estimate::default(),
         simulation,
         surface: surface_analysis(
             &head.names.surface,

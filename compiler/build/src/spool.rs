@@ -11,7 +11,7 @@ use crate::output::ProgramText;
 pub(crate) enum Sink {
     Memory(String),
     File {
-        writer: std::io::BufWriter<tempfile::NamedTempFile>,
+        writer: std::io::BufWriter<crate::temps::TempFile>,
         lines: usize,
         bytes: u64,
         error: Option<std::io::Error>,
@@ -24,10 +24,7 @@ impl Sink {
             None => Sink::Memory(String::new()),
             Some(dir) => {
                 std::fs::create_dir_all(dir)?;
-                let file = tempfile::Builder::new()
-                    .prefix(".lensc-")
-                    .suffix(".tmp")
-                    .tempfile_in(dir)?;
+                let file = crate::temps::TempFile::create_in(dir)?;
                 Sink::File {
                     writer: std::io::BufWriter::with_capacity(1 << 20, file),
                     lines: 0,

@@ -19,7 +19,7 @@ use lensc_runtime::verify::heightmap::Sweep;
 use std::path::Path;
 
 use crate::evaluate::evaluator;
-use crate::height_map::{self, LatheFrame, Window};
+use crate::height_map::{self, LatheFrame};
 use crate::output::Built;
 use crate::parts;
 use crate::report;
@@ -105,9 +105,8 @@ pub fn build(
     let lowered = &head.surface.lowered;
     let design = evaluator(&lowered.tape).0;
     let apertures = &p.lenslets;
-    let window = Window::of(head, height_map::lathe_centre(&lowered.domain, apertures));
+    let window = height_map::window(head, height_map::lathe_centre(&lowered.domain, apertures));
     let grid = window.polar();
-    window.check_size(head, &grid).map_err(|d| vec![d])?;
     let mut sweep = Sweep::new(grid, p.nose_radius);
     let mut printed = Vec::new();
     let mut write_error: Option<ProgramError> = None;

@@ -5,15 +5,14 @@
 
 use lensc_grammar::Diagnostic;
 use lensc_lang::check::trim_num;
-use lensc_lang::codes;
 use lensc_lang::lower::diagnostics::RuntimeError;
 use lensc_lang::lower::job::RasterSpec;
-use lensc_runtime::plan::raster::{Axis, RasterTool};
+use lensc_runtime::plan::raster::{Axis, RasterTool, check_clearance};
 use lensc_runtime::post::Provenance;
 use lensc_runtime::verify::heightmap::Sweep;
 
 use crate::evaluate::evaluator;
-use crate::height_map::{self, Window, domain_centre};
+use crate::height_map::{self, domain_centre};
 use crate::output::{Built, ProgramText};
 use crate::parts;
 use crate::report;
@@ -28,20 +27,12 @@ pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnost
         lensc_runtime::plan::raster::plan_raster(raster, &tool, kernel.as_ref(), &lowered.domain)
             .map_err(|e| vec![parts::failed(head, RuntimeError::Raster(e))])?;
     let mut errors = Vec::new();
-    // The knife's flank must clear the steepest slope along the cut.
+    // The knife's flank must clear the steepest slope along the cut, as
+    // lowering found it on the planes and now on every planned contact.
     if let Some(clearance) = spec.clearance
-        && clearance <= path.max_slope_along.value
+        && let Err(e) = check_clearance(clearance, path.max_slope_along)
     {
-        errors.push(head.error(
-            codes::CLEARANCE_TOO_SMALL,
-            format!(
-                "the clearance angle ({}°) is not above the surface's steepest slope along the cut ({}°, at ({}, {}) mm): the flank would rub",
-                trim_num(clearance.to_degrees()),
-                trim_num(path.max_slope_along.value.to_degrees()),
-                trim_num(path.max_slope_along.x),
-                trim_num(path.max_slope_along.y)
-            ),
-        ));
+        errors.push(parts::failed(head, RuntimeError::Raster(e)));
     }
     let feed = spec.feed;
     let moves = lensc_runtime::emit::raster::raster_moves(&path, feed);
@@ -94,9 +85,8 @@ pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnost
     let simulation = match tool {
         RasterTool::Knife { nose_radius } => {
             let along_x = raster.along == Axis::X;
-            let window = Window::of(head, domain_centre(&lowered.domain));
+            let window = height_map::window(head, domain_centre(&lowered.domain));
             let grid = window.cartesian(along_x);
-            window.check_size(head, &grid).map_err(|d| vec![d])?;
             let mut sweep = Sweep::new(grid, nose_radius);
             height_map::sweep_mill_moves(&mut sweep, &moves, along_x, resolution);
             let frame = height_map::RasterFrame {

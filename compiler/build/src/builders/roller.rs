@@ -17,7 +17,7 @@ use lensc_runtime::post::Provenance;
 use lensc_runtime::verify::heightmap::Sweep;
 
 use crate::evaluate::evaluator;
-use crate::height_map::{self, RollerFrame, Window};
+use crate::height_map::{self, RollerFrame};
 use crate::output::Built;
 use crate::parts;
 use crate::report;
@@ -94,12 +94,11 @@ pub fn build(
     let mut sink = Sink::new(spool_dir).map_err(|e| vec![cannot_spool(&e, site)])?;
     // The height map over the window, from the printed points of every
     // pass (the finish pass's envelope lies below the rough one's).
-    let window = Window::of(
+    let window = height_map::window(
         head,
         ((z_start + z_end) / 2.0, (design_y.0 + design_y.1) / 2.0),
     );
     let grid = window.roller(roller_radius);
-    window.check_size(head, &grid).map_err(|d| vec![d])?;
     let mut sweep = Sweep::new(grid, rho);
     let mut current_pass = usize::MAX;
     let mut write_error: Option<ProgramError> = None;
