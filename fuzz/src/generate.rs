@@ -169,6 +169,7 @@ impl Gen<'_> {
                     "",
                     "self.lens",
                     "dir/",
+                    "big.lens",
                 ]);
                 let _ = writeln!(self.out, "use \"{path}\"");
                 self.decls.push(("part_surface".into(), Category::Surface));

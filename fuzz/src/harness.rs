@@ -9,6 +9,8 @@ use std::path::{Path, PathBuf};
 use lensc_build::driver;
 use lensc_grammar::Diagnostic;
 use lensc_lang::loader::FileSystem;
+use lensc_lang::lower::job::Limits;
+use lensc_lang::sandbox::ReadError;
 use lensc_lang::source::SourceMap;
 
 /// How far an input went.
@@ -49,10 +51,28 @@ impl MemFs {
 }
 
 impl FileSystem for MemFs {
-    fn read(&self, path: &Path) -> std::io::Result<Vec<u8>> {
+    /// Named files are read; a few names stand for what the sandbox
+    /// refuses (a directory, a file too large, one outside the root).
+    fn read(&self, path: &Path) -> Result<Vec<u8>, ReadError> {
         let name = path.file_name().map(|n| n.to_string_lossy().into_owned());
-        name.and_then(|n| self.files.get(&n).cloned())
-            .ok_or_else(|| std::io::Error::from(std::io::ErrorKind::NotFound))
+        let name = name.unwrap_or_default();
+        if let Some(text) = self.files.get(&name) {
+            return Ok(text.clone());
+        }
+        Err(match name.as_str() {
+            "dir" => ReadError::NotAFile {
+                what: "a directory",
+            },
+            "big.lens" => ReadError::TooLarge {
+                bytes: 1 << 30,
+                limit: 16 << 20,
+            },
+            "up.lens" => ReadError::OutsideRoot {
+                resolved: PathBuf::from("/elsewhere/up.lens"),
+                root: PathBuf::from("/project"),
+            },
+            _ => ReadError::Io(std::io::Error::from(std::io::ErrorKind::NotFound)),
+        })
     }
     fn canonical(&self, path: &Path) -> PathBuf {
         path.to_path_buf()
@@ -87,7 +107,7 @@ pub fn run(fs: &MemFs, bytes: &[u8], depth: Depth, out_dir: &Path) -> Result<Rea
         Depth::Check => {}
         Depth::Lower => {
             for job in &c.checked.jobs {
-                if let Err(diags) = lensc_build::pipeline::lower(job, None) {
+                if let Err(diags) = lensc_build::pipeline::lower(job, None, &Limits::default()) {
                     well_formed(&diags, sources)?;
                     render(&diags, sources)?;
                 }
