@@ -31,6 +31,11 @@ use crate::codes;
 /// roller's program of that many points is 6–9 GB of text).
 pub const MAX_POINTS: u64 = 200_000_000;
 
+/// Most samples of a fast tool servo's following simulation for one job:
+/// ten times seed 003's whole array (231 M samples, about 8 s), so about
+/// a minute and a half of simulation at most.
+pub const MAX_SERVO_SAMPLES: u64 = 2_000_000_000;
+
 /// The default largest program (bytes) a build writes: 4 GB.
 pub const DEFAULT_MAX_PROGRAM_SIZE: u64 = 4_000_000_000;
 
@@ -62,6 +67,9 @@ pub struct Estimate {
     pub program_bytes: f64,
     /// The strategy's parameter that sets the point count, for the help.
     pub driver: &'static str,
+    /// Samples of the fast tool servo's following simulation: the cutting
+    /// time at the servo's data rate (0 where no servo is simulated).
+    pub servo_samples: f64,
 }
 
 /// The job's estimate, from its typed spec; surfaces are evaluated with
@@ -98,6 +106,21 @@ pub fn refusals(spec: &JobSpec, e: &Estimate, limits: &Limits) -> Vec<Diagnostic
                 "make `{}` coarser: the point count scales with it",
                 e.driver
             )),
+        );
+    }
+    // (The servo is simulated sample by sample: a spindle crawling at
+    // 1e-9 rpm would take forever, whatever its points.)
+    if over(e.servo_samples, MAX_SERVO_SAMPLES) {
+        out.push(
+            head.error(
+                codes::TOO_MANY_POINTS,
+                format!(
+                    "this job's servo simulation needs about {} samples (its cutting time at the servo's data rate), more than the {} lensc simulates for one job",
+                    count(e.servo_samples),
+                    count(MAX_SERVO_SAMPLES as f64)
+                ),
+            )
+            .with_help("raise `spindle_speed` (or `surface_speed`): the cutting time scales with its inverse"),
         );
     }
     if over(e.program_bytes, limits.max_program_size) {
@@ -285,6 +308,7 @@ fn turning(s: &TurningSpec, evaluate: Evaluate) -> Estimate {
     let arcs = curve.arcs(st.chord_tolerance * FIT_SHARE).min(points);
     let blocks = passes * (4.0 + arcs);
     Estimate {
+        servo_samples: 0.0,
         points,
         program_bytes: blocks * TURNING_BLOCK,
         driver: "chord_tolerance",
@@ -323,6 +347,7 @@ fn spiral(s: &SpiralSpec, evaluate: Evaluate) -> Estimate {
             points: f64::INFINITY,
             program_bytes: f64::INFINITY,
             driver: "feed",
+            servo_samples: f64::INFINITY,
         };
     }
     let tol = sp.chord_tolerance * UNOPTIMISED_CHORD_SHARE;
@@ -335,7 +360,7 @@ fn spiral(s: &SpiralSpec, evaluate: Evaluate) -> Estimate {
                 .any(|&(fx, fy, fr)| (x - fx).hypot(y - fy) <= fr + grow)
         })
     };
-    let (mut points, mut seeded) = (1.0, 0.0);
+    let (mut points, mut seeded, mut seconds) = (1.0, 0.0, 0.0);
     let (mut xs, mut ys) = (Vec::new(), Vec::new());
     let mut out = Vec::new();
     for j in 0..rings {
@@ -379,9 +404,17 @@ fn spiral(s: &SpiralSpec, evaluate: Evaluate) -> Estimate {
             seeded += per_ring * dc / span;
         }
         points += per_ring * n.max(1.0);
+        seconds += per_ring * tau / sp.speed.at(r);
     }
+    // The following simulation samples the servo at its data rate.
+    let servo_samples = if s.servo.is_some() {
+        seconds / sp.min_interval
+    } else {
+        0.0
+    };
     Estimate {
         points,
+        servo_samples,
         program_bytes: points * SPIRAL_BLOCK,
         // Where the seeds alone make most of the points, the feed per
         // revolution sets the count; else the tolerance does.
@@ -412,6 +445,7 @@ fn raster(s: &RasterSpec, evaluate: Evaluate) -> Estimate {
     let planes = ((v1 - v0) / r.stepover + 1e-9).floor() + 1.0;
     if !planes.is_finite() || planes > 1e9 {
         return Estimate {
+            servo_samples: 0.0,
             points: f64::INFINITY,
             program_bytes: f64::INFINITY,
             driver: "stepover",
@@ -479,6 +513,7 @@ fn raster(s: &RasterSpec, evaluate: Evaluate) -> Estimate {
         bytes += weight * (RASTER_PASS + arcs * RASTER_BLOCK);
     }
     Estimate {
+        servo_samples: 0.0,
         points,
         program_bytes: bytes,
         driver: "chord_tolerance",
@@ -500,6 +535,7 @@ fn grinding(s: &GrindingSpec) -> Estimate {
     let g = &s.grinding;
     let points = ((g.end - g.start).abs() / g.interval).ceil() + 1.0;
     Estimate {
+        servo_samples: 0.0,
         points,
         program_bytes: points * GRINDING_BLOCK,
         driver: "interval",
@@ -517,6 +553,7 @@ fn roller(s: &RollerSpec) -> Estimate {
         .map(|p| (tau * (h.z_end - h.z_start) / p.pitch / p.c_step).ceil() + 1.0)
         .sum();
     Estimate {
+        servo_samples: 0.0,
         points,
         program_bytes: points * ROLLER_BLOCK,
         driver: "c_step",
