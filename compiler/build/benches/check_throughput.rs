@@ -11,10 +11,14 @@
 //! stages in one process, which criterion does not print.
 
 use std::hint::black_box;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use lensc_build::driver;
 use lensc_lang::loader::RealFs;
+
+#[path = "../../../runtime/benches/support/timing.rs"]
+mod timing;
+use timing::best_of;
 
 /// A realistic job file: surfaces, tools, strategies, machines and jobs
 /// that use each other, with comments and units of every kind.
@@ -50,18 +54,6 @@ job j{i} {{ surface: s{i}, tool: t{i}, machine: m{i}, strategy: g{i} }}
         i += 1;
     }
     s
-}
-
-/// Best of `runs` timings of `f` (the least disturbed by other load).
-fn best_of(runs: usize, mut f: impl FnMut()) -> Duration {
-    (0..runs)
-        .map(|_| {
-            let t = Instant::now();
-            f();
-            t.elapsed()
-        })
-        .min()
-        .expect("runs > 0")
 }
 
 fn main() {
