@@ -8,7 +8,8 @@ use lensc_lang::check::trim_num;
 use lensc_lang::codes;
 use lensc_lang::lower::diagnostics::RuntimeError;
 use lensc_lang::lower::job::RasterSpec;
-use lensc_runtime::plan::raster::{Axis, RasterTool};
+use lensc_runtime::plan::optimise::Summary;
+use lensc_runtime::plan::raster::{Axis, RasterPath, RasterTool};
 use lensc_runtime::post::Provenance;
 use lensc_runtime::verify::heightmap::Sweep;
 
@@ -27,59 +28,24 @@ pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnost
     let path =
         lensc_runtime::plan::raster::plan_raster(raster, &tool, kernel.as_ref(), &lowered.domain)
             .map_err(|e| vec![parts::failed(head, RuntimeError::Raster(e))])?;
-    let mut errors = Vec::new();
     // The knife's flank must clear the steepest slope along the cut.
-    if let Some(clearance) = spec.clearance
-        && clearance <= path.max_slope_along.value
-    {
-        errors.push(head.error(
-            codes::CLEARANCE_TOO_SMALL,
-            format!(
-                "the clearance angle ({}°) is not above the surface's steepest slope along the cut ({}°, at ({}, {}) mm): the flank would rub",
-                trim_num(clearance.to_degrees()),
-                trim_num(path.max_slope_along.value.to_degrees()),
-                trim_num(path.max_slope_along.x),
-                trim_num(path.max_slope_along.y)
-            ),
-        ));
-    }
+    let mut errors: Vec<Diagnostic> = clearance_error(spec, &path).into_iter().collect();
     let feed = spec.feed;
     let moves = lensc_runtime::emit::raster::raster_moves(&path, feed);
     errors.extend(parts::travel_error(head, &moves));
     if !errors.is_empty() {
         return Err(errors);
     }
-    let mut header = parts::header(
-        head,
-        prov,
-        "units mm; X Y Z of the tool centre, +Z out of the material; no cutter compensation",
-    );
-    header.push(format!("tool {}: {}", head.names.tool, spec.tool_words));
-    header.push(format!(
-        "strategy {}: raster along {}, {}, stepover {} um, {}, {} passes, {} points",
-        head.names.strategy,
-        if raster.along == Axis::X { "x" } else { "y" },
-        if raster.zigzag { "zigzag" } else { "one way" },
-        trim_num(raster.stepover * 1000.0),
-        lensc_runtime::emit::tolerance_words(raster.chord_tolerance),
-        path.pass_count,
-        path.point_count
-    ));
     let (moves, optimised) = lensc_runtime::plan::optimise::optimise(
         &moves,
         raster.chord_tolerance * lensc_runtime::plan::optimise::FIT_SHARE,
         &dialect.arc_planes,
     );
-    header.push(lensc_runtime::emit::optimisation_words(&optimised));
-    header.push(format!(
-        "machine {}: {} 3-axis mill",
-        head.names.machine, dialect.name
-    ));
     let resolution = head.resolution;
     let text = lensc_runtime::emit::raster::emit_mill(
         dialect,
         &head.name,
-        &header,
+        &header_lines(spec, prov, &path, &optimised),
         &moves,
         resolution,
         raster.chord_tolerance,
@@ -88,8 +54,6 @@ pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnost
     let section = report::Raster::new(&path, raster, feed, &optimised);
     let time = section.cutting_time_s;
     let toolpath = report::Toolpath::Raster(section);
-    let program_name = head.program_name();
-    let text = ProgramText::Memory(text);
     let mut plots = crate::plots::PlotSeries::default();
     let simulation = match tool {
         RasterTool::Knife { nose_radius } => {
@@ -139,16 +103,61 @@ pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnost
             height_map: None,
         }),
     };
-    let report = parts::report(head, prov, &program_name, &text, toolpath, simulation);
-    Ok(Built {
-        report_name: format!("{}.report.json", head.name),
-        program_name,
-        program: text,
-        report,
-        beside: Vec::new(),
-        cut_points: path.point_count,
-        cutting_time: time,
-        plots,
-        warnings: Vec::new(),
+    let text = ProgramText::Memory(text);
+    let cut = (path.point_count, time);
+    Ok(parts::built(
+        head, prov, text, toolpath, simulation, plots, cut,
+    ))
+}
+
+/// E0145 unless the knife's clearance angle is above the planner's
+/// steepest slope along the cut: else its flank would rub.
+fn clearance_error(spec: &RasterSpec, path: &RasterPath) -> Option<Diagnostic> {
+    let clearance = spec.clearance?;
+    let steepest = &path.max_slope_along;
+    (clearance <= steepest.value).then(|| {
+        spec.head.error(
+            codes::CLEARANCE_TOO_SMALL,
+            format!(
+                "the clearance angle ({}°) is not above the surface's steepest slope along the cut ({}°, at ({}, {}) mm): the flank would rub",
+                trim_num(clearance.to_degrees()),
+                trim_num(steepest.value.to_degrees()),
+                trim_num(steepest.x),
+                trim_num(steepest.y)
+            ),
+        )
     })
+}
+
+/// The program's header: provenance, units, surface, the tool, the raster
+/// and its optimisation, and the machine in words.
+fn header_lines(
+    spec: &RasterSpec,
+    prov: &Provenance,
+    path: &RasterPath,
+    optimised: &Summary,
+) -> Vec<String> {
+    let (head, raster) = (&spec.head, &spec.raster);
+    let mut header = parts::header(
+        head,
+        prov,
+        "units mm; X Y Z of the tool centre, +Z out of the material; no cutter compensation",
+    );
+    header.push(format!("tool {}: {}", head.names.tool, spec.tool_words));
+    header.push(format!(
+        "strategy {}: raster along {}, {}, stepover {} um, {}, {} passes, {} points",
+        head.names.strategy,
+        if raster.along == Axis::X { "x" } else { "y" },
+        if raster.zigzag { "zigzag" } else { "one way" },
+        trim_num(raster.stepover * 1000.0),
+        lensc_runtime::emit::tolerance_words(raster.chord_tolerance),
+        path.pass_count,
+        path.point_count
+    ));
+    header.push(lensc_runtime::emit::optimisation_words(optimised));
+    header.push(format!(
+        "machine {}: {} 3-axis mill",
+        head.names.machine, head.dialect.name
+    ));
+    header
 }
