@@ -170,6 +170,31 @@ impl<'a> Parts<'a> {
             )
         })
     }
+    /// E0131 for a machine that is not a `lathe` (`note` follows its kind
+    /// in the message) and for a tool that is not a round nose: what a
+    /// servo lathe's strategy (`what`) needs.
+    pub fn needs_servo_lathe(&self, what: &str, lathe: &str, note: &str) -> Vec<Diagnostic> {
+        let mut errors = Vec::new();
+        if self.machine.kind.name != lathe {
+            errors.push(self.error(
+                codes::UNSUPPORTED_COMBINATION,
+                format!(
+                    "{what} needs an `{lathe}`{note}; this machine is a `{}`",
+                    self.machine.kind.name
+                ),
+            ));
+        }
+        if self.tool.kind.name != "round_nose" {
+            errors.push(self.error(
+                codes::UNSUPPORTED_COMBINATION,
+                format!(
+                    "{what} needs a `round_nose` tool; this is a `{}`",
+                    self.tool.kind.name
+                ),
+            ));
+        }
+        errors
+    }
     /// The surface lowered to IR, or E0131.
     pub fn lowered(&self) -> Result<LoweredSurface, Diagnostic> {
         crate::lower::surface::lower_surface(self.surface)
@@ -179,6 +204,21 @@ impl<'a> Parts<'a> {
     pub fn max_spindle_speed(&self) -> f64 {
         let spindle = value::block(&self.machine.fields, "spindle").expect("required");
         value::num(spindle, "max_speed").expect("required")
+    }
+    /// E0143 if `speed` (rad/s) is above the machine's spindle limit.
+    pub fn spindle_limit(&self, speed: f64) -> Option<Diagnostic> {
+        let max = self.max_spindle_speed();
+        let rpm = |w: f64| crate::check::trim_num(w * 60.0 / (2.0 * std::f64::consts::PI));
+        (speed > max).then(|| {
+            self.error(
+                codes::SPINDLE_TOO_FAST,
+                format!(
+                    "the spindle speed ({} rpm) is above the machine's maximum ({} rpm)",
+                    rpm(speed),
+                    rpm(max)
+                ),
+            )
+        })
     }
     /// The job's head, once its surface is lowered and its dialect known.
     fn head(&self, dialect: Dialect, lowered: LoweredSurface) -> JobHead {
