@@ -16,6 +16,7 @@ mod diagnostics;
 mod dialects;
 mod examples;
 mod fuzz_properties;
+mod interrupt;
 mod jit_conformance;
 mod plots;
 mod rs274;

@@ -15,3 +15,4 @@ pub mod pipeline;
 pub mod plots;
 pub mod report;
 pub(crate) mod spool;
+pub mod temps;

@@ -33,7 +33,7 @@ pub struct Built {
 pub enum ProgramText {
     Memory(String),
     Spooled {
-        file: tempfile::NamedTempFile,
+        file: crate::temps::TempFile,
         lines: usize,
         bytes: u64,
     },
@@ -67,7 +67,7 @@ impl ProgramText {
             ProgramText::Spooled { file, .. } => {
                 readable_by_all(file.as_file())?;
                 file.as_file().sync_all()?;
-                file.persist(path).map(|_| ()).map_err(|e| e.error)
+                file.persist(path)
             }
         }
     }
@@ -98,13 +98,9 @@ pub fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
     std::fs::create_dir_all(dir)?;
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".lensc-")
-        .suffix(".tmp")
-        .tempfile_in(dir)?;
+    let mut tmp = crate::temps::TempFile::create_in(dir)?;
     tmp.write_all(text.as_bytes())?;
     readable_by_all(tmp.as_file())?;
     tmp.as_file().sync_all()?;
-    tmp.persist(path).map_err(|e| e.error)?;
-    Ok(())
+    tmp.persist(path)
 }

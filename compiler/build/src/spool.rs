@@ -19,7 +19,7 @@ pub(crate) enum Sink {
 /// A spool file being written, with what it holds so far and the first
 /// error writing it met.
 pub(crate) struct Spool {
-    writer: std::io::BufWriter<tempfile::NamedTempFile>,
+    writer: std::io::BufWriter<crate::temps::TempFile>,
     lines: usize,
     bytes: u64,
     error: Option<std::io::Error>,
@@ -40,10 +40,7 @@ impl Sink {
             None => Sink::Memory(String::new()),
             Some(dir) => {
                 std::fs::create_dir_all(dir)?;
-                let file = tempfile::Builder::new()
-                    .prefix(".lensc-")
-                    .suffix(".tmp")
-                    .tempfile_in(dir)?;
+                let file = crate::temps::TempFile::create_in(dir)?;
                 Sink::File(Spool {
                     writer: std::io::BufWriter::with_capacity(1 << 20, file),
                     lines: 0,

@@ -1,4 +1,9 @@
-//! The `lensc` command's library half: what the binary renders for people
-//! (diagnostics through ariadne), kept here so the tests can render too.
+//! lensc: the last step of the pipeline (source text → syntax tree →
+//! checked values → typed jobs → toolpath → move stream → program →
+//! report). The binary parses the command line (clap, one file per
+//! subcommand under `commands/`), calls `lensc-build` and `lensc-lang`,
+//! and renders what they return; this library half holds the rendering of
+//! diagnostics (ariadne for people, JSON lines for tools), so the tests
+//! can render as the binary does.
 
 pub mod render;

@@ -1,6 +1,7 @@
 //! The `lensc` command line: `check`, `build`, `report`, `analyse` and
 //! `sample`. Exit codes: 0 success (warnings allowed), 1 errors in the
-//! input, 2 usage errors, 101 an internal error.
+//! input, 2 usage errors, 101 an internal error, 130 and 143 a `build` or
+//! `report` stopped by SIGINT or SIGTERM.
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -9,6 +10,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand, ValueEnum};
 
 mod commands;
+mod interrupt;
 mod output;
 
 use output::Output;

@@ -1,9 +1,10 @@
 //! Profile turning: the planned profile path to a lathe program.
 
 use super::{Emitted, optimisation_words, tolerance_words, x_word};
+use crate::moves::Move;
 use crate::moves::{self, Position};
 use crate::plan::optimise::{self, optimise};
-use crate::plan::turning::{Feed, Move, Toolpath, TurningJob};
+use crate::plan::turning::{Feed, Toolpath, TurningJob};
 use crate::post::header::{Provenance, duration, num};
 use crate::post::{ProgramError, ProgramWriter, Setup};
 use std::f64::consts::PI;
@@ -105,11 +106,12 @@ pub fn turning_moves(job: &TurningJob, path: &Toolpath) -> Vec<moves::Move> {
         None => moves::Move::SpindleOn(Some(job.strategy.spindle_speed)),
     });
     out.extend(path.moves.iter().map(|m| match *m {
-        Move::Rapid { x, z } => moves::Move::Rapid(Position::xz(corrected(x), z)),
-        Move::Feed { x, z } => moves::Move::Linear {
-            to: Position::xz(corrected(x), z),
+        Move::Rapid(to) => Move::Rapid(Position::xz(corrected(to.x), to.z)),
+        Move::Linear { to, .. } => Move::Linear {
+            to: Position::xz(corrected(to.x), to.z),
             feed: Some(feed),
         },
+        other => other,
     }));
     out.push(moves::Move::SpindleOff);
     out

@@ -6,6 +6,7 @@ use nalgebra::Vector2;
 
 use crate::machine::Lathe;
 use crate::machine::tool::RoundNoseTool;
+use crate::moves::{Move, Position};
 use crate::plan::envelope::{self, Pieces};
 use crate::surface::Profile;
 use crate::surface::SurfaceInfo;
@@ -109,18 +110,11 @@ pub struct Seam {
     pub angle: f64,
 }
 
-/// One motion in the dialect-independent move stream.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Move {
-    /// Positioning at rapid rate, out of the material.
-    Rapid { x: f64, z: f64 },
-    /// Cutting motion at the programmed feed.
-    Feed { x: f64, z: f64 },
-}
-
 /// A planned path and what planning learned about the part.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Toolpath {
+    /// The nose centre's path in X and Z: rapids out of the material and
+    /// cutting moves (`Linear` with no feed: `emit` gives them the job's).
     pub moves: Vec<Move>,
     /// Tool-centre points of the cut (the feed moves), in cutting order.
     pub cut_points: usize,
@@ -367,14 +361,8 @@ fn link_passes(passes: &[Vec<Vector2<f64>>], strat: &ProfileTurning) -> LinkedPa
         }
     };
     for cut in passes {
-        moves.push(Move::Rapid {
-            x: cut[0].x,
-            z: safe_z,
-        });
-        moves.push(Move::Feed {
-            x: cut[0].x,
-            z: cut[0].y,
-        });
+        moves.push(Move::Rapid(Position::xz(cut[0].x, safe_z)));
+        moves.push(cutting(cut[0].x, cut[0].y));
         cut_length += (safe_z - cut[0].y).abs();
         let mut time = (safe_z - cut[0].y).abs() / speed_at(cut[0].x);
         for w in cut.windows(2) {
@@ -383,12 +371,9 @@ fn link_passes(passes: &[Vec<Vector2<f64>>], strat: &ProfileTurning) -> LinkedPa
             time += len / speed_at(0.5 * (w[0].x + w[1].x));
         }
         pass_times.push(time);
-        moves.extend(cut.iter().skip(1).map(|c| Move::Feed { x: c.x, z: c.y }));
+        moves.extend(cut.iter().skip(1).map(|c| cutting(c.x, c.y)));
         let last = cut[cut.len() - 1];
-        moves.push(Move::Rapid {
-            x: last.x,
-            z: safe_z,
-        });
+        moves.push(Move::Rapid(Position::xz(last.x, safe_z)));
     }
     LinkedPasses {
         moves,
@@ -397,10 +382,21 @@ fn link_passes(passes: &[Vec<Vector2<f64>>], strat: &ProfileTurning) -> LinkedPa
     }
 }
 
+/// A cutting move of the nose centre to (x, z), at the job's feed.
+fn cutting(x: f64, z: f64) -> Move {
+    Move::Linear {
+        to: Position::xz(x, z),
+        feed: None,
+    }
+}
+
 /// The first move, X before Z, that leaves the machine's travel.
 fn travel_error(machine: &Lathe, moves: &[Move]) -> Option<PlanError> {
     moves.iter().find_map(|m| {
-        let (Move::Rapid { x, z } | Move::Feed { x, z }) = *m;
+        let (Move::Rapid(to) | Move::Linear { to, .. }) = *m else {
+            return None;
+        };
+        let (x, z) = (to.x, to.z);
         [('X', x, machine.travel_x), ('Z', z, machine.travel_z)]
             .into_iter()
             .find_map(|(axis, value, (min, max))| {

@@ -8,7 +8,8 @@ use lensc_lang::check::trim_num;
 use lensc_lang::codes;
 use lensc_lang::lower::diagnostics::RuntimeError;
 use lensc_lang::lower::job::TurningSpec;
-use lensc_runtime::plan::turning::{Move, Toolpath};
+use lensc_runtime::moves::Move;
+use lensc_runtime::plan::turning::Toolpath;
 use lensc_runtime::post::Provenance;
 use lensc_runtime::surface::SectionAlongX;
 
@@ -106,8 +107,8 @@ fn warnings(spec: &TurningSpec, path: &Toolpath) -> Vec<Diagnostic> {
         .moves
         .iter()
         .filter_map(|m| match *m {
-            Move::Feed { x, .. } => Some(x.abs()),
-            Move::Rapid { .. } => None,
+            Move::Linear { to, .. } => Some(to.x.abs()),
+            _ => None,
         })
         .fold(f64::INFINITY, f64::min);
     if h > 0.0 && inmost < h {

@@ -8,6 +8,7 @@ use crate::output::{Output, cannot_write, load_jobs};
 
 /// Runs the subcommand; returns the exit code.
 pub fn run(out: &Output, file: &Path, job: Option<&str>, dialect: Option<&str>, dir: &Path) -> u8 {
+    crate::interrupt::clean_temporaries(dir);
     let c = match load_jobs(out, file, job) {
         Ok(c) => c,
         Err(code) => return code,

@@ -58,12 +58,9 @@ fn passes(path: &Toolpath) -> Vec<Vec<(f64, f64)>> {
     let mut out: Vec<Vec<(f64, f64)>> = Vec::new();
     for m in &path.moves {
         match *m {
-            Move::Rapid { .. } => {
-                if out.last().is_none_or(|p| !p.is_empty()) {
-                    out.push(Vec::new());
-                }
-            }
-            Move::Feed { x, z } => out.last_mut().expect("a rapid first").push((x, z)),
+            Move::Rapid(_) if out.last().is_none_or(|p| !p.is_empty()) => out.push(Vec::new()),
+            Move::Linear { to, .. } => out.last_mut().expect("a rapid first").push((to.x, to.z)),
+            _ => {}
         }
     }
     out.retain(|p| !p.is_empty());
