@@ -100,32 +100,63 @@ pub fn parse(source: &str, file: FileId) -> (File, Vec<Diagnostic>) {
         return (File::default(), diags);
     }
     let mut items = Vec::new();
-    for (start, end) in scan.chunks {
-        let text = &source[start..end];
-        if text.trim().is_empty() {
+    let chunks: Vec<(usize, usize)> = scan
+        .chunks
+        .into_iter()
+        .filter(|&(s, e)| !source[s..e].trim().is_empty())
+        .collect();
+    // Items are parsed a batch at a time (a pest call per item costs more
+    // than the item: 200,000 one-line `let`s took a second); a batch that
+    // does not parse is parsed again item by item, for every error in it.
+    for batch in batches(&chunks) {
+        let (start, end) = (batch[0].0, batch[batch.len() - 1].1);
+        if batch.len() > 1
+            && let Ok(pairs) = LensParser::parse(Rule::file, &source[start..end])
+        {
+            let mut b = Builder {
+                file,
+                offset: start,
+                diags: &mut diags,
+            };
+            b.items(pairs, &mut items);
             continue;
         }
-        let mut b = Builder {
-            file,
-            offset: start,
-            diags: &mut diags,
-        };
-        match LensParser::parse(Rule::file, text) {
-            Ok(mut pairs) => {
-                let file_pair = pairs.next().expect("file rule");
-                for p in file_pair.into_inner() {
-                    if p.as_rule() != Rule::EOI {
-                        items.push(b.item(p));
-                    }
+        for &(start, end) in batch {
+            let text = &source[start..end];
+            let mut b = Builder {
+                file,
+                offset: start,
+                diags: &mut diags,
+            };
+            match LensParser::parse(Rule::file, text) {
+                Ok(pairs) => b.items(pairs, &mut items),
+                Err(e) => {
+                    let d = b.syntax_error(source, text, e);
+                    diags.push(d);
                 }
-            }
-            Err(e) => {
-                let d = b.syntax_error(source, text, e);
-                diags.push(d);
             }
         }
     }
     (File { items }, diags)
+}
+
+/// Bytes of source parsed in one pest call, at most (one item may be longer).
+const BATCH_BYTES: usize = 16 << 10;
+
+/// Consecutive items grouped into batches of about `BATCH_BYTES`.
+fn batches(chunks: &[(usize, usize)]) -> impl Iterator<Item = &[(usize, usize)]> {
+    let mut rest = chunks;
+    std::iter::from_fn(move || {
+        let first = rest.first()?;
+        let n = rest
+            .iter()
+            .position(|&(_, e)| e - first.0 > BATCH_BYTES)
+            .unwrap_or(rest.len())
+            .max(1);
+        let (batch, tail) = rest.split_at(n);
+        rest = tail;
+        Some(batch)
+    })
 }
 
 struct Scan {
@@ -597,6 +628,16 @@ impl Builder<'_> {
     /// `text` is the item that failed, `source` the whole file: what was
     /// found is described from the whole file, so an item cut short by the
     /// next one reports that item's keyword, not "end of file".
+    /// The items of a parsed `file`, in order.
+    fn items(&mut self, mut pairs: Pairs<Rule>, items: &mut Vec<Item>) {
+        let file_pair = pairs.next().expect("file rule");
+        for p in file_pair.into_inner() {
+            if p.as_rule() != Rule::EOI {
+                items.push(self.item(p));
+            }
+        }
+    }
+
     fn syntax_error(&self, source: &str, text: &str, e: pest::error::Error<Rule>) -> Diagnostic {
         use pest::error::{ErrorVariant, InputLocation};
         let at = match e.location {

@@ -39,6 +39,10 @@ fn render_file(path: &Path) -> (String, String, usize) {
     let json = String::from_utf8(json)
         .expect("utf8")
         .replace(&root_prefix, "");
+    // The project root is named resolved (E0107).
+    let canonical_prefix = format!("{}/", root.canonicalize().expect("root").display());
+    let human = human.replace(&canonical_prefix, "");
+    let json = json.replace(&canonical_prefix, "");
     let errors = c.diags().iter().filter(|d| d.is_error()).count();
 
     // Every diagnostic is well formed: a code, words, spans inside the file.

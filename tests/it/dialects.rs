@@ -84,6 +84,7 @@ fn every_example_builds_in_every_dialect_its_machine_offers() {
                 let request = Request {
                     job: Some(&job.name.name),
                     dialect: Some(dialect),
+                    ..Request::default()
                 };
                 let (programs, diags) = plan_and_emit(
                     &checked,
@@ -128,6 +129,7 @@ fn a_dialect_the_machine_does_not_offer_is_refused_with_what_it_offers() {
         Request {
             job: Some("lin_oblate"),
             dialect: Some("fanuc_0i_lathe"),
+            ..Request::default()
         },
         "x.lens",
         None,
@@ -161,6 +163,7 @@ fn a_fanuc_lathe_program_is_in_diameter_with_radius_arc_centres() {
         Request {
             job: None,
             dialect: Some("fanuc_0i_lathe"),
+            ..Request::default()
         },
         "fanuc_lathe.lens",
         None,
@@ -223,6 +226,7 @@ fn a_fast_tool_servo_table_holds_the_same_points_as_the_linuxcnc_program() {
             Request {
                 job: None,
                 dialect: Some(dialect),
+                ..Request::default()
             },
             "fts_small_array.lens",
             None,

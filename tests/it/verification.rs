@@ -395,6 +395,10 @@ fn a_simulation_window_too_fine_is_refused_with_its_size() {
         "{err}"
     );
     assert!(!dir.path().join("j.ngc").exists());
+    // The window and its spacing are the job's: `check` finds it too.
+    let checked = lensc(dir.path(), &["check", "job.lens"]);
+    assert_eq!(checked.status.code(), Some(1));
+    assert_eq!(text(&checked.stderr), err);
 }
 
 #[test]

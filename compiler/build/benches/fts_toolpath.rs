@@ -28,7 +28,9 @@ fn main() {
     assert!(!c.has_errors(), "the example checks");
     let job = &c.checked.jobs[0];
     let t = Instant::now();
-    let Ok(lensc_lang::lower::job::JobSpec::Spiral(spec)) = lensc_build::pipeline::lower(job, None)
+    let limits = lensc_lang::lower::job::Limits::default();
+    let Ok((lensc_lang::lower::job::JobSpec::Spiral(spec), _)) =
+        lensc_build::pipeline::lower(job, None, &limits)
     else {
         panic!("lowers to a spiral")
     };

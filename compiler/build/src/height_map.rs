@@ -1,170 +1,28 @@
 //! The height-map simulation of a surface job, as the job builders use it:
 //! the window the job's `simulate` block asks for (or a default one where
-//! the surface is representative), the grid over it in the coordinates of
-//! the cut (Cartesian for a raster, polar for a lathe, angle and axial
-//! position for a roller), the frames that tie those coordinates to the
-//! design (the report's `simulation.height_map` section is
-//! `crate::report::HeightMap`).
+//! the surface is representative; the window and its grids in the
+//! coordinates of the cut are the runtime's `verify::window`), the frames
+//! that tie those coordinates to the design (the report's
+//! `simulation.height_map` section is `crate::report::HeightMap`).
 
-use lensc_grammar::Diagnostic;
 use lensc_runtime::moves::{Move, Plane};
 use lensc_runtime::surface::analysis::Domain;
 use lensc_runtime::surface::ir::SurfaceFn;
-use lensc_runtime::verify::heightmap::{Frame, Grid, HeightMap, Sweep};
+use lensc_runtime::verify::heightmap::{Frame, HeightMap, Sweep};
 use std::f64::consts::TAU;
 
 use lensc_lang::check::trim_num;
-use lensc_lang::codes;
 use lensc_lang::lower::job::JobHead;
 
-/// The most cells a window may have (8 bytes each in the map, plus the
-/// passes gathered per column).
-pub const MAX_CELLS: usize = 4_000_000;
-/// The default window: this wide (mm) and this fine (mm).
-pub const DEFAULT_SIZE: f64 = 0.2;
-pub const DEFAULT_SPACING: f64 = 1e-3;
+pub use lensc_runtime::verify::window::Window;
 
-/// The part of the surface (x, y in the design's coordinates, mm) that is
-/// simulated, and the grid spacing (mm).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Window {
-    pub x: (f64, f64),
-    pub y: (f64, f64),
-    pub spacing: f64,
-    /// Set by the job's `simulate` block, not by default.
-    pub given: bool,
-}
-
-impl Window {
-    /// The job's window (lowering checked it is not empty), or the
-    /// default one about `centre`.
-    pub fn of(head: &JobHead, centre: (f64, f64)) -> Window {
-        match head.simulate {
-            Some(s) => Window {
-                x: s.x,
-                y: s.y,
-                spacing: s.spacing.unwrap_or(DEFAULT_SPACING),
-                given: true,
-            },
-            None => {
-                let h = DEFAULT_SIZE / 2.0;
-                Window {
-                    x: (centre.0 - h, centre.0 + h),
-                    y: (centre.1 - h, centre.1 + h),
-                    spacing: DEFAULT_SPACING,
-                    given: false,
-                }
-            }
-        }
-    }
-
-    pub fn contains(&self, x: f64, y: f64) -> bool {
-        x >= self.x.0 && x <= self.x.1 && y >= self.y.0 && y <= self.y.1
-    }
-
-    /// E0149 when `grid` has more cells than the simulation takes.
-    pub fn check_size(&self, head: &JobHead, grid: &Grid) -> Result<(), Diagnostic> {
-        let cells = grid.ns * grid.nu;
-        if cells <= MAX_CELLS {
-            return Ok(());
-        }
-        let (file, span) = head.simulate.map_or(head.site, |s| s.site);
-        Err(Diagnostic::error(
-            codes::SIMULATION_TOO_LARGE,
-            format!(
-                "the simulation grid would have {cells} cells ({} × {}), more than the {MAX_CELLS} it takes",
-                grid.ns, grid.nu
-            ),
-            file,
-            span,
-        )
-        .with_label("this window")
-        .with_help("make the window smaller or its spacing coarser"))
-    }
-
-    /// Columns along x (`along_x`) or y, rows across.
-    pub fn cartesian(&self, along_x: bool) -> Grid {
-        let count = |r: (f64, f64)| ((r.1 - r.0) / self.spacing + 1e-9).floor() as usize + 1;
-        let (s, u) = if along_x {
-            (self.x, self.y)
-        } else {
-            (self.y, self.x)
-        };
-        Grid {
-            s0: s.0,
-            ds: self.spacing,
-            ns: count(s),
-            u0: u.0,
-            du: self.spacing,
-            nu: count(u),
-            period: None,
-        }
-    }
-
-    /// Columns at spindle angles, rows at radii, covering the window; the
-    /// whole turn when it holds the axis.
-    pub fn polar(&self) -> Grid {
-        let corners = [
-            (self.x.0, self.y.0),
-            (self.x.1, self.y.0),
-            (self.x.1, self.y.1),
-            (self.x.0, self.y.1),
-        ];
-        let r_max = corners.iter().map(|c| c.0.hypot(c.1)).fold(0.0, f64::max);
-        let near = (
-            0.0f64.clamp(self.x.0, self.x.1),
-            0.0f64.clamp(self.y.0, self.y.1),
-        );
-        let r_min = near.0.hypot(near.1);
-        let nu = ((r_max - r_min) / self.spacing).floor() as usize + 1;
-        if r_min < self.spacing {
-            let ns = (TAU * r_max / self.spacing).ceil().max(8.0) as usize;
-            return Grid {
-                s0: 0.0,
-                ds: TAU / ns as f64,
-                ns,
-                u0: 0.0,
-                du: self.spacing,
-                nu: (r_max / self.spacing).floor() as usize + 1,
-                period: Some(TAU),
-            };
-        }
-        let mid = ((self.y.0 + self.y.1) / 2.0).atan2((self.x.0 + self.x.1) / 2.0);
-        let relative = |c: &(f64, f64)| {
-            let a = c.1.atan2(c.0) - mid;
-            a - TAU * (a / TAU).round()
-        };
-        let lo = corners.iter().map(relative).fold(f64::INFINITY, f64::min);
-        let hi = corners
-            .iter()
-            .map(relative)
-            .fold(f64::NEG_INFINITY, f64::max);
-        let ds = self.spacing / r_max;
-        Grid {
-            s0: mid + lo,
-            ds,
-            ns: ((hi - lo) / ds).ceil() as usize + 1,
-            u0: r_min,
-            du: self.spacing,
-            nu,
-            period: Some(TAU),
-        }
-    }
-
-    /// Columns at spindle angles (design y over the roller radius), rows
-    /// along the roller axis (design x).
-    pub fn roller(&self, roller_radius: f64) -> Grid {
-        let ds = self.spacing / roller_radius;
-        let span = ((self.y.1 - self.y.0) / roller_radius).min(TAU - ds);
-        Grid {
-            s0: self.y.0 / roller_radius,
-            ds,
-            ns: (span / ds + 1e-9).floor() as usize + 1,
-            u0: self.x.0,
-            du: self.spacing,
-            nu: ((self.x.1 - self.x.0) / self.spacing + 1e-9).floor() as usize + 1,
-            period: Some(TAU),
-        }
+/// The window a job simulates: the one its `simulate` block gives (its
+/// grid's size was checked by lowering), or the default one about
+/// `centre`, which is small enough for every grid.
+pub fn window(head: &JobHead, centre: (f64, f64)) -> Window {
+    match head.simulate {
+        Some(s) => Window::given(s.x, s.y, s.spacing),
+        None => Window::about(centre),
     }
 }
 

@@ -1,6 +1,9 @@
 //! What a built job is before it reaches the disk (`Built`, the program's
 //! text in memory or spooled) and how every output file is put in place:
-//! atomically, readable by all, with no temporary file left on failure.
+//! atomically, readable by all, with no temporary file left on failure,
+//! and never in place of a symbolic link (`--out` itself may be one: the
+//! user chose it; a link planted at an output's name is refused, not
+//! followed or replaced).
 
 use std::path::Path;
 
@@ -65,11 +68,39 @@ impl ProgramText {
         match self {
             ProgramText::Memory(t) => write_atomic(path, &t),
             ProgramText::Spooled { file, .. } => {
+                not_a_link(path)?;
                 readable_by_all(file.as_file())?;
                 file.as_file().sync_all()?;
                 file.persist(path)
             }
         }
+    }
+}
+
+/// Where the output `name` goes in `dir`: refused unless `name` is one plain
+/// file name (a dialect's table extension comes from the job file, and
+/// must not carry the file out of `--out`).
+pub fn output_path(dir: &Path, name: &str) -> std::io::Result<std::path::PathBuf> {
+    let mut parts = Path::new(name).components();
+    match (parts.next(), parts.next()) {
+        (Some(std::path::Component::Normal(n)), None) if n == name => Ok(dir.join(name)),
+        _ => Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!("`{name}` is not a plain file name: outputs are written only inside --out"),
+        )),
+    }
+}
+
+/// Refuses a target that is a symbolic link: the rename would replace the
+/// link, not write where it points, but a link there means someone expects
+/// the output elsewhere — it is theirs to remove.
+fn not_a_link(path: &Path) -> std::io::Result<()> {
+    match std::fs::symlink_metadata(path) {
+        Ok(m) if m.file_type().is_symlink() => Err(std::io::Error::new(
+            std::io::ErrorKind::AlreadyExists,
+            "it is a symbolic link (lensc writes no output through or over one; remove it)",
+        )),
+        _ => Ok(()),
     }
 }
 
@@ -98,9 +129,24 @@ pub fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
     std::fs::create_dir_all(dir)?;
+    not_a_link(path)?;
     let mut tmp = crate::temps::TempFile::create_in(dir)?;
     tmp.write_all(text.as_bytes())?;
     readable_by_all(tmp.as_file())?;
     tmp.as_file().sync_all()?;
     tmp.persist(path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn outputs_stay_inside_the_output_directory() {
+        let dir = Path::new("out");
+        assert_eq!(output_path(dir, "job.ngc").unwrap(), dir.join("job.ngc"));
+        for bad in ["job./../../x", "/etc/x", "..", "a/b", "", "job.ngc/"] {
+            assert!(output_path(dir, bad).is_err(), "{bad}");
+        }
+    }
 }

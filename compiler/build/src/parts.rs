@@ -110,6 +110,8 @@ fn report(
             fts_table: None,
         },
         toolpath,
+        // Filled in by the pipeline, which made the estimate.
+        estimate: report::Estimate::default(),
         simulation,
         surface: surface_analysis(
             &head.names.surface,

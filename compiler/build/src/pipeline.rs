@@ -7,7 +7,7 @@ use std::path::Path;
 use lensc_grammar::Diagnostic;
 use lensc_lang::Checked;
 use lensc_lang::check::CheckedJob;
-use lensc_lang::lower::job::{JobSpec, lower_job};
+use lensc_lang::lower::job::{Estimate, JobSpec, Limits, lower_job};
 use lensc_runtime::post::Provenance;
 use lensc_runtime::surface::ir::{SurfaceFn, SurfaceTape};
 
@@ -22,6 +22,20 @@ pub struct Request<'a> {
     pub job: Option<&'a str>,
     /// This dialect instead of each machine's own (it must offer it).
     pub dialect: Option<&'a str>,
+    /// The largest program (bytes) to write (`--max-program-size`); the
+    /// default limit if `None`.
+    pub max_program_size: Option<u64>,
+}
+
+impl Request<'_> {
+    /// The limits the build is held to.
+    pub fn limits(&self) -> Limits {
+        let mut l = Limits::default();
+        if let Some(m) = self.max_program_size {
+            l.max_program_size = m;
+        }
+        l
+    }
 }
 
 /// How the build evaluates surfaces while lowering: the JIT, or the
@@ -31,9 +45,21 @@ fn evaluate(tape: &SurfaceTape) -> Box<dyn SurfaceFn + Sync> {
 }
 
 /// Lowers one checked job as a build does (its checks are what `lensc
-/// check` reports beyond the checker's).
-pub fn lower(job: &CheckedJob, dialect: Option<&str>) -> Result<JobSpec, Vec<Diagnostic>> {
-    lower_job(job, dialect, &evaluate)
+/// check` reports beyond the checker's), with the estimate of what it
+/// writes; a job whose estimate is over `limits` is refused.
+pub fn lower(
+    job: &CheckedJob,
+    dialect: Option<&str>,
+    limits: &Limits,
+) -> Result<(JobSpec, Estimate), Vec<Diagnostic>> {
+    let spec = lower_job(job, dialect, &evaluate)?;
+    let estimate = lensc_lang::lower::job::estimate(&spec, &evaluate);
+    let refused = lensc_lang::lower::job::refusals(&spec, &estimate, limits);
+    if refused.is_empty() {
+        Ok((spec, estimate))
+    } else {
+        Err(refused)
+    }
 }
 
 /// Builds programs and reports (without writing them) for the checked
@@ -58,9 +84,11 @@ pub fn plan_and_emit(
         .iter()
         .filter(|j| request.job.is_none_or(|n| j.name.name == n));
     for job in jobs {
-        let built = lower(job, request.dialect).and_then(|spec| build(&spec, &prov, spool_dir));
+        let built = lower(job, request.dialect, &request.limits())
+            .and_then(|(spec, est)| Ok((build(&spec, &prov, spool_dir)?, est)));
         match built {
-            Ok(mut b) => {
+            Ok((mut b, est)) => {
+                b.report.estimate = (&est).into();
                 diags.append(&mut b.warnings);
                 out.push(b);
             }

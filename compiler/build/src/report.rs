@@ -40,6 +40,9 @@ pub struct Report {
     pub program: Program,
     /// The toolpath as planned, by strategy.
     pub toolpath: Toolpath,
+    /// What the job was estimated to write before it was planned (the
+    /// figures its limits were checked against).
+    pub estimate: Estimate,
     /// What the program cuts, simulated from its moves as printed.
     pub simulation: Simulation,
     /// The surface's analysis over its whole domain (what `lensc analyse`
@@ -82,6 +85,26 @@ pub struct Program {
     /// the servo from a table (absent otherwise).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fts_table: Option<FtsTable>,
+}
+
+/// What a job was estimated to write before it was planned: within 2× of
+/// `toolpath.cut_points` and `program.bytes` for every example.
+#[derive(Clone, Copy, Debug, Default, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct Estimate {
+    /// Cut points (counted as `toolpath.cut_points` counts them).
+    pub cut_points: u64,
+    /// Bytes of the program.
+    pub program_bytes: u64,
+}
+
+impl From<&lensc_lang::lower::job::Estimate> for Estimate {
+    fn from(e: &lensc_lang::lower::job::Estimate) -> Estimate {
+        Estimate {
+            cut_points: e.points.round() as u64,
+            program_bytes: e.program_bytes.round() as u64,
+        }
+    }
 }
 
 /// A fast-tool-servo table written beside the program.

@@ -9,6 +9,13 @@ pub const CANNOT_READ: &str = "E0103";
 pub const IMPORT_CYCLE: &str = "E0104";
 pub const NOT_IN_MODULE: &str = "E0105";
 pub const SELF_REFERENCE: &str = "E0106";
+/// A `use` (or the file given with `--root`) that resolves, after
+/// symlinks, outside the project root.
+pub const OUTSIDE_ROOT: &str = "E0107";
+/// A path that names a FIFO, device, socket or directory, not a regular file.
+pub const NOT_A_FILE: &str = "E0108";
+/// A file over the size limit of what lensc reads (16 MiB).
+pub const FILE_TOO_LARGE: &str = "E0109";
 pub const UNKNOWN_UNIT: &str = "E0110";
 pub const DIMENSION_MISMATCH: &str = "E0111";
 pub const BAD_ARGUMENT_DIMENSION: &str = "E0112";
@@ -46,6 +53,10 @@ pub const DIALECT_NOT_OFFERED: &str = "E0148";
 pub const SIMULATION_TOO_LARGE: &str = "E0149";
 pub const NOT_PRINTABLE: &str = "E0150";
 pub const CANNOT_WRITE: &str = "E0151";
+/// A job asks for more points than lensc plans for one job.
+pub const TOO_MANY_POINTS: &str = "E0160";
+/// A job's program would be larger than `--max-program-size`.
+pub const PROGRAM_TOO_LARGE: &str = "E0161";
 
 pub const UNUSED: &str = "W0001";
 pub const WRAP_GAP: &str = "W0002";
@@ -64,6 +75,9 @@ pub const ALL: &[&str] = &[
     IMPORT_CYCLE,
     NOT_IN_MODULE,
     SELF_REFERENCE,
+    OUTSIDE_ROOT,
+    NOT_A_FILE,
+    FILE_TOO_LARGE,
     UNKNOWN_UNIT,
     DIMENSION_MISMATCH,
     BAD_ARGUMENT_DIMENSION,
@@ -102,6 +116,8 @@ pub const ALL: &[&str] = &[
     SIMULATION_TOO_LARGE,
     NOT_PRINTABLE,
     CANNOT_WRITE,
+    TOO_MANY_POINTS,
+    PROGRAM_TOO_LARGE,
     UNUSED,
     SEAM_LEFT_UNCUT,
     CENTRE_LEFT_UNCUT,

@@ -3,7 +3,8 @@
 //! surface IR (here) → toolpaths and programs (`lensc-build` driving
 //! `lensc-runtime`) → the `lensc` binary's output.
 //!
-//! Here files are loaded with their `use`s (`loader`, `source`); names are
+//! Here files are loaded with their `use`s (`loader`, `source`; `sandbox`
+//! the files a job may read); names are
 //! resolved and every value checked for its unit and range against the
 //! schema (`check`: `scope`, `expr`, `params`, `rules`; `schema`, one file
 //! per category of kind; `units`, `value`, `codes`); and checked jobs and
@@ -18,6 +19,7 @@ pub mod codes;
 pub mod domain;
 pub mod loader;
 pub mod lower;
+pub mod sandbox;
 pub mod schema;
 pub mod source;
 pub mod units;
@@ -27,6 +29,7 @@ use std::path::Path;
 
 use lensc_grammar::Diagnostic;
 use loader::{FileSystem, Loaded};
+use sandbox::ReadError;
 
 /// The result of checking one file: its sources and everything found.
 pub struct Checked {
@@ -43,10 +46,20 @@ impl Checked {
     }
 }
 
-/// Loads and checks `path`. An I/O error on the root file itself is the
-/// caller's to report.
-pub fn check_path(fs: &dyn FileSystem, path: &Path) -> std::io::Result<Checked> {
-    let loaded = loader::load(fs, path)?;
+/// Loads and checks `path`, with the directory it is in as the project
+/// root. An error reading the file itself is the caller's to report.
+pub fn check_path(fs: &dyn FileSystem, path: &Path) -> Result<Checked, ReadError> {
+    check_path_in(fs, path, None)
+}
+
+/// Loads and checks `path` with `root` as the project root (`None`: the
+/// directory `path` is in); `path` must lie inside it.
+pub fn check_path_in(
+    fs: &dyn FileSystem,
+    path: &Path,
+    root: Option<&Path>,
+) -> Result<Checked, ReadError> {
+    let loaded = loader::load_in(fs, path, root)?;
     let checked = check::check(&loaded);
     Ok(Checked { loaded, checked })
 }

@@ -1,7 +1,9 @@
 //! Loads a job file and everything it `use`s: standard-library modules
 //! embedded in the binary (shown as `std/NAME.lens`) and other `.lens`
-//! files by path relative to the file that uses them. File access goes
-//! through the `FileSystem` trait so the compiler core stays pure.
+//! files by path relative to the file that uses them, never from outside
+//! the project root (`sandbox` says which files may be read and how). File
+//! access goes through the `FileSystem` trait so the compiler core stays
+//! pure.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -11,6 +13,7 @@ use lensc_grammar::diagnostic::codes as syntax_codes;
 use lensc_grammar::{Diagnostic, FileId};
 
 use crate::codes;
+use crate::sandbox::{self, ReadError};
 use crate::source::SourceMap;
 use lensc_grammar::suggest::did_you_mean;
 
@@ -32,20 +35,23 @@ pub const STDLIB: &[(&str, &str)] = &[
 pub const PRELUDE: &str = "dialects";
 
 pub trait FileSystem {
-    fn read(&self, path: &Path) -> std::io::Result<Vec<u8>>;
-    /// A key that is equal for two paths naming the same file.
+    /// The text of a regular file, bounded in size.
+    fn read(&self, path: &Path) -> Result<Vec<u8>, ReadError>;
+    /// The path made absolute with its symlinks resolved: equal for two
+    /// paths naming the same file, and what the project root is checked on.
     fn canonical(&self, path: &Path) -> PathBuf;
 }
 
-/// The real file system.
+/// The real file system: regular files of at most
+/// `sandbox::MAX_FILE_BYTES`, read without blocking.
 pub struct RealFs;
 
 impl FileSystem for RealFs {
-    fn read(&self, path: &Path) -> std::io::Result<Vec<u8>> {
-        std::fs::read(path)
+    fn read(&self, path: &Path) -> Result<Vec<u8>, ReadError> {
+        sandbox::read_regular(path, sandbox::MAX_FILE_BYTES)
     }
     fn canonical(&self, path: &Path) -> PathBuf {
-        std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf())
+        sandbox::resolve(path)
     }
 }
 
@@ -77,26 +83,51 @@ impl Loaded {
     }
 }
 
-/// Loads `root` (as the user named it) and the closure of its `use`s.
-pub fn load(fs: &dyn FileSystem, root: &Path) -> Result<Loaded, std::io::Error> {
-    let bytes = fs.read(root)?;
-    Ok(load_bytes(fs, Key::Path(fs.canonical(root)), root, bytes))
+/// Loads `file` (as the user named it) and the closure of its `use`s,
+/// with the directory `file` is in as the project root.
+pub fn load(fs: &dyn FileSystem, file: &Path) -> Result<Loaded, ReadError> {
+    load_in(fs, file, None)
+}
+
+/// Loads `file` and the closure of its `use`s, none of which may resolve
+/// outside `root` (`None`: the directory `file` is in). `file` itself must
+/// lie inside a `root` given.
+pub fn load_in(fs: &dyn FileSystem, file: &Path, root: Option<&Path>) -> Result<Loaded, ReadError> {
+    let resolved = fs.canonical(file);
+    let root = match root {
+        Some(r) => fs.canonical(r),
+        None => fs.canonical(directory_of(file)),
+    };
+    if !sandbox::inside(&resolved, &root) {
+        return Err(ReadError::OutsideRoot { resolved, root });
+    }
+    let bytes = fs.read(&resolved)?;
+    Ok(load_bytes(fs, root, Key::Path(resolved), file, bytes))
 }
 
 /// Loads source text given directly (tests, benchmarks); `use` of a path
-/// is resolved relative to the working directory.
+/// is resolved relative to the working directory, which is the root.
 pub fn load_text(fs: &dyn FileSystem, name: &str, text: &[u8]) -> Loaded {
     load_bytes(
         fs,
+        fs.canonical(Path::new(".")),
         Key::Path(PathBuf::from(name)),
         Path::new(name),
         text.to_vec(),
     )
 }
 
-fn load_bytes(fs: &dyn FileSystem, key: Key, path: &Path, bytes: Vec<u8>) -> Loaded {
+/// The directory a file is in (`.` for a bare file name).
+fn directory_of(file: &Path) -> &Path {
+    file.parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."))
+}
+
+fn load_bytes(fs: &dyn FileSystem, root: PathBuf, key: Key, path: &Path, bytes: Vec<u8>) -> Loaded {
     let mut l = Loader {
         fs,
+        root,
         loaded: Loaded {
             sources: SourceMap::default(),
             files: Vec::new(),
@@ -122,6 +153,8 @@ enum Key {
 
 struct Loader<'f> {
     fs: &'f dyn FileSystem,
+    /// The project root, resolved: no file outside it is read.
+    root: PathBuf,
     loaded: Loaded,
     keys: HashMap<Key, FileId>,
     /// Files being loaded, outermost first, to detect import cycles.
@@ -268,7 +301,8 @@ impl Loader<'_> {
     }
 
     /// `use "file.lens"`, relative to the file that uses it: read once,
-    /// and never while it is still being loaded (a cycle).
+    /// never while it is still being loaded (a cycle), and never from
+    /// outside the project root.
     fn use_file(
         &mut self,
         from: FileId,
@@ -280,7 +314,14 @@ impl Loader<'_> {
     ) {
         let base = from_path.and_then(Path::parent).unwrap_or(Path::new(""));
         let full = base.join(path);
-        let key = Key::Path(self.fs.canonical(&full));
+        let resolved = self.fs.canonical(&full);
+        if !sandbox::inside(&resolved, &self.root) {
+            self.loaded
+                .diags
+                .push(outside_root(from, pspan, &full, &resolved, &self.root));
+            return;
+        }
+        let key = Key::Path(resolved.clone());
         if let Some(pos) = self.stack.iter().position(|(k, _)| *k == key) {
             let mut chain: Vec<String> = self.stack[pos..]
                 .iter()
@@ -301,23 +342,59 @@ impl Loader<'_> {
             imports.push(Import::All { file: f, span });
             return;
         }
-        match self.fs.read(&full) {
+        match self.fs.read(&resolved) {
             Ok(bytes) => {
                 let f = self.add(key, full.display().to_string(), Some(full), bytes);
                 imports.push(Import::All { file: f, span });
             }
             Err(e) => self.loaded.diags.push(
                 Diagnostic::error(
-                    codes::CANNOT_READ,
-                    format!("cannot read `{}`: {}", full.display(), plain_io_error(&e)),
+                    e.code(),
+                    format!("cannot read `{}`: {e}", full.display()),
                     from,
                     pspan,
                 )
                 .with_label("used here")
-                .with_help("paths are relative to the file that uses them"),
+                .with_help(match e {
+                    ReadError::NotAFile { .. } => {
+                        "only regular files are read: a FIFO or device could block or never end"
+                            .to_string()
+                    }
+                    ReadError::TooLarge { limit, .. } => format!(
+                        "files of at most {} MiB are read; split it into files joined by `use`",
+                        limit >> 20
+                    ),
+                    _ => "paths are relative to the file that uses them".to_string(),
+                }),
             ),
         }
     }
+}
+
+/// E0107: a `use` of a file outside the project root. The file is not
+/// read, so nothing of it can show in a diagnostic.
+fn outside_root(
+    from: FileId,
+    pspan: Span,
+    full: &Path,
+    resolved: &Path,
+    root: &Path,
+) -> Diagnostic {
+    Diagnostic::error(
+        codes::OUTSIDE_ROOT,
+        format!(
+            "cannot use `{}`: it lies outside the project root `{}`",
+            full.display(),
+            root.display()
+        ),
+        from,
+        pspan,
+    )
+    .with_label(format!("this resolves to `{}`", resolved.display()))
+    .with_help(
+        "a job file reads only files under its project root (by default the directory of \
+         the file given on the command line); give `--root DIR` to widen it",
+    )
 }
 
 /// The OS error without its "(os error 2)" tail.

@@ -13,6 +13,7 @@ mod commands;
 mod interrupt;
 mod output;
 
+use lensc_build::driver;
 use output::Output;
 
 #[derive(Parser)]
@@ -30,6 +31,15 @@ struct Cli {
     /// Colour in human diagnostics.
     #[arg(long, global = true, value_enum, default_value_t = ColorChoice::Auto)]
     color: ColorChoice,
+    /// The project root: no file outside it is read on a job's behalf (a
+    /// `use` that resolves there is an error). Default: the directory of
+    /// the file given.
+    #[arg(long, global = true, value_name = "DIR")]
+    root: Option<PathBuf>,
+    /// Print every diagnostic: without it, after 100 of one code the rest
+    /// are counted in one summary line per code.
+    #[arg(long, global = true)]
+    all_diagnostics: bool,
 }
 
 #[derive(Subcommand)]
@@ -39,6 +49,11 @@ enum Command {
         /// The .lens files to check.
         #[arg(required = true)]
         files: Vec<PathBuf>,
+        /// The largest program to write, in bytes or with a unit (`500MB`,
+        /// `4GB`, `2GiB`): a job whose program is estimated larger is
+        /// refused before it is planned.
+        #[arg(long, value_name = "SIZE", default_value = "4GB", value_parser = parse_size)]
+        max_program_size: u64,
     },
     /// Check a file and write a program for each of its jobs.
     Build {
@@ -54,6 +69,11 @@ enum Command {
         /// Directory for the programs.
         #[arg(long, default_value = "out")]
         out: PathBuf,
+        /// The largest program to write, in bytes or with a unit (`500MB`,
+        /// `4GB`, `2GiB`): a job whose program is estimated larger is
+        /// refused before it is planned.
+        #[arg(long, value_name = "SIZE", default_value = "4GB", value_parser = parse_size)]
+        max_program_size: u64,
     },
     /// Plan and simulate a file's jobs as `build` does and write SVG plots
     /// of what each program will cut: `JOB.profile.svg` (profile jobs: the
@@ -72,6 +92,11 @@ enum Command {
         /// Directory for the plots.
         #[arg(long, default_value = "out")]
         out: PathBuf,
+        /// The largest program to write, in bytes or with a unit (`500MB`,
+        /// `4GB`, `2GiB`): a job whose program is estimated larger is
+        /// refused before it is planned.
+        #[arg(long, value_name = "SIZE", default_value = "4GB", value_parser = parse_size)]
+        max_program_size: u64,
     },
     /// Analyse a surface over its aperture: sag range, slopes and radii of
     /// curvature with where they occur, as JSON on stdout.
@@ -140,12 +165,23 @@ fn run(cli: Cli) -> u8 {
             std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none()
         }
     };
+    if let Some(root) = &cli.root
+        && !root.is_dir()
+    {
+        eprintln!("error: --root {}: no such directory", root.display());
+        return 2;
+    }
     let out = Output {
         format: cli.message_format,
         color,
+        root: cli.root,
+        all_diagnostics: cli.all_diagnostics,
     };
     match cli.command {
-        Command::Check { files } => commands::check::run(&out, &files),
+        Command::Check {
+            files,
+            max_program_size,
+        } => commands::check::run(&out, &files, max_program_size),
         Command::Analyse {
             file,
             surface,
@@ -162,12 +198,60 @@ fn run(cli: Cli) -> u8 {
             file,
             job,
             out: dir,
-        } => commands::report::run(&out, &file, job.as_deref(), &dir),
+            max_program_size,
+        } => commands::report::run(&out, &file, job.as_deref(), &dir, max_program_size),
         Command::Build {
             file,
             job,
             dialect,
             out: dir,
-        } => commands::build::run(&out, &file, job.as_deref(), dialect.as_deref(), &dir),
+            max_program_size,
+        } => commands::build::run(
+            &out,
+            &file,
+            driver::Request {
+                job: job.as_deref(),
+                dialect: dialect.as_deref(),
+                max_program_size: Some(max_program_size),
+            },
+            &dir,
+        ),
+    }
+}
+
+/// A size in bytes: a whole number, optionally with a decimal (`kB`, `MB`,
+/// `GB`, `TB`) or binary (`KiB`, `MiB`, `GiB`, `TiB`) unit.
+fn parse_size(text: &str) -> Result<u64, String> {
+    let t = text.trim();
+    let split = t
+        .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .unwrap_or(t.len());
+    let (number, unit) = t.split_at(split);
+    let factor: f64 = match unit.trim().to_ascii_lowercase().as_str() {
+        "" | "b" => 1.0,
+        "kb" | "k" => 1e3,
+        "mb" | "m" => 1e6,
+        "gb" | "g" => 1e9,
+        "tb" | "t" => 1e12,
+        "kib" => 1024.0,
+        "mib" => 1024.0 * 1024.0,
+        "gib" => 1024.0 * 1024.0 * 1024.0,
+        "tib" => 1024.0 * 1024.0 * 1024.0 * 1024.0,
+        other => {
+            return Err(format!(
+                "unknown unit `{other}`: use B, kB, MB, GB, TB, KiB, MiB, GiB or TiB"
+            ));
+        }
+    };
+    let n: f64 = number.parse().map_err(|_| {
+        format!(
+            "`{text}` is not a size: write a number of bytes, or one with a unit (`500MB`, `4GB`)"
+        )
+    })?;
+    let bytes = n * factor;
+    if (1.0..1.8e19).contains(&bytes) {
+        Ok(bytes as u64)
+    } else {
+        Err(format!("`{text}` is not a size lensc can hold to"))
     }
 }

@@ -185,6 +185,29 @@ pub const MAX_SEGMENTS: usize = 2_000_000;
 /// which the curvature is checked.
 const SCAN_POINTS: usize = 4096;
 
+/// What a pass's profile shows before any wheel centre is placed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GrindingScan {
+    /// Number of intervals.
+    pub segments: usize,
+    /// Smallest concave radius of curvature (mm) on the range and its x,
+    /// if any part of the range is concave.
+    pub min_concave: Option<(f64, f64)>,
+}
+
+/// Checks a pass against its profile before planning: its parameters are
+/// in range, the profile is defined at every contact station, interval
+/// midpoint and scan point, and the wheel fits its smallest concave radius
+/// of curvature there. The compiler's lowering runs it so `lensc check`
+/// reports these; the planner runs it as its first step, on the same
+/// points, so the figures agree.
+pub fn check_profile_grinding(
+    p: &ProfileGrinding,
+    profile: &dyn Profile,
+) -> Result<GrindingScan, GrindingError> {
+    scan_profile(p, profile, |_| {})
+}
+
 /// Plans one grinding pass of `p` along `profile`: wheel-centre points at
 /// contact-x interval δ with each interval's commanded z velocity and
 /// acceleration (paper eqs 17–19).
@@ -192,20 +215,11 @@ pub fn plan_profile_grinding(
     p: &ProfileGrinding,
     profile: &dyn Profile,
 ) -> Result<GrindingPath, GrindingError> {
-    check_parameters(p)?;
+    let mut contacts = Vec::new();
+    let scan = scan_profile(p, profile, |c| contacts.push(c))?;
+    let (segments, min_concave) = (scan.segments, scan.min_concave);
     let wheel_radius = 0.5 * p.wheel_diameter;
     let length = (p.end - p.start).abs();
-    let segments = segment_count(length, p.interval)?;
-    let (contacts, min_concave) = contact_points(p, profile, segments)?;
-    if let Some((curvature_radius, x)) = min_concave
-        && wheel_radius > curvature_radius
-    {
-        return Err(GrindingError::WheelTooLarge {
-            x,
-            wheel_radius,
-            curvature_radius,
-        });
-    }
 
     // Wheel centres (eqs 5–6 in our frame) and the commands (eqs 17–19).
     let centres: Vec<Vector2<f64>> = contacts
@@ -262,16 +276,20 @@ type Contact = (f64, ProfilePoint);
 /// The smallest concave radius of curvature (mm) and its x, if any.
 type MinConcave = Option<(f64, f64)>;
 
-/// The contact points, one per station, and the smallest concave radius
-/// of curvature (and its x) over the contact points, interval midpoints
-/// and an even scan; or the first x where the profile is undefined.
-fn contact_points(
+/// The check of `check_profile_grinding`, handing each contact station
+/// (in order, `segments + 1` of them) to `station` as it is evaluated:
+/// the smallest concave radius of curvature (and its x) over the contact
+/// points, interval midpoints and an even scan, or the first x where the
+/// profile is undefined, or the wheel that does not fit.
+fn scan_profile(
     p: &ProfileGrinding,
     profile: &dyn Profile,
-    segments: usize,
-) -> Result<(Vec<Contact>, MinConcave), GrindingError> {
+    mut station: impl FnMut(Contact),
+) -> Result<GrindingScan, GrindingError> {
+    check_parameters(p)?;
+    let segments = segment_count((p.end - p.start).abs(), p.interval)?;
     let dir = (p.end - p.start).signum();
-    let station = |i: usize| {
+    let at = |i: usize| {
         if i >= segments {
             p.end
         } else {
@@ -292,18 +310,30 @@ fn contact_points(
         }
         Ok(pt)
     };
-    let mut contacts = Vec::with_capacity(segments + 1);
     for i in 0..=segments {
-        let x = station(i);
-        contacts.push((x, check(x)?));
+        let x = at(i);
+        station((x, check(x)?));
         if i > 0 {
-            check(0.5 * (station(i - 1) + x))?;
+            check(0.5 * (at(i - 1) + x))?;
         }
     }
     for i in 0..=SCAN_POINTS {
         check(p.start + (p.end - p.start) * i as f64 / SCAN_POINTS as f64)?;
     }
-    Ok((contacts, min_concave))
+    let wheel_radius = 0.5 * p.wheel_diameter;
+    if let Some((curvature_radius, x)) = min_concave
+        && wheel_radius > curvature_radius
+    {
+        return Err(GrindingError::WheelTooLarge {
+            x,
+            wheel_radius,
+            curvature_radius,
+        });
+    }
+    Ok(GrindingScan {
+        segments,
+        min_concave,
+    })
 }
 
 /// The pass's points with each interval's commands, and their extremes.

@@ -126,6 +126,15 @@ pub enum RasterError {
         x: f64,
         y: f64,
     },
+    /// The knife's clearance angle (rad) is not above the surface's
+    /// steepest slope along the cut (rad), found at (x, y): its flank
+    /// would rub.
+    ClearanceTooSmall {
+        clearance: f64,
+        slope: f64,
+        x: f64,
+        y: f64,
+    },
     /// The surface (or its derivatives) is not finite at this point of the
     /// aperture.
     Undefined { x: f64, y: f64 },
@@ -156,6 +165,16 @@ impl std::fmt::Display for RasterError {
                 f,
                 "tool radius {tool_radius} mm exceeds the smallest concave radius \
                  {min_radius} mm at ({x}, {y})"
+            ),
+            RasterError::ClearanceTooSmall {
+                clearance,
+                slope,
+                x,
+                y,
+            } => write!(
+                f,
+                "clearance angle {clearance} rad does not clear the slope {slope} rad \
+                 along the cut at ({x}, {y})"
             ),
             RasterError::Undefined { x, y } => write!(f, "surface undefined at ({x}, {y})"),
             RasterError::NoContact { x, y } => {
@@ -269,17 +288,70 @@ pub fn tool_contact(
     })
 }
 
-/// Plans the raster over `aperture`: path planes at v0 + k·stepover (v is y
-/// when cutting along x), each pass running between the points where the
-/// contact point meets the aperture edge.
-pub fn plan_raster(
+/// What the raster's path planes show before any pass is sampled: the
+/// figures gathered at every contact of the planes' scans and span ends.
+/// The planned path's figures (`RasterPath`) extend them over every
+/// sampled contact.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RasterScan {
+    /// Steepest slope along the cut, atan |∂z/∂u| (rad), at a contact point.
+    pub max_slope_along: Extremum,
+    /// Steepest slope across the cut, atan |∂z/∂v| (rad), at a contact point.
+    pub max_slope_across: Extremum,
+    /// Smallest radius of curvature (mm) of the section along the cut where
+    /// it is concave; `None` if nowhere concave.
+    pub min_concave_radius_along: Option<Extremum>,
+}
+
+/// Checks a raster against its surface before planning: its parameters
+/// are in range, the surface is defined and has a contact wherever a path
+/// plane crosses the aperture, and the tool fits the smallest concave
+/// radius it must fit at the contacts of its planes. The compiler's
+/// lowering runs it so `lensc check` reports these; the planner runs the
+/// same scan as its first phase, so the figures agree.
+pub fn check_raster(
     r: &Raster,
     tool: &RasterTool,
     surface: &dyn SurfaceFn,
     aperture: &Domain,
-) -> Result<RasterPath, RasterError> {
-    validate(r, tool, aperture)?;
+) -> Result<RasterScan, RasterError> {
     let cutter = Cutter::new(tool, surface, r.along);
+    let (_, summary) = scan_planes(r, tool, &cutter, aperture)?;
+    Ok(RasterScan {
+        max_slope_along: summary.slope_along,
+        max_slope_across: summary.slope_across,
+        min_concave_radius_along: summary.concave_along,
+    })
+}
+
+/// The knife's flank must clear the steepest slope along the cut:
+/// `ClearanceTooSmall` unless `clearance` (rad) is above `slope_along`.
+/// Lowering applies it to the planes' scan, the build to the planned path.
+pub fn check_clearance(clearance: f64, slope_along: Extremum) -> Result<(), RasterError> {
+    if clearance > slope_along.value {
+        return Ok(());
+    }
+    Err(RasterError::ClearanceTooSmall {
+        clearance,
+        slope: slope_along.value,
+        x: slope_along.x,
+        y: slope_along.y,
+    })
+}
+
+/// A path plane (v) and the spans of contacts it cuts.
+type Line = (f64, Vec<(Contact, Contact)>);
+
+/// Phase 1 of the raster: where each plane at v0 + k·stepover (v is y
+/// when cutting along x) cuts, with the surface and the tool checked
+/// there; the planes that cut, and the figures gathered.
+fn scan_planes(
+    r: &Raster,
+    tool: &RasterTool,
+    cutter: &Cutter,
+    aperture: &Domain,
+) -> Result<(Vec<Line>, Summary), RasterError> {
+    validate(r, tool, aperture)?;
     let ((x0, x1), (y0, y1)) = aperture.bounds();
     let ((u0, u1), (v0, v1)) = match r.along {
         Axis::X => ((x0, x1), (y0, y1)),
@@ -297,8 +369,6 @@ pub fn plan_raster(
         });
     }
     let (last, extra) = (last as i64, extra as i64);
-
-    // Phase 1: where each plane cuts, with the surface checked there.
     let mut summary = Summary::new(r.along);
     let mut lines = Vec::new();
     for k in -extra..=last + extra {
@@ -315,6 +385,21 @@ pub fn plan_raster(
         return Err(RasterError::NothingToCut);
     }
     summary.check_tool(cutter.radius)?;
+    Ok((lines, summary))
+}
+
+/// Plans the raster over `aperture`: path planes at v0 + k·stepover (v is y
+/// when cutting along x), each pass running between the points where the
+/// contact point meets the aperture edge.
+pub fn plan_raster(
+    r: &Raster,
+    tool: &RasterTool,
+    surface: &dyn SurfaceFn,
+    aperture: &Domain,
+) -> Result<RasterPath, RasterError> {
+    let cutter = Cutter::new(tool, surface, r.along);
+    // Phase 1: where each plane cuts, with the surface checked there.
+    let (lines, mut summary) = scan_planes(r, tool, &cutter, aperture)?;
 
     // Phase 2: the exact centres of each pass, chord by chord.
     let mut budget = MAX_POINTS;

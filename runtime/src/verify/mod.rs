@@ -4,3 +4,4 @@
 pub mod follow;
 pub mod heightmap;
 pub mod simulate;
+pub mod window;

@@ -81,12 +81,11 @@ pub fn build(
     let data_rate = 1.0 / p.spiral.min_interval;
     let mut following = following(spec, data_rate);
     // The height map over the window, from the same printed points.
-    let window = Window::of(
+    let window = height_map::window(
         head,
         height_map::lathe_centre(&head.surface.lowered.domain, &p.lenslets),
     );
     let grid = window.polar();
-    window.check_size(head, &grid).map_err(|d| vec![d])?;
     let mut sweep = Sweep::new(grid, p.nose_radius);
     let mut printed = Vec::new();
     let planned = Prepared::of(spec).planner().plan(&p.fast_axis, |pts| {

@@ -5,16 +5,15 @@
 
 use lensc_grammar::Diagnostic;
 use lensc_lang::check::trim_num;
-use lensc_lang::codes;
 use lensc_lang::lower::diagnostics::RuntimeError;
 use lensc_lang::lower::job::RasterSpec;
 use lensc_runtime::plan::optimise::Summary;
-use lensc_runtime::plan::raster::{Axis, RasterPath, RasterTool};
+use lensc_runtime::plan::raster::{Axis, RasterPath, RasterTool, check_clearance};
 use lensc_runtime::post::Provenance;
 use lensc_runtime::verify::heightmap::Sweep;
 
 use crate::evaluate::evaluator;
-use crate::height_map::{self, Window, domain_centre};
+use crate::height_map::{self, domain_centre};
 use crate::output::{Built, ProgramText};
 use crate::parts;
 use crate::report;
@@ -28,8 +27,14 @@ pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnost
     let path =
         lensc_runtime::plan::raster::plan_raster(raster, &tool, kernel.as_ref(), &lowered.domain)
             .map_err(|e| vec![parts::failed(head, RuntimeError::Raster(e))])?;
-    // The knife's flank must clear the steepest slope along the cut.
-    let mut errors: Vec<Diagnostic> = clearance_error(spec, &path).into_iter().collect();
+    let mut errors = Vec::new();
+    // The knife's flank must clear the steepest slope along the cut, as
+    // lowering found it on the planes and now on every planned contact.
+    if let Some(clearance) = spec.clearance
+        && let Err(e) = check_clearance(clearance, path.max_slope_along)
+    {
+        errors.push(parts::failed(head, RuntimeError::Raster(e)));
+    }
     let feed = spec.feed;
     let moves = lensc_runtime::emit::raster::raster_moves(&path, feed);
     errors.extend(parts::travel_error(head, &moves));
@@ -58,9 +63,8 @@ pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnost
     let simulation = match tool {
         RasterTool::Knife { nose_radius } => {
             let along_x = raster.along == Axis::X;
-            let window = Window::of(head, domain_centre(&lowered.domain));
+            let window = height_map::window(head, domain_centre(&lowered.domain));
             let grid = window.cartesian(along_x);
-            window.check_size(head, &grid).map_err(|d| vec![d])?;
             let mut sweep = Sweep::new(grid, nose_radius);
             height_map::sweep_mill_moves(&mut sweep, &moves, along_x, resolution);
             let frame = height_map::RasterFrame {
@@ -108,25 +112,6 @@ pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnost
     Ok(parts::built(
         head, prov, text, toolpath, simulation, plots, cut,
     ))
-}
-
-/// E0145 unless the knife's clearance angle is above the planner's
-/// steepest slope along the cut: else its flank would rub.
-fn clearance_error(spec: &RasterSpec, path: &RasterPath) -> Option<Diagnostic> {
-    let clearance = spec.clearance?;
-    let steepest = &path.max_slope_along;
-    (clearance <= steepest.value).then(|| {
-        spec.head.error(
-            codes::CLEARANCE_TOO_SMALL,
-            format!(
-                "the clearance angle ({}°) is not above the surface's steepest slope along the cut ({}°, at ({}, {}) mm): the flank would rub",
-                trim_num(clearance.to_degrees()),
-                trim_num(steepest.value.to_degrees()),
-                trim_num(steepest.x),
-                trim_num(steepest.y)
-            ),
-        )
-    })
 }
 
 /// The program's header: provenance, units, surface, the tool, the raster

@@ -16,7 +16,7 @@ use lensc_runtime::post::Provenance;
 use lensc_runtime::verify::heightmap::Sweep;
 
 use crate::evaluate::evaluator;
-use crate::height_map::{self, RollerFrame, Window};
+use crate::height_map::{self, RollerFrame};
 use crate::output::Built;
 use crate::parts;
 use crate::report;
@@ -46,9 +46,8 @@ pub fn build(
     // The height map over the window, from the printed points of every
     // pass (the finish pass's envelope lies below the rough one's).
     let (design_y, z) = (spec.design_y, (helix.z_start, helix.z_end));
-    let window = Window::of(head, ((z.0 + z.1) / 2.0, (design_y.0 + design_y.1) / 2.0));
+    let window = height_map::window(head, ((z.0 + z.1) / 2.0, (design_y.0 + design_y.1) / 2.0));
     let grid = window.roller(helix.roller_radius);
-    window.check_size(head, &grid).map_err(|d| vec![d])?;
     let mut sweep = Sweep::new(grid, rho);
     let mut current_pass = usize::MAX;
     let planned = plan_roller_helix_into(helix, rho, kernel.as_ref(), |pass, pts| {

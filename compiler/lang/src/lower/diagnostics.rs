@@ -5,7 +5,8 @@
 //! variant fails to compile until it has its words; no Rust value is ever
 //! printed with `{:?}`. It lives here, not in lensc-build, because
 //! lowering runs the planners' preconditions (turning's profile checks,
-//! the roller's tool check) and reports their errors as `build` does.
+//! the raster's plane scan and clearance, grinding's station scan, the
+//! roller's tool check) and reports their errors as `build` does.
 
 use crate::check::trim_num;
 use crate::codes;
@@ -17,6 +18,7 @@ use lensc_runtime::plan::raster::RasterError;
 use lensc_runtime::plan::roller::RollerError;
 use lensc_runtime::plan::turning::PlanError;
 use lensc_runtime::post::ProgramError;
+use lensc_runtime::verify::window::TooManyCells;
 
 /// Every error a build can meet after checking, with what its message
 /// needs beyond the error itself.
@@ -38,6 +40,9 @@ pub enum RuntimeError<'a> {
     Grinding(GrindingError),
     /// A roller job could not be checked or planned.
     Roller(RollerError),
+    /// The job's simulation window makes too large a grid (the
+    /// diagnostic points at the window).
+    Simulation(TooManyCells),
     /// The program could not be written in the machine's dialect.
     Program(ProgramError),
     /// The surface could not be lowered to something that evaluates it.
@@ -81,6 +86,17 @@ impl RuntimeError<'_> {
             RuntimeError::Raster(e) => raster(e),
             RuntimeError::Grinding(e) => grinding(e),
             RuntimeError::Roller(e) => roller(e),
+            RuntimeError::Simulation(e) => Coded {
+                label: "this window",
+                ..coded(
+                    codes::SIMULATION_TOO_LARGE,
+                    format!(
+                        "the simulation grid would have {} cells ({} × {}), more than the {} it takes",
+                        e.cells, e.columns, e.rows, e.limit
+                    ),
+                )
+                .help("make the window smaller or its spacing coarser")
+            },
             RuntimeError::Program(e) => Coded {
                 label: "no program was written for this job",
                 ..coded(codes::NOT_PRINTABLE, e.message())
@@ -246,6 +262,21 @@ fn raster(e: RasterError) -> Coded {
             ),
         )
         .help("use a tool whose radius is below the smallest concave radius of curvature"),
+        RasterError::ClearanceTooSmall {
+            clearance,
+            slope,
+            x,
+            y,
+        } => coded(
+            codes::CLEARANCE_TOO_SMALL,
+            format!(
+                "the clearance angle ({}°) is not above the surface's steepest slope along the cut ({}°, at ({}, {}) mm): the flank would rub",
+                trim_num(clearance.to_degrees()),
+                trim_num(slope.to_degrees()),
+                trim_num(x),
+                trim_num(y)
+            ),
+        ),
         RasterError::Undefined { x, y } | RasterError::NoContact { x, y } => coded(
             codes::UNDEFINED_ON_PATH,
             format!(

@@ -6,15 +6,19 @@
 //! planning is checked here — a strategy on a machine or with a tool that
 //! cannot run it, a dialect the machine does not offer or that cannot
 //! print its resolution, a tool larger than the surface's smallest concave
-//! radius of curvature, a feed or spindle speed above the machine's limit —
-//! so `lensc check` reports it as `lensc build` does. Every error found is
-//! returned together.
+//! radius of curvature, a knife's clearance below the slope along the
+//! cut, a feed or spindle speed above the machine's limit, a simulation
+//! window too fine (`window.rs`) — so `lensc check` reports it as `lensc
+//! build` does. Every error found is returned together.
 
+mod estimate;
 mod mill;
 mod roller;
 mod spiral;
 mod turning;
+mod window;
 
+pub use estimate::{DEFAULT_MAX_PROGRAM_SIZE, Estimate, Limits, MAX_POINTS, estimate, refusals};
 pub use mill::{GrindingSpec, RasterSpec};
 pub use roller::RollerSpec;
 pub use spiral::{Settling, SpiralSpec};
@@ -304,9 +308,12 @@ pub fn lower_job(
             spiral::lower(&p, d, evaluate).map(JobSpec::Spiral),
             Setup::Lathe,
         ),
-        "raster" => (mill::lower_raster(&p, d).map(JobSpec::Raster), Setup::Mill),
+        "raster" => (
+            mill::lower_raster(&p, d, evaluate).map(JobSpec::Raster),
+            Setup::Mill,
+        ),
         "profile_grinding" => (
-            mill::lower_grinding(&p, d).map(JobSpec::Grinding),
+            mill::lower_grinding(&p, d, evaluate).map(JobSpec::Grinding),
             Setup::Lathe,
         ),
         "roller_helix" => (
@@ -328,8 +335,14 @@ pub fn lower_job(
         );
     }
     match spec {
-        Ok(spec) if errors.is_empty() => Ok(spec),
-        Ok(_) => Err(errors),
+        Ok(spec) => {
+            errors.extend(window::check_grid(&spec));
+            if errors.is_empty() {
+                Ok(spec)
+            } else {
+                Err(errors)
+            }
+        }
         Err(mut more) => {
             errors.append(&mut more);
             Err(errors)

@@ -8,6 +8,9 @@
 //! of others), `coefficients` (the `A4`, `X2Y1`, `Z11`, `Q3` families),
 //! `apertures`, `tools`, `machines`, `dialects` and `strategies`.
 
+use std::collections::HashSet;
+use std::sync::OnceLock;
+
 use lensc_grammar::ast::DeclKind;
 
 use crate::units::Dim;
@@ -271,13 +274,26 @@ pub fn kind(name: &str) -> Option<&'static Kind> {
 
 /// Whether `name` is a word some parameter takes (`convex`, `linuxcnc`…):
 /// such names cannot be declared, so `sense: convex` always means the word.
+/// Asked once per declared name: the words are gathered into a set once.
 pub fn is_word(name: &str) -> bool {
-    fn in_params(params: &[Param], name: &str) -> bool {
-        params.iter().any(|p| match p.ty {
-            Ty::Word(words) => words.contains(&name),
-            Ty::Block(sub) => in_params(sub, name),
-            _ => false,
-        })
+    fn gather(params: &'static [Param], into: &mut HashSet<&'static str>) {
+        for p in params {
+            match p.ty {
+                Ty::Word(words) => into.extend(words.iter().copied()),
+                Ty::Block(sub) => gather(sub, into),
+                _ => {}
+            }
+        }
     }
-    KINDS.iter().any(|k| in_params(k.params, name)) || in_params(JOB_PARAMS, name)
+    static WORDS: OnceLock<HashSet<&'static str>> = OnceLock::new();
+    WORDS
+        .get_or_init(|| {
+            let mut words = HashSet::new();
+            for k in KINDS {
+                gather(k.params, &mut words);
+            }
+            gather(JOB_PARAMS, &mut words);
+            words
+        })
+        .contains(name)
 }

@@ -7,23 +7,28 @@ use lensc_build::driver;
 use crate::output::{Output, cannot_write, load_jobs};
 
 /// Runs the subcommand; returns the exit code.
-pub fn run(out: &Output, file: &Path, job: Option<&str>, dialect: Option<&str>, dir: &Path) -> u8 {
+pub fn run(out: &Output, file: &Path, request: driver::Request, dir: &Path) -> u8 {
     crate::interrupt::clean_temporaries(dir);
-    let c = match load_jobs(out, file, job) {
+    let c = match load_jobs(out, file, request.job) {
         Ok(c) => c,
         Err(code) => return code,
     };
-    let (programs, diags) = driver::plan_and_emit(
-        &c,
-        driver::Request { job, dialect },
-        &file.display().to_string(),
-        Some(dir),
-    );
+    let (programs, diags) =
+        driver::plan_and_emit(&c, request, &file.display().to_string(), Some(dir));
     out.diagnostics(&c, &diags);
     if diags.iter().any(|d| d.is_error()) {
         return 1;
     }
     for built in programs {
+        let names = std::iter::once(&built.program_name)
+            .chain([&built.report_name])
+            .chain(built.beside.iter().map(|(name, _)| name));
+        for name in names {
+            if let Err(e) = driver::output_path(dir, name) {
+                cannot_write(&dir.join(name), &e);
+                return 1;
+            }
+        }
         let target = dir.join(&built.program_name);
         let report_path = dir.join(&built.report_name);
         let report = built.report.to_json_text();

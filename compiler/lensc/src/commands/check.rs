@@ -1,11 +1,16 @@
 //! `lensc check`: check files for errors without building anything: the
 //! checker's findings and, once a file checks, every job lowered as `build`
-//! lowers it (everything knowable without planning).
+//! lowers it (everything knowable without planning, the limits on its
+//! points and program size included).
 
 use crate::output::{Output, load};
 
 /// Runs the subcommand; returns the exit code.
-pub fn run(out: &Output, files: &[std::path::PathBuf]) -> u8 {
+pub fn run(out: &Output, files: &[std::path::PathBuf], max_program_size: u64) -> u8 {
+    let limits = lensc_lang::lower::job::Limits {
+        max_program_size,
+        ..Default::default()
+    };
     let mut code = 0;
     for f in files {
         let Some(c) = load(out, f) else {
@@ -21,7 +26,7 @@ pub fn run(out: &Output, files: &[std::path::PathBuf]) -> u8 {
                 c.checked
                     .jobs
                     .iter()
-                    .filter_map(|j| lensc_build::pipeline::lower(j, None).err())
+                    .filter_map(|j| lensc_build::pipeline::lower(j, None, &limits).err())
                     .flatten(),
             );
         }

@@ -7,7 +7,7 @@ use lensc_build::driver;
 use crate::output::{Output, cannot_write, load_jobs};
 
 /// Runs the subcommand; returns the exit code.
-pub fn run(out: &Output, file: &Path, job: Option<&str>, dir: &Path) -> u8 {
+pub fn run(out: &Output, file: &Path, job: Option<&str>, dir: &Path, max_program_size: u64) -> u8 {
     crate::interrupt::clean_temporaries(dir);
     let c = match load_jobs(out, file, job) {
         Ok(c) => c,
@@ -17,7 +17,11 @@ pub fn run(out: &Output, file: &Path, job: Option<&str>, dir: &Path) -> u8 {
     // the output directory and dropped: only the plots are kept).
     let (built, diags) = driver::plan_and_emit(
         &c,
-        driver::Request { job, dialect: None },
+        driver::Request {
+            job,
+            dialect: None,
+            max_program_size: Some(max_program_size),
+        },
         &file.display().to_string(),
         Some(dir),
     );
@@ -46,7 +50,8 @@ pub fn run(out: &Output, file: &Path, job: Option<&str>, dir: &Path) -> u8 {
     }
     for (name, svg) in plots {
         let path = dir.join(&name);
-        if let Err(e) = driver::write_atomic(&path, &svg) {
+        if let Err(e) = driver::output_path(dir, &name).and_then(|p| driver::write_atomic(&p, &svg))
+        {
             cannot_write(&path, &e);
             return 1;
         }

@@ -277,6 +277,26 @@ fn table2_concave_lens() {
     assert!(last.x < 1.5 && last.contact_x == 1.5);
 }
 
+/// The pre-plan check scans the planner's own points: the same figures,
+/// the same refusal.
+#[test]
+fn the_pre_plan_check_agrees_with_the_planner() {
+    let surf = table2_concave();
+    let p = table2_pass(0.002, 0.01, 1.5);
+    let scan = check_profile_grinding(&p, &surf).unwrap();
+    let path = plan_profile_grinding(&p, &surf).unwrap();
+    assert_eq!(scan.segments, path.segments);
+    assert_eq!(scan.min_concave, path.min_concave_radius);
+    let mut p = p;
+    p.wheel_diameter = 9.0;
+    let refused = check_profile_grinding(&p, &surf);
+    assert!(
+        matches!(refused, Err(GrindingError::WheelTooLarge { .. })),
+        "{refused:?}"
+    );
+    assert_eq!(refused.err(), plan_profile_grinding(&p, &surf).err());
+}
+
 fn print_figures(name: &str, path: &GrindingPath) {
     println!(
         "{name}: {} segments, {} s, max |v| {:.6e} mm/s, max |a| {:.6e} mm/s², \

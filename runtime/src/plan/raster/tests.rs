@@ -593,6 +593,53 @@ fn tool_larger_than_the_hollow_is_refused() {
     }
 }
 
+/// The pre-plan check finds what the planner finds first, with the same
+/// figures: the tool too large for the hollow, and on a part it fits, the
+/// planes' steepest slope, which the planned path only extends.
+#[test]
+fn the_pre_plan_check_agrees_with_the_planner() {
+    let bowl = Conic {
+        radius: 1.0,
+        k: 0.0,
+        s: 1.0,
+    };
+    let aperture = Domain::Circle { radius: 0.8 };
+    let r = raster(Axis::X, 0.01, 1e-4);
+    let knife = RasterTool::Knife { nose_radius: 0.7 };
+    let checked = check_raster(&r, &knife, &bowl, &aperture);
+    assert!(
+        matches!(checked, Err(RasterError::ToolTooLarge { .. })),
+        "{checked:?}"
+    );
+    assert_eq!(
+        checked.err(),
+        plan_raster(&r, &knife, &bowl, &aperture).err()
+    );
+
+    let lens = convex(1.0, -1.0);
+    let scan = check_raster(&r, &KNIFE, &lens, &aperture).unwrap();
+    let path = plan_raster(&r, &KNIFE, &lens, &aperture).unwrap();
+    assert!(scan.max_slope_along.value <= path.max_slope_along.value);
+    assert!(
+        (scan.max_slope_along.value - path.max_slope_along.value).abs() < 1e-9,
+        "the steepest slope lies at a span's end"
+    );
+    assert!(check_clearance(40f64.to_radians(), scan.max_slope_along).is_ok());
+    match check_clearance(20f64.to_radians(), scan.max_slope_along) {
+        Err(RasterError::ClearanceTooSmall { slope, x, y, .. }) => {
+            assert_eq!(
+                (slope, x, y),
+                (
+                    scan.max_slope_along.value,
+                    scan.max_slope_along.x,
+                    scan.max_slope_along.y
+                )
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
 /// Each pass starts and ends with the contact point exactly on the
 /// aperture edge.
 #[test]

@@ -1,16 +1,20 @@
 //! Lowering the jobs of 2- and 3-axis machines beyond the lathe: iso-plane
 //! raster on a mill and profile grinding with a spherical wheel, each
-//! checked for its machine, its tool and its feed.
+//! checked for its machine, its tool and its feed, and against its surface
+//! by the planner's own pre-plan check (the tool against the smallest
+//! concave radius, the knife's clearance against the steepest slope).
 
 use lensc_grammar::Diagnostic;
-use lensc_runtime::plan::grinding::ProfileGrinding;
-use lensc_runtime::plan::raster::{Axis, Raster, RasterTool};
+use lensc_runtime::plan::grinding::{ProfileGrinding, check_profile_grinding};
+use lensc_runtime::plan::raster::{Axis, Raster, RasterTool, check_clearance, check_raster};
 use lensc_runtime::post::Dialect;
+use lensc_runtime::surface::SectionAlongX;
 use lensc_runtime::surface::analysis::Domain;
 
-use super::{JobHead, Parts};
+use super::{Evaluate, JobHead, Parts};
 use crate::check::trim_num;
 use crate::codes;
+use crate::lower::diagnostics::RuntimeError;
 use crate::value;
 
 /// A `raster` job on a `mill_3axis`, typed.
@@ -35,7 +39,11 @@ pub struct GrindingSpec {
     pub retract: f64,
 }
 
-pub(super) fn lower_raster(p: &Parts, dialect: Dialect) -> Result<RasterSpec, Vec<Diagnostic>> {
+pub(super) fn lower_raster(
+    p: &Parts,
+    dialect: Dialect,
+    evaluate: Evaluate,
+) -> Result<RasterSpec, Vec<Diagnostic>> {
     let errors: Vec<Diagnostic> = [
         p.needs("machine", p.machine, &["mill_3axis"], "raster"),
         p.needs("tool", p.tool, &["microshaper", "ball_end"], "raster"),
@@ -46,7 +54,7 @@ pub(super) fn lower_raster(p: &Parts, dialect: Dialect) -> Result<RasterSpec, Ve
     if !errors.is_empty() {
         return Err(errors);
     }
-    let (st, t, m) = (&p.strategy.fields, &p.tool.fields, &p.machine.fields);
+    let (st, t) = (&p.strategy.fields, &p.tool.fields);
     let raster = Raster {
         along: if value::word(st, "along") == Some("y") {
             Axis::Y
@@ -84,28 +92,33 @@ pub(super) fn lower_raster(p: &Parts, dialect: Dialect) -> Result<RasterSpec, Ve
     };
     let lowered = p.lowered().map_err(|d| vec![d])?;
     let feed = value::num(st, "feed").expect("required");
-    let max_feed = value::num(m, "max_feed").expect("required");
-    if feed > max_feed {
-        return Err(vec![p.error(
-            codes::FEED_TOO_HIGH,
-            format!(
-                "the cutting feed ({} mm/min) is above the machine's maximum ({} mm/min)",
-                trim_num(feed * 60.0),
-                trim_num(max_feed * 60.0)
-            ),
-        )]);
+    let clearance = value::num(t, "clearance");
+    let mut errors: Vec<Diagnostic> = feed_error(p, "cutting", feed).into_iter().collect();
+    // The checks the planner makes first, on the planes it cuts.
+    let kernel = evaluate(&lowered.tape);
+    let scanned = check_raster(&raster, &tool, kernel.as_ref(), &lowered.domain)
+        .and_then(|scan| clearance.map_or(Ok(()), |c| check_clearance(c, scan.max_slope_along)));
+    if let Err(e) = scanned {
+        errors.push(RuntimeError::Raster(e).at(p.site()));
+    }
+    if !errors.is_empty() {
+        return Err(errors);
     }
     Ok(RasterSpec {
         head: p.head(dialect, lowered),
         raster,
         tool,
         tool_words,
-        clearance: value::num(t, "clearance"),
+        clearance,
         feed,
     })
 }
 
-pub(super) fn lower_grinding(p: &Parts, dialect: Dialect) -> Result<GrindingSpec, Vec<Diagnostic>> {
+pub(super) fn lower_grinding(
+    p: &Parts,
+    dialect: Dialect,
+    evaluate: Evaluate,
+) -> Result<GrindingSpec, Vec<Diagnostic>> {
     let errors: Vec<Diagnostic> = [
         p.needs("machine", p.machine, &["grinder_2axis"], "profile grinding"),
         p.needs("tool", p.tool, &["spherical_wheel"], "profile grinding"),
@@ -116,7 +129,7 @@ pub(super) fn lower_grinding(p: &Parts, dialect: Dialect) -> Result<GrindingSpec
     if !errors.is_empty() {
         return Err(errors);
     }
-    let (st, t, m) = (&p.strategy.fields, &p.tool.fields, &p.machine.fields);
+    let (st, t) = (&p.strategy.fields, &p.tool.fields);
     let lowered = p.lowered().map_err(|d| vec![d])?;
     let edge = match lowered.domain {
         Domain::Circle { radius } | Domain::Annulus { outer: radius, .. } => radius,
@@ -131,20 +144,33 @@ pub(super) fn lower_grinding(p: &Parts, dialect: Dialect) -> Result<GrindingSpec
         start: value::num(st, "from").unwrap_or(0.0),
         end: value::num(st, "to").unwrap_or(edge),
     };
-    let max_feed = value::num(m, "max_feed").expect("required");
-    if feed > max_feed {
-        return Err(vec![p.error(
-            codes::FEED_TOO_HIGH,
-            format!(
-                "the grinding feed ({} mm/min) is above the machine's maximum ({} mm/min)",
-                trim_num(feed * 60.0),
-                trim_num(max_feed * 60.0)
-            ),
-        )]);
+    let mut errors: Vec<Diagnostic> = feed_error(p, "grinding", feed).into_iter().collect();
+    // The checks the planner makes first, on its own contact stations.
+    let kernel = evaluate(&lowered.tape);
+    if let Err(e) = check_profile_grinding(&grinding, &SectionAlongX(kernel.as_ref())) {
+        errors.push(RuntimeError::Grinding(e).at(p.site()));
+    }
+    if !errors.is_empty() {
+        return Err(errors);
     }
     Ok(GrindingSpec {
         head: p.head(dialect, lowered),
         grinding,
         retract: value::num(st, "retract").unwrap_or(1.0),
+    })
+}
+
+/// E0142 when the `what` feed (mm/s) is above the machine's maximum.
+fn feed_error(p: &Parts, what: &str, feed: f64) -> Option<Diagnostic> {
+    let max_feed = value::num(&p.machine.fields, "max_feed").expect("required");
+    (feed > max_feed).then(|| {
+        p.error(
+            codes::FEED_TOO_HIGH,
+            format!(
+                "the {what} feed ({} mm/min) is above the machine's maximum ({} mm/min)",
+                trim_num(feed * 60.0),
+                trim_num(max_feed * 60.0)
+            ),
+        )
     })
 }
