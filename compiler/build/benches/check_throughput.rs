@@ -15,7 +15,7 @@
 //! stages in one process, which criterion does not print.
 
 use std::hint::black_box;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use lensc_build::driver;
 use lensc_lang::loader::RealFs;
