@@ -157,8 +157,26 @@ impl<'a> Parts<'a> {
     pub fn error(&self, code: &'static str, msg: String) -> Diagnostic {
         site_error(self.site(), code, msg)
     }
+    /// E0131 for the machine and for the tool unless each is of a kind
+    /// `what` can use.
+    pub fn needs_kinds(
+        &self,
+        what: &str,
+        machines: &[&str],
+        tools: &[&str],
+    ) -> Result<(), Vec<Diagnostic>> {
+        all_clear(
+            [
+                self.needs("machine", self.machine, machines, what),
+                self.needs("tool", self.tool, tools, what),
+            ]
+            .into_iter()
+            .flatten()
+            .collect(),
+        )
+    }
     /// E0131 unless `o` is one of `kinds`.
-    pub fn needs(&self, part: &str, o: &Object, kinds: &[&str], what: &str) -> Option<Diagnostic> {
+    fn needs(&self, part: &str, o: &Object, kinds: &[&str], what: &str) -> Option<Diagnostic> {
         (!kinds.contains(&o.kind.name)).then(|| {
             self.error(
                 codes::UNSUPPORTED_COMBINATION,
@@ -260,6 +278,15 @@ impl<'a> Parts<'a> {
             travel: ["x", "y", "z", "c"].map(|a| travel.and_then(|t| value::range(t, a))),
             simulate: simulate(self.job).ok().flatten(),
         }
+    }
+}
+
+/// Nothing, if no error was found; else every error found.
+pub(crate) fn all_clear(errors: Vec<Diagnostic>) -> Result<(), Vec<Diagnostic>> {
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(errors)
     }
 }
 

@@ -11,7 +11,7 @@ use lensc_runtime::plan::roller::{
 use lensc_runtime::post::Dialect;
 use lensc_runtime::surface::analysis::Domain;
 
-use super::{Evaluate, JobHead, Parts};
+use super::{Evaluate, JobHead, Parts, all_clear};
 use crate::check::trim_num;
 use crate::codes;
 use crate::lower::diagnostics::RuntimeError;
@@ -66,9 +66,7 @@ pub(super) fn lower(
     let mut errors = tool_errors(p, &rt, &check);
     let spindle_speed = value::num(st, "spindle_speed").expect("required");
     errors.extend(p.spindle_limit(spindle_speed));
-    if !errors.is_empty() {
-        return Err(errors);
-    }
+    all_clear(errors)?;
     let (z_start, z_end) = value::range(st, "z").unwrap_or(design_x);
     let helix = RollerHelix {
         roller_radius,

@@ -12,7 +12,7 @@ use lensc_runtime::post::Dialect;
 use lensc_runtime::surface::analysis::Domain;
 use lensc_runtime::surface::ir::SurfaceFn;
 
-use super::{Evaluate, JobHead, Parts};
+use super::{Evaluate, JobHead, Parts, all_clear};
 use crate::check::trim_num;
 use crate::codes;
 use crate::lower::diagnostics::RuntimeError;
@@ -68,10 +68,7 @@ pub(super) fn lower(
     } else {
         ("fts_lathe", "fast-tool-servo turning")
     };
-    let errors = p.needs_servo_lathe(what, lathe, "");
-    if !errors.is_empty() {
-        return Err(errors);
-    }
+    all_clear(p.needs_servo_lathe(what, lathe, ""))?;
     let (m, t, st) = (&p.machine.fields, &p.tool.fields, &strategy.fields);
     let travel = value::block(m, "travel").expect("required");
     // The axis that carries the surface: the servo, or Z itself.
@@ -131,9 +128,7 @@ pub(super) fn lower(
         part_top: design.sag_max.value,
     };
     errors.extend(machine_limits(p, &spiral, travel));
-    if !errors.is_empty() {
-        return Err(errors);
-    }
+    all_clear(errors)?;
 
     let retract = value::num(st, "retract").unwrap_or(1.0);
     Ok(SpiralSpec {
