@@ -166,6 +166,11 @@ const ROLLER_BLOCK: f64 = 38.0;
 /// Chords a bisection from a span of `span` makes over a stretch `ds`
 /// where a chord may be at most `h` long: the span halved until it fits.
 fn chords(ds: f64, span: f64, h: f64) -> f64 {
+    // A tolerance so fine it is zero once shared out (5e-324 mm): no chord
+    // is short enough, and the sampler would halve every seed 40 times.
+    if h == 0.0 {
+        return f64::INFINITY;
+    }
     if !(h.is_finite() && h > 0.0) || h >= span {
         return ds / span;
     }

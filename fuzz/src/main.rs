@@ -1,0 +1,410 @@
+//! `cargo run --release -p fuzz -- --seconds N [--seed S] [--build-every K]`:
+//! fuzzes lensc for N seconds. Each input is a file from the
+//! structure-aware generator (`generate`), a mutation of a real file
+//! (`mutate`) or, every K-th, a small whole job (`small_jobs`) that is
+//! built and written. Every input runs under the supervisor (`supervise`:
+//! panics caught, hangs timed out) through the harness (`harness`: every
+//! diagnostic coded and spanned). Failing inputs are saved in
+//! fuzz/crashes/; the run ends with throughput and counts, and exits 1 if
+//! anything failed.
+
+mod generate;
+mod harness;
+mod mutate;
+mod rng;
+mod small_jobs;
+mod supervise;
+
+use std::collections::HashMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+use clap::Parser;
+
+use harness::{Depth, MemFs};
+use mutate::Corpus;
+use rng::Rng;
+use supervise::{Outcome, Supervisor};
+
+#[derive(Parser)]
+#[command(
+    about = "Fuzz lensc: generated and mutated .lens files through check, lowering, build and writing"
+)]
+struct Cli {
+    /// How long to run.
+    #[arg(long, default_value_t = 60)]
+    seconds: u64,
+    /// The run's seed (default: from the clock); printed at the start.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Every K-th input is a small whole job that is built and written.
+    #[arg(long, default_value_t = 50)]
+    build_every: u64,
+    /// Stop after inputs 0..N of the seed even if time is left (CI runs a
+    /// range of a fixed seed that a longer run has shown clean).
+    #[arg(long, value_name = "N")]
+    inputs: Option<u64>,
+    /// Worker threads, each with its own share of the inputs.
+    #[arg(long, default_value_t = 1)]
+    jobs: u64,
+    /// Seconds an input may take before it counts as a hang.
+    #[arg(long, default_value_t = 10)]
+    timeout: u64,
+    /// Run only inputs A..B of the seed (or input A), naming each first:
+    /// for an input that aborted the process.
+    #[arg(long, value_name = "A[..B]")]
+    replay: Option<String>,
+    /// Print input I of the seed to stdout and stop.
+    #[arg(long, value_name = "I")]
+    print: Option<u64>,
+}
+
+/// Where an input came from.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
+enum Source {
+    Generated,
+    Mutated,
+    SmallJob,
+}
+
+/// Makes input `index` of the run seeded `seed`.
+fn input(seed: u64, index: u64, build_every: u64, corpus: &Corpus) -> (Source, Vec<u8>, Depth) {
+    let mut rng = Rng::for_input(seed, index);
+    // Drawn, not `index % K`: lanes take every J-th index, and a tier on a
+    // fixed stride would fall to one lane.
+    if build_every > 0 && rng.below(build_every as usize) == 0 {
+        return (
+            Source::SmallJob,
+            small_jobs::file(&mut rng).into_bytes(),
+            Depth::Build,
+        );
+    }
+    // Lowering JIT-compiles every surface: one clean input in eight.
+    let depth = if rng.below(8) == 0 {
+        Depth::Lower
+    } else {
+        Depth::Check
+    };
+    if rng.chance(0.5) {
+        (
+            Source::Generated,
+            generate::file(&mut rng).into_bytes(),
+            depth,
+        )
+    } else {
+        (Source::Mutated, mutate::mutant(corpus, &mut rng), depth)
+    }
+}
+
+#[derive(Default)]
+struct Counts {
+    inputs: HashMap<Source, u64>,
+    checked: u64,
+    clean: u64,
+    lowered: u64,
+    build_inputs: u64,
+    built: u64,
+    written: u64,
+    unwritten: u64,
+    panics: u64,
+    hangs: u64,
+    uncoded: u64,
+    build_time: Duration,
+    slowest_build: Duration,
+    slow_builds: u64,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let seed = cli.seed.unwrap_or_else(|| {
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map(|d| d.as_nanos() as u64)
+            .unwrap_or(1)
+    });
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let corpus = match Corpus::load(&root) {
+        Ok(c) => c,
+        Err(e) => {
+            eprintln!("fuzz: cannot read the corpus under {}: {e}", root.display());
+            return ExitCode::from(2);
+        }
+    };
+    if let Some(i) = cli.print {
+        let (_, bytes, _) = input(seed, i, cli.build_every, &corpus);
+        let _ = std::io::stdout().write_all(&bytes);
+        return ExitCode::SUCCESS;
+    }
+    let out = match tempfile::tempdir() {
+        Ok(d) => d,
+        Err(e) => {
+            eprintln!("fuzz: cannot make a temporary output directory: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    supervise::install_panic_hook();
+    let (range, deadline) = match cli.replay.as_deref().map(parse_range) {
+        Some(Some(r)) => (r, None),
+        Some(None) => {
+            eprintln!("fuzz: --replay takes A or A..B");
+            return ExitCode::from(2);
+        }
+        None => (
+            0..cli.inputs.unwrap_or(u64::MAX),
+            Some(Duration::from_secs(cli.seconds)),
+        ),
+    };
+    let jobs = if cli.replay.is_some() {
+        1
+    } else {
+        cli.jobs.max(1)
+    };
+    eprintln!(
+        "fuzz: seed {seed}, build every {}th input, {} s, {jobs} worker(s)",
+        cli.build_every, cli.seconds
+    );
+    let run = Run {
+        cli: &cli,
+        seed,
+        corpus: &corpus,
+        fs: std::sync::Arc::new(MemFs::new(&corpus.files)),
+        out: out.path(),
+        crashes: Path::new(env!("CARGO_MANIFEST_DIR")).join("crashes"),
+        seen: Mutex::new(HashMap::new()),
+        start: Instant::now(),
+        deadline,
+    };
+    let totals = std::thread::scope(|scope| {
+        let lanes: Vec<_> = (0..jobs)
+            .map(|lane| {
+                let run = &run;
+                let range = range.clone();
+                scope.spawn(move || run.lane(range.skip(lane as usize).step_by(jobs as usize)))
+            })
+            .collect();
+        let mut totals = Counts::default();
+        for lane in lanes {
+            match lane.join() {
+                Ok(c) => totals.add(c),
+                Err(_) => totals.panics += 1,
+            }
+        }
+        totals
+    });
+    let distinct = run.seen.lock().map(|s| s.len()).unwrap_or(0);
+    summary(&totals, run.start.elapsed(), distinct, jobs);
+    if totals.panics + totals.hangs + totals.uncoded > 0 {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+/// What every lane of a run shares.
+struct Run<'a> {
+    cli: &'a Cli,
+    seed: u64,
+    corpus: &'a Corpus,
+    fs: std::sync::Arc<MemFs>,
+    out: &'a Path,
+    crashes: PathBuf,
+    /// Failure messages seen so far and how often.
+    seen: Mutex<HashMap<String, u32>>,
+    start: Instant,
+    deadline: Option<Duration>,
+}
+
+impl Run<'_> {
+    /// Runs these inputs (one lane's share) until the deadline.
+    fn lane(&self, indices: impl Iterator<Item = u64>) -> Counts {
+        let cli = self.cli;
+        let mut counts = Counts::default();
+        let mut sup = None;
+        for index in indices {
+            if self.deadline.is_some_and(|d| self.start.elapsed() >= d) {
+                break;
+            }
+            if cli.replay.is_some() {
+                eprintln!("fuzz: input {index}");
+            }
+            // Each lane builds into a directory of its own.
+            let sup = sup.get_or_insert_with(|| {
+                let dir = self.out.join(format!("lane-{index}"));
+                let _ = std::fs::create_dir_all(&dir);
+                Supervisor::new(
+                    self.seed,
+                    std::sync::Arc::clone(&self.fs),
+                    dir,
+                    Duration::from_secs(cli.timeout),
+                )
+            });
+            let (source, bytes, depth) = input(self.seed, index, cli.build_every, self.corpus);
+            *counts.inputs.entry(source).or_default() += 1;
+            let began = Instant::now();
+            let outcome = sup.run(index, bytes.clone(), depth);
+            let took = began.elapsed();
+            if let Some((what, message)) = counts.record(outcome, depth, took, cli.timeout) {
+                self.failed(what, &message, index, source, &bytes);
+            }
+        }
+        counts
+    }
+
+    /// Reports a failure and saves its input (the first three of each
+    /// message).
+    fn failed(&self, what: &str, message: &str, index: u64, source: Source, bytes: &[u8]) {
+        let n = {
+            let Ok(mut seen) = self.seen.lock() else {
+                return;
+            };
+            let n = seen.entry(message.to_string()).or_default();
+            *n += 1;
+            *n
+        };
+        if n <= 3 {
+            let saved = save(&self.crashes, what, self.seed, index, bytes, message);
+            // Not `eprintln!`, which panics if stderr cannot be written.
+            let _ = writeln!(
+                std::io::stderr(),
+                "fuzz: {what} on input {index} ({source:?}): {message}\n      saved as {saved}"
+            );
+        }
+    }
+}
+
+impl Counts {
+    /// Counts one input's outcome; returns what failed, if anything.
+    fn record(
+        &mut self,
+        outcome: Outcome,
+        depth: Depth,
+        took: Duration,
+        timeout: u64,
+    ) -> Option<(&'static str, String)> {
+        match outcome {
+            Outcome::Done(Ok(r)) => {
+                self.checked += 1;
+                self.clean += u64::from(r.clean);
+                self.lowered += r.lowered as u64;
+                self.built += r.built as u64;
+                self.written += r.written as u64;
+                self.unwritten += r.unwritten as u64;
+                if matches!(depth, Depth::Build) {
+                    self.build_inputs += 1;
+                    self.build_time += took;
+                    self.slowest_build = self.slowest_build.max(took);
+                    self.slow_builds += u64::from(took > Duration::from_secs(1));
+                }
+                None
+            }
+            Outcome::Done(Err(fault)) => {
+                self.checked += 1;
+                self.uncoded += 1;
+                Some(("uncoded", fault))
+            }
+            Outcome::Panicked(m) => {
+                self.panics += 1;
+                Some(("panic", m))
+            }
+            Outcome::Hung => {
+                self.hangs += 1;
+                Some(("hang", format!("no answer in {timeout} s")))
+            }
+        }
+    }
+
+    fn add(&mut self, o: Counts) {
+        for (k, v) in o.inputs {
+            *self.inputs.entry(k).or_default() += v;
+        }
+        self.checked += o.checked;
+        self.clean += o.clean;
+        self.lowered += o.lowered;
+        self.build_inputs += o.build_inputs;
+        self.built += o.built;
+        self.written += o.written;
+        self.unwritten += o.unwritten;
+        self.panics += o.panics;
+        self.hangs += o.hangs;
+        self.uncoded += o.uncoded;
+        self.build_time += o.build_time;
+        self.slowest_build = self.slowest_build.max(o.slowest_build);
+        self.slow_builds += o.slow_builds;
+    }
+}
+
+fn parse_range(s: &str) -> Option<std::ops::Range<u64>> {
+    match s.split_once("..") {
+        Some((a, b)) => Some(a.parse().ok()?..b.parse().ok()?),
+        None => {
+            let a: u64 = s.parse().ok()?;
+            Some(a..a + 1)
+        }
+    }
+}
+
+/// Saves a failing input (as bytes) and what went wrong beside it.
+fn save(dir: &Path, what: &str, seed: u64, index: u64, bytes: &[u8], message: &str) -> String {
+    let path: PathBuf = dir.join(format!("{what}-{seed}-{index}.lens"));
+    let note = format!(
+        "{what}: {message}\nreplay: cargo run --release -p fuzz -- --seed {seed} --replay {index}\n"
+    );
+    let written = std::fs::create_dir_all(dir)
+        .and_then(|()| std::fs::write(&path, bytes))
+        .and_then(|()| std::fs::write(path.with_extension("txt"), note));
+    match written {
+        Ok(()) => path.display().to_string(),
+        Err(e) => format!("(not saved: {e})"),
+    }
+}
+
+/// The run's figures, on stdout (a full disk or a closed pipe loses them
+/// quietly rather than panicking).
+fn summary(c: &Counts, elapsed: Duration, distinct: usize, lanes: u64) {
+    let secs = elapsed.as_secs_f64().max(1e-9);
+    // Lanes run side by side: their build time is shared out among them.
+    let check_secs = (elapsed.saturating_sub(c.build_time / lanes as u32))
+        .as_secs_f64()
+        .max(1e-9);
+    let check_only = c.checked.saturating_sub(c.build_inputs);
+    let get = |s| c.inputs.get(&s).copied().unwrap_or(0);
+    let mut out = std::io::stdout().lock();
+    let _ = writeln!(out, "fuzz: {secs:.1} s, {lanes} lane(s)");
+    let _ = writeln!(
+        out,
+        "  inputs            {} ({} generated, {} mutated, {} small jobs), {:.0}/s",
+        get(Source::Generated) + get(Source::Mutated) + get(Source::SmallJob),
+        get(Source::Generated),
+        get(Source::Mutated),
+        get(Source::SmallJob),
+        c.checked as f64 / secs
+    );
+    let _ = writeln!(
+        out,
+        "  through check     {} ({} clean), {:.0} inputs/s outside builds",
+        c.checked,
+        c.clean,
+        check_only as f64 / check_secs
+    );
+    let _ = writeln!(out, "  jobs lowered      {}", c.lowered);
+    let _ = writeln!(
+        out,
+        "  through build     {} jobs built and {} written ({} not written: I/O) from {} small-job inputs, {:.2} builds/s over the run, {:.1} builds/s per lane while building, slowest {:.2} s, {} over 1 s",
+        c.built,
+        c.written,
+        c.unwritten,
+        c.build_inputs,
+        c.built as f64 / secs,
+        c.built as f64 * lanes as f64 / c.build_time.as_secs_f64().max(1e-9),
+        c.slowest_build.as_secs_f64(),
+        c.slow_builds
+    );
+    let _ = writeln!(
+        out,
+        "  panics {}, hangs {}, uncoded rejections {} ({} distinct)",
+        c.panics, c.hangs, c.uncoded, distinct
+    );
+}
