@@ -9,27 +9,18 @@
 
 use std::hint::black_box;
 use std::io::Write as _;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use lensc_runtime::moves::{Feed, Move, Position};
 use lensc_runtime::post::Dialect;
 use lensc_runtime::post::ProgramWriter;
 use lensc_runtime::post::Setup;
 
-const MOVES: usize = 1_000_000;
+#[path = "support/timing.rs"]
+mod timing;
+use timing::best_run;
 
-fn best_of(runs: usize, mut f: impl FnMut() -> usize) -> (Duration, usize) {
-    let mut best = (Duration::MAX, 0);
-    for _ in 0..runs {
-        let t = Instant::now();
-        let bytes = f();
-        let e = t.elapsed();
-        if e < best.0 {
-            best = (e, bytes);
-        }
-    }
-    best
-}
+const MOVES: usize = 1_000_000;
 
 fn main() {
     let stream: Vec<Move> = (0..MOVES)
@@ -91,11 +82,11 @@ fn main() {
     let (mut ours, mut ours_bytes) = (Duration::MAX, 0);
     let (mut base, mut base_bytes) = (Duration::MAX, 0);
     for _ in 0..7 {
-        let (d, b) = best_of(1, ours_run);
+        let (d, b) = best_run(1, ours_run);
         if d < ours {
             (ours, ours_bytes) = (d, b);
         }
-        let (d, b) = best_of(1, base_run);
+        let (d, b) = best_run(1, base_run);
         if d < base {
             (base, base_bytes) = (d, b);
         }

@@ -14,56 +14,20 @@
 //! A plain harness: best of N runs with `Instant`, ratios from one process.
 
 use std::hint::black_box;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use lensc_runtime::plan::envelope::{binary_search, centre_height, points_near, split_at_corners};
 use lensc_runtime::surface::{Profile, ProfilePoint};
 
-struct Arcs {
-    r: f64,
-    w: f64,
-    s: f64,
-}
+#[path = "support/timing.rs"]
+mod timing;
+use timing::best_of;
 
-impl Profile for Arcs {
-    fn point(&self, u: f64) -> ProfilePoint {
-        let p = self.w + self.s;
-        let c = (u / p).floor() * p + 0.5 * p;
-        let d = u - c;
-        if d.abs() > 0.5 * self.w {
-            return ProfilePoint {
-                z: 0.0,
-                dz: 0.0,
-                d2z: 0.0,
-            };
-        }
-        let rim = (self.r * self.r - 0.25 * self.w * self.w).sqrt();
-        let q = (self.r * self.r - d * d).sqrt();
-        ProfilePoint {
-            z: q - rim,
-            dz: -d / q,
-            d2z: -self.r * self.r / (q * q * q),
-        }
-    }
-}
-
-fn best_of(runs: usize, mut f: impl FnMut()) -> Duration {
-    (0..runs)
-        .map(|_| {
-            let t = Instant::now();
-            f();
-            t.elapsed()
-        })
-        .min()
-        .expect("at least one run")
-}
+#[path = "../src/plan/envelope/lei_arcs.rs"]
+mod lei_arcs;
 
 fn main() {
-    let profile = Arcs {
-        r: 0.788,
-        w: 0.534,
-        s: 0.02,
-    };
+    let profile = lei_arcs::lei();
     let rho = 0.5;
     // The whole profile: ten periods, as the paper turns it.
     let (a, b) = (0.0, 10.0 * 0.554);
@@ -80,7 +44,7 @@ fn main() {
     let xs: Vec<f64> = (0..400).map(|i| 2.2 + 1.0 * i as f64 / 400.0).collect();
 
     {
-        struct Counting<'a>(&'a Arcs, std::cell::Cell<usize>);
+        struct Counting<'a>(&'a lei_arcs::Arcs, std::cell::Cell<usize>);
         impl Profile for Counting<'_> {
             fn point(&self, u: f64) -> ProfilePoint {
                 self.1.set(self.1.get() + 1);

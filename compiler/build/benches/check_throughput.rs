@@ -20,6 +20,10 @@ use std::time::{Duration, Instant};
 use lensc_build::driver;
 use lensc_lang::loader::RealFs;
 
+#[path = "../../../runtime/benches/support/timing.rs"]
+mod timing;
+use timing::best_of;
+
 /// A realistic job file: surfaces, tools, strategies, machines and jobs
 /// that use each other, with comments and units of every kind.
 fn generate(lines: usize) -> String {
@@ -54,18 +58,6 @@ job j{i} {{ surface: s{i}, tool: t{i}, machine: m{i}, strategy: g{i} }}
         i += 1;
     }
     s
-}
-
-/// Best of `runs` timings of `f` (the least disturbed by other load).
-fn best_of(runs: usize, mut f: impl FnMut()) -> Duration {
-    (0..runs)
-        .map(|_| {
-            let t = Instant::now();
-            f();
-            t.elapsed()
-        })
-        .min()
-        .expect("runs > 0")
 }
 
 fn main() {

@@ -13,26 +13,18 @@
 //! A plain harness: best of N runs with `Instant`, ratios from one process.
 
 use std::hint::black_box;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use lensc_runtime::surface::ir::{Graph, Interpreter, SurfaceFn, SurfaceTape};
 use lensc_runtime::surface::jit::JitSurface;
 
+#[path = "../../../runtime/benches/support/timing.rs"]
+mod timing;
+use timing::best_of;
+
 const POINTS: usize = 100_000;
 const RUNS: usize = 15;
 const COMPILES: usize = 20;
-
-/// Best of `runs` timings of `f` (the least disturbed by other load).
-fn best_of(runs: usize, mut f: impl FnMut()) -> Duration {
-    (0..runs)
-        .map(|_| {
-            let t = Instant::now();
-            f();
-            t.elapsed()
-        })
-        .min()
-        .expect("at least one run")
-}
 
 // ---- the conic of revolution with A4 … A16 ---------------------------------
 

@@ -9,7 +9,8 @@ use lensc_runtime::post::ProgramError;
 use lensc_runtime::post::Provenance;
 
 use crate::evaluate::surface_analysis;
-use crate::output::ProgramText;
+use crate::output::{Built, ProgramText};
+use crate::plots::PlotSeries;
 use crate::report;
 use lensc_lang::codes;
 use lensc_lang::lower::diagnostics::RuntimeError;
@@ -32,9 +33,63 @@ pub(crate) fn header(head: &JobHead, prov: &Provenance, units: &str) -> Vec<Stri
     ]
 }
 
+/// The lines of a header whose coordinates are the tool nose's centre (the
+/// servo lathes'): provenance, units, coordinates and feed, surface, and
+/// the round-nose tool.
+pub(crate) fn nose_centre_header(
+    head: &JobHead,
+    prov: &Provenance,
+    units: &str,
+    nose_radius: f64,
+) -> Vec<String> {
+    let mut lines = header(head, prov, units);
+    // The coordinates' words stand between the units and the surface.
+    lines.insert(
+        3,
+        format!(
+            "coordinates are the centre of the tool nose; {}",
+            inverse_time_words(head)
+        ),
+    );
+    lines.push(format!(
+        "tool {}: round nose, nose radius {} mm",
+        head.names.tool,
+        lensc_lang::check::trim_num(nose_radius)
+    ));
+    lines
+}
+
+/// A built job: its program, the report beside it (from the toolpath's
+/// section and the simulation), the plots, and the points and time (s) of
+/// the cut; nothing beside the program and no warnings, until its builder
+/// adds them.
+pub(crate) fn built(
+    head: &JobHead,
+    prov: &Provenance,
+    program: ProgramText,
+    toolpath: report::Toolpath,
+    simulation: report::Simulation,
+    plots: PlotSeries,
+    (cut_points, cutting_time): (usize, f64),
+) -> Built {
+    let program_name = head.program_name();
+    let report = report(head, prov, &program_name, &program, toolpath, simulation);
+    Built {
+        report_name: format!("{}.report.json", head.name),
+        program_name,
+        program,
+        report,
+        beside: Vec::new(),
+        cut_points,
+        cutting_time,
+        plots,
+        warnings: Vec::new(),
+    }
+}
+
 /// The report beside a program: provenance, the program, the toolpath's
 /// own section, the simulation and the surface's analysis.
-pub(crate) fn report(
+fn report(
     head: &JobHead,
     prov: &Provenance,
     program_name: &str,

@@ -7,6 +7,7 @@
 use lensc_runtime::verify::follow::RadialBins;
 use lensc_runtime::verify::heightmap::ErrorRaster;
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 /// Radii sampled by a profile's cut simulation.
@@ -292,6 +293,25 @@ fn legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
         .map_err(err)
 }
 
+/// Draws a chart's mesh and axes, the same on every plot: each axis's
+/// description and its ticks over the range shown.
+fn draw_axes(
+    chart: &mut ChartContext<'_, SVGBackend<'_>, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    (x_desc, (x0, x1)): (&str, (f64, f64)),
+    (y_desc, (y0, y1)): (&str, (f64, f64)),
+) -> Result<(), String> {
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .x_label_formatter(&ticks(x0, x1))
+        .y_label_formatter(&ticks(y0, y1))
+        .axis_desc_style((FONT, 16))
+        .label_style((FONT, 13))
+        .draw()
+        .map_err(err)
+}
+
 /// A profile's series thinned for drawing, with the ranges of its axes.
 struct ProfileView {
     design: Vec<(f64, f64)>,
@@ -422,16 +442,11 @@ fn draw_profile_and_path(area: &Area, p: &ProfileSeries, v: &ProfileView) -> Res
         .build_cartesian_2d(r0..r1, z0..z1)
         .map_err(err)?
         .set_secondary_coord(r0..r1, c0..c1);
-    chart
-        .configure_mesh()
-        .x_desc("radius r (mm)")
-        .y_desc("height z (mm)")
-        .x_label_formatter(&ticks(r0, r1))
-        .y_label_formatter(&ticks(z0, z1))
-        .axis_desc_style((FONT, 16))
-        .label_style((FONT, 13))
-        .draw()
-        .map_err(err)?;
+    draw_axes(
+        &mut chart,
+        ("radius r (mm)", (r0, r1)),
+        ("height z (mm)", (z0, z1)),
+    )?;
     chart
         .configure_secondary_axes()
         .y_desc(format!("{} centre Z (mm)", p.tool))
@@ -476,16 +491,11 @@ fn draw_profile_error(area: &Area, p: &ProfileSeries, v: &ProfileView) -> Result
         .y_label_area_size(90)
         .build_cartesian_2d(r0..r1, e0..e1)
         .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc("radius r (mm)")
-        .y_desc("form error, cut − design (nm)")
-        .x_label_formatter(&ticks(r0, r1))
-        .y_label_formatter(&ticks(e0, e1))
-        .axis_desc_style((FONT, 16))
-        .label_style((FONT, 13))
-        .draw()
-        .map_err(err)?;
+    draw_axes(
+        &mut chart,
+        ("radius r (mm)", (r0, r1)),
+        ("form error, cut − design (nm)", (e0, e1)),
+    )?;
     for (k, &r) in p.seams.iter().enumerate() {
         let drawn = chart
             .draw_series(DashedLineSeries::new(
@@ -726,16 +736,11 @@ fn following_svg(job: &str, f: &FollowingSeries) -> Result<String, String> {
             .y_label_area_size(90)
             .build_cartesian_2d(b.from..b.to, e0..e1)
             .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("radius r (mm)")
-            .y_desc("following error (nm)")
-            .x_label_formatter(&ticks(b.from, b.to))
-            .y_label_formatter(&ticks(e0, e1))
-            .axis_desc_style((FONT, 16))
-            .label_style((FONT, 13))
-            .draw()
-            .map_err(err)?;
+        draw_axes(
+            &mut chart,
+            ("radius r (mm)", (b.from, b.to)),
+            ("following error (nm)", (e0, e1)),
+        )?;
         chart
             .draw_series(LineSeries::new(points, CENTRE.stroke_width(1)))
             .map_err(err)?

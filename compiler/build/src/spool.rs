@@ -1,36 +1,52 @@
 //! Spooling a program as it is written: in memory, or in a temporary file
 //! in the output directory (the programs of spiral and roller jobs run to
-//! millions of lines), so memory stays bounded however long it is.
+//! millions of lines), so memory stays bounded however long it is; and
+//! the first error met writing it, kept until the program is done.
 
 use lensc_grammar::{Diagnostic, FileId, Span};
+use lensc_lang::lower::job::JobHead;
+use lensc_runtime::post::ProgramError;
 use std::path::Path;
 
 use crate::output::ProgramText;
 
-/// Where the program text goes as it is written: memory, or a spool file.
+/// Where a text goes as it is written: memory, or a spool file.
 pub(crate) enum Sink {
     Memory(String),
-    File {
-        writer: std::io::BufWriter<crate::temps::TempFile>,
-        lines: usize,
-        bytes: u64,
-        error: Option<std::io::Error>,
-    },
+    File(Spool),
+}
+
+/// A spool file being written, with what it holds so far and the first
+/// error writing it met.
+pub(crate) struct Spool {
+    writer: std::io::BufWriter<crate::temps::TempFile>,
+    lines: usize,
+    bytes: u64,
+    error: Option<std::io::Error>,
 }
 
 impl Sink {
-    pub(crate) fn new(spool_dir: Option<&Path>) -> std::io::Result<Sink> {
+    /// A sink in memory, or spooled into `spool_dir`; E0151 at `site` if
+    /// the spool file cannot be made.
+    pub(crate) fn new(
+        spool_dir: Option<&Path>,
+        site: (FileId, Span),
+    ) -> Result<Sink, Vec<Diagnostic>> {
+        Sink::open(spool_dir).map_err(|e| vec![cannot_spool(&e, site)])
+    }
+
+    fn open(spool_dir: Option<&Path>) -> std::io::Result<Sink> {
         Ok(match spool_dir {
             None => Sink::Memory(String::new()),
             Some(dir) => {
                 std::fs::create_dir_all(dir)?;
                 let file = crate::temps::TempFile::create_in(dir)?;
-                Sink::File {
+                Sink::File(Spool {
                     writer: std::io::BufWriter::with_capacity(1 << 20, file),
                     lines: 0,
                     bytes: 0,
                     error: None,
-                }
+                })
             }
         })
     }
@@ -38,44 +54,93 @@ impl Sink {
     pub(crate) fn push(&mut self, text: String) {
         match self {
             Sink::Memory(all) => all.push_str(&text),
-            Sink::File {
-                writer,
-                lines,
-                bytes,
-                error,
-            } => {
-                if error.is_none() {
-                    use std::io::Write;
-                    *lines += text.bytes().filter(|&b| b == b'\n').count();
-                    *bytes += text.len() as u64;
-                    if let Err(e) = writer.write_all(text.as_bytes()) {
-                        *error = Some(e);
-                    }
-                }
+            Sink::File(spool) => spool.push(&text),
+        }
+    }
+
+    /// The whole text; E0151 at `site` if the spool file could not be
+    /// written.
+    pub(crate) fn finish(self, site: (FileId, Span)) -> Result<ProgramText, Vec<Diagnostic>> {
+        match self {
+            Sink::Memory(text) => Ok(ProgramText::Memory(text)),
+            Sink::File(spool) => spool.finish().map_err(|e| vec![cannot_spool(&e, site)]),
+        }
+    }
+}
+
+impl Spool {
+    fn push(&mut self, text: &str) {
+        if self.error.is_none() {
+            use std::io::Write;
+            self.lines += text.bytes().filter(|&b| b == b'\n').count();
+            self.bytes += text.len() as u64;
+            if let Err(e) = self.writer.write_all(text.as_bytes()) {
+                self.error = Some(e);
             }
         }
     }
 
-    pub(crate) fn finish(self) -> std::io::Result<ProgramText> {
-        match self {
-            Sink::Memory(text) => Ok(ProgramText::Memory(text)),
-            Sink::File {
-                writer,
-                lines,
-                bytes,
-                error,
-            } => {
-                if let Some(e) = error {
-                    return Err(e);
-                }
-                let file = writer.into_inner().map_err(|e| e.into_error())?;
-                Ok(ProgramText::Spooled { file, lines, bytes })
+    fn finish(self) -> std::io::Result<ProgramText> {
+        if let Some(e) = self.error {
+            return Err(e);
+        }
+        let file = self.writer.into_inner().map_err(|e| e.into_error())?;
+        Ok(ProgramText::Spooled {
+            file,
+            lines: self.lines,
+            bytes: self.bytes,
+        })
+    }
+}
+
+/// A program streamed into a sink piece by piece as it is planned: the
+/// first error met writing it is kept, and no more is written after it.
+pub(crate) struct ProgramSink {
+    sink: Sink,
+    error: Option<ProgramError>,
+}
+
+impl ProgramSink {
+    pub(crate) fn new(
+        spool_dir: Option<&Path>,
+        site: (FileId, Span),
+    ) -> Result<ProgramSink, Vec<Diagnostic>> {
+        Ok(ProgramSink {
+            sink: Sink::new(spool_dir, site)?,
+            error: None,
+        })
+    }
+
+    /// Extends the program with `extend`, unless writing it has failed.
+    pub(crate) fn extend(&mut self, extend: impl FnOnce() -> Result<(), ProgramError>) {
+        if self.error.is_none()
+            && let Err(e) = extend()
+        {
+            self.error = Some(e);
+        }
+    }
+
+    /// Pushes the text the program has written so far.
+    pub(crate) fn push(&mut self, text: Result<String, ProgramError>) {
+        match text {
+            Ok(t) => self.sink.push(t),
+            Err(e) => {
+                self.error.get_or_insert(e);
             }
+        }
+    }
+
+    /// The sink with the whole program in it, or E0150 for the first error
+    /// met writing it.
+    pub(crate) fn written(self, head: &JobHead) -> Result<Sink, Vec<Diagnostic>> {
+        match self.error {
+            Some(e) => Err(vec![crate::parts::not_printable(head, e)]),
+            None => Ok(self.sink),
         }
     }
 }
 
 /// E0151: the spool file could not be written.
-pub(crate) fn cannot_spool(e: &std::io::Error, site: (FileId, Span)) -> Diagnostic {
+fn cannot_spool(e: &std::io::Error, site: (FileId, Span)) -> Diagnostic {
     lensc_lang::lower::diagnostics::RuntimeError::Spool(e).at(site)
 }

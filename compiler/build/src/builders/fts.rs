@@ -11,19 +11,18 @@ use lensc_lang::codes;
 use lensc_lang::lower::diagnostics::RuntimeError;
 use lensc_lang::lower::job::SpiralSpec;
 use lensc_runtime::emit::fts::FtsProgram;
-use lensc_runtime::plan::fts::{Planner, SpindleSpeed};
-use lensc_runtime::post::ProgramError;
+use lensc_runtime::plan::fts::{FtsSummary, Planner, SpindleSpeed};
 use lensc_runtime::post::Provenance;
 use lensc_runtime::surface::ir::SurfaceFn;
 use lensc_runtime::verify::heightmap::Sweep;
 use std::path::Path;
 
 use crate::evaluate::evaluator;
-use crate::height_map::{self, LatheFrame};
+use crate::height_map::{self, LatheFrame, Window};
 use crate::output::Built;
 use crate::parts;
 use crate::report;
-use crate::spool::{Sink, cannot_spool};
+use crate::spool::{ProgramSink, Sink};
 
 /// A spiral job ready to plan: its spec and the trajectory's kernel.
 pub struct Prepared<'s> {
@@ -57,20 +56,13 @@ pub fn build(
     prov: &Provenance,
     spool_dir: Option<&Path>,
 ) -> Result<Built, Vec<Diagnostic>> {
-    let prepared = Prepared::of(spec);
     let (p, head) = (spec, &spec.head);
-    let dialect = &head.dialect;
     let site = head.site;
     let not_printable = |e| vec![parts::not_printable(head, e)];
-    // A fast tool servo whose controller takes a table: its motion goes
-    // there, and the program moves X and C a revolution a block.
-    let table_name = match &dialect.fts_table {
-        Some(ext) if !p.slow => Some(format!("{}.{ext}", head.name)),
-        _ => None,
-    };
+    let table_name = table_name(spec);
     let header = header_lines(spec, prov, table_name.as_deref());
     let mut program = FtsProgram::new(
-        dialect,
+        &head.dialect,
         &head.name,
         &header,
         head.resolution,
@@ -79,38 +71,24 @@ pub fn build(
         table_name.as_deref(),
     )
     .map_err(not_printable)?;
-    let mut sink = Sink::new(spool_dir).map_err(|e| vec![cannot_spool(&e, site)])?;
+    let mut sink = ProgramSink::new(spool_dir, site)?;
     let mut table_sink = match table_name {
-        Some(_) => Some(Sink::new(spool_dir).map_err(|e| vec![cannot_spool(&e, site)])?),
+        Some(_) => Some(Sink::new(spool_dir, site)?),
         None => None,
     };
     // The fast axis's servo, run on the commands as printed as they are
     // planned (a slow tool servo's Z has no servo model here).
     let data_rate = 1.0 / p.spiral.min_interval;
-    let features = p.bounds.features.clone().unwrap_or_default();
-    let mut following = match (&p.servo, p.slow) {
-        (Some(servo), false) => lensc_runtime::verify::follow::FollowingSimulation::new(
-            servo,
-            data_rate,
-            &features,
-            lensc_runtime::verify::follow::RadialBins::new(
-                p.spiral.start_radius.abs().min(p.spiral.end_radius.abs()),
-                p.spiral.start_radius.abs().max(p.spiral.end_radius.abs()),
-                crate::plots::FOLLOWING_BINS,
-            ),
-        ),
-        _ => None,
-    };
+    let mut following = following(spec, data_rate);
     // The height map over the window, from the same printed points.
-    let lowered = &head.surface.lowered;
-    let design = evaluator(&lowered.tape).0;
-    let apertures = &p.lenslets;
-    let window = height_map::window(head, height_map::lathe_centre(&lowered.domain, apertures));
+    let window = height_map::window(
+        head,
+        height_map::lathe_centre(&head.surface.lowered.domain, &p.lenslets),
+    );
     let grid = window.polar();
     let mut sweep = Sweep::new(grid, p.nose_radius);
     let mut printed = Vec::new();
-    let mut write_error: Option<ProgramError> = None;
-    let planned = prepared.planner().plan(&p.fast_axis, |pts| {
+    let planned = Prepared::of(spec).planner().plan(&p.fast_axis, |pts| {
         let as_printed = |v: f64| lensc_runtime::verify::simulate::as_printed(v, head.resolution);
         printed.clear();
         printed.extend(pts.iter().map(|q| lensc_runtime::plan::fts::SpiralPoint {
@@ -124,59 +102,110 @@ pub fn build(
         if let Some(sim) = following.as_mut() {
             sim.extend(&printed);
         }
-        if write_error.is_none()
-            && let Err(e) = program.extend(pts)
-        {
-            write_error = Some(e);
-        }
-        match program.take_text() {
-            Ok(t) => sink.push(t),
-            Err(e) => write_error = write_error.take().or(Some(e)),
-        }
+        sink.extend(|| program.extend(pts));
+        sink.push(program.take_text());
         if let Some(t) = table_sink.as_mut() {
             t.push(program.take_table_text());
         }
     });
-    let axis = if p.slow { "Z" } else { "the fast axis" };
     let summary = planned.map_err(|error| {
         vec![
             RuntimeError::Spiral {
                 error,
                 speed: &p.spiral.speed,
-                axis,
+                axis: axis_words(spec),
             }
             .at(site),
         ]
     })?;
-    if let Some(e) = write_error {
-        return Err(not_printable(e));
-    }
+    let mut sink = sink.written(head)?;
     if let Some(t) = table_sink.as_mut() {
         t.push(program.take_table_text());
     }
-    let rest = program.finish().map_err(not_printable)?;
-    sink.push(rest);
+    sink.push(program.finish().map_err(not_printable)?);
     let mut beside = Vec::new();
     if let (Some(name), Some(t)) = (table_name, table_sink) {
-        let table = t.finish().map_err(|e| vec![cannot_spool(&e, site)])?;
-        beside.push((name, table));
+        beside.push((name, t.finish(site)?));
     }
-    let text = sink.finish().map_err(|e| vec![cannot_spool(&e, site)])?;
-    let program_name = head.program_name();
+    let text = sink.finish(site)?;
+    let mut plots = crate::plots::PlotSeries::default();
+    let height_map = simulated_height_map(spec, sweep, window, &mut plots);
+    let simulation = simulation(following, height_map, data_rate, p.slow, &mut plots);
+    let toolpath = toolpath(spec, &summary);
+    let cut = (summary.points, summary.time);
+    let mut built = parts::built(head, prov, text, toolpath, simulation, plots, cut);
+    if let Some((name, table)) = beside.first() {
+        built.report.program.fts_table = Some(report::FtsTable {
+            file: name.clone(),
+            rows: table.lines().saturating_sub(2),
+        });
+    }
+    built.beside = beside;
+    built.warnings = chords_warning(spec, &summary, data_rate)
+        .into_iter()
+        .collect();
+    Ok(built)
+}
+
+/// The table a fast tool servo's controller reads its motion from
+/// (`JOB.EXT`), if its dialect takes one: the program then moves X and C a
+/// revolution a block.
+fn table_name(spec: &SpiralSpec) -> Option<String> {
+    match &spec.head.dialect.fts_table {
+        Some(ext) if !spec.slow => Some(format!("{}.{ext}", spec.head.name)),
+        _ => None,
+    }
+}
+
+/// The axis that carries the surface, in words.
+fn axis_words(spec: &SpiralSpec) -> &'static str {
+    if spec.slow { "Z" } else { "the fast axis" }
+}
+
+/// The fast axis's servo following, simulated over radial bins of the
+/// spiral, where it has a servo model.
+fn following(
+    spec: &SpiralSpec,
+    data_rate: f64,
+) -> Option<lensc_runtime::verify::follow::FollowingSimulation> {
+    use lensc_runtime::verify::follow::{FollowingSimulation, RadialBins};
+    let servo = spec.servo.as_ref().filter(|_| !spec.slow)?;
+    let (r0, r1) = (spec.spiral.start_radius.abs(), spec.spiral.end_radius.abs());
+    FollowingSimulation::new(
+        servo,
+        data_rate,
+        spec.bounds.features.as_deref().unwrap_or_default(),
+        RadialBins::new(r0.min(r1), r0.max(r1), crate::plots::FOLLOWING_BINS),
+    )
+}
+
+/// The spiral's section of the report: a fast or a slow tool servo's.
+fn toolpath(spec: &SpiralSpec, summary: &FtsSummary) -> report::Toolpath {
     let spiral = report::Spiral::new(
-        &summary,
-        &p.spiral,
-        p.settling.as_ref(),
-        p.servo.as_ref(),
-        p.nose_radius,
+        summary,
+        &spec.spiral,
+        spec.settling.as_ref(),
+        spec.servo.as_ref(),
+        spec.nose_radius,
     );
-    let toolpath = if p.slow {
+    if spec.slow {
         report::Toolpath::SpiralTurning(spiral)
     } else {
         report::Toolpath::FtsSpiral(spiral)
-    };
-    let mut plots = crate::plots::PlotSeries::default();
-    let frame = LatheFrame::new(design.as_ref(), window, lowered.domain, apertures);
+    }
+}
+
+/// The height map the swept nose leaves over the window, for the report,
+/// and its form error for the plots.
+fn simulated_height_map(
+    spec: &SpiralSpec,
+    sweep: Sweep,
+    window: Window,
+    plots: &mut crate::plots::PlotSeries,
+) -> report::HeightMap {
+    let lowered = &spec.head.surface.lowered;
+    let design = evaluator(&lowered.tape).0;
+    let frame = LatheFrame::new(design.as_ref(), window, lowered.domain, &spec.lenslets);
     let map = sweep.finish(&frame);
     plots.form_error = Some(height_map::form_error_series(
         &map,
@@ -187,54 +216,36 @@ pub fn build(
         1.5 * window.spacing,
         ("x (mm)", "y (mm)"),
     ));
-    let height_map = report::HeightMap::new(
+    report::HeightMap::new(
         &map,
         &window,
         "columns at spindle angles (column step in rad), rows at radii",
-        p.spiral.feed_per_rev,
-    );
-    let simulation = simulation(following, height_map, data_rate, p.slow, &mut plots);
-    let mut report = parts::report(head, prov, &program_name, &text, toolpath, simulation);
-    if let Some((name, table)) = beside.first() {
-        report.program.fts_table = Some(report::FtsTable {
-            file: name.clone(),
-            rows: table.lines().saturating_sub(2),
-        });
-    }
-    // Chords the data period kept from their share of the tolerance.
-    let share = p.spiral.chord_tolerance * lensc_runtime::plan::optimise::UNOPTIMISED_CHORD_SHARE;
-    let warnings = summary
-        .chords_over_tolerance
-        .map(|o| {
-            Diagnostic::warning(
-                codes::CHORDS_OVER_TOLERANCE,
-                format!(
-                    "{} chords of the spiral stray up to {} nm from the exact path (their share of the tolerance is {} nm), the worst at r = {} mm: {} may not be commanded faster than its data rate ({} Hz) allows",
-                    o.count,
-                    trim_num(o.deviation * 1e6),
-                    trim_num(share * 1e6),
-                    trim_num(o.at_radius),
-                    axis,
-                    trim_num(data_rate)
-                ),
-                site.0,
-                site.1,
-            )
-            .with_label("this job")
-            .with_help("lower the spindle or surface speed, or give the axis a higher `data_rate`; the report's `chords_over_tolerance` says how many and where")
-        })
-        .into_iter()
-        .collect();
-    Ok(Built {
-        report_name: format!("{}.report.json", head.name),
-        program_name,
-        program: text,
-        report,
-        beside,
-        cut_points: summary.points,
-        cutting_time: summary.time,
-        plots,
-        warnings,
+        spec.spiral.feed_per_rev,
+    )
+}
+
+/// W: chords the data period kept from their share of the tolerance.
+fn chords_warning(spec: &SpiralSpec, summary: &FtsSummary, data_rate: f64) -> Option<Diagnostic> {
+    let share =
+        spec.spiral.chord_tolerance * lensc_runtime::plan::optimise::UNOPTIMISED_CHORD_SHARE;
+    let (file, span) = spec.head.site;
+    summary.chords_over_tolerance.map(|o| {
+        Diagnostic::warning(
+            codes::CHORDS_OVER_TOLERANCE,
+            format!(
+                "{} chords of the spiral stray up to {} nm from the exact path (their share of the tolerance is {} nm), the worst at r = {} mm: {} may not be commanded faster than its data rate ({} Hz) allows",
+                o.count,
+                trim_num(o.deviation * 1e6),
+                trim_num(share * 1e6),
+                trim_num(o.at_radius),
+                axis_words(spec),
+                trim_num(data_rate)
+            ),
+            file,
+            span,
+        )
+        .with_label("this job")
+        .with_help("lower the spindle or surface speed, or give the axis a higher `data_rate`; the report's `chords_over_tolerance` says how many and where")
     })
 }
 
@@ -276,7 +287,7 @@ fn rpm(w: f64) -> f64 {
 /// The program's header: provenance, units, the surface, tool, spiral
 /// and machine in words, and the settling offset.
 fn header_lines(spec: &SpiralSpec, prov: &Provenance, table: Option<&str>) -> Vec<String> {
-    let (head, spiral, slow, rho) = (&spec.head, &spec.spiral, spec.slow, spec.nose_radius);
+    let (head, spiral, slow) = (&spec.head, &spec.spiral, spec.slow);
     let settling = spec.settling.as_ref();
     let table_words;
     let (servo_words, axis_words) = if slow {
@@ -297,41 +308,26 @@ fn header_lines(spec: &SpiralSpec, prov: &Provenance, table: Option<&str>) -> Ve
             trim_num(rpm(max))
         ),
     };
-    let mut lines = vec![
-        format!("lensc {}: job {}", prov.lensc_version, head.name),
-        format!("source {} fnv1a64 {:016x}", prov.source, prov.source_hash),
-        format!(
-            "units mm; X is {}, C the spindle angle in degrees counted on from the start, {axis_words}, +Z out of the material",
-            lensc_runtime::emit::x_word(&head.dialect)
+    let units = format!(
+        "units mm; X is {}, C the spindle angle in degrees counted on from the start, {axis_words}, +Z out of the material",
+        lensc_runtime::emit::x_word(&head.dialect)
+    );
+    let mut lines = parts::nose_centre_header(head, prov, &units, spec.nose_radius);
+    lines.push(format!(
+        "strategy {}: {servo_words} spiral from r = {} mm, feed {} um/rev, {speed}, path tolerance {} nm [chords {}, blending {} nm]",
+        head.names.strategy,
+        trim_num(spiral.start_radius),
+        trim_num(spiral.feed_per_rev * 1000.0),
+        trim_num(spiral.chord_tolerance * 1e6),
+        trim_num(
+            spiral.chord_tolerance * lensc_runtime::plan::optimise::UNOPTIMISED_CHORD_SHARE * 1e6
         ),
-        format!(
-            "coordinates are the centre of the tool nose; {}",
-            parts::inverse_time_words(head)
-        ),
-        format!("surface {}: {}", head.names.surface, head.surface.words),
-        format!(
-            "tool {}: round nose, nose radius {} mm",
-            head.names.tool,
-            trim_num(rho)
-        ),
-        format!(
-            "strategy {}: {servo_words} spiral from r = {} mm, feed {} um/rev, {speed}, path tolerance {} nm [chords {}, blending {} nm]",
-            head.names.strategy,
-            trim_num(spiral.start_radius),
-            trim_num(spiral.feed_per_rev * 1000.0),
-            trim_num(spiral.chord_tolerance * 1e6),
-            trim_num(
-                spiral.chord_tolerance
-                    * lensc_runtime::plan::optimise::UNOPTIMISED_CHORD_SHARE
-                    * 1e6
-            ),
-            trim_num(spiral.chord_tolerance * lensc_runtime::plan::optimise::BLEND_SHARE * 1e6)
-        ),
-        format!(
-            "machine {}: {} {servo_words} lathe",
-            head.names.machine, head.dialect.name
-        ),
-    ];
+        trim_num(spiral.chord_tolerance * lensc_runtime::plan::optimise::BLEND_SHARE * 1e6)
+    ));
+    lines.push(format!(
+        "machine {}: {} {servo_words} lathe",
+        head.names.machine, head.dialect.name
+    ));
     match settling {
         None if slow => {}
         Some(s) => lines.push(format!(

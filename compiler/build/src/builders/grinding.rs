@@ -68,8 +68,6 @@ pub fn build(spec: &GrindingSpec, prov: &Provenance) -> Result<Built, Vec<Diagno
     )
     .map_err(|e| vec![parts::not_printable(head, e)])?;
     let toolpath = report::Toolpath::ProfileGrinding((&path).into());
-    let program_name = head.program_name();
-    let text = ProgramText::Memory(text);
     // What the wheel's section (a circle of its radius about the centre)
     // leaves along the programmed centres.
     use lensc_runtime::surface::Profile as _;
@@ -82,14 +80,6 @@ pub fn build(spec: &GrindingSpec, prov: &Provenance) -> Result<Built, Vec<Diagno
         (grinding.start, grinding.end),
         crate::plots::PROFILE_SAMPLES,
     );
-    let report = parts::report(
-        head,
-        prov,
-        &program_name,
-        &text,
-        toolpath,
-        report::Simulation::Profile((&cut).into()),
-    );
     let plots = crate::plots::PlotSeries {
         profile: Some(crate::plots::profile_series(
             &cut,
@@ -101,15 +91,13 @@ pub fn build(spec: &GrindingSpec, prov: &Provenance) -> Result<Built, Vec<Diagno
         )),
         ..Default::default()
     };
-    Ok(Built {
-        report_name: format!("{}.report.json", head.name),
-        program_name,
-        program: text,
-        report,
-        beside: Vec::new(),
-        cut_points: path.points.len(),
-        cutting_time: path.total_time,
+    Ok(parts::built(
+        head,
+        prov,
+        ProgramText::Memory(text),
+        toolpath,
+        report::Simulation::Profile((&cut).into()),
         plots,
-        warnings: Vec::new(),
-    })
+        (path.points.len(), path.total_time),
+    ))
 }

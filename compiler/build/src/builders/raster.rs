@@ -7,7 +7,8 @@ use lensc_grammar::Diagnostic;
 use lensc_lang::check::trim_num;
 use lensc_lang::lower::diagnostics::RuntimeError;
 use lensc_lang::lower::job::RasterSpec;
-use lensc_runtime::plan::raster::{Axis, RasterTool, check_clearance};
+use lensc_runtime::plan::optimise::Summary;
+use lensc_runtime::plan::raster::{Axis, RasterPath, RasterTool, check_clearance};
 use lensc_runtime::post::Provenance;
 use lensc_runtime::verify::heightmap::Sweep;
 
@@ -40,37 +41,16 @@ pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnost
     if !errors.is_empty() {
         return Err(errors);
     }
-    let mut header = parts::header(
-        head,
-        prov,
-        "units mm; X Y Z of the tool centre, +Z out of the material; no cutter compensation",
-    );
-    header.push(format!("tool {}: {}", head.names.tool, spec.tool_words));
-    header.push(format!(
-        "strategy {}: raster along {}, {}, stepover {} um, {}, {} passes, {} points",
-        head.names.strategy,
-        if raster.along == Axis::X { "x" } else { "y" },
-        if raster.zigzag { "zigzag" } else { "one way" },
-        trim_num(raster.stepover * 1000.0),
-        lensc_runtime::emit::tolerance_words(raster.chord_tolerance),
-        path.pass_count,
-        path.point_count
-    ));
     let (moves, optimised) = lensc_runtime::plan::optimise::optimise(
         &moves,
         raster.chord_tolerance * lensc_runtime::plan::optimise::FIT_SHARE,
         &dialect.arc_planes,
     );
-    header.push(lensc_runtime::emit::optimisation_words(&optimised));
-    header.push(format!(
-        "machine {}: {} 3-axis mill",
-        head.names.machine, dialect.name
-    ));
     let resolution = head.resolution;
     let text = lensc_runtime::emit::raster::emit_mill(
         dialect,
         &head.name,
-        &header,
+        &header_lines(spec, prov, &path, &optimised),
         &moves,
         resolution,
         raster.chord_tolerance,
@@ -79,8 +59,6 @@ pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnost
     let section = report::Raster::new(&path, raster, feed, &optimised);
     let time = section.cutting_time_s;
     let toolpath = report::Toolpath::Raster(section);
-    let program_name = head.program_name();
-    let text = ProgramText::Memory(text);
     let mut plots = crate::plots::PlotSeries::default();
     let simulation = match tool {
         RasterTool::Knife { nose_radius } => {
@@ -129,16 +107,42 @@ pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnost
             height_map: None,
         }),
     };
-    let report = parts::report(head, prov, &program_name, &text, toolpath, simulation);
-    Ok(Built {
-        report_name: format!("{}.report.json", head.name),
-        program_name,
-        program: text,
-        report,
-        beside: Vec::new(),
-        cut_points: path.point_count,
-        cutting_time: time,
-        plots,
-        warnings: Vec::new(),
-    })
+    let text = ProgramText::Memory(text);
+    let cut = (path.point_count, time);
+    Ok(parts::built(
+        head, prov, text, toolpath, simulation, plots, cut,
+    ))
+}
+
+/// The program's header: provenance, units, surface, the tool, the raster
+/// and its optimisation, and the machine in words.
+fn header_lines(
+    spec: &RasterSpec,
+    prov: &Provenance,
+    path: &RasterPath,
+    optimised: &Summary,
+) -> Vec<String> {
+    let (head, raster) = (&spec.head, &spec.raster);
+    let mut header = parts::header(
+        head,
+        prov,
+        "units mm; X Y Z of the tool centre, +Z out of the material; no cutter compensation",
+    );
+    header.push(format!("tool {}: {}", head.names.tool, spec.tool_words));
+    header.push(format!(
+        "strategy {}: raster along {}, {}, stepover {} um, {}, {} passes, {} points",
+        head.names.strategy,
+        if raster.along == Axis::X { "x" } else { "y" },
+        if raster.zigzag { "zigzag" } else { "one way" },
+        trim_num(raster.stepover * 1000.0),
+        lensc_runtime::emit::tolerance_words(raster.chord_tolerance),
+        path.pass_count,
+        path.point_count
+    ));
+    header.push(lensc_runtime::emit::optimisation_words(optimised));
+    header.push(format!(
+        "machine {}: {} 3-axis mill",
+        head.names.machine, head.dialect.name
+    ));
+    header
 }

@@ -45,7 +45,6 @@ pub fn build(spec: &TurningSpec, prov: &Provenance) -> Result<Built, Vec<Diagnos
         stream,
         optimised,
     } = emitted;
-    let program_name = format!("{}.{}", job.name, job.machine.dialect.extension);
     let mut plots = crate::plots::PlotSeries::default();
     let simulation = if job.tool.centre_height == 0.0 {
         use lensc_runtime::surface::Profile as _;
@@ -80,29 +79,20 @@ pub fn build(spec: &TurningSpec, prov: &Provenance) -> Result<Built, Vec<Diagnos
         })
     };
     let toolpath = report::ProfileTurning::new(job, &path, &optimised);
-    let text = ProgramText::Memory(text);
-    let mut report = crate::parts::report(
+    let mut built = crate::parts::built(
         head,
         prov,
-        &program_name,
-        &text,
+        ProgramText::Memory(text),
         report::Toolpath::ProfileTurning(toolpath),
         simulation,
+        plots,
+        (path.cut_points, path.cutting_time()),
     );
     // A profile-turning report names a surface written in place "" (the
     // other strategies give its kind), as it always has.
-    report.surface.surface = head.names.surface_declared.clone();
-    Ok(Built {
-        report_name: format!("{}.report.json", job.name),
-        program_name,
-        program: text,
-        cut_points: path.cut_points,
-        cutting_time: path.cutting_time(),
-        report,
-        beside: Vec::new(),
-        plots,
-        warnings,
-    })
+    built.report.surface.surface = head.names.surface_declared.clone();
+    built.warnings = warnings;
+    Ok(built)
 }
 
 /// What the path leaves uncut: the centre, when the edge is set off the

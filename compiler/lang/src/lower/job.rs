@@ -157,8 +157,26 @@ impl<'a> Parts<'a> {
     pub fn error(&self, code: &'static str, msg: String) -> Diagnostic {
         site_error(self.site(), code, msg)
     }
+    /// E0131 for the machine and for the tool unless each is of a kind
+    /// `what` can use.
+    pub fn needs_kinds(
+        &self,
+        what: &str,
+        machines: &[&str],
+        tools: &[&str],
+    ) -> Result<(), Vec<Diagnostic>> {
+        all_clear(
+            [
+                self.needs("machine", self.machine, machines, what),
+                self.needs("tool", self.tool, tools, what),
+            ]
+            .into_iter()
+            .flatten()
+            .collect(),
+        )
+    }
     /// E0131 unless `o` is one of `kinds`.
-    pub fn needs(&self, part: &str, o: &Object, kinds: &[&str], what: &str) -> Option<Diagnostic> {
+    fn needs(&self, part: &str, o: &Object, kinds: &[&str], what: &str) -> Option<Diagnostic> {
         (!kinds.contains(&o.kind.name)).then(|| {
             self.error(
                 codes::UNSUPPORTED_COMBINATION,
@@ -174,6 +192,31 @@ impl<'a> Parts<'a> {
             )
         })
     }
+    /// E0131 for a machine that is not a `lathe` (`note` follows its kind
+    /// in the message) and for a tool that is not a round nose: what a
+    /// servo lathe's strategy (`what`) needs.
+    pub fn needs_servo_lathe(&self, what: &str, lathe: &str, note: &str) -> Vec<Diagnostic> {
+        let mut errors = Vec::new();
+        if self.machine.kind.name != lathe {
+            errors.push(self.error(
+                codes::UNSUPPORTED_COMBINATION,
+                format!(
+                    "{what} needs an `{lathe}`{note}; this machine is a `{}`",
+                    self.machine.kind.name
+                ),
+            ));
+        }
+        if self.tool.kind.name != "round_nose" {
+            errors.push(self.error(
+                codes::UNSUPPORTED_COMBINATION,
+                format!(
+                    "{what} needs a `round_nose` tool; this is a `{}`",
+                    self.tool.kind.name
+                ),
+            ));
+        }
+        errors
+    }
     /// The surface lowered to IR, or E0131.
     pub fn lowered(&self) -> Result<LoweredSurface, Diagnostic> {
         crate::lower::surface::lower_surface(self.surface)
@@ -183,6 +226,21 @@ impl<'a> Parts<'a> {
     pub fn max_spindle_speed(&self) -> f64 {
         let spindle = value::block(&self.machine.fields, "spindle").expect("required");
         value::num(spindle, "max_speed").expect("required")
+    }
+    /// E0143 if `speed` (rad/s) is above the machine's spindle limit.
+    pub fn spindle_limit(&self, speed: f64) -> Option<Diagnostic> {
+        let max = self.max_spindle_speed();
+        let rpm = |w: f64| crate::check::trim_num(w * 60.0 / (2.0 * std::f64::consts::PI));
+        (speed > max).then(|| {
+            self.error(
+                codes::SPINDLE_TOO_FAST,
+                format!(
+                    "the spindle speed ({} rpm) is above the machine's maximum ({} rpm)",
+                    rpm(speed),
+                    rpm(max)
+                ),
+            )
+        })
     }
     /// The job's head, once its surface is lowered and its dialect known.
     fn head(&self, dialect: Dialect, lowered: LoweredSurface) -> JobHead {
@@ -220,6 +278,15 @@ impl<'a> Parts<'a> {
             travel: ["x", "y", "z", "c"].map(|a| travel.and_then(|t| value::range(t, a))),
             simulate: simulate(self.job).ok().flatten(),
         }
+    }
+}
+
+/// Nothing, if no error was found; else every error found.
+pub(crate) fn all_clear(errors: Vec<Diagnostic>) -> Result<(), Vec<Diagnostic>> {
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(errors)
     }
 }
 

@@ -3,43 +3,9 @@
 use super::*;
 use crate::surface::ProfilePoint;
 
-/// Convex circular arcs of radius R, width w, separated by flat seams
-/// of width s at z = 0 (Lei et al. 2021's cylinder array profile).
-struct Arcs {
-    r: f64,
-    w: f64,
-    s: f64,
-}
-
-impl Profile for Arcs {
-    fn point(&self, u: f64) -> ProfilePoint {
-        let p = self.w + self.s;
-        let c = (u / p).floor() * p + 0.5 * p;
-        let d = u - c;
-        if d.abs() > 0.5 * self.w {
-            return ProfilePoint {
-                z: 0.0,
-                dz: 0.0,
-                d2z: 0.0,
-            };
-        }
-        let rim = (self.r * self.r - 0.25 * self.w * self.w).sqrt();
-        let q = (self.r * self.r - d * d).sqrt();
-        ProfilePoint {
-            z: q - rim,
-            dz: -d / q,
-            d2z: -self.r * self.r / (q * q * q),
-        }
-    }
-}
-
-fn lei() -> Arcs {
-    Arcs {
-        r: 0.788,
-        w: 0.534,
-        s: 0.02,
-    }
-}
+#[path = "lei_arcs.rs"]
+mod lei_arcs;
+use lei_arcs::{Arcs, lei};
 
 #[test]
 fn corners_are_found_where_the_arcs_meet_the_seams() {

@@ -11,7 +11,7 @@ use lensc_runtime::post::Dialect;
 use lensc_runtime::surface::SectionAlongX;
 use lensc_runtime::surface::analysis::Domain;
 
-use super::{Evaluate, JobHead, Parts};
+use super::{Evaluate, JobHead, Parts, all_clear};
 use crate::check::trim_num;
 use crate::codes;
 use crate::lower::diagnostics::RuntimeError;
@@ -44,16 +44,7 @@ pub(super) fn lower_raster(
     dialect: Dialect,
     evaluate: Evaluate,
 ) -> Result<RasterSpec, Vec<Diagnostic>> {
-    let errors: Vec<Diagnostic> = [
-        p.needs("machine", p.machine, &["mill_3axis"], "raster"),
-        p.needs("tool", p.tool, &["microshaper", "ball_end"], "raster"),
-    ]
-    .into_iter()
-    .flatten()
-    .collect();
-    if !errors.is_empty() {
-        return Err(errors);
-    }
+    p.needs_kinds("raster", &["mill_3axis"], &["microshaper", "ball_end"])?;
     let (st, t) = (&p.strategy.fields, &p.tool.fields);
     let raster = Raster {
         along: if value::word(st, "along") == Some("y") {
@@ -101,9 +92,7 @@ pub(super) fn lower_raster(
     if let Err(e) = scanned {
         errors.push(RuntimeError::Raster(e).at(p.site()));
     }
-    if !errors.is_empty() {
-        return Err(errors);
-    }
+    all_clear(errors)?;
     Ok(RasterSpec {
         head: p.head(dialect, lowered),
         raster,
@@ -119,16 +108,7 @@ pub(super) fn lower_grinding(
     dialect: Dialect,
     evaluate: Evaluate,
 ) -> Result<GrindingSpec, Vec<Diagnostic>> {
-    let errors: Vec<Diagnostic> = [
-        p.needs("machine", p.machine, &["grinder_2axis"], "profile grinding"),
-        p.needs("tool", p.tool, &["spherical_wheel"], "profile grinding"),
-    ]
-    .into_iter()
-    .flatten()
-    .collect();
-    if !errors.is_empty() {
-        return Err(errors);
-    }
+    p.needs_kinds("profile grinding", &["grinder_2axis"], &["spherical_wheel"])?;
     let (st, t) = (&p.strategy.fields, &p.tool.fields);
     let lowered = p.lowered().map_err(|d| vec![d])?;
     let edge = match lowered.domain {
@@ -150,9 +130,7 @@ pub(super) fn lower_grinding(
     if let Err(e) = check_profile_grinding(&grinding, &SectionAlongX(kernel.as_ref())) {
         errors.push(RuntimeError::Grinding(e).at(p.site()));
     }
-    if !errors.is_empty() {
-        return Err(errors);
-    }
+    all_clear(errors)?;
     Ok(GrindingSpec {
         head: p.head(dialect, lowered),
         grinding,

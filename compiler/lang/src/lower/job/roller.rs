@@ -11,7 +11,7 @@ use lensc_runtime::plan::roller::{
 use lensc_runtime::post::Dialect;
 use lensc_runtime::surface::analysis::Domain;
 
-use super::{Evaluate, JobHead, Parts};
+use super::{Evaluate, JobHead, Parts, all_clear};
 use crate::check::trim_num;
 use crate::codes;
 use crate::lower::diagnostics::RuntimeError;
@@ -37,54 +37,15 @@ pub(super) fn lower(
     dialect: Dialect,
     evaluate: Evaluate,
 ) -> Result<RollerSpec, Vec<Diagnostic>> {
-    let (surface, tool, machine, strategy) = (p.surface, p.tool, p.machine, p.strategy);
-    let err = |code: &'static str, msg: String| p.error(code, msg);
-    let mut errors = Vec::new();
-    if machine.kind.name != "sts_lathe" {
-        errors.push(err(
-            codes::UNSUPPORTED_COMBINATION,
-            format!(
-                "roller helix turning needs an `sts_lathe` (C, Z, X); this machine is a `{}`",
-                machine.kind.name
-            ),
-        ));
-    }
-    if tool.kind.name != "round_nose" {
-        errors.push(err(
-            codes::UNSUPPORTED_COMBINATION,
-            format!(
-                "roller helix turning needs a `round_nose` tool; this is a `{}`",
-                tool.kind.name
-            ),
-        ));
-    }
-    let roller = (surface.kind.name == "wrap")
-        .then(|| value::object(&surface.fields, "onto"))
-        .flatten()
-        .and_then(|r| value::num(&r.fields, "radius"));
-    if roller.is_none() {
-        errors.push(
-            err(
-                codes::UNSUPPORTED_COMBINATION,
-                format!(
-                    "roller helix turning needs a design wrapped onto a roller; this surface is a `{}`",
-                    surface.kind.name
-                ),
-            )
-            .with_help("write `wrap(design, onto: roller(radius: …))`"),
-        );
-    }
-    let Some(roller_radius) = roller.filter(|_| errors.is_empty()) else {
-        return Err(errors);
-    };
-    let (t, st) = (&tool.fields, &strategy.fields);
+    let roller_radius = roller_radius(p)?;
+    let (t, st) = (&p.tool.fields, &p.strategy.fields);
     let lowered = p.lowered().map_err(|d| vec![d])?;
     let Domain::Rect {
         x: design_x,
         y: design_y,
     } = lowered.domain
     else {
-        return Err(vec![err(
+        return Err(vec![p.error(
             codes::UNSUPPORTED_COMBINATION,
             "a wrapped design needs a rectangular domain (x along the roller, y around it)".into(),
         )]);
@@ -102,23 +63,10 @@ pub(super) fn lower(
     };
     let check = check_roller_tool(kernel.as_ref(), &region, roller_radius, &rt)
         .map_err(|e| vec![RuntimeError::Roller(e).at(p.site())])?;
-    errors.extend(tool_errors(p, &rt, &check));
+    let mut errors = tool_errors(p, &rt, &check);
     let spindle_speed = value::num(st, "spindle_speed").expect("required");
-    let max_spindle = p.max_spindle_speed();
-    if spindle_speed > max_spindle {
-        let rpm = |w: f64| trim_num(w * 60.0 / (2.0 * std::f64::consts::PI));
-        errors.push(err(
-            codes::SPINDLE_TOO_FAST,
-            format!(
-                "the spindle speed ({} rpm) is above the machine's maximum ({} rpm)",
-                rpm(spindle_speed),
-                rpm(max_spindle)
-            ),
-        ));
-    }
-    if !errors.is_empty() {
-        return Err(errors);
-    }
+    errors.extend(p.spindle_limit(spindle_speed));
+    all_clear(errors)?;
     let (z_start, z_end) = value::range(st, "z").unwrap_or(design_x);
     let helix = RollerHelix {
         roller_radius,
@@ -151,23 +99,46 @@ pub(super) fn lower(
     })
 }
 
+/// The roller's radius (mm), or E0131 for each part that cannot make a
+/// roller helix: it needs an `sts_lathe`, a round nose, and a design
+/// wrapped onto a roller.
+fn roller_radius(p: &Parts) -> Result<f64, Vec<Diagnostic>> {
+    let surface = p.surface;
+    let mut errors = p.needs_servo_lathe("roller helix turning", "sts_lathe", " (C, Z, X)");
+    let roller = (surface.kind.name == "wrap")
+        .then(|| value::object(&surface.fields, "onto"))
+        .flatten()
+        .and_then(|r| value::num(&r.fields, "radius"));
+    if roller.is_none() {
+        errors.push(
+            p.error(
+                codes::UNSUPPORTED_COMBINATION,
+                format!(
+                    "roller helix turning needs a design wrapped onto a roller; this surface is a `{}`",
+                    surface.kind.name
+                ),
+            )
+            .with_help("write `wrap(design, onto: roller(radius: …))`"),
+        );
+    }
+    roller.filter(|_| errors.is_empty()).ok_or(errors)
+}
+
 /// The rough pass, if the strategy has one, then the finish pass.
 fn passes(st: &[value::Field]) -> Vec<HelixPass> {
-    let finish = value::block(st, "finish").expect("required");
-    let mut passes = Vec::new();
-    if let Some(rough) = value::block(st, "rough") {
-        passes.push(HelixPass {
-            c_step: value::num(rough, "c_step").expect("required"),
-            pitch: value::num(rough, "pitch").expect("required"),
-            finish_allowance: value::num(rough, "finish_allowance").expect("required"),
-        });
-    }
-    passes.push(HelixPass {
-        c_step: value::num(finish, "c_step").expect("required"),
-        pitch: value::num(finish, "pitch").expect("required"),
-        finish_allowance: 0.0,
+    let pass = |block: &[value::Field], finish_allowance: f64| HelixPass {
+        c_step: value::num(block, "c_step").expect("required"),
+        pitch: value::num(block, "pitch").expect("required"),
+        finish_allowance,
+    };
+    let rough = value::block(st, "rough").map(|rough| {
+        pass(
+            rough,
+            value::num(rough, "finish_allowance").expect("required"),
+        )
     });
-    passes
+    let finish = pass(value::block(st, "finish").expect("required"), 0.0);
+    rough.into_iter().chain([finish]).collect()
 }
 
 /// What the tool check found wrong: the nose, the clearance, the opening.

@@ -9,9 +9,10 @@ use lensc_grammar::Diagnostic;
 use lensc_runtime::machine::servo::SecondOrderServo;
 use lensc_runtime::plan::fts::{FastAxis, FtsSpiral, SpindleSpeed, TrajectoryBounds};
 use lensc_runtime::post::Dialect;
+use lensc_runtime::surface::analysis::Domain;
 use lensc_runtime::surface::ir::SurfaceFn;
 
-use super::{Evaluate, JobHead, Parts};
+use super::{Evaluate, JobHead, Parts, all_clear};
 use crate::check::trim_num;
 use crate::codes;
 use crate::lower::diagnostics::RuntimeError;
@@ -60,102 +61,41 @@ pub(super) fn lower(
     dialect: Dialect,
     evaluate: Evaluate,
 ) -> Result<SpiralSpec, Vec<Diagnostic>> {
-    let (surface, tool, machine, strategy) = (p.surface, p.tool, p.machine, p.strategy);
-    let err = |code: &'static str, msg: String| p.error(code, msg);
-    let mut errors = Vec::new();
+    let (surface, strategy) = (p.surface, p.strategy);
     let slow = strategy.kind.name == "spiral_turning";
-    let (want, what) = if slow {
+    let (lathe, what) = if slow {
         ("sts_lathe", "slow-tool-servo spiral turning")
     } else {
         ("fts_lathe", "fast-tool-servo turning")
     };
-    if machine.kind.name != want {
-        errors.push(err(
-            codes::UNSUPPORTED_COMBINATION,
-            format!(
-                "{what} needs an `{want}`; this machine is a `{}`",
-                machine.kind.name
-            ),
-        ));
-    }
-    if tool.kind.name != "round_nose" {
-        errors.push(err(
-            codes::UNSUPPORTED_COMBINATION,
-            format!(
-                "{what} needs a `round_nose` tool; this is a `{}`",
-                tool.kind.name
-            ),
-        ));
-    }
-    if !errors.is_empty() {
-        return Err(errors);
-    }
-    let (m, t, st) = (&machine.fields, &tool.fields, &strategy.fields);
+    all_clear(p.needs_servo_lathe(what, lathe, ""))?;
+    let (m, t, st) = (&p.machine.fields, &p.tool.fields, &strategy.fields);
     let travel = value::block(m, "travel").expect("required");
     // The axis that carries the surface: the servo, or Z itself.
     let fast = value::block(m, if slow { "z_axis" } else { "fast_axis" }).expect("required");
-    let max_spindle = p.max_spindle_speed();
     let rho = value::num(t, "nose_radius").expect("required");
     let servo = if slow {
         None
     } else {
         servo_model(fast).map_err(|()| {
-            vec![err(
+            vec![p.error(
                 codes::MISSING_PARAMETER,
                 "the fast axis's servo model needs either `resonance` and `resonant_peak`, or `natural_frequency` and `damping`".into(),
             )]
         })?
     };
-    let fast_axis = FastAxis {
-        stroke: if slow {
-            let (lo, hi) = value::range(travel, "z").expect("required");
-            hi - lo
-        } else {
-            value::num(fast, "stroke").expect("required")
-        },
-        max_acceleration: value::num(fast, "max_acceleration").expect("required"),
-    };
-    let speed = match value::num(st, "surface_speed") {
-        Some(v) => SpindleSpeed::SurfaceSpeed {
-            speed: v,
-            max: value::num(st, "spindle_cap").unwrap_or(max_spindle),
-        },
-        None => SpindleSpeed::Constant(value::num(st, "spindle_speed").expect("one of them")),
-    };
+    let fast_axis = fast_axis(slow, travel, fast);
+    let speed = spindle_speed(st, p.max_spindle_speed());
 
     let lowered = p.lowered().map_err(|d| vec![d])?;
     // The spiral starts where the surface's farthest point from the axis is.
-    let outer = match lowered.domain {
-        lensc_runtime::surface::analysis::Domain::Circle { radius }
-        | lensc_runtime::surface::analysis::Domain::Annulus { outer: radius, .. } => radius,
-        lensc_runtime::surface::analysis::Domain::Rect { x, y } => [x.0, x.1]
-            .iter()
-            .flat_map(|a| [y.0, y.1].map(|b| a.hypot(b)))
-            .fold(0.0, f64::max),
-    };
-    let start = value::num(st, "from").unwrap_or(outer);
+    let start = value::num(st, "from").unwrap_or(outer_radius(&lowered.domain));
     // The fastest surface speed the job reaches: what d_traj is made of.
     let fastest = match speed {
         SpindleSpeed::SurfaceSpeed { speed, .. } => speed,
         SpindleSpeed::Constant(w) => w * start,
     };
-
-    // The settling offset, where the surface is an array of dimples.
-    let settle_word = value::word(st, "settle");
-    let settling = if slow || settle_word == Some("none") {
-        None
-    } else {
-        settling(surface, st, servo, fast, fastest)
-    };
-    if settle_word == Some("auto") && settling.is_none() {
-        return Err(vec![
-            err(
-                codes::UNSUPPORTED_COMBINATION,
-                "`settle: auto` needs an array of concave lenslets with circular apertures, whose continuation rises above the land".into(),
-            )
-            .with_help("use `settle: none` to follow the surface as it is"),
-        ]);
-    }
+    let settling = settling_offset(p, slow, servo, fast, fastest)?;
     let trajectory = match &settling {
         Some(s) => crate::lower::surface::lower_trajectory(surface, s.offset)
             .map_err(|e| vec![RuntimeError::Trajectory(e).at(p.site())])?,
@@ -168,7 +108,7 @@ pub(super) fn lower(
     let design_kernel = evaluate(&lowered.tape);
     let design =
         lensc_runtime::surface::analysis::analyse(design_kernel.as_ref(), &lowered.domain, 201);
-    errors.extend(tool_checks(p, design_kernel.as_ref(), &lowered, &design));
+    let mut errors = tool_checks(p, design_kernel.as_ref(), &lowered, &design);
 
     let spiral = FtsSpiral {
         feed_per_rev: value::num(st, "feed").expect("required") * 2.0 * std::f64::consts::PI,
@@ -179,64 +119,18 @@ pub(super) fn lower(
         start_radius: start,
         end_radius: 0.0,
     };
-    // With a settling offset, the trajectory is level outside each
-    // lenslet's continuation, which meets the plateau d_traj past the rim.
-    let features = settling.as_ref().and_then(|s| {
-        let (_, rim) = crate::lower::surface::array_lenslet(surface)?;
-        let centres = crate::lower::surface::array_centres(surface)?;
-        Some(
-            centres
-                .into_iter()
-                .map(|(x, y)| (x, y, rim + s.d_traj))
-                .collect(),
-        )
-    });
     let bounds = TrajectoryBounds {
         z_max: analysis.sag_max.value,
         // Margin over the sampled steepest slope: the contact search
         // window must contain the contact.
         max_slope: (analysis.max_slope.value * 1.1).min(1.5),
-        features,
+        features: settling.as_ref().and_then(|s| settled_features(surface, s)),
         part_top: design.sag_max.value,
     };
-    let spin_max = match speed {
-        SpindleSpeed::Constant(w) => w,
-        // The spiral runs in to the axis, where the cap is reached.
-        SpindleSpeed::SurfaceSpeed { max, .. } => max,
-    };
-    if spin_max > max_spindle {
-        errors.push(err(
-            codes::SPINDLE_TOO_FAST,
-            format!(
-                "the spindle speed ({} rpm) is above the machine's maximum ({} rpm)",
-                trim_num(rpm(spin_max)),
-                trim_num(rpm(max_spindle))
-            ),
-        ));
-    }
-    let (tx0, tx1) = value::range(travel, "x").expect("required");
-    if start > tx1 || tx0 > 0.0 {
-        errors.push(err(
-            codes::OUT_OF_TRAVEL,
-            format!(
-                "the spiral moves X from {} mm to 0, outside the machine's travel {} .. {} mm",
-                trim_num(start),
-                trim_num(tx0),
-                trim_num(tx1)
-            ),
-        ));
-    }
-    if !errors.is_empty() {
-        return Err(errors);
-    }
+    errors.extend(machine_limits(p, &spiral, travel));
+    all_clear(errors)?;
 
     let retract = value::num(st, "retract").unwrap_or(1.0);
-    // The lenslets' own apertures (the planner's features reach on to
-    // where the trajectory meets the settling plateau).
-    let lenslets = crate::lower::surface::array_lenslet(surface)
-        .zip(crate::lower::surface::array_centres(surface))
-        .map(|((_, rim), centres)| centres.into_iter().map(|(x, y)| (x, y, rim)).collect())
-        .unwrap_or_default();
     Ok(SpiralSpec {
         head: p.head(dialect, lowered),
         slow,
@@ -248,8 +142,122 @@ pub(super) fn lower(
         servo,
         settling,
         safe_w: analysis.sag_max.value + rho + retract,
-        lenslets,
+        lenslets: lenslets(surface),
     })
+}
+
+/// What the axis carrying the surface can do: the fast tool servo's
+/// stroke, or a slow tool servo's Z travel, and its acceleration.
+fn fast_axis(slow: bool, travel: &[value::Field], fast: &[value::Field]) -> FastAxis {
+    FastAxis {
+        stroke: if slow {
+            let (lo, hi) = value::range(travel, "z").expect("required");
+            hi - lo
+        } else {
+            value::num(fast, "stroke").expect("required")
+        },
+        max_acceleration: value::num(fast, "max_acceleration").expect("required"),
+    }
+}
+
+/// The strategy's spindle speed: a constant surface speed capped (by the
+/// strategy or the machine's limit, rad/s), or a constant spindle speed.
+fn spindle_speed(st: &[value::Field], max_spindle: f64) -> SpindleSpeed {
+    match value::num(st, "surface_speed") {
+        Some(v) => SpindleSpeed::SurfaceSpeed {
+            speed: v,
+            max: value::num(st, "spindle_cap").unwrap_or(max_spindle),
+        },
+        None => SpindleSpeed::Constant(value::num(st, "spindle_speed").expect("one of them")),
+    }
+}
+
+/// The lenslets' own apertures, if the surface is an array (the planner's
+/// features reach on to where the trajectory meets the settling plateau).
+fn lenslets(surface: &Object) -> Vec<(f64, f64, f64)> {
+    crate::lower::surface::array_lenslet(surface)
+        .zip(crate::lower::surface::array_centres(surface))
+        .map(|((_, rim), centres)| centres.into_iter().map(|(x, y)| (x, y, rim)).collect())
+        .unwrap_or_default()
+}
+
+/// How far from the spindle axis the surface's farthest point lies (mm).
+fn outer_radius(domain: &Domain) -> f64 {
+    match *domain {
+        Domain::Circle { radius } | Domain::Annulus { outer: radius, .. } => radius,
+        Domain::Rect { x, y } => [x.0, x.1]
+            .iter()
+            .flat_map(|a| [y.0, y.1].map(|b| a.hypot(b)))
+            .fold(0.0, f64::max),
+    }
+}
+
+/// The settling offset, where the strategy asks for one (`settle`, not on
+/// a slow tool servo) and the surface is an array of dimples; an error if
+/// `settle: auto` finds none.
+fn settling_offset(
+    p: &Parts,
+    slow: bool,
+    servo: Option<SecondOrderServo>,
+    fast: &[value::Field],
+    fastest: f64,
+) -> Result<Option<Settling>, Vec<Diagnostic>> {
+    let st = &p.strategy.fields;
+    let settle_word = value::word(st, "settle");
+    let settling = if slow || settle_word == Some("none") {
+        None
+    } else {
+        settling(p.surface, st, servo, fast, fastest)
+    };
+    if settle_word == Some("auto") && settling.is_none() {
+        return Err(vec![
+            p.error(
+                codes::UNSUPPORTED_COMBINATION,
+                "`settle: auto` needs an array of concave lenslets with circular apertures, whose continuation rises above the land".into(),
+            )
+            .with_help("use `settle: none` to follow the surface as it is"),
+        ]);
+    }
+    Ok(settling)
+}
+
+/// The planner's features with a settling offset: the trajectory is level
+/// outside each lenslet's continuation, which meets the plateau d_traj
+/// past the rim.
+fn settled_features(surface: &Object, s: &Settling) -> Option<Vec<(f64, f64, f64)>> {
+    let (_, rim) = crate::lower::surface::array_lenslet(surface)?;
+    let centres = crate::lower::surface::array_centres(surface)?;
+    Some(
+        centres
+            .into_iter()
+            .map(|(x, y)| (x, y, rim + s.d_traj))
+            .collect(),
+    )
+}
+
+/// The spindle's speed and the X travel against the spiral: if it
+/// turns faster than the machine allows (E0143), E0141 if it runs outside X.
+fn machine_limits(p: &Parts, spiral: &FtsSpiral, travel: &[value::Field]) -> Vec<Diagnostic> {
+    let spin_max = match spiral.speed {
+        SpindleSpeed::Constant(w) => w,
+        // The spiral runs in to the axis, where the cap is reached.
+        SpindleSpeed::SurfaceSpeed { max, .. } => max,
+    };
+    let start = spiral.start_radius;
+    let mut errors: Vec<Diagnostic> = p.spindle_limit(spin_max).into_iter().collect();
+    let (tx0, tx1) = value::range(travel, "x").expect("required");
+    if start > tx1 || tx0 > 0.0 {
+        errors.push(p.error(
+            codes::OUT_OF_TRAVEL,
+            format!(
+                "the spiral moves X from {} mm to 0, outside the machine's travel {} .. {} mm",
+                trim_num(start),
+                trim_num(tx0),
+                trim_num(tx1)
+            ),
+        ));
+    }
+    errors
 }
 
 /// The fast axis's second-order servo model, from its resonance and peak
@@ -336,7 +344,7 @@ fn tool_checks(
 /// each with where (x, y), over an n × n grid of the domain.
 fn polar_slopes(
     f: &dyn SurfaceFn,
-    domain: &lensc_runtime::surface::analysis::Domain,
+    domain: &Domain,
     n: usize,
 ) -> ((f64, f64, f64), (f64, f64, f64)) {
     let (xs, ys, out) = lensc_runtime::surface::analysis::grid(f, domain, n);
@@ -387,8 +395,4 @@ fn settling(
         d_traj: surface_speed * time,
         offset,
     })
-}
-
-fn rpm(w: f64) -> f64 {
-    w * 60.0 / (2.0 * std::f64::consts::PI)
 }
