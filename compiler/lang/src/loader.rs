@@ -13,6 +13,7 @@ use lensc_grammar::diagnostic::codes as syntax_codes;
 use lensc_grammar::{Diagnostic, FileId};
 
 use crate::codes;
+pub use crate::sandbox::plain_io_error;
 use crate::sandbox::{self, ReadError};
 use crate::source::SourceMap;
 use lensc_grammar::suggest::did_you_mean;
@@ -395,17 +396,4 @@ fn outside_root(
         "a job file reads only files under its project root (by default the directory of \
          the file given on the command line); give `--root DIR` to widen it",
     )
-}
-
-/// The OS error without its "(os error 2)" tail.
-pub fn plain_io_error(e: &std::io::Error) -> String {
-    match e.kind() {
-        std::io::ErrorKind::NotFound => "no such file".into(),
-        std::io::ErrorKind::PermissionDenied => "permission denied".into(),
-        std::io::ErrorKind::IsADirectory => "it is a directory".into(),
-        _ => {
-            let s = e.to_string();
-            s.split(" (os error").next().unwrap_or(&s).to_lowercase()
-        }
-    }
 }

@@ -49,7 +49,7 @@ impl From<std::io::Error> for ReadError {
 impl std::fmt::Display for ReadError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            ReadError::Io(e) => f.write_str(&crate::loader::plain_io_error(e)),
+            ReadError::Io(e) => f.write_str(&plain_io_error(e)),
             ReadError::NotAFile { what } => write!(f, "it is {what}, not a regular file"),
             ReadError::TooLarge { limit, .. } => {
                 write!(f, "it is larger than the limit of {} MiB", limit >> 20)
@@ -165,6 +165,19 @@ pub fn resolve(path: &Path) -> PathBuf {
 /// Whether the resolved path lies inside the resolved root (or is it).
 pub fn inside(resolved: &Path, root: &Path) -> bool {
     resolved.starts_with(root)
+}
+
+/// The OS error without its "(os error 2)" tail.
+pub fn plain_io_error(e: &std::io::Error) -> String {
+    match e.kind() {
+        std::io::ErrorKind::NotFound => "no such file".into(),
+        std::io::ErrorKind::PermissionDenied => "permission denied".into(),
+        std::io::ErrorKind::IsADirectory => "it is a directory".into(),
+        _ => {
+            let s = e.to_string();
+            s.split(" (os error").next().unwrap_or(&s).to_lowercase()
+        }
+    }
 }
 
 #[cfg(test)]
