@@ -10,31 +10,9 @@ use proptest::prelude::*;
 
 const TOL: f64 = 1e-13;
 
-const UNARY: [Unary; 12] = [
-    Unary::Neg,
-    Unary::Sqrt,
-    Unary::Abs,
-    Unary::Sin,
-    Unary::Cos,
-    Unary::Tan,
-    Unary::Asin,
-    Unary::Acos,
-    Unary::Atan,
-    Unary::Exp,
-    Unary::Ln,
-    Unary::Floor,
-];
+const UNARY: [Unary; 12] = Unary::ALL;
 
-const BINARY: [Binary; 8] = [
-    Binary::Add,
-    Binary::Sub,
-    Binary::Mul,
-    Binary::Div,
-    Binary::Pow,
-    Binary::Atan2,
-    Binary::Min,
-    Binary::Max,
-];
+const BINARY: [Binary; 8] = Binary::ALL;
 
 /// Agreement: equal (also ±∞ and ±0), both NaN, or within TOL relative.
 fn agree(a: f64, b: f64) -> bool {

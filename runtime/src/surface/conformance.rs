@@ -24,31 +24,9 @@ pub trait Backend: SurfaceFn + Sized {
 /// 1 and the values (they sum the same terms in other orders).
 const TOL: f64 = 1e-12;
 
-const UNARY: [Unary; 12] = [
-    Unary::Neg,
-    Unary::Sqrt,
-    Unary::Abs,
-    Unary::Sin,
-    Unary::Cos,
-    Unary::Tan,
-    Unary::Asin,
-    Unary::Acos,
-    Unary::Atan,
-    Unary::Exp,
-    Unary::Ln,
-    Unary::Floor,
-];
+const UNARY: [Unary; 12] = Unary::ALL;
 
-const BINARY: [Binary; 8] = [
-    Binary::Add,
-    Binary::Sub,
-    Binary::Mul,
-    Binary::Div,
-    Binary::Pow,
-    Binary::Atan2,
-    Binary::Min,
-    Binary::Max,
-];
+const BINARY: [Binary; 8] = Binary::ALL;
 
 /// A linear form a·x + b·y + c: an argument whose own second derivatives
 /// vanish, so the chain rule through it is short.

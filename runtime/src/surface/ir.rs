@@ -39,6 +39,24 @@ pub enum Unary {
     Floor,
 }
 
+impl Unary {
+    /// Every function of one argument (for suites that try them all).
+    pub const ALL: [Unary; 12] = [
+        Unary::Neg,
+        Unary::Sqrt,
+        Unary::Abs,
+        Unary::Sin,
+        Unary::Cos,
+        Unary::Tan,
+        Unary::Asin,
+        Unary::Acos,
+        Unary::Atan,
+        Unary::Exp,
+        Unary::Ln,
+        Unary::Floor,
+    ];
+}
+
 /// Functions of two arguments.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Binary {
@@ -51,6 +69,20 @@ pub enum Binary {
     Atan2,
     Min,
     Max,
+}
+
+impl Binary {
+    /// Every function of two arguments.
+    pub const ALL: [Binary; 8] = [
+        Binary::Add,
+        Binary::Sub,
+        Binary::Mul,
+        Binary::Div,
+        Binary::Pow,
+        Binary::Atan2,
+        Binary::Min,
+        Binary::Max,
+    ];
 }
 
 /// One node. Constants are stored by their bits so the arena can
