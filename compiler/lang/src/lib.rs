@@ -10,13 +10,14 @@
 //! per category of kind; `units`, `value`, `codes`); and checked jobs and
 //! surfaces are lowered to what the runtime plans (`lower`, with
 //! `lower::surface` one file per surface family, `domain` the apertures both
-//! share). Errors are data
+//! share); `format` is `lensc fmt`'s canonical layout. Errors are data
 //! (`Diagnostic`s with codes and spans; `lower::diagnostics` maps every runtime
 //! error to one); nothing here plans, writes or renders.
 
 pub mod check;
 pub mod codes;
 pub mod domain;
+pub mod format;
 pub mod loader;
 pub mod lower;
 pub mod sandbox;

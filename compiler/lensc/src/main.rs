@@ -1,5 +1,5 @@
-//! The `lensc` command line: `check`, `build`, `report`, `analyse` and
-//! `sample`. Exit codes: 0 success (warnings allowed), 1 errors in the
+//! The `lensc` command line: `check`, `build`, `report`, `analyse`,
+//! `sample` and `fmt`. Exit codes: 0 success (warnings allowed), 1 errors in the
 //! input, 2 usage errors, 101 an internal error, 130 and 143 a `build` or
 //! `report` stopped by SIGINT or SIGTERM.
 
@@ -110,6 +110,16 @@ enum Command {
         #[arg(long, default_value_t = 201, value_name = "N")]
         grid: usize,
     },
+    /// Put .lens files in the one canonical layout (comments kept where
+    /// they were, meaning unchanged), rewriting each file that changes.
+    Fmt {
+        /// The .lens files to format.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Write nothing: list the files that would change and exit 1 if any would.
+        #[arg(long)]
+        check: bool,
+    },
     /// Evaluate a surface: CSV on stdout with the header
     /// x,y,z,dzdx,dzdy,curvature_x,curvature_y (mm and 1/mm).
     #[command(group(clap::ArgGroup::new("at").required(true).args(["grid", "radial", "points"])))]
@@ -182,6 +192,7 @@ fn run(cli: Cli) -> u8 {
             files,
             max_program_size,
         } => commands::check::run(&out, &files, max_program_size),
+        Command::Fmt { files, check } => commands::fmt::run(&out, &files, check),
         Command::Analyse {
             file,
             surface,

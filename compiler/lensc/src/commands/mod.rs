@@ -4,5 +4,6 @@
 pub mod analyse;
 pub mod build;
 pub mod check;
+pub mod fmt;
 pub mod report;
 pub mod sample;
