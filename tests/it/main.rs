@@ -16,6 +16,7 @@ mod diagnostics;
 mod dialects;
 mod examples;
 mod floods;
+mod fmt;
 mod fuzz_properties;
 mod interrupt;
 mod jit_conformance;

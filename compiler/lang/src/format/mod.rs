@@ -1,7 +1,9 @@
 //! `lensc fmt`'s one canonical layout of a `.lens` file (also what a
 //! language server's formatting request answers): items at the left
-//! margin, four spaces a level, one space around `=`, `:` and operators,
-//! a number and its unit one space apart, each block, list and call on
+//! margin, four spaces a level, one space around `=` and operators and
+//! after `:` (but `10 rad/(3 mm)`, a quantity over a bracketed one, is
+//! written as the compound unit it reads as), a number and its unit one
+//! space apart (`7°` together), each block, list and call on
 //! one line (`{ a: 1, b: 2 }`, `[a, b]`, `f(a, b)`) unless its author
 //! broke it over lines or a comment inside needs a line, then one element
 //! a line (block entries without commas, list elements and arguments with

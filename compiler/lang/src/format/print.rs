@@ -111,10 +111,17 @@ impl<'t, 's> Printer<'t, 's> {
     }
 
     /// Comments on the same source line as `*prev` and before `limit`,
-    /// written after the element that ends there.
-    fn trailing(&mut self, prev: &mut usize, limit: usize) {
+    /// written after the element that ends there; a block comment after
+    /// the comma, which the element at `limit` (`next`) follows on its
+    /// line, is left to lead that element.
+    fn trailing(&mut self, prev: &mut usize, limit: usize, next: bool) {
         while let Some(c) = self.peek().filter(|c| c.start < limit) {
-            if self.t.newlines(*prev, c.start) > 0 {
+            let after_comma = self
+                .t
+                .src
+                .get(*prev..c.start)
+                .is_some_and(|s| s.contains(','));
+            if self.t.newlines(*prev, c.start) > 0 || (after_comma && self.leads(c, limit, next)) {
                 return;
             }
             self.out.push(' ');
@@ -126,9 +133,17 @@ impl<'t, 's> Printer<'t, 's> {
         }
     }
 
+    /// Whether the block comment `c` leads the element starting at `limit`
+    /// (`next`: an element starts there, not a closing bracket): the
+    /// element follows it on its line.
+    fn leads(&self, c: Comment, limit: usize, next: bool) -> bool {
+        next && !c.line && self.t.newlines(c.end, limit) == 0
+    }
+
     /// Comments before `limit` on lines of their own, with the blank lines
-    /// before them kept (none right after an opening bracket).
-    fn own_lines(&mut self, prev: &mut usize, limit: usize, first: &mut bool) {
+    /// before them kept (none right after an opening bracket). Returns
+    /// whether the last one leads the element at `limit` on its line.
+    fn own_lines(&mut self, prev: &mut usize, limit: usize, next: bool, first: &mut bool) -> bool {
         while let Some(c) = self.peek().filter(|c| c.start < limit) {
             if !*first && self.t.newlines(*prev, c.start) > 1 {
                 self.blank_line();
@@ -137,8 +152,13 @@ impl<'t, 's> Printer<'t, 's> {
             self.comment(c);
             *prev = c.end;
             *first = false;
-            self.trailing(prev, limit);
+            if self.leads(c, limit, next) {
+                self.out.push(' ');
+                return true;
+            }
+            self.trailing(prev, limit, next);
         }
+        false
     }
 
     /// A sequence laid out one element a line, between an opening bracket
@@ -155,27 +175,30 @@ impl<'t, 's> Printer<'t, 's> {
     ) {
         let mut prev = open_end;
         if !top {
-            self.trailing(&mut prev, spans.first().map_or(close, |s| s.start as usize));
+            let limit = spans.first().map_or(close, |s| s.start as usize);
+            self.trailing(&mut prev, limit, !spans.is_empty());
             self.indent += 1;
         }
         let mut first = true;
         for (k, span) in spans.iter().enumerate() {
             let start = span.start as usize;
-            self.own_lines(&mut prev, start, &mut first);
-            if !first && self.t.newlines(prev, start) > 1 {
-                self.blank_line();
+            if !self.own_lines(&mut prev, start, true, &mut first) {
+                if !first && self.t.newlines(prev, start) > 1 {
+                    self.blank_line();
+                }
+                self.newline();
             }
-            self.newline();
             first = false;
             print(self, k);
             if let Sep::Comma = sep {
                 self.out.push(',');
             }
             prev = span.end as usize;
-            let next = spans.get(k + 1).map_or(close, |s| s.start as usize);
-            self.trailing(&mut prev, next);
+            let next = spans.get(k + 1);
+            let limit = next.map_or(close, |s| s.start as usize);
+            self.trailing(&mut prev, limit, next.is_some());
         }
-        self.own_lines(&mut prev, close, &mut first);
+        self.own_lines(&mut prev, close, false, &mut first);
         if !top {
             self.indent -= 1;
             self.newline();
@@ -360,10 +383,21 @@ impl<'t, 's> Printer<'t, 's> {
                 self.expr(operand);
             }
             ExprKind::Binary { op, lhs, rhs } => {
+                // `10 rad/(3 mm)`: a quantity over a bracketed one reads as
+                // the compound unit it is (and parses as a division: no
+                // unit part starts with `(`).
+                let per = *op == BinaryOp::Div
+                    && matches!(lhs.kind, ExprKind::Quantity { unit: Some(_), .. })
+                    && self.parens(lhs).0 == 0
+                    && self.parens(rhs).0 > 0;
                 self.expr(lhs);
-                self.out.push(' ');
-                self.out.push_str(op.symbol());
-                self.out.push(' ');
+                if per {
+                    self.out.push('/');
+                } else {
+                    self.out.push(' ');
+                    self.out.push_str(op.symbol());
+                    self.out.push(' ');
+                }
                 self.expr(rhs);
             }
             ExprKind::Call { callee, args } => {

@@ -27,6 +27,10 @@ fn spacing_is_normalised() {
         "let r = -10 mm .. 2.5e-3 mm^-1\n"
     );
     assert_eq!(fmt("let e = 5 em"), "let e = 5 em\n");
+    assert_eq!(
+        fmt("let k = 10 rad / (3 mm) + 1 mm / (x) + (1 mm)/(2) + 1/(2)"),
+        "let k = 10 rad/(3 mm) + 1 mm/(x) + (1 mm) / (2) + 1 / (2)\n"
+    );
 }
 
 #[test]
@@ -59,7 +63,7 @@ fn comments_stay_where_they_were() {
     let src = "// head\n\n\n// about a\nlet a = 1 // trailing\n/* own */\nlet b = 2\nsurface s = conic { // opener\n    radius: 1 mm, /* after radius */ conic: -1\n\n    // before sense\n    sense: convex\n    // dangling\n}\n// end\n";
     assert_eq!(
         fmt(src),
-        "// head\n\n// about a\nlet a = 1 // trailing\n/* own */\nlet b = 2\nsurface s = conic { // opener\n    radius: 1 mm /* after radius */\n    conic: -1\n\n    // before sense\n    sense: convex\n    // dangling\n}\n// end\n"
+        "// head\n\n// about a\nlet a = 1 // trailing\n/* own */\nlet b = 2\nsurface s = conic { // opener\n    radius: 1 mm\n    /* after radius */ conic: -1\n\n    // before sense\n    sense: convex\n    // dangling\n}\n// end\n"
     );
     // A comment inside a one-line block breaks it.
     assert_eq!(
