@@ -431,7 +431,11 @@ impl<'t, 's> Printer<'t, 's> {
             }
         }
         if layers > 0 {
-            self.tok(e.span.end as usize - 1, "");
+            self.flush_before(e.span.end as usize - 1);
+            // `(1 /* why */)`: no space between a comment and the bracket.
+            if self.out.ends_with("*/ ") {
+                self.out.pop();
+            }
             for _ in 0..layers {
                 self.out.push(')');
             }

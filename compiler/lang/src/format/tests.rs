@@ -75,7 +75,7 @@ fn comments_stay_where_they_were() {
         fmt("let a = /* x */ 1 + // y\n  2"),
         "let a = /* x */ 1 + // y\n    2\n"
     );
-    assert_eq!(fmt("let a = (1 /* in */)"), "let a = (1 /* in */ )\n");
+    assert_eq!(fmt("let a = (1 /* in */)"), "let a = (1 /* in */)\n");
 }
 
 #[test]
