@@ -202,13 +202,17 @@ impl<'a> Checker<'a> {
                 span,
             )
             .with_label(format!("this is {d}"));
+            let examples = dims
+                .iter()
+                .map(|d| example_unit(*d))
+                .collect::<Vec<_>>()
+                .join(" or ");
             diag = diag.with_help(if d.is_none() {
-                format!(
-                    "write a unit after the number, for example {}",
-                    example_unit(dims[0])
-                )
+                format!("write a unit after the number, for example {examples}")
+            } else if dims == [Dim::NONE] {
+                format!("`{}`: {}; write it as a plain number, with no unit", f.name, p.doc)
             } else {
-                format!("`{}` is {}: {}", f.name, want, p.doc)
+                format!("`{}`: {}; write it as, for example, {examples}", f.name, p.doc)
             });
             self.err(diag);
             return;
