@@ -18,6 +18,7 @@
 pub mod check;
 pub mod codes;
 pub mod domain;
+pub mod explain;
 pub mod loader;
 pub mod lower;
 pub mod sandbox;

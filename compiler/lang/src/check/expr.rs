@@ -157,7 +157,7 @@ impl<'a> Checker<'a> {
                         callee.span,
                     )
                     .with_label("not a function")
-                    .with_help("only functions (`sin(…)`) and kinds (`circle(…)`) take arguments in brackets; to multiply, write `*`, as in `a * (2)`"),
+                    .with_help("only functions (`sin(…)`) and kinds (`circle(…)`) take arguments in brackets; to multiply, write `*` between the factors"),
                 );
                 Value::Error
             }

@@ -210,9 +210,12 @@ impl<'a> Checker<'a> {
             diag = diag.with_help(if d.is_none() {
                 format!("write a unit after the number, for example {examples}")
             } else if dims == [Dim::NONE] {
-                format!("`{}`: {}; write it as a plain number, with no unit", f.name, p.doc)
+                format!(
+                    "write `{}` as a plain number, with no unit ({})",
+                    f.name, p.doc
+                )
             } else {
-                format!("`{}`: {}; write it as, for example, {examples}", f.name, p.doc)
+                format!("write `{}` as, for example, {examples} ({})", f.name, p.doc)
             });
             self.err(diag);
             return;

@@ -311,10 +311,15 @@ impl<'a> Checker<'a> {
     /// built-in name, a word, a second definition): uses of it are not
     /// reported again.
     fn refused_here(&self, file: FileId, name: &str) -> bool {
-        self.loaded.file(file).ast.items.iter().any(|i| match &i.kind {
-            ItemKind::Let { name: n, .. } | ItemKind::Decl { name: n, .. } => n.name == name,
-            _ => false,
-        })
+        self.loaded
+            .file(file)
+            .ast
+            .items
+            .iter()
+            .any(|i| match &i.kind {
+                ItemKind::Let { name: n, .. } | ItemKind::Decl { name: n, .. } => n.name == name,
+                _ => false,
+            })
     }
 
     pub(super) fn unknown_name(&mut self, file: FileId, span: Span, name: &str) {

@@ -85,7 +85,7 @@ fn dialect_help(requested: &str, offered: &[&Object], names: &[String]) -> Strin
     let offers = format!("its machine offers {}", names.join(", "));
     let offered_names: Vec<String> = offered.iter().map(|o| dialect_name(o)).collect();
     if let Some(s) = did_you_mean(requested, offered_names.iter().map(String::as_str)) {
-        return format!("did you mean `--dialect {s}`? {offers}");
+        return format!("did you mean `--dialect {s}`? {}", capitalised(&offers));
     }
     let std_dialects = || {
         crate::stdlib::items()
@@ -225,4 +225,12 @@ pub(crate) fn exact_num(v: f64) -> String {
     }
     let t = format!("{v:.12}");
     t.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+/// `its machine …` → `Its machine …`, to start a sentence.
+fn capitalised(s: &str) -> String {
+    let mut c = s.chars();
+    c.next()
+        .map(|f| f.to_uppercase().chain(c).collect())
+        .unwrap_or_default()
 }
