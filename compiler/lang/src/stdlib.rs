@@ -7,7 +7,7 @@
 use std::sync::OnceLock;
 
 use lensc_grammar::FileId;
-use lensc_grammar::ast::{DeclKind, ItemKind};
+use lensc_grammar::ast::{DeclKind, Expr, ExprKind, ItemKind};
 
 use crate::loader::STDLIB;
 
@@ -21,6 +21,9 @@ pub struct StdItem {
     /// The comment lines just above the declaration, joined into one
     /// paragraph per blank comment line.
     pub doc: String,
+    /// The name its value is made from: a kind (`lathe { … }`) or another
+    /// item it copies (`linuxcnc_lathe { … }`).
+    pub made_from: Option<String>,
 }
 
 impl StdItem {
@@ -51,15 +54,38 @@ fn module_items(module: &'static str, text: &str) -> Vec<StdItem> {
     file.items
         .iter()
         .filter_map(|item| match &item.kind {
-            ItemKind::Decl { kind, name, .. } => Some(StdItem {
+            ItemKind::Decl { kind, name, value } => Some(StdItem {
                 module,
                 name: name.name.clone(),
                 kind: *kind,
                 doc: doc_above(text, item.span.start as usize),
+                made_from: head_name(value),
             }),
             _ => None,
         })
         .collect()
+}
+
+/// `lathe` of `lathe { … }`, `circle` of `circle(…)`, `a` of `a`.
+fn head_name(e: &Expr) -> Option<String> {
+    match &e.kind {
+        ExprKind::Name(n) => Some(n.clone()),
+        ExprKind::WithBlock { base, .. } => head_name(base),
+        ExprKind::Call { callee, .. } => head_name(callee),
+        _ => None,
+    }
+}
+
+/// The built-in kind an item is made with, following the items it copies.
+pub fn kind_of(item: &StdItem) -> Option<&str> {
+    let mut name = item.made_from.as_deref()?;
+    for _ in 0..items().len() {
+        match find(name) {
+            Some(i) => name = i.made_from.as_deref()?,
+            None => return Some(name),
+        }
+    }
+    None
 }
 
 /// The `//` comment block that ends on the line just above byte `start`.

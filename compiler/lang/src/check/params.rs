@@ -318,7 +318,11 @@ impl<'a> Checker<'a> {
                     file,
                     span,
                 )
-                .with_label(format!("this is {d}")),
+                .with_label(format!("this is {d}"))
+                .with_help(format!(
+                    "write both ends as {dim}, for example {}",
+                    example_unit(dim)
+                )),
             );
         } else if lo >= hi {
             self.err(
@@ -328,7 +332,19 @@ impl<'a> Checker<'a> {
                     file,
                     span,
                 )
-                .with_label("the start must be below the end"),
+                .with_label("the start must be below the end")
+                .with_help({
+                    let (unit, factor) = d.display_unit();
+                    if lo == hi {
+                        "its ends are equal: give the range a length".to_string()
+                    } else {
+                        format!(
+                            "write the lower end first: `{} {unit} .. {} {unit}`",
+                            trim_num(hi * factor),
+                            trim_num(lo * factor)
+                        )
+                    }
+                }),
             );
         }
     }
