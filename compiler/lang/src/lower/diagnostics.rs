@@ -100,6 +100,7 @@ impl RuntimeError<'_> {
             RuntimeError::Program(e) => Coded {
                 label: "no program was written for this job",
                 ..coded(codes::NOT_PRINTABLE, e.message())
+                    .help(crate::lower::job::NOT_PRINTABLE_HELP)
             },
             RuntimeError::Surface(e) => coded(
                 codes::UNSUPPORTED_COMBINATION,
@@ -185,7 +186,8 @@ fn turning(e: PlanError) -> Coded {
                 rpm(speed),
                 rpm(max)
             ),
-        ),
+        )
+        .help(format!("lower `spindle_speed` to at most {} rpm (with `surface_speed`, cap it with `spindle_cap`)", rpm(max))),
         PlanError::Undefined { at_radius } => coded(
             codes::UNDEFINED_ON_PATH,
             format!(
@@ -213,7 +215,8 @@ fn spiral(e: FtsError, speed: &SpindleSpeed, axis: &str) -> Coded {
                 um(range),
                 um(stroke)
             ),
-        ),
+        )
+        .help("use a fast axis with a longer `stroke`, or a surface whose height varies less around each turn"),
         FtsError::AccelerationExceeded {
             acceleration,
             max,
@@ -276,7 +279,8 @@ fn raster(e: RasterError) -> Coded {
                 trim_num(x),
                 trim_num(y)
             ),
-        ),
+        )
+        .help(format!("use a tool whose `clearance` is above {}°", trim_num(slope.to_degrees()))),
         RasterError::Undefined { x, y } | RasterError::NoContact { x, y } => coded(
             codes::UNDEFINED_ON_PATH,
             format!(

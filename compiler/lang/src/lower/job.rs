@@ -190,6 +190,7 @@ impl<'a> Parts<'a> {
                     o.kind.name
                 ),
             )
+            .with_help(stdlib_made_by(part, kinds))
         })
     }
     /// E0131 for a machine that is not a `lathe` (`note` follows its kind
@@ -198,22 +199,28 @@ impl<'a> Parts<'a> {
     pub fn needs_servo_lathe(&self, what: &str, lathe: &str, note: &str) -> Vec<Diagnostic> {
         let mut errors = Vec::new();
         if self.machine.kind.name != lathe {
-            errors.push(self.error(
-                codes::UNSUPPORTED_COMBINATION,
-                format!(
-                    "{what} needs an `{lathe}`{note}; this machine is a `{}`",
-                    self.machine.kind.name
-                ),
-            ));
+            errors.push(
+                self.error(
+                    codes::UNSUPPORTED_COMBINATION,
+                    format!(
+                        "{what} needs an `{lathe}`{note}; this machine is a `{}`",
+                        self.machine.kind.name
+                    ),
+                )
+                .with_help(stdlib_made_by("machine", &[lathe])),
+            );
         }
         if self.tool.kind.name != "round_nose" {
-            errors.push(self.error(
-                codes::UNSUPPORTED_COMBINATION,
-                format!(
-                    "{what} needs a `round_nose` tool; this is a `{}`",
-                    self.tool.kind.name
-                ),
-            ));
+            errors.push(
+                self.error(
+                    codes::UNSUPPORTED_COMBINATION,
+                    format!(
+                        "{what} needs a `round_nose` tool; this is a `{}`",
+                        self.tool.kind.name
+                    ),
+                )
+                .with_help(stdlib_made_by("tool", &["round_nose"])),
+            );
         }
         errors
     }
@@ -240,6 +247,7 @@ impl<'a> Parts<'a> {
                     rpm(max)
                 ),
             )
+            .with_help(format!("lower `spindle_speed` to at most {} rpm", rpm(max)))
         })
     }
     /// The job's head, once its surface is lowered and its dialect known.
@@ -358,7 +366,8 @@ pub fn lower_job(
     {
         errors.push(
             Diagnostic::error(codes::NOT_PRINTABLE, e.message(), job.file, job.name.span)
-                .with_label("no program was written for this job"),
+                .with_label("no program was written for this job")
+                .with_help(NOT_PRINTABLE_HELP),
         );
     }
     match spec {
@@ -399,4 +408,33 @@ fn simulate(job: &CheckedJob) -> Result<Option<Simulate>, Diagnostic> {
         .with_label("this window"));
     }
     Ok(Some(s))
+}
+
+/// What to do when a job's dialect cannot write its program (E0150).
+pub const NOT_PRINTABLE_HELP: &str = "write the program in a dialect of the machine that can (`lensc build --dialect NAME`; `lensc list dialects`), or change the machine (its `resolution`, its `dialect`) so this one can";
+
+/// What to write instead of a part of the wrong kind: the standard
+/// library's items of the kinds needed, with their `use`, or how to make
+/// one.
+fn stdlib_made_by(part: &str, kinds: &[&str]) -> String {
+    let made: Vec<&crate::stdlib::StdItem> = crate::stdlib::items()
+        .iter()
+        .filter(|i| crate::stdlib::kind_of(i).is_some_and(|k| kinds.contains(&k)))
+        .collect();
+    match made.as_slice() {
+        [] => format!(
+            "make one: `{part} NAME = {} {{ … }}` (`lensc list` shows its parameters)",
+            kinds[0]
+        ),
+        [one, ..] => format!(
+            "the standard library's {} {}: add `{}` and write `{part}: {}`",
+            made.iter()
+                .map(|i| format!("`{}`", i.name))
+                .collect::<Vec<_>>()
+                .join(", "),
+            if made.len() == 1 { "is one" } else { "are" },
+            one.use_line(),
+            one.name
+        ),
+    }
 }

@@ -7,6 +7,7 @@ pub mod diagnostics;
 pub mod job;
 pub mod surface;
 
+use lensc_grammar::suggest::did_you_mean;
 use lensc_grammar::{Diagnostic, FileId};
 use lensc_runtime::post::Dialect;
 
@@ -72,12 +73,39 @@ pub fn dialect(job: &CheckedJob, requested: Option<&str>) -> Result<Dialect, Dia
             span,
         )
         .with_label("this job")
-        .with_help(format!(
-            "its machine offers {}; add the dialect to the machine's `other_dialects` if its controller reads it",
-            names.join(", ")
-        )));
+        .with_help(dialect_help(requested.unwrap_or(""), &offered, &names)));
     };
     Ok(dialect_of(o, dialect_name(o)))
+}
+
+/// What to write instead of a dialect the machine does not offer: the
+/// nearest name it offers; else, for a dialect the standard library has,
+/// how to add it to the machine; else the nearest dialect there is.
+fn dialect_help(requested: &str, offered: &[&Object], names: &[String]) -> String {
+    let offers = format!("its machine offers {}", names.join(", "));
+    let offered_names: Vec<String> = offered.iter().map(|o| dialect_name(o)).collect();
+    if let Some(s) = did_you_mean(requested, offered_names.iter().map(String::as_str)) {
+        return format!("did you mean `--dialect {s}`? {}", capitalised(&offers));
+    }
+    let std_dialects = || {
+        crate::stdlib::items()
+            .iter()
+            .filter(|i| i.kind == lensc_grammar::ast::DeclKind::Dialect)
+            .map(|i| i.name.as_str())
+    };
+    if std_dialects().any(|d| d == requested) {
+        return format!(
+            "{offers}; if its controller reads `{requested}`, add it to the machine's `other_dialects: [{requested}]`"
+        );
+    }
+    match did_you_mean(requested, std_dialects()) {
+        Some(s) => format!(
+            "no standard dialect is called `{requested}`: did you mean `{s}`? {offers}; `lensc list dialects` shows them all"
+        ),
+        None => format!(
+            "no standard dialect is called `{requested}`; {offers}; `lensc list dialects` shows them all"
+        ),
+    }
 }
 
 /// The names of the dialects a job's machine offers, its own first.
@@ -197,4 +225,12 @@ pub(crate) fn exact_num(v: f64) -> String {
     }
     let t = format!("{v:.12}");
     t.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+/// `its machine …` → `Its machine …`, to start a sentence.
+fn capitalised(s: &str) -> String {
+    let mut c = s.chars();
+    c.next()
+        .map(|f| f.to_uppercase().chain(c).collect())
+        .unwrap_or_default()
 }

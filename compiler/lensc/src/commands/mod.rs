@@ -5,5 +5,7 @@ pub mod analyse;
 pub mod build;
 pub mod check;
 pub mod fmt;
+pub mod explain;
+pub mod list;
 pub mod report;
 pub mod sample;

@@ -308,7 +308,7 @@ fn tool_checks(
                 trim_num(r.x),
                 trim_num(r.y)
             ),
-        ));
+        ).with_help(format!("use a tool whose `nose_radius` is below {} um", trim_num(r.value * 1000.0))));
     }
     let (around, across) = polar_slopes(design_kernel, &lowered.domain, 201);
     if clearance <= around.0 {
@@ -321,7 +321,7 @@ fn tool_checks(
                 trim_num(around.1),
                 trim_num(around.2)
             ),
-        ));
+        ).with_help(format!("use a tool whose `clearance` is above {}°", trim_num(around.0.to_degrees()))));
     }
     if let Some(included) = value::num(t, "included_angle")
         && included / 2.0 <= across.0
@@ -335,7 +335,7 @@ fn tool_checks(
                 trim_num(across.1),
                 trim_num(across.2)
             ),
-        ));
+        ).with_help(format!("use a tool whose `included_angle` is above {}°", trim_num(2.0 * across.0.to_degrees()))));
     }
     errors
 }
