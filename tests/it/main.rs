@@ -16,6 +16,7 @@ mod diagnostics;
 mod dialects;
 mod examples;
 mod floods;
+mod fts_advice;
 mod fuzz_properties;
 mod interrupt;
 mod jit_conformance;
