@@ -18,6 +18,7 @@ mod examples;
 mod explain;
 mod floods;
 mod fmt;
+mod fts_advice;
 mod fuzz_properties;
 mod interrupt;
 mod jit_conformance;

@@ -11,7 +11,7 @@ use lensc_lang::codes;
 use lensc_lang::lower::diagnostics::RuntimeError;
 use lensc_lang::lower::job::SpiralSpec;
 use lensc_runtime::emit::fts::FtsProgram;
-use lensc_runtime::plan::fts::{FtsSummary, Planner, SpindleSpeed};
+use lensc_runtime::plan::fts::{FtsError, FtsSummary, Planner, SpindleSpeed};
 use lensc_runtime::post::Provenance;
 use lensc_runtime::surface::ir::SurfaceFn;
 use lensc_runtime::verify::heightmap::Sweep;
@@ -23,6 +23,8 @@ use crate::output::Built;
 use crate::parts;
 use crate::report;
 use crate::spool::{ProgramSink, Sink};
+
+pub mod advice;
 
 /// A spiral job ready to plan: its spec and the trajectory's kernel.
 pub struct Prepared<'s> {
@@ -109,11 +111,18 @@ pub fn build(
         }
     });
     let summary = planned.map_err(|error| {
+        let advice = match error {
+            FtsError::AccelerationExceeded { acceleration, .. } => {
+                Some(advice::search(spec, acceleration))
+            }
+            _ => None,
+        };
         vec![
             RuntimeError::Spiral {
                 error,
                 speed: &p.spiral.speed,
                 axis: axis_words(spec),
+                advice,
             }
             .at(site),
         ]

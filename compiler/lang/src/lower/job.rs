@@ -21,7 +21,7 @@ mod window;
 pub use estimate::{DEFAULT_MAX_PROGRAM_SIZE, Estimate, Limits, MAX_POINTS, estimate, refusals};
 pub use mill::{GrindingSpec, RasterSpec};
 pub use roller::RollerSpec;
-pub use spiral::{Settling, SpiralSpec};
+pub use spiral::{AtSpeed, Settling, SpiralSpec};
 pub use turning::TurningSpec;
 
 use lensc_grammar::{Diagnostic, FileId, Span};
