@@ -17,6 +17,7 @@ mod dialects;
 mod examples;
 mod floods;
 mod fuzz_properties;
+mod headers;
 mod interrupt;
 mod jit_conformance;
 mod limits;
