@@ -57,6 +57,8 @@ pub const CANNOT_WRITE: &str = "E0151";
 pub const TOO_MANY_POINTS: &str = "E0160";
 /// A job's program would be larger than `--max-program-size`.
 pub const PROGRAM_TOO_LARGE: &str = "E0161";
+/// A path tolerance finer than the machine's resolution can hold.
+pub const TOLERANCE_BELOW_RESOLUTION: &str = "E0180";
 
 pub const UNUSED: &str = "W0001";
 pub const WRAP_GAP: &str = "W0002";
@@ -118,6 +120,7 @@ pub const ALL: &[&str] = &[
     CANNOT_WRITE,
     TOO_MANY_POINTS,
     PROGRAM_TOO_LARGE,
+    TOLERANCE_BELOW_RESOLUTION,
     UNUSED,
     SEAM_LEFT_UNCUT,
     CENTRE_LEFT_UNCUT,

@@ -15,6 +15,7 @@ mod estimate;
 mod mill;
 mod roller;
 mod spiral;
+pub mod tolerance;
 mod turning;
 mod window;
 
@@ -358,6 +359,7 @@ pub fn lower_job(
             Setup::Lathe,
         ),
     };
+    errors.extend(tolerance::below_resolution(&p, strategy));
     if let Ok(d) = &dialect
         && let Some(resolution) = value::num(&p.machine.fields, "resolution")
         && let Err(e) = lensc_runtime::post::check_dialect(d, setup, resolution)
