@@ -20,6 +20,7 @@ mod floods;
 mod fmt;
 mod fts_advice;
 mod fuzz_properties;
+mod headers;
 mod interrupt;
 mod jit_conformance;
 mod limits;

@@ -54,7 +54,7 @@ pub(crate) fn nose_centre_header(
     lines.push(format!(
         "tool {}: round nose, nose radius {} mm",
         head.names.tool,
-        lensc_lang::check::trim_num(nose_radius)
+        lensc_lang::lower::exact_in(nose_radius, "mm")
     ));
     lines
 }

@@ -15,6 +15,7 @@ mod estimate;
 mod mill;
 mod roller;
 mod spiral;
+pub mod tolerance;
 mod turning;
 mod window;
 
@@ -33,6 +34,12 @@ use crate::codes;
 use crate::lower::diagnostics::RuntimeError;
 use crate::lower::surface::LoweredSurface;
 use crate::value::{self, Object};
+
+/// The path tolerance a strategy that states none is held to: 10 nm, the
+/// f64 a `.lens` file's `10 nm` reads as (10 × 1e-6 mm, one ulp under
+/// 1e-5), so that a job leaving it out and one writing it are the same job
+/// and the header's `10 nm` reads back to it.
+pub const DEFAULT_PATH_TOLERANCE: f64 = 10.0 * 1e-6;
 
 /// How lowering evaluates a surface for the checks that analyse it: the
 /// build passes its JIT (with the interpreter behind it), so the figures
@@ -360,6 +367,7 @@ pub fn lower_job(
             Setup::Lathe,
         ),
     };
+    errors.extend(tolerance::below_resolution(&p, strategy));
     if let Ok(d) = &dialect
         && let Some(resolution) = value::num(&p.machine.fields, "resolution")
         && let Err(e) = lensc_runtime::post::check_dialect(d, setup, resolution)

@@ -22,24 +22,16 @@ pub fn describe(o: &Object) -> String {
     let mut words = vec![o.kind.name.to_string()];
     for fl in &o.fields {
         match &fl.value {
-            Value::Num(v, d) => {
-                let (unit, factor) = d.display_unit();
-                words.push(format!(
-                    "{} {}{}{unit}",
-                    fl.name,
-                    exact_num(v * factor),
-                    if unit.is_empty() { "" } else { " " }
-                ));
-            }
+            Value::Num(v, d) => words.push(format!("{} {}", fl.name, stated(*v, *d))),
             Value::Word(w) => words.push(format!("{} {w}", fl.name)),
             Value::Object(inner) => words.push(format!("{} [{}]", fl.name, describe(inner))),
             Value::Range(a, b, d) => {
-                let (unit, factor) = d.display_unit();
+                let (unit, _) = d.display_unit();
                 words.push(format!(
                     "{} {} .. {} {unit}",
                     fl.name,
-                    exact_num(a * factor),
-                    exact_num(b * factor)
+                    exact_in(*a, &unit),
+                    exact_in(*b, &unit)
                 ));
             }
             _ => {}
@@ -215,16 +207,23 @@ pub fn job_site(job: &CheckedJob) -> (FileId, lensc_grammar::Span) {
     (job.file, job.name.span)
 }
 
-/// A parameter as a header states it: the shortest decimal that reads
-/// back as the same f64 (never an exponent), or 12 decimals when a unit
-/// conversion left a long tail (0.08499999999999999).
-pub(crate) fn exact_num(v: f64) -> String {
-    let s = format!("{v}");
-    if s.trim_start_matches('-').len() <= 17 {
-        return s;
+/// A figure `v` (base units) as a header states it in `unit`: the
+/// shortest decimal that reads back, through the unit, to the same f64
+/// (scientific notation past 17 characters, never `-0`).
+pub fn exact_in(v: f64, unit: &str) -> String {
+    lensc_runtime::post::header::exact_in(v, crate::units::size_of(unit).unwrap_or(1.0))
+}
+
+/// A quantity as a header states it: the figure in its dimension's display
+/// unit, and that unit (`3 deg`, `0.5 mm`, `0.00021 1/mm^3`, `-0.62`).
+pub fn stated(v: f64, d: crate::units::Dim) -> String {
+    let (unit, _) = d.display_unit();
+    let n = exact_in(v, &unit);
+    if unit.is_empty() {
+        n
+    } else {
+        format!("{n} {unit}")
     }
-    let t = format!("{v:.12}");
-    t.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
 /// `its machine …` → `Its machine …`, to start a sentence.

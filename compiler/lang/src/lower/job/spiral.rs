@@ -151,7 +151,7 @@ pub(super) fn lower(
     let spiral = FtsSpiral {
         feed_per_rev: value::num(st, "feed").expect("required") * 2.0 * std::f64::consts::PI,
         speed,
-        chord_tolerance: value::num(st, "chord_tolerance").unwrap_or(10e-6),
+        chord_tolerance: value::num(st, "chord_tolerance").unwrap_or(super::DEFAULT_PATH_TOLERANCE),
         seed_arc: value::num(st, "seed_arc").unwrap_or(0.1),
         min_interval: 1.0 / value::num(fast, "data_rate").unwrap_or(if slow { 1e3 } else { 20e3 }),
         start_radius: start,
