@@ -6,3 +6,4 @@ pub mod build;
 pub mod check;
 pub mod report;
 pub mod sample;
+pub mod verify;
