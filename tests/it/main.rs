@@ -9,6 +9,7 @@
 
 mod common;
 
+mod bad_programs;
 mod build_errors;
 mod cli;
 mod determinism;
@@ -21,6 +22,7 @@ mod interrupt;
 mod jit_conformance;
 mod limits;
 mod plots;
+mod read_back;
 mod rs274;
 mod sandbox;
 mod seed_sketches;

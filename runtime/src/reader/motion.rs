@@ -344,10 +344,8 @@ impl State {
         let v = self.css_speed?;
         let r = start[0]?.abs().min(end[0]?.abs());
         let rpm = 1000.0 * v / (2.0 * std::f64::consts::PI * r);
-        Some(match self.cap {
-            Some(cap) => rpm.min(cap),
-            None => rpm,
-        })
+        // Uncapped, the speed at the centre is unbounded: `NoSpeedCap`.
+        self.cap.map(|cap| rpm.min(cap))
     }
 
     /// An arc's words, radii and length (mm), by the controller's rules.
