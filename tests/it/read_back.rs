@@ -107,3 +107,32 @@ fn every_example_program_reads_back_whole() {
     }
     assert!(read >= 15, "{read} programs");
 }
+
+/// With the read-back on, a build writes a program only if it reads
+/// clean; a job whose program the reader refuses fails with the reader's
+/// code at the job and leaves no program behind.
+#[test]
+fn a_build_reading_back_writes_only_what_reads_clean() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_lensc"))
+        .current_dir(root())
+        .args(["build", "examples/even_asphere_turning.lens", "--out"])
+        .arg(dir.path())
+        .env("NO_COLOR", "1")
+        .env("LENSC_READ_BACK", "1")
+        .output()
+        .expect("run lensc");
+    let stderr = text(&out.stderr);
+    for job in ["insert_finish", "insert_finish_css"] {
+        let program = dir.path().join(format!("{job}.ngc"));
+        let refused = stderr.contains(&format!("{job}.ngc, line "));
+        assert_ne!(program.exists(), refused, "{job}: {stderr}");
+        if refused {
+            assert_eq!(out.status.code(), Some(1));
+            assert!(stderr.contains("[E03"), "{stderr}");
+        } else {
+            let text = std::fs::read_to_string(&program).expect("read");
+            assert!(codes(&format!("{job}.ngc"), &text).is_empty());
+        }
+    }
+}

@@ -55,6 +55,9 @@ enum MCode {
     SpindleOff,
     PositionOn,
     PositionOff,
+    /// Spindle orientation (M19 on LinuxCNC, Fanuc mills, Heidenhain):
+    /// stopped and held at an angle, as a knife cuts.
+    Orient,
     ToolChange,
     End,
     Stop,
@@ -286,7 +289,10 @@ impl State {
                     .flatten()
                 {
                     Some(g) => {
-                        if let Some((_, o)) = groups.iter().find(|(o, _)| same_group(*o, g)) {
+                        let siemens = self.lex.controller == Controller::Siemens;
+                        if let Some((_, o)) =
+                            groups.iter().find(|(o, _)| same_group(*o, g, siemens))
+                        {
                             out.push(conflict(w, o, line));
                         }
                         groups.push((g, w));
@@ -385,7 +391,7 @@ impl State {
             2 | 30 => MCode::End,
             0 | 1 => MCode::Stop,
             7..=9 => MCode::Coolant,
-            19 if self.lex.controller == Controller::LinuxCnc => MCode::SpindleOff,
+            19 => MCode::Orient,
             _ => return None,
         })
     }
@@ -402,6 +408,18 @@ impl State {
                         self.feed = None;
                     }
                     self.feed_mode = Some(m);
+                    if self.lex.controller == Controller::Siemens {
+                        // G94 G95 G96 G97 are one group (15) on a Sinumerik:
+                        // a feed type cancels constant surface speed.
+                        self.css = Some(false);
+                    }
+                }
+                GGroup::SpindleMode(_) if self.lex.controller == Controller::Siemens => {
+                    // G96 and G97 feed per revolution.
+                    if self.feed_mode != Some(FeedMode::PerRevolution) {
+                        self.feed = None;
+                    }
+                    self.feed_mode = Some(FeedMode::PerRevolution);
                 }
                 GGroup::Diameter(d) => self.diameter = d && self.machine.lathe,
                 GGroup::Motion(m) => self.motion = Some(m),
@@ -489,7 +507,11 @@ impl State {
             match k.name.as_str() {
                 "SPCON" => self.position_mode = true,
                 "SPCOF" => self.position_mode = false,
-                "SPOS" => self.spindle_on = false,
+                "SPOS" => {
+                    // Stopped and held at an angle: as M19 elsewhere.
+                    self.spindle_on = false;
+                    self.position_mode = true;
+                }
                 _ => {}
             }
         }
@@ -497,7 +519,7 @@ impl State {
             match m {
                 MCode::SpindleOn => self.spindle_start(w, out),
                 MCode::SpindleOff => self.spindle_on = false,
-                MCode::PositionOn => {
+                MCode::PositionOn | MCode::Orient => {
                     self.position_mode = true;
                     self.spindle_on = false;
                 }
@@ -569,18 +591,25 @@ impl State {
             ));
         }
         self.spindle_on = speed.is_some_and(|s| s > 0.0);
+        self.position_mode = false;
     }
 }
 
-fn same_group(a: GGroup, b: GGroup) -> bool {
+/// Whether two G codes are of one modal group (`siemens`: G94 G95 G96
+/// G97 are one, group 15).
+fn same_group(a: GGroup, b: GGroup, siemens: bool) -> bool {
     use GGroup::*;
+    let feed_type = |g| matches!(g, Feed(_) | SpindleMode(_));
+    if siemens && feed_type(a) && feed_type(b) {
+        return true;
+    }
     !matches!(a, NonModal | WorkOffset) && std::mem::discriminant(&a) == std::mem::discriminant(&b)
 }
 
 fn same_m_group(a: MCode, b: MCode) -> bool {
     use MCode::*;
     let group = |m| match m {
-        SpindleOn | SpindleOff | PositionOn | PositionOff => 1,
+        SpindleOn | SpindleOff | PositionOn | PositionOff | Orient => 1,
         End | Stop => 2,
         ToolChange => 3,
         Coolant | Other => 0,

@@ -48,7 +48,10 @@ impl State {
             .iter()
             .filter(|w| matches!(w.letter, 'I' | 'J' | 'K' | 'R'))
             .collect();
-        let Some(first) = axes.first().or(centre.first()) else {
+        // Centre words alone make a move only in an arc mode (a full
+        // circle); elsewhere they belong to their block (`M19 R0`).
+        let arc_mode = matches!(self.motion, Some(Motion::Cw | Motion::Ccw));
+        let Some(first) = axes.first().or(centre.first().filter(|_| arc_mode)) else {
             return;
         };
         let last = b.words.last().expect("a word");
