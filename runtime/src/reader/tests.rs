@@ -115,3 +115,43 @@ fn the_header_names_machine_and_dialect() {
     let h = header_names("N9 ; machine generic_3axis_mill: heidenhain_iso 3-axis mill *\n");
     assert_eq!(h.map(|h| h.dialect), Some("heidenhain_iso".into()));
 }
+
+#[test]
+fn heidenhain_reads_arc_centres_where_they_are() {
+    let mut d = Dialect::linuxcnc();
+    d.comment = crate::dialect::CommentStyle::Semicolon;
+    d.block_end = " *".into();
+    d.line_numbers = Some(1);
+    d.max_line_number = Some(99999);
+    d.arc_centre_absolute = true;
+    d.surface_speed = Vec::new();
+    assert_eq!(Controller::of(&d), Controller::HeidenhainIso);
+    let mill = MachineLimits {
+        lathe: false,
+        travel: [
+            Some((-250.0, 250.0)),
+            Some((-200.0, 200.0)),
+            Some((-150.0, 150.0)),
+            None,
+        ],
+        max_feed: Some(5000.0),
+        max_spindle_rpm: None,
+    };
+    // The centre (X0.2, Z-10) is the circle's, not an offset from the start.
+    let good = "%J G71 *\nN1 ; +Z out of the material *\nN2 G17 G90 G40 *\nN3 T1 G17 S1000 *\nN4 M3 *\nN5 G00 Z1. *\nN6 G00 X-1. Y0. *\nN7 G94 G01 Z-0.1 F100. *\nN8 G18 G03 X1.5 Z-0.1126 I0.2 K-10. *\nN9 G00 Z1. *\nN10 M30 *\nN99999999 %J G71 *\n";
+    assert_eq!(rules(good, &d, &mill), vec![]);
+    d.arc_centre_absolute = false;
+    assert_eq!(rules(good, &d, &mill), vec![Rule::ArcRadiusMismatch]);
+}
+
+#[test]
+fn a_sinumerik_feed_type_cancels_constant_surface_speed() {
+    let mut d = Dialect::linuxcnc();
+    d.comment = crate::dialect::CommentStyle::Semicolon;
+    assert_eq!(Controller::of(&d), Controller::Siemens);
+    let text = "G18 G71 G90 DIAMOF G40 G94\nT1 D1\nS500 M3\nG0 X3. Z1.5\nG95 G1 Z0.1 F0.002\nG0 Z1.5\nM30\n";
+    // G94 (group 15 with G96/G97) states the spindle-speed mode: no G97 needed.
+    assert_eq!(rules(text, &d, &lathe()), vec![]);
+    let both = text.replace("G95 G1", "G95 G96 G1");
+    assert!(rules(&both, &d, &lathe()).contains(&Rule::SameModalGroup));
+}
