@@ -61,3 +61,52 @@ fn the_programs_they_were_made_from_read_clean() {
         );
     }
 }
+
+#[test]
+fn a_program_without_a_header_is_read_by_the_machine_and_dialect_given() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let clean = std::fs::read_to_string(root().join("tests/bad_programs/clean/fanuc_base.nc"))
+        .expect("read");
+    let bare: String = clean
+        .lines()
+        .filter(|l| !l.starts_with("(machine "))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let path = dir.path().join("bare.nc");
+    std::fs::write(&path, bare).expect("write");
+    let p = path.to_str().expect("utf8");
+    let out = lensc(&root(), &["verify", p]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out.stderr).contains("give --machine and --dialect"));
+    let args = [
+        "verify",
+        p,
+        "--machine",
+        "linuxcnc_lathe",
+        "--dialect",
+        "fanuc_0i_lathe",
+    ];
+    let out = lensc(&root(), &args);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    // Read as LinuxCNC, the Fanuc program's diameters and O word are wrong.
+    let args = [
+        "verify",
+        p,
+        "--machine",
+        "linuxcnc_lathe",
+        "--dialect",
+        "linuxcnc",
+    ];
+    assert_eq!(lensc(&root(), &args).status.code(), Some(1));
+    let args = [
+        "verify",
+        p,
+        "--machine",
+        "no_such_machine",
+        "--dialect",
+        "linuxcnc",
+    ];
+    let out = lensc(&root(), &args);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out.stderr).contains("no machine `no_such_machine`"));
+}
