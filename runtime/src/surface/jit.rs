@@ -7,14 +7,19 @@
 //! is inside the generated code, so a batch costs one call. The loop takes
 //! two points per pass in the lanes of an `F64X2` (about twice the
 //! throughput of one lane on arithmetic-heavy tapes, as measured by
-//! `benches/surface_eval.rs`) and an odd last point in a scalar pass.
+//! `benches/surface_eval.rs`) and an odd last point in a scalar pass; both
+//! passes compute the same bits for a point (the same IEEE operations, and
+//! a lane never depends on its neighbour).
 //!
 //! Arithmetic, `sqrt`, `abs` and negation are native instructions
 //! (IEEE-exact, as in Rust); `min`/`max` are a select sequence with Rust's
 //! `f64::min`/`max` behaviour (the non-NaN operand wins, ties return the
 //! first operand); whole powers are expanded by repeated squaring in the
-//! order compiler-rt's `__powidf2` (Rust's `f64::powi`) multiplies;
-//! everything else (sin … ln, pow, atan2) calls the interpreter's own
+//! order compiler-rt's `__powidf2` (Rust's `f64::powi`) multiplies; sin,
+//! cos and exp are inline on both lanes (`vecmath`, within 1 ulp of libm;
+//! sin and cos of one argument share its reduction), lanes they do not
+//! cover (huge, infinite or NaN arguments) going to libm; everything else
+//! (tan … ln, pow, atan2) calls the interpreter's own
 //! `apply_unary`/`apply_binary` through `extern "C"` wrappers registered as
 //! JIT symbols, once per lane.
 
@@ -36,6 +41,8 @@ use cranelift_codegen::settings::{self, Configurable};
 use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
 use cranelift_jit::{JITBuilder, JITModule};
 use cranelift_module::{FuncId, Linkage, Module, default_libcall_names};
+
+mod vecmath;
 
 /// Why a tape could not be compiled (a cranelift or host error, never a
 /// user error: every valid tape compiles).
@@ -173,7 +180,11 @@ fn host_isa() -> Result<OwnedTargetIsa, JitError> {
 
 /// How many points one pass of the tape evaluates: two side by side in
 /// the lanes of an `F64X2` (cranelift has no 4-lane f64 on x86-64) in the
-/// main loop, one (`F64`) for the odd point left at the end.
+/// main loop, one (`F64`) for the odd point left at the end. A single
+/// point is not evaluated in both lanes of a vector pass: the scalar pass
+/// is about three times faster on one point (its selects are predicted
+/// branches, not blends in the chain of dependencies), and planners that
+/// follow a tool point by point call it once per point.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Lanes {
     One,
@@ -216,6 +227,8 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
     let mut emit = Emitter {
         module,
         imports: HashMap::new(),
+        trig: HashMap::new(),
+        trig_uses: trig_arguments(tape),
     };
 
     let entry = b.create_block();
@@ -275,6 +288,11 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
 struct Emitter<'m> {
     module: &'m mut JITModule,
     imports: HashMap<Libm, FuncRef>,
+    /// sin and cos of each argument already reduced in this pass.
+    trig: HashMap<Id, (Value, Value)>,
+    /// For each argument of a sin or cos: whether the tape takes its sin,
+    /// its cos.
+    trig_uses: HashMap<Id, (bool, bool)>,
 }
 
 impl Emitter<'_> {
@@ -296,6 +314,7 @@ impl Emitter<'_> {
         };
         let x = b.ins().load(lanes.ty(), load, cx, 0);
         let y = b.ins().load(lanes.ty(), load, cy, 0);
+        self.trig.clear();
         let mut val: Vec<Option<Value>> = vec![None; tape.graph.len()];
         for id in tape.live_nodes() {
             let get =
@@ -304,6 +323,10 @@ impl Emitter<'_> {
                 Node::Const(bits) => constant(b, lanes, bits),
                 Node::Var(Var::X) => x,
                 Node::Var(Var::Y) => y,
+                Node::Unary(op @ (Unary::Sin | Unary::Cos), a) if lanes == Lanes::Two => {
+                    let (sin, cos) = self.sin_cos(b, a, get(a))?;
+                    if op == Unary::Sin { sin } else { cos }
+                }
                 Node::Unary(op, a) => self.unary(b, lanes, op, get(a))?,
                 Node::Binary(op, a, c) => self.binary(b, lanes, op, get(a), get(c))?,
                 Node::PowI(a, k) => powi(b, lanes, get(a), k),
@@ -342,6 +365,62 @@ impl Emitter<'_> {
         Ok(())
     }
 
+    /// sin a and cos a on both lanes (node `arg`, value `a`), reduced once
+    /// per argument; should a lane fall outside the inline code, the twins
+    /// answer, only for the functions the tape uses.
+    fn sin_cos(
+        &mut self,
+        b: &mut FunctionBuilder,
+        arg: Id,
+        a: Value,
+    ) -> Result<(Value, Value), JitError> {
+        if let Some(&pair) = self.trig.get(&arg) {
+            return Ok(pair);
+        }
+        let (sin, cos, ok) = vecmath::sin_cos(b, a);
+        let (want_sin, want_cos) = self.trig_uses.get(&arg).copied().unwrap_or((true, true));
+        let wanted: Vec<(Value, Libm)> = [(want_sin, sin, Libm::Sin), (want_cos, cos, Libm::Cos)]
+            .into_iter()
+            .filter_map(|(w, v, f)| w.then_some((v, f)))
+            .collect();
+        let mut got = self.guard(b, ok, a, &wanted)?.into_iter();
+        let sin = if want_sin { got.next() } else { None }.unwrap_or(sin);
+        let cos = if want_cos { got.next() } else { None }.unwrap_or(cos);
+        self.trig.insert(arg, (sin, cos));
+        Ok((sin, cos))
+    }
+
+    /// The inline values where `ok` holds in both lanes (the common case:
+    /// one branch, no call); otherwise the twins' values, which are the
+    /// same bits where `ok` holds and libm's where it does not.
+    fn guard(
+        &mut self,
+        b: &mut FunctionBuilder,
+        ok: Value,
+        a: Value,
+        fast: &[(Value, Libm)],
+    ) -> Result<Vec<Value>, JitError> {
+        let cold = b.create_block();
+        let join = b.create_block();
+        for _ in fast {
+            b.append_block_param(join, types::F64X2);
+        }
+        b.set_cold_block(cold);
+        let all = b.ins().vall_true(ok);
+        let fast_args: Vec<_> = fast.iter().map(|&(v, _)| v.into()).collect();
+        b.ins().brif(all, join, &fast_args, cold, &[]);
+
+        b.switch_to_block(cold);
+        let mut twins = Vec::with_capacity(fast.len());
+        for &(_, f) in fast {
+            twins.push(self.call(b, Lanes::Two, f, &[a])?.into());
+        }
+        b.ins().jump(join, &twins);
+
+        b.switch_to_block(join);
+        Ok(b.block_params(join).to_vec())
+    }
+
     fn unary(
         &mut self,
         b: &mut FunctionBuilder,
@@ -354,13 +433,19 @@ impl Emitter<'_> {
             Unary::Sqrt => b.ins().sqrt(a),
             Unary::Abs => b.ins().fabs(a),
             Unary::Floor => b.ins().floor(a),
+            Unary::Exp if lanes == Lanes::Two => {
+                let (e, ok) = vecmath::exp(b, a);
+                self.guard(b, ok, a, &[(e, Libm::Exp)])?[0]
+            }
+            // The scalar pass calls the twins of the inline code; `pass`
+            // gives sin and cos of one argument one inline reduction.
+            Unary::Exp => self.call(b, lanes, Libm::Exp, &[a])?,
             Unary::Sin => self.call(b, lanes, Libm::Sin, &[a])?,
             Unary::Cos => self.call(b, lanes, Libm::Cos, &[a])?,
             Unary::Tan => self.call(b, lanes, Libm::Tan, &[a])?,
             Unary::Asin => self.call(b, lanes, Libm::Asin, &[a])?,
             Unary::Acos => self.call(b, lanes, Libm::Acos, &[a])?,
             Unary::Atan => self.call(b, lanes, Libm::Atan, &[a])?,
-            Unary::Exp => self.call(b, lanes, Libm::Exp, &[a])?,
             Unary::Ln => self.call(b, lanes, Libm::Ln, &[a])?,
         })
     }
@@ -443,6 +528,20 @@ impl Emitter<'_> {
     }
 }
 
+/// For each argument of a live sin or cos: whether the tape takes its sin,
+/// its cos.
+fn trig_arguments(tape: &SurfaceTape) -> HashMap<Id, (bool, bool)> {
+    let mut used: HashMap<Id, (bool, bool)> = HashMap::new();
+    for id in tape.live_nodes() {
+        match tape.graph.node(id) {
+            Node::Unary(Unary::Sin, a) => used.entry(a).or_default().0 = true,
+            Node::Unary(Unary::Cos, a) => used.entry(a).or_default().1 = true,
+            _ => {}
+        }
+    }
+    used
+}
+
 /// A constant, in every lane.
 fn constant(b: &mut FunctionBuilder, lanes: Lanes, bits: u64) -> Value {
     match lanes {
@@ -456,8 +555,8 @@ fn constant(b: &mut FunctionBuilder, lanes: Lanes, bits: u64) -> Value {
     }
 }
 
-/// `cond ? t : f` lane by lane, for a condition from `fcmp`: a flag with
-/// one lane, a lane mask with two.
+/// `cond ? t : f` lane by lane, for a condition from `fcmp` or `icmp`: a
+/// flag with one lane, a lane mask with two.
 fn select(b: &mut FunctionBuilder, lanes: Lanes, cond: Value, t: Value, f: Value) -> Value {
     match lanes {
         Lanes::One => b.ins().select(cond, t, f),
@@ -569,8 +668,10 @@ impl Libm {
     }
 }
 
-// The C-ABI entry points the kernel calls. Each is the interpreter's own
-// function for that operation, so both backends share one implementation.
+// The C-ABI entry points the kernel calls. sin, cos and exp are the twins
+// of the kernel's inline code (`vecmath`, within 1 ulp of libm); each other
+// is the interpreter's own function for that operation, so both backends
+// share one implementation.
 macro_rules! libm_entries {
     ($($name:ident = $kind:ident::$op:ident ($($arg:ident),+);)*) => {
         $(extern "C" fn $name($($arg: f64),+) -> f64 {
@@ -581,14 +682,23 @@ macro_rules! libm_entries {
     (@apply Binary::$op:ident, $a:ident, $b:ident) => { apply_binary(Binary::$op, $a, $b) };
 }
 
+extern "C" fn lensc_jit_sin(a: f64) -> f64 {
+    vecmath::sin_cos_twin(a).0
+}
+
+extern "C" fn lensc_jit_cos(a: f64) -> f64 {
+    vecmath::sin_cos_twin(a).1
+}
+
+extern "C" fn lensc_jit_exp(a: f64) -> f64 {
+    vecmath::exp_twin(a)
+}
+
 libm_entries! {
-    lensc_jit_sin = Unary::Sin(a);
-    lensc_jit_cos = Unary::Cos(a);
     lensc_jit_tan = Unary::Tan(a);
     lensc_jit_asin = Unary::Asin(a);
     lensc_jit_acos = Unary::Acos(a);
     lensc_jit_atan = Unary::Atan(a);
-    lensc_jit_exp = Unary::Exp(a);
     lensc_jit_ln = Unary::Ln(a);
     lensc_jit_pow = Binary::Pow(a, b);
     lensc_jit_atan2 = Binary::Atan2(a, b);
