@@ -34,7 +34,8 @@ use cranelift_codegen::Context;
 use cranelift_codegen::ir::condcodes::{FloatCC, IntCC};
 use cranelift_codegen::ir::immediates::Ieee64;
 use cranelift_codegen::ir::{
-    AbiParam, FuncRef, InstBuilder, MemFlagsData, Type, UserFuncName, Value, types,
+    AbiParam, FuncRef, InstBuilder, MemFlagsData, StackSlotData, StackSlotKind, Type, UserFuncName,
+    Value, types,
 };
 use cranelift_codegen::isa::OwnedTargetIsa;
 use cranelift_codegen::settings::{self, Configurable};
@@ -105,6 +106,9 @@ impl JitSurface {
         let mut jb = JITBuilder::with_isa(host_isa()?, default_libcall_names());
         for f in Libm::ALL {
             jb.symbol(f.symbol(), f.address());
+        }
+        for t in Twin::ALL {
+            jb.symbol(t.symbol(), t.address());
         }
         // From here on, an early return frees whatever was allocated.
         let mut guard = ModuleGuard(Some(JITModule::new(jb)));
@@ -227,8 +231,8 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
     let mut emit = Emitter {
         module,
         imports: HashMap::new(),
+        twins: HashMap::new(),
         trig: HashMap::new(),
-        trig_uses: trig_arguments(tape),
     };
 
     let entry = b.create_block();
@@ -288,11 +292,9 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
 struct Emitter<'m> {
     module: &'m mut JITModule,
     imports: HashMap<Libm, FuncRef>,
+    twins: HashMap<Twin, FuncRef>,
     /// sin and cos of each argument already reduced in this pass.
     trig: HashMap<Id, (Value, Value)>,
-    /// For each argument of a sin or cos: whether the tape takes its sin,
-    /// its cos.
-    trig_uses: HashMap<Id, (bool, bool)>,
 }
 
 impl Emitter<'_> {
@@ -366,8 +368,8 @@ impl Emitter<'_> {
     }
 
     /// sin a and cos a on both lanes (node `arg`, value `a`), reduced once
-    /// per argument; should a lane fall outside the inline code, the twins
-    /// answer, only for the functions the tape uses.
+    /// per argument; should a lane fall outside the inline code, the twin
+    /// answers.
     fn sin_cos(
         &mut self,
         b: &mut FunctionBuilder,
@@ -378,27 +380,24 @@ impl Emitter<'_> {
             return Ok(pair);
         }
         let (sin, cos, ok) = vecmath::sin_cos(b, a);
-        let (want_sin, want_cos) = self.trig_uses.get(&arg).copied().unwrap_or((true, true));
-        let wanted: Vec<(Value, Libm)> = [(want_sin, sin, Libm::Sin), (want_cos, cos, Libm::Cos)]
-            .into_iter()
-            .filter_map(|(w, v, f)| w.then_some((v, f)))
-            .collect();
-        let mut got = self.guard(b, ok, a, &wanted)?.into_iter();
-        let sin = if want_sin { got.next() } else { None }.unwrap_or(sin);
-        let cos = if want_cos { got.next() } else { None }.unwrap_or(cos);
+        let got = self.guard(b, ok, a, Twin::SinCos, &[sin, cos])?;
+        let (sin, cos) = (got[0], got[1]);
         self.trig.insert(arg, (sin, cos));
         Ok((sin, cos))
     }
 
     /// The inline values where `ok` holds in both lanes (the common case:
-    /// one branch, no call); otherwise the twins' values, which are the
-    /// same bits where `ok` holds and libm's where it does not.
+    /// one branch, no call); otherwise the twins' values for both lanes
+    /// (one call), which are the same bits where `ok` holds and libm's
+    /// where it does not. `fast` are the inline results in the order the
+    /// twin writes them.
     fn guard(
         &mut self,
         b: &mut FunctionBuilder,
         ok: Value,
         a: Value,
-        fast: &[(Value, Libm)],
+        twin: Twin,
+        fast: &[Value],
     ) -> Result<Vec<Value>, JitError> {
         let cold = b.create_block();
         let join = b.create_block();
@@ -407,18 +406,52 @@ impl Emitter<'_> {
         }
         b.set_cold_block(cold);
         let all = b.ins().vall_true(ok);
-        let fast_args: Vec<_> = fast.iter().map(|&(v, _)| v.into()).collect();
+        let fast_args: Vec<_> = fast.iter().map(|&v| v.into()).collect();
         b.ins().brif(all, join, &fast_args, cold, &[]);
 
         b.switch_to_block(cold);
-        let mut twins = Vec::with_capacity(fast.len());
-        for &(_, f) in fast {
-            twins.push(self.call(b, Lanes::Two, f, &[a])?.into());
-        }
-        b.ins().jump(join, &twins);
+        let slot = b.create_sized_stack_slot(StackSlotData::new(
+            StackSlotKind::ExplicitSlot,
+            16 * twin.outputs(),
+            4,
+        ));
+        let ptr = self.module.target_config().pointer_type();
+        let at = b.ins().stack_addr(ptr, slot, 0);
+        let lo = b.ins().extractlane(a, 0);
+        let hi = b.ins().extractlane(a, 1);
+        let fref = self.twin(b, twin)?;
+        b.ins().call(fref, &[lo, hi, at]);
+        let slow: Vec<_> = (0..fast.len())
+            .map(|k| {
+                let v = b
+                    .ins()
+                    .load(types::F64X2, MemFlagsData::trusted(), at, 16 * k as i32);
+                v.into()
+            })
+            .collect();
+        b.ins().jump(join, &slow);
 
         b.switch_to_block(join);
         Ok(b.block_params(join).to_vec())
+    }
+
+    /// The import of a twin, declared once.
+    fn twin(&mut self, b: &mut FunctionBuilder, twin: Twin) -> Result<FuncRef, JitError> {
+        if let Some(&r) = self.twins.get(&twin) {
+            return Ok(r);
+        }
+        let mut sig = self.module.make_signature();
+        sig.params.push(AbiParam::new(types::F64));
+        sig.params.push(AbiParam::new(types::F64));
+        sig.params
+            .push(AbiParam::new(self.module.target_config().pointer_type()));
+        let fid = self
+            .module
+            .declare_function(twin.symbol(), Linkage::Import, &sig)
+            .map_err(|e| JitError(format!("declaring {}: {e}", twin.symbol())))?;
+        let r = self.module.declare_func_in_func(fid, b.func);
+        self.twins.insert(twin, r);
+        Ok(r)
     }
 
     fn unary(
@@ -435,7 +468,7 @@ impl Emitter<'_> {
             Unary::Floor => b.ins().floor(a),
             Unary::Exp if lanes == Lanes::Two => {
                 let (e, ok) = vecmath::exp(b, a);
-                self.guard(b, ok, a, &[(e, Libm::Exp)])?[0]
+                self.guard(b, ok, a, Twin::Exp, &[e])?[0]
             }
             // The scalar pass calls the twins of the inline code; `pass`
             // gives sin and cos of one argument one inline reduction.
@@ -528,20 +561,6 @@ impl Emitter<'_> {
     }
 }
 
-/// For each argument of a live sin or cos: whether the tape takes its sin,
-/// its cos.
-fn trig_arguments(tape: &SurfaceTape) -> HashMap<Id, (bool, bool)> {
-    let mut used: HashMap<Id, (bool, bool)> = HashMap::new();
-    for id in tape.live_nodes() {
-        match tape.graph.node(id) {
-            Node::Unary(Unary::Sin, a) => used.entry(a).or_default().0 = true,
-            Node::Unary(Unary::Cos, a) => used.entry(a).or_default().1 = true,
-            _ => {}
-        }
-    }
-    used
-}
-
 /// A constant, in every lane.
 fn constant(b: &mut FunctionBuilder, lanes: Lanes, bits: u64) -> Value {
     match lanes {
@@ -597,6 +616,59 @@ fn powi(b: &mut FunctionBuilder, lanes: Lanes, a: Value, n: i32) -> Value {
     } else {
         r
     }
+}
+
+/// The twins of the inline sin, cos and exp for both lanes at once, called
+/// where a lane falls outside the inline code: `f(a0, a1, out)` writes
+/// each result for both lanes to `out`, 16 bytes apiece.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum Twin {
+    /// sin a0, sin a1, cos a0, cos a1.
+    SinCos,
+    /// exp a0, exp a1.
+    Exp,
+}
+
+impl Twin {
+    const ALL: [Twin; 2] = [Twin::SinCos, Twin::Exp];
+
+    fn outputs(self) -> u32 {
+        match self {
+            Twin::SinCos => 2,
+            Twin::Exp => 1,
+        }
+    }
+
+    fn symbol(self) -> &'static str {
+        match self {
+            Twin::SinCos => "lensc_jit_sin_cos_pair",
+            Twin::Exp => "lensc_jit_exp_pair",
+        }
+    }
+
+    fn address(self) -> *const u8 {
+        type F = unsafe extern "C" fn(f64, f64, *mut f64);
+        match self {
+            Twin::SinCos => lensc_jit_sin_cos_pair as F as *const u8,
+            Twin::Exp => lensc_jit_exp_pair as F as *const u8,
+        }
+    }
+}
+
+/// # Safety
+/// `out` points to four writable doubles.
+unsafe extern "C" fn lensc_jit_sin_cos_pair(a0: f64, a1: f64, out: *mut f64) {
+    let ((s0, c0), (s1, c1)) = (vecmath::sin_cos_twin(a0), vecmath::sin_cos_twin(a1));
+    // SAFETY: the kernel passes a 32-byte stack slot (`Emitter::guard`).
+    unsafe { out.cast::<[f64; 4]>().write_unaligned([s0, s1, c0, c1]) }
+}
+
+/// # Safety
+/// `out` points to two writable doubles.
+unsafe extern "C" fn lensc_jit_exp_pair(a0: f64, a1: f64, out: *mut f64) {
+    let pair = [vecmath::exp_twin(a0), vecmath::exp_twin(a1)];
+    // SAFETY: the kernel passes a 16-byte stack slot (`Emitter::guard`).
+    unsafe { out.cast::<[f64; 2]>().write_unaligned(pair) }
 }
 
 /// The functions the kernel calls rather than inlines.

@@ -285,7 +285,8 @@ pub(super) fn exp(b: &mut FunctionBuilder, a: Value) -> (Value, Value) {
 /// The twin of `sin_cos`: the same operations on one double, libm beyond
 /// the bound.
 pub(super) fn sin_cos_twin(a: f64) -> (f64, f64) {
-    if !(a.abs() < TRIG_LIMIT) {
+    // Huge, infinite or NaN: libm's.
+    if a.is_nan() || a.abs() >= TRIG_LIMIT {
         return (a.sin(), a.cos());
     }
     let k = f64::from_bits;
@@ -310,8 +311,8 @@ pub(super) fn sin_cos_twin(a: f64) -> (f64, f64) {
         y0 - ((z * (0.5 * y1 - v * r) - y1) - v * k(S1))
     };
     let cos = {
-        let r = z * (k(C1) + z * (k(C2) + z * k(C3)))
-            + (zz * zz) * (k(C4) + z * (k(C5) + z * k(C6)));
+        let r =
+            z * (k(C1) + z * (k(C2) + z * k(C3))) + (zz * zz) * (k(C4) + z * (k(C5) + z * k(C6)));
         let hz = 0.5 * z;
         let w = 1.0 - hz;
         w + (((1.0 - w) - hz) + (z * r - y0 * y1))
@@ -319,16 +320,13 @@ pub(super) fn sin_cos_twin(a: f64) -> (f64, f64) {
     let q = t.to_bits();
     let (odd, half) = (q & 1 != 0, q & 2 != 0);
     let (s, c) = if odd { (cos, sin) } else { (sin, cos) };
-    (
-        if half { -s } else { s },
-        if odd != half { -c } else { c },
-    )
+    (if half { -s } else { s }, if odd != half { -c } else { c })
 }
 
 /// The twin of `exp`: the same operations on one double, libm beyond the
 /// bound.
 pub(super) fn exp_twin(a: f64) -> f64 {
-    if !(a.abs() < EXP_LIMIT) {
+    if a.is_nan() || a.abs() >= EXP_LIMIT {
         return a.exp();
     }
     let k = f64::from_bits;
@@ -343,7 +341,10 @@ pub(super) fn exp_twin(a: f64) -> f64 {
         .fold(k(P5), |p, c| k(c) + xx * p);
     let c = x - xx * p;
     let y = 1.0 - ((lo - (x * c) / (2.0 - c)) - hi);
-    let e = t.to_bits().wrapping_add((1023 - TO_INT.to_bits() as i64) as u64) << 52;
+    let e = t
+        .to_bits()
+        .wrapping_add((1023 - TO_INT.to_bits() as i64) as u64)
+        << 52;
     y * f64::from_bits(e)
 }
 
@@ -359,7 +360,11 @@ mod tests {
     /// apart, so a lost sign of zero fails.
     fn ulps(got: f64, want: f64) -> u64 {
         if got.is_nan() || want.is_nan() {
-            return if got.is_nan() && want.is_nan() { 0 } else { u64::MAX };
+            return if got.is_nan() && want.is_nan() {
+                0
+            } else {
+                u64::MAX
+            };
         }
         // Doubles ordered as integers: negative ones mirrored below zero.
         let key = |v: f64| {
@@ -381,13 +386,20 @@ mod tests {
             let e = g.unary(Unary::Exp, y);
             [s, c, e, s, c, e]
         } else {
-            [Unary::Sin, Unary::Cos, Unary::Exp, Unary::Sin, Unary::Cos, Unary::Exp]
-                .into_iter()
-                .zip([x, x, x, y, y, y])
-                .map(|(op, v)| g.unary(op, v))
-                .collect::<Vec<_>>()
-                .try_into()
-                .expect("six outputs")
+            [
+                Unary::Sin,
+                Unary::Cos,
+                Unary::Exp,
+                Unary::Sin,
+                Unary::Cos,
+                Unary::Exp,
+            ]
+            .into_iter()
+            .zip([x, x, x, y, y, y])
+            .map(|(op, v)| g.unary(op, v))
+            .collect::<Vec<_>>()
+            .try_into()
+            .expect("six outputs")
         };
         JitSurface::compile(&SurfaceTape::with_outputs(g, outputs)).expect("compiles")
     }
@@ -494,7 +506,8 @@ mod tests {
     #[test]
     fn sin_cos_and_exp_are_within_one_ulp_of_libm() {
         let args = arguments();
-        let checks: [(&str, usize, fn(f64) -> f64); 6] = [
+        type Check = (&'static str, usize, fn(f64) -> f64);
+        let checks: [Check; 6] = [
             ("sin x", 0, f64::sin),
             ("cos x", 1, f64::cos),
             ("exp x", 2, f64::exp),
@@ -506,7 +519,10 @@ mod tests {
         kernel(false).eval_batch(&args, &args, &mut out);
         for (name, k, f) in checks {
             let (d, at, ones) = worst(&out, &args, k, f);
-            println!("{name}: worst {d} ulp (at {at:e}), {ones} of {} off by one", args.len());
+            println!(
+                "{name}: worst {d} ulp (at {at:e}), {ones} of {} off by one",
+                args.len()
+            );
             assert!(d <= 1, "{name} is {d} ulp from libm at {at:e}");
         }
         // Each on its own, and a point alone (the scalar pass): the same
@@ -516,7 +532,11 @@ mod tests {
         single.eval_batch(&args, &args, &mut alone);
         for (i, &a) in args.iter().enumerate() {
             assert_eq!(alone[6 * i].to_bits(), out[6 * i].to_bits(), "sin {a:e}");
-            assert_eq!(alone[6 * i + 1].to_bits(), out[6 * i + 4].to_bits(), "cos {a:e}");
+            assert_eq!(
+                alone[6 * i + 1].to_bits(),
+                out[6 * i + 4].to_bits(),
+                "cos {a:e}"
+            );
             if i % 5 == 0 || i < 100 {
                 let one = single.eval(a, a);
                 let same = |k: usize, j: usize| {
@@ -550,7 +570,16 @@ mod tests {
     #[test]
     fn special_values_are_libms() {
         let f = kernel(false);
-        for a in [f64::INFINITY, f64::NEG_INFINITY, f64::NAN, 1e300, -0.0, 0.0, 710.0, -746.0] {
+        for a in [
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            1e300,
+            -0.0,
+            0.0,
+            710.0,
+            -746.0,
+        ] {
             let o = f.eval(a, a);
             for (k, want) in [a.sin(), a.cos(), a.exp()].into_iter().enumerate() {
                 assert!(
