@@ -344,6 +344,10 @@ fn cell_index(g: &mut Graph, t: Id, n: f64, offset: f64) -> Id {
     let top = g.constant_node(n - 1.0);
     let lo = g.binary(Binary::Max, f, zero);
     let i = g.binary(Binary::Min, lo, top);
+    if offset == 0.0 {
+        // Already in 0 ..= n − 1: clamping again changes nothing.
+        return i;
+    }
     let off = g.constant_node(offset);
     let shifted = g.add(i, off);
     let clamped_lo = g.binary(Binary::Max, shifted, zero);
