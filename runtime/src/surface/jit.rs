@@ -27,6 +27,7 @@ use std::collections::HashMap;
 use std::fmt;
 use std::sync::OnceLock;
 
+use crate::surface::fdlibm;
 use crate::surface::ir::{
     Binary, Id, Node, SurfaceFn, SurfaceTape, Unary, Var, apply_binary, apply_unary,
 };
@@ -658,7 +659,7 @@ impl Twin {
 /// # Safety
 /// `out` points to four writable doubles.
 unsafe extern "C" fn lensc_jit_sin_cos_pair(a0: f64, a1: f64, out: *mut f64) {
-    let ((s0, c0), (s1, c1)) = (vecmath::sin_cos_twin(a0), vecmath::sin_cos_twin(a1));
+    let ((s0, c0), (s1, c1)) = (fdlibm::sin_cos(a0), fdlibm::sin_cos(a1));
     // SAFETY: the kernel passes a 32-byte stack slot (`Emitter::guard`).
     unsafe { out.cast::<[f64; 4]>().write_unaligned([s0, s1, c0, c1]) }
 }
@@ -666,7 +667,7 @@ unsafe extern "C" fn lensc_jit_sin_cos_pair(a0: f64, a1: f64, out: *mut f64) {
 /// # Safety
 /// `out` points to two writable doubles.
 unsafe extern "C" fn lensc_jit_exp_pair(a0: f64, a1: f64, out: *mut f64) {
-    let pair = [vecmath::exp_twin(a0), vecmath::exp_twin(a1)];
+    let pair = [fdlibm::exp(a0), fdlibm::exp(a1)];
     // SAFETY: the kernel passes a 16-byte stack slot (`Emitter::guard`).
     unsafe { out.cast::<[f64; 2]>().write_unaligned(pair) }
 }
@@ -755,15 +756,15 @@ macro_rules! libm_entries {
 }
 
 extern "C" fn lensc_jit_sin(a: f64) -> f64 {
-    vecmath::sin_cos_twin(a).0
+    crate::surface::fdlibm::sin(a)
 }
 
 extern "C" fn lensc_jit_cos(a: f64) -> f64 {
-    vecmath::sin_cos_twin(a).1
+    crate::surface::fdlibm::cos(a)
 }
 
 extern "C" fn lensc_jit_exp(a: f64) -> f64 {
-    vecmath::exp_twin(a)
+    crate::surface::fdlibm::exp(a)
 }
 
 libm_entries! {
