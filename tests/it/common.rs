@@ -122,6 +122,9 @@ pub struct Built {
     pub stderr: String,
     /// Every file written (programs and reports), by name.
     pub files: BTreeMap<String, Written>,
+    /// The codes `lensc verify` found in each program too large to keep
+    /// whole, read from the file as the build wrote it.
+    pub abridged_findings: BTreeMap<String, std::collections::BTreeSet<String>>,
 }
 
 impl Built {
@@ -182,14 +185,52 @@ pub fn built_examples() -> &'static [Built] {
                     .expect("utf8")
                     .to_string();
                 let (dir, stderr) = build_into(&example, None);
+                let files = read_written(dir.path());
+                let abridged_findings = files
+                    .iter()
+                    .filter(|(_, f)| matches!(f, Written::Abridged(_)))
+                    .filter(|(name, _)| !name.ends_with(".json") && !name.ends_with(".fts"))
+                    .map(|(name, _)| (name.clone(), verify_codes(&dir.path().join(name))))
+                    .collect();
                 Built {
                     example,
                     stderr,
-                    files: read_written(dir.path()),
+                    files,
+                    abridged_findings,
                 }
             })
             .collect()
     })
+}
+
+/// The codes `lensc verify` finds in the program at `path` (exit status
+/// 1 exactly when it finds any).
+pub fn verify_codes(path: &Path) -> std::collections::BTreeSet<String> {
+    let out = lensc(
+        &root(),
+        &[
+            "--message-format",
+            "json",
+            "verify",
+            path.to_str().expect("utf8"),
+        ],
+    );
+    let found: std::collections::BTreeSet<String> = text(&out.stdout)
+        .lines()
+        .map(|l| {
+            let v: serde_json::Value = serde_json::from_str(l).expect("json line");
+            v["code"].as_str().expect("code").to_string()
+        })
+        .collect();
+    let expected = if found.is_empty() { 0 } else { 1 };
+    assert_eq!(
+        out.status.code(),
+        Some(expected),
+        "{}: {}",
+        path.display(),
+        text(&out.stderr)
+    );
+    found
 }
 
 /// The build of one example (`examples/….lens`) from [`built_examples`].

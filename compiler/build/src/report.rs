@@ -9,6 +9,7 @@
 //! angles in degrees where the name ends in `_deg`; times in s. A number
 //! that was not finite (an empty set's PV, say) is written as `null`.
 
+use lensc_runtime::emit::roller::FeedLimited;
 use lensc_runtime::machine::servo::SecondOrderServo;
 use lensc_runtime::plan::fts::{FtsSpiral, FtsSummary, SpindleSpeed};
 use lensc_runtime::plan::grinding::GrindingPath;
@@ -691,6 +692,7 @@ impl RollerHelix {
     /// `tool`, which passed `check`.
     pub fn new(
         path: &RollerPath,
+        limited: &[FeedLimited],
         check: &ToolCheck,
         tool: &RollerTool,
         roller_radius: f64,
@@ -702,7 +704,8 @@ impl RollerHelix {
             passes: path
                 .passes
                 .iter()
-                .map(|p| HelixPass {
+                .enumerate()
+                .map(|(i, p)| HelixPass {
                     c_step_deg: p.c_step.to_degrees(),
                     pitch_mm: p.pitch,
                     finish_allowance_mm: p.finish_allowance,
@@ -711,6 +714,7 @@ impl RollerHelix {
                     x_min_mm: p.x_min,
                     x_max_mm: p.x_max,
                     cutting_time_s: p.time,
+                    feed_limited_moves: limited.get(i).map_or(0, |l| l.moves),
                     fingerprint_fnv1a64: format!("{:016x}", p.fingerprint),
                 })
                 .collect(),
@@ -747,8 +751,12 @@ pub struct HelixPass {
     pub x_min_mm: f64,
     /// Highest radius of the nose centre (mm).
     pub x_max_mm: f64,
-    /// Estimated cutting time (s), or null without a spindle speed.
+    /// Estimated cutting time (s), or null without a spindle speed: the
+    /// spindle's pace, and the moves the feed limit slowed at that limit.
     pub cutting_time_s: Option<f64>,
+    /// Moves of the pass slowed below the spindle's pace because X and Z
+    /// together would have fed above the machine's feed limit.
+    pub feed_limited_moves: usize,
     /// FNV-1a 64 of every point of the pass, 16 hex digits.
     pub fingerprint_fnv1a64: String,
 }

@@ -109,6 +109,20 @@ enum FeedMode {
 const FEED_DECIMALS: u32 = 6;
 const INVERSE_TIME_DECIMALS: u32 = 3;
 
+/// The shortest move time (s), at least `t`, whose inverse-time F as
+/// printed (1/min, rounded to its decimals) is not above 60 / `t`: a move
+/// slowed to a limit must not read faster than the limit once printed.
+/// Times so long that F would print as 0 are returned as they are.
+pub fn inverse_time_not_faster(t: f64) -> f64 {
+    let scale = 10f64.powi(INVERSE_TIME_DECIMALS as i32);
+    let units = (60.0 / t * scale).floor();
+    if units >= 1.0 {
+        60.0 / (units / scale)
+    } else {
+        t
+    }
+}
+
 impl ProgramWriter {
     /// Starts a program for job `job`: `axes` are the machine's axis
     /// letters among "XYZC"; `path_tolerance` (mm), the most the controller

@@ -10,7 +10,7 @@ use lensc_grammar::Diagnostic;
 use lensc_lang::lower::diagnostics::RuntimeError;
 use lensc_lang::lower::exact_in;
 use lensc_lang::lower::job::RollerSpec;
-use lensc_runtime::emit::roller::RollerProgram;
+use lensc_runtime::emit::roller::{RollerLimits, RollerProgram};
 use lensc_runtime::plan::roller::plan_roller_helix_into;
 use lensc_runtime::post::Provenance;
 use lensc_runtime::verify::heightmap::Sweep;
@@ -37,7 +37,10 @@ pub fn build(
         &head.dialect,
         &head.name,
         &header_lines(spec, prov),
-        resolution,
+        RollerLimits {
+            resolution,
+            max_feed: spec.max_feed,
+        },
         spec.safe_x,
         spec.spindle_speed,
     )
@@ -62,7 +65,8 @@ pub fn build(
         sink.extend(|| program.extend(pass, pts));
         sink.push(program.take_text());
     });
-    let path = planned.map_err(|e| vec![RuntimeError::Roller(e).at(site)])?;
+    let mut path = planned.map_err(|e| vec![RuntimeError::Roller(e).at(site)])?;
+    let limited = program.feed_limited().to_vec();
     let mut sink = sink.written(head)?;
     sink.push(
         program
@@ -70,7 +74,19 @@ pub fn build(
             .map_err(|e| vec![parts::not_printable(head, e)])?,
     );
     let text = sink.finish(site)?;
-    let section = report::RollerHelix::new(&path, &spec.check, &spec.tool, helix.roller_radius);
+    // The moves the feed limit slowed take longer than the spindle's pace.
+    for (pass, l) in path.passes.iter_mut().zip(&limited) {
+        pass.time = pass
+            .time
+            .map(|t| t + l.added_time * pass.cycle_offsets.len() as f64);
+    }
+    let section = report::RollerHelix::new(
+        &path,
+        &limited,
+        &spec.check,
+        &spec.tool,
+        helix.roller_radius,
+    );
     let cut = (section.cut_points, section.cutting_time_s);
     let frame = RollerFrame {
         kernel: kernel.as_ref(),

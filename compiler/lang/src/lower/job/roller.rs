@@ -30,6 +30,9 @@ pub struct RollerSpec {
     pub safe_x: f64,
     /// The spindle speed (rad/s).
     pub spindle_speed: f64,
+    /// The machine's feed limit (mm/s): moves the spindle's pace would
+    /// take faster are slowed to it.
+    pub max_feed: f64,
 }
 
 pub(super) fn lower(
@@ -96,6 +99,7 @@ pub(super) fn lower(
         check,
         design_y,
         spindle_speed,
+        max_feed: value::num(&p.machine.fields, "max_feed").expect("required"),
     })
 }
 
