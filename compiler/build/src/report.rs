@@ -808,7 +808,9 @@ pub struct Skipped {
 }
 
 /// A profile's simulated cut: the form error (cut minus design, positive
-/// where material is left) over the radii the cut reaches.
+/// where material is left) over the radii the cut reaches, with the
+/// figures defined as [`Figures`] defines them (PV largest minus least,
+/// RMS about the mean, the mean, the largest deviation either way).
 #[derive(Clone, Debug, Serialize, JsonSchema)]
 #[schemars(deny_unknown_fields)]
 pub struct ProfileCut {
@@ -820,14 +822,31 @@ pub struct ProfileCut {
     pub from_radius_mm: Option<f64>,
     /// Last radius sampled (mm), null if none.
     pub to_radius_mm: Option<f64>,
-    /// Peak to valley of the form error (nm).
+    /// Peak to valley of the form error: largest minus least (nm).
     pub form_error_pv_nm: Option<f64>,
-    /// RMS of the form error (nm).
+    /// RMS of the form error about its mean (nm).
     pub form_error_rms_nm: Option<f64>,
+    /// The mean form error (nm): piston, a uniform shift from the design;
+    /// null if no radius was cut.
+    pub form_error_mean_nm: Option<f64>,
+    /// The error of the largest magnitude, sign kept (nm), and where; its
+    /// value and radius are null if no radius was cut.
+    pub largest_deviation_nm: AtRadiusOrNull,
     /// The most material left above the design (nm) and where.
     pub max_residual_nm: AtRadius,
     /// The deepest cut below the design (nm) and where.
     pub max_gouge_nm: AtRadius,
+}
+
+/// A value and the radius (mm) where it occurs, either null where there
+/// is none.
+#[derive(Clone, Copy, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct AtRadiusOrNull {
+    /// The value, in the unit the enclosing field's name gives.
+    pub value: Option<f64>,
+    /// Radius (mm) where it occurs.
+    pub at_radius_mm: Option<f64>,
 }
 
 impl From<&lensc_runtime::verify::simulate::ProfileCut> for ProfileCut {
@@ -839,6 +858,11 @@ impl From<&lensc_runtime::verify::simulate::ProfileCut> for ProfileCut {
             to_radius_mm: cut.samples.last().map(|s| s.0),
             form_error_pv_nm: finite(cut.pv * 1e6),
             form_error_rms_nm: finite(cut.rms * 1e6),
+            form_error_mean_nm: finite(cut.mean * 1e6),
+            largest_deviation_nm: AtRadiusOrNull {
+                value: finite(cut.largest_deviation.0 * 1e6),
+                at_radius_mm: finite(cut.largest_deviation.1),
+            },
             max_residual_nm: AtRadius {
                 value: cut.max_residual.0 * 1e6,
                 at_radius_mm: cut.max_residual.1,
@@ -1043,19 +1067,30 @@ pub struct Grid {
     pub row_step_mm: f64,
 }
 
-/// PV, RMS and extremes of a set of form errors.
+/// The figures of a set of form errors, as an optician reads them: the
+/// error is the cut minus the design at each point counted (positive
+/// where material is left); `pv_nm` is its largest minus its least value
+/// over the points counted, `rms_nm` its root mean square about its mean
+/// (so never above PV), `mean_nm` the mean itself (piston: a part cut
+/// uniformly deep shows here and in `largest_deviation_nm`, not in PV or
+/// RMS), and the extremes say where they are.
 #[derive(Clone, Copy, Debug, Serialize, JsonSchema)]
 #[schemars(deny_unknown_fields)]
 pub struct Figures {
     /// Cells counted.
     pub cells: usize,
-    /// Peak to valley (nm).
+    /// Peak to valley: the largest error minus the least (nm).
     pub pv_nm: f64,
-    /// RMS (nm).
+    /// RMS of the error about its mean (nm).
     pub rms_nm: f64,
-    /// The most material left above the design (nm) and where.
+    /// The mean error (nm): piston, a uniform shift from the design.
+    pub mean_nm: f64,
+    /// The error of the largest magnitude, sign kept (nm), and where: the
+    /// largest deviation from the design in either direction.
+    pub largest_deviation_nm: AtPoint,
+    /// The most material left above the design (nm, ≥ 0) and where.
     pub max_residual_nm: AtPoint,
-    /// The deepest cut below the design (nm) and where.
+    /// The deepest cut below the design (nm, ≥ 0) and where.
     pub max_gouge_nm: AtPoint,
 }
 
@@ -1070,6 +1105,8 @@ impl From<&ErrorFigures> for Figures {
             cells: f.count,
             pv_nm: f.pv * 1e6,
             rms_nm: f.rms * 1e6,
+            mean_nm: f.mean * 1e6,
+            largest_deviation_nm: at(f.largest_deviation),
             max_residual_nm: at(f.max_residual),
             max_gouge_nm: at(f.max_gouge),
         }

@@ -441,55 +441,13 @@ fn in_features(features: &[(f64, f64, f64)], x: f64, y: f64) -> bool {
             .any(|&(cx, cy, r)| (x - cx).hypot(y - cy) <= r)
 }
 
-/// PV, RMS and extremes of a set of errors, with where they are.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ErrorFigures {
-    pub count: usize,
-    pub pv: f64,
-    pub rms: f64,
-    /// Most material left (mm, ≥ 0) and where (x, y).
-    pub max_residual: (f64, (f64, f64)),
-    /// Deepest cut below the design (mm, ≥ 0) and where.
-    pub max_gouge: (f64, (f64, f64)),
-}
+/// The figures of a set of errors at (x, y) points (see
+/// [`super::figures`]: PV max − min, RMS about the mean, the mean and the
+/// largest deviation).
+pub type ErrorFigures = super::figures::ErrorFigures<(f64, f64)>;
 
-#[derive(Default)]
-struct Tally {
-    n: usize,
-    sum2: f64,
-    min: (f64, (f64, f64)),
-    max: (f64, (f64, f64)),
-}
-
-impl Tally {
-    fn new() -> Tally {
-        Tally {
-            n: 0,
-            sum2: 0.0,
-            min: (f64::INFINITY, (0.0, 0.0)),
-            max: (f64::NEG_INFINITY, (0.0, 0.0)),
-        }
-    }
-    fn add(&mut self, e: f64, at: (f64, f64)) {
-        self.n += 1;
-        self.sum2 += e * e;
-        if e < self.min.0 {
-            self.min = (e, at);
-        }
-        if e > self.max.0 {
-            self.max = (e, at);
-        }
-    }
-    fn figures(&self) -> Option<ErrorFigures> {
-        (self.n > 0).then(|| ErrorFigures {
-            count: self.n,
-            pv: self.max.0 - self.min.0,
-            rms: (self.sum2 / self.n as f64).sqrt(),
-            max_residual: (self.max.0.max(0.0), self.max.1),
-            max_gouge: ((-self.min.0).max(0.0), self.min.1),
-        })
-    }
-}
+/// The statistics of errors at (x, y) points, as they are gathered.
+type Tally = super::figures::ErrorStats<(f64, f64)>;
 
 /// Scallop heights between neighbouring passes (mm).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -698,7 +656,7 @@ impl HeightMap {
             features: features
                 .iter()
                 .zip(&per)
-                .filter(|(_, t)| t.0.n > 0)
+                .filter(|(_, t)| t.0.count > 0)
                 .map(|(&(cx, cy, _), t)| FeatureFigures {
                     centre: (cx, cy),
                     surface: t.0.figures(),

@@ -10,6 +10,7 @@
 //! bounded below by its end discs and the move offset by ρ; along an arc
 //! of radius R, by its end discs and the arcs of radius R ± ρ.
 
+use super::figures::ErrorStats;
 use crate::moves::{Move, Plane};
 use crate::post::format::{decimals_for, fixed_units};
 use std::f64::consts::PI;
@@ -21,9 +22,16 @@ pub struct ProfileCut {
     /// surface's height minus the design's (mm; positive where material is
     /// left, negative where the cut went below the design).
     pub samples: Vec<(f64, f64)>,
-    /// Peak to valley and RMS of the error (mm).
+    /// Peak to valley (largest minus least) and RMS about the mean of
+    /// the error (mm; 0 if no radius was cut).
     pub pv: f64,
     pub rms: f64,
+    /// The mean error (mm; piston: a uniform datum shift), NaN if no
+    /// radius was cut.
+    pub mean: f64,
+    /// The error of the largest magnitude (mm, sign kept) and where; NaN
+    /// if no radius was cut.
+    pub largest_deviation: (f64, f64),
     /// The most material left above the design (mm, ≥ 0) and where.
     pub max_residual: (f64, f64),
     /// The deepest cut below the design (mm, ≥ 0) and where.
@@ -263,27 +271,20 @@ pub fn profile_cut(
             out.push((x, cut - design(x)));
         }
     }
-    let (mut hi, mut lo) = ((f64::NAN, f64::NEG_INFINITY), (f64::NAN, f64::INFINITY));
-    let mut sum2 = 0.0;
+    let mut stats = ErrorStats::<f64>::new();
     for &(x, e) in &out {
-        if e > hi.1 {
-            hi = (x, e);
-        }
-        if e < lo.1 {
-            lo = (x, e);
-        }
-        sum2 += e * e;
+        stats.add(e, x);
     }
-    let rms = if out.is_empty() {
-        0.0
-    } else {
-        (sum2 / out.len() as f64).sqrt()
-    };
+    let f = stats.figures();
+    let (pv, rms, mean) = f.map_or((0.0, 0.0, f64::NAN), |f| (f.pv, f.rms, f.mean));
+    let nowhere = (0.0, f64::NAN);
     ProfileCut {
-        pv: if out.is_empty() { 0.0 } else { hi.1 - lo.1 },
+        pv,
         rms,
-        max_residual: (hi.1.max(0.0), hi.0),
-        max_gouge: ((-lo.1).max(0.0), lo.0),
+        mean,
+        largest_deviation: f.map_or((f64::NAN, f64::NAN), |f| f.largest_deviation),
+        max_residual: f.map_or(nowhere, |f| f.max_residual),
+        max_gouge: f.map_or(nowhere, |f| f.max_gouge),
         samples: out,
     }
 }
