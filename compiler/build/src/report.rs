@@ -45,6 +45,9 @@ pub struct Report {
     pub estimate: Estimate,
     /// What the program cuts, simulated from its moves as printed.
     pub simulation: Simulation,
+    /// The acceptance gate: each criterion the simulated part is held to,
+    /// its limit, what was measured, and whether it passed.
+    pub acceptance: Acceptance,
     /// The surface's analysis over its whole domain (what `lensc analyse`
     /// prints).
     pub surface: SurfaceAnalysis,
@@ -836,6 +839,13 @@ pub struct ProfileCut {
     pub max_residual_nm: AtRadius,
     /// The deepest cut below the design (nm) and where.
     pub max_gouge_nm: AtRadius,
+    /// The area of the surface of revolution the sampled radii stand for
+    /// (mm²; each sample 2π r times the spacing).
+    pub simulated_area_mm2: f64,
+    /// The part of it at radii the cut does not reach (mm²).
+    pub uncut_area_mm2: f64,
+    /// The first radius the cut does not reach (mm), null if none.
+    pub first_uncut_radius_mm: Option<f64>,
 }
 
 /// A value and the radius (mm) where it occurs, either null where there
@@ -871,6 +881,9 @@ impl From<&lensc_runtime::verify::simulate::ProfileCut> for ProfileCut {
                 value: cut.max_gouge.0 * 1e6,
                 at_radius_mm: cut.max_gouge.1,
             },
+            simulated_area_mm2: cut.area,
+            uncut_area_mm2: cut.uncut_area,
+            first_uncut_radius_mm: cut.uncut_at,
         }
     }
 }
@@ -958,6 +971,13 @@ pub struct HeightMap {
     pub grid: Grid,
     /// Cells of the window no pass reached.
     pub uncut_cells: usize,
+    /// The part's area those cells cover (mm²).
+    pub uncut_area_mm2: f64,
+    /// One of those cells, x and y (mm), or null if none.
+    pub first_uncut_mm: Option<[f64; 2]>,
+    /// The part's area the map evaluates, every cell counted whether cut
+    /// or not (mm²).
+    pub simulated_area_mm2: f64,
     /// Form error over the cut surface, scallops included; null if no
     /// cell was cut.
     pub surface: Option<Figures>,
@@ -1016,6 +1036,9 @@ impl HeightMap {
                 row_step_mm: g.du,
             },
             uncut_cells: map.uncut,
+            uncut_area_mm2: map.uncut_area,
+            first_uncut_mm: map.uncut_at.map(|(x, y)| [x, y]),
+            simulated_area_mm2: map.area,
             surface: map.surface.as_ref().map(Figures::from),
             contact: map.contact.as_ref().map(Figures::from),
             scallops: ScallopReport {
@@ -1171,6 +1194,107 @@ impl From<&FeatureFigures> for LensletHeightMap {
             scallops: f.scallops.as_ref().map(Scallops::from),
         }
     }
+}
+
+/// The acceptance gate of a job (README, "Acceptance"): the criteria
+/// its `accept` block states, the rest at defaults derived from the
+/// strategy's path tolerance and the machine's resolution, each compared
+/// with the simulated part. Form figures are those of [`Figures`] at the
+/// passes' contacts (a profile job's: over its sampled radii).
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct Acceptance {
+    /// `gate`: a criterion missed, or one that cannot be measured, is an
+    /// error and no program is written; `warn` (`lensc build
+    /// --accept=warn`, and `lensc report`): a warning, the program is
+    /// written; `none`: the job says `accept: none`, nothing is checked.
+    pub mode: AcceptanceMode,
+    /// Every criterion measured and met (true when `mode` is `none`).
+    pub passed: bool,
+    /// Each criterion the job is held to, in a fixed order.
+    pub criteria: Vec<CriterionResult>,
+}
+
+impl Acceptance {
+    /// Before the pipeline's gate has run: no criterion yet.
+    pub fn pending() -> Acceptance {
+        Acceptance {
+            mode: AcceptanceMode::None,
+            passed: true,
+            criteria: Vec::new(),
+        }
+    }
+}
+
+/// How a build treats its acceptance criteria.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum AcceptanceMode {
+    /// A criterion missed is an error; no program is written.
+    Gate,
+    /// A criterion missed is a warning; the program is written.
+    Warn,
+    /// The job opted out (`accept: none`).
+    None,
+}
+
+/// One acceptance criterion and what the simulation found.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct CriterionResult {
+    /// Its name in an `accept` block: `form_pv`, `form_rms`, `max_gouge`,
+    /// `max_residual`, `uncut_area`, `max_following_error`,
+    /// `max_cutting_time`.
+    pub criterion: &'static str,
+    /// The unit of `limit` and `measured`: `nm`, `mm2`, `fraction` (of the
+    /// area simulated) or `s`.
+    pub unit: &'static str,
+    /// The limit the figure may not exceed.
+    pub limit: f64,
+    /// Stated in the job's `accept` block, or the default.
+    pub source: LimitSource,
+    /// How a default limit was derived; null when stated.
+    pub default_rule: Option<String>,
+    /// The figure measured; null if the simulation could not measure it.
+    pub measured: Option<f64>,
+    /// Where on the part: a PV's highest and lowest points, a gouge's
+    /// deepest, a residual's highest, the first uncut cell, the worst
+    /// following error; empty for a figure with no one place (RMS,
+    /// cutting time).
+    pub at: Vec<Place>,
+    /// Measured and within the limit.
+    pub passed: bool,
+    /// Why the figure could not be measured; null if it was.
+    pub unmeasured: Option<&'static str>,
+}
+
+/// Where a limit came from.
+#[derive(Clone, Copy, Debug, Serialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum LimitSource {
+    /// The job's `accept` block.
+    Stated,
+    /// Derived from the strategy's tolerance (`default_rule` says how).
+    Default,
+}
+
+/// A place on the part: a point (x, y) of a surface job, or a radius of
+/// a profile job or a spiral.
+#[derive(Clone, Copy, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct Place {
+    /// What is there: `highest`, `lowest`, `deepest`, `first_uncut`,
+    /// `worst`.
+    pub what: &'static str,
+    /// x (mm), for a point.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub x_mm: Option<f64>,
+    /// y (mm), for a point.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub y_mm: Option<f64>,
+    /// The radius (mm), for a radius.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub radius_mm: Option<f64>,
 }
 
 /// The analysis of a surface over its domain (also what `lensc analyse`

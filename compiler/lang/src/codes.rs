@@ -58,6 +58,14 @@ pub const TOO_MANY_POINTS: &str = "E0160";
 /// A job's program would be larger than `--max-program-size`.
 pub const PROGRAM_TOO_LARGE: &str = "E0161";
 
+/// The simulated part misses one of its job's acceptance criteria (the
+/// message names which, by how much and where); no program is written.
+pub const ACCEPTANCE_MISSED: &str = "E0195";
+/// A job's acceptance criterion that its simulation cannot measure (a
+/// tool shape the height map does not model, no servo model); no program
+/// is written unless the job says `accept: none`.
+pub const ACCEPTANCE_UNMEASURED: &str = "E0196";
+
 pub const UNUSED: &str = "W0001";
 pub const WRAP_GAP: &str = "W0002";
 pub const SEAM_LEFT_UNCUT: &str = "W0003";
@@ -65,6 +73,10 @@ pub const CENTRE_LEFT_UNCUT: &str = "W0004";
 /// A servo's data period keeps a spiral's chords from meeting their share
 /// of the path tolerance.
 pub const CHORDS_OVER_TOLERANCE: &str = "W0005";
+/// E0195 under `lensc build --accept=warn`: the program is written.
+pub const ACCEPTANCE_MISSED_WARNING: &str = "W0020";
+/// E0196 under `lensc build --accept=warn`: the program is written.
+pub const ACCEPTANCE_UNMEASURED_WARNING: &str = "W0021";
 
 /// All codes, for the uniqueness test and the reference in README.
 pub const ALL: &[&str] = &[
@@ -118,10 +130,14 @@ pub const ALL: &[&str] = &[
     CANNOT_WRITE,
     TOO_MANY_POINTS,
     PROGRAM_TOO_LARGE,
+    ACCEPTANCE_MISSED,
+    ACCEPTANCE_UNMEASURED,
     UNUSED,
     SEAM_LEFT_UNCUT,
     CENTRE_LEFT_UNCUT,
     CHORDS_OVER_TOLERANCE,
+    ACCEPTANCE_MISSED_WARNING,
+    ACCEPTANCE_UNMEASURED_WARNING,
 ];
 
 #[cfg(test)]

@@ -74,6 +74,12 @@ enum Command {
         /// refused before it is planned.
         #[arg(long, value_name = "SIZE", default_value = "4GB", value_parser = parse_size)]
         max_program_size: u64,
+        /// What a job whose simulated part misses its acceptance criteria
+        /// (its `accept` block, or the defaults) is: `error` (no program
+        /// is written, exit 1) or `warn` (the program is written, for
+        /// exploration).
+        #[arg(long, value_enum, default_value_t = AcceptChoice::Error)]
+        accept: AcceptChoice,
     },
     /// Plan and simulate a file's jobs as `build` does and write SVG plots
     /// of what each program will cut: `JOB.profile.svg` (profile jobs: the
@@ -135,6 +141,12 @@ enum Command {
 enum MessageFormat {
     Human,
     Json,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum AcceptChoice {
+    Error,
+    Warn,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -206,6 +218,7 @@ fn run(cli: Cli) -> u8 {
             dialect,
             out: dir,
             max_program_size,
+            accept,
         } => commands::build::run(
             &out,
             &file,
@@ -213,6 +226,10 @@ fn run(cli: Cli) -> u8 {
                 job: job.as_deref(),
                 dialect: dialect.as_deref(),
                 max_program_size: Some(max_program_size),
+                accept: match accept {
+                    AcceptChoice::Error => lensc_build::accept::Mode::Gate,
+                    AcceptChoice::Warn => lensc_build::accept::Mode::Warn,
+                },
             },
             &dir,
         ),

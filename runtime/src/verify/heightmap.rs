@@ -434,6 +434,15 @@ impl ColumnCut<'_> {
     }
 }
 
+/// The part's area (mm²) of the grid cell at (s, u): the parallelogram
+/// its two steps span on the part.
+fn cell_area(frame: &dyn Frame, g: &Grid, s: f64, u: f64) -> f64 {
+    let (x0, y0) = frame.xy(s, u);
+    let (x1, y1) = frame.xy(s + g.ds, u);
+    let (x2, y2) = frame.xy(s, u + g.du);
+    ((x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0)).abs()
+}
+
 fn in_features(features: &[(f64, f64, f64)], x: f64, y: f64) -> bool {
     features.is_empty()
         || features
@@ -509,6 +518,13 @@ pub struct HeightMap {
     pub scallops: Option<Scallops>,
     /// Cells in the window that no pass reached.
     pub uncut: usize,
+    /// The part's area (mm²) those cells cover, and one of them (x, y),
+    /// if any.
+    pub uncut_area: f64,
+    pub uncut_at: Option<(f64, f64)>,
+    /// The area (mm²) of every cell counted, cut or not: the area the
+    /// map evaluates.
+    pub area: f64,
     /// RMS of the error along each row (the cutting direction) and along
     /// each column (the step-over direction) about its least-squares
     /// quadratic (the form's trend), averaged over rows and columns (mm).
@@ -603,6 +619,7 @@ impl HeightMap {
             .collect();
         let mut all_cusps = Vec::new();
         let mut uncut = 0;
+        let (mut uncut_area, mut uncut_at, mut area) = (0.0, None, 0.0);
         let mut errors = Vec::with_capacity(g.ns * g.nu);
         for (j, c) in columns.iter().enumerate() {
             let s = g.s(j);
@@ -611,9 +628,14 @@ impl HeightMap {
                 if e.is_nan() {
                     if frame.inside(x, y) && in_features(features, x, y) {
                         uncut += 1;
+                        let a = cell_area(frame, &g, s, g.u(i));
+                        uncut_area += a;
+                        area += a;
+                        uncut_at.get_or_insert((x, y));
                     }
                     continue;
                 }
+                area += cell_area(frame, &g, s, g.u(i));
                 surface.add(e, (x, y));
                 if let Some(f) = which(x, y) {
                     per[f].0.add(e, (x, y));
@@ -651,6 +673,9 @@ impl HeightMap {
             contact: contact.figures(),
             scallops: scallops(&all_cusps),
             uncut,
+            uncut_area,
+            uncut_at,
+            area,
             rq_cutting,
             rq_stepover,
             features: features

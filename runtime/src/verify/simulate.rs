@@ -32,6 +32,12 @@ pub struct ProfileCut {
     /// The error of the largest magnitude (mm, sign kept) and where; NaN
     /// if no radius was cut.
     pub largest_deviation: (f64, f64),
+    /// The area (mm²) of the surface of revolution the radii sampled
+    /// stand for (each 2π|r| times the spacing), the part of it at radii
+    /// the cut does not reach, and the first such radius, if any.
+    pub area: f64,
+    pub uncut_area: f64,
+    pub uncut_at: Option<f64>,
     /// The most material left above the design (mm, ≥ 0) and where.
     pub max_residual: (f64, f64),
     /// The deepest cut below the design (mm, ≥ 0) and where.
@@ -261,14 +267,21 @@ pub fn profile_cut(
         }
     }
     let mut out = Vec::with_capacity(n);
+    let step = (to - from).abs() / (n - 1) as f64;
+    let (mut area, mut uncut_area, mut uncut_at) = (0.0, 0.0, None);
     for k in 0..n {
         let x = from + (to - from) * k as f64 / (n - 1) as f64;
         let cut = in_bin[bin(x)]
             .iter()
             .filter_map(|&i| pieces[i].bottom(rho, x))
             .fold(f64::INFINITY, f64::min);
+        let ring = 2.0 * PI * x.abs() * step;
+        area += ring;
         if cut.is_finite() {
             out.push((x, cut - design(x)));
+        } else {
+            uncut_area += ring;
+            uncut_at.get_or_insert(x);
         }
     }
     let mut stats = ErrorStats::<f64>::new();
@@ -283,6 +296,9 @@ pub fn profile_cut(
         rms,
         mean,
         largest_deviation: f.map_or((f64::NAN, f64::NAN), |f| f.largest_deviation),
+        area,
+        uncut_area,
+        uncut_at,
         max_residual: f.map_or(nowhere, |f| f.max_residual),
         max_gouge: f.map_or(nowhere, |f| f.max_gouge),
         samples: out,

@@ -100,6 +100,9 @@ fn a_raster_keeps_each_blocks_worst_error_and_its_sign() {
         contact: None,
         scallops: None,
         uncut: 1,
+        uncut_area: 1e-6,
+        uncut_at: Some((0.0, 0.0)),
+        area: 1e-2,
         rq_cutting: 0.0,
         rq_stepover: 0.0,
         features: Vec::new(),
@@ -313,4 +316,37 @@ fn a_tilt_has_the_figures_of_a_ramp() {
     assert!((c.largest_deviation.0.abs() - 40e-6).abs() < 1e-9, "{c:?}");
     let y = c.largest_deviation.1.1;
     assert!((y - 0.01).abs() < 1e-6 || (y - 0.09).abs() < 1e-6, "at {y}");
+}
+
+/// Passes that stop short leave cells uncut: their count, the area they
+/// cover on the part (the grid's cells are 1 µm squares) and one of them.
+#[test]
+fn cells_no_pass_reaches_are_uncut_area() {
+    let (r, f) = (0.085, 0.010);
+    let mut sweep = Sweep::new(grid(101, 0.001), r);
+    for k in -12..=22 {
+        let u = k as f64 * f;
+        sweep.lift();
+        // Every pass stops at s = 60 µm: columns 61 … 100 are uncut.
+        sweep.point(-0.01, u, r);
+        sweep.point(0.0605, u, r);
+    }
+    let frame = Flat {
+        z: |_, _| 0.0,
+        window: (0.0, 0.1, 0.0, 0.1),
+    };
+    let map = sweep.finish(&frame);
+    assert_eq!(map.uncut, 40 * 101);
+    assert!(
+        (map.uncut_area - 40.0 * 101.0 * 1e-6).abs() < 1e-12,
+        "{}",
+        map.uncut_area
+    );
+    assert!(
+        (map.area - 101.0 * 101.0 * 1e-6).abs() < 1e-12,
+        "{}",
+        map.area
+    );
+    let (x, _) = map.uncut_at.unwrap();
+    assert!(x > 0.060, "{x}");
 }
