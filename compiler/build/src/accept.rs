@@ -49,6 +49,9 @@ pub fn gate(spec: &JobSpec, built: &mut Built, mode: Mode) -> Vec<Diagnostic> {
     let tolerance = spec.path_tolerance();
     let mut results = Vec::new();
     let mut diags = Vec::new();
+    // Criteria the simulation cannot measure, by the reason: one
+    // diagnostic a reason.
+    let mut unmeasured: Vec<(&'static str, Vec<&'static str>, Option<(FileId, Span)>)> = Vec::new();
     for c in Criterion::ALL {
         let stated = head.accept.stated(c);
         let limit = match stated {
@@ -63,11 +66,24 @@ pub fn gate(spec: &JobSpec, built: &mut Built, mode: Mode) -> Vec<Diagnostic> {
             },
         };
         let r = judge(c, &limit, built);
-        if !r.passed {
-            let site = stated.map(|l| l.site).unwrap_or(head.site);
-            diags.push(diagnostic(c, &limit, &r, site, stated.is_some(), mode));
+        match r.unmeasured {
+            Some(why) => match unmeasured.iter_mut().find(|u| u.0 == why) {
+                Some(u) => {
+                    u.1.push(c.name());
+                    u.2 = u.2.or(stated.map(|l| l.site));
+                }
+                None => unmeasured.push((why, vec![c.name()], stated.map(|l| l.site))),
+            },
+            None if !r.passed => {
+                let site = stated.map(|l| l.site).unwrap_or(head.site);
+                diags.push(missed(c, &limit, &r, site, stated.is_some(), mode));
+            }
+            None => {}
         }
         results.push(r);
+    }
+    for (why, names, site) in unmeasured {
+        diags.push(cannot_measure(why, &names, site, head.site, mode));
     }
     built.report.acceptance = crate::report::Acceptance {
         mode: match mode {
@@ -145,7 +161,9 @@ fn unit(c: Criterion, fraction: bool) -> (&'static str, f64) {
 /// `c` measured on `built` and compared with `limit`.
 fn judge(c: Criterion, limit: &Limit, built: &Built) -> CriterionResult {
     let (unit, factor) = unit(c, limit.fraction);
-    let limit_shown = limit.value * factor;
+    // In the report's unit, without the scaling's last-digit noise (50
+    // nm, not 49.99999999999999).
+    let limit_shown = round_to(limit.value * factor, 1e-9);
     let measured = measure(c, limit.fraction, built);
     let (value, at, unmeasured) = match measured {
         Ok(m) => (Some(m.value), m.at, None),
@@ -303,9 +321,10 @@ fn form_figure(c: Criterion, form: Form) -> Result<Measured, &'static str> {
 /// The figure and its unit for a message.
 fn shown(v: f64, unit: &str) -> String {
     match unit {
+        "nm" if v.abs() >= 1000.0 => format!("{} µm", trim_num(round_to(v / 1000.0, 0.001))),
         "nm" => format!("{} nm", trim_num(round_to(v, 0.01))),
         "mm2" => format!("{} mm²", trim_num(v)),
-        "fraction" => format!("{} of the area simulated", trim_num(v)),
+        "fraction" => format!("{} %", trim_num(round_to(v * 100.0, 0.001))),
         _ => hours(v),
     }
 }
@@ -342,62 +361,87 @@ fn places(at: &[Place]) -> String {
     at.iter().map(one).collect::<Vec<_>>().join(", ")
 }
 
-/// The diagnostic of a criterion missed or not measured.
+/// An error under `Mode::Gate`, else a warning, labelled.
 fn diagnostic(
+    mode: Mode,
+    (error, warning): (&'static str, &'static str),
+    message: String,
+    (file, span): (FileId, Span),
+    label: &str,
+) -> Diagnostic {
+    match mode {
+        Mode::Gate => Diagnostic::error(error, message, file, span),
+        Mode::Warn => Diagnostic::warning(warning, message, file, span),
+    }
+    .with_label(label)
+}
+
+/// E0195 (W0020): a criterion measured and missed, by how much and where.
+fn missed(
     c: Criterion,
     limit: &Limit,
     r: &CriterionResult,
-    (file, span): (FileId, Span),
+    site: (FileId, Span),
     stated: bool,
     mode: Mode,
 ) -> Diagnostic {
-    let (missed, unmeasured) = match mode {
-        Mode::Gate => (codes::ACCEPTANCE_MISSED, codes::ACCEPTANCE_UNMEASURED),
-        Mode::Warn => (
-            codes::ACCEPTANCE_MISSED_WARNING,
-            codes::ACCEPTANCE_UNMEASURED_WARNING,
-        ),
+    let v = r.measured.unwrap_or(f64::NAN);
+    let where_ = if r.at.is_empty() {
+        String::new()
+    } else {
+        format!("; {}", places(&r.at))
     };
-    let limit_words = shown(r.limit, r.unit);
-    let whose = if stated { "" } else { "default " };
-    let (code, message) = match (r.measured, r.unmeasured) {
-        (Some(v), _) => {
-            let where_ = if r.at.is_empty() {
-                String::new()
-            } else {
-                format!("; {}", places(&r.at))
-            };
-            (
-                missed,
-                format!(
-                    "the simulated part misses `{}`: {}, over the {whose}limit of {limit_words} by {}{where_}",
-                    c.name(),
-                    shown(v, r.unit),
-                    shown(v - r.limit, r.unit),
-                ),
-            )
-        }
-        (None, why) => (
-            unmeasured,
-            format!(
-                "`{}` ({whose}limit {limit_words}) cannot be checked: {}",
-                c.name(),
-                why.unwrap_or("the figure is not a number")
-            ),
-        ),
+    let as_fraction = if r.unit == "fraction" {
+        " (as a fraction of the area simulated)"
+    } else {
+        ""
     };
-    let d = match mode {
-        Mode::Gate => Diagnostic::error(code, message, file, span),
-        Mode::Warn => Diagnostic::warning(code, message, file, span),
-    };
-    let d = d.with_label(if stated { "this limit" } else { "this job" });
-    let help = match (&limit.rule, r.measured) {
-        (_, None) => "say `accept: none` to build without the gate, or state only criteria the simulation measures; `--accept=warn` writes the program anyway".to_string(),
-        (Some(rule), _) => format!(
-            "the default limit is {rule}; state the limit the part needs in `accept {{ {}: … }}`, or `accept: none`; `--accept=warn` writes the program anyway; the report's `acceptance` lists every criterion",
+    let message = format!(
+        "the simulated part misses `{}`{as_fraction}: {}, over the {}limit of {} by {}{where_}",
+        c.name(),
+        shown(v, r.unit),
+        if stated { "" } else { "default " },
+        shown(r.limit, r.unit),
+        shown(v - r.limit, r.unit),
+    );
+    let help = match &limit.rule {
+        Some(rule) => format!(
+            "the default limit is {rule}; state the limit the part needs in `accept: {{ {}: … }}`, or `accept: none`; `--accept=warn` writes the program anyway; the report's `acceptance` lists every criterion",
             c.name()
         ),
-        (None, _) => "the report's `acceptance` lists every criterion; `--accept=warn` writes the program anyway".to_string(),
+        None => "the report's `acceptance` lists every criterion; `--accept=warn` writes the program anyway".to_string(),
     };
-    d.with_help(help)
+    diagnostic(
+        mode,
+        (codes::ACCEPTANCE_MISSED, codes::ACCEPTANCE_MISSED_WARNING),
+        message,
+        site,
+        if stated { "this limit" } else { "this job" },
+    )
+    .with_help(help)
+}
+
+/// E0196 (W0021): criteria the simulation cannot measure, and why; at
+/// the first of them stated, or at the job.
+fn cannot_measure(
+    why: &str,
+    names: &[&str],
+    stated: Option<(FileId, Span)>,
+    job: (FileId, Span),
+    mode: Mode,
+) -> Diagnostic {
+    let listed: Vec<String> = names.iter().map(|n| format!("`{n}`")).collect();
+    let listed = match listed.as_slice() {
+        [one] => one.clone(),
+        [init @ .., last] => format!("{} and {last}", init.join(", ")),
+        [] => String::new(),
+    };
+    diagnostic(
+        mode,
+        (codes::ACCEPTANCE_UNMEASURED, codes::ACCEPTANCE_UNMEASURED_WARNING),
+        format!("{listed} cannot be checked: {why}"),
+        stated.unwrap_or(job),
+        if stated.is_some() { "this limit" } else { "this job" },
+    )
+    .with_help("say `accept: none` to build without the gate, or state only criteria the simulation measures; `--accept=warn` writes the program anyway")
 }
