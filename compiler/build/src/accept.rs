@@ -96,6 +96,10 @@ pub fn gate(spec: &JobSpec, built: &mut Built, mode: Mode) -> Vec<Diagnostic> {
     diags
 }
 
+/// Why criteria cannot be measured, their names, and where the first of
+/// them was stated (none: all at their defaults).
+type Unmeasured = (&'static str, Vec<&'static str>, Option<(FileId, Span)>);
+
 /// A limit in the criterion's own base unit (mm, mm², a fraction, s), and
 /// how it was derived if it is a default.
 struct Limit {
