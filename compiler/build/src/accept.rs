@@ -51,7 +51,7 @@ pub fn gate(spec: &JobSpec, built: &mut Built, mode: Mode) -> Vec<Diagnostic> {
     let mut diags = Vec::new();
     // Criteria the simulation cannot measure, by the reason: one
     // diagnostic a reason.
-    let mut unmeasured: Vec<(&'static str, Vec<&'static str>, Option<(FileId, Span)>)> = Vec::new();
+    let mut unmeasured: Vec<Unmeasured> = Vec::new();
     for c in Criterion::ALL {
         let stated = head.accept.stated(c);
         let limit = match stated {
