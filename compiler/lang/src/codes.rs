@@ -57,6 +57,11 @@ pub const CANNOT_WRITE: &str = "E0151";
 pub const TOO_MANY_POINTS: &str = "E0160";
 /// A job's program would be larger than `--max-program-size`.
 pub const PROGRAM_TOO_LARGE: &str = "E0161";
+/// A path tolerance finer than the machine's resolution can hold.
+pub const TOLERANCE_BELOW_RESOLUTION: &str = "E0180";
+/// `lensc fmt` refused to write a layout that would not parse back to the
+/// same program (a formatter bug; the file is left as it is).
+pub const FORMAT_WOULD_CHANGE_MEANING: &str = "E0185";
 
 /// The simulated part misses one of its job's acceptance criteria (the
 /// message names which, by how much and where); no program is written.
@@ -130,12 +135,14 @@ pub const ALL: &[&str] = &[
     CANNOT_WRITE,
     TOO_MANY_POINTS,
     PROGRAM_TOO_LARGE,
+    TOLERANCE_BELOW_RESOLUTION,
     ACCEPTANCE_MISSED,
     ACCEPTANCE_UNMEASURED,
     UNUSED,
     SEAM_LEFT_UNCUT,
     CENTRE_LEFT_UNCUT,
     CHORDS_OVER_TOLERANCE,
+    FORMAT_WOULD_CHANGE_MEANING,
     ACCEPTANCE_MISSED_WARNING,
     ACCEPTANCE_UNMEASURED_WARNING,
 ];
