@@ -57,6 +57,16 @@ pub const CANNOT_WRITE: &str = "E0151";
 pub const TOO_MANY_POINTS: &str = "E0160";
 /// A job's program would be larger than `--max-program-size`.
 pub const PROGRAM_TOO_LARGE: &str = "E0161";
+/// Roughing passes (a stock) without their own feed.
+pub const ROUGHING_NEEDS_FEED: &str = "E0170";
+/// A raster's spindle: a rotating cutter without a speed, or a knife
+/// (which cuts with the spindle held) given one.
+pub const RASTER_SPINDLE: &str = "E0171";
+/// A dialect's word format that does not read (`S5`, `X4.4`).
+pub const BAD_WORD_FORMAT: &str = "E0172";
+/// A tool call or coolant the job asks for that its dialect cannot write
+/// (a tool number too long for the T word, no mist word).
+pub const CANNOT_CALL_TOOL: &str = "E0173";
 
 pub const UNUSED: &str = "W0001";
 pub const WRAP_GAP: &str = "W0002";
@@ -118,6 +128,10 @@ pub const ALL: &[&str] = &[
     CANNOT_WRITE,
     TOO_MANY_POINTS,
     PROGRAM_TOO_LARGE,
+    ROUGHING_NEEDS_FEED,
+    RASTER_SPINDLE,
+    BAD_WORD_FORMAT,
+    CANNOT_CALL_TOOL,
     UNUSED,
     SEAM_LEFT_UNCUT,
     CENTRE_LEFT_UNCUT,
