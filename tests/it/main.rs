@@ -11,6 +11,7 @@ mod common;
 
 mod build_errors;
 mod cli;
+mod complete_programs;
 mod determinism;
 mod diagnostics;
 mod dialects;

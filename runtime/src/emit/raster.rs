@@ -190,14 +190,23 @@ mod tests {
             });
             assert!(lifted, "no link over {a:?} → {b:?}");
         }
-        let one_way = raster_moves(&path, RasterCut { zigzag: false, ..cut });
+        let one_way = raster_moves(
+            &path,
+            RasterCut {
+                zigzag: false,
+                ..cut
+            },
+        );
         assert_eq!(rapids_to_safe(&one_way), 5);
     }
 
     #[test]
     fn the_spindle_starts_before_the_first_feed_move_or_is_held_for_a_knife() {
         let path = zigzag_path();
-        for (speed, first) in [(Some(100.0), Move::SpindleOn(100.0)), (None, Move::SpindleHeld)] {
+        for (speed, first) in [
+            (Some(100.0), Move::SpindleOn(100.0)),
+            (None, Move::SpindleHeld),
+        ] {
             let stream = raster_moves(
                 &path,
                 RasterCut {

@@ -550,7 +550,12 @@ impl ProgramWriter {
                     "a spindle speed of {v} that prints as S{out}"
                 )));
             }
-            None => return Err(ProgramError::NotPrintable { word: 'S', value: v }),
+            None => {
+                return Err(ProgramError::NotPrintable {
+                    word: 'S',
+                    value: v,
+                });
+            }
         }
         if let Some(f) = f {
             let whole = out.split('.').next().unwrap_or("").len() as u32;
@@ -1098,10 +1103,7 @@ fn fits(number: &str, f: WordFormat) -> Result<(), String> {
             ));
         }
         (Some(max), Some(d)) if d.len() as u32 > max => {
-            return Err(format!(
-                "{} takes at most {max} decimals",
-                f.letter
-            ));
+            return Err(format!("{} takes at most {max} decimals", f.letter));
         }
         _ => {}
     }

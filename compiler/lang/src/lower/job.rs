@@ -410,7 +410,10 @@ fn start_error(job: &CheckedJob, dialect: &Dialect, setup: Setup) -> Option<Diag
     use lensc_runtime::post::writer::{coolant_word, tool_call_lines};
     let start = program_start(job);
     let (e, field) = match tool_call_lines(dialect, setup, &start) {
-        Err(e) => (e, value::field(&job.fields, "tool_number").or(value::field(&job.fields, "tool_offset"))),
+        Err(e) => (
+            e,
+            value::field(&job.fields, "tool_number").or(value::field(&job.fields, "tool_offset")),
+        ),
         Ok(_) => (
             coolant_word(dialect, start.coolant).err()?,
             value::field(&job.fields, "coolant"),
@@ -420,7 +423,9 @@ fn start_error(job: &CheckedJob, dialect: &Dialect, setup: Setup) -> Option<Diag
     Some(
         Diagnostic::error(codes::CANNOT_CALL_TOOL, e.message(), file, span)
             .with_label(format!("not in `{}`", dialect.name))
-            .with_help("choose a tool number, offset or coolant the dialect can write, or another dialect"),
+            .with_help(
+                "choose a tool number, offset or coolant the dialect can write, or another dialect",
+            ),
     )
 }
 

@@ -137,7 +137,10 @@ const GCODE_PARAMS: &[Param] = &[
         "spindle_orient",
         "the blocks that stop the spindle at a fixed angle and hold it, for a knife that cuts with the spindle still (`M19`)",
     ),
-    text("coolant_flood", "the flood-coolant word (`M8`); absent: none"),
+    text(
+        "coolant_flood",
+        "the flood-coolant word (`M8`); absent: none",
+    ),
     text("coolant_mist", "the mist-coolant word (`M7`); absent: none"),
     text(
         "coolant_off",
