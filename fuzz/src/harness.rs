@@ -96,6 +96,7 @@ pub fn run(fs: &MemFs, bytes: &[u8], depth: Depth, out_dir: &Path) -> Result<Rea
     let sources = &c.loaded.sources;
     well_formed(c.diags(), sources)?;
     render(c.diags(), sources)?;
+    formats(bytes)?;
     let mut reached = Reached {
         clean: !c.has_errors(),
         ..Reached::default()
@@ -131,6 +132,31 @@ pub fn run(fs: &MemFs, bytes: &[u8], depth: Depth, out_dir: &Path) -> Result<Rea
         }
     }
     Ok(reached)
+}
+
+/// `lensc fmt`'s invariant: a file that parses is formatted (to the same
+/// tree: `format_source` refuses otherwise, with E0185), and formatting
+/// the result again changes nothing.
+fn formats(bytes: &[u8]) -> Result<(), Fault> {
+    use lensc_lang::format::format_source;
+    let Ok(text) = std::str::from_utf8(bytes) else {
+        return Ok(());
+    };
+    let once = match format_source(text) {
+        Ok(once) => once,
+        Err(d)
+            if d.iter()
+                .any(|d| d.code == lensc_lang::codes::FORMAT_WOULD_CHANGE_MEANING) =>
+        {
+            return Err("lensc fmt would change what this file means (E0185)".into());
+        }
+        Err(_) => return Ok(()),
+    };
+    match format_source(&once) {
+        Ok(twice) if twice == once => Ok(()),
+        Ok(_) => Err("lensc fmt of its own output changed it again".into()),
+        Err(_) => Err("lensc fmt's output does not format".into()),
+    }
 }
 
 /// The invariant: every diagnostic has a code and a primary span lying in

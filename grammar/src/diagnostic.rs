@@ -106,4 +106,15 @@ pub mod codes {
     /// A unit power of zero, or a file too large to address with 32-bit spans.
     pub const BAD_UNIT_POWER: &str = "E0006";
     pub const TOO_LARGE: &str = "E0007";
+
+    /// Every syntax code, for `lensc explain` and its test.
+    pub const ALL: &[&str] = &[
+        SYNTAX,
+        TOO_DEEP,
+        BAD_NUMBER,
+        BAD_ESCAPE,
+        NOT_UTF8,
+        BAD_UNIT_POWER,
+        TOO_LARGE,
+    ];
 }

@@ -115,3 +115,38 @@ fn check_reports_every_bad_build_error_that_needs_no_toolpath() {
         assert_eq!(checked.status.code(), Some(i32::from(errors)), "{rel}");
     }
 }
+
+/// `--dialect` misspelled, or naming a dialect the machine does not offer:
+/// the help names the one meant, or says how to add it to the machine.
+#[test]
+fn a_dialect_the_machine_does_not_offer_is_explained() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let out = dir.path().to_str().expect("utf-8");
+    let job = "examples/even_asphere_turning.lens";
+    let mut seen = String::new();
+    for dialect in [
+        "siemens_840d_lath",
+        "fanuc_0i_lath",
+        "fanuc_0i_lathe",
+        "fanuk",
+    ] {
+        let run = lensc(
+            &root(),
+            &[
+                "build",
+                job,
+                "--out",
+                out,
+                "--dialect",
+                dialect,
+                "--color",
+                "never",
+            ],
+        );
+        assert_eq!(run.status.code(), Some(1), "{dialect}");
+        seen.push_str(&format!("--- --dialect {dialect}\n{}", text(&run.stderr)));
+    }
+    insta::with_settings!({ snapshot_path => "../snapshots/bad_builds", prepend_module_to_snapshot => false, omit_expression => true }, {
+        insta::assert_snapshot!("dialect_not_offered", seen);
+    });
+}

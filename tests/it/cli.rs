@@ -221,10 +221,12 @@ fn plan_errors_name_their_location() {
     let dir = tempfile::tempdir().expect("tmp");
     let src = "use std::machines::linuxcnc_lathe
 use std::strategies::finish_turning
-// A concave sphere of radius 0.3 mm cannot be cut with a 0.5 mm nose.
+// A concave sphere of radius 0.3 mm cannot be cut with a 0.5 mm nose (at a
+// tolerance the lathe's 0.1 um holds).
 surface bowl = sphere { radius: 0.3 mm, sense: concave, aperture: circle(radius: 0.2 mm) }
 tool big = round_nose { nose_radius: 0.5 mm, clearance: 7 deg }
-job gouge { surface: bowl, tool: big, machine: linuxcnc_lathe, strategy: finish_turning }
+strategy finish = finish_turning { chord_tolerance: 150 nm }
+job gouge { surface: bowl, tool: big, machine: linuxcnc_lathe, strategy: finish }
 ";
     std::fs::write(dir.path().join("gouge.lens"), src).expect("write");
     let out = lensc(
@@ -417,10 +419,12 @@ fn annular_aperture_cuts_from_outer_to_inner_edge() {
     let dir = tempfile::tempdir().expect("tmp");
     let src = "use std::machines::linuxcnc_lathe
 use std::strategies::finish_turning
-// A concave sphere R = 10 mm cut only on the ring 1 mm <= r <= 2 mm.
+// A concave sphere R = 10 mm cut only on the ring 1 mm <= r <= 2 mm (at a
+// tolerance the lathe's 0.1 um holds).
 surface ring = sphere { radius: 10 mm, sense: concave, aperture: annulus(inner: 1 mm, outer: 2 mm) }
 tool t = round_nose { nose_radius: 0.5 mm, clearance: 7 deg }
-job ring_cut { surface: ring, tool: t, machine: linuxcnc_lathe, strategy: finish_turning }
+strategy finish = finish_turning { chord_tolerance: 150 nm }
+job ring_cut { surface: ring, tool: t, machine: linuxcnc_lathe, strategy: finish }
 ";
     std::fs::write(dir.path().join("ring.lens"), src).expect("write");
     let out = lensc(dir.path(), &["build", "ring.lens"]);

@@ -154,7 +154,7 @@ fn a_fanuc_lathe_program_is_in_diameter_with_radius_arc_centres() {
         "use std::machines::linuxcnc_lathe\n\
          use std::tools::diamond_r496um\n\
          surface insert = conic { radius: 12 mm, conic: -0.6, sense: concave, aperture: circle(radius: 3 mm) }\n\
-         strategy finish = profile_turning { feed: 2 um/rev, spindle_speed: 1000 rpm, chord_tolerance: 50 nm }\n\
+         strategy finish = profile_turning { feed: 2 um/rev, spindle_speed: 1000 rpm, chord_tolerance: 150 nm }\n\
          job fanuc_insert { surface: insert, tool: diamond_r496um, machine: linuxcnc_lathe, strategy: finish }\n",
     )
     .expect("write");

@@ -432,28 +432,28 @@ fn a_profile_job_refuses_a_simulation_window() {
 }
 
 #[test]
-fn seed_000_paths_cut_within_the_figure_before_the_machines_rounding() {
-    // Issue #6's figure for every seed 000 job: the path lensc plans and
-    // optimises (chords, arcs) puts the knife's contacts within 1 nm RMS and
-    // 5 nm PV of the design. The generic mill then prints to 0.1 um, whose
-    // rounding alone is ±50 nm (the report's `contact`); `contact_unrounded`
-    // sweeps the same moves unrounded.
+fn seed_000_paths_cut_within_their_tolerance_before_and_after_rounding() {
+    // Every seed 000 job: the generic mill prints to 0.1 um, so its path
+    // tolerance is 200 nm (10 nm cannot be held there: E0180). The path
+    // lensc plans and optimises (chords, arcs) puts the knife's contacts
+    // within the chords' and the fitting's shares of it (T/10 + 3T/20 =
+    // 50 nm; `contact_unrounded` sweeps the moves unrounded), and the
+    // program as printed, rounding included (`contact`), within T. (Issue
+    // #6's 1 nm RMS, 5 nm PV at 10 nm is `seed_000_knife_contacts_…`, on a
+    // mill that holds 10 nm.)
     let all = reports("examples/lin2022_scraping.lens");
     assert_eq!(all.len(), 6);
     for r in all {
         let h = &r["simulation"]["height_map"];
         let c = &h["contact_unrounded"];
         assert!(num(&c["cells"]) > 1000.0, "{}: {c}", r["job"]);
-        let (rms, pv) = (num(&c["rms_nm"]), num(&c["pv_nm"]));
-        assert!(rms < 1.0 && pv < 5.0, "{}: {c}", r["job"]);
-        // Rounding to 0.1 um moves the printed contacts by at most half of
-        // it plus what a rounded arc centre makes of that.
+        for k in ["max_residual_nm", "max_gouge_nm"] {
+            assert!(num(&c[k]["value"]) <= 50.0, "{}: {c}", r["job"]);
+        }
         let printed = &h["contact"];
-        assert!(
-            num(&printed["max_residual_nm"]["value"]) < 100.0,
-            "{printed}"
-        );
-        assert!(num(&printed["max_gouge_nm"]["value"]) < 100.0, "{printed}");
+        for k in ["max_residual_nm", "max_gouge_nm"] {
+            assert!(num(&printed[k]["value"]) <= 200.0, "{printed}");
+        }
     }
 }
 

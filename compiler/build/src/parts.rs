@@ -54,7 +54,7 @@ pub(crate) fn nose_centre_header(
     lines.push(format!(
         "tool {}: round nose, nose radius {} mm",
         head.names.tool,
-        lensc_lang::check::trim_num(nose_radius)
+        lensc_lang::lower::exact_in(nose_radius, "mm")
     ));
     lines
 }
@@ -136,7 +136,8 @@ pub(crate) fn travel_error(
             lensc_lang::check::trim_num(lo),
             lensc_lang::check::trim_num(hi)
         ),
-    ))
+    )
+    .with_help("check the machine's `travel`, the part's size and where it sits, and the strategy's retract height; or use a machine with more travel"))
 }
 
 /// E0150: the program cannot be written in the job's dialect.

@@ -469,8 +469,12 @@ pub struct FastAxis {
     pub max_acceleration_m_per_s2: f64,
     /// Radius of the largest acceleration (mm).
     pub max_acceleration_at_radius_mm: f64,
-    /// The highest speed at which the axis keeps within its acceleration
-    /// limit.
+    /// The highest speed at which the axis would keep within its
+    /// acceleration limit were acceleration to scale with the square of
+    /// the speed: an estimate, not planned (at the trajectory's corners
+    /// the sampling reaches the data period and acceleration scales with
+    /// the speed itself; a settling offset changes with speed). A refused
+    /// job's E0147 help gives a speed that was planned and passes.
     pub highest_allowed_speed: AllowedSpeed,
 }
 

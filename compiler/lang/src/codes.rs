@@ -67,6 +67,11 @@ pub const BAD_WORD_FORMAT: &str = "E0172";
 /// A tool call or coolant the job asks for that its dialect cannot write
 /// (a tool number too long for the T word, no mist word).
 pub const CANNOT_CALL_TOOL: &str = "E0173";
+/// A path tolerance finer than the machine's resolution can hold.
+pub const TOLERANCE_BELOW_RESOLUTION: &str = "E0180";
+/// `lensc fmt` refused to write a layout that would not parse back to the
+/// same program (a formatter bug; the file is left as it is).
+pub const FORMAT_WOULD_CHANGE_MEANING: &str = "E0185";
 
 pub const UNUSED: &str = "W0001";
 pub const WRAP_GAP: &str = "W0002";
@@ -132,10 +137,12 @@ pub const ALL: &[&str] = &[
     RASTER_SPINDLE,
     BAD_WORD_FORMAT,
     CANNOT_CALL_TOOL,
+    TOLERANCE_BELOW_RESOLUTION,
     UNUSED,
     SEAM_LEFT_UNCUT,
     CENTRE_LEFT_UNCUT,
     CHORDS_OVER_TOLERANCE,
+    FORMAT_WOULD_CHANGE_MEANING,
 ];
 
 #[cfg(test)]

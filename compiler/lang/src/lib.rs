@@ -7,21 +7,25 @@
 //! the files a job may read); names are
 //! resolved and every value checked for its unit and range against the
 //! schema (`check`: `scope`, `expr`, `params`, `rules`; `schema`, one file
-//! per category of kind; `units`, `value`, `codes`); and checked jobs and
+//! per category of kind; `units`, `value`, `codes`; `stdlib` the standard
+//! library's items and their documentation); and checked jobs and
 //! surfaces are lowered to what the runtime plans (`lower`, with
 //! `lower::surface` one file per surface family, `domain` the apertures both
-//! share). Errors are data
+//! share); `format` is `lensc fmt`'s canonical layout. Errors are data
 //! (`Diagnostic`s with codes and spans; `lower::diagnostics` maps every runtime
 //! error to one); nothing here plans, writes or renders.
 
 pub mod check;
 pub mod codes;
 pub mod domain;
+pub mod explain;
+pub mod format;
 pub mod loader;
 pub mod lower;
 pub mod sandbox;
 pub mod schema;
 pub mod source;
+pub mod stdlib;
 pub mod units;
 pub mod value;
 

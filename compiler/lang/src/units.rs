@@ -186,6 +186,26 @@ pub fn lookup(name: &str) -> Option<&'static UnitDef> {
     UNITS.iter().find(|u| u.name == name)
 }
 
+/// How many base units one `unit` is, computed as the checker computes a
+/// `.lens` quantity's unit (`mm/min`: 1 × 60⁻¹, each part's size to its
+/// power, in the order written): what a header figure in this unit is
+/// multiplied by when read back. `mm/s^2` and `mm·rad` read as written, a
+/// leading `1` (`1/mm^3`) as nothing; `None` if a part is no unit.
+pub fn size_of(unit: &str) -> Option<f64> {
+    let mut size = 1.0_f64;
+    for (k, quotient) in unit.split('/').enumerate() {
+        for part in quotient.split('·').filter(|p| k > 0 || *p != "1") {
+            let (name, power) = match part.split_once('^') {
+                Some((n, p)) => (n, p.parse::<i32>().ok()?),
+                None => (part, 1),
+            };
+            let power = if k > 0 { -power } else { power };
+            size *= lookup(name)?.factor.powi(power);
+        }
+    }
+    Some(size)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -201,6 +221,16 @@ mod tests {
         assert_eq!(Dim::ANGLE / Dim::LENGTH * Dim::LENGTH, Dim::ANGLE);
         assert_eq!(Dim::new(2, 0, -2).sqrt(), Some(Dim::SPEED));
         assert_eq!(Dim::LENGTH.sqrt(), None);
+    }
+
+    #[test]
+    fn a_units_size_is_the_checkers() {
+        assert_eq!(size_of("mm/min"), Some(1.0 / 60.0));
+        assert_eq!(size_of("rpm"), Some(2.0 * PI / 60.0));
+        assert_eq!(size_of("1/mm^3"), Some(1.0));
+        assert_eq!(size_of("mm/s^2"), Some(1.0));
+        assert_eq!(size_of("um"), Some(1e-3));
+        assert_eq!(size_of("furlong"), None);
     }
 
     #[test]

@@ -1,5 +1,5 @@
-//! The `lensc` command line: `check`, `build`, `report`, `analyse` and
-//! `sample`. Exit codes: 0 success (warnings allowed), 1 errors in the
+//! The `lensc` command line: `check`, `build`, `report`, `analyse`,
+//! `sample`, `fmt`, `list` and `explain`. Exit codes: 0 success (warnings allowed), 1 errors in the
 //! input, 2 usage errors, 101 an internal error, 130 and 143 a `build` or
 //! `report` stopped by SIGINT or SIGTERM.
 
@@ -110,6 +110,16 @@ enum Command {
         #[arg(long, default_value_t = 201, value_name = "N")]
         grid: usize,
     },
+    /// Put .lens files in the one canonical layout (comments kept where
+    /// they were, meaning unchanged), rewriting each file that changes.
+    Fmt {
+        /// The .lens files to format.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Write nothing: list the files that would change and exit 1 if any would.
+        #[arg(long)]
+        check: bool,
+    },
     /// Evaluate a surface: CSV on stdout with the header
     /// x,y,z,dzdx,dzdy,curvature_x,curvature_y (mm and 1/mm).
     #[command(group(clap::ArgGroup::new("at").required(true).args(["grid", "radial", "points"])))]
@@ -129,6 +139,40 @@ enum Command {
         #[arg(long, value_name = "FILE.csv")]
         points: Option<PathBuf>,
     },
+
+    /// List the kinds a file can build and the standard library's machines,
+    /// tools, dialects and strategies: documentation, parameters with their
+    /// dimension, range and default, and each item's values (a machine's
+    /// travel, feed, spindle, resolution and dialects).
+    List {
+        /// Only this category.
+        #[arg(value_enum)]
+        category: Option<commands::list::Listed>,
+        /// Only this kind or item, in full.
+        name: Option<String>,
+        /// For people, or JSON (`{"categories": [...]}`, README "lensc list --format json").
+        #[arg(long, value_enum, default_value_t = Format::Human)]
+        format: Format,
+    },
+    /// Explain a diagnostic code (`E0147`), with an example that causes it
+    /// and its fix.
+    Explain {
+        /// The code, as printed (`E0147`; `e147` and `147` work too).
+        code: Option<String>,
+        /// Every code with its title.
+        #[arg(long)]
+        list: bool,
+        /// For people (Markdown), or JSON.
+        #[arg(long, value_enum, default_value_t = Format::Human)]
+        format: Format,
+    },
+}
+
+/// How `list` and `explain` print.
+#[derive(Clone, Copy, ValueEnum, PartialEq)]
+enum Format {
+    Human,
+    Json,
 }
 
 #[derive(Clone, Copy, ValueEnum, PartialEq)]
@@ -178,10 +222,19 @@ fn run(cli: Cli) -> u8 {
         all_diagnostics: cli.all_diagnostics,
     };
     match cli.command {
+        Command::List {
+            category,
+            name,
+            format,
+        } => commands::list::run(category, name.as_deref(), format == Format::Json),
+        Command::Explain { code, list, format } => {
+            commands::explain::run(code.as_deref(), list, format == Format::Json)
+        }
         Command::Check {
             files,
             max_program_size,
         } => commands::check::run(&out, &files, max_program_size),
+        Command::Fmt { files, check } => commands::fmt::run(&out, &files, check),
         Command::Analyse {
             file,
             surface,

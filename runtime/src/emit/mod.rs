@@ -11,7 +11,7 @@ pub mod turning;
 use crate::dialect::Dialect;
 use crate::moves;
 use crate::plan::optimise;
-use crate::post::header::num;
+use crate::post::header::{exact_in, num};
 use crate::post::{ProgramError, ProgramWriter, Setup};
 
 /// A program, the move stream it was written from, and what
@@ -22,11 +22,12 @@ pub struct Emitted {
     pub optimised: optimise::Summary,
 }
 
-/// How a path's tolerance T is stated in a header, with its shares.
+/// How a path's tolerance T is stated in a header (exactly, in nm as a
+/// `.lens` file reads nm), with its shares (figures for people).
 pub fn tolerance_words(t: f64) -> String {
     format!(
         "path tolerance {} nm [chords {}, fitting {}, blending {} nm]",
-        num(t * 1e6),
+        exact_in(t, 1e-6),
         num(t * optimise::CHORD_SHARE * 1e6),
         num(t * optimise::FIT_SHARE * 1e6),
         num(t * optimise::BLEND_SHARE * 1e6)

@@ -5,9 +5,12 @@ use crate::moves::Move;
 use crate::moves::{self, Position, Start};
 use crate::plan::optimise::{self, optimise};
 use crate::plan::turning::{Feed, PassRates, Toolpath, TurningJob};
-use crate::post::header::{Provenance, duration, num};
+use crate::post::header::{Provenance, duration, exact, exact_in, num};
 use crate::post::{ProgramError, ProgramWriter, Setup};
 use std::f64::consts::PI;
+
+/// One m/min in mm/s, as a `.lens` file reads `m/min` (1000 × 60⁻¹).
+const M_PER_MIN: f64 = 1000.0 / 60.0;
 
 /// Writes a lathe program for a profile-turning path in the machine's
 /// dialect, optimised (lines merged, arcs fitted) within the fitting share
@@ -23,7 +26,7 @@ pub fn emit(
     } else {
         format!(
             ", edge {} mm off the spindle axis: X = sqrt[r² − h²] of the nose-centre radius r",
-            num(job.tool.centre_height)
+            exact(job.tool.centre_height)
         )
     };
     let header = [
@@ -38,7 +41,7 @@ pub fn emit(
         format!(
             "tool {}: round nose, nose radius {} mm{centre_height}",
             job.tool_name,
-            num(job.tool.nose_radius)
+            exact(job.tool.nose_radius)
         ),
         format!(
             "strategy {}: profile turning, {} points, {}{}{}",
@@ -48,7 +51,7 @@ pub fn emit(
             match job.strategy.surface_speed {
                 Some(v) => format!(
                     ", constant surface speed {} m/min capped at {} rpm",
-                    num(v * 0.06),
+                    exact_in(v, M_PER_MIN),
                     num((job.strategy.spindle_speed * 60.0 / (2.0 * PI)).floor())
                 ),
                 None => String::new(),
@@ -154,8 +157,8 @@ fn roughing_words(job: &TurningJob, path: &Toolpath) -> String {
         return String::new();
     };
     let stock = match r.stock {
-        Stock::Flat { top } => format!("flat stock at Z{}", num(top)),
-        Stock::Offset { allowance } => format!("stock {} mm over the surface", num(allowance)),
+        Stock::Flat { top } => format!("flat stock at Z{}", exact(top)),
+        Stock::Offset { allowance } => format!("stock {} mm over the surface", exact(allowance)),
     };
     let feed = match r.feed {
         Feed::PerRevolution(f) => format!("{} mm/rev", num(f * 2.0 * PI)),
@@ -167,7 +170,7 @@ fn roughing_words(job: &TurningJob, path: &Toolpath) -> String {
     format!(
         ", after {} roughing passes from {stock}, at most {} mm each at {feed}{speed}, {} mm left for the finish",
         path.roughing_passes,
-        num(r.depth_of_cut),
-        num(r.finish_allowance)
+        exact(r.depth_of_cut),
+        exact(r.finish_allowance)
     )
 }

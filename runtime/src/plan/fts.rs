@@ -113,6 +113,18 @@ pub struct SpiralPoint {
     pub t: f64,
 }
 
+/// What a search over the real check found for a spiral refused for its
+/// fast axis's acceleration; speeds in the job's own kind (spindle speed,
+/// rad/s, or surface speed, mm/s).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SpeedAdvice {
+    /// `passes` was planned and keeps within the axis's limits; `fails`,
+    /// the lowest speed tried above it, does not.
+    Found { passes: f64, fails: f64 },
+    /// No speed tried passes; `lowest_tried` was the slowest.
+    NotFound { lowest_tried: f64 },
+}
+
 /// Why a spiral cannot be planned.
 #[derive(Clone, Debug, PartialEq)]
 pub enum FtsError {
@@ -120,14 +132,13 @@ pub enum FtsError {
     Undefined { x: f64, c: f64 },
     /// The fast axis would travel further than its stroke.
     StrokeExceeded { range: f64, stroke: f64 },
-    /// The fast axis would accelerate beyond its limit; the highest speed
-    /// that respects it (rad/s for constant speed, mm/s for constant
-    /// surface speed).
+    /// The fast axis would accelerate beyond its limit (mm/s²), the
+    /// worst at `at_radius` (mm). With a check (`Planner::check`) the
+    /// acceleration is the largest met before the planner stopped.
     AccelerationExceeded {
         acceleration: f64,
         max: f64,
         at_radius: f64,
-        highest_allowed_speed: f64,
     },
     /// Parameters that cannot make a spiral.
     Invalid(&'static str),
@@ -148,7 +159,11 @@ pub struct FtsSummary {
     pub max_acceleration_at: f64,
     /// The highest spindle speed (constant speed, rad/s) or surface speed
     /// (constant surface speed, mm/s) at which every point's acceleration
-    /// stays within the limit.
+    /// would stay within the limit were it to scale with the square of the
+    /// speed: an estimate, exact only where neither the sampling (split
+    /// down to the data period at corners, where acceleration scales with
+    /// the speed itself) nor the trajectory (the settling offset) changes
+    /// with speed. A refusal's advice is searched instead (`SpeedAdvice`).
     pub highest_allowed_speed: f64,
     /// Highest spindle speed used (rad/s) and the surface speed (mm/s) at
     /// the outermost point.
@@ -292,6 +307,12 @@ impl Planner<'_> {
             p = ray.point(u);
         }
         let (w, at) = envelope::piece_max(&ray, rho, x, x - reach, x + reach);
+        if at.is_nan() {
+            // A slope that is not a number (the trajectory undefined near
+            // x) leaves no contact: the height is unknown here, not the
+            // last guess's (which lost the nose radius).
+            return (f64::NAN, 0.0);
+        }
         (w, at - x)
     }
 
@@ -454,6 +475,23 @@ impl Planner<'_> {
     pub fn plan(
         &self,
         fast_axis: &FastAxis,
+        sink: impl FnMut(&[SpiralPoint]),
+    ) -> Result<FtsSummary, FtsError> {
+        self.run(fast_axis, false, sink)
+    }
+
+    /// Plans the spiral as `plan` does, keeping no point, to see whether
+    /// it passes the fast axis's limits: the same pass or fail as `plan`, but
+    /// stopped at the first batch of revolutions that accelerates beyond
+    /// the limit (a refusal costs only the revolutions up to it).
+    pub fn check(&self, fast_axis: &FastAxis) -> Result<FtsSummary, FtsError> {
+        self.run(fast_axis, true, |_| {})
+    }
+
+    fn run(
+        &self,
+        fast_axis: &FastAxis,
+        stop_over_limit: bool,
         mut sink: impl FnMut(&[SpiralPoint]),
     ) -> Result<FtsSummary, FtsError> {
         let s = self.spiral;
@@ -528,6 +566,9 @@ impl Planner<'_> {
                 sink(&buffer);
             }
             k = hi;
+            if stop_over_limit && summary.max_acceleration > fast_axis.max_acceleration {
+                break;
+            }
         }
         summary.time = last.last().map_or(0.0, |p| p.t);
         let range = summary.w_max - summary.w_min;
@@ -542,7 +583,6 @@ impl Planner<'_> {
                 acceleration: summary.max_acceleration,
                 max: fast_axis.max_acceleration,
                 at_radius: summary.max_acceleration_at,
-                highest_allowed_speed: summary.highest_allowed_speed,
             });
         }
         Ok(summary)

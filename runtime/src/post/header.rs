@@ -50,8 +50,52 @@ pub fn write_comment(out: &mut String, text: &str) {
     let _ = writeln!(out, "({line})");
 }
 
-/// A header figure to 10 decimals (0.1 pm in mm), trailing zeros trimmed:
-/// no exponent, and `1e-5` shows as `0.00001`, not `0.000009999…`.
+/// A number as a header states it: Rust's shortest digits that read back
+/// to the same f64, in plain notation while that takes at most 17
+/// characters (sign aside) or is no longer than the other, else in
+/// scientific notation (`-1.2e-17`, not 20 zeros); zero is `0`, never `-0`
+/// (a signed zero states the same part).
+pub fn exact(v: f64) -> String {
+    if v == 0.0 {
+        return "0".into();
+    }
+    let plain = format!("{v}");
+    let scientific = format!("{v:e}");
+    if plain.trim_start_matches('-').len() <= 17 || plain.len() <= scientific.len() {
+        plain
+    } else {
+        scientific
+    }
+}
+
+/// `v` (base units) stated in a unit of `size` base units, so that it reads
+/// back to `v` exactly: the shortest decimal `d` with `d * size == v` (a
+/// `.lens` file's `d unit` is `d × size`, and 10 nm is 9.999999999999999e-6
+/// mm, not 1e-5). If no decimal of up to 17 significant digits reads back
+/// (a product with `size` skips some f64), the nearest figure, `v / size`.
+pub fn exact_in(v: f64, size: f64) -> String {
+    if size == 1.0 || !v.is_finite() {
+        return exact(v);
+    }
+    let shown = v / size;
+    let reads_back = |d: f64| d * size == v;
+    if reads_back(shown) {
+        // Often already the shortest (v = 2 mm shown in um is 2000).
+        let s = exact(shown);
+        if s.parse::<f64>().is_ok_and(reads_back) {
+            return s;
+        }
+    }
+    (0..17)
+        .filter_map(|digits| format!("{shown:.digits$e}").parse::<f64>().ok())
+        .find(|&d| reads_back(d))
+        .map_or_else(|| exact(shown), exact)
+}
+
+/// A figure derived for people (a share of a tolerance, a measured
+/// deviation) to 10 decimals (0.1 pm in mm), trailing zeros trimmed: no
+/// exponent, and `1e-5` shows as `0.00001`, not `0.000009999…`. What the
+/// job states is printed with [`exact`] or [`exact_in`].
 pub fn num(v: f64) -> String {
     let s = format!("{v:.10}");
     let s = s.trim_end_matches('0').trim_end_matches('.');
@@ -67,5 +111,55 @@ pub fn duration(secs: f64) -> String {
         format!("{m} min {s} s")
     } else {
         format!("{s} s")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exact_reads_back_and_never_writes_minus_zero() {
+        for v in [
+            -1.2e-17,
+            3.4e-19,
+            1e-5,
+            0.1,
+            5.540000000000001,
+            8.5,
+            -0.62,
+            1e300,
+            -2.5e-12,
+        ] {
+            let s = exact(v);
+            assert_eq!(s.parse::<f64>().map(f64::to_bits), Ok(v.to_bits()), "{s}");
+        }
+        assert_eq!(exact(-0.0), "0");
+        assert_eq!(exact(-1.2e-17), "-1.2e-17");
+        assert_eq!(exact(-0.0000034), "-0.0000034");
+        assert_eq!(exact(5.540000000000001), "5.540000000000001");
+        assert_eq!(exact(-2.7700000000000005), "-2.7700000000000005");
+    }
+
+    #[test]
+    fn exact_in_a_unit_reads_back_through_that_units_size() {
+        // 10 nm as a .lens file reads it, and the same in degrees.
+        let nm = 1e-6;
+        let t = 10.0 * nm;
+        assert_ne!(t, 1e-5);
+        assert_eq!(exact_in(t, nm), "10");
+        let deg = std::f64::consts::PI / 180.0;
+        for (written, size) in [
+            (3.0, deg),
+            (0.025, deg),
+            (1.4999999999999998, nm),
+            (4.0, 1e-3),
+        ] {
+            let v = written * size;
+            let s = exact_in(v, size);
+            let d: f64 = s.parse().expect("a number");
+            assert_eq!((d * size).to_bits(), v.to_bits(), "{s}");
+        }
+        assert_eq!(exact_in(3.0 * deg, deg), "3");
     }
 }

@@ -9,9 +9,10 @@ use lensc_grammar::Diagnostic;
 use lensc_lang::check::trim_num;
 use lensc_lang::codes;
 use lensc_lang::lower::diagnostics::RuntimeError;
+use lensc_lang::lower::exact_in;
 use lensc_lang::lower::job::SpiralSpec;
 use lensc_runtime::emit::fts::FtsProgram;
-use lensc_runtime::plan::fts::{FtsSummary, Planner, SpindleSpeed};
+use lensc_runtime::plan::fts::{FtsError, FtsSummary, Planner, SpindleSpeed};
 use lensc_runtime::post::Provenance;
 use lensc_runtime::surface::ir::SurfaceFn;
 use lensc_runtime::verify::heightmap::Sweep;
@@ -23,6 +24,8 @@ use crate::output::Built;
 use crate::parts;
 use crate::report;
 use crate::spool::{ProgramSink, Sink};
+
+pub mod advice;
 
 /// A spiral job ready to plan: its spec and the trajectory's kernel.
 pub struct Prepared<'s> {
@@ -110,11 +113,18 @@ pub fn build(
         }
     });
     let summary = planned.map_err(|error| {
+        let advice = match error {
+            FtsError::AccelerationExceeded { acceleration, .. } => {
+                Some(advice::search(spec, acceleration))
+            }
+            _ => None,
+        };
         vec![
             RuntimeError::Spiral {
                 error,
                 speed: &p.spiral.speed,
                 axis: axis_words(spec),
+                advice,
             }
             .at(site),
         ]
@@ -281,10 +291,6 @@ fn simulation(
     report::Simulation::Following(following)
 }
 
-fn rpm(w: f64) -> f64 {
-    w * 60.0 / (2.0 * std::f64::consts::PI)
-}
-
 /// The program's header: provenance, units, the surface, tool, spiral
 /// and machine in words, and the settling offset.
 fn header_lines(spec: &SpiralSpec, prov: &Provenance, table: Option<&str>) -> Vec<String> {
@@ -302,11 +308,11 @@ fn header_lines(spec: &SpiralSpec, prov: &Provenance, table: Option<&str>) -> Ve
         ("fast-tool-servo", "Z the fast tool servo's axis")
     };
     let speed = match spiral.speed {
-        SpindleSpeed::Constant(w) => format!("constant spindle speed {} rpm", trim_num(rpm(w))),
+        SpindleSpeed::Constant(w) => format!("constant spindle speed {} rpm", exact_in(w, "rpm")),
         SpindleSpeed::SurfaceSpeed { speed, max } => format!(
             "constant surface speed {} m/min capped at {} rpm",
-            trim_num(speed * 60.0 / 1000.0),
-            trim_num(rpm(max))
+            exact_in(speed, "m/min"),
+            exact_in(max, "rpm")
         ),
     };
     let units = format!(
@@ -317,9 +323,9 @@ fn header_lines(spec: &SpiralSpec, prov: &Provenance, table: Option<&str>) -> Ve
     lines.push(format!(
         "strategy {}: {servo_words} spiral from r = {} mm, feed {} um/rev, {speed}, path tolerance {} nm [chords {}, blending {} nm]",
         head.names.strategy,
-        trim_num(spiral.start_radius),
-        trim_num(spiral.feed_per_rev * 1000.0),
-        trim_num(spiral.chord_tolerance * 1e6),
+        exact_in(spiral.start_radius, "mm"),
+        exact_in(spiral.feed_per_rev, "um"),
+        exact_in(spiral.chord_tolerance, "nm"),
         trim_num(
             spiral.chord_tolerance * lensc_runtime::plan::optimise::UNOPTIMISED_CHORD_SHARE * 1e6
         ),
@@ -333,10 +339,10 @@ fn header_lines(spec: &SpiralSpec, prov: &Provenance, table: Option<&str>) -> Ve
         None if slow => {}
         Some(s) => lines.push(format!(
             "settling: tool held {} um above the land, lenslets continued {} um past their rims [settling time {} ms at {} m/min]",
-            trim_num(s.offset * 1000.0),
-            trim_num(s.d_traj * 1000.0),
-            trim_num(s.time * 1000.0),
-            trim_num(s.surface_speed * 0.06)
+            exact_in(s.offset, "um"),
+            exact_in(s.d_traj, "um"),
+            exact_in(s.time, "ms"),
+            exact_in(s.surface_speed, "m/min")
         )),
         None => lines.push("settling: none, the tool follows the surface".into()),
     }

@@ -4,8 +4,8 @@
 //! its own feed, and the cut simulated along the whole profile.
 
 use lensc_grammar::Diagnostic;
-use lensc_lang::check::trim_num;
 use lensc_lang::lower::diagnostics::RuntimeError;
+use lensc_lang::lower::exact_in;
 use lensc_lang::lower::job::GrindingSpec;
 use lensc_runtime::post::Provenance;
 use lensc_runtime::surface::SectionAlongX;
@@ -45,16 +45,16 @@ pub fn build(spec: &GrindingSpec, prov: &Provenance) -> Result<Built, Vec<Diagno
     header.push(format!(
         "tool {}: spherical wheel, diameter {} mm; coordinates are the wheel centre",
         head.names.tool,
-        trim_num(grinding.wheel_diameter)
+        exact_in(grinding.wheel_diameter, "mm")
     ));
     header.push(format!(
         "strategy {}: profile grinding from x = {} to {} mm, interval {} um, feed {} um/s, smoothness {}; {} intervals, each at its own feed",
         head.names.strategy,
-        trim_num(grinding.start),
-        trim_num(grinding.end),
-        trim_num(grinding.interval * 1000.0),
-        trim_num(feed * 1000.0),
-        trim_num(grinding.smoothness),
+        exact_in(grinding.start, "mm"),
+        exact_in(grinding.end, "mm"),
+        exact_in(grinding.interval, "um"),
+        exact_in(feed, "um/s"),
+        exact_in(grinding.smoothness, ""),
         path.segments
     ));
     header.push(format!(

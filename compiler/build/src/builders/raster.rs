@@ -4,8 +4,8 @@
 //! travel, the program written, and the cut simulated as a height map.
 
 use lensc_grammar::Diagnostic;
-use lensc_lang::check::trim_num;
 use lensc_lang::lower::diagnostics::RuntimeError;
+use lensc_lang::lower::exact_in;
 use lensc_lang::lower::job::RasterSpec;
 use lensc_runtime::plan::optimise::Summary;
 use lensc_runtime::plan::raster::{Axis, RasterPath, RasterTool, check_clearance};
@@ -141,7 +141,7 @@ fn header_lines(
         head.names.strategy,
         if raster.along == Axis::X { "x" } else { "y" },
         if raster.zigzag { "zigzag" } else { "one way" },
-        trim_num(raster.stepover * 1000.0),
+        exact_in(raster.stepover, "um"),
         lensc_runtime::emit::tolerance_words(raster.chord_tolerance),
         path.pass_count,
         path.point_count

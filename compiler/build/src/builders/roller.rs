@@ -7,8 +7,8 @@
 use std::path::Path;
 
 use lensc_grammar::Diagnostic;
-use lensc_lang::check::trim_num;
 use lensc_lang::lower::diagnostics::RuntimeError;
+use lensc_lang::lower::exact_in;
 use lensc_lang::lower::job::RollerSpec;
 use lensc_runtime::emit::roller::RollerProgram;
 use lensc_runtime::plan::roller::plan_roller_helix_into;
@@ -117,7 +117,7 @@ pub fn build(
 /// helix and its passes, and the machine in words.
 fn header_lines(spec: &RollerSpec, prov: &Provenance) -> Vec<String> {
     let (head, helix) = (&spec.head, &spec.helix);
-    let deg = |a: f64| trim_num(a.to_degrees());
+    let deg = |a: f64| exact_in(a, "°");
     let pass_words: Vec<String> = helix
         .passes
         .iter()
@@ -125,8 +125,8 @@ fn header_lines(spec: &RollerSpec, prov: &Provenance) -> Vec<String> {
             format!(
                 "c step {}°, pitch {} um, allowance {} um",
                 deg(p.c_step),
-                trim_num(p.pitch * 1000.0),
-                trim_num(p.finish_allowance * 1000.0)
+                exact_in(p.pitch, "um"),
+                exact_in(p.finish_allowance, "um")
             )
         })
         .collect();
@@ -138,9 +138,9 @@ fn header_lines(spec: &RollerSpec, prov: &Provenance) -> Vec<String> {
     lines.push(format!(
         "strategy {}: roller helix from z = {} to {} mm at {} rpm; passes: {}",
         head.names.strategy,
-        trim_num(helix.z_start),
-        trim_num(helix.z_end),
-        trim_num(spec.spindle_speed * 60.0 / (2.0 * std::f64::consts::PI)),
+        exact_in(helix.z_start, "mm"),
+        exact_in(helix.z_end, "mm"),
+        exact_in(spec.spindle_speed, "rpm"),
         pass_words.join("; ")
     ));
     lines.push(format!(

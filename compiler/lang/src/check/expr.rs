@@ -156,7 +156,8 @@ impl<'a> Checker<'a> {
                         file,
                         callee.span,
                     )
-                    .with_label("not a function"),
+                    .with_label("not a function")
+                    .with_help("only functions (`sin(…)`) and kinds (`circle(…)`) take arguments in brackets; to multiply, write `*` between the factors"),
                 );
                 Value::Error
             }
@@ -279,10 +280,11 @@ impl<'a> Checker<'a> {
             span,
         )
         .with_label("not a kind or declaration");
+        let scope = &self.scopes[file.0 as usize];
         let mut cands: Vec<&str> = schema::KINDS.iter().map(|k| k.name).collect();
-        cands.extend(self.scopes[file.0 as usize].keys().copied());
-        d = d.with_help(match did_you_mean(w, cands) {
-            Some(s) => format!("did you mean `{s}`?"),
+        cands.extend(scope.keys().copied());
+        d = d.with_help(match super::scope::known_elsewhere(scope, w, cands) {
+            Some(help) => help,
             None => format!(
                 "the kinds are: {}",
                 schema::KINDS
@@ -400,6 +402,44 @@ impl<'a> Checker<'a> {
         }
     }
 
+    /// `5 mm / min`: a unit written with spaces around `/` (or `*`) reads
+    /// as a division by the function `min` or the name `s`; say how a unit
+    /// is written instead.
+    fn spaced_unit(
+        &self,
+        file: FileId,
+        op: BinaryOp,
+        (a, sa): (&Value, Span),
+        (b, sb): (&Value, Span),
+    ) -> Option<Diagnostic> {
+        let (BinaryOp::Div | BinaryOp::Mul) = op else {
+            return None;
+        };
+        let (name, read_as): (&str, String) = match (a, b) {
+            (Value::Num(..), Value::Function(f)) => (f, format!("the function `{f}`")),
+            (Value::Num(..), Value::Word(w)) => (w, format!("an unknown name `{w}`")),
+            _ => return None,
+        };
+        units::lookup(name)?;
+        let text = &self.loaded.sources.get(file).text;
+        let left = text.get(sa.start as usize..sa.end as usize)?;
+        let sign = if op == BinaryOp::Div { "/" } else { "*" };
+        Some(
+            Diagnostic::error(
+                codes::WRONG_VALUE,
+                format!(
+                    "a unit is written without spaces around `{sign}`: here `{name}` is read as {read_as}, not as the unit"
+                ),
+                file,
+                sb,
+            )
+            .with_label(format!("a unit after `{sign}` is written without spaces"))
+            .with_help(format!(
+                "write the unit without spaces around `{sign}`: `{left}{sign}{name}`"
+            )),
+        )
+    }
+
     pub(super) fn binary(
         &mut self,
         file: FileId,
@@ -411,6 +451,10 @@ impl<'a> Checker<'a> {
         let (x, da, y, db) = match (&a, &b) {
             (Value::Num(x, da), Value::Num(y, db)) => (*x, *da, *y, *db),
             _ => {
+                if let Some(d) = self.spaced_unit(file, op, (&a, sa), (&b, sb)) {
+                    self.err(d);
+                    return Value::Error;
+                }
                 let verb = match op {
                     BinaryOp::Range => "make a range of",
                     _ => "do arithmetic on",

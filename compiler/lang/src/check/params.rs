@@ -202,13 +202,20 @@ impl<'a> Checker<'a> {
                 span,
             )
             .with_label(format!("this is {d}"));
+            let examples = dims
+                .iter()
+                .map(|d| example_unit(*d))
+                .collect::<Vec<_>>()
+                .join(" or ");
             diag = diag.with_help(if d.is_none() {
+                format!("write a unit after the number, for example {examples}")
+            } else if dims == [Dim::NONE] {
                 format!(
-                    "write a unit after the number, for example {}",
-                    example_unit(dims[0])
+                    "write `{}` as a plain number, with no unit ({})",
+                    f.name, p.doc
                 )
             } else {
-                format!("`{}` is {}: {}", f.name, want, p.doc)
+                format!("write `{}` as, for example, {examples} ({})", f.name, p.doc)
             });
             self.err(diag);
             return;
@@ -311,7 +318,11 @@ impl<'a> Checker<'a> {
                     file,
                     span,
                 )
-                .with_label(format!("this is {d}")),
+                .with_label(format!("this is {d}"))
+                .with_help(format!(
+                    "write both ends as {dim}, for example {}",
+                    example_unit(dim)
+                )),
             );
         } else if lo >= hi {
             self.err(
@@ -321,7 +332,19 @@ impl<'a> Checker<'a> {
                     file,
                     span,
                 )
-                .with_label("the start must be below the end"),
+                .with_label("the start must be below the end")
+                .with_help({
+                    let (unit, factor) = d.display_unit();
+                    if lo == hi {
+                        "its ends are equal: give the range a length".to_string()
+                    } else {
+                        format!(
+                            "write the lower end first: `{} {unit} .. {} {unit}`",
+                            trim_num(hi * factor),
+                            trim_num(lo * factor)
+                        )
+                    }
+                }),
             );
         }
     }

@@ -12,6 +12,7 @@ use super::{COORDINATES, Checker, Decl, FUNCTIONS, State};
 use crate::codes;
 use crate::loader::{Import, ParsedFile};
 use crate::schema::{self, Category};
+use crate::stdlib;
 use crate::units;
 use crate::value::Value;
 
@@ -94,19 +95,28 @@ impl<'a> Checker<'a> {
             );
             return false;
         }
-        if FUNCTIONS.contains(&name.name.as_str())
-            || schema::kind(&name.name).is_some()
-            || COORDINATES.contains(&name.name.as_str())
-        {
+        let n = name.name.as_str();
+        let builtin = if FUNCTIONS.contains(&n) {
+            Some("a built-in function")
+        } else if schema::kind(n).is_some() {
+            Some("a built-in kind")
+        } else if COORDINATES.contains(&n) {
+            Some("a coordinate of surface formulas (x, y, r)")
+        } else {
+            None
+        };
+        if let Some(what) = builtin {
             self.err(
                 Diagnostic::error(
                     codes::DUPLICATE_NAME,
-                    format!("`{}` is a built-in name", name.name),
+                    format!("`{n}` is {what} and cannot be given another meaning"),
                     file,
                     name.span,
                 )
                 .with_label("this would hide the built-in")
-                .with_help("choose another name"),
+                .with_help(format!(
+                    "choose another name, such as `{n}_1`, and use that name where this one is used"
+                )),
             );
             return false;
         }
@@ -297,6 +307,21 @@ impl<'a> Checker<'a> {
         Some(i)
     }
 
+    /// Whether `file` declares `name` but its declaration was refused (a
+    /// built-in name, a word, a second definition): uses of it are not
+    /// reported again.
+    fn refused_here(&self, file: FileId, name: &str) -> bool {
+        self.loaded
+            .file(file)
+            .ast
+            .items
+            .iter()
+            .any(|i| match &i.kind {
+                ItemKind::Let { name: n, .. } | ItemKind::Decl { name: n, .. } => n.name == name,
+                _ => false,
+            })
+    }
+
     pub(super) fn unknown_name(&mut self, file: FileId, span: Span, name: &str) {
         let scope = &self.scopes[file.0 as usize];
         let mut candidates: Vec<&str> = scope.keys().copied().collect();
@@ -309,12 +334,16 @@ impl<'a> Checker<'a> {
             span,
         )
         .with_label("not defined");
+        if self.refused_here(file, name) {
+            // Its declaration was refused, with its own error.
+            return;
+        }
         if COORDINATES.contains(&name) {
             d = d.with_help(
                 "coordinates can only be used inside a surface formula such as `z(x, y) = …`",
             );
-        } else if let Some(s) = did_you_mean(name, candidates) {
-            d = d.with_help(format!("did you mean `{s}`?"));
+        } else if let Some(help) = known_elsewhere(scope, name, candidates) {
+            d = d.with_help(help);
         } else if units::lookup(name).is_some() {
             d = d.with_help(format!(
                 "`{name}` is a unit: write it right after a number, as in `1 {name}`"
@@ -349,4 +378,33 @@ impl<'a> Checker<'a> {
             }
         }
     }
+}
+
+/// Help for a name not in `scope`: the `use` that brings it in when the
+/// standard library declares it, else the nearest of `candidates` or of the
+/// standard library's names ("did you mean `s`?", with its `use` when the
+/// file has not imported it).
+pub(super) fn known_elsewhere<'c>(
+    scope: &HashMap<&str, usize>,
+    name: &str,
+    candidates: impl IntoIterator<Item = &'c str>,
+) -> Option<String> {
+    let use_it = |item: &stdlib::StdItem| {
+        format!(
+            "{} of the standard library: add `{}` at the top of the file",
+            Category::of(item.kind).noun(),
+            item.use_line()
+        )
+    };
+    if let Some(item) = stdlib::find(name) {
+        return Some(format!("`{name}` is {}", use_it(item)));
+    }
+    let stdlib_names = stdlib::items().iter().map(|i| i.name.as_str());
+    let s = did_you_mean(name, candidates.into_iter().chain(stdlib_names))?;
+    Some(match stdlib::find(s) {
+        Some(item) if !scope.contains_key(s) => {
+            format!("did you mean `{s}`? It is {}", use_it(item))
+        }
+        _ => format!("did you mean `{s}`?"),
+    })
 }

@@ -12,7 +12,7 @@ use crate::check::trim_num;
 use crate::codes;
 use crate::lower::surface::LowerError;
 use lensc_grammar::{Diagnostic, FileId, Span};
-use lensc_runtime::plan::fts::{FtsError, SpindleSpeed};
+use lensc_runtime::plan::fts::{FtsError, SpeedAdvice, SpindleSpeed};
 use lensc_runtime::plan::grinding::GrindingError;
 use lensc_runtime::plan::raster::RasterError;
 use lensc_runtime::plan::roller::RollerError;
@@ -27,12 +27,14 @@ pub enum RuntimeError<'a> {
     /// Profile turning could not be planned.
     Turning(PlanError),
     /// A spiral could not be planned. `speed` is how the job gives its
-    /// spindle speed (the help names the highest speed in the same kind);
-    /// `axis` names the axis that carries the surface.
+    /// spindle speed (the help names speeds in the same kind); `axis`
+    /// names the axis that carries the surface; `advice`, for a refused
+    /// acceleration, what a search over the real check found.
     Spiral {
         error: FtsError,
         speed: &'a SpindleSpeed,
         axis: &'a str,
+        advice: Option<SpeedAdvice>,
     },
     /// A raster could not be planned.
     Raster(RasterError),
@@ -82,7 +84,12 @@ impl RuntimeError<'_> {
     pub fn at(self, (file, span): (FileId, Span)) -> Diagnostic {
         let c = match self {
             RuntimeError::Turning(e) => turning(e),
-            RuntimeError::Spiral { error, speed, axis } => spiral(error, speed, axis),
+            RuntimeError::Spiral {
+                error,
+                speed,
+                axis,
+                advice,
+            } => spiral(error, speed, axis, advice),
             RuntimeError::Raster(e) => raster(e),
             RuntimeError::Grinding(e) => grinding(e),
             RuntimeError::Roller(e) => roller(e),
@@ -100,6 +107,7 @@ impl RuntimeError<'_> {
             RuntimeError::Program(e) => Coded {
                 label: "no program was written for this job",
                 ..coded(codes::NOT_PRINTABLE, e.message())
+                    .help(crate::lower::job::NOT_PRINTABLE_HELP)
             },
             RuntimeError::Surface(e) => coded(
                 codes::UNSUPPORTED_COMBINATION,
@@ -185,7 +193,8 @@ fn turning(e: PlanError) -> Coded {
                 rpm(speed),
                 rpm(max)
             ),
-        ),
+        )
+        .help(format!("lower `spindle_speed` to at most {} rpm (with `surface_speed`, cap it with `spindle_cap`)", rpm(max))),
         PlanError::Undefined { at_radius } => coded(
             codes::UNDEFINED_ON_PATH,
             format!(
@@ -196,7 +205,7 @@ fn turning(e: PlanError) -> Coded {
     }
 }
 
-fn spiral(e: FtsError, speed: &SpindleSpeed, axis: &str) -> Coded {
+fn spiral(e: FtsError, speed: &SpindleSpeed, axis: &str, advice: Option<SpeedAdvice>) -> Coded {
     match e {
         FtsError::Undefined { x, c } => coded(
             codes::UNDEFINED_ON_PATH,
@@ -213,21 +222,32 @@ fn spiral(e: FtsError, speed: &SpindleSpeed, axis: &str) -> Coded {
                 um(range),
                 um(stroke)
             ),
-        ),
+        )
+        .help("use a fast axis with a longer `stroke`, or a surface whose height varies less around each turn"),
         FtsError::AccelerationExceeded {
             acceleration,
             max,
             at_radius,
-            highest_allowed_speed,
         } => {
-            let allowed = match speed {
-                SpindleSpeed::Constant(_) => {
-                    format!("a spindle speed of {} rpm", rpm(highest_allowed_speed))
-                }
-                SpindleSpeed::SurfaceSpeed { .. } => format!(
-                    "a surface speed of {} m/min",
-                    trim_num(highest_allowed_speed * 0.06)
+            let words = |v: f64| match speed {
+                SpindleSpeed::Constant(_) => format!("{} rpm", rpm(v)),
+                SpindleSpeed::SurfaceSpeed { .. } => format!("{} m/min", trim_num(v * 0.06)),
+            };
+            let kind = match speed {
+                SpindleSpeed::Constant(_) => "spindle speed",
+                SpindleSpeed::SurfaceSpeed { .. } => "surface speed",
+            };
+            let help = match advice {
+                Some(SpeedAdvice::Found { passes, fails }) => format!(
+                    "the highest speed found that respects it is a {kind} of {} (planned and checked; {} is refused)",
+                    words(passes),
+                    words(fails)
                 ),
+                Some(SpeedAdvice::NotFound { lowest_tried }) => format!(
+                    "no {kind} tried respects it, down to {}: the acceleration does not fall with the speed there (a spindle cap, or the path itself)",
+                    words(lowest_tried)
+                ),
+                None => format!("lower the {kind}"),
             };
             coded(
                 codes::ACCELERATION_EXCEEDED,
@@ -238,7 +258,7 @@ fn spiral(e: FtsError, speed: &SpindleSpeed, axis: &str) -> Coded {
                     trim_num(max / 1000.0)
                 ),
             )
-            .help(format!("the highest speed that respects it is {allowed}"))
+            .help(help)
         }
         FtsError::Invalid(why) => coded(codes::UNSUPPORTED_COMBINATION, why.to_string()),
     }
@@ -276,7 +296,8 @@ fn raster(e: RasterError) -> Coded {
                 trim_num(x),
                 trim_num(y)
             ),
-        ),
+        )
+        .help(format!("use a tool whose `clearance` is above {}°", trim_num(slope.to_degrees()))),
         RasterError::Undefined { x, y } | RasterError::NoContact { x, y } => coded(
             codes::UNDEFINED_ON_PATH,
             format!(

@@ -15,13 +15,14 @@ mod estimate;
 mod mill;
 mod roller;
 mod spiral;
+pub mod tolerance;
 mod turning;
 mod window;
 
 pub use estimate::{DEFAULT_MAX_PROGRAM_SIZE, Estimate, Limits, MAX_POINTS, estimate, refusals};
 pub use mill::{GrindingSpec, RasterSpec};
 pub use roller::RollerSpec;
-pub use spiral::{Settling, SpiralSpec};
+pub use spiral::{AtSpeed, Settling, SpiralSpec};
 pub use turning::TurningSpec;
 
 use lensc_grammar::{Diagnostic, FileId, Span};
@@ -34,6 +35,12 @@ use crate::codes;
 use crate::lower::diagnostics::RuntimeError;
 use crate::lower::surface::LoweredSurface;
 use crate::value::{self, Object};
+
+/// The path tolerance a strategy that states none is held to: 10 nm, the
+/// f64 a `.lens` file's `10 nm` reads as (10 × 1e-6 mm, one ulp under
+/// 1e-5), so that a job leaving it out and one writing it are the same job
+/// and the header's `10 nm` reads back to it.
+pub const DEFAULT_PATH_TOLERANCE: f64 = 10.0 * 1e-6;
 
 /// How lowering evaluates a surface for the checks that analyse it: the
 /// build passes its JIT (with the interpreter behind it), so the figures
@@ -193,6 +200,7 @@ impl<'a> Parts<'a> {
                     o.kind.name
                 ),
             )
+            .with_help(stdlib_made_by(part, kinds))
         })
     }
     /// E0131 for a machine that is not a `lathe` (`note` follows its kind
@@ -201,22 +209,28 @@ impl<'a> Parts<'a> {
     pub fn needs_servo_lathe(&self, what: &str, lathe: &str, note: &str) -> Vec<Diagnostic> {
         let mut errors = Vec::new();
         if self.machine.kind.name != lathe {
-            errors.push(self.error(
-                codes::UNSUPPORTED_COMBINATION,
-                format!(
-                    "{what} needs an `{lathe}`{note}; this machine is a `{}`",
-                    self.machine.kind.name
-                ),
-            ));
+            errors.push(
+                self.error(
+                    codes::UNSUPPORTED_COMBINATION,
+                    format!(
+                        "{what} needs an `{lathe}`{note}; this machine is a `{}`",
+                        self.machine.kind.name
+                    ),
+                )
+                .with_help(stdlib_made_by("machine", &[lathe])),
+            );
         }
         if self.tool.kind.name != "round_nose" {
-            errors.push(self.error(
-                codes::UNSUPPORTED_COMBINATION,
-                format!(
-                    "{what} needs a `round_nose` tool; this is a `{}`",
-                    self.tool.kind.name
-                ),
-            ));
+            errors.push(
+                self.error(
+                    codes::UNSUPPORTED_COMBINATION,
+                    format!(
+                        "{what} needs a `round_nose` tool; this is a `{}`",
+                        self.tool.kind.name
+                    ),
+                )
+                .with_help(stdlib_made_by("tool", &["round_nose"])),
+            );
         }
         errors
     }
@@ -243,6 +257,7 @@ impl<'a> Parts<'a> {
                     rpm(max)
                 ),
             )
+            .with_help(format!("lower `spindle_speed` to at most {} rpm", rpm(max)))
         })
     }
     /// The job's head, once its surface is lowered and its dialect known.
@@ -356,13 +371,15 @@ pub fn lower_job(
             Setup::Lathe,
         ),
     };
+    errors.extend(tolerance::below_resolution(&p, strategy));
     if let Ok(d) = &dialect
         && let Some(resolution) = value::num(&p.machine.fields, "resolution")
     {
         if let Err(e) = lensc_runtime::post::check_dialect(d, setup, resolution) {
             errors.push(
                 Diagnostic::error(codes::NOT_PRINTABLE, e.message(), job.file, job.name.span)
-                    .with_label("no program was written for this job"),
+                    .with_label("no program was written for this job")
+                    .with_help(NOT_PRINTABLE_HELP),
             );
         } else if let Some(e) = start_error(job, d, setup) {
             errors.push(e);
@@ -451,4 +468,33 @@ fn simulate(job: &CheckedJob) -> Result<Option<Simulate>, Diagnostic> {
         .with_label("this window"));
     }
     Ok(Some(s))
+}
+
+/// What to do when a job's dialect cannot write its program (E0150).
+pub const NOT_PRINTABLE_HELP: &str = "write the program in a dialect of the machine that can (`lensc build --dialect NAME`; `lensc list dialects`), or change the machine (its `resolution`, its `dialect`) so this one can";
+
+/// What to write instead of a part of the wrong kind: the standard
+/// library's items of the kinds needed, with their `use`, or how to make
+/// one.
+fn stdlib_made_by(part: &str, kinds: &[&str]) -> String {
+    let made: Vec<&crate::stdlib::StdItem> = crate::stdlib::items()
+        .iter()
+        .filter(|i| crate::stdlib::kind_of(i).is_some_and(|k| kinds.contains(&k)))
+        .collect();
+    match made.as_slice() {
+        [] => format!(
+            "make one: `{part} NAME = {} {{ … }}` (`lensc list` shows its parameters)",
+            kinds[0]
+        ),
+        [one, ..] => format!(
+            "the standard library's {} {}: add `{}` and write `{part}: {}`",
+            made.iter()
+                .map(|i| format!("`{}`", i.name))
+                .collect::<Vec<_>>()
+                .join(", "),
+            if made.len() == 1 { "is one" } else { "are" },
+            one.use_line(),
+            one.name
+        ),
+    }
 }

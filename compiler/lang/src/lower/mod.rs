@@ -7,6 +7,7 @@ pub mod diagnostics;
 pub mod job;
 pub mod surface;
 
+use lensc_grammar::suggest::did_you_mean;
 use lensc_grammar::{Diagnostic, FileId};
 use lensc_runtime::post::Dialect;
 
@@ -21,24 +22,16 @@ pub fn describe(o: &Object) -> String {
     let mut words = vec![o.kind.name.to_string()];
     for fl in &o.fields {
         match &fl.value {
-            Value::Num(v, d) => {
-                let (unit, factor) = d.display_unit();
-                words.push(format!(
-                    "{} {}{}{unit}",
-                    fl.name,
-                    exact_num(v * factor),
-                    if unit.is_empty() { "" } else { " " }
-                ));
-            }
+            Value::Num(v, d) => words.push(format!("{} {}", fl.name, stated(*v, *d))),
             Value::Word(w) => words.push(format!("{} {w}", fl.name)),
             Value::Object(inner) => words.push(format!("{} [{}]", fl.name, describe(inner))),
             Value::Range(a, b, d) => {
-                let (unit, factor) = d.display_unit();
+                let (unit, _) = d.display_unit();
                 words.push(format!(
                     "{} {} .. {} {unit}",
                     fl.name,
-                    exact_num(a * factor),
-                    exact_num(b * factor)
+                    exact_in(*a, &unit),
+                    exact_in(*b, &unit)
                 ));
             }
             _ => {}
@@ -72,10 +65,7 @@ pub fn dialect(job: &CheckedJob, requested: Option<&str>) -> Result<Dialect, Dia
             span,
         )
         .with_label("this job")
-        .with_help(format!(
-            "its machine offers {}; add the dialect to the machine's `other_dialects` if its controller reads it",
-            names.join(", ")
-        )));
+        .with_help(dialect_help(requested.unwrap_or(""), &offered, &names)));
     };
     check_word_formats(o)?;
     Ok(dialect_of(o, dialect_name(o)))
@@ -104,6 +94,36 @@ fn check_word_formats(o: &Object) -> Result<(), Diagnostic> {
         }
     }
     Ok(())
+}
+
+/// What to write instead of a dialect the machine does not offer: the
+/// nearest name it offers; else, for a dialect the standard library has,
+/// how to add it to the machine; else the nearest dialect there is.
+fn dialect_help(requested: &str, offered: &[&Object], names: &[String]) -> String {
+    let offers = format!("its machine offers {}", names.join(", "));
+    let offered_names: Vec<String> = offered.iter().map(|o| dialect_name(o)).collect();
+    if let Some(s) = did_you_mean(requested, offered_names.iter().map(String::as_str)) {
+        return format!("did you mean `--dialect {s}`? {}", capitalised(&offers));
+    }
+    let std_dialects = || {
+        crate::stdlib::items()
+            .iter()
+            .filter(|i| i.kind == lensc_grammar::ast::DeclKind::Dialect)
+            .map(|i| i.name.as_str())
+    };
+    if std_dialects().any(|d| d == requested) {
+        return format!(
+            "{offers}; if its controller reads `{requested}`, add it to the machine's `other_dialects: [{requested}]`"
+        );
+    }
+    match did_you_mean(requested, std_dialects()) {
+        Some(s) => format!(
+            "no standard dialect is called `{requested}`: did you mean `{s}`? {offers}; `lensc list dialects` shows them all"
+        ),
+        None => format!(
+            "no standard dialect is called `{requested}`; {offers}; `lensc list dialects` shows them all"
+        ),
+    }
 }
 
 /// The names of the dialects a job's machine offers, its own first.
@@ -226,14 +246,29 @@ pub fn job_site(job: &CheckedJob) -> (FileId, lensc_grammar::Span) {
     (job.file, job.name.span)
 }
 
-/// A parameter as a header states it: the shortest decimal that reads
-/// back as the same f64 (never an exponent), or 12 decimals when a unit
-/// conversion left a long tail (0.08499999999999999).
-pub(crate) fn exact_num(v: f64) -> String {
-    let s = format!("{v}");
-    if s.trim_start_matches('-').len() <= 17 {
-        return s;
+/// A figure `v` (base units) as a header states it in `unit`: the
+/// shortest decimal that reads back, through the unit, to the same f64
+/// (scientific notation past 17 characters, never `-0`).
+pub fn exact_in(v: f64, unit: &str) -> String {
+    lensc_runtime::post::header::exact_in(v, crate::units::size_of(unit).unwrap_or(1.0))
+}
+
+/// A quantity as a header states it: the figure in its dimension's display
+/// unit, and that unit (`3 deg`, `0.5 mm`, `0.00021 1/mm^3`, `-0.62`).
+pub fn stated(v: f64, d: crate::units::Dim) -> String {
+    let (unit, _) = d.display_unit();
+    let n = exact_in(v, &unit);
+    if unit.is_empty() {
+        n
+    } else {
+        format!("{n} {unit}")
     }
-    let t = format!("{v:.12}");
-    t.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+/// `its machine …` → `Its machine …`, to start a sentence.
+fn capitalised(s: &str) -> String {
+    let mut c = s.chars();
+    c.next()
+        .map(|f| f.to_uppercase().chain(c).collect())
+        .unwrap_or_default()
 }

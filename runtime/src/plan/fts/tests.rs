@@ -185,16 +185,28 @@ fn too_little_stroke_or_acceleration_is_refused() {
             |_| {},
         )
         .expect_err("acceleration");
-    let FtsError::AccelerationExceeded {
-        highest_allowed_speed,
-        ..
-    } = e
-    else {
-        panic!("{e:?}")
+    assert!(matches!(e, FtsError::AccelerationExceeded { .. }), "{e:?}");
+    // The check stops early with the same verdict.
+    let weak = FastAxis {
+        stroke: 5.0,
+        max_acceleration: 1.0,
     };
-    // Replanned at that speed, it passes (just).
+    let checked = p.check(&weak).expect_err("acceleration");
+    assert!(matches!(checked, FtsError::AccelerationExceeded { .. }));
+    // Here the sampling is set by the chord tolerance alone and the
+    // surface does not depend on speed: acceleration scales with the
+    // square of the speed, and the estimate is a bound.
+    let strong = FastAxis {
+        stroke: 5.0,
+        max_acceleration: 1e9,
+    };
+    let at_speed = p.plan(&strong, |_| {}).expect("plans").max_acceleration;
+    let SpindleSpeed::Constant(w) = s.speed else {
+        unreachable!()
+    };
+    let estimate = w * (weak.max_acceleration / at_speed).sqrt();
     let slower = FtsSpiral {
-        speed: SpindleSpeed::Constant(highest_allowed_speed * 0.999),
+        speed: SpindleSpeed::Constant(estimate * 0.999),
         ..s.clone()
     };
     let p2 = planner(&slower, &d, 0.496);
@@ -230,4 +242,56 @@ fn surface_speed_is_capped_near_the_centre() {
     // Seed 003: the corner lenslet at 22.7 mm at 125 rpm sees 17.8 m/min.
     let v = 22.7 * 125.0 * 2.0 * std::f64::consts::PI / 60.0 * 60.0 / 1000.0;
     assert_eq!(format!("{v:.1}"), "17.8");
+}
+
+/// The dimple, but its slopes not a number in a sliver of spindle angle
+/// off its rim: heights the minimum of a level and a surface undefined
+/// there give (the value skips the NaN, the derivatives do not; even at
+/// a point that is not a number the value is the level).
+struct SlopeHole(Dimple);
+
+impl SurfaceFn for SlopeHole {
+    fn eval_batch(&self, xs: &[f64], ys: &[f64], out: &mut [f64]) {
+        self.0.eval_batch(xs, ys, out);
+        for (i, (&x, &y)) in xs.iter().zip(ys).enumerate() {
+            if x.is_nan() || y.is_nan() || (x > 1.0 && y.abs() < 0.05) {
+                out[6 * i] = out[6 * i].min(self.0.h);
+                out[6 * i + 1..6 * i + 6].fill(f64::NAN);
+            }
+        }
+    }
+}
+
+#[test]
+fn a_slope_that_is_not_a_number_is_undefined_not_a_lost_nose() {
+    // Before, the contact search ran on NaN and returned the level
+    // itself, W a nose radius too low for one data period: an
+    // acceleration of 10⁵ m/s² instead of an honest refusal.
+    let d = SlopeHole(Dimple {
+        r: 20.0,
+        h: 0.004,
+        cx: 0.0,
+    });
+    let s = spiral();
+    let slope = ((2.0 * d.0.r * d.0.h - d.0.h * d.0.h).sqrt() / (d.0.r - d.0.h)).atan();
+    let p = Planner {
+        spiral: &s,
+        surface: &d,
+        nose_radius: 0.496,
+        bounds: TrajectoryBounds {
+            z_max: d.0.h,
+            max_slope: slope,
+            features: None,
+            part_top: d.0.h,
+        },
+    };
+    let fa = FastAxis {
+        stroke: 5.0,
+        max_acceleration: 1e12,
+    };
+    let e = p.plan(&fa, |_| {}).expect_err("undefined");
+    let FtsError::Undefined { x, .. } = e else {
+        panic!("{e:?}")
+    };
+    assert!(x > 1.0, "{x}");
 }

@@ -59,7 +59,7 @@ pub(super) fn lower_raster(
         },
         zigzag: value::word(st, "direction") == Some("zigzag"),
         stepover: value::num(st, "stepover").expect("required"),
-        chord_tolerance: value::num(st, "chord_tolerance").unwrap_or(10e-6),
+        chord_tolerance: value::num(st, "chord_tolerance").unwrap_or(super::DEFAULT_PATH_TOLERANCE),
         max_step: value::num(st, "max_step"),
         lin_angle: value::num(st, "lin_angle"),
         retract: value::num(st, "retract").unwrap_or(1.0),
@@ -71,7 +71,7 @@ pub(super) fn lower_raster(
                 RasterTool::Ball { radius: d / 2.0 },
                 format!(
                     "ball-end mill, diameter {} mm, referenced at the ball centre",
-                    trim_num(d)
+                    crate::lower::exact_in(d, "mm")
                 ),
             )
         }
@@ -81,7 +81,7 @@ pub(super) fn lower_raster(
                 RasterTool::Knife { nose_radius: r },
                 format!(
                     "microshaper knife, nose radius {} mm, its edge across the cut, referenced at the nose centre",
-                    trim_num(r)
+                    crate::lower::exact_in(r, "mm")
                 ),
             )
         }

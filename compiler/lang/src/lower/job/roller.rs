@@ -155,7 +155,7 @@ fn tool_errors(p: &Parts, rt: &RollerTool, check: &ToolCheck) -> Vec<Diagnostic>
                 trim_num(check.min_radius_axial_at.0),
                 trim_num(check.min_radius_axial_at.1)
             ),
-        ));
+        ).with_help(format!("use a tool whose `nose_radius` is below {} mm", trim_num(check.min_radius_axial))));
     }
     if !check.clearance_ok {
         errors.push(p.error(
@@ -165,7 +165,7 @@ fn tool_errors(p: &Parts, rt: &RollerTool, check: &ToolCheck) -> Vec<Diagnostic>
                 deg(rt.clearance_angle),
                 deg(check.max_slope_cutting_on_roller)
             ),
-        ));
+        ).with_help(format!("use a tool whose `clearance` is above {}°", deg(check.max_slope_cutting_on_roller))));
     }
     if !check.opening_ok {
         errors.push(p.error(
@@ -175,7 +175,7 @@ fn tool_errors(p: &Parts, rt: &RollerTool, check: &ToolCheck) -> Vec<Diagnostic>
                 deg(rt.opening_angle / 2.0),
                 deg(check.max_slope_axial)
             ),
-        ));
+        ).with_help(format!("use a tool whose `included_angle` is above {}°", deg(2.0 * check.max_slope_axial))));
     }
     errors
 }

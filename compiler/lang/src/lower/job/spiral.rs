@@ -16,7 +16,7 @@ use super::{Evaluate, JobHead, Parts, all_clear};
 use crate::check::trim_num;
 use crate::codes;
 use crate::lower::diagnostics::RuntimeError;
-use crate::lower::surface::LoweredSurface;
+use crate::lower::surface::{LowerError, LoweredSurface};
 use crate::value::{self, Object};
 
 /// A spiral job, typed: what the spiral planner needs.
@@ -39,6 +39,50 @@ pub struct SpiralSpec {
     /// The lenslets' own apertures (centre x, y and rim radius, mm), if
     /// the surface is an array.
     pub lenslets: Vec<(f64, f64, f64)>,
+    /// The surface as declared: what the trajectory is made from again
+    /// at another speed (`at_speed`).
+    pub surface_object: Object,
+}
+
+/// A spiral job at another speed: what a search for the highest speed
+/// its fast axis allows plans.
+pub struct AtSpeed {
+    pub spiral: FtsSpiral,
+    /// The trajectory and its bounds, where they change with speed (a
+    /// settling offset); `None`: the job's own.
+    pub trajectory: Option<(LoweredSurface, TrajectoryBounds)>,
+}
+
+impl SpiralSpec {
+    /// The job were the strategy's speed `speed` instead: the settling
+    /// offset follows the fastest surface speed, and with it the
+    /// trajectory the nose centre follows.
+    pub fn at_speed(&self, speed: SpindleSpeed, evaluate: Evaluate) -> Result<AtSpeed, LowerError> {
+        let spiral = FtsSpiral {
+            speed,
+            ..self.spiral.clone()
+        };
+        let Some(settling) = self.settling else {
+            return Ok(AtSpeed {
+                spiral,
+                trajectory: None,
+            });
+        };
+        let v = fastest(speed, spiral.start_radius);
+        let settling = settling_at(&self.surface_object, settling.time, settling.band, v)
+            .ok_or(LowerError::Unsupported("no settling offset at this speed"))?;
+        let (trajectory, bounds) = settled_trajectory(
+            &self.surface_object,
+            Some(&settling),
+            &self.head.surface.lowered.domain,
+            self.bounds.part_top,
+            evaluate,
+        )?;
+        Ok(AtSpeed {
+            spiral,
+            trajectory: Some((trajectory, bounds)),
+        })
+    }
 }
 
 /// The settling offset and how it was found.
@@ -90,47 +134,34 @@ pub(super) fn lower(
     let lowered = p.lowered().map_err(|d| vec![d])?;
     // The spiral starts where the surface's farthest point from the axis is.
     let start = value::num(st, "from").unwrap_or(outer_radius(&lowered.domain));
-    // The fastest surface speed the job reaches: what d_traj is made of.
-    let fastest = match speed {
-        SpindleSpeed::SurfaceSpeed { speed, .. } => speed,
-        SpindleSpeed::Constant(w) => w * start,
-    };
-    let settling = settling_offset(p, slow, servo, fast, fastest)?;
-    let trajectory = match &settling {
-        Some(s) => crate::lower::surface::lower_trajectory(surface, s.offset)
-            .map_err(|e| vec![RuntimeError::Trajectory(e).at(p.site())])?,
-        None => crate::lower::surface::lower_surface(surface).expect("lowered above"),
-    };
-    let analysis = {
-        let k = evaluate(&trajectory.tape);
-        lensc_runtime::surface::analysis::analyse(k.as_ref(), &lowered.domain, 201)
-    };
+    let settling = settling_offset(p, slow, servo, fast, fastest(speed, start))?;
     let design_kernel = evaluate(&lowered.tape);
     let design =
         lensc_runtime::surface::analysis::analyse(design_kernel.as_ref(), &lowered.domain, 201);
+    let (trajectory, bounds) = settled_trajectory(
+        surface,
+        settling.as_ref(),
+        &lowered.domain,
+        design.sag_max.value,
+        evaluate,
+    )
+    .map_err(|e| vec![RuntimeError::Trajectory(e).at(p.site())])?;
     let mut errors = tool_checks(p, design_kernel.as_ref(), &lowered, &design);
 
     let spiral = FtsSpiral {
         feed_per_rev: value::num(st, "feed").expect("required") * 2.0 * std::f64::consts::PI,
         speed,
-        chord_tolerance: value::num(st, "chord_tolerance").unwrap_or(10e-6),
+        chord_tolerance: value::num(st, "chord_tolerance").unwrap_or(super::DEFAULT_PATH_TOLERANCE),
         seed_arc: value::num(st, "seed_arc").unwrap_or(0.1),
         min_interval: 1.0 / value::num(fast, "data_rate").unwrap_or(if slow { 1e3 } else { 20e3 }),
         start_radius: start,
         end_radius: 0.0,
     };
-    let bounds = TrajectoryBounds {
-        z_max: analysis.sag_max.value,
-        // Margin over the sampled steepest slope: the contact search
-        // window must contain the contact.
-        max_slope: (analysis.max_slope.value * 1.1).min(1.5),
-        features: settling.as_ref().and_then(|s| settled_features(surface, s)),
-        part_top: design.sag_max.value,
-    };
     errors.extend(machine_limits(p, &spiral, travel));
     all_clear(errors)?;
 
     let retract = value::num(st, "retract").unwrap_or(1.0);
+    let safe_w = bounds.z_max + rho + retract;
     Ok(SpiralSpec {
         head: p.head(dialect, lowered),
         slow,
@@ -141,9 +172,48 @@ pub(super) fn lower(
         trajectory,
         servo,
         settling,
-        safe_w: analysis.sag_max.value + rho + retract,
+        safe_w,
         lenslets: lenslets(surface),
+        surface_object: surface.clone(),
     })
+}
+
+/// The fastest surface speed (mm/s) a spiral from `start` (mm) reaches:
+/// what the settling path d_traj is made of.
+fn fastest(speed: SpindleSpeed, start: f64) -> f64 {
+    match speed {
+        SpindleSpeed::SurfaceSpeed { speed, .. } => speed,
+        SpindleSpeed::Constant(w) => w * start,
+    }
+}
+
+/// The surface the nose centre follows (the design, or with a settling
+/// offset its lenslets continued and lifted over the land) and what the
+/// planner knows of it beforehand; `part_top` is the design's highest.
+fn settled_trajectory(
+    surface: &Object,
+    settling: Option<&Settling>,
+    domain: &Domain,
+    part_top: f64,
+    evaluate: Evaluate,
+) -> Result<(LoweredSurface, TrajectoryBounds), LowerError> {
+    let trajectory = match settling {
+        Some(s) => crate::lower::surface::lower_trajectory(surface, s.offset)?,
+        None => crate::lower::surface::lower_surface(surface)?,
+    };
+    let analysis = {
+        let k = evaluate(&trajectory.tape);
+        lensc_runtime::surface::analysis::analyse(k.as_ref(), domain, 201)
+    };
+    let bounds = TrajectoryBounds {
+        z_max: analysis.sag_max.value,
+        // Margin over the sampled steepest slope: the contact search
+        // window must contain the contact.
+        max_slope: (analysis.max_slope.value * 1.1).min(1.5),
+        features: settling.and_then(|s| settled_features(surface, s)),
+        part_top,
+    };
+    Ok((trajectory, bounds))
 }
 
 /// What the axis carrying the surface can do: the fast tool servo's
@@ -308,7 +378,7 @@ fn tool_checks(
                 trim_num(r.x),
                 trim_num(r.y)
             ),
-        ));
+        ).with_help(format!("use a tool whose `nose_radius` is below {} um", trim_num(r.value * 1000.0))));
     }
     let (around, across) = polar_slopes(design_kernel, &lowered.domain, 201);
     if clearance <= around.0 {
@@ -321,7 +391,7 @@ fn tool_checks(
                 trim_num(around.1),
                 trim_num(around.2)
             ),
-        ));
+        ).with_help(format!("use a tool whose `clearance` is above {}°", trim_num(around.0.to_degrees()))));
     }
     if let Some(included) = value::num(t, "included_angle")
         && included / 2.0 <= across.0
@@ -335,7 +405,7 @@ fn tool_checks(
                 trim_num(across.1),
                 trim_num(across.2)
             ),
-        ));
+        ).with_help(format!("use a tool whose `included_angle` is above {}°", trim_num(2.0 * across.0.to_degrees()))));
     }
     errors
 }
@@ -379,12 +449,25 @@ fn settling(
     fast: &[value::Field],
     surface_speed: f64,
 ) -> Option<Settling> {
-    let (lenslet, rim) = crate::lower::surface::array_lenslet(surface)?;
+    crate::lower::surface::array_lenslet(surface)?;
     let band = value::num(fast, "settling_band").unwrap_or(0.002);
     let (time, band) = match value::num(st, "settling_time") {
         Some(t) => (t, None),
         None => (servo?.settling_time(band)?, Some(band)),
     };
+    settling_at(surface, time, band, surface_speed)
+}
+
+/// The settling offset for an array of concave lenslets whose servo
+/// settles in `time` (s; into `band`, when that came from its model) at
+/// the surface speed `surface_speed` (mm/s).
+fn settling_at(
+    surface: &Object,
+    time: f64,
+    band: Option<f64>,
+    surface_speed: f64,
+) -> Option<Settling> {
+    let (lenslet, rim) = crate::lower::surface::array_lenslet(surface)?;
     let f = lensc_runtime::surface::ir::Interpreter::new(&lenslet.tape);
     let along = |u: f64| f.eval(u, 0.0)[0];
     let offset = lensc_runtime::plan::fts::settling_offset(along, rim, surface_speed, time);

@@ -155,7 +155,7 @@ fn profile_turning(f: &[Field], surface: &Object, max_spindle: f64) -> ProfileTu
             .or_else(|| value::num(f, "spindle_cap"))
             .unwrap_or(max_spindle),
         surface_speed: value::num(f, "surface_speed"),
-        chord_tolerance: value::num(f, "chord_tolerance").unwrap_or(10e-6),
+        chord_tolerance: value::num(f, "chord_tolerance").unwrap_or(super::DEFAULT_PATH_TOLERANCE),
         start_radius: value::num(f, "from"),
         // An annular aperture's cut ends at its inner edge.
         end_radius: value::num(f, "to").unwrap_or_else(|| {
@@ -234,7 +234,7 @@ fn surface_info(o: &Object) -> Option<SurfaceInfo> {
             description: format!(
                 "{}, aperture radius {} mm; +Z out of the material",
                 crate::lower::describe(o),
-                trim_num(aperture_radius)
+                crate::lower::exact_in(aperture_radius, "mm")
             ),
             aperture_radius,
         });
@@ -259,12 +259,7 @@ fn surface_info(o: &Object) -> Option<SurfaceInfo> {
         match (&fl.value, fl.name.as_str()) {
             (_, "sense" | "convention" | "aperture") => {}
             (Value::Num(v, d), name) => {
-                let (unit, factor) = d.display_unit();
-                words.push(format!(
-                    "{name} {}{}{unit}",
-                    crate::lower::exact_num(v * factor),
-                    if unit.is_empty() { "" } else { " " }
-                ));
+                words.push(format!("{name} {}", crate::lower::stated(*v, *d)));
             }
             _ => {}
         }
@@ -273,11 +268,14 @@ fn surface_info(o: &Object) -> Option<SurfaceInfo> {
     let aperture = if inner > 0.0 {
         format!(
             "annular aperture {} .. {} mm",
-            trim_num(inner),
-            trim_num(aperture_radius)
+            crate::lower::exact_in(inner, "mm"),
+            crate::lower::exact_in(aperture_radius, "mm")
         )
     } else {
-        format!("aperture radius {} mm", trim_num(aperture_radius))
+        format!(
+            "aperture radius {} mm",
+            crate::lower::exact_in(aperture_radius, "mm")
+        )
     };
     let side_words = if side.signed {
         ", radius signed as in lens design"

@@ -116,6 +116,7 @@ fn array_height_settled(
     // min over the candidates that contain the point; +BIG where none do.
     const BIG: f64 = 1e6;
     let big = g.constant_node(BIG);
+    let half_big = g.constant_node(BIG / 2.0);
     let rim_c = g.constant_node(rim);
     let mut best = big;
     for (cx, cy) in candidates {
@@ -124,6 +125,13 @@ fn array_height_settled(
         let zl = height(g, lenslet, u, v)?;
         let z = g.sub(zl, rim_c);
         if settle.is_some() {
+            // A neighbour continued far past its rim may have no height
+            // there (a sphere beyond its radius: NaN). The minimum's value
+            // would skip it but not its derivatives (d min = db + s·(da −
+            // db) with s = 0 still reads da), so a continuation counts
+            // only where it is defined.
+            let defined = g.sub(z, half_big);
+            let z = g.select(defined, z, big);
             best = g.binary(Binary::Min, best, z);
             continue;
         }
@@ -135,7 +143,6 @@ fn array_height_settled(
         let plateau = g.constant_node(h);
         return Ok(g.binary(Binary::Min, best, plateau));
     }
-    let half_big = g.constant_node(BIG / 2.0);
     let test = g.sub(best, half_big);
     let land = g.constant_node(0.0);
     Ok(g.select(test, best, land))

@@ -381,6 +381,39 @@ surface h = hex_grid(l, pitch: 1 mm, count_x: 3, count_y: 2)";
 }
 
 #[test]
+fn a_settled_trajectory_has_finite_slopes_wherever_a_spiral_goes() {
+    // Issue 15's 5 × 5 hex array (R 3 mm): at its edges the cell indices
+    // clamp, and a neighbour 3.02 mm off was continued past its sphere's
+    // radius (NaN). The minimum's value skipped it, its slopes did not:
+    // the planner lost the nose radius there (102,427 m/s² at r = 3.49
+    // mm, outside every lenslet).
+    let src =
+        "surface l = sphere { radius: 3 mm, sense: concave, aperture: circle(diameter: 0.9 mm) }
+surface h = hex_grid(l, pitch: 1 mm, count_x: 5, count_y: 5)";
+    let c = crate::check_text(&crate::loader::RealFs, "t.lens", src.as_bytes());
+    assert!(!c.has_errors(), "{:?}", c.diags());
+    let o = c.checked.declarations.get("h").expect("surface");
+    let settle = 0.017694;
+    let f = Interpreter::new(&lower_trajectory(o, settle).expect("lowers").tape);
+    let n = 281;
+    for i in 0..n {
+        for j in 0..n {
+            let (x, y) = (
+                -3.5 + 7.0 * i as f64 / (n - 1) as f64,
+                -3.5 + 7.0 * j as f64 / (n - 1) as f64,
+            );
+            let out = f.eval(x, y);
+            assert!(out.iter().all(|v| v.is_finite()), "({x}, {y}): {out:?}");
+            assert!(out[0] <= settle, "({x}, {y}) above the plateau");
+        }
+    }
+    // The point the spiral met: on the plateau, level.
+    let out = f.eval(3.473, 0.4332);
+    assert_eq!(out[0], settle);
+    assert_eq!(out[1..3], [0.0, 0.0]);
+}
+
+#[test]
 fn qbfs_is_the_sphere_plus_the_published_departure() {
     // Best-fit sphere R = 25 mm, ρ_max = 4 mm, a_0 … a_3 in µm.
     let src = "surface q = qbfs { radius: 25 mm, sense: concave, norm_radius: 4 mm, aperture: circle(radius: 4 mm), Q0: 2 um, Q1: -1 um, Q2: 0.5 um, Q3: 0.25 um }";

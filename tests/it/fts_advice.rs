@@ -1,0 +1,148 @@
+//! E0147's advice is a true bound: for every fast-tool-servo example (its
+//! servo weakened until the job is refused), the small array of
+//! tests/jobs/ and the refused jobs of tests/bad_builds/, the job built at
+//! the advised speed passes, and the speed the advice names as refused,
+//! within 5 % above it, is refused by the planner itself: the advice is
+//! neither optimistic nor absurdly conservative.
+
+use std::path::Path;
+
+use crate::common::{examples, root};
+use lensc_build::builders::fts::{Prepared, advice};
+use lensc_build::driver::{Request, check_path, plan_and_emit};
+use lensc_lang::check::trim_num;
+use lensc_lang::loader::RealFs;
+use lensc_lang::lower::job::JobSpec;
+use lensc_runtime::plan::fts::{FtsError, SpeedAdvice};
+
+/// The fast tool servo the examples use, with `max_acceleration` weakened.
+const WEAK_FTS5000: &str = "machine nanoform_x_fts5000 = fts_lathe {
+    dialect: linuxcnc
+    resolution: 1 nm
+    travel: { x: -10 mm .. 220 mm, z: -150 mm .. 150 mm }
+    max_feed: 1000 mm/min
+    spindle: { max_speed: 1000 rpm }
+    fast_axis: { stroke: 5 mm, max_acceleration: 3 G, resonance: 1367 Hz, resonant_peak: 1.0, data_rate: 20 kHz }
+}";
+
+/// The job's single spiral, lowered as a build lowers it.
+fn spiral_of(file: &Path) -> lensc_lang::lower::job::SpiralSpec {
+    let checked = check_path(&RealFs, file).expect("readable");
+    assert!(!checked.has_errors(), "{}", file.display());
+    let job = &checked.checked.jobs[0];
+    let (spec, _) = lensc_build::pipeline::lower(job, None, &Default::default())
+        .unwrap_or_else(|d| panic!("{}: {d:?}", file.display()));
+    match spec {
+        JobSpec::Spiral(s) => s,
+        _ => panic!("{} is not a spiral job", file.display()),
+    }
+}
+
+/// The refusal's acceleration (mm/s²) when the job is planned as written.
+fn refused_at(file: &Path) -> Option<f64> {
+    let spec = spiral_of(file);
+    match Prepared::of(&spec).planner().check(&spec.fast_axis) {
+        Ok(_) => None,
+        Err(FtsError::AccelerationExceeded { acceleration, .. }) => Some(acceleration),
+        Err(e) => panic!("{}: {e:?}", file.display()),
+    }
+}
+
+/// `text` with its strategy's speed (`spindle_speed: … rpm` or
+/// `surface_speed: … m/min`) set to `value` in the same unit.
+fn with_speed(text: &str, value: &str) -> String {
+    for key in ["spindle_speed: ", "surface_speed: "] {
+        if let Some(at) = text.find(key) {
+            let start = at + key.len();
+            let end = start + text[start..].find(' ').expect("a unit follows");
+            return format!("{}{value}{}", &text[..start], &text[end..]);
+        }
+    }
+    panic!("no speed in {text}")
+}
+
+/// A speed (rad/s or mm/s) as E0147's help writes it, in the job's unit.
+fn written(text: &str, v: f64) -> String {
+    trim_num(if text.contains("spindle_speed: ") {
+        v * 60.0 / (2.0 * std::f64::consts::PI)
+    } else {
+        v * 60.0 / 1000.0
+    })
+}
+
+/// Finds the advice for the refused job `text`, builds it at the advised
+/// speed (it must pass) and plans it at the speed named as refused (it
+/// must be refused, within 5 % above). Returns both, in the job's unit.
+fn advice_holds(name: &str, text: &str) -> (String, String) {
+    let dir = tempfile::tempdir().expect("tmp");
+    let file = dir.path().join(format!("{name}.lens"));
+    std::fs::write(&file, text).expect("write");
+    let acceleration =
+        refused_at(&file).unwrap_or_else(|| panic!("{name} is not refused as written"));
+    let SpeedAdvice::Found { passes, fails } = advice::search(&spiral_of(&file), acceleration)
+    else {
+        panic!("{name}: no speed found")
+    };
+    let (passes, fails) = (written(text, passes), written(text, fails));
+    let number = |s: &str| s.parse::<f64>().expect("a number");
+    assert!(
+        number(&fails) <= 1.05 * number(&passes),
+        "{name}: {passes} passes, {fails} fails: too conservative"
+    );
+    // Refused at the speed named as refused, by the planner itself.
+    std::fs::write(&file, with_speed(text, &fails)).expect("write");
+    assert!(refused_at(&file).is_some(), "{name}: {fails} passes");
+    // Built at the advised speed: passes, with no error at all.
+    std::fs::write(&file, with_speed(text, &passes)).expect("write");
+    let checked = check_path(&RealFs, &file).expect("readable");
+    let spool = tempfile::tempdir().expect("tmp");
+    let (built, diags) = plan_and_emit(&checked, Request::default(), name, Some(spool.path()));
+    assert!(
+        !diags.iter().any(|d| d.is_error()),
+        "{name} at {passes}: {diags:?}"
+    );
+    assert_eq!(built.len(), 1);
+    (passes, fails)
+}
+
+#[test]
+fn every_fts_example_builds_at_its_advised_speed() {
+    let mut tried = 0;
+    for path in examples() {
+        let text = std::fs::read_to_string(&path).expect("read");
+        if !text.contains("fts_spiral") {
+            continue;
+        }
+        let servo = "use std::machines::nanoform_x_fts5000";
+        assert!(
+            text.contains(servo),
+            "{}: teach this test its machine",
+            path.display()
+        );
+        let weak = text.replace(servo, WEAK_FTS5000);
+        let name = path.file_stem().expect("stem").to_string_lossy();
+        let (passes, fails) = advice_holds(&name, &weak);
+        eprintln!("{name} (servo at 3 G): {passes} passes, {fails} fails");
+        tried += 1;
+    }
+    assert!(tried >= 1, "no fast-tool-servo example");
+}
+
+#[test]
+fn the_small_array_builds_at_its_advised_speed() {
+    let text = std::fs::read_to_string(root().join("tests/jobs/fts_small_array.lens"))
+        .expect("read")
+        .replace("use std::machines::nanoform_x_fts5000", WEAK_FTS5000);
+    let (passes, fails) = advice_holds("fts_small_array", &text);
+    eprintln!("fts_small_array (servo at 3 G): {passes} passes, {fails} fails");
+}
+
+#[test]
+fn refused_bad_builds_build_at_their_advised_speed() {
+    for name in ["fts_hex_array_too_fast", "fts_acceleration_exceeded"] {
+        let text = std::fs::read_to_string(root().join(format!("tests/bad_builds/{name}.lens")))
+            .expect("read");
+        let (passes, fails) = advice_holds(name, &text);
+        eprintln!("{name}: {passes} passes, {fails} fails");
+    }
+}
