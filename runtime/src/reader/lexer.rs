@@ -5,7 +5,7 @@
 //! reading a line (line length, comments, number format).
 
 use super::{Controller, Rule};
-use crate::dialect::{CommentStyle, Dialect};
+use crate::dialect::{CommentStyle, Dialect, WordFormat};
 
 /// A finding as the line reports it: rule, span within the line, message,
 /// hint.
@@ -63,6 +63,8 @@ pub(crate) struct Lexer {
     max_line_length: Option<usize>,
     max_decimals: Option<u32>,
     max_digits: Option<u32>,
+    /// The dialect's format of each word (`S5`, `X4.4`).
+    formats: Vec<WordFormat>,
 }
 
 impl Lexer {
@@ -74,6 +76,7 @@ impl Lexer {
             max_line_length: d.max_line_length,
             max_decimals: d.max_decimals,
             max_digits: d.max_digits,
+            formats: d.word_formats.clone(),
         }
     }
 
@@ -285,18 +288,26 @@ impl Lexer {
     /// dialect's number format.
     fn number_format(&self, w: &Word, code: &str, out: &mut Vec<Found>) {
         let text = &code[w.span.0..w.span.1];
-        if w.point && integer_only(self.controller, w.letter) {
+        let format = self.formats.iter().find(|f| f.letter == w.letter);
+        let whole = format.is_some_and(|f| f.decimals.is_none());
+        if w.point && (whole || integer_only(self.controller, w.letter)) {
+            let whose = if integer_only(self.controller, w.letter) {
+                "this controller reads"
+            } else {
+                "the dialect's format gives"
+            };
             out.push((
                 Rule::DecimalPoint,
                 w.span,
                 format!(
-                    "`{text}`: this controller reads {} words as whole numbers, without a decimal point",
+                    "`{text}`: {whose} {} words as whole numbers, without a decimal point",
                     w.letter
                 ),
                 Some(format!("write {}{}", w.letter, w.value.trunc())),
             ));
         }
-        if let Some(max) = self.max_decimals
+        let max_decimals = format.and_then(|f| f.decimals).or(self.max_decimals);
+        if let Some(max) = max_decimals
             && w.decimals > max as usize
         {
             out.push((
@@ -324,6 +335,20 @@ impl Lexer {
                 Rule::TooManyDigits,
                 w.span,
                 format!("`{text}` has {digits} digits; the controller reads at most {max}"),
+                None,
+            ));
+        }
+        let before = digits.saturating_sub(w.decimals);
+        if let Some(f) = format
+            && before > f.integer_digits as usize
+        {
+            out.push((
+                Rule::TooManyDigits,
+                w.span,
+                format!(
+                    "`{text}` has {before} digits before the point; the dialect's {} words have at most {}",
+                    w.letter, f.integer_digits
+                ),
                 None,
             ));
         }

@@ -112,6 +112,7 @@ impl State {
         for (lines, code) in [
             (&d.c_axis_on, MCode::PositionOn),
             (&d.c_axis_off, MCode::PositionOff),
+            (&d.spindle_orient, MCode::Orient),
             (&d.fts_on, MCode::Other),
             (&d.fts_off, MCode::Other),
         ] {
@@ -144,7 +145,7 @@ impl State {
             feed_codes,
             max_line_number: d.max_line_number,
             numbered: lex.controller == Controller::HeidenhainIso && d.line_numbers.is_some(),
-            css_capable: machine.lathe || !d.surface_speed.is_empty(),
+            css_capable: machine.lathe || d.constant_rpm.is_some() || !d.surface_speed.is_empty(),
             metric: None,
             plane: None,
             absolute: None,

@@ -125,6 +125,7 @@ fn heidenhain_reads_arc_centres_where_they_are() {
     d.max_line_number = Some(99999);
     d.arc_centre_absolute = true;
     d.surface_speed = Vec::new();
+    d.constant_rpm = None;
     assert_eq!(Controller::of(&d), Controller::HeidenhainIso);
     let mill = MachineLimits {
         lathe: false,
