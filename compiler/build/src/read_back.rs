@@ -13,11 +13,10 @@ use lensc_runtime::reader;
 
 use crate::output::ProgramText;
 
-/// Whether builds read their programs back before writing them. Off
-/// until every program is complete (issue 14, item 1: tool calls, spindle
-/// starts with G97, integer S words): today's programs break the reader's
-/// tool and spindle rules. `LENSC_READ_BACK=1` turns it on for one run.
-pub const READ_BACK_BY_DEFAULT: bool = false;
+/// Whether builds read their programs back before writing them (on since
+/// every program is complete: issue 14, item 1). `LENSC_READ_BACK=1`
+/// turns it on where this is off.
+pub const READ_BACK_BY_DEFAULT: bool = true;
 
 /// Whether this run reads its programs back.
 pub fn enabled() -> bool {
