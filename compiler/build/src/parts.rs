@@ -151,3 +151,31 @@ pub(crate) fn not_printable(head: &JobHead, e: ProgramError) -> Diagnostic {
 pub(crate) fn failed(head: &JobHead, e: RuntimeError) -> Diagnostic {
     e.at(head.site)
 }
+
+/// What a lathe or grinder program cuts, read from its text as the
+/// controller reads it (`reader::read_moves`, arcs blended as the
+/// controller blends them) with a round edge of radius `rho` along it,
+/// against `design` over `range` (`simulate::program_cut`). Only the moves
+/// are taken here: the read-back judges the rules.
+pub(crate) fn program_cut(
+    head: &JobHead,
+    text: &str,
+    rho: f64,
+    design: &dyn Fn(f64) -> f64,
+    range: (f64, f64),
+) -> lensc_runtime::verify::simulate::ProfileCut {
+    let machine = lensc_runtime::reader::MachineLimits {
+        lathe: true,
+        travel: [None; 4],
+        max_feed: None,
+        max_spindle_rpm: None,
+    };
+    let (_, moves) = lensc_runtime::reader::read_moves(text, &head.dialect, &machine);
+    lensc_runtime::verify::simulate::program_cut(
+        &moves,
+        rho,
+        design,
+        range,
+        crate::plots::PROFILE_SAMPLES,
+    )
+}

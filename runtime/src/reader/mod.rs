@@ -114,6 +114,36 @@ pub struct Finding {
     pub hint: Option<String>,
 }
 
+/// A move as the controller makes it from the text, in machine
+/// coordinates: absolute, in mm (an inch program's too), X the radius on a
+/// lathe (a diameter program's too), C in degrees; an axis is `None`
+/// until the program first states it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Executed {
+    pub from: [Option<f64>; 4],
+    pub to: [Option<f64>; 4],
+    pub path: Path,
+}
+
+/// The path of an [`Executed`] move.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Path {
+    Rapid,
+    Line,
+    /// An arc in `plane` about `centre` (its two coordinates in the
+    /// plane's order: XY (X, Y), ZX (Z, X), YZ (Y, Z)), turning `turn`
+    /// rad (> 0) clockwise (`cw`) or counter-clockwise as seen in that
+    /// order. Where its start and end radii differ (within the
+    /// controller's limit) the controller blends them: see
+    /// `verify::simulate`.
+    Arc {
+        plane: crate::moves::Plane,
+        centre: (f64, f64),
+        cw: bool,
+        turn: f64,
+    },
+}
+
 /// Reads `text` (a whole program) in `dialect` on `machine`: every rule
 /// broken, the first line breaking each, in order of their lines.
 pub fn read(text: &str, dialect: &Dialect, machine: &MachineLimits) -> Vec<Finding> {
@@ -124,6 +154,25 @@ pub fn read(text: &str, dialect: &Dialect, machine: &MachineLimits) -> Vec<Findi
         offset += line.len();
     }
     r.finish()
+}
+
+/// Reads `text` as [`read`] does, and hands over every move the
+/// controller would make, in order (a block with no motion mode makes
+/// none, nor an arc with no plane or centre the reader can take).
+pub fn read_moves(
+    text: &str,
+    dialect: &Dialect,
+    machine: &MachineLimits,
+) -> (Vec<Finding>, Vec<Executed>) {
+    let mut r = Reader::new(dialect, machine);
+    r.state.moves = Some(Vec::new());
+    let mut offset = 0;
+    for line in text.split_inclusive('\n') {
+        r.line(line, offset);
+        offset += line.len();
+    }
+    let moves = r.state.moves.take().unwrap_or_default();
+    (r.finish(), moves)
 }
 
 /// Reads a program from `input` line by line (a program of millions of

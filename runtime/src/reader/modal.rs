@@ -102,6 +102,8 @@ pub(crate) struct State {
     pub away: usize,
     /// The highest point along `away` a feed move has reached.
     pub top: Option<f64>,
+    /// The moves made so far, when they are asked for.
+    pub moves: Option<Vec<super::Executed>>,
     ended: bool,
 }
 
@@ -164,6 +166,7 @@ impl State {
             pos: [None; 4],
             away: 2,
             top: None,
+            moves: None,
             ended: false,
             lex,
         }

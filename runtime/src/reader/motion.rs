@@ -29,7 +29,7 @@
 
 use super::lexer::{Block, Found, Word};
 use super::modal::{FeedMode, Motion, State};
-use super::{Controller, Rule};
+use super::{Controller, Executed, Path, Rule};
 use crate::moves::Plane;
 
 const LETTERS: [char; 4] = ['X', 'Y', 'Z', 'C'];
@@ -76,9 +76,19 @@ impl State {
             self.position_mode = true;
         }
         self.travel(&end, &axes, out);
-        match motion {
-            Motion::Rapid => self.rapid(&start, &end, span, out),
+        let path = match motion {
+            Motion::Rapid => {
+                self.rapid(&start, &end, span, out);
+                Some(Path::Rapid)
+            }
             _ => self.feed_move(motion, b, &start, &end, &centre, span, line, out),
+        };
+        if let (Some(moves), Some(path)) = (&mut self.moves, path) {
+            moves.push(Executed {
+                from: start,
+                to: end,
+                path,
+            });
         }
         self.pos = end;
     }
@@ -214,13 +224,16 @@ impl State {
         span: (usize, usize),
         line: &str,
         out: &mut Vec<Found>,
-    ) {
+    ) -> Option<Path> {
         self.may_cut(b, span, out);
-        let length = match motion {
+        let (length, path) = match motion {
             Motion::Cw | Motion::Ccw => {
-                self.arc(motion == Motion::Cw, start, end, centre, span, line, out)
+                match self.arc(motion == Motion::Cw, start, end, centre, span, line, out) {
+                    Some((length, arc)) => (Some(length), Some(arc)),
+                    None => (None, None),
+                }
             }
-            _ => chord(start, end),
+            _ => (chord(start, end), Some(Path::Line)),
         };
         if let Some(length) = length {
             self.feed_limit(b, start, end, length, span, out);
@@ -228,6 +241,7 @@ impl State {
         if let Some(v) = end[self.away] {
             self.top = Some(self.top.map_or(v, |t| t.max(v)));
         }
+        path
     }
 
     /// Tool, spindle, feed mode and feed, before any cut.
@@ -351,7 +365,8 @@ impl State {
         self.cap.map(|cap| rpm.min(cap))
     }
 
-    /// An arc's words, radii and length (mm), by the controller's rules.
+    /// An arc's words, radii and length (mm), by the controller's rules,
+    /// and the arc as the controller makes it.
     #[allow(clippy::too_many_arguments)]
     fn arc(
         &self,
@@ -362,7 +377,7 @@ impl State {
         span: (usize, usize),
         line: &str,
         out: &mut Vec<Found>,
-    ) -> Option<f64> {
+    ) -> Option<(f64, Path)> {
         let Some(plane) = self.plane else {
             out.push((
                 Rule::ModalStateUnstated,
@@ -444,7 +459,13 @@ impl State {
             (Some(p), Some(q)) => q - p,
             _ => 0.0,
         };
-        Some((0.5 * (r1 + r2) * turn).hypot(rise))
+        let arc = Path::Arc {
+            plane,
+            centre: (ca, cb),
+            cw,
+            turn,
+        };
+        Some(((0.5 * (r1 + r2) * turn).hypot(rise), arc))
     }
 
     fn arc_radii(

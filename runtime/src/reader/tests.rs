@@ -156,3 +156,38 @@ fn a_sinumerik_feed_type_cancels_constant_surface_speed() {
     let both = text.replace("G95 G1", "G95 G96 G1");
     assert!(rules(&both, &d, &lathe()).contains(&Rule::SameModalGroup));
 }
+
+#[test]
+fn the_moves_are_handed_over_in_machine_coordinates() {
+    // The Fanuc program of the test above: X a diameter, I, K the centre
+    // from the start (a radius).
+    let mut d = Dialect::linuxcnc();
+    d.start = vec!["%".into(), "O{number} ({JOB})".into()];
+    d.lathe_setup = vec!["G18 G21 G40 G80 G90".into()];
+    d.lathe_x_diameter = true;
+    let text = "%\nO1 (J)\nG18 G21 G40 G80 G90\nT0101\nG97 S500 M3\nG0 X6. Z1.5\nG95 G1 Z0.1 F0.002\nG2 X0. Z0.4693 I-3. K-12.\nG0 Z1.5\nM5\nM30\n%\n";
+    let (found, moves) = read_moves(text, &d, &lathe());
+    assert_eq!(found, vec![]);
+    let paths: Vec<Path> = moves.iter().map(|m| m.path).collect();
+    assert_eq!(paths.len(), 4, "{moves:?}");
+    assert_eq!(moves[0].to, [Some(3.0), None, Some(1.5), None]);
+    assert_eq!((paths[1], moves[1].to[2]), (Path::Line, Some(0.1)));
+    let Path::Arc {
+        plane,
+        centre,
+        cw,
+        turn,
+    } = paths[2]
+    else {
+        panic!("{paths:?}")
+    };
+    assert_eq!(
+        (plane, centre, cw),
+        (crate::moves::Plane::Zx, (0.1 - 12.0, 0.0), true)
+    );
+    // From (X 3, Z 0.1) to (X 0, Z 0.4693) about (X 0, Z -11.9).
+    let want = 3f64.atan2(12.0);
+    assert!((turn - want).abs() < 1e-12, "{turn} {want}");
+    assert_eq!(moves[2].to, [Some(0.0), None, Some(0.4693), None]);
+    assert_eq!(paths[3], Path::Rapid);
+}

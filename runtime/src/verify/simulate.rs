@@ -7,12 +7,26 @@
 //! centre follows the moves; the material is on the −Z side, so the cut
 //! surface is the lower envelope of the disc swept along every cutting
 //! move. The envelope is exact: a disc swept along a straight move is
-//! bounded below by its end discs and the move offset by ρ; along an arc
-//! of radius R, by its end discs and the arcs of radius R ± ρ.
+//! bounded below by its end discs and the move offset by ρ; along an arc,
+//! by its end discs and the arc offset by ±ρ along its normal.
+//!
+//! Arcs as the controller cuts them. A printed arc's end is rarely at
+//! exactly its start radius from the printed centre (every coordinate is
+//! rounded to the resolution). LinuxCNC does not cut a circle at the start
+//! radius and jump: posemath's `pmCircleInit` takes the start radius and
+//! `spiral` = end radius − start radius, and `pmCirclePoint` puts the
+//! point at angle θ of the arc's sweep Θ at radius r₀ + spiral · θ / Θ — a
+//! spiral that ends exactly on the printed end point. The simulation cuts
+//! every arc so (Fanuc's manuals describe the same linear blend, "spiral
+//! interpolation", for radii that differ within parameter 3410; the other
+//! controllers are taken to do likewise). `program_cut` takes the moves
+//! from the program's text as the reader executes them (`reader::
+//! read_moves`); `profile_cut` from the planned move stream, as printed.
 
 use super::figures::ErrorStats;
 use crate::moves::{Move, Plane};
 use crate::post::format::{decimals_for, fixed_units};
+use crate::reader::{Executed, Path};
 use std::f64::consts::PI;
 
 /// What a profile program cuts, against the design.
@@ -51,11 +65,13 @@ enum Piece {
         a: (f64, f64),
         b: (f64, f64),
     },
-    /// Centre, radius, and the arc's start angle and signed sweep, angles
+    /// Centre, radius at the start and at the end (blended linearly in
+    /// the angle), and the arc's start angle and signed sweep, angles
     /// measured from +Z towards +X (the G18 sense).
     Arc {
         o: (f64, f64),
         r: f64,
+        r_end: f64,
         start: f64,
         sweep: f64,
         a: (f64, f64),
@@ -106,10 +122,10 @@ fn pieces(stream: &[Move], resolution: f64) -> Vec<Piece> {
                 } else {
                     -(a0 - a1).rem_euclid(2.0 * PI)
                 };
-                let r = (at.0 - o.0).hypot(at.1 - o.1);
                 out.push(Piece::Arc {
                     o,
-                    r,
+                    r: (at.0 - o.0).hypot(at.1 - o.1),
+                    r_end: (next.0 - o.0).hypot(next.1 - o.1),
                     start: a0,
                     sweep,
                     a: at,
@@ -139,13 +155,19 @@ pub fn centre_path(stream: &[Move], resolution: f64) -> Vec<Vec<(f64, f64)>> {
         }
         let run = runs.last_mut().expect("pushed");
         if let Piece::Arc {
-            o, r, start, sweep, ..
+            o,
+            r,
+            r_end,
+            start,
+            sweep,
+            ..
         } = piece
         {
             let steps = (sweep.abs().to_degrees().ceil() as usize).max(1);
             for k in 1..steps {
-                let ang = start + sweep * k as f64 / steps as f64;
-                run.push((o.0 + r * ang.sin(), o.1 + r * ang.cos()));
+                let f = k as f64 / steps as f64;
+                let (ang, rr) = (start + sweep * f, r + (r_end - r) * f);
+                run.push((o.0 + rr * ang.sin(), o.1 + rr * ang.cos()));
             }
         }
         run.push(b);
@@ -165,7 +187,10 @@ impl Piece {
     fn reach(&self, rho: f64) -> (f64, f64) {
         match *self {
             Piece::Line { a, b } => (a.0.min(b.0) - rho, a.0.max(b.0) + rho),
-            Piece::Arc { o, r, .. } => (o.0 - r - rho, o.0 + r + rho),
+            Piece::Arc { o, r, r_end, .. } => {
+                let r = r.max(r_end);
+                (o.0 - r - rho, o.0 + r + rho)
+            }
         }
     }
 
@@ -204,38 +229,98 @@ impl Piece {
                 }
             }
             Piece::Arc {
-                o, r, start, sweep, ..
+                o,
+                r,
+                r_end,
+                start,
+                sweep,
+                ..
             } => {
-                for rr in [r + rho, r - rho] {
-                    if rr <= 0.0 {
-                        continue;
-                    }
-                    let s = (x - o.0) / rr;
-                    if s.abs() > 1.0 {
-                        continue;
-                    }
-                    let base = s.asin();
-                    for ang in [base, PI - base] {
-                        // Within the arc's sweep from its start?
-                        let mut t = ang - start;
-                        if sweep >= 0.0 {
-                            t = t.rem_euclid(2.0 * PI);
-                            if t > sweep {
-                                continue;
-                            }
-                        } else {
-                            t = (-t).rem_euclid(2.0 * PI);
-                            if t > -sweep {
-                                continue;
-                            }
-                        }
-                        see(Some(o.1 + rr * ang.cos()));
-                    }
+                for side in [1.0, -1.0] {
+                    see(spiral_offset_at(
+                        o,
+                        (r, r_end),
+                        (start, sweep),
+                        side * rho,
+                        x,
+                    ));
                 }
             }
         }
         low
     }
+}
+
+/// The offset by `off` (mm, + outward) along the normal of the arc about
+/// `o` from radius `r0` to `r1` (linear in the angle), from angle `start`
+/// through the signed `sweep`: its height where it crosses abscissa `x`,
+/// the lowest of the crossings within the sweep. The crossings of the
+/// offset circle at the mean radius start Newton's method on the exact
+/// offset point p(θ) = c(θ) + off · n(θ), c(θ) = o + r(θ) (sin θ, cos θ),
+/// n the unit normal (r u − r′ t) / √(r² + r′²).
+fn spiral_offset_at(
+    o: (f64, f64),
+    (r0, r1): (f64, f64),
+    (start, sweep): (f64, f64),
+    off: f64,
+    x: f64,
+) -> Option<f64> {
+    let k = if sweep != 0.0 { (r1 - r0) / sweep } else { 0.0 };
+    let rr = 0.5 * (r0 + r1) + off;
+    if rr <= 0.0 {
+        return None;
+    }
+    let s = (x - o.0) / rr;
+    if s.abs() > 1.0 {
+        return None;
+    }
+    // The angle travelled from the start, in the sweep's direction.
+    let travelled = |ang: f64| {
+        if sweep >= 0.0 {
+            (ang - start).rem_euclid(2.0 * PI)
+        } else {
+            (start - ang).rem_euclid(2.0 * PI)
+        }
+    };
+    let mut low: Option<f64> = None;
+    let base = s.asin();
+    for guess in [base, PI - base] {
+        let t0 = travelled(guess);
+        // θ unwrapped from the start, so r(θ) is the blend's.
+        let mut theta = start + t0 * sweep.signum();
+        let point = |theta: f64| {
+            let r = r0 + k * (theta - start);
+            let h = r.hypot(k);
+            let (sn, cs) = theta.sin_cos();
+            let px = o.0 + r * sn + off * (r * sn - k * cs) / h;
+            let pz = o.1 + r * cs + off * (r * cs + k * sn) / h;
+            let slope = k * sn + r * cs + off * (2.0 * k * sn + r * cs) / h;
+            (px, pz, slope)
+        };
+        if k != 0.0 {
+            for _ in 0..8 {
+                let (px, _, slope) = point(theta);
+                let step = (px - x) / slope;
+                if !step.is_finite() || step.abs() > 1e-3 {
+                    break;
+                }
+                theta -= step;
+                if step.abs() < 1e-15 {
+                    break;
+                }
+            }
+        }
+        let t = (theta - start) * sweep.signum();
+        if !(-1e-12..=sweep.abs() + 1e-12).contains(&t) {
+            continue;
+        }
+        let (px, pz, _) = point(theta);
+        if (px - x).abs() > 1e-9 {
+            continue;
+        }
+        low = Some(low.map_or(pz, |l| l.min(pz)));
+    }
+    low
 }
 
 /// Simulates the cut of a lathe `stream` (nose radius `rho`, coordinates
@@ -247,10 +332,70 @@ pub fn profile_cut(
     rho: f64,
     resolution: f64,
     design: &dyn Fn(f64) -> f64,
+    range: (f64, f64),
+    samples: usize,
+) -> ProfileCut {
+    cut_of(&pieces(stream, resolution), rho, design, range, samples)
+}
+
+/// Simulates the cut of a lathe program from the moves its controller
+/// makes (`reader::read_moves`: X, Z in machine coordinates, arcs in
+/// G18 blended from their start radius to their end radius), as
+/// `profile_cut` does: the error of the program as written.
+pub fn program_cut(
+    moves: &[Executed],
+    rho: f64,
+    design: &dyn Fn(f64) -> f64,
+    range: (f64, f64),
+    samples: usize,
+) -> ProfileCut {
+    cut_of(&executed_pieces(moves), rho, design, range, samples)
+}
+
+/// The cutting moves among the executed `moves`: feed moves with X and Z
+/// known at both ends, arcs in the ZX plane (G18).
+fn executed_pieces(moves: &[Executed]) -> Vec<Piece> {
+    let mut out = Vec::new();
+    for m in moves {
+        let (Some(ax), Some(az), Some(bx), Some(bz)) = (m.from[0], m.from[2], m.to[0], m.to[2])
+        else {
+            continue;
+        };
+        let (a, b) = ((ax, az), (bx, bz));
+        match m.path {
+            Path::Rapid => {}
+            Path::Line => out.push(Piece::Line { a, b }),
+            Path::Arc {
+                plane: Plane::Zx,
+                centre: (cz, cx),
+                cw,
+                turn,
+            } => {
+                let o = (cx, cz);
+                out.push(Piece::Arc {
+                    o,
+                    r: (a.0 - o.0).hypot(a.1 - o.1),
+                    r_end: (b.0 - o.0).hypot(b.1 - o.1),
+                    start: (a.0 - o.0).atan2(a.1 - o.1),
+                    sweep: if cw { -turn } else { turn },
+                    a,
+                    b,
+                });
+            }
+            Path::Arc { .. } => {}
+        }
+    }
+    out
+}
+
+/// The cut of `pieces` (see `profile_cut`).
+fn cut_of(
+    pieces: &[Piece],
+    rho: f64,
+    design: &dyn Fn(f64) -> f64,
     (from, to): (f64, f64),
     samples: usize,
 ) -> ProfileCut {
-    let pieces = pieces(stream, resolution);
     let n = samples.max(2);
     // Each piece listed in the bins of radii its swept disc can reach.
     let bins = 1024usize;

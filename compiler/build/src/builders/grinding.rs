@@ -75,13 +75,12 @@ pub fn build(spec: &GrindingSpec, prov: &Provenance) -> Result<Built, Vec<Diagno
     // What the wheel's section (a circle of its radius about the centre)
     // leaves along the programmed centres.
     use lensc_runtime::surface::Profile as _;
-    let cut = lensc_runtime::verify::simulate::profile_cut(
-        &stream,
+    let cut = parts::program_cut(
+        head,
+        &text,
         grinding.wheel_diameter / 2.0,
-        resolution,
         &|x: f64| profile.point(x).z,
         (grinding.start, grinding.end),
-        crate::plots::PROFILE_SAMPLES,
     );
     let plots = crate::plots::PlotSeries {
         profile: Some(crate::plots::profile_series(

@@ -15,7 +15,7 @@ use lensc_runtime::surface::SectionAlongX;
 
 use crate::evaluate::evaluator;
 use crate::output::{Built, ProgramText};
-use crate::plots::{PROFILE_SAMPLES, profile_series};
+use crate::plots::profile_series;
 use crate::report;
 
 /// Builds one profile-turning job, or says why it cannot be built.
@@ -55,14 +55,7 @@ pub fn build(spec: &TurningSpec, prov: &Provenance) -> Result<Built, Vec<Diagnos
                 .start_radius
                 .unwrap_or(job.surface.aperture_radius),
         );
-        let cut = lensc_runtime::verify::simulate::profile_cut(
-            &stream,
-            job.tool.nose_radius,
-            job.machine.resolution,
-            &design,
-            range,
-            PROFILE_SAMPLES,
-        );
+        let cut = crate::parts::program_cut(head, &text, job.tool.nose_radius, &design, range);
         plots.profile = Some(profile_series(
             &cut,
             &design,

@@ -156,3 +156,91 @@ fn a_path_dropped_too_low_is_a_gouge_where_it_drops() {
         cut.max_gouge
     );
 }
+
+/// An arc about (0, 10) through its lowest point (0, 0), ±0.2 rad about
+/// it, printed with its end `delta` mm further from the centre than its
+/// start, as the reader hands it over.
+fn blended_arc(delta: f64) -> Vec<Executed> {
+    let (o, r) = ((0.0, 10.0), 10.0);
+    let at = |ang: f64, rr: f64| {
+        [
+            Some(o.0 + rr * ang.sin()),
+            None,
+            Some(o.1 + rr * ang.cos()),
+            None,
+        ]
+    };
+    vec![Executed {
+        from: at(PI - 0.2, r),
+        to: at(PI + 0.2, r + delta),
+        path: Path::Arc {
+            plane: Plane::Zx,
+            centre: (o.1, o.0),
+            cw: false,
+            turn: 0.4,
+        },
+    }]
+}
+
+#[test]
+fn an_arc_whose_end_radius_differs_is_cut_as_the_controller_blends_it() {
+    let delta = 1e-4;
+    let pieces = executed_pieces(&blended_arc(delta));
+    assert_eq!(pieces.len(), 1);
+    let bottom = |x: f64| pieces[0].bottom(RHO, x).expect("reached");
+    // Halfway round, the radius is halfway from start to end (LinuxCNC's
+    // pmCirclePoint); a sweep at the start radius would cut -0.5.
+    let mid = bottom(0.0);
+    // (The spiral's normal tilts by r′/r: 0.16 pm lower.)
+    assert!((mid - (-0.5 - delta / 2.0)).abs() < 1e-9, "{mid}");
+    // A quarter of the way from the start and from the end: a quarter and
+    // three quarters of the difference.
+    for (f, share) in [(0.25, 0.25), (0.75, 0.75)] {
+        let ang = PI - 0.2 + 0.4 * f;
+        let rr = 10.0 + RHO + delta * share;
+        let x = rr * ang.sin();
+        let z = bottom(x);
+        let want = 10.0 + rr * ang.cos();
+        assert!((z - want).abs() < 1e-9, "{f}: {z} {want}");
+    }
+    // With no difference, the circle of the start radius.
+    let circle = executed_pieces(&blended_arc(0.0));
+    assert!((circle[0].bottom(RHO, 0.0).expect("reached") + 0.5).abs() < 1e-12);
+}
+
+#[test]
+fn the_program_cut_of_a_blended_arc_follows_the_spiral_not_the_start_circle() {
+    let delta = 5.7e-5;
+    let moves = blended_arc(delta);
+    // The design: the lower envelope of 200 001 discs along the spiral
+    // r = 10 + δ θ / 0.4 about (0, 10) (their spacing leaves < 0.1 nm).
+    let n = 200_000;
+    let centres: Vec<(f64, f64)> = (0..=n)
+        .map(|i| {
+            let f = i as f64 / n as f64;
+            let (ang, rr) = (PI - 0.2 + 0.4 * f, 10.0 + delta * f);
+            (rr * ang.sin(), 10.0 + rr * ang.cos())
+        })
+        .collect();
+    let envelope = |x: f64| {
+        centres
+            .iter()
+            .filter_map(|&c| disc_bottom(c, RHO, x))
+            .fold(f64::INFINITY, f64::min)
+    };
+    let cut = program_cut(&moves, RHO, &envelope, (-1.5, 1.5), 61);
+    assert!(
+        cut.pv < 1e-9 && cut.mean.abs() < 1e-9,
+        "{} {}",
+        cut.pv,
+        cut.mean
+    );
+    // The circle of the start radius would leave δ-sized errors near the
+    // end of the arc.
+    let mut circle = executed_pieces(&moves);
+    if let Piece::Arc { r, r_end, .. } = &mut circle[0] {
+        *r_end = *r;
+    }
+    let circle_cut = cut_of(&circle, RHO, &envelope, (-1.5, 1.5), 61);
+    assert!(circle_cut.pv > 0.5 * delta, "{}", circle_cut.pv);
+}
