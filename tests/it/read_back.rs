@@ -29,6 +29,7 @@ fn every_program_snapshot_reads_back() {
         let mut files: Vec<_> = std::fs::read_dir(root().join("tests/snapshots").join(dir))
             .expect("snapshots")
             .map(|e| e.expect("entry").path())
+            .filter(|p| p.extension().is_some_and(|e| e == "snap"))
             .collect();
         files.sort();
         for snap in files {

@@ -4,7 +4,8 @@
 use crate::dialect::Dialect;
 use crate::moves::{self, Position};
 use crate::plan::optimise::{self};
-use crate::post::format::push_fixed;
+use crate::post::format::{fixed_units, push_fixed};
+use crate::post::writer::inverse_time_not_faster;
 use crate::post::{ProgramError, ProgramWriter};
 use std::f64::consts::PI;
 use std::fmt::Write as _;
@@ -23,6 +24,34 @@ pub struct FtsProgram {
     last: Option<crate::plan::fts::SpiralPoint>,
     /// Where the fast axis goes when the dialect takes it as a table.
     table: Option<FtsTable>,
+    /// The spindle's limit (rad/s) and C's printed decimals, once set.
+    spindle: Option<SpindleHold>,
+}
+
+/// The spindle's limit every move's C is held under, as printed.
+#[derive(Clone, Copy, Debug)]
+pub struct SpindleHold {
+    /// rad/s.
+    pub max_speed: f64,
+    /// Decimals of C (degrees) as the dialect prints it.
+    pub c_decimals: u32,
+}
+
+impl SpindleHold {
+    /// The time (s) of a move planned to take `t` that turns C from `c0`
+    /// to `c1` (rad): `t`, or where C as printed (each end rounded to its
+    /// decimals) would turn faster than the limit, the least time that
+    /// holds it, F printed never faster.
+    fn time(&self, t: f64, c0: f64, c1: f64) -> f64 {
+        let printed = |c: f64| {
+            let scale = 10f64.powi(self.c_decimals as i32);
+            fixed_units(c.to_degrees(), self.c_decimals)
+                .map_or(c.to_degrees(), |n| n as f64 / scale)
+        };
+        let turned = (printed(c1) - printed(c0)).abs().to_radians();
+        let least = inverse_time_not_faster(turned / self.max_speed);
+        if t >= least { t } else { least }
+    }
 }
 
 /// The fast-tool-servo table written beside a program: one row per
@@ -77,7 +106,18 @@ impl FtsProgram {
             safe_w,
             last: None,
             table,
+            spindle: None,
         })
+    }
+
+    /// Holds every move's C under the spindle's limit as printed (a spiral
+    /// planned at the limit reads above it where C's rounding lengthens a
+    /// step): such a move takes the least time that holds it.
+    pub fn hold_spindle_under(&mut self, max_speed: f64) {
+        self.spindle = Some(SpindleHold {
+            max_speed,
+            c_decimals: self.writer.dialect().c_decimals,
+        });
     }
 
     /// The move stream of spiral points: the first is reached by rapids
@@ -86,6 +126,7 @@ impl FtsProgram {
         last: Option<crate::plan::fts::SpiralPoint>,
         safe_w: f64,
         points: &[crate::plan::fts::SpiralPoint],
+        spindle: Option<SpindleHold>,
     ) -> Vec<moves::Move> {
         let mut out = Vec::with_capacity(points.len() + 3);
         let mut last = last;
@@ -94,7 +135,9 @@ impl FtsProgram {
                 None => out.extend(approach(p, p.w, safe_w)),
                 Some(q) => out.push(moves::Move::Linear {
                     to: Position::xzc(p.x, p.w, p.c),
-                    feed: Some(moves::Feed::InverseTime(p.t - q.t)),
+                    feed: Some(moves::Feed::InverseTime(
+                        spindle.map_or(p.t - q.t, |s| s.time(p.t - q.t, q.c, p.c)),
+                    )),
                 }),
             }
             last = Some(*p);
@@ -113,7 +156,7 @@ impl FtsProgram {
         if self.table.is_some() {
             return self.extend_table(points);
         }
-        let stream = Self::moves(self.last, self.safe_w, points);
+        let stream = Self::moves(self.last, self.safe_w, points, self.spindle);
         if let Some(p) = points.last() {
             self.last = Some(*p);
         }
@@ -164,7 +207,7 @@ impl FtsProgram {
                 }
                 Some(q) if p.c - q.c >= 2.0 * PI * (1.0 - 1e-12) => {
                     table.programmed = Some(*p);
-                    self.writer.write(&revolution(&q, p))?;
+                    self.writer.write(&revolution(&q, p, self.spindle))?;
                 }
                 Some(_) => {}
             }
@@ -193,7 +236,7 @@ impl FtsProgram {
             if let (Some(q), Some(p)) = (table.programmed, self.last)
                 && q != p
             {
-                self.writer.write(&revolution(&q, &p))?;
+                self.writer.write(&revolution(&q, &p, self.spindle))?;
             }
             for line in self.writer.dialect().fts_off.clone() {
                 self.writer
@@ -232,13 +275,51 @@ fn approach(p: &crate::plan::fts::SpiralPoint, z: f64, safe_w: f64) -> [moves::M
 }
 
 /// X and C from spiral point `q` to `p` in the time the spiral takes.
-fn revolution(q: &crate::plan::fts::SpiralPoint, p: &crate::plan::fts::SpiralPoint) -> moves::Move {
+fn revolution(
+    q: &crate::plan::fts::SpiralPoint,
+    p: &crate::plan::fts::SpiralPoint,
+    spindle: Option<SpindleHold>,
+) -> moves::Move {
     moves::Move::Linear {
         to: Position {
             x: p.x,
             c: p.c,
             ..Position::KEEP
         },
-        feed: Some(moves::Feed::InverseTime(p.t - q.t)),
+        feed: Some(moves::Feed::InverseTime(
+            spindle.map_or(p.t - q.t, |s| s.time(p.t - q.t, q.c, p.c)),
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The steps of a spiral near its centre at the spindle's limit: C
+    /// printed to 5 decimals of a degree, each step's F as printed read
+    /// back (the reader's rule: |ΔC| F / 360 ≤ the limit in rpm).
+    #[test]
+    fn no_step_turns_c_faster_than_the_spindle_limit_as_printed() {
+        let hold = SpindleHold {
+            max_speed: 1000.0 / 60.0 * 2.0 * PI,
+            c_decimals: 5,
+        };
+        let printed = |c: f64| (c.to_degrees() * 1e5).round() / 1e5;
+        let f_printed = |t: f64| (60.0 / t * 1e3).round() / 1e3;
+        let mut slowed = 0;
+        for k in 0..2000 {
+            // Steps of 1° to 350° planned at exactly 1000 rpm.
+            let c0 = 0.37 + k as f64 * 0.001;
+            let c1 = c0 + (1.0 + k as f64 * 0.17).to_radians();
+            let planned = (c1 - c0) / hold.max_speed;
+            let t = hold.time(planned, c0, c1);
+            assert!(t >= planned);
+            slowed += usize::from(t > planned);
+            let rpm = (printed(c1) - printed(c0)).abs() * f_printed(t) / 360.0;
+            assert!(rpm <= 1000.0 * (1.0 + 1e-12), "{k}: {rpm}");
+        }
+        // Rounding lengthens about half the printed steps.
+        assert!(slowed > 200, "{slowed}");
     }
 }

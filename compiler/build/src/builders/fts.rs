@@ -74,6 +74,7 @@ pub fn build(
         table_name.as_deref(),
     )
     .map_err(not_printable)?;
+    program.hold_spindle_under(spec.max_spindle_speed);
     program.call_tool(&head.start).map_err(not_printable)?;
     let mut sink = ProgramSink::new(spool_dir, site)?;
     let mut table_sink = match table_name {

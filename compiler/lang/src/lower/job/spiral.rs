@@ -42,6 +42,9 @@ pub struct SpiralSpec {
     /// The surface as declared: what the trajectory is made from again
     /// at another speed (`at_speed`).
     pub surface_object: Object,
+    /// The machine's spindle limit (rad/s): no move of the program may
+    /// turn C faster, as printed.
+    pub max_spindle_speed: f64,
 }
 
 /// A spiral job at another speed: what a search for the highest speed
@@ -175,6 +178,7 @@ pub(super) fn lower(
         safe_w,
         lenslets: lenslets(surface),
         surface_object: surface.clone(),
+        max_spindle_speed: p.max_spindle_speed(),
     })
 }
 
