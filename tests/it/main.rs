@@ -25,6 +25,7 @@ mod interrupt;
 mod jit_conformance;
 mod limits;
 mod list;
+mod lsp;
 mod plots;
 mod rs274;
 mod sandbox;
