@@ -14,6 +14,7 @@ mod cli;
 mod determinism;
 mod diagnostics;
 mod dialects;
+mod editors;
 mod examples;
 mod explain;
 mod floods;
