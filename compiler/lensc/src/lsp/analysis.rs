@@ -16,8 +16,13 @@ use lsp_types::{self as lsp, Uri};
 
 use super::text::{LineIndex, path_to_uri, uri_to_path};
 
+/// The open documents by their URI's text (a `Uri` caches parts of
+/// itself in cells, so it is no map key).
+pub type Docs = HashMap<String, Document>;
+
 /// A document the editor has open.
 pub struct Document {
+    pub uri: Uri,
     pub text: String,
     /// Its file, resolved, for `file://` documents.
     pub path: Option<PathBuf>,
@@ -25,7 +30,7 @@ pub struct Document {
 
 /// The documents open, read before the disk.
 pub struct Overlay<'d> {
-    pub docs: &'d HashMap<Uri, Document>,
+    pub docs: &'d Docs,
 }
 
 impl FileSystem for Overlay<'_> {
@@ -49,11 +54,11 @@ pub struct Analysis {
 
 /// Checks the document `uri`: with the workspace root as the project root
 /// when the document lies inside it, else the document's directory.
-pub fn analyse(docs: &HashMap<Uri, Document>, root: Option<&Path>, uri: &Uri) -> Option<Analysis> {
+pub fn analyse(docs: &Docs, root: Option<&Path>, uri: &str) -> Option<Analysis> {
     let doc = docs.get(uri)?;
     let fs = Overlay { docs };
     let Some(path) = &doc.path else {
-        let c = lensc_lang::check_text(&fs, uri.as_str(), doc.text.as_bytes());
+        let c = lensc_lang::check_text(&fs, uri, doc.text.as_bytes());
         return Some(Analysis {
             checked: c,
             refused: None,
@@ -68,7 +73,7 @@ pub fn analyse(docs: &HashMap<Uri, Document>, root: Option<&Path>, uri: &Uri) ->
             refused: None,
         }),
         Err(e) => Some(Analysis {
-            checked: lensc_lang::check_text(&fs, uri.as_str(), b"let unchecked = 0"),
+            checked: lensc_lang::check_text(&fs, uri, b"let unchecked = 0"),
             refused: Some(e.to_string()),
         }),
     }
@@ -77,8 +82,20 @@ pub fn analyse(docs: &HashMap<Uri, Document>, root: Option<&Path>, uri: &Uri) ->
 /// Where the standard library's files are written for an editor to open:
 /// `$XDG_CACHE_HOME/lensc/std-HASH/` (else `~/.cache`, else the temporary
 /// directory), named by a hash of their text so two versions of lensc
-/// never share one. Written once, read-only.
-pub fn stdlib_dir() -> std::io::Result<PathBuf> {
+/// never share one. Written once, read-only; looked for once a session.
+pub fn stdlib_dir() -> Option<&'static Path> {
+    static DIR: std::sync::OnceLock<Option<PathBuf>> = std::sync::OnceLock::new();
+    DIR.get_or_init(|| match write_stdlib() {
+        Ok(d) => Some(d),
+        Err(e) => {
+            eprintln!("lensc lsp: cannot write the standard library for the editor: {e}");
+            None
+        }
+    })
+    .as_deref()
+}
+
+fn write_stdlib() -> std::io::Result<PathBuf> {
     let base = std::env::var_os("XDG_CACHE_HOME")
         .filter(|v| !v.is_empty())
         .map(PathBuf::from)
@@ -118,7 +135,7 @@ pub fn source_uri(a: &Analysis, doc_uri: &Uri, file: FileId) -> Option<Uri> {
         Some(p) => Some(path_to_uri(&absolute(p))),
         None => {
             let module = src.name.strip_prefix("std/")?;
-            Some(path_to_uri(&stdlib_dir().ok()?.join(module)))
+            Some(path_to_uri(&stdlib_dir()?.join(module)))
         }
     }
 }

@@ -113,58 +113,16 @@ fn unit_items() -> Vec<CompletionItem> {
 }
 
 /// The names already given in the innermost block, before and after the
-/// cursor (the text of its bracket, at its own level).
+/// cursor (but not the one being typed).
 fn given_names(text: &str, cx: &Context) -> HashSet<String> {
-    let mut names = HashSet::new();
-    let depth = cx.frames.len();
-    // Every word followed by `:` whose context is this very block.
-    let mut i = 0;
-    while let Some(rel) = text[i..].find(':') {
-        let colon = i + rel;
-        i = colon + 1;
-        if text[colon + 1..].starts_with(':') || text[..colon].ends_with(':') {
-            continue;
-        }
-        let end = text[..colon].trim_end_matches([' ', '\t']).len();
-        let Some((start, w)) = context::word_around(text, end) else {
-            continue;
-        };
-        if start == cx.word_start {
-            continue;
-        }
-        let there = context::at(text, start);
-        if there.frames.len() == depth
-            && !there.in_trivia
-            && there
-                .frames
-                .iter()
-                .zip(&cx.frames)
-                .all(|(a, b)| a.owner == b.owner)
-            && same_bracket(text, start, cx.word_start)
-        {
-            names.insert(w.to_string());
-        }
-    }
-    names
-}
-
-/// Whether no bracket closes between two offsets at the same depth.
-fn same_bracket(text: &str, a: usize, b: usize) -> bool {
-    let (lo, hi) = if a < b { (a, b) } else { (b, a) };
-    let mut depth = 0i32;
-    for c in text[lo..hi].chars() {
-        match c {
-            '{' | '(' | '[' => depth += 1,
-            '}' | ')' | ']' => {
-                depth -= 1;
-                if depth < 0 {
-                    return false;
-                }
-            }
-            _ => {}
-        }
-    }
-    true
+    let Some(frame) = cx.frame() else {
+        return HashSet::new();
+    };
+    context::entries(text)
+        .into_iter()
+        .filter(|(id, _, at)| *id == frame.id && *at != cx.word_start)
+        .map(|(_, name, _)| name)
+        .collect()
 }
 
 /// Where a value goes: the parameter's words, the names in scope, the
@@ -181,7 +139,7 @@ fn value_items(a: Option<&Analysis>, cx: &Context) -> Vec<CompletionItem> {
             item(
                 w,
                 CompletionItemKind::ENUM_MEMBER,
-                Some(format!("{p}")),
+                Some(p.to_string()),
                 None,
             )
         }));

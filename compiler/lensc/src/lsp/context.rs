@@ -25,6 +25,8 @@ pub struct Frame {
     pub at_name: bool,
     /// The parameter whose value is being written, after `name:`.
     pub param: Option<String>,
+    /// Which bracket this is: the count of brackets opened before it.
+    pub id: usize,
 }
 
 /// The cursor's surroundings.
@@ -55,7 +57,8 @@ impl Context {
 
 #[derive(Clone, Debug, PartialEq)]
 enum Tok {
-    Word(String),
+    /// A word and where it starts.
+    Word(String, usize),
     Number,
     Punct(char),
 }
@@ -83,25 +86,56 @@ pub fn at(text: &str, offset: usize) -> Context {
         .last()
         .map_or(offset, |(i, _)| i);
     cx.word = before[cx.word_start..].to_string();
-    let mut toks: Vec<Tok> = Vec::new();
-    let mut chars = text[..cx.word_start].char_indices().peekable();
+    let s = scan(text, cx.word_start);
+    cx.frames = s.frames;
+    cx.in_trivia = s.in_trivia;
+    cx.after_number =
+        s.last == Some(Tok::Number) && !text[..cx.word_start].ends_with('\n') && !cx.in_trivia;
+    // At the top level an item starts at a keyword on a fresh line.
+    cx.item_start = cx.frames.is_empty() && cx.line.trim_start() == cx.word;
+    cx
+}
+
+/// Every `name:` of every block and call in `text`: the bracket it is
+/// written in (`Frame::id`), the name and where it starts.
+pub fn entries(text: &str) -> Vec<(usize, String, usize)> {
+    scan(text, text.len()).entries
+}
+
+/// What a scan of `text[..end]` found.
+#[derive(Default)]
+struct Scan {
+    frames: Vec<Frame>,
+    /// `end` is inside a comment or a string.
+    in_trivia: bool,
+    last: Option<Tok>,
+    /// The token before `last`.
+    prev: Option<Tok>,
+    /// Brackets opened so far: the next frame's id.
+    opened: usize,
+    entries: Vec<(usize, String, usize)>,
+}
+
+fn scan(text: &str, end: usize) -> Scan {
+    let mut s = Scan::default();
+    let mut chars = text[..end].char_indices().peekable();
     while let Some((i, c)) = chars.next() {
-        let rest = &text[i..cx.word_start];
+        let rest = &text[i..end];
         if rest.starts_with("//") {
             match rest.find('\n') {
                 Some(n) => skip_to(&mut chars, i + n),
                 None => {
-                    cx.in_trivia = true;
+                    s.in_trivia = true;
                     break;
                 }
             }
             continue;
         }
-        if rest.starts_with("/*") {
-            match rest[2..].find("*/") {
+        if let Some(inner) = rest.strip_prefix("/*") {
+            match inner.find("*/") {
                 Some(n) => skip_to(&mut chars, i + 2 + n + 2),
                 None => {
-                    cx.in_trivia = true;
+                    s.in_trivia = true;
                     break;
                 }
             }
@@ -122,26 +156,25 @@ pub fn at(text: &str, offset: usize) -> Context {
                 }
             }
             if !closed {
-                cx.in_trivia = true;
+                s.in_trivia = true;
                 break;
             }
-            toks.push(Tok::Punct('"'));
+            s.tok(Tok::Punct('"'));
             continue;
         }
         if c == '\n' {
-            newline(&mut cx.frames, toks.last());
+            newline(&mut s.frames, s.last.as_ref());
             continue;
         }
         if c.is_whitespace() {
             continue;
         }
         if c.is_ascii_digit() {
-            while let Some(&(_, d)) = chars.peek() {
+            while let Some(&(j, d)) = chars.peek() {
                 if d.is_ascii_digit() || d == '.' {
                     chars.next();
                 } else if d == 'e' || d == 'E' {
                     // An exponent only if a digit (or sign) follows.
-                    let j = chars.peek().map_or(0, |(j, _)| *j);
                     let next = text[j + 1..].chars().next();
                     if next.is_some_and(|n| n.is_ascii_digit() || n == '+' || n == '-') {
                         chars.next();
@@ -153,31 +186,25 @@ pub fn at(text: &str, offset: usize) -> Context {
                     break;
                 }
             }
-            toks.push(Tok::Number);
+            s.tok(Tok::Number);
             continue;
         }
         if is_word_char(c) {
-            let mut end = i + c.len_utf8();
+            let mut w_end = i + c.len_utf8();
             while let Some(&(j, d)) = chars.peek() {
                 if !is_word_char(d) {
                     break;
                 }
-                end = j + d.len_utf8();
+                w_end = j + d.len_utf8();
                 chars.next();
             }
-            let w = text[i..end].to_string();
-            toks.push(Tok::Word(w));
+            s.tok(Tok::Word(text[i..w_end].to_string(), i));
             continue;
         }
-        punct(&mut cx.frames, &toks, c);
-        toks.push(Tok::Punct(c));
+        punct(&mut s, c);
+        s.tok(Tok::Punct(c));
     }
-    cx.after_number = toks.last() == Some(&Tok::Number)
-        && !text[..cx.word_start].ends_with('\n')
-        && !cx.in_trivia;
-    // At the top level an item starts at a keyword on a fresh line.
-    cx.item_start = cx.frames.is_empty() && cx.line.trim_start() == cx.word;
-    cx
+    s
 }
 
 fn skip_to(chars: &mut std::iter::Peekable<std::str::CharIndices<'_>>, end: usize) {
@@ -203,47 +230,41 @@ fn newline(frames: &mut [Frame], last: Option<&Tok>) {
     }
 }
 
-fn punct(frames: &mut Vec<Frame>, toks: &[Tok], c: char) {
-    let word = |k: usize| match toks.len().checked_sub(k).and_then(|i| toks.get(i)) {
-        Some(Tok::Word(w)) => Some(w.as_str()),
+fn punct(s: &mut Scan, c: char) {
+    let word = match &s.last {
+        Some(Tok::Word(w, at)) => Some((w.clone(), *at)),
         _ => None,
     };
     match c {
         '{' | '(' => {
-            let owner = match (word(1), word(2)) {
-                (Some(_), Some("job")) if c == '{' => Owner::Job,
-                (Some(w), _) => Owner::Name(w.to_string()),
-                _ if c == '{' && toks.last() == Some(&Tok::Punct(':')) => {
-                    let p = frames.last().and_then(|f| f.param.clone());
-                    p.map_or(Owner::Other, Owner::Param)
+            let owner = match (&word, s.frames.last()) {
+                (Some(_), _) if c == '{' && s.job_name_follows() => Owner::Job,
+                (Some((w, _)), _) => Owner::Name(w.clone()),
+                (None, Some(f)) if c == '{' && s.last == Some(Tok::Punct(':')) => {
+                    f.param.clone().map_or(Owner::Other, Owner::Param)
                 }
                 _ => Owner::Other,
             };
             let at_name = owner != Owner::Other;
-            frames.push(Frame {
-                owner,
-                at_name,
-                param: None,
-            });
+            s.push(owner, at_name);
         }
-        '[' => frames.push(Frame {
-            owner: Owner::Other,
-            at_name: false,
-            param: None,
-        }),
+        '[' => s.push(Owner::Other, false),
         '}' | ')' | ']' => {
-            frames.pop();
+            s.frames.pop();
         }
         ':' => {
-            if let Some(f) = frames.last_mut()
+            if let Some(f) = s.frames.last_mut()
                 && f.at_name
             {
                 f.at_name = false;
-                f.param = word(1).map(str::to_string);
+                f.param = word.as_ref().map(|(w, _)| w.clone());
+                if let Some((w, at)) = word {
+                    s.entries.push((f.id, w, at));
+                }
             }
         }
         ',' => {
-            if let Some(f) = frames.last_mut()
+            if let Some(f) = s.frames.last_mut()
                 && f.owner != Owner::Other
             {
                 f.at_name = true;
@@ -251,11 +272,32 @@ fn punct(frames: &mut Vec<Frame>, toks: &[Tok], c: char) {
             }
         }
         '=' => {
-            if let Some(f) = frames.last_mut() {
+            if let Some(f) = s.frames.last_mut() {
                 f.at_name = false;
             }
         }
         _ => {}
+    }
+}
+
+impl Scan {
+    fn push(&mut self, owner: Owner, at_name: bool) {
+        self.frames.push(Frame {
+            owner,
+            at_name,
+            param: None,
+            id: self.opened,
+        });
+        self.opened += 1;
+    }
+
+    fn tok(&mut self, t: Tok) {
+        self.prev = self.last.replace(t);
+    }
+
+    /// Whether the word just read is a job's name (`job NAME {`).
+    fn job_name_follows(&self) -> bool {
+        matches!(&self.prev, Some(Tok::Word(w, _)) if w == "job")
     }
 }
 

@@ -27,7 +27,7 @@ use lsp_types::request::{self as req, Request as _};
 use lsp_types::{self as lsp, Uri};
 use serde::de::DeserializeOwned;
 
-use analysis::{Analysis, Document};
+use analysis::{Analysis, Docs, Document};
 use text::LineIndex;
 
 /// Runs the server until the editor says `exit`; returns the exit code.
@@ -86,11 +86,18 @@ fn serve(connection: &Connection) -> Result<(), Box<dyn std::error::Error + Send
                 if connection.handle_shutdown(&r)? {
                     return Ok(());
                 }
-                let resp = server.request(r);
+                let id = r.id.clone();
+                let resp = guarded(|| server.request(r)).unwrap_or_else(|| {
+                    Response::new_err(
+                        id,
+                        ErrorCode::InternalError as i32,
+                        "lensc lsp failed on this request (a bug: please report it)".into(),
+                    )
+                });
                 connection.sender.send(Message::Response(resp))?;
             }
             Message::Notification(n) => {
-                for out in server.notification(n) {
+                for out in guarded(|| server.notification(n)).unwrap_or_default() {
                     connection.sender.send(Message::Notification(out))?;
                 }
             }
@@ -98,6 +105,13 @@ fn serve(connection: &Connection) -> Result<(), Box<dyn std::error::Error + Send
         }
     }
     Ok(())
+}
+
+/// A bug that panics on one message costs that answer (an internal
+/// error; the panic's message goes to stderr, the editor's log), never
+/// the session.
+fn guarded<T>(f: impl FnOnce() -> T) -> Option<T> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).ok()
 }
 
 /// The first workspace folder (or the root URI) the editor opened.
@@ -113,9 +127,9 @@ fn workspace_root(p: &lsp::InitializeParams) -> Option<PathBuf> {
 }
 
 struct Server {
-    docs: HashMap<Uri, Document>,
-    /// Each open document checked after its last change.
-    analyses: HashMap<Uri, Analysis>,
+    docs: Docs,
+    /// Each open document checked after its last change, by URI.
+    analyses: HashMap<String, Analysis>,
     root: Option<PathBuf>,
 }
 
@@ -127,27 +141,27 @@ impl Server {
                     let uri = p.text_document.uri;
                     let path = analysis::document_path(&uri);
                     self.docs.insert(
-                        uri.clone(),
+                        uri.as_str().to_string(),
                         Document {
+                            uri,
                             text: p.text_document.text,
                             path,
                         },
                     );
-                    uri
                 }),
             note::DidChangeTextDocument::METHOD => {
                 params::<lsp::DidChangeTextDocumentParams>(n.params).and_then(|p| {
-                    let doc = self.docs.get_mut(&p.text_document.uri)?;
+                    let doc = self.docs.get_mut(p.text_document.uri.as_str())?;
                     for c in p.content_changes {
                         apply_change(&mut doc.text, c);
                     }
-                    Some(p.text_document.uri)
+                    Some(())
                 })
             }
             note::DidCloseTextDocument::METHOD => {
                 if let Some(p) = params::<lsp::DidCloseTextDocumentParams>(n.params) {
-                    self.docs.remove(&p.text_document.uri);
-                    self.analyses.remove(&p.text_document.uri);
+                    self.docs.remove(p.text_document.uri.as_str());
+                    self.analyses.remove(p.text_document.uri.as_str());
                     return vec![publish(p.text_document.uri, Vec::new())];
                 }
                 None
@@ -160,13 +174,14 @@ impl Server {
         // A change can change what every other open document sees through
         // its `use`s: all are checked again (a handful, each in
         // milliseconds).
-        let uris: Vec<Uri> = self.docs.keys().cloned().collect();
+        let keys: Vec<String> = self.docs.keys().cloned().collect();
         let mut out = Vec::new();
-        for u in uris {
-            if let Some(a) = analysis::analyse(&self.docs, self.root.as_deref(), &u) {
-                let diags = analysis::diagnostics(&a, &u, &self.docs[&u].text);
-                out.push(publish(u.clone(), diags));
-                self.analyses.insert(u, a);
+        for k in keys {
+            if let Some(a) = analysis::analyse(&self.docs, self.root.as_deref(), &k) {
+                let doc = &self.docs[&k];
+                let diags = analysis::diagnostics(&a, &doc.uri, &doc.text);
+                out.push(publish(doc.uri.clone(), diags));
+                self.analyses.insert(k, a);
             }
         }
         out
@@ -219,18 +234,18 @@ impl Server {
         let p: lsp::TextDocumentPositionParams =
             serde_json::from_value(r.params.clone()).map_err(|e| format!("bad parameters: {e}"))?;
         let uri = &p.text_document.uri;
-        let Some(doc) = self.docs.get(uri) else {
+        let Some(doc) = self.docs.get(uri.as_str()) else {
             return Ok(serde_json::Value::Null);
         };
         let at = LineIndex::new(&doc.text).offset(p.position);
-        let v = answer(self.analyses.get(uri), uri, &doc.text, at);
+        let v = answer(self.analyses.get(uri.as_str()), uri, &doc.text, at);
         serde_json::to_value(v).map_err(|e| e.to_string())
     }
 
     /// The document in `lensc fmt`'s layout, as one edit; no edit when it
     /// is already, or while it has syntax errors (shown as diagnostics).
     fn format(&self, uri: &Uri) -> serde_json::Value {
-        let Some(doc) = self.docs.get(uri) else {
+        let Some(doc) = self.docs.get(uri.as_str()) else {
             return serde_json::Value::Null;
         };
         let edits = match lensc_lang::format::format_source(&doc.text) {
@@ -269,4 +284,61 @@ fn publish(uri: Uri, diagnostics: Vec<lsp::Diagnostic>) -> Notification {
             version: None,
         },
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use super::*;
+
+    /// Every example, standard-library file and file of the bad-input
+    /// corpora, asked for hover, completion and definition at every 11th
+    /// byte and formatted: no answer panics, and every position maps back
+    /// to its offset's character.
+    #[test]
+    fn no_question_about_any_corpus_file_panics() {
+        let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let mut files = Vec::new();
+        for dir in ["examples", "stdlib", "tests/bad", "tests/bad_builds"] {
+            for e in std::fs::read_dir(repo.join(dir)).expect(dir) {
+                let p = e.expect("entry").path();
+                if p.extension().is_some_and(|x| x == "lens") {
+                    files.push(p);
+                }
+            }
+        }
+        assert!(files.len() > 100, "{}", files.len());
+        let mut asked = 0;
+        for path in files {
+            let Ok(text) = std::fs::read_to_string(&path) else {
+                continue; // a corpus file that is not UTF-8
+            };
+            let uri = text::path_to_uri(&path.canonicalize().expect("path"));
+            let mut docs = Docs::new();
+            docs.insert(
+                uri.as_str().to_string(),
+                Document {
+                    uri: uri.clone(),
+                    path: analysis::document_path(&uri),
+                    text: text.clone(),
+                },
+            );
+            let a = analysis::analyse(&docs, None, uri.as_str()).expect("analysed");
+            let _ = analysis::diagnostics(&a, &uri, &text);
+            let ix = LineIndex::new(&text);
+            for at in (0..=text.len()).step_by(11) {
+                let p = ix.position(at);
+                let back = ix.offset(p);
+                let char_start = (0..=at).rev().find(|&i| text.is_char_boundary(i));
+                assert_eq!(Some(back), char_start, "{path:?} {at}");
+                let _ = hover::hover(Some(&a), &text, at);
+                let _ = completion::complete(Some(&a), &text, at);
+                let _ = definition::definition(&a, &uri, &text, at);
+                asked += 1;
+            }
+            let _ = lensc_lang::format::format_source(&text);
+        }
+        assert!(asked > 1000, "{asked}");
+    }
 }
