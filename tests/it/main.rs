@@ -9,6 +9,7 @@
 
 mod common;
 
+mod bad_programs;
 mod build_errors;
 mod cli;
 mod determinism;
@@ -28,6 +29,7 @@ mod limits;
 mod list;
 mod lsp;
 mod plots;
+mod read_back;
 mod rs274;
 mod sandbox;
 mod seed_sketches;
