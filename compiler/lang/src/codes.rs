@@ -63,6 +63,14 @@ pub const TOLERANCE_BELOW_RESOLUTION: &str = "E0180";
 /// same program (a formatter bug; the file is left as it is).
 pub const FORMAT_WOULD_CHANGE_MEANING: &str = "E0185";
 
+/// The simulated part misses one of its job's acceptance criteria (the
+/// message names which, by how much and where); no program is written.
+pub const ACCEPTANCE_MISSED: &str = "E0195";
+/// A job's acceptance criterion that its simulation cannot measure (a
+/// tool shape the height map does not model, no servo model); no program
+/// is written unless the job says `accept: none`.
+pub const ACCEPTANCE_UNMEASURED: &str = "E0196";
+
 pub const UNUSED: &str = "W0001";
 pub const WRAP_GAP: &str = "W0002";
 pub const SEAM_LEFT_UNCUT: &str = "W0003";
@@ -70,6 +78,10 @@ pub const CENTRE_LEFT_UNCUT: &str = "W0004";
 /// A servo's data period keeps a spiral's chords from meeting their share
 /// of the path tolerance.
 pub const CHORDS_OVER_TOLERANCE: &str = "W0005";
+/// E0195 under `lensc build --accept=warn`: the program is written.
+pub const ACCEPTANCE_MISSED_WARNING: &str = "W0020";
+/// E0196 under `lensc build --accept=warn`: the program is written.
+pub const ACCEPTANCE_UNMEASURED_WARNING: &str = "W0021";
 
 /// All codes, for the uniqueness test and the reference in README.
 // Programs read back from their text (`lensc verify`, and `lensc build`
@@ -225,6 +237,8 @@ pub const ALL: &[&str] = &[
     TOO_MANY_POINTS,
     PROGRAM_TOO_LARGE,
     TOLERANCE_BELOW_RESOLUTION,
+    ACCEPTANCE_MISSED,
+    ACCEPTANCE_UNMEASURED,
     UNUSED,
     SEAM_LEFT_UNCUT,
     CENTRE_LEFT_UNCUT,
@@ -260,6 +274,8 @@ pub const ALL: &[&str] = &[
     PROGRAM_BLOCK_END,
     PROGRAM_END,
     PROGRAM_NESTED_COMMENT,
+    ACCEPTANCE_MISSED_WARNING,
+    ACCEPTANCE_UNMEASURED_WARNING,
 ];
 
 #[cfg(test)]
