@@ -1,5 +1,5 @@
 //! The `lensc` command line: `check`, `build`, `report`, `analyse`,
-//! `sample`, `fmt`, `list` and `explain`. Exit codes: 0 success (warnings allowed), 1 errors in the
+//! `sample`, `fmt`, `list`, `explain` and `lsp` (a language server). Exit codes: 0 success (warnings allowed), 1 errors in the
 //! input, 2 usage errors, 101 an internal error, 130 and 143 a `build` or
 //! `report` stopped by SIGINT or SIGTERM.
 
@@ -11,6 +11,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 
 mod commands;
 mod interrupt;
+mod lsp;
 mod output;
 
 use lensc_build::driver;
@@ -188,6 +189,10 @@ enum Command {
         #[arg(long, value_enum, default_value_t = Format::Human)]
         format: Format,
     },
+    /// Run a language server on stdin and stdout for an editor: diagnostics
+    /// as you type, hover, completion, go to definition and formatting
+    /// (editors/README.md says how to set one up).
+    Lsp,
 }
 
 /// How `list` and `explain` print.
@@ -250,6 +255,7 @@ fn run(cli: Cli) -> u8 {
         all_diagnostics: cli.all_diagnostics,
     };
     match cli.command {
+        Command::Lsp => lsp::run(),
         Command::List {
             category,
             name,
