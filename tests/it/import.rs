@@ -119,11 +119,11 @@ fn cases() -> Vec<(&'static str, Vec<Want>, Vec<&'static str>, f64)> {
     let cone = want(
         "surface_1",
         // z = tan(0.5°) r: the axicon's cone.
-        Sag::Rotational(f64::INFINITY, 0.0, &[(1, 0.008726867790758790)]),
+        Sag::Rotational(f64::INFINITY, 0.0, &[(1, 0.008_726_867_790_758_79)]),
         11.43,
         false,
     );
-    assert!((0.5f64.to_radians().tan() - 0.008726867790758790).abs() < 1e-17);
+    assert!((0.5f64.to_radians().tan() - 0.008_726_867_790_758_79).abs() < 1e-17);
     let bench = vec![
         want(
             "surface_1",

@@ -162,3 +162,37 @@ fn numbers_read_back_to_the_last_place() {
     assert_eq!(write::num(-2e-8), "-2e-8");
     assert_eq!(write::num(0.02), "0.02");
 }
+
+#[test]
+fn a_surface_without_a_semi_diameter_is_named_and_skipped() {
+    let json = r#"{"surface_group": {"surfaces": [
+        {"geometry": {"type": "Plane"}},
+        {"geometry": {"type": "StandardGeometry", "radius": 30.0, "conic": -1.0, "cs": {"x": 0.5}}, "aperture": null},
+        {"geometry": {"type": "Plane"}}]}}"#;
+    let out = import("o.json", json.as_bytes());
+    let codes: Vec<&str> = out.diags.iter().map(|d| d.code).collect();
+    assert_eq!(
+        codes,
+        vec![
+            codes::IMPORT_POSITION_IGNORED,
+            codes::IMPORT_NO_SEMI_DIAMETER,
+            codes::IMPORT_NOTHING
+        ]
+    );
+    assert!(out.lens.is_none());
+}
+
+#[test]
+fn a_toroid_sweeping_away_from_its_profile_is_not_imported() {
+    let text = SINGLET.replace(
+        "SURF 2\n  TYPE STANDARD\n  CURV -0.01",
+        "SURF 2\n  TYPE TOROIDAL\n  CURV -0.01\n  PARM 1 40",
+    );
+    let out = import("t.zmx", text.as_bytes());
+    assert_eq!(out.diags[0].code, codes::IMPORT_UNSUPPORTED_SURFACE);
+    assert!(
+        out.diags[0].message.contains("toroid"),
+        "{}",
+        out.diags[0].message
+    );
+}
