@@ -2,7 +2,8 @@
 //! file through `lensc-lang`; the pipeline lowers each job to its typed
 //! `JobSpec` and hands it to its strategy's builder (`builders/`), which
 //! plans with `lensc-runtime`, emits the program (spooled and written
-//! atomically), simulates what it will cut and fills the build report;
+//! atomically, once read back by the controllers' rules: `read_back`),
+//! simulates what it will cut and fills the build report;
 //! plots draw that report.
 
 pub mod builders;
@@ -13,6 +14,7 @@ pub mod output;
 pub(crate) mod parts;
 pub mod pipeline;
 pub mod plots;
+pub mod read_back;
 pub mod report;
 pub(crate) mod spool;
 pub mod temps;

@@ -84,8 +84,16 @@ pub fn plan_and_emit(
         .iter()
         .filter(|j| request.job.is_none_or(|n| j.name.name == n));
     for job in jobs {
-        let built = lower(job, request.dialect, &request.limits())
-            .and_then(|(spec, est)| Ok((build(&spec, &prov, spool_dir)?, est)));
+        let built = lower(job, request.dialect, &request.limits()).and_then(|(spec, est)| {
+            let b = build(&spec, &prov, spool_dir)?;
+            if crate::read_back::enabled() {
+                let refused = crate::read_back::findings(job, spec.head(), &b.program);
+                if !refused.is_empty() {
+                    return Err(refused);
+                }
+            }
+            Ok((b, est))
+        });
         match built {
             Ok((mut b, est)) => {
                 b.report.estimate = (&est).into();

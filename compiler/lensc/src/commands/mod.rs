@@ -10,3 +10,4 @@ pub mod import;
 pub mod list;
 pub mod report;
 pub mod sample;
+pub mod verify;
