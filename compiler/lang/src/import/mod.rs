@@ -84,6 +84,21 @@ pub enum Shape {
         rotation_radius: Option<f64>,
         terms: Vec<(u32, f64)>,
     },
+    /// A conic of revolution plus Σ c_ij x^i y^j, each (i, j, c_ij) in
+    /// mm^(1−i−j).
+    XyPolynomial {
+        curvature: f64,
+        conic: f64,
+        terms: Vec<(u32, u32, f64)>,
+    },
+    /// A conic of revolution plus Σ a_j Z_j(ρ, θ), ρ = r / `norm_radius`,
+    /// the Z_j normalised and numbered as ANSI Z80.28 (j from 0), a_j in mm.
+    Zernike {
+        curvature: f64,
+        conic: f64,
+        norm_radius: f64,
+        terms: Vec<(u32, f64)>,
+    },
 }
 
 impl Shape {
@@ -100,6 +115,12 @@ impl Shape {
                 terms,
                 ..
             } => *cy == 0.0 && rotation_radius.is_none() && terms.iter().all(|(_, a)| *a == 0.0),
+            Shape::XyPolynomial {
+                curvature, terms, ..
+            } => *curvature == 0.0 && terms.iter().all(|(_, _, a)| *a == 0.0),
+            Shape::Zernike {
+                curvature, terms, ..
+            } => *curvature == 0.0 && terms.iter().all(|(_, a)| *a == 0.0),
         }
     }
 
@@ -138,6 +159,30 @@ impl Shape {
                     Some(r) => r - r.signum() * ((r - zy).powi(2) - x * x).sqrt(),
                 }
             }
+            Shape::XyPolynomial {
+                curvature,
+                conic: k,
+                terms,
+            } => {
+                conic(*curvature, *k, x * x + y * y)
+                    + terms
+                        .iter()
+                        .map(|(i, j, c)| c * x.powi(*i as i32) * y.powi(*j as i32))
+                        .sum::<f64>()
+            }
+            Shape::Zernike {
+                curvature,
+                conic: k,
+                norm_radius,
+                terms,
+            } => {
+                let (rho, theta) = ((x * x + y * y).sqrt() / norm_radius, y.atan2(x));
+                conic(*curvature, *k, x * x + y * y)
+                    + terms
+                        .iter()
+                        .map(|(j, a)| a * zernike_ansi_value(*j, rho, theta))
+                        .sum::<f64>()
+            }
         }
     }
 
@@ -172,8 +217,93 @@ impl Shape {
                 rotation_radius: rotation_radius.map(|r| -r),
                 terms: neg(terms),
             },
+            // Turned over about y, x becomes −x: a term odd in x keeps its
+            // sign when the sag's is reversed.
+            Shape::XyPolynomial {
+                curvature,
+                conic,
+                terms,
+            } => Shape::XyPolynomial {
+                curvature: -curvature,
+                conic: *conic,
+                terms: terms
+                    .iter()
+                    .map(|(i, j, c)| (*i, *j, if i % 2 == 1 { *c } else { -c }))
+                    .collect(),
+            },
+            // θ becomes π − θ: cos mθ changes sign with m odd, sin mθ with m even.
+            Shape::Zernike {
+                curvature,
+                conic,
+                norm_radius,
+                terms,
+            } => Shape::Zernike {
+                curvature: -curvature,
+                conic: *conic,
+                norm_radius: *norm_radius,
+                terms: terms
+                    .iter()
+                    .map(|(j, a)| {
+                        let (_, m) = ansi_nm(*j);
+                        let odd_in_x = if m >= 0 { m % 2 == 1 } else { m % 2 == 0 };
+                        (*j, if odd_in_x { *a } else { -a })
+                    })
+                    .collect(),
+            },
         }
     }
+}
+
+/// (n, m) of ANSI Z80.28 index j (from 0): m < 0 is a sine term.
+pub fn ansi_nm(j: u32) -> (u32, i32) {
+    let mut n = 0;
+    while (n + 1) * (n + 2) / 2 <= j {
+        n += 1;
+    }
+    (n, 2 * j as i32 - (n * (n + 2)) as i32)
+}
+
+/// (n, m) of Noll's index j (from 1, Zemax's "Zernike Standard" order):
+/// m < 0 is a sine term, odd j the sines.
+pub fn noll_nm(j: u32) -> (u32, i32) {
+    let mut n = 0;
+    while (n + 1) * (n + 2) / 2 < j {
+        n += 1;
+    }
+    let k = j - n * (n + 1) / 2;
+    let m = if n % 2 == 0 {
+        2 * (k / 2)
+    } else {
+        2 * ((k - 1) / 2) + 1
+    } as i32;
+    (n, if m != 0 && j % 2 == 1 { -m } else { m })
+}
+
+/// The ANSI index of (n, m).
+pub fn ansi_index(n: u32, m: i32) -> u32 {
+    ((n * (n + 2)) as i32 + m) as u32 / 2
+}
+
+/// Z_j(ρ, θ), ANSI-numbered and normalised: sqrt(2(n+1)/(1+δ_m0))
+/// R_n^|m|(ρ) cos mθ (m ≥ 0) or sin |m|θ (m < 0).
+fn zernike_ansi_value(j: u32, rho: f64, theta: f64) -> f64 {
+    let (n, m) = ansi_nm(j);
+    let ma = m.unsigned_abs();
+    let fact = |k: u32| (1..=k).map(f64::from).product::<f64>();
+    let radial: f64 = (0..=(n - ma) / 2)
+        .map(|s| {
+            let sign = if s % 2 == 0 { 1.0 } else { -1.0 };
+            sign * fact(n - s) / (fact(s) * fact((n + ma) / 2 - s) * fact((n - ma) / 2 - s))
+                * rho.powi((n - 2 * s) as i32)
+        })
+        .sum();
+    let norm = (2.0 * f64::from(n + 1) / if m == 0 { 2.0 } else { 1.0 }).sqrt();
+    let angular = if m >= 0 {
+        (f64::from(ma) * theta).cos()
+    } else {
+        (f64::from(ma) * theta).sin()
+    };
+    norm * radial * angular
 }
 
 /// Which reader a file is for.

@@ -196,3 +196,25 @@ fn a_toroid_sweeping_away_from_its_profile_is_not_imported() {
         out.diags[0].message
     );
 }
+
+#[test]
+fn noll_numbers_map_to_ansi_as_opticstudio_lists_them() {
+    // Z2 cos, Z3 sin, Z5 sin 2θ, Z6 cos 2θ, Z7 sin θ, Z11 spherical.
+    let want = [
+        (1, (0, 0)),
+        (2, (1, 1)),
+        (3, (1, -1)),
+        (4, (2, 0)),
+        (5, (2, -2)),
+        (6, (2, 2)),
+        (7, (3, -1)),
+        (8, (3, 1)),
+        (9, (3, -3)),
+        (10, (3, 3)),
+        (11, (4, 0)),
+    ];
+    for (j, nm) in want {
+        assert_eq!(noll_nm(j), nm, "Z{j}");
+        assert_eq!(ansi_nm(ansi_index(nm.0, nm.1)), nm);
+    }
+}

@@ -56,8 +56,8 @@ fn surface(out: &mut String, e: &Entry, s: &Surface) {
         Some(glass) => {
             let _ = writeln!(
                 out,
-                "// A rear surface ({} before it): turned over for the tool, so every\n\
-                 // curvature and coefficient has the opposite sign to the designer's.",
+                "// A rear surface ({} before it): the tool meets it with the part turned\n\
+                 // over about y, so this is the designer's sag reversed in sign (and in x).",
                 clean(glass)
             );
             s.shape.turned_over()
@@ -134,12 +134,47 @@ fn surface(out: &mut String, e: &Entry, s: &Surface) {
             fields.extend(coefficients(terms));
             "toroid"
         }
+        Shape::XyPolynomial {
+            curvature,
+            conic,
+            terms,
+        } => {
+            base(&mut fields, *curvature, *conic);
+            optical(&mut fields, &aperture);
+            fields.extend(
+                terms
+                    .iter()
+                    .map(|(i, j, c)| format!("X{i}Y{j}: {}", coefficient(i + j, *c))),
+            );
+            "xy_polynomial"
+        }
+        Shape::Zernike {
+            curvature,
+            conic,
+            norm_radius,
+            terms,
+        } => {
+            base(&mut fields, *curvature, *conic);
+            optical(&mut fields, &aperture);
+            fields.push(format!("norm_radius: {} mm", num(*norm_radius)));
+            fields.push("ordering: ansi".into());
+            fields.extend(terms.iter().map(|(j, a)| format!("Z{j}: {} mm", num(*a))));
+            "zernike"
+        }
     };
     let _ = writeln!(out, "surface {name} = {kind} {{");
     for f in fields {
         let _ = writeln!(out, "    {f}");
     }
     out.push_str("}\n");
+}
+
+/// The conic base of a polynomial or Zernike surface (none when flat).
+fn base(fields: &mut Vec<String>, curvature: f64, conic: f64) {
+    if curvature != 0.0 {
+        fields.push(format!("radius: {} mm", num(1.0 / curvature)));
+        fields.push(format!("conic: {}", num(conic)));
+    }
 }
 
 /// `convention: optical` and the aperture.

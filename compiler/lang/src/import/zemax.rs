@@ -10,7 +10,8 @@
 //! TOROIDAL, PARM 1 the radius of rotation (0 is a cylinder), PARM 2…8
 //! the coefficients α1 … α7 of y², y⁴ … y¹⁴ of the y–z profile and PARM 0
 //! its extrapolation flag (no part of the shape). COORDBRK moves
-//! the surfaces after it and is not a surface. Every other type, every
+//! the surfaces after it and is not a surface. XPOLYNOM and SZERNSAG keep
+//! their terms in extra data (`extra_data_shape`). Every other type, every
 //! parameter a type does not use and all extra data are named in a
 //! warning, never dropped silently.
 
@@ -170,7 +171,8 @@ fn surfaces_to_entries(
             .glass
             .as_deref()
             .is_some_and(|g| g.eq_ignore_ascii_case("MIRROR"));
-        if i > 0 && !mirror {
+        // A coordinate break moves the axes, not the light out of its medium.
+        if i > 0 && !mirror && type_name != "COORDBRK" {
             medium = s.glass.clone().filter(|g| !is_air(g));
         }
         if type_name == "COORDBRK" {
@@ -247,8 +249,26 @@ fn shape(
         "EVENASPH" | "ODDASPHE" | "ODDASPH" => &[1, 2, 3, 4, 5, 6, 7, 8],
         "BICONICX" => &[1, 2],
         "TOROIDAL" => &[0, 1, 2, 3, 4, 5, 6, 7, 8],
+        "XPOLYNOM" => &[],
+        "SZERNSAG" => &[0],
         other => return Err(format!("lensc does not import Zemax {other} surfaces")),
     };
+    if matches!(type_name, "XPOLYNOM" | "SZERNSAG") {
+        for (i, (v, span)) in &s.parms {
+            if *v != 0.0 && !used.contains(i) {
+                let what = if type_name == "SZERNSAG" && (1..=8).contains(i) {
+                    format!(
+                        "the r^{} term α{i} = {v} (lensc's `zernike` has no power terms)",
+                        2 * i
+                    )
+                } else {
+                    format!("parameter {i} = {v} of a {type_name} surface")
+                };
+                dropped.push((*span, what));
+            }
+        }
+        return extra_data_shape(s, type_name, scale, dropped);
+    }
     for (i, (v, span)) in &s.parms {
         if *v != 0.0 && !used.contains(i) {
             dropped.push((
@@ -306,6 +326,91 @@ fn shape(
             terms: terms(&|i| 2 * i, 2, 8, dropped),
         },
     })
+}
+
+/// The shapes held in extra data: XDAT 1 the number of terms N, XDAT 2
+/// the normalisation radius R, XDAT 3 … N+2 the terms' coefficients (lens
+/// units). XPOLYNOM (extended polynomial): term t of x, y, x², xy, y², x³ …
+/// over (x/R, y/R). SZERNSAG (Zernike standard sag): Noll's Z1 … ZN over
+/// r/R, normalised, written in lensc's ANSI numbering.
+fn extra_data_shape(
+    s: &Raw,
+    type_name: &str,
+    scale: f64,
+    dropped: &mut Vec<(Span, String)>,
+) -> Result<Shape, String> {
+    let xdat = |i: u32| s.xdat.get(&i).map_or(0.0, |(v, _)| *v);
+    let count = xdat(1).max(0.0) as u32;
+    let norm = xdat(2) * scale;
+    if norm <= 0.0 {
+        return Err("its normalisation radius (extra data 2) is not positive".into());
+    }
+    let mut terms = Vec::new();
+    for (i, (v, span)) in &s.xdat {
+        let t = i.wrapping_sub(2);
+        if *i < 3 || *v == 0.0 {
+            continue;
+        }
+        if t > count {
+            dropped.push((
+                *span,
+                format!("extra data {i} = {v} (past the {count} terms extra data 1 counts)"),
+            ));
+            continue;
+        }
+        terms.push((t, v * scale, *span));
+    }
+    let (curvature, conic) = (s.curv / scale, s.conic);
+    if type_name == "XPOLYNOM" {
+        let mut kept = Vec::new();
+        for (t, a, span) in terms {
+            let (i, j) = xy_term(t);
+            if i + j > super::TOP_POWER {
+                dropped.push((
+                    span,
+                    format!("the x^{i} y^{j} term (lensc names powers up to 20)"),
+                ));
+            } else {
+                kept.push((i, j, a / norm.powi((i + j) as i32)));
+            }
+        }
+        return Ok(Shape::XyPolynomial {
+            curvature,
+            conic,
+            terms: kept,
+        });
+    }
+    let mut kept = Vec::new();
+    for (t, a, span) in terms {
+        let (n, m) = super::noll_nm(t);
+        if n > super::TOP_POWER {
+            dropped.push((
+                span,
+                format!("Zernike term {t} (radial order {n}; lensc goes to 20)"),
+            ));
+        } else {
+            kept.push((super::ansi_index(n, m), a));
+        }
+    }
+    kept.sort_by_key(|t| t.0);
+    Ok(Shape::Zernike {
+        curvature,
+        conic,
+        norm_radius: norm,
+        terms: kept,
+    })
+}
+
+/// (i, j) of the extended polynomial's term t (from 1): x, y, x², xy, y², x³ …
+fn xy_term(t: u32) -> (u32, u32) {
+    let mut degree = 1;
+    let mut first = 1;
+    while t > first + degree {
+        first += degree + 1;
+        degree += 1;
+    }
+    let j = t - first;
+    (degree - j, j)
 }
 
 /// No glass: air (or a blank `GLAS`).
