@@ -7,7 +7,8 @@
 //!
 //! Geometries: `Plane`; `StandardGeometry` (conic); `EvenAsphere`,
 //! coefficient i (from 0) of r^(2i+2); `OddAsphere`, coefficient i of
-//! r^(i+1). Python's `json` writes an infinite radius as `Infinity`,
+//! r^(i+1); `BiconicGeometry` (`radius_x`, `radius_y`, `conic_x`,
+//! `conic_y`). Python's `json` writes an infinite radius as `Infinity`,
 //! which is read as flat. Any other geometry is named in a warning.
 
 use lensc_grammar::{Diagnostic, FileId, Span};
@@ -134,6 +135,18 @@ fn shape(
             conic,
             terms: terms(|i| i + 1, dropped),
         }),
+        "BiconicGeometry" => {
+            let c = |key: &str| match number(&g[key]) {
+                Some(r) if r.is_finite() && r != 0.0 => 1.0 / r,
+                _ => 0.0,
+            };
+            Ok(Shape::Biconic {
+                cx: c("radius_x"),
+                cy: c("radius_y"),
+                kx: number(&g["conic_x"]).unwrap_or(0.0),
+                ky: number(&g["conic_y"]).unwrap_or(0.0),
+            })
+        }
         other => Err(format!("lensc does not import optiland {other} geometries")),
     }
 }

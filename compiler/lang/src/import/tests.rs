@@ -218,3 +218,30 @@ fn noll_numbers_map_to_ansi_as_opticstudio_lists_them() {
         assert_eq!(ansi_nm(ansi_index(nm.0, nm.1)), nm);
     }
 }
+
+#[test]
+fn an_optiland_biconic_is_read_by_its_own_keys() {
+    let json = r#"{"surface_group": {"surfaces": [
+        {"geometry": {"type": "Plane"}},
+        {"geometry": {"type": "BiconicGeometry", "radius_x": 40.0, "radius_y": Infinity, "conic_x": -1.0, "conic_y": 0.0},
+         "aperture": {"type": "RadialAperture", "r_max": 5.0, "r_min": 0.0}},
+        {"geometry": {"type": "Plane"}}]}}"#;
+    let mut diags = Vec::new();
+    let p = optiland::read("b.json", json, &mut diags).expect("reads");
+    assert!(diags.is_empty(), "{diags:?}");
+    let What::Surface(s) = &p.entries[1].what else {
+        panic!("{:?}", p.entries[1].what)
+    };
+    assert_eq!(
+        s.shape,
+        Shape::Biconic {
+            cx: 1.0 / 40.0,
+            cy: 0.0,
+            kx: -1.0,
+            ky: 0.0
+        }
+    );
+    let out = import("b.json", json.as_bytes());
+    let lens = out.lens.expect("written");
+    assert!(lens.contains("acylinder"), "{lens}");
+}
