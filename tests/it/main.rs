@@ -24,6 +24,7 @@ mod fmt;
 mod fts_advice;
 mod fuzz_properties;
 mod headers;
+mod import;
 mod interrupt;
 mod jit_conformance;
 mod limits;
