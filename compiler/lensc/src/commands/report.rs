@@ -13,9 +13,9 @@ pub fn run(out: &Output, file: &Path, job: Option<&str>, dir: &Path, max_program
         Ok(c) => c,
         Err(code) => return code,
     };
-    // The programs are built as `build` builds them (spooled into
-    // the output directory and dropped: only the plots are kept).
-    let (built, diags) = driver::plan_and_emit(
+    // The jobs are planned and simulated as `build` does them; no program
+    // is formatted (only the plots are kept).
+    let (built, diags) = driver::plan_and_simulate(
         &c,
         driver::Request {
             job,
@@ -23,7 +23,6 @@ pub fn run(out: &Output, file: &Path, job: Option<&str>, dir: &Path, max_program
             max_program_size: Some(max_program_size),
         },
         &file.display().to_string(),
-        Some(dir),
     );
     out.diagnostics(&c, &diags);
     if diags.iter().any(|d| d.is_error()) {
