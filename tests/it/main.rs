@@ -9,6 +9,7 @@
 
 mod common;
 
+mod bad_programs;
 mod build_errors;
 mod cli;
 mod determinism;
@@ -26,6 +27,7 @@ mod jit_conformance;
 mod limits;
 mod list;
 mod plots;
+mod read_back;
 mod rs274;
 mod sandbox;
 mod seed_sketches;

@@ -74,6 +74,28 @@ enum Command {
         /// refused before it is planned.
         #[arg(long, value_name = "SIZE", default_value = "4GB", value_parser = parse_size)]
         max_program_size: u64,
+        /// What a job whose simulated part misses its acceptance criteria
+        /// (its `accept` block, or the defaults) is: `error` (no program
+        /// is written, exit 1) or `warn` (the program is written, for
+        /// exploration).
+        #[arg(long, value_enum, default_value_t = AcceptChoice::Error)]
+        accept: AcceptChoice,
+    },
+    /// Read a program back from its text as its controller would: modal
+    /// state block by block, and every rule it breaks (feed moves with the
+    /// spindle stopped or before a tool call, moves outside the travel or
+    /// over the machine's feed, rapids into the part, arcs the controller
+    /// refuses, number formats, comments, line lengths). Machine and
+    /// dialect default to those the program's header names.
+    Verify {
+        /// The program to read.
+        program: PathBuf,
+        /// The machine to read it for (default: the header's).
+        #[arg(long)]
+        machine: Option<String>,
+        /// The dialect to read it in (default: the header's).
+        #[arg(long)]
+        dialect: Option<String>,
     },
     /// Plan and simulate a file's jobs as `build` does and write SVG plots
     /// of what each program will cut: `JOB.profile.svg` (profile jobs: the
@@ -182,6 +204,12 @@ enum MessageFormat {
 }
 
 #[derive(Clone, Copy, ValueEnum)]
+enum AcceptChoice {
+    Error,
+    Warn,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
 enum ColorChoice {
     Auto,
     Always,
@@ -234,6 +262,11 @@ fn run(cli: Cli) -> u8 {
             files,
             max_program_size,
         } => commands::check::run(&out, &files, max_program_size),
+        Command::Verify {
+            program,
+            machine,
+            dialect,
+        } => commands::verify::run(&out, &program, machine.as_deref(), dialect.as_deref()),
         Command::Fmt { files, check } => commands::fmt::run(&out, &files, check),
         Command::Analyse {
             file,
@@ -259,6 +292,7 @@ fn run(cli: Cli) -> u8 {
             dialect,
             out: dir,
             max_program_size,
+            accept,
         } => commands::build::run(
             &out,
             &file,
@@ -266,6 +300,10 @@ fn run(cli: Cli) -> u8 {
                 job: job.as_deref(),
                 dialect: dialect.as_deref(),
                 max_program_size: Some(max_program_size),
+                accept: match accept {
+                    AcceptChoice::Error => lensc_build::accept::Mode::Gate,
+                    AcceptChoice::Warn => lensc_build::accept::Mode::Warn,
+                },
             },
             &dir,
         ),

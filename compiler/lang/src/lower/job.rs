@@ -11,6 +11,7 @@
 //! window too fine (`window.rs`) — so `lensc check` reports it as `lensc
 //! build` does. Every error found is returned together.
 
+pub mod accept;
 mod estimate;
 mod mill;
 mod roller;
@@ -64,6 +65,17 @@ pub enum JobSpec {
 }
 
 impl JobSpec {
+    /// The tolerance the strategy plans its path to (mm): its
+    /// `chord_tolerance`, or `None` for a strategy that has none (a
+    /// roller helix's fixed angle steps, a grinder's intervals).
+    pub fn path_tolerance(&self) -> Option<f64> {
+        match self {
+            JobSpec::Turning(s) => Some(s.job.strategy.chord_tolerance),
+            JobSpec::Spiral(s) => Some(s.spiral.chord_tolerance),
+            JobSpec::Raster(s) => Some(s.raster.chord_tolerance),
+            JobSpec::Grinding(_) | JobSpec::Roller(_) => None,
+        }
+    }
     /// What every job has: names, surface, dialect, machine limits.
     pub fn head(&self) -> &JobHead {
         match self {
@@ -93,6 +105,8 @@ pub struct JobHead {
     pub travel: [Option<(f64, f64)>; 4],
     /// The job's `simulate` window, if it states one.
     pub simulate: Option<Simulate>,
+    /// What the simulated part must meet for the program to be written.
+    pub accept: accept::Accept,
 }
 
 impl JobHead {
@@ -292,6 +306,7 @@ impl<'a> Parts<'a> {
             resolution: value::num(m, "resolution").expect("required"),
             travel: ["x", "y", "z", "c"].map(|a| travel.and_then(|t| value::range(t, a))),
             simulate: simulate(self.job).ok().flatten(),
+            accept: accept::lower(self.job).unwrap_or_default(),
         }
     }
 }
@@ -340,6 +355,9 @@ pub fn lower_job(
         );
     }
     if let Err(d) = simulate(job) {
+        errors.push(d);
+    }
+    if let Err(d) = accept::lower(job) {
         errors.push(d);
     }
     // Until a dialect is known the strategy is lowered in LinuxCNC's: its

@@ -5,6 +5,7 @@
 
 pub mod diagnostics;
 pub mod job;
+pub mod read_back;
 pub mod surface;
 
 use lensc_grammar::suggest::did_you_mean;
@@ -128,7 +129,7 @@ fn offered(job: &CheckedJob) -> Vec<&Object> {
 }
 
 /// A checked `gcode { … }` dialect as the post-processor reads it.
-fn dialect_of(o: &Object, name: String) -> Dialect {
+pub(crate) fn dialect_of(o: &Object, name: String) -> Dialect {
     let f = &o.fields;
     let text = |n: &str, default: &str| match value::field(f, n).map(|x| &x.value) {
         Some(Value::Str(s)) => s.clone(),

@@ -4,8 +4,9 @@
 pub mod analyse;
 pub mod build;
 pub mod check;
-pub mod fmt;
 pub mod explain;
+pub mod fmt;
 pub mod list;
 pub mod report;
 pub mod sample;
+pub mod verify;

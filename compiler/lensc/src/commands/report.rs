@@ -14,13 +14,16 @@ pub fn run(out: &Output, file: &Path, job: Option<&str>, dir: &Path, max_program
         Err(code) => return code,
     };
     // The jobs are planned and simulated as `build` does them; no program
-    // is formatted (only the plots are kept).
+    // is formatted (only the plots are kept), a part that misses its
+    // acceptance criteria plotted all the same (warned): the plots show
+    // where.
     let (built, diags) = driver::plan_and_simulate(
         &c,
         driver::Request {
             job,
             dialect: None,
             max_program_size: Some(max_program_size),
+            accept: lensc_build::accept::Mode::Warn,
         },
         &file.display().to_string(),
     );
