@@ -57,6 +57,16 @@ pub const CANNOT_WRITE: &str = "E0151";
 pub const TOO_MANY_POINTS: &str = "E0160";
 /// A job's program would be larger than `--max-program-size`.
 pub const PROGRAM_TOO_LARGE: &str = "E0161";
+/// Roughing passes (a stock) without their own feed.
+pub const ROUGHING_NEEDS_FEED: &str = "E0170";
+/// A raster's spindle: a rotating cutter without a speed, or a knife
+/// (which cuts with the spindle held) given one.
+pub const RASTER_SPINDLE: &str = "E0171";
+/// A dialect's word format that does not read (`S5`, `X4.4`).
+pub const BAD_WORD_FORMAT: &str = "E0172";
+/// A tool call or coolant the job asks for that its dialect cannot write
+/// (a tool number too long for the T word, no mist word).
+pub const CANNOT_CALL_TOOL: &str = "E0173";
 /// A path tolerance finer than the machine's resolution can hold.
 pub const TOLERANCE_BELOW_RESOLUTION: &str = "E0180";
 /// `lensc fmt` refused to write a layout that would not parse back to the
@@ -236,6 +246,10 @@ pub const ALL: &[&str] = &[
     CANNOT_WRITE,
     TOO_MANY_POINTS,
     PROGRAM_TOO_LARGE,
+    ROUGHING_NEEDS_FEED,
+    RASTER_SPINDLE,
+    BAD_WORD_FORMAT,
+    CANNOT_CALL_TOOL,
     TOLERANCE_BELOW_RESOLUTION,
     ACCEPTANCE_MISSED,
     ACCEPTANCE_UNMEASURED,
