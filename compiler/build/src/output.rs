@@ -9,6 +9,19 @@ use std::path::Path;
 
 use lensc_grammar::Diagnostic;
 
+/// Where a build puts the programs it formats.
+#[derive(Clone, Copy, Debug)]
+pub enum Destination<'a> {
+    /// In memory (small jobs, tests).
+    Memory,
+    /// Spooled to a temporary file in this directory (the output
+    /// directory) as it is written, so memory stays flat.
+    Spool(&'a Path),
+    /// Nowhere: the jobs are planned and simulated and no program is
+    /// formatted (`lensc report`); each comes back empty.
+    Nowhere,
+}
+
 /// One job's output, not yet written.
 pub struct Built {
     /// File name of the program (`JOB.ngc`); the report is `JOB.report.json`.

@@ -14,7 +14,7 @@ use lensc_runtime::surface::ir::{SurfaceFn, SurfaceTape};
 
 use crate::builders;
 use crate::evaluate::evaluator;
-use crate::output::Built;
+use crate::output::{Built, Destination};
 
 /// What `lensc build` was asked for beyond the file.
 #[derive(Clone, Copy, Debug, Default)]
@@ -75,6 +75,29 @@ pub fn plan_and_emit(
     source_name: &str,
     spool_dir: Option<&Path>,
 ) -> (Vec<Built>, Vec<Diagnostic>) {
+    let to = spool_dir.map_or(Destination::Memory, Destination::Spool);
+    plan_jobs(c, request, source_name, to)
+}
+
+/// Plans and simulates the checked jobs as `plan_and_emit` does, with
+/// their reports and plots, but formats no program of the spiral and
+/// roller jobs (whose programs run to millions of lines): theirs come
+/// back empty. For `lensc report`, which writes no program; a number a
+/// dialect cannot print (E0150) is found by the build alone.
+pub fn plan_and_simulate(
+    c: &Checked,
+    request: Request,
+    source_name: &str,
+) -> (Vec<Built>, Vec<Diagnostic>) {
+    plan_jobs(c, request, source_name, Destination::Nowhere)
+}
+
+fn plan_jobs(
+    c: &Checked,
+    request: Request,
+    source_name: &str,
+    to: Destination,
+) -> (Vec<Built>, Vec<Diagnostic>) {
     let mut diags = Vec::new();
     let mut out = Vec::new();
     let prov = Provenance {
@@ -89,8 +112,9 @@ pub fn plan_and_emit(
         .filter(|j| request.job.is_none_or(|n| j.name.name == n));
     for job in jobs {
         let built = lower(job, request.dialect, &request.limits()).and_then(|(spec, est)| {
-            let mut b = build(&spec, &prov, spool_dir)?;
-            if crate::read_back::enabled() {
+            let mut b = build(&spec, &prov, to)?;
+            // A program formatted nowhere has nothing to read back.
+            if crate::read_back::enabled() && !matches!(to, Destination::Nowhere) {
                 let refused = crate::read_back::findings(job, spec.head(), &b.program);
                 if !refused.is_empty() {
                     return Err(refused);
@@ -117,19 +141,16 @@ pub fn plan_and_emit(
     (out, diags)
 }
 
-/// Plans, emits and simulates one lowered job with its strategy's builder
-/// (the acceptance gate is `plan_and_emit`'s, after it).
-pub fn build(
-    spec: &JobSpec,
-    prov: &Provenance,
-    spool_dir: Option<&Path>,
-) -> Result<Built, Vec<Diagnostic>> {
+/// Plans, emits and simulates one lowered job with its strategy's builder;
+/// the long programs go `to` memory, a spool file or nowhere (the
+/// acceptance gate is `plan_and_emit`'s, after it).
+pub fn build(spec: &JobSpec, prov: &Provenance, to: Destination) -> Result<Built, Vec<Diagnostic>> {
     match spec {
         JobSpec::Turning(s) => builders::turning::build(s, prov),
-        JobSpec::Spiral(s) => builders::fts::build(s, prov, spool_dir),
+        JobSpec::Spiral(s) => builders::fts::build(s, prov, to),
         JobSpec::Raster(s) => builders::raster::build(s, prov),
         JobSpec::Grinding(s) => builders::grinding::build(s, prov),
-        JobSpec::Roller(s) => builders::roller::build(s, prov, spool_dir),
+        JobSpec::Roller(s) => builders::roller::build(s, prov, to),
     }
 }
 

@@ -1,19 +1,20 @@
 //! Spooling a program as it is written: in memory, or in a temporary file
 //! in the output directory (the programs of spiral and roller jobs run to
-//! millions of lines), so memory stays bounded however long it is; and
-//! the first error met writing it, kept until the program is done.
+//! millions of lines), so memory stays bounded however long it is, or
+//! nowhere (`lensc report` formats none); and the first error met writing
+//! it, kept until the program is done.
 
 use lensc_grammar::{Diagnostic, FileId, Span};
 use lensc_lang::lower::job::JobHead;
 use lensc_runtime::post::ProgramError;
-use std::path::Path;
 
-use crate::output::ProgramText;
+use crate::output::{Destination, ProgramText};
 
-/// Where a text goes as it is written: memory, or a spool file.
+/// Where a text goes as it is written: memory, a spool file, or nowhere.
 pub(crate) enum Sink {
     Memory(String),
     File(Spool),
+    Nowhere,
 }
 
 /// A spool file being written, with what it holds so far and the first
@@ -26,19 +27,16 @@ pub(crate) struct Spool {
 }
 
 impl Sink {
-    /// A sink in memory, or spooled into `spool_dir`; E0151 at `site` if
-    /// the spool file cannot be made.
-    pub(crate) fn new(
-        spool_dir: Option<&Path>,
-        site: (FileId, Span),
-    ) -> Result<Sink, Vec<Diagnostic>> {
-        Sink::open(spool_dir).map_err(|e| vec![cannot_spool(&e, site)])
+    /// A sink for `to`; E0151 at `site` if the spool file cannot be made.
+    pub(crate) fn new(to: Destination, site: (FileId, Span)) -> Result<Sink, Vec<Diagnostic>> {
+        Sink::open(to).map_err(|e| vec![cannot_spool(&e, site)])
     }
 
-    fn open(spool_dir: Option<&Path>) -> std::io::Result<Sink> {
-        Ok(match spool_dir {
-            None => Sink::Memory(String::new()),
-            Some(dir) => {
+    fn open(to: Destination) -> std::io::Result<Sink> {
+        Ok(match to {
+            Destination::Memory => Sink::Memory(String::new()),
+            Destination::Nowhere => Sink::Nowhere,
+            Destination::Spool(dir) => {
                 std::fs::create_dir_all(dir)?;
                 let file = crate::temps::TempFile::create_in(dir)?;
                 Sink::File(Spool {
@@ -55,6 +53,7 @@ impl Sink {
         match self {
             Sink::Memory(all) => all.push_str(&text),
             Sink::File(spool) => spool.push(&text),
+            Sink::Nowhere => {}
         }
     }
 
@@ -64,6 +63,7 @@ impl Sink {
         match self {
             Sink::Memory(text) => Ok(ProgramText::Memory(text)),
             Sink::File(spool) => spool.finish().map_err(|e| vec![cannot_spool(&e, site)]),
+            Sink::Nowhere => Ok(ProgramText::Memory(String::new())),
         }
     }
 }
@@ -102,18 +102,20 @@ pub(crate) struct ProgramSink {
 
 impl ProgramSink {
     pub(crate) fn new(
-        spool_dir: Option<&Path>,
+        to: Destination,
         site: (FileId, Span),
     ) -> Result<ProgramSink, Vec<Diagnostic>> {
         Ok(ProgramSink {
-            sink: Sink::new(spool_dir, site)?,
+            sink: Sink::new(to, site)?,
             error: None,
         })
     }
 
-    /// Extends the program with `extend`, unless writing it has failed.
+    /// Extends the program with `extend`, unless writing it has failed or
+    /// it goes nowhere (then nothing is formatted).
     pub(crate) fn extend(&mut self, extend: impl FnOnce() -> Result<(), ProgramError>) {
         if self.error.is_none()
+            && !matches!(self.sink, Sink::Nowhere)
             && let Err(e) = extend()
         {
             self.error = Some(e);

@@ -72,6 +72,13 @@ pub const TOLERANCE_BELOW_RESOLUTION: &str = "E0180";
 /// `lensc fmt` refused to write a layout that would not parse back to the
 /// same program (a formatter bug; the file is left as it is).
 pub const FORMAT_WOULD_CHANGE_MEANING: &str = "E0185";
+/// `lensc import`: the file is not a prescription lensc reads (not a
+/// `.zmx` or optiland JSON file, or a value in it that is not a number).
+pub const IMPORT_UNREADABLE: &str = "E0350";
+/// `lensc import`: not one surface of the file can be imported.
+pub const IMPORT_NOTHING: &str = "E0351";
+/// `lensc import`: a non-sequential Zemax design.
+pub const IMPORT_NON_SEQUENTIAL: &str = "E0352";
 
 /// The simulated part misses one of its job's acceptance criteria (the
 /// message names which, by how much and where); no program is written.
@@ -92,6 +99,14 @@ pub const CHORDS_OVER_TOLERANCE: &str = "W0005";
 pub const ACCEPTANCE_MISSED_WARNING: &str = "W0020";
 /// E0196 under `lensc build --accept=warn`: the program is written.
 pub const ACCEPTANCE_UNMEASURED_WARNING: &str = "W0021";
+/// `lensc import`: a surface of a type (or form) lensc does not import.
+pub const IMPORT_UNSUPPORTED_SURFACE: &str = "W0015";
+/// `lensc import`: a parameter of an imported surface that is not carried over.
+pub const IMPORT_PARAMETER_DROPPED: &str = "W0016";
+/// `lensc import`: a surface with power but no semi-diameter to make its aperture from.
+pub const IMPORT_NO_SEMI_DIAMETER: &str = "W0017";
+/// `lensc import`: a decentre or tilt (a coordinate break) that is not applied.
+pub const IMPORT_POSITION_IGNORED: &str = "W0018";
 
 /// All codes, for the uniqueness test and the reference in README.
 // Programs read back from their text (`lensc verify`, and `lensc build`
@@ -258,6 +273,13 @@ pub const ALL: &[&str] = &[
     CENTRE_LEFT_UNCUT,
     CHORDS_OVER_TOLERANCE,
     FORMAT_WOULD_CHANGE_MEANING,
+    IMPORT_UNREADABLE,
+    IMPORT_NOTHING,
+    IMPORT_NON_SEQUENTIAL,
+    IMPORT_UNSUPPORTED_SURFACE,
+    IMPORT_PARAMETER_DROPPED,
+    IMPORT_NO_SEMI_DIAMETER,
+    IMPORT_POSITION_IGNORED,
     PROGRAM_UNCLOSED_COMMENT,
     PROGRAM_LINE_TOO_LONG,
     PROGRAM_UNKNOWN_WORD,

@@ -11,7 +11,8 @@
 //! library's items and their documentation); and checked jobs and
 //! surfaces are lowered to what the runtime plans (`lower`, with
 //! `lower::surface` one file per surface family, `domain` the apertures both
-//! share); `format` is `lensc fmt`'s canonical layout. Errors are data
+//! share); `format` is `lensc fmt`'s canonical layout; `import` reads lens
+//! designers' prescriptions (Zemax, optiland) and writes them as `.lens` text. Errors are data
 //! (`Diagnostic`s with codes and spans; `lower::diagnostics` maps every runtime
 //! error to one); nothing here plans, writes or renders.
 
@@ -20,6 +21,7 @@ pub mod codes;
 pub mod domain;
 pub mod explain;
 pub mod format;
+pub mod import;
 pub mod loader;
 pub mod lower;
 pub mod sandbox;

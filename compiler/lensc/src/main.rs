@@ -1,5 +1,5 @@
 //! The `lensc` command line: `check`, `build`, `report`, `analyse`,
-//! `sample`, `fmt`, `list` and `explain`. Exit codes: 0 success (warnings allowed), 1 errors in the
+//! `sample`, `fmt`, `list`, `explain`, `import` and `lsp` (a language server). Exit codes: 0 success (warnings allowed), 1 errors in the
 //! input, 2 usage errors, 101 an internal error, 130 and 143 a `build` or
 //! `report` stopped by SIGINT or SIGTERM.
 
@@ -11,6 +11,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 
 mod commands;
 mod interrupt;
+mod lsp;
 mod output;
 
 use lensc_build::driver;
@@ -176,6 +177,18 @@ enum Command {
         #[arg(long, value_enum, default_value_t = Format::Human)]
         format: Format,
     },
+    /// Import a lens designer's prescription (a Zemax OpticStudio `.zmx` or
+    /// an optiland JSON export) as a `.lens` file: one `surface` per optical
+    /// surface, the designer's signs kept with `convention: optical`, each
+    /// aperture from the semi-diameter. What is not imported is named in a
+    /// warning and a comment.
+    Import {
+        /// The `.zmx` or optiland `.json` file.
+        file: PathBuf,
+        /// Write the `.lens` file here (default: stdout).
+        #[arg(short = 'o', long = "output", value_name = "OUT.lens")]
+        output: Option<PathBuf>,
+    },
     /// Explain a diagnostic code (`E0147`), with an example that causes it
     /// and its fix.
     Explain {
@@ -188,6 +201,10 @@ enum Command {
         #[arg(long, value_enum, default_value_t = Format::Human)]
         format: Format,
     },
+    /// Run a language server on stdin and stdout for an editor: diagnostics
+    /// as you type, hover, completion, go to definition and formatting
+    /// (editors/README.md says how to set one up).
+    Lsp,
 }
 
 /// How `list` and `explain` print.
@@ -250,6 +267,7 @@ fn run(cli: Cli) -> u8 {
         all_diagnostics: cli.all_diagnostics,
     };
     match cli.command {
+        Command::Lsp => lsp::run(),
         Command::List {
             category,
             name,
@@ -268,6 +286,7 @@ fn run(cli: Cli) -> u8 {
             dialect,
         } => commands::verify::run(&out, &program, machine.as_deref(), dialect.as_deref()),
         Command::Fmt { files, check } => commands::fmt::run(&out, &files, check),
+        Command::Import { file, output } => commands::import::run(&out, &file, output.as_deref()),
         Command::Analyse {
             file,
             surface,

@@ -24,7 +24,7 @@
 //! acceleration is the second divided difference of W in time, checked
 //! against the machine's limit.
 
-use rayon::prelude::*;
+use std::ops::ControlFlow;
 
 use crate::plan::envelope;
 use crate::surface::ir::SurfaceFn;
@@ -475,7 +475,7 @@ impl Planner<'_> {
     pub fn plan(
         &self,
         fast_axis: &FastAxis,
-        sink: impl FnMut(&[SpiralPoint]),
+        sink: impl FnMut(&[SpiralPoint]) + Send,
     ) -> Result<FtsSummary, FtsError> {
         self.run(fast_axis, false, sink)
     }
@@ -492,7 +492,7 @@ impl Planner<'_> {
         &self,
         fast_axis: &FastAxis,
         stop_over_limit: bool,
-        mut sink: impl FnMut(&[SpiralPoint]),
+        mut sink: impl FnMut(&[SpiralPoint]) + Send,
     ) -> Result<FtsSummary, FtsError> {
         let s = self.spiral;
         let ok = |v: f64| v.is_finite() && v > 0.0;
@@ -522,53 +522,60 @@ impl Planner<'_> {
             chords_over_tolerance: None,
         };
         let batch = 64;
-        // The last two points, for the acceleration across batches.
+        // The last two points, for the acceleration across revolutions.
         let mut last: Vec<SpiralPoint> = Vec::with_capacity(2);
         let mut buffer: Vec<SpiralPoint> = Vec::new();
+        let mut undefined = None;
         let total = self.total_angle();
-        let mut k = 0;
-        while k <= revs {
-            let hi = (k + batch).min(revs + 1);
-            let chunks: Vec<Revolution> = (k..hi)
-                .into_par_iter()
-                .map(|j| {
-                    if j == revs {
-                        // The end point of the spiral.
-                        (vec![(total, self.centre(total))], None)
-                    } else {
-                        self.revolution(j)
-                    }
-                })
-                .collect();
-            for (pts, over) in chunks {
-                ChordShortfall::merge(&mut summary.chords_over_tolerance, over);
-                buffer.clear();
-                for (c, w) in pts {
-                    let x = self.radius(c);
-                    if !(w.is_finite() && x.is_finite()) {
-                        return Err(FtsError::Undefined { x, c });
-                    }
-                    let t = match last.last() {
-                        None => 0.0,
-                        Some(p) => {
-                            let spin = s.speed.at(0.5 * (p.x + x));
-                            p.t + (c - p.c) / spin
-                        }
-                    };
-                    let point = SpiralPoint { x, c, w, t };
-                    self.account(&mut summary, &last, point, fast_axis);
-                    if last.len() == 2 {
-                        last.remove(0);
-                    }
-                    last.push(point);
-                    buffer.push(point);
+        let make = |j: usize| {
+            if j == revs {
+                // The end point of the spiral.
+                (vec![(total, self.centre(total))], None)
+            } else {
+                self.revolution(j)
+            }
+        };
+        let mut j = 0;
+        let take = |(pts, over): Revolution| {
+            ChordShortfall::merge(&mut summary.chords_over_tolerance, over);
+            buffer.clear();
+            for (c, w) in pts {
+                let x = self.radius(c);
+                if !(w.is_finite() && x.is_finite()) {
+                    undefined = Some(FtsError::Undefined { x, c });
+                    return ControlFlow::Break(());
                 }
-                sink(&buffer);
+                let t = match last.last() {
+                    None => 0.0,
+                    Some(p) => {
+                        let spin = s.speed.at(0.5 * (p.x + x));
+                        p.t + (c - p.c) / spin
+                    }
+                };
+                let point = SpiralPoint { x, c, w, t };
+                self.account(&mut summary, &last, point, fast_axis);
+                if last.len() == 2 {
+                    last.remove(0);
+                }
+                last.push(point);
+                buffer.push(point);
             }
-            k = hi;
-            if stop_over_limit && summary.max_acceleration > fast_axis.max_acceleration {
-                break;
+            sink(&buffer);
+            j += 1;
+            // A check stops after the batch of revolutions that went over.
+            let batch_done = j % batch == 0 || j > revs;
+            if stop_over_limit
+                && batch_done
+                && summary.max_acceleration > fast_axis.max_acceleration
+            {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
             }
+        };
+        crate::plan::stream::in_order(revs + 1, batch, make, take);
+        if let Some(e) = undefined {
+            return Err(e);
         }
         summary.time = last.last().map_or(0.0, |p| p.t);
         let range = summary.w_max - summary.w_min;

@@ -8,4 +8,5 @@ pub mod grinding;
 pub mod optimise;
 pub mod raster;
 pub mod roller;
+pub mod stream;
 pub mod turning;

@@ -53,6 +53,7 @@
 //! only on its index: the output is identical for any thread count.
 
 use std::f64::consts::TAU;
+use std::ops::ControlFlow;
 
 use rayon::prelude::*;
 
@@ -752,7 +753,7 @@ pub fn plan_roller_helix_into(
     h: &RollerHelix,
     nose_radius: f64,
     design: &(dyn SurfaceFn + Sync),
-    mut sink: impl FnMut(usize, &[RollerPoint]),
+    mut sink: impl FnMut(usize, &[RollerPoint]) + Send,
 ) -> Result<RollerPath, RollerError> {
     validate(h, nose_radius)?;
     let rho = nose_radius;
@@ -848,7 +849,7 @@ impl PassPlan<'_> {
         &self,
         centre: &(impl Fn(f64, f64) -> f64 + Sync),
         (cycle_offsets, max_depth_of_cut): (Vec<f64>, f64),
-        sink: &mut impl FnMut(usize, &[RollerPoint]),
+        sink: &mut (impl FnMut(usize, &[RollerPoint]) + Send),
     ) -> Result<PassSummary, RollerError> {
         let (h, pass, steps, total) = (self.h, self.pass, self.steps, self.total);
         let r_r = h.roller_radius;
@@ -890,21 +891,25 @@ impl PassPlan<'_> {
             max_depth_of_cut,
             fingerprint: 0xcbf2_9ce4_8422_2325,
         };
-        const BATCH: usize = 32;
-        for first in (0..chunks).step_by(BATCH) {
-            let done: Vec<Result<Vec<RollerPoint>, RollerError>> = (first
-                ..(first + BATCH).min(chunks))
-                .into_par_iter()
-                .map(|j| {
-                    let k0 = j * per_chunk;
-                    (k0..(k0 + per_chunk).min(steps + 1)).map(&point).collect()
-                })
-                .collect();
-            for pts in done {
-                let pts = pts?;
+        let mut undefined = None;
+        let make = |j: usize| -> Result<Vec<RollerPoint>, RollerError> {
+            let k0 = j * per_chunk;
+            (k0..(k0 + per_chunk).min(steps + 1)).map(&point).collect()
+        };
+        let take = |pts: Result<Vec<RollerPoint>, RollerError>| match pts {
+            Ok(pts) => {
                 sum.tally(&pts);
                 sink(self.index, &pts);
+                ControlFlow::Continue(())
             }
+            Err(e) => {
+                undefined = Some(e);
+                ControlFlow::Break(())
+            }
+        };
+        crate::plan::stream::in_order(chunks, 32, make, take);
+        if let Some(e) = undefined {
+            return Err(e);
         }
         Ok(sum)
     }

@@ -16,11 +16,10 @@ use lensc_runtime::plan::fts::{FtsError, FtsSummary, Planner, SpindleSpeed};
 use lensc_runtime::post::Provenance;
 use lensc_runtime::surface::ir::SurfaceFn;
 use lensc_runtime::verify::heightmap::Sweep;
-use std::path::Path;
 
 use crate::evaluate::evaluator;
 use crate::height_map::{self, LatheFrame, Window};
-use crate::output::Built;
+use crate::output::{Built, Destination};
 use crate::parts;
 use crate::report;
 use crate::spool::{ProgramSink, Sink};
@@ -51,13 +50,13 @@ impl<'s> Prepared<'s> {
     }
 }
 
-/// Builds one `fts_spiral` job, or says why it cannot be built. With a
-/// `spool_dir` the program goes to a temporary file there as it is
-/// written, so memory stays bounded however long it is.
+/// Builds one `fts_spiral` job, or says why it cannot be built. Spooled
+/// (`to`), the program goes to a temporary file as it is written, so
+/// memory stays bounded however long it is.
 pub fn build(
     spec: &SpiralSpec,
     prov: &Provenance,
-    spool_dir: Option<&Path>,
+    to: Destination,
 ) -> Result<Built, Vec<Diagnostic>> {
     let (p, head) = (spec, &spec.head);
     let site = head.site;
@@ -76,9 +75,9 @@ pub fn build(
     .map_err(not_printable)?;
     program.hold_spindle_under(spec.max_spindle_speed);
     program.call_tool(&head.start).map_err(not_printable)?;
-    let mut sink = ProgramSink::new(spool_dir, site)?;
+    let mut sink = ProgramSink::new(to, site)?;
     let mut table_sink = match table_name {
-        Some(_) => Some(Sink::new(spool_dir, site)?),
+        Some(_) => Some(Sink::new(to, site)?),
         None => None,
     };
     // The fast axis's servo, run on the commands as printed as they are

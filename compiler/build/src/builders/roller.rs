@@ -4,8 +4,6 @@
 //! section-4 tool checks were made in lowering); the program streamed like
 //! the spiral's, the cut simulated as a height map.
 
-use std::path::Path;
-
 use lensc_grammar::Diagnostic;
 use lensc_lang::lower::diagnostics::RuntimeError;
 use lensc_lang::lower::exact_in;
@@ -17,7 +15,7 @@ use lensc_runtime::verify::heightmap::Sweep;
 
 use crate::evaluate::evaluator;
 use crate::height_map::{self, RollerFrame};
-use crate::output::Built;
+use crate::output::{Built, Destination};
 use crate::parts;
 use crate::report;
 use crate::spool::ProgramSink;
@@ -26,7 +24,7 @@ use crate::spool::ProgramSink;
 pub fn build(
     spec: &RollerSpec,
     prov: &Provenance,
-    spool_dir: Option<&Path>,
+    to: Destination,
 ) -> Result<Built, Vec<Diagnostic>> {
     let (head, helix, rho) = (&spec.head, &spec.helix, spec.tool.nose_radius);
     let site = head.site;
@@ -48,7 +46,7 @@ pub fn build(
     program
         .call_tool(&head.start)
         .map_err(|e| vec![parts::not_printable(head, e)])?;
-    let mut sink = ProgramSink::new(spool_dir, site)?;
+    let mut sink = ProgramSink::new(to, site)?;
     // The height map over the window, from the printed points of every
     // pass (the finish pass's envelope lies below the rough one's).
     let (design_y, z) = (spec.design_y, (helix.z_start, helix.z_end));

@@ -52,6 +52,9 @@ pub struct Checked {
     /// Every surface, tool, machine and strategy the root file can name
     /// (its own and those it uses) that checked, by name.
     pub declarations: HashMap<String, Rc<Object>>,
+    /// Every `let` of every loaded file that evaluated: its file, where its
+    /// name is written, and its value (what an editor's hover shows).
+    pub lets: Vec<(FileId, Span, Value)>,
 }
 
 impl Checked {
@@ -124,12 +127,24 @@ pub fn check(loaded: &Loaded) -> Checked {
             }
         }
     }
+    let lets = c
+        .decls
+        .iter()
+        .zip(&c.state)
+        .filter_map(|(d, s)| match (d.kind, s) {
+            (None, State::Done(v)) if !matches!(v, Value::Error) => {
+                Some((d.file, d.name.span, v.clone()))
+            }
+            _ => None,
+        })
+        .collect();
     let mut diags = loaded.diags.clone();
     diags.append(&mut c.diags);
     Checked {
         jobs,
         diags,
         declarations,
+        lets,
     }
 }
 

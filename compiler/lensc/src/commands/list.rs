@@ -220,7 +220,7 @@ fn as_written(text: &str, f: &Field) -> String {
     }
 }
 
-fn kind_doc(k: &'static Kind) -> KindDoc {
+pub(crate) fn kind_doc(k: &'static Kind) -> KindDoc {
     KindDoc {
         name: k.name,
         makes: k.category.noun(),
@@ -231,7 +231,7 @@ fn kind_doc(k: &'static Kind) -> KindDoc {
     }
 }
 
-fn param_doc(p: &'static Param) -> ParamDoc {
+pub(crate) fn param_doc(p: &Param) -> ParamDoc {
     let (doc, default) = split_default(p.doc);
     let (takes, unit, range) = match p.ty {
         Ty::Quantity(dims) => {
@@ -305,7 +305,7 @@ fn range_text(check: Check, factor: f64) -> Option<String> {
     })
 }
 
-fn value_text(v: &Value) -> String {
+pub(crate) fn value_text(v: &Value) -> String {
     let n = lensc_lang::check::trim_num;
     match v {
         Value::Num(x, d) => {

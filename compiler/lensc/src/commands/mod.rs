@@ -6,6 +6,7 @@ pub mod build;
 pub mod check;
 pub mod explain;
 pub mod fmt;
+pub mod import;
 pub mod list;
 pub mod report;
 pub mod sample;

@@ -13,11 +13,11 @@ pub fn run(out: &Output, file: &Path, job: Option<&str>, dir: &Path, max_program
         Ok(c) => c,
         Err(code) => return code,
     };
-    // The programs are built as `build` builds them (spooled into
-    // the output directory and dropped: only the plots are kept), a part
-    // that misses its acceptance criteria plotted all the same (warned):
-    // the plots show where.
-    let (built, diags) = driver::plan_and_emit(
+    // The jobs are planned and simulated as `build` does them; no program
+    // is formatted (only the plots are kept), a part that misses its
+    // acceptance criteria plotted all the same (warned): the plots show
+    // where.
+    let (built, diags) = driver::plan_and_simulate(
         &c,
         driver::Request {
             job,
@@ -26,7 +26,6 @@ pub fn run(out: &Output, file: &Path, job: Option<&str>, dir: &Path, max_program
             accept: lensc_build::accept::Mode::Warn,
         },
         &file.display().to_string(),
-        Some(dir),
     );
     out.diagnostics(&c, &diags);
     if diags.iter().any(|d| d.is_error()) {

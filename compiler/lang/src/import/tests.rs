@@ -1,0 +1,247 @@
+use super::*;
+
+const SINGLET: &str = "VERS 190000\nMODE SEQ\nUNIT MM X W X CM MR CPMM\n\
+SURF 0\n  TYPE STANDARD\n  CURV 0.0\n  DISZ INFINITY\n\
+SURF 1\n  TYPE EVENASPH\n  COMM front\n  CURV 0.02\n  CONI -1.5\n  PARM 1 0\n  PARM 2 1.5E-5\n  PARM 3 -2E-8\n  DISZ 4\n  GLAS N-BK7 0 0 1.5168 64.17\n  DIAM 6 1 0 0 1 \"\"\n\
+SURF 2\n  TYPE STANDARD\n  CURV -0.01\n  DISZ 90\n  DIAM 6\n\
+SURF 3\n  TYPE STANDARD\n  CURV 0\n  DIAM 1\n";
+
+fn rotational(e: &Entry) -> (f64, f64, Vec<(u32, f64)>, Option<String>) {
+    match &e.what {
+        What::Surface(Surface {
+            shape:
+                Shape::Rotational {
+                    curvature,
+                    conic,
+                    terms,
+                },
+            rear_of,
+            ..
+        }) => (*curvature, *conic, terms.clone(), rear_of.clone()),
+        other => panic!("surface {}: {other:?}", e.number),
+    }
+}
+
+#[test]
+fn zemax_even_asphere_terms_start_at_r_squared() {
+    let mut diags = Vec::new();
+    let p = zemax::read("s.zmx", SINGLET, &mut diags).expect("reads");
+    assert!(diags.is_empty(), "{diags:?}");
+    assert_eq!(p.entries.len(), 4);
+    assert!(matches!(p.entries[0].what, What::Skipped(_)));
+    let (c, k, terms, rear) = rotational(&p.entries[1]);
+    assert_eq!((c, k, rear), (0.02, -1.5, None));
+    assert_eq!(terms, vec![(4, 1.5e-5), (6, -2e-8)]);
+    assert_eq!(p.entries[1].comment, "front");
+    // The back of the N-BK7 element: glass before it, air after.
+    let (c, _, _, rear) = rotational(&p.entries[2]);
+    assert_eq!((c, rear.as_deref()), (-0.01, Some("N-BK7")));
+}
+
+#[test]
+fn zemax_lens_units_convert_to_mm() {
+    let inches = SINGLET.replace("UNIT MM", "UNIT IN");
+    let p = zemax::read("s.zmx", &inches, &mut Vec::new()).expect("reads");
+    let (c, _, terms, _) = rotational(&p.entries[1]);
+    assert!((c - 0.02 / 25.4).abs() < 1e-15);
+    // A4 in in^-3 is A4 / 25.4^3 in mm^-3.
+    assert!((terms[0].1 - 1.5e-5 / 25.4f64.powi(3)).abs() < 1e-20);
+    let What::Surface(s) = &p.entries[1].what else {
+        panic!()
+    };
+    assert_eq!(s.semi_diameter, 6.0 * 25.4);
+}
+
+#[test]
+fn utf16_with_a_byte_order_mark_is_read() {
+    let mut bytes = vec![0xFF, 0xFE];
+    for u in SINGLET.encode_utf16() {
+        bytes.extend(u.to_le_bytes());
+    }
+    assert_eq!(decode(&bytes), SINGLET);
+    let out = import("s.zmx", &bytes);
+    assert!(out.lens.is_some(), "{:?}", out.diags);
+}
+
+#[test]
+fn unknown_types_and_unused_parameters_are_warned_about() {
+    let text = SINGLET
+        .replace("SURF 2\n  TYPE STANDARD", "SURF 2\n  TYPE GRID_SAG")
+        .replace("PARM 3 -2E-8", "PARM 3 -2E-8\n  XDAT 1 7");
+    let out = import("s.zmx", text.as_bytes());
+    let codes: Vec<&str> = out.diags.iter().map(|d| d.code).collect();
+    assert_eq!(
+        codes,
+        vec![
+            codes::IMPORT_PARAMETER_DROPPED,
+            codes::IMPORT_UNSUPPORTED_SURFACE
+        ]
+    );
+    let lens = out.lens.expect("written");
+    assert!(lens.contains("GRID_SAG"), "{lens}");
+    assert!(lens.contains("Not imported: extra data 1 = 7"), "{lens}");
+}
+
+#[test]
+fn non_sequential_and_garbage_are_errors() {
+    let out = import("n.zmx", b"MODE NSC\nSURF 0\n");
+    assert_eq!(out.diags[0].code, codes::IMPORT_NON_SEQUENTIAL);
+    assert!(out.lens.is_none());
+    let out = import("g.zmx", b"SURF 0\n CURV abc\n");
+    assert_eq!(out.diags[0].code, codes::IMPORT_UNREADABLE);
+    let out = import("g.json", b"{\"surface_group\": ");
+    assert_eq!(out.diags[0].code, codes::IMPORT_UNREADABLE);
+    let out = import("f.zmx", b"SURF 0\nSURF 1\n CURV 0\n DIAM 3\nSURF 2\n");
+    assert_eq!(out.diags[0].code, codes::IMPORT_NOTHING);
+}
+
+#[test]
+fn python_infinities_become_readable() {
+    assert_eq!(
+        optiland::read(
+            "o.json",
+            r#"{"surface_group": {"surfaces": [{"geometry": {"type": "Plane", "radius": Infinity, "cs": {}}, "comment": "Infinity"}]}}"#,
+            &mut Vec::new()
+        )
+        .expect("reads")
+        .entries
+        .len(),
+        1
+    );
+}
+
+#[test]
+fn turning_over_negates_the_sag() {
+    let shapes = [
+        Shape::Rotational {
+            curvature: -0.05,
+            conic: -0.7,
+            terms: vec![(3, 1e-4), (4, -2e-5)],
+        },
+        Shape::Biconic {
+            cx: 0.02,
+            cy: -0.03,
+            kx: 0.5,
+            ky: -1.0,
+        },
+        Shape::Toroid {
+            cy: 0.05,
+            conic: 0.0,
+            rotation_radius: Some(30.0),
+            terms: vec![(4, 1e-5)],
+        },
+    ];
+    for s in shapes {
+        let t = s.turned_over();
+        for (x, y) in [(0.3, 1.1), (-2.0, 0.5), (1.7, -1.9)] {
+            assert!((s.sag(x, y) + t.sag(x, y)).abs() < 1e-15, "{s:?}");
+        }
+    }
+}
+
+#[test]
+fn numbers_read_back_to_the_last_place() {
+    for v in [
+        1.5e-5,
+        -2e-8,
+        22.01359,
+        1.0 / 0.0454,
+        1e9,
+        -0.1,
+        3.0,
+        1.0 / 3.0,
+    ] {
+        let back: f64 = write::num(v).parse().expect("a number");
+        assert!((back - v).abs() <= 2.0 * f64::EPSILON * v.abs(), "{v}");
+    }
+    // A conversion's last-digit noise is not written.
+    assert_eq!(write::num(1.0 / (0.8 / 25.4)), "31.75");
+    let v = 1.86000372000744e-5;
+    let back: f64 = write::num(v).parse().expect("a number");
+    assert!((back - v).abs() <= 2.0 * f64::EPSILON * v);
+    assert_eq!(write::num(-2e-8), "-2e-8");
+    assert_eq!(write::num(0.02), "0.02");
+}
+
+#[test]
+fn a_surface_without_a_semi_diameter_is_named_and_skipped() {
+    let json = r#"{"surface_group": {"surfaces": [
+        {"geometry": {"type": "Plane"}},
+        {"geometry": {"type": "StandardGeometry", "radius": 30.0, "conic": -1.0, "cs": {"x": 0.5}}, "aperture": null},
+        {"geometry": {"type": "Plane"}}]}}"#;
+    let out = import("o.json", json.as_bytes());
+    let codes: Vec<&str> = out.diags.iter().map(|d| d.code).collect();
+    assert_eq!(
+        codes,
+        vec![
+            codes::IMPORT_POSITION_IGNORED,
+            codes::IMPORT_NO_SEMI_DIAMETER,
+            codes::IMPORT_NOTHING
+        ]
+    );
+    assert!(out.lens.is_none());
+}
+
+#[test]
+fn a_toroid_sweeping_away_from_its_profile_is_not_imported() {
+    let text = SINGLET.replace(
+        "SURF 2\n  TYPE STANDARD\n  CURV -0.01",
+        "SURF 2\n  TYPE TOROIDAL\n  CURV -0.01\n  PARM 1 40",
+    );
+    let out = import("t.zmx", text.as_bytes());
+    assert_eq!(out.diags[0].code, codes::IMPORT_UNSUPPORTED_SURFACE);
+    assert!(
+        out.diags[0].message.contains("toroid"),
+        "{}",
+        out.diags[0].message
+    );
+}
+
+#[test]
+fn noll_numbers_map_to_ansi_as_opticstudio_lists_them() {
+    // Z2 cos, Z3 sin, Z5 sin 2θ, Z6 cos 2θ, Z7 sin θ, Z11 spherical.
+    let want = [
+        (1, (0, 0)),
+        (2, (1, 1)),
+        (3, (1, -1)),
+        (4, (2, 0)),
+        (5, (2, -2)),
+        (6, (2, 2)),
+        (7, (3, -1)),
+        (8, (3, 1)),
+        (9, (3, -3)),
+        (10, (3, 3)),
+        (11, (4, 0)),
+    ];
+    for (j, nm) in want {
+        assert_eq!(noll_nm(j), nm, "Z{j}");
+        assert_eq!(ansi_nm(ansi_index(nm.0, nm.1)), nm);
+    }
+}
+
+#[test]
+fn an_optiland_biconic_is_read_by_its_own_keys() {
+    let json = r#"{"surface_group": {"surfaces": [
+        {"geometry": {"type": "Plane"}},
+        {"geometry": {"type": "BiconicGeometry", "radius_x": 40.0, "radius_y": Infinity, "conic_x": -1.0, "conic_y": 0.0},
+         "aperture": {"type": "RadialAperture", "r_max": 5.0, "r_min": 0.0}},
+        {"geometry": {"type": "Plane"}}]}}"#;
+    let mut diags = Vec::new();
+    let p = optiland::read("b.json", json, &mut diags).expect("reads");
+    assert!(diags.is_empty(), "{diags:?}");
+    let What::Surface(s) = &p.entries[1].what else {
+        panic!("{:?}", p.entries[1].what)
+    };
+    assert_eq!(
+        s.shape,
+        Shape::Biconic {
+            cx: 1.0 / 40.0,
+            cy: 0.0,
+            kx: -1.0,
+            ky: 0.0
+        }
+    );
+    let out = import("b.json", json.as_bytes());
+    let lens = out.lens.expect("written");
+    assert!(lens.contains("acylinder"), "{lens}");
+}

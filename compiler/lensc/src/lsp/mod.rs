@@ -1,0 +1,344 @@
+//! `lensc lsp`: a language server over stdin and stdout (JSON-RPC, the
+//! Language Server Protocol; transport `lsp-server`, types `lsp-types`).
+//! It keeps the documents the editor has open, checks each as it changes
+//! and publishes the checker's diagnostics with their codes, and answers
+//! hover, completion, go to definition and formatting (`lensc fmt`'s
+//! layout). Positions are the protocol's UTF-16 columns (`text`); what the
+//! cursor is on is read from the text (`context`) and the checker's own
+//! tables (`lookup`); the standard library's files are written to a cache
+//! directory for an editor to open (`analysis::stdlib_dir`).
+//!
+//! This file holds the message loop and the dispatch; one file per answer.
+
+mod analysis;
+mod completion;
+mod context;
+mod definition;
+mod hover;
+mod lookup;
+mod text;
+
+use std::collections::HashMap;
+use std::path::PathBuf;
+
+use lsp_server::{Connection, ErrorCode, Message, Notification, Request, Response};
+use lsp_types::notification::{self as note, Notification as _};
+use lsp_types::request::{self as req, Request as _};
+use lsp_types::{self as lsp, Uri};
+use serde::de::DeserializeOwned;
+
+use analysis::{Analysis, Docs, Document};
+use text::LineIndex;
+
+/// Runs the server until the editor says `exit`; returns the exit code.
+pub fn run() -> u8 {
+    let (connection, io_threads) = Connection::stdio();
+    let code = match serve(&connection) {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("lensc lsp: {e}");
+            1
+        }
+    };
+    drop(connection);
+    match io_threads.join() {
+        Ok(()) => code,
+        Err(_) => 1,
+    }
+}
+
+fn capabilities() -> lsp::ServerCapabilities {
+    lsp::ServerCapabilities {
+        position_encoding: Some(lsp::PositionEncodingKind::UTF16),
+        text_document_sync: Some(lsp::TextDocumentSyncCapability::Kind(
+            lsp::TextDocumentSyncKind::INCREMENTAL,
+        )),
+        hover_provider: Some(lsp::HoverProviderCapability::Simple(true)),
+        completion_provider: Some(lsp::CompletionOptions {
+            trigger_characters: Some(vec![":".into()]),
+            ..Default::default()
+        }),
+        definition_provider: Some(lsp::OneOf::Left(true)),
+        document_formatting_provider: Some(lsp::OneOf::Left(true)),
+        ..Default::default()
+    }
+}
+
+fn serve(connection: &Connection) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
+    let (id, params) = connection.initialize_start()?;
+    let params: lsp::InitializeParams = serde_json::from_value(params)?;
+    let result = lsp::InitializeResult {
+        capabilities: capabilities(),
+        server_info: Some(lsp::ServerInfo {
+            name: "lensc".into(),
+            version: Some(env!("CARGO_PKG_VERSION").into()),
+        }),
+    };
+    connection.initialize_finish(id, serde_json::to_value(result)?)?;
+    let mut server = Server {
+        docs: HashMap::new(),
+        analyses: HashMap::new(),
+        root: workspace_root(&params),
+    };
+    for msg in &connection.receiver {
+        match msg {
+            Message::Request(r) => {
+                if connection.handle_shutdown(&r)? {
+                    return Ok(());
+                }
+                let id = r.id.clone();
+                let resp = guarded(|| server.request(r)).unwrap_or_else(|| {
+                    Response::new_err(
+                        id,
+                        ErrorCode::InternalError as i32,
+                        "lensc lsp failed on this request (a bug: please report it)".into(),
+                    )
+                });
+                connection.sender.send(Message::Response(resp))?;
+            }
+            Message::Notification(n) => {
+                for out in guarded(|| server.notification(n)).unwrap_or_default() {
+                    connection.sender.send(Message::Notification(out))?;
+                }
+            }
+            Message::Response(_) => {}
+        }
+    }
+    Ok(())
+}
+
+/// A bug that panics on one message costs that answer (an internal
+/// error; the panic's message goes to stderr, the editor's log), never
+/// the session.
+fn guarded<T>(f: impl FnOnce() -> T) -> Option<T> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).ok()
+}
+
+/// The first workspace folder (or the root URI) the editor opened.
+#[allow(deprecated)]
+fn workspace_root(p: &lsp::InitializeParams) -> Option<PathBuf> {
+    let folder = p
+        .workspace_folders
+        .as_ref()
+        .and_then(|f| f.first())
+        .map(|f| f.uri.clone())
+        .or_else(|| p.root_uri.clone())?;
+    analysis::document_path(&folder)
+}
+
+struct Server {
+    docs: Docs,
+    /// Each open document checked after its last change, by URI.
+    analyses: HashMap<String, Analysis>,
+    root: Option<PathBuf>,
+}
+
+impl Server {
+    fn notification(&mut self, n: Notification) -> Vec<Notification> {
+        let changed = match n.method.as_str() {
+            note::DidOpenTextDocument::METHOD => params::<lsp::DidOpenTextDocumentParams>(n.params)
+                .map(|p| {
+                    let uri = p.text_document.uri;
+                    let path = analysis::document_path(&uri);
+                    self.docs.insert(
+                        uri.as_str().to_string(),
+                        Document {
+                            uri,
+                            text: p.text_document.text,
+                            path,
+                        },
+                    );
+                }),
+            note::DidChangeTextDocument::METHOD => {
+                params::<lsp::DidChangeTextDocumentParams>(n.params).and_then(|p| {
+                    let doc = self.docs.get_mut(p.text_document.uri.as_str())?;
+                    for c in p.content_changes {
+                        apply_change(&mut doc.text, c);
+                    }
+                    Some(())
+                })
+            }
+            note::DidCloseTextDocument::METHOD => {
+                if let Some(p) = params::<lsp::DidCloseTextDocumentParams>(n.params) {
+                    self.docs.remove(p.text_document.uri.as_str());
+                    self.analyses.remove(p.text_document.uri.as_str());
+                    return vec![publish(p.text_document.uri, Vec::new())];
+                }
+                None
+            }
+            _ => None,
+        };
+        if changed.is_none() {
+            return Vec::new();
+        }
+        // A change can change what every other open document sees through
+        // its `use`s: all are checked again (a handful, each in
+        // milliseconds).
+        let keys: Vec<String> = self.docs.keys().cloned().collect();
+        let mut out = Vec::new();
+        for k in keys {
+            if let Some(a) = analysis::analyse(&self.docs, self.root.as_deref(), &k) {
+                let doc = &self.docs[&k];
+                let diags = analysis::diagnostics(&a, &doc.uri, &doc.text);
+                out.push(publish(doc.uri.clone(), diags));
+                self.analyses.insert(k, a);
+            }
+        }
+        out
+    }
+
+    fn request(&mut self, r: Request) -> Response {
+        let id = r.id.clone();
+        let result = match r.method.as_str() {
+            req::HoverRequest::METHOD => self.with_position(r, |a, _, text, at| {
+                hover::hover(a, text, at).map(|(md, s, e)| lsp::Hover {
+                    contents: lsp::HoverContents::Markup(lsp::MarkupContent {
+                        kind: lsp::MarkupKind::Markdown,
+                        value: md,
+                    }),
+                    range: Some(LineIndex::new(text).range(s, e)),
+                })
+            }),
+            req::Completion::METHOD => self.with_position(r, |a, _, text, at| {
+                Some(lsp::CompletionResponse::Array(completion::complete(
+                    a, text, at,
+                )))
+            }),
+            req::GotoDefinition::METHOD => self.with_position(r, |a, uri, text, at| {
+                definition::definition(a?, uri, text, at).map(lsp::GotoDefinitionResponse::Scalar)
+            }),
+            req::Formatting::METHOD => match params::<lsp::DocumentFormattingParams>(r.params) {
+                Some(p) => Ok(self.format(&p.text_document.uri)),
+                None => Err("bad formatting parameters".to_string()),
+            },
+            _ => {
+                return Response::new_err(
+                    id,
+                    ErrorCode::MethodNotFound as i32,
+                    format!("lensc lsp does not answer `{}`", r.method),
+                );
+            }
+        };
+        match result {
+            Ok(v) => Response::new_ok(id, v),
+            Err(e) => Response::new_err(id, ErrorCode::InvalidParams as i32, e),
+        }
+    }
+
+    /// Answers a request about a position in an open document.
+    fn with_position<T: serde::Serialize>(
+        &self,
+        r: Request,
+        answer: impl FnOnce(Option<&Analysis>, &Uri, &str, usize) -> Option<T>,
+    ) -> Result<serde_json::Value, String> {
+        let p: lsp::TextDocumentPositionParams =
+            serde_json::from_value(r.params.clone()).map_err(|e| format!("bad parameters: {e}"))?;
+        let uri = &p.text_document.uri;
+        let Some(doc) = self.docs.get(uri.as_str()) else {
+            return Ok(serde_json::Value::Null);
+        };
+        let at = LineIndex::new(&doc.text).offset(p.position);
+        let v = answer(self.analyses.get(uri.as_str()), uri, &doc.text, at);
+        serde_json::to_value(v).map_err(|e| e.to_string())
+    }
+
+    /// The document in `lensc fmt`'s layout, as one edit; no edit when it
+    /// is already, or while it has syntax errors (shown as diagnostics).
+    fn format(&self, uri: &Uri) -> serde_json::Value {
+        let Some(doc) = self.docs.get(uri.as_str()) else {
+            return serde_json::Value::Null;
+        };
+        let edits = match lensc_lang::format::format_source(&doc.text) {
+            Ok(f) if f != doc.text => vec![lsp::TextEdit {
+                range: LineIndex::new(&doc.text).range(0, doc.text.len()),
+                new_text: f,
+            }],
+            _ => Vec::new(),
+        };
+        serde_json::to_value(edits).unwrap_or_default()
+    }
+}
+
+fn params<T: DeserializeOwned>(v: serde_json::Value) -> Option<T> {
+    serde_json::from_value(v).ok()
+}
+
+fn apply_change(text: &mut String, c: lsp::TextDocumentContentChangeEvent) {
+    match c.range {
+        None => *text = c.text,
+        Some(r) => {
+            let ix = LineIndex::new(text);
+            let (s, e) = (ix.offset(r.start), ix.offset(r.end));
+            let (s, e) = (s.min(e), s.max(e));
+            text.replace_range(s..e, &c.text);
+        }
+    }
+}
+
+fn publish(uri: Uri, diagnostics: Vec<lsp::Diagnostic>) -> Notification {
+    Notification::new(
+        note::PublishDiagnostics::METHOD.to_string(),
+        lsp::PublishDiagnosticsParams {
+            uri,
+            diagnostics,
+            version: None,
+        },
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use super::*;
+
+    /// Every example, standard-library file and file of the bad-input
+    /// corpora, asked for hover, completion and definition at every 11th
+    /// byte and formatted: no answer panics, and every position maps back
+    /// to its offset's character.
+    #[test]
+    fn no_question_about_any_corpus_file_panics() {
+        let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let mut files = Vec::new();
+        for dir in ["examples", "stdlib", "tests/bad", "tests/bad_builds"] {
+            for e in std::fs::read_dir(repo.join(dir)).expect(dir) {
+                let p = e.expect("entry").path();
+                if p.extension().is_some_and(|x| x == "lens") {
+                    files.push(p);
+                }
+            }
+        }
+        assert!(files.len() > 100, "{}", files.len());
+        let mut asked = 0;
+        for path in files {
+            let Ok(text) = std::fs::read_to_string(&path) else {
+                continue; // a corpus file that is not UTF-8
+            };
+            let uri = text::path_to_uri(&path.canonicalize().expect("path"));
+            let mut docs = Docs::new();
+            docs.insert(
+                uri.as_str().to_string(),
+                Document {
+                    uri: uri.clone(),
+                    path: analysis::document_path(&uri),
+                    text: text.clone(),
+                },
+            );
+            let a = analysis::analyse(&docs, None, uri.as_str()).expect("analysed");
+            let _ = analysis::diagnostics(&a, &uri, &text);
+            let ix = LineIndex::new(&text);
+            for at in (0..=text.len()).step_by(11) {
+                let p = ix.position(at);
+                let back = ix.offset(p);
+                let char_start = (0..=at).rev().find(|&i| text.is_char_boundary(i));
+                assert_eq!(Some(back), char_start, "{path:?} {at}");
+                let _ = hover::hover(Some(&a), &text, at);
+                let _ = completion::complete(Some(&a), &text, at);
+                let _ = definition::definition(&a, &uri, &text, at);
+                asked += 1;
+            }
+            let _ = lensc_lang::format::format_source(&text);
+        }
+        assert!(asked > 1000, "{asked}");
+    }
+}

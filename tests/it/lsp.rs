@@ -1,0 +1,394 @@
+//! `lensc lsp` end to end: the real binary started as an editor starts
+//! it, spoken to in JSON-RPC over its stdin and stdout (initialize,
+//! initialized, didOpen, didChange, publishDiagnostics, hover, completion,
+//! definition, formatting, shutdown, exit), every answer checked.
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::path::Path;
+use std::process::{Child, ChildStdin, Command, Stdio};
+use std::sync::mpsc::{Receiver, channel};
+use std::time::Duration;
+
+use serde_json::{Value, json};
+
+use crate::common::{lensc, root};
+
+const JOB: &str = r#"// A µ-turning job: the µ and ° before later spans test UTF-16 columns.
+use std::machines::linuxcnc_lathe
+use "common.lens"
+
+let depth = 2 * 5 um + margin
+
+surface lens = conic {
+    radius: 22.405 mm
+    conic: -1
+    sense: convex
+    aperture: circle(radius: 1.6 mm)
+}
+
+tool knife = round_nose { nose_radius: 85 µm, clearance: 10° }
+
+machine lathe1 = linuxcnc_lathe { resolution: 2 nm }
+
+strategy pass = profile_turning {
+    feed: 20 um/s
+    spindle_speed: 1000 rpm
+    chord_tolerance: depth
+}
+
+job j { surface: lens, tool: knife, machine: lathe1, strategy: pass }
+"#;
+
+const COMMON: &str = "// Shared figures.\nlet margin = 3 um\n";
+
+/// An editor's end of the connection.
+struct Client {
+    child: Child,
+    stdin: ChildStdin,
+    incoming: Receiver<Value>,
+    next_id: i64,
+}
+
+impl Client {
+    fn start(cwd: &Path, cache: &Path) -> Client {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_lensc"))
+            .arg("lsp")
+            .current_dir(cwd)
+            .env("XDG_CACHE_HOME", cache)
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .expect("start lensc lsp");
+        let stdin = child.stdin.take().expect("stdin");
+        let mut out = BufReader::new(child.stdout.take().expect("stdout"));
+        let (tx, incoming) = channel();
+        std::thread::spawn(move || {
+            loop {
+                // Headers up to a blank line, then Content-Length bytes.
+                let mut length = None;
+                loop {
+                    let mut line = String::new();
+                    if out.read_line(&mut line).unwrap_or(0) == 0 {
+                        return;
+                    }
+                    let line = line.trim_end();
+                    if line.is_empty() {
+                        break;
+                    }
+                    if let Some(n) = line.strip_prefix("Content-Length: ") {
+                        length = n.parse::<usize>().ok();
+                    }
+                }
+                let mut body = vec![0; length.expect("a Content-Length header")];
+                out.read_exact(&mut body).expect("a message body");
+                let msg: Value = serde_json::from_slice(&body).expect("JSON");
+                if tx.send(msg).is_err() {
+                    return;
+                }
+            }
+        });
+        Client {
+            child,
+            stdin,
+            incoming,
+            next_id: 1,
+        }
+    }
+
+    fn send(&mut self, msg: Value) {
+        let body = msg.to_string();
+        write!(self.stdin, "Content-Length: {}\r\n\r\n{body}", body.len()).expect("write");
+        self.stdin.flush().expect("flush");
+    }
+
+    fn notify(&mut self, method: &str, params: Value) {
+        self.send(json!({"jsonrpc": "2.0", "method": method, "params": params}));
+    }
+
+    /// Sends a request and returns its result (notifications on the way
+    /// are passed over).
+    fn request(&mut self, method: &str, params: Value) -> Value {
+        let id = self.next_id;
+        self.next_id += 1;
+        self.send(json!({"jsonrpc": "2.0", "id": id, "method": method, "params": params}));
+        loop {
+            let msg = self.next();
+            if msg["id"] == json!(id) {
+                assert!(msg.get("error").is_none(), "{method}: {msg}");
+                return msg["result"].clone();
+            }
+        }
+    }
+
+    /// The next diagnostics published for `uri`.
+    fn diagnostics(&mut self, uri: &str) -> Vec<Value> {
+        loop {
+            let msg = self.next();
+            if msg["method"] == "textDocument/publishDiagnostics" && msg["params"]["uri"] == uri {
+                return msg["params"]["diagnostics"]
+                    .as_array()
+                    .expect("a list")
+                    .clone();
+            }
+        }
+    }
+
+    fn next(&mut self) -> Value {
+        self.incoming
+            .recv_timeout(Duration::from_secs(60))
+            .expect("an answer from lensc lsp within a minute")
+    }
+}
+
+fn uri_of(p: &Path) -> String {
+    format!("file://{}", p.display())
+}
+
+/// The protocol position of the `n`th (0-based) occurrence of `needle`
+/// in `text`, plus `plus` characters: its line, and its column in UTF-16
+/// code units, counted here independently of the server.
+fn pos(text: &str, needle: &str, n: usize, plus: usize) -> Value {
+    let at = text.match_indices(needle).nth(n).expect(needle).0;
+    let line_start = text[..at].rfind('\n').map_or(0, |i| i + 1);
+    let line = text[..at].matches('\n').count();
+    let col = text[line_start..at].encode_utf16().count() + plus;
+    json!({"line": line, "character": col})
+}
+
+fn at(uri: &str, p: Value) -> Value {
+    json!({"textDocument": {"uri": uri}, "position": p})
+}
+
+fn hover_text(c: &mut Client, uri: &str, p: Value) -> String {
+    let h = c.request("textDocument/hover", at(uri, p));
+    h["contents"]["value"].as_str().unwrap_or("").to_string()
+}
+
+fn labels(v: &Value) -> Vec<String> {
+    v.as_array()
+        .expect("a completion list")
+        .iter()
+        .map(|i| i["label"].as_str().expect("a label").to_string())
+        .collect()
+}
+
+#[test]
+fn an_editor_session() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let work = dir.path().canonicalize().expect("dir").join("work");
+    let cache = dir.path().join("cache");
+    std::fs::create_dir_all(&work).expect("mkdir");
+    std::fs::write(work.join("job.lens"), JOB).expect("write");
+    std::fs::write(work.join("common.lens"), COMMON).expect("write");
+    let uri = uri_of(&work.join("job.lens"));
+
+    let mut c = Client::start(&work, &cache);
+    let init = c.request(
+        "initialize",
+        json!({"processId": null, "rootUri": uri_of(&work), "capabilities": {}}),
+    );
+    let caps = &init["capabilities"];
+    assert_eq!(caps["hoverProvider"], json!(true), "{init}");
+    assert_eq!(caps["definitionProvider"], json!(true));
+    assert_eq!(caps["documentFormattingProvider"], json!(true));
+    assert_eq!(init["serverInfo"]["name"], "lensc");
+    c.notify("initialized", json!({}));
+
+    // The file as saved checks clean.
+    c.notify(
+        "textDocument/didOpen",
+        json!({"textDocument": {"uri": uri, "languageId": "lens", "version": 1, "text": JOB}}),
+    );
+    assert_eq!(c.diagnostics(&uri), Vec::<Value>::new());
+
+    // Typing `s` over the `m` of `85 µm`: an incremental change whose
+    // column counts `µ` as one UTF-16 unit. The checker's E0122 comes
+    // back at `85 µs`, its columns in UTF-16 too.
+    let m = pos(JOB, "µm,", 0, 1);
+    let end = json!({"line": m["line"], "character": m["character"].as_u64().expect("col") + 1});
+    c.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": uri, "version": 2},
+               "contentChanges": [{"range": {"start": m, "end": end}, "text": "s"}]}),
+    );
+    let d = c.diagnostics(&uri);
+    assert_eq!(d.len(), 1, "{d:?}");
+    assert_eq!(d[0]["code"], "E0122");
+    assert_eq!(d[0]["severity"], 1);
+    assert_eq!(d[0]["source"], "lensc");
+    assert!(
+        d[0]["message"]
+            .as_str()
+            .expect("message")
+            .contains("`nose_radius` must be a length, but this is a time"),
+        "{}",
+        d[0]["message"]
+    );
+    let bad = JOB.replace("85 µm", "85 µs");
+    assert_eq!(d[0]["range"]["start"], pos(&bad, "85 µs", 0, 0));
+    assert_eq!(d[0]["range"]["end"], pos(&bad, "85 µs", 0, 5));
+
+    // A whole-text change back: clean again.
+    c.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": uri, "version": 3}, "contentChanges": [{"text": JOB}]}),
+    );
+    assert_eq!(c.diagnostics(&uri), Vec::<Value>::new());
+
+    // Hover: a parameter (documentation, dimension, unit, range), a kind,
+    // a `let`'s evaluated value with its unit, a standard-library item.
+    let h = hover_text(&mut c, &uri, pos(JOB, "nose_radius", 0, 2));
+    assert!(
+        h.contains("**nose_radius**: a length, in mm, > 0, required"),
+        "{h}"
+    );
+    assert!(h.contains("radius of the cutting edge's nose"), "{h}");
+    let h = hover_text(&mut c, &uri, pos(JOB, "conic {", 0, 1));
+    assert!(h.starts_with("**conic** — a surface, built-in kind"), "{h}");
+    assert!(h.contains("- `radius`:"), "{h}");
+    let h = hover_text(&mut c, &uri, pos(JOB, "depth", 1, 1));
+    assert!(h.contains("let depth = 0.013 mm"), "{h}");
+    assert!(h.contains("a length"), "{h}");
+    let h = hover_text(&mut c, &uri, pos(JOB, "linuxcnc_lathe {", 0, 3));
+    assert!(h.contains("of the standard library"), "{h}");
+    assert!(h.contains("`use std::machines::linuxcnc_lathe`"), "{h}");
+    let h = hover_text(&mut c, &uri, pos(JOB, "µm,", 0, 1));
+    assert!(h.contains("a unit of a length: 1 µm = 0.001 mm"), "{h}");
+
+    // Completion: a block's parameters not yet given, after typing a line.
+    let typed = JOB.replace(
+        "    chord_tolerance: depth\n",
+        "    chord_tolerance: depth\n    \n",
+    );
+    c.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": uri, "version": 4}, "contentChanges": [{"text": typed}]}),
+    );
+    c.diagnostics(&uri);
+    let empty = typed
+        .lines()
+        .position(|l| l == "    ")
+        .expect("the new line");
+    let l = labels(&c.request(
+        "textDocument/completion",
+        at(&uri, json!({"line": empty, "character": 4})),
+    ));
+    assert!(!l.contains(&"feed".to_string()), "`feed` is given: {l:?}");
+    assert!(!l.contains(&"spindle_speed".to_string()), "{l:?}");
+    let profile = lensc_lang::schema::kind("profile_turning").expect("kind");
+    for p in profile.params {
+        if !["feed", "spindle_speed", "chord_tolerance"].contains(&p.name) {
+            assert!(l.contains(&p.name.to_string()), "{} missing: {l:?}", p.name);
+        }
+    }
+    // Standard-library modules after `use std::`, a module's items after
+    // `use std::machines::`, units after a number, kinds in a value.
+    let typed = format!("use std::\n{JOB}");
+    c.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": uri, "version": 5}, "contentChanges": [{"text": typed}]}),
+    );
+    c.diagnostics(&uri);
+    let l = labels(&c.request(
+        "textDocument/completion",
+        at(&uri, json!({"line": 0, "character": 9})),
+    ));
+    assert_eq!(l, ["machines", "tools", "strategies", "dialects"]);
+    let typed = format!("use std::machines::\n{JOB}");
+    c.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": uri, "version": 6}, "contentChanges": [{"text": typed}]}),
+    );
+    c.diagnostics(&uri);
+    let l = labels(&c.request(
+        "textDocument/completion",
+        at(&uri, json!({"line": 0, "character": 19})),
+    ));
+    assert!(l.contains(&"linuxcnc_lathe".to_string()), "{l:?}");
+    assert!(!l.contains(&"fanuc".to_string()), "{l:?}");
+    let l = labels(&c.request(
+        "textDocument/completion",
+        at(&uri, pos(&typed, "85 ", 0, 3)),
+    ));
+    for u in ["um", "µm", "mm", "nm", "deg", "rpm"] {
+        assert!(l.contains(&u.to_string()), "{u}: {l:?}");
+    }
+    let l = labels(&c.request(
+        "textDocument/completion",
+        at(&uri, pos(&typed, "conic {", 0, 0)),
+    ));
+    assert!(
+        l.contains(&"asphere".to_string()) && l.contains(&"depth".to_string()),
+        "{l:?}"
+    );
+    c.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": uri, "version": 7}, "contentChanges": [{"text": JOB}]}),
+    );
+    c.diagnostics(&uri);
+
+    // Go to definition: into the standard library (written to the cache
+    // directory) and across a `use` of another file.
+    let def = c.request(
+        "textDocument/definition",
+        at(&uri, pos(JOB, "linuxcnc_lathe {", 0, 2)),
+    );
+    let target = def["uri"].as_str().expect("a location");
+    let path = target.strip_prefix("file://").expect("a file");
+    assert!(Path::new(path).starts_with(&cache), "{target}");
+    let std_text = std::fs::read_to_string(path).expect("the stdlib copy");
+    assert_eq!(
+        std_text,
+        std::fs::read_to_string(root().join("stdlib/machines.lens")).expect("stdlib")
+    );
+    let line = def["range"]["start"]["line"].as_u64().expect("line") as usize;
+    assert!(
+        std_text
+            .lines()
+            .nth(line)
+            .expect("line")
+            .contains("machine linuxcnc_lathe ="),
+        "{def}"
+    );
+    let def = c.request(
+        "textDocument/definition",
+        at(&uri, pos(JOB, "margin", 0, 1)),
+    );
+    assert_eq!(def["uri"], uri_of(&work.join("common.lens")));
+    assert_eq!(def["range"]["start"], json!({"line": 1, "character": 4}));
+    let def = c.request("textDocument/definition", at(&uri, pos(JOB, "depth", 1, 0)));
+    assert_eq!(def["uri"], uri);
+    assert_eq!(def["range"]["start"], pos(JOB, "depth", 0, 0));
+
+    // Formatting answers what `lensc fmt` writes.
+    let messy = "tool t = round_nose{nose_radius:85 um,clearance:7 deg}\n";
+    std::fs::write(work.join("messy.lens"), messy).expect("write");
+    let messy_uri = uri_of(&work.join("messy.lens"));
+    c.notify(
+        "textDocument/didOpen",
+        json!({"textDocument": {"uri": messy_uri, "languageId": "lens", "version": 1, "text": messy}}),
+    );
+    c.diagnostics(&messy_uri);
+    let out = lensc(&work, &["fmt", "messy.lens"]);
+    assert!(out.status.success());
+    let formatted = std::fs::read_to_string(work.join("messy.lens")).expect("read");
+    assert_ne!(formatted, messy);
+    let edits = c.request(
+        "textDocument/formatting",
+        json!({"textDocument": {"uri": messy_uri}, "options": {"tabSize": 4, "insertSpaces": true}}),
+    );
+    assert_eq!(edits.as_array().map(Vec::len), Some(1), "{edits}");
+    assert_eq!(edits[0]["newText"], formatted);
+    assert_eq!(
+        edits[0]["range"]["start"],
+        json!({"line": 0, "character": 0})
+    );
+    assert_eq!(edits[0]["range"]["end"], json!({"line": 1, "character": 0}));
+
+    let r = c.request("shutdown", Value::Null);
+    assert_eq!(r, Value::Null);
+    c.notify("exit", Value::Null);
+    let status = c.child.wait().expect("wait");
+    assert!(status.success(), "{status}");
+}
