@@ -188,6 +188,7 @@ mod tests {
             max_feed: max_feed_mm_min / 60.0,
         };
         let mut p = RollerProgram::new(&dialect, "t", &[], limits, 5.0, TAU_RAD_S).expect("writer");
+        p.call_tool(&moves::Start::default()).expect("tool");
         let step = 0.025f64.to_radians();
         let points: Vec<RollerPoint> = (0..6)
             .map(|k| RollerPoint {
@@ -278,7 +279,14 @@ mod tests {
             assert!(u >= t);
             let f = 60.0 / u;
             assert_eq!((f * 1e3).round() / 1e3, f);
-            assert!(f <= 60.0 / t && f > 60.0 / t - 1e-3);
+            assert!(f <= 60.0 / t * (1.0 + 1e-12) && f > 60.0 / t - 1e-3);
+        }
+        // A time that is already a whole number of units is kept.
+        for f in [1000.0, 864_000.0, 0.001, 59.999] {
+            assert_eq!(
+                60.0 / crate::post::writer::inverse_time_not_faster(60.0 / f),
+                f
+            );
         }
     }
 }

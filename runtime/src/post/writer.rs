@@ -131,10 +131,13 @@ const INVERSE_TIME_DECIMALS: u32 = 3;
 /// The shortest move time (s), at least `t`, whose inverse-time F as
 /// printed (1/min, rounded to its decimals) is not above 60 / `t`: a move
 /// slowed to a limit must not read faster than the limit once printed.
-/// Times so long that F would print as 0 are returned as they are.
+/// Times so long that F would print as 0 are returned as they are. A
+/// quotient a rounding error below a whole number of units (60 / t for t
+/// = 60 / F itself) is taken as that number: F is then above 60 / t by at
+/// most 1e-12 of it, far inside any controller's (and the reader's) limit.
 pub fn inverse_time_not_faster(t: f64) -> f64 {
     let scale = 10f64.powi(INVERSE_TIME_DECIMALS as i32);
-    let units = (60.0 / t * scale).floor();
+    let units = (60.0 / t * scale * (1.0 + 1e-12)).floor();
     if units >= 1.0 {
         60.0 / (units / scale)
     } else {
