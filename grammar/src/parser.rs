@@ -66,6 +66,18 @@ static PRATT: LazyLock<PrattParser<Rule>> = LazyLock::new(|| {
 /// Parses one source file. Always returns a tree (possibly partial) and the
 /// syntax diagnostics found, in source order.
 pub fn parse(source: &str, file: FileId) -> (File, Vec<Diagnostic>) {
+    parse_with(source, file, true)
+}
+
+/// `parse` by pest alone, without the hand-written fast path (`descent`):
+/// the reference that tests and the fuzzer compare `parse` with. Its
+/// result is the same, tree and diagnostics, only slower.
+#[doc(hidden)]
+pub fn parse_reference(source: &str, file: FileId) -> (File, Vec<Diagnostic>) {
+    parse_with(source, file, false)
+}
+
+fn parse_with(source: &str, file: FileId, fast: bool) -> (File, Vec<Diagnostic>) {
     let mut diags = Vec::new();
     if source.len() > u32::MAX as usize / 2 {
         diags.push(Diagnostic::error(
@@ -110,6 +122,11 @@ pub fn parse(source: &str, file: FileId) -> (File, Vec<Diagnostic>) {
     // does not parse is parsed again item by item, for every error in it.
     for batch in batches(&chunks) {
         let (start, end) = (batch[0].0, batch[batch.len() - 1].1);
+        // Text with nothing to report takes the hand-written path; pest
+        // parses the rest, and every error is reported from there.
+        if fast && crate::descent::items(&source[start..end], start, &mut items).is_some() {
+            continue;
+        }
         if batch.len() > 1
             && let Ok(pairs) = LensParser::parse(Rule::file, &source[start..end])
         {
