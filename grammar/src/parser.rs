@@ -260,20 +260,21 @@ fn scan(src: &str) -> Scan {
             b')' | b']' | b'}' => depth = depth.saturating_sub(1),
             _ => {}
         }
-        let is_word = c.is_ascii_alphanumeric() || c == b'_';
-        if is_word
-            && at_word_start
-            && i > 0
-            && starts_item(&src[i..])
-            && preceded_by_line_start(b, i)
-        {
-            // Also inside an unclosed bracket: an item keyword at the start of
-            // a line followed by a name cannot continue the previous item,
-            // so a missing `)` or `}` does not swallow the rest of the file.
-            starts.push(i);
-            powers = 0;
+        let is_word = is_word_byte(c);
+        if is_word {
+            if at_word_start && i > 0 && preceded_by_line_start(b, i) && starts_item(&src[i..]) {
+                // Also inside an unclosed bracket: an item keyword at the start of
+                // a line followed by a name cannot continue the previous item,
+                // so a missing `)` or `}` does not swallow the rest of the file.
+                starts.push(i);
+                powers = 0;
+            }
+            // The rest of the word changes nothing above: pass over it.
+            i += b[i..].iter().take_while(|&&w| is_word_byte(w)).count();
+            at_word_start = false;
+            continue;
         }
-        at_word_start = !is_word;
+        at_word_start = true;
         i += 1;
     }
     let mut chunks = Vec::with_capacity(starts.len());
@@ -286,6 +287,10 @@ fn scan(src: &str) -> Scan {
         too_deep_at: None,
         why: TooDeep::Brackets,
     }
+}
+
+fn is_word_byte(b: u8) -> bool {
+    b.is_ascii_alphanumeric() || b == b'_'
 }
 
 /// `surface name`, `let name`, `use "…"`, `use std…`: an item keyword followed
