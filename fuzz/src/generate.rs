@@ -417,7 +417,11 @@ impl Gen<'_> {
                 }
                 self.out.push(']');
             }
-            Ty::Block(params) => {
+            Ty::BlockOr(_, words) if self.rng.chance(0.2) => {
+                let w = self.rng.pick(words);
+                self.out.push_str(w);
+            }
+            Ty::Block(params) | Ty::BlockOr(params, _) => {
                 if self.depth > 4 {
                     self.out.push_str("{}");
                     return;

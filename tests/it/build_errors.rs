@@ -70,6 +70,14 @@ const PLANNING_ONLY: &[(&str, &str)] = &[
     ),
     ("W0003", "the seams are found on the planned envelope"),
     (
+        "E0195",
+        "the acceptance gate compares the part the planned program cuts",
+    ),
+    (
+        "E0196",
+        "what the simulation of the planned program cannot measure",
+    ),
+    (
         "W0004",
         "the pip at the centre is found on the planned moves",
     ),
@@ -114,6 +122,47 @@ fn check_reports_every_bad_build_error_that_needs_no_toolpath() {
         let errors = found.iter().any(|c| c.starts_with('E'));
         assert_eq!(checked.status.code(), Some(i32::from(errors)), "{rel}");
     }
+}
+
+/// `--accept=warn` turns a job's acceptance errors into warnings: the
+/// program and its report are written, the report's `acceptance` says
+/// which criterion failed, by the figure measured.
+#[test]
+fn accept_warn_writes_the_program_and_reports_the_miss() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let out = dir.path().to_str().expect("utf-8");
+    let file = "tests/bad_builds/accept_form_pv_missed.lens";
+    let gated = lensc(&root(), &["build", file, "--out", out]);
+    assert_eq!(gated.status.code(), Some(1));
+    assert!(text(&gated.stderr).contains("[E0195]"));
+    assert_eq!(std::fs::read_dir(dir.path()).expect("out").count(), 0);
+    let warned = lensc(&root(), &["build", file, "--out", out, "--accept=warn"]);
+    let stderr = text(&warned.stderr);
+    assert_eq!(warned.status.code(), Some(0), "{stderr}");
+    assert!(
+        stderr.contains("[W0020]") && !stderr.contains("[E0195]"),
+        "{stderr}"
+    );
+    assert!(dir.path().join("sphere.ngc").exists());
+    let report: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("sphere.report.json")).expect("report"),
+    )
+    .expect("json");
+    let a = &report["acceptance"];
+    assert_eq!(a["mode"], "warn");
+    assert_eq!(a["passed"], false);
+    let pv = a["criteria"]
+        .as_array()
+        .expect("criteria")
+        .iter()
+        .find(|c| c["criterion"] == "form_pv")
+        .expect("form_pv");
+    assert_eq!(pv["passed"], false);
+    assert_eq!(pv["source"], "stated");
+    assert_eq!(pv["limit"], 50.0);
+    // The figure the report's simulation gives, not another.
+    assert_eq!(pv["measured"], report["simulation"]["form_error_pv_nm"]);
+    assert!(pv["measured"].as_f64().expect("measured") > 50.0);
 }
 
 /// `--dialect` misspelled, or naming a dialect the machine does not offer:

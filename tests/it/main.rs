@@ -12,6 +12,7 @@ mod common;
 mod bad_programs;
 mod build_errors;
 mod cli;
+mod complete_programs;
 mod determinism;
 mod diagnostics;
 mod dialects;

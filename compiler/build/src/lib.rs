@@ -3,9 +3,11 @@
 //! `JobSpec` and hands it to its strategy's builder (`builders/`), which
 //! plans with `lensc-runtime`, emits the program (spooled and written
 //! atomically, once read back by the controllers' rules: `read_back`),
-//! simulates what it will cut and fills the build report;
-//! plots draw that report.
+//! simulates what it will cut and fills the build report; the acceptance
+//! gate (`accept`) holds the simulated part to the job's criteria; plots
+//! draw that report.
 
+pub mod accept;
 pub mod builders;
 pub mod driver;
 pub mod evaluate;

@@ -113,6 +113,8 @@ fn report(
         // Filled in by the pipeline, which made the estimate.
         estimate: report::Estimate::default(),
         simulation,
+        // Filled in by the pipeline's acceptance gate.
+        acceptance: report::Acceptance::pending(),
         surface: surface_analysis(
             &head.names.surface,
             head.surface.kind,

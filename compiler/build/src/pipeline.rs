@@ -1,6 +1,7 @@
 //! The pipeline over a file's jobs: each checked job is lowered to its
 //! typed `JobSpec` (lensc-lang, with every check that needs no planning)
-//! and handed to its strategy's builder — the one `match` over `JobSpec`.
+//! and handed to its strategy's builder — the one `match` over `JobSpec` —
+//! and what it built is held to the job's acceptance criteria (`accept`).
 
 use std::path::Path;
 
@@ -25,6 +26,9 @@ pub struct Request<'a> {
     /// The largest program (bytes) to write (`--max-program-size`); the
     /// default limit if `None`.
     pub max_program_size: Option<u64>,
+    /// Whether a job whose simulated part misses its acceptance criteria
+    /// is an error (the default) or a warning (`--accept=warn`).
+    pub accept: crate::accept::Mode,
 }
 
 impl Request<'_> {
@@ -85,20 +89,27 @@ pub fn plan_and_emit(
         .filter(|j| request.job.is_none_or(|n| j.name.name == n));
     for job in jobs {
         let built = lower(job, request.dialect, &request.limits()).and_then(|(spec, est)| {
-            let b = build(&spec, &prov, spool_dir)?;
+            let mut b = build(&spec, &prov, spool_dir)?;
             if crate::read_back::enabled() {
                 let refused = crate::read_back::findings(job, spec.head(), &b.program);
                 if !refused.is_empty() {
                     return Err(refused);
                 }
             }
-            Ok((b, est))
+            b.report.estimate = (&est).into();
+            let gate = crate::accept::gate(&spec, &mut b, request.accept);
+            Ok((b, gate))
         });
         match built {
-            Ok((mut b, est)) => {
-                b.report.estimate = (&est).into();
+            Ok((mut b, mut gate)) => {
                 diags.append(&mut b.warnings);
-                out.push(b);
+                let refused = gate.iter().any(|d| d.is_error());
+                diags.append(&mut gate);
+                // A job that fails its gate is not written (its spooled
+                // program is removed as it is dropped).
+                if !refused {
+                    out.push(b);
+                }
             }
             Err(mut d) => diags.append(&mut d),
         }
@@ -106,7 +117,8 @@ pub fn plan_and_emit(
     (out, diags)
 }
 
-/// Plans, emits and simulates one lowered job with its strategy's builder.
+/// Plans, emits and simulates one lowered job with its strategy's builder
+/// (the acceptance gate is `plan_and_emit`'s, after it).
 pub fn build(
     spec: &JobSpec,
     prov: &Provenance,

@@ -45,6 +45,9 @@ pub struct Report {
     pub estimate: Estimate,
     /// What the program cuts, simulated from its moves as printed.
     pub simulation: Simulation,
+    /// The acceptance gate: each criterion the simulated part is held to,
+    /// its limit, what was measured, and whether it passed.
+    pub acceptance: Acceptance,
     /// The surface's analysis over its whole domain (what `lensc analyse`
     /// prints).
     pub surface: SurfaceAnalysis,
@@ -812,7 +815,9 @@ pub struct Skipped {
 }
 
 /// A profile's simulated cut: the form error (cut minus design, positive
-/// where material is left) over the radii the cut reaches.
+/// where material is left) over the radii the cut reaches, with the
+/// figures defined as [`Figures`] defines them (PV largest minus least,
+/// RMS about the mean, the mean, the largest deviation either way).
 #[derive(Clone, Debug, Serialize, JsonSchema)]
 #[schemars(deny_unknown_fields)]
 pub struct ProfileCut {
@@ -824,14 +829,38 @@ pub struct ProfileCut {
     pub from_radius_mm: Option<f64>,
     /// Last radius sampled (mm), null if none.
     pub to_radius_mm: Option<f64>,
-    /// Peak to valley of the form error (nm).
+    /// Peak to valley of the form error: largest minus least (nm).
     pub form_error_pv_nm: Option<f64>,
-    /// RMS of the form error (nm).
+    /// RMS of the form error about its mean (nm).
     pub form_error_rms_nm: Option<f64>,
+    /// The mean form error (nm): piston, a uniform shift from the design;
+    /// null if no radius was cut.
+    pub form_error_mean_nm: Option<f64>,
+    /// The error of the largest magnitude, sign kept (nm), and where; its
+    /// value and radius are null if no radius was cut.
+    pub largest_deviation_nm: AtRadiusOrNull,
     /// The most material left above the design (nm) and where.
     pub max_residual_nm: AtRadius,
     /// The deepest cut below the design (nm) and where.
     pub max_gouge_nm: AtRadius,
+    /// The area of the surface of revolution the sampled radii stand for
+    /// (mm²; each sample 2π r times the spacing).
+    pub simulated_area_mm2: f64,
+    /// The part of it at radii the cut does not reach (mm²).
+    pub uncut_area_mm2: f64,
+    /// The first radius the cut does not reach (mm), null if none.
+    pub first_uncut_radius_mm: Option<f64>,
+}
+
+/// A value and the radius (mm) where it occurs, either null where there
+/// is none.
+#[derive(Clone, Copy, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct AtRadiusOrNull {
+    /// The value, in the unit the enclosing field's name gives.
+    pub value: Option<f64>,
+    /// Radius (mm) where it occurs.
+    pub at_radius_mm: Option<f64>,
 }
 
 impl From<&lensc_runtime::verify::simulate::ProfileCut> for ProfileCut {
@@ -843,6 +872,11 @@ impl From<&lensc_runtime::verify::simulate::ProfileCut> for ProfileCut {
             to_radius_mm: cut.samples.last().map(|s| s.0),
             form_error_pv_nm: finite(cut.pv * 1e6),
             form_error_rms_nm: finite(cut.rms * 1e6),
+            form_error_mean_nm: finite(cut.mean * 1e6),
+            largest_deviation_nm: AtRadiusOrNull {
+                value: finite(cut.largest_deviation.0 * 1e6),
+                at_radius_mm: finite(cut.largest_deviation.1),
+            },
             max_residual_nm: AtRadius {
                 value: cut.max_residual.0 * 1e6,
                 at_radius_mm: cut.max_residual.1,
@@ -851,6 +885,9 @@ impl From<&lensc_runtime::verify::simulate::ProfileCut> for ProfileCut {
                 value: cut.max_gouge.0 * 1e6,
                 at_radius_mm: cut.max_gouge.1,
             },
+            simulated_area_mm2: cut.area,
+            uncut_area_mm2: cut.uncut_area,
+            first_uncut_radius_mm: cut.uncut_at,
         }
     }
 }
@@ -938,6 +975,13 @@ pub struct HeightMap {
     pub grid: Grid,
     /// Cells of the window no pass reached.
     pub uncut_cells: usize,
+    /// The part's area those cells cover (mm²).
+    pub uncut_area_mm2: f64,
+    /// One of those cells, x and y (mm), or null if none.
+    pub first_uncut_mm: Option<[f64; 2]>,
+    /// The part's area the map evaluates, every cell counted whether cut
+    /// or not (mm²).
+    pub simulated_area_mm2: f64,
     /// Form error over the cut surface, scallops included; null if no
     /// cell was cut.
     pub surface: Option<Figures>,
@@ -996,6 +1040,9 @@ impl HeightMap {
                 row_step_mm: g.du,
             },
             uncut_cells: map.uncut,
+            uncut_area_mm2: map.uncut_area,
+            first_uncut_mm: map.uncut_at.map(|(x, y)| [x, y]),
+            simulated_area_mm2: map.area,
             surface: map.surface.as_ref().map(Figures::from),
             contact: map.contact.as_ref().map(Figures::from),
             scallops: ScallopReport {
@@ -1047,19 +1094,30 @@ pub struct Grid {
     pub row_step_mm: f64,
 }
 
-/// PV, RMS and extremes of a set of form errors.
+/// The figures of a set of form errors, as an optician reads them: the
+/// error is the cut minus the design at each point counted (positive
+/// where material is left); `pv_nm` is its largest minus its least value
+/// over the points counted, `rms_nm` its root mean square about its mean
+/// (so never above PV), `mean_nm` the mean itself (piston: a part cut
+/// uniformly deep shows here and in `largest_deviation_nm`, not in PV or
+/// RMS), and the extremes say where they are.
 #[derive(Clone, Copy, Debug, Serialize, JsonSchema)]
 #[schemars(deny_unknown_fields)]
 pub struct Figures {
     /// Cells counted.
     pub cells: usize,
-    /// Peak to valley (nm).
+    /// Peak to valley: the largest error minus the least (nm).
     pub pv_nm: f64,
-    /// RMS (nm).
+    /// RMS of the error about its mean (nm).
     pub rms_nm: f64,
-    /// The most material left above the design (nm) and where.
+    /// The mean error (nm): piston, a uniform shift from the design.
+    pub mean_nm: f64,
+    /// The error of the largest magnitude, sign kept (nm), and where: the
+    /// largest deviation from the design in either direction.
+    pub largest_deviation_nm: AtPoint,
+    /// The most material left above the design (nm, ≥ 0) and where.
     pub max_residual_nm: AtPoint,
-    /// The deepest cut below the design (nm) and where.
+    /// The deepest cut below the design (nm, ≥ 0) and where.
     pub max_gouge_nm: AtPoint,
 }
 
@@ -1074,6 +1132,8 @@ impl From<&ErrorFigures> for Figures {
             cells: f.count,
             pv_nm: f.pv * 1e6,
             rms_nm: f.rms * 1e6,
+            mean_nm: f.mean * 1e6,
+            largest_deviation_nm: at(f.largest_deviation),
             max_residual_nm: at(f.max_residual),
             max_gouge_nm: at(f.max_gouge),
         }
@@ -1138,6 +1198,107 @@ impl From<&FeatureFigures> for LensletHeightMap {
             scallops: f.scallops.as_ref().map(Scallops::from),
         }
     }
+}
+
+/// The acceptance gate of a job (README, "Acceptance"): the criteria
+/// its `accept` block states, the rest at defaults derived from the
+/// strategy's path tolerance and the machine's resolution, each compared
+/// with the simulated part. Form figures are those of [`Figures`] at the
+/// passes' contacts (a profile job's: over its sampled radii).
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct Acceptance {
+    /// `gate`: a criterion missed, or one that cannot be measured, is an
+    /// error and no program is written; `warn` (`lensc build
+    /// --accept=warn`, and `lensc report`): a warning, the program is
+    /// written; `none`: the job says `accept: none`, nothing is checked.
+    pub mode: AcceptanceMode,
+    /// Every criterion measured and met (true when `mode` is `none`).
+    pub passed: bool,
+    /// Each criterion the job is held to, in a fixed order.
+    pub criteria: Vec<CriterionResult>,
+}
+
+impl Acceptance {
+    /// Before the pipeline's gate has run: no criterion yet.
+    pub fn pending() -> Acceptance {
+        Acceptance {
+            mode: AcceptanceMode::None,
+            passed: true,
+            criteria: Vec::new(),
+        }
+    }
+}
+
+/// How a build treats its acceptance criteria.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum AcceptanceMode {
+    /// A criterion missed is an error; no program is written.
+    Gate,
+    /// A criterion missed is a warning; the program is written.
+    Warn,
+    /// The job opted out (`accept: none`).
+    None,
+}
+
+/// One acceptance criterion and what the simulation found.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct CriterionResult {
+    /// Its name in an `accept` block: `form_pv`, `form_rms`, `max_gouge`,
+    /// `max_residual`, `uncut_area`, `max_following_error`,
+    /// `max_cutting_time`.
+    pub criterion: &'static str,
+    /// The unit of `limit` and `measured`: `nm`, `mm2`, `fraction` (of the
+    /// area simulated) or `s`.
+    pub unit: &'static str,
+    /// The limit the figure may not exceed.
+    pub limit: f64,
+    /// Stated in the job's `accept` block, or the default.
+    pub source: LimitSource,
+    /// How a default limit was derived; null when stated.
+    pub default_rule: Option<String>,
+    /// The figure measured; null if the simulation could not measure it.
+    pub measured: Option<f64>,
+    /// Where on the part: a PV's highest and lowest points, a gouge's
+    /// deepest, a residual's highest, the first uncut cell, the worst
+    /// following error; empty for a figure with no one place (RMS,
+    /// cutting time).
+    pub at: Vec<Place>,
+    /// Measured and within the limit.
+    pub passed: bool,
+    /// Why the figure could not be measured; null if it was.
+    pub unmeasured: Option<&'static str>,
+}
+
+/// Where a limit came from.
+#[derive(Clone, Copy, Debug, Serialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum LimitSource {
+    /// The job's `accept` block.
+    Stated,
+    /// Derived from the strategy's tolerance (`default_rule` says how).
+    Default,
+}
+
+/// A place on the part: a point (x, y) of a surface job, or a radius of
+/// a profile job or a spiral.
+#[derive(Clone, Copy, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct Place {
+    /// What is there: `highest`, `lowest`, `deepest`, `first_uncut`,
+    /// `worst`.
+    pub what: &'static str,
+    /// x (mm), for a point.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub x_mm: Option<f64>,
+    /// y (mm), for a point.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub y_mm: Option<f64>,
+    /// The radius (mm), for a radius.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub radius_mm: Option<f64>,
 }
 
 /// The analysis of a surface over its domain (also what `lensc analyse`

@@ -57,11 +57,29 @@ pub const CANNOT_WRITE: &str = "E0151";
 pub const TOO_MANY_POINTS: &str = "E0160";
 /// A job's program would be larger than `--max-program-size`.
 pub const PROGRAM_TOO_LARGE: &str = "E0161";
+/// Roughing passes (a stock) without their own feed.
+pub const ROUGHING_NEEDS_FEED: &str = "E0170";
+/// A raster's spindle: a rotating cutter without a speed, or a knife
+/// (which cuts with the spindle held) given one.
+pub const RASTER_SPINDLE: &str = "E0171";
+/// A dialect's word format that does not read (`S5`, `X4.4`).
+pub const BAD_WORD_FORMAT: &str = "E0172";
+/// A tool call or coolant the job asks for that its dialect cannot write
+/// (a tool number too long for the T word, no mist word).
+pub const CANNOT_CALL_TOOL: &str = "E0173";
 /// A path tolerance finer than the machine's resolution can hold.
 pub const TOLERANCE_BELOW_RESOLUTION: &str = "E0180";
 /// `lensc fmt` refused to write a layout that would not parse back to the
 /// same program (a formatter bug; the file is left as it is).
 pub const FORMAT_WOULD_CHANGE_MEANING: &str = "E0185";
+
+/// The simulated part misses one of its job's acceptance criteria (the
+/// message names which, by how much and where); no program is written.
+pub const ACCEPTANCE_MISSED: &str = "E0195";
+/// A job's acceptance criterion that its simulation cannot measure (a
+/// tool shape the height map does not model, no servo model); no program
+/// is written unless the job says `accept: none`.
+pub const ACCEPTANCE_UNMEASURED: &str = "E0196";
 
 pub const UNUSED: &str = "W0001";
 pub const WRAP_GAP: &str = "W0002";
@@ -70,6 +88,10 @@ pub const CENTRE_LEFT_UNCUT: &str = "W0004";
 /// A servo's data period keeps a spiral's chords from meeting their share
 /// of the path tolerance.
 pub const CHORDS_OVER_TOLERANCE: &str = "W0005";
+/// E0195 under `lensc build --accept=warn`: the program is written.
+pub const ACCEPTANCE_MISSED_WARNING: &str = "W0020";
+/// E0196 under `lensc build --accept=warn`: the program is written.
+pub const ACCEPTANCE_UNMEASURED_WARNING: &str = "W0021";
 
 /// All codes, for the uniqueness test and the reference in README.
 // Programs read back from their text (`lensc verify`, and `lensc build`
@@ -224,7 +246,13 @@ pub const ALL: &[&str] = &[
     CANNOT_WRITE,
     TOO_MANY_POINTS,
     PROGRAM_TOO_LARGE,
+    ROUGHING_NEEDS_FEED,
+    RASTER_SPINDLE,
+    BAD_WORD_FORMAT,
+    CANNOT_CALL_TOOL,
     TOLERANCE_BELOW_RESOLUTION,
+    ACCEPTANCE_MISSED,
+    ACCEPTANCE_UNMEASURED,
     UNUSED,
     SEAM_LEFT_UNCUT,
     CENTRE_LEFT_UNCUT,
@@ -260,6 +288,8 @@ pub const ALL: &[&str] = &[
     PROGRAM_BLOCK_END,
     PROGRAM_END,
     PROGRAM_NESTED_COMMENT,
+    ACCEPTANCE_MISSED_WARNING,
+    ACCEPTANCE_UNMEASURED_WARNING,
 ];
 
 #[cfg(test)]

@@ -25,6 +25,7 @@ impl Dim {
     pub const ROTATIONAL_SPEED: Dim = Dim::new(0, 1, -1);
     pub const FREQUENCY: Dim = Dim::new(0, 0, -1);
     pub const ACCELERATION: Dim = Dim::new(1, 0, -2);
+    pub const AREA: Dim = Dim::new(2, 0, 0);
 
     pub const fn new(length: i8, angle: i8, time: i8) -> Dim {
         Dim {

@@ -74,6 +74,12 @@ enum Command {
         /// refused before it is planned.
         #[arg(long, value_name = "SIZE", default_value = "4GB", value_parser = parse_size)]
         max_program_size: u64,
+        /// What a job whose simulated part misses its acceptance criteria
+        /// (its `accept` block, or the defaults) is: `error` (no program
+        /// is written, exit 1) or `warn` (the program is written, for
+        /// exploration).
+        #[arg(long, value_enum, default_value_t = AcceptChoice::Error)]
+        accept: AcceptChoice,
     },
     /// Read a program back from its text as its controller would: modal
     /// state block by block, and every rule it breaks (feed moves with the
@@ -198,6 +204,12 @@ enum MessageFormat {
 }
 
 #[derive(Clone, Copy, ValueEnum)]
+enum AcceptChoice {
+    Error,
+    Warn,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
 enum ColorChoice {
     Auto,
     Always,
@@ -280,6 +292,7 @@ fn run(cli: Cli) -> u8 {
             dialect,
             out: dir,
             max_program_size,
+            accept,
         } => commands::build::run(
             &out,
             &file,
@@ -287,6 +300,10 @@ fn run(cli: Cli) -> u8 {
                 job: job.as_deref(),
                 dialect: dialect.as_deref(),
                 max_program_size: Some(max_program_size),
+                accept: match accept {
+                    AcceptChoice::Error => lensc_build::accept::Mode::Gate,
+                    AcceptChoice::Warn => lensc_build::accept::Mode::Warn,
+                },
             },
             &dir,
         ),

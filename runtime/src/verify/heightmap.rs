@@ -434,6 +434,15 @@ impl ColumnCut<'_> {
     }
 }
 
+/// The part's area (mm²) of the grid cell at (s, u): the parallelogram
+/// its two steps span on the part.
+fn cell_area(frame: &dyn Frame, g: &Grid, s: f64, u: f64) -> f64 {
+    let (x0, y0) = frame.xy(s, u);
+    let (x1, y1) = frame.xy(s + g.ds, u);
+    let (x2, y2) = frame.xy(s, u + g.du);
+    ((x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0)).abs()
+}
+
 fn in_features(features: &[(f64, f64, f64)], x: f64, y: f64) -> bool {
     features.is_empty()
         || features
@@ -441,55 +450,13 @@ fn in_features(features: &[(f64, f64, f64)], x: f64, y: f64) -> bool {
             .any(|&(cx, cy, r)| (x - cx).hypot(y - cy) <= r)
 }
 
-/// PV, RMS and extremes of a set of errors, with where they are.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ErrorFigures {
-    pub count: usize,
-    pub pv: f64,
-    pub rms: f64,
-    /// Most material left (mm, ≥ 0) and where (x, y).
-    pub max_residual: (f64, (f64, f64)),
-    /// Deepest cut below the design (mm, ≥ 0) and where.
-    pub max_gouge: (f64, (f64, f64)),
-}
+/// The figures of a set of errors at (x, y) points (see
+/// [`super::figures`]: PV max − min, RMS about the mean, the mean and the
+/// largest deviation).
+pub type ErrorFigures = super::figures::ErrorFigures<(f64, f64)>;
 
-#[derive(Default)]
-struct Tally {
-    n: usize,
-    sum2: f64,
-    min: (f64, (f64, f64)),
-    max: (f64, (f64, f64)),
-}
-
-impl Tally {
-    fn new() -> Tally {
-        Tally {
-            n: 0,
-            sum2: 0.0,
-            min: (f64::INFINITY, (0.0, 0.0)),
-            max: (f64::NEG_INFINITY, (0.0, 0.0)),
-        }
-    }
-    fn add(&mut self, e: f64, at: (f64, f64)) {
-        self.n += 1;
-        self.sum2 += e * e;
-        if e < self.min.0 {
-            self.min = (e, at);
-        }
-        if e > self.max.0 {
-            self.max = (e, at);
-        }
-    }
-    fn figures(&self) -> Option<ErrorFigures> {
-        (self.n > 0).then(|| ErrorFigures {
-            count: self.n,
-            pv: self.max.0 - self.min.0,
-            rms: (self.sum2 / self.n as f64).sqrt(),
-            max_residual: (self.max.0.max(0.0), self.max.1),
-            max_gouge: ((-self.min.0).max(0.0), self.min.1),
-        })
-    }
-}
+/// The statistics of errors at (x, y) points, as they are gathered.
+type Tally = super::figures::ErrorStats<(f64, f64)>;
 
 /// Scallop heights between neighbouring passes (mm).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -551,6 +518,13 @@ pub struct HeightMap {
     pub scallops: Option<Scallops>,
     /// Cells in the window that no pass reached.
     pub uncut: usize,
+    /// The part's area (mm²) those cells cover, and one of them (x, y),
+    /// if any.
+    pub uncut_area: f64,
+    pub uncut_at: Option<(f64, f64)>,
+    /// The area (mm²) of every cell counted, cut or not: the area the
+    /// map evaluates.
+    pub area: f64,
     /// RMS of the error along each row (the cutting direction) and along
     /// each column (the step-over direction) about its least-squares
     /// quadratic (the form's trend), averaged over rows and columns (mm).
@@ -645,6 +619,7 @@ impl HeightMap {
             .collect();
         let mut all_cusps = Vec::new();
         let mut uncut = 0;
+        let (mut uncut_area, mut uncut_at, mut area) = (0.0, None, 0.0);
         let mut errors = Vec::with_capacity(g.ns * g.nu);
         for (j, c) in columns.iter().enumerate() {
             let s = g.s(j);
@@ -653,9 +628,14 @@ impl HeightMap {
                 if e.is_nan() {
                     if frame.inside(x, y) && in_features(features, x, y) {
                         uncut += 1;
+                        let a = cell_area(frame, &g, s, g.u(i));
+                        uncut_area += a;
+                        area += a;
+                        uncut_at.get_or_insert((x, y));
                     }
                     continue;
                 }
+                area += cell_area(frame, &g, s, g.u(i));
                 surface.add(e, (x, y));
                 if let Some(f) = which(x, y) {
                     per[f].0.add(e, (x, y));
@@ -693,12 +673,15 @@ impl HeightMap {
             contact: contact.figures(),
             scallops: scallops(&all_cusps),
             uncut,
+            uncut_area,
+            uncut_at,
+            area,
             rq_cutting,
             rq_stepover,
             features: features
                 .iter()
                 .zip(&per)
-                .filter(|(_, t)| t.0.n > 0)
+                .filter(|(_, t)| t.0.count > 0)
                 .map(|(&(cx, cy, _), t)| FeatureFigures {
                     centre: (cx, cy),
                     surface: t.0.figures(),

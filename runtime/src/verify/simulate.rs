@@ -10,6 +10,7 @@
 //! bounded below by its end discs and the move offset by ρ; along an arc
 //! of radius R, by its end discs and the arcs of radius R ± ρ.
 
+use super::figures::ErrorStats;
 use crate::moves::{Move, Plane};
 use crate::post::format::{decimals_for, fixed_units};
 use std::f64::consts::PI;
@@ -21,9 +22,22 @@ pub struct ProfileCut {
     /// surface's height minus the design's (mm; positive where material is
     /// left, negative where the cut went below the design).
     pub samples: Vec<(f64, f64)>,
-    /// Peak to valley and RMS of the error (mm).
+    /// Peak to valley (largest minus least) and RMS about the mean of
+    /// the error (mm; 0 if no radius was cut).
     pub pv: f64,
     pub rms: f64,
+    /// The mean error (mm; piston: a uniform datum shift), NaN if no
+    /// radius was cut.
+    pub mean: f64,
+    /// The error of the largest magnitude (mm, sign kept) and where; NaN
+    /// if no radius was cut.
+    pub largest_deviation: (f64, f64),
+    /// The area (mm²) of the surface of revolution the radii sampled
+    /// stand for (each 2π|r| times the spacing), the part of it at radii
+    /// the cut does not reach, and the first such radius, if any.
+    pub area: f64,
+    pub uncut_area: f64,
+    pub uncut_at: Option<f64>,
     /// The most material left above the design (mm, ≥ 0) and where.
     pub max_residual: (f64, f64),
     /// The deepest cut below the design (mm, ≥ 0) and where.
@@ -253,37 +267,40 @@ pub fn profile_cut(
         }
     }
     let mut out = Vec::with_capacity(n);
+    let step = (to - from).abs() / (n - 1) as f64;
+    let (mut area, mut uncut_area, mut uncut_at) = (0.0, 0.0, None);
     for k in 0..n {
         let x = from + (to - from) * k as f64 / (n - 1) as f64;
         let cut = in_bin[bin(x)]
             .iter()
             .filter_map(|&i| pieces[i].bottom(rho, x))
             .fold(f64::INFINITY, f64::min);
+        let ring = 2.0 * PI * x.abs() * step;
+        area += ring;
         if cut.is_finite() {
             out.push((x, cut - design(x)));
+        } else {
+            uncut_area += ring;
+            uncut_at.get_or_insert(x);
         }
     }
-    let (mut hi, mut lo) = ((f64::NAN, f64::NEG_INFINITY), (f64::NAN, f64::INFINITY));
-    let mut sum2 = 0.0;
+    let mut stats = ErrorStats::<f64>::new();
     for &(x, e) in &out {
-        if e > hi.1 {
-            hi = (x, e);
-        }
-        if e < lo.1 {
-            lo = (x, e);
-        }
-        sum2 += e * e;
+        stats.add(e, x);
     }
-    let rms = if out.is_empty() {
-        0.0
-    } else {
-        (sum2 / out.len() as f64).sqrt()
-    };
+    let f = stats.figures();
+    let (pv, rms, mean) = f.map_or((0.0, 0.0, f64::NAN), |f| (f.pv, f.rms, f.mean));
+    let nowhere = (0.0, f64::NAN);
     ProfileCut {
-        pv: if out.is_empty() { 0.0 } else { hi.1 - lo.1 },
+        pv,
         rms,
-        max_residual: (hi.1.max(0.0), hi.0),
-        max_gouge: ((-lo.1).max(0.0), lo.0),
+        mean,
+        largest_deviation: f.map_or((f64::NAN, f64::NAN), |f| f.largest_deviation),
+        area,
+        uncut_area,
+        uncut_at,
+        max_residual: f.map_or(nowhere, |f| f.max_residual),
+        max_gouge: f.map_or(nowhere, |f| f.max_gouge),
         samples: out,
     }
 }

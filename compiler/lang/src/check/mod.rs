@@ -228,6 +228,7 @@ fn ty_words(ty: &Ty) -> String {
         Ty::Text => "a string `\"…\"`".into(),
         Ty::Texts => "a list of strings `[\"…\"]`".into(),
         Ty::Block(_) => "a block `{ … }`".into(),
+        Ty::BlockOr(_, words) => format!("a block `{{ … }}` or {}", one_of(words)),
         Ty::Range(d) => format!("a range `from .. to` of {d}"),
         Ty::Formula { coords, .. } => format!("a formula of {}", quoted(coords)),
     }
@@ -243,6 +244,7 @@ fn example_unit(d: Dim) -> &'static str {
         Dim::TIME => "`1 ms`",
         Dim::FREQUENCY => "`20 kHz`",
         Dim::ACCELERATION => "`25 g`",
+        Dim::AREA => "`0.01 mm^2`",
         _ => "`1 mm^-3`",
     }
 }

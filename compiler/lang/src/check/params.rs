@@ -174,7 +174,8 @@ impl<'a> Checker<'a> {
                     }
                 }
             }
-            (Ty::Block(sub), Value::Block(fields)) => {
+            (Ty::BlockOr(_, words), Value::Word(w)) => self.check_word(p, f, words, w),
+            (Ty::Block(sub) | Ty::BlockOr(sub, _), Value::Block(fields)) => {
                 let owner = format!("`{}` of {owner}", f.name);
                 self.validate(sub, fields, &owner, f.name_span, file, &[]);
             }

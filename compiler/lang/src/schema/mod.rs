@@ -67,6 +67,9 @@ pub enum Ty {
     Texts,
     /// A nested block with its own parameters.
     Block(&'static [Param]),
+    /// A nested block with its own parameters, or one of these words
+    /// instead (`accept: none`).
+    BlockOr(&'static [Param], &'static [&'static str]),
     /// `lo .. hi`, both of this dimension.
     Range(Dim),
     /// `name(coords) = expr` giving this dimension, over these coordinates.
@@ -266,6 +269,84 @@ pub static JOB_PARAMS: &[Param] = &[
         Check::Any,
         "the window of a surface job's height-map simulation (design x, y); default a 0.2 mm square where the surface is representative",
     ),
+    opt(
+        "tool_number",
+        NUMBER,
+        Check::Count,
+        "the tool's number in the machine's turret, magazine or tool table (the program's T word); default 1",
+    ),
+    opt(
+        "tool_offset",
+        NUMBER,
+        Check::Count,
+        "the tool's offset register (Fanuc's second T pair, H; Siemens' D); default the tool number",
+    ),
+    opt(
+        "spindle_direction",
+        Ty::Word(&["cw", "ccw"]),
+        Check::Any,
+        "which way the spindle turns, as M3 (`cw`, default) and M4 (`ccw`) name it: the way that brings the work into the tool's rake face as it is set up",
+    ),
+    opt(
+        "coolant",
+        Ty::Word(&["flood", "mist", "off"]),
+        Check::Any,
+        "coolant through the whole program: `flood` (M8), `mist` (M7) or `off` (default)",
+    ),
+    opt(
+        "accept",
+        Ty::BlockOr(ACCEPT_PARAMS, &["none"]),
+        Check::Any,
+        "the acceptance criteria the simulated part must meet for the program to be written, or `none`; each left out has a default derived from the strategy's tolerance (README, \"Acceptance\")",
+    ),
+];
+
+/// The criteria of a job's `accept` block: each a limit on a figure of
+/// the simulated part (README, "Acceptance", says how each is measured
+/// and how its default is derived).
+pub static ACCEPT_PARAMS: &[Param] = &[
+    opt(
+        "form_pv",
+        LENGTH,
+        Check::NonNegative,
+        "the largest peak-to-valley form error (largest minus least of cut − design at the contacts); default 2 × (path tolerance + resolution)",
+    ),
+    opt(
+        "form_rms",
+        LENGTH,
+        Check::NonNegative,
+        "the largest RMS form error, about its mean, at the contacts; default (path tolerance + resolution) / 2",
+    ),
+    opt(
+        "max_gouge",
+        LENGTH,
+        Check::NonNegative,
+        "the deepest cut below the design allowed anywhere; default path tolerance + resolution",
+    ),
+    opt(
+        "max_residual",
+        LENGTH,
+        Check::NonNegative,
+        "the most material allowed above the design at the contacts (scallops apart); default path tolerance + resolution",
+    ),
+    opt(
+        "uncut_area",
+        Ty::Quantity(&[Dim::AREA, Dim::NONE]),
+        Check::NonNegative,
+        "the most area left uncut: an area (`0.01 mm^2`), or a plain number, a fraction of the area simulated (`0`, `0.001`); default 0",
+    ),
+    opt(
+        "max_following_error",
+        LENGTH,
+        Check::NonNegative,
+        "the largest following error of the fast tool servo's model (jobs with a servo model)",
+    ),
+    opt(
+        "max_cutting_time",
+        Ty::Quantity(&[Dim::TIME]),
+        Check::NonNegative,
+        "the longest estimated cutting time",
+    ),
 ];
 
 pub fn kind(name: &str) -> Option<&'static Kind> {
@@ -281,6 +362,10 @@ pub fn is_word(name: &str) -> bool {
             match p.ty {
                 Ty::Word(words) => into.extend(words.iter().copied()),
                 Ty::Block(sub) => gather(sub, into),
+                Ty::BlockOr(sub, words) => {
+                    gather(sub, into);
+                    into.extend(words.iter().copied());
+                }
                 _ => {}
             }
         }

@@ -248,6 +248,11 @@ fn param_doc(p: &'static Param) -> ParamDoc {
         Ty::Text => ("a string".into(), None, None),
         Ty::Texts => ("a list of strings".into(), None, None),
         Ty::Block(_) => ("a block { … }".into(), None, None),
+        Ty::BlockOr(_, words) => (
+            format!("a block {{ … }} or one of {}", words.join(", ")),
+            None,
+            None,
+        ),
         Ty::Range(d) => (
             format!("a range lo .. hi, each {d}"),
             Some(d.display_unit().0),
@@ -268,7 +273,7 @@ fn param_doc(p: &'static Param) -> ParamDoc {
         default: default.filter(|_| !p.required),
         doc,
         params: match p.ty {
-            Ty::Block(sub) => sub.iter().map(param_doc).collect(),
+            Ty::Block(sub) | Ty::BlockOr(sub, _) => sub.iter().map(param_doc).collect(),
             _ => Vec::new(),
         },
     }

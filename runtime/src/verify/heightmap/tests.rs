@@ -100,6 +100,9 @@ fn a_raster_keeps_each_blocks_worst_error_and_its_sign() {
         contact: None,
         scallops: None,
         uncut: 1,
+        uncut_area: 1e-6,
+        uncut_at: Some((0.0, 0.0)),
+        area: 1e-2,
         rq_cutting: 0.0,
         rq_stepover: 0.0,
         features: Vec::new(),
@@ -256,4 +259,94 @@ fn angles_wrap_and_arcs_are_followed() {
     assert!((h - (10.0 - 101f64.sqrt())).abs() < 1e-12);
     let h = minor_arc_height((0.0, 0.0), (2.0, 0.0), (1.0, -10.0), 1.0).unwrap();
     assert!((h - (-10.0 + 101f64.sqrt())).abs() < 1e-12);
+}
+
+/// Passes `f` apart along s over the window, the nose centre at height
+/// `h(s, u)` above a flat design: the map the sweep makes.
+fn swept_flat(h: impl Fn(f64, f64) -> f64) -> HeightMap {
+    let (r, f) = (0.085, 0.010);
+    let mut sweep = Sweep::new(grid(101, 0.001), r);
+    for k in -12..=22 {
+        let u = k as f64 * f;
+        sweep.lift();
+        for j in 0..=21 {
+            let s = -0.01 + 0.01 * j as f64;
+            sweep.point(s, u, r + h(s, u));
+        }
+    }
+    let frame = Flat {
+        z: |_, _| 0.0,
+        window: (0.0, 0.1, 0.0, 0.1),
+    };
+    sweep.finish(&frame)
+}
+
+/// A part cut uniformly 44 nm deep: the form (PV, RMS at the contacts)
+/// is perfect, and the shift shows in the mean and the largest deviation
+/// (where an optician looks for a datum error) rather than vanishing.
+#[test]
+fn a_uniform_gouge_shows_in_the_mean_and_the_largest_deviation() {
+    let map = swept_flat(|_, _| -44e-6);
+    let c = map.contact.unwrap();
+    assert!(c.pv < 1e-12 && c.rms < 1e-12, "{c:?}");
+    assert!((c.mean + 44e-6).abs() < 1e-12, "{c:?}");
+    assert!((c.largest_deviation.0 + 44e-6).abs() < 1e-12, "{c:?}");
+    assert!((c.max_gouge.0 - 44e-6).abs() < 1e-12, "{c:?}");
+    // Over the surface the scallops add to the mean, not to the gouge.
+    let s = map.surface.unwrap();
+    assert!((s.max_gouge.0 - 44e-6).abs() < 1e-12, "{s:?}");
+    assert!(s.rms <= s.pv, "{s:?}");
+}
+
+/// A cut tilted 1 nm per µm along u, centred on the design in the
+/// middle of the 100 µm window: the contacts are the valleys of the nine
+/// passes inside it (u = 10 … 90 µm, −40 … +40 nm), so PV 80 nm, mean 0,
+/// RMS about the mean that of the nine-step ramp (10 nm × √(20/3)), and
+/// the largest deviation at an outer pass.
+#[test]
+fn a_tilt_has_the_figures_of_a_ramp() {
+    let slope = 1e-3; // 1 nm per µm
+    let map = swept_flat(|_, u| slope * (u - 0.05));
+    let c = map.contact.unwrap();
+    assert!((c.pv - 80e-6).abs() < 1e-9, "{c:?}");
+    assert!(c.mean.abs() < 1e-9, "{c:?}");
+    let ramp = 10e-6 * (20.0f64 / 3.0).sqrt();
+    assert!((c.rms - ramp).abs() < 1e-9, "{} vs {ramp}", c.rms);
+    assert!(c.rms <= c.pv / 2.0);
+    assert!((c.largest_deviation.0.abs() - 40e-6).abs() < 1e-9, "{c:?}");
+    let y = c.largest_deviation.1.1;
+    assert!((y - 0.01).abs() < 1e-6 || (y - 0.09).abs() < 1e-6, "at {y}");
+}
+
+/// Passes that stop short leave cells uncut: their count, the area they
+/// cover on the part (the grid's cells are 1 µm squares) and one of them.
+#[test]
+fn cells_no_pass_reaches_are_uncut_area() {
+    let (r, f) = (0.085, 0.010);
+    let mut sweep = Sweep::new(grid(101, 0.001), r);
+    for k in -12..=22 {
+        let u = k as f64 * f;
+        sweep.lift();
+        // Every pass stops at s = 60 µm: columns 61 … 100 are uncut.
+        sweep.point(-0.01, u, r);
+        sweep.point(0.0605, u, r);
+    }
+    let frame = Flat {
+        z: |_, _| 0.0,
+        window: (0.0, 0.1, 0.0, 0.1),
+    };
+    let map = sweep.finish(&frame);
+    assert_eq!(map.uncut, 40 * 101);
+    assert!(
+        (map.uncut_area - 40.0 * 101.0 * 1e-6).abs() < 1e-12,
+        "{}",
+        map.uncut_area
+    );
+    assert!(
+        (map.area - 101.0 * 101.0 * 1e-6).abs() < 1e-12,
+        "{}",
+        map.area
+    );
+    let (x, _) = map.uncut_at.unwrap();
+    assert!(x > 0.060, "{x}");
 }

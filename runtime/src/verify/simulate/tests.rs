@@ -39,6 +39,38 @@ fn one_exact_arc_cuts_the_sphere_it_offsets() {
     assert!(cut.pv < 1e-9 && cut.rms < 1e-9, "{} {}", cut.pv, cut.rms);
 }
 
+/// The same arc set 44 nm too deep (the sphere, which reported
+/// "PV 6.03 nm, RMS 42.6 nm"): the form is perfect (PV and RMS about the
+/// mean below a picometre, never RMS > PV) and the shift is the mean and
+/// the largest deviation, a gouge of 44 nm.
+#[test]
+fn an_arc_set_too_deep_shows_its_shift_in_the_mean() {
+    let (r, deep) = (10.0, 44e-6);
+    let rc = r + RHO;
+    let start = (2.0f64, (rc * rc - 4.0).sqrt() - r - deep);
+    let stream = [
+        Move::Rapid(Position::xz(start.0, 5.0)),
+        linear(start.0, start.1),
+        Move::Arc {
+            to: Position::xz(0.0, RHO - deep),
+            centre: Position::xz(0.0, -r - deep),
+            plane: Plane::Zx,
+            ccw: false,
+            feed: None,
+        },
+    ];
+    let cut = profile_cut(&stream, RHO, 1e-9, &convex(r), (0.0, 1.5), 301);
+    assert!(cut.pv < 1e-9 && cut.rms < 1e-9, "{} {}", cut.pv, cut.rms);
+    assert!(cut.rms <= cut.pv);
+    assert!((cut.mean + deep).abs() < 1e-9, "{}", cut.mean);
+    assert!(
+        (cut.largest_deviation.0 + deep).abs() < 1e-9,
+        "{:?}",
+        cut.largest_deviation
+    );
+    assert!((cut.max_gouge.0 - deep).abs() < 1e-9, "{:?}", cut.max_gouge);
+}
+
 #[test]
 fn the_centre_path_follows_the_printed_moves_and_breaks_at_rapids() {
     let stream = [

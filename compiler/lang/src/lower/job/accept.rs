@@ -1,0 +1,144 @@
+//! A job's acceptance criteria, typed: the limits its `accept` block
+//! states (the checker has checked each one's dimension and sign), where
+//! each was written, or `accept: none`. The defaults for the criteria a
+//! job leaves out, and the comparison with the simulated part, are the
+//! build's (lensc-build `accept`): they need the simulation.
+
+use lensc_grammar::{Diagnostic, FileId, Span};
+
+use crate::check::CheckedJob;
+use crate::codes;
+use crate::units::Dim;
+use crate::value::{self, Value};
+
+/// A figure of the simulated part an `accept` block can limit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Criterion {
+    /// Peak-to-valley form error at the contacts (mm).
+    FormPv,
+    /// RMS form error about its mean at the contacts (mm).
+    FormRms,
+    /// The deepest cut below the design anywhere (mm).
+    MaxGouge,
+    /// The most material above the design at the contacts (mm).
+    MaxResidual,
+    /// Area left uncut (mm², or a fraction of the area simulated).
+    UncutArea,
+    /// The fast tool servo model's largest following error (mm).
+    MaxFollowingError,
+    /// The estimated cutting time (s).
+    MaxCuttingTime,
+}
+
+impl Criterion {
+    /// Every criterion, in the order reports and messages list them.
+    pub const ALL: [Criterion; 7] = [
+        Criterion::FormPv,
+        Criterion::FormRms,
+        Criterion::MaxGouge,
+        Criterion::MaxResidual,
+        Criterion::UncutArea,
+        Criterion::MaxFollowingError,
+        Criterion::MaxCuttingTime,
+    ];
+
+    /// Its name in an `accept` block.
+    pub fn name(self) -> &'static str {
+        match self {
+            Criterion::FormPv => "form_pv",
+            Criterion::FormRms => "form_rms",
+            Criterion::MaxGouge => "max_gouge",
+            Criterion::MaxResidual => "max_residual",
+            Criterion::UncutArea => "uncut_area",
+            Criterion::MaxFollowingError => "max_following_error",
+            Criterion::MaxCuttingTime => "max_cutting_time",
+        }
+    }
+}
+
+/// A limit an `accept` block states.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Limit {
+    /// In base units (mm, mm², s), or a fraction for an uncut area given
+    /// as a plain number.
+    pub value: f64,
+    /// An uncut area given as a fraction of the area simulated.
+    pub fraction: bool,
+    /// Where it was written.
+    pub site: (FileId, Span),
+}
+
+/// What a job asks of the simulated part.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub enum Accept {
+    /// No `accept` block: every criterion at its default.
+    #[default]
+    Defaults,
+    /// The limits stated (the rest at their defaults), and where the
+    /// block was written.
+    Stated {
+        limits: Vec<(Criterion, Limit)>,
+        site: (FileId, Span),
+    },
+    /// `accept: none`: no gate.
+    Nothing,
+}
+
+impl Accept {
+    /// The limit stated for `c`, if any.
+    pub fn stated(&self, c: Criterion) -> Option<&Limit> {
+        match self {
+            Accept::Stated { limits, .. } => limits.iter().find(|(k, _)| *k == c).map(|(_, l)| l),
+            _ => None,
+        }
+    }
+}
+
+/// The job's `accept` block, typed; E0123 for an uncut fraction above 1
+/// (the checker has refused wrong dimensions, negative limits and unknown
+/// names).
+pub(super) fn lower(job: &CheckedJob) -> Result<Accept, Diagnostic> {
+    let Some(field) = value::field(&job.fields, "accept") else {
+        return Ok(Accept::Defaults);
+    };
+    let block = match &field.value {
+        Value::Word(w) if w == "none" => return Ok(Accept::Nothing),
+        Value::Block(b) => b,
+        _ => return Ok(Accept::Defaults),
+    };
+    let mut limits = Vec::new();
+    for c in Criterion::ALL {
+        let Some(f) = value::field(block, c.name()) else {
+            continue;
+        };
+        let Value::Num(v, dim) = f.value else {
+            continue;
+        };
+        let fraction = c == Criterion::UncutArea && dim == Dim::NONE;
+        if fraction && v > 1.0 {
+            return Err(Diagnostic::error(
+                codes::OUT_OF_RANGE,
+                format!(
+                    "`uncut_area` as a plain number is a fraction of the area simulated, at most 1, but it is {}",
+                    crate::check::trim_num(v)
+                ),
+                f.file,
+                f.span,
+            )
+            .with_label("more than the whole")
+            .with_help("give a fraction from 0 to 1, or an area with its unit, as in `0.01 mm^2`"));
+        }
+        limits.push((
+            c,
+            Limit {
+                value: v,
+                fraction,
+                site: (f.file, f.span),
+            },
+        ));
+    }
+    Ok(Accept::Stated {
+        limits,
+        site: (field.file, field.span),
+    })
+}
