@@ -70,6 +70,14 @@ pub trait Frame: Sync {
     fn features(&self) -> &[(f64, f64, f64)] {
         &[]
     }
+    /// The part's area (mm²) of the grid cell at (s, u): the parallelogram
+    /// its two steps span on the part.
+    fn cell_area(&self, g: &Grid, s: f64, u: f64) -> f64 {
+        let (x0, y0) = self.xy(s, u);
+        let (x1, y1) = self.xy(s + g.ds, u);
+        let (x2, y2) = self.xy(s, u + g.du);
+        ((x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0)).abs()
+    }
 }
 
 /// Where the nose's centre goes, as a program commands it: what a
@@ -226,35 +234,41 @@ impl Sweep {
     /// The envelope in every column against the design, as one tile of a
     /// larger map: its totals (its `frame`'s feature `f` being the whole
     /// map's `feature(f)`) and its cells' errors on `layout`'s blocks.
+    /// Its columns are taken one after the other unless `parallel`
+    /// (rayon runs the tiles side by side; columns in parallel within
+    /// them would let a waiting thread start yet another tile).
     pub(crate) fn finish_tile(
         self,
         frame: &dyn Frame,
         feature: &dyn Fn(usize) -> usize,
         layout: &RasterLayout,
+        parallel: bool,
     ) -> (Totals, Vec<(usize, f64)>) {
         let g = self.grid;
-        let columns = self.columns(frame);
+        let columns = if parallel {
+            self.columns(frame)
+        } else {
+            let r = self.radius;
+            self.columns
+                .into_iter()
+                .enumerate()
+                .map(|(j, centres)| column(&g, r, j, centres, frame))
+                .collect()
+        };
         let totals = Totals::gather(&g, &columns, frame, feature);
-        let mut blocks: Vec<(usize, f64)> = Vec::new();
+        // Each block's worst, the first of equals in column order.
+        let mut worst: std::collections::BTreeMap<usize, f64> = Default::default();
         for (j, c) in columns.iter().enumerate() {
             for (i, &e) in c.errors.iter().enumerate() {
                 if let Some(b) = layout.block(frame, g.s(j), g.u(i), e) {
-                    blocks.push((b, e));
+                    let w = worst.entry(b).or_insert(e);
+                    if e.abs() > w.abs() {
+                        *w = e;
+                    }
                 }
             }
         }
-        // Each block's worst, the first of equals in column order.
-        blocks.sort_by_key(|&(b, _)| b);
-        blocks.dedup_by(|later, kept| {
-            if later.0 != kept.0 {
-                return false;
-            }
-            if later.1.abs() > kept.1.abs() {
-                kept.1 = later.1;
-            }
-            true
-        });
-        (totals, blocks)
+        (totals, worst.into_iter().collect())
     }
 
     fn columns(self, frame: &dyn Frame) -> Vec<Column> {
@@ -435,10 +449,15 @@ impl ColumnCut<'_> {
                 *c = self.height(p, u);
             }
         }
-        let points: Vec<(f64, f64)> = (0..g.nu).map(|i| (self.s, g.u(i))).collect();
-        let mut design = vec![0.0; g.nu];
+        // The design only where the cut is (the window, its lenslets).
+        let rows: Vec<usize> = (0..g.nu).filter(|&i| !cut[i].is_nan()).collect();
+        let points: Vec<(f64, f64)> = rows.iter().map(|&i| (self.s, g.u(i))).collect();
+        let mut design = vec![0.0; rows.len()];
         self.frame.design(&points, &mut design);
-        cut.iter().zip(&design).map(|(c, d)| c - d).collect()
+        for (&i, d) in rows.iter().zip(&design) {
+            cut[i] -= d;
+        }
+        cut
     }
 
     /// Contacts: the least error over each piece inside the rows, from
@@ -519,15 +538,6 @@ impl ColumnCut<'_> {
         }
         cusps
     }
-}
-
-/// The part's area (mm²) of the grid cell at (s, u): the parallelogram
-/// its two steps span on the part.
-fn cell_area(frame: &dyn Frame, g: &Grid, s: f64, u: f64) -> f64 {
-    let (x0, y0) = frame.xy(s, u);
-    let (x1, y1) = frame.xy(s + g.ds, u);
-    let (x2, y2) = frame.xy(s, u + g.du);
-    ((x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0)).abs()
 }
 
 fn in_features(features: &[(f64, f64, f64)], x: f64, y: f64) -> bool {
@@ -634,7 +644,10 @@ impl RasterLayout {
         if px > self.x.1 + edge || py > self.y.1 + edge {
             return None;
         }
-        let (bx, by) = ((bx as usize).min(self.nx - 1), (by as usize).min(self.ny - 1));
+        let (bx, by) = (
+            (bx as usize).min(self.nx - 1),
+            (by as usize).min(self.ny - 1),
+        );
         Some(by * self.nx + bx)
     }
 
@@ -783,7 +796,11 @@ impl CuspTally {
     }
     fn merge(&mut self, o: &CuspTally) {
         if o.count > 0 {
-            self.max = if self.count == 0 { o.max } else { self.max.max(o.max) };
+            self.max = if self.count == 0 {
+                o.max
+            } else {
+                self.max.max(o.max)
+            };
             self.count += o.count;
             self.sum += o.sum;
         }
@@ -831,7 +848,12 @@ pub(crate) struct Totals {
 }
 
 impl Totals {
-    fn gather(g: &Grid, columns: &[Column], frame: &dyn Frame, feature: &dyn Fn(usize) -> usize) -> Totals {
+    fn gather(
+        g: &Grid,
+        columns: &[Column],
+        frame: &dyn Frame,
+        feature: &dyn Fn(usize) -> usize,
+    ) -> Totals {
         let features = frame.features();
         let which = |x: f64, y: f64| {
             features
@@ -848,7 +870,7 @@ impl Totals {
                     if frame.inside(x, y) && in_features(features, x, y) {
                         t.uncut += 1;
                         t.cells += 1;
-                        let a = cell_area(frame, g, s, g.u(i));
+                        let a = frame.cell_area(g, s, g.u(i));
                         t.uncut_area += a;
                         t.area += a;
                         t.uncut_at.get_or_insert((x, y));
@@ -856,7 +878,7 @@ impl Totals {
                     continue;
                 }
                 t.cells += 1;
-                t.area += cell_area(frame, g, s, g.u(i));
+                t.area += frame.cell_area(g, s, g.u(i));
                 t.surface.add(e, (x, y));
                 if let Some(f) = which(x, y) {
                     t.features.entry(f).or_default().surface.add(e, (x, y));
@@ -907,8 +929,14 @@ impl Totals {
         self.uncut_area += o.uncut_area;
         self.uncut_at = self.uncut_at.or(o.uncut_at);
         self.area += o.area;
-        self.rq_cutting = (self.rq_cutting.0 + o.rq_cutting.0, self.rq_cutting.1 + o.rq_cutting.1);
-        self.rq_stepover = (self.rq_stepover.0 + o.rq_stepover.0, self.rq_stepover.1 + o.rq_stepover.1);
+        self.rq_cutting = (
+            self.rq_cutting.0 + o.rq_cutting.0,
+            self.rq_cutting.1 + o.rq_cutting.1,
+        );
+        self.rq_stepover = (
+            self.rq_stepover.0 + o.rq_stepover.0,
+            self.rq_stepover.1 + o.rq_stepover.1,
+        );
         self.cells += o.cells;
     }
 }
@@ -922,7 +950,13 @@ impl HeightMap {
         features: &[(f64, f64, f64)],
         errors: Vec<f64>,
     ) -> HeightMap {
-        let per_line = |rq: (f64, usize)| if rq.1 == 0 { f64::NAN } else { rq.0 / rq.1 as f64 };
+        let per_line = |rq: (f64, usize)| {
+            if rq.1 == 0 {
+                f64::NAN
+            } else {
+                rq.0 / rq.1 as f64
+            }
+        };
         HeightMap {
             grid: g,
             nose_radius: r,

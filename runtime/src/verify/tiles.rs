@@ -45,10 +45,12 @@ impl Recorder {
     /// The band of u every tile's passes lie in: each tile's rows widened
     /// by the nose's reach.
     pub fn band_of(tiles: &[Tile], nose_radius: f64) -> (f64, f64) {
-        tiles.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |b, t| {
-            let band = super::heightmap::band(&t.grid, nose_radius);
-            (b.0.min(band.0), b.1.max(band.1))
-        })
+        tiles
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |b, t| {
+                let band = super::heightmap::band(&t.grid, nose_radius);
+                (b.0.min(band.0), b.1.max(band.1))
+            })
     }
 
     /// Steps kept (points and lifts).
@@ -64,7 +66,12 @@ impl Recorder {
         let at = self.steps.len();
         if at % BLOCK == 0 {
             let before = at.checked_sub(1).map(|i| self.steps[i]);
-            self.extents.push([f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY]);
+            self.extents.push([
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+            ]);
             if let Some(b) = before {
                 self.widen(b);
             }
@@ -183,6 +190,9 @@ impl Frame for TileFrame<'_> {
     fn xy(&self, s: f64, u: f64) -> (f64, f64) {
         self.base.xy(s, u)
     }
+    fn cell_area(&self, g: &super::heightmap::Grid, s: f64, u: f64) -> f64 {
+        self.base.cell_area(g, s, u)
+    }
     fn inside(&self, x: f64, y: f64) -> bool {
         self.base.inside(x, y)
             && self.own.as_ref().is_none_or(|(_, _, earlier)| {
@@ -222,11 +232,14 @@ pub fn simulate(
         .map(|tile| {
             let mut sweep = Sweep::new(tile.grid, nose_radius);
             let g = tile.grid;
-            let s_range = g.period.is_none().then(|| (g.s0, g.s(g.ns.saturating_sub(1))));
+            let s_range = g
+                .period
+                .is_none()
+                .then(|| (g.s0, g.s(g.ns.saturating_sub(1))));
             recorder.replay(&mut sweep, s_range);
             let tile_frame = TileFrame::new(frame, tile.feature);
             let global = |f: usize| tile.feature.unwrap_or(f);
-            sweep.finish_tile(&tile_frame, &global, &layout)
+            sweep.finish_tile(&tile_frame, &global, &layout, tiles.len() == 1)
         })
         .collect();
     let mut totals = Totals::default();

@@ -142,24 +142,29 @@ impl Window {
         }
     }
 
-    /// The tiles of a lathe's polar grid: lenslet by lenslet when there
-    /// are `features` (discs: centre x, y, radius), each over the part of
-    /// the window its square covers; else the window's whole grid.
+    /// The tiles of a lathe's polar grid: lenslet by lenslet when the
+    /// window reaches more than one of the `features` (discs: centre x, y,
+    /// radius), each over the part of the window its square covers, its
+    /// index counted among the lenslets that reach into the window; else
+    /// the window's whole grid.
     pub fn polar_tiles(&self, features: &[(f64, f64, f64)]) -> Vec<Tile> {
-        if features.is_empty() {
+        let squares: Vec<Window> = features
+            .iter()
+            .map(|&(cx, cy, r)| Window {
+                x: (self.x.0.max(cx - r), self.x.1.min(cx + r)),
+                y: (self.y.0.max(cy - r), self.y.1.min(cy + r)),
+                ..*self
+            })
+            .filter(|w| w.x.1 >= w.x.0 && w.y.1 >= w.y.0)
+            .collect();
+        if squares.len() < 2 {
             return split(&self.polar(), None);
         }
-        let mut tiles = Vec::new();
-        for (k, &(cx, cy, r)) in features.iter().enumerate() {
-            let x = (self.x.0.max(cx - r), self.x.1.min(cx + r));
-            let y = (self.y.0.max(cy - r), self.y.1.min(cy + r));
-            if x.1 < x.0 || y.1 < y.0 {
-                continue;
-            }
-            let square = Window { x, y, ..*self };
-            tiles.extend(split(&square.polar(), Some(k)));
-        }
-        tiles
+        squares
+            .iter()
+            .enumerate()
+            .flat_map(|(k, square)| split(&square.polar(), Some(k)))
+            .collect()
     }
 
     pub fn contains(&self, x: f64, y: f64) -> bool {
@@ -319,11 +324,14 @@ mod tests {
     /// that reach into the window only.
     #[test]
     fn a_lathe_goes_lenslet_by_lenslet() {
-        let features = [(2.0, 0.0, 0.5), (-2.0, 0.0, 0.5), (0.0, 2.0, 0.5)];
+        let features = [(0.0, 2.0, 0.5), (2.0, 0.0, 0.5), (-2.0, 0.0, 0.5)];
         let w = Window::given((-3.0, 3.0), (-1.0, 1.0), Some(5e-3));
         let tiles = w.polar_tiles(&features);
         let owners: Vec<Option<usize>> = tiles.iter().map(|t| t.feature).collect();
         assert_eq!(owners, [Some(0), Some(1)]);
+        // One lenslet in the window: the window's own grid.
+        let one = Window::given((1.0, 3.0), (-1.0, 1.0), Some(5e-3));
+        assert_eq!(one.polar_tiles(&features), split(&one.polar(), None));
         // Each covers its lenslet's square: radii 1.5 .. 2.55 mm.
         let g = tiles[0].grid;
         assert!((g.u0 - 1.5).abs() < 1e-12 && g.u(g.nu - 1) > 2.5, "{g:?}");

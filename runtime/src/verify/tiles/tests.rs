@@ -94,13 +94,29 @@ fn tiles_give_the_one_grids_figures() {
     let m = &t.map;
     assert_eq!(m.tiles, 5);
     assert_eq!((m.cells, m.uncut), (whole.cells, whole.uncut));
-    assert!(whole.uncut > 0 && whole.uncut < whole.cells, "{}", whole.uncut);
+    assert!(
+        whole.uncut > 0 && whole.uncut < whole.cells,
+        "{}",
+        whole.uncut
+    );
     assert!(close(m.area, whole.area) && close(m.uncut_area, whole.uncut_area));
     let same = |a: &Option<ErrorFiguresXY>, b: &Option<ErrorFiguresXY>| {
         let (a, b) = (a.unwrap(), b.unwrap());
         assert_eq!(
-            (a.count, a.pv, a.max_gouge, a.max_residual, a.largest_deviation),
-            (b.count, b.pv, b.max_gouge, b.max_residual, b.largest_deviation)
+            (
+                a.count,
+                a.pv,
+                a.max_gouge,
+                a.max_residual,
+                a.largest_deviation
+            ),
+            (
+                b.count,
+                b.pv,
+                b.max_gouge,
+                b.max_residual,
+                b.largest_deviation
+            )
         );
         assert!(close(a.mean, b.mean) && close(a.rms, b.rms), "{a:?} {b:?}");
     };
@@ -119,7 +135,10 @@ fn tiles_give_the_one_grids_figures() {
         same(&a.contact, &b.contact);
     }
     let r = whole.raster(&f, (0.0, 0.12), (0.0, 0.1), 0.001, 16);
-    assert_eq!((t.raster.nx, t.raster.ny, t.raster.block), (r.nx, r.ny, r.block));
+    assert_eq!(
+        (t.raster.nx, t.raster.ny, t.raster.block),
+        (r.nx, r.ny, r.block)
+    );
     let bits = |c: &[f64]| c.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
     assert_eq!(bits(&t.raster.cells), bits(&r.cells));
 }
