@@ -64,7 +64,7 @@ impl Recorder {
 
     fn keep(&mut self, step: (f64, f64, f64)) {
         let at = self.steps.len();
-        if at % BLOCK == 0 {
+        if at.is_multiple_of(BLOCK) {
             let before = at.checked_sub(1).map(|i| self.steps[i]);
             self.extents.push([
                 f64::INFINITY,
@@ -162,9 +162,15 @@ impl NosePath for Recorder {
 /// lenslet (those no earlier lenslet holds, as the whole map counts them).
 struct TileFrame<'a> {
     base: &'a dyn Frame,
-    /// The tile's lenslet: its index and disc, and the earlier lenslets
-    /// that overlap it.
-    own: Option<(usize, [(f64, f64, f64); 1], Vec<(f64, f64, f64)>)>,
+    /// The tile's lenslet, if it goes lenslet by lenslet.
+    own: Option<Lenslet>,
+}
+
+/// A tile's lenslet: its disc (centre x, y, radius), and the earlier
+/// lenslets that overlap it.
+struct Lenslet {
+    disc: [(f64, f64, f64); 1],
+    earlier: Vec<(f64, f64, f64)>,
 }
 
 impl<'a> TileFrame<'a> {
@@ -177,7 +183,10 @@ impl<'a> TileFrame<'a> {
                 .filter(|&&(x, y, q)| (x - cx).hypot(y - cy) <= r + q)
                 .copied()
                 .collect();
-            (k, [all[k]], earlier)
+            Lenslet {
+                disc: [all[k]],
+                earlier,
+            }
         });
         TileFrame { base, own }
     }
@@ -195,15 +204,15 @@ impl Frame for TileFrame<'_> {
     }
     fn inside(&self, x: f64, y: f64) -> bool {
         self.base.inside(x, y)
-            && self.own.as_ref().is_none_or(|(_, _, earlier)| {
-                !earlier
+            && self.own.as_ref().is_none_or(|own| {
+                !own.earlier
                     .iter()
                     .any(|&(cx, cy, r)| (x - cx).hypot(y - cy) <= r)
             })
     }
     fn features(&self) -> &[(f64, f64, f64)] {
         match &self.own {
-            Some((_, disc, _)) => disc,
+            Some(own) => &own.disc,
             None => self.base.features(),
         }
     }
