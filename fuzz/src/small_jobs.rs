@@ -190,7 +190,7 @@ fn grinding(rng: &mut Rng, out: &mut String) {
     );
     let _ = writeln!(
         out,
-        "strategy st = profile_grinding {{ interval: {} um, feed: {} um/s, smoothness: {} }}",
+        "strategy st = profile_grinding {{ interval: {} um, feed: {} um/s, smoothness: {}, spindle_speed: 1000 rpm }}",
         rng.log_uniform(0.5, 20.0),
         rng.log_uniform(1.0, 100.0),
         free_number(rng, 0.01, 0.99)

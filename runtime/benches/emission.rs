@@ -45,6 +45,8 @@ fn main() {
             1e-5,
         )
         .expect("a LinuxCNC lathe program");
+        w.call_tool(&lensc_runtime::moves::Start::default())
+            .expect("tool 1");
         let mut sink = std::io::BufWriter::new(std::io::sink());
         let mut bytes = 0;
         for chunk in stream.chunks(4096) {

@@ -1,5 +1,6 @@
-//! A controller's dialect as data: the lines around the moves, the words
-//! and the limits of its number format.
+//! A controller's dialect as data: the lines around the moves, the words,
+//! the format of each word's number, and how a program starts (modal
+//! state, tool call, spindle, coolant) and ends.
 
 use crate::moves::Plane;
 
@@ -27,6 +28,10 @@ pub struct Dialect {
     pub program_number: u32,
     pub lathe_setup: Vec<String>,
     pub mill_setup: Vec<String>,
+    /// Blocks that call the tool after the setup (`{tool}`, `{offset}`,
+    /// `{tool:2}` and `{offset:2}` zero-padded to two digits).
+    pub lathe_tool_call: Vec<String>,
+    pub mill_tool_call: Vec<String>,
     /// Lines holding the controller's blending to `{tolerance}`.
     pub path_tolerance: Vec<String>,
     pub c_axis_on: Vec<String>,
@@ -60,8 +65,26 @@ pub struct Dialect {
     pub per_minute: Option<String>,
     pub per_revolution: Option<String>,
     pub inverse_time: Option<String>,
+    /// Spindle on clockwise (M3) and counter-clockwise (M4).
     pub spindle_on: String,
+    pub spindle_ccw: String,
     pub spindle_off: String,
+    /// The word that cancels constant surface speed, written in the block
+    /// of a constant-rpm start (`G97 S1000 M3`); none: the controller has
+    /// no constant surface speed to cancel.
+    pub constant_rpm: Option<String>,
+    /// Blocks that stop the spindle at a fixed angle and hold it there,
+    /// for a tool that cuts with the spindle still (a shaping knife).
+    pub spindle_orient: Vec<String>,
+    /// Coolant words: flood, mist and off; none: the controller has none.
+    pub coolant_flood: Option<String>,
+    pub coolant_mist: Option<String>,
+    pub coolant_off: Option<String>,
+    /// How each word's number is written (`S5`: an integer of at most five
+    /// digits, no point; `X4.4`: at most four digits before the point and
+    /// four after, the point always written). Words without one follow
+    /// the writer's defaults.
+    pub word_formats: Vec<WordFormat>,
     pub c_letter: char,
     pub c_decimals: u32,
     pub max_decimals: Option<u32>,
@@ -73,7 +96,62 @@ pub struct Dialect {
     pub block_end: String,
 }
 
+/// How one word's number is written, as a dialect states it (`S5`,
+/// `X4.4`): its letter, the most digits before the point, and the most
+/// after it, or `None` for an integer word written without a point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct WordFormat {
+    pub letter: char,
+    pub integer_digits: u32,
+    pub decimals: Option<u32>,
+}
+
+impl WordFormat {
+    /// Reads `S5` or `X4.4`, or says what is wrong with it.
+    pub fn parse(text: &str) -> Result<WordFormat, String> {
+        let mut chars = text.chars();
+        let letter = chars
+            .next()
+            .filter(|c| c.is_ascii_uppercase())
+            .ok_or_else(|| format!("`{text}` does not start with an upper-case word letter"))?;
+        let rest = chars.as_str();
+        let digits = |s: &str| {
+            (!s.is_empty() && s.len() <= 2 && s.bytes().all(|b| b.is_ascii_digit()))
+                .then(|| s.parse::<u32>().ok())
+                .flatten()
+        };
+        let bad = || {
+            format!(
+                "`{text}` is not a word format: a letter, the most digits before the point and, for a word written with a point, `.` and the most after it (`S5`, `X4.4`)"
+            )
+        };
+        let (integer_digits, decimals) = match rest.split_once('.') {
+            None => (digits(rest).ok_or_else(bad)?, None),
+            Some((i, d)) => (
+                digits(i).ok_or_else(bad)?,
+                Some(digits(d).filter(|&d| d <= 9).ok_or_else(bad)?),
+            ),
+        };
+        if integer_digits == 0 || integer_digits > 18 {
+            return Err(bad());
+        }
+        Ok(WordFormat {
+            letter,
+            integer_digits,
+            decimals,
+        })
+    }
+}
+
 impl Dialect {
+    /// The format the dialect gives the word `letter`, if any.
+    pub fn format_of(&self, letter: char) -> Option<WordFormat> {
+        self.word_formats
+            .iter()
+            .copied()
+            .find(|f| f.letter == letter)
+    }
+
     /// LinuxCNC's RS274NGC as `stdlib/dialects.lens` declares it, for the
     /// runtime's own tests and benchmarks.
     pub fn linuxcnc() -> Dialect {
@@ -84,8 +162,10 @@ impl Dialect {
             comment: CommentStyle::Parentheses,
             start: Vec::new(),
             program_number: 1,
-            lathe_setup: lines(&["G18 G21 G90 G8 G40 G49 G80"]),
-            mill_setup: lines(&["G17 G21 G90 G40 G49 G80"]),
+            lathe_setup: lines(&["G18 G21 G90 G8 G40 G49 G80 G94"]),
+            mill_setup: lines(&["G17 G21 G90 G40 G49 G80 G94"]),
+            lathe_tool_call: lines(&["T{tool} M6 G43"]),
+            mill_tool_call: lines(&["T{tool} M6 G43 H{offset}"]),
             path_tolerance: lines(&["G64 P{tolerance}"]),
             c_axis_on: Vec::new(),
             c_axis_off: Vec::new(),
@@ -107,7 +187,17 @@ impl Dialect {
             per_revolution: Some("G95".into()),
             inverse_time: Some("G93".into()),
             spindle_on: "M3".into(),
+            spindle_ccw: "M4".into(),
             spindle_off: "M5".into(),
+            constant_rpm: Some("G97".into()),
+            spindle_orient: lines(&["M19 R0"]),
+            coolant_flood: Some("M8".into()),
+            coolant_mist: Some("M7".into()),
+            coolant_off: Some("M9".into()),
+            word_formats: ["S5", "T3", "M3", "H3"]
+                .iter()
+                .map(|f| WordFormat::parse(f).expect("LinuxCNC's word formats"))
+                .collect(),
             c_letter: 'C',
             c_decimals: 5,
             max_decimals: None,

@@ -10,6 +10,8 @@
 //!   (`moves`) and a program;
 //! - `post/`: the move stream (`moves`) to program text in a dialect
 //!   given as data (`dialect`, which a machine also names);
+//! - `reader/`: a program read back from its text as its controller
+//!   reads it (modal state, the controllers' refusals);
 //! - `verify/`: what the program will cut (simulation, height maps,
 //!   following error).
 //!
@@ -21,5 +23,6 @@ pub mod machine;
 pub mod moves;
 pub mod plan;
 pub mod post;
+pub mod reader;
 pub mod surface;
 pub mod verify;

@@ -112,8 +112,11 @@ pub enum Move {
         ccw: bool,
         feed: Option<Feed>,
     },
-    /// Spindle on, at a speed (rad/s) if it is not a C axis.
-    SpindleOn(Option<f64>),
+    /// Spindle on at a constant speed (rad/s), turning the job's way.
+    SpindleOn(f64),
+    /// Spindle stopped at a fixed angle and held there: for a tool that
+    /// cuts with the spindle still (a shaping knife).
+    SpindleHeld,
     /// Spindle on at constant surface speed (mm/s at the tool's radius),
     /// turning no faster than `cap` (rad/s).
     SpindleSurfaceSpeed {
@@ -143,4 +146,45 @@ pub fn outside_travel(
                 (!v.is_nan() && (v < lo || v > hi)).then_some((letter, v, (lo, hi)))
             })
     })
+}
+
+/// Which way the spindle turns, seen as the controller's M3 (clockwise)
+/// and M4 (counter-clockwise) name it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Rotation {
+    #[default]
+    Clockwise,
+    CounterClockwise,
+}
+
+/// Coolant for the whole program.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Coolant {
+    #[default]
+    Off,
+    Flood,
+    Mist,
+}
+
+/// What a program states before its first move, whatever its strategy:
+/// the tool it calls (its number and offset register), which way the
+/// spindle turns when it turns, and the coolant.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Start {
+    pub tool: u32,
+    pub offset: u32,
+    pub rotation: Rotation,
+    pub coolant: Coolant,
+}
+
+impl Default for Start {
+    /// Tool 1 with offset 1, clockwise, no coolant.
+    fn default() -> Start {
+        Start {
+            tool: 1,
+            offset: 1,
+            rotation: Rotation::Clockwise,
+            coolant: Coolant::Off,
+        }
+    }
 }

@@ -102,6 +102,8 @@ fn every_example_builds_in_every_dialect_its_machine_offers() {
                     let text = p.program.text().expect("program text");
                     obeys(dialect, &text)
                         .unwrap_or_else(|e| panic!("{} in {dialect}: {e}", p.program_name));
+                    crate::complete_programs::complete(dialect, &text)
+                        .unwrap_or_else(|e| panic!("{} in {dialect}: {e}", p.program_name));
                     assert_eq!(p.report.program.dialect, dialect.as_str());
                     let shown = if text.len() > common::WHOLE_SNAPSHOT_LIMIT {
                         abridged(&text)

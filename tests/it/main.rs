@@ -9,8 +9,10 @@
 
 mod common;
 
+mod bad_programs;
 mod build_errors;
 mod cli;
+mod complete_programs;
 mod determinism;
 mod diagnostics;
 mod dialects;
@@ -26,6 +28,7 @@ mod jit_conformance;
 mod limits;
 mod list;
 mod plots;
+mod read_back;
 mod rs274;
 mod sandbox;
 mod seed_sketches;

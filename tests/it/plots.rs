@@ -253,7 +253,7 @@ fn a_failing_job_leaves_no_plot_at_all() {
         "surface bowl = conic { radius: 1.5 mm, conic: 0, sense: concave, aperture: circle(radius: 1 mm) }
 use std::machines::nano_grinder
 use std::tools::wheel_d4mm
-strategy g = profile_grinding { interval: 2 um, feed: 10 um/s, smoothness: 0.5 }
+strategy g = profile_grinding { interval: 2 um, feed: 10 um/s, smoothness: 0.5, spindle_speed: 30000 rpm }
 job wheel { surface: bowl, tool: wheel_d4mm, machine: nano_grinder, strategy: g }
 use std::machines::linuxcnc_lathe
 tool small = round_nose { nose_radius: 0.1 mm, clearance: 10 deg }

@@ -2,9 +2,10 @@
 //! file through `lensc-lang`; the pipeline lowers each job to its typed
 //! `JobSpec` and hands it to its strategy's builder (`builders/`), which
 //! plans with `lensc-runtime`, emits the program (spooled and written
-//! atomically), simulates what it will cut and fills the build report;
-//! the acceptance gate (`accept`) holds the simulated part to the job's
-//! criteria; plots draw that report.
+//! atomically, once read back by the controllers' rules: `read_back`),
+//! simulates what it will cut and fills the build report; the acceptance
+//! gate (`accept`) holds the simulated part to the job's criteria; plots
+//! draw that report.
 
 pub mod accept;
 pub mod builders;
@@ -15,6 +16,7 @@ pub mod output;
 pub(crate) mod parts;
 pub mod pipeline;
 pub mod plots;
+pub mod read_back;
 pub mod report;
 pub(crate) mod spool;
 pub mod temps;

@@ -90,6 +90,12 @@ pub fn plan_and_emit(
     for job in jobs {
         let built = lower(job, request.dialect, &request.limits()).and_then(|(spec, est)| {
             let mut b = build(&spec, &prov, spool_dir)?;
+            if crate::read_back::enabled() {
+                let refused = crate::read_back::findings(job, spec.head(), &b.program);
+                if !refused.is_empty() {
+                    return Err(refused);
+                }
+            }
             b.report.estimate = (&est).into();
             let gate = crate::accept::gate(&spec, &mut b, request.accept);
             Ok((b, gate))

@@ -57,6 +57,16 @@ pub const CANNOT_WRITE: &str = "E0151";
 pub const TOO_MANY_POINTS: &str = "E0160";
 /// A job's program would be larger than `--max-program-size`.
 pub const PROGRAM_TOO_LARGE: &str = "E0161";
+/// Roughing passes (a stock) without their own feed.
+pub const ROUGHING_NEEDS_FEED: &str = "E0170";
+/// A raster's spindle: a rotating cutter without a speed, or a knife
+/// (which cuts with the spindle held) given one.
+pub const RASTER_SPINDLE: &str = "E0171";
+/// A dialect's word format that does not read (`S5`, `X4.4`).
+pub const BAD_WORD_FORMAT: &str = "E0172";
+/// A tool call or coolant the job asks for that its dialect cannot write
+/// (a tool number too long for the T word, no mist word).
+pub const CANNOT_CALL_TOOL: &str = "E0173";
 /// A path tolerance finer than the machine's resolution can hold.
 pub const TOLERANCE_BELOW_RESOLUTION: &str = "E0180";
 /// `lensc fmt` refused to write a layout that would not parse back to the
@@ -84,6 +94,107 @@ pub const ACCEPTANCE_MISSED_WARNING: &str = "W0020";
 pub const ACCEPTANCE_UNMEASURED_WARNING: &str = "W0021";
 
 /// All codes, for the uniqueness test and the reference in README.
+// Programs read back from their text (`lensc verify`, and `lensc build`
+// before it writes a program): one code per rule of
+// `lensc_runtime::reader::Rule`, E0300–E0349.
+/// A comment never closed on its line.
+pub const PROGRAM_UNCLOSED_COMMENT: &str = "E0300";
+/// A line over the dialect's length limit.
+pub const PROGRAM_LINE_TOO_LONG: &str = "E0301";
+/// A letter, code or keyword the controller does not read.
+pub const PROGRAM_UNKNOWN_WORD: &str = "E0302";
+/// A word with no number after its letter.
+pub const PROGRAM_MALFORMED_NUMBER: &str = "E0303";
+/// A number with more digits than the controller reads.
+pub const PROGRAM_TOO_MANY_DIGITS: &str = "E0304";
+/// A number with more decimals than the controller reads.
+pub const PROGRAM_TOO_MANY_DECIMALS: &str = "E0305";
+/// A decimal point in a word read as a whole number.
+pub const PROGRAM_DECIMAL_POINT: &str = "E0306";
+/// Two codes of one modal group in a block.
+pub const PROGRAM_SAME_MODAL_GROUP: &str = "E0307";
+/// One address twice in a block.
+pub const PROGRAM_REPEATED_WORD: &str = "E0308";
+/// A feed move before the feed mode (G93/G94/G95) is stated.
+pub const PROGRAM_NO_FEED_MODE: &str = "E0309";
+/// A feed move with the spindle stopped.
+pub const PROGRAM_SPINDLE_STOPPED: &str = "E0310";
+/// A feed move with no F in force (every one in inverse time).
+pub const PROGRAM_NO_FEED_RATE: &str = "E0311";
+/// A cut before a tool call.
+pub const PROGRAM_NO_TOOL: &str = "E0312";
+/// A move outside the machine's travel.
+pub const PROGRAM_OUTSIDE_TRAVEL: &str = "E0313";
+/// A feed above the machine's limit.
+pub const PROGRAM_FEED_TOO_HIGH: &str = "E0314";
+/// A rapid across or into the material cut so far.
+pub const PROGRAM_RAPID_INTO_PART: &str = "E0315";
+/// An arc whose start and end radii differ beyond the controller's limit.
+pub const PROGRAM_ARC_RADII: &str = "E0316";
+/// An arc of zero radius.
+pub const PROGRAM_ZERO_RADIUS_ARC: &str = "E0317";
+/// An arc that ends where it starts: a full circle.
+pub const PROGRAM_FULL_CIRCLE: &str = "E0318";
+/// An arc's centre words not those of its plane, or none.
+pub const PROGRAM_ARC_WORDS: &str = "E0319";
+/// A move before units, distance mode or plane are stated.
+pub const PROGRAM_MODAL_UNSTATED: &str = "E0320";
+/// Axis words with no motion mode in force.
+pub const PROGRAM_NO_MOTION_MODE: &str = "E0321";
+/// A spindle start before G96 or G97 is stated.
+pub const PROGRAM_SPINDLE_SPEED_MODE: &str = "E0322";
+/// A spindle start with no speed.
+pub const PROGRAM_NO_SPINDLE_SPEED: &str = "E0323";
+/// A spindle speed or cap above the machine's.
+pub const PROGRAM_SPINDLE_TOO_FAST: &str = "E0324";
+/// Constant surface speed with no spindle speed limit.
+pub const PROGRAM_NO_SPEED_CAP: &str = "E0325";
+/// A block number missing or above the controller's limit.
+pub const PROGRAM_BLOCK_NUMBER: &str = "E0326";
+/// A block without the dialect's block end.
+pub const PROGRAM_BLOCK_END: &str = "E0327";
+/// A program with no end, or a block after it.
+pub const PROGRAM_END: &str = "E0328";
+/// A comment opened inside a comment.
+pub const PROGRAM_NESTED_COMMENT: &str = "E0329";
+
+/// The code of a rule a program read back breaks.
+pub fn program_rule(rule: lensc_runtime::reader::Rule) -> &'static str {
+    use lensc_runtime::reader::Rule::*;
+    match rule {
+        UnclosedComment => PROGRAM_UNCLOSED_COMMENT,
+        LineTooLong => PROGRAM_LINE_TOO_LONG,
+        UnknownWord => PROGRAM_UNKNOWN_WORD,
+        MalformedNumber => PROGRAM_MALFORMED_NUMBER,
+        TooManyDigits => PROGRAM_TOO_MANY_DIGITS,
+        TooManyDecimals => PROGRAM_TOO_MANY_DECIMALS,
+        DecimalPoint => PROGRAM_DECIMAL_POINT,
+        SameModalGroup => PROGRAM_SAME_MODAL_GROUP,
+        RepeatedWord => PROGRAM_REPEATED_WORD,
+        NoFeedMode => PROGRAM_NO_FEED_MODE,
+        SpindleStopped => PROGRAM_SPINDLE_STOPPED,
+        NoFeedRate => PROGRAM_NO_FEED_RATE,
+        NoTool => PROGRAM_NO_TOOL,
+        OutsideTravel => PROGRAM_OUTSIDE_TRAVEL,
+        FeedTooHigh => PROGRAM_FEED_TOO_HIGH,
+        RapidIntoPart => PROGRAM_RAPID_INTO_PART,
+        ArcRadiusMismatch => PROGRAM_ARC_RADII,
+        ZeroRadiusArc => PROGRAM_ZERO_RADIUS_ARC,
+        FullCircle => PROGRAM_FULL_CIRCLE,
+        ArcWords => PROGRAM_ARC_WORDS,
+        ModalStateUnstated => PROGRAM_MODAL_UNSTATED,
+        NoMotionMode => PROGRAM_NO_MOTION_MODE,
+        SpindleSpeedMode => PROGRAM_SPINDLE_SPEED_MODE,
+        NoSpindleSpeed => PROGRAM_NO_SPINDLE_SPEED,
+        SpindleTooFast => PROGRAM_SPINDLE_TOO_FAST,
+        NoSpeedCap => PROGRAM_NO_SPEED_CAP,
+        BlockNumber => PROGRAM_BLOCK_NUMBER,
+        BlockEnd => PROGRAM_BLOCK_END,
+        ProgramEnd => PROGRAM_END,
+        NestedComment => PROGRAM_NESTED_COMMENT,
+    }
+}
+
 pub const ALL: &[&str] = &[
     UNKNOWN_NAME,
     DUPLICATE_NAME,
@@ -135,6 +246,10 @@ pub const ALL: &[&str] = &[
     CANNOT_WRITE,
     TOO_MANY_POINTS,
     PROGRAM_TOO_LARGE,
+    ROUGHING_NEEDS_FEED,
+    RASTER_SPINDLE,
+    BAD_WORD_FORMAT,
+    CANNOT_CALL_TOOL,
     TOLERANCE_BELOW_RESOLUTION,
     ACCEPTANCE_MISSED,
     ACCEPTANCE_UNMEASURED,
@@ -143,6 +258,36 @@ pub const ALL: &[&str] = &[
     CENTRE_LEFT_UNCUT,
     CHORDS_OVER_TOLERANCE,
     FORMAT_WOULD_CHANGE_MEANING,
+    PROGRAM_UNCLOSED_COMMENT,
+    PROGRAM_LINE_TOO_LONG,
+    PROGRAM_UNKNOWN_WORD,
+    PROGRAM_MALFORMED_NUMBER,
+    PROGRAM_TOO_MANY_DIGITS,
+    PROGRAM_TOO_MANY_DECIMALS,
+    PROGRAM_DECIMAL_POINT,
+    PROGRAM_SAME_MODAL_GROUP,
+    PROGRAM_REPEATED_WORD,
+    PROGRAM_NO_FEED_MODE,
+    PROGRAM_SPINDLE_STOPPED,
+    PROGRAM_NO_FEED_RATE,
+    PROGRAM_NO_TOOL,
+    PROGRAM_OUTSIDE_TRAVEL,
+    PROGRAM_FEED_TOO_HIGH,
+    PROGRAM_RAPID_INTO_PART,
+    PROGRAM_ARC_RADII,
+    PROGRAM_ZERO_RADIUS_ARC,
+    PROGRAM_FULL_CIRCLE,
+    PROGRAM_ARC_WORDS,
+    PROGRAM_MODAL_UNSTATED,
+    PROGRAM_NO_MOTION_MODE,
+    PROGRAM_SPINDLE_SPEED_MODE,
+    PROGRAM_NO_SPINDLE_SPEED,
+    PROGRAM_SPINDLE_TOO_FAST,
+    PROGRAM_NO_SPEED_CAP,
+    PROGRAM_BLOCK_NUMBER,
+    PROGRAM_BLOCK_END,
+    PROGRAM_END,
+    PROGRAM_NESTED_COMMENT,
     ACCEPTANCE_MISSED_WARNING,
     ACCEPTANCE_UNMEASURED_WARNING,
 ];

@@ -81,6 +81,22 @@ enum Command {
         #[arg(long, value_enum, default_value_t = AcceptChoice::Error)]
         accept: AcceptChoice,
     },
+    /// Read a program back from its text as its controller would: modal
+    /// state block by block, and every rule it breaks (feed moves with the
+    /// spindle stopped or before a tool call, moves outside the travel or
+    /// over the machine's feed, rapids into the part, arcs the controller
+    /// refuses, number formats, comments, line lengths). Machine and
+    /// dialect default to those the program's header names.
+    Verify {
+        /// The program to read.
+        program: PathBuf,
+        /// The machine to read it for (default: the header's).
+        #[arg(long)]
+        machine: Option<String>,
+        /// The dialect to read it in (default: the header's).
+        #[arg(long)]
+        dialect: Option<String>,
+    },
     /// Plan and simulate a file's jobs as `build` does and write SVG plots
     /// of what each program will cut: `JOB.profile.svg` (profile jobs: the
     /// design, the tool-centre path and the simulated cut, with the form
@@ -246,6 +262,11 @@ fn run(cli: Cli) -> u8 {
             files,
             max_program_size,
         } => commands::check::run(&out, &files, max_program_size),
+        Command::Verify {
+            program,
+            machine,
+            dialect,
+        } => commands::verify::run(&out, &program, machine.as_deref(), dialect.as_deref()),
         Command::Fmt { files, check } => commands::fmt::run(&out, &files, check),
         Command::Analyse {
             file,

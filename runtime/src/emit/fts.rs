@@ -102,6 +102,12 @@ impl FtsProgram {
         out
     }
 
+    /// Calls the tool and sets the coolant (`ProgramWriter::call_tool`):
+    /// once, before the first point.
+    pub fn call_tool(&mut self, start: &moves::Start) -> Result<(), ProgramError> {
+        self.writer.call_tool(start)
+    }
+
     /// Appends points in spiral order.
     pub fn extend(&mut self, points: &[crate::plan::fts::SpiralPoint]) -> Result<(), ProgramError> {
         if self.table.is_some() {
@@ -149,8 +155,8 @@ impl FtsProgram {
                     table.programmed = Some(*p);
                     // The slow Z holds the servo's zero at the part's
                     // vertex: the table's W is the whole height.
-                    let [to_start, above, plunge] = approach(p, 0.0, self.safe_w);
-                    self.writer.write_all(&[to_start, above])?;
+                    let [above, to_start, plunge] = approach(p, 0.0, self.safe_w);
+                    self.writer.write_all(&[above, to_start])?;
                     for line in self.writer.dialect().fts_on.clone() {
                         self.writer.block_line(&line.replace("{table}", &name))?;
                     }
@@ -202,17 +208,17 @@ impl FtsProgram {
     }
 }
 
-/// Rapids to a spiral's first point above the part, then a one-second
-/// plunge of Z to `z`.
+/// Rapids up to the safe height first, then over the spiral's first
+/// point, then a one-second plunge of Z to `z`.
 fn approach(p: &crate::plan::fts::SpiralPoint, z: f64, safe_w: f64) -> [moves::Move; 3] {
     [
         moves::Move::Rapid(Position {
-            x: p.x,
-            c: p.c,
+            z: safe_w,
             ..Position::KEEP
         }),
         moves::Move::Rapid(Position {
-            z: safe_w,
+            x: p.x,
+            c: p.c,
             ..Position::KEEP
         }),
         moves::Move::Linear {

@@ -1,22 +1,28 @@
 //! Profile grinding: the wheel-centre path to a lathe program.
 
 use crate::dialect::Dialect;
-use crate::moves::{self, Position};
+use crate::moves::{self, Position, Start};
 use crate::post::{ProgramError, ProgramWriter, Setup};
 
-/// The move stream of a grinding pass: the wheel centre's X and Z, each
-/// interval at the feed that moves the contact point at v_f (the interval
-/// takes its contact-x length over v_f).
+/// The move stream of a grinding pass: the work spindle started at
+/// `spindle_speed` (rad/s), up to the safe height, then the wheel centre's
+/// X and Z, each interval at the feed that moves the contact point at v_f
+/// (the interval takes its contact-x length over v_f).
 pub fn grinding_moves(
     path: &crate::plan::grinding::GrindingPath,
     feed: f64,
     safe_z: f64,
+    spindle_speed: f64,
 ) -> Vec<moves::Move> {
     let Some(first) = path.points.first() else {
         return Vec::new();
     };
     let mut out = vec![
-        moves::Move::SpindleOn(None),
+        moves::Move::SpindleOn(spindle_speed),
+        moves::Move::Rapid(Position {
+            z: safe_z,
+            ..Position::KEEP
+        }),
         moves::Move::Rapid(Position::xz(first.x, safe_z)),
         moves::Move::Linear {
             to: Position::xz(first.x, first.z),
@@ -40,15 +46,15 @@ pub fn grinding_moves(
     out
 }
 
-/// A program for a grinding pass: X and Z of the wheel centre.
+/// A program for a grinding pass's move stream (`grinding_moves`): X and
+/// Z of the wheel centre.
 pub fn emit_grinding(
     dialect: &Dialect,
     job: &str,
     header: &[String],
-    path: &crate::plan::grinding::GrindingPath,
-    feed: f64,
-    safe_z: f64,
+    stream: &[moves::Move],
     resolution: f64,
+    start: &Start,
 ) -> Result<String, ProgramError> {
     // Wheel centres are exact at each interval: blending held to the
     // machine's resolution.
@@ -61,6 +67,7 @@ pub fn emit_grinding(
         resolution,
         resolution,
     )?;
-    w.write_all(&grinding_moves(path, feed, safe_z))?;
+    w.call_tool(start)?;
+    w.write_all(stream)?;
     w.finish()
 }

@@ -58,6 +58,7 @@ pub fn x_word(dialect: &Dialect) -> &'static str {
 /// A lathe program on the X, Z and C axes (the spiral and helix
 /// strategies), its controller blending corners by at most
 /// `path_tolerance` (mm).
+/// Its tool is called by the program's owner (`call_tool`) before any move.
 fn xzc_lathe_writer(
     dialect: &Dialect,
     job: &str,

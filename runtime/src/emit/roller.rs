@@ -40,6 +40,17 @@ impl RollerProgram {
         })
     }
 
+    /// Calls the tool and sets the coolant (`ProgramWriter::call_tool`),
+    /// then rapids X out to the safe radius before any other move: once,
+    /// before the first pass.
+    pub fn call_tool(&mut self, start: &moves::Start) -> Result<(), ProgramError> {
+        self.writer.call_tool(start)?;
+        self.writer.write(&moves::Move::Rapid(Position {
+            x: self.safe_x,
+            ..Position::KEEP
+        }))
+    }
+
     /// Appends points of pass `pass`; a new pass retracts X, moves to its
     /// start on the next whole turn of C, and plunges in one second.
     pub fn extend(

@@ -2,9 +2,9 @@
 
 use super::{Emitted, optimisation_words, tolerance_words, x_word};
 use crate::moves::Move;
-use crate::moves::{self, Position};
+use crate::moves::{self, Position, Start};
 use crate::plan::optimise::{self, optimise};
-use crate::plan::turning::{Feed, Toolpath, TurningJob};
+use crate::plan::turning::{Feed, PassRates, Toolpath, TurningJob};
 use crate::post::header::{Provenance, duration, exact, exact_in, num};
 use crate::post::{ProgramError, ProgramWriter, Setup};
 use std::f64::consts::PI;
@@ -15,7 +15,12 @@ const M_PER_MIN: f64 = 1000.0 / 60.0;
 /// Writes a lathe program for a profile-turning path in the machine's
 /// dialect, optimised (lines merged, arcs fitted) within the fitting share
 /// of the strategy's tolerance.
-pub fn emit(job: &TurningJob, path: &Toolpath, prov: &Provenance) -> Result<Emitted, ProgramError> {
+pub fn emit(
+    job: &TurningJob,
+    path: &Toolpath,
+    prov: &Provenance,
+    start: &Start,
+) -> Result<Emitted, ProgramError> {
     let centre_height = if job.tool.centre_height == 0.0 {
         String::new()
     } else {
@@ -76,6 +81,7 @@ pub fn emit(job: &TurningJob, path: &Toolpath, prov: &Provenance) -> Result<Emit
         job.machine.resolution,
         tolerance * optimise::BLEND_SHARE,
     )?;
+    w.call_tool(start)?;
     w.write_all(&stream)?;
     Ok(Emitted {
         text: w.finish()?,
@@ -84,12 +90,24 @@ pub fn emit(job: &TurningJob, path: &Toolpath, prov: &Provenance) -> Result<Emit
     })
 }
 
-/// The move stream of a profile-turning path: spindle on, the planner's
-/// moves (X corrected for an edge set off centre), spindle off.
+/// The move stream of a profile-turning path: the spindle started, a
+/// rapid up to the safe height before any other move, the planner's moves
+/// (X corrected for an edge set off centre) at each pass's feed, the
+/// spindle switched to the finish's speed before the finish pass where
+/// roughing runs at its own, and the spindle stopped.
 pub fn turning_moves(job: &TurningJob, path: &Toolpath) -> Vec<moves::Move> {
-    let feed = match job.strategy.feed {
+    let finish = PassRates::finish(&job.strategy);
+    let rough = PassRates::roughing(&job.strategy);
+    let feed = |r: &PassRates| match r.feed {
         Feed::PerRevolution(f) => moves::Feed::PerRevolution(f),
         Feed::PerTime(v) => moves::Feed::PerTime(v),
+    };
+    let spindle = |r: &PassRates| match r.surface_speed {
+        Some(v) => moves::Move::SpindleSurfaceSpeed {
+            surface_speed: v,
+            cap: r.spindle_speed,
+        },
+        None => moves::Move::SpindleOn(r.spindle_speed),
     };
     // An edge set h off the axis cuts radius sqrt(X² + h²).
     let h = job.tool.centre_height;
@@ -100,22 +118,34 @@ pub fn turning_moves(job: &TurningJob, path: &Toolpath) -> Vec<moves::Move> {
             x.signum() * (x * x - h * h).max(0.0).sqrt()
         }
     };
-    let mut out = Vec::with_capacity(path.moves.len() + 2);
-    out.push(match job.strategy.surface_speed {
-        Some(v) => moves::Move::SpindleSurfaceSpeed {
-            surface_speed: v,
-            cap: job.strategy.spindle_speed,
-        },
-        None => moves::Move::SpindleOn(Some(job.strategy.spindle_speed)),
-    });
-    out.extend(path.moves.iter().map(|m| match *m {
-        Move::Rapid(to) => Move::Rapid(Position::xz(corrected(to.x), to.z)),
-        Move::Linear { to, .. } => Move::Linear {
-            to: Position::xz(corrected(to.x), to.z),
-            feed: Some(feed),
-        },
-        other => other,
-    }));
+    // Where the finish pass begins; every move before it is roughing.
+    let finish_from = path
+        .pass_starts
+        .get(path.roughing_passes)
+        .copied()
+        .unwrap_or(0);
+    let mut out = Vec::with_capacity(path.moves.len() + 4);
+    out.push(spindle(if finish_from > 0 { &rough } else { &finish }));
+    if let Some(Move::Rapid(to)) = path.moves.first() {
+        out.push(Move::Rapid(Position {
+            z: to.z,
+            ..Position::KEEP
+        }));
+    }
+    for (i, m) in path.moves.iter().enumerate() {
+        if i == finish_from && i > 0 && spindle(&rough) != spindle(&finish) {
+            out.push(spindle(&finish));
+        }
+        let rates = if i < finish_from { &rough } else { &finish };
+        out.push(match *m {
+            Move::Rapid(to) => Move::Rapid(Position::xz(corrected(to.x), to.z)),
+            Move::Linear { to, .. } => Move::Linear {
+                to: Position::xz(corrected(to.x), to.z),
+                feed: Some(feed(rates)),
+            },
+            other => other,
+        });
+    }
     out.push(moves::Move::SpindleOff);
     out
 }
@@ -130,8 +160,15 @@ fn roughing_words(job: &TurningJob, path: &Toolpath) -> String {
         Stock::Flat { top } => format!("flat stock at Z{}", exact(top)),
         Stock::Offset { allowance } => format!("stock {} mm over the surface", exact(allowance)),
     };
+    let feed = match r.feed {
+        Feed::PerRevolution(f) => format!("{} mm/rev", num(f * 2.0 * PI)),
+        Feed::PerTime(v) => format!("{} mm/min", num(v * 60.0)),
+    };
+    let speed = r.spindle_speed.map_or(String::new(), |w| {
+        format!(" at {} rpm", num(w * 60.0 / (2.0 * PI)))
+    });
     format!(
-        ", after {} roughing passes from {stock}, at most {} mm each, {} mm left for the finish",
+        ", after {} roughing passes from {stock}, at most {} mm each at {feed}{speed}, {} mm left for the finish",
         path.roughing_passes,
         exact(r.depth_of_cut),
         exact(r.finish_allowance)

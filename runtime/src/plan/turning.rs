@@ -72,6 +72,11 @@ pub struct Roughing {
     /// Material (mm, along the normal) the last roughing pass leaves for
     /// the finish pass.
     pub finish_allowance: f64,
+    /// The roughing passes' own feed.
+    pub feed: Feed,
+    /// Their own constant spindle speed (rad/s); `None`: the finish's
+    /// (its constant speed, or its constant surface speed and cap).
+    pub spindle_speed: Option<f64>,
 }
 
 /// The stock a job starts from.
@@ -136,6 +141,9 @@ pub struct Toolpath {
     pub seams: Vec<Seam>,
     /// Roughing passes before the finish pass.
     pub roughing_passes: usize,
+    /// Where each pass begins in `moves` (its rapid above the first
+    /// point), roughing passes first.
+    pub pass_starts: Vec<usize>,
 }
 
 impl Toolpath {
@@ -253,7 +261,7 @@ pub fn plan_profile_turning(
     let mut passes = roughing_passes(&section, rho, strat, &cut);
     let roughing_count = passes.len();
     passes.push(cut);
-    let linked = link_passes(&passes, strat);
+    let linked = link_passes(&passes, roughing_count, strat);
     let cut = passes.pop().expect("the finish pass");
     let cutting_time = linked.pass_times.iter().sum();
 
@@ -271,6 +279,7 @@ pub fn plan_profile_turning(
         max_slope: scan.max_slope,
         seams,
         roughing_passes: roughing_count,
+        pass_starts: linked.pass_starts,
     })
 }
 
@@ -309,17 +318,27 @@ fn scan_profile(
 }
 
 /// The feed and spindle speed the machine cannot give.
+/// The finish's and, with roughing passes, theirs.
 fn rate_errors(machine: &Lathe, strat: &ProfileTurning, feed_speed: f64) -> Vec<PlanError> {
     let mut errors = Vec::new();
-    if feed_speed > machine.max_feed {
+    let rough = strat.roughing.map(|_| PassRates::roughing(strat));
+    let rough_feed = rough.map(|r| match r.feed {
+        Feed::PerRevolution(f) => f * r.spindle_speed,
+        Feed::PerTime(v) => v,
+    });
+    let fastest = rough_feed.map_or(feed_speed, |r| r.max(feed_speed));
+    if fastest > machine.max_feed {
         errors.push(PlanError::FeedTooHigh {
-            feed: feed_speed,
+            feed: fastest,
             max: machine.max_feed,
         });
     }
-    if strat.spindle_speed > machine.max_spindle_speed {
+    let spindle = rough.map_or(strat.spindle_speed, |r| {
+        r.spindle_speed.max(strat.spindle_speed)
+    });
+    if spindle > machine.max_spindle_speed {
         errors.push(PlanError::SpindleTooFast {
-            speed: strat.spindle_speed,
+            speed: spindle,
             max: machine.max_spindle_speed,
         });
     }
@@ -333,12 +352,19 @@ struct LinkedPasses {
     cut_length: f64,
     /// Cutting time (s) of each pass.
     pass_times: Vec<f64>,
+    /// Where each pass begins in `moves`.
+    pass_starts: Vec<usize>,
 }
 
 /// Each pass in turn: a rapid above its first point at the safe height
 /// (the retract above the highest point of any pass), a feed down to it,
-/// the pass, and a rapid back up.
-fn link_passes(passes: &[Vec<Vector2<f64>>], strat: &ProfileTurning) -> LinkedPasses {
+/// the pass, and a rapid back up. The first `roughing` passes are timed
+/// at the roughing feed and spindle speed.
+fn link_passes(
+    passes: &[Vec<Vector2<f64>>],
+    roughing: usize,
+    strat: &ProfileTurning,
+) -> LinkedPasses {
     let top = passes
         .iter()
         .flatten()
@@ -348,27 +374,22 @@ fn link_passes(passes: &[Vec<Vector2<f64>>], strat: &ProfileTurning) -> LinkedPa
     let mut moves = Vec::with_capacity(passes.iter().map(|p| p.len() + 3).sum());
     let mut cut_length = 0.0;
     let mut pass_times = Vec::with_capacity(passes.len());
-    // The feed speed (mm/s) at radius r.
-    let speed_at = |r: f64| match (strat.feed, strat.surface_speed) {
-        (Feed::PerTime(v), _) => v,
-        (Feed::PerRevolution(f), None) => f * strat.spindle_speed,
-        (Feed::PerRevolution(f), Some(v)) => {
-            f * if r.abs() * strat.spindle_speed > v {
-                v / r.abs()
-            } else {
-                strat.spindle_speed
-            }
-        }
-    };
-    for cut in passes {
+    let mut pass_starts = Vec::with_capacity(passes.len());
+    for (i, cut) in passes.iter().enumerate() {
+        let rates = if i < roughing {
+            PassRates::roughing(strat)
+        } else {
+            PassRates::finish(strat)
+        };
+        pass_starts.push(moves.len());
         moves.push(Move::Rapid(Position::xz(cut[0].x, safe_z)));
         moves.push(cutting(cut[0].x, cut[0].y));
         cut_length += (safe_z - cut[0].y).abs();
-        let mut time = (safe_z - cut[0].y).abs() / speed_at(cut[0].x);
+        let mut time = (safe_z - cut[0].y).abs() / rates.speed_at(cut[0].x);
         for w in cut.windows(2) {
             let len = (w[1] - w[0]).norm();
             cut_length += len;
-            time += len / speed_at(0.5 * (w[0].x + w[1].x));
+            time += len / rates.speed_at(0.5 * (w[0].x + w[1].x));
         }
         pass_times.push(time);
         moves.extend(cut.iter().skip(1).map(|c| cutting(c.x, c.y)));
@@ -379,6 +400,61 @@ fn link_passes(passes: &[Vec<Vector2<f64>>], strat: &ProfileTurning) -> LinkedPa
         moves,
         cut_length,
         pass_times,
+        pass_starts,
+    }
+}
+
+/// The feed and spindle one pass runs at.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PassRates {
+    pub feed: Feed,
+    /// Constant speed, or the cap under constant surface speed (rad/s).
+    pub spindle_speed: f64,
+    /// Constant surface speed (mm/s), if the pass runs at one.
+    pub surface_speed: Option<f64>,
+}
+
+impl PassRates {
+    /// The finish pass's: the strategy's feed and spindle.
+    pub fn finish(strat: &ProfileTurning) -> PassRates {
+        PassRates {
+            feed: strat.feed,
+            spindle_speed: strat.spindle_speed,
+            surface_speed: strat.surface_speed,
+        }
+    }
+
+    /// A roughing pass's: its own feed, and its own constant spindle
+    /// speed if it has one, else the finish's spindle.
+    pub fn roughing(strat: &ProfileTurning) -> PassRates {
+        let finish = PassRates::finish(strat);
+        match strat.roughing {
+            Some(r) => PassRates {
+                feed: r.feed,
+                spindle_speed: r.spindle_speed.unwrap_or(finish.spindle_speed),
+                surface_speed: if r.spindle_speed.is_some() {
+                    None
+                } else {
+                    finish.surface_speed
+                },
+            },
+            None => finish,
+        }
+    }
+
+    /// The feed speed (mm/s) at radius r.
+    pub fn speed_at(&self, r: f64) -> f64 {
+        match (self.feed, self.surface_speed) {
+            (Feed::PerTime(v), _) => v,
+            (Feed::PerRevolution(f), None) => f * self.spindle_speed,
+            (Feed::PerRevolution(f), Some(v)) => {
+                f * if r.abs() * self.spindle_speed > v {
+                    v / r.abs()
+                } else {
+                    self.spindle_speed
+                }
+            }
+        }
     }
 }
 

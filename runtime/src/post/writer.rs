@@ -4,8 +4,8 @@
 use super::ProgramError;
 use super::format::{decimals_for, fixed_units, push_fixed, push_units_to};
 use super::header::{num, write_comment};
-use crate::dialect::{CommentStyle, Dialect};
-use crate::moves::{Plane, Position};
+use crate::dialect::{CommentStyle, Dialect, WordFormat};
+use crate::moves::{Coolant, Plane, Position, Rotation, Start};
 use std::f64::consts::PI;
 
 /// Which safe-start lines a program uses, and the arc plane they select.
@@ -88,6 +88,8 @@ pub struct ProgramWriter {
     /// Where the axes are (mm, rad; the stream's values).
     at: [f64; 4],
     plane: Plane,
+    /// The setup's plane: G18 for a lathe, G17 for a mill.
+    plane_at_start: Plane,
     mode: Option<FeedMode>,
     /// The last feed printed, in units of its last decimal.
     last_feed: Option<i64>,
@@ -95,7 +97,24 @@ pub struct ProgramWriter {
     block: u64,
     c_axis_on: bool,
     job: String,
+    /// The tool call and coolant, once written (`call_tool`).
+    start: Option<Start>,
+    /// What the spindle is doing.
+    spindle: Spindle,
+    /// The most digits before the point per word letter A…Z, as a power
+    /// of ten (`u64::MAX`: no limit).
+    integer_limit: [u64; 26],
+    /// Decimals of feeds per minute and per revolution.
+    feed_decimals: u32,
     pub moves: usize,
+}
+
+/// The spindle's state as the program has set it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Spindle {
+    Stopped,
+    Turning,
+    Held,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -185,13 +204,48 @@ impl ProgramWriter {
                 Setup::Lathe => Plane::Zx,
                 Setup::Mill => Plane::Xy,
             },
+            plane_at_start: match setup {
+                Setup::Lathe => Plane::Zx,
+                Setup::Mill => Plane::Xy,
+            },
             // The first feed states its mode, whatever the setup says.
             mode: None,
             last_feed: None,
             block: dialect.line_numbers.unwrap_or(0),
             c_axis_on: false,
             job: job.to_string(),
+            start: None,
+            spindle: Spindle::Stopped,
+            integer_limit: integer_limits(dialect),
+            feed_decimals: dialect
+                .format_of('F')
+                .and_then(|f| f.decimals)
+                .map_or(FEED_DECIMALS, |d| d.min(FEED_DECIMALS)),
             moves: 0,
+        }
+    }
+
+    /// Calls the tool and sets the coolant: the dialect's tool-call blocks
+    /// for this kind of program, then the coolant word. Every program
+    /// calls it once, after `new` and before its first move (a move
+    /// before it is refused).
+    pub fn call_tool(&mut self, start: &Start) -> Result<(), ProgramError> {
+        for line in tool_call_lines(&self.dialect, self.setup_kind(), start)? {
+            self.block_line(&line)?;
+        }
+        if let Some(word) = coolant_word(&self.dialect, start.coolant)? {
+            self.block_line(&word)?;
+        }
+        self.start = Some(*start);
+        Ok(())
+    }
+
+    /// Whether the program is a lathe's (its X scale or plane says so).
+    fn setup_kind(&self) -> Setup {
+        if self.plane_at_start == Plane::Zx {
+            Setup::Lathe
+        } else {
+            Setup::Mill
         }
     }
 
@@ -275,6 +329,7 @@ impl ProgramWriter {
     /// Writes one block of the dialect's own words, checked as it is written.
     pub fn block_line(&mut self, words: &str) -> Result<(), ProgramError> {
         check_numbers(words, self.dialect.comment)?;
+        check_word_formats(words, &self.dialect)?;
         let start = self.text.len();
         self.begin_block();
         self.text.extend_from_slice(words.as_bytes());
@@ -320,7 +375,21 @@ impl ProgramWriter {
         if digits > self.max_digits {
             return Err(self.too_many_digits(letter, v, digits));
         }
+        let limit = self.integer_limit[letter_index(letter)];
+        if limit != u64::MAX && n.unsigned_abs() / 10u64.pow(d.min(18)) >= limit {
+            return Err(self.too_many_integer_digits(letter, v));
+        }
         Ok(())
+    }
+
+    #[cold]
+    fn too_many_integer_digits(&self, letter: char, v: f64) -> ProgramError {
+        let f = self.dialect.format_of(letter);
+        ProgramError::Unsupported(format!(
+            "{letter}{v} ({} writes at most {} digits before the point in {letter})",
+            self.dialect.name,
+            f.map_or(0, |f| f.integer_digits)
+        ))
     }
 
     #[cold]
@@ -331,15 +400,15 @@ impl ProgramWriter {
         ))
     }
 
-    /// Appends a value's digits, refusing more than the dialect's limit.
-    fn value(&mut self, letter: char, v: f64, n: i64, d: u32) -> Result<(), ProgramError> {
-        self.number(letter, v, n, d)
-    }
-
     /// Writes one move, straight into the text (no allocation per move:
     /// a move that changes no printed axis is written and then cut off).
     pub fn write(&mut self, m: &crate::moves::Move) -> Result<(), ProgramError> {
         use crate::moves::Move as M;
+        if self.start.is_none() {
+            return Err(ProgramError::Unsupported(
+                "a move before the tool is called (the writer's `call_tool`)".into(),
+            ));
+        }
         let (word, to, feed, arc) = match *m {
             M::Rapid(to) => (Word::Rapid, to, None, None),
             M::Linear { to, feed } => (Word::Linear, to, feed, None),
@@ -369,54 +438,23 @@ impl ProgramWriter {
         let start = self.text.len();
         let r = match *m {
             M::Rapid(_) | M::Linear { .. } | M::Arc { .. } => self.write(m),
-            M::SpindleOn(speed) => {
-                self.begin_block();
-                if let Some(w) = speed {
-                    let rpm = w * 60.0 / (2.0 * PI);
-                    self.text.push(b'S');
-                    match fixed_units(rpm, 3) {
-                        Some(n) => self.value('S', rpm, n, 3)?,
-                        None => {
-                            return Err(ProgramError::NotPrintable {
-                                word: 'S',
-                                value: rpm,
-                            });
-                        }
-                    }
-                    self.text.push(b' ');
-                }
-                let on = self.dialect.spindle_on.clone();
-                self.text.extend_from_slice(on.as_bytes());
-                self.end_block(start)
-            }
+            M::SpindleOn(speed) => self.spindle_rpm(speed),
             M::SpindleSurfaceSpeed { surface_speed, cap } => {
-                let lines = self.dialect.surface_speed.clone();
+                self.spindle_surface_speed(surface_speed, cap)
+            }
+            M::SpindleHeld => {
+                self.spindle = Spindle::Held;
+                let lines = self.dialect.spindle_orient.clone();
                 if lines.is_empty() {
                     return Err(ProgramError::Unsupported(format!(
-                        "constant surface speed ({} has no `surface_speed` lines)",
+                        "a spindle held still for a shaping tool ({} has no `spindle_orient`)",
                         self.dialect.name
                     )));
                 }
-                let mut speed = String::new();
-                let mut rpm = String::new();
-                let m_per_min = surface_speed * 60.0 / 1000.0;
-                let cap_rpm = cap * 60.0 / (2.0 * PI);
-                if !(push_fixed(&mut speed, m_per_min, 3)
-                    && push_fixed(&mut rpm, cap_rpm.floor(), 0))
-                {
-                    return Err(ProgramError::NotPrintable {
-                        word: 'S',
-                        value: m_per_min,
-                    });
-                }
-                for line in lines {
-                    let l = line.replace("{speed}", &speed).replace("{cap}", &rpm);
-                    self.block_line(&l)?;
-                }
-                let on = self.dialect.spindle_on.clone();
-                self.block_line(&on)
+                lines.iter().try_for_each(|l| self.block_line(l))
             }
             M::SpindleOff => {
+                self.spindle = Spindle::Stopped;
                 let off = self.dialect.spindle_off.clone();
                 self.block_line(&off)
             }
@@ -425,6 +463,110 @@ impl ProgramWriter {
             self.text.truncate(start);
         }
         r
+    }
+
+    /// The spindle-on word for the job's direction.
+    fn spindle_on_word(&self) -> String {
+        match self.start.map(|s| s.rotation) {
+            Some(Rotation::CounterClockwise) => self.dialect.spindle_ccw.clone(),
+            _ => self.dialect.spindle_on.clone(),
+        }
+    }
+
+    /// A constant-rpm start in one block: the word cancelling constant
+    /// surface speed (`G97`), the speed in the S word's format, the
+    /// spindle-on word (`G97 S1000 M3`).
+    fn spindle_rpm(&mut self, speed: f64) -> Result<(), ProgramError> {
+        let rpm = speed * 60.0 / (2.0 * PI);
+        let s = self.s_value(rpm, false)?;
+        let mut block = String::new();
+        if let Some(w) = &self.dialect.constant_rpm {
+            block.push_str(w);
+            block.push(' ');
+        }
+        block.push('S');
+        block.push_str(&s);
+        block.push(' ');
+        block.push_str(&self.spindle_on_word());
+        self.spindle = Spindle::Turning;
+        // Some controllers group G96/G97 with the feed modes (Sinumerik's
+        // group 15): the next feed states its mode again.
+        self.mode = None;
+        self.block_line(&block)
+    }
+
+    /// Constant surface speed: the dialect's blocks (the cap first where
+    /// the controller needs it), each number in the S word's format, then
+    /// the spindle-on word.
+    fn spindle_surface_speed(&mut self, surface_speed: f64, cap: f64) -> Result<(), ProgramError> {
+        let lines = self.dialect.surface_speed.clone();
+        if lines.is_empty() {
+            return Err(ProgramError::Unsupported(format!(
+                "constant surface speed ({} has no `surface_speed` lines)",
+                self.dialect.name
+            )));
+        }
+        let speed = self.s_value(surface_speed * 60.0 / 1000.0, false)?;
+        let rpm = self.s_value(cap * 60.0 / (2.0 * PI), true)?;
+        for line in lines {
+            let l = line.replace("{speed}", &speed).replace("{cap}", &rpm);
+            self.block_line(&l)?;
+        }
+        let on = self.spindle_on_word();
+        self.spindle = Spindle::Turning;
+        self.mode = None;
+        self.block_line(&on)
+    }
+
+    /// A spindle value (rpm or m/min) as the dialect's S word takes it:
+    /// rounded to a whole number without a point where S is an integer
+    /// word (a cap rounded down, `floor`), else to its decimals (3 by
+    /// default) with the point. Refused if it is not finite, prints as
+    /// zero or has more digits than the word allows.
+    fn s_value(&self, v: f64, floor: bool) -> Result<String, ProgramError> {
+        let f = self.dialect.format_of('S');
+        let decimals = f.map_or(Some(3), |f| f.decimals);
+        // A cap rounds down, past the last bits a unit conversion leaves
+        // (3000 rpm as rad/s and back is 2999.9999999999995).
+        let v_floor = if floor { (v + 1e-6).floor() } else { v };
+        let mut out = String::new();
+        let printed = match decimals {
+            None => {
+                let n = v_floor.round();
+                (n.is_finite() && n.abs() < 1e15).then(|| {
+                    out.push_str(&format!("{}", n as i64));
+                    n != 0.0
+                })
+            }
+            Some(d) => {
+                let ok = push_fixed(&mut out, v_floor, d);
+                ok.then(|| fixed_units(v_floor, d).is_some_and(|n| n != 0))
+            }
+        };
+        match printed {
+            Some(true) => {}
+            Some(false) => {
+                return Err(ProgramError::Unsupported(format!(
+                    "a spindle speed of {v} that prints as S{out}"
+                )));
+            }
+            None => {
+                return Err(ProgramError::NotPrintable {
+                    word: 'S',
+                    value: v,
+                });
+            }
+        }
+        if let Some(f) = f {
+            let whole = out.split('.').next().unwrap_or("").len() as u32;
+            if whole > f.integer_digits {
+                return Err(ProgramError::Unsupported(format!(
+                    "S{out} ({} writes at most {} digits in S)",
+                    self.dialect.name, f.integer_digits
+                )));
+            }
+        }
+        Ok(out)
     }
 
     /// A motion block: its words straight into the text, each a copy of
@@ -444,11 +586,16 @@ impl ProgramWriter {
         if !to.c.is_nan() && !self.c_axis_on && self.letters[3].is_some() {
             self.c_axis_on_lines()?;
         }
+        if !matches!(word, Word::Rapid) && self.spindle == Spindle::Stopped && !self.c_axis_on {
+            return Err(ProgramError::Unsupported(
+                "a feed move with the spindle stopped".into(),
+            ));
+        }
         let start = self.text.len();
         self.begin_block();
         let mode = feed.map(|f| match f {
-            F::PerTime(v) => (FeedMode::PerMinute, v * 60.0, FEED_DECIMALS),
-            F::PerRevolution(v) => (FeedMode::PerRevolution, v * 2.0 * PI, FEED_DECIMALS),
+            F::PerTime(v) => (FeedMode::PerMinute, v * 60.0, self.feed_decimals),
+            F::PerRevolution(v) => (FeedMode::PerRevolution, v * 2.0 * PI, self.feed_decimals),
             F::InverseTime(t) => (FeedMode::InverseTime, 60.0 / t, INVERSE_TIME_DECIMALS),
         });
         let mode_changes = mode.is_some_and(|(m, _, _)| self.mode != Some(m));
@@ -535,7 +682,7 @@ impl ProgramWriter {
         (m, value, d): (FeedMode, f64, u32),
         mode_changes: bool,
     ) -> Result<(), ProgramError> {
-        let Some(n) = fixed_units(value, d) else {
+        let Some(n) = fixed_units(value, d).filter(|&n| n > 0) else {
             return Err(ProgramError::NotPrintable { word: 'F', value });
         };
         if mode_changes || m == FeedMode::InverseTime || self.last_feed != Some(n) {
@@ -662,6 +809,21 @@ impl ProgramWriter {
 
     /// Ends the program; the text not yet taken, checked.
     pub fn finish(mut self) -> Result<String, ProgramError> {
+        let Some(start) = self.start else {
+            return Err(ProgramError::Unsupported(
+                "a program that calls no tool (the writer's `call_tool`)".into(),
+            ));
+        };
+        if self.spindle != Spindle::Stopped {
+            self.spindle = Spindle::Stopped;
+            let off = self.dialect.spindle_off.clone();
+            self.block_line(&off)?;
+        }
+        if start.coolant != Coolant::Off
+            && let Some(off) = self.dialect.coolant_off.clone()
+        {
+            self.block_line(&off)?;
+        }
         if self.c_axis_on {
             for line in self.dialect.c_axis_off.clone() {
                 self.block_line(&line)?;
@@ -769,7 +931,189 @@ pub fn check_dialect(
             setup.name(),
         )));
     }
+    check_number_words(dialect, decimals)?;
+    tool_call_lines(dialect, setup, &Start::default())?;
     Ok(decimals)
+}
+
+/// The words the writer prints numbers into must take what it prints:
+/// axes and arc centres with a point and the resolution's decimals, C
+/// with its own, F with a point.
+fn check_number_words(dialect: &Dialect, decimals: u32) -> Result<(), ProgramError> {
+    for f in &dialect.word_formats {
+        let needs = match f.letter {
+            'X' | 'Y' | 'Z' | 'I' | 'J' | 'K' => Some(decimals),
+            c if c == dialect.c_letter => Some(dialect.c_decimals),
+            'F' => Some(0),
+            _ => None,
+        };
+        let Some(needs) = needs else { continue };
+        match f.decimals {
+            Some(d) if d >= needs => {}
+            _ => {
+                return Err(ProgramError::Unsupported(format!(
+                    "the machine's numbers in {} ({} needs {needs} decimals and a point; the dialect's format `{}` gives {})",
+                    f.letter,
+                    dialect.name,
+                    format_text(f),
+                    f.decimals.map_or("none".to_string(), |d| d.to_string())
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A word format as a dialect file writes it (`S5`, `X4.4`).
+pub fn format_text(f: &WordFormat) -> String {
+    match f.decimals {
+        Some(d) => format!("{}{}.{d}", f.letter, f.integer_digits),
+        None => format!("{}{}", f.letter, f.integer_digits),
+    }
+}
+
+/// The dialect's tool-call blocks for a program of this `setup`, its
+/// placeholders filled: `{tool}` and `{offset}`, and `{tool:2}` and
+/// `{offset:2}` zero-padded to two digits (Fanuc's `T0101`). Each block
+/// is checked against the dialect's word formats, so a tool number that
+/// does not fit its word is refused here.
+pub fn tool_call_lines(
+    dialect: &Dialect,
+    setup: Setup,
+    start: &Start,
+) -> Result<Vec<String>, ProgramError> {
+    let lines = match setup {
+        Setup::Lathe => &dialect.lathe_tool_call,
+        Setup::Mill => &dialect.mill_tool_call,
+    };
+    if lines.is_empty() {
+        return Err(ProgramError::Unsupported(format!(
+            "a tool call ({} has no `{}_tool_call`)",
+            dialect.name,
+            setup.name()
+        )));
+    }
+    let two = |n: u32| {
+        (n < 100).then(|| format!("{n:02}")).ok_or_else(|| {
+            ProgramError::Unsupported(format!(
+                "tool or offset number {n} in the two digits `{}` gives it",
+                dialect.name
+            ))
+        })
+    };
+    let mut out = Vec::with_capacity(lines.len());
+    for line in lines {
+        let mut l = line.clone();
+        if l.contains("{tool:2}") {
+            l = l.replace("{tool:2}", &two(start.tool)?);
+        }
+        if l.contains("{offset:2}") {
+            l = l.replace("{offset:2}", &two(start.offset)?);
+        }
+        let l = l
+            .replace("{tool}", &start.tool.to_string())
+            .replace("{offset}", &start.offset.to_string());
+        check_numbers(&l, dialect.comment)?;
+        check_word_formats(&l, dialect)?;
+        out.push(l);
+    }
+    Ok(out)
+}
+
+/// The dialect's word for the job's coolant (none for `Off`), or why it
+/// cannot be given.
+pub fn coolant_word(dialect: &Dialect, coolant: Coolant) -> Result<Option<String>, ProgramError> {
+    let (word, name) = match coolant {
+        Coolant::Off => return Ok(None),
+        Coolant::Flood => (&dialect.coolant_flood, "flood"),
+        Coolant::Mist => (&dialect.coolant_mist, "mist"),
+    };
+    match word {
+        Some(w) if dialect.coolant_off.is_some() => Ok(Some(w.clone())),
+        _ => Err(ProgramError::Unsupported(format!(
+            "{name} coolant ({} has no `coolant_{name}` or no `coolant_off` word)",
+            dialect.name
+        ))),
+    }
+}
+
+/// A word letter's index A…Z (anything else shares Z's: only the
+/// writer's own letters reach here).
+#[inline(always)]
+fn letter_index(letter: char) -> usize {
+    (letter as usize).wrapping_sub('A' as usize).min(25)
+}
+
+/// Per letter A…Z, 10 to the most digits before the point its format
+/// allows (`u64::MAX`: no limit).
+fn integer_limits(dialect: &Dialect) -> [u64; 26] {
+    let mut limits = [u64::MAX; 26];
+    for f in &dialect.word_formats {
+        if f.letter.is_ascii_uppercase() {
+            limits[letter_index(f.letter)] = 10u64.saturating_pow(f.integer_digits);
+        }
+    }
+    limits
+}
+
+/// Every word of a block of code checked against the dialect's word
+/// formats: no point in an integer word, no more digits before or after
+/// the point than its format allows. Comments are not code.
+pub fn check_word_formats(text: &str, dialect: &Dialect) -> Result<(), ProgramError> {
+    if dialect.word_formats.is_empty() {
+        return Ok(());
+    }
+    let opens = match dialect.comment {
+        CommentStyle::Parentheses => '(',
+        CommentStyle::Semicolon => ';',
+    };
+    for line in text.split('\n') {
+        let code = &line[..line.find(opens).unwrap_or(line.len())];
+        for word in code.split_whitespace() {
+            let mut chars = word.chars();
+            let Some(letter) = chars.next() else { continue };
+            let Some(f) = dialect.format_of(letter) else {
+                continue;
+            };
+            let number = chars.as_str().trim_start_matches(['-', '+']);
+            if number.is_empty() || !number.bytes().all(|b| b.is_ascii_digit() || b == b'.') {
+                continue;
+            }
+            if let Err(why) = fits(number, f) {
+                return Err(ProgramError::Unsupported(format!(
+                    "the word `{word}` ({why}) in the line `{line}`"
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Whether the digits of a number (no sign) fit a word format.
+fn fits(number: &str, f: WordFormat) -> Result<(), String> {
+    let (whole, decimals) = match number.split_once('.') {
+        Some((w, d)) => (w, Some(d)),
+        None => (number, None),
+    };
+    match (f.decimals, decimals) {
+        (None, Some(_)) => {
+            return Err(format!(
+                "{} is an integer word, written without a decimal point",
+                f.letter
+            ));
+        }
+        (Some(max), Some(d)) if d.len() as u32 > max => {
+            return Err(format!("{} takes at most {max} decimals", f.letter));
+        }
+        _ => {}
+    }
+    if whole.len() as u32 > f.integer_digits {
+        return Err(format!(
+            "{} takes at most {} digits before the point",
+            f.letter, f.integer_digits
+        ));
+    }
+    Ok(())
 }
 
 /// The final check on program text: outside comments, no word's number

@@ -527,6 +527,18 @@ pub fn apply_unary(op: Unary, a: f64) -> f64 {
     }
 }
 
+/// A function of one argument as surface kernels evaluate it: sin, cos
+/// and exp by `fdlibm` (the JIT's own, within 1 ulp of libm), the rest as
+/// `apply_unary`.
+pub fn kernel_unary(op: Unary, a: f64) -> f64 {
+    match op {
+        Unary::Sin => super::fdlibm::sin(a),
+        Unary::Cos => super::fdlibm::cos(a),
+        Unary::Exp => super::fdlibm::exp(a),
+        _ => apply_unary(op, a),
+    }
+}
+
 pub fn apply_binary(op: Binary, a: f64, b: f64) -> f64 {
     match op {
         Binary::Add => a + b,
@@ -674,7 +686,7 @@ impl SurfaceFn for Interpreter {
                     Op::Const(c) => c,
                     Op::Var(Var::X) => x,
                     Op::Var(Var::Y) => y,
-                    Op::Unary(u, a) => apply_unary(u, v[a]),
+                    Op::Unary(u, a) => kernel_unary(u, v[a]),
                     Op::Binary(b, a, c) => apply_binary(b, v[a], v[c]),
                     Op::PowI(a, n) => v[a].powi(n),
                     Op::Step(a) => {

@@ -7,14 +7,19 @@
 //! is inside the generated code, so a batch costs one call. The loop takes
 //! two points per pass in the lanes of an `F64X2` (about twice the
 //! throughput of one lane on arithmetic-heavy tapes, as measured by
-//! `benches/surface_eval.rs`) and an odd last point in a scalar pass.
+//! `benches/surface_eval.rs`) and an odd last point in a scalar pass; both
+//! passes compute the same bits for a point (the same IEEE operations, and
+//! a lane never depends on its neighbour).
 //!
 //! Arithmetic, `sqrt`, `abs` and negation are native instructions
 //! (IEEE-exact, as in Rust); `min`/`max` are a select sequence with Rust's
 //! `f64::min`/`max` behaviour (the non-NaN operand wins, ties return the
 //! first operand); whole powers are expanded by repeated squaring in the
-//! order compiler-rt's `__powidf2` (Rust's `f64::powi`) multiplies;
-//! everything else (sin … ln, pow, atan2) calls the interpreter's own
+//! order compiler-rt's `__powidf2` (Rust's `f64::powi`) multiplies; sin,
+//! cos and exp are inline on both lanes (`vecmath`, within 1 ulp of libm;
+//! sin and cos of one argument share its reduction), lanes they do not
+//! cover (huge, infinite or NaN arguments) going to libm; everything else
+//! (tan … ln, pow, atan2) calls the interpreter's own
 //! `apply_unary`/`apply_binary` through `extern "C"` wrappers registered as
 //! JIT symbols, once per lane.
 
@@ -22,6 +27,7 @@ use std::collections::HashMap;
 use std::fmt;
 use std::sync::OnceLock;
 
+use crate::surface::fdlibm;
 use crate::surface::ir::{
     Binary, Id, Node, SurfaceFn, SurfaceTape, Unary, Var, apply_binary, apply_unary,
 };
@@ -29,13 +35,16 @@ use cranelift_codegen::Context;
 use cranelift_codegen::ir::condcodes::{FloatCC, IntCC};
 use cranelift_codegen::ir::immediates::Ieee64;
 use cranelift_codegen::ir::{
-    AbiParam, FuncRef, InstBuilder, MemFlagsData, Type, UserFuncName, Value, types,
+    AbiParam, FuncRef, InstBuilder, MemFlagsData, StackSlotData, StackSlotKind, Type, UserFuncName,
+    Value, types,
 };
 use cranelift_codegen::isa::OwnedTargetIsa;
 use cranelift_codegen::settings::{self, Configurable};
 use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
 use cranelift_jit::{JITBuilder, JITModule};
 use cranelift_module::{FuncId, Linkage, Module, default_libcall_names};
+
+mod vecmath;
 
 /// Why a tape could not be compiled (a cranelift or host error, never a
 /// user error: every valid tape compiles).
@@ -98,6 +107,9 @@ impl JitSurface {
         let mut jb = JITBuilder::with_isa(host_isa()?, default_libcall_names());
         for f in Libm::ALL {
             jb.symbol(f.symbol(), f.address());
+        }
+        for t in Twin::ALL {
+            jb.symbol(t.symbol(), t.address());
         }
         // From here on, an early return frees whatever was allocated.
         let mut guard = ModuleGuard(Some(JITModule::new(jb)));
@@ -173,7 +185,11 @@ fn host_isa() -> Result<OwnedTargetIsa, JitError> {
 
 /// How many points one pass of the tape evaluates: two side by side in
 /// the lanes of an `F64X2` (cranelift has no 4-lane f64 on x86-64) in the
-/// main loop, one (`F64`) for the odd point left at the end.
+/// main loop, one (`F64`) for the odd point left at the end. A single
+/// point is not evaluated in both lanes of a vector pass: the scalar pass
+/// is about three times faster on one point (its selects are predicted
+/// branches, not blends in the chain of dependencies), and planners that
+/// follow a tool point by point call it once per point.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Lanes {
     One,
@@ -216,6 +232,8 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
     let mut emit = Emitter {
         module,
         imports: HashMap::new(),
+        twins: HashMap::new(),
+        trig: HashMap::new(),
     };
 
     let entry = b.create_block();
@@ -275,6 +293,9 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
 struct Emitter<'m> {
     module: &'m mut JITModule,
     imports: HashMap<Libm, FuncRef>,
+    twins: HashMap<Twin, FuncRef>,
+    /// sin and cos of each argument already reduced in this pass.
+    trig: HashMap<Id, (Value, Value)>,
 }
 
 impl Emitter<'_> {
@@ -296,6 +317,7 @@ impl Emitter<'_> {
         };
         let x = b.ins().load(lanes.ty(), load, cx, 0);
         let y = b.ins().load(lanes.ty(), load, cy, 0);
+        self.trig.clear();
         let mut val: Vec<Option<Value>> = vec![None; tape.graph.len()];
         for id in tape.live_nodes() {
             let get =
@@ -304,6 +326,10 @@ impl Emitter<'_> {
                 Node::Const(bits) => constant(b, lanes, bits),
                 Node::Var(Var::X) => x,
                 Node::Var(Var::Y) => y,
+                Node::Unary(op @ (Unary::Sin | Unary::Cos), a) if lanes == Lanes::Two => {
+                    let (sin, cos) = self.sin_cos(b, a, get(a))?;
+                    if op == Unary::Sin { sin } else { cos }
+                }
                 Node::Unary(op, a) => self.unary(b, lanes, op, get(a))?,
                 Node::Binary(op, a, c) => self.binary(b, lanes, op, get(a), get(c))?,
                 Node::PowI(a, k) => powi(b, lanes, get(a), k),
@@ -342,6 +368,93 @@ impl Emitter<'_> {
         Ok(())
     }
 
+    /// sin a and cos a on both lanes (node `arg`, value `a`), reduced once
+    /// per argument; should a lane fall outside the inline code, the twin
+    /// answers.
+    fn sin_cos(
+        &mut self,
+        b: &mut FunctionBuilder,
+        arg: Id,
+        a: Value,
+    ) -> Result<(Value, Value), JitError> {
+        if let Some(&pair) = self.trig.get(&arg) {
+            return Ok(pair);
+        }
+        let (sin, cos, ok) = vecmath::sin_cos(b, a);
+        let got = self.guard(b, ok, a, Twin::SinCos, &[sin, cos])?;
+        let (sin, cos) = (got[0], got[1]);
+        self.trig.insert(arg, (sin, cos));
+        Ok((sin, cos))
+    }
+
+    /// The inline values where `ok` holds in both lanes (the common case:
+    /// one branch, no call); otherwise the twins' values for both lanes
+    /// (one call), which are the same bits where `ok` holds and libm's
+    /// where it does not. `fast` are the inline results in the order the
+    /// twin writes them.
+    fn guard(
+        &mut self,
+        b: &mut FunctionBuilder,
+        ok: Value,
+        a: Value,
+        twin: Twin,
+        fast: &[Value],
+    ) -> Result<Vec<Value>, JitError> {
+        let cold = b.create_block();
+        let join = b.create_block();
+        for _ in fast {
+            b.append_block_param(join, types::F64X2);
+        }
+        b.set_cold_block(cold);
+        let all = b.ins().vall_true(ok);
+        let fast_args: Vec<_> = fast.iter().map(|&v| v.into()).collect();
+        b.ins().brif(all, join, &fast_args, cold, &[]);
+
+        b.switch_to_block(cold);
+        let slot = b.create_sized_stack_slot(StackSlotData::new(
+            StackSlotKind::ExplicitSlot,
+            16 * twin.outputs(),
+            4,
+        ));
+        let ptr = self.module.target_config().pointer_type();
+        let at = b.ins().stack_addr(ptr, slot, 0);
+        let lo = b.ins().extractlane(a, 0);
+        let hi = b.ins().extractlane(a, 1);
+        let fref = self.twin(b, twin)?;
+        b.ins().call(fref, &[lo, hi, at]);
+        let slow: Vec<_> = (0..fast.len())
+            .map(|k| {
+                let v = b
+                    .ins()
+                    .load(types::F64X2, MemFlagsData::trusted(), at, 16 * k as i32);
+                v.into()
+            })
+            .collect();
+        b.ins().jump(join, &slow);
+
+        b.switch_to_block(join);
+        Ok(b.block_params(join).to_vec())
+    }
+
+    /// The import of a twin, declared once.
+    fn twin(&mut self, b: &mut FunctionBuilder, twin: Twin) -> Result<FuncRef, JitError> {
+        if let Some(&r) = self.twins.get(&twin) {
+            return Ok(r);
+        }
+        let mut sig = self.module.make_signature();
+        sig.params.push(AbiParam::new(types::F64));
+        sig.params.push(AbiParam::new(types::F64));
+        sig.params
+            .push(AbiParam::new(self.module.target_config().pointer_type()));
+        let fid = self
+            .module
+            .declare_function(twin.symbol(), Linkage::Import, &sig)
+            .map_err(|e| JitError(format!("declaring {}: {e}", twin.symbol())))?;
+        let r = self.module.declare_func_in_func(fid, b.func);
+        self.twins.insert(twin, r);
+        Ok(r)
+    }
+
     fn unary(
         &mut self,
         b: &mut FunctionBuilder,
@@ -354,13 +467,19 @@ impl Emitter<'_> {
             Unary::Sqrt => b.ins().sqrt(a),
             Unary::Abs => b.ins().fabs(a),
             Unary::Floor => b.ins().floor(a),
+            Unary::Exp if lanes == Lanes::Two => {
+                let (e, ok) = vecmath::exp(b, a);
+                self.guard(b, ok, a, Twin::Exp, &[e])?[0]
+            }
+            // The scalar pass calls the twins of the inline code; `pass`
+            // gives sin and cos of one argument one inline reduction.
+            Unary::Exp => self.call(b, lanes, Libm::Exp, &[a])?,
             Unary::Sin => self.call(b, lanes, Libm::Sin, &[a])?,
             Unary::Cos => self.call(b, lanes, Libm::Cos, &[a])?,
             Unary::Tan => self.call(b, lanes, Libm::Tan, &[a])?,
             Unary::Asin => self.call(b, lanes, Libm::Asin, &[a])?,
             Unary::Acos => self.call(b, lanes, Libm::Acos, &[a])?,
             Unary::Atan => self.call(b, lanes, Libm::Atan, &[a])?,
-            Unary::Exp => self.call(b, lanes, Libm::Exp, &[a])?,
             Unary::Ln => self.call(b, lanes, Libm::Ln, &[a])?,
         })
     }
@@ -456,8 +575,8 @@ fn constant(b: &mut FunctionBuilder, lanes: Lanes, bits: u64) -> Value {
     }
 }
 
-/// `cond ? t : f` lane by lane, for a condition from `fcmp`: a flag with
-/// one lane, a lane mask with two.
+/// `cond ? t : f` lane by lane, for a condition from `fcmp` or `icmp`: a
+/// flag with one lane, a lane mask with two.
 fn select(b: &mut FunctionBuilder, lanes: Lanes, cond: Value, t: Value, f: Value) -> Value {
     match lanes {
         Lanes::One => b.ins().select(cond, t, f),
@@ -498,6 +617,59 @@ fn powi(b: &mut FunctionBuilder, lanes: Lanes, a: Value, n: i32) -> Value {
     } else {
         r
     }
+}
+
+/// The twins of the inline sin, cos and exp for both lanes at once, called
+/// where a lane falls outside the inline code: `f(a0, a1, out)` writes
+/// each result for both lanes to `out`, 16 bytes apiece.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum Twin {
+    /// sin a0, sin a1, cos a0, cos a1.
+    SinCos,
+    /// exp a0, exp a1.
+    Exp,
+}
+
+impl Twin {
+    const ALL: [Twin; 2] = [Twin::SinCos, Twin::Exp];
+
+    fn outputs(self) -> u32 {
+        match self {
+            Twin::SinCos => 2,
+            Twin::Exp => 1,
+        }
+    }
+
+    fn symbol(self) -> &'static str {
+        match self {
+            Twin::SinCos => "lensc_jit_sin_cos_pair",
+            Twin::Exp => "lensc_jit_exp_pair",
+        }
+    }
+
+    fn address(self) -> *const u8 {
+        type F = unsafe extern "C" fn(f64, f64, *mut f64);
+        match self {
+            Twin::SinCos => lensc_jit_sin_cos_pair as F as *const u8,
+            Twin::Exp => lensc_jit_exp_pair as F as *const u8,
+        }
+    }
+}
+
+/// # Safety
+/// `out` points to four writable doubles.
+unsafe extern "C" fn lensc_jit_sin_cos_pair(a0: f64, a1: f64, out: *mut f64) {
+    let ((s0, c0), (s1, c1)) = (fdlibm::sin_cos(a0), fdlibm::sin_cos(a1));
+    // SAFETY: the kernel passes a 32-byte stack slot (`Emitter::guard`).
+    unsafe { out.cast::<[f64; 4]>().write_unaligned([s0, s1, c0, c1]) }
+}
+
+/// # Safety
+/// `out` points to two writable doubles.
+unsafe extern "C" fn lensc_jit_exp_pair(a0: f64, a1: f64, out: *mut f64) {
+    let pair = [fdlibm::exp(a0), fdlibm::exp(a1)];
+    // SAFETY: the kernel passes a 16-byte stack slot (`Emitter::guard`).
+    unsafe { out.cast::<[f64; 2]>().write_unaligned(pair) }
 }
 
 /// The functions the kernel calls rather than inlines.
@@ -569,8 +741,10 @@ impl Libm {
     }
 }
 
-// The C-ABI entry points the kernel calls. Each is the interpreter's own
-// function for that operation, so both backends share one implementation.
+// The C-ABI entry points the kernel calls. sin, cos and exp are the twins
+// of the kernel's inline code (`vecmath`, within 1 ulp of libm); each other
+// is the interpreter's own function for that operation, so both backends
+// share one implementation.
 macro_rules! libm_entries {
     ($($name:ident = $kind:ident::$op:ident ($($arg:ident),+);)*) => {
         $(extern "C" fn $name($($arg: f64),+) -> f64 {
@@ -581,14 +755,23 @@ macro_rules! libm_entries {
     (@apply Binary::$op:ident, $a:ident, $b:ident) => { apply_binary(Binary::$op, $a, $b) };
 }
 
+extern "C" fn lensc_jit_sin(a: f64) -> f64 {
+    crate::surface::fdlibm::sin(a)
+}
+
+extern "C" fn lensc_jit_cos(a: f64) -> f64 {
+    crate::surface::fdlibm::cos(a)
+}
+
+extern "C" fn lensc_jit_exp(a: f64) -> f64 {
+    crate::surface::fdlibm::exp(a)
+}
+
 libm_entries! {
-    lensc_jit_sin = Unary::Sin(a);
-    lensc_jit_cos = Unary::Cos(a);
     lensc_jit_tan = Unary::Tan(a);
     lensc_jit_asin = Unary::Asin(a);
     lensc_jit_acos = Unary::Acos(a);
     lensc_jit_atan = Unary::Atan(a);
-    lensc_jit_exp = Unary::Exp(a);
     lensc_jit_ln = Unary::Ln(a);
     lensc_jit_pow = Binary::Pow(a, b);
     lensc_jit_atan2 = Binary::Atan2(a, b);

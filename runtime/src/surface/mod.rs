@@ -11,6 +11,7 @@
 pub mod analysis;
 #[cfg(test)]
 mod conformance;
+pub mod fdlibm;
 pub mod forbes;
 pub mod ir;
 #[cfg(feature = "jit")]

@@ -74,6 +74,7 @@ pub fn build(
         table_name.as_deref(),
     )
     .map_err(not_printable)?;
+    program.call_tool(&head.start).map_err(not_printable)?;
     let mut sink = ProgramSink::new(spool_dir, site)?;
     let mut table_sink = match table_name {
         Some(_) => Some(Sink::new(spool_dir, site)?),

@@ -32,10 +32,9 @@ pub fn build(spec: &GrindingSpec, prov: &Provenance) -> Result<Built, Vec<Diagno
         .map(|q| q.z)
         .fold(f64::NEG_INFINITY, f64::max);
     let safe_z = top + retract;
-    if let Some(e) = parts::travel_error(
-        head,
-        &lensc_runtime::emit::grinding::grinding_moves(&path, feed, safe_z),
-    ) {
+    let stream =
+        lensc_runtime::emit::grinding::grinding_moves(&path, feed, safe_z, spec.spindle_speed);
+    if let Some(e) = parts::travel_error(head, &stream) {
         return Err(vec![e]);
     }
     let units = format!(
@@ -64,14 +63,18 @@ pub fn build(spec: &GrindingSpec, prov: &Provenance) -> Result<Built, Vec<Diagno
     ));
     let resolution = head.resolution;
     let text = lensc_runtime::emit::grinding::emit_grinding(
-        dialect, &head.name, &header, &path, feed, safe_z, resolution,
+        dialect,
+        &head.name,
+        &header,
+        &stream,
+        resolution,
+        &head.start,
     )
     .map_err(|e| vec![parts::not_printable(head, e)])?;
     let toolpath = report::Toolpath::ProfileGrinding((&path).into());
     // What the wheel's section (a circle of its radius about the centre)
     // leaves along the programmed centres.
     use lensc_runtime::surface::Profile as _;
-    let stream = lensc_runtime::emit::grinding::grinding_moves(&path, feed, safe_z);
     let cut = lensc_runtime::verify::simulate::profile_cut(
         &stream,
         grinding.wheel_diameter / 2.0,

@@ -36,7 +36,14 @@ pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnost
         errors.push(parts::failed(head, RuntimeError::Raster(e)));
     }
     let feed = spec.feed;
-    let moves = lensc_runtime::emit::raster::raster_moves(&path, feed);
+    let moves = lensc_runtime::emit::raster::raster_moves(
+        &path,
+        lensc_runtime::emit::raster::RasterCut {
+            feed,
+            spindle_speed: spec.spindle_speed,
+            zigzag: raster.zigzag,
+        },
+    );
     errors.extend(parts::travel_error(head, &moves));
     if !errors.is_empty() {
         return Err(errors);
@@ -52,8 +59,8 @@ pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnost
         &head.name,
         &header_lines(spec, prov, &path, &optimised),
         &moves,
-        resolution,
-        raster.chord_tolerance,
+        (resolution, raster.chord_tolerance),
+        &head.start,
     )
     .map_err(|e| vec![parts::not_printable(head, e)])?;
     let section = report::Raster::new(&path, raster, feed, &optimised);

@@ -43,6 +43,9 @@ pub fn build(
         spec.spindle_speed,
     )
     .map_err(|e| vec![parts::not_printable(head, e)])?;
+    program
+        .call_tool(&head.start)
+        .map_err(|e| vec![parts::not_printable(head, e)])?;
     let mut sink = ProgramSink::new(spool_dir, site)?;
     // The height map over the window, from the printed points of every
     // pass (the finish pass's envelope lies below the rough one's).

@@ -32,7 +32,7 @@ pub fn build(spec: &TurningSpec, prov: &Provenance) -> Result<Built, Vec<Diagnos
                 .collect::<Vec<_>>()
         })?;
     let warnings = warnings(spec, &path);
-    let emitted = match lensc_runtime::emit::turning::emit(job, &path, prov) {
+    let emitted = match lensc_runtime::emit::turning::emit(job, &path, prov, &head.start) {
         Ok(e) => e,
         Err(e) => {
             let mut all = warnings;

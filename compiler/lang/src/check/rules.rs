@@ -226,6 +226,21 @@ impl<'a> Checker<'a> {
             );
             return false;
         }
+        if let Some(at) = stock
+            && value::field(f, "rough_feed").is_none()
+        {
+            self.err(
+                Diagnostic::error(
+                    codes::ROUGHING_NEEDS_FEED,
+                    format!("`{}` gives the stock, but no `rough_feed` says how fast the roughing passes cut", at.name),
+                    at.file,
+                    at.span,
+                )
+                .with_label("the stock")
+                .with_help("add `rough_feed: …` (per revolution or per minute); roughing passes no longer run at the finish feed"),
+            );
+            return false;
+        }
         if let (Some(from), Some(to)) = (value::num(&o.fields, "from"), value::num(&o.fields, "to"))
             && from <= to
         {

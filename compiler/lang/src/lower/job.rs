@@ -27,6 +27,7 @@ pub use spiral::{AtSpeed, Settling, SpiralSpec};
 pub use turning::TurningSpec;
 
 use lensc_grammar::{Diagnostic, FileId, Span};
+use lensc_runtime::moves::{Coolant, Rotation, Start};
 use lensc_runtime::post::{Dialect, Setup};
 use lensc_runtime::surface::ir::{SurfaceFn, SurfaceTape};
 
@@ -107,6 +108,8 @@ pub struct JobHead {
     pub simulate: Option<Simulate>,
     /// What the simulated part must meet for the program to be written.
     pub accept: accept::Accept,
+    /// The tool call, spindle direction and coolant every program states.
+    pub start: Start,
 }
 
 impl JobHead {
@@ -308,6 +311,7 @@ impl<'a> Parts<'a> {
             travel: ["x", "y", "z", "c"].map(|a| travel.and_then(|t| value::range(t, a))),
             simulate: simulate(self.job).ok().flatten(),
             accept: accept::lower(self.job).unwrap_or_default(),
+            start: program_start(self.job),
         }
     }
 }
@@ -389,13 +393,16 @@ pub fn lower_job(
     errors.extend(tolerance::below_resolution(&p, strategy));
     if let Ok(d) = &dialect
         && let Some(resolution) = value::num(&p.machine.fields, "resolution")
-        && let Err(e) = lensc_runtime::post::check_dialect(d, setup, resolution)
     {
-        errors.push(
-            Diagnostic::error(codes::NOT_PRINTABLE, e.message(), job.file, job.name.span)
-                .with_label("no program was written for this job")
-                .with_help(NOT_PRINTABLE_HELP),
-        );
+        if let Err(e) = lensc_runtime::post::check_dialect(d, setup, resolution) {
+            errors.push(
+                Diagnostic::error(codes::NOT_PRINTABLE, e.message(), job.file, job.name.span)
+                    .with_label("no program was written for this job")
+                    .with_help(NOT_PRINTABLE_HELP),
+            );
+        } else if let Some(e) = start_error(job, d, setup) {
+            errors.push(e);
+        }
     }
     match spec {
         Ok(spec) => {
@@ -411,6 +418,51 @@ pub fn lower_job(
             Err(errors)
         }
     }
+}
+
+/// The job's tool call, spindle direction and coolant (tool 1, its offset
+/// the tool's number, clockwise, no coolant unless it says otherwise).
+fn program_start(job: &CheckedJob) -> Start {
+    let f = &job.fields;
+    let tool = value::num(f, "tool_number").map_or(1, |n| n as u32);
+    Start {
+        tool,
+        offset: value::num(f, "tool_offset").map_or(tool, |n| n as u32),
+        rotation: match value::word(f, "spindle_direction") {
+            Some("ccw") => Rotation::CounterClockwise,
+            _ => Rotation::Clockwise,
+        },
+        coolant: match value::word(f, "coolant") {
+            Some("flood") => Coolant::Flood,
+            Some("mist") => Coolant::Mist,
+            _ => Coolant::Off,
+        },
+    }
+}
+
+/// E0173 if the dialect cannot call the job's tool (its number does not
+/// fit the T word) or give its coolant, at the field that asks for it.
+fn start_error(job: &CheckedJob, dialect: &Dialect, setup: Setup) -> Option<Diagnostic> {
+    use lensc_runtime::post::writer::{coolant_word, tool_call_lines};
+    let start = program_start(job);
+    let (e, field) = match tool_call_lines(dialect, setup, &start) {
+        Err(e) => (
+            e,
+            value::field(&job.fields, "tool_number").or(value::field(&job.fields, "tool_offset")),
+        ),
+        Ok(_) => (
+            coolant_word(dialect, start.coolant).err()?,
+            value::field(&job.fields, "coolant"),
+        ),
+    };
+    let (file, span) = field.map_or((job.file, job.name.span), |f| (f.file, f.span));
+    Some(
+        Diagnostic::error(codes::CANNOT_CALL_TOOL, e.message(), file, span)
+            .with_label(format!("not in `{}`", dialect.name))
+            .with_help(
+                "choose a tool number, offset or coolant the dialect can write, or another dialect",
+            ),
+    )
 }
 
 /// The job's `simulate` block, if any; an error if its window is empty.

@@ -5,6 +5,7 @@
 
 pub mod diagnostics;
 pub mod job;
+pub mod read_back;
 pub mod surface;
 
 use lensc_grammar::suggest::did_you_mean;
@@ -67,7 +68,33 @@ pub fn dialect(job: &CheckedJob, requested: Option<&str>) -> Result<Dialect, Dia
         .with_label("this job")
         .with_help(dialect_help(requested.unwrap_or(""), &offered, &names)));
     };
+    check_word_formats(o)?;
     Ok(dialect_of(o, dialect_name(o)))
+}
+
+/// E0172 at the first of a dialect's `word_formats` that does not read.
+fn check_word_formats(o: &Object) -> Result<(), Diagnostic> {
+    let Some(field) = value::field(&o.fields, "word_formats") else {
+        return Ok(());
+    };
+    let Value::List(items) = &field.value else {
+        return Ok(());
+    };
+    for (v, span) in items {
+        if let Value::Str(text) = v
+            && let Err(why) = lensc_runtime::dialect::WordFormat::parse(text)
+        {
+            return Err(Diagnostic::error(
+                codes::BAD_WORD_FORMAT,
+                format!("the dialect `{}` has a word format that does not read: {why}", dialect_name(o)),
+                field.file,
+                *span,
+            )
+            .with_label("this format")
+            .with_help("write a letter, the most digits before the point, and for a word with a point `.` and the most decimals: `S5`, `X4.4`"));
+        }
+    }
+    Ok(())
 }
 
 /// What to write instead of a dialect the machine does not offer: the
@@ -128,7 +155,7 @@ fn offered(job: &CheckedJob) -> Vec<&Object> {
 }
 
 /// A checked `gcode { … }` dialect as the post-processor reads it.
-fn dialect_of(o: &Object, name: String) -> Dialect {
+pub(crate) fn dialect_of(o: &Object, name: String) -> Dialect {
     let f = &o.fields;
     let text = |n: &str, default: &str| match value::field(f, n).map(|x| &x.value) {
         Some(Value::Str(s)) => s.clone(),
@@ -161,6 +188,8 @@ fn dialect_of(o: &Object, name: String) -> Dialect {
         program_number: count("program_number").unwrap_or(1) as u32,
         lathe_setup: lines("lathe_setup"),
         mill_setup: lines("mill_setup"),
+        lathe_tool_call: lines("lathe_tool_call"),
+        mill_tool_call: lines("mill_tool_call"),
         path_tolerance: lines("path_tolerance"),
         c_axis_on: lines("c_axis_on"),
         c_axis_off: lines("c_axis_off"),
@@ -190,7 +219,18 @@ fn dialect_of(o: &Object, name: String) -> Dialect {
         per_revolution: opt_text("per_revolution"),
         inverse_time: opt_text("inverse_time"),
         spindle_on: text("spindle_on", "M3"),
+        spindle_ccw: text("spindle_ccw", "M4"),
         spindle_off: text("spindle_off", "M5"),
+        constant_rpm: opt_text("constant_rpm"),
+        spindle_orient: lines("spindle_orient"),
+        coolant_flood: opt_text("coolant_flood"),
+        coolant_mist: opt_text("coolant_mist"),
+        coolant_off: opt_text("coolant_off"),
+        // Checked by `word_formats` before the dialect is built.
+        word_formats: lines("word_formats")
+            .iter()
+            .filter_map(|t| lensc_runtime::dialect::WordFormat::parse(t).ok())
+            .collect(),
         c_letter: text("c_letter", "C").chars().next().unwrap_or('C'),
         c_decimals: count("c_decimals").unwrap_or(5) as u32,
         max_decimals: count("max_decimals").map(|v| v as u32),

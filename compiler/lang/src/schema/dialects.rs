@@ -43,6 +43,14 @@ const GCODE_PARAMS: &[Param] = &[
     ),
     texts("mill_setup", "the safe-start lines of a mill program"),
     texts(
+        "lathe_tool_call",
+        "the blocks that call a lathe program's tool after its setup (`{tool}`, `{offset}`; `{tool:2}`, `{offset:2}` zero-padded to two digits: Fanuc's `T{tool:2}{offset:2}`); a lathe program is refused without them",
+    ),
+    texts(
+        "mill_tool_call",
+        "the blocks that call a mill program's tool after its setup (`T{tool} M6`, `G43 H{offset}`); a mill program is refused without them",
+    ),
+    texts(
         "path_tolerance",
         "lines that hold the controller's blending to `{tolerance}`; left out if absent",
     ),
@@ -113,7 +121,35 @@ const GCODE_PARAMS: &[Param] = &[
         "inverse_time",
         "the word for inverse-time feeds (F = 1/minutes of the move); absent: moves that turn the C axis cannot be timed",
     ),
-    text("spindle_on", "the spindle-on word; default `M3`"),
+    text(
+        "spindle_on",
+        "the word that starts the spindle clockwise; default `M3`",
+    ),
+    text(
+        "spindle_ccw",
+        "the word that starts the spindle counter-clockwise; default `M4`",
+    ),
+    text(
+        "constant_rpm",
+        "the word that cancels constant surface speed, written in the block of every constant-rpm start (`G97`: `G97 S1000 M3`); absent: none",
+    ),
+    texts(
+        "spindle_orient",
+        "the blocks that stop the spindle at a fixed angle and hold it, for a knife that cuts with the spindle still (`M19`)",
+    ),
+    text(
+        "coolant_flood",
+        "the flood-coolant word (`M8`); absent: none",
+    ),
+    text("coolant_mist", "the mist-coolant word (`M7`); absent: none"),
+    text(
+        "coolant_off",
+        "the word that stops the coolant (`M9`); absent: no coolant can be asked for",
+    ),
+    texts(
+        "word_formats",
+        "how each word's number is written: `S5` an integer word of at most 5 digits, written without a point; `X4.4` at most 4 digits before the point and 4 after, the point always written. Words without one follow the writer's defaults (axes to the machine's resolution, F to 6 decimals, S to 3, all with a point)",
+    ),
     text("spindle_off", "the spindle-off word; default `M5`"),
     text("c_letter", "the spindle's C-axis letter; default `C`"),
     opt(

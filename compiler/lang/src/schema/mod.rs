@@ -270,6 +270,30 @@ pub static JOB_PARAMS: &[Param] = &[
         "the window of a surface job's height-map simulation (design x, y); `simulate: { spacing: 2 um }` simulates the whole part, in tiles; default a 0.2 mm square where the surface is representative",
     ),
     opt(
+        "tool_number",
+        NUMBER,
+        Check::Count,
+        "the tool's number in the machine's turret, magazine or tool table (the program's T word); default 1",
+    ),
+    opt(
+        "tool_offset",
+        NUMBER,
+        Check::Count,
+        "the tool's offset register (Fanuc's second T pair, H; Siemens' D); default the tool number",
+    ),
+    opt(
+        "spindle_direction",
+        Ty::Word(&["cw", "ccw"]),
+        Check::Any,
+        "which way the spindle turns, as M3 (`cw`, default) and M4 (`ccw`) name it: the way that brings the work into the tool's rake face as it is set up",
+    ),
+    opt(
+        "coolant",
+        Ty::Word(&["flood", "mist", "off"]),
+        Check::Any,
+        "coolant through the whole program: `flood` (M8), `mist` (M7) or `off` (default)",
+    ),
+    opt(
         "accept",
         Ty::BlockOr(ACCEPT_PARAMS, &["none"]),
         Check::Any,

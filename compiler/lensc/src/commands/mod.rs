@@ -9,3 +9,4 @@ pub mod fmt;
 pub mod list;
 pub mod report;
 pub mod sample;
+pub mod verify;

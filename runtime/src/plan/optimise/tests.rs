@@ -9,7 +9,7 @@ const TOL: f64 = 2.5e-6;
 fn lathe_stream(pts: &[(f64, f64)]) -> Vec<Move> {
     let feed = Some(Feed::PerRevolution(0.001));
     let mut s = vec![
-        Move::SpindleOn(Some(100.0)),
+        Move::SpindleOn(100.0),
         Move::Rapid(Position::xz(pts[0].0, pts[0].1 + 1.0)),
         Move::Linear {
             to: Position::xz(pts[0].0, pts[0].1),

@@ -153,6 +153,8 @@ fn planned_centres_are_the_exact_offset_of_aspheres() {
             stock: Stock::Offset { allowance: 0.1 },
             depth_of_cut: 0.1,
             finish_allowance: 0.01,
+            feed: Feed::PerRevolution(0.01),
+            spindle_speed: None,
         });
         j.strategy.roughing = None;
         j.strategy.chord_tolerance = 1e-5;
@@ -193,6 +195,8 @@ fn offset_stock_passes_are_exact_offsets_of_the_sphere() {
         stock: Stock::Offset { allowance: 0.25 },
         depth_of_cut: 0.1,
         finish_allowance: 0.02,
+        feed: Feed::PerRevolution(0.01),
+        spindle_speed: None,
     });
     let path = plan_profile_turning(&j, &s).expect("plans");
     assert_eq!(path.roughing_passes, 3);
@@ -213,6 +217,8 @@ fn flat_stock_passes_remove_at_most_the_depth_of_cut() {
         stock: Stock::Flat { top: 0.05 },
         depth_of_cut: 0.1,
         finish_allowance: 0.01,
+        feed: Feed::PerRevolution(0.01),
+        spindle_speed: None,
     });
     let path = plan_profile_turning(&j, &s).expect("plans");
     let ps = passes(&path);

@@ -7,11 +7,18 @@ fn written(axes: &str, stream: &[M]) -> Result<String, ProgramError> {
     written_in(&Dialect::linuxcnc(), Setup::Mill, axes, stream)
 }
 
+/// A program of `stream` after the tool call (tool 1) and a spindle start
+/// at 1000 rpm; the spindle stopped at the end.
 fn written_in(d: &Dialect, setup: Setup, axes: &str, stream: &[M]) -> Result<String, ProgramError> {
     let mut w = ProgramWriter::new(d, setup, "t1", &["t".into()], axes, 1e-3, 1e-3)?;
+    w.call_tool(&Start::default())?;
+    w.write(&M::SpindleOn(RPM_1000))?;
     w.write_all(stream)?;
     w.finish()
 }
+
+/// 1000 rpm in rad/s.
+const RPM_1000: f64 = 1000.0 * 2.0 * PI / 60.0;
 
 #[test]
 fn unchanged_words_and_feeds_are_left_out() {
@@ -41,7 +48,7 @@ fn unchanged_words_and_feeds_are_left_out() {
     .expect("writes");
     assert_eq!(
         text,
-        "(t)\nG17 G21 G90 G40 G49 G80\nG64 P0.001\nG0 X1. Y2. Z5.\nG94 G1 Z0.5 F60.\nG1 X1.5\nG1 Y2.5 F120.\nM2\n"
+        "(t)\nG17 G21 G90 G40 G49 G80 G94\nG64 P0.001\nT1 M6 G43 H1\nG97 S1000 M3\nG0 X1. Y2. Z5.\nG94 G1 Z0.5 F60.\nG1 X1.5\nG1 Y2.5 F120.\nM5\nM2\n"
     );
 }
 
@@ -67,7 +74,7 @@ fn inverse_time_writes_a_feed_on_every_move_and_c_in_degrees() {
     .expect("writes");
     assert_eq!(
         text,
-        "(t)\nG17 G21 G90 G40 G49 G80\nG64 P0.001\nG93 G1 X1. Z0. C90. F120.\nG1 X0.9 C180. F120.\nG95 G1 X0.8 Z0.1 F0.006283\nM2\n"
+        "(t)\nG17 G21 G90 G40 G49 G80 G94\nG64 P0.001\nT1 M6 G43 H1\nG97 S1000 M3\nG93 G1 X1. Z0. C90. F120.\nG1 X0.9 C180. F120.\nG95 G1 X0.8 Z0.1 F0.006283\nM5\nM2\n"
     );
 }
 
@@ -102,7 +109,7 @@ fn a_dialect_given_as_data_shapes_every_line() {
     .expect("writes");
     assert_eq!(
         text,
-        "%T1 G71 *\nN1 ; t *\nN2 G17 G90 *\nN3 G0 X1. Y0. Z0. *\nN4 G94 G3 X0. Y1. I0. J0. F60. *\nN5 M30 *\nN99999999 %T1 G71 *\n"
+        "%T1 G71 *\nN1 ; t *\nN2 G17 G90 *\nN3 T1 M6 G43 H1 *\nN4 G97 S1000 M3 *\nN5 G0 X1. Y0. Z0. *\nN6 G94 G3 X0. Y1. I0. J0. F60. *\nN7 M5 *\nN8 M30 *\nN99999999 %T1 G71 *\n"
     );
 }
 
@@ -298,6 +305,7 @@ proptest::proptest! {
         let dialect = Dialect::linuxcnc();
         let mut w = ProgramWriter::new(&dialect, Setup::Lathe, "t", &[], "XZC", resolution, 1e-5)
             .expect("a lathe program");
+        w.call_tool(&Start::default()).expect("tool 1");
         w.write_all(&stream).expect("printable");
         let text = w.finish().expect("checked");
         proptest::prop_assert!(check_numbers(&text, CommentStyle::Parentheses).is_ok());
@@ -331,4 +339,141 @@ proptest::proptest! {
         proptest::prop_assert_eq!(written, expected);
         proptest::prop_assert!(text.lines().all(|l| l.len() <= 255));
     }
+}
+
+/// A Fanuc-like lathe dialect: integer S and T, two-digit tool pairs.
+fn fanuc_like() -> Dialect {
+    let mut d = Dialect::linuxcnc();
+    d.name = "fanuc_like".into();
+    d.lathe_setup = vec!["G18 G21 G40 G80 G90 G94".into()];
+    d.lathe_tool_call = vec!["T{tool:2}{offset:2}".into()];
+    d.surface_speed = vec!["G50 S{cap}".into(), "G96 S{speed}".into()];
+    d.word_formats = ["X4.4", "Z4.4", "I4.4", "K4.4", "S5", "T4", "M3"]
+        .iter()
+        .map(|f| WordFormat::parse(f).expect("format"))
+        .collect();
+    d
+}
+
+#[test]
+fn an_integer_s_word_has_no_point_and_a_constant_rpm_start_cancels_g96() {
+    let text = written_in(&fanuc_like(), Setup::Lathe, "XZ", &[]).expect("writes");
+    assert!(text.contains("\nT0101\nG97 S1000 M3\n"), "{text}");
+    assert!(!text.contains("S1000."), "{text}");
+    // Constant surface speed: the clamp before G96, both integers.
+    let mut w = ProgramWriter::new(&fanuc_like(), Setup::Lathe, "t", &[], "XZ", 1e-3, 1e-3)
+        .expect("starts");
+    w.call_tool(&Start::default()).expect("T0101");
+    w.write(&M::SpindleSurfaceSpeed {
+        surface_speed: 2000.0,
+        cap: RPM_1000 * 3.0,
+    })
+    .expect("writes");
+    let text = w.finish().expect("ends");
+    assert!(text.contains("G50 S3000\nG96 S120\nM3\n"), "{text}");
+}
+
+#[test]
+fn word_formats_refuse_a_point_in_an_integer_word_and_too_many_digits() {
+    let d = fanuc_like();
+    assert!(check_word_formats("G97 S1000 M3", &d).is_ok());
+    for bad in ["S1000. M3", "T010101", "M30.", "G0 X12345.6", "G1 Z1.23456"] {
+        assert!(check_word_formats(bad, &d).is_err(), "{bad} passed");
+    }
+    // Comments are not code.
+    assert!(check_word_formats("(S1000.)", &d).is_ok());
+    // A dialect line that breaks its own format is refused as written.
+    let mut d = fanuc_like();
+    d.end = vec!["M30.".into()];
+    assert!(written_in(&d, Setup::Lathe, "XZ", &[]).is_err());
+}
+
+#[test]
+fn word_formats_read_as_fanuc_manuals_write_them() {
+    assert_eq!(
+        WordFormat::parse("X4.4"),
+        Ok(WordFormat {
+            letter: 'X',
+            integer_digits: 4,
+            decimals: Some(4)
+        })
+    );
+    assert_eq!(WordFormat::parse("S5").map(|f| f.decimals), Ok(None));
+    for bad in ["", "s5", "S", "S.4", "X4.", "X4.44.4", "X0", "X99"] {
+        assert!(WordFormat::parse(bad).is_err(), "{bad} read");
+    }
+}
+
+#[test]
+fn a_tool_call_is_the_dialects_and_a_number_that_does_not_fit_is_refused() {
+    let d = fanuc_like();
+    let start = Start {
+        tool: 12,
+        offset: 3,
+        ..Start::default()
+    };
+    assert_eq!(
+        tool_call_lines(&d, Setup::Lathe, &start),
+        Ok(vec!["T1203".to_string()])
+    );
+    let too_big = Start {
+        tool: 100,
+        ..Start::default()
+    };
+    assert!(tool_call_lines(&d, Setup::Lathe, &too_big).is_err());
+    let mut none = Dialect::linuxcnc();
+    none.mill_tool_call.clear();
+    assert!(check_dialect(&none, Setup::Mill, 1e-3).is_err());
+    assert!(written_in(&none, Setup::Mill, "XYZ", &[]).is_err());
+}
+
+#[test]
+fn no_move_before_the_tool_call_and_no_feed_with_the_spindle_stopped() {
+    let d = Dialect::linuxcnc();
+    let cut = M::Linear {
+        to: P::xyz(1.0, 0.0, 0.0),
+        feed: Some(F::PerTime(1.0)),
+    };
+    let mut w = ProgramWriter::new(&d, Setup::Mill, "t", &[], "XYZ", 1e-3, 1e-3).expect("starts");
+    assert!(w.write(&M::Rapid(P::xyz(0.0, 0.0, 5.0))).is_err());
+    assert!(
+        ProgramWriter::new(&d, Setup::Mill, "t", &[], "XYZ", 1e-3, 1e-3)
+            .expect("starts")
+            .finish()
+            .is_err(),
+        "a program without a tool call"
+    );
+    w.call_tool(&Start::default()).expect("T1");
+    w.write(&M::Rapid(P::xyz(0.0, 0.0, 5.0))).expect("a rapid");
+    let Err(ProgramError::Unsupported(why)) = w.write(&cut) else {
+        panic!("a feed move with the spindle stopped was written")
+    };
+    assert!(why.contains("spindle stopped"), "{why}");
+    // Held still for a knife, the spindle is oriented first.
+    w.write(&M::SpindleHeld).expect("M19");
+    w.write(&cut).expect("a cut");
+    let text = w.finish().expect("ends");
+    assert!(text.contains("M19 R0\nG94 G1 X1. Z0. F60.\n"), "{text}");
+    assert!(text.ends_with("M5\nM2\n"), "{text}");
+}
+
+#[test]
+fn the_spindle_turns_the_jobs_way_and_coolant_is_on_between_call_and_end() {
+    let d = Dialect::linuxcnc();
+    let mut w = ProgramWriter::new(&d, Setup::Mill, "t", &[], "XYZ", 1e-3, 1e-3).expect("starts");
+    w.call_tool(&Start {
+        rotation: crate::moves::Rotation::CounterClockwise,
+        coolant: Coolant::Mist,
+        ..Start::default()
+    })
+    .expect("T1 M7");
+    w.write(&M::SpindleOn(RPM_1000)).expect("M4");
+    let text = w.finish().expect("ends");
+    assert!(
+        text.ends_with("T1 M6 G43 H1\nM7\nG97 S1000 M4\nM5\nM9\nM2\n"),
+        "{text}"
+    );
+    let mut dry = Dialect::linuxcnc();
+    dry.coolant_mist = None;
+    assert!(coolant_word(&dry, Coolant::Mist).is_err());
 }

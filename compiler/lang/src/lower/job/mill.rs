@@ -29,6 +29,9 @@ pub struct RasterSpec {
     pub clearance: Option<f64>,
     /// The cutting feed (mm/s).
     pub feed: f64,
+    /// The cutter's spindle speed (rad/s); none for a knife, which cuts
+    /// with the spindle held still.
+    pub spindle_speed: Option<f64>,
 }
 
 /// A `profile_grinding` job on a `grinder_2axis`, typed.
@@ -37,6 +40,8 @@ pub struct GrindingSpec {
     pub grinding: ProfileGrinding,
     /// Height (mm) above the part's top for the rapid moves.
     pub retract: f64,
+    /// The work spindle's speed (rad/s).
+    pub spindle_speed: f64,
 }
 
 pub(super) fn lower_raster(
@@ -85,6 +90,8 @@ pub(super) fn lower_raster(
     let feed = value::num(st, "feed").expect("required");
     let clearance = value::num(t, "clearance");
     let mut errors: Vec<Diagnostic> = feed_error(p, "cutting", feed).into_iter().collect();
+    let spindle_speed = value::num(st, "spindle_speed");
+    errors.extend(raster_spindle_error(p, &tool, spindle_speed));
     // The checks the planner makes first, on the planes it cuts.
     let kernel = evaluate(&lowered.tape);
     let scanned = check_raster(&raster, &tool, kernel.as_ref(), &lowered.domain)
@@ -100,7 +107,36 @@ pub(super) fn lower_raster(
         tool_words,
         clearance,
         feed,
+        spindle_speed,
     })
+}
+
+/// E0171: a rotating cutter (a ball-end mill) needs its spindle speed; a
+/// knife cuts with the spindle held still and is given none.
+fn raster_spindle_error(p: &Parts, tool: &RasterTool, speed: Option<f64>) -> Option<Diagnostic> {
+    match (tool, speed) {
+        (RasterTool::Ball { .. }, None) => Some(
+            p.error(
+                codes::RASTER_SPINDLE,
+                "a ball-end mill cuts turning: this raster states no `spindle_speed`, so its program would plunge a stationary cutter".into(),
+            )
+            .with_help("add `spindle_speed: …` (rpm) to the raster strategy"),
+        ),
+        (RasterTool::Knife { .. }, Some(_)) => {
+            let f = value::field(&p.strategy.fields, "spindle_speed").expect("given");
+            Some(
+                Diagnostic::error(
+                    codes::RASTER_SPINDLE,
+                    "a microshaper knife cuts with the spindle held still (oriented), not turning",
+                    f.file,
+                    f.span,
+                )
+                .with_label("a turning spindle would swing the knife through the part")
+                .with_help("remove `spindle_speed`: the program orients and holds the spindle"),
+            )
+        }
+        _ => None,
+    }
 }
 
 pub(super) fn lower_grinding(
@@ -135,6 +171,7 @@ pub(super) fn lower_grinding(
         head: p.head(dialect, lowered),
         grinding,
         retract: value::num(st, "retract").unwrap_or(1.0),
+        spindle_speed: value::num(st, "spindle_speed").expect("required"),
     })
 }
 

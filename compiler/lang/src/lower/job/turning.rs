@@ -137,12 +137,17 @@ fn name_of(p: &Parts, part: &str, o: &Object) -> String {
         .unwrap_or_else(|| o.kind.name.to_string())
 }
 
+/// A feed field (per revolution or per minute), if given.
+fn feed_of(f: &[Field], name: &str) -> Option<Feed> {
+    match value::field(f, name).map(|x| &x.value) {
+        Some(Value::Num(v, d)) if *d == Dim::FEED_PER_REV => Some(Feed::PerRevolution(*v)),
+        Some(Value::Num(v, _)) => Some(Feed::PerTime(*v)),
+        _ => None,
+    }
+}
+
 fn profile_turning(f: &[Field], surface: &Object, max_spindle: f64) -> ProfileTurning {
-    let feed = match value::field(f, "feed").map(|x| &x.value) {
-        Some(Value::Num(v, d)) if *d == Dim::FEED_PER_REV => Feed::PerRevolution(*v),
-        Some(Value::Num(v, _)) => Feed::PerTime(*v),
-        _ => unreachable!("feed is required and checked"),
-    };
+    let feed = feed_of(f, "feed").expect("feed is required and checked");
     ProfileTurning {
         feed,
         // Under constant surface speed the spindle speed is its cap.
@@ -195,6 +200,9 @@ fn roughing(f: &[Field]) -> Option<Roughing> {
         stock,
         depth_of_cut: value::num(f, "depth_of_cut")?,
         finish_allowance: value::num(f, "finish_allowance").unwrap_or(0.0),
+        // The checker refuses a stock without it (E0170).
+        feed: feed_of(f, "rough_feed")?,
+        spindle_speed: value::num(f, "rough_spindle_speed"),
     })
 }
 

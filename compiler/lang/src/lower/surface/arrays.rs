@@ -16,6 +16,65 @@ pub(super) fn array_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id
     array_height_settled(g, o, x, y, None)
 }
 
+/// An array's six outputs, the slopes and curvatures by the chain rule:
+/// each lenslet's own tape (its derivatives in closed form where it has
+/// them, as a surface of revolution does) at the point's offset (u, v)
+/// from its centre, whose derivatives in x and y are those in u and v (the
+/// centre is constant over a cell). The height is `array_height`'s, node
+/// for node; each slope is the one of the lenslet whose height wins. Half
+/// the nodes of differentiating the height in x and y, and a tenth of its
+/// divisions.
+pub(super) fn array_outputs(
+    g: &mut Graph,
+    o: &Object,
+    x: Id,
+    y: Id,
+) -> Result<[Id; 6], LowerError> {
+    let f = &o.fields;
+    let lenslet =
+        value::object(f, "lenslet").ok_or(LowerError::Unsupported("array without a lenslet"))?;
+    let ap = domain_of(region(lenslet).ok_or(LowerError::Aperture("lenslet without an aperture"))?)
+        .map_err(LowerError::Aperture)?;
+    let own = super::lower_surface(lenslet)?.tape;
+    let rim = rim_height(lenslet, &ap)?;
+    let candidates = match o.kind.name {
+        "grid" | "linear_array" => grid_cells(g, o, (x, y), half_extent(&ap))?,
+        _ => hex_cells(g, o, (x, y), half_extent(&ap))?,
+    };
+    let big = g.constant_node(BIG);
+    let rim_c = g.constant_node(rim);
+    let zero = g.constant_node(0.0);
+    let mut best = big;
+    let mut slopes = [zero; 5];
+    for (cx, cy) in candidates {
+        let u = g.sub(x, cx);
+        let v = g.sub(y, cy);
+        let zl = height(g, lenslet, u, v)?;
+        let z = g.sub(zl, rim_c);
+        let inside_test = inside(g, &ap, u, v);
+        let h = g.select(inside_test, z, big);
+        // This lenslet's slopes where its height is below the best so far.
+        let map = g.import(&own.graph, u, v);
+        let wins = g.sub(h, best);
+        for (slope, out) in slopes.iter_mut().zip(&own.outputs[1..]) {
+            *slope = g.select(wins, map[out.0 as usize], *slope);
+        }
+        best = g.binary(Binary::Min, best, h);
+    }
+    let half_big = g.constant_node(BIG / 2.0);
+    let test = g.sub(best, half_big);
+    let z = g.select(test, best, zero);
+    let mut outputs = [z; 6];
+    for (o, slope) in outputs[1..].iter_mut().zip(slopes) {
+        *o = g.select(test, slope, zero);
+    }
+    Ok(outputs)
+}
+
+/// The height that stands for "no lenslet here" while the lowest lenslet
+/// is sought: far above any lens.
+const BIG: f64 = 1e6;
+
 /// The tool trajectory over an array for fast-tool-servo turning with a
 /// settling offset h (Hashimoto & Yan, fig. 16): each lenslet continued
 /// past its rim until it rises h above the land, the land itself at h.
@@ -114,7 +173,6 @@ fn array_height_settled(
         _ => hex_cells(g, o, (x, y), (hx, hy))?,
     };
     // min over the candidates that contain the point; +BIG where none do.
-    const BIG: f64 = 1e6;
     let big = g.constant_node(BIG);
     let half_big = g.constant_node(BIG / 2.0);
     let rim_c = g.constant_node(rim);
@@ -293,6 +351,10 @@ fn cell_index(g: &mut Graph, t: Id, n: f64, offset: f64) -> Id {
     let top = g.constant_node(n - 1.0);
     let lo = g.binary(Binary::Max, f, zero);
     let i = g.binary(Binary::Min, lo, top);
+    if offset == 0.0 {
+        // Already in 0 ..= n − 1: clamping again changes nothing.
+        return i;
+    }
     let off = g.constant_node(offset);
     let shifted = g.add(i, off);
     let clamped_lo = g.binary(Binary::Max, shifted, zero);

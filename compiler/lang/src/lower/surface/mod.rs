@@ -98,6 +98,13 @@ pub fn lower_surface(o: &Object) -> Result<LoweredSurface, LowerError> {
     }
     let mut g = Graph::new();
     let (x, y) = (g.x(), g.y());
+    if matches!(o.kind.name, "grid" | "hex_grid" | "linear_array") {
+        let outputs = arrays::array_outputs(&mut g, o, x, y)?;
+        return Ok(LoweredSurface {
+            tape: SurfaceTape::with_outputs(g, outputs),
+            domain,
+        });
+    }
     let z = height(&mut g, o, x, y)?;
     Ok(LoweredSurface {
         tape: SurfaceTape::new(g, z),

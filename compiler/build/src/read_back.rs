@@ -1,0 +1,61 @@
+//! Every program a build makes is read back from its text before it is
+//! put in place, by the rules of `lensc verify` (`lensc_runtime::reader`):
+//! a program the reader refuses is never written, and its job fails with
+//! the reader's findings, at the job, each naming the program's line.
+
+use std::io::BufReader;
+
+use lensc_grammar::Diagnostic;
+use lensc_lang::check::CheckedJob;
+use lensc_lang::lower::job::JobHead;
+use lensc_lang::lower::read_back::job_machine;
+use lensc_runtime::reader;
+
+use crate::output::ProgramText;
+
+/// Whether builds read their programs back before writing them. Off
+/// until every program is complete (issue 14, item 1: tool calls, spindle
+/// starts with G97, integer S words): today's programs break the reader's
+/// tool and spindle rules. `LENSC_READ_BACK=1` turns it on for one run.
+pub const READ_BACK_BY_DEFAULT: bool = false;
+
+/// Whether this run reads its programs back.
+pub fn enabled() -> bool {
+    READ_BACK_BY_DEFAULT || std::env::var_os("LENSC_READ_BACK").is_some_and(|v| v == "1")
+}
+
+/// The reader's findings in `program` as errors at the job; none if it
+/// reads clean.
+pub(crate) fn findings(job: &CheckedJob, head: &JobHead, program: &ProgramText) -> Vec<Diagnostic> {
+    let machine = job_machine(job);
+    let found = match program {
+        ProgramText::Memory(text) => Ok(reader::read(text, &head.dialect, &machine)),
+        ProgramText::Spooled { file, .. } => std::fs::File::open(file.path())
+            .and_then(|f| reader::read_from(BufReader::new(f), &head.dialect, &machine)),
+    };
+    let name = head.program_name();
+    match found {
+        Ok(found) => found
+            .iter()
+            .map(|f| {
+                let d = head.error(
+                    lensc_lang::codes::program_rule(f.rule),
+                    format!(
+                        "{name}, line {}, read back as the controller reads it: {}",
+                        f.line, f.message
+                    ),
+                );
+                let help =
+                    "no program was written; `lensc verify` reads a program by the same rules";
+                d.with_help(match &f.hint {
+                    Some(h) => format!("{h}; {help}"),
+                    None => help.to_string(),
+                })
+            })
+            .collect(),
+        Err(e) => vec![head.error(
+            lensc_lang::codes::CANNOT_WRITE,
+            format!("{name} could not be read back before writing: {e}"),
+        )],
+    }
+}

@@ -1,0 +1,68 @@
+//! What a program's header comments say that the reader uses: the machine
+//! and dialect it was written for (`(machine NAME: DIALECT lathe)`, or
+//! `; machine …` where comments are semicolons), and which way is out of
+//! the material.
+
+/// The machine and dialect a header names, and the words after them
+/// (`lathe`, `3-axis mill`, `fast-tool-servo lathe`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct HeaderNames {
+    pub machine: String,
+    pub dialect: String,
+    pub kind: String,
+}
+
+/// The names in the first `machine NAME: DIALECT …` comment of `text`, if
+/// its header has one.
+pub fn header_names(text: &str) -> Option<HeaderNames> {
+    text.lines().take(200).find_map(|line| {
+        let comment = comment_text(line)?;
+        let rest = comment.trim().strip_prefix("machine ")?;
+        let (machine, rest) = rest.split_once(": ")?;
+        let mut words = rest.split_whitespace();
+        let dialect = words.next()?.to_string();
+        let kind = words.collect::<Vec<_>>().join(" ");
+        Some(HeaderNames {
+            machine: machine.trim().to_string(),
+            dialect,
+            kind,
+        })
+    })
+}
+
+/// The source file a header names (`source PATH fnv1a64 …`), if any.
+pub fn header_source(text: &str) -> Option<String> {
+    text.lines().take(200).find_map(|line| {
+        let rest = comment_text(line)?.trim().strip_prefix("source ")?;
+        rest.rsplit_once(" fnv1a64 ").map(|(p, _)| p.to_string())
+    })
+}
+
+/// The text of a whole-line comment in any dialect: `(…)`, `; …`, or a
+/// numbered `N9 ; … *`.
+fn comment_text(line: &str) -> Option<&str> {
+    let t = line.trim();
+    if let Some(inner) = t.strip_prefix('(') {
+        return inner.strip_suffix(')');
+    }
+    let t = match t.strip_prefix('N') {
+        Some(rest) => rest.trim_start_matches(|c: char| c.is_ascii_digit()).trim(),
+        None => t,
+    };
+    let inner = t.strip_prefix(';')?;
+    Some(inner.trim_end().trim_end_matches('*'))
+}
+
+/// The axis (0 X, 2 Z) whose positive direction leads out of the material,
+/// if this header comment says so: `+Z out of the material` on lathes and
+/// mills, X for a roller (`the radius of the nose centre about the roller
+/// axis`).
+pub(crate) fn away_axis(comment: &str) -> Option<usize> {
+    if comment.contains("+Z out of the material") {
+        Some(2)
+    } else if comment.contains("about the roller axis") {
+        Some(0)
+    } else {
+        None
+    }
+}

@@ -1,0 +1,386 @@
+//! One line of program text to its words, as the dialect's controller
+//! splits it: the block number, address words (`X1.5`), Siemens'
+//! keywords (`DIAMOF`, `LIMS=3000.`), comments, and the `%` lines that
+//! open and close a program; with the refusals a controller makes while
+//! reading a line (line length, comments, number format).
+
+use super::{Controller, Rule};
+use crate::dialect::{CommentStyle, Dialect};
+
+/// A finding as the line reports it: rule, span within the line, message,
+/// hint.
+pub(crate) type Found = (Rule, (usize, usize), String, Option<String>);
+
+/// An address word: a letter and its number.
+#[derive(Clone, Debug)]
+pub(crate) struct Word {
+    pub letter: char,
+    pub value: f64,
+    pub span: (usize, usize),
+    pub point: bool,
+    /// Digits after the point.
+    pub decimals: usize,
+}
+
+impl Word {
+    /// The word as written.
+    pub fn text<'a>(&self, line: &'a str) -> &'a str {
+        &line[self.span.0..self.span.1]
+    }
+}
+
+/// A Siemens keyword (`DIAMOF`, `LIMS=3000.`, `T="DIAMOND"`).
+#[derive(Clone, Debug)]
+pub(crate) struct Keyword {
+    pub name: String,
+    pub value: Option<f64>,
+    pub span: (usize, usize),
+}
+
+/// A line's contents.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Block {
+    pub number: Option<Word>,
+    pub words: Vec<Word>,
+    pub keywords: Vec<Keyword>,
+    /// Comment texts, in order.
+    pub comments: Vec<String>,
+    /// A `%` line: the program's start or end marker.
+    pub percent: bool,
+}
+
+impl Block {
+    pub fn is_empty(&self) -> bool {
+        self.words.is_empty() && self.keywords.is_empty()
+    }
+}
+
+/// How a dialect's lines are split.
+pub(crate) struct Lexer {
+    pub controller: Controller,
+    comment: CommentStyle,
+    block_end: String,
+    max_line_length: Option<usize>,
+    max_decimals: Option<u32>,
+    max_digits: Option<u32>,
+}
+
+impl Lexer {
+    pub fn new(d: &Dialect) -> Lexer {
+        Lexer {
+            controller: Controller::of(d),
+            comment: d.comment,
+            block_end: d.block_end.trim().to_string(),
+            max_line_length: d.max_line_length,
+            max_decimals: d.max_decimals,
+            max_digits: d.max_digits,
+        }
+    }
+
+    /// Splits `line` (without its line break) into a block.
+    pub fn block(&self, line: &str, out: &mut Vec<Found>) -> Block {
+        let mut b = Block::default();
+        if let Some(max) = self.max_line_length
+            && line.chars().count() > max
+        {
+            out.push((
+                Rule::LineTooLong,
+                (0, line.len()),
+                format!(
+                    "this line has {} characters; the controller reads at most {max}",
+                    line.chars().count()
+                ),
+                Some("split the line or shorten its comment".into()),
+            ));
+        }
+        let mut code = line.trim_end();
+        if code.trim().is_empty() {
+            return b;
+        }
+        if !self.block_end.is_empty() {
+            match code.strip_suffix(self.block_end.as_str()) {
+                Some(c) => code = c,
+                None => out.push((
+                    Rule::BlockEnd,
+                    (0, line.len()),
+                    format!("this block does not end with `{}`", self.block_end),
+                    Some(format!("end every block with ` {}`", self.block_end)),
+                )),
+            }
+        }
+        let code = self.strip_comments(code, &mut b, out);
+        self.words(code, &mut b, out);
+        b
+    }
+
+    /// The line up to its comments (their texts kept in `b`); a `(` never
+    /// closed or opened inside another is refused.
+    fn strip_comments(&self, code: &str, b: &mut Block, out: &mut Vec<Found>) -> String {
+        let semicolon =
+            self.comment == CommentStyle::Semicolon || self.controller == Controller::LinuxCnc;
+        let mut kept = String::with_capacity(code.len());
+        let mut chars = code.char_indices();
+        while let Some((i, c)) = chars.next() {
+            if c == ';' && semicolon {
+                b.comments.push(code[i + 1..].trim().to_string());
+                kept.extend(std::iter::repeat_n(' ', code.len() - i));
+                break;
+            }
+            if c != '(' || self.comment != CommentStyle::Parentheses {
+                kept.push(c);
+                continue;
+            }
+            let Some(close) = code[i + 1..].find(')') else {
+                out.push((
+                    Rule::UnclosedComment,
+                    (i, code.len()),
+                    "this comment is never closed: the controller refuses the block".into(),
+                    Some("close it with `)` on the same line".into()),
+                ));
+                kept.extend(std::iter::repeat_n(' ', code.len() - i));
+                break;
+            };
+            let inner = &code[i + 1..i + 1 + close];
+            if let Some(nested) = inner.find('(') {
+                out.push((
+                    Rule::NestedComment,
+                    (i + 1 + nested, i + 2 + nested),
+                    "a comment opened inside a comment: the controller refuses the block".into(),
+                    Some("comments cannot nest; write `[` `]` inside one".into()),
+                ));
+            }
+            b.comments.push(inner.to_string());
+            kept.extend(std::iter::repeat_n(' ', close + 2));
+            for _ in 0..inner.chars().count() + 1 {
+                chars.next();
+            }
+        }
+        kept
+    }
+
+    /// The words of a line with its comments blanked (byte positions kept).
+    fn words(&self, code: String, b: &mut Block, out: &mut Vec<Found>) {
+        let bytes = code.as_bytes();
+        let mut i = 0;
+        while i < bytes.len() {
+            let c = bytes[i];
+            if c.is_ascii_whitespace() {
+                i += 1;
+                continue;
+            }
+            if c == b'%' && b.words.iter().all(|w| w.letter == 'N') && b.keywords.is_empty() {
+                // A program's start or end marker, with its name.
+                b.percent = true;
+                i += code[i..]
+                    .find(char::is_whitespace)
+                    .unwrap_or(code.len() - i);
+                continue;
+            }
+            if !c.is_ascii_alphabetic() {
+                let end = i + code[i..].chars().next().map_or(1, char::len_utf8);
+                out.push(unknown(
+                    (i, end),
+                    "a character the controller does not read here",
+                ));
+                i = end;
+                continue;
+            }
+            let start = i;
+            while i < bytes.len() && bytes[i].is_ascii_alphabetic() {
+                i += 1;
+            }
+            let name = &code[start..i];
+            if name.len() > 1 {
+                i = self.keyword(&code, start, i, b, out);
+                continue;
+            }
+            let mut letter = name.chars().next().unwrap_or('?');
+            if self.controller == Controller::LinuxCnc {
+                letter = letter.to_ascii_uppercase();
+            }
+            if self.controller == Controller::Siemens && bytes.get(i) == Some(&b'=') {
+                i += 1;
+                if bytes.get(i) == Some(&b'"') {
+                    let close = code[i + 1..].find('"').map_or(code.len(), |c| i + 2 + c);
+                    b.keywords.push(Keyword {
+                        name: name.to_string(),
+                        value: None,
+                        span: (start, close),
+                    });
+                    i = close;
+                    continue;
+                }
+            }
+            let (number, end) = number(&code, i);
+            i = end;
+            let Some((value, point, decimals)) = number else {
+                out.push((
+                    Rule::MalformedNumber,
+                    (start, end.max(start + 1)),
+                    format!(
+                        "`{}` has no number after its letter",
+                        &code[start..end.max(start + 1)]
+                    ),
+                    None,
+                ));
+                continue;
+            };
+            let w = Word {
+                letter,
+                value,
+                span: (start, end),
+                point,
+                decimals,
+            };
+            self.number_format(&w, &code, out);
+            if w.letter == 'N' && b.words.is_empty() && b.number.is_none() {
+                b.number = Some(w);
+            } else {
+                b.words.push(w);
+            }
+        }
+    }
+
+    /// A word of several letters: Siemens' keywords, read up to its value.
+    fn keyword(
+        &self,
+        code: &str,
+        start: usize,
+        mut i: usize,
+        b: &mut Block,
+        out: &mut Vec<Found>,
+    ) -> usize {
+        let bytes = code.as_bytes();
+        let name = &code[start..i];
+        let mut value = None;
+        if bytes.get(i) == Some(&b'=') {
+            let (n, end) = number(code, i + 1);
+            value = n.map(|n| n.0);
+            if n.is_none() {
+                out.push((
+                    Rule::MalformedNumber,
+                    (start, end.max(i + 1)),
+                    format!("`{name}=` has no number"),
+                    None,
+                ));
+            }
+            i = end;
+        }
+        if self.controller == Controller::Siemens && SIEMENS_KEYWORDS.contains(&name) {
+            b.keywords.push(Keyword {
+                name: name.to_string(),
+                value,
+                span: (start, i),
+            });
+        } else {
+            out.push(unknown(
+                (start, i),
+                &format!("`{}` is not a word this controller reads", &code[start..i]),
+            ));
+        }
+        i
+    }
+
+    /// Digits, decimals and the decimal point of a word against the
+    /// dialect's number format.
+    fn number_format(&self, w: &Word, code: &str, out: &mut Vec<Found>) {
+        let text = &code[w.span.0..w.span.1];
+        if w.point && integer_only(self.controller, w.letter) {
+            out.push((
+                Rule::DecimalPoint,
+                w.span,
+                format!(
+                    "`{text}`: this controller reads {} words as whole numbers, without a decimal point",
+                    w.letter
+                ),
+                Some(format!("write {}{}", w.letter, w.value.trunc())),
+            ));
+        }
+        if let Some(max) = self.max_decimals
+            && w.decimals > max as usize
+        {
+            out.push((
+                Rule::TooManyDecimals,
+                w.span,
+                format!(
+                    "`{text}` has {} decimals; the controller reads at most {max}",
+                    w.decimals
+                ),
+                None,
+            ));
+        }
+        let digits = text
+            .trim_start_matches(|c: char| {
+                c.is_ascii_alphabetic() || c == '=' || c == '-' || c == '+'
+            })
+            .trim_start_matches('0')
+            .chars()
+            .filter(char::is_ascii_digit)
+            .count();
+        if let Some(max) = self.max_digits
+            && digits > max as usize
+        {
+            out.push((
+                Rule::TooManyDigits,
+                w.span,
+                format!("`{text}` has {digits} digits; the controller reads at most {max}"),
+                None,
+            ));
+        }
+    }
+}
+
+/// Siemens keywords the reader knows (840D sl programming manual): the
+/// ones lensc's dialects write and their opposites.
+const SIEMENS_KEYWORDS: &[&str] = &[
+    "DIAMOF", "DIAMON", "DIAM90", "COMPCAD", "COMPCURV", "COMPON", "COMPOF", "SPCON", "SPCOF",
+    "SPOS", "CTOL", "OTOL", "ATOL", "LIMS", "SOFT", "BRISK", "FFWON", "FFWOF",
+];
+
+/// Whether a controller reads `letter` as a whole number only (a decimal
+/// point in it is refused): block and program numbers and M codes
+/// everywhere; Fanuc's S, T, D, H, P and L too (its manuals: "a decimal
+/// point cannot be used" in these addresses).
+fn integer_only(c: Controller, letter: char) -> bool {
+    match letter {
+        'N' | 'O' | 'M' => true,
+        'T' => c != Controller::LinuxCnc,
+        'S' | 'D' | 'H' | 'P' | 'L' => c == Controller::Fanuc,
+        _ => false,
+    }
+}
+
+fn unknown(span: (usize, usize), message: &str) -> Found {
+    (Rule::UnknownWord, span, message.to_string(), None)
+}
+
+/// A number at `code[i..]`: sign, digits, a point, digits (at least one
+/// digit). Returns (value, has a point, decimals) and where it ends.
+fn number(code: &str, mut i: usize) -> (Option<(f64, bool, usize)>, usize) {
+    let bytes = code.as_bytes();
+    let start = i;
+    if matches!(bytes.get(i), Some(b'+' | b'-')) {
+        i += 1;
+    }
+    let mut digits = 0;
+    let mut point = false;
+    let mut decimals = 0;
+    while let Some(&c) = bytes.get(i) {
+        match c {
+            b'0'..=b'9' => {
+                digits += 1;
+                if point {
+                    decimals += 1;
+                }
+            }
+            b'.' if !point => point = true,
+            _ => break,
+        }
+        i += 1;
+    }
+    if digits == 0 {
+        return (None, i);
+    }
+    let value = code[start..i].parse::<f64>().ok();
+    (value.map(|v| (v, point, decimals)), i)
+}

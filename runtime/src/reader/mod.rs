@@ -1,0 +1,229 @@
+//! Reading a program back as its controller reads it, from the text alone:
+//! the words of each line (`lexer`), the modal state block by block and
+//! the rules a controller (or a careful machinist) refuses a block for
+//! (`modal`), and what the header says (`header`). It is written from the
+//! controllers' programming rules — LinuxCNC's RS274NGC interpreter, the
+//! Fanuc 0i/30i manuals, Siemens 840D sl, Heidenhain TNC ISO, and the
+//! ultra-precision lathes' G-code — and shares no code with the writer
+//! (`post/`): it takes the dialect and the machine only as data (limits,
+//! travel, the dialect's own block lists and number format).
+//!
+//! Which controller a dialect is for is read from its data
+//! ([`Controller::of`]): a block end with `*` is Heidenhain's; `;` comments
+//! are Siemens'; a program number line (`O{number}`) is Fanuc's; `G21` in
+//! the setup is LinuxCNC's; anything else is read by the ultra-precision
+//! lathes' rules (G71 metric, M19/M18 position mode as the dialect says).
+//!
+//! Every finding names its line and a byte span in the whole text, with a
+//! [`Rule`] (its diagnostic code lives with the compiler's others).
+
+mod header;
+mod lexer;
+mod modal;
+mod motion;
+
+pub use header::{HeaderNames, header_names, header_source};
+
+use crate::dialect::Dialect;
+
+/// What the reader needs of the machine, as data.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MachineLimits {
+    /// A lathe (X a radius or diameter about the spindle) or not.
+    pub lathe: bool,
+    /// Travel of X (radius on a lathe), Y, Z (mm) and C (rad), where stated.
+    pub travel: [Option<(f64, f64)>; 4],
+    /// Highest programmable feed (mm/min).
+    pub max_feed: Option<f64>,
+    /// Highest spindle speed (rpm).
+    pub max_spindle_rpm: Option<f64>,
+}
+
+/// The family of controller whose rules a dialect is read by.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Controller {
+    LinuxCnc,
+    Fanuc,
+    Siemens,
+    HeidenhainIso,
+    UltraPrecision,
+}
+
+impl Controller {
+    /// The controller a dialect writes for, from its data (see the module
+    /// documentation).
+    pub fn of(d: &Dialect) -> Controller {
+        let setup = d.lathe_setup.iter().chain(&d.mill_setup);
+        if d.block_end.trim_end().ends_with('*') {
+            Controller::HeidenhainIso
+        } else if d.comment == crate::dialect::CommentStyle::Semicolon {
+            Controller::Siemens
+        } else if d.start.iter().any(|l| l.trim_start().starts_with('O')) {
+            Controller::Fanuc
+        } else if setup.flat_map(|l| l.split_whitespace()).any(|w| w == "G21") {
+            Controller::LinuxCnc
+        } else {
+            Controller::UltraPrecision
+        }
+    }
+}
+
+/// A rule a program breaks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Rule {
+    UnclosedComment,
+    LineTooLong,
+    UnknownWord,
+    MalformedNumber,
+    TooManyDigits,
+    TooManyDecimals,
+    DecimalPoint,
+    SameModalGroup,
+    RepeatedWord,
+    NoFeedMode,
+    SpindleStopped,
+    NoFeedRate,
+    NoTool,
+    OutsideTravel,
+    FeedTooHigh,
+    RapidIntoPart,
+    ArcRadiusMismatch,
+    ZeroRadiusArc,
+    FullCircle,
+    ArcWords,
+    ModalStateUnstated,
+    NoMotionMode,
+    SpindleSpeedMode,
+    NoSpindleSpeed,
+    SpindleTooFast,
+    NoSpeedCap,
+    BlockNumber,
+    BlockEnd,
+    ProgramEnd,
+    NestedComment,
+}
+
+/// One thing wrong with a program: where (line from 1, byte span in the
+/// whole text), what, and how to mend it where that is known.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Finding {
+    pub rule: Rule,
+    pub line: usize,
+    pub span: (usize, usize),
+    pub message: String,
+    pub hint: Option<String>,
+}
+
+/// Reads `text` (a whole program) in `dialect` on `machine`: every rule
+/// broken, the first line breaking each, in order of their lines.
+pub fn read(text: &str, dialect: &Dialect, machine: &MachineLimits) -> Vec<Finding> {
+    let mut r = Reader::new(dialect, machine);
+    let mut offset = 0;
+    for line in text.split_inclusive('\n') {
+        r.line(line, offset);
+        offset += line.len();
+    }
+    r.finish()
+}
+
+/// Reads a program from `input` line by line (a program of millions of
+/// lines is never held whole); bytes that are not UTF-8 are read as `�`,
+/// which no controller reads either.
+pub fn read_from(
+    mut input: impl std::io::BufRead,
+    dialect: &Dialect,
+    machine: &MachineLimits,
+) -> std::io::Result<Vec<Finding>> {
+    let mut r = Reader::new(dialect, machine);
+    let mut buf = Vec::new();
+    let mut offset = 0;
+    loop {
+        buf.clear();
+        let n = input.read_until(b'\n', &mut buf)?;
+        if n == 0 {
+            break;
+        }
+        r.line(&String::from_utf8_lossy(&buf), offset);
+        offset += n;
+    }
+    Ok(r.finish())
+}
+
+/// A program read line by line (the largest run to millions of lines and
+/// are read from their spool file as they are).
+pub struct Reader {
+    state: modal::State,
+    findings: Vec<Finding>,
+    /// Lines breaking each rule after its first.
+    repeats: std::collections::BTreeMap<Rule, usize>,
+    line_no: usize,
+    last_span: (usize, usize),
+}
+
+impl Reader {
+    pub fn new(dialect: &Dialect, machine: &MachineLimits) -> Reader {
+        Reader {
+            state: modal::State::new(dialect, machine),
+            findings: Vec::new(),
+            repeats: Default::default(),
+            line_no: 0,
+            last_span: (0, 0),
+        }
+    }
+
+    /// Reads one line (with or without its line break) that starts at
+    /// byte `offset` of the program.
+    pub fn line(&mut self, line: &str, offset: usize) {
+        self.line_no += 1;
+        let text = line.trim_end_matches(['\n', '\r']);
+        self.last_span = (offset, offset + text.len());
+        let mut out = Vec::new();
+        self.state.line(text, &mut out);
+        for (rule, (s, e), message, hint) in out {
+            if self.findings.iter().any(|f| f.rule == rule) {
+                *self.repeats.entry(rule).or_default() += 1;
+                continue;
+            }
+            self.findings.push(Finding {
+                rule,
+                line: self.line_no,
+                span: (offset + s, offset + e),
+                message,
+                hint,
+            });
+        }
+    }
+
+    /// Every finding, once the whole program is read.
+    pub fn finish(mut self) -> Vec<Finding> {
+        let mut out = Vec::new();
+        self.state.finish(&mut out);
+        for (rule, _, message, hint) in out {
+            self.findings.push(Finding {
+                rule,
+                line: self.line_no.max(1),
+                span: self.last_span,
+                message,
+                hint,
+            });
+        }
+        for f in &mut self.findings {
+            if let Some(n) = self.repeats.get(&f.rule) {
+                let more = format!(
+                    "{n} more line{} break{} this rule",
+                    if *n == 1 { "" } else { "s" },
+                    if *n == 1 { "s" } else { "" }
+                );
+                f.hint = Some(match f.hint.take() {
+                    Some(h) => format!("{h}; {more}"),
+                    None => more,
+                });
+            }
+        }
+        self.findings.sort_by_key(|f| f.line);
+        self.findings
+    }
+}
+
+#[cfg(test)]
+mod tests;

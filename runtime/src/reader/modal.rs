@@ -1,0 +1,640 @@
+//! The controller's modal state, block by block: units, plane, absolute or
+//! incremental, feed mode and feed, spindle (on, speed, constant surface
+//! speed and its cap, position mode), the tool called, X as a diameter or
+//! a radius; the words of each block sorted into their modal groups and
+//! applied in the controller's order (modes, then spindle, then the move,
+//! then the program's end). The moves themselves are `motion`'s.
+
+use super::lexer::{Block, Found, Lexer, Word};
+use super::{Controller, MachineLimits, Rule};
+use crate::dialect::Dialect;
+use crate::moves::Plane;
+
+/// How F is read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum FeedMode {
+    PerMinute,
+    PerRevolution,
+    InverseTime,
+}
+
+/// The motion modes a program may leave in force.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Motion {
+    Rapid,
+    Linear,
+    Cw,
+    Ccw,
+    /// G80: canned cycles off, in LinuxCNC the motion mode "none".
+    Cancel,
+}
+
+/// The modal group of a G code (value × 10, `G05.1` is 51).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum GGroup {
+    Motion(Motion),
+    Plane(Plane),
+    Distance(bool),
+    Feed(FeedMode),
+    Units(bool),
+    CutterComp,
+    ToolLength,
+    Diameter(bool),
+    PathControl,
+    SpindleMode(bool),
+    SpindleCap,
+    NonModal,
+    WorkOffset,
+    Cycle,
+}
+
+/// What an M code does, for this dialect.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum MCode {
+    SpindleOn,
+    SpindleOff,
+    PositionOn,
+    PositionOff,
+    /// Spindle orientation (M19 on LinuxCNC, Fanuc mills, Heidenhain):
+    /// stopped and held at an angle, as a knife cuts.
+    Orient,
+    ToolChange,
+    End,
+    Stop,
+    Coolant,
+    Other,
+}
+
+/// The state of a program being read.
+pub(crate) struct State {
+    pub lex: Lexer,
+    pub machine: MachineLimits,
+    pub arc_tolerance: f64,
+    pub arc_planes: Vec<Plane>,
+    pub arc_centre_absolute: bool,
+    dialect_m: Vec<(i64, MCode)>,
+    feed_codes: Vec<(i64, FeedMode)>,
+    max_line_number: Option<u64>,
+    numbered: bool,
+    /// Whether the spindle-speed mode must be stated before a start.
+    css_capable: bool,
+    // The modal state.
+    pub metric: Option<bool>,
+    pub plane: Option<Plane>,
+    pub absolute: Option<bool>,
+    pub feed_mode: Option<FeedMode>,
+    pub motion: Option<Motion>,
+    pub feed: Option<f64>,
+    /// G96 (true) or G97 (false), once stated.
+    pub css: Option<bool>,
+    pub css_speed: Option<f64>,
+    pub cap: Option<f64>,
+    pub rpm: Option<f64>,
+    pub spindle_on: bool,
+    /// The spindle held in position control, turned by C moves.
+    pub position_mode: bool,
+    tool_selected: bool,
+    pub tool_loaded: bool,
+    pub diameter: bool,
+    /// X (radius), Y, Z (mm), C (degrees), where known.
+    pub pos: [Option<f64>; 4],
+    /// The axis whose + leads out of the material (header).
+    pub away: usize,
+    /// The highest point along `away` a feed move has reached.
+    pub top: Option<f64>,
+    ended: bool,
+}
+
+impl State {
+    pub fn new(d: &Dialect, machine: &MachineLimits) -> State {
+        let lex = Lexer::new(d);
+        let mut dialect_m = Vec::new();
+        for (lines, code) in [
+            (&d.c_axis_on, MCode::PositionOn),
+            (&d.c_axis_off, MCode::PositionOff),
+            (&d.fts_on, MCode::Other),
+            (&d.fts_off, MCode::Other),
+        ] {
+            for w in lines.iter().flat_map(|l| l.split_whitespace()) {
+                if let Some(n) = w.strip_prefix('M').and_then(|n| n.parse::<i64>().ok()) {
+                    dialect_m.push((n, code));
+                }
+            }
+        }
+        let code = |w: &Option<String>| {
+            w.as_deref()
+                .and_then(|w| w.strip_prefix('G'))
+                .and_then(|n| n.parse::<f64>().ok())
+                .map(|v| (v * 10.0).round() as i64)
+        };
+        let mut feed_codes = vec![(940, FeedMode::PerMinute)];
+        for (w, m) in [
+            (&d.per_minute, FeedMode::PerMinute),
+            (&d.per_revolution, FeedMode::PerRevolution),
+            (&d.inverse_time, FeedMode::InverseTime),
+        ] {
+            feed_codes.extend(code(w).map(|c| (c, m)));
+        }
+        State {
+            machine: machine.clone(),
+            arc_tolerance: d.arc_radius_tolerance,
+            arc_planes: d.arc_planes.clone(),
+            arc_centre_absolute: d.arc_centre_absolute,
+            dialect_m,
+            feed_codes,
+            max_line_number: d.max_line_number,
+            numbered: lex.controller == Controller::HeidenhainIso && d.line_numbers.is_some(),
+            css_capable: machine.lathe || !d.surface_speed.is_empty(),
+            metric: None,
+            plane: None,
+            absolute: None,
+            feed_mode: None,
+            motion: None,
+            feed: None,
+            css: None,
+            css_speed: None,
+            cap: None,
+            rpm: None,
+            spindle_on: false,
+            position_mode: false,
+            tool_selected: false,
+            tool_loaded: false,
+            diameter: machine.lathe && d.lathe_x_diameter,
+            pos: [None; 4],
+            away: 2,
+            top: None,
+            ended: false,
+            lex,
+        }
+    }
+
+    /// Reads one line.
+    pub fn line(&mut self, line: &str, out: &mut Vec<Found>) {
+        let b = self.lex.block(line, out);
+        for c in &b.comments {
+            if let Some(a) = super::header::away_axis(c) {
+                self.away = a;
+            }
+        }
+        self.block_number(&b, line, out);
+        if b.is_empty() {
+            return;
+        }
+        if self.ended && !b.percent {
+            out.push((
+                Rule::ProgramEnd,
+                (0, line.len()),
+                "a block after the program's end: the controller never runs it".into(),
+                Some("end the program with its last block".into()),
+            ));
+            return;
+        }
+        self.repeated(&b, line, out);
+        let Some((groups, ms)) = self.classify(&b, line, out) else {
+            return;
+        };
+        self.modes(&b, &groups, line, out);
+        self.spindle_and_tool(&b, &groups, &ms, line, out);
+        // G50 S and G4 take their own words; no move.
+        if !groups
+            .iter()
+            .any(|(g, _)| matches!(g, GGroup::SpindleCap | GGroup::NonModal))
+        {
+            self.move_block(&b, line, out);
+        }
+        if ms.iter().any(|(m, _)| *m == MCode::End) {
+            self.ended = true;
+            self.spindle_on = false;
+        }
+    }
+
+    /// What is wrong once the whole program is read.
+    pub fn finish(&mut self, out: &mut Vec<Found>) {
+        if !self.ended {
+            out.push((
+                Rule::ProgramEnd,
+                (0, 0),
+                "the program has no end (M2 or M30): the controller stops without resetting".into(),
+                Some("end the program with M30 (M2 on LinuxCNC)".into()),
+            ));
+        }
+    }
+
+    fn block_number(&self, b: &Block, line: &str, out: &mut Vec<Found>) {
+        match &b.number {
+            None if self.numbered && !b.percent && !(b.is_empty() && b.comments.is_empty()) => {
+                out.push((
+                    Rule::BlockNumber,
+                    (0, line.len().min(1)),
+                    "this block has no block number; every block of this dialect is numbered"
+                        .into(),
+                    Some("start the block with N and its number".into()),
+                ));
+            }
+            Some(n) if !b.percent => {
+                if let Some(max) = self.max_line_number
+                    && n.value > max as f64
+                {
+                    out.push((
+                        Rule::BlockNumber,
+                        n.span,
+                        format!("block number {} is above the controller's {max}", n.value),
+                        None,
+                    ));
+                }
+            }
+            _ => {}
+        }
+    }
+
+    /// A letter other than G and M twice in one block.
+    fn repeated(&self, b: &Block, line: &str, out: &mut Vec<Found>) {
+        for (i, w) in b.words.iter().enumerate() {
+            if matches!(w.letter, 'G' | 'M') {
+                continue;
+            }
+            if b.words[..i].iter().any(|o| o.letter == w.letter) {
+                out.push((
+                    Rule::RepeatedWord,
+                    w.span,
+                    format!(
+                        "a second {} word in one block (`{}`): the controller refuses it",
+                        w.letter,
+                        w.text(line)
+                    ),
+                    None,
+                ));
+            }
+        }
+    }
+
+    /// The block's G and M codes with their groups; unknown codes and two
+    /// of one modal group are refused (`None`: the block is not run).
+    #[allow(clippy::type_complexity)]
+    fn classify<'b>(
+        &self,
+        b: &'b Block,
+        line: &str,
+        out: &mut Vec<Found>,
+    ) -> Option<(Vec<(GGroup, &'b Word)>, Vec<(MCode, &'b Word)>)> {
+        let before = out.len();
+        let mut groups: Vec<(GGroup, &'b Word)> = Vec::new();
+        let mut ms: Vec<(MCode, &'b Word)> = Vec::new();
+        for w in &b.words {
+            let scaled = w.value * 10.0;
+            let code = scaled.round() as i64;
+            match w.letter {
+                'G' => match ((scaled - code as f64).abs() < 1e-9)
+                    .then(|| self.g_group(code))
+                    .flatten()
+                {
+                    Some(g) => {
+                        let siemens = self.lex.controller == Controller::Siemens;
+                        if let Some((_, o)) =
+                            groups.iter().find(|(o, _)| same_group(*o, g, siemens))
+                        {
+                            out.push(conflict(w, o, line));
+                        }
+                        groups.push((g, w));
+                    }
+                    None => out.push(unknown_code(w, line)),
+                },
+                'M' => match self.m_code(w.value as i64).filter(|_| !w.point) {
+                    Some(m) => {
+                        if let Some((_, o)) = ms.iter().find(|(o, _)| same_m_group(*o, m)) {
+                            out.push(conflict(w, o, line));
+                        }
+                        ms.push((m, w));
+                    }
+                    None if w.point => {}
+                    None => out.push(unknown_code(w, line)),
+                },
+                l if self.known_letter(l) => {}
+                _ => out.push((
+                    Rule::UnknownWord,
+                    w.span,
+                    format!(
+                        "`{}`: the controller has no {} word",
+                        w.text(line),
+                        w.letter
+                    ),
+                    None,
+                )),
+            }
+        }
+        (out.len() == before).then_some((groups, ms))
+    }
+
+    fn known_letter(&self, l: char) -> bool {
+        match self.lex.controller {
+            Controller::Fanuc => "XYZCIJKRFSTDHPQLNO".contains(l),
+            Controller::UltraPrecision => "XYZCWIJKRFSTDHPQLNO".contains(l),
+            Controller::LinuxCnc => "XYZABCUVWIJKRFSTDHPQLN".contains(l),
+            Controller::Siemens => "XYZABCIJKRFSTDHPLN".contains(l),
+            Controller::HeidenhainIso => "XYZABCIJKRFSTLPHN".contains(l),
+        }
+    }
+
+    fn g_group(&self, code: i64) -> Option<GGroup> {
+        use Controller::*;
+        let c = self.lex.controller;
+        let metric_codes = match c {
+            LinuxCnc | Fanuc => (200, 210),
+            _ => (700, 710),
+        };
+        Some(match code {
+            0 => GGroup::Motion(Motion::Rapid),
+            10 => GGroup::Motion(Motion::Linear),
+            20 => GGroup::Motion(Motion::Cw),
+            30 => GGroup::Motion(Motion::Ccw),
+            170 => GGroup::Plane(Plane::Xy),
+            180 => GGroup::Plane(Plane::Zx),
+            190 => GGroup::Plane(Plane::Yz),
+            900 => GGroup::Distance(true),
+            910 => GGroup::Distance(false),
+            400 | 410 | 420 => GGroup::CutterComp,
+            960 if c != HeidenhainIso => GGroup::SpindleMode(true),
+            970 if c != HeidenhainIso => GGroup::SpindleMode(false),
+            40 => GGroup::NonModal,
+            540..=590 if code % 10 == 0 => GGroup::WorkOffset,
+            c2 if c2 == metric_codes.0 => GGroup::Units(false),
+            c2 if c2 == metric_codes.1 => GGroup::Units(true),
+            7000 if c == Siemens => GGroup::Units(false),
+            7100 if c == Siemens => GGroup::Units(true),
+            800 if c == LinuxCnc => GGroup::Motion(Motion::Cancel),
+            800 if c == Fanuc || c == UltraPrecision => GGroup::Cycle,
+            430 | 490 if c == LinuxCnc || c == Fanuc => GGroup::ToolLength,
+            70 if c == LinuxCnc => GGroup::Diameter(true),
+            80 if c == LinuxCnc => GGroup::Diameter(false),
+            610 | 640 if c == LinuxCnc => GGroup::PathControl,
+            600 | 640 | 6410 | 6420 if c == Siemens => GGroup::PathControl,
+            500 if c == Fanuc || c == UltraPrecision => GGroup::SpindleCap,
+            51 if c == Fanuc => GGroup::NonModal,
+            _ => {
+                return self
+                    .feed_codes
+                    .iter()
+                    .find(|(f, _)| *f == code)
+                    .map(|(_, m)| GGroup::Feed(*m));
+            }
+        })
+    }
+
+    fn m_code(&self, n: i64) -> Option<MCode> {
+        if let Some((_, m)) = self.dialect_m.iter().find(|(c, _)| *c == n) {
+            return Some(*m);
+        }
+        Some(match n {
+            3 | 4 => MCode::SpindleOn,
+            5 => MCode::SpindleOff,
+            6 => MCode::ToolChange,
+            2 | 30 => MCode::End,
+            0 | 1 => MCode::Stop,
+            7..=9 => MCode::Coolant,
+            19 => MCode::Orient,
+            _ => return None,
+        })
+    }
+
+    /// Units, plane, distance, feed mode, diameter mode.
+    fn modes(&mut self, b: &Block, groups: &[(GGroup, &Word)], line: &str, out: &mut Vec<Found>) {
+        for (g, _) in groups {
+            match *g {
+                GGroup::Units(m) => self.metric = Some(m),
+                GGroup::Plane(p) => self.plane = Some(p),
+                GGroup::Distance(a) => self.absolute = Some(a),
+                GGroup::Feed(m) => {
+                    if self.feed_mode != Some(m) {
+                        self.feed = None;
+                    }
+                    self.feed_mode = Some(m);
+                    if self.lex.controller == Controller::Siemens {
+                        // G94 G95 G96 G97 are one group (15) on a Sinumerik:
+                        // a feed type cancels constant surface speed.
+                        self.css = Some(false);
+                    }
+                }
+                GGroup::SpindleMode(_) if self.lex.controller == Controller::Siemens => {
+                    // G96 and G97 feed per revolution.
+                    if self.feed_mode != Some(FeedMode::PerRevolution) {
+                        self.feed = None;
+                    }
+                    self.feed_mode = Some(FeedMode::PerRevolution);
+                }
+                GGroup::Diameter(d) => self.diameter = d && self.machine.lathe,
+                GGroup::Motion(m) => self.motion = Some(m),
+                _ => {}
+            }
+        }
+        for k in &b.keywords {
+            match k.name.as_str() {
+                "DIAMON" | "DIAM90" => self.diameter = self.machine.lathe,
+                "DIAMOF" => self.diameter = false,
+                _ => {}
+            }
+        }
+        if let Some(f) = b.words.iter().find(|w| w.letter == 'F') {
+            if f.value <= 0.0 {
+                out.push((
+                    Rule::NoFeedRate,
+                    f.span,
+                    format!("`{}`: a feed must be above zero", f.text(line)),
+                    None,
+                ));
+            } else {
+                self.feed = Some(f.value);
+            }
+        }
+    }
+
+    /// Spindle speed and its mode, the cap, spindle on and off, position
+    /// mode, the tool call.
+    fn spindle_and_tool(
+        &mut self,
+        b: &Block,
+        groups: &[(GGroup, &Word)],
+        ms: &[(MCode, &Word)],
+        line: &str,
+        out: &mut Vec<Found>,
+    ) {
+        let has = |g: GGroup| groups.iter().any(|(o, _)| *o == g);
+        let s = b.words.iter().find(|w| w.letter == 'S');
+        // The rpm and caps this block sets, to hold against the maximum.
+        let mut speeds = Vec::new();
+        if has(GGroup::SpindleCap) {
+            self.cap = s.map(|s| s.value);
+            speeds.extend(s.map(|s| (s.value, s.span)));
+        } else if let Some(cap) = b.keywords.iter().find(|k| k.name == "LIMS") {
+            self.cap = cap.value;
+            speeds.extend(cap.value.map(|v| (v, cap.span)));
+        } else {
+            if let Some(d) = b.words.iter().find(|w| w.letter == 'D')
+                && has(GGroup::SpindleMode(true))
+                && self.lex.controller == Controller::LinuxCnc
+            {
+                self.cap = Some(d.value);
+                speeds.push((d.value, d.span));
+            }
+            if has(GGroup::SpindleMode(true)) {
+                self.css = Some(true);
+            } else if has(GGroup::SpindleMode(false)) {
+                self.css = Some(false);
+            }
+            if let Some(s) = s {
+                if self.css == Some(true) {
+                    self.css_speed = Some(s.value);
+                } else {
+                    self.rpm = Some(s.value);
+                    speeds.push((s.value, s.span));
+                }
+            }
+        }
+        if has(GGroup::SpindleMode(true)) && self.cap.is_none() {
+            let (_, w) = groups
+                .iter()
+                .find(|(g, _)| *g == GGroup::SpindleMode(true))
+                .expect("found above");
+            out.push((
+                Rule::NoSpeedCap,
+                w.span,
+                "constant surface speed with no spindle speed limit: at the centre the spindle would run to its maximum".into(),
+                Some("set the limit first (LinuxCNC: G96 D…; Fanuc: G50 S…; Siemens: LIMS=…)".into()),
+            ));
+        }
+        self.speed_limits(&speeds, line, out);
+        self.tool(b, ms);
+        for k in &b.keywords {
+            match k.name.as_str() {
+                "SPCON" => self.position_mode = true,
+                "SPCOF" => self.position_mode = false,
+                "SPOS" => {
+                    // Stopped and held at an angle: as M19 elsewhere.
+                    self.spindle_on = false;
+                    self.position_mode = true;
+                }
+                _ => {}
+            }
+        }
+        for (m, w) in ms {
+            match m {
+                MCode::SpindleOn => self.spindle_start(w, out),
+                MCode::SpindleOff => self.spindle_on = false,
+                MCode::PositionOn | MCode::Orient => {
+                    self.position_mode = true;
+                    self.spindle_on = false;
+                }
+                MCode::PositionOff => self.position_mode = false,
+                _ => {}
+            }
+        }
+    }
+
+    fn tool(&mut self, b: &Block, ms: &[(MCode, &Word)]) {
+        let t = b.words.iter().any(|w| w.letter == 'T') || b.keywords.iter().any(|k| k.name == "T");
+        if t {
+            self.tool_selected = true;
+        }
+        let needs_change = match self.lex.controller {
+            Controller::LinuxCnc => true,
+            Controller::Fanuc | Controller::Siemens => !self.machine.lathe,
+            _ => false,
+        };
+        if (!needs_change && t)
+            || (needs_change
+                && self.tool_selected
+                && ms.iter().any(|(m, _)| *m == MCode::ToolChange))
+        {
+            self.tool_loaded = true;
+        }
+    }
+
+    /// The speeds this block sets (an rpm, or a cap) against the
+    /// spindle's maximum.
+    fn speed_limits(&self, speeds: &[(f64, (usize, usize))], line: &str, out: &mut Vec<Found>) {
+        let Some(max) = self.machine.max_spindle_rpm else {
+            return;
+        };
+        for &(v, span) in speeds {
+            if v > max * (1.0 + 1e-12) {
+                out.push((
+                    Rule::SpindleTooFast,
+                    span,
+                    format!(
+                        "`{}` asks {v} rpm of a spindle whose maximum is {max} rpm",
+                        &line[span.0..span.1]
+                    ),
+                    None,
+                ));
+            }
+        }
+    }
+
+    fn spindle_start(&mut self, w: &Word, out: &mut Vec<Found>) {
+        if self.css.is_none() && self.css_capable {
+            out.push((
+                Rule::SpindleSpeedMode,
+                w.span,
+                "the spindle starts before G96 or G97 is stated: a G96 left by an earlier program would read S as a surface speed".into(),
+                Some("state G97 (constant rpm) or G96 (constant surface speed) before the start".into()),
+            ));
+        }
+        let speed = match self.css {
+            Some(true) => self.css_speed,
+            _ => self.rpm,
+        };
+        if !speed.is_some_and(|s| s > 0.0) {
+            out.push((
+                Rule::NoSpindleSpeed,
+                w.span,
+                "the spindle starts with no speed stated (S): it would not turn".into(),
+                Some("give the speed with S in this block or before it".into()),
+            ));
+        }
+        self.spindle_on = speed.is_some_and(|s| s > 0.0);
+        self.position_mode = false;
+    }
+}
+
+/// Whether two G codes are of one modal group (`siemens`: G94 G95 G96
+/// G97 are one, group 15).
+fn same_group(a: GGroup, b: GGroup, siemens: bool) -> bool {
+    use GGroup::*;
+    let feed_type = |g| matches!(g, Feed(_) | SpindleMode(_));
+    if siemens && feed_type(a) && feed_type(b) {
+        return true;
+    }
+    !matches!(a, NonModal | WorkOffset) && std::mem::discriminant(&a) == std::mem::discriminant(&b)
+}
+
+fn same_m_group(a: MCode, b: MCode) -> bool {
+    use MCode::*;
+    let group = |m| match m {
+        SpindleOn | SpindleOff | PositionOn | PositionOff | Orient => 1,
+        End | Stop => 2,
+        ToolChange => 3,
+        Coolant | Other => 0,
+    };
+    group(a) != 0 && group(a) == group(b)
+}
+
+fn conflict(w: &Word, other: &Word, line: &str) -> Found {
+    (
+        Rule::SameModalGroup,
+        w.span,
+        format!(
+            "`{}` and `{}` are of one modal group: a block may hold only one of them",
+            other.text(line),
+            w.text(line)
+        ),
+        Some("split them into two blocks in the order meant".into()),
+    )
+}
+
+fn unknown_code(w: &Word, line: &str) -> Found {
+    (
+        Rule::UnknownWord,
+        w.span,
+        format!("`{}` is not a code this controller knows", w.text(line)),
+        None,
+    )
+}

@@ -1,0 +1,536 @@
+//! The move of a block, as the controller would make it from the modal
+//! state: where it ends, whether it may be made at all (tool, spindle,
+//! feed mode and feed), whether it stays in the machine's travel and under
+//! its feed, whether a rapid crosses material already cut, and whether an
+//! arc is one the controller accepts.
+//!
+//! Rapids and the material: the reader knows no stock, so it takes the
+//! highest point any feed move has reached so far, along the axis the
+//! header names as out of the material (`+Z out of the material`; X on a
+//! roller), as the top of the material. A rapid that moves across (any
+//! other axis, C included) while either end is below that top, or that
+//! plunges below it, is refused. This is conservative: a rapid beside the
+//! part below its top is refused too.
+//!
+//! Arcs, by each controller's rule:
+//! - LinuxCNC (`interp_arc.cc`, `arc_data_ijk`, with its default
+//!   `CENTER_ARC_RADIUS_TOLERANCE_MM` = 2 × 0.01 × √2 mm and the relative
+//!   0.1 %): refused when the radii differ by more than 100 times that, or
+//!   by more than it and 0.1 % of the radius; a radius under 0.00127 mm is
+//!   a zero-radius arc;
+//! - Siemens 840D (MD 21000 `CIRCLE_ERROR_CONST` 0.01 mm, MD 21010
+//!   `CIRCLE_ERROR_FACTOR` 0.001): refused beyond the larger of 0.01 mm and
+//!   0.1 % of the radius (alarm 14095);
+//! - Fanuc (parameter 3410, alarm PS0020), Heidenhain and the
+//!   ultra-precision lathes: the dialect's `arc_radius_tolerance`, as the
+//!   controller's setting.
+//!
+//! An arc that ends where it starts is a full circle on every one of them.
+
+use super::lexer::{Block, Found, Word};
+use super::modal::{FeedMode, Motion, State};
+use super::{Controller, Rule};
+use crate::moves::Plane;
+
+const LETTERS: [char; 4] = ['X', 'Y', 'Z', 'C'];
+const AXIS: [&str; 4] = ["X", "Y", "Z", "C"];
+
+impl State {
+    /// The block's move, if it has one.
+    pub(crate) fn move_block(&mut self, b: &Block, line: &str, out: &mut Vec<Found>) {
+        let axes: Vec<&Word> = b
+            .words
+            .iter()
+            .filter(|w| LETTERS.contains(&w.letter))
+            .collect();
+        let centre: Vec<&Word> = b
+            .words
+            .iter()
+            .filter(|w| matches!(w.letter, 'I' | 'J' | 'K' | 'R'))
+            .collect();
+        // Centre words alone make a move only in an arc mode (a full
+        // circle); elsewhere they belong to their block (`M19 R0`).
+        let arc_mode = matches!(self.motion, Some(Motion::Cw | Motion::Ccw));
+        let Some(first) = axes.first().or(centre.first().filter(|_| arc_mode)) else {
+            return;
+        };
+        let last = b.words.last().expect("a word");
+        let span = (first.span.0, last.span.1);
+        let Some(motion) = self.motion.filter(|m| *m != Motion::Cancel) else {
+            out.push((
+                Rule::NoMotionMode,
+                first.span,
+                format!(
+                    "`{}` with no motion mode in force (G0, G1, G2, G3): the controller refuses it",
+                    first.text(line)
+                ),
+                None,
+            ));
+            return;
+        };
+        self.stated(span, out);
+        let start = self.pos;
+        let end = self.end_point(&axes);
+        if self.lex.controller == Controller::LinuxCnc && axes.iter().any(|w| w.letter == 'C') {
+            // LinuxCNC drives the spindle as the rotary axis C.
+            self.position_mode = true;
+        }
+        self.travel(&end, &axes, out);
+        match motion {
+            Motion::Rapid => self.rapid(&start, &end, span, out),
+            _ => self.feed_move(motion, b, &start, &end, &centre, span, line, out),
+        }
+        self.pos = end;
+    }
+
+    /// Units and distance mode must be stated before the first move.
+    fn stated(&self, span: (usize, usize), out: &mut Vec<Found>) {
+        let mut missing = Vec::new();
+        if self.metric.is_none() {
+            missing.push("units (G21 or G71)");
+        }
+        if self.absolute.is_none() {
+            missing.push("absolute or incremental (G90 or G91)");
+        }
+        if !missing.is_empty() {
+            out.push((
+                Rule::ModalStateUnstated,
+                span,
+                format!(
+                    "a move before the program states {}: the controller would use whatever an earlier program left",
+                    missing.join(" and ")
+                ),
+                None,
+            ));
+        }
+    }
+
+    fn end_point(&self, axes: &[&Word]) -> [Option<f64>; 4] {
+        let mut end = self.pos;
+        let unit = if self.metric == Some(false) {
+            25.4
+        } else {
+            1.0
+        };
+        for w in axes {
+            let i = LETTERS
+                .iter()
+                .position(|l| *l == w.letter)
+                .expect("an axis");
+            let mut v = w.value;
+            if i != 3 {
+                v *= unit;
+            }
+            if i == 0 && self.diameter {
+                v /= 2.0;
+            }
+            end[i] = if self.absolute == Some(false) {
+                self.pos[i].map(|p| p + v)
+            } else {
+                Some(v)
+            };
+        }
+        end
+    }
+
+    fn travel(&self, end: &[Option<f64>; 4], axes: &[&Word], out: &mut Vec<Found>) {
+        for (i, w) in axes
+            .iter()
+            .map(|w| (LETTERS.iter().position(|l| *l == w.letter), w))
+        {
+            let i = i.expect("an axis");
+            let (Some(v), Some((lo, hi))) = (end[i], self.machine.travel[i]) else {
+                continue;
+            };
+            let (v, lo, hi, unit) = if i == 3 {
+                (v, lo.to_degrees(), hi.to_degrees(), "°")
+            } else {
+                (v, lo, hi, " mm")
+            };
+            if v < lo - 1e-9 || v > hi + 1e-9 {
+                out.push((
+                    Rule::OutsideTravel,
+                    w.span,
+                    format!(
+                        "this move takes {} to {}{unit}, outside the machine's travel {} .. {}{unit}",
+                        AXIS[i],
+                        num(v),
+                        num(lo),
+                        num(hi)
+                    ),
+                    None,
+                ));
+            }
+        }
+    }
+
+    /// A rapid may not cross or plunge into the material cut so far.
+    fn rapid(
+        &self,
+        start: &[Option<f64>; 4],
+        end: &[Option<f64>; 4],
+        span: (usize, usize),
+        out: &mut Vec<Found>,
+    ) {
+        let a = self.away;
+        let (Some(top), Some(p), Some(q)) = (self.top, start[a], end[a]) else {
+            return;
+        };
+        let across = (0..4).any(|i| i != a && end[i].is_some() && end[i] != start[i]);
+        let low = p.min(q);
+        let bad = if across {
+            low < top - 1e-7
+        } else {
+            q < p && q < top - 1e-7
+        };
+        if bad {
+            out.push((
+                Rule::RapidIntoPart,
+                span,
+                format!(
+                    "a rapid {} at {}{} mm, below the highest point cut so far ({} mm): it would run the tool through the part",
+                    if across { "across" } else { "down" },
+                    AXIS[a],
+                    num(low.min(q)),
+                    num(top)
+                ),
+                Some(format!(
+                    "retract along +{} above {} mm before moving across",
+                    AXIS[a],
+                    num(top)
+                )),
+            ));
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn feed_move(
+        &mut self,
+        motion: Motion,
+        b: &Block,
+        start: &[Option<f64>; 4],
+        end: &[Option<f64>; 4],
+        centre: &[&Word],
+        span: (usize, usize),
+        line: &str,
+        out: &mut Vec<Found>,
+    ) {
+        self.may_cut(b, span, out);
+        let length = match motion {
+            Motion::Cw | Motion::Ccw => {
+                self.arc(motion == Motion::Cw, start, end, centre, span, line, out)
+            }
+            _ => chord(start, end),
+        };
+        if let Some(length) = length {
+            self.feed_limit(b, start, end, length, span, out);
+        }
+        if let Some(v) = end[self.away] {
+            self.top = Some(self.top.map_or(v, |t| t.max(v)));
+        }
+    }
+
+    /// Tool, spindle, feed mode and feed, before any cut.
+    fn may_cut(&self, b: &Block, span: (usize, usize), out: &mut Vec<Found>) {
+        if !self.tool_loaded {
+            out.push((
+                Rule::NoTool,
+                span,
+                "a cut before any tool is called: the controller cuts with whatever tool and offset it holds".into(),
+                Some(match self.lex.controller {
+                    Controller::LinuxCnc => "call the tool first: T… M6 (and G43)".into(),
+                    _ => "call the tool and its offset first (T…)".into(),
+                }),
+            ));
+        }
+        if !(self.spindle_on || self.position_mode) {
+            out.push((
+                Rule::SpindleStopped,
+                span,
+                "a feed move with the spindle stopped: the tool would plunge into a standing part"
+                    .into(),
+                Some("start the spindle (S… M3) before the first feed move".into()),
+            ));
+        }
+        if self.feed_mode.is_none() {
+            out.push((
+                Rule::NoFeedMode,
+                span,
+                "a feed move before the feed mode is stated (G94, G95 or G93): F would be read in whatever mode an earlier program left".into(),
+                None,
+            ));
+        }
+        let has_f = b.words.iter().any(|w| w.letter == 'F');
+        if self.feed.is_none() || (self.feed_mode == Some(FeedMode::InverseTime) && !has_f) {
+            out.push((
+                Rule::NoFeedRate,
+                span,
+                if self.feed_mode == Some(FeedMode::InverseTime) && self.feed.is_some() {
+                    "in inverse time (G93) every feed move carries its own F".into()
+                } else {
+                    "a feed move with no feed (F) stated in the feed mode in force".into()
+                },
+                None,
+            ));
+        }
+    }
+
+    /// The feed of the move (mm/min) against the machine's, and in inverse
+    /// time C's speed against the spindle's.
+    fn feed_limit(
+        &self,
+        b: &Block,
+        start: &[Option<f64>; 4],
+        end: &[Option<f64>; 4],
+        length: f64,
+        span: (usize, usize),
+        out: &mut Vec<Found>,
+    ) {
+        let (Some(f), Some(mode)) = (self.feed, self.feed_mode) else {
+            return;
+        };
+        let unit = if self.metric == Some(false) {
+            25.4
+        } else {
+            1.0
+        };
+        let rate = match mode {
+            FeedMode::PerMinute => Some(f * unit),
+            FeedMode::InverseTime => Some(length * f),
+            FeedMode::PerRevolution => self.revolutions(start, end).map(|rpm| f * unit * rpm),
+        };
+        let fspan = b
+            .words
+            .iter()
+            .find(|w| w.letter == 'F')
+            .map_or(span, |w| w.span);
+        if let (Some(rate), Some(max)) = (rate, self.machine.max_feed)
+            && rate > max * (1.0 + 1e-9)
+        {
+            out.push((
+                Rule::FeedTooHigh,
+                fspan,
+                format!(
+                    "this move feeds at {} mm/min, above the machine's {} mm/min",
+                    num(rate),
+                    num(max)
+                ),
+                None,
+            ));
+        }
+        if mode == FeedMode::InverseTime
+            && let (Some(c0), Some(c1), Some(max)) =
+                (start[3], end[3], self.machine.max_spindle_rpm)
+        {
+            let rpm = (c1 - c0).abs() * f / 360.0;
+            if rpm > max * (1.0 + 1e-9) {
+                out.push((
+                    Rule::SpindleTooFast,
+                    fspan,
+                    format!(
+                        "this move turns C at {} rpm, above the spindle's {} rpm",
+                        num(rpm),
+                        num(max)
+                    ),
+                    None,
+                ));
+            }
+        }
+    }
+
+    /// The spindle's speed (rpm) over a move: the stated rpm, or at
+    /// constant surface speed the speed at its smaller radius, capped.
+    fn revolutions(&self, start: &[Option<f64>; 4], end: &[Option<f64>; 4]) -> Option<f64> {
+        if self.css != Some(true) {
+            return self.rpm;
+        }
+        let v = self.css_speed?;
+        let r = start[0]?.abs().min(end[0]?.abs());
+        let rpm = 1000.0 * v / (2.0 * std::f64::consts::PI * r);
+        // Uncapped, the speed at the centre is unbounded: `NoSpeedCap`.
+        self.cap.map(|cap| rpm.min(cap))
+    }
+
+    /// An arc's words, radii and length (mm), by the controller's rules.
+    #[allow(clippy::too_many_arguments)]
+    fn arc(
+        &self,
+        cw: bool,
+        start: &[Option<f64>; 4],
+        end: &[Option<f64>; 4],
+        centre: &[&Word],
+        span: (usize, usize),
+        line: &str,
+        out: &mut Vec<Found>,
+    ) -> Option<f64> {
+        let Some(plane) = self.plane else {
+            out.push((
+                Rule::ModalStateUnstated,
+                span,
+                "an arc before the plane is stated (G17, G18 or G19)".into(),
+                None,
+            ));
+            return None;
+        };
+        let (a, b, letters, third) = match plane {
+            Plane::Xy => (0, 1, ['I', 'J'], 2),
+            Plane::Zx => (2, 0, ['K', 'I'], 1),
+            Plane::Yz => (1, 2, ['J', 'K'], 0),
+        };
+        let mut arc_words = |msg: String, s| out.push((Rule::ArcWords, s, msg, None));
+        if !self.arc_planes.contains(&plane) {
+            arc_words(
+                format!("this dialect has no arcs in the {plane:?} plane"),
+                span,
+            );
+            return None;
+        }
+        if let Some(w) = centre.iter().find(|w| !letters.contains(&w.letter)) {
+            arc_words(
+                format!(
+                    "`{}` in an arc of the {} plane, whose centre words are {} and {}",
+                    w.text(line),
+                    plane_name(plane),
+                    letters[0],
+                    letters[1]
+                ),
+                w.span,
+            );
+            return None;
+        }
+        if centre.is_empty() {
+            arc_words("an arc with no centre (I, J or K)".into(), span);
+            return None;
+        }
+        let (Some(sa), Some(sb), Some(ea), Some(eb)) = (start[a], start[b], end[a], end[b]) else {
+            return None;
+        };
+        let unit = if self.metric == Some(false) {
+            25.4
+        } else {
+            1.0
+        };
+        let word = |l: char| {
+            centre
+                .iter()
+                .find(|w| w.letter == l)
+                .map(|w| w.value * unit)
+        };
+        let (ca, cb) = if self.arc_centre_absolute {
+            (
+                word(letters[0]).unwrap_or(sa),
+                word(letters[1]).unwrap_or(sb),
+            )
+        } else {
+            (
+                sa + word(letters[0]).unwrap_or(0.0),
+                sb + word(letters[1]).unwrap_or(0.0),
+            )
+        };
+        let r1 = (sa - ca).hypot(sb - cb);
+        let r2 = (ea - ca).hypot(eb - cb);
+        self.arc_radii(r1, r2, (sa, sb) == (ea, eb), span, out);
+        let turn = {
+            let t = (eb - cb).atan2(ea - ca) - (sb - cb).atan2(sa - ca);
+            let tau = std::f64::consts::TAU;
+            let t = if cw {
+                (-t).rem_euclid(tau)
+            } else {
+                t.rem_euclid(tau)
+            };
+            if t == 0.0 { tau } else { t }
+        };
+        let rise = match (start[third], end[third]) {
+            (Some(p), Some(q)) => q - p,
+            _ => 0.0,
+        };
+        Some((0.5 * (r1 + r2) * turn).hypot(rise))
+    }
+
+    fn arc_radii(
+        &self,
+        r1: f64,
+        r2: f64,
+        closed: bool,
+        span: (usize, usize),
+        out: &mut Vec<Found>,
+    ) {
+        let zero = match self.lex.controller {
+            Controller::LinuxCnc => 0.00127,
+            _ => 1e-6,
+        };
+        if r1 < zero || r2 < zero {
+            out.push((
+                Rule::ZeroRadiusArc,
+                span,
+                format!(
+                    "an arc of radius {} mm: the controller refuses a zero-radius arc",
+                    num(r1.min(r2))
+                ),
+                None,
+            ));
+            return;
+        }
+        if closed {
+            out.push((
+                Rule::FullCircle,
+                span,
+                format!("this arc ends where it starts: the controller cuts a full circle of radius {} mm", num(r1)),
+                Some("an arc meant to have no length should be left out".into()),
+            ));
+        }
+        let diff = (r1 - r2).abs();
+        let (bad, limit) = match self.lex.controller {
+            Controller::LinuxCnc => {
+                let abs = 2.0 * 0.01 * std::f64::consts::SQRT_2;
+                let rel = diff / r1.max(r2);
+                (diff > abs * 100.0 || (rel > 0.001 && diff > abs), abs)
+            }
+            Controller::Siemens => {
+                let limit = 0.01f64.max(0.001 * r1.max(r2));
+                (diff > limit, limit)
+            }
+            _ => (diff > self.arc_tolerance, self.arc_tolerance),
+        };
+        if bad {
+            out.push((
+                Rule::ArcRadiusMismatch,
+                span,
+                format!(
+                    "the arc's radius is {} mm at its start and {} mm at its end; the controller allows {} mm",
+                    num(r1),
+                    num(r2),
+                    num(limit)
+                ),
+                None,
+            ));
+        }
+    }
+}
+
+fn chord(start: &[Option<f64>; 4], end: &[Option<f64>; 4]) -> Option<f64> {
+    let mut sum = 0.0;
+    for i in 0..3 {
+        match (start[i], end[i]) {
+            (Some(p), Some(q)) => sum += (q - p) * (q - p),
+            (None, Some(_)) => return None,
+            _ => {}
+        }
+    }
+    Some(sum.sqrt())
+}
+
+fn plane_name(p: Plane) -> &'static str {
+    match p {
+        Plane::Xy => "XY (G17)",
+        Plane::Zx => "ZX (G18)",
+        Plane::Yz => "YZ (G19)",
+    }
+}
+
+/// A figure for a message: up to 7 decimals, no trailing zeros.
+fn num(v: f64) -> String {
+    let s = format!("{v:.7}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" { "0".into() } else { s.to_string() }
+}

@@ -1,0 +1,157 @@
+use super::*;
+
+fn lathe() -> MachineLimits {
+    MachineLimits {
+        lathe: true,
+        travel: [Some((-10.0, 150.0)), None, Some((-100.0, 100.0)), None],
+        max_feed: Some(2000.0),
+        max_spindle_rpm: Some(3000.0),
+    }
+}
+
+/// The rules broken, in order of their lines.
+fn rules(text: &str, d: &Dialect, m: &MachineLimits) -> Vec<Rule> {
+    read(text, d, m).into_iter().map(|f| f.rule).collect()
+}
+
+const GOOD: &str = "(units mm; X is the radius, Z along the spindle axis, +Z out of the material)
+G18 G21 G90 G8 G40 G49 G80
+T1 M6
+G97 S500 M3
+G0 X3 Z1.5
+G95 G1 Z0.1 F0.002
+G2 X0 Z0.469317 I-3 K-12
+G0 Z1.5
+M5
+M2
+";
+
+#[test]
+fn a_complete_program_reads_clean() {
+    assert_eq!(rules(GOOD, &Dialect::linuxcnc(), &lathe()), vec![]);
+}
+
+#[test]
+fn each_change_breaks_its_rule() {
+    let d = Dialect::linuxcnc();
+    let cases: &[(&str, &str, Rule)] = &[
+        ("T1 M6\n", "", Rule::NoTool),
+        ("G97 S500 M3\n", "G97 S500\n", Rule::SpindleStopped),
+        ("G97 S500 M3\n", "S500 M3\n", Rule::SpindleSpeedMode),
+        ("G95 G1 Z0.1 F0.002", "G1 Z0.1 F0.002", Rule::NoFeedMode),
+        ("G95 G1 Z0.1 F0.002", "G95 G1 Z0.1", Rule::NoFeedRate),
+        ("G0 X3 Z1.5", "G0 X3 Z151.5", Rule::OutsideTravel),
+        ("F0.002", "F5", Rule::FeedTooHigh),
+        ("G0 Z1.5\nM5", "G0 Z1.5 X5\nG0 Z0\nM5", Rule::RapidIntoPart),
+        ("Z0.469317", "Z0.6", Rule::ArcRadiusMismatch),
+        ("I-3 K-12", "I-3 J-12", Rule::ArcWords),
+        ("G18 G21 G90", "G18 G90", Rule::ModalStateUnstated),
+        ("M2\n", "", Rule::ProgramEnd),
+        ("G0 X3 Z1.5", "G0 G1 X3 Z1.5", Rule::SameModalGroup),
+        ("G0 X3 Z1.5", "G0 X3 X3 Z1.5", Rule::RepeatedWord),
+        ("G97 S500", "G97 S5000", Rule::SpindleTooFast),
+        ("G97 S500", "G96 S50", Rule::NoSpeedCap),
+        ("G0 X3 Z1.5", "G0 X3 Z1.5 (approach", Rule::UnclosedComment),
+        ("G0 X3 Z1.5", "G0 X3 Z1.5 (a (b) c)", Rule::NestedComment),
+        ("G0 X3 Z1.5", "G0 X3 Z1.5 E3", Rule::UnknownWord),
+        ("M5", "M5.5", Rule::DecimalPoint),
+    ];
+    for (from, to, rule) in cases {
+        let text = GOOD.replacen(from, to, 1);
+        assert_ne!(text, GOOD, "{from}");
+        let found = rules(&text, &d, &lathe());
+        assert!(found.contains(rule), "{to}: {found:?}");
+    }
+}
+
+#[test]
+fn fanuc_reads_x_as_a_diameter_and_s_as_a_whole_number() {
+    let mut d = Dialect::linuxcnc();
+    d.start = vec!["%".into(), "O{number} ({JOB})".into()];
+    d.lathe_setup = vec!["G18 G21 G40 G80 G90".into()];
+    d.lathe_x_diameter = true;
+    d.max_digits = Some(8);
+    d.max_decimals = Some(4);
+    assert_eq!(Controller::of(&d), Controller::Fanuc);
+    let good = "%\nO1 (J)\nG18 G21 G40 G80 G90\nT0101\nG97 S500 M3\nG0 X6. Z1.5\nG95 G1 Z0.1 F0.002\nG2 X0. Z0.4693 I-3. K-12.\nG0 Z1.5\nM5\nM30\n%\n";
+    assert_eq!(rules(good, &d, &lathe()), vec![]);
+    let bad = good.replace("S500", "S500.");
+    assert_eq!(rules(&bad, &d, &lathe()), vec![Rule::DecimalPoint]);
+    let bad = good.replace("Z0.4693", "Z0.46932");
+    assert_eq!(rules(&bad, &d, &lathe()), vec![Rule::TooManyDecimals]);
+}
+
+#[test]
+fn inverse_time_needs_f_in_every_feed_block() {
+    let text = "(+Z out of the material)\nG18 G21 G90 G8\nT1 M6\nG0 X2 C0\nG0 Z1\nG93 G1 Z0 F60\nG1 X1.99 C10 F100\nG1 X1.98 C20\nG0 Z1\nM2\n";
+    let found = read(text, &Dialect::linuxcnc(), &lathe());
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert_eq!((found[0].rule, found[0].line), (Rule::NoFeedRate, 8));
+}
+
+#[test]
+fn a_finding_spans_its_words_in_the_whole_text() {
+    let text = GOOD.replace("G0 X3 Z1.5\n", "G0 X3 Z1.5 E3\n");
+    let found = read(&text, &Dialect::linuxcnc(), &lathe());
+    let f = found
+        .iter()
+        .find(|f| f.rule == Rule::UnknownWord)
+        .expect("found");
+    assert_eq!(&text[f.span.0..f.span.1], "E3");
+    assert_eq!(f.line, 5);
+}
+
+#[test]
+fn the_header_names_machine_and_dialect() {
+    let h = header_names("(lensc)\n(machine ultra_precision_lathe: linuxcnc lathe)\nG0 X0\n");
+    assert_eq!(
+        h,
+        Some(HeaderNames {
+            machine: "ultra_precision_lathe".into(),
+            dialect: "linuxcnc".into(),
+            kind: "lathe".into()
+        })
+    );
+    let h = header_names("N9 ; machine generic_3axis_mill: heidenhain_iso 3-axis mill *\n");
+    assert_eq!(h.map(|h| h.dialect), Some("heidenhain_iso".into()));
+}
+
+#[test]
+fn heidenhain_reads_arc_centres_where_they_are() {
+    let mut d = Dialect::linuxcnc();
+    d.comment = crate::dialect::CommentStyle::Semicolon;
+    d.block_end = " *".into();
+    d.line_numbers = Some(1);
+    d.max_line_number = Some(99999);
+    d.arc_centre_absolute = true;
+    d.surface_speed = Vec::new();
+    assert_eq!(Controller::of(&d), Controller::HeidenhainIso);
+    let mill = MachineLimits {
+        lathe: false,
+        travel: [
+            Some((-250.0, 250.0)),
+            Some((-200.0, 200.0)),
+            Some((-150.0, 150.0)),
+            None,
+        ],
+        max_feed: Some(5000.0),
+        max_spindle_rpm: None,
+    };
+    // The centre (X0.2, Z-10) is the circle's, not an offset from the start.
+    let good = "%J G71 *\nN1 ; +Z out of the material *\nN2 G17 G90 G40 *\nN3 T1 G17 S1000 *\nN4 M3 *\nN5 G00 Z1. *\nN6 G00 X-1. Y0. *\nN7 G94 G01 Z-0.1 F100. *\nN8 G18 G03 X1.5 Z-0.1126 I0.2 K-10. *\nN9 G00 Z1. *\nN10 M30 *\nN99999999 %J G71 *\n";
+    assert_eq!(rules(good, &d, &mill), vec![]);
+    d.arc_centre_absolute = false;
+    assert_eq!(rules(good, &d, &mill), vec![Rule::ArcRadiusMismatch]);
+}
+
+#[test]
+fn a_sinumerik_feed_type_cancels_constant_surface_speed() {
+    let mut d = Dialect::linuxcnc();
+    d.comment = crate::dialect::CommentStyle::Semicolon;
+    assert_eq!(Controller::of(&d), Controller::Siemens);
+    let text = "G18 G71 G90 DIAMOF G40 G94\nT1 D1\nS500 M3\nG0 X3. Z1.5\nG95 G1 Z0.1 F0.002\nG0 Z1.5\nM30\n";
+    // G94 (group 15 with G96/G97) states the spindle-speed mode: no G97 needed.
+    assert_eq!(rules(text, &d, &lathe()), vec![]);
+    let both = text.replace("G95 G1", "G95 G96 G1");
+    assert!(rules(&both, &d, &lathe()).contains(&Rule::SameModalGroup));
+}
