@@ -376,7 +376,7 @@ fn a_simulation_window_too_fine_is_refused_with_its_size() {
          use std::tools::microshaper_r85um\n\
          strategy scrape = raster { along: x, direction: one_way, stepover: 50 um, chord_tolerance: 1 um, feed: 100 mm/min }\n\
          job j { surface: s, tool: microshaper_r85um, machine: generic_3axis_mill, strategy: scrape,\n\
-             simulate: { x: -1 mm .. 1 mm, y: -1 mm .. 1 mm, spacing: 0.5 um } }\n",
+             simulate: { x: -1 mm .. 1 mm, y: -1 mm .. 1 mm, spacing: 20 nm } }\n",
     )
     .expect("write");
     let out = lensc(
@@ -391,7 +391,7 @@ fn a_simulation_window_too_fine_is_refused_with_its_size() {
     assert_eq!(out.status.code(), Some(1));
     let err = text(&out.stderr);
     assert!(
-        err.contains("E0149") && err.contains("16008001 cells"),
+        err.contains("E0149") && err.contains("10000200001 cells in 10001 tiles"),
         "{err}"
     );
     assert!(!dir.path().join("j.ngc").exists());

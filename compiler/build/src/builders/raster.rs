@@ -10,13 +10,13 @@ use lensc_lang::lower::job::RasterSpec;
 use lensc_runtime::plan::optimise::Summary;
 use lensc_runtime::plan::raster::{Axis, RasterPath, RasterTool, check_clearance};
 use lensc_runtime::post::Provenance;
-use lensc_runtime::verify::heightmap::Sweep;
 
 use crate::evaluate::evaluator;
-use crate::height_map::{self, domain_centre};
+use crate::height_map::{self, Simulation, domain_centre};
 use crate::output::{Built, ProgramText};
 use crate::parts;
 use crate::report;
+use lensc_runtime::verify::window::split;
 
 /// Builds a `raster` job on a `mill_3axis`.
 pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnostic>> {
@@ -70,22 +70,24 @@ pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnost
     let simulation = match tool {
         RasterTool::Knife { nose_radius } => {
             let along_x = raster.along == Axis::X;
-            let window = height_map::window(head, domain_centre(&lowered.domain));
+            let window = height_map::window(
+                head,
+                domain_centre(&lowered.domain),
+                height_map::domain_extent(&lowered.domain),
+            );
             let grid = window.cartesian(along_x);
-            let mut sweep = Sweep::new(grid, nose_radius);
-            height_map::sweep_mill_moves(&mut sweep, &moves, along_x, resolution);
+            let mut sweep = Simulation::new(grid, split(&grid, None), nose_radius);
+            height_map::sweep_mill_moves(sweep.path(), &moves, along_x, resolution);
             let frame = height_map::RasterFrame {
                 kernel: kernel.as_ref(),
                 along_x,
                 window,
                 domain: lowered.domain,
             };
-            let map = sweep.finish(&frame);
+            let (map, errors) = sweep.finish(&frame, &window, window.spacing);
             plots.form_error = Some(height_map::form_error_series(
-                &map,
-                &frame,
+                errors,
                 &window,
-                window.spacing,
                 ("x (mm)", "y (mm)"),
             ));
             let coordinates = if along_x {
@@ -97,12 +99,13 @@ pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnost
                 report::HeightMap::new(&map, &window, coordinates, raster.stepover);
             // The path's own error apart from the machine's resolution: the
             // same moves swept as computed (rounded to a picometre only).
-            let mut unrounded = Sweep::new(grid, nose_radius);
-            height_map::sweep_mill_moves(&mut unrounded, &moves, along_x, 1e-9);
+            let mut unrounded = Simulation::new(grid, split(&grid, None), nose_radius);
+            height_map::sweep_mill_moves(unrounded.path(), &moves, along_x, 1e-9);
             height_map.raster = Some(report::RasterEdge {
                 edge: "the knife's edge in its rake face, across the cut, as the planner places it",
                 contact_unrounded: unrounded
-                    .finish(&frame)
+                    .finish(&frame, &window, window.spacing)
+                    .0
                     .contact
                     .as_ref()
                     .map(report::Figures::from),
