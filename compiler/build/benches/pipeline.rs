@@ -173,28 +173,27 @@ fn plan_roller(spec: &JobSpec, keep: Option<&mut Vec<Vec<[f64; 3]>>>) -> usize {
 /// Seed 002's simulation alone, as its builder runs it: every printed
 /// point swept over the window's grid, the map finished against the design.
 fn simulate_roller(spec: &JobSpec, passes: &[Vec<[f64; 3]>]) -> usize {
-    use lensc_build::height_map::{self, RollerFrame};
+    use lensc_build::height_map::{self, RollerFrame, Simulation};
+    use lensc_runtime::verify::heightmap::NosePath;
     let JobSpec::Roller(s) = spec else {
         panic!("a roller")
     };
     let (head, helix) = (&s.head, &s.helix);
     let lowered = &head.surface.lowered;
     let (kernel, _) = lensc_build::evaluate::evaluator(&lowered.tape);
+    let (design_y, z) = (s.design_y, (helix.z_start, helix.z_end));
     let window = height_map::window(
         head,
-        (
-            (helix.z_start + helix.z_end) / 2.0,
-            (s.design_y.0 + s.design_y.1) / 2.0,
-        ),
+        ((z.0 + z.1) / 2.0, (design_y.0 + design_y.1) / 2.0),
+        height_map::roller_extent(&lowered.domain, z, design_y),
     );
-    let mut sweep = lensc_runtime::verify::heightmap::Sweep::new(
-        window.roller(helix.roller_radius),
-        s.tool.nose_radius,
-    );
+    let grid = window.roller(helix.roller_radius);
+    let tiles = lensc_runtime::verify::window::split(&grid, None);
+    let mut sweep = Simulation::new(grid, tiles, s.tool.nose_radius);
     for pass in passes {
-        sweep.lift();
+        sweep.path().lift();
         for &[c, z, x] in pass {
-            sweep.point(c, z, x);
+            sweep.path().point(c, z, x);
         }
     }
     let frame = RollerFrame {
@@ -203,7 +202,7 @@ fn simulate_roller(spec: &JobSpec, passes: &[Vec<[f64; 3]>]) -> usize {
         roller_radius: helix.roller_radius,
         domain: lowered.domain,
     };
-    let map = sweep.finish(&frame);
+    let map = sweep.finish(&frame, &window, window.spacing);
     std::hint::black_box(&map);
     passes.iter().map(Vec::len).sum()
 }
