@@ -21,6 +21,9 @@
 //! run on a quiet 2-core machine; too slow for CI). `PIPELINE_RUNS=N`
 //! changes the number of runs (default 2).
 
+#[path = "../../../runtime/benches/support/timing.rs"]
+mod timing;
+
 use std::path::Path;
 use std::time::Instant;
 
@@ -50,36 +53,14 @@ impl Times {
     }
 }
 
-/// The process's CPU time so far (s), every thread's.
-fn cpu_now() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    // Fields after the command's closing parenthesis: utime is the 12th
-    // and stime the 13th of them, in clock ticks (100 a second).
-    let rest = stat.rsplit_once(')').map_or("", |(_, r)| r);
-    let f: Vec<f64> = rest
-        .split_whitespace()
-        .map(|v| v.parse().unwrap_or(0.0))
-        .collect();
-    (f.get(11).copied().unwrap_or(f64::NAN) + f.get(12).copied().unwrap_or(f64::NAN)) / 100.0
-}
-
 fn timed<R>(f: impl FnOnce() -> R) -> (Times, R) {
-    let (t, c) = (Instant::now(), cpu_now());
+    let (t, c) = (Instant::now(), timing::cpu_seconds());
     let r = f();
     let times = Times {
         wall: t.elapsed().as_secs_f64(),
-        cpu: cpu_now() - c,
+        cpu: timing::cpu_seconds() - c,
     };
     (times, r)
-}
-
-fn peak_rss_mb() -> f64 {
-    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
-    status
-        .lines()
-        .find_map(|l| l.strip_prefix("VmHWM:"))
-        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<f64>().ok())
-        .map_or(f64::NAN, |kb| kb / 1024.0)
 }
 
 fn runs() -> usize {
@@ -273,6 +254,6 @@ fn main() {
     ratio("report / build", reported, built, "< 1");
     println!(
         "  peak resident memory (the simulation's points held in memory): {:.0} MB",
-        peak_rss_mb()
+        timing::peak_resident_mb()
     );
 }

@@ -13,39 +13,16 @@
 //! fewer cells, to stay cheap. Figures are printed, never gated on: the
 //! machine is shared.
 
+#[path = "../../../runtime/benches/support/timing.rs"]
+mod timing;
+
 use std::time::{Duration, Instant};
-
-/// CPU seconds (user + system) this process has used so far.
-fn cpu_seconds() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    // Fields after the command's closing parenthesis: utime is the 14th
-    // field of the line, stime the 15th, in clock ticks (100 a second).
-    let after = stat.rsplit_once(')').map_or("", |(_, rest)| rest);
-    let fields: Vec<&str> = after.split_whitespace().collect();
-    let ticks = |k: usize| {
-        fields
-            .get(k)
-            .and_then(|f| f.parse::<f64>().ok())
-            .unwrap_or(f64::NAN)
-    };
-    (ticks(11) + ticks(12)) / 100.0
-}
-
-/// The process's peak resident memory (MB).
-fn peak_resident_mb() -> f64 {
-    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
-    status
-        .lines()
-        .find_map(|l| l.strip_prefix("VmHWM:"))
-        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<f64>().ok())
-        .map_or(f64::NAN, |kb| kb / 1024.0)
-}
 
 fn build(src: &str) -> (Duration, f64, serde_json::Value) {
     let c =
         lensc_build::driver::check_text(&lensc_lang::loader::RealFs, "bench.lens", src.as_bytes());
     assert!(!c.has_errors(), "the bench's job checks");
-    let (t, cpu) = (Instant::now(), cpu_seconds());
+    let (t, cpu) = (Instant::now(), timing::cpu_seconds());
     // The program spooled to a temporary file, as `lensc build` does, so
     // the peak memory is the simulation's, not the 500 MB program text's.
     let spool = std::env::temp_dir();
@@ -55,7 +32,7 @@ fn build(src: &str) -> (Duration, f64, serde_json::Value) {
         "bench.lens",
         Some(spool.as_path()),
     );
-    let (e, cpu) = (t.elapsed(), cpu_seconds() - cpu);
+    let (e, cpu) = (t.elapsed(), timing::cpu_seconds() - cpu);
     assert!(
         diags.iter().all(|d| !d.is_error()),
         "the bench's job builds"
@@ -100,7 +77,7 @@ fn main() {
     );
     println!(
         "  peak resident memory:             {:>8.0} MB",
-        peak_resident_mb()
+        timing::peak_resident_mb()
     );
     println!(
         "  contacts over every lenslet: PV {} nm, RMS {} nm",
