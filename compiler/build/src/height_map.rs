@@ -11,7 +11,7 @@ use lensc_runtime::moves::{Move, Plane};
 use lensc_runtime::surface::analysis::Domain;
 use lensc_runtime::surface::ir::SurfaceFn;
 use lensc_runtime::verify::heightmap::{
-    ErrorRaster, Frame, Grid, HeightMap, NosePath, RasterLayout,
+    Cutter, ErrorRaster, Frame, Grid, HeightMap, NosePath, RasterLayout,
 };
 use lensc_runtime::verify::tiles::{Recorder, simulate};
 use lensc_runtime::verify::window::Tile;
@@ -37,17 +37,30 @@ pub struct Simulation {
     /// The window's whole grid (the report's), and its tiles.
     pub grid: Grid,
     pub tiles: Vec<Tile>,
-    nose_radius: f64,
+    cutter: Cutter,
     recorder: Recorder,
 }
 
 impl Simulation {
+    /// A simulation of a round nose of `nose_radius` whose edge lies
+    /// across the cut (a knife, a lathe's diamond).
     pub fn new(grid: Grid, tiles: Vec<Tile>, nose_radius: f64) -> Simulation {
+        Simulation::of(
+            grid,
+            tiles,
+            Cutter::Nose {
+                radius: nose_radius,
+            },
+        )
+    }
+
+    /// A simulation of `cutter`.
+    pub fn of(grid: Grid, tiles: Vec<Tile>, cutter: Cutter) -> Simulation {
         Simulation {
             grid,
-            recorder: Recorder::new(Recorder::band_of(&tiles, nose_radius)),
+            recorder: Recorder::new(Recorder::band_of(&tiles, cutter.radius())),
             tiles,
-            nose_radius,
+            cutter,
         }
     }
 
@@ -70,7 +83,7 @@ impl Simulation {
             &self.recorder,
             &self.tiles,
             self.grid,
-            self.nose_radius,
+            self.cutter,
             frame,
             layout,
         );
