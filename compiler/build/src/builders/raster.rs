@@ -90,7 +90,15 @@ pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnost
     );
     let grid = window.cartesian(along_x);
     let mut sweep = Simulation::of(grid, split(&grid, None), cutter);
-    height_map::sweep_mill_moves(sweep.path(), &moves, along_x, resolution);
+    // The program as written: its text read as the controller reads it.
+    let machine = lensc_runtime::reader::MachineLimits {
+        lathe: false,
+        travel: [None; 4],
+        max_feed: None,
+        max_spindle_rpm: None,
+    };
+    let (_, executed) = lensc_runtime::reader::read_moves(&text, dialect, &machine);
+    height_map::sweep_mill_program(sweep.path(), &executed, along_x);
     let frame = height_map::RasterFrame {
         kernel: kernel.as_ref(),
         along_x,
