@@ -277,16 +277,18 @@ pub fn sweep_mill_moves(sweep: &mut dyn NosePath, moves: &[Move], along_x: bool,
     }
 }
 
-/// The largest sagitta (mm) of the chords a blended arc is swept as: a
-/// hundredth of a nanometre.
-const ARC_SAGITTA: f64 = 1e-8;
+/// The largest change of radius (mm) over one circular piece of a
+/// blended arc: a circle at the piece's mean radius strays at most half of
+/// it, a tenth of a nanometre, from the controller's blend.
+const ARC_BLEND_STEP: f64 = 2e-7;
 
 /// Feeds a mill program's moves, read from its text as the controller
 /// reads it (`reader::read_moves`), to `sweep`: rapids lift the tool;
 /// straight moves are followed; an arc in the plane of the cut is cut as
 /// the controller cuts it, its radius blended from the start's to the
-/// end's over its turn (see `verify::simulate`), in chords of at most
-/// `ARC_SAGITTA`; an arc in another plane by its chord.
+/// end's over its turn (see `verify::simulate`), in circular pieces over
+/// which the radius changes by at most `ARC_BLEND_STEP` (each at most a
+/// quarter turn); an arc in another plane by its chord.
 pub fn sweep_mill_program(sweep: &mut dyn NosePath, moves: &[Executed], along_x: bool) {
     let su = |p: [f64; 3]| if along_x { (p[0], p[1]) } else { (p[1], p[0]) };
     let xyz = |v: &[Option<f64>; 4]| Some([v[0]?, v[1]?, v[2]?]);
@@ -329,15 +331,27 @@ pub fn sweep_mill_program(sweep: &mut dyn NosePath, moves: &[Executed], along_x:
             let r1 = (b.0 - centre.0).hypot(b.1 - centre.1);
             let start = (a.1 - centre.1).atan2(a.0 - centre.0);
             let sweep_angle = if cw { -turn } else { turn };
-            let step = (8.0 * ARC_SAGITTA / r0.max(r1).max(1e-9)).sqrt();
-            let n = ((sweep_angle.abs() / step).ceil() as usize).clamp(1, 1_000_000);
-            for k in 1..n {
-                let f = k as f64 / n as f64;
-                let (theta, r) = (start + f * sweep_angle, r0 + f * (r1 - r0));
-                let p = back((centre.0 + r * theta.cos(), centre.1 + r * theta.sin()));
+            let n = ((r1 - r0).abs() / ARC_BLEND_STEP)
+                .max(sweep_angle.abs() / std::f64::consts::FRAC_PI_2)
+                .ceil()
+                .clamp(1.0, 1e6) as usize;
+            // The centre in the sweep's (s, h): (X, Z) or (Y, Z).
+            let (cs, ch) = match plane {
+                Plane::Zx => (centre.1, centre.0),
+                _ => centre,
+            };
+            for k in 1..=n {
+                let p = if k == n {
+                    to
+                } else {
+                    let f = k as f64 / n as f64;
+                    let (theta, r) = (start + f * sweep_angle, r0 + f * (r1 - r0));
+                    back((centre.0 + r * theta.cos(), centre.1 + r * theta.sin()))
+                };
                 let (s, u) = su(p);
-                sweep.point(s, u, p[2]);
+                sweep.arc(s, u, p[2], (cs, ch));
             }
+            continue;
         }
         let (s, u) = su(to);
         sweep.point(s, u, to[2]);
