@@ -17,6 +17,7 @@ use crate::evaluate::evaluator;
 use crate::height_map::{self, RollerFrame};
 use crate::output::{Built, Destination};
 use crate::parts;
+use crate::progress::Meter;
 use crate::report;
 use crate::spool::ProgramSink;
 
@@ -25,6 +26,7 @@ pub fn build(
     spec: &RollerSpec,
     prov: &Provenance,
     to: Destination,
+    meter: Meter,
 ) -> Result<Built, Vec<Diagnostic>> {
     let (head, helix, rho) = (&spec.head, &spec.helix, spec.tool.nose_radius);
     let site = head.site;
@@ -46,7 +48,7 @@ pub fn build(
     program
         .call_tool(&head.start)
         .map_err(|e| vec![parts::not_printable(head, e)])?;
-    let mut sink = ProgramSink::new(to, site)?;
+    let mut sink = ProgramSink::new(to, site, meter)?;
     // The height map over the window, from the printed points of every
     // pass (the finish pass's envelope lies below the rough one's).
     let (design_y, z) = (spec.design_y, (helix.z_start, helix.z_end));
@@ -63,6 +65,7 @@ pub fn build(
         for q in pts {
             sweep.point(q.c, printed(q.z), printed(q.x));
         }
+        sink.planned(pts.len());
         sink.extend(|| program.extend(pass, pts));
         sink.push(program.take_text());
     });
