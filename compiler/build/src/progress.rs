@@ -3,8 +3,8 @@
 //! so far. The build only counts; the caller renders (the `lensc` binary
 //! draws a bar on a terminal or prints JSON lines). Reports are coarse:
 //! the planners' callbacks add to a counter (a revolution or a pass at a
-//! time, never a point at a time), and the observer hears of it once
-//! every `STEP` of the job's estimated points.
+//! time, never a point at a time), and the observer hears of it once a
+//! step: the job's estimated points over `STEPS`, at least `MIN_STEP`.
 
 use std::fmt;
 
@@ -133,7 +133,8 @@ impl Meter<'_> {
         Observer::default().meter("", 0)
     }
 
-    /// `n` more points planned.
+    /// `n` more points planned (after their text: `bytes`), told once a
+    /// step.
     pub fn points(&mut self, n: usize) {
         self.points += n as u64;
         if self.points - self.told >= self.step {
@@ -146,8 +147,8 @@ impl Meter<'_> {
         self.bytes += n as u64;
     }
 
-    /// Tells the observer the counts now (at the end of planning).
-    pub fn tell(&mut self) {
+    /// Tells the observer the counts now.
+    fn tell(&mut self) {
         self.told = self.points;
         self.observer.event(Event::Planned {
             job: self.job,
@@ -177,24 +178,24 @@ mod tests {
         let observer = Observer(Some(&seen));
         // 4 million points estimated: a step of 20,000.
         let mut m = observer.meter("j", 4_000_000);
+        // As the builders count: a revolution's text, then its points.
         for _ in 0..4_000 {
-            m.points(1_000);
             m.bytes(30_000);
+            m.points(1_000);
         }
-        m.tell();
         let seen = seen.0.into_inner().unwrap();
-        assert_eq!(seen.len(), 201);
+        assert_eq!(seen.len(), 200);
         assert_eq!(seen[0], (20_000, 600_000));
         assert_eq!(*seen.last().unwrap(), (4_000_000, 120_000_000));
-        assert!(seen.windows(2).all(|w| w[0].0 < w[1].0 || w[1] == w[0]));
+        assert!(seen.windows(2).all(|w| w[0].0 < w[1].0 && w[0].1 < w[1].1));
     }
 
     #[test]
-    fn a_small_job_is_told_at_its_end_only() {
+    fn a_small_job_is_not_told_while_it_plans() {
         let seen = Seen(Mutex::new(Vec::new()));
         let mut m = Observer(Some(&seen)).meter("j", 500);
         m.points(500);
-        m.tell();
-        assert_eq!(seen.0.into_inner().unwrap(), vec![(500, 0)]);
+        // Under a step: the pipeline tells the job's counts at its end.
+        assert!(seen.0.into_inner().unwrap().is_empty());
     }
 }

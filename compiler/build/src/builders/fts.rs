@@ -113,9 +113,9 @@ pub fn build(
         if let Some(sim) = following.as_mut() {
             sim.extend(&printed);
         }
-        sink.planned(pts.len());
         sink.extend(|| program.extend(pts));
         sink.push(program.take_text());
+        sink.planned(pts.len());
         if let Some(t) = table_sink.as_mut() {
             t.push(program.take_table_text());
         }

@@ -70,9 +70,9 @@ pub fn build(
         for q in pts {
             sweep.path().point(q.c, printed(q.z), printed(q.x));
         }
-        sink.planned(pts.len());
         sink.extend(|| program.extend(pass, pts));
         sink.push(program.take_text());
+        sink.planned(pts.len());
     });
     let mut path = planned.map_err(|e| vec![RuntimeError::Roller(e).at(site)])?;
     let limited = program.feed_limited().to_vec();
