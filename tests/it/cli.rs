@@ -235,8 +235,12 @@ job gouge { surface: bowl, tool: big, machine: linuxcnc_lathe, strategy: finish 
     );
     assert_eq!(out.status.code(), Some(1));
     let stdout = text(&out.stdout);
-    let v: serde_json::Value =
-        serde_json::from_str(stdout.lines().next().expect("a diagnostic")).expect("json");
+    // The first diagnostic, among the progress events.
+    let v: serde_json::Value = stdout
+        .lines()
+        .map(|l| serde_json::from_str::<serde_json::Value>(l).expect("json"))
+        .find(|v| v.get("event").is_none())
+        .expect("a diagnostic");
     assert_eq!(v["code"], "E0140");
     assert!(
         v["message"].as_str().expect("msg").contains("300 um"),

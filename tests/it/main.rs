@@ -31,6 +31,7 @@ mod limits;
 mod list;
 mod lsp;
 mod plots;
+mod progress;
 mod read_back;
 mod rs274;
 mod sandbox;

@@ -16,6 +16,7 @@ pub mod output;
 pub(crate) mod parts;
 pub mod pipeline;
 pub mod plots;
+pub mod progress;
 pub mod read_back;
 pub mod report;
 pub(crate) mod spool;

@@ -15,6 +15,7 @@ use lensc_runtime::surface::ir::{SurfaceFn, SurfaceTape};
 use crate::builders;
 use crate::evaluate::evaluator;
 use crate::output::{Built, Destination};
+use crate::progress::{Event, Meter, Observer, Phase};
 
 /// What `lensc build` was asked for beyond the file.
 #[derive(Clone, Copy, Debug, Default)]
@@ -29,6 +30,8 @@ pub struct Request<'a> {
     /// Whether a job whose simulated part misses its acceptance criteria
     /// is an error (the default) or a warning (`--accept=warn`).
     pub accept: crate::accept::Mode,
+    /// Who hears how far the build has got (`progress`), if anyone.
+    pub progress: Observer<'a>,
 }
 
 impl Request<'_> {
@@ -105,52 +108,114 @@ fn plan_jobs(
         source_hash: source_hash(&c.loaded),
         lensc_version: env!("CARGO_PKG_VERSION").to_string(),
     };
-    let jobs = c
+    let jobs: Vec<&CheckedJob> = c
         .checked
         .jobs
         .iter()
-        .filter(|j| request.job.is_none_or(|n| j.name.name == n));
-    for job in jobs {
-        let built = lower(job, request.dialect, &request.limits()).and_then(|(spec, est)| {
-            let mut b = build(&spec, &prov, to)?;
-            // A program formatted nowhere has nothing to read back.
-            if crate::read_back::enabled() && !matches!(to, Destination::Nowhere) {
-                let refused = crate::read_back::findings(job, spec.head(), &b.program);
-                if !refused.is_empty() {
-                    return Err(refused);
-                }
-            }
-            b.report.estimate = (&est).into();
-            let gate = crate::accept::gate(&spec, &mut b, request.accept);
-            Ok((b, gate))
+        .filter(|j| request.job.is_none_or(|n| j.name.name == n))
+        .collect();
+    let observer = request.progress;
+    for (index, job) in jobs.iter().enumerate() {
+        let name = job.name.name.as_str();
+        observer.event(Event::Job {
+            job: name,
+            index,
+            jobs: jobs.len(),
         });
-        match built {
+        match build_job(job, &request, &prov, to) {
             Ok((mut b, mut gate)) => {
                 diags.append(&mut b.warnings);
                 let refused = gate.iter().any(|d| d.is_error());
                 diags.append(&mut gate);
+                observer.event(Event::JobDone {
+                    job: name,
+                    built: !refused,
+                    points: b.cut_points as u64,
+                    bytes: b.program.bytes(),
+                });
                 // A job that fails its gate is not written (its spooled
                 // program is removed as it is dropped).
                 if !refused {
                     out.push(b);
                 }
             }
-            Err(mut d) => diags.append(&mut d),
+            Err(mut d) => {
+                diags.append(&mut d);
+                observer.event(Event::JobDone {
+                    job: name,
+                    built: false,
+                    points: 0,
+                    bytes: 0,
+                });
+            }
         }
     }
     (out, diags)
+}
+
+/// One job lowered, built, read back and held to its acceptance criteria,
+/// its observer told of each phase: what it built and the gate's
+/// findings, or why it could not be built.
+fn build_job(
+    job: &CheckedJob,
+    request: &Request,
+    prov: &Provenance,
+    to: Destination,
+) -> Result<(Built, Vec<Diagnostic>), Vec<Diagnostic>> {
+    let (name, observer) = (job.name.name.as_str(), request.progress);
+    let phase = |phase, est: Option<&Estimate>| {
+        observer.event(Event::Phase {
+            job: name,
+            phase,
+            estimated_points: est.map_or(0, |e| e.points as u64),
+            estimated_bytes: est.map_or(0, |e| e.program_bytes as u64),
+        })
+    };
+    phase(Phase::Lowering, None);
+    let (spec, est) = lower(job, request.dialect, &request.limits())?;
+    phase(Phase::Planning, Some(&est));
+    let meter = observer.meter(name, est.points as u64);
+    let mut b = build_metered(&spec, prov, to, meter)?;
+    // Every count, told at the end of planning.
+    observer.event(Event::Planned {
+        job: name,
+        points: b.cut_points as u64,
+        bytes: b.program.bytes(),
+    });
+    // A program formatted nowhere has nothing to read back.
+    if crate::read_back::enabled() && !matches!(to, Destination::Nowhere) {
+        phase(Phase::ReadingBack, Some(&est));
+        let refused = crate::read_back::findings(job, spec.head(), &b.program);
+        if !refused.is_empty() {
+            return Err(refused);
+        }
+    }
+    b.report.estimate = (&est).into();
+    let gate = crate::accept::gate(&spec, &mut b, request.accept);
+    Ok((b, gate))
 }
 
 /// Plans, emits and simulates one lowered job with its strategy's builder;
 /// the long programs go `to` memory, a spool file or nowhere (the
 /// acceptance gate is `plan_and_emit`'s, after it).
 pub fn build(spec: &JobSpec, prov: &Provenance, to: Destination) -> Result<Built, Vec<Diagnostic>> {
+    build_metered(spec, prov, to, Meter::silent())
+}
+
+/// `build`, the points the streamed builders plan and the bytes they
+/// format counted by `meter` as they go.
+fn build_metered(
+    spec: &JobSpec,
+    prov: &Provenance,
+    to: Destination,
+    meter: Meter,
+) -> Result<Built, Vec<Diagnostic>> {
     match spec {
         JobSpec::Turning(s) => builders::turning::build(s, prov),
-        JobSpec::Spiral(s) => builders::fts::build(s, prov, to),
+        JobSpec::Spiral(s) => builders::fts::build(s, prov, to, meter),
         JobSpec::Raster(s) => builders::raster::build(s, prov),
         JobSpec::Grinding(s) => builders::grinding::build(s, prov),
-        JobSpec::Roller(s) => builders::roller::build(s, prov, to),
+        JobSpec::Roller(s) => builders::roller::build(s, prov, to, meter),
     }
 }
 

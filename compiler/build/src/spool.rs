@@ -9,6 +9,7 @@ use lensc_lang::lower::job::JobHead;
 use lensc_runtime::post::ProgramError;
 
 use crate::output::{Destination, ProgramText};
+use crate::progress::Meter;
 
 /// Where a text goes as it is written: memory, a spool file, or nowhere.
 pub(crate) enum Sink {
@@ -95,20 +96,30 @@ impl Spool {
 
 /// A program streamed into a sink piece by piece as it is planned: the
 /// first error met writing it is kept, and no more is written after it.
-pub(crate) struct ProgramSink {
+pub(crate) struct ProgramSink<'a> {
     sink: Sink,
     error: Option<ProgramError>,
+    /// Counts the points planned and the bytes formatted, for the
+    /// build's observer.
+    meter: Meter<'a>,
 }
 
-impl ProgramSink {
+impl<'a> ProgramSink<'a> {
     pub(crate) fn new(
         to: Destination,
         site: (FileId, Span),
-    ) -> Result<ProgramSink, Vec<Diagnostic>> {
+        meter: Meter<'a>,
+    ) -> Result<ProgramSink<'a>, Vec<Diagnostic>> {
         Ok(ProgramSink {
             sink: Sink::new(to, site)?,
             error: None,
+            meter,
         })
+    }
+
+    /// `n` more points planned (a revolution's or a pass's at a time).
+    pub(crate) fn planned(&mut self, n: usize) {
+        self.meter.points(n);
     }
 
     /// Extends the program with `extend`, unless writing it has failed or
@@ -125,7 +136,10 @@ impl ProgramSink {
     /// Pushes the text the program has written so far.
     pub(crate) fn push(&mut self, text: Result<String, ProgramError>) {
         match text {
-            Ok(t) => self.sink.push(t),
+            Ok(t) => {
+                self.meter.bytes(t.len());
+                self.sink.push(t);
+            }
             Err(e) => {
                 self.error.get_or_insert(e);
             }

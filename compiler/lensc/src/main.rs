@@ -13,6 +13,7 @@ mod commands;
 mod interrupt;
 mod lsp;
 mod output;
+mod progress;
 
 use lensc_build::driver;
 use output::Output;
@@ -81,6 +82,10 @@ enum Command {
         /// exploration).
         #[arg(long, value_enum, default_value_t = AcceptChoice::Error)]
         accept: AcceptChoice,
+        /// No progress: neither the bar a terminal shows nor the JSON
+        /// progress events of `--message-format json`.
+        #[arg(long, short)]
+        quiet: bool,
     },
     /// Read a program back from its text as its controller would: modal
     /// state block by block, and every rule it breaks (feed moves with the
@@ -120,6 +125,10 @@ enum Command {
         /// refused before it is planned.
         #[arg(long, value_name = "SIZE", default_value = "4GB", value_parser = parse_size)]
         max_program_size: u64,
+        /// No progress: neither the bar a terminal shows nor the JSON
+        /// progress events of `--message-format json`.
+        #[arg(long, short)]
+        quiet: bool,
     },
     /// Analyse a surface over its aperture: sag range, slopes and radii of
     /// curvature with where they occur, as JSON on stdout.
@@ -304,7 +313,8 @@ fn run(cli: Cli) -> u8 {
             job,
             out: dir,
             max_program_size,
-        } => commands::report::run(&out, &file, job.as_deref(), &dir, max_program_size),
+            quiet,
+        } => commands::report::run(&out, &file, job.as_deref(), &dir, max_program_size, quiet),
         Command::Build {
             file,
             job,
@@ -312,6 +322,7 @@ fn run(cli: Cli) -> u8 {
             out: dir,
             max_program_size,
             accept,
+            quiet,
         } => commands::build::run(
             &out,
             &file,
@@ -323,8 +334,10 @@ fn run(cli: Cli) -> u8 {
                     AcceptChoice::Error => lensc_build::accept::Mode::Gate,
                     AcceptChoice::Warn => lensc_build::accept::Mode::Warn,
                 },
+                progress: lensc_build::progress::Observer::default(),
             },
             &dir,
+            quiet,
         ),
     }
 }

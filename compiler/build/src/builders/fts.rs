@@ -21,6 +21,7 @@ use crate::evaluate::evaluator;
 use crate::height_map::{self, LatheFrame, Simulation, Window};
 use crate::output::{Built, Destination};
 use crate::parts;
+use crate::progress::Meter;
 use crate::report;
 use crate::spool::{ProgramSink, Sink};
 
@@ -57,6 +58,7 @@ pub fn build(
     spec: &SpiralSpec,
     prov: &Provenance,
     to: Destination,
+    meter: Meter,
 ) -> Result<Built, Vec<Diagnostic>> {
     let (p, head) = (spec, &spec.head);
     let site = head.site;
@@ -75,7 +77,7 @@ pub fn build(
     .map_err(not_printable)?;
     program.hold_spindle_under(spec.max_spindle_speed);
     program.call_tool(&head.start).map_err(not_printable)?;
-    let mut sink = ProgramSink::new(to, site)?;
+    let mut sink = ProgramSink::new(to, site, meter)?;
     let mut table_sink = match table_name {
         Some(_) => Some(Sink::new(to, site)?),
         None => None,
@@ -113,6 +115,7 @@ pub fn build(
         }
         sink.extend(|| program.extend(pts));
         sink.push(program.take_text());
+        sink.planned(pts.len());
         if let Some(t) = table_sink.as_mut() {
             t.push(program.take_table_text());
         }

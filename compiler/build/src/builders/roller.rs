@@ -17,6 +17,7 @@ use crate::evaluate::evaluator;
 use crate::height_map::{self, RollerFrame, Simulation};
 use crate::output::{Built, Destination};
 use crate::parts;
+use crate::progress::Meter;
 use crate::report;
 use crate::spool::ProgramSink;
 use lensc_runtime::verify::window::split;
@@ -26,6 +27,7 @@ pub fn build(
     spec: &RollerSpec,
     prov: &Provenance,
     to: Destination,
+    meter: Meter,
 ) -> Result<Built, Vec<Diagnostic>> {
     let (head, helix, rho) = (&spec.head, &spec.helix, spec.tool.nose_radius);
     let site = head.site;
@@ -47,7 +49,7 @@ pub fn build(
     program
         .call_tool(&head.start)
         .map_err(|e| vec![parts::not_printable(head, e)])?;
-    let mut sink = ProgramSink::new(to, site)?;
+    let mut sink = ProgramSink::new(to, site, meter)?;
     // The height map over the window, from the printed points of every
     // pass (the finish pass's envelope lies below the rough one's).
     let (design_y, z) = (spec.design_y, (helix.z_start, helix.z_end));
@@ -70,6 +72,7 @@ pub fn build(
         }
         sink.extend(|| program.extend(pass, pts));
         sink.push(program.take_text());
+        sink.planned(pts.len());
     });
     let mut path = planned.map_err(|e| vec![RuntimeError::Roller(e).at(site)])?;
     let limited = program.feed_limited().to_vec();

@@ -2,70 +2,111 @@
 
 use std::path::Path;
 
-use lensc_build::driver;
+use lensc_build::driver::{self, Built};
 
 use crate::output::{Output, cannot_write, load_jobs};
+use crate::progress::Reporter;
 
 /// Runs the subcommand; returns the exit code.
-pub fn run(out: &Output, file: &Path, request: driver::Request, dir: &Path) -> u8 {
+pub fn run(out: &Output, file: &Path, request: driver::Request, dir: &Path, quiet: bool) -> u8 {
     crate::interrupt::clean_temporaries(dir);
     let c = match load_jobs(out, file, request.job) {
         Ok(c) => c,
         Err(code) => return code,
     };
-    let (programs, diags) =
-        driver::plan_and_emit(&c, request, &file.display().to_string(), Some(dir));
+    let source = file.display().to_string();
+    let reporter = Reporter::new(out, quiet, &source, jobs_asked(&c, request.job));
+    let request = driver::Request {
+        progress: reporter.observer(),
+        ..request
+    };
+    let (programs, diags) = driver::plan_and_emit(&c, request, &source, Some(dir));
     out.diagnostics(&c, &diags);
-    if diags.iter().any(|d| d.is_error()) {
-        return 1;
+    let code = if diags.iter().any(|d| d.is_error()) {
+        1
+    } else {
+        programs
+            .into_iter()
+            .try_for_each(|built| write_job(built, dir, &reporter))
+            .map_or_else(|code| code, |()| 0)
+    };
+    reporter.done(code == 0);
+    code
+}
+
+/// The jobs of the file a run builds: `job` alone, or all.
+pub fn jobs_asked(c: &driver::Checked, job: Option<&str>) -> usize {
+    c.checked
+        .jobs
+        .iter()
+        .filter(|j| job.is_none_or(|n| j.name.name == n))
+        .count()
+}
+
+/// Puts one built job's files in `dir` (the report first: a program on
+/// disk always has its report beside it) and says what was written.
+fn write_job(built: Built, dir: &Path, reporter: &Reporter) -> Result<(), u8> {
+    let names = std::iter::once(&built.program_name)
+        .chain([&built.report_name])
+        .chain(built.beside.iter().map(|(name, _)| name));
+    for name in names {
+        if let Err(e) = driver::output_path(dir, name) {
+            cannot_write(&dir.join(name), &e);
+            return Err(1);
+        }
     }
-    for built in programs {
-        let names = std::iter::once(&built.program_name)
-            .chain([&built.report_name])
-            .chain(built.beside.iter().map(|(name, _)| name));
-        for name in names {
-            if let Err(e) = driver::output_path(dir, name) {
-                cannot_write(&dir.join(name), &e);
-                return 1;
-            }
-        }
-        let target = dir.join(&built.program_name);
-        let report_path = dir.join(&built.report_name);
-        let report = built.report.to_json_text();
-        let lines = built.program.lines();
-        let beside: Vec<String> = built
-            .beside
-            .iter()
-            .map(|(name, text)| format!(", {} ({} lines)", dir.join(name).display(), text.lines()))
-            .collect();
-        // The report is written first: a program on disk always has
-        // its report beside it.
-        let mut written =
-            driver::write_atomic(&report_path, &report).map_err(|e| (report_path.clone(), e));
-        // Then what the program reads, then the program.
-        for (name, text) in built.beside {
-            let path = dir.join(&name);
-            written = written.and_then(|()| text.write_to(&path).map_err(|e| (path, e)));
-        }
-        let written = written.and_then(|()| {
-            built
-                .program
-                .write_to(&target)
-                .map_err(|e| (target.clone(), e))
+    let job = built.report.job.clone();
+    let target = dir.join(&built.program_name);
+    let report_path = dir.join(&built.report_name);
+    let report = built.report.to_json_text();
+    let lines = built.program.lines();
+    let beside: Vec<String> = built
+        .beside
+        .iter()
+        .map(|(name, text)| format!(", {} ({} lines)", dir.join(name).display(), text.lines()))
+        .collect();
+    let total = report.len() as u64
+        + built.program.bytes()
+        + built.beside.iter().map(|(_, t)| t.bytes()).sum::<u64>();
+    reporter.writing(&job, total);
+    let mut so_far = 0;
+    let mut wrote = |bytes: u64| {
+        so_far += bytes;
+        reporter.wrote(&job, bytes, so_far);
+    };
+    let mut written = driver::write_atomic(&report_path, &report)
+        .map(|()| wrote(report.len() as u64))
+        .map_err(|e| (report_path.clone(), e));
+    // Then what the program reads, then the program.
+    for (name, text) in built.beside {
+        let (path, bytes) = (dir.join(&name), text.bytes());
+        written = written.and_then(|()| {
+            text.write_to(&path)
+                .map(|()| wrote(bytes))
+                .map_err(|e| (path, e))
         });
-        if let Err((path, e)) = written {
-            cannot_write(&path, &e);
-            return 1;
-        }
-        eprintln!(
-            "wrote {} ({} lines, {} cut points, estimated cutting time {:.1} s){} and {}",
-            target.display(),
-            lines,
-            built.cut_points,
-            built.cutting_time,
-            beside.concat(),
-            report_path.display()
-        );
     }
-    0
+    let program_bytes = built.program.bytes();
+    let written = written.and_then(|()| {
+        built
+            .program
+            .write_to(&target)
+            .map(|()| wrote(program_bytes))
+            .map_err(|e| (target.clone(), e))
+    });
+    if let Err((path, e)) = written {
+        cannot_write(&path, &e);
+        return Err(1);
+    }
+    reporter.written(&job, 2 + beside.len(), total);
+    eprintln!(
+        "wrote {} ({} lines, {} cut points, estimated cutting time {:.1} s){} and {}",
+        target.display(),
+        lines,
+        built.cut_points,
+        built.cutting_time,
+        beside.concat(),
+        report_path.display()
+    );
+    Ok(())
 }
