@@ -28,9 +28,12 @@
 //! the envelope `envelope::piece_max` computes on a `Profile`. For a smooth
 //! section with ρ below its concave radius of curvature the function under
 //! the max has a single stationary point (its derivative can only cross
-//! zero downwards), so Newton's method from u = x on the exact derivatives
-//! finds the maximum; should it not converge, `piece_max` over the whole
-//! window does. Sections with concave corners or steps (seams between
+//! zero downwards), so Newton's method on the exact derivatives, from the
+//! previous point's contact (u = x for a revolution's first point), finds
+//! the maximum. Where it peaks on a convex corner instead (the ridge
+//! between two dimples of a grid) Newton bounces across it, and the corner
+//! is closed in on from both sides (`ridge`); should neither converge,
+//! `piece_max` over the whole window does. Sections with concave corners or steps (seams between
 //! lenslets) have several local maxima: when the planner's survey finds
 //! such corners, each window is scanned first and every local maximum
 //! refined (see `centre_height_scanned`). The paper's own method — normals
@@ -49,8 +52,10 @@
 //! Output. `plan_roller_helix` returns every pass's points (job 1's finish
 //! pass is 3 960 001 points, ~95 MB); `plan_roller_helix_into` hands them
 //! in order, a revolution at a time, to a sink and keeps only the figures.
-//! Revolutions are computed in parallel batches and each point depends
-//! only on its index: the output is identical for any thread count.
+//! Revolutions are computed in parallel batches; a point's contact search
+//! starts from the previous point's contact, and each revolution's first
+//! from u = x, so a revolution depends only on its index: the output is
+//! identical for any thread count.
 
 use std::f64::consts::TAU;
 use std::ops::ControlFlow;
@@ -60,6 +65,9 @@ use rayon::prelude::*;
 use crate::plan::envelope;
 use crate::surface::ir::SurfaceFn;
 use crate::surface::{Profile, ProfilePoint};
+
+mod ridge;
+use ridge::Probe;
 
 /// One helix over the whole cut.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -279,10 +287,27 @@ fn phi(section: &dyn Profile, rho: f64, x: f64, u: f64) -> (f64, f64) {
 /// The exact lowest nose-centre height over `section` at axial position
 /// `x`, for a section that is smooth (or has convex corners only) with ρ
 /// below its concave radius of curvature: Newton's method on
-/// φ′(u) = z′(u) − (u − x)/sqrt(ρ² − (u − x)²) from u = x, else
-/// `envelope::piece_max` over the whole window [x − ρ, x + ρ].
+/// φ′(u) = z′(u) − (u − x)/sqrt(ρ² − (u − x)²) from u = x; where Newton
+/// bounces across a convex corner (a ridge between dimples) the corner is
+/// closed in on (`ridge::corner_max`); else `envelope::piece_max` over the
+/// whole window [x − ρ, x + ρ].
 pub fn centre_height(section: &dyn Profile, rho: f64, x: f64) -> f64 {
-    let (mut u, mut p) = (x, section.point(x));
+    centre_height_from(section, rho, x, x).0
+}
+
+/// `centre_height`, Newton starting at `start` instead of at x (a start
+/// outside the open window starts at x), and the contact found: the
+/// height and the contact's u. Any start reaches the same stationary
+/// point; a start near it (the previous point's contact along a helix)
+/// saves iterations, each one a call of the surface's kernel.
+pub fn centre_height_from(section: &dyn Profile, rho: f64, x: f64, start: f64) -> (f64, f64) {
+    let mut u = if (start - x).abs() < rho { start } else { x };
+    let mut p = section.point(u);
+    // The nearest points seen on either side of the maximum (φ′ > 0 on
+    // the left, < 0 on the right), and how often Newton crossed it.
+    let (mut left, mut right): (Option<Probe>, Option<Probe>) = (None, None);
+    let mut crossings = 0;
+    let mut last_rising = None;
     for _ in 0..12 {
         let d = u - x;
         let s2 = rho * rho - d * d;
@@ -299,15 +324,44 @@ pub fn centre_height(section: &dyn Profile, rho: f64, x: f64) -> f64 {
         if step.abs() <= 1e-9 {
             // The single stationary point: φ here is below the maximum by
             // ~|φ″| step² / 2, far below a picometre.
-            return p.z + root;
+            return (p.z + root, u);
+        }
+        let here = Probe {
+            u,
+            z: p.z,
+            dz: p.dz,
+            d2z: p.d2z,
+            phi: p.z + root,
+            dphi,
+            ddphi,
+        };
+        let rising = dphi > 0.0;
+        if last_rising.is_some_and(|r| r != rising) {
+            crossings += 1;
+        }
+        last_rising = Some(rising);
+        if rising {
+            left = Some(left.map_or(here, |q| if q.u > u { q } else { here }));
+        } else {
+            right = Some(right.map_or(here, |q| if q.u < u { q } else { here }));
         }
         u += step;
+        if let (Some(lo), Some(hi)) = (left, right)
+            && lo.u < hi.u
+            && (u <= lo.u || u >= hi.u || crossings > 2)
+        {
+            // Bouncing across a corner of the section: close in on it.
+            if let Some(found) = ridge::corner_max(section, rho, x, lo, hi) {
+                return found;
+            }
+            break;
+        }
         if (u - x).abs() >= rho {
             break;
         }
         p = section.point(u);
     }
-    envelope::piece_max(section, rho, x, x - rho, x + rho).0
+    envelope::piece_max(section, rho, x, x - rho, x + rho)
 }
 
 /// Intervals the nose window is scanned in, for sections with corners.
@@ -763,12 +817,12 @@ pub fn plan_roller_helix_into(
     };
     let s = survey_reach(h, rho, design)?;
     let scanned = s.corners > 0;
-    let centre = |y: f64, x: f64| {
+    let centre = |y: f64, x: f64, start: f64| {
         let section = AxialSection { design, y };
         if scanned {
-            centre_height_scanned(&section, rho, x)
+            (centre_height_scanned(&section, rho, x), x)
         } else {
-            centre_height(&section, rho, x)
+            centre_height_from(&section, rho, x, start)
         }
     };
     let mut summaries = Vec::with_capacity(h.passes.len());
@@ -843,17 +897,21 @@ struct PassPlan<'a> {
 impl PassPlan<'_> {
     /// Plans the pass's points, a revolution at a time in parallel
     /// batches, hands them to `sink` in order, and sums them up.
-    /// `centre(y, x)` is the nose-centre height over the design;
+    /// `centre(y, x, start)` is the nose-centre height over the design
+    /// and the contact's u, its search started at u = `start`;
     /// `(cycle_offsets, max_depth_of_cut)` come from `cycles`.
     fn run(
         &self,
-        centre: &(impl Fn(f64, f64) -> f64 + Sync),
+        centre: &(impl Fn(f64, f64, f64) -> (f64, f64) + Sync),
         (cycle_offsets, max_depth_of_cut): (Vec<f64>, f64),
         sink: &mut (impl FnMut(usize, &[RollerPoint]) + Send),
     ) -> Result<PassSummary, RollerError> {
         let (h, pass, steps, total) = (self.h, self.pass, self.steps, self.total);
         let r_r = h.roller_radius;
-        let point = |k: usize| -> Result<RollerPoint, RollerError> {
+        // Point k, its contact searched from the previous point's contact
+        // `offset` (u − x) on: one C step on, it has moved a fraction of a
+        // micrometre.
+        let point = |k: usize, offset: &mut f64| -> Result<RollerPoint, RollerError> {
             let (c, z) = if k == steps {
                 (total, h.z_end)
             } else {
@@ -861,7 +919,9 @@ impl PassPlan<'_> {
                 (c, h.z_start + pass.pitch * c / TAU)
             };
             let y = r_r * c.rem_euclid(TAU);
-            let x = r_r + centre(y, z) + pass.finish_allowance;
+            let (height, contact) = centre(y, z, z + *offset);
+            *offset = contact - z;
+            let x = r_r + height + pass.finish_allowance;
             if x.is_finite() {
                 Ok(RollerPoint { c, z, x })
             } else {
@@ -894,7 +954,12 @@ impl PassPlan<'_> {
         let mut undefined = None;
         let make = |j: usize| -> Result<Vec<RollerPoint>, RollerError> {
             let k0 = j * per_chunk;
-            (k0..(k0 + per_chunk).min(steps + 1)).map(&point).collect()
+            // Each revolution starts its search at u = x: its points depend
+            // on their index alone, whichever thread makes them.
+            let mut offset = 0.0;
+            (k0..(k0 + per_chunk).min(steps + 1))
+                .map(|k| point(k, &mut offset))
+                .collect()
         };
         let take = |pts: Result<Vec<RollerPoint>, RollerError>| match pts {
             Ok(pts) => {
