@@ -582,6 +582,26 @@ impl Local {
         self.zvv / (1.0 + self.zv * self.zv).powf(1.5)
     }
 
+    /// Whether `max_principal_curvature` is surely not positive, from
+    /// signs alone: the mean curvature is negative and the Gaussian
+    /// positive (a convex cap) by a margin far above the rounding of
+    /// either, so the curvature as computed is not positive either
+    /// (√(h² − k) ≤ |h| when k ≥ 0) and its radius is no concave radius.
+    /// Saves the square roots and divisions at every convex contact.
+    fn surely_not_concave(&self) -> bool {
+        let (e, f, g) = (
+            1.0 + self.zu * self.zu,
+            self.zu * self.zv,
+            1.0 + self.zv * self.zv,
+        );
+        let (gl, fm, en) = (g * self.zuu, 2.0 * f * self.zuv, e * self.zvv);
+        let mean = en - fm + gl;
+        let (ln, mm) = (self.zuu * self.zvv, self.zuv * self.zuv);
+        let gauss = ln - mm;
+        const MARGIN: f64 = 1e-9;
+        mean < -MARGIN * (gl.abs() + fm.abs() + en.abs()) && gauss > MARGIN * (ln.abs() + mm)
+    }
+
     /// The larger principal curvature (1/mm), positive where concave.
     fn max_principal_curvature(&self) -> f64 {
         let w2 = 1.0 + self.zu * self.zu + self.zv * self.zv;
@@ -998,6 +1018,10 @@ struct Summary {
     /// The smallest concave radius the tool must fit (across the cut for
     /// the knife, principal for the ball).
     tool_limit: Option<Extremum>,
+    /// |z_u| and |z_v| at the steepest contacts so far: a contact no
+    /// steeper cannot have a larger slope (atan is monotonic), so its
+    /// arctangent is never taken (most contacts' are not).
+    steepest: [f64; 2],
 }
 
 impl Summary {
@@ -1013,30 +1037,51 @@ impl Summary {
             slope_across: zero,
             concave_along: None,
             tool_limit: None,
+            steepest: [f64::NEG_INFINITY; 2],
         }
     }
 
     fn see(&mut self, c: &Contact, cutter: &Cutter) {
         let (x, y) = xy(self.along, c.u, c.v);
         let at = |value: f64| Extremum { value, x, y };
-        let along = c.l.zu.abs().atan();
-        if along > self.slope_along.value || self.slope_along.x.is_nan() {
-            self.slope_along = at(along);
-        }
-        let across = c.l.zv.abs().atan();
-        if across > self.slope_across.value || self.slope_across.x.is_nan() {
-            self.slope_across = at(across);
+        for (k, (slope, extremum)) in [
+            (c.l.zu.abs(), &mut self.slope_along),
+            (c.l.zv.abs(), &mut self.slope_across),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            // atan(s) > atan(steepest) only if s > steepest.
+            if slope > self.steepest[k] || extremum.x.is_nan() {
+                let angle = slope.atan();
+                if angle > extremum.value || extremum.x.is_nan() {
+                    *extremum = at(angle);
+                    self.steepest[k] = slope;
+                }
+            }
         }
         let smaller = |old: &Option<Extremum>, radius: f64| {
             radius.is_finite() && radius > 0.0 && old.is_none_or(|e| radius < e.value)
         };
-        let r_along = 1.0 / c.l.curvature_along();
-        if smaller(&self.concave_along, r_along) {
-            self.concave_along = Some(at(r_along));
+        // A radius is positive only where the section curves towards the
+        // tool (its second derivative positive): elsewhere its power and
+        // division are not worked out.
+        if c.l.zuu > 0.0 {
+            let r_along = 1.0 / c.l.curvature_along();
+            if smaller(&self.concave_along, r_along) {
+                self.concave_along = Some(at(r_along));
+            }
         }
-        let r_tool = cutter.limiting_radius(&c.l);
-        if smaller(&self.tool_limit, r_tool) {
-            self.tool_limit = Some(at(r_tool));
+        let concave = if cutter.ball {
+            !c.l.surely_not_concave()
+        } else {
+            c.l.zvv > 0.0
+        };
+        if concave {
+            let r_tool = cutter.limiting_radius(&c.l);
+            if smaller(&self.tool_limit, r_tool) {
+                self.tool_limit = Some(at(r_tool));
+            }
         }
     }
 
