@@ -136,21 +136,6 @@ pub fn push_units_to(text: &mut Vec<u8>, n: i64, decimals: u32) -> usize {
     digits
 }
 
-/// Prints `n` units of 10^−decimals at the start of `room`, as
-/// `print_units` prints them (the rest of `room` is filler); returns the
-/// number's length and its count of digits.
-#[inline(always)]
-pub fn print_units_at(room: &mut [u8; PRINTED_ROOM], n: i64, decimals: u32) -> (usize, usize) {
-    *room = [b'0'; PRINTED_ROOM];
-    print_into(room, n, decimals)
-}
-
-/// 10^`d` (`d` at most 18).
-#[inline(always)]
-pub fn pow10(d: u32) -> u64 {
-    POW10[d.min(18) as usize]
-}
-
 /// Prints into `room` (at least `PRINTED_ROOM` long, all `'0'`); returns
 /// the number's length and its count of digits.
 #[inline(always)]

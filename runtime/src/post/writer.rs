@@ -2,14 +2,11 @@
 //! word, with every number through the one fixed-point formatter.
 
 use super::ProgramError;
-use super::format::{decimals_for, fixed_units, pow10, push_fixed};
+use super::format::{decimals_for, fixed_units, push_fixed, push_units_to};
 use super::header::{num, write_comment};
 use crate::dialect::{CommentStyle, Dialect, WordFormat};
 use crate::moves::{Coolant, Plane, Position, Rotation, Start};
-use block::{Block, NUMBER_ROOM, Snippet};
 use std::f64::consts::PI;
-
-mod block;
 
 /// Which safe-start lines a program uses, and the arc plane they select.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -109,9 +106,6 @@ pub struct ProgramWriter {
     integer_limit: [u64; 26],
     /// Decimals of feeds per minute and per revolution.
     feed_decimals: u32,
-    /// The room a motion block is printed into (`Block`): bytes of the
-    /// longest one the dialect's words allow.
-    block_room: usize,
     pub moves: usize,
 }
 
@@ -244,44 +238,8 @@ impl ProgramWriter {
                 .format_of('F')
                 .and_then(|f| f.decimals)
                 .map_or(FEED_DECIMALS, |d| d.min(FEED_DECIMALS)),
-            block_room: 0,
             moves: 0,
         }
-        .with_block_room()
-    }
-
-    /// The writer with its block room sized for the longest motion
-    /// block: a block number, a feed-mode word, a plane word, the motion
-    /// word, four axes, two arc centres, a feed and the block end, each
-    /// piece at least the fixed size it is copied as.
-    fn with_block_room(mut self) -> Self {
-        let feed_mode = [
-            &self.dialect.per_minute,
-            &self.dialect.per_revolution,
-            &self.dialect.inverse_time,
-        ]
-        .iter()
-        .map(|w| w.as_deref().map_or(0, str::len) + 1)
-        .max()
-        .unwrap_or(0);
-        let motion = self
-            .motion_words
-            .iter()
-            .map(Snippet::room)
-            .max()
-            .unwrap_or(0);
-        let axes: usize = self.axis_words.iter().map(|w| w.room() + NUMBER_ROOM).sum();
-        let room = 2
-            + 20
-            + feed_mode
-            + 4
-            + motion
-            + axes
-            + 2 * (2 + NUMBER_ROOM)
-            + (2 + NUMBER_ROOM)
-            + self.line_end.room();
-        self.block_room = room;
-        self
     }
 
     /// Calls the tool and sets the coolant: the dialect's tool-call blocks
@@ -349,53 +307,24 @@ impl ProgramWriter {
     fn end_block(&mut self, start: usize) -> Result<(), ProgramError> {
         // The line's length is where the text ends now: nothing rescanned.
         if self.text.len() - start + self.dialect.block_end.len() > self.max_line_length {
-            let e = self.line_too_long(&self.text[start..]);
-            self.text.truncate(start);
-            return Err(e);
+            return Err(self.line_too_long(start));
         }
         self.line_end.push_to(&mut self.text);
-        self.next_block_number();
-        Ok(())
-    }
-
-    /// The next block's number, if the dialect numbers blocks.
-    #[inline(always)]
-    fn next_block_number(&mut self) {
         if let Some(step) = self.dialect.line_numbers {
             self.block += step;
             if self.dialect.max_line_number.is_some_and(|m| self.block > m) {
                 self.block = step;
             }
         }
+        Ok(())
     }
 
-    /// Starts a motion block: its number, if the dialect numbers blocks.
-    #[inline(always)]
-    fn begin_motion_block(&self, b: &mut Block) {
-        if self.dialect.line_numbers.is_some() {
-            b.push(b'N');
-            b.push_bytes(itoa::Buffer::new().format(self.block).as_bytes());
-            b.push(b' ');
-        }
-    }
-
-    /// Ends a motion block: the dialect's block end, the line-length
-    /// limit, the next block number. Its length.
-    #[inline(always)]
-    fn end_motion_block(&mut self, mut b: Block) -> Result<usize, ProgramError> {
-        if b.len() + self.dialect.block_end.len() > self.max_line_length {
-            return Err(self.line_too_long(b.as_bytes()));
-        }
-        b.push_snippet(&self.line_end);
-        self.next_block_number();
-        Ok(b.len())
-    }
-
-    /// Refuses the block `text` (its block end not yet written) for its length.
+    /// Refuses the block begun at byte `start` for its length.
     #[cold]
-    fn line_too_long(&self, text: &[u8]) -> ProgramError {
-        let mut line = String::from_utf8_lossy(text).into_owned();
+    fn line_too_long(&mut self, start: usize) -> ProgramError {
+        let mut line = String::from_utf8_lossy(&self.text[start..]).into_owned();
         line.push_str(&self.dialect.block_end);
+        self.text.truncate(start);
         ProgramError::Unsupported(format!(
             "a line of {} characters ({} reads at most {}): {line}",
             line.len(),
@@ -449,28 +378,22 @@ impl ProgramWriter {
         }
     }
 
-    /// Appends a value's digits (`Block::push_units`), refused if more than
+    /// Appends a value's digits (`push_units_to`), refused if more than
     /// the dialect's limit (the caller cuts the block off). The digits
     /// come from an integer count of units, so they cannot spell an
     /// exponent, NaN or `-0`: `check_number` holds of them by construction
     /// (the format module's tests hold the printer to that), and is
     /// asserted again in debug builds.
     #[inline(always)]
-    fn number(
-        &self,
-        b: &mut Block,
-        letter: char,
-        v: f64,
-        n: i64,
-        d: u32,
-    ) -> Result<(), ProgramError> {
-        let (_printed, digits) = b.push_units(n, d);
-        debug_assert!(check_number(_printed).is_ok());
+    fn number(&mut self, letter: char, v: f64, n: i64, d: u32) -> Result<(), ProgramError> {
+        let at = self.text.len();
+        let digits = push_units_to(&mut self.text, n, d);
+        debug_assert!(check_number(&self.text[at..]).is_ok());
         if digits > self.max_digits {
             return Err(self.too_many_digits(letter, v, digits));
         }
         let limit = self.integer_limit[letter_index(letter)];
-        if limit != u64::MAX && n.unsigned_abs() / pow10(d) >= limit {
+        if limit != u64::MAX && n.unsigned_abs() / 10u64.pow(d.min(18)) >= limit {
             return Err(self.too_many_integer_digits(letter, v));
         }
         Ok(())
@@ -518,20 +441,12 @@ impl ProgramWriter {
             }
             _ => return self.write_spindle(m),
         };
-        if !to.c.is_nan() && !self.c_axis_on && self.letters[3].is_some() {
-            self.c_axis_on_lines()?;
+        let start = self.text.len();
+        let r = self.motion(word, to, feed, arc);
+        if r.is_err() {
+            self.text.truncate(start);
         }
-        // The block is printed into room at the end of the text, taken
-        // out for the while so the block and the writer are borrowed
-        // apart, and cut back to the block (to nothing if it is refused
-        // or changes no printed axis).
-        let mut text = std::mem::take(&mut self.text);
-        let at = text.len();
-        text.resize(at + self.block_room, 0);
-        let r = self.motion(Block::new(&mut text[at..]), word, to, feed, arc);
-        text.truncate(at + *r.as_ref().unwrap_or(&0));
-        self.text = text;
-        r.map(|_| ())
+        r
     }
 
     /// Writes a move that is not a motion: the spindle's.
@@ -679,19 +594,22 @@ impl ProgramWriter {
     #[inline(always)]
     fn motion(
         &mut self,
-        mut b: Block,
         word: Word,
         to: Position,
         feed: Option<crate::moves::Feed>,
         arc: Option<(Plane, Position)>,
-    ) -> Result<usize, ProgramError> {
+    ) -> Result<(), ProgramError> {
         use crate::moves::Feed as F;
+        if !to.c.is_nan() && !self.c_axis_on && self.letters[3].is_some() {
+            self.c_axis_on_lines()?;
+        }
         if !matches!(word, Word::Rapid) && self.spindle == Spindle::Stopped && !self.c_axis_on {
             return Err(ProgramError::Unsupported(
                 "a feed move with the spindle stopped".into(),
             ));
         }
-        self.begin_motion_block(&mut b);
+        let start = self.text.len();
+        self.begin_block();
         let mode = feed.map(|f| match f {
             F::PerTime(v) => (FeedMode::PerMinute, v * 60.0, self.feed_decimals),
             F::PerRevolution(v) => (FeedMode::PerRevolution, v * 2.0 * PI, self.feed_decimals),
@@ -701,8 +619,9 @@ impl ProgramWriter {
         if let Some((m, _, _)) = mode
             && mode_changes
         {
-            b.push_bytes(self.feed_mode_word(m)?.as_bytes());
-            b.push(b' ');
+            let w = self.feed_mode_word(m)?.to_string();
+            self.text.extend_from_slice(w.as_bytes());
+            self.text.push(b' ');
         }
         if let Some((plane, _)) = arc {
             if !self.dialect.arc_planes.contains(&plane) {
@@ -712,7 +631,7 @@ impl ProgramWriter {
                 )));
             }
             if plane != self.plane {
-                b.push_bytes(match plane {
+                self.text.extend_from_slice(match plane {
                     Plane::Xy => b"G17 ",
                     Plane::Zx => b"G18 ",
                     Plane::Yz => b"G19 ",
@@ -720,7 +639,7 @@ impl ProgramWriter {
                 self.plane = plane;
             }
         }
-        b.push_snippet(&self.motion_words[word as usize]);
+        self.motion_words[word as usize].push_to(&mut self.text);
         let axes = to.axes();
         let mut printed = [0i64; 4];
         let mut changed = 0u8;
@@ -742,21 +661,22 @@ impl ProgramWriter {
             if self.last[i] == Some(n) {
                 continue;
             }
-            b.push_snippet(&self.axis_words[i]);
-            self.number(&mut b, letter, value, n, d)?;
+            self.axis_words[i].push_to(&mut self.text);
+            self.number(letter, value, n, d)?;
             printed[i] = n;
             changed |= 1 << i;
         }
         if changed == 0 {
-            return Ok(0);
+            self.text.truncate(start);
+            return Ok(());
         }
         if let Some((plane, centre)) = arc {
-            self.arc_centre(&mut b, plane, to, centre)?;
+            self.arc_centre(plane, to, centre)?;
         }
         if let Some(mode) = mode {
-            self.feed_word(&mut b, mode, mode_changes)?;
+            self.feed_word(mode, mode_changes)?;
         }
-        let len = self.end_motion_block(b)?;
+        self.end_block(start)?;
         for (i, n) in printed.into_iter().enumerate() {
             if changed & 1 << i != 0 {
                 self.last[i] = Some(n);
@@ -768,7 +688,7 @@ impl ProgramWriter {
             }
         }
         self.moves += 1;
-        Ok(len)
+        Ok(())
     }
 
     /// The feed word: written when the mode or the printed feed changes,
@@ -776,7 +696,6 @@ impl ProgramWriter {
     #[inline(always)]
     fn feed_word(
         &mut self,
-        b: &mut Block,
         (m, value, d): (FeedMode, f64, u32),
         mode_changes: bool,
     ) -> Result<(), ProgramError> {
@@ -784,8 +703,8 @@ impl ProgramWriter {
             return Err(ProgramError::NotPrintable { word: 'F', value });
         };
         if mode_changes || m == FeedMode::InverseTime || self.last_feed != Some(n) {
-            b.push_bytes(b" F");
-            self.number(b, 'F', value, n, d)?;
+            self.text.extend_from_slice(b" F");
+            self.number('F', value, n, d)?;
         }
         self.last_feed = Some(n);
         self.mode = Some(m);
@@ -836,8 +755,7 @@ impl ProgramWriter {
     /// controller checks them.
     #[inline(never)]
     fn arc_centre(
-        &self,
-        block: &mut Block,
+        &mut self,
         plane: Plane,
         to: Position,
         centre: Position,
@@ -883,8 +801,8 @@ impl ProgramWriter {
                 });
             };
             let letter = ['I', 'J', 'K'][i];
-            block.push_bytes(&[b' ', letter as u8]);
-            self.number(block, letter, c - from, cu - fu, self.decimals)?;
+            self.text.extend_from_slice(&[b' ', letter as u8]);
+            self.number(letter, c - from, cu - fu, self.decimals)?;
         }
         Ok(())
     }
@@ -948,6 +866,47 @@ impl ProgramWriter {
 fn utf8(text: Vec<u8>) -> Result<String, ProgramError> {
     String::from_utf8(text)
         .map_err(|_| ProgramError::Unsupported("program text that is not UTF-8".into()))
+}
+
+/// A short piece of program text (a word's letter, a motion word, a
+/// block end), kept in a fixed array so appending it is a copy of fixed
+/// size and a cut back (no call to `memcpy`); longer pieces as they are.
+struct Snippet {
+    room: [u8; SNIPPET_ROOM],
+    len: usize,
+    long: Box<[u8]>,
+}
+
+const SNIPPET_ROOM: usize = 16;
+
+impl Snippet {
+    fn new(text: &str) -> Snippet {
+        let b = text.as_bytes();
+        let mut room = [0; SNIPPET_ROOM];
+        if b.len() <= SNIPPET_ROOM {
+            room[..b.len()].copy_from_slice(b);
+        }
+        Snippet {
+            room,
+            len: b.len(),
+            long: if b.len() > SNIPPET_ROOM {
+                b.into()
+            } else {
+                Box::default()
+            },
+        }
+    }
+
+    #[inline]
+    fn push_to(&self, text: &mut Vec<u8>) {
+        if self.len <= SNIPPET_ROOM {
+            let at = text.len();
+            text.extend_from_slice(&self.room);
+            text.truncate(at + self.len);
+        } else {
+            text.extend_from_slice(&self.long);
+        }
+    }
 }
 
 #[derive(Clone, Copy)]
