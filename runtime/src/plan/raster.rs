@@ -582,6 +582,26 @@ impl Local {
         self.zvv / (1.0 + self.zv * self.zv).powf(1.5)
     }
 
+    /// Whether `max_principal_curvature` is surely not positive, from
+    /// signs alone: the mean curvature is negative and the Gaussian
+    /// positive (a convex cap) by a margin far above the rounding of
+    /// either, so the curvature as computed is not positive either
+    /// (√(h² − k) ≤ |h| when k ≥ 0) and its radius is no concave radius.
+    /// Saves the square roots and divisions at every convex contact.
+    fn surely_not_concave(&self) -> bool {
+        let (e, f, g) = (
+            1.0 + self.zu * self.zu,
+            self.zu * self.zv,
+            1.0 + self.zv * self.zv,
+        );
+        let (gl, fm, en) = (g * self.zuu, 2.0 * f * self.zuv, e * self.zvv);
+        let mean = en - fm + gl;
+        let (ln, mm) = (self.zuu * self.zvv, self.zuv * self.zuv);
+        let gauss = ln - mm;
+        const MARGIN: f64 = 1e-9;
+        mean < -MARGIN * (gl.abs() + fm.abs() + en.abs()) && gauss > MARGIN * (ln.abs() + mm)
+    }
+
     /// The larger principal curvature (1/mm), positive where concave.
     fn max_principal_curvature(&self) -> f64 {
         let w2 = 1.0 + self.zu * self.zu + self.zv * self.zv;
@@ -968,25 +988,86 @@ impl<'a> Cutter<'a> {
                 return Ok(true);
             }
         }
-        let mut d = [0.0; PROBES + 1];
-        for (i, di) in d.iter_mut().enumerate().take(PROBES).skip(1) {
+        let mut probes = [[0.0; 2]; PROBES + 1];
+        let mut quick = [0.0; PROBES + 1];
+        for i in 1..PROBES {
             let s = i as f64 / PROBES as f64;
             let q = self.contact(plane, c0.u + s * (c1.u - c0.u), c0.v + s * (c1.v - c0.v))?;
             summary.see(&q, self);
-            *di = distance_to_segment(q.c, p0, p1);
+            probes[i] = q.c;
+            let f = foot_on_segment(q.c, p0, p1);
+            quick[i] = ((f[0] - q.c[0]).powi(2) + (f[1] - q.c[1]).powi(2)).sqrt();
         }
-        let m = (1..PROBES)
-            .max_by(|&i, &j| d[i].total_cmp(&d[j]))
-            .unwrap_or(1);
-        let (lo, mid, hi) = (d[m - 1], d[m], d[m + 1]);
-        let bend = 2.0 * mid - lo - hi;
-        let peak = if bend > 0.0 {
-            mid + (hi - lo) * (hi - lo) / (8.0 * bend)
-        } else {
-            mid
-        };
-        Ok(peak.max(mid) > r.chord_tolerance * crate::plan::optimise::CHORD_SHARE)
+        let limit = r.chord_tolerance * crate::plan::optimise::CHORD_SHARE;
+        // The distances by √(dx² + dy²), within a few ulps of `hypot`'s,
+        // settle almost every chord; one those ulps could turn is measured
+        // again with `hypot`, so each decision is the one its distances give.
+        if let Some(split) = clear_decision(&quick, limit) {
+            return Ok(split);
+        }
+        let mut d = [0.0; PROBES + 1];
+        for i in 1..PROBES {
+            d[i] = distance_to_segment(probes[i], p0, p1);
+        }
+        Ok(chord_peak(&d) > limit)
     }
+}
+
+/// The chord's largest distance from the curve, estimated from its probes'
+/// distances `d` (the ends' zero): the peak of the parabola through the
+/// largest and its neighbours, or the largest itself.
+fn chord_peak(d: &[f64; PROBES + 1]) -> f64 {
+    let m = (1..PROBES)
+        .max_by(|&i, &j| d[i].total_cmp(&d[j]))
+        .unwrap_or(1);
+    let (lo, mid, hi) = (d[m - 1], d[m], d[m + 1]);
+    let bend = 2.0 * mid - lo - hi;
+    let peak = if bend > 0.0 {
+        mid + (hi - lo) * (hi - lo) / (8.0 * bend)
+    } else {
+        mid
+    };
+    peak.max(mid)
+}
+
+/// Whether `chord_peak` of the probes' distances exceeds `limit`, decided
+/// from distances `d` each within a relative `SLACK` of them (its own
+/// rounding included), or `None` if that slack could turn the decision:
+/// the largest above the limit by a margin splits the chord; a peak
+/// bounded below it (by interval arithmetic on the parabola, the largest
+/// probe clear of the others) keeps it.
+fn clear_decision(d: &[f64; PROBES + 1], limit: f64) -> Option<bool> {
+    const SLACK: f64 = 1e-14;
+    const MARGIN: f64 = 1e-9;
+    let inner = &d[1..PROBES];
+    // Squares that underflow lose the relative bound.
+    if inner.iter().any(|&x| !(x >= 1e-150 && x.is_finite())) {
+        return None;
+    }
+    let m = (1..PROBES)
+        .max_by(|&i, &j| d[i].total_cmp(&d[j]))
+        .unwrap_or(1);
+    let top = d[m];
+    if top > limit * (1.0 + MARGIN) {
+        return Some(true);
+    }
+    if (1..PROBES).any(|i| i != m && d[i] >= top * (1.0 - 4.0 * SLACK)) {
+        return None;
+    }
+    let up = |x: f64| x * (1.0 + SLACK);
+    let down = |x: f64| x * (1.0 - SLACK);
+    let (lo, mid, hi) = (d[m - 1], d[m], d[m + 1]);
+    let bend_min = 2.0 * down(mid) - up(lo) - up(hi);
+    let bend_max = 2.0 * up(mid) - down(lo) - down(hi);
+    let peak_max = if bend_max <= 0.0 {
+        up(mid)
+    } else if bend_min > 0.0 {
+        let rise = (hi - lo).abs() + SLACK * (hi + lo);
+        up(mid) + rise * rise / (8.0 * bend_min)
+    } else {
+        return None;
+    };
+    (peak_max * (1.0 + MARGIN) < limit).then_some(false)
 }
 
 /// Figures gathered over every contact point the planner evaluates.
@@ -998,6 +1079,10 @@ struct Summary {
     /// The smallest concave radius the tool must fit (across the cut for
     /// the knife, principal for the ball).
     tool_limit: Option<Extremum>,
+    /// |z_u| and |z_v| at the steepest contacts so far: a contact no
+    /// steeper cannot have a larger slope (atan is monotonic), so its
+    /// arctangent is never taken (most contacts' are not).
+    steepest: [f64; 2],
 }
 
 impl Summary {
@@ -1013,30 +1098,51 @@ impl Summary {
             slope_across: zero,
             concave_along: None,
             tool_limit: None,
+            steepest: [f64::NEG_INFINITY; 2],
         }
     }
 
     fn see(&mut self, c: &Contact, cutter: &Cutter) {
         let (x, y) = xy(self.along, c.u, c.v);
         let at = |value: f64| Extremum { value, x, y };
-        let along = c.l.zu.abs().atan();
-        if along > self.slope_along.value || self.slope_along.x.is_nan() {
-            self.slope_along = at(along);
-        }
-        let across = c.l.zv.abs().atan();
-        if across > self.slope_across.value || self.slope_across.x.is_nan() {
-            self.slope_across = at(across);
+        for (k, (slope, extremum)) in [
+            (c.l.zu.abs(), &mut self.slope_along),
+            (c.l.zv.abs(), &mut self.slope_across),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            // atan(s) > atan(steepest) only if s > steepest.
+            if slope > self.steepest[k] || extremum.x.is_nan() {
+                let angle = slope.atan();
+                if angle > extremum.value || extremum.x.is_nan() {
+                    *extremum = at(angle);
+                    self.steepest[k] = slope;
+                }
+            }
         }
         let smaller = |old: &Option<Extremum>, radius: f64| {
             radius.is_finite() && radius > 0.0 && old.is_none_or(|e| radius < e.value)
         };
-        let r_along = 1.0 / c.l.curvature_along();
-        if smaller(&self.concave_along, r_along) {
-            self.concave_along = Some(at(r_along));
+        // A radius is positive only where the section curves towards the
+        // tool (its second derivative positive): elsewhere its power and
+        // division are not worked out.
+        if c.l.zuu > 0.0 {
+            let r_along = 1.0 / c.l.curvature_along();
+            if smaller(&self.concave_along, r_along) {
+                self.concave_along = Some(at(r_along));
+            }
         }
-        let r_tool = cutter.limiting_radius(&c.l);
-        if smaller(&self.tool_limit, r_tool) {
-            self.tool_limit = Some(at(r_tool));
+        let concave = if cutter.ball {
+            !c.l.surely_not_concave()
+        } else {
+            c.l.zvv > 0.0
+        };
+        if concave {
+            let r_tool = cutter.limiting_radius(&c.l);
+            if smaller(&self.tool_limit, r_tool) {
+                self.tool_limit = Some(at(r_tool));
+            }
         }
     }
 
@@ -1062,14 +1168,19 @@ fn distance3(a: [f64; 3], b: [f64; 3]) -> f64 {
 }
 
 fn distance_to_segment(q: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    distance2(q, foot_on_segment(q, a, b))
+}
+
+/// The point of the segment from a to b nearest to q.
+fn foot_on_segment(q: [f64; 2], a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
     let ab = [b[0] - a[0], b[1] - a[1]];
     let aq = [q[0] - a[0], q[1] - a[1]];
     let len2 = ab[0] * ab[0] + ab[1] * ab[1];
     if len2 == 0.0 {
-        return distance2(q, a);
+        return a;
     }
     let t = ((aq[0] * ab[0] + aq[1] * ab[1]) / len2).clamp(0.0, 1.0);
-    distance2(q, [a[0] + t * ab[0], a[1] + t * ab[1]])
+    [a[0] + t * ab[0], a[1] + t * ab[1]]
 }
 
 #[cfg(test)]

@@ -929,3 +929,37 @@ fn appendix_a1_as_printed() {
     eprintln!("A1 at k=-20, q=0.8: printed {p}, exact {e}");
     assert!((p - e).abs() > 0.05);
 }
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(5_000))]
+
+    /// The quick chord decision, from distances a few ulps off the exact
+    /// ones, is the exact decision whenever it decides: over random probe
+    /// distances (ties among them included) and limits at, near and far
+    /// from the chord's peak.
+    #[test]
+    fn the_quick_chord_decision_is_the_exact_one(
+        exact in proptest::collection::vec(
+            proptest::prop_oneof![1e-9f64..1e-5, proptest::strategy::Just(4e-7)],
+            PROBES - 1,
+        ),
+        ulps in proptest::collection::vec(-4i32..=4, PROBES - 1),
+        at in proptest::prop_oneof![
+            -1e-13f64..1e-13,
+            -1e-8f64..1e-8,
+            -0.5f64..0.5,
+            proptest::strategy::Just(0.0),
+        ],
+    ) {
+        let mut d = [0.0; PROBES + 1];
+        let mut quick = [0.0; PROBES + 1];
+        for i in 1..PROBES {
+            d[i] = exact[i - 1];
+            quick[i] = d[i] * (1.0 + ulps[i - 1] as f64 * f64::EPSILON);
+        }
+        let limit = chord_peak(&d) * (1.0 + at);
+        if let Some(split) = clear_decision(&quick, limit) {
+            proptest::prop_assert_eq!(split, chord_peak(&d) > limit);
+        }
+    }
+}

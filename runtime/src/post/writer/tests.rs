@@ -477,3 +477,105 @@ fn the_spindle_turns_the_jobs_way_and_coolant_is_on_between_call_and_end() {
     dry.coolant_mist = None;
     assert!(coolant_word(&dry, Coolant::Mist).is_err());
 }
+
+/// A value for the block printer's property test: anywhere in a range,
+/// on a rounding tie at `d` decimals, a negative that rounds to zero
+/// (`-0` must print as `0.`), or at the edge of `limit` integer digits.
+fn printer_value(d: u32, limit: u32) -> impl proptest::strategy::Strategy<Value = f64> {
+    use proptest::prelude::*;
+    let unit = 10f64.powi(-(d as i32));
+    let edge = 10f64.powi(limit as i32);
+    prop_oneof![
+        -1000.0f64..1000.0,
+        (-100_000i64..100_000).prop_map(move |k| (k as f64 + 0.5) * unit),
+        (0.0f64..0.5).prop_map(move |f| -f * unit),
+        Just(-0.0),
+        (-3i64..3, any::<bool>())
+            .prop_map(move |(k, neg)| (edge + k as f64 * unit * 0.5) * if neg { -1.0 } else { 1.0 }),
+    ]
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(400))]
+
+    /// The block printer against a straightforward reference, move by
+    /// move, over random values, decimals and dialect word formats: each
+    /// word as `f64::round` and `{:.N}` print it (ties away from zero, no
+    /// `-0`), unchanged words left out, and a block refused exactly when
+    /// a word has more digits before the point than its format allows or
+    /// more digits in all than the dialect's limit.
+    #[test]
+    fn blocks_print_what_a_plain_formatter_prints(
+        resolution in proptest::sample::select(vec![1e-3, 1e-4, 1e-6]),
+        formats in (1u32..6, 0u32..3, 1u32..6, 0u32..3, 2u32..7, 0u32..7),
+        max_digits in proptest::option::of(5u32..13),
+        seed in proptest::collection::vec((0u8..8, 0.01f64..2000.0), 1..40),
+        values in proptest::collection::vec(
+            (printer_value(3, 3), printer_value(4, 2), printer_value(6, 1)),
+            40,
+        ),
+    ) {
+        let d = decimals_for(resolution);
+        let (xi, xd, zi, zd, fi, fd) = formats;
+        let mut dialect = Dialect::linuxcnc();
+        dialect.max_digits = max_digits;
+        for f in [format!("X{xi}.{}", d + xd), format!("Z{zi}.{}", d + zd), format!("F{fi}.{fd}")] {
+            dialect.word_formats.push(WordFormat::parse(&f).expect("a format"));
+        }
+        let mut w = ProgramWriter::new(&dialect, Setup::Mill, "t", &[], "XYZ", resolution, 1e-3)
+            .expect("a mill program");
+        w.call_tool(&Start::default()).expect("tool 1");
+        w.write(&M::SpindleOn(RPM_1000)).expect("spindle");
+        w.take_text().expect("text");
+        let feed_d = fd.min(6);
+        let word = |letter: char, n: i64, d: u32, integer: u32| {
+            let s = std_word(n, d);
+            let whole = s.trim_start_matches('-').split('.').next().unwrap_or("").len();
+            let digits = s.bytes().filter(u8::is_ascii_digit).count();
+            let fits = whole as u32 <= integer && max_digits.is_none_or(|m| digits <= m as usize);
+            fits.then(|| format!(" {letter}{s}"))
+        };
+        let (mut last, mut last_feed, mut first) = ([None::<i64>; 3], None::<i64>, true);
+        for (k, &(pick, feed)) in seed.iter().enumerate() {
+            let (a, b, c) = values[k];
+            let v = [a, b, c];
+            let axes = [v[pick as usize % 3], v[(pick as usize + 1) % 3], v[(pick as usize + 2) % 3]];
+            let got = w
+                .write(&M::Linear { to: P::xyz(axes[0], axes[1], axes[2]), feed: Some(F::PerTime(feed)) })
+                .and_then(|()| w.take_text());
+            // The reference.
+            let mut line = String::from(if first { "G94 G1" } else { "G1" });
+            let mut next = last;
+            let mut refused = false;
+            for (i, (letter, integer)) in [('X', xi), ('Y', u32::MAX), ('Z', zi)].into_iter().enumerate() {
+                let n = (axes[i] * 10f64.powi(d as i32)).round() as i64;
+                if last[i] == Some(n) {
+                    continue;
+                }
+                match word(letter, n, d, integer) {
+                    Some(wd) => line += &wd,
+                    None => refused = true,
+                }
+                next[i] = Some(n);
+            }
+            let nf = (feed * 60.0 * 10f64.powi(feed_d as i32)).round() as i64;
+            if next == last {
+                proptest::prop_assert_eq!(got, Ok(String::new()));
+                continue;
+            }
+            if first || last_feed != Some(nf) {
+                match word('F', nf, feed_d, fi) {
+                    Some(wd) => line += &wd,
+                    None => refused = true,
+                }
+            }
+            if refused {
+                proptest::prop_assert!(got.is_err(), "{:?} printed, the reference refuses it", got);
+                continue;
+            }
+            line.push('\n');
+            proptest::prop_assert_eq!(got, Ok(line));
+            (last, last_feed, first) = (next, Some(nf), false);
+        }
+    }
+}
