@@ -57,6 +57,7 @@ use std::ops::ControlFlow;
 
 use rayon::prelude::*;
 
+use crate::plan::chords::{self, ChordPlacement};
 use crate::plan::envelope;
 use crate::surface::ir::SurfaceFn;
 use crate::surface::{Profile, ProfilePoint};
@@ -93,6 +94,9 @@ pub struct RollerHelix {
     pub design_length_around: Option<f64>,
     /// Spindle speed (rad/s), for the cutting times.
     pub spindle_speed: Option<f64>,
+    /// Where the points sit across the curve around the roller
+    /// (`plan::chords`): each point's X moved by its chords' sag.
+    pub chords: ChordPlacement,
 }
 
 /// One programmed point of a pass.
@@ -894,7 +898,16 @@ impl PassPlan<'_> {
         let mut undefined = None;
         let make = |j: usize| -> Result<Vec<RollerPoint>, RollerError> {
             let k0 = j * per_chunk;
-            (k0..(k0 + per_chunk).min(steps + 1)).map(&point).collect()
+            let k1 = (k0 + per_chunk).min(steps + 1);
+            if h.chords == ChordPlacement::OnPath {
+                return (k0..k1).map(&point).collect();
+            }
+            // Two points beyond each end, for the end chords' sags.
+            let lo = k0.saturating_sub(2);
+            let around: Vec<RollerPoint> = (lo..(k1 + 2).min(steps + 1))
+                .map(&point)
+                .collect::<Result<_, _>>()?;
+            Ok(placed(h.chords, &around, k0 - lo, k1 - k0))
         };
         let take = |pts: Result<Vec<RollerPoint>, RollerError>| match pts {
             Ok(pts) => {
@@ -913,6 +926,41 @@ impl PassPlan<'_> {
         }
         Ok(sum)
     }
+}
+
+/// `count` points of `around` from `first` on, each X moved by the bands
+/// of the chords it joins (`plan::chords`). The C steps are equal (the
+/// last, shorter step of a pass is taken as one of them), so each chord's
+/// deviation from the path comes from the second differences of X at its
+/// ends; a chord at the end of the pass, with a point beyond one end
+/// only, takes that end's.
+fn placed(
+    placement: ChordPlacement,
+    around: &[RollerPoint],
+    first: usize,
+    count: usize,
+) -> Vec<RollerPoint> {
+    let x = |i: usize| around[i].x;
+    let n = around.len();
+    // The band of the chord from point i to point i + 1 of `around`, if
+    // there is such a chord.
+    let band = |i: Option<usize>| -> Option<chords::Band> {
+        let i = i.filter(|&i| i + 1 < n)?;
+        let second = |k: usize| -(x(k - 1) - 2.0 * x(k) + x(k + 1)) / 8.0;
+        Some(match (i > 0, i + 2 < n) {
+            (true, true) => chords::uniform_band([x(i - 1), x(i), x(i + 1), x(i + 2)]),
+            (true, false) => chords::Band::of(&[second(i)]),
+            (false, true) => chords::Band::of(&[second(i + 1)]),
+            (false, false) => chords::Band::default(),
+        })
+    };
+    (first..first + count)
+        .map(|i| {
+            let mut p = around[i];
+            p.x += placement.offset(band(i.checked_sub(1)), band(Some(i)));
+            p
+        })
+        .collect()
 }
 
 impl PassSummary {
