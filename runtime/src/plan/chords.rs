@@ -16,21 +16,24 @@
 //!   +s/2 at its ends and −s/2 at its middle: ±tolerance/2 for the same
 //!   points (on a concave stretch the points move into the material, by
 //!   half the sag there).
-//! - `Clear`: each point raised by the larger gouging sag of the two
-//!   chords it joins (0 where neither gouges), so both ends of every chord
-//!   are at least its own sag above the exact path and no chord enters the
-//!   material; the part is left up to the tolerance proud instead.
+//! - `Clear`: each point raised by the most the path rises above either
+//!   chord it joins (0 where neither gouges), so both ends of every chord
+//!   are at least that far above the exact path and no chord enters the
+//!   material, plus a margin (half the machine's resolution, so rounding
+//!   a coordinate to it cannot bring a point back down); the part is left
+//!   up to the tolerance proud instead.
 
 /// Where the programmed points sit (the strategy's `chords`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum ChordPlacement {
     /// On the exact path: convex stretches gouge by up to the tolerance.
     #[default]
     OnPath,
     /// Off the path by half the sag: every chord within ±tolerance/2.
     Straddle,
-    /// Above the path by the sag: no chord enters the material.
-    Clear,
+    /// Above the path by the sag and `margin` (mm): no chord enters the
+    /// material, even once the points are rounded to the resolution.
+    Clear { margin: f64 },
 }
 
 impl ChordPlacement {
@@ -39,16 +42,16 @@ impl ChordPlacement {
         match self {
             ChordPlacement::OnPath => "on_path",
             ChordPlacement::Straddle => "straddle",
-            ChordPlacement::Clear => "clear",
+            ChordPlacement::Clear { .. } => "clear",
         }
     }
 
-    /// The placement a strategy's word names.
-    pub fn from_word(word: &str) -> Option<ChordPlacement> {
+    /// The placement a strategy's word names; `clear` with `margin` (mm).
+    pub fn from_word(word: &str, margin: f64) -> Option<ChordPlacement> {
         match word {
             "on_path" => Some(ChordPlacement::OnPath),
             "straddle" => Some(ChordPlacement::Straddle),
-            "clear" => Some(ChordPlacement::Clear),
+            "clear" => Some(ChordPlacement::Clear { margin }),
             _ => None,
         }
     }
@@ -59,19 +62,20 @@ impl ChordPlacement {
         match self {
             ChordPlacement::OnPath => sag,
             ChordPlacement::Straddle => 0.5 * sag,
-            ChordPlacement::Clear => 0.0,
+            ChordPlacement::Clear { .. } => 0.0,
         }
     }
 
     /// The first placement, in the order of least displacement, whose
     /// promised gouge for chords of sag up to `sag` is within `max_gouge`
     /// (mm): all three place the same points, so this is the default that
-    /// meets a job's `max_gouge` (`Clear` when nothing else does).
-    pub fn least_for(sag: f64, max_gouge: f64) -> ChordPlacement {
+    /// meets a job's `max_gouge` (`Clear` with `margin` when nothing else
+    /// does).
+    pub fn least_for(sag: f64, max_gouge: f64, margin: f64) -> ChordPlacement {
         [ChordPlacement::OnPath, ChordPlacement::Straddle]
             .into_iter()
             .find(|p| p.promised_gouge(sag) <= max_gouge)
-            .unwrap_or(ChordPlacement::Clear)
+            .unwrap_or(ChordPlacement::Clear { margin })
     }
 
     /// How far (mm, out of the material) to move a point that ends the
@@ -87,7 +91,7 @@ impl ChordPlacement {
         match self {
             ChordPlacement::OnPath => 0.0,
             ChordPlacement::Straddle => 0.5 * (hi + lo),
-            ChordPlacement::Clear => hi,
+            ChordPlacement::Clear { margin } => hi + margin,
         }
     }
 }
@@ -194,7 +198,7 @@ mod tests {
             (g - sag / 2.0).abs() < 1e-12 && (e - sag / 2.0).abs() < 1e-12,
             "{g} {e}"
         );
-        let (g, e) = errors(ChordPlacement::Clear, &v, k);
+        let (g, e) = errors(ChordPlacement::Clear { margin: 0.0 }, &v, k);
         assert!(g.abs() < 1e-12 && (e - sag).abs() < 1e-12, "{g} {e}");
     }
 
@@ -202,7 +206,7 @@ mod tests {
     fn clear_leaves_a_concave_path_where_it_is() {
         let k = -8.0e-6;
         let v = parabola(k, 12);
-        let (g, e) = errors(ChordPlacement::Clear, &v, k);
+        let (g, e) = errors(ChordPlacement::Clear { margin: 0.0 }, &v, k);
         assert!(g.abs() < 1e-12 && (e + k / 8.0).abs() < 1e-12, "{g} {e}");
     }
 
@@ -226,11 +230,14 @@ mod tests {
     #[test]
     fn the_default_is_the_least_displacement_that_meets_max_gouge() {
         let least = ChordPlacement::least_for;
-        assert_eq!(least(2.5e-6, 5e-6), ChordPlacement::OnPath);
-        assert_eq!(least(8e-6, 5e-6), ChordPlacement::Straddle);
-        assert_eq!(least(2.5e-6, 0.0), ChordPlacement::Clear);
+        assert_eq!(least(2.5e-6, 5e-6, 0.0), ChordPlacement::OnPath);
+        assert_eq!(least(8e-6, 5e-6, 0.0), ChordPlacement::Straddle);
+        assert_eq!(
+            least(2.5e-6, 0.0, 5e-7),
+            ChordPlacement::Clear { margin: 5e-7 }
+        );
         for w in ["on_path", "straddle", "clear"] {
-            assert_eq!(ChordPlacement::from_word(w).unwrap().word(), w);
+            assert_eq!(ChordPlacement::from_word(w, 0.0).unwrap().word(), w);
         }
     }
 }

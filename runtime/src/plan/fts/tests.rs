@@ -337,7 +337,7 @@ fn each_chord_placement_errs_as_it_promises() {
     for chords in [
         ChordPlacement::OnPath,
         ChordPlacement::Straddle,
-        ChordPlacement::Clear,
+        ChordPlacement::Clear { margin: 0.0 },
     ] {
         let s = FtsSpiral {
             chords,
