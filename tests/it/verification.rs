@@ -500,3 +500,38 @@ fn seed_002_rollers_cut_within_the_figure() {
         }
     }
 }
+
+#[test]
+fn a_ball_end_raster_is_simulated_with_its_scallops_and_contacts() {
+    // A 0.4 mm ball over a 2 mm convex sphere at 10 um stepover: the ball
+    // swept along the printed path leaves the scallop of its radius on
+    // that curvature, its contacts sit on the design as computed, and the
+    // acceptance gate measures every criterion (issue #15: ball-end
+    // rasters simulated, not skipped).
+    let source = "surface dome = sphere { radius: 2 mm, sense: convex, aperture: circle(diameter: 0.4 mm) }
+tool ball = ball_end { diameter: 0.4 mm }
+use std::machines::generic_3axis_mill
+strategy scrape = raster { along: y, direction: zigzag, stepover: 10 um, feed: 100 mm/min, spindle_speed: 12000 rpm, chord_tolerance: 200 nm }
+job dome_ball { surface: dome, tool: ball, machine: generic_3axis_mill, strategy: scrape }
+";
+    let r = report_of(source, "dome_ball");
+    let h = &r["simulation"]["height_map"];
+    assert_eq!(h["uncut_cells"], 0, "{h}");
+    let expected = scallop(0.2, 0.01, 2.0) * 1e6;
+    let mean = num(&h["scallops"]["simulated"]["mean_nm"]);
+    assert!(
+        (mean - expected).abs() < 0.01 * expected,
+        "{mean} vs {expected}"
+    );
+    // As computed (rounded to a picometre), the contacts lie on the design:
+    // no gouge, a mean within a nanometre.
+    let exact = &h["contact_unrounded"];
+    assert!(num(&exact["mean_nm"]).abs() < 1.0, "{exact}");
+    assert!(num(&exact["max_gouge_nm"]["value"]) < 1.0, "{exact}");
+    assert!(num(&exact["rms_nm"]) < 5.0, "{exact}");
+    let acceptance = &r["acceptance"];
+    assert_eq!(acceptance["passed"], true, "{acceptance}");
+    for c in acceptance["criteria"].as_array().expect("criteria") {
+        assert!(c["unmeasured"].is_null(), "{c}");
+    }
+}

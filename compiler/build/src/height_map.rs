@@ -8,10 +8,11 @@
 //! `simulation.height_map` section is `crate::report::HeightMap`).
 
 use lensc_runtime::moves::{Move, Plane};
+use lensc_runtime::reader::{Executed, Path as ExecutedPath};
 use lensc_runtime::surface::analysis::Domain;
 use lensc_runtime::surface::ir::SurfaceFn;
 use lensc_runtime::verify::heightmap::{
-    ErrorRaster, Frame, Grid, HeightMap, NosePath, RasterLayout,
+    Cutter, ErrorRaster, Frame, Grid, HeightMap, NosePath, RasterLayout,
 };
 use lensc_runtime::verify::tiles::{Recorder, simulate};
 use lensc_runtime::verify::window::Tile;
@@ -37,17 +38,30 @@ pub struct Simulation {
     /// The window's whole grid (the report's), and its tiles.
     pub grid: Grid,
     pub tiles: Vec<Tile>,
-    nose_radius: f64,
+    cutter: Cutter,
     recorder: Recorder,
 }
 
 impl Simulation {
+    /// A simulation of a round nose of `nose_radius` whose edge lies
+    /// across the cut (a knife, a lathe's diamond).
     pub fn new(grid: Grid, tiles: Vec<Tile>, nose_radius: f64) -> Simulation {
+        Simulation::of(
+            grid,
+            tiles,
+            Cutter::Nose {
+                radius: nose_radius,
+            },
+        )
+    }
+
+    /// A simulation of `cutter`.
+    pub fn of(grid: Grid, tiles: Vec<Tile>, cutter: Cutter) -> Simulation {
         Simulation {
             grid,
-            recorder: Recorder::new(Recorder::band_of(&tiles, nose_radius)),
+            recorder: Recorder::new(Recorder::band_of(&tiles, cutter.radius())),
             tiles,
-            nose_radius,
+            cutter,
         }
     }
 
@@ -70,7 +84,7 @@ impl Simulation {
             &self.recorder,
             &self.tiles,
             self.grid,
-            self.nose_radius,
+            self.cutter,
             frame,
             layout,
         );
@@ -260,6 +274,73 @@ pub fn sweep_mill_moves(sweep: &mut dyn NosePath, moves: &[Move], along_x: bool,
             }
             _ => {}
         }
+    }
+}
+
+/// The largest sagitta (mm) of the chords a blended arc is swept as: a
+/// hundredth of a nanometre.
+const ARC_SAGITTA: f64 = 1e-8;
+
+/// Feeds a mill program's moves, read from its text as the controller
+/// reads it (`reader::read_moves`), to `sweep`: rapids lift the tool;
+/// straight moves are followed; an arc in the plane of the cut is cut as
+/// the controller cuts it, its radius blended from the start's to the
+/// end's over its turn (see `verify::simulate`), in chords of at most
+/// `ARC_SAGITTA`; an arc in another plane by its chord.
+pub fn sweep_mill_program(sweep: &mut dyn NosePath, moves: &[Executed], along_x: bool) {
+    let su = |p: [f64; 3]| if along_x { (p[0], p[1]) } else { (p[1], p[0]) };
+    let xyz = |v: &[Option<f64>; 4]| Some([v[0]?, v[1]?, v[2]?]);
+    let mut cutting = false;
+    for m in moves {
+        let (Some(from), Some(to)) = (xyz(&m.from), xyz(&m.to)) else {
+            sweep.lift();
+            cutting = false;
+            continue;
+        };
+        if m.path == ExecutedPath::Rapid {
+            sweep.lift();
+            cutting = false;
+            continue;
+        }
+        if !cutting {
+            let (s, u) = su(from);
+            sweep.point(s, u, from[2]);
+            cutting = true;
+        }
+        if let ExecutedPath::Arc {
+            plane,
+            centre,
+            cw,
+            turn,
+        } = m.path
+            && matches!((plane, along_x), (Plane::Zx, true) | (Plane::Yz, false))
+        {
+            // The plane's two coordinates in its order: (Z, X) or (Y, Z).
+            let in_plane = |p: [f64; 3]| match plane {
+                Plane::Zx => (p[2], p[0]),
+                _ => (p[1], p[2]),
+            };
+            let back = |(a, b): (f64, f64)| match plane {
+                Plane::Zx => [b, from[1], a],
+                _ => [from[0], a, b],
+            };
+            let (a, b) = (in_plane(from), in_plane(to));
+            let r0 = (a.0 - centre.0).hypot(a.1 - centre.1);
+            let r1 = (b.0 - centre.0).hypot(b.1 - centre.1);
+            let start = (a.1 - centre.1).atan2(a.0 - centre.0);
+            let sweep_angle = if cw { -turn } else { turn };
+            let step = (8.0 * ARC_SAGITTA / r0.max(r1).max(1e-9)).sqrt();
+            let n = ((sweep_angle.abs() / step).ceil() as usize).clamp(1, 1_000_000);
+            for k in 1..n {
+                let f = k as f64 / n as f64;
+                let (theta, r) = (start + f * sweep_angle, r0 + f * (r1 - r0));
+                let p = back((centre.0 + r * theta.cos(), centre.1 + r * theta.sin()));
+                let (s, u) = su(p);
+                sweep.point(s, u, p[2]);
+            }
+        }
+        let (s, u) = su(to);
+        sweep.point(s, u, to[2]);
     }
 }
 

@@ -22,6 +22,26 @@
 
 use rayon::prelude::*;
 
+mod ball;
+pub use ball::BallSweep;
+
+/// The cutter a height map sweeps: a round nose whose edge lies across
+/// the cut (a knife, a lathe's diamond), or a ball (a ball-end mill),
+/// which reaches its radius along the path as well.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Cutter {
+    Nose { radius: f64 },
+    Ball { radius: f64 },
+}
+
+impl Cutter {
+    pub fn radius(&self) -> f64 {
+        match *self {
+            Cutter::Nose { radius } | Cutter::Ball { radius } => radius,
+        }
+    }
+}
+
 /// The simulation grid: columns along the cut, rows across it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Grid {
@@ -255,20 +275,7 @@ impl Sweep {
                 .map(|(j, centres)| column(&g, r, j, centres, frame))
                 .collect()
         };
-        let totals = Totals::gather(&g, &columns, frame, feature);
-        // Each block's worst, the first of equals in column order.
-        let mut worst: std::collections::BTreeMap<usize, f64> = Default::default();
-        for (j, c) in columns.iter().enumerate() {
-            for (i, &e) in c.errors.iter().enumerate() {
-                if let Some(b) = layout.block(frame, g.s(j), g.u(i), e) {
-                    let w = worst.entry(b).or_insert(e);
-                    if e.abs() > w.abs() {
-                        *w = e;
-                    }
-                }
-            }
-        }
-        (totals, worst.into_iter().collect())
+        finish_columns(&g, &columns, frame, feature, layout)
     }
 
     fn columns(self, frame: &dyn Frame) -> Vec<Column> {
@@ -279,6 +286,31 @@ impl Sweep {
             .map(|(j, centres)| column(&g, r, j, centres, frame))
             .collect()
     }
+}
+
+/// A tile's columns' totals and their cells' worst errors on `layout`'s
+/// blocks.
+fn finish_columns(
+    g: &Grid,
+    columns: &[Column],
+    frame: &dyn Frame,
+    feature: &dyn Fn(usize) -> usize,
+    layout: &RasterLayout,
+) -> (Totals, Vec<(usize, f64)>) {
+    let totals = Totals::gather(g, columns, frame, feature);
+    // Each block's worst, the first of equals in column order.
+    let mut worst: std::collections::BTreeMap<usize, f64> = Default::default();
+    for (j, c) in columns.iter().enumerate() {
+        for (i, &e) in c.errors.iter().enumerate() {
+            if let Some(b) = layout.block(frame, g.s(j), g.u(i), e) {
+                let w = worst.entry(b).or_insert(e);
+                if e.abs() > w.abs() {
+                    *w = e;
+                }
+            }
+        }
+    }
+    (totals, worst.into_iter().collect())
 }
 
 /// The height on the minor arc from `a` to `b` about `o` at `s` (between

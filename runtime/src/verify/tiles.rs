@@ -9,7 +9,9 @@
 
 use rayon::prelude::*;
 
-use super::heightmap::{ErrorRaster, Frame, HeightMap, NosePath, RasterLayout, Sweep, Totals};
+use super::heightmap::{
+    BallSweep, Cutter, ErrorRaster, Frame, HeightMap, NosePath, RasterLayout, Sweep, Totals,
+};
 use super::window::Tile;
 
 /// Steps a block holds: its extent lets a tile skip it whole.
@@ -111,8 +113,7 @@ impl Recorder {
 
     /// Sweeps the blocks that reach `grid`'s band (and, on a grid that does
     /// not repeat, its columns) into `sweep`.
-    fn replay(&self, sweep: &mut Sweep, s_range: Option<(f64, f64)>) {
-        let band = sweep.band();
+    fn replay(&self, sweep: &mut dyn NosePath, band: (f64, f64), s_range: Option<(f64, f64)>) {
         for (b, e) in self.extents.iter().enumerate() {
             let misses_s = s_range.is_some_and(|(lo, hi)| e[1] < lo || e[0] > hi);
             if e[3] < band.0 || e[2] > band.1 || misses_s {
@@ -226,29 +227,44 @@ pub struct TiledMap {
 }
 
 /// Simulates `tiles` (of a map whose nominal grid is `grid`) from the
-/// path `recorder` kept, with a nose of `nose_radius`, against `frame`'s
-/// design, the errors drawn on `layout`'s blocks.
+/// path `recorder` kept, with `cutter`, against `frame`'s design, the
+/// errors drawn on `layout`'s blocks.
 pub fn simulate(
     recorder: &Recorder,
     tiles: &[Tile],
     grid: super::heightmap::Grid,
-    nose_radius: f64,
+    cutter: Cutter,
     frame: &dyn Frame,
     layout: RasterLayout,
 ) -> TiledMap {
+    let nose_radius = cutter.radius();
     let results: Vec<(Totals, Vec<(usize, f64)>)> = tiles
         .par_iter()
         .map(|tile| {
-            let mut sweep = Sweep::new(tile.grid, nose_radius);
             let g = tile.grid;
-            let s_range = g
-                .period
-                .is_none()
-                .then(|| (g.s0, g.s(g.ns.saturating_sub(1))));
-            recorder.replay(&mut sweep, s_range);
             let tile_frame = TileFrame::new(frame, tile.feature);
             let global = |f: usize| tile.feature.unwrap_or(f);
-            sweep.finish_tile(&tile_frame, &global, &layout, tiles.len() == 1)
+            let parallel = tiles.len() == 1;
+            match cutter {
+                Cutter::Nose { radius } => {
+                    let mut sweep = Sweep::new(g, radius);
+                    let s_range = g
+                        .period
+                        .is_none()
+                        .then(|| (g.s0, g.s(g.ns.saturating_sub(1))));
+                    let band = sweep.band();
+                    recorder.replay(&mut sweep, band, s_range);
+                    sweep.finish_tile(&tile_frame, &global, &layout, parallel)
+                }
+                // A ball reaches columns its radius from its centre.
+                Cutter::Ball { radius } => {
+                    let mut sweep = BallSweep::new(g, radius);
+                    let s_range = (g.s0 - radius, g.s(g.ns.saturating_sub(1)) + radius);
+                    let band = sweep.band();
+                    recorder.replay(&mut sweep, band, Some(s_range));
+                    sweep.finish_tile(&tile_frame, &global, &layout, parallel)
+                }
+            }
         })
         .collect();
     let mut totals = Totals::default();

@@ -74,7 +74,16 @@ fn tiled(threads: usize) -> TiledMap {
         .num_threads(threads)
         .build()
         .expect("a pool");
-    pool.install(|| simulate(&recorder, &tiles, GRID, NOSE, &frame(), layout))
+    pool.install(|| {
+        simulate(
+            &recorder,
+            &tiles,
+            GRID,
+            Cutter::Nose { radius: NOSE },
+            &frame(),
+            layout,
+        )
+    })
 }
 
 fn close(a: f64, b: f64) -> bool {
