@@ -141,19 +141,19 @@ impl Band {
     }
 }
 
-/// The exact path's height above the middle of the chord from v₀ to v₁
-/// between equally spaced points, estimated at each end's curvature: a
-/// chord of length h on a path of second derivative v″ sags by −h² v″ / 8,
-/// and h² v″ is the second difference there. `heights` holds the chord's
-/// ends and one point beyond each, `[v₋₁, v₀, v₁, v₂]`.
-pub fn uniform_band(heights: [f64; 4]) -> Band {
-    let [a, b, c, d] = heights;
-    Band::of(&[-(a - 2.0 * b + c) / 8.0, -(b - 2.0 * c + d) / 8.0])
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The exact path's height above the middle of the chord from v₀ to v₁
+    /// between equally spaced points, estimated at each end's curvature: a
+    /// chord of length h on a path of second derivative v″ sags by −h² v″ / 8,
+    /// and h² v″ is the second difference there. `heights` holds the chord's
+    /// ends and one point beyond each, `[v₋₁, v₀, v₁, v₂]`.
+    fn uniform_band(heights: [f64; 4]) -> Band {
+        let [a, b, c, d] = heights;
+        Band::of(&[-(a - 2.0 * b + c) / 8.0, -(b - 2.0 * c + d) / 8.0])
+    }
 
     /// Points on a parabola v = −k u² / 2 (convex: it bulges up), one
     /// unit apart; the exact chord sag is k / 8 everywhere.

@@ -857,6 +857,9 @@ impl PassPlan<'_> {
     ) -> Result<PassSummary, RollerError> {
         let (h, pass, steps, total) = (self.h, self.pass, self.steps, self.total);
         let r_r = h.roller_radius;
+        // X on the exact path at spindle angle c and axial position z.
+        let exact =
+            |c: f64, z: f64| r_r + centre(r_r * c.rem_euclid(TAU), z) + pass.finish_allowance;
         let point = |k: usize| -> Result<RollerPoint, RollerError> {
             let (c, z) = if k == steps {
                 (total, h.z_end)
@@ -864,8 +867,7 @@ impl PassPlan<'_> {
                 let c = k as f64 * pass.c_step;
                 (c, h.z_start + pass.pitch * c / TAU)
             };
-            let y = r_r * c.rem_euclid(TAU);
-            let x = r_r + centre(y, z) + pass.finish_allowance;
+            let x = exact(c, z);
             if x.is_finite() {
                 Ok(RollerPoint { c, z, x })
             } else {
@@ -873,7 +875,7 @@ impl PassPlan<'_> {
                     pass: self.index,
                     c,
                     z,
-                    y,
+                    y: r_r * c.rem_euclid(TAU),
                 })
             }
         };
@@ -902,12 +904,12 @@ impl PassPlan<'_> {
             if h.chords == ChordPlacement::OnPath {
                 return (k0..k1).map(&point).collect();
             }
-            // Two points beyond each end, for the end chords' sags.
-            let lo = k0.saturating_sub(2);
-            let around: Vec<RollerPoint> = (lo..(k1 + 2).min(steps + 1))
+            // A point beyond each end, for the end chords.
+            let lo = k0.saturating_sub(1);
+            let around: Vec<RollerPoint> = (lo..(k1 + 1).min(steps + 1))
                 .map(&point)
                 .collect::<Result<_, _>>()?;
-            Ok(placed(h.chords, &around, k0 - lo, k1 - k0))
+            Ok(placed(h.chords, &around, k0 - lo, k1 - k0, &exact))
         };
         let take = |pts: Result<Vec<RollerPoint>, RollerError>| match pts {
             Ok(pts) => {
@@ -929,30 +931,29 @@ impl PassPlan<'_> {
 }
 
 /// `count` points of `around` from `first` on, each X moved by the bands
-/// of the chords it joins (`plan::chords`). The C steps are equal (the
-/// last, shorter step of a pass is taken as one of them), so each chord's
-/// deviation from the path comes from the second differences of X at its
-/// ends; a chord at the end of the pass, with a point beyond one end
-/// only, takes that end's.
+/// of the chords it joins (`plan::chords`): how far the exact path, X =
+/// `exact(c, z)`, lies above each chord at its quarters and middle. (Not
+/// from the points' second differences: where dimples meet in a sharp
+/// ridge around the roller those say nothing of the chord across it.)
 fn placed(
     placement: ChordPlacement,
     around: &[RollerPoint],
     first: usize,
     count: usize,
+    exact: &impl Fn(f64, f64) -> f64,
 ) -> Vec<RollerPoint> {
-    let x = |i: usize| around[i].x;
-    let n = around.len();
-    // The band of the chord from point i to point i + 1 of `around`, if
-    // there is such a chord.
     let band = |i: Option<usize>| -> Option<chords::Band> {
-        let i = i.filter(|&i| i + 1 < n)?;
-        let second = |k: usize| -(x(k - 1) - 2.0 * x(k) + x(k + 1)) / 8.0;
-        Some(match (i > 0, i + 2 < n) {
-            (true, true) => chords::uniform_band([x(i - 1), x(i), x(i + 1), x(i + 2)]),
-            (true, false) => chords::Band::of(&[second(i)]),
-            (false, true) => chords::Band::of(&[second(i + 1)]),
-            (false, false) => chords::Band::default(),
-        })
+        let i = i.filter(|&i| i + 1 < around.len())?;
+        let (p, q) = (around[i], around[i + 1]);
+        let above = |t: f64| {
+            let at = |a: f64, b: f64| a + t * (b - a);
+            exact(at(p.c, q.c), at(p.z, q.z)) - at(p.x, q.x)
+        };
+        let d = [above(0.25), above(0.5), above(0.75)];
+        // An undefined path between two defined points moves nothing.
+        Some(chords::Band::from_quarters(
+            d.map(|v| if v.is_finite() { v } else { 0.0 }),
+        ))
     };
     (first..first + count)
         .map(|i| {
