@@ -11,6 +11,7 @@ mod common;
 
 mod bad_programs;
 mod build_errors;
+mod chords;
 mod cli;
 mod complete_programs;
 mod determinism;

@@ -370,6 +370,9 @@ pub struct Spiral {
     pub cutting_time_s: f64,
     /// The path tolerance the spiral was planned to (mm).
     pub chord_tolerance_mm: f64,
+    /// Where the points sit across the curve of the path: `on_path`,
+    /// `straddle` or `clear` (the strategy's `chords`, or the default).
+    pub chords: String,
     /// Chords the data period kept further from the exact path than their
     /// share of the tolerance, where the nose reaches the part; null if
     /// none.
@@ -414,6 +417,7 @@ impl Spiral {
             cut_points: s.points,
             cutting_time_s: s.time,
             chord_tolerance_mm: spiral.chord_tolerance,
+            chords: spiral.chords.word().to_string(),
             chords_over_tolerance: s.chords_over_tolerance.map(|o| ChordsOverTolerance {
                 count: o.count,
                 max_deviation_nm: o.deviation * 1e6,
@@ -681,6 +685,10 @@ pub struct RollerHelix {
     pub cutting_time_s: f64,
     /// The roller's radius (mm).
     pub roller_radius_mm: f64,
+    /// Where the points sit across the curve around the roller:
+    /// `on_path`, `straddle` or `clear` (the strategy's `chords`, or the
+    /// default).
+    pub chords: String,
     /// Each helix pass, roughing first.
     pub passes: Vec<HelixPass>,
     /// The tool checks of Liu et al. section 4.
@@ -691,16 +699,18 @@ pub struct RollerHelix {
 }
 
 impl RollerHelix {
-    /// The section of `path` on a roller of `roller_radius` (mm), cut by
-    /// `tool`, which passed `check`.
+    /// The section of `path`, planned as `helix` asks, cut by `tool`,
+    /// which passed `check`.
     pub fn new(
         path: &RollerPath,
         limited: &[FeedLimited],
         check: &ToolCheck,
         tool: &RollerTool,
-        roller_radius: f64,
+        helix: &lensc_runtime::plan::roller::RollerHelix,
     ) -> RollerHelix {
+        let roller_radius = helix.roller_radius;
         RollerHelix {
+            chords: helix.chords.word().to_string(),
             cut_points: path.passes.iter().map(|p| p.points).sum(),
             cutting_time_s: path.passes.iter().filter_map(|p| p.time).sum(),
             roller_radius_mm: roller_radius,

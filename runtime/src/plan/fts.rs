@@ -26,6 +26,7 @@
 
 use std::ops::ControlFlow;
 
+use crate::plan::chords::{Band, ChordPlacement};
 use crate::plan::envelope;
 use crate::surface::ir::SurfaceFn;
 use crate::surface::{Profile, ProfilePoint};
@@ -73,6 +74,10 @@ pub struct FtsSpiral {
     pub min_interval: f64,
     pub start_radius: f64,
     pub end_radius: f64,
+    /// Where the points sit across the curve of W (`plan::chords`): each
+    /// point's W moved by the sags of the chords it joins, measured at the
+    /// chords' midpoints as the sampler splits them.
+    pub chords: ChordPlacement,
 }
 
 /// The fast axis's limits.
@@ -176,9 +181,11 @@ pub struct FtsSummary {
     pub chords_over_tolerance: Option<ChordShortfall>,
 }
 
-/// One revolution's points (spindle angle, nose-centre height) and the
-/// chords among them that could not meet the chord tolerance.
-pub type Revolution = (Vec<(f64, f64)>, Option<ChordShortfall>);
+/// One revolution's points (spindle angle, nose-centre height on the
+/// exact path, and the band of the chord from it to the next point: how
+/// far the path lies above it, `plan::chords`) and the chords among them
+/// that could not meet the chord tolerance.
+pub type Revolution = (Vec<(f64, f64, Band)>, Option<ChordShortfall>);
 
 /// Chords the sampler could not split down to the chord tolerance: two
 /// points may not be closer in time than the servo's data period, and
@@ -338,25 +345,35 @@ impl Planner<'_> {
                 let mut at = c0;
                 for (a, b) in spans {
                     if a > at {
-                        out.push((at, level));
+                        out.push((at, level, Band::default()));
                     }
                     self.sample(a.max(at), b, &mut out, &mut over);
                     at = b;
                 }
                 if at < c1 {
-                    out.push((at, level));
+                    out.push((at, level, Band::default()));
                 }
             }
         }
-        out.dedup_by(|b, a| b.0 == a.0);
+        // A point repeated: the chord from it is the later one's.
+        out.dedup_by(|b, a| {
+            let same = b.0 == a.0;
+            if same {
+                a.2 = a.2.union(b.2);
+            }
+            same
+        });
         // Where W stays level (the land, or the settling plateau), the
-        // spiral between the ends of the level stretch is one move.
-        let mut kept: Vec<(f64, f64)> = Vec::with_capacity(out.len() / 4 + 2);
+        // spiral between the ends of the level stretch is one move, its
+        // band the union of the chords it replaces.
+        let mut kept: Vec<(f64, f64, Band)> = Vec::with_capacity(out.len() / 4 + 2);
         for (i, p) in out.iter().enumerate() {
             let level_before = kept.last().is_some_and(|q| q.1 == p.1);
             let level_after = out.get(i + 1).is_some_and(|q| q.1 == p.1);
             if !(level_before && level_after) {
                 kept.push(*p);
+            } else if let Some(q) = kept.last_mut() {
+                q.2 = q.2.union(p.2);
             }
         }
         (kept, over)
@@ -369,7 +386,7 @@ impl Planner<'_> {
         &self,
         c0: f64,
         c1: f64,
-        out: &mut Vec<(f64, f64)>,
+        out: &mut Vec<(f64, f64, Band)>,
         over: &mut Option<ChordShortfall>,
     ) {
         let tol = self.spiral.chord_tolerance * crate::plan::optimise::UNOPTIMISED_CHORD_SHARE;
@@ -413,12 +430,36 @@ impl Planner<'_> {
                             }),
                         );
                     }
-                    out.push(left);
+                    let band = self.chord_band(left, (m, wm), right, &mut hint);
+                    out.push((left.0, left.1, band));
                     left = right;
                 }
             }
             prev = next;
         }
+    }
+
+    /// The band of the chord from `left` to `right` (`plan::chords`), its
+    /// middle `mid` on the exact path: from the path's height above the
+    /// chord there and at its quarters (not measured, and not needed, with
+    /// the points on the path).
+    fn chord_band(
+        &self,
+        left: (f64, f64),
+        mid: (f64, f64),
+        right: (f64, f64),
+        hint: &mut f64,
+    ) -> Band {
+        if self.spiral.chords == ChordPlacement::OnPath {
+            return Band::default();
+        }
+        let mut above = |t: f64| {
+            let (w, h) = self.centre_near(left.0 + t * (right.0 - left.0), Some(*hint));
+            *hint = h;
+            w - (left.1 + t * (right.1 - left.1))
+        };
+        let (quarter, three) = (above(0.25), above(0.75));
+        Band::from_quarters([quarter, mid.1 - 0.5 * (left.1 + right.1), three])
     }
 
     /// The spans of spindle angle in [c0, c1) where the spiral passes over
@@ -530,16 +571,23 @@ impl Planner<'_> {
         let make = |j: usize| {
             if j == revs {
                 // The end point of the spiral.
-                (vec![(total, self.centre(total))], None)
+                (vec![(total, self.centre(total), Band::default())], None)
             } else {
                 self.revolution(j)
             }
         };
         let mut j = 0;
+        // The band of the chord into the next point, from the revolution
+        // before (`plan::chords`).
+        let mut band_before = None;
         let take = |(pts, over): Revolution| {
             ChordShortfall::merge(&mut summary.chords_over_tolerance, over);
             buffer.clear();
-            for (c, w) in pts {
+            for (c, w, band) in pts {
+                // The spiral's end point starts no chord.
+                let after = (j < revs).then_some(band);
+                let w = w + s.chords.offset(band_before, after);
+                band_before = after;
                 let x = self.radius(c);
                 if !(w.is_finite() && x.is_finite()) {
                     undefined = Some(FtsError::Undefined { x, c });

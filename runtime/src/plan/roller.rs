@@ -62,6 +62,7 @@ use std::ops::ControlFlow;
 
 use rayon::prelude::*;
 
+use crate::plan::chords::{self, ChordPlacement};
 use crate::plan::envelope;
 use crate::surface::ir::SurfaceFn;
 use crate::surface::{Profile, ProfilePoint};
@@ -101,6 +102,9 @@ pub struct RollerHelix {
     pub design_length_around: Option<f64>,
     /// Spindle speed (rad/s), for the cutting times.
     pub spindle_speed: Option<f64>,
+    /// Where the points sit across the curve around the roller
+    /// (`plan::chords`): each point's X moved by its chords' sag.
+    pub chords: ChordPlacement,
 }
 
 /// One programmed point of a pass.
@@ -908,6 +912,13 @@ impl PassPlan<'_> {
     ) -> Result<PassSummary, RollerError> {
         let (h, pass, steps, total) = (self.h, self.pass, self.steps, self.total);
         let r_r = h.roller_radius;
+        // X on the exact path at spindle angle c and axial position z,
+        // and the contact's u, its search started at u = `start`.
+        let exact_from = |c: f64, z: f64, start: f64| -> (f64, f64) {
+            let (height, contact) = centre(r_r * c.rem_euclid(TAU), z, start);
+            (r_r + height + pass.finish_allowance, contact)
+        };
+        let exact = |c: f64, z: f64| exact_from(c, z, z).0;
         // Point k, its contact searched from the previous point's contact
         // `offset` (u − x) on: one C step on, it has moved a fraction of a
         // micrometre.
@@ -918,10 +929,8 @@ impl PassPlan<'_> {
                 let c = k as f64 * pass.c_step;
                 (c, h.z_start + pass.pitch * c / TAU)
             };
-            let y = r_r * c.rem_euclid(TAU);
-            let (height, contact) = centre(y, z, z + *offset);
+            let (x, contact) = exact_from(c, z, z + *offset);
             *offset = contact - z;
-            let x = r_r + height + pass.finish_allowance;
             if x.is_finite() {
                 Ok(RollerPoint { c, z, x })
             } else {
@@ -929,7 +938,7 @@ impl PassPlan<'_> {
                     pass: self.index,
                     c,
                     z,
-                    y,
+                    y: r_r * c.rem_euclid(TAU),
                 })
             }
         };
@@ -957,9 +966,16 @@ impl PassPlan<'_> {
             // Each revolution starts its search at u = x: its points depend
             // on their index alone, whichever thread makes them.
             let mut offset = 0.0;
-            (k0..(k0 + per_chunk).min(steps + 1))
+            let k1 = (k0 + per_chunk).min(steps + 1);
+            if h.chords == ChordPlacement::OnPath {
+                return (k0..k1).map(|k| point(k, &mut offset)).collect();
+            }
+            // A point beyond each end, for the end chords.
+            let lo = k0.saturating_sub(1);
+            let around: Vec<RollerPoint> = (lo..(k1 + 1).min(steps + 1))
                 .map(|k| point(k, &mut offset))
-                .collect()
+                .collect::<Result<_, _>>()?;
+            Ok(placed(h.chords, &around, k0 - lo, k1 - k0, &exact))
         };
         let take = |pts: Result<Vec<RollerPoint>, RollerError>| match pts {
             Ok(pts) => {
@@ -978,6 +994,40 @@ impl PassPlan<'_> {
         }
         Ok(sum)
     }
+}
+
+/// `count` points of `around` from `first` on, each X moved by the bands
+/// of the chords it joins (`plan::chords`): how far the exact path, X =
+/// `exact(c, z)`, lies above each chord at its quarters and middle. (Not
+/// from the points' second differences: where dimples meet in a sharp
+/// ridge around the roller those say nothing of the chord across it.)
+fn placed(
+    placement: ChordPlacement,
+    around: &[RollerPoint],
+    first: usize,
+    count: usize,
+    exact: &impl Fn(f64, f64) -> f64,
+) -> Vec<RollerPoint> {
+    let band = |i: Option<usize>| -> Option<chords::Band> {
+        let i = i.filter(|&i| i + 1 < around.len())?;
+        let (p, q) = (around[i], around[i + 1]);
+        let above = |t: f64| {
+            let at = |a: f64, b: f64| a + t * (b - a);
+            exact(at(p.c, q.c), at(p.z, q.z)) - at(p.x, q.x)
+        };
+        let d = [above(0.25), above(0.5), above(0.75)];
+        // An undefined path between two defined points moves nothing.
+        Some(chords::Band::from_quarters(
+            d.map(|v| if v.is_finite() { v } else { 0.0 }),
+        ))
+    };
+    (first..first + count)
+        .map(|i| {
+            let mut p = around[i];
+            p.x += placement.offset(band(i.checked_sub(1)), band(Some(i)));
+            p
+        })
+        .collect()
 }
 
 impl PassSummary {

@@ -89,13 +89,7 @@ pub fn build(
             .time
             .map(|t| t + l.added_time * pass.cycle_offsets.len() as f64);
     }
-    let section = report::RollerHelix::new(
-        &path,
-        &limited,
-        &spec.check,
-        &spec.tool,
-        helix.roller_radius,
-    );
+    let section = report::RollerHelix::new(&path, &limited, &spec.check, &spec.tool, helix);
     let cut = (section.cut_points, section.cutting_time_s);
     let frame = RollerFrame {
         kernel: kernel.as_ref(),

@@ -12,6 +12,7 @@
 //! build` does. Every error found is returned together.
 
 pub mod accept;
+mod chords;
 mod estimate;
 mod mill;
 mod roller;

@@ -16,6 +16,12 @@ const CHORD_TOLERANCE: Param = opt(
     Check::Positive,
     "largest chord deviation from the exact tool-centre path; default 10 nm",
 );
+const CHORDS: Param = opt(
+    "chords",
+    Ty::Word(&["on_path", "straddle", "clear"]),
+    Check::Any,
+    "where the points sit across the curve: `on_path` (convex stretches gouge by up to the chords' sag), `straddle` (moved off the path so each chord errs by at most ±half the sag), `clear` (raised so no chord enters the material); default the first of these whose gouge meets the job's `max_gouge`",
+);
 
 // The parameters both spiral strategies share.
 const SPIRAL_FEED: Param = req(
@@ -64,6 +70,7 @@ pub(super) const FTS_SPIRAL: Kind = Kind {
         SURFACE_SPEED,
         SPINDLE_CAP,
         CHORD_TOLERANCE,
+        CHORDS,
         SEED_ARC,
         opt(
             "settle",
@@ -95,6 +102,7 @@ pub(super) const SPIRAL_TURNING: Kind = Kind {
         SURFACE_SPEED,
         SPINDLE_CAP,
         CHORD_TOLERANCE,
+        CHORDS,
         SEED_ARC,
         SPIRAL_FROM,
         RETRACT,
@@ -153,6 +161,7 @@ pub(super) const ROLLER_HELIX: Kind = Kind {
             Check::Any,
             "the finish pass (Liu et al.: 0.1° and 5 µm)",
         ),
+        CHORDS,
         opt(
             "z",
             Ty::Range(Dim::LENGTH),

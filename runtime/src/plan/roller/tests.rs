@@ -104,6 +104,7 @@ fn job1() -> RollerHelix {
         depth_of_cut: None,
         design_length_around: Some(6.0 * std::f64::consts::PI),
         spindle_speed: None,
+        chords: crate::plan::chords::ChordPlacement::OnPath,
     }
 }
 

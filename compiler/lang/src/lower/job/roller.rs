@@ -5,11 +5,13 @@
 //! are made here, before the helix is planned.
 
 use lensc_grammar::Diagnostic;
+use lensc_runtime::plan::chords::ChordPlacement;
 use lensc_runtime::plan::roller::{
     DesignRegion, HelixPass, RollerHelix, RollerTool, ToolCheck, check_roller_tool,
 };
 use lensc_runtime::post::Dialect;
 use lensc_runtime::surface::analysis::Domain;
+use lensc_runtime::surface::ir::SurfaceFn;
 
 use super::{Evaluate, JobHead, Parts, all_clear};
 use crate::check::trim_num;
@@ -89,6 +91,13 @@ pub(super) fn lower(
         depth_of_cut: None,
         design_length_around: Some(design_y.1 - design_y.0),
         spindle_speed: Some(spindle_speed),
+        chords: ChordPlacement::OnPath,
+    };
+    let finish_step = helix.passes.last().map_or(0.0, |f| f.c_step);
+    let sag = chord_sag(kernel.as_ref(), &region, roller_radius * finish_step);
+    let helix = RollerHelix {
+        chords: super::chords::placement(p, sag),
+        ..helix
     };
     let retract = value::num(st, "retract").unwrap_or(1.0);
     Ok(RollerSpec {
@@ -101,6 +110,26 @@ pub(super) fn lower(
         spindle_speed,
         max_feed: value::num(&p.machine.fields, "max_feed").expect("required"),
     })
+}
+
+/// The largest sag (mm) of a chord `arc` mm long around the roller where
+/// the design bulges out of the material (∂²z/∂y² < 0), on the tool
+/// check's grid: −arc² ∂²z/∂y² / 8. The nose centre's path is flatter
+/// than the design there (its radius of curvature the design's plus ρ),
+/// so its chords sag no more than this.
+fn chord_sag(design: &dyn SurfaceFn, region: &DesignRegion, arc: f64) -> f64 {
+    let (nx, ny) = region.samples;
+    let at = |(a, b): (f64, f64), i: usize, n: usize| a + (b - a) * i as f64 / (n - 1) as f64;
+    let mut bulge = 0.0f64;
+    for i in 0..nx {
+        for j in 0..ny {
+            let o = design.eval(at(region.x, i, nx), at(region.y, j, ny));
+            if o[5].is_finite() {
+                bulge = bulge.max(-o[5]);
+            }
+        }
+    }
+    arc * arc * bulge / 8.0
 }
 
 /// The roller's radius (mm), or E0131 for each part that cannot make a

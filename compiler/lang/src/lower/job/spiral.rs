@@ -7,6 +7,7 @@
 
 use lensc_grammar::Diagnostic;
 use lensc_runtime::machine::servo::SecondOrderServo;
+use lensc_runtime::plan::chords::ChordPlacement;
 use lensc_runtime::plan::fts::{FastAxis, FtsSpiral, SpindleSpeed, TrajectoryBounds};
 use lensc_runtime::post::Dialect;
 use lensc_runtime::surface::analysis::Domain;
@@ -151,7 +152,7 @@ pub(super) fn lower(
     .map_err(|e| vec![RuntimeError::Trajectory(e).at(p.site())])?;
     let mut errors = tool_checks(p, design_kernel.as_ref(), &lowered, &design);
 
-    let spiral = FtsSpiral {
+    let mut spiral = FtsSpiral {
         feed_per_rev: value::num(st, "feed").expect("required") * 2.0 * std::f64::consts::PI,
         speed,
         chord_tolerance: value::num(st, "chord_tolerance").unwrap_or(super::DEFAULT_PATH_TOLERANCE),
@@ -159,7 +160,13 @@ pub(super) fn lower(
         min_interval: 1.0 / value::num(fast, "data_rate").unwrap_or(if slow { 1e3 } else { 20e3 }),
         start_radius: start,
         end_radius: 0.0,
+        chords: ChordPlacement::OnPath,
     };
+    // W's chords stray from the path by up to their share of the tolerance.
+    spiral.chords = super::chords::placement(
+        p,
+        spiral.chord_tolerance * lensc_runtime::plan::optimise::UNOPTIMISED_CHORD_SHARE,
+    );
     errors.extend(machine_limits(p, &spiral, travel));
     all_clear(errors)?;
 
