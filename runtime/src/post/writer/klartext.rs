@@ -197,3 +197,193 @@ impl ProgramWriter {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::{ProgramWriter, Setup};
+    use crate::dialect::{Dialect, Language, WordFormat};
+    use crate::moves::{Feed as F, Move as M, Plane, Position as P, Start};
+    use crate::post::ProgramError;
+    use crate::reader::{self, MachineLimits, Path};
+    use std::f64::consts::PI;
+
+    /// `heidenhain_tnc_klartext` as `stdlib/dialects.lens` declares it.
+    fn klartext() -> Dialect {
+        let lines = |l: &[&str]| l.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        Dialect {
+            name: "heidenhain_tnc_klartext".into(),
+            language: Language::Klartext,
+            extension: "H".into(),
+            comment: crate::dialect::CommentStyle::Semicolon,
+            start: lines(&["BEGIN PGM {JOB} MM"]),
+            lathe_setup: Vec::new(),
+            mill_setup: Vec::new(),
+            lathe_tool_call: Vec::new(),
+            mill_tool_call: lines(&["TOOL CALL {tool} Z"]),
+            path_tolerance: lines(&["CYCL DEF 32.0 TOLERANCE", "CYCL DEF 32.1 T{tolerance}"]),
+            surface_speed: Vec::new(),
+            constant_rpm: None,
+            spindle_orient: lines(&["M19"]),
+            coolant_mist: None,
+            end: lines(&["M30"]),
+            trailer: lines(&["END PGM {JOB} MM"]),
+            rapid: "L".into(),
+            linear: "L".into(),
+            arc_cw: "C".into(),
+            arc_ccw: "C".into(),
+            arc_planes: vec![Plane::Xy],
+            arc_centre_absolute: true,
+            per_minute: Some("F".into()),
+            per_revolution: None,
+            inverse_time: None,
+            word_formats: ["S5", "M3", "F5.3"]
+                .iter()
+                .map(|f| WordFormat::parse(f).expect("format"))
+                .collect(),
+            line_numbers: Some(1),
+            max_line_length: Some(254),
+            ..Dialect::linuxcnc()
+        }
+    }
+
+    fn mill() -> MachineLimits {
+        MachineLimits {
+            lathe: false,
+            travel: [Some((-50.0, 50.0)), Some((-50.0, 50.0)), Some((-50.0, 50.0)), None],
+            max_feed: Some(5000.0),
+            max_spindle_rpm: Some(24000.0),
+        }
+    }
+
+    fn written(stream: &[M]) -> Result<String, ProgramError> {
+        let header = ["units mm; X Y Z of the tool centre, +Z out of the material".to_string()];
+        let mut w =
+            ProgramWriter::new(&klartext(), Setup::Mill, "dome", &header, "XYZ", 1e-3, 1e-3)?;
+        w.call_tool(&Start::default())?;
+        w.write(&M::SpindleOn(12000.0 * 2.0 * PI / 60.0))?;
+        w.write_all(stream)?;
+        w.finish()
+    }
+
+    fn arc(to: P, centre: P, ccw: bool) -> M {
+        M::Arc {
+            to,
+            centre,
+            plane: Plane::Xy,
+            ccw,
+            feed: Some(F::PerTime(5.0)),
+        }
+    }
+
+    #[test]
+    fn a_milling_program_in_klartext_reads_back_as_written() {
+        let o = P::xyz(0.0, 0.0, f64::NAN);
+        let text = written(&[
+            M::Rapid(P::xyz(1.0, 0.0, 5.0)),
+            M::Linear {
+                to: P::xyz(1.0, 0.0, -0.25),
+                feed: Some(F::PerTime(2.0)),
+            },
+            arc(P::xyz(0.0, 1.0, -0.25), o, true),
+            arc(P::xyz(-1.0, 0.0, -0.25), o, true),
+            arc(P::xyz(-2.0, 0.0, -0.25), P::xyz(-1.5, 0.0, f64::NAN), false),
+            M::Rapid(P::xyz(-2.0, 0.0, 5.0)),
+            M::Linear {
+                to: P::xyz(-2.0, 0.0, 4.0),
+                feed: Some(F::PerTime(5.0)),
+            },
+        ])
+        .expect("writes");
+        assert_eq!(
+            text,
+            "0 BEGIN PGM DOME MM\n\
+             1 ; units mm; X Y Z of the tool centre, +Z out of the material\n\
+             2 CYCL DEF 32.0 TOLERANCE\n\
+             3 CYCL DEF 32.1 T0.001\n\
+             4 TOOL CALL 1 Z\n\
+             5 TOOL CALL Z S12000\n\
+             6 M3\n\
+             7 L X+1 Y+0 Z+5 R0 FMAX\n\
+             8 L Z-0.25 R0 F120\n\
+             9 CC X+0 Y+0\n\
+             10 C X+0 Y+1 DR+ F300\n\
+             11 C X-1 Y+0 DR+\n\
+             12 CC X-1.5 Y+0\n\
+             13 C X-2 DR-\n\
+             14 L Z+5 R0 FMAX\n\
+             15 L Z+4 R0 F300\n\
+             16 M5\n\
+             17 M30\n\
+             18 END PGM DOME MM\n"
+        );
+        let (findings, moves) = reader::read_moves(&text, &klartext(), &mill());
+        assert!(findings.is_empty(), "{findings:?}");
+        let arcs: Vec<_> = moves
+            .iter()
+            .filter_map(|m| match m.path {
+                Path::Arc { centre, cw, .. } => Some((centre, cw)),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(
+            arcs,
+            [((0.0, 0.0), false), ((0.0, 0.0), false), ((-1.5, 0.0), true)]
+        );
+        assert_eq!(moves.len(), 7);
+    }
+
+    #[test]
+    fn what_klartext_cannot_say_is_refused() {
+        let zx = M::Arc {
+            to: P::xyz(1.0, 0.0, 0.0),
+            centre: P::xyz(0.5, 0.0, 0.0),
+            plane: Plane::Zx,
+            ccw: false,
+            feed: Some(F::PerTime(1.0)),
+        };
+        let e = written(&[M::Rapid(P::xyz(0.0, 0.0, 0.0)), zx]).expect_err("refused");
+        assert!(e.message().contains("zx"), "{}", e.message());
+        let per_rev = M::Linear {
+            to: P::xyz(1.0, 0.0, 0.0),
+            feed: Some(F::PerRevolution(0.001)),
+        };
+        let e = written(&[per_rev]).expect_err("refused");
+        assert!(e.message().contains("mm/min"), "{}", e.message());
+        let lathe = ProgramWriter::new(&klartext(), Setup::Lathe, "t", &[], "XZ", 1e-3, 1e-3);
+        assert!(lathe.is_err_and(|e| e.message().contains("milling")));
+    }
+
+    #[test]
+    fn the_reader_refuses_what_a_tnc_refuses() {
+        let good = written(&[
+            M::Rapid(P::xyz(1.0, 0.0, 5.0)),
+            M::Linear {
+                to: P::xyz(1.0, 0.0, -0.25),
+                feed: Some(F::PerTime(2.0)),
+            },
+            arc(P::xyz(0.0, 1.0, -0.25), P::xyz(0.0, 0.0, f64::NAN), true),
+        ])
+        .expect("writes");
+        let rules = |text: &str| -> Vec<reader::Rule> {
+            reader::read(text, &klartext(), &mill())
+                .into_iter()
+                .map(|f| f.rule)
+                .collect()
+        };
+        assert!(rules(&good).is_empty());
+        let cases = [
+            ("8 L Z-0.25", "9 L Z-0.25", reader::Rule::BlockSequence),
+            ("9 CC X+0 Y+0\n", "", reader::Rule::NoCircleCentre),
+            ("END PGM DOME MM", "END PGM OTHER MM", reader::Rule::ProgramFrame),
+            ("0 BEGIN PGM DOME MM\n", "0 ; no begin\n", reader::Rule::ProgramFrame),
+            ("R0 F120", "RL F120", reader::Rule::UnknownWord),
+            ("DR+", "", reader::Rule::ArcWords),
+            ("6 M3", "6 M5", reader::Rule::SpindleStopped),
+        ];
+        for (from, to, rule) in cases {
+            let bad = good.replacen(from, to, 1);
+            assert_ne!(bad, good, "{from}");
+            assert!(rules(&bad).contains(&rule), "{from} → {to}: {:?}", rules(&bad));
+        }
+    }
+}
