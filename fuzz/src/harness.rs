@@ -97,6 +97,7 @@ pub fn run(fs: &MemFs, bytes: &[u8], depth: Depth, out_dir: &Path) -> Result<Rea
     well_formed(c.diags(), sources)?;
     render(c.diags(), sources)?;
     formats(bytes)?;
+    parses_alike(bytes)?;
     let mut reached = Reached {
         clean: !c.has_errors(),
         ..Reached::default()
@@ -156,6 +157,20 @@ fn formats(bytes: &[u8]) -> Result<(), Fault> {
         Ok(twice) if twice == once => Ok(()),
         Ok(_) => Err("lensc fmt of its own output changed it again".into()),
         Err(_) => Err("lensc fmt's output does not format".into()),
+    }
+}
+
+/// The parser's fast path (`lensc_grammar`'s hand-written descent) and
+/// pest alone give the same tree and the same diagnostics.
+fn parses_alike(bytes: &[u8]) -> Result<(), Fault> {
+    let Ok(text) = std::str::from_utf8(bytes) else {
+        return Ok(());
+    };
+    let id = lensc_grammar::FileId(0);
+    if lensc_grammar::parse(text, id) == lensc_grammar::parse_reference(text, id) {
+        Ok(())
+    } else {
+        Err("the parser's fast path and pest disagree".into())
     }
 }
 

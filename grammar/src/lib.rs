@@ -10,13 +10,14 @@
 extern crate alloc;
 
 pub mod ast;
+mod descent;
 pub mod diagnostic;
 pub mod parser;
 pub mod suggest;
 
 pub use ast::Span;
 pub use diagnostic::{Diagnostic, FileId, Label, Severity};
-pub use parser::parse;
+pub use parser::{parse, parse_reference};
 
 #[cfg(test)]
 mod tests;

@@ -66,6 +66,18 @@ static PRATT: LazyLock<PrattParser<Rule>> = LazyLock::new(|| {
 /// Parses one source file. Always returns a tree (possibly partial) and the
 /// syntax diagnostics found, in source order.
 pub fn parse(source: &str, file: FileId) -> (File, Vec<Diagnostic>) {
+    parse_with(source, file, true)
+}
+
+/// `parse` by pest alone, without the hand-written fast path (`descent`):
+/// the reference that tests and the fuzzer compare `parse` with. Its
+/// result is the same, tree and diagnostics, only slower.
+#[doc(hidden)]
+pub fn parse_reference(source: &str, file: FileId) -> (File, Vec<Diagnostic>) {
+    parse_with(source, file, false)
+}
+
+fn parse_with(source: &str, file: FileId, fast: bool) -> (File, Vec<Diagnostic>) {
     let mut diags = Vec::new();
     if source.len() > u32::MAX as usize / 2 {
         diags.push(Diagnostic::error(
@@ -110,6 +122,11 @@ pub fn parse(source: &str, file: FileId) -> (File, Vec<Diagnostic>) {
     // does not parse is parsed again item by item, for every error in it.
     for batch in batches(&chunks) {
         let (start, end) = (batch[0].0, batch[batch.len() - 1].1);
+        // Text with nothing to report takes the hand-written path; pest
+        // parses the rest, and every error is reported from there.
+        if fast && crate::descent::items(&source[start..end], start, &mut items).is_some() {
+            continue;
+        }
         if batch.len() > 1
             && let Ok(pairs) = LensParser::parse(Rule::file, &source[start..end])
         {
@@ -243,20 +260,21 @@ fn scan(src: &str) -> Scan {
             b')' | b']' | b'}' => depth = depth.saturating_sub(1),
             _ => {}
         }
-        let is_word = c.is_ascii_alphanumeric() || c == b'_';
-        if is_word
-            && at_word_start
-            && i > 0
-            && starts_item(&src[i..])
-            && preceded_by_line_start(b, i)
-        {
-            // Also inside an unclosed bracket: an item keyword at the start of
-            // a line followed by a name cannot continue the previous item,
-            // so a missing `)` or `}` does not swallow the rest of the file.
-            starts.push(i);
-            powers = 0;
+        let is_word = is_word_byte(c);
+        if is_word {
+            if at_word_start && i > 0 && preceded_by_line_start(b, i) && starts_item(&src[i..]) {
+                // Also inside an unclosed bracket: an item keyword at the start of
+                // a line followed by a name cannot continue the previous item,
+                // so a missing `)` or `}` does not swallow the rest of the file.
+                starts.push(i);
+                powers = 0;
+            }
+            // The rest of the word changes nothing above: pass over it.
+            i += b[i..].iter().take_while(|&&w| is_word_byte(w)).count();
+            at_word_start = false;
+            continue;
         }
-        at_word_start = !is_word;
+        at_word_start = true;
         i += 1;
     }
     let mut chunks = Vec::with_capacity(starts.len());
@@ -269,6 +287,10 @@ fn scan(src: &str) -> Scan {
         too_deep_at: None,
         why: TooDeep::Brackets,
     }
+}
+
+fn is_word_byte(b: u8) -> bool {
+    b.is_ascii_alphanumeric() || b == b'_'
 }
 
 /// `surface name`, `let name`, `use "…"`, `use std…`: an item keyword followed

@@ -131,3 +131,209 @@ fn formulas_and_named_arguments() {
     };
     assert_eq!(args[0].name.as_ref().map(|n| n.name.as_str()), Some("x"));
 }
+
+/// Every `.lens` file of the repository (examples, the standard library,
+/// the bad-input corpora), read from disk.
+fn repository_files() -> Vec<(std::path::PathBuf, String)> {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut files = Vec::new();
+    let mut dirs = vec![
+        root.join("examples"),
+        root.join("stdlib"),
+        root.join("tests"),
+    ];
+    while let Some(dir) = dirs.pop() {
+        for entry in std::fs::read_dir(&dir).expect("readable folder").flatten() {
+            let path = entry.path();
+            if path.is_dir() {
+                dirs.push(path);
+            } else if path.extension().is_some_and(|e| e == "lens") {
+                // A bad input that is not UTF-8 never reaches the parser.
+                if let Ok(text) = std::fs::read_to_string(&path) {
+                    files.push((path, text));
+                }
+            }
+        }
+    }
+    files.sort();
+    assert!(files.len() > 100, "found {} files", files.len());
+    files
+}
+
+/// The fast path and pest agree: the same tree, the same diagnostics.
+fn agree(text: &str) {
+    let fast = parse(text, FileId(0));
+    let reference = crate::parse_reference(text, FileId(0));
+    if fast != reference {
+        let (f, r) = (format!("{fast:#?}"), format!("{reference:#?}"));
+        let at = f
+            .lines()
+            .zip(r.lines())
+            .position(|(a, b)| a != b)
+            .unwrap_or(0);
+        let window = |s: &str| {
+            s.lines()
+                .skip(at.saturating_sub(8))
+                .take(12)
+                .collect::<Vec<_>>()
+                .join("\n")
+        };
+        panic!(
+            "the paths differ on {text:?}\nfast:\n{}\npest:\n{}",
+            window(&f),
+            window(&r)
+        );
+    }
+}
+
+#[test]
+fn fast_path_agrees_with_pest_on_every_repository_file() {
+    for (path, text) in repository_files() {
+        agree(&text);
+        // A file that pest parses with nothing to report never needs pest.
+        if crate::parse_reference(&text, FileId(0)).1.is_empty() {
+            let mut items = Vec::new();
+            assert!(
+                crate::descent::items(&text, 0, &mut items).is_some(),
+                "{} took the slow path",
+                path.display()
+            );
+        }
+    }
+}
+
+#[test]
+fn fast_path_agrees_with_pest_on_the_corners_of_the_grammar() {
+    let exprs = [
+        "1 + 2 * 3 ^ 2 ^ 2",
+        "-x ^ 2",
+        "-x * 2",
+        "- - x",
+        "2 ^ -1 ^ 2",
+        "2 ^ -1 * 3",
+        "1..2",
+        "1 ..2 mm",
+        "1. + 2",
+        "1.5e3",
+        "1e",
+        "2e-3 mm",
+        "3em",
+        "1E+2",
+        "5 rad/mm * x",
+        "10 rad/(3 mm)",
+        "9.81 m/s^2",
+        "1.2e-5 mm^-3",
+        "2 mm^x",
+        "2 mm^-",
+        "2 mm^123",
+        "2 mm^0",
+        "2 mm^-0",
+        "2 mm/s^0",
+        "7°",
+        "85 µm",
+        "85 μm",
+        "85 µ",
+        "5 mm/ 2",
+        "5 mm / 2",
+        "5 tool",
+        "5 _a",
+        "5 a_1b",
+        "1e999",
+        "f(a: 1, b: 2,)",
+        "f(a: :b)",
+        "f(a::b)",
+        "f()",
+        "f(,)",
+        "f(1 2)",
+        "[1, 2,]",
+        "[]",
+        "[,]",
+        "[1 2]",
+        "(1)",
+        "((1) + (2))",
+        "a { b: 1, }",
+        "a { b: 1 c: 2 }",
+        "a { z(x, y) = x * y }",
+        "a { z(x,) = x }",
+        "a {,}",
+        "{ b: [1, 2] }",
+        "a(1) { b: 2 } (3)",
+        "\"a\\\"b\\\\c\\nd\\te\"",
+        "\"\\q\"",
+        "\"open",
+        "x // comment\n+ 1",
+        "x /* c */ + /* d */ 1",
+        "x /* open",
+        "x + ",
+        "x +\n",
+        "1 mm : 2",
+        "\u{feff}1",
+        "a\u{e9}",
+        "job",
+        "x ^",
+    ];
+    for e in exprs {
+        agree(&format!("let a = {e}\n"));
+        agree(&format!("surface s = t {{ p: {e} }}\nlet b = 1\n"));
+    }
+    let files = [
+        "use std::machines::x\n",
+        "use std :: machines\n",
+        "use std\n",
+        "use \"p.lens\"\n",
+        "use \"p\\q.lens\"\n",
+        "job j { surface: s }\n",
+        "job let { }\n",
+        "let job = 1\n",
+        "dialect d = x { }\n",
+        "let a = 1 let b = 2\n",
+        "/* a */ let a = 1 // b\n",
+        "let a = 1\n/* unclosed",
+        "",
+        "\n\n",
+        "let a = 1\n}\n",
+        "letx = 1\n",
+    ];
+    for f in files {
+        agree(f);
+    }
+    // Deep chains: the fast path gives up and pest reports the depth.
+    agree(&format!("let a = {}1\n", "1 + ".repeat(250)));
+    agree(&format!("let a = {}1{}\n", "f(".repeat(40), ")".repeat(40)));
+}
+
+#[test]
+fn fast_path_agrees_with_pest_on_mutated_files() {
+    const BITS: [&str; 24] = [
+        "-", "+", "*", "/", "^", ".", ",", ":", "(", ")", "{", "}", "[", "]", "\"", "\\", " ",
+        "\n", "//", "/*", "°", "µ", "0", "e",
+    ];
+    let mut state = 0x9E37_79B9_7F4A_7C15_u64;
+    let mut next = |n: usize| {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        ((state >> 33) as usize) % n.max(1)
+    };
+    for (_, text) in repository_files() {
+        let chars: Vec<char> = text.chars().collect();
+        for _ in 0..12 {
+            let mut m: Vec<char> = chars.clone();
+            for _ in 0..1 + next(3) {
+                let at = next(m.len() + 1);
+                match next(3) {
+                    0 if at < m.len() => {
+                        let len = 1 + next(4).min(m.len() - at - 1);
+                        m.drain(at..at + len);
+                    }
+                    1 => m
+                        .splice(at..at, BITS[next(BITS.len())].chars())
+                        .for_each(drop),
+                    _ if at < m.len() => m[at] = BITS[next(BITS.len())].chars().next().unwrap(),
+                    _ => {}
+                }
+            }
+            agree(&m.into_iter().collect::<String>());
+        }
+    }
+}

@@ -376,7 +376,7 @@ fn a_simulation_window_too_fine_is_refused_with_its_size() {
          use std::tools::microshaper_r85um\n\
          strategy scrape = raster { along: x, direction: one_way, stepover: 50 um, chord_tolerance: 1 um, feed: 100 mm/min }\n\
          job j { surface: s, tool: microshaper_r85um, machine: generic_3axis_mill, strategy: scrape,\n\
-             simulate: { x: -1 mm .. 1 mm, y: -1 mm .. 1 mm, spacing: 0.5 um } }\n",
+             simulate: { x: -1 mm .. 1 mm, y: -1 mm .. 1 mm, spacing: 20 nm } }\n",
     )
     .expect("write");
     let out = lensc(
@@ -391,7 +391,7 @@ fn a_simulation_window_too_fine_is_refused_with_its_size() {
     assert_eq!(out.status.code(), Some(1));
     let err = text(&out.stderr);
     assert!(
-        err.contains("E0149") && err.contains("16008001 cells"),
+        err.contains("E0149") && err.contains("10000200001 cells in 10001 tiles"),
         "{err}"
     );
     assert!(!dir.path().join("j.ngc").exists());
@@ -498,5 +498,40 @@ fn seed_002_rollers_cut_within_the_figure() {
             let (rms, pv) = (num(&c["rms_nm"]), num(&c["pv_nm"]));
             assert!(rms < 1.0 && pv < 5.0, "{}: {c}", r["job"]);
         }
+    }
+}
+
+#[test]
+fn a_ball_end_raster_is_simulated_with_its_scallops_and_contacts() {
+    // A 0.4 mm ball over a 2 mm convex sphere at 10 um stepover: the ball
+    // swept along the printed path leaves the scallop of its radius on
+    // that curvature, its contacts sit on the design as computed, and the
+    // acceptance gate measures every criterion (issue #15: ball-end
+    // rasters simulated, not skipped).
+    let source = "surface dome = sphere { radius: 2 mm, sense: convex, aperture: circle(diameter: 0.4 mm) }
+tool ball = ball_end { diameter: 0.4 mm }
+use std::machines::generic_3axis_mill
+strategy scrape = raster { along: y, direction: zigzag, stepover: 10 um, feed: 100 mm/min, spindle_speed: 12000 rpm, chord_tolerance: 200 nm }
+job dome_ball { surface: dome, tool: ball, machine: generic_3axis_mill, strategy: scrape }
+";
+    let r = report_of(source, "dome_ball");
+    let h = &r["simulation"]["height_map"];
+    assert_eq!(h["uncut_cells"], 0, "{h}");
+    let expected = scallop(0.2, 0.01, 2.0) * 1e6;
+    let mean = num(&h["scallops"]["simulated"]["mean_nm"]);
+    assert!(
+        (mean - expected).abs() < 0.01 * expected,
+        "{mean} vs {expected}"
+    );
+    // As computed (rounded to a picometre), the contacts lie on the design:
+    // no gouge, a mean within a nanometre.
+    let exact = &h["contact_unrounded"];
+    assert!(num(&exact["mean_nm"]).abs() < 1.0, "{exact}");
+    assert!(num(&exact["max_gouge_nm"]["value"]) < 1.0, "{exact}");
+    assert!(num(&exact["rms_nm"]) < 5.0, "{exact}");
+    let acceptance = &r["acceptance"];
+    assert_eq!(acceptance["passed"], true, "{acceptance}");
+    for c in acceptance["criteria"].as_array().expect("criteria") {
+        assert!(c["unmeasured"].is_null(), "{c}");
     }
 }

@@ -11,6 +11,9 @@
 //! 100 of them; issue 17 asks for the whole command under 1 s).
 //!
 //! Run: cargo bench -p lensc-build --bench check_throughput
+//! For a profiler (callgrind counts instructions, steady on a loaded
+//! machine): `CHECK_THROUGHPUT_ONCE=parse` or `=check` runs that stage once
+//! on the 10,000-line file and nothing else.
 //! A plain harness (no criterion): the figure wanted is a ratio of three
 //! stages in one process, which criterion does not print.
 
@@ -63,6 +66,17 @@ job j{i} {{ surface: s{i}, tool: t{i}, machine: m{i}, strategy: g{i} }}
 fn main() {
     let src = generate(10_000);
     let lines = src.lines().count();
+    match std::env::var("CHECK_THROUGHPUT_ONCE").as_deref() {
+        Ok("parse") => {
+            black_box(lensc_grammar::parse(&src, lensc_grammar::FileId(0)));
+            return;
+        }
+        Ok("check") => {
+            black_box(driver::check_text(&RealFs, "bench.lens", src.as_bytes()));
+            return;
+        }
+        _ => {}
+    }
     // Sanity: the generated file is valid, so check does all of its work.
     let c = driver::check_text(&RealFs, "bench.lens", src.as_bytes());
     assert!(!c.has_errors(), "generated file has errors");

@@ -10,16 +10,10 @@
 //!
 //! Run: cargo bench -p lensc --bench fts_toolpath
 
-use std::time::Instant;
+#[path = "../../../runtime/benches/support/timing.rs"]
+mod timing;
 
-fn peak_rss_mb() -> f64 {
-    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
-    status
-        .lines()
-        .find_map(|l| l.strip_prefix("VmHWM:"))
-        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<f64>().ok())
-        .map_or(f64::NAN, |kb| kb / 1024.0)
-}
+use std::time::Instant;
 
 fn main() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
@@ -78,6 +72,6 @@ fn main() {
     );
     println!(
         "  peak resident memory:             {:>8.1} MB",
-        peak_rss_mb()
+        timing::peak_resident_mb()
     );
 }

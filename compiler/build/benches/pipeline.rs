@@ -21,6 +21,9 @@
 //! run on a quiet 2-core machine; too slow for CI). `PIPELINE_RUNS=N`
 //! changes the number of runs (default 2).
 
+#[path = "../../../runtime/benches/support/timing.rs"]
+mod timing;
+
 use std::path::Path;
 use std::time::Instant;
 
@@ -50,36 +53,14 @@ impl Times {
     }
 }
 
-/// The process's CPU time so far (s), every thread's.
-fn cpu_now() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    // Fields after the command's closing parenthesis: utime is the 12th
-    // and stime the 13th of them, in clock ticks (100 a second).
-    let rest = stat.rsplit_once(')').map_or("", |(_, r)| r);
-    let f: Vec<f64> = rest
-        .split_whitespace()
-        .map(|v| v.parse().unwrap_or(0.0))
-        .collect();
-    (f.get(11).copied().unwrap_or(f64::NAN) + f.get(12).copied().unwrap_or(f64::NAN)) / 100.0
-}
-
 fn timed<R>(f: impl FnOnce() -> R) -> (Times, R) {
-    let (t, c) = (Instant::now(), cpu_now());
+    let (t, c) = (Instant::now(), timing::cpu_seconds());
     let r = f();
     let times = Times {
         wall: t.elapsed().as_secs_f64(),
-        cpu: cpu_now() - c,
+        cpu: timing::cpu_seconds() - c,
     };
     (times, r)
-}
-
-fn peak_rss_mb() -> f64 {
-    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
-    status
-        .lines()
-        .find_map(|l| l.strip_prefix("VmHWM:"))
-        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<f64>().ok())
-        .map_or(f64::NAN, |kb| kb / 1024.0)
 }
 
 fn runs() -> usize {
@@ -173,28 +154,27 @@ fn plan_roller(spec: &JobSpec, keep: Option<&mut Vec<Vec<[f64; 3]>>>) -> usize {
 /// Seed 002's simulation alone, as its builder runs it: every printed
 /// point swept over the window's grid, the map finished against the design.
 fn simulate_roller(spec: &JobSpec, passes: &[Vec<[f64; 3]>]) -> usize {
-    use lensc_build::height_map::{self, RollerFrame};
+    use lensc_build::height_map::{self, RollerFrame, Simulation};
+    use lensc_runtime::verify::heightmap::NosePath;
     let JobSpec::Roller(s) = spec else {
         panic!("a roller")
     };
     let (head, helix) = (&s.head, &s.helix);
     let lowered = &head.surface.lowered;
     let (kernel, _) = lensc_build::evaluate::evaluator(&lowered.tape);
+    let (design_y, z) = (s.design_y, (helix.z_start, helix.z_end));
     let window = height_map::window(
         head,
-        (
-            (helix.z_start + helix.z_end) / 2.0,
-            (s.design_y.0 + s.design_y.1) / 2.0,
-        ),
+        ((z.0 + z.1) / 2.0, (design_y.0 + design_y.1) / 2.0),
+        height_map::roller_extent(&lowered.domain, z, design_y),
     );
-    let mut sweep = lensc_runtime::verify::heightmap::Sweep::new(
-        window.roller(helix.roller_radius),
-        s.tool.nose_radius,
-    );
+    let grid = window.roller(helix.roller_radius);
+    let tiles = lensc_runtime::verify::window::split(&grid, None);
+    let mut sweep = Simulation::new(grid, tiles, s.tool.nose_radius);
     for pass in passes {
-        sweep.lift();
+        sweep.path().lift();
         for &[c, z, x] in pass {
-            sweep.point(c, z, x);
+            sweep.path().point(c, z, x);
         }
     }
     let frame = RollerFrame {
@@ -203,7 +183,7 @@ fn simulate_roller(spec: &JobSpec, passes: &[Vec<[f64; 3]>]) -> usize {
         roller_radius: helix.roller_radius,
         domain: lowered.domain,
     };
-    let map = sweep.finish(&frame);
+    let map = sweep.finish(&frame, &window, window.spacing);
     std::hint::black_box(&map);
     passes.iter().map(Vec::len).sum()
 }
@@ -274,6 +254,6 @@ fn main() {
     ratio("report / build", reported, built, "< 1");
     println!(
         "  peak resident memory (the simulation's points held in memory): {:.0} MB",
-        peak_rss_mb()
+        timing::peak_resident_mb()
     );
 }

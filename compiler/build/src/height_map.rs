@@ -1,33 +1,113 @@
 //! The height-map simulation of a surface job, as the job builders use it:
-//! the window the job's `simulate` block asks for (or a default one where
-//! the surface is representative; the window and its grids in the
-//! coordinates of the cut are the runtime's `verify::window`), the frames
+//! the window the job's `simulate` block asks for (the whole part's extent
+//! where it leaves a range out, or a default window where the surface is
+//! representative; the window, its grids in the coordinates of the cut
+//! and their tiles are the runtime's `verify::window`), the path kept as
+//! it is planned and simulated tile by tile (`verify::tiles`), the frames
 //! that tie those coordinates to the design (the report's
 //! `simulation.height_map` section is `crate::report::HeightMap`).
 
 use lensc_runtime::moves::{Move, Plane};
+use lensc_runtime::reader::{Executed, Path as ExecutedPath};
 use lensc_runtime::surface::analysis::Domain;
 use lensc_runtime::surface::ir::SurfaceFn;
-use lensc_runtime::verify::heightmap::{Frame, HeightMap, Sweep};
+use lensc_runtime::verify::heightmap::{
+    Cutter, ErrorRaster, Frame, Grid, HeightMap, NosePath, RasterLayout,
+};
+use lensc_runtime::verify::tiles::{Recorder, simulate};
+use lensc_runtime::verify::window::Tile;
 use std::f64::consts::TAU;
 
 use lensc_lang::check::trim_num;
 use lensc_lang::lower::job::JobHead;
 
+pub use lensc_lang::lower::job::window::{domain_extent, roller_extent};
 pub use lensc_runtime::verify::window::Window;
 
-/// The window a job simulates: the one its `simulate` block gives (its
-/// grid's size was checked by lowering), or the default one about
-/// `centre`, which is small enough for every grid.
-pub fn window(head: &JobHead, centre: (f64, f64)) -> Window {
-    match head.simulate {
-        Some(s) => Window::given(s.x, s.y, s.spacing),
-        None => Window::about(centre),
+/// The window a job simulates: the one its `simulate` block gives, a
+/// range it leaves out being the part's `extent` (its tiles' size was
+/// checked by lowering), or the default one about `centre`, which is
+/// small enough for every grid.
+pub fn window(head: &JobHead, centre: (f64, f64), extent: ((f64, f64), (f64, f64))) -> Window {
+    lensc_lang::lower::job::window::simulated(head, extent).unwrap_or_else(|| Window::about(centre))
+}
+
+/// A height-map simulation under way: the path kept as it is planned
+/// (only what reaches the tiles), then swept tile by tile.
+pub struct Simulation {
+    /// The window's whole grid (the report's), and its tiles.
+    pub grid: Grid,
+    pub tiles: Vec<Tile>,
+    cutter: Cutter,
+    recorder: Recorder,
+}
+
+impl Simulation {
+    /// A simulation of a round nose of `nose_radius` whose edge lies
+    /// across the cut (a knife, a lathe's diamond).
+    pub fn new(grid: Grid, tiles: Vec<Tile>, nose_radius: f64) -> Simulation {
+        Simulation::of(
+            grid,
+            tiles,
+            Cutter::Nose {
+                radius: nose_radius,
+            },
+        )
+    }
+
+    /// A simulation of `cutter`.
+    pub fn of(grid: Grid, tiles: Vec<Tile>, cutter: Cutter) -> Simulation {
+        Simulation {
+            grid,
+            recorder: Recorder::new(Recorder::band_of(&tiles, cutter.radius())),
+            tiles,
+            cutter,
+        }
+    }
+
+    /// Where the planned path goes.
+    pub fn path(&mut self) -> &mut Recorder {
+        &mut self.recorder
+    }
+
+    /// The map of every tile against `frame`'s design, and its error on a
+    /// raster of at most `plots::RASTER_SIDE` blocks a side over `window`,
+    /// blocks no finer than `min_block` (mm).
+    pub fn finish(
+        self,
+        frame: &dyn Frame,
+        window: &Window,
+        min_block: f64,
+    ) -> (HeightMap, ErrorRaster) {
+        let layout = RasterLayout::new(window.x, window.y, min_block, crate::plots::RASTER_SIDE);
+        let t = simulate(
+            &self.recorder,
+            &self.tiles,
+            self.grid,
+            self.cutter,
+            frame,
+            layout,
+        );
+        (t.map, t.raster)
     }
 }
 
-/// The design's heights z at (x, y) points.
+/// The design's heights z at (x, y) points (a few at a time on the
+/// stack: the simulation asks for one to six points per contact).
 fn heights(kernel: &dyn SurfaceFn, xy: impl Iterator<Item = (f64, f64)>, out: &mut [f64]) {
+    const FEW: usize = 8;
+    if out.len() <= FEW {
+        let (mut xs, mut ys, mut all) = ([0.0; FEW], [0.0; FEW], [0.0; 6 * FEW]);
+        let n = out.len();
+        for (k, (x, y)) in xy.take(n).enumerate() {
+            (xs[k], ys[k]) = (x, y);
+        }
+        kernel.eval_batch(&xs[..n], &ys[..n], &mut all[..6 * n]);
+        for (o, v) in out.iter_mut().zip(all.chunks_exact(6)) {
+            *o = v[0];
+        }
+        return;
+    }
     let (xs, ys): (Vec<f64>, Vec<f64>) = xy.unzip();
     let mut all = vec![0.0; 6 * xs.len()];
     kernel.eval_batch(&xs, &ys, &mut all);
@@ -54,6 +134,25 @@ impl Frame for RasterFrame<'_> {
     fn inside(&self, x: f64, y: f64) -> bool {
         self.window.contains(x, y) && self.domain.contains(x, y)
     }
+}
+
+thread_local! {
+    /// The last spindle angle turned to and its cosine and sine: a
+    /// column's cells share their angle.
+    static TURNED: std::cell::Cell<(f64, f64, f64)> = const { std::cell::Cell::new((f64::NAN, 1.0, 0.0)) };
+}
+
+/// cos s and sin s, from the last angle asked for when it is the same.
+fn turned(s: f64) -> (f64, f64) {
+    TURNED.with(|last| {
+        let (a, cos, sin) = last.get();
+        if a == s {
+            return (cos, sin);
+        }
+        let (cos, sin) = (s.cos(), s.sin());
+        last.set((s, cos, sin));
+        (cos, sin)
+    })
 }
 
 /// A spiral on a lathe: s the spindle angle, u the radius, h the height
@@ -93,7 +192,13 @@ impl Frame for LatheFrame<'_> {
         heights(self.kernel, points.iter().map(|&(s, u)| self.xy(s, u)), out);
     }
     fn xy(&self, s: f64, u: f64) -> (f64, f64) {
-        (u * s.cos(), u * s.sin())
+        let (cos, sin) = turned(s);
+        (u * cos, u * sin)
+    }
+    /// The polar cell's parallelogram: its radial step times its
+    /// angular step's chord across, u · du · sin(ds).
+    fn cell_area(&self, g: &Grid, _: f64, u: f64) -> f64 {
+        (u * g.du * g.ds.sin()).abs()
     }
     fn inside(&self, x: f64, y: f64) -> bool {
         self.window.contains(x, y) && self.domain.contains(x, y)
@@ -130,7 +235,7 @@ impl Frame for RollerFrame<'_> {
 /// Feeds a mill's (optimised) move stream to `sweep`, as printed: rapids
 /// lift the tool; straight moves and arcs in the plane of the cut are
 /// followed.
-pub fn sweep_mill_moves(sweep: &mut Sweep, moves: &[Move], along_x: bool, resolution: f64) {
+pub fn sweep_mill_moves(sweep: &mut dyn NosePath, moves: &[Move], along_x: bool, resolution: f64) {
     let printed = |v: f64| lensc_runtime::verify::simulate::as_printed(v, resolution);
     let mut at = [f64::NAN; 3];
     let to_here = |to: &lensc_runtime::moves::Position, at: &mut [f64; 3]| {
@@ -172,6 +277,73 @@ pub fn sweep_mill_moves(sweep: &mut Sweep, moves: &[Move], along_x: bool, resolu
     }
 }
 
+/// The largest sagitta (mm) of the chords a blended arc is swept as: a
+/// hundredth of a nanometre.
+const ARC_SAGITTA: f64 = 1e-8;
+
+/// Feeds a mill program's moves, read from its text as the controller
+/// reads it (`reader::read_moves`), to `sweep`: rapids lift the tool;
+/// straight moves are followed; an arc in the plane of the cut is cut as
+/// the controller cuts it, its radius blended from the start's to the
+/// end's over its turn (see `verify::simulate`), in chords of at most
+/// `ARC_SAGITTA`; an arc in another plane by its chord.
+pub fn sweep_mill_program(sweep: &mut dyn NosePath, moves: &[Executed], along_x: bool) {
+    let su = |p: [f64; 3]| if along_x { (p[0], p[1]) } else { (p[1], p[0]) };
+    let xyz = |v: &[Option<f64>; 4]| Some([v[0]?, v[1]?, v[2]?]);
+    let mut cutting = false;
+    for m in moves {
+        let (Some(from), Some(to)) = (xyz(&m.from), xyz(&m.to)) else {
+            sweep.lift();
+            cutting = false;
+            continue;
+        };
+        if m.path == ExecutedPath::Rapid {
+            sweep.lift();
+            cutting = false;
+            continue;
+        }
+        if !cutting {
+            let (s, u) = su(from);
+            sweep.point(s, u, from[2]);
+            cutting = true;
+        }
+        if let ExecutedPath::Arc {
+            plane,
+            centre,
+            cw,
+            turn,
+        } = m.path
+            && matches!((plane, along_x), (Plane::Zx, true) | (Plane::Yz, false))
+        {
+            // The plane's two coordinates in its order: (Z, X) or (Y, Z).
+            let in_plane = |p: [f64; 3]| match plane {
+                Plane::Zx => (p[2], p[0]),
+                _ => (p[1], p[2]),
+            };
+            let back = |(a, b): (f64, f64)| match plane {
+                Plane::Zx => [b, from[1], a],
+                _ => [from[0], a, b],
+            };
+            let (a, b) = (in_plane(from), in_plane(to));
+            let r0 = (a.0 - centre.0).hypot(a.1 - centre.1);
+            let r1 = (b.0 - centre.0).hypot(b.1 - centre.1);
+            let start = (a.1 - centre.1).atan2(a.0 - centre.0);
+            let sweep_angle = if cw { -turn } else { turn };
+            let step = (8.0 * ARC_SAGITTA / r0.max(r1).max(1e-9)).sqrt();
+            let n = ((sweep_angle.abs() / step).ceil() as usize).clamp(1, 1_000_000);
+            for k in 1..n {
+                let f = k as f64 / n as f64;
+                let (theta, r) = (start + f * sweep_angle, r0 + f * (r1 - r0));
+                let p = back((centre.0 + r * theta.cos(), centre.1 + r * theta.sin()));
+                let (s, u) = su(p);
+                sweep.point(s, u, p[2]);
+            }
+        }
+        let (s, u) = su(to);
+        sweep.point(s, u, to[2]);
+    }
+}
+
 /// The default window's centre on a lathe: the outermost lenslet's
 /// centre, or half way out along x.
 pub fn lathe_centre(domain: &Domain, features: &[(f64, f64, f64)]) -> (f64, f64) {
@@ -192,24 +364,15 @@ pub fn domain_centre(domain: &Domain) -> (f64, f64) {
     }
 }
 
-/// A height map as the series of its plot: the error on a raster of at
-/// most `plots::RASTER_SIDE` blocks a side over the window, blocks no
-/// finer than `min_block` (mm).
+/// A height map's error on its raster (see [`Simulation::finish`]) as
+/// the series of its plot.
 pub fn form_error_series(
-    map: &HeightMap,
-    frame: &dyn Frame,
+    raster: ErrorRaster,
     window: &Window,
-    min_block: f64,
     axes: (&'static str, &'static str),
 ) -> crate::plots::FormErrorSeries {
     crate::plots::FormErrorSeries {
-        raster: map.raster(
-            frame,
-            window.x,
-            window.y,
-            min_block,
-            crate::plots::RASTER_SIDE,
-        ),
+        raster,
         window: (window.x, window.y),
         spacing: window.spacing,
         x_axis: axes.0,

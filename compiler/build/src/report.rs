@@ -1046,6 +1046,8 @@ impl HeightMap {
                 rows: g.nu,
                 column_step: g.ds,
                 row_step_mm: g.du,
+                tiles: map.tiles,
+                cells_evaluated: map.cells,
             },
             uncut_cells: map.uncut,
             uncut_area_mm2: map.uncut_area,
@@ -1100,6 +1102,14 @@ pub struct Grid {
     pub column_step: f64,
     /// Step between rows (mm).
     pub row_step_mm: f64,
+    /// The tiles it was simulated in, each a run of whole columns and
+    /// its memory freed before the next; a lathe's window over more than
+    /// one lenslet goes lenslet by lenslet (each on its own polar grid
+    /// over its square), and `columns` and `rows` are then the window's
+    /// whole grid, not what was swept.
+    pub tiles: usize,
+    /// Cells evaluated: in the window (and its lenslets), cut or not.
+    pub cells_evaluated: usize,
 }
 
 /// The figures of a set of form errors, as an optician reads them: the

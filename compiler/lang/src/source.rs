@@ -14,6 +14,19 @@ pub struct SourceFile {
     line_starts: Vec<usize>,
 }
 
+/// The byte offset where each line of `text` starts: 0, then one past
+/// every line feed.
+pub fn line_starts(text: &str) -> Vec<usize> {
+    let mut starts = vec![0];
+    starts.extend(
+        text.bytes()
+            .enumerate()
+            .filter(|(_, b)| *b == b'\n')
+            .map(|(i, _)| i + 1),
+    );
+    starts
+}
+
 #[derive(Default)]
 pub struct SourceMap {
     files: Vec<SourceFile>,
@@ -21,13 +34,7 @@ pub struct SourceMap {
 
 impl SourceMap {
     pub fn add(&mut self, name: String, path: Option<PathBuf>, text: String) -> FileId {
-        let mut line_starts = vec![0];
-        line_starts.extend(
-            text.bytes()
-                .enumerate()
-                .filter(|(_, b)| *b == b'\n')
-                .map(|(i, _)| i + 1),
-        );
+        let line_starts = line_starts(&text);
         self.files.push(SourceFile {
             name,
             path,

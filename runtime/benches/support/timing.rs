@@ -24,3 +24,30 @@ pub fn best_run<T>(runs: usize, mut f: impl FnMut() -> T) -> (Duration, T) {
     }
     best.expect("at least one run")
 }
+
+/// The CPU time this process has used so far (s), every thread's, user
+/// and system: `/proc/self/stat`'s utime and stime, in clock ticks (100 a
+/// second), the 12th and 13th fields after the command's parenthesis.
+pub fn cpu_seconds() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    let rest = stat.rsplit_once(')').map_or("", |(_, r)| r);
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |k: usize| {
+        fields
+            .get(k)
+            .and_then(|f| f.parse::<f64>().ok())
+            .unwrap_or(f64::NAN)
+    };
+    (ticks(11) + ticks(12)) / 100.0
+}
+
+/// The process's peak resident memory so far (MB): `/proc/self/status`'s
+/// VmHWM.
+pub fn peak_resident_mb() -> f64 {
+    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmHWM:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<f64>().ok())
+        .map_or(f64::NAN, |kb| kb / 1024.0)
+}

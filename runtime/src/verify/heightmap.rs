@@ -22,6 +22,26 @@
 
 use rayon::prelude::*;
 
+mod ball;
+pub use ball::BallSweep;
+
+/// The cutter a height map sweeps: a round nose whose edge lies across
+/// the cut (a knife, a lathe's diamond), or a ball (a ball-end mill),
+/// which reaches its radius along the path as well.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Cutter {
+    Nose { radius: f64 },
+    Ball { radius: f64 },
+}
+
+impl Cutter {
+    pub fn radius(&self) -> f64 {
+        match *self {
+            Cutter::Nose { radius } | Cutter::Ball { radius } => radius,
+        }
+    }
+}
+
 /// The simulation grid: columns along the cut, rows across it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Grid {
@@ -36,14 +56,19 @@ pub struct Grid {
     /// Columns are spindle angles repeating every `period` (2π); the
     /// columns must span less than one period.
     pub period: Option<f64>,
+    /// On a tile, the index of its first column and row on the grid it is
+    /// cut from (whose `s0`, `u0` it keeps, so its cells lie exactly
+    /// where that grid's do); 0 on a whole grid.
+    pub j0: usize,
+    pub i0: usize,
 }
 
 impl Grid {
     pub fn s(&self, j: usize) -> f64 {
-        self.s0 + j as f64 * self.ds
+        self.s0 + (self.j0 + j) as f64 * self.ds
     }
     pub fn u(&self, i: usize) -> f64 {
-        self.u0 + i as f64 * self.du
+        self.u0 + (self.i0 + i) as f64 * self.du
     }
     fn u_end(&self) -> f64 {
         self.u(self.nu.saturating_sub(1))
@@ -65,6 +90,40 @@ pub trait Frame: Sync {
     fn features(&self) -> &[(f64, f64, f64)] {
         &[]
     }
+    /// The part's area (mm²) of the grid cell at (s, u): the parallelogram
+    /// its two steps span on the part.
+    fn cell_area(&self, g: &Grid, s: f64, u: f64) -> f64 {
+        let (x0, y0) = self.xy(s, u);
+        let (x1, y1) = self.xy(s + g.ds, u);
+        let (x2, y2) = self.xy(s, u + g.du);
+        ((x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0)).abs()
+    }
+}
+
+/// Where the nose's centre goes, as a program commands it: what a
+/// [`Sweep`] gathers and a [`super::tiles::Recorder`] keeps for tiles.
+pub trait NosePath {
+    /// The tool leaves the part: the next point starts a new pass.
+    fn lift(&mut self);
+    /// The next commanded point of the current pass: cutting coordinate
+    /// `s` (unwrapped angle for a lathe), step-over coordinate `u`,
+    /// height `h` of the nose centre, reached along a straight line.
+    fn point(&mut self, s: f64, u: f64, h: f64);
+    /// The next point reached along a circular arc in the (s, h) plane
+    /// (u constant) about `centre`; the arc is the minor one.
+    fn arc(&mut self, s: f64, u: f64, h: f64, centre: (f64, f64));
+}
+
+impl NosePath for Sweep {
+    fn lift(&mut self) {
+        Sweep::lift(self)
+    }
+    fn point(&mut self, s: f64, u: f64, h: f64) {
+        Sweep::point(self, s, u, h)
+    }
+    fn arc(&mut self, s: f64, u: f64, h: f64, centre: (f64, f64)) {
+        Sweep::arc(self, s, u, h, centre)
+    }
 }
 
 /// Tool-centre positions gathered column by column as the path streams.
@@ -81,16 +140,22 @@ pub struct Sweep {
     s_range: (f64, f64),
 }
 
+/// The band of step-over coordinates (u) whose passes, with a nose of
+/// `nose_radius`, can reach `grid`'s rows.
+pub fn band(grid: &Grid, nose_radius: f64) -> (f64, f64) {
+    let margin = nose_radius + grid.du;
+    (grid.u0 - margin, grid.u_end() + margin)
+}
+
 impl Sweep {
     pub fn new(grid: Grid, nose_radius: f64) -> Sweep {
-        let margin = nose_radius + grid.du;
         Sweep {
             grid,
             radius: nose_radius,
-            band: (grid.u0 - margin, grid.u_end() + margin),
+            band: band(&grid, nose_radius),
             columns: vec![Vec::new(); grid.ns],
             last: None,
-            s_range: (grid.s0, grid.s(grid.ns.saturating_sub(1))),
+            s_range: (grid.s(0), grid.s(grid.ns.saturating_sub(1))),
         }
     }
 
@@ -123,28 +188,31 @@ impl Sweep {
     fn segment(&mut self, a: (f64, f64, f64), b: (f64, f64, f64), arc: Option<(f64, f64)>) {
         let (lo, hi) = (a.0.min(b.0), a.0.max(b.0));
         let g = self.grid;
-        let bases: Vec<f64> = match g.period {
+        // The periods (turns) whose columns the segment may cross.
+        let turns = match g.period {
             None => {
                 if hi < self.s_range.0 || lo > self.s_range.1 {
                     return;
                 }
-                vec![g.s0]
+                (0, 0, 0.0)
             }
-            Some(p) => {
-                let m0 = ((lo - g.s(g.ns - 1)) / p).ceil() as i64;
-                let m1 = ((hi - g.s0) / p).floor() as i64;
-                (m0..=m1).map(|m| g.s0 + m as f64 * p).collect()
-            }
+            Some(p) => (
+                ((lo - g.s(g.ns - 1)) / p).ceil() as i64,
+                ((hi - g.s(0)) / p).floor() as i64,
+                p,
+            ),
         };
-        for base in bases {
-            let j_lo = ((lo - base) / g.ds).ceil().max(0.0) as usize;
+        for m in turns.0..=turns.1 {
+            // Column indices on the whole grid (this one's from j0 on).
+            let base = g.s0 + m as f64 * turns.2;
+            let j_lo = ((lo - base) / g.ds).ceil().max(g.j0 as f64) as usize;
             let j_hi = ((hi - base) / g.ds).floor();
-            if j_hi < 0.0 {
+            if j_hi < g.j0 as f64 {
                 continue;
             }
-            let j_hi = (j_hi as usize).min(g.ns - 1);
-            for j in j_lo..=j_hi {
-                let s = base + j as f64 * g.ds;
+            let j_hi = (j_hi as usize).min(g.j0 + g.ns - 1);
+            for jg in j_lo..=j_hi {
+                let (j, s) = (jg - g.j0, base + jg as f64 * g.ds);
                 let t = if b.0 == a.0 {
                     0.0
                 } else {
@@ -166,18 +234,83 @@ impl Sweep {
         }
     }
 
+    /// The band of step-over coordinates (u) whose passes reach the rows.
+    pub fn band(&self) -> (f64, f64) {
+        self.band
+    }
+
     /// The envelope in every column, against the design.
     pub fn finish(self, frame: &dyn Frame) -> HeightMap {
+        let (g, r) = (self.grid, self.radius);
+        let columns = self.columns(frame);
+        let totals = Totals::gather(&g, &columns, frame, &|f| f);
+        let mut errors = Vec::with_capacity(g.ns * g.nu);
+        for c in &columns {
+            errors.extend_from_slice(&c.errors);
+        }
+        HeightMap::of(g, r, totals, frame.features(), errors)
+    }
+
+    /// The envelope in every column against the design, as one tile of a
+    /// larger map: its totals (its `frame`'s feature `f` being the whole
+    /// map's `feature(f)`) and its cells' errors on `layout`'s blocks.
+    /// Its columns are taken one after the other unless `parallel`
+    /// (rayon runs the tiles side by side; columns in parallel within
+    /// them would let a waiting thread start yet another tile).
+    pub(crate) fn finish_tile(
+        self,
+        frame: &dyn Frame,
+        feature: &dyn Fn(usize) -> usize,
+        layout: &RasterLayout,
+        parallel: bool,
+    ) -> (Totals, Vec<(usize, f64)>) {
         let g = self.grid;
-        let r = self.radius;
-        let columns: Vec<Column> = self
-            .columns
+        let columns = if parallel {
+            self.columns(frame)
+        } else {
+            let r = self.radius;
+            self.columns
+                .into_iter()
+                .enumerate()
+                .map(|(j, centres)| column(&g, r, j, centres, frame))
+                .collect()
+        };
+        finish_columns(&g, &columns, frame, feature, layout)
+    }
+
+    fn columns(self, frame: &dyn Frame) -> Vec<Column> {
+        let (g, r) = (self.grid, self.radius);
+        self.columns
             .into_par_iter()
             .enumerate()
             .map(|(j, centres)| column(&g, r, j, centres, frame))
-            .collect();
-        HeightMap::gather(g, r, columns, frame)
+            .collect()
     }
+}
+
+/// A tile's columns' totals and their cells' worst errors on `layout`'s
+/// blocks.
+fn finish_columns(
+    g: &Grid,
+    columns: &[Column],
+    frame: &dyn Frame,
+    feature: &dyn Fn(usize) -> usize,
+    layout: &RasterLayout,
+) -> (Totals, Vec<(usize, f64)>) {
+    let totals = Totals::gather(g, columns, frame, feature);
+    // Each block's worst, the first of equals in column order.
+    let mut worst: std::collections::BTreeMap<usize, f64> = Default::default();
+    for (j, c) in columns.iter().enumerate() {
+        for (i, &e) in c.errors.iter().enumerate() {
+            if let Some(b) = layout.block(frame, g.s(j), g.u(i), e) {
+                let w = worst.entry(b).or_insert(e);
+                if e.abs() > w.abs() {
+                    *w = e;
+                }
+            }
+        }
+    }
+    (totals, worst.into_iter().collect())
 }
 
 /// The height on the minor arc from `a` to `b` about `o` at `s` (between
@@ -348,10 +481,15 @@ impl ColumnCut<'_> {
                 *c = self.height(p, u);
             }
         }
-        let points: Vec<(f64, f64)> = (0..g.nu).map(|i| (self.s, g.u(i))).collect();
-        let mut design = vec![0.0; g.nu];
+        // The design only where the cut is (the window, its lenslets).
+        let rows: Vec<usize> = (0..g.nu).filter(|&i| !cut[i].is_nan()).collect();
+        let points: Vec<(f64, f64)> = rows.iter().map(|&i| (self.s, g.u(i))).collect();
+        let mut design = vec![0.0; rows.len()];
         self.frame.design(&points, &mut design);
-        cut.iter().zip(&design).map(|(c, d)| c - d).collect()
+        for (&i, d) in rows.iter().zip(&design) {
+            cut[i] -= d;
+        }
+        cut
     }
 
     /// Contacts: the least error over each piece inside the rows, from
@@ -434,15 +572,6 @@ impl ColumnCut<'_> {
     }
 }
 
-/// The part's area (mm²) of the grid cell at (s, u): the parallelogram
-/// its two steps span on the part.
-fn cell_area(frame: &dyn Frame, g: &Grid, s: f64, u: f64) -> f64 {
-    let (x0, y0) = frame.xy(s, u);
-    let (x1, y1) = frame.xy(s + g.ds, u);
-    let (x2, y2) = frame.xy(s, u + g.du);
-    ((x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0)).abs()
-}
-
 fn in_features(features: &[(f64, f64, f64)], x: f64, y: f64) -> bool {
     features.is_empty()
         || features
@@ -494,6 +623,88 @@ pub struct ErrorRaster {
     pub cells: Vec<f64>,
 }
 
+/// The blocks of an [`ErrorRaster`], before any cell is placed in them
+/// (see [`HeightMap::raster`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RasterLayout {
+    x: (f64, f64),
+    y: (f64, f64),
+    block: f64,
+    nx: usize,
+    ny: usize,
+}
+
+impl RasterLayout {
+    /// Square blocks over `x` × `y` (mm) widened by half of `min_block` on
+    /// every side, no smaller than `min_block`, at most `max_side` a side.
+    pub fn new(x: (f64, f64), y: (f64, f64), min_block: f64, max_side: usize) -> RasterLayout {
+        let half = (min_block / 2.0).max(0.0);
+        let (x, y) = ((x.0 - half, x.1 + half), (y.0 - half, y.1 + half));
+        let (w, h) = ((x.1 - x.0).max(0.0), (y.1 - y.0).max(0.0));
+        let max_side = max_side.max(1);
+        let block = (w.max(h) / max_side as f64).max(min_block);
+        let count = |extent: f64| {
+            if block > 0.0 && block.is_finite() {
+                ((extent / block - 1e-9).ceil().max(1.0) as usize).min(max_side)
+            } else {
+                1
+            }
+        };
+        RasterLayout {
+            x,
+            y,
+            block,
+            nx: count(w),
+            ny: count(h),
+        }
+    }
+
+    /// The block (row by row) the cut cell at (s, u) with error `e` falls
+    /// in; `None` for an uncut cell or one outside the blocks.
+    fn block(&self, frame: &dyn Frame, s: f64, u: f64, e: f64) -> Option<usize> {
+        if e.is_nan() {
+            return None;
+        }
+        let (px, py) = frame.xy(s, u);
+        let bx = ((px - self.x.0) / self.block).floor();
+        let by = ((py - self.y.0) / self.block).floor();
+        if !(bx >= 0.0 && by >= 0.0) {
+            return None;
+        }
+        // Cells on the far edges belong to the last blocks.
+        let edge = 1e-9 * self.block;
+        if px > self.x.1 + edge || py > self.y.1 + edge {
+            return None;
+        }
+        let (bx, by) = (
+            (bx as usize).min(self.nx - 1),
+            (by as usize).min(self.ny - 1),
+        );
+        Some(by * self.nx + bx)
+    }
+
+    /// The raster of these blocks holding `cells` (row by row).
+    pub fn raster(&self, cells: Vec<f64>) -> ErrorRaster {
+        ErrorRaster {
+            x: self.x,
+            y: self.y,
+            block: self.block,
+            nx: self.nx,
+            ny: self.ny,
+            cells,
+        }
+    }
+
+    /// The number of blocks.
+    pub fn len(&self) -> usize {
+        self.nx * self.ny
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
 impl ErrorRaster {
     /// The least and largest error over the blocks, if any holds one.
     pub fn range(&self) -> Option<(f64, f64)> {
@@ -531,6 +742,13 @@ pub struct HeightMap {
     pub rq_cutting: f64,
     pub rq_stepover: f64,
     pub features: Vec<FeatureFigures>,
+    /// Cells evaluated: in the window (and its lenslets, if any), cut or
+    /// not.
+    pub cells: usize,
+    /// The tiles the map was simulated in (1: one grid, whose `errors`
+    /// are kept; more: `errors` is empty and only the figures and a
+    /// downsampled map are kept).
+    pub tiles: usize,
 }
 
 /// The RMS roughness of a line of errors: about their least-squares
@@ -594,101 +812,208 @@ fn solve3(m: [[f64; 3]; 3], r: [f64; 3]) -> Option<[f64; 3]> {
     Some(out)
 }
 
-fn mean(values: impl Iterator<Item = f64>) -> f64 {
-    let (mut n, mut sum) = (0usize, 0.0);
-    for v in values {
-        n += 1;
-        sum += v;
-    }
-    if n == 0 { f64::NAN } else { sum / n as f64 }
+/// Scallop heights as they are gathered: how many, the largest, the sum.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct CuspTally {
+    count: usize,
+    max: f64,
+    sum: f64,
 }
 
-impl HeightMap {
-    fn gather(g: Grid, r: f64, columns: Vec<Column>, frame: &dyn Frame) -> HeightMap {
+impl CuspTally {
+    fn add(&mut self, h: f64) {
+        self.max = if self.count == 0 { h } else { self.max.max(h) };
+        self.count += 1;
+        self.sum += h;
+    }
+    fn merge(&mut self, o: &CuspTally) {
+        if o.count > 0 {
+            self.max = if self.count == 0 {
+                o.max
+            } else {
+                self.max.max(o.max)
+            };
+            self.count += o.count;
+            self.sum += o.sum;
+        }
+    }
+    fn scallops(&self) -> Option<Scallops> {
+        (self.count > 0).then(|| Scallops {
+            count: self.count,
+            max: self.max,
+            mean: self.sum / self.count as f64,
+        })
+    }
+}
+
+/// One lenslet's statistics as they are gathered: surface, contacts,
+/// scallops.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct FeatureTally {
+    surface: Tally,
+    contact: Tally,
+    cusps: CuspTally,
+}
+
+/// A height map's statistics as they are gathered, over a whole window
+/// or one tile of it; two over disjoint cells merge into the statistics
+/// of both (see [`super::figures`]), so a map cut into tiles totals them
+/// exactly. The roughness figures are means of lines (rows, columns), so
+/// a tile contributes the lines it holds (a line cut by tiles counts as
+/// one per tile).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(crate) struct Totals {
+    surface: Tally,
+    contact: Tally,
+    cusps: CuspTally,
+    /// By the whole map's feature index.
+    features: std::collections::BTreeMap<usize, FeatureTally>,
+    uncut: usize,
+    uncut_area: f64,
+    uncut_at: Option<(f64, f64)>,
+    area: f64,
+    /// Sums and counts of the lines' RMS roughness.
+    rq_cutting: (f64, usize),
+    rq_stepover: (f64, usize),
+    /// Cells evaluated (in the window and its features, cut or not).
+    cells: usize,
+}
+
+impl Totals {
+    fn gather(
+        g: &Grid,
+        columns: &[Column],
+        frame: &dyn Frame,
+        feature: &dyn Fn(usize) -> usize,
+    ) -> Totals {
         let features = frame.features();
         let which = |x: f64, y: f64| {
             features
                 .iter()
                 .position(|&(cx, cy, fr)| (x - cx).hypot(y - cy) <= fr)
+                .map(feature)
         };
-        let mut surface = Tally::new();
-        let mut contact = Tally::new();
-        let mut per: Vec<(Tally, Tally, Vec<f64>)> = features
-            .iter()
-            .map(|_| (Tally::new(), Tally::new(), Vec::new()))
-            .collect();
-        let mut all_cusps = Vec::new();
-        let mut uncut = 0;
-        let (mut uncut_area, mut uncut_at, mut area) = (0.0, None, 0.0);
-        let mut errors = Vec::with_capacity(g.ns * g.nu);
+        let mut t = Totals::default();
         for (j, c) in columns.iter().enumerate() {
             let s = g.s(j);
             for (i, &e) in c.errors.iter().enumerate() {
                 let (x, y) = frame.xy(s, g.u(i));
                 if e.is_nan() {
                     if frame.inside(x, y) && in_features(features, x, y) {
-                        uncut += 1;
-                        let a = cell_area(frame, &g, s, g.u(i));
-                        uncut_area += a;
-                        area += a;
-                        uncut_at.get_or_insert((x, y));
+                        t.uncut += 1;
+                        t.cells += 1;
+                        let a = frame.cell_area(g, s, g.u(i));
+                        t.uncut_area += a;
+                        t.area += a;
+                        t.uncut_at.get_or_insert((x, y));
                     }
                     continue;
                 }
-                area += cell_area(frame, &g, s, g.u(i));
-                surface.add(e, (x, y));
+                t.cells += 1;
+                t.area += frame.cell_area(g, s, g.u(i));
+                t.surface.add(e, (x, y));
                 if let Some(f) = which(x, y) {
-                    per[f].0.add(e, (x, y));
+                    t.features.entry(f).or_default().surface.add(e, (x, y));
                 }
             }
             for &(u, e) in &c.valleys {
                 let (x, y) = frame.xy(s, u);
-                contact.add(e, (x, y));
+                t.contact.add(e, (x, y));
                 if let Some(f) = which(x, y) {
-                    per[f].1.add(e, (x, y));
+                    t.features.entry(f).or_default().contact.add(e, (x, y));
                 }
             }
             for &(u, h) in &c.cusps {
-                all_cusps.push(h);
+                t.cusps.add(h);
                 let (x, y) = frame.xy(s, u);
                 if let Some(f) = which(x, y) {
-                    per[f].2.push(h);
+                    t.features.entry(f).or_default().cusps.add(h);
                 }
             }
-            errors.extend_from_slice(&c.errors);
         }
-        let scallops = |h: &[f64]| {
-            (!h.is_empty()).then(|| Scallops {
-                count: h.len(),
-                max: h.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b)),
-                mean: mean(h.iter().copied()),
-            })
+        let lines = |rq: &mut (f64, usize), v: Option<f64>| {
+            if let Some(v) = v {
+                rq.0 += v;
+                rq.1 += 1;
+            }
         };
-        let rq_stepover = mean(columns.iter().filter_map(|c| rq(c.errors.iter().copied())));
-        let rq_cutting = mean((0..g.nu).filter_map(|i| rq(columns.iter().map(|c| c.errors[i]))));
+        for c in columns {
+            lines(&mut t.rq_stepover, rq(c.errors.iter().copied()));
+        }
+        for i in 0..g.nu {
+            lines(&mut t.rq_cutting, rq(columns.iter().map(|c| c.errors[i])));
+        }
+        t
+    }
+
+    /// Adds another tile's totals (disjoint cells).
+    pub(crate) fn merge(&mut self, o: &Totals) {
+        self.surface.merge(&o.surface);
+        self.contact.merge(&o.contact);
+        self.cusps.merge(&o.cusps);
+        for (&k, f) in &o.features {
+            let mine = self.features.entry(k).or_default();
+            mine.surface.merge(&f.surface);
+            mine.contact.merge(&f.contact);
+            mine.cusps.merge(&f.cusps);
+        }
+        self.uncut += o.uncut;
+        self.uncut_area += o.uncut_area;
+        self.uncut_at = self.uncut_at.or(o.uncut_at);
+        self.area += o.area;
+        self.rq_cutting = (
+            self.rq_cutting.0 + o.rq_cutting.0,
+            self.rq_cutting.1 + o.rq_cutting.1,
+        );
+        self.rq_stepover = (
+            self.rq_stepover.0 + o.rq_stepover.0,
+            self.rq_stepover.1 + o.rq_stepover.1,
+        );
+        self.cells += o.cells;
+    }
+}
+
+impl HeightMap {
+    /// The map of `totals` on `g` (its `features` the whole map's).
+    pub(crate) fn of(
+        g: Grid,
+        r: f64,
+        t: Totals,
+        features: &[(f64, f64, f64)],
+        errors: Vec<f64>,
+    ) -> HeightMap {
+        let per_line = |rq: (f64, usize)| {
+            if rq.1 == 0 {
+                f64::NAN
+            } else {
+                rq.0 / rq.1 as f64
+            }
+        };
         HeightMap {
             grid: g,
             nose_radius: r,
-            surface: surface.figures(),
-            contact: contact.figures(),
-            scallops: scallops(&all_cusps),
-            uncut,
-            uncut_area,
-            uncut_at,
-            area,
-            rq_cutting,
-            rq_stepover,
-            features: features
+            surface: t.surface.figures(),
+            contact: t.contact.figures(),
+            scallops: t.cusps.scallops(),
+            uncut: t.uncut,
+            uncut_area: t.uncut_area,
+            uncut_at: t.uncut_at,
+            area: t.area,
+            rq_cutting: per_line(t.rq_cutting),
+            rq_stepover: per_line(t.rq_stepover),
+            features: t
+                .features
                 .iter()
-                .zip(&per)
-                .filter(|(_, t)| t.0.count > 0)
-                .map(|(&(cx, cy, _), t)| FeatureFigures {
-                    centre: (cx, cy),
-                    surface: t.0.figures(),
-                    contact: t.1.figures(),
-                    scallops: scallops(&t.2),
+                .filter(|(_, f)| f.surface.count > 0)
+                .map(|(&k, f)| FeatureFigures {
+                    centre: (features[k].0, features[k].1),
+                    surface: f.surface.figures(),
+                    contact: f.contact.figures(),
+                    scallops: f.cusps.scallops(),
                 })
                 .collect(),
+            cells: t.cells,
+            tiles: 1,
             errors,
         }
     }
@@ -710,54 +1035,22 @@ impl HeightMap {
         min_block: f64,
         max_side: usize,
     ) -> ErrorRaster {
-        let half = (min_block / 2.0).max(0.0);
-        let (x, y) = ((x.0 - half, x.1 + half), (y.0 - half, y.1 + half));
-        let (w, h) = ((x.1 - x.0).max(0.0), (y.1 - y.0).max(0.0));
-        let max_side = max_side.max(1);
-        let block = (w.max(h) / max_side as f64).max(min_block);
-        let count = |extent: f64| {
-            if block > 0.0 && block.is_finite() {
-                ((extent / block - 1e-9).ceil().max(1.0) as usize).min(max_side)
-            } else {
-                1
-            }
-        };
-        let (nx, ny) = (count(w), count(h));
-        let mut cells = vec![f64::NAN; nx * ny];
+        let layout = RasterLayout::new(x, y, min_block, max_side);
+        let mut cells = vec![f64::NAN; layout.nx * layout.ny];
         let g = &self.grid;
         for j in 0..g.ns {
             let s = g.s(j);
             for i in 0..g.nu {
                 let e = self.errors[j * g.nu + i];
-                if e.is_nan() {
-                    continue;
-                }
-                let (px, py) = frame.xy(s, g.u(i));
-                let bx = ((px - x.0) / block).floor();
-                let by = ((py - y.0) / block).floor();
-                if !(bx >= 0.0 && by >= 0.0) {
-                    continue;
-                }
-                // Cells on the far edges belong to the last blocks.
-                let edge = 1e-9 * block;
-                if px > x.1 + edge || py > y.1 + edge {
-                    continue;
-                }
-                let (bx, by) = ((bx as usize).min(nx - 1), (by as usize).min(ny - 1));
-                let c = &mut cells[by * nx + bx];
-                if c.is_nan() || e.abs() > c.abs() {
-                    *c = e;
+                if let Some(b) = layout.block(frame, s, g.u(i), e) {
+                    let c = &mut cells[b];
+                    if c.is_nan() || e.abs() > c.abs() {
+                        *c = e;
+                    }
                 }
             }
         }
-        ErrorRaster {
-            x,
-            y,
-            block,
-            nx,
-            ny,
-            cells,
-        }
+        layout.raster(cells)
     }
 
     /// The scallop a round nose of radius `r` leaves between passes `step`

@@ -5,4 +5,5 @@ pub mod figures;
 pub mod follow;
 pub mod heightmap;
 pub mod simulate;
+pub mod tiles;
 pub mod window;

@@ -1,16 +1,58 @@
 //! The window of a height map: the part of the design (x, y in mm) a
 //! simulation covers, the grid over it in the coordinates of the cut
 //! (Cartesian for a raster, polar for a lathe, angle and axial position
-//! for a roller), and the most cells a grid may have. A window given by
-//! the job is known before planning, so its grid's size is checked then.
+//! for a roller), the tiles that grid is simulated in (each small enough
+//! to hold in memory; a lathe's lenslets one by one), and the most cells a
+//! simulation may have. A window given by the job is known before
+//! planning, so its size is checked then.
 
 use std::f64::consts::TAU;
 
 use crate::verify::heightmap::Grid;
 
-/// The most cells a window's grid may have (8 bytes each in the map, plus
-/// the passes gathered per column).
-pub const MAX_CELLS: usize = 4_000_000;
+/// The most cells a simulation may have. Tiles bound its memory, not its
+/// time: about 0.1 µs a cell on one core (measured by
+/// `compiler/build/benches/whole_part.rs`), so this is minutes on two.
+pub const MAX_CELLS: usize = 2_000_000_000;
+/// A tile's most cells (its errors are 8 bytes each; each of its columns
+/// also holds every pass within the nose's reach of its rows): a tile is
+/// a run of whole columns, so a column's passes, contacts and scallops
+/// are all in one tile.
+pub const TILE_CELLS: usize = 1 << 20;
+
+/// One tile of a simulation: a run of columns of the window's grid (at
+/// most `TILE_CELLS` cells, or one column), and the lenslet (an index
+/// into the frame's features) whose cells it holds, if the simulation
+/// goes lenslet by lenslet.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tile {
+    pub grid: Grid,
+    pub feature: Option<usize>,
+}
+
+/// `grid` cut into runs of columns of at most `TILE_CELLS` cells.
+pub fn split(grid: &Grid, feature: Option<usize>) -> Vec<Tile> {
+    split_columns(grid, feature, (TILE_CELLS / grid.nu.max(1)).max(1))
+}
+
+/// `grid` cut into runs of at most `most` columns.
+pub fn split_columns(grid: &Grid, feature: Option<usize>, most: usize) -> Vec<Tile> {
+    let runs = grid.ns.div_ceil(most.max(1)).max(1);
+    (0..runs)
+        .map(|c| {
+            let (j0, j1) = (c * grid.ns / runs, (c + 1) * grid.ns / runs);
+            Tile {
+                grid: Grid {
+                    j0: grid.j0 + j0,
+                    ns: j1 - j0,
+                    ..*grid
+                },
+                feature,
+            }
+        })
+        .collect()
+}
+
 /// The default window: this wide (mm) and this fine (mm).
 pub const DEFAULT_SIZE: f64 = 0.2;
 pub const DEFAULT_SPACING: f64 = 1e-3;
@@ -26,38 +68,52 @@ pub struct Window {
     pub given: bool,
 }
 
-/// A grid with more cells than a simulation takes.
+/// A simulation tiles cannot bound: more cells than lensc takes (its
+/// time), or a column longer than a tile holds (its memory).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TooManyCells {
     pub cells: usize,
-    pub columns: usize,
+    pub tiles: usize,
+    /// The longest column's rows.
     pub rows: usize,
-    pub limit: usize,
+}
+
+impl TooManyCells {
+    /// The most cells, and rows to a column.
+    pub const CELLS: usize = MAX_CELLS;
+    pub const ROWS: usize = TILE_CELLS;
 }
 
 impl std::fmt::Display for TooManyCells {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "{} cells ({} × {}) exceed the limit of {}",
-            self.cells, self.columns, self.rows, self.limit
+            "{} cells in {} tiles, columns of {} rows: more than {} cells or {} rows a column",
+            self.cells,
+            self.tiles,
+            self.rows,
+            Self::CELLS,
+            Self::ROWS
         )
     }
 }
 
 impl std::error::Error for TooManyCells {}
 
-/// `TooManyCells` when `grid` has more than `MAX_CELLS` cells.
-pub fn check_cells(grid: &Grid) -> Result<(), TooManyCells> {
-    let cells = grid.ns * grid.nu;
-    if cells <= MAX_CELLS {
+/// `TooManyCells` when `tiles` have more than `MAX_CELLS` cells between
+/// them, or a column more than `TILE_CELLS` rows.
+pub fn check_cells(tiles: &[Tile]) -> Result<(), TooManyCells> {
+    let cells = tiles.iter().fold(0usize, |n, t| {
+        n.saturating_add(t.grid.ns.saturating_mul(t.grid.nu))
+    });
+    let rows = tiles.iter().map(|t| t.grid.nu).max().unwrap_or(0);
+    if cells <= MAX_CELLS && rows <= TILE_CELLS {
         return Ok(());
     }
     Err(TooManyCells {
         cells,
-        columns: grid.ns,
-        rows: grid.nu,
-        limit: MAX_CELLS,
+        tiles: tiles.len(),
+        rows,
     })
 }
 
@@ -86,6 +142,31 @@ impl Window {
         }
     }
 
+    /// The tiles of a lathe's polar grid: lenslet by lenslet when the
+    /// window reaches more than one of the `features` (discs: centre x, y,
+    /// radius), each over the part of the window its square covers, its
+    /// index counted among the lenslets that reach into the window; else
+    /// the window's whole grid.
+    pub fn polar_tiles(&self, features: &[(f64, f64, f64)]) -> Vec<Tile> {
+        let squares: Vec<Window> = features
+            .iter()
+            .map(|&(cx, cy, r)| Window {
+                x: (self.x.0.max(cx - r), self.x.1.min(cx + r)),
+                y: (self.y.0.max(cy - r), self.y.1.min(cy + r)),
+                ..*self
+            })
+            .filter(|w| w.x.1 >= w.x.0 && w.y.1 >= w.y.0)
+            .collect();
+        if squares.len() < 2 {
+            return split(&self.polar(), None);
+        }
+        squares
+            .iter()
+            .enumerate()
+            .flat_map(|(k, square)| split(&square.polar(), Some(k)))
+            .collect()
+    }
+
     pub fn contains(&self, x: f64, y: f64) -> bool {
         x >= self.x.0 && x <= self.x.1 && y >= self.y.0 && y <= self.y.1
     }
@@ -106,6 +187,8 @@ impl Window {
             du: self.spacing,
             nu: count(u),
             period: None,
+            j0: 0,
+            i0: 0,
         }
     }
 
@@ -135,6 +218,8 @@ impl Window {
                 du: self.spacing,
                 nu: (r_max / self.spacing).floor() as usize + 1,
                 period: Some(TAU),
+                j0: 0,
+                i0: 0,
             };
         }
         let mid = ((self.y.0 + self.y.1) / 2.0).atan2((self.x.0 + self.x.1) / 2.0);
@@ -156,6 +241,8 @@ impl Window {
             du: self.spacing,
             nu,
             period: Some(TAU),
+            j0: 0,
+            i0: 0,
         }
     }
 
@@ -172,6 +259,8 @@ impl Window {
             du: self.spacing,
             nu: ((self.x.1 - self.x.0) / self.spacing + 1e-9).floor() as usize + 1,
             period: Some(TAU),
+            j0: 0,
+            i0: 0,
         }
     }
 }
@@ -199,15 +288,52 @@ mod tests {
                 w.roller(0.05),
                 w.roller(100.0),
             ] {
-                assert!(check_cells(&grid).is_ok(), "{centre:?}: {grid:?}");
+                let tiles = split(&grid, None);
+                assert_eq!(tiles.len(), 1, "{centre:?}: {grid:?}");
+                assert!(check_cells(&tiles).is_ok(), "{centre:?}: {grid:?}");
             }
         }
     }
 
     #[test]
     fn a_fine_window_is_too_large() {
-        let w = Window::given((-1.0, 1.0), (-1.0, 1.0), Some(0.5e-3));
-        let e = check_cells(&w.cartesian(true)).unwrap_err();
-        assert_eq!((e.cells, e.columns, e.rows), (16_008_001, 4001, 4001));
+        let w = Window::given((-1.0, 1.0), (-1.0, 1.0), Some(20e-6));
+        let tiles = split(&w.cartesian(true), None);
+        let e = check_cells(&tiles).unwrap_err();
+        assert_eq!((e.cells, e.tiles), (100_001 * 100_001, 10_001));
+    }
+
+    /// Tiles cover their grid's cells once each, at the grid's own places.
+    #[test]
+    fn tiles_cover_the_grid_once() {
+        let w = Window::given((0.0, 5.0), (0.0, 3.0), Some(1e-3));
+        let g = w.cartesian(true);
+        let tiles = split(&g, None);
+        // 5001 columns of 3001 rows, 349 to a tile.
+        assert_eq!(tiles.len(), 15);
+        let cells: usize = tiles.iter().map(|t| t.grid.ns * t.grid.nu).sum();
+        assert_eq!(cells, g.ns * g.nu);
+        for t in &tiles {
+            assert!(t.grid.ns * t.grid.nu <= TILE_CELLS && t.grid.nu == g.nu);
+            assert_eq!(t.grid.s(t.grid.ns - 1), g.s(t.grid.j0 + t.grid.ns - 1));
+            assert_eq!(t.grid.u(0), g.u(t.grid.i0));
+        }
+    }
+
+    /// A lathe with lenslets goes lenslet by lenslet, over the lenslets
+    /// that reach into the window only.
+    #[test]
+    fn a_lathe_goes_lenslet_by_lenslet() {
+        let features = [(0.0, 2.0, 0.5), (2.0, 0.0, 0.5), (-2.0, 0.0, 0.5)];
+        let w = Window::given((-3.0, 3.0), (-1.0, 1.0), Some(5e-3));
+        let tiles = w.polar_tiles(&features);
+        let owners: Vec<Option<usize>> = tiles.iter().map(|t| t.feature).collect();
+        assert_eq!(owners, [Some(0), Some(1)]);
+        // One lenslet in the window: the window's own grid.
+        let one = Window::given((1.0, 3.0), (-1.0, 1.0), Some(5e-3));
+        assert_eq!(one.polar_tiles(&features), split(&one.polar(), None));
+        // Each covers its lenslet's square: radii 1.5 .. 2.55 mm.
+        let g = tiles[0].grid;
+        assert!((g.u0 - 1.5).abs() < 1e-12 && g.u(g.nu - 1) > 2.5, "{g:?}");
     }
 }

@@ -15,10 +15,10 @@ use lensc_runtime::emit::fts::FtsProgram;
 use lensc_runtime::plan::fts::{FtsError, FtsSummary, Planner, SpindleSpeed};
 use lensc_runtime::post::Provenance;
 use lensc_runtime::surface::ir::SurfaceFn;
-use lensc_runtime::verify::heightmap::Sweep;
+use lensc_runtime::verify::heightmap::NosePath;
 
 use crate::evaluate::evaluator;
-use crate::height_map::{self, LatheFrame, Window};
+use crate::height_map::{self, LatheFrame, Simulation, Window};
 use crate::output::{Built, Destination};
 use crate::parts;
 use crate::report;
@@ -85,12 +85,17 @@ pub fn build(
     let data_rate = 1.0 / p.spiral.min_interval;
     let mut following = following(spec, data_rate);
     // The height map over the window, from the same printed points.
+    let domain = &head.surface.lowered.domain;
     let window = height_map::window(
         head,
-        height_map::lathe_centre(&head.surface.lowered.domain, &p.lenslets),
+        height_map::lathe_centre(domain, &p.lenslets),
+        height_map::domain_extent(domain),
     );
-    let grid = window.polar();
-    let mut sweep = Sweep::new(grid, p.nose_radius);
+    let mut sweep = Simulation::new(
+        window.polar(),
+        window.polar_tiles(&p.lenslets),
+        p.nose_radius,
+    );
     let mut printed = Vec::new();
     let planned = Prepared::of(spec).planner().plan(&p.fast_axis, |pts| {
         let as_printed = |v: f64| lensc_runtime::verify::simulate::as_printed(v, head.resolution);
@@ -101,7 +106,7 @@ pub fn build(
             ..*q
         }));
         for q in &printed {
-            sweep.point(q.c, q.x, q.w);
+            sweep.path().point(q.c, q.x, q.w);
         }
         if let Some(sim) = following.as_mut() {
             sim.extend(&printed);
@@ -210,21 +215,19 @@ fn toolpath(spec: &SpiralSpec, summary: &FtsSummary) -> report::Toolpath {
 /// and its form error for the plots.
 fn simulated_height_map(
     spec: &SpiralSpec,
-    sweep: Sweep,
+    sweep: Simulation,
     window: Window,
     plots: &mut crate::plots::PlotSeries,
 ) -> report::HeightMap {
     let lowered = &spec.head.surface.lowered;
     let design = evaluator(&lowered.tape).0;
     let frame = LatheFrame::new(design.as_ref(), window, lowered.domain, &spec.lenslets);
-    let map = sweep.finish(&frame);
+    // A polar grid's cells lie askew to the raster's blocks: √2 times the
+    // spacing puts a cell in every block (1.5 for margin).
+    let (map, raster) = sweep.finish(&frame, &window, 1.5 * window.spacing);
     plots.form_error = Some(height_map::form_error_series(
-        &map,
-        &frame,
+        raster,
         &window,
-        // A polar grid's cells lie askew to the raster's blocks: √2 times
-        // the spacing puts a cell in every block (1.5 for margin).
-        1.5 * window.spacing,
         ("x (mm)", "y (mm)"),
     ));
     report::HeightMap::new(

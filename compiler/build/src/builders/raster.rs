@@ -10,13 +10,14 @@ use lensc_lang::lower::job::RasterSpec;
 use lensc_runtime::plan::optimise::Summary;
 use lensc_runtime::plan::raster::{Axis, RasterPath, RasterTool, check_clearance};
 use lensc_runtime::post::Provenance;
-use lensc_runtime::verify::heightmap::Sweep;
+use lensc_runtime::verify::heightmap::Cutter;
 
 use crate::evaluate::evaluator;
-use crate::height_map::{self, domain_centre};
+use crate::height_map::{self, Simulation, domain_centre};
 use crate::output::{Built, ProgramText};
 use crate::parts;
 use crate::report;
+use lensc_runtime::verify::window::split;
 
 /// Builds a `raster` job on a `mill_3axis`.
 pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnostic>> {
@@ -67,53 +68,69 @@ pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnost
     let time = section.cutting_time_s;
     let toolpath = report::Toolpath::Raster(section);
     let mut plots = crate::plots::PlotSeries::default();
-    let simulation = match tool {
-        RasterTool::Knife { nose_radius } => {
-            let along_x = raster.along == Axis::X;
-            let window = height_map::window(head, domain_centre(&lowered.domain));
-            let grid = window.cartesian(along_x);
-            let mut sweep = Sweep::new(grid, nose_radius);
-            height_map::sweep_mill_moves(&mut sweep, &moves, along_x, resolution);
-            let frame = height_map::RasterFrame {
-                kernel: kernel.as_ref(),
-                along_x,
-                window,
-                domain: lowered.domain,
-            };
-            let map = sweep.finish(&frame);
-            plots.form_error = Some(height_map::form_error_series(
-                &map,
-                &frame,
-                &window,
-                window.spacing,
-                ("x (mm)", "y (mm)"),
-            ));
-            let coordinates = if along_x {
-                "columns along x, rows along y"
-            } else {
-                "columns along y, rows along x"
-            };
-            let mut height_map =
-                report::HeightMap::new(&map, &window, coordinates, raster.stepover);
-            // The path's own error apart from the machine's resolution: the
-            // same moves swept as computed (rounded to a picometre only).
-            let mut unrounded = Sweep::new(grid, nose_radius);
-            height_map::sweep_mill_moves(&mut unrounded, &moves, along_x, 1e-9);
-            height_map.raster = Some(report::RasterEdge {
-                edge: "the knife's edge in its rake face, across the cut, as the planner places it",
-                contact_unrounded: unrounded
-                    .finish(&frame)
-                    .contact
-                    .as_ref()
-                    .map(report::Figures::from),
-            });
-            report::Simulation::HeightMap(report::HeightMapOnly { height_map })
-        }
-        RasterTool::Ball { .. } => report::Simulation::Skipped(report::Skipped {
-            skipped: "a ball's cut reaches a radius along the path as well as across it; the height map sweeps edges that lie across the cut",
-            height_map: None,
-        }),
+    // The knife's edge lies across the cut; a ball reaches its radius
+    // along the path too (see lensc_runtime::verify::heightmap).
+    let (cutter, edge) = match tool {
+        RasterTool::Knife { nose_radius } => (
+            Cutter::Nose {
+                radius: nose_radius,
+            },
+            "the knife's edge in its rake face, across the cut, as the planner places it",
+        ),
+        RasterTool::Ball { radius } => (
+            Cutter::Ball { radius },
+            "the ball swept along the path: every point within its radius of the centre's printed path",
+        ),
     };
+    let along_x = raster.along == Axis::X;
+    let window = height_map::window(
+        head,
+        domain_centre(&lowered.domain),
+        height_map::domain_extent(&lowered.domain),
+    );
+    let grid = window.cartesian(along_x);
+    let mut sweep = Simulation::of(grid, split(&grid, None), cutter);
+    // The program as written: its text read as the controller reads it.
+    let machine = lensc_runtime::reader::MachineLimits {
+        lathe: false,
+        travel: [None; 4],
+        max_feed: None,
+        max_spindle_rpm: None,
+    };
+    let (_, executed) = lensc_runtime::reader::read_moves(&text, dialect, &machine);
+    height_map::sweep_mill_program(sweep.path(), &executed, along_x);
+    let frame = height_map::RasterFrame {
+        kernel: kernel.as_ref(),
+        along_x,
+        window,
+        domain: lowered.domain,
+    };
+    let (map, errors) = sweep.finish(&frame, &window, window.spacing);
+    plots.form_error = Some(height_map::form_error_series(
+        errors,
+        &window,
+        ("x (mm)", "y (mm)"),
+    ));
+    let coordinates = if along_x {
+        "columns along x, rows along y"
+    } else {
+        "columns along y, rows along x"
+    };
+    let mut height_map = report::HeightMap::new(&map, &window, coordinates, raster.stepover);
+    // The path's own error apart from the machine's resolution: the
+    // same moves swept as computed (rounded to a picometre only).
+    let mut unrounded = Simulation::of(grid, split(&grid, None), cutter);
+    height_map::sweep_mill_moves(unrounded.path(), &moves, along_x, 1e-9);
+    height_map.raster = Some(report::RasterEdge {
+        edge,
+        contact_unrounded: unrounded
+            .finish(&frame, &window, window.spacing)
+            .0
+            .contact
+            .as_ref()
+            .map(report::Figures::from),
+    });
+    let simulation = report::Simulation::HeightMap(report::HeightMapOnly { height_map });
     let text = ProgramText::Memory(text);
     let cut = (path.point_count, time);
     Ok(parts::built(

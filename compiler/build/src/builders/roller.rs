@@ -11,14 +11,15 @@ use lensc_lang::lower::job::RollerSpec;
 use lensc_runtime::emit::roller::{RollerLimits, RollerProgram};
 use lensc_runtime::plan::roller::plan_roller_helix_into;
 use lensc_runtime::post::Provenance;
-use lensc_runtime::verify::heightmap::Sweep;
+use lensc_runtime::verify::heightmap::NosePath;
 
 use crate::evaluate::evaluator;
-use crate::height_map::{self, RollerFrame};
+use crate::height_map::{self, RollerFrame, Simulation};
 use crate::output::{Built, Destination};
 use crate::parts;
 use crate::report;
 use crate::spool::ProgramSink;
+use lensc_runtime::verify::window::split;
 
 /// Builds one `roller_helix` job, or says why it cannot be built.
 pub fn build(
@@ -50,18 +51,22 @@ pub fn build(
     // The height map over the window, from the printed points of every
     // pass (the finish pass's envelope lies below the rough one's).
     let (design_y, z) = (spec.design_y, (helix.z_start, helix.z_end));
-    let window = height_map::window(head, ((z.0 + z.1) / 2.0, (design_y.0 + design_y.1) / 2.0));
+    let window = height_map::window(
+        head,
+        ((z.0 + z.1) / 2.0, (design_y.0 + design_y.1) / 2.0),
+        height_map::roller_extent(&lowered.domain, z, design_y),
+    );
     let grid = window.roller(helix.roller_radius);
-    let mut sweep = Sweep::new(grid, rho);
+    let mut sweep = Simulation::new(grid, split(&grid, None), rho);
     let mut current_pass = usize::MAX;
     let planned = plan_roller_helix_into(helix, rho, kernel.as_ref(), |pass, pts| {
         if pass != current_pass {
-            sweep.lift();
+            sweep.path().lift();
             current_pass = pass;
         }
         let printed = |v: f64| lensc_runtime::verify::simulate::as_printed(v, resolution);
         for q in pts {
-            sweep.point(q.c, printed(q.z), printed(q.x));
+            sweep.path().point(q.c, printed(q.z), printed(q.x));
         }
         sink.extend(|| program.extend(pass, pts));
         sink.push(program.take_text());
@@ -95,13 +100,11 @@ pub fn build(
         roller_radius: helix.roller_radius,
         domain: lowered.domain,
     };
-    let map = sweep.finish(&frame);
+    let (map, raster) = sweep.finish(&frame, &window, window.spacing);
     let plots = crate::plots::PlotSeries {
         form_error: Some(height_map::form_error_series(
-            &map,
-            &frame,
+            raster,
             &window,
-            window.spacing,
             (
                 "along the roller axis, design x (mm)",
                 "around the roller, design y (mm)",

@@ -33,7 +33,7 @@ impl<'a> Checker<'a> {
 
     /// A file's own `let`s and declarations, by name.
     fn declare_items(&mut self, pf: &'a ParsedFile) -> HashMap<&'a str, usize> {
-        let mut scope: HashMap<&'a str, usize> = HashMap::new();
+        let mut scope: HashMap<&'a str, usize> = HashMap::with_capacity(pf.ast.items.len());
         for item in &pf.ast.items {
             let (name, kind, value) = match &item.kind {
                 ItemKind::Let { name, value } => (name, None, value),

@@ -98,8 +98,12 @@ impl RuntimeError<'_> {
                 ..coded(
                     codes::SIMULATION_TOO_LARGE,
                     format!(
-                        "the simulation grid would have {} cells ({} × {}), more than the {} it takes",
-                        e.cells, e.columns, e.rows, e.limit
+                        "the simulation would have {} cells in {} tiles, its columns {} rows long: more than the {} cells (its time) or {} rows a column (a tile's memory) it takes",
+                        e.cells,
+                        e.tiles,
+                        e.rows,
+                        TooManyCells::CELLS,
+                        TooManyCells::ROWS
                     ),
                 )
                 .help("make the window smaller or its spacing coarser")

@@ -18,7 +18,7 @@ mod roller;
 mod spiral;
 pub mod tolerance;
 mod turning;
-mod window;
+pub mod window;
 
 pub use estimate::{DEFAULT_MAX_PROGRAM_SIZE, Estimate, Limits, MAX_POINTS, estimate, refusals};
 pub use mill::{GrindingSpec, RasterSpec};
@@ -144,11 +144,12 @@ pub struct SurfaceSpec {
 }
 
 /// A `simulate { x: …, y: …, spacing: … }` block: the window of the
-/// height map (mm), checked non-empty, and where it was written.
+/// height map (mm), checked non-empty, and where it was written; a range
+/// left out is the whole part's (`window::simulated`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Simulate {
-    pub x: (f64, f64),
-    pub y: (f64, f64),
+    pub x: Option<(f64, f64)>,
+    pub y: Option<(f64, f64)>,
     pub spacing: Option<f64>,
     pub site: (FileId, Span),
 }
@@ -471,12 +472,13 @@ fn simulate(job: &CheckedJob) -> Result<Option<Simulate>, Diagnostic> {
     };
     let b = value::block(&job.fields, "simulate").expect("checked block");
     let s = Simulate {
-        x: value::range(b, "x").expect("required"),
-        y: value::range(b, "y").expect("required"),
+        x: value::range(b, "x"),
+        y: value::range(b, "y"),
         spacing: value::num(b, "spacing"),
         site: (field.file, field.span),
     };
-    if !(s.x.1 > s.x.0 && s.y.1 > s.y.0) {
+    let low_to_high = |r: Option<(f64, f64)>| r.is_none_or(|r| r.1 > r.0);
+    if !(low_to_high(s.x) && low_to_high(s.y)) {
         return Err(Diagnostic::error(
             codes::WRONG_VALUE,
             "the simulation window is empty: each range must run from low to high",

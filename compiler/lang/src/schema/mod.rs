@@ -247,17 +247,17 @@ pub static JOB_PARAMS: &[Param] = &[
     opt(
         "simulate",
         Ty::Block(&[
-            req(
+            opt(
                 "x",
                 Ty::Range(Dim::LENGTH),
                 Check::Any,
-                "the window's extent in x",
+                "the window's extent in x; the whole part's when left out",
             ),
-            req(
+            opt(
                 "y",
                 Ty::Range(Dim::LENGTH),
                 Check::Any,
-                "the window's extent in y",
+                "the window's extent in y; the whole part's when left out",
             ),
             opt(
                 "spacing",
@@ -267,7 +267,7 @@ pub static JOB_PARAMS: &[Param] = &[
             ),
         ]),
         Check::Any,
-        "the window of a surface job's height-map simulation (design x, y); default a 0.2 mm square where the surface is representative",
+        "the window of a surface job's height-map simulation (design x, y); `simulate: { spacing: 2 um }` simulates the whole part, in tiles; default a 0.2 mm square where the surface is representative",
     ),
     opt(
         "tool_number",

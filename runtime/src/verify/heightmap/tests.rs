@@ -31,6 +31,8 @@ fn grid(n: usize, spacing: f64) -> Grid {
         du: spacing,
         nu: n,
         period: None,
+        j0: 0,
+        i0: 0,
     }
 }
 
@@ -106,6 +108,8 @@ fn a_raster_keeps_each_blocks_worst_error_and_its_sign() {
         rq_cutting: 0.0,
         rq_stepover: 0.0,
         features: Vec::new(),
+        cells: 100 * 100,
+        tiles: 1,
     };
     let r = map.raster(&frame, (0.0, 0.1), (0.0, 0.1), 0.0, 10);
     assert_eq!((r.nx, r.ny), (10, 10));
@@ -229,6 +233,8 @@ fn angles_wrap_and_arcs_are_followed() {
         du: 0.001,
         nu: 11,
         period: Some(std::f64::consts::TAU),
+        j0: 0,
+        i0: 0,
     };
     let mut sweep = Sweep::new(g, r);
     for k in 0..40 {

@@ -1,0 +1,181 @@
+//! Tests of simulation in tiles: the same figures as one grid, and the
+//! same for any number of threads.
+
+use super::*;
+use crate::verify::heightmap::Grid;
+use crate::verify::window::split_columns;
+
+/// A gently curved design on a Cartesian window, with two lenslets.
+struct Wavy {
+    features: Vec<(f64, f64, f64)>,
+}
+fn design(x: f64, y: f64) -> f64 {
+    2e-4 * (40.0 * x).sin() * (30.0 * y).cos()
+}
+impl Frame for Wavy {
+    fn design(&self, points: &[(f64, f64)], out: &mut [f64]) {
+        for (o, &(s, u)) in out.iter_mut().zip(points) {
+            *o = design(s, u);
+        }
+    }
+    fn xy(&self, s: f64, u: f64) -> (f64, f64) {
+        (s, u)
+    }
+    fn inside(&self, x: f64, y: f64) -> bool {
+        (0.0..=0.12).contains(&x) && (0.0..=0.1).contains(&y)
+    }
+    fn features(&self) -> &[(f64, f64, f64)] {
+        &self.features
+    }
+}
+
+const GRID: Grid = Grid {
+    s0: 0.0,
+    ds: 0.001,
+    ns: 121,
+    u0: 0.0,
+    du: 0.001,
+    nu: 101,
+    period: None,
+    j0: 0,
+    i0: 0,
+};
+const NOSE: f64 = 0.005;
+
+/// Passes 7 µm apart along s, points every 3 µm on the design with a
+/// ripple, a lift between passes; three passes stop short (a strip
+/// uncut).
+fn cut(path: &mut dyn NosePath) {
+    for k in -14..=30 {
+        let u = k as f64 * 0.007;
+        path.lift();
+        let end = if (4..=6).contains(&k) { 30 } else { 45 };
+        for j in 0..=end {
+            let s = -0.005 + 0.003 * j as f64;
+            let ripple = 3e-6 * (j as f64 * 0.9 + k as f64).sin();
+            path.point(s, u, NOSE + design(s, u) + ripple);
+        }
+    }
+}
+
+fn frame() -> Wavy {
+    Wavy {
+        features: vec![(0.03, 0.05, 0.02), (0.09, 0.05, 0.03), (0.07, 0.05, 0.02)],
+    }
+}
+
+fn tiled(threads: usize) -> TiledMap {
+    let tiles = split_columns(&GRID, None, 25);
+    assert_eq!(tiles.len(), 5);
+    let mut recorder = Recorder::new(Recorder::band_of(&tiles, NOSE));
+    cut(&mut recorder);
+    let layout = RasterLayout::new((0.0, 0.12), (0.0, 0.1), 0.001, 16);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("a pool");
+    pool.install(|| {
+        simulate(
+            &recorder,
+            &tiles,
+            GRID,
+            Cutter::Nose { radius: NOSE },
+            &frame(),
+            layout,
+        )
+    })
+}
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-15 + 1e-12 * a.abs().max(b.abs())
+}
+
+/// Cut into 5 tiles, the map has the one grid's figures: counts,
+/// extremes and their places exactly, means and RMS to rounding, every
+/// lenslet's, and the same downsampled map.
+#[test]
+fn tiles_give_the_one_grids_figures() {
+    let mut sweep = Sweep::new(GRID, NOSE);
+    cut(&mut sweep);
+    let f = frame();
+    let whole = sweep.finish(&f);
+    let t = tiled(2);
+    let m = &t.map;
+    assert_eq!(m.tiles, 5);
+    assert_eq!((m.cells, m.uncut), (whole.cells, whole.uncut));
+    assert!(
+        whole.uncut > 0 && whole.uncut < whole.cells,
+        "{}",
+        whole.uncut
+    );
+    assert!(close(m.area, whole.area) && close(m.uncut_area, whole.uncut_area));
+    let same = |a: &Option<ErrorFiguresXY>, b: &Option<ErrorFiguresXY>| {
+        let (a, b) = (a.unwrap(), b.unwrap());
+        assert_eq!(
+            (
+                a.count,
+                a.pv,
+                a.max_gouge,
+                a.max_residual,
+                a.largest_deviation
+            ),
+            (
+                b.count,
+                b.pv,
+                b.max_gouge,
+                b.max_residual,
+                b.largest_deviation
+            )
+        );
+        assert!(close(a.mean, b.mean) && close(a.rms, b.rms), "{a:?} {b:?}");
+    };
+    same(&m.surface, &whole.surface);
+    same(&m.contact, &whole.contact);
+    let (sa, sb) = (m.scallops.unwrap(), whole.scallops.unwrap());
+    assert_eq!((sa.count, sa.max), (sb.count, sb.max));
+    assert!(close(sa.mean, sb.mean));
+    // Whole columns in each tile: the step-over roughness is the grid's.
+    assert!(close(m.rq_stepover, whole.rq_stepover));
+    assert_eq!(m.features.len(), 3);
+    assert_eq!(whole.features.len(), 3);
+    for (a, b) in m.features.iter().zip(&whole.features) {
+        assert_eq!(a.centre, b.centre);
+        same(&a.surface, &b.surface);
+        same(&a.contact, &b.contact);
+    }
+    let r = whole.raster(&f, (0.0, 0.12), (0.0, 0.1), 0.001, 16);
+    assert_eq!(
+        (t.raster.nx, t.raster.ny, t.raster.block),
+        (r.nx, r.ny, r.block)
+    );
+    let bits = |c: &[f64]| c.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&t.raster.cells), bits(&r.cells));
+}
+
+type ErrorFiguresXY = crate::verify::heightmap::ErrorFigures;
+
+/// One thread or two: the same map, bit for bit.
+#[test]
+fn the_same_map_for_any_number_of_threads() {
+    let (one, two) = (tiled(1), tiled(2));
+    assert_eq!(format!("{:?}", one.map), format!("{:?}", two.map));
+    let bits = |c: &[f64]| c.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&one.raster.cells), bits(&two.raster.cells));
+}
+
+/// The recorder keeps only what reaches the tiles' band, and an arc's
+/// centre with the step it ends at.
+#[test]
+fn the_recorder_keeps_the_band_only() {
+    let mut r = Recorder::new((0.0, 1.0));
+    r.point(0.0, 5.0, 0.0);
+    r.point(1.0, 5.0, 0.0); // outside: not kept
+    r.point(2.0, 0.5, 0.0); // reaches: both ends kept
+    r.arc(3.0, 0.5, 0.0, (2.5, 1.0));
+    r.lift();
+    r.point(0.0, 0.7, 0.0);
+    r.point(1.0, 0.7, 0.0);
+    assert_eq!(r.len(), 2 + 1 + 1 + 2);
+    assert_eq!(r.arcs, [(2, (2.5, 1.0))]);
+    assert!(r.steps[3].0.is_nan());
+}
