@@ -91,7 +91,12 @@ fn klartext_as_words(line: &str) -> String {
         Some("L") => {
             let g = if words.contains(&"FMAX") { "G0" } else { "G1" };
             std::iter::once(g)
-                .chain(words[1..].iter().copied().filter(|w| *w != "FMAX" && *w != "R0"))
+                .chain(
+                    words[1..]
+                        .iter()
+                        .copied()
+                        .filter(|w| *w != "FMAX" && *w != "R0"),
+                )
                 .collect::<Vec<_>>()
                 .join(" ")
         }

@@ -257,12 +257,16 @@ impl Klartext {
                     b.words.push(word('I', x, head));
                     b.words.push(word('J', y, head));
                 }
-                None => out.push((
-                    Rule::NoCircleCentre,
-                    head,
-                    "an arc before any circle centre (CC): the TNC refuses it".into(),
-                    Some("state the centre first: `CC X… Y…`".into()),
-                )),
+                None => {
+                    out.push((
+                        Rule::NoCircleCentre,
+                        head,
+                        "an arc before any circle centre (CC): the TNC refuses it".into(),
+                        Some("state the centre first: `CC X… Y…`".into()),
+                    ));
+                    // The TNC refuses the block: no move is read from it.
+                    b.words.clear();
+                }
             }
         }
     }
@@ -373,4 +377,83 @@ fn unknown(span: (usize, usize), t: &str) -> Found {
         format!("`{t}` is not a Klartext block or word this reader knows"),
         None,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::dialect::{CommentStyle, Dialect, Language};
+    use crate::reader::{MachineLimits, Rule, read};
+
+    fn klartext() -> Dialect {
+        Dialect {
+            language: Language::Klartext,
+            comment: CommentStyle::Semicolon,
+            line_numbers: Some(1),
+            arc_centre_absolute: true,
+            ..Dialect::linuxcnc()
+        }
+    }
+
+    const MILL: MachineLimits = MachineLimits {
+        lathe: false,
+        travel: [None; 4],
+        max_feed: None,
+        max_spindle_rpm: None,
+    };
+
+    #[test]
+    fn any_line_is_read_without_a_panic() {
+        let lines = [
+            "",
+            "5",
+            "5 ;",
+            ";",
+            "BEGIN",
+            "END PGM",
+            "BEGIN PGM X CM",
+            "C",
+            "CC X",
+            "CC X+1",
+            "L X+",
+            "L X+1e5",
+            "L Xé",
+            "é",
+            "TOOL",
+            "TOOL CALL",
+            "TOOL CALL Y",
+            "CYCL",
+            "L DR-",
+            "C X+1 DR",
+            "99999999999999999999999 L X+1",
+            "L ++1",
+            "M",
+            "M3.5",
+            "STOP",
+            "BLK",
+            "L X+1 X+2 R0 F0",
+            "C X+1 Y+1 DR+ DR-",
+        ];
+        for l in lines {
+            let text = format!("0 BEGIN PGM T MM\n1 {l}\n{l}\n3 END PGM T MM\n");
+            let _ = read(&text, &klartext(), &MILL);
+        }
+    }
+
+    #[test]
+    fn units_come_from_begin_pgm() {
+        let rules = |text: &str| -> Vec<Rule> {
+            read(text, &klartext(), &MILL)
+                .into_iter()
+                .map(|f| f.rule)
+                .collect()
+        };
+        let inch = "0 BEGIN PGM T INCH\n1 L X+1 R0 FMAX\n2 M30\n3 END PGM T INCH\n";
+        assert!(rules(inch).is_empty(), "{:?}", rules(inch));
+        let none = "0 L X+1 R0 FMAX\n1 M30\n2 END PGM T MM\n";
+        let found = rules(none);
+        assert!(found.contains(&Rule::ProgramFrame), "{found:?}");
+        assert!(found.contains(&Rule::ModalStateUnstated), "{found:?}");
+        let after = "0 BEGIN PGM T MM\n1 M30\n2 END PGM T MM\n3 L X+1 R0 FMAX\n";
+        assert!(rules(after).contains(&Rule::ProgramFrame));
+    }
 }

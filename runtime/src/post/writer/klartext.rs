@@ -249,7 +249,12 @@ mod tests {
     fn mill() -> MachineLimits {
         MachineLimits {
             lathe: false,
-            travel: [Some((-50.0, 50.0)), Some((-50.0, 50.0)), Some((-50.0, 50.0)), None],
+            travel: [
+                Some((-50.0, 50.0)),
+                Some((-50.0, 50.0)),
+                Some((-50.0, 50.0)),
+                None,
+            ],
             max_feed: Some(5000.0),
             max_spindle_rpm: Some(24000.0),
         }
@@ -327,7 +332,11 @@ mod tests {
             .collect();
         assert_eq!(
             arcs,
-            [((0.0, 0.0), false), ((0.0, 0.0), false), ((-1.5, 0.0), true)]
+            [
+                ((0.0, 0.0), false),
+                ((0.0, 0.0), false),
+                ((-1.5, 0.0), true)
+            ]
         );
         assert_eq!(moves.len(), 7);
     }
@@ -374,8 +383,16 @@ mod tests {
         let cases = [
             ("8 L Z-0.25", "9 L Z-0.25", reader::Rule::BlockSequence),
             ("9 CC X+0 Y+0\n", "", reader::Rule::NoCircleCentre),
-            ("END PGM DOME MM", "END PGM OTHER MM", reader::Rule::ProgramFrame),
-            ("0 BEGIN PGM DOME MM\n", "0 ; no begin\n", reader::Rule::ProgramFrame),
+            (
+                "END PGM DOME MM",
+                "END PGM OTHER MM",
+                reader::Rule::ProgramFrame,
+            ),
+            (
+                "0 BEGIN PGM DOME MM\n",
+                "0 ; no begin\n",
+                reader::Rule::ProgramFrame,
+            ),
             ("R0 F120", "RL F120", reader::Rule::UnknownWord),
             ("DR+", "", reader::Rule::ArcWords),
             ("6 M3", "6 M5", reader::Rule::SpindleStopped),
@@ -383,7 +400,11 @@ mod tests {
         for (from, to, rule) in cases {
             let bad = good.replacen(from, to, 1);
             assert_ne!(bad, good, "{from}");
-            assert!(rules(&bad).contains(&rule), "{from} → {to}: {:?}", rules(&bad));
+            assert!(
+                rules(&bad).contains(&rule),
+                "{from} → {to}: {:?}",
+                rules(&bad)
+            );
         }
     }
 }
