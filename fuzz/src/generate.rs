@@ -29,6 +29,7 @@ const STD_ITEMS: &[(&str, &str, Category)] = &[
     ("dialects", "fanuc_0i_lathe", Category::Dialect),
     ("dialects", "siemens_840d_lathe", Category::Dialect),
     ("dialects", "heidenhain_iso", Category::Dialect),
+    ("dialects", "heidenhain_tnc_klartext", Category::Dialect),
 ];
 
 /// Dimensions a wrong unit is drawn from.

@@ -13,6 +13,20 @@ pub enum CommentStyle {
     Semicolon,
 }
 
+/// The language a dialect's programs are written in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Language {
+    /// ISO 6983 address words (`G1 X1. F100.`): every dialect but one.
+    #[default]
+    GCode,
+    /// Heidenhain's conversational language (`L X+1 R0 F100`,
+    /// `CC X+0 Y+0`, `C X+1 Y+0 DR-`, `TOOL CALL 1 Z`, `BEGIN PGM`):
+    /// TNC mills only. Blocks are numbered from 0 without a letter; the
+    /// program opens with `BEGIN PGM {JOB} MM` (the `start` lines) and
+    /// closes with `END PGM {JOB} MM` (the `trailer`), both numbered.
+    Klartext,
+}
+
 /// A controller's G-code dialect, as data (declared in `stdlib/dialects.lens`
 /// or a shop's own file): the lines around the moves, the words, the
 /// limits of its number format. Lines may hold `{job}`, `{JOB}`,
@@ -20,6 +34,7 @@ pub enum CommentStyle {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Dialect {
     pub name: String,
+    pub language: Language,
     /// Program file extension, without the dot.
     pub extension: String,
     pub comment: CommentStyle,
@@ -158,6 +173,7 @@ impl Dialect {
         let lines = |l: &[&str]| l.iter().map(|s| s.to_string()).collect::<Vec<_>>();
         Dialect {
             name: "linuxcnc".into(),
+            language: Language::GCode,
             extension: "ngc".into(),
             comment: CommentStyle::Parentheses,
             start: Vec::new(),

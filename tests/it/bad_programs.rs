@@ -48,7 +48,7 @@ fn every_bad_program_is_refused_with_its_code() {
 #[test]
 fn the_programs_they_were_made_from_read_clean() {
     let clean = files("tests/bad_programs/clean");
-    assert_eq!(clean.len(), 5, "one per controller");
+    assert_eq!(clean.len(), 6, "one per controller");
     for path in clean {
         let rel = path.strip_prefix(root()).expect("inside repo");
         let out = lensc(&root(), &["verify", rel.to_str().expect("utf8")]);

@@ -64,8 +64,63 @@ fn number(w: &str) -> Option<&str> {
     .then_some(n)
 }
 
+/// A Klartext block as the G-code words of the same meaning, for the
+/// rules above (TNC conversational programming): `TOOL CALL 1 Z S1000` →
+/// `T1 S1000`, `L … FMAX` → `G0 …`, `L … F…` → `G1 …`, `C … DR-` →
+/// `G2 …`, `DR+` → `G3`; the block number and `BEGIN`/`END PGM` left out.
+fn klartext_as_words(line: &str) -> String {
+    let rest = line
+        .trim_start_matches(|c: char| c.is_ascii_digit())
+        .trim_start();
+    let rest = rest.split(';').next().unwrap_or("").trim();
+    let words: Vec<&str> = rest.split_whitespace().collect();
+    match words.first().copied() {
+        Some("BEGIN" | "END" | "CYCL" | "BLK") | None => String::new(),
+        Some("TOOL") => words[2..]
+            .iter()
+            .map(|w| {
+                if w.bytes().all(|b| b.is_ascii_digit()) {
+                    format!("T{w}")
+                } else {
+                    w.to_string()
+                }
+            })
+            .filter(|w| w != "Z")
+            .collect::<Vec<_>>()
+            .join(" "),
+        Some("L") => {
+            let g = if words.contains(&"FMAX") { "G0" } else { "G1" };
+            std::iter::once(g)
+                .chain(
+                    words[1..]
+                        .iter()
+                        .copied()
+                        .filter(|w| *w != "FMAX" && *w != "R0"),
+                )
+                .collect::<Vec<_>>()
+                .join(" ")
+        }
+        Some("C") => {
+            let g = if words.contains(&"DR-") { "G2" } else { "G3" };
+            std::iter::once(g)
+                .chain(words[1..].iter().copied().filter(|w| !w.starts_with("DR")))
+                .collect::<Vec<_>>()
+                .join(" ")
+        }
+        Some("CC") => String::new(),
+        Some(_) => rest.to_string(),
+    }
+}
+
 /// The rules above, or the first line that breaks one.
 pub fn complete(dialect: &str, program: &str) -> Result<(), String> {
+    if dialect == "heidenhain_tnc_klartext" {
+        let words: String = program
+            .lines()
+            .map(|l| klartext_as_words(l) + "\n")
+            .collect();
+        return complete("klartext as words", &words);
+    }
     let mut tool = false;
     let mut spindle = Spindle::Stopped;
     let mut s_given = false;

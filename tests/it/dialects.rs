@@ -61,6 +61,28 @@ fn obeys(dialect: &str, program: &str) -> Result<(), String> {
                 }
             }
         }
+        "heidenhain_tnc_klartext" => {
+            let name = lines[0]
+                .strip_prefix("0 BEGIN PGM ")
+                .and_then(|r| r.strip_suffix(" MM"))
+                .ok_or_else(|| format!("not a Klartext program start: {}", lines[0]))?;
+            let last = lines.last().copied().unwrap_or("");
+            if !last.ends_with(&format!(" END PGM {name} MM")) {
+                return Err(format!("not closed by END PGM {name} MM: {last}"));
+            }
+            for (i, l) in lines.iter().enumerate() {
+                let (n, rest) = l.split_once(' ').unwrap_or((l, ""));
+                if n.parse::<usize>() != Ok(i) {
+                    return Err(format!("block {i} numbered otherwise: {l}"));
+                }
+                if rest.starts_with('G') || rest.starts_with('N') || rest.contains(" G0") {
+                    return Err(format!("G-code in Klartext: {l}"));
+                }
+                if rest.starts_with("L ") && !rest.contains(" R0") {
+                    return Err(format!("an L block without R0: {l}"));
+                }
+            }
+        }
         "ultra_precision_lathe_gcode" => {
             if lines.iter().any(|l| l.contains("G8") || l.contains("G64")) {
                 return Err("LinuxCNC words in an ultra-precision lathe program".into());

@@ -67,6 +67,8 @@ pub const BAD_WORD_FORMAT: &str = "E0172";
 /// A tool call or coolant the job asks for that its dialect cannot write
 /// (a tool number too long for the T word, no mist word).
 pub const CANNOT_CALL_TOOL: &str = "E0173";
+/// A machine that is not a mill naming a Klartext dialect.
+pub const KLARTEXT_ON_A_LATHE: &str = "E0174";
 /// A path tolerance finer than the machine's resolution can hold.
 pub const TOLERANCE_BELOW_RESOLUTION: &str = "E0180";
 /// `lensc fmt` refused to write a layout that would not parse back to the
@@ -172,6 +174,12 @@ pub const PROGRAM_BLOCK_END: &str = "E0327";
 pub const PROGRAM_END: &str = "E0328";
 /// A comment opened inside a comment.
 pub const PROGRAM_NESTED_COMMENT: &str = "E0329";
+/// Klartext: a block number out of sequence.
+pub const PROGRAM_BLOCK_SEQUENCE: &str = "E0330";
+/// Klartext: an arc before any circle centre.
+pub const PROGRAM_NO_CIRCLE_CENTRE: &str = "E0331";
+/// Klartext: the program not framed by `BEGIN PGM` and `END PGM` of one name.
+pub const PROGRAM_FRAME: &str = "E0332";
 
 /// The code of a rule a program read back breaks.
 pub fn program_rule(rule: lensc_runtime::reader::Rule) -> &'static str {
@@ -207,6 +215,9 @@ pub fn program_rule(rule: lensc_runtime::reader::Rule) -> &'static str {
         BlockEnd => PROGRAM_BLOCK_END,
         ProgramEnd => PROGRAM_END,
         NestedComment => PROGRAM_NESTED_COMMENT,
+        BlockSequence => PROGRAM_BLOCK_SEQUENCE,
+        NoCircleCentre => PROGRAM_NO_CIRCLE_CENTRE,
+        ProgramFrame => PROGRAM_FRAME,
     }
 }
 
@@ -265,6 +276,7 @@ pub const ALL: &[&str] = &[
     RASTER_SPINDLE,
     BAD_WORD_FORMAT,
     CANNOT_CALL_TOOL,
+    KLARTEXT_ON_A_LATHE,
     TOLERANCE_BELOW_RESOLUTION,
     ACCEPTANCE_MISSED,
     ACCEPTANCE_UNMEASURED,
@@ -310,6 +322,9 @@ pub const ALL: &[&str] = &[
     PROGRAM_BLOCK_END,
     PROGRAM_END,
     PROGRAM_NESTED_COMMENT,
+    PROGRAM_BLOCK_SEQUENCE,
+    PROGRAM_NO_CIRCLE_CENTRE,
+    PROGRAM_FRAME,
     ACCEPTANCE_MISSED_WARNING,
     ACCEPTANCE_UNMEASURED_WARNING,
 ];

@@ -4,7 +4,7 @@
 use super::ProgramError;
 use super::format::{decimals_for, fixed_units, push_fixed, push_units_to};
 use super::header::{num, write_comment};
-use crate::dialect::{CommentStyle, Dialect, WordFormat};
+use crate::dialect::{CommentStyle, Dialect, Language, WordFormat};
 use crate::moves::{Coolant, Plane, Position, Rotation, Start};
 use std::f64::consts::PI;
 
@@ -106,6 +106,9 @@ pub struct ProgramWriter {
     integer_limit: [u64; 26],
     /// Decimals of feeds per minute and per revolution.
     feed_decimals: u32,
+    /// Klartext: the circle centre `CC` last written, in units of the
+    /// axes' last decimal.
+    circle_centre: Option<(i64, i64)>,
     pub moves: usize,
 }
 
@@ -169,9 +172,7 @@ impl ProgramWriter {
         check_dialect_words(dialect)?;
         for line in &dialect.start {
             let l = w.fill(line, path_tolerance);
-            check_numbers(&l, dialect.comment)?;
-            w.text.extend_from_slice(l.as_bytes());
-            w.text.push(b'\n');
+            w.line_as_written(&l)?;
         }
         for line in header {
             w.comment(line);
@@ -228,7 +229,11 @@ impl ProgramWriter {
             // The first feed states its mode, whatever the setup says.
             mode: None,
             last_feed: None,
-            block: dialect.line_numbers.unwrap_or(0),
+            // Klartext numbers from 0 (`0 BEGIN PGM`).
+            block: match dialect.language {
+                Language::Klartext => 0,
+                Language::GCode => dialect.line_numbers.unwrap_or(0),
+            },
             c_axis_on: false,
             job: job.to_string(),
             start: None,
@@ -238,6 +243,7 @@ impl ProgramWriter {
                 .format_of('F')
                 .and_then(|f| f.decimals)
                 .map_or(FEED_DECIMALS, |d| d.min(FEED_DECIMALS)),
+            circle_centre: None,
             moves: 0,
         }
     }
@@ -294,7 +300,9 @@ impl ProgramWriter {
     #[inline]
     fn begin_block(&mut self) {
         if self.dialect.line_numbers.is_some() {
-            self.text.push(b'N');
+            if self.dialect.language == Language::GCode {
+                self.text.push(b'N');
+            }
             self.text
                 .extend_from_slice(itoa::Buffer::new().format(self.block).as_bytes());
             self.text.push(b' ');
@@ -341,6 +349,18 @@ impl ProgramWriter {
     /// The dialect the program is written in.
     pub fn dialect(&self) -> &Dialect {
         &self.dialect
+    }
+
+    /// A `start` or `trailer` line: as it is in G-code (`%`), a numbered
+    /// block in Klartext (`0 BEGIN PGM NAME MM`, `END PGM NAME MM`).
+    fn line_as_written(&mut self, l: &str) -> Result<(), ProgramError> {
+        if self.dialect.language == Language::Klartext {
+            return self.block_line(l);
+        }
+        check_numbers(l, self.dialect.comment)?;
+        self.text.extend_from_slice(l.as_bytes());
+        self.text.push(b'\n');
+        Ok(())
     }
 
     /// Writes one block of the dialect's own words, checked as it is written.
@@ -442,7 +462,10 @@ impl ProgramWriter {
             _ => return self.write_spindle(m),
         };
         let start = self.text.len();
-        let r = self.motion(word, to, feed, arc);
+        let r = match self.dialect.language {
+            Language::GCode => self.motion(word, to, feed, arc),
+            Language::Klartext => self.klartext_motion(word, to, feed, arc),
+        };
         if r.is_err() {
             self.text.truncate(start);
         }
@@ -496,6 +519,14 @@ impl ProgramWriter {
     fn spindle_rpm(&mut self, speed: f64) -> Result<(), ProgramError> {
         let rpm = speed * 60.0 / (2.0 * PI);
         let s = self.s_value(rpm, false)?;
+        if self.dialect.language == Language::Klartext {
+            // The speed is the tool call's: `TOOL CALL Z S…` changes it
+            // for the tool in the spindle; M3 starts it in its own block.
+            self.spindle = Spindle::Turning;
+            self.block_line(&format!("TOOL CALL Z S{s}"))?;
+            let on = self.spindle_on_word();
+            return self.block_line(&on);
+        }
         let mut block = String::new();
         if let Some(w) = &self.dialect.constant_rpm {
             block.push_str(w);
@@ -760,6 +791,41 @@ impl ProgramWriter {
         to: Position,
         centre: Position,
     ) -> Result<(), ProgramError> {
+        self.check_arc_radii(plane, to, centre)?;
+        let (a, b) = plane.axes();
+        // I J K in that order, whatever the plane's orientation.
+        for i in [a.min(b), a.max(b)] {
+            let c = centre.axes()[i];
+            let from = if self.dialect.arc_centre_absolute {
+                0.0
+            } else {
+                self.at[i]
+            };
+            let (Some(cu), Some(fu)) = (
+                fixed_units(c, self.decimals),
+                fixed_units(from, self.decimals),
+            ) else {
+                return Err(ProgramError::NotPrintable {
+                    word: ['I', 'J', 'K'][i],
+                    value: c,
+                });
+            };
+            let letter = ['I', 'J', 'K'][i];
+            self.text.extend_from_slice(&[b' ', letter as u8]);
+            self.number(letter, c - from, cu - fu, self.decimals)?;
+        }
+        Ok(())
+    }
+
+    /// An arc's start and end radii, from the rounded centre, start and
+    /// end, as the controller measures them: refused beyond the
+    /// dialect's `arc_radius_tolerance`.
+    fn check_arc_radii(
+        &self,
+        plane: Plane,
+        to: Position,
+        centre: Position,
+    ) -> Result<(), ProgramError> {
         // The controller measures the radius from the rounded centre
         // to the rounded start and end, and refuses a mismatch.
         let (a, b) = plane.axes();
@@ -782,27 +848,6 @@ impl ProgramWriter {
                 num(mismatch),
                 num(self.dialect.arc_radius_tolerance)
             )));
-        }
-        // I J K in that order, whatever the plane's orientation.
-        for i in [a.min(b), a.max(b)] {
-            let c = centre.axes()[i];
-            let from = if self.dialect.arc_centre_absolute {
-                0.0
-            } else {
-                self.at[i]
-            };
-            let (Some(cu), Some(fu)) = (
-                fixed_units(c, self.decimals),
-                fixed_units(from, self.decimals),
-            ) else {
-                return Err(ProgramError::NotPrintable {
-                    word: ['I', 'J', 'K'][i],
-                    value: c,
-                });
-            };
-            let letter = ['I', 'J', 'K'][i];
-            self.text.extend_from_slice(&[b' ', letter as u8]);
-            self.number(letter, c - from, cu - fu, self.decimals)?;
         }
         Ok(())
     }
@@ -852,9 +897,7 @@ impl ProgramWriter {
         }
         for line in self.dialect.trailer.clone() {
             let l = self.fill(&line, 0.0);
-            check_numbers(&l, self.dialect.comment)?;
-            self.text.extend_from_slice(l.as_bytes());
-            self.text.push(b'\n');
+            self.line_as_written(&l)?;
         }
         utf8(self.text)
     }
@@ -940,7 +983,15 @@ pub fn check_dialect(
         Setup::Lathe => &dialect.lathe_setup,
         Setup::Mill => &dialect.mill_setup,
     };
-    if setup_lines.is_empty() {
+    if dialect.language == Language::Klartext && setup == Setup::Lathe {
+        return Err(ProgramError::Unsupported(format!(
+            "lathe programs ({} is Heidenhain Klartext, a TNC milling language)",
+            dialect.name
+        )));
+    }
+    // A Klartext program states its units in `BEGIN PGM … MM` and the
+    // tool's plane in its tool call: it needs no setup blocks.
+    if setup_lines.is_empty() && dialect.language == Language::GCode {
         return Err(ProgramError::Unsupported(format!(
             "{} programs ({} has no `{}_setup`)",
             setup.name(),
@@ -1198,5 +1249,6 @@ pub(crate) fn check_number(num: &[u8]) -> Result<(), &'static str> {
     Ok(())
 }
 
+mod klartext;
 #[cfg(test)]
 mod tests;

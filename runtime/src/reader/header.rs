@@ -38,17 +38,15 @@ pub fn header_source(text: &str) -> Option<String> {
     })
 }
 
-/// The text of a whole-line comment in any dialect: `(…)`, `; …`, or a
-/// numbered `N9 ; … *`.
+/// The text of a whole-line comment in any dialect: `(…)`, `; …`, a
+/// numbered `N9 ; … *`, or Klartext's `9 ; …`.
 fn comment_text(line: &str) -> Option<&str> {
     let t = line.trim();
     if let Some(inner) = t.strip_prefix('(') {
         return inner.strip_suffix(')');
     }
-    let t = match t.strip_prefix('N') {
-        Some(rest) => rest.trim_start_matches(|c: char| c.is_ascii_digit()).trim(),
-        None => t,
-    };
+    let t = t.strip_prefix('N').unwrap_or(t);
+    let t = t.trim_start_matches(|c: char| c.is_ascii_digit()).trim();
     let inner = t.strip_prefix(';')?;
     Some(inner.trim_end().trim_end_matches('*'))
 }

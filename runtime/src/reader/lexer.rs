@@ -83,19 +83,7 @@ impl Lexer {
     /// Splits `line` (without its line break) into a block.
     pub fn block(&self, line: &str, out: &mut Vec<Found>) -> Block {
         let mut b = Block::default();
-        if let Some(max) = self.max_line_length
-            && line.chars().count() > max
-        {
-            out.push((
-                Rule::LineTooLong,
-                (0, line.len()),
-                format!(
-                    "this line has {} characters; the controller reads at most {max}",
-                    line.chars().count()
-                ),
-                Some("split the line or shorten its comment".into()),
-            ));
-        }
+        self.line_length(line, out);
         let mut code = line.trim_end();
         if code.trim().is_empty() {
             return b;
@@ -114,6 +102,23 @@ impl Lexer {
         let code = self.strip_comments(code, &mut b, out);
         self.words(code, &mut b, out);
         b
+    }
+
+    /// The dialect's line-length limit.
+    pub(crate) fn line_length(&self, line: &str, out: &mut Vec<Found>) {
+        if let Some(max) = self.max_line_length
+            && line.chars().count() > max
+        {
+            out.push((
+                Rule::LineTooLong,
+                (0, line.len()),
+                format!(
+                    "this line has {} characters; the controller reads at most {max}",
+                    line.chars().count()
+                ),
+                Some("split the line or shorten its comment".into()),
+            ));
+        }
     }
 
     /// The line up to its comments (their texts kept in `b`); a `(` never
@@ -286,7 +291,7 @@ impl Lexer {
 
     /// Digits, decimals and the decimal point of a word against the
     /// dialect's number format.
-    fn number_format(&self, w: &Word, code: &str, out: &mut Vec<Found>) {
+    pub(crate) fn number_format(&self, w: &Word, code: &str, out: &mut Vec<Found>) {
         let text = &code[w.span.0..w.span.1];
         let format = self.formats.iter().find(|f| f.letter == w.letter);
         let whole = format.is_some_and(|f| f.decimals.is_none());
@@ -381,7 +386,7 @@ fn unknown(span: (usize, usize), message: &str) -> Found {
 
 /// A number at `code[i..]`: sign, digits, a point, digits (at least one
 /// digit). Returns (value, has a point, decimals) and where it ends.
-fn number(code: &str, mut i: usize) -> (Option<(f64, bool, usize)>, usize) {
+pub(crate) fn number(code: &str, mut i: usize) -> (Option<(f64, bool, usize)>, usize) {
     let bytes = code.as_bytes();
     let start = i;
     if matches!(bytes.get(i), Some(b'+' | b'-')) {

@@ -9,7 +9,8 @@
 //! travel, the dialect's own block lists and number format).
 //!
 //! Which controller a dialect is for is read from its data
-//! ([`Controller::of`]): a block end with `*` is Heidenhain's; `;` comments
+//! ([`Controller::of`]): a Klartext dialect is a TNC's in Klartext
+//! (`klartext`, its own lexer: Klartext has no address-word blocks); a block end with `*` is Heidenhain's; `;` comments
 //! are Siemens'; a program number line (`O{number}`) is Fanuc's; `G21` in
 //! the setup is LinuxCNC's; anything else is read by the ultra-precision
 //! lathes' rules (G71 metric, M19/M18 position mode as the dialect says).
@@ -18,6 +19,7 @@
 //! [`Rule`] (its diagnostic code lives with the compiler's others).
 
 mod header;
+mod klartext;
 mod lexer;
 mod modal;
 mod motion;
@@ -46,6 +48,7 @@ pub enum Controller {
     Fanuc,
     Siemens,
     HeidenhainIso,
+    HeidenhainKlartext,
     UltraPrecision,
 }
 
@@ -54,7 +57,9 @@ impl Controller {
     /// documentation).
     pub fn of(d: &Dialect) -> Controller {
         let setup = d.lathe_setup.iter().chain(&d.mill_setup);
-        if d.block_end.trim_end().ends_with('*') {
+        if d.language == crate::dialect::Language::Klartext {
+            Controller::HeidenhainKlartext
+        } else if d.block_end.trim_end().ends_with('*') {
             Controller::HeidenhainIso
         } else if d.comment == crate::dialect::CommentStyle::Semicolon {
             Controller::Siemens
@@ -101,6 +106,13 @@ pub enum Rule {
     BlockEnd,
     ProgramEnd,
     NestedComment,
+    /// Klartext: a block number out of sequence.
+    BlockSequence,
+    /// Klartext: an arc `C` before any circle centre `CC`.
+    NoCircleCentre,
+    /// Klartext: the program not opened by `BEGIN PGM` or not closed by
+    /// `END PGM` of the same name.
+    ProgramFrame,
 }
 
 /// One thing wrong with a program: where (line from 1, byte span in the

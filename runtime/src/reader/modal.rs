@@ -5,6 +5,7 @@
 //! applied in the controller's order (modes, then spindle, then the move,
 //! then the program's end). The moves themselves are `motion`'s.
 
+use super::klartext::Klartext;
 use super::lexer::{Block, Found, Lexer, Word};
 use super::{Controller, MachineLimits, Rule};
 use crate::dialect::Dialect;
@@ -105,6 +106,8 @@ pub(crate) struct State {
     /// The moves made so far, when they are asked for.
     pub moves: Option<Vec<super::Executed>>,
     ended: bool,
+    /// A Klartext program's own reader, whose blocks become words.
+    klartext: Option<Klartext>,
 }
 
 impl State {
@@ -146,7 +149,10 @@ impl State {
             dialect_m,
             feed_codes,
             max_line_number: d.max_line_number,
-            numbered: lex.controller == Controller::HeidenhainIso && d.line_numbers.is_some(),
+            numbered: matches!(
+                lex.controller,
+                Controller::HeidenhainIso | Controller::HeidenhainKlartext
+            ) && d.line_numbers.is_some(),
             css_capable: machine.lathe || d.constant_rpm.is_some() || !d.surface_speed.is_empty(),
             metric: None,
             plane: None,
@@ -168,13 +174,17 @@ impl State {
             top: None,
             moves: None,
             ended: false,
+            klartext: (lex.controller == Controller::HeidenhainKlartext).then(Klartext::default),
             lex,
         }
     }
 
     /// Reads one line.
     pub fn line(&mut self, line: &str, out: &mut Vec<Found>) {
-        let b = self.lex.block(line, out);
+        let b = match &mut self.klartext {
+            Some(k) => k.block(&self.lex, line, out),
+            None => self.lex.block(line, out),
+        };
         for c in &b.comments {
             if let Some(a) = super::header::away_axis(c) {
                 self.away = a;
@@ -214,6 +224,9 @@ impl State {
 
     /// What is wrong once the whole program is read.
     pub fn finish(&mut self, out: &mut Vec<Found>) {
+        if let Some(k) = &self.klartext {
+            k.finish(out);
+        }
         if !self.ended {
             out.push((
                 Rule::ProgramEnd,
@@ -336,6 +349,7 @@ impl State {
             Controller::LinuxCnc => "XYZABCUVWIJKRFSTDHPQLN".contains(l),
             Controller::Siemens => "XYZABCIJKRFSTDHPLN".contains(l),
             Controller::HeidenhainIso => "XYZABCIJKRFSTLPHN".contains(l),
+            Controller::HeidenhainKlartext => "XYZIJFSTN".contains(l),
         }
     }
 
@@ -357,8 +371,8 @@ impl State {
             900 => GGroup::Distance(true),
             910 => GGroup::Distance(false),
             400 | 410 | 420 => GGroup::CutterComp,
-            960 if c != HeidenhainIso => GGroup::SpindleMode(true),
-            970 if c != HeidenhainIso => GGroup::SpindleMode(false),
+            960 if c != HeidenhainIso && c != HeidenhainKlartext => GGroup::SpindleMode(true),
+            970 if c != HeidenhainIso && c != HeidenhainKlartext => GGroup::SpindleMode(false),
             40 => GGroup::NonModal,
             540..=590 if code % 10 == 0 => GGroup::WorkOffset,
             c2 if c2 == metric_codes.0 => GGroup::Units(false),

@@ -253,6 +253,7 @@ impl State {
                 "a cut before any tool is called: the controller cuts with whatever tool and offset it holds".into(),
                 Some(match self.lex.controller {
                     Controller::LinuxCnc => "call the tool first: T… M6 (and G43)".into(),
+                    Controller::HeidenhainKlartext => "call the tool first: TOOL CALL … Z".into(),
                     _ => "call the tool and its offset first (T…)".into(),
                 }),
             ));

@@ -45,6 +45,7 @@ pub fn describe(o: &Object) -> String {
 /// the one `requested` (by `lensc build --dialect`) among it and its
 /// `other_dialects`; E0148 if the machine offers no dialect of that name.
 pub fn dialect(job: &CheckedJob, requested: Option<&str>) -> Result<Dialect, Diagnostic> {
+    klartext_on_a_lathe(job)?;
     let offered = offered(job);
     let chosen = match requested {
         None => offered.first().copied(),
@@ -70,6 +71,47 @@ pub fn dialect(job: &CheckedJob, requested: Option<&str>) -> Result<Dialect, Dia
     };
     check_word_formats(o)?;
     Ok(dialect_of(o, dialect_name(o)))
+}
+
+/// E0174 where a machine that is not a mill names a Klartext dialect
+/// (as its `dialect` or among its `other_dialects`): Klartext is the TNC
+/// mills' language, with no lathe programs.
+fn klartext_on_a_lathe(job: &CheckedJob) -> Result<(), Diagnostic> {
+    let machine = value::object(&job.fields, "machine").expect("checked job part");
+    if machine.kind.name == "mill_3axis" {
+        return Ok(());
+    }
+    let klartext = |o: &Object| value::word(&o.fields, "language") == Some("klartext");
+    let mut named = Vec::new();
+    if let Some(f) = value::field(&machine.fields, "dialect")
+        && let Value::Object(o) = &f.value
+    {
+        named.push((o.as_ref(), f.file, f.span));
+    }
+    if let Some(f) = value::field(&machine.fields, "other_dialects")
+        && let Value::List(items) = &f.value
+    {
+        for (v, span) in items {
+            if let Value::Object(o) = v {
+                named.push((o.as_ref(), f.file, *span));
+            }
+        }
+    }
+    let Some((o, file, span)) = named.into_iter().find(|(o, _, _)| klartext(o)) else {
+        return Ok(());
+    };
+    Err(Diagnostic::error(
+        codes::KLARTEXT_ON_A_LATHE,
+        format!(
+            "`{}` is Heidenhain Klartext, a language for TNC mills; this machine is a `{}`",
+            dialect_name(o),
+            machine.kind.name
+        ),
+        file,
+        span,
+    )
+    .with_label("a Klartext dialect on a machine that is not a mill")
+    .with_help("Klartext programs only mills: name a G-code dialect this machine's controller reads (`linuxcnc`, `fanuc_0i_lathe`, `siemens_840d_lathe`, `ultra_precision_lathe_gcode`)"))
 }
 
 /// E0172 at the first of a dialect's `word_formats` that does not read.
@@ -179,6 +221,10 @@ pub(crate) fn dialect_of(o: &Object, name: String) -> Dialect {
     use lensc_runtime::moves::Plane;
     Dialect {
         name,
+        language: match value::word(f, "language") {
+            Some("klartext") => lensc_runtime::dialect::Language::Klartext,
+            _ => lensc_runtime::dialect::Language::GCode,
+        },
         extension: text("extension", "nc"),
         comment: match value::word(f, "comment") {
             Some("semicolon") => lensc_runtime::post::CommentStyle::Semicolon,

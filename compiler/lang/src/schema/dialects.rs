@@ -15,6 +15,12 @@ const fn texts(name: &'static str, doc: &'static str) -> Param {
 /// lensc. Lines may hold `{job}`, `{JOB}` (upper case), `{number}` and
 /// `{tolerance}` (mm, to the machine's decimals).
 const GCODE_PARAMS: &[Param] = &[
+    opt(
+        "language",
+        Ty::Word(&["gcode", "klartext"]),
+        Check::Any,
+        "the program language: `gcode` (ISO address words, the default) or `klartext` (Heidenhain's conversational language for TNC mills: `L X+1 R0 F100`, `CC`/`C` arcs, `TOOL CALL`, numbered `BEGIN PGM`/`END PGM`); a Klartext dialect has no lathe programs",
+    ),
     req(
         "extension",
         Ty::Text,
