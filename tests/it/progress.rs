@@ -306,6 +306,7 @@ fn a_terminal_sees_the_bar() {
         let out = Command::new("script")
             .args(["-qefc", &format!("{command} {extra}"), "/dev/null"])
             .env("NO_COLOR", "1")
+            .env("LENSC_PROGRESS_AFTER_MS", "0")
             .output()
             .expect("run script");
         assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));

@@ -18,8 +18,15 @@ use serde_json::json;
 use crate::MessageFormat;
 use crate::output::Output;
 
-/// How long a build runs before its bar is drawn.
-const SHOW_AFTER: Duration = Duration::from_secs(1);
+/// How long a build runs before its bar is drawn: a second, or
+/// `LENSC_PROGRESS_AFTER_MS` milliseconds (the tests draw it at once, on
+/// machines fast enough to build their jobs within the second).
+fn show_after() -> Duration {
+    std::env::var("LENSC_PROGRESS_AFTER_MS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .map_or(Duration::from_secs(1), Duration::from_millis)
+}
 
 /// Follows one `build` or `report` run.
 pub struct Reporter {
@@ -182,7 +189,7 @@ fn event_json(e: Event<'_>) -> serde_json::Value {
 }
 
 /// The bar of the job in hand, drawn on stderr once the run has lasted
-/// `SHOW_AFTER` (a thread of its own turns it on then and redraws it).
+/// `show_after()` (a thread of its own turns it on then and redraws it).
 struct Bars {
     start: Instant,
     shown: AtomicBool,
@@ -201,12 +208,13 @@ impl Bars {
             label: Mutex::new(String::new()),
         });
         let weak = Arc::downgrade(&bars);
+        let after = show_after();
         // Ends with the run: the bars dropped, nothing left to draw.
         let _ = std::thread::Builder::new()
             .name("progress".into())
             .spawn(move || {
                 while let Some(bars) = weak.upgrade() {
-                    if !bars.shown.load(Ordering::Relaxed) && bars.start.elapsed() >= SHOW_AFTER {
+                    if !bars.shown.load(Ordering::Relaxed) && bars.start.elapsed() >= after {
                         bars.shown.store(true, Ordering::Relaxed);
                         bars.with(|b| b.set_draw_target(ProgressDrawTarget::stderr()));
                     }
