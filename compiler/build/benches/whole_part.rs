@@ -49,11 +49,15 @@ fn main() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let example = std::fs::read_to_string(root.join("examples/hashimoto2025_lens_array.lens"))
         .expect("seed 003 example");
-    let job_end = "max_cutting_time: 4 h } }";
-    assert!(example.contains(job_end), "the example's job line");
+    // The job's block closed one `}` later, with the whole part simulated.
+    let job = example
+        .lines()
+        .find(|l| l.starts_with("job "))
+        .expect("the example's job line");
+    let block = job.trim_end().strip_suffix('}').expect("a job block");
     let whole = example.replace(
-        job_end,
-        &format!("max_cutting_time: 4 h }}, simulate: {{ spacing: {spacing} um }} }}"),
+        job,
+        &format!("{block}, simulate: {{ spacing: {spacing} um }} }}"),
     );
     let (base, base_cpu, _) = build(&example);
     let (t, cpu, report) = build(&whole);
