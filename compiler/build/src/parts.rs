@@ -152,6 +152,23 @@ pub(crate) fn failed(head: &JobHead, e: RuntimeError) -> Diagnostic {
     e.at(head.site)
 }
 
+/// The moves the controller makes reading `text` (`reader::read_moves`)
+/// on a lathe or a mill: only the moves are taken here, the read-back
+/// judges the rules.
+pub(crate) fn executed_moves(
+    head: &JobHead,
+    text: &str,
+    lathe: bool,
+) -> Vec<lensc_runtime::reader::Executed> {
+    let machine = lensc_runtime::reader::MachineLimits {
+        lathe,
+        travel: [None; 4],
+        max_feed: None,
+        max_spindle_rpm: None,
+    };
+    lensc_runtime::reader::read_moves(text, &head.dialect, &machine).1
+}
+
 /// What a lathe or grinder program cuts, read from its text as the
 /// controller reads it (`reader::read_moves`, arcs blended as the
 /// controller blends them) with a round edge of radius `rho` along it,
@@ -164,15 +181,8 @@ pub(crate) fn program_cut(
     design: &dyn Fn(f64) -> f64,
     range: (f64, f64),
 ) -> lensc_runtime::verify::simulate::ProfileCut {
-    let machine = lensc_runtime::reader::MachineLimits {
-        lathe: true,
-        travel: [None; 4],
-        max_feed: None,
-        max_spindle_rpm: None,
-    };
-    let (_, moves) = lensc_runtime::reader::read_moves(text, &head.dialect, &machine);
     lensc_runtime::verify::simulate::program_cut(
-        &moves,
+        &executed_moves(head, text, true),
         rho,
         design,
         range,

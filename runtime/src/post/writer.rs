@@ -708,7 +708,16 @@ impl ProgramWriter {
             self.feed_word(mode, mode_changes)?;
         }
         self.end_block(start)?;
-        for (i, n) in printed.into_iter().enumerate() {
+        self.moved(&printed, changed, axes);
+        Ok(())
+    }
+
+    /// A motion block written: the printed values of the axes `changed`
+    /// (bit i for axis i) become the modal ones, the tool is at `axes`
+    /// (NaN: an axis that did not move).
+    #[inline]
+    fn moved(&mut self, printed: &[i64], changed: u8, axes: [f64; 4]) {
+        for (i, &n) in printed.iter().enumerate() {
             if changed & 1 << i != 0 {
                 self.last[i] = Some(n);
             }
@@ -719,7 +728,6 @@ impl ProgramWriter {
             }
         }
         self.moves += 1;
-        Ok(())
     }
 
     /// The feed word: written when the mode or the printed feed changes,

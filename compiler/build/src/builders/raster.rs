@@ -91,13 +91,7 @@ pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnost
     let grid = window.cartesian(along_x);
     let mut sweep = Simulation::of(grid, split(&grid, None), cutter);
     // The program as written: its text read as the controller reads it.
-    let machine = lensc_runtime::reader::MachineLimits {
-        lathe: false,
-        travel: [None; 4],
-        max_feed: None,
-        max_spindle_rpm: None,
-    };
-    let (_, executed) = lensc_runtime::reader::read_moves(&text, dialect, &machine);
+    let executed = parts::executed_moves(head, &text, false);
     height_map::sweep_mill_program(sweep.path(), &executed, along_x);
     let frame = height_map::RasterFrame {
         kernel: kernel.as_ref(),

@@ -127,17 +127,7 @@ impl ProgramWriter {
             (_, None) => {}
         }
         self.end_block(start)?;
-        for (i, n) in printed.into_iter().enumerate() {
-            if changed & 1 << i != 0 {
-                self.last[i] = Some(n);
-            }
-        }
-        for (at, v) in self.at.iter_mut().zip(axes) {
-            if !v.is_nan() {
-                *at = v;
-            }
-        }
-        self.moves += 1;
+        self.moved(&printed, changed, axes);
         Ok(true)
     }
 
