@@ -58,7 +58,7 @@ pub fn build(
         ((z.0 + z.1) / 2.0, (design_y.0 + design_y.1) / 2.0),
         height_map::roller_extent(&lowered.domain, z, design_y),
     );
-    let grid = window.roller(helix.roller_radius);
+    let grid = window.roller(helix.roller_radius, helix.y_start);
     let mut sweep = Simulation::new(grid, split(&grid, None), rho);
     let mut current_pass = usize::MAX;
     let planned = plan_roller_helix_into(helix, rho, kernel.as_ref(), |pass, pts| {
@@ -95,6 +95,7 @@ pub fn build(
         kernel: kernel.as_ref(),
         window,
         roller_radius: helix.roller_radius,
+        y_start: helix.y_start,
         domain: lowered.domain,
     };
     let (map, raster) = sweep.finish(&frame, &window, window.spacing);
@@ -113,7 +114,7 @@ pub fn build(
     let height_map = report::HeightMap::new(
         &map,
         &window,
-        "columns at spindle angles (column step in rad; design y = roller radius × angle), rows along the roller axis (design x)",
+        "columns at spindle angles (column step in rad; design y = the design's first y + roller radius × angle), rows along the roller axis (design x)",
         finish_pitch,
     );
     Ok(parts::built(
@@ -150,11 +151,12 @@ fn header_lines(spec: &RollerSpec, prov: &Provenance) -> Vec<String> {
     );
     let mut lines = parts::nose_centre_header(head, prov, &units, spec.tool.nose_radius);
     lines.push(format!(
-        "strategy {}: roller helix from z = {} to {} mm at {} rpm; passes: {}",
+        "strategy {}: roller helix from z = {} to {} mm at {} rpm, C 0 at design y = {} mm; passes: {}",
         head.names.strategy,
         exact_in(helix.z_start, "mm"),
         exact_in(helix.z_end, "mm"),
         exact_in(spec.spindle_speed, "rpm"),
+        exact_in(helix.y_start, "mm"),
         pass_words.join("; ")
     ));
     lines.push(format!(
