@@ -5,6 +5,8 @@
 //! the spiral's, the cut simulated as a height map.
 
 use lensc_grammar::Diagnostic;
+use lensc_lang::check::trim_num;
+use lensc_lang::codes;
 use lensc_lang::lower::diagnostics::RuntimeError;
 use lensc_lang::lower::exact_in;
 use lensc_lang::lower::job::RollerSpec;
@@ -117,7 +119,7 @@ pub fn build(
         "columns at spindle angles (column step in rad; design y = the design's first y + roller radius × angle), rows along the roller axis (design x)",
         finish_pitch,
     );
-    Ok(parts::built(
+    let mut built = parts::built(
         head,
         prov,
         text,
@@ -125,7 +127,49 @@ pub fn build(
         report::Simulation::HeightMap(report::HeightMapOnly { height_map }),
         plots,
         cut,
-    ))
+    );
+    built.warnings.extend(seam_warning(spec, kernel.as_ref()));
+    Ok(built)
+}
+
+/// W0006: where the roller closes, the design's last row meets its first
+/// (design y = y_start + 2πR against y_start); a step there higher than
+/// the machine's resolution is cut as a step, all along the helix.
+fn seam_warning(
+    spec: &RollerSpec,
+    design: &dyn lensc_runtime::surface::ir::SurfaceFn,
+) -> Option<Diagnostic> {
+    let (head, helix) = (&spec.head, &spec.helix);
+    let (step, _) = lensc_runtime::plan::roller::seam_step(
+        design,
+        helix.roller_radius,
+        helix.y_start,
+        (helix.z_start, helix.z_end),
+        401,
+    );
+    if step.is_nan() || step <= head.resolution {
+        return None;
+    }
+    let (file, span) = head.site;
+    let ends = (
+        helix.y_start,
+        helix.y_start + std::f64::consts::TAU * helix.roller_radius,
+    );
+    Some(
+        Diagnostic::warning(
+            codes::SEAM_STEP,
+            format!(
+                "the design does not close around the roller: its ends (design y = {} and {} mm) differ in height by up to {} um, so a step is cut where the roller closes",
+                trim_num(ends.0),
+                trim_num(ends.1),
+                trim_num(step * 1000.0)
+            ),
+            file,
+            span,
+        )
+        .with_label("this job")
+        .with_help("make the design periodic over its y extent L around the roller (the same height at its first y and at its first y + L), for instance a whole number of periods"),
+    )
 }
 
 /// The program's header: provenance, units, the surface and tool, the
