@@ -372,3 +372,60 @@ fn machining_time_is_given_per_pass_and_in_total() {
     let total = tp["cutting_time_s"].as_f64().expect("total");
     assert!((sum - total).abs() <= 1e-9 * total, "{sum} vs {total}");
 }
+
+/// A wrapped design goes round the roller from its first row to its last,
+/// wherever its domain starts: the same ripples given over y in 0 .. 2π mm
+/// and, moved, over −π .. π mm cut the same program move for move (before
+/// the roller's angle 0 was taken as design y = 0, so a design centred on
+/// y = 0 — seed 002's microlens grid — was cut only over its upper half,
+/// the rest of the roller left as land, with a step at the seam).
+#[test]
+fn a_wrapped_design_wraps_from_its_first_row_wherever_its_domain_starts() {
+    let job = |y0: &str, shift: &str| {
+        format!(
+            "surface ripples = freeform {{\n\
+                 z(x, y) = 2 um * cos(12.566370614359172 rad/mm * (y - {shift})) - 2 um\n\
+                 domain: rect(x: 0 mm .. 0.4 mm, y: {y0} .. {y0} + 6.283185307179586 mm)\n\
+             }}\n\
+             surface roller_ripples = wrap(ripples, onto: roller(radius: 1 mm))\n\
+             use std::machines::moore_nanotech_450fg\n\
+             tool nose = round_nose {{ nose_radius: 0.1 mm, clearance: 12 deg, included_angle: 100 deg }}\n\
+             strategy s = roller_helix {{ finish: {{ c_step: 1 deg, pitch: 5 um }}, z: 0.1 mm .. 0.3 mm, spindle_speed: 60 rpm }}\n\
+             job ripples {{ surface: roller_ripples, tool: nose, machine: moore_nanotech_450fg, strategy: s, accept: none }}\n"
+        )
+    };
+    let moves = |source: String| -> (Vec<String>, String) {
+        let dir = tempfile::tempdir().expect("tmp");
+        std::fs::write(dir.path().join("job.lens"), source).expect("write");
+        let out_dir = dir.path().to_str().expect("utf8");
+        let out = lensc(dir.path(), &["build", "job.lens", "--out", out_dir]);
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+        let program = std::fs::read_to_string(dir.path().join("ripples.ngc")).expect("program");
+        let header = program
+            .lines()
+            .find(|l| l.contains("C 0 at design y"))
+            .expect("the header names C 0's design y")
+            .to_string();
+        let moves = program
+            .lines()
+            .filter(|l| l.starts_with("G1"))
+            .map(str::to_string)
+            .collect();
+        (moves, header)
+    };
+    let (from_zero, h0) = moves(job("0 mm", "0 mm"));
+    let (centred, h1) = moves(job("-3.141592653589793 mm", "-3.141592653589793 mm"));
+    assert!(h0.contains("C 0 at design y = 0 mm"), "{h0}");
+    assert!(h1.contains("C 0 at design y = -3.14159265358979"), "{h1}");
+    assert!(from_zero.len() > 14_000, "{} moves", from_zero.len());
+    let differ = from_zero
+        .iter()
+        .zip(&centred)
+        .filter(|(a, b)| a != b)
+        .count();
+    assert_eq!(
+        (from_zero.len(), differ),
+        (centred.len(), 0),
+        "the centred design's program differs"
+    );
+}

@@ -168,7 +168,7 @@ fn simulate_roller(spec: &JobSpec, passes: &[Vec<[f64; 3]>]) -> usize {
         ((z.0 + z.1) / 2.0, (design_y.0 + design_y.1) / 2.0),
         height_map::roller_extent(&lowered.domain, z, design_y),
     );
-    let grid = window.roller(helix.roller_radius);
+    let grid = window.roller(helix.roller_radius, helix.y_start);
     let tiles = lensc_runtime::verify::window::split(&grid, None);
     let mut sweep = Simulation::new(grid, tiles, s.tool.nose_radius);
     for pass in passes {
@@ -181,6 +181,7 @@ fn simulate_roller(spec: &JobSpec, passes: &[Vec<[f64; 3]>]) -> usize {
         kernel: kernel.as_ref(),
         window,
         roller_radius: helix.roller_radius,
+        y_start: helix.y_start,
         domain: lowered.domain,
     };
     let map = sweep.finish(&frame, &window, window.spacing);

@@ -214,6 +214,8 @@ pub struct RollerFrame<'a> {
     pub kernel: &'a (dyn SurfaceFn + Sync),
     pub window: Window,
     pub roller_radius: f64,
+    /// Design y under spindle angle 0 (`RollerHelix::y_start`).
+    pub y_start: f64,
     pub domain: Domain,
 }
 
@@ -225,7 +227,7 @@ impl Frame for RollerFrame<'_> {
         }
     }
     fn xy(&self, s: f64, u: f64) -> (f64, f64) {
-        (u, self.roller_radius * s.rem_euclid(TAU))
+        (u, self.y_start + self.roller_radius * s.rem_euclid(TAU))
     }
     fn inside(&self, x: f64, y: f64) -> bool {
         self.window.contains(x, y) && self.domain.contains(x, y)

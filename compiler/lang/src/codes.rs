@@ -97,6 +97,8 @@ pub const CENTRE_LEFT_UNCUT: &str = "W0004";
 /// A servo's data period keeps a spiral's chords from meeting their share
 /// of the path tolerance.
 pub const CHORDS_OVER_TOLERANCE: &str = "W0005";
+/// A wrapped design whose two ends do not meet where the roller closes.
+pub const SEAM_STEP: &str = "W0006";
 /// E0195 under `lensc build --accept=warn`: the program is written.
 pub const ACCEPTANCE_MISSED_WARNING: &str = "W0020";
 /// E0196 under `lensc build --accept=warn`: the program is written.
@@ -284,6 +286,7 @@ pub const ALL: &[&str] = &[
     SEAM_LEFT_UNCUT,
     CENTRE_LEFT_UNCUT,
     CHORDS_OVER_TOLERANCE,
+    SEAM_STEP,
     FORMAT_WOULD_CHANGE_MEANING,
     IMPORT_UNREADABLE,
     IMPORT_NOTHING,

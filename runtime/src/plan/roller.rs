@@ -87,6 +87,10 @@ pub struct HelixPass {
 pub struct RollerHelix {
     /// Design radius R_r (mm): the radius of the pattern's z = 0 (eq 1).
     pub roller_radius: f64,
+    /// Design y (mm) under spindle angle 0: where the design's domain
+    /// starts around the roller, so the design wraps from its first row to
+    /// its last (`design_y`). A design centred on y = 0 starts at −L/2.
+    pub y_start: f64,
     /// Rough passes, then the finish pass; allowances may not rise.
     pub passes: Vec<HelixPass>,
     /// Axial range of the cut in design x (mm), z_start < z_end; the helix
@@ -105,6 +109,14 @@ pub struct RollerHelix {
     /// Where the points sit across the curve around the roller
     /// (`plan::chords`): each point's X moved by its chords' sag.
     pub chords: ChordPlacement,
+}
+
+impl RollerHelix {
+    /// The design y (mm) under spindle angle `c` (rad): the arc R_r·c from
+    /// the seam, counted from `y_start`, all the way round once.
+    pub fn design_y(&self, c: f64) -> f64 {
+        self.y_start + self.roller_radius * c.rem_euclid(TAU)
+    }
 }
 
 /// One programmed point of a pass.
@@ -243,11 +255,13 @@ pub fn check_wrap(roller_radius: f64, design_length_around: f64) -> Result<WrapF
 }
 
 /// The largest jumps in z and in ∂z/∂y across the seam where the roller
-/// closes (y = 2π R_r meets y = 0), over `samples` axial positions in
-/// [x0, x1]: the paper warns against a discontinuous wrap-around.
+/// closes (design y = `y_start` + 2π R_r meets y = `y_start`), over
+/// `samples` axial positions in [x0, x1]: the paper warns against a
+/// discontinuous wrap-around.
 pub fn seam_step(
     design: &dyn SurfaceFn,
     roller_radius: f64,
+    y_start: f64,
     x: (f64, f64),
     samples: usize,
 ) -> (f64, f64) {
@@ -255,7 +269,10 @@ pub fn seam_step(
     let (mut dz, mut ds) = (0.0f64, 0.0f64);
     for i in 0..n {
         let u = x.0 + (x.1 - x.0) * i as f64 / (n - 1) as f64;
-        let (a, b) = (design.eval(u, 0.0), design.eval(u, TAU * roller_radius));
+        let (a, b) = (
+            design.eval(u, y_start),
+            design.eval(u, y_start + TAU * roller_radius),
+        );
         dz = dz.max((a[0] - b[0]).abs());
         ds = ds.max((a[2] - b[2]).abs());
     }
@@ -868,7 +885,7 @@ fn survey_reach(
     let x_range = (h.z_start - rho, h.z_end + rho);
     let region = DesignRegion {
         x: x_range,
-        y: (0.0, TAU * r_r),
+        y: (h.y_start, h.y_start + TAU * r_r),
         samples: (count(x_range.1 - x_range.0), count(TAU * r_r)),
     };
     let s = survey(design, &region, r_r);
@@ -915,7 +932,7 @@ impl PassPlan<'_> {
         // X on the exact path at spindle angle c and axial position z,
         // and the contact's u, its search started at u = `start`.
         let exact_from = |c: f64, z: f64, start: f64| -> (f64, f64) {
-            let (height, contact) = centre(r_r * c.rem_euclid(TAU), z, start);
+            let (height, contact) = centre(h.design_y(c), z, start);
             (r_r + height + pass.finish_allowance, contact)
         };
         let exact = |c: f64, z: f64| exact_from(c, z, z).0;
@@ -938,7 +955,7 @@ impl PassPlan<'_> {
                     pass: self.index,
                     c,
                     z,
-                    y: r_r * c.rem_euclid(TAU),
+                    y: h.design_y(c),
                 })
             }
         };

@@ -246,13 +246,14 @@ impl Window {
         }
     }
 
-    /// Columns at spindle angles (design y over the roller radius), rows
-    /// along the roller axis (design x).
-    pub fn roller(&self, roller_radius: f64) -> Grid {
+    /// Columns at spindle angles (design y less `y_start`, the design y
+    /// at angle 0, over the roller radius), rows along the roller axis
+    /// (design x).
+    pub fn roller(&self, roller_radius: f64, y_start: f64) -> Grid {
         let ds = self.spacing / roller_radius;
         let span = ((self.y.1 - self.y.0) / roller_radius).min(TAU - ds);
         Grid {
-            s0: self.y.0 / roller_radius,
+            s0: (self.y.0 - y_start) / roller_radius,
             ds,
             ns: (span / ds + 1e-9).floor() as usize + 1,
             u0: self.x.0,
@@ -285,8 +286,8 @@ mod tests {
                 w.cartesian(true),
                 w.cartesian(false),
                 w.polar(),
-                w.roller(0.05),
-                w.roller(100.0),
+                w.roller(0.05, 0.0),
+                w.roller(100.0, 0.0),
             ] {
                 let tiles = split(&grid, None);
                 assert_eq!(tiles.len(), 1, "{centre:?}: {grid:?}");

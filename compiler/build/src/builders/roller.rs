@@ -5,6 +5,8 @@
 //! the spiral's, the cut simulated as a height map.
 
 use lensc_grammar::Diagnostic;
+use lensc_lang::check::trim_num;
+use lensc_lang::codes;
 use lensc_lang::lower::diagnostics::RuntimeError;
 use lensc_lang::lower::exact_in;
 use lensc_lang::lower::job::RollerSpec;
@@ -58,7 +60,7 @@ pub fn build(
         ((z.0 + z.1) / 2.0, (design_y.0 + design_y.1) / 2.0),
         height_map::roller_extent(&lowered.domain, z, design_y),
     );
-    let grid = window.roller(helix.roller_radius);
+    let grid = window.roller(helix.roller_radius, helix.y_start);
     let mut sweep = Simulation::new(grid, split(&grid, None), rho);
     let mut current_pass = usize::MAX;
     let planned = plan_roller_helix_into(helix, rho, kernel.as_ref(), |pass, pts| {
@@ -95,6 +97,7 @@ pub fn build(
         kernel: kernel.as_ref(),
         window,
         roller_radius: helix.roller_radius,
+        y_start: helix.y_start,
         domain: lowered.domain,
     };
     let (map, raster) = sweep.finish(&frame, &window, window.spacing);
@@ -113,10 +116,10 @@ pub fn build(
     let height_map = report::HeightMap::new(
         &map,
         &window,
-        "columns at spindle angles (column step in rad; design y = roller radius × angle), rows along the roller axis (design x)",
+        "columns at spindle angles (column step in rad; design y = the design's first y + roller radius × angle), rows along the roller axis (design x)",
         finish_pitch,
     );
-    Ok(parts::built(
+    let mut built = parts::built(
         head,
         prov,
         text,
@@ -124,7 +127,49 @@ pub fn build(
         report::Simulation::HeightMap(report::HeightMapOnly { height_map }),
         plots,
         cut,
-    ))
+    );
+    built.warnings.extend(seam_warning(spec, kernel.as_ref()));
+    Ok(built)
+}
+
+/// W0006: where the roller closes, the design's last row meets its first
+/// (design y = y_start + 2πR against y_start); a step there higher than
+/// the machine's resolution is cut as a step, all along the helix.
+fn seam_warning(
+    spec: &RollerSpec,
+    design: &dyn lensc_runtime::surface::ir::SurfaceFn,
+) -> Option<Diagnostic> {
+    let (head, helix) = (&spec.head, &spec.helix);
+    let (step, _) = lensc_runtime::plan::roller::seam_step(
+        design,
+        helix.roller_radius,
+        helix.y_start,
+        (helix.z_start, helix.z_end),
+        401,
+    );
+    if step.is_nan() || step <= head.resolution {
+        return None;
+    }
+    let (file, span) = head.site;
+    let ends = (
+        helix.y_start,
+        helix.y_start + std::f64::consts::TAU * helix.roller_radius,
+    );
+    Some(
+        Diagnostic::warning(
+            codes::SEAM_STEP,
+            format!(
+                "the design does not close around the roller: its ends (design y = {} and {} mm) differ in height by up to {} um, so a step is cut where the roller closes",
+                trim_num(ends.0),
+                trim_num(ends.1),
+                trim_num(step * 1000.0)
+            ),
+            file,
+            span,
+        )
+        .with_label("this job")
+        .with_help("make the design periodic over its y extent L around the roller (the same height at its first y and at its first y + L), for instance a whole number of periods"),
+    )
 }
 
 /// The program's header: provenance, units, the surface and tool, the
@@ -150,11 +195,12 @@ fn header_lines(spec: &RollerSpec, prov: &Provenance) -> Vec<String> {
     );
     let mut lines = parts::nose_centre_header(head, prov, &units, spec.tool.nose_radius);
     lines.push(format!(
-        "strategy {}: roller helix from z = {} to {} mm at {} rpm; passes: {}",
+        "strategy {}: roller helix from z = {} to {} mm at {} rpm, C 0 at design y = {} mm; passes: {}",
         head.names.strategy,
         exact_in(helix.z_start, "mm"),
         exact_in(helix.z_end, "mm"),
         exact_in(spec.spindle_speed, "rpm"),
+        exact_in(helix.y_start, "mm"),
         pass_words.join("; ")
     ));
     lines.push(format!(

@@ -86,6 +86,7 @@ impl SurfaceFn for Groove {
 fn job1() -> RollerHelix {
     RollerHelix {
         roller_radius: 3.0,
+        y_start: 0.0,
         passes: vec![
             HelixPass {
                 c_step: 1f64.to_radians(),
@@ -167,7 +168,7 @@ fn roller_radius_and_wrap() {
     let e = check_wrap(2.99, 6.0 * std::f64::consts::PI).expect_err("overlap");
     assert!(matches!(e, RollerError::Overlap { .. }), "{e:?}");
     // Job 1 closes smoothly: 10 periods around (section 3.1).
-    let (dz, ds) = seam_step(&Sinusoid, 3.0, (0.0, TAU), 100);
+    let (dz, ds) = seam_step(&Sinusoid, 3.0, 0.0, (0.0, TAU), 100);
     assert!(dz < 1e-14 && ds < 1e-13, "{dz} {ds}");
 }
 

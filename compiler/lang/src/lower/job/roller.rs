@@ -75,6 +75,9 @@ pub(super) fn lower(
     let (z_start, z_end) = value::range(st, "z").unwrap_or(design_x);
     let helix = RollerHelix {
         roller_radius,
+        // Spindle angle 0 is the design's first row: a design centred on
+        // y = 0 wraps from −L/2, not from its middle.
+        y_start: design_y.0,
         passes: passes(st),
         z_start,
         z_end,

@@ -63,7 +63,7 @@ pub fn tiles(spec: &JobSpec, window: &Window) -> Option<Vec<Tile>> {
             RasterTool::Ball { .. } => return None,
         },
         JobSpec::Spiral(s) => window.polar_tiles(&s.lenslets),
-        JobSpec::Roller(r) => split(&window.roller(r.helix.roller_radius), None),
+        JobSpec::Roller(r) => split(&window.roller(r.helix.roller_radius, r.helix.y_start), None),
         JobSpec::Turning(_) | JobSpec::Grinding(_) => return None,
     })
 }
