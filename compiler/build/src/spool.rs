@@ -10,6 +10,7 @@ use lensc_runtime::post::ProgramError;
 
 use crate::output::{Destination, ProgramText};
 use crate::progress::Meter;
+use crate::read_back::{ReadAlong, ReadBack};
 
 /// Where a text goes as it is written: memory, a spool file, or nowhere.
 pub(crate) enum Sink {
@@ -25,15 +26,19 @@ pub(crate) struct Spool {
     lines: usize,
     bytes: u64,
     error: Option<std::io::Error>,
+    /// The program read back as it is spooled, if it is to be.
+    reader: Option<ReadAlong>,
 }
 
 impl Sink {
     /// A sink for `to`; E0151 at `site` if the spool file cannot be made.
     pub(crate) fn new(to: Destination, site: (FileId, Span)) -> Result<Sink, Vec<Diagnostic>> {
-        Sink::open(to).map_err(|e| vec![cannot_spool(&e, site)])
+        Sink::open(to, None).map_err(|e| vec![cannot_spool(&e, site)])
     }
 
-    fn open(to: Destination) -> std::io::Result<Sink> {
+    /// A sink for `to` whose text, if spooled, is read back (`read`) on a
+    /// thread of its own as it is spooled.
+    fn open(to: Destination, read: Option<&ReadBack>) -> std::io::Result<Sink> {
         Ok(match to {
             Destination::Memory => Sink::Memory(String::new()),
             Destination::Nowhere => Sink::Nowhere,
@@ -45,6 +50,7 @@ impl Sink {
                     lines: 0,
                     bytes: 0,
                     error: None,
+                    reader: read.map(ReadAlong::start),
                 })
             }
         })
@@ -53,7 +59,7 @@ impl Sink {
     pub(crate) fn push(&mut self, text: String) {
         match self {
             Sink::Memory(all) => all.push_str(&text),
-            Sink::File(spool) => spool.push(&text),
+            Sink::File(spool) => spool.push(text),
             Sink::Nowhere => {}
         }
     }
@@ -70,13 +76,15 @@ impl Sink {
 }
 
 impl Spool {
-    fn push(&mut self, text: &str) {
+    fn push(&mut self, text: String) {
         if self.error.is_none() {
             use std::io::Write;
             self.lines += text.bytes().filter(|&b| b == b'\n').count();
             self.bytes += text.len() as u64;
             if let Err(e) = self.writer.write_all(text.as_bytes()) {
                 self.error = Some(e);
+            } else if let Some(r) = self.reader.as_mut() {
+                r.read(text);
             }
         }
     }
@@ -90,6 +98,7 @@ impl Spool {
             file,
             lines: self.lines,
             bytes: self.bytes,
+            read: self.reader,
         })
     }
 }
@@ -105,13 +114,16 @@ pub(crate) struct ProgramSink<'a> {
 }
 
 impl<'a> ProgramSink<'a> {
+    /// A program's sink for `to`; spooled, it is read back (`read`) as
+    /// it is spooled.
     pub(crate) fn new(
         to: Destination,
         site: (FileId, Span),
         meter: Meter<'a>,
+        read: Option<&ReadBack>,
     ) -> Result<ProgramSink<'a>, Vec<Diagnostic>> {
         Ok(ProgramSink {
-            sink: Sink::new(to, site)?,
+            sink: Sink::open(to, read).map_err(|e| vec![cannot_spool(&e, site)])?,
             error: None,
             meter,
         })

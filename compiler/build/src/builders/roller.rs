@@ -18,6 +18,7 @@ use crate::height_map::{self, RollerFrame, Simulation};
 use crate::output::{Built, Destination};
 use crate::parts;
 use crate::progress::Meter;
+use crate::read_back::ReadBack;
 use crate::report;
 use crate::spool::ProgramSink;
 use lensc_runtime::verify::window::split;
@@ -28,6 +29,7 @@ pub fn build(
     prov: &Provenance,
     to: Destination,
     meter: Meter,
+    read: Option<&ReadBack>,
 ) -> Result<Built, Vec<Diagnostic>> {
     let (head, helix, rho) = (&spec.head, &spec.helix, spec.tool.nose_radius);
     let site = head.site;
@@ -49,7 +51,7 @@ pub fn build(
     program
         .call_tool(&head.start)
         .map_err(|e| vec![parts::not_printable(head, e)])?;
-    let mut sink = ProgramSink::new(to, site, meter)?;
+    let mut sink = ProgramSink::new(to, site, meter, read)?;
     // The height map over the window, from the printed points of every
     // pass (the finish pass's envelope lies below the rough one's).
     let (design_y, z) = (spec.design_y, (helix.z_start, helix.z_end));
