@@ -9,7 +9,7 @@ use lensc_lang::lower::diagnostics::RuntimeError;
 use lensc_lang::lower::exact_in;
 use lensc_lang::lower::job::RollerSpec;
 use lensc_runtime::emit::roller::{RollerLimits, RollerProgram};
-use lensc_runtime::plan::roller::plan_roller_helix_into;
+use lensc_runtime::plan::roller::plan_roller_helix_sectioned;
 use lensc_runtime::post::Provenance;
 use lensc_runtime::verify::heightmap::NosePath;
 
@@ -35,6 +35,8 @@ pub fn build(
     let site = head.site;
     let lowered = &head.surface.lowered;
     let (kernel, _) = evaluator(&lowered.tape);
+    // The contact searches need z, ∂z/∂x and ∂²z/∂x² only.
+    let (section, _) = evaluator(&lowered.tape.axial_section());
     let resolution = head.resolution;
     let mut program = RollerProgram::new(
         &head.dialect,
@@ -63,19 +65,25 @@ pub fn build(
     let grid = window.roller(helix.roller_radius);
     let mut sweep = Simulation::new(grid, split(&grid, None), rho);
     let mut current_pass = usize::MAX;
-    let planned = plan_roller_helix_into(helix, rho, kernel.as_ref(), |pass, pts| {
-        if pass != current_pass {
-            sweep.path().lift();
-            current_pass = pass;
-        }
-        let printed = |v: f64| lensc_runtime::verify::simulate::as_printed(v, resolution);
-        for q in pts {
-            sweep.path().point(q.c, printed(q.z), printed(q.x));
-        }
-        sink.extend(|| program.extend(pass, pts));
-        sink.push(program.take_text());
-        sink.planned(pts.len());
-    });
+    let planned = plan_roller_helix_sectioned(
+        helix,
+        rho,
+        kernel.as_ref(),
+        section.as_ref(),
+        |pass, pts| {
+            if pass != current_pass {
+                sweep.path().lift();
+                current_pass = pass;
+            }
+            let printed = |v: f64| lensc_runtime::verify::simulate::as_printed(v, resolution);
+            for q in pts {
+                sweep.path().point(q.c, printed(q.z), printed(q.x));
+            }
+            sink.extend(|| program.extend(pass, pts));
+            sink.push(program.take_text());
+            sink.planned(pts.len());
+        },
+    );
     let mut path = planned.map_err(|e| vec![RuntimeError::Roller(e).at(site)])?;
     let limited = program.feed_limited().to_vec();
     let mut sink = sink.written(head)?;
