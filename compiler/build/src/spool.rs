@@ -172,3 +172,54 @@ impl<'a> ProgramSink<'a> {
 fn cannot_spool(e: &std::io::Error, site: (FileId, Span)) -> Diagnostic {
     lensc_lang::lower::diagnostics::RuntimeError::Spool(e).at(site)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lensc_runtime::dialect::Dialect;
+    use lensc_runtime::reader::{self, MachineLimits};
+
+    /// A program spooled in pieces with its read-back: the file holds the
+    /// whole text, and the reader that read it along finds what a reading
+    /// of the whole text finds (here a feed over the machine's and no
+    /// program end).
+    #[test]
+    fn a_spooled_program_is_read_as_it_is_written() {
+        let read = ReadBack {
+            dialect: Dialect::linuxcnc(),
+            machine: MachineLimits {
+                lathe: true,
+                travel: [Some((-10.0, 150.0)), None, Some((-100.0, 100.0)), None],
+                max_feed: Some(2000.0),
+                max_spindle_rpm: Some(3000.0),
+            },
+        };
+        let pieces = [
+            "G18 G21 G90 G8 G40 G49 G80\nT1 M6\nG97 S5",
+            "00 M3\nG0 X3 Z1.5\n",
+            "G94 G1 Z0.1 F5000\n",
+            "G1 Z0.2\nM5\n",
+        ];
+        let whole: String = pieces.concat();
+        let dir = tempfile::tempdir().expect("a directory");
+        let mut sink = Sink::open(Destination::Spool(dir.path()), Some(&read)).expect("a spool");
+        for p in pieces {
+            sink.push(p.to_string());
+        }
+        let site = (FileId(0), Span { start: 0, end: 0 });
+        let Ok(ProgramText::Spooled {
+            file,
+            read: Some(along),
+            ..
+        }) = sink.finish(site)
+        else {
+            panic!("a spooled program with its reader")
+        };
+        assert_eq!(std::fs::read_to_string(file.path()).expect("read"), whole);
+        let want = reader::read(&whole, &read.dialect, &read.machine);
+        let rules: Vec<_> = want.iter().map(|f| f.rule).collect();
+        assert!(rules.contains(&reader::Rule::FeedTooHigh), "{want:?}");
+        assert!(rules.contains(&reader::Rule::ProgramEnd), "{want:?}");
+        assert_eq!(along.finish(), want);
+    }
+}
