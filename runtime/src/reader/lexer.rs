@@ -334,14 +334,17 @@ impl Lexer {
                 None,
             ));
         }
-        let digits = text
-            .trim_start_matches(|c: char| {
-                c.is_ascii_alphabetic() || c == '=' || c == '-' || c == '+'
-            })
-            .trim_start_matches('0')
-            .bytes()
-            .filter(u8::is_ascii_digit)
-            .count();
+        // The digits after the letters, `=`, the sign and leading zeros
+        // (byte by byte: every one of those characters is ASCII).
+        let t = text.as_bytes();
+        let mut i = 0;
+        while i < t.len() && (t[i].is_ascii_alphabetic() || matches!(t[i], b'=' | b'-' | b'+')) {
+            i += 1;
+        }
+        while i < t.len() && t[i] == b'0' {
+            i += 1;
+        }
+        let digits = t[i..].iter().filter(|b| b.is_ascii_digit()).count();
         if let Some(max) = self.max_digits
             && digits > max as usize
         {
