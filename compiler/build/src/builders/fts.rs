@@ -54,7 +54,8 @@ impl<'s> Prepared<'s> {
 
 /// Builds one `fts_spiral` job, or says why it cannot be built. Spooled
 /// (`to`), the program goes to a temporary file as it is written, so
-/// memory stays bounded however long it is.
+/// memory stays bounded however long it is, and is read back (`read`) on
+/// a thread of its own as it goes.
 pub fn build(
     spec: &SpiralSpec,
     prov: &Provenance,

@@ -23,7 +23,8 @@ use crate::report;
 use crate::spool::ProgramSink;
 use lensc_runtime::verify::window::split;
 
-/// Builds one `roller_helix` job, or says why it cannot be built.
+/// Builds one `roller_helix` job, or says why it cannot be built; its
+/// program spooled (`to`) is read back (`read`) as it is spooled.
 pub fn build(
     spec: &RollerSpec,
     prov: &Provenance,
