@@ -3,8 +3,9 @@
 //!
 //! - seed 003's 10 × 10 array (`examples/hashimoto2025_lens_array.lens`,
 //!   11.65 M lines, 502 MB): `build` (planned, formatted, simulated, the
-//!   program spooled and put in place) against its planning alone (the
-//!   planner's points counted, nothing else). Goal: ≤ 1.2×.
+//!   program spooled, read back and put in place, as `lensc build` makes
+//!   it) against its planning alone (the planner's points counted,
+//!   nothing else). Goal: ≤ 1.2×.
 //! - seed 002's microlens roller (`examples/liu_roller_microlens.lens`,
 //!   21.6 M points, 709 MB): `build`, goal ≤ 6 s; and `report` (planned
 //!   and simulated, no program formatted, the plots drawn) against its
@@ -28,6 +29,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use lensc_build::output::Destination;
+use lensc_lang::Checked;
 use lensc_lang::lower::job::{JobSpec, Limits};
 use lensc_runtime::post::Provenance;
 
@@ -70,15 +72,15 @@ fn runs() -> usize {
         .unwrap_or(2)
 }
 
-/// The example's one job, lowered as a build lowers it.
-fn lowered(example: &str) -> JobSpec {
+/// The example checked, and its one job lowered as a build lowers it.
+fn lowered(example: &str) -> (Checked, JobSpec) {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let c = lensc_build::driver::check_path(&lensc_lang::loader::RealFs, &root.join(example))
         .expect("example");
     assert!(!c.has_errors(), "{example} checks");
     let (spec, _) = lensc_build::pipeline::lower(&c.checked.jobs[0], None, &Limits::default())
         .unwrap_or_else(|_| panic!("{example} lowers"));
-    spec
+    (c, spec)
 }
 
 fn provenance() -> Provenance {
@@ -89,11 +91,18 @@ fn provenance() -> Provenance {
     }
 }
 
-/// `lensc build` of one lowered job into `dir`: built (spooled there),
-/// the program put in place, then removed. Returns its size (bytes).
-fn build(spec: &JobSpec, dir: &Path) -> u64 {
-    let built = lensc_build::pipeline::build(spec, &provenance(), Destination::Spool(dir))
-        .unwrap_or_else(|_| panic!("builds"));
+/// `lensc build` of the example's job (lowered to `spec`) into `dir`:
+/// built (spooled there, read back as it is spooled), the program put in
+/// place, then removed. Returns its size (bytes).
+fn build(c: &Checked, spec: &JobSpec, dir: &Path) -> u64 {
+    let job = &c.checked.jobs[0];
+    let built = lensc_build::pipeline::build_and_read_back(
+        job,
+        spec,
+        &provenance(),
+        Destination::Spool(dir),
+    )
+    .unwrap_or_else(|_| panic!("builds and reads back"));
     let bytes = built.program.bytes();
     let path = dir.join(&built.program_name);
     built.program.write_to(&path).expect("program written");
@@ -130,15 +139,19 @@ fn plan_roller(spec: &JobSpec, keep: Option<&mut Vec<Vec<[f64; 3]>>>) -> usize {
     let JobSpec::Roller(s) = spec else {
         panic!("a roller")
     };
-    let (kernel, _) = lensc_build::evaluate::evaluator(&s.head.surface.lowered.tape);
+    let tape = &s.head.surface.lowered.tape;
+    let (kernel, _) = lensc_build::evaluate::evaluator(tape);
+    // The contact searches on the axial section's kernel, as the builder's.
+    let (section, _) = lensc_build::evaluate::evaluator(&tape.axial_section());
     let mut n = 0;
     let resolution = s.head.resolution;
     let printed = |v: f64| lensc_runtime::verify::simulate::as_printed(v, resolution);
     let mut keep = keep;
-    lensc_runtime::plan::roller::plan_roller_helix_into(
+    lensc_runtime::plan::roller::plan_roller_helix_sectioned(
         &s.helix,
         s.tool.nose_radius,
         kernel.as_ref(),
+        section.as_ref(),
         |pass, pts| {
             n += pts.len();
             if let Some(k) = keep.as_deref_mut() {
@@ -218,24 +231,24 @@ fn main() {
         rayon::current_num_threads()
     );
 
-    let array = lowered("examples/hashimoto2025_lens_array.lens");
+    let (checked, array) = lowered("examples/hashimoto2025_lens_array.lens");
     println!("seed 003 10 x 10 array");
     let (plan, points) = best(|| plan_spiral(&array));
-    let (built, bytes) = best(|| build(&array, dir.path()));
+    let (built, bytes) = best(|| build(&checked, &array, dir.path()));
     println!("  {points} points, {:.0} MB", bytes as f64 / 1e6);
     line("planning alone", plan);
     line("build", built);
     ratio("build / planning", built, plan, "≤ 1.2×");
-    drop(array);
+    drop((checked, array));
 
-    let roller = lowered("examples/liu_roller_microlens.lens");
+    let (checked, roller) = lowered("examples/liu_roller_microlens.lens");
     println!("seed 002 microlens roller");
     let (plan, points) = best(|| plan_roller(&roller, None));
     let mut passes = Vec::new();
     plan_roller(&roller, Some(&mut passes));
     let (sim, _) = best(|| simulate_roller(&roller, &passes));
     drop(passes);
-    let (built, bytes) = best(|| build(&roller, dir.path()));
+    let (built, bytes) = best(|| build(&checked, &roller, dir.path()));
     let (reported, _) = best(|| report(&roller));
     println!("  {points} points, {:.0} MB", bytes as f64 / 1e6);
     line("planning alone", plan);

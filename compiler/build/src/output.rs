@@ -52,6 +52,9 @@ pub enum ProgramText {
         file: crate::temps::TempFile,
         lines: usize,
         bytes: u64,
+        /// The reader reading the text as it was spooled, if it was
+        /// (its findings are taken by the read-back).
+        read: Option<crate::read_back::ReadAlong>,
     },
 }
 

@@ -16,6 +16,7 @@ use crate::builders;
 use crate::evaluate::evaluator;
 use crate::output::{Built, Destination};
 use crate::progress::{Event, Meter, Observer, Phase};
+use crate::read_back::ReadBack;
 
 /// What `lensc build` was asked for beyond the file.
 #[derive(Clone, Copy, Debug, Default)]
@@ -175,47 +176,73 @@ fn build_job(
     let (spec, est) = lower(job, request.dialect, &request.limits())?;
     phase(Phase::Planning, Some(&est));
     let meter = observer.meter(name, est.points as u64);
-    let mut b = build_metered(&spec, prov, to, meter)?;
+    // A program formatted nowhere has nothing to read back.
+    let read = (crate::read_back::enabled() && !matches!(to, Destination::Nowhere))
+        .then(|| ReadBack::of(job, spec.head()));
+    let mut b = build_metered(&spec, prov, to, meter, read.as_ref())?;
     // Every count, told at the end of planning.
     observer.event(Event::Planned {
         job: name,
         points: b.cut_points as u64,
         bytes: b.program.bytes(),
     });
-    // A program formatted nowhere has nothing to read back.
-    if crate::read_back::enabled() && !matches!(to, Destination::Nowhere) {
+    if read.is_some() {
         phase(Phase::ReadingBack, Some(&est));
-        let refused = crate::read_back::findings(job, spec.head(), &b.program);
-        if !refused.is_empty() {
-            return Err(refused);
-        }
+        read_back(job, &spec, &mut b)?;
     }
     b.report.estimate = (&est).into();
     let gate = crate::accept::gate(&spec, &mut b, request.accept);
     Ok((b, gate))
 }
 
+/// The reader's findings in `b`'s program (`job` lowered to `spec`) as
+/// errors, if it refuses it.
+fn read_back(job: &CheckedJob, spec: &JobSpec, b: &mut Built) -> Result<(), Vec<Diagnostic>> {
+    let refused = crate::read_back::findings(job, spec.head(), &mut b.program);
+    if refused.is_empty() {
+        Ok(())
+    } else {
+        Err(refused)
+    }
+}
+
 /// Plans, emits and simulates one lowered job with its strategy's builder;
 /// the long programs go `to` memory, a spool file or nowhere (the
 /// acceptance gate is `plan_and_emit`'s, after it).
 pub fn build(spec: &JobSpec, prov: &Provenance, to: Destination) -> Result<Built, Vec<Diagnostic>> {
-    build_metered(spec, prov, to, Meter::silent())
+    build_metered(spec, prov, to, Meter::silent(), None)
+}
+
+/// `build` of `job` (lowered to `spec`) as `lensc build` makes it: its
+/// program read back as well, or the reader's findings if it refuses it.
+pub fn build_and_read_back(
+    job: &CheckedJob,
+    spec: &JobSpec,
+    prov: &Provenance,
+    to: Destination,
+) -> Result<Built, Vec<Diagnostic>> {
+    let read = ReadBack::of(job, spec.head());
+    let mut b = build_metered(spec, prov, to, Meter::silent(), Some(&read))?;
+    read_back(job, spec, &mut b)?;
+    Ok(b)
 }
 
 /// `build`, the points the streamed builders plan and the bytes they
-/// format counted by `meter` as they go.
+/// format counted by `meter` as they go; a streamed program spooled is
+/// read back (`read`) as it is spooled.
 fn build_metered(
     spec: &JobSpec,
     prov: &Provenance,
     to: Destination,
     meter: Meter,
+    read: Option<&ReadBack>,
 ) -> Result<Built, Vec<Diagnostic>> {
     match spec {
         JobSpec::Turning(s) => builders::turning::build(s, prov),
-        JobSpec::Spiral(s) => builders::fts::build(s, prov, to, meter),
+        JobSpec::Spiral(s) => builders::fts::build(s, prov, to, meter, read),
         JobSpec::Raster(s) => builders::raster::build(s, prov),
         JobSpec::Grinding(s) => builders::grinding::build(s, prov),
-        JobSpec::Roller(s) => builders::roller::build(s, prov, to, meter),
+        JobSpec::Roller(s) => builders::roller::build(s, prov, to, meter, read),
     }
 }
 

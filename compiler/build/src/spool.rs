@@ -10,6 +10,7 @@ use lensc_runtime::post::ProgramError;
 
 use crate::output::{Destination, ProgramText};
 use crate::progress::Meter;
+use crate::read_back::{ReadAlong, ReadBack};
 
 /// Where a text goes as it is written: memory, a spool file, or nowhere.
 pub(crate) enum Sink {
@@ -25,15 +26,19 @@ pub(crate) struct Spool {
     lines: usize,
     bytes: u64,
     error: Option<std::io::Error>,
+    /// The program read back as it is spooled, if it is to be.
+    reader: Option<ReadAlong>,
 }
 
 impl Sink {
     /// A sink for `to`; E0151 at `site` if the spool file cannot be made.
     pub(crate) fn new(to: Destination, site: (FileId, Span)) -> Result<Sink, Vec<Diagnostic>> {
-        Sink::open(to).map_err(|e| vec![cannot_spool(&e, site)])
+        Sink::open(to, None).map_err(|e| vec![cannot_spool(&e, site)])
     }
 
-    fn open(to: Destination) -> std::io::Result<Sink> {
+    /// A sink for `to` whose text, if spooled, is read back (`read`) on a
+    /// thread of its own as it is spooled.
+    fn open(to: Destination, read: Option<&ReadBack>) -> std::io::Result<Sink> {
         Ok(match to {
             Destination::Memory => Sink::Memory(String::new()),
             Destination::Nowhere => Sink::Nowhere,
@@ -45,6 +50,7 @@ impl Sink {
                     lines: 0,
                     bytes: 0,
                     error: None,
+                    reader: read.map(ReadAlong::start),
                 })
             }
         })
@@ -53,7 +59,7 @@ impl Sink {
     pub(crate) fn push(&mut self, text: String) {
         match self {
             Sink::Memory(all) => all.push_str(&text),
-            Sink::File(spool) => spool.push(&text),
+            Sink::File(spool) => spool.push(text),
             Sink::Nowhere => {}
         }
     }
@@ -70,13 +76,15 @@ impl Sink {
 }
 
 impl Spool {
-    fn push(&mut self, text: &str) {
+    fn push(&mut self, text: String) {
         if self.error.is_none() {
             use std::io::Write;
             self.lines += text.bytes().filter(|&b| b == b'\n').count();
             self.bytes += text.len() as u64;
             if let Err(e) = self.writer.write_all(text.as_bytes()) {
                 self.error = Some(e);
+            } else if let Some(r) = self.reader.as_mut() {
+                r.read(text);
             }
         }
     }
@@ -90,6 +98,7 @@ impl Spool {
             file,
             lines: self.lines,
             bytes: self.bytes,
+            read: self.reader,
         })
     }
 }
@@ -105,13 +114,16 @@ pub(crate) struct ProgramSink<'a> {
 }
 
 impl<'a> ProgramSink<'a> {
+    /// A program's sink for `to`; spooled, it is read back (`read`) as
+    /// it is spooled.
     pub(crate) fn new(
         to: Destination,
         site: (FileId, Span),
         meter: Meter<'a>,
+        read: Option<&ReadBack>,
     ) -> Result<ProgramSink<'a>, Vec<Diagnostic>> {
         Ok(ProgramSink {
-            sink: Sink::new(to, site)?,
+            sink: Sink::open(to, read).map_err(|e| vec![cannot_spool(&e, site)])?,
             error: None,
             meter,
         })
@@ -159,4 +171,55 @@ impl<'a> ProgramSink<'a> {
 /// E0151: the spool file could not be written.
 fn cannot_spool(e: &std::io::Error, site: (FileId, Span)) -> Diagnostic {
     lensc_lang::lower::diagnostics::RuntimeError::Spool(e).at(site)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lensc_runtime::dialect::Dialect;
+    use lensc_runtime::reader::{self, MachineLimits};
+
+    /// A program spooled in pieces with its read-back: the file holds the
+    /// whole text, and the reader that read it along finds what a reading
+    /// of the whole text finds (here a feed over the machine's and no
+    /// program end).
+    #[test]
+    fn a_spooled_program_is_read_as_it_is_written() {
+        let read = ReadBack {
+            dialect: Dialect::linuxcnc(),
+            machine: MachineLimits {
+                lathe: true,
+                travel: [Some((-10.0, 150.0)), None, Some((-100.0, 100.0)), None],
+                max_feed: Some(2000.0),
+                max_spindle_rpm: Some(3000.0),
+            },
+        };
+        let pieces = [
+            "G18 G21 G90 G8 G40 G49 G80\nT1 M6\nG97 S5",
+            "00 M3\nG0 X3 Z1.5\n",
+            "G94 G1 Z0.1 F5000\n",
+            "G1 Z0.2\nM5\n",
+        ];
+        let whole: String = pieces.concat();
+        let dir = tempfile::tempdir().expect("a directory");
+        let mut sink = Sink::open(Destination::Spool(dir.path()), Some(&read)).expect("a spool");
+        for p in pieces {
+            sink.push(p.to_string());
+        }
+        let site = (FileId(0), Span { start: 0, end: 0 });
+        let Ok(ProgramText::Spooled {
+            file,
+            read: Some(along),
+            ..
+        }) = sink.finish(site)
+        else {
+            panic!("a spooled program with its reader")
+        };
+        assert_eq!(std::fs::read_to_string(file.path()).expect("read"), whole);
+        let want = reader::read(&whole, &read.dialect, &read.machine);
+        let rules: Vec<_> = want.iter().map(|f| f.rule).collect();
+        assert!(rules.contains(&reader::Rule::FeedTooHigh), "{want:?}");
+        assert!(rules.contains(&reader::Rule::ProgramEnd), "{want:?}");
+        assert_eq!(along.finish(), want);
+    }
 }

@@ -828,6 +828,21 @@ pub fn plan_roller_helix_into(
     h: &RollerHelix,
     nose_radius: f64,
     design: &(dyn SurfaceFn + Sync),
+    sink: impl FnMut(usize, &[RollerPoint]) + Send,
+) -> Result<RollerPath, RollerError> {
+    plan_roller_helix_sectioned(h, nose_radius, design, design, sink)
+}
+
+/// `plan_roller_helix_into`, the contact searches evaluating the design's
+/// axial sections with `section`: the design's own evaluator, or one that
+/// computes only z, ∂z/∂x and ∂²z/∂x² of it, bit for bit as the design's
+/// does (a kernel compiled from `SurfaceTape::axial_section`, with half
+/// the work per call). The survey and the wrap's seam use `design`.
+pub fn plan_roller_helix_sectioned(
+    h: &RollerHelix,
+    nose_radius: f64,
+    design: &(dyn SurfaceFn + Sync),
+    section: &(dyn SurfaceFn + Sync),
     mut sink: impl FnMut(usize, &[RollerPoint]) + Send,
 ) -> Result<RollerPath, RollerError> {
     validate(h, nose_radius)?;
@@ -839,7 +854,7 @@ pub fn plan_roller_helix_into(
     let s = survey_reach(h, rho, design)?;
     let scanned = s.corners > 0;
     let centre = |y: f64, x: f64, start: f64| {
-        let section = AxialSection { design, y };
+        let section = AxialSection { design: section, y };
         if scanned {
             (centre_height_scanned(&section, rho, x), x)
         } else {

@@ -427,6 +427,37 @@ impl<B: Backend> Conformance<B> {
             }
         }
     }
+
+    /// A tape's axial section (`SurfaceTape::axial_section`) gives z,
+    /// ∂z/∂x and ∂²z/∂x² bit for bit as the whole tape does, in batches
+    /// of every length (both lanes and the odd point), and NaN for the
+    /// three outputs along y.
+    pub fn axial_sections_keep_the_x_outputs_bit_for_bit() {
+        let same = |a: f64, b: f64| a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan());
+        for build in [trig_and_exp, every_other_operation] {
+            let whole = tape(build);
+            let (all, section) = (B::build(&whole), B::build(&whole.axial_section()));
+            for n in [1, 2, 7, 100] {
+                let (xs, ys): (Vec<f64>, Vec<f64>) = points(n).into_iter().unzip();
+                let (mut a, mut s) = (vec![0.0; 6 * n], vec![0.0; 6 * n]);
+                all.eval_batch(&xs, &ys, &mut a);
+                section.eval_batch(&xs, &ys, &mut s);
+                for i in 0..n {
+                    for k in [0, 1, 3] {
+                        assert!(
+                            same(a[6 * i + k], s[6 * i + k]),
+                            "batch of {n}, point {i}, output {k}: {:e} whole, {:e} in the section",
+                            a[6 * i + k],
+                            s[6 * i + k]
+                        );
+                    }
+                    for k in [2, 4, 5] {
+                        assert!(s[6 * i + k].is_nan(), "output {k} is not computed");
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// z = sin x + cos y + tan x + exp(xy).
@@ -542,6 +573,10 @@ macro_rules! surface_fn_tests {
         );
         $crate::surface::conformance::surface_fn_test!(
             batches_of_every_length_agree_with_single_points,
+            $backend
+        );
+        $crate::surface::conformance::surface_fn_test!(
+            axial_sections_keep_the_x_outputs_bit_for_bit,
             $backend
         );
     };

@@ -585,6 +585,21 @@ impl SurfaceTape {
         SurfaceTape { graph, outputs }
     }
 
+    /// The tape of the surface's sections at fixed y (a roller's axial
+    /// sections): z, ∂z/∂x and ∂²z/∂x² computed exactly as this tape
+    /// computes them, the three outputs that take a derivative along y
+    /// NaN — not computed, so a kernel compiled from it does none of
+    /// their work (their nodes are dead).
+    pub fn axial_section(&self) -> SurfaceTape {
+        let mut graph = self.graph.clone();
+        let none = graph.constant_node(f64::NAN);
+        let [z, zx, _, zxx, _, _] = self.outputs;
+        SurfaceTape {
+            graph,
+            outputs: [z, zx, none, zxx, none, none],
+        }
+    }
+
     /// The nodes the outputs need, in tape order (dead nodes dropped).
     pub fn live_nodes(&self) -> Vec<Id> {
         let n = self.graph.len();

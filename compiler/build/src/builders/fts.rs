@@ -22,6 +22,7 @@ use crate::height_map::{self, LatheFrame, Simulation, Window};
 use crate::output::{Built, Destination};
 use crate::parts;
 use crate::progress::Meter;
+use crate::read_back::ReadBack;
 use crate::report;
 use crate::spool::{ProgramSink, Sink};
 
@@ -53,12 +54,14 @@ impl<'s> Prepared<'s> {
 
 /// Builds one `fts_spiral` job, or says why it cannot be built. Spooled
 /// (`to`), the program goes to a temporary file as it is written, so
-/// memory stays bounded however long it is.
+/// memory stays bounded however long it is, and is read back (`read`) on
+/// a thread of its own as it goes.
 pub fn build(
     spec: &SpiralSpec,
     prov: &Provenance,
     to: Destination,
     meter: Meter,
+    read: Option<&ReadBack>,
 ) -> Result<Built, Vec<Diagnostic>> {
     let (p, head) = (spec, &spec.head);
     let site = head.site;
@@ -77,7 +80,7 @@ pub fn build(
     .map_err(not_printable)?;
     program.hold_spindle_under(spec.max_spindle_speed);
     program.call_tool(&head.start).map_err(not_printable)?;
-    let mut sink = ProgramSink::new(to, site, meter)?;
+    let mut sink = ProgramSink::new(to, site, meter, read)?;
     let mut table_sink = match table_name {
         Some(_) => Some(Sink::new(to, site)?),
         None => None,

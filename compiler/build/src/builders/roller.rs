@@ -11,7 +11,7 @@ use lensc_lang::lower::diagnostics::RuntimeError;
 use lensc_lang::lower::exact_in;
 use lensc_lang::lower::job::RollerSpec;
 use lensc_runtime::emit::roller::{RollerLimits, RollerProgram};
-use lensc_runtime::plan::roller::plan_roller_helix_into;
+use lensc_runtime::plan::roller::plan_roller_helix_sectioned;
 use lensc_runtime::post::Provenance;
 use lensc_runtime::verify::heightmap::NosePath;
 
@@ -20,21 +20,26 @@ use crate::height_map::{self, RollerFrame, Simulation};
 use crate::output::{Built, Destination};
 use crate::parts;
 use crate::progress::Meter;
+use crate::read_back::ReadBack;
 use crate::report;
 use crate::spool::ProgramSink;
 use lensc_runtime::verify::window::split;
 
-/// Builds one `roller_helix` job, or says why it cannot be built.
+/// Builds one `roller_helix` job, or says why it cannot be built; its
+/// program spooled (`to`) is read back (`read`) as it is spooled.
 pub fn build(
     spec: &RollerSpec,
     prov: &Provenance,
     to: Destination,
     meter: Meter,
+    read: Option<&ReadBack>,
 ) -> Result<Built, Vec<Diagnostic>> {
     let (head, helix, rho) = (&spec.head, &spec.helix, spec.tool.nose_radius);
     let site = head.site;
     let lowered = &head.surface.lowered;
     let (kernel, _) = evaluator(&lowered.tape);
+    // The contact searches need z, ∂z/∂x and ∂²z/∂x² only.
+    let (section, _) = evaluator(&lowered.tape.axial_section());
     let resolution = head.resolution;
     let mut program = RollerProgram::new(
         &head.dialect,
@@ -51,7 +56,7 @@ pub fn build(
     program
         .call_tool(&head.start)
         .map_err(|e| vec![parts::not_printable(head, e)])?;
-    let mut sink = ProgramSink::new(to, site, meter)?;
+    let mut sink = ProgramSink::new(to, site, meter, read)?;
     // The height map over the window, from the printed points of every
     // pass (the finish pass's envelope lies below the rough one's).
     let (design_y, z) = (spec.design_y, (helix.z_start, helix.z_end));
@@ -63,19 +68,25 @@ pub fn build(
     let grid = window.roller(helix.roller_radius, helix.y_start);
     let mut sweep = Simulation::new(grid, split(&grid, None), rho);
     let mut current_pass = usize::MAX;
-    let planned = plan_roller_helix_into(helix, rho, kernel.as_ref(), |pass, pts| {
-        if pass != current_pass {
-            sweep.path().lift();
-            current_pass = pass;
-        }
-        let printed = |v: f64| lensc_runtime::verify::simulate::as_printed(v, resolution);
-        for q in pts {
-            sweep.path().point(q.c, printed(q.z), printed(q.x));
-        }
-        sink.extend(|| program.extend(pass, pts));
-        sink.push(program.take_text());
-        sink.planned(pts.len());
-    });
+    let planned = plan_roller_helix_sectioned(
+        helix,
+        rho,
+        kernel.as_ref(),
+        section.as_ref(),
+        |pass, pts| {
+            if pass != current_pass {
+                sweep.path().lift();
+                current_pass = pass;
+            }
+            let printed = |v: f64| lensc_runtime::verify::simulate::as_printed(v, resolution);
+            for q in pts {
+                sweep.path().point(q.c, printed(q.z), printed(q.x));
+            }
+            sink.extend(|| program.extend(pass, pts));
+            sink.push(program.take_text());
+            sink.planned(pts.len());
+        },
+    );
     let mut path = planned.map_err(|e| vec![RuntimeError::Roller(e).at(site)])?;
     let limited = program.feed_limited().to_vec();
     let mut sink = sink.written(head)?;
