@@ -804,6 +804,7 @@ impl<'a> Cutter<'a> {
     /// Takes the surface `l` at the point solve `s` asked for, and moves
     /// the solve on: damped Newton for v with g(v) = 0 (`newton_at`),
     /// g'(v) = 1 − ρ ∂(z_v/W)/∂v, each step halved until |g| falls.
+    #[inline(always)]
     fn advance(&self, plane: f64, s: &mut Solve, l: Local) {
         match s.stage {
             Stage::Start => {
@@ -840,6 +841,7 @@ impl<'a> Cutter<'a> {
 
     /// The next Newton step of solve `s` from where it is, or its end:
     /// converged, out of steps, or its plane's offset folding over.
+    #[inline(always)]
     fn step(&self, plane: f64, s: &mut Solve) {
         let rho = self.radius;
         let scale = 1.0 + plane.abs() + rho;
