@@ -712,10 +712,7 @@ impl ProgramWriter {
         let axes = to.axes();
         // The arc's centre words, worked out (and its radii checked)
         // before the room is taken, printed after the axes' words.
-        let centre = match arc {
-            Some((plane, centre)) => Some(self.centre_words(plane, to, centre)),
-            None => None,
-        };
+        let centre = arc.map(|(plane, centre)| self.centre_words(plane, to, centre));
         let at = self.text.len();
         let room = block_room(&mut self.text, &mut self.zeroed);
         let mut pos = 0;
