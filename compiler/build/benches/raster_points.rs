@@ -2,8 +2,10 @@
 //! `plan_raster` over a sphere (the tape lensc's own lowering builds, run
 //! by the JIT kernel), against a baseline in the same run: the same
 //! planner over a hand-written sphere with its derivatives written out.
-//! Also the surface evaluations per point (a counting wrapper) and the
-//! kernel's own ns per evaluation, so the profile reads as calls × cost.
+//! Also the surface evaluations per point and the kernel calls they take
+//! (a counting wrapper; the planner asks for a chord's probes in one
+//! batch) and the kernel's own ns per evaluation, so the profile reads as
+//! calls × cost.
 //!
 //! Goal (issue #18): ≤ 0.5 µs per point on the JIT kernel. Run:
 //!     cargo bench -p lensc-build --bench raster_points
@@ -58,15 +60,18 @@ impl SurfaceFn for SphereByHand {
     }
 }
 
-/// Counts the points a planner asks a surface for.
+/// Counts the points a planner asks a surface for, and its calls (a
+/// batch of points is one call of the kernel).
 struct Counting<'a> {
     inner: &'a dyn SurfaceFn,
     points: Cell<usize>,
+    calls: Cell<usize>,
 }
 
 impl SurfaceFn for Counting<'_> {
     fn eval_batch(&self, xs: &[f64], ys: &[f64], out: &mut [f64]) {
         self.points.set(self.points.get() + xs.len());
+        self.calls.set(self.calls.get() + 1);
         self.inner.eval_batch(xs, ys, out);
     }
 }
@@ -92,9 +97,11 @@ fn main() {
     let counting = Counting {
         inner: &jit,
         points: Cell::new(0),
+        calls: Cell::new(0),
     };
     plan(&counting);
     let evals = counting.points.get() as f64 / points as f64;
+    let calls = counting.calls.get() as f64 / points as f64;
     // The two alternate, best of RUNS each, so a change in the machine's
     // load falls on both; their CPU time is summed too (time waiting for
     // a core not counted: on a loaded machine the steadier figure).
@@ -135,6 +142,6 @@ fn main() {
         cpu(ours_cpu),
         cpu(base_cpu)
     );
-    println!("  surface evaluations:   {evals:>8.1} per point");
+    println!("  surface evaluations:   {evals:>8.1} per point, in {calls:.1} kernel calls");
     println!("  one JIT evaluation:    {eval_ns:>8.1} ns");
 }

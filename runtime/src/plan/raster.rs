@@ -531,7 +531,7 @@ fn xy(along: Axis, u: f64, v: f64) -> (f64, f64) {
 
 /// The surface and its exact derivatives in path coordinates: u along the
 /// cut, v across it.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 struct Local {
     z: f64,
     zu: f64,
@@ -544,7 +544,12 @@ struct Local {
 impl Local {
     fn at(surface: &dyn SurfaceFn, along: Axis, u: f64, v: f64) -> Local {
         let (x, y) = xy(along, u, v);
-        let o = surface.eval(x, y);
+        Local::from_outputs(&surface.eval(x, y), along)
+    }
+
+    /// The surface's six outputs at a point (`SurfaceFn`'s order) in path
+    /// coordinates.
+    fn from_outputs(o: &[f64], along: Axis) -> Local {
         match along {
             Axis::X => Local {
                 z: o[0],
@@ -628,6 +633,57 @@ struct Contact {
     c: [f64; 2],
 }
 
+/// Most Newton steps of one contact solve.
+const MAX_STEPS: u32 = 60;
+/// Most halvings of one Newton step before the solve gives up.
+const MAX_HALVINGS: u32 = 40;
+/// Most contacts solved side by side (`Cutter::contacts`).
+const MAX_BATCH: usize = PROBES;
+
+/// A contact solve's point: the surface there, g(v), W² and W
+/// (`Cutter::newton_at`).
+#[derive(Clone, Copy, Debug, Default)]
+struct Newton {
+    l: Local,
+    g: f64,
+    w2: f64,
+    w: f64,
+}
+
+/// One contact solve of `Cutter::contacts`: at t along the cut, v its
+/// current guess.
+struct Solve {
+    t: f64,
+    v: f64,
+    /// The solve at v (once the surface there is known).
+    at: Newton,
+    /// Newton steps taken.
+    steps: u32,
+    stage: Stage,
+}
+
+/// Where a contact solve stands.
+enum Stage {
+    /// Waiting for the surface at its first guess.
+    Start,
+    /// Waiting for the surface at v + `step`, the Newton step halved
+    /// `halvings` times.
+    Step { step: f64, halvings: u32 },
+    /// Solved, or refused.
+    Done(Result<Contact, RasterError>),
+}
+
+impl Solve {
+    /// The v at which the solve needs the surface next, if it does.
+    fn asks(&self) -> Option<f64> {
+        match self.stage {
+            Stage::Start => Some(self.v),
+            Stage::Step { step, .. } => Some(self.v + step),
+            Stage::Done(_) => None,
+        }
+    }
+}
+
 /// One point of a ball plane's scan.
 enum Probe {
     /// The contact lies in the aperture.
@@ -672,77 +728,168 @@ impl<'a> Cutter<'a> {
     /// The contact at `t` along the cut for the plane at `plane`; `guess`
     /// starts the solve for the contact's v.
     fn contact(&self, plane: f64, t: f64, guess: f64) -> Result<Contact, RasterError> {
-        let rho = self.radius;
-        // The slope along the cut that tilts the tool's normal: the ball's
-        // contact normal is the surface's; the knife's edge, across the cut,
-        // sees only the cross-section (its normal in the plane u = t).
-        let zu = |l: &Local| if self.ball { l.zu } else { 0.0 };
-        // Find v with g(v) = v − ρ z_v/W − plane = 0 (the centre's v on
-        // the plane), W = √(1 + z_u² + z_v²) (z_u = 0 for the knife), by
-        // damped Newton with g'(v) = 1 − ρ ∂(z_v/W)/∂v.
-        let scale = 1.0 + plane.abs() + rho;
-        let resid = |v: f64, l: &Local| {
-            let w = (1.0 + zu(l) * zu(l) + l.zv * l.zv).sqrt();
-            v - rho * l.zv / w - plane
-        };
-        let mut v = if guess.is_finite() { guess } else { plane };
-        let mut l = Local::at(self.surface, self.along, t, v);
-        if !l.is_finite() {
-            return Err(self.error_at(t, v, false));
-        }
-        let mut g = resid(v, &l);
-        for _ in 0..60 {
-            if g.abs() <= 1e-16 * scale {
+        let [c] = self.contacts(plane, [(t, guess)]);
+        c
+    }
+
+    /// The contacts at each (t, guess) of `at` for the plane at `plane`,
+    /// each solved as `contact` solves it alone (the same points asked
+    /// for, in the same order, so the same contact to the last bit), the
+    /// solves taking their steps side by side: every round asks the
+    /// surface for one point of each unfinished solve in one batch, and
+    /// the solves' chains of square roots and divisions overlap.
+    fn contacts<const N: usize>(
+        &self,
+        plane: f64,
+        at: [(f64, f64); N],
+    ) -> [Result<Contact, RasterError>; N] {
+        const { assert!(N <= MAX_BATCH, "a batch of contacts fits the buffers") };
+        let mut solves = at.map(|(t, guess)| Solve {
+            t,
+            v: if guess.is_finite() { guess } else { plane },
+            at: Newton::default(),
+            steps: 0,
+            stage: Stage::Start,
+        });
+        let (mut xs, mut ys) = ([0.0; MAX_BATCH], [0.0; MAX_BATCH]);
+        let mut out = [0.0; 6 * MAX_BATCH];
+        let mut asked = [0; MAX_BATCH];
+        loop {
+            let mut k = 0;
+            for (i, s) in solves.iter().enumerate() {
+                if let Some(v) = s.asks() {
+                    (xs[k], ys[k]) = xy(self.along, s.t, v);
+                    asked[k] = i;
+                    k += 1;
+                }
+            }
+            if k == 0 {
                 break;
             }
-            let w2 = 1.0 + zu(&l) * zu(&l) + l.zv * l.zv;
-            let w = w2.sqrt();
-            let dq = l.zvv / w - l.zv * (zu(&l) * l.zuv + l.zv * l.zvv) / (w2 * w);
-            let jac = 1.0 - rho * dq;
-            if jac.is_nan() || jac <= 0.0 {
-                // The plane's offset folds over: the tool is too large for
-                // the hollow here, or no contact lies on this plane.
-                let min_radius = self.limiting_radius(&l);
-                if min_radius > 0.0 && rho > min_radius {
-                    let (x, y) = xy(self.along, t, v);
-                    return Err(RasterError::ToolTooLarge {
-                        tool_radius: rho,
-                        min_radius,
-                        x,
-                        y,
-                    });
-                }
-                return Err(self.error_at(t, v, true));
+            self.surface
+                .eval_batch(&xs[..k], &ys[..k], &mut out[..6 * k]);
+            for (j, o) in out[..6 * k].chunks_exact(6).enumerate() {
+                let l = Local::from_outputs(o, self.along);
+                self.advance(plane, &mut solves[asked[j]], l);
             }
-            let mut step = -g / jac;
-            let mut improved = false;
-            for _ in 0..40 {
-                let vn = v + step;
-                let ln = Local::at(self.surface, self.along, t, vn);
-                if ln.is_finite() {
-                    let gn = resid(vn, &ln);
-                    if gn.abs() < g.abs() {
-                        (v, l, g) = (vn, ln, gn);
-                        improved = true;
-                        break;
+        }
+        solves.map(|s| match s.stage {
+            Stage::Done(c) => c,
+            _ => unreachable!("a solve asks for points until it is done"),
+        })
+    }
+
+    /// The slope along the cut that tilts the tool's normal: the ball's
+    /// contact normal is the surface's; the knife's edge, across the cut,
+    /// sees only the cross-section (its normal in the plane u = t).
+    fn lean(&self, l: &Local) -> f64 {
+        if self.ball { l.zu } else { 0.0 }
+    }
+
+    /// The solve's function at v (the surface `l` there): g(v) = v −
+    /// ρ z_v/W − plane, zero where the centre's v is on the plane, W =
+    /// √(1 + z_u² + z_v²) (z_u = 0 for the knife); with W² and W.
+    fn newton_at(&self, plane: f64, v: f64, l: Local) -> Newton {
+        let zu = self.lean(&l);
+        let w2 = 1.0 + zu * zu + l.zv * l.zv;
+        let w = w2.sqrt();
+        Newton {
+            l,
+            g: v - self.radius * l.zv / w - plane,
+            w2,
+            w,
+        }
+    }
+
+    /// Takes the surface `l` at the point solve `s` asked for, and moves
+    /// the solve on: damped Newton for v with g(v) = 0 (`newton_at`),
+    /// g'(v) = 1 − ρ ∂(z_v/W)/∂v, each step halved until |g| falls.
+    #[inline(always)]
+    fn advance(&self, plane: f64, s: &mut Solve, l: Local) {
+        match s.stage {
+            Stage::Start => {
+                if !l.is_finite() {
+                    s.stage = Stage::Done(Err(self.error_at(s.t, s.v, false)));
+                    return;
+                }
+                s.at = self.newton_at(plane, s.v, l);
+                self.step(plane, s);
+            }
+            Stage::Step { step, halvings } => {
+                let vn = s.v + step;
+                if l.is_finite() {
+                    let next = self.newton_at(plane, vn, l);
+                    if next.g.abs() < s.at.g.abs() {
+                        (s.v, s.at) = (vn, next);
+                        s.steps += 1;
+                        self.step(plane, s);
+                        return;
                     }
                 }
-                step *= 0.5;
+                if halvings + 1 < MAX_HALVINGS {
+                    s.stage = Stage::Step {
+                        step: step * 0.5,
+                        halvings: halvings + 1,
+                    };
+                } else {
+                    self.conclude(plane, s);
+                }
             }
-            if !improved {
-                break;
-            }
+            Stage::Done(_) => {}
         }
-        if g.is_nan() || g.abs() > 1e-13 * scale {
-            return Err(self.error_at(t, v, true));
+    }
+
+    /// The next Newton step of solve `s` from where it is, or its end:
+    /// converged, out of steps, or its plane's offset folding over.
+    #[inline(always)]
+    fn step(&self, plane: f64, s: &mut Solve) {
+        let rho = self.radius;
+        let scale = 1.0 + plane.abs() + rho;
+        let Newton { l, g, w2, w } = s.at;
+        if s.steps == MAX_STEPS || g.abs() <= 1e-16 * scale {
+            return self.conclude(plane, s);
         }
-        let w = (1.0 + zu(&l) * zu(&l) + l.zv * l.zv).sqrt();
-        Ok(Contact {
-            u: t,
-            v,
-            l,
-            c: [t - rho * zu(&l) / w, l.z + rho / w],
-        })
+        let zu = self.lean(&l);
+        let dq = l.zvv / w - l.zv * (zu * l.zuv + l.zv * l.zvv) / (w2 * w);
+        let jac = 1.0 - rho * dq;
+        if jac.is_nan() || jac <= 0.0 {
+            // The plane's offset folds over: the tool is too large for
+            // the hollow here, or no contact lies on this plane.
+            let min_radius = self.limiting_radius(&l);
+            s.stage = Stage::Done(Err(if min_radius > 0.0 && rho > min_radius {
+                let (x, y) = xy(self.along, s.t, s.v);
+                RasterError::ToolTooLarge {
+                    tool_radius: rho,
+                    min_radius,
+                    x,
+                    y,
+                }
+            } else {
+                self.error_at(s.t, s.v, true)
+            }));
+            return;
+        }
+        s.stage = Stage::Step {
+            step: -g / jac,
+            halvings: 0,
+        };
+    }
+
+    /// The contact solve `s` has reached, or why there is none.
+    fn conclude(&self, plane: f64, s: &mut Solve) {
+        let rho = self.radius;
+        let scale = 1.0 + plane.abs() + rho;
+        let Newton { l, g, w, .. } = s.at;
+        s.stage = Stage::Done(if g.is_nan() || g.abs() > 1e-13 * scale {
+            Err(self.error_at(s.t, s.v, true))
+        } else {
+            Ok(Contact {
+                u: s.t,
+                v: s.v,
+                l,
+                c: [s.t - rho * self.lean(&l) / w, l.z + rho / w],
+            })
+        });
     }
 
     /// Where the surface stops being defined on the plane at v, between
@@ -990,9 +1137,12 @@ impl<'a> Cutter<'a> {
         }
         let mut probes = [[0.0; 2]; PROBES + 1];
         let mut quick = [0.0; PROBES + 1];
-        for i in 1..PROBES {
-            let s = i as f64 / PROBES as f64;
-            let q = self.contact(plane, c0.u + s * (c1.u - c0.u), c0.v + s * (c1.v - c0.v))?;
+        let at: [(f64, f64); PROBES - 1] = std::array::from_fn(|k| {
+            let s = (k + 1) as f64 / PROBES as f64;
+            (c0.u + s * (c1.u - c0.u), c0.v + s * (c1.v - c0.v))
+        });
+        for (i, q) in (1..PROBES).zip(self.contacts(plane, at)) {
+            let q = q?;
             summary.see(&q, self);
             probes[i] = q.c;
             let f = foot_on_segment(q.c, p0, p1);

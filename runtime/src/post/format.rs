@@ -39,6 +39,12 @@ const POW10: [u64; 19] = {
     t
 };
 
+/// 10^`decimals`, exactly, for up to 18 decimals (more are taken as 18).
+#[inline(always)]
+pub(super) fn pow10(decimals: u32) -> u64 {
+    POW10[decimals.min(18) as usize]
+}
+
 /// The same as doubles (all exact: 10^18 = 2^18 · 5^18 and 5^18 < 2^53).
 const POW10_F64: [f64; 19] = {
     let mut t = [1f64; 19];
@@ -55,13 +61,78 @@ const POW10_F64: [f64; 19] = {
 /// digits. Two values print the same exactly when their units are equal.
 #[inline]
 pub fn fixed_units(value: f64, decimals: u32) -> Option<i64> {
-    let scaled = value * POW10_F64[decimals.min(18) as usize];
-    // NaN fails the comparison. Rounding cannot cross 1e18: doubles that
-    // large are spaced 128 apart, so they are whole numbers already.
-    if scaled.abs() < 1e18 {
-        Some(round_half_away(scaled))
-    } else {
-        None
+    Decimals::new(decimals).units(value)
+}
+
+/// A number of decimals (at most 18) and what rounding to it and
+/// printing it take, worked out once for a word that prints many
+/// numbers: `fixed_units` and `print_units` are these two methods.
+#[derive(Clone, Copy, Debug)]
+pub struct Decimals {
+    /// 10^d as a double (exact).
+    scale: f64,
+    /// 10^(8 − d) where d ≤ 8: a count of units times this is the
+    /// number in units of 10^−8, split at a constant.
+    to_eighths: u64,
+    /// 10^(8 + d) where d ≤ 8, else 0: unit counts below it have at most
+    /// eight digits either side of the point.
+    short_below: u64,
+    d: u32,
+}
+
+impl Decimals {
+    /// `decimals` places (more than 18 are taken as 18).
+    pub const fn new(decimals: u32) -> Decimals {
+        let d = if decimals < 18 { decimals } else { 18 };
+        Decimals {
+            scale: POW10_F64[d as usize],
+            to_eighths: if d <= 8 { POW10[8 - d as usize] } else { 0 },
+            short_below: if d <= 8 { POW10[8 + d as usize] } else { 0 },
+            d,
+        }
+    }
+
+    /// The number of decimals.
+    #[inline(always)]
+    pub fn places(&self) -> u32 {
+        self.d
+    }
+
+    /// `value` in units of the last decimal, rounded half away from zero;
+    /// `None` if it is not finite or does not fit in 18 digits.
+    #[inline(always)]
+    pub fn units(&self, value: f64) -> Option<i64> {
+        let scaled = value * self.scale;
+        // NaN fails the comparison. Rounding cannot cross 1e18: doubles
+        // that large are spaced 128 apart, so they are whole numbers already.
+        if scaled.abs() < 1e18 {
+            Some(round_half_away(scaled))
+        } else {
+            None
+        }
+    }
+
+    /// Prints `n` units into `room`, whatever it held, as `print_units`
+    /// prints them; returns the number's length and its count of digits
+    /// (bytes of `room` after the number are left as filler).
+    #[inline(always)]
+    pub fn print(&self, room: &mut [u8; PRINTED_ROOM], n: i64) -> (usize, usize) {
+        let mag = n.unsigned_abs();
+        if mag < self.short_below {
+            // At most 8 digits either side of the point: scaled to 8
+            // decimals it splits at a constant (a multiply, where 10^d
+            // would divide).
+            let m8 = mag * self.to_eighths;
+            print_short(
+                room,
+                n < 0,
+                (m8 / 100_000_000) as u32,
+                (m8 % 100_000_000) as u32,
+            )
+        } else {
+            let p = POW10[self.d as usize];
+            print_long(room, n < 0, mag / p, mag % p, self.d as usize)
+        }
     }
 }
 
@@ -136,26 +207,12 @@ pub fn push_units_to(text: &mut Vec<u8>, n: i64, decimals: u32) -> usize {
     digits
 }
 
-/// Prints into `room` (at least `PRINTED_ROOM` long, all `'0'`); returns
-/// the number's length and its count of digits.
+/// Prints `n` units of 10^−decimals into `room`, whatever it held, as
+/// `print_units` prints them; returns the number's length and its count
+/// of digits (bytes of `room` after the number are left as filler).
 #[inline(always)]
 fn print_into(room: &mut [u8; PRINTED_ROOM], n: i64, decimals: u32) -> (usize, usize) {
-    let d = decimals.min(18) as usize;
-    let mag = n.unsigned_abs();
-    if d <= 8 && mag < POW10[8 + d] {
-        // At most 8 digits either side of the point: scaled to 8 decimals
-        // it splits at a constant (a multiply, where 10^d would divide).
-        let m8 = mag * POW10[8 - d];
-        print_short(
-            room,
-            n < 0,
-            (m8 / 100_000_000) as u32,
-            (m8 % 100_000_000) as u32,
-        )
-    } else {
-        let p = POW10[d];
-        print_long(room, n < 0, mag / p, mag % p, d)
-    }
+    Decimals::new(decimals).print(room, n)
 }
 
 /// Writes `v`'s digits right-aligned to end at `end`, two at a time.
@@ -238,6 +295,9 @@ fn print_long(
     mut frac: u64,
     d: usize,
 ) -> (usize, usize) {
+    // The zeros the digits do not overwrite are the number's own (a zero
+    // integer part, the decimals' leading zeros): put them there first.
+    *room = [b'0'; PRINTED_ROOM];
     let mut shown = 0;
     if frac != 0 {
         shown = d;
@@ -250,8 +310,6 @@ fn print_long(
     let whole_digits = whole.checked_ilog10().map_or(1, |l| l as usize + 1);
     let point = minus + whole_digits;
     let len = point + 1 + shown;
-    // Zeros the digits do not overwrite are the number's own: a zero
-    // integer part, the decimals' leading zeros.
     if negative {
         room[0] = b'-';
     }

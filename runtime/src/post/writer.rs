@@ -2,7 +2,9 @@
 //! word, with every number through the one fixed-point formatter.
 
 use super::ProgramError;
-use super::format::{decimals_for, fixed_units, push_fixed, push_units_to};
+use super::format::{
+    Decimals, PRINTED_ROOM, decimals_for, fixed_units, pow10, push_fixed, push_units_to,
+};
 use super::header::{num, write_comment};
 use crate::dialect::{CommentStyle, Dialect, Language, WordFormat};
 use crate::moves::{Coolant, Plane, Position, Rotation, Start};
@@ -69,10 +71,20 @@ pub struct ProgramWriter {
     decimals: u32,
     /// Letters of the machine's axes among X, Y, Z, C (others are refused).
     letters: [Option<char>; 4],
-    /// What goes before each axis's number: a space and its letter.
-    axis_words: [Snippet; 4],
     /// Decimals of each axis: the resolution's, C's own for C.
     axis_decimals: [u32; 4],
+    /// Factor from the move stream's value to the printed one per axis:
+    /// X's scale (2 in diameter mode), 1, 1, degrees per radian for C
+    /// (`f64::to_degrees` is this same product).
+    axis_scale: [f64; 4],
+    /// Each axis's decimals, ready to round and print with.
+    axis_formats: [Decimals; 4],
+    /// What goes before each axis's number: a space and its letter.
+    axis_heads: [WordHead; 4],
+    /// Per axis, the unit count (of its last decimal) from which its
+    /// word has more digits before the point than its format allows
+    /// (`u64::MAX`: no limit).
+    axis_unit_limits: [u64; 4],
     /// The motion words: rapid, linear, clockwise and counter-clockwise arc.
     motion_words: [Snippet; 4],
     /// The dialect's block end and the newline.
@@ -81,8 +93,6 @@ pub struct ProgramWriter {
     max_digits: usize,
     /// The dialect's line-length limit (none: `usize::MAX`).
     max_line_length: usize,
-    /// Factor from the move stream's X to the printed X (2 in diameter mode).
-    x_scale: f64,
     /// The last value printed per axis, in units of its last decimal.
     last: [Option<i64>; 4],
     /// Where the axes are (mm, rad; the stream's values).
@@ -106,10 +116,15 @@ pub struct ProgramWriter {
     integer_limit: [u64; 26],
     /// Decimals of feeds per minute and per revolution.
     feed_decimals: u32,
+    /// The same, ready to round and print with.
+    feed_format: Decimals,
     /// Klartext: the circle centre `CC` last written, in units of the
     /// axes' last decimal.
     circle_centre: Option<(i64, i64)>,
     pub moves: usize,
+    /// The text's capacity when its spare capacity was last zeroed (0:
+    /// not since its allocation): see `room`.
+    zeroed: usize,
 }
 
 /// The spindle's state as the program has set it.
@@ -130,6 +145,7 @@ enum FeedMode {
 /// Decimals of feeds per minute and per revolution, and of inverse time.
 const FEED_DECIMALS: u32 = 6;
 const INVERSE_TIME_DECIMALS: u32 = 3;
+const INVERSE_TIME_FORMAT: Decimals = Decimals::new(INVERSE_TIME_DECIMALS);
 
 /// The shortest move time (s), at least `t`, whose inverse-time F as
 /// printed (1/min, rounded to its decimals) is not above 60 / `t`: a move
@@ -188,6 +204,17 @@ impl ProgramWriter {
     /// prepared and no axis position known.
     fn blank(dialect: &Dialect, setup: Setup, job: &str, axes: &str, decimals: u32) -> Self {
         let has = |c: char| axes.contains(c).then_some(c);
+        let axis_decimals = [decimals, decimals, decimals, dialect.c_decimals];
+        let limits = integer_limits(dialect);
+        let feed_decimals = dialect
+            .format_of('F')
+            .and_then(|f| f.decimals)
+            .map_or(FEED_DECIMALS, |d| d.min(FEED_DECIMALS));
+        let x_scale = if setup == Setup::Lathe && dialect.lathe_x_diameter {
+            2.0
+        } else {
+            1.0
+        };
         let letters = [
             has('X'),
             has('Y'),
@@ -199,8 +226,14 @@ impl ProgramWriter {
             dialect: dialect.clone(),
             decimals,
             letters,
-            axis_words: letters.map(|l| Snippet::new(&format!(" {}", l.unwrap_or(' ')))),
-            axis_decimals: [decimals, decimals, decimals, dialect.c_decimals],
+            axis_decimals,
+            axis_scale: [x_scale, 1.0, 1.0, 180.0 / PI],
+            axis_formats: axis_decimals.map(Decimals::new),
+            axis_heads: letters.map(|l| WordHead::new(l.unwrap_or(' '))),
+            axis_unit_limits: std::array::from_fn(|i| {
+                let limit = letters[i].map_or(u64::MAX, |l| limits[letter_index(l)]);
+                limit.saturating_mul(pow10(axis_decimals[i]))
+            }),
             motion_words: [
                 &dialect.rapid,
                 &dialect.linear,
@@ -211,11 +244,6 @@ impl ProgramWriter {
             line_end: Snippet::new(&format!("{}\n", dialect.block_end)),
             max_digits: dialect.max_digits.map_or(usize::MAX, |m| m as usize),
             max_line_length: dialect.max_line_length.unwrap_or(usize::MAX),
-            x_scale: if setup == Setup::Lathe && dialect.lathe_x_diameter {
-                2.0
-            } else {
-                1.0
-            },
             last: [None; 4],
             at: [f64::NAN; 4],
             plane: match setup {
@@ -238,13 +266,12 @@ impl ProgramWriter {
             job: job.to_string(),
             start: None,
             spindle: Spindle::Stopped,
-            integer_limit: integer_limits(dialect),
-            feed_decimals: dialect
-                .format_of('F')
-                .and_then(|f| f.decimals)
-                .map_or(FEED_DECIMALS, |d| d.min(FEED_DECIMALS)),
+            integer_limit: limits,
+            feed_decimals,
+            feed_format: Decimals::new(feed_decimals),
             circle_centre: None,
             moves: 0,
+            zeroed: 0,
         }
     }
 
@@ -318,13 +345,19 @@ impl ProgramWriter {
             return Err(self.line_too_long(start));
         }
         self.line_end.push_to(&mut self.text);
+        self.next_block_number();
+        Ok(())
+    }
+
+    /// The next block's number, if the dialect numbers blocks.
+    #[inline(always)]
+    fn next_block_number(&mut self) {
         if let Some(step) = self.dialect.line_numbers {
             self.block += step;
             if self.dialect.max_line_number.is_some_and(|m| self.block > m) {
                 self.block = step;
             }
         }
-        Ok(())
     }
 
     /// Refuses the block begun at byte `start` for its length.
@@ -617,11 +650,13 @@ impl ProgramWriter {
         Ok(out)
     }
 
-    /// A motion block: its words straight into the text, each a copy of
-    /// fixed size (a snippet's room, a number's room) cut back to length.
-    /// The values printed are kept word by word and become the last
-    /// printed values only when the block is written (a block refused
-    /// leaves them as they were).
+    /// A motion block: its prefix (block number, feed-mode and plane
+    /// words) into the text, then its words printed into one room added
+    /// at the text's end (`BLOCK_ROOM`) and cut back to their length: the
+    /// text's length is touched twice a block, not twice a word. The
+    /// values printed are kept word by word and become the last printed
+    /// values only when the block is written (a block refused leaves them
+    /// as they were).
     #[inline(always)]
     fn motion(
         &mut self,
@@ -642,9 +677,9 @@ impl ProgramWriter {
         let start = self.text.len();
         self.begin_block();
         let mode = feed.map(|f| match f {
-            F::PerTime(v) => (FeedMode::PerMinute, v * 60.0, self.feed_decimals),
-            F::PerRevolution(v) => (FeedMode::PerRevolution, v * 2.0 * PI, self.feed_decimals),
-            F::InverseTime(t) => (FeedMode::InverseTime, 60.0 / t, INVERSE_TIME_DECIMALS),
+            F::PerTime(v) => (FeedMode::PerMinute, v * 60.0, self.feed_format),
+            F::PerRevolution(v) => (FeedMode::PerRevolution, v * 2.0 * PI, self.feed_format),
+            F::InverseTime(t) => (FeedMode::InverseTime, 60.0 / t, INVERSE_TIME_FORMAT),
         });
         let mode_changes = mode.is_some_and(|(m, _, _)| self.mode != Some(m));
         if let Some((m, _, _)) = mode
@@ -670,44 +705,109 @@ impl ProgramWriter {
                 self.plane = plane;
             }
         }
-        self.motion_words[word as usize].push_to(&mut self.text);
+        let motion_word = &self.motion_words[word as usize];
+        if motion_word.len > SNIPPET_ROOM {
+            self.text.extend_from_slice(&motion_word.long);
+        }
         let axes = to.axes();
+        // The arc's centre words, worked out (and its radii checked)
+        // before the room is taken, printed after the axes' words.
+        let centre = arc.map(|(plane, centre)| self.centre_words(plane, to, centre));
+        let at = self.text.len();
+        let room = block_room(&mut self.text, &mut self.zeroed);
+        let mut pos = 0;
+        if motion_word.len <= SNIPPET_ROOM {
+            room[..SNIPPET_ROOM].copy_from_slice(&motion_word.room);
+            pos = motion_word.len;
+        }
+        let max_digits = self.max_digits;
         let mut printed = [0i64; 4];
         let mut changed = 0u8;
+        let mut refusal = None;
         for i in 0..4 {
             let v = axes[i];
             if v.is_nan() {
                 continue;
             }
-            let value = match i {
-                0 => v * self.x_scale,
-                3 => v.to_degrees(),
-                _ => v,
-            };
-            let d = self.axis_decimals[i];
-            let (Some(letter), Some(n)) = (self.letters[i], fixed_units(value, d)) else {
-                return Err(self.not_printable(i, v));
+            let value = v * self.axis_scale[i];
+            let format = &self.axis_formats[i];
+            let (Some(letter), Some(n)) = (self.letters[i], format.units(value)) else {
+                refusal = Some(Refusal::NotPrintable(i, v));
+                break;
             };
             // Modal: a word whose printed value has not changed is left out.
             if self.last[i] == Some(n) {
                 continue;
             }
-            self.axis_words[i].push_to(&mut self.text);
-            self.number(letter, value, n, d)?;
+            let unit_limit = self.axis_unit_limits[i];
+            let head = &self.axis_heads[i];
+            match print_word(
+                room, pos, head, letter, value, n, format, max_digits, unit_limit,
+            ) {
+                Ok(p) => pos = p,
+                Err(r) => {
+                    refusal = Some(r);
+                    break;
+                }
+            }
             printed[i] = n;
             changed |= 1 << i;
         }
-        if changed == 0 {
-            self.text.truncate(start);
-            return Ok(());
+        if refusal.is_none() && changed != 0 {
+            if let Some(centre) = centre {
+                match centre {
+                    Ok(words) => {
+                        let format = Decimals::new(self.decimals);
+                        for (letter, value, n) in words {
+                            let limit = self.integer_limit[letter_index(letter)];
+                            let unit_limit = limit.saturating_mul(pow10(self.decimals));
+                            let head = WordHead::new(letter);
+                            match print_word(
+                                room, pos, &head, letter, value, n, &format, max_digits, unit_limit,
+                            ) {
+                                Ok(p) => pos = p,
+                                Err(r) => {
+                                    refusal = Some(r);
+                                    break;
+                                }
+                            }
+                        }
+                    }
+                    Err(r) => refusal = Some(r),
+                }
+            }
+            if let Some(mode) = mode
+                && refusal.is_none()
+            {
+                let modal = (&mut self.last_feed, &mut self.mode);
+                let limit = self.integer_limit[letter_index('F')];
+                match feed_word(room, pos, mode, mode_changes, modal, max_digits, limit) {
+                    Ok(p) => pos = p,
+                    Err(r) => refusal = Some(r),
+                }
+            }
         }
-        if let Some((plane, centre)) = arc {
-            self.arc_centre(plane, to, centre)?;
+        // The line's length is where its words end: nothing rescanned.
+        let too_long = at - start + pos + self.dialect.block_end.len() > self.max_line_length;
+        if refusal.is_none() && changed != 0 && !too_long && self.line_end.len <= SNIPPET_ROOM {
+            room[pos..pos + SNIPPET_ROOM].copy_from_slice(&self.line_end.room);
+            pos += self.line_end.len;
+            self.text.truncate(at + pos);
+        } else {
+            self.text.truncate(at + pos);
+            if let Some(r) = refusal {
+                return Err(self.refused(r));
+            }
+            if changed == 0 {
+                self.text.truncate(start);
+                return Ok(());
+            }
+            if too_long {
+                return Err(self.line_too_long(start));
+            }
+            self.text.extend_from_slice(&self.line_end.long);
         }
-        if let Some(mode) = mode {
-            self.feed_word(mode, mode_changes)?;
-        }
-        self.end_block(start)?;
+        self.next_block_number();
         self.moved(&printed, changed, axes);
         Ok(())
     }
@@ -715,7 +815,7 @@ impl ProgramWriter {
     /// A motion block written: the printed values of the axes `changed`
     /// (bit i for axis i) become the modal ones, the tool is at `axes`
     /// (NaN: an axis that did not move).
-    #[inline]
+    #[inline(always)]
     fn moved(&mut self, printed: &[i64], changed: u8, axes: [f64; 4]) {
         for (i, &n) in printed.iter().enumerate() {
             if changed & 1 << i != 0 {
@@ -728,26 +828,6 @@ impl ProgramWriter {
             }
         }
         self.moves += 1;
-    }
-
-    /// The feed word: written when the mode or the printed feed changes,
-    /// and on every move in inverse time.
-    #[inline(always)]
-    fn feed_word(
-        &mut self,
-        (m, value, d): (FeedMode, f64, u32),
-        mode_changes: bool,
-    ) -> Result<(), ProgramError> {
-        let Some(n) = fixed_units(value, d).filter(|&n| n > 0) else {
-            return Err(ProgramError::NotPrintable { word: 'F', value });
-        };
-        if mode_changes || m == FeedMode::InverseTime || self.last_feed != Some(n) {
-            self.text.extend_from_slice(b" F");
-            self.number('F', value, n, d)?;
-        }
-        self.last_feed = Some(n);
-        self.mode = Some(m);
-        Ok(())
     }
 
     /// The dialect's lines that switch the C axis on, before its first move.
@@ -790,39 +870,50 @@ impl ProgramWriter {
         }
     }
 
-    /// An arc's centre words, once its radii are checked as the
-    /// controller checks them.
+    /// An arc's centre words (letter, value, units), once its radii are
+    /// checked as the controller checks them.
     #[inline(never)]
-    fn arc_centre(
-        &mut self,
+    fn centre_words(
+        &self,
         plane: Plane,
         to: Position,
         centre: Position,
-    ) -> Result<(), ProgramError> {
-        self.check_arc_radii(plane, to, centre)?;
+    ) -> Result<[(char, f64, i64); 2], Refusal> {
+        if let Err(e) = self.check_arc_radii(plane, to, centre) {
+            return Err(Refusal::Error(Box::new(e)));
+        }
         let (a, b) = plane.axes();
         // I J K in that order, whatever the plane's orientation.
-        for i in [a.min(b), a.max(b)] {
+        let mut words = [(' ', 0.0, 0); 2];
+        for (word, i) in words.iter_mut().zip([a.min(b), a.max(b)]) {
             let c = centre.axes()[i];
             let from = if self.dialect.arc_centre_absolute {
                 0.0
             } else {
                 self.at[i]
             };
+            let letter = ['I', 'J', 'K'][i];
             let (Some(cu), Some(fu)) = (
                 fixed_units(c, self.decimals),
                 fixed_units(from, self.decimals),
             ) else {
-                return Err(ProgramError::NotPrintable {
-                    word: ['I', 'J', 'K'][i],
-                    value: c,
-                });
+                return Err(Refusal::Unprintable(letter, c));
             };
-            let letter = ['I', 'J', 'K'][i];
-            self.text.extend_from_slice(&[b' ', letter as u8]);
-            self.number(letter, c - from, cu - fu, self.decimals)?;
+            *word = (letter, c - from, cu - fu);
         }
-        Ok(())
+        Ok(words)
+    }
+
+    /// The error for a word the block's room refused.
+    #[cold]
+    fn refused(&self, r: Refusal) -> ProgramError {
+        match r {
+            Refusal::NotPrintable(i, v) => self.not_printable(i, v),
+            Refusal::Unprintable(word, value) => ProgramError::NotPrintable { word, value },
+            Refusal::TooManyDigits(letter, v, digits) => self.too_many_digits(letter, v, digits),
+            Refusal::IntegerDigits(letter, v) => self.too_many_integer_digits(letter, v),
+            Refusal::Error(e) => *e,
+        }
     }
 
     /// An arc's start and end radii, from the rounded centre, start and
@@ -873,7 +964,8 @@ impl ProgramWriter {
     /// `ProgramWriter`); the
     /// next chunk starts with room for as much again.
     pub fn take_text(&mut self) -> Result<String, ProgramError> {
-        let room = self.text.len();
+        let room = self.text.len() + BLOCK_ROOM;
+        self.zeroed = 0;
         utf8(std::mem::replace(&mut self.text, Vec::with_capacity(room)))
     }
 
@@ -958,6 +1050,161 @@ impl Snippet {
             text.extend_from_slice(&self.long);
         }
     }
+}
+
+/// Room for a motion block's words after its prefix: the motion word,
+/// four axis words, two arc-centre words, the feed word (each a space,
+/// its letter and the longest number) and the line end.
+const BLOCK_ROOM: usize = SNIPPET_ROOM + 7 * WORD_ROOM + SNIPPET_ROOM;
+
+/// A space, a letter (up to four bytes) and the longest number, with the
+/// head's fixed-size copy ending within it.
+const WORD_ROOM: usize = 5 + PRINTED_ROOM;
+
+/// `BLOCK_ROOM` bytes added at the end of `text` for a block to be
+/// printed into (the caller cuts the text back to what it printed): bytes
+/// of its spare capacity, zeroed once per allocation (`zeroed`: the
+/// capacity when they were), not byte by byte each block.
+#[inline(always)]
+fn block_room<'t>(text: &'t mut Vec<u8>, zeroed: &mut usize) -> &'t mut [u8; BLOCK_ROOM] {
+    let at = text.len();
+    if text.capacity() - at < BLOCK_ROOM || *zeroed != text.capacity() {
+        zero_spare_capacity(text, zeroed);
+    }
+    // SAFETY: `at + BLOCK_ROOM` is within the capacity, and every byte of
+    // the spare capacity is initialised: it was zeroed when `zeroed` was
+    // set to the capacity, and the allocation is still that one (a `Vec`
+    // only reallocates to a larger capacity; the writer replaces its text
+    // only in `take_text`, which resets `zeroed`, and `finish`); a `Vec`
+    // never de-initialises bytes beyond its length.
+    unsafe { text.set_len(at + BLOCK_ROOM) };
+    match text.last_chunk_mut::<BLOCK_ROOM>() {
+        Some(room) => room,
+        None => unreachable!("the room was just added"),
+    }
+}
+
+/// Room for a block at the end of `text`, and its whole spare capacity
+/// zeroed (once per allocation: `block_room`).
+#[cold]
+fn zero_spare_capacity(text: &mut Vec<u8>, zeroed: &mut usize) {
+    text.reserve(BLOCK_ROOM);
+    text.spare_capacity_mut()
+        .fill(std::mem::MaybeUninit::new(0));
+    *zeroed = text.capacity();
+}
+
+/// Why a word cannot go into a block, found while the block is printed
+/// into its room (the error is made once the room is given back).
+enum Refusal {
+    /// Axis i's value (the stream's) cannot be printed, or the machine
+    /// has no such axis.
+    NotPrintable(usize, f64),
+    /// The word's value cannot be printed.
+    Unprintable(char, f64),
+    /// More digits in all than the dialect takes.
+    TooManyDigits(char, f64, usize),
+    /// More digits before the point than the letter's format allows.
+    IntegerDigits(char, f64),
+    /// Any other refusal (an arc's radii).
+    Error(Box<ProgramError>),
+}
+
+/// Prints the word ` L<n>` (`head`, the space and letter L, then `n`
+/// units of the last of `format`'s
+/// decimals, `value` what they round) at `pos` of a block's room through
+/// the one number formatter; the word's end, or why the dialect refuses
+/// it: more digits than `max_digits`, or a unit count of `unit_limit` or
+/// more (more digits before the point than the letter's format allows).
+/// The digits come from an integer count of units, so they cannot spell
+/// an exponent, NaN or `-0`: `check_number` holds of them by
+/// construction (the format module's tests hold the printer to that), and
+/// is asserted again in debug builds.
+#[inline(always)]
+#[allow(clippy::too_many_arguments, reason = "one word's parts, inlined")]
+fn print_word(
+    room: &mut [u8; BLOCK_ROOM],
+    pos: usize,
+    head: &WordHead,
+    letter: char,
+    value: f64,
+    n: i64,
+    format: &Decimals,
+    max_digits: usize,
+    unit_limit: u64,
+) -> Result<usize, Refusal> {
+    let Some(word) = room
+        .get_mut(pos..)
+        .and_then(|r| r.first_chunk_mut::<WORD_ROOM>())
+    else {
+        unreachable!("a block's words fit its room")
+    };
+    // A space and the letter (UTF-8: up to four bytes), then the number.
+    word[..WORD_HEAD].copy_from_slice(&head.bytes);
+    let Some(number) = word[head.len..].first_chunk_mut::<PRINTED_ROOM>() else {
+        unreachable!("a word's room holds the longest number")
+    };
+    let (len, digits) = format.print(number, n);
+    debug_assert!(check_number(&number[..len]).is_ok());
+    if digits > max_digits {
+        return Err(Refusal::TooManyDigits(letter, value, digits));
+    }
+    // |n| / 10^d ≥ limit exactly when |n| ≥ limit · 10^d (a product too
+    // large for a u64 is more than any |n|, as is no limit at all).
+    if n.unsigned_abs() >= unit_limit {
+        return Err(Refusal::IntegerDigits(letter, value));
+    }
+    Ok(pos + head.len + len)
+}
+
+/// Room for a word's head: a space and a letter of up to four bytes.
+const WORD_HEAD: usize = 8;
+
+/// A word's head, a space and its letter, as a copy of fixed size.
+#[derive(Clone, Copy)]
+struct WordHead {
+    bytes: [u8; WORD_HEAD],
+    len: usize,
+}
+
+impl WordHead {
+    #[inline(always)]
+    fn new(letter: char) -> WordHead {
+        let mut bytes = [b' '; WORD_HEAD];
+        let len = 1 + letter.encode_utf8(&mut bytes[1..]).len();
+        WordHead { bytes, len }
+    }
+}
+
+/// The feed word, printed at `pos` of the block's room: written when the
+/// mode or the printed feed changes, and on every move in inverse time;
+/// the last printed feed and mode (`modal`) become this one's. `limit` is
+/// 10 to the most digits F takes before the point. Its end, or why it is
+/// refused.
+#[inline(always)]
+fn feed_word(
+    room: &mut [u8; BLOCK_ROOM],
+    pos: usize,
+    (m, value, format): (FeedMode, f64, Decimals),
+    mode_changes: bool,
+    (last_feed, mode): (&mut Option<i64>, &mut Option<FeedMode>),
+    max_digits: usize,
+    limit: u64,
+) -> Result<usize, Refusal> {
+    let Some(n) = format.units(value).filter(|&n| n > 0) else {
+        return Err(Refusal::Unprintable('F', value));
+    };
+    let mut end = pos;
+    if mode_changes || m == FeedMode::InverseTime || *last_feed != Some(n) {
+        let unit_limit = limit.saturating_mul(pow10(format.places()));
+        let head = WordHead::new('F');
+        end = print_word(
+            room, pos, &head, 'F', value, n, &format, max_digits, unit_limit,
+        )?;
+    }
+    *last_feed = Some(n);
+    *mode = Some(m);
+    Ok(end)
 }
 
 #[derive(Clone, Copy)]

@@ -963,3 +963,67 @@ proptest::proptest! {
         }
     }
 }
+
+/// Contacts solved side by side in one batch are the contacts solved one
+/// at a time, to the last bit, refusals included (points beyond the
+/// hyperboloid's domain, planes the tool cannot reach): the batch asks
+/// for each solve's points as the solve alone would.
+#[test]
+fn contacts_solved_side_by_side_are_those_solved_alone() {
+    // Defined out to 1/√11 ≈ 0.30 mm; a hollow of radius 0.1 mm.
+    let oblate = convex(1.0, 10.0);
+    let hollow = Conic {
+        radius: 0.1,
+        k: 0.0,
+        s: 1.0,
+    };
+    let tools = [
+        RasterTool::Ball { radius: 0.2 },
+        RasterTool::Ball { radius: 0.05 },
+        KNIFE,
+    ];
+    let mut seed = 0x2545_f491_4f6c_dd1du64;
+    let mut next = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let (mut solved, mut refused) = (0, 0);
+    for (surface, reach) in [(&oblate as &dyn SurfaceFn, 0.35), (&hollow, 0.12)] {
+        for along in [Axis::X, Axis::Y] {
+            for tool in &tools {
+                let cutter = Cutter::new(tool, surface, along);
+                for _ in 0..200 {
+                    let plane = reach * (2.0 * next() - 1.0);
+                    let at: [(f64, f64); PROBES - 1] = std::array::from_fn(|_| {
+                        let guess = if next() < 0.1 {
+                            f64::NAN
+                        } else {
+                            plane + 0.02 * (next() - 0.5)
+                        };
+                        (reach * (2.0 * next() - 1.0), guess)
+                    });
+                    let together = cutter.contacts(plane, at);
+                    for (&(t, guess), c) in at.iter().zip(&together) {
+                        let alone = cutter.contact(plane, t, guess);
+                        assert_eq!(
+                            format!("{c:?}"),
+                            format!("{alone:?}"),
+                            "at t {t}, plane {plane}"
+                        );
+                        match c {
+                            Ok(_) => solved += 1,
+                            Err(_) => refused += 1,
+                        }
+                    }
+                }
+            }
+        }
+    }
+    // Both outcomes are exercised.
+    assert!(
+        solved > 1000 && refused > 1000,
+        "{solved} solved, {refused} refused"
+    );
+}

@@ -499,7 +499,8 @@ proptest::proptest! {
     #![proptest_config(proptest::prelude::ProptestConfig::with_cases(400))]
 
     /// The block printer against a straightforward reference, move by
-    /// move, over random values, decimals and dialect word formats: each
+    /// move, over random values, decimals and dialect word formats (X, Y
+    /// and Z, and C in degrees from the stream's radians): each
     /// word as `f64::round` and `{:.N}` print it (ties away from zero, no
     /// `-0`), unchanged words left out, and a block refused exactly when
     /// a word has more digits before the point than its format allows or
@@ -507,22 +508,23 @@ proptest::proptest! {
     #[test]
     fn blocks_print_what_a_plain_formatter_prints(
         resolution in proptest::sample::select(vec![1e-3, 1e-4, 1e-6]),
-        formats in (1u32..6, 0u32..3, 1u32..6, 0u32..3, 2u32..7, 0u32..7),
+        formats in (1u32..6, 0u32..3, 1u32..6, 0u32..3, 2u32..7, 0u32..7, 2u32..7),
         max_digits in proptest::option::of(5u32..13),
         seed in proptest::collection::vec((0u8..8, 0.01f64..2000.0), 1..40),
         values in proptest::collection::vec(
-            (printer_value(3, 3), printer_value(4, 2), printer_value(6, 1)),
+            (printer_value(3, 3), printer_value(4, 2), printer_value(6, 1), printer_value(5, 4)),
             40,
         ),
     ) {
         let d = decimals_for(resolution);
-        let (xi, xd, zi, zd, fi, fd) = formats;
+        let (xi, xd, zi, zd, fi, fd, ci) = formats;
         let mut dialect = Dialect::linuxcnc();
         dialect.max_digits = max_digits;
-        for f in [format!("X{xi}.{}", d + xd), format!("Z{zi}.{}", d + zd), format!("F{fi}.{fd}")] {
+        let cd = dialect.c_decimals;
+        for f in [format!("X{xi}.{}", d + xd), format!("Z{zi}.{}", d + zd), format!("F{fi}.{fd}"), format!("C{ci}.{cd}")] {
             dialect.word_formats.push(WordFormat::parse(&f).expect("a format"));
         }
-        let mut w = ProgramWriter::new(&dialect, Setup::Mill, "t", &[], "XYZ", resolution, 1e-3)
+        let mut w = ProgramWriter::new(&dialect, Setup::Mill, "t", &[], "XYZC", resolution, 1e-3)
             .expect("a mill program");
         w.call_tool(&Start::default()).expect("tool 1");
         w.write(&M::SpindleOn(RPM_1000)).expect("spindle");
@@ -535,20 +537,25 @@ proptest::proptest! {
             let fits = whole as u32 <= integer && max_digits.is_none_or(|m| digits <= m as usize);
             fits.then(|| format!(" {letter}{s}"))
         };
-        let (mut last, mut last_feed, mut first) = ([None::<i64>; 3], None::<i64>, true);
+        let (mut last, mut last_feed, mut first) = ([None::<i64>; 4], None::<i64>, true);
         for (k, &(pick, feed)) in seed.iter().enumerate() {
-            let (a, b, c) = values[k];
+            let (a, b, c, degrees) = values[k];
             let v = [a, b, c];
             let axes = [v[pick as usize % 3], v[(pick as usize + 1) % 3], v[(pick as usize + 2) % 3]];
+            // C in the stream is in radians; the program prints degrees.
+            let radians = degrees.to_radians();
+            let to = P { x: axes[0], y: axes[1], z: axes[2], c: radians };
             let got = w
-                .write(&M::Linear { to: P::xyz(axes[0], axes[1], axes[2]), feed: Some(F::PerTime(feed)) })
+                .write(&M::Linear { to, feed: Some(F::PerTime(feed)) })
                 .and_then(|()| w.take_text());
             // The reference.
             let mut line = String::from(if first { "G94 G1" } else { "G1" });
             let mut next = last;
             let mut refused = false;
-            for (i, (letter, integer)) in [('X', xi), ('Y', u32::MAX), ('Z', zi)].into_iter().enumerate() {
-                let n = (axes[i] * 10f64.powi(d as i32)).round() as i64;
+            let printed = [axes[0], axes[1], axes[2], radians.to_degrees()];
+            let words = [('X', xi, d), ('Y', u32::MAX, d), ('Z', zi, d), ('C', ci, cd)];
+            for (i, (letter, integer, d)) in words.into_iter().enumerate() {
+                let n = (printed[i] * 10f64.powi(d as i32)).round() as i64;
                 if last[i] == Some(n) {
                     continue;
                 }
