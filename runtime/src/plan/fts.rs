@@ -26,7 +26,7 @@
 
 use std::ops::ControlFlow;
 
-use crate::plan::chords::{Band, ChordPlacement};
+use crate::plan::chords::{self, Band, ChordPlacement};
 use crate::plan::envelope;
 use crate::surface::ir::SurfaceFn;
 use crate::surface::{Profile, ProfilePoint};
@@ -376,7 +376,52 @@ impl Planner<'_> {
                 q.2 = q.2.union(p.2);
             }
         }
+        if self.spiral.chords == ChordPlacement::Straddle {
+            kept = self.straddled(&kept, c1);
+        }
         (kept, over)
+    }
+
+    /// The revolution's points `pts`, up to the next revolution's first at
+    /// `c1`, moved in W to straddle the exact path (`plan::chords`): each
+    /// chord within half the chords' share either way, chords split where
+    /// their neighbours bend the other way (down to the servo's data
+    /// period). Its first point, which the revolution before shares, and
+    /// the next revolution's first stay on the path, so every revolution
+    /// is placed on its own, in parallel.
+    fn straddled(&self, pts: &[(f64, f64, Band)], c1: f64) -> Vec<(f64, f64, Band)> {
+        let share = self.spiral.chord_tolerance * crate::plan::optimise::UNOPTIMISED_CHORD_SHARE;
+        let knot = |c: f64, w: f64| chords::Knot { s: c, u: c, z: w };
+        let mut knots: Vec<chords::Knot> = pts.iter().map(|p| knot(p.0, p.1)).collect();
+        let mut hint = None;
+        let mut exact = |c: f64| {
+            let (w, h) = self.centre_near(c, hint);
+            hint = Some(h);
+            (c, w)
+        };
+        let last = knots.last().map(|k| k.s);
+        if last.is_some_and(|l| c1 > l) {
+            knots.push(knot(c1, exact(c1).1));
+        }
+        let min_interval = self.spiral.min_interval;
+        let speed = self.spiral.speed;
+        let can_split = |a: &chords::Knot, b: &chords::Knot| {
+            b.s - a.s > 2.0 * speed.at(self.radius(b.s)) * min_interval
+        };
+        let (mut placed, _) = chords::straddle(
+            &knots,
+            (Some(0.0), Some(0.0)),
+            0.5 * share,
+            &mut exact,
+            &can_split,
+        );
+        if last.is_some_and(|l| c1 > l) {
+            placed.pop();
+        }
+        placed
+            .into_iter()
+            .map(|k| (k.s, k.z, Band::default()))
+            .collect()
     }
 
     /// Samples [c0, c1) into `out`: seeds a seed arc apart, each interval
@@ -450,7 +495,12 @@ impl Planner<'_> {
         right: (f64, f64),
         hint: &mut f64,
     ) -> Band {
-        if self.spiral.chords == ChordPlacement::OnPath {
+        // Straddling measures its chords itself, once the revolution is
+        // sampled (`straddled`).
+        if matches!(
+            self.spiral.chords,
+            ChordPlacement::OnPath | ChordPlacement::Straddle
+        ) {
             return Band::default();
         }
         let mut above = |t: f64| {

@@ -211,6 +211,7 @@ pub(super) const RASTER: Kind = Kind {
             "distance between passes",
         ),
         CHORD_TOLERANCE,
+        CHORDS,
         opt(
             "max_step",
             LENGTH,
@@ -310,6 +311,7 @@ pub(super) const PROFILE_TURNING: Kind = Kind {
             Check::Positive,
             "the path's tolerance: the most the program, as the machine runs it, may stray from the exact tool-centre path; default 10 nm",
         ),
+        CHORDS,
         opt(
             "from",
             LENGTH,
