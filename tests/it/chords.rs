@@ -1,10 +1,13 @@
 //! Chords on either side of the curve (#15, item 5): a strategy's
-//! `chords: on_path | straddle | clear`, built and simulated, against what
-//! each promises: the same points; on the path, convex stretches gouge by
-//! up to the chords' sag; straddling, the error split to about ±half of
-//! it (half the PV); clear, no gouge beyond the machine's resolution (the
-//! points are raised half of it more, so rounding cannot cut either). And
-//! the default: the least displacement that meets the job's `max_gouge`.
+//! `chords: on_path | straddle | straddle_long | clear`, built and
+//! simulated, against what each promises: on the path, convex stretches
+//! gouge by up to the chords' sag; straddling, the error within ±half of
+//! it (half the PV), inflections included (chords split there);
+//! straddling long chords, within ±the sag with fewer points; clear, no
+//! gouge beyond the machine's resolution (the points are raised half of it
+//! more, so rounding cannot cut either). For spirals, helices, rasters and
+//! profile turning. And the default: the least displacement that meets the
+//! job's `max_gouge`.
 
 use crate::common::{lensc, text};
 
@@ -149,6 +152,28 @@ fn on_a_fast_tool_servo_spiral_each_placement_meets_its_promise() {
     each_meets_its_promise(50.0, "waves", |c| {
         waves(c, ", accept: { max_gouge: 200 nm }")
     });
+}
+
+#[test]
+fn straddling_long_chords_takes_fewer_points_for_the_same_error() {
+    // Chords sampled to twice the share (100 nm), straddled: each within
+    // ±50 nm, the error of points on the path, with about 1/√2 of them.
+    // Measured: 2,633 points against 3,528 on the path; PV 87.5, RMS 18.9,
+    // gouge 49.0, residual 38.6 nm (on the path 92.0, 19.7, 49.3, 42.7).
+    let sag = 50.0;
+    let accept = ", accept: { max_gouge: 200 nm }";
+    let on = build(&waves(", chords: on_path", accept), "waves");
+    let long = build(&waves(", chords: straddle_long", accept), "waves");
+    assert_eq!(long.chords, "straddle_long");
+    assert!(
+        (long.points as f64) < 0.8 * on.points as f64,
+        "{long:?} {on:?}"
+    );
+    assert!(
+        long.gouge <= sag + RESOLUTION_NM && long.residual <= sag + RESOLUTION_NM,
+        "{long:?}"
+    );
+    assert!(long.gouge > 0.75 * sag, "{long:?}");
 }
 
 #[test]

@@ -31,6 +31,10 @@ pub enum ChordPlacement {
     OnPath,
     /// Off the path by half the sag: every chord within ±tolerance/2.
     Straddle,
+    /// Chords sampled to twice the sag (about √2 longer, fewer points),
+    /// straddling: every chord within ±tolerance, the largest error of
+    /// points on the path, with about 1/√2 of their number.
+    StraddleLong,
     /// Above the path by the sag and `margin` (mm): no chord enters the
     /// material, even once the points are rounded to the resolution.
     Clear { margin: f64 },
@@ -42,6 +46,7 @@ impl ChordPlacement {
         match self {
             ChordPlacement::OnPath => "on_path",
             ChordPlacement::Straddle => "straddle",
+            ChordPlacement::StraddleLong => "straddle_long",
             ChordPlacement::Clear { .. } => "clear",
         }
     }
@@ -51,17 +56,38 @@ impl ChordPlacement {
         match word {
             "on_path" => Some(ChordPlacement::OnPath),
             "straddle" => Some(ChordPlacement::Straddle),
+            "straddle_long" => Some(ChordPlacement::StraddleLong),
             "clear" => Some(ChordPlacement::Clear { margin }),
             _ => None,
         }
     }
 
-    /// The deepest a chord of sag up to `sag` cuts below the exact path
-    /// (mm) with this placement: the sag, half of it, or nothing.
+    /// How many times the chords' share its chords are sampled to: 2 for
+    /// `StraddleLong`, else 1.
+    pub fn sag_factor(self) -> f64 {
+        if self == ChordPlacement::StraddleLong {
+            2.0
+        } else {
+            1.0
+        }
+    }
+
+    /// Whether the points straddle the path (`chords::straddle`).
+    pub fn straddles(self) -> bool {
+        matches!(
+            self,
+            ChordPlacement::Straddle | ChordPlacement::StraddleLong
+        )
+    }
+
+    /// The deepest a chord cuts below the exact path (mm) with this
+    /// placement when the chords' share is `sag`: the sag, half of it, the
+    /// sag again (twice the sag, halved), or nothing.
     pub fn promised_gouge(self, sag: f64) -> f64 {
         match self {
             ChordPlacement::OnPath => sag,
             ChordPlacement::Straddle => 0.5 * sag,
+            ChordPlacement::StraddleLong => sag,
             ChordPlacement::Clear { .. } => 0.0,
         }
     }
@@ -98,7 +124,7 @@ impl ChordPlacement {
         let (hi, lo) = both.fold((0.0f64, 0.0f64), |(h, l), b| (h.max(b.hi), l.min(b.lo)));
         match self {
             ChordPlacement::OnPath => 0.0,
-            ChordPlacement::Straddle => 0.5 * (hi + lo),
+            ChordPlacement::Straddle | ChordPlacement::StraddleLong => 0.5 * (hi + lo),
             ChordPlacement::Clear { margin } => hi + margin,
         }
     }
@@ -132,31 +158,49 @@ pub struct Knot {
     pub z: f64,
 }
 
+/// How many heights `Band::samples` reads along a chord.
+const SAMPLES: usize = 34;
+
 /// A chord between two knots, with the exact path at a quarter, half and
-/// three quarters of the way between their parameters.
+/// three quarters of the way between their parameters, the heights read
+/// off the quartic through them, and the last check of its error.
 #[derive(Clone, Copy, Debug)]
 struct Span {
     inner: [Knot; 3],
     band: Band,
+    samples: [(f64, f64); SAMPLES],
+    /// The end offsets last checked and the error they gave.
+    checked: Option<(f64, f64, f64)>,
 }
 
 impl Span {
     fn new(a: &Knot, b: &Knot, inner: [Knot; 3]) -> Span {
+        let samples = Band::samples((a.u, a.z), (b.u, b.z), inner.map(|k| (k.u, k.z)));
         Span {
             inner,
-            band: Band::between((a.u, a.z), (b.u, b.z), inner.map(|k| (k.u, k.z))),
+            band: Band::of(&samples.map(|s| s.1)),
+            samples,
+            checked: None,
         }
     }
 
-    /// The largest error either way of the chord from `a` to `b` with its
-    /// ends moved up by `o0` and `o1`: the path's height above it, read
-    /// off the quartic through the three inner points and the ends.
-    fn worst(&self, a: &Knot, b: &Knot, o0: f64, o1: f64) -> f64 {
-        let samples = Band::samples((a.u, a.z), (b.u, b.z), self.inner.map(|k| (k.u, k.z)));
-        samples
+    /// The largest error either way of the chord with its ends moved up by
+    /// `o0` and `o1`: the path's height above it, read off the quartic
+    /// through the three inner points and the ends.
+    fn worst(&mut self, o0: f64, o1: f64) -> f64 {
+        if let Some((c0, c1, e)) = self.checked
+            && c0 == o0
+            && c1 == o1
+        {
+            return e;
+        }
+        let e = self
+            .samples
             .iter()
             .map(|&(t, d)| (d - ((1.0 - t) * o0 + t * o1)).abs())
-            .fold(o0.abs().max(o1.abs()), f64::max)
+            .fold(o0.abs().max(o1.abs()), f64::max);
+        self.checked = Some((o0, o1, e));
+        e
     }
 }
 
@@ -220,7 +264,7 @@ pub fn straddle(
             })
             .collect();
         let errors: Vec<f64> = (0..n - 1)
-            .map(|j| spans[j].worst(&knots[j], &knots[j + 1], offsets[j], offsets[j + 1]))
+            .map(|j| spans[j].worst(offsets[j], offsets[j + 1]))
             .collect();
         let over = |e: f64| e > bound * (1.0 + 1e-9);
         let wide = |b: Band| over(b.hi.max(-b.lo));
@@ -312,13 +356,12 @@ impl Band {
     /// there) at 33 points. Where the points do not advance along u (a
     /// chord standing upright), their heights alone.
     pub fn between(a: (f64, f64), b: (f64, f64), inner: [(f64, f64); 3]) -> Band {
-        let d: Vec<f64> = Band::samples(a, b, inner).iter().map(|s| s.1).collect();
-        Band::of(&d)
+        Band::of(&Band::samples(a, b, inner).map(|s| s.1))
     }
 
     /// The heights (t, d) `between` reads: the fraction t of the chord
     /// along u and the path's height d above it there.
-    fn samples(a: (f64, f64), b: (f64, f64), inner: [(f64, f64); 3]) -> Vec<(f64, f64)> {
+    fn samples(a: (f64, f64), b: (f64, f64), inner: [(f64, f64); 3]) -> [(f64, f64); SAMPLES] {
         let span = b.0 - a.0;
         let t = inner.map(|p| (p.0 - a.0) / span);
         let d: [f64; 3] = std::array::from_fn(|k| inner[k].1 - (a.1 + t[k] * (b.1 - a.1)));
@@ -328,17 +371,18 @@ impl Band {
             && span.is_finite()
             && nodes.windows(2).all(|w| w[1] > w[0])
             && d.iter().all(|v| v.is_finite());
+        // The chord's ends (the path on them) fill what is not read.
+        let mut out = [(0.0, 0.0); SAMPLES];
         if !advancing {
-            let t = t.map(|v| {
-                if v.is_finite() {
-                    v.clamp(0.0, 1.0)
+            for k in 0..3 {
+                let tk = if t[k].is_finite() {
+                    t[k].clamp(0.0, 1.0)
                 } else {
                     0.5
-                }
-            });
-            return (0..3)
-                .map(|k| (t[k], if d[k].is_finite() { d[k] } else { 0.0 }))
-                .collect();
+                };
+                out[k] = (tk, if d[k].is_finite() { d[k] } else { 0.0 });
+            }
+            return out;
         }
         let at = |x: f64| {
             let mut sum = 0.0;
@@ -353,13 +397,14 @@ impl Band {
             }
             sum
         };
-        (1..32)
-            .map(|k| {
-                let x = k as f64 / 32.0;
-                (x, at(x))
-            })
-            .chain((0..3).map(|k| (t[k], d[k])))
-            .collect()
+        for k in 1..32 {
+            let x = k as f64 / 32.0;
+            out[k - 1] = (x, at(x));
+        }
+        for k in 0..3 {
+            out[31 + k] = (t[k], d[k]);
+        }
+        out
     }
 
     /// The larger of two bands (`hi` the higher, `lo` the lower): one

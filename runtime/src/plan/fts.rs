@@ -376,7 +376,7 @@ impl Planner<'_> {
                 q.2 = q.2.union(p.2);
             }
         }
-        if self.spiral.chords == ChordPlacement::Straddle {
+        if self.spiral.chords.straddles() {
             kept = self.straddled(&kept, c1);
         }
         (kept, over)
@@ -390,7 +390,9 @@ impl Planner<'_> {
     /// the next revolution's first stay on the path, so every revolution
     /// is placed on its own, in parallel.
     fn straddled(&self, pts: &[(f64, f64, Band)], c1: f64) -> Vec<(f64, f64, Band)> {
-        let share = self.spiral.chord_tolerance * crate::plan::optimise::UNOPTIMISED_CHORD_SHARE;
+        let share = self.spiral.chord_tolerance
+            * crate::plan::optimise::UNOPTIMISED_CHORD_SHARE
+            * self.spiral.chords.sag_factor();
         let knot = |c: f64, w: f64| chords::Knot { s: c, u: c, z: w };
         let mut knots: Vec<chords::Knot> = pts.iter().map(|p| knot(p.0, p.1)).collect();
         let mut hint = None;
@@ -405,8 +407,11 @@ impl Planner<'_> {
         }
         let min_interval = self.spiral.min_interval;
         let speed = self.spiral.speed;
+        // Not below the servo's data period, nor where the nose cuts air
+        // (both ends above the part's top: a settling plateau's corners).
+        let air = self.bounds.part_top + self.nose_radius - 1e-9;
         let can_split = |a: &chords::Knot, b: &chords::Knot| {
-            b.s - a.s > 2.0 * speed.at(self.radius(b.s)) * min_interval
+            b.s - a.s > 2.0 * speed.at(self.radius(b.s)) * min_interval && a.z.min(b.z) < air
         };
         let (mut placed, _) = chords::straddle(
             &knots,
@@ -434,7 +439,9 @@ impl Planner<'_> {
         out: &mut Vec<(f64, f64, Band)>,
         over: &mut Option<ChordShortfall>,
     ) {
-        let tol = self.spiral.chord_tolerance * crate::plan::optimise::UNOPTIMISED_CHORD_SHARE;
+        let tol = self.spiral.chord_tolerance
+            * crate::plan::optimise::UNOPTIMISED_CHORD_SHARE
+            * self.spiral.chords.sag_factor();
         let r = self.radius(c0).max(self.spiral.seed_arc);
         let seeds = (((c1 - c0) * r / self.spiral.seed_arc).ceil() as usize).max(2);
         // The contact's offset along the ray at the last point computed:
@@ -499,7 +506,7 @@ impl Planner<'_> {
         // sampled (`straddled`).
         if matches!(
             self.spiral.chords,
-            ChordPlacement::OnPath | ChordPlacement::Straddle
+            ChordPlacement::OnPath | ChordPlacement::Straddle | ChordPlacement::StraddleLong
         ) {
             return Band::default();
         }

@@ -414,7 +414,8 @@ pub fn plan_raster(
             let pts = cutter.sample(r, *v, a, b, &mut budget, &mut summary)?;
             let mut centres: Vec<[f64; 3]> = pts.iter().map(|c| cutter.centre_xyz(*v, c)).collect();
             if r.chords != ChordPlacement::OnPath {
-                let share = r.chord_tolerance * crate::plan::optimise::CHORD_SHARE;
+                let share =
+                    r.chord_tolerance * crate::plan::optimise::CHORD_SHARE * r.chords.sag_factor();
                 centres = cutter.place(r.chords, *v, &pts, &centres, share)?;
             }
             line.push(centres);
@@ -945,7 +946,7 @@ impl<'a> Cutter<'a> {
         centres: &[[f64; 3]],
         share: f64,
     ) -> Result<Vec<[f64; 3]>, RasterError> {
-        if placement == ChordPlacement::Straddle {
+        if placement.straddles() {
             let knots: Vec<chords::Knot> = pts
                 .iter()
                 .map(|c| chords::Knot {
@@ -1071,7 +1072,7 @@ impl<'a> Cutter<'a> {
             let f = foot_on_segment(q.c, p0, p1);
             quick[i] = ((f[0] - q.c[0]).powi(2) + (f[1] - q.c[1]).powi(2)).sqrt();
         }
-        let limit = r.chord_tolerance * crate::plan::optimise::CHORD_SHARE;
+        let limit = r.chord_tolerance * crate::plan::optimise::CHORD_SHARE * r.chords.sag_factor();
         // The distances by √(dx² + dy²), within a few ulps of `hypot`'s,
         // settle almost every chord; one those ulps could turn is measured
         // again with `hypot`, so each decision is the one its distances give.

@@ -580,7 +580,7 @@ fn cut_path(section: &Section, rho: f64, strat: &ProfileTurning) -> Vec<Vector2<
         start,
         end,
     } = *section;
-    let tol = strat.chord_tolerance * crate::plan::optimise::CHORD_SHARE;
+    let tol = strat.chord_tolerance * crate::plan::optimise::CHORD_SHARE * placement.sag_factor();
     // The ends of the cut in the tool's x: the normal offsets of its ends.
     let (x0, x1) = (
         tool_centre(profile, rho, start).x,
@@ -675,7 +675,7 @@ fn placed(
     params: &[f64],
     share: f64,
 ) -> Vec<Vector2<f64>> {
-    if placement == ChordPlacement::Straddle {
+    if placement.straddles() {
         let knots: Vec<chords::Knot> = pts
             .iter()
             .zip(params)
