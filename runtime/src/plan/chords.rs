@@ -15,7 +15,11 @@
 //!   sag (the mean of the two chords it joins), so a chord errs by about
 //!   +s/2 at its ends and −s/2 at its middle: ±tolerance/2 for the same
 //!   points (on a concave stretch the points move into the material, by
-//!   half the sag there).
+//!   half the sag there). Where a chord bending one way meets one bending
+//!   the other no shared offset splits both, so `straddle` splits the
+//!   chords left beyond ±tolerance/2 until none is.
+//! - `StraddleLong`: the chords sampled to twice the tolerance (about √2
+//!   longer, fewer points), then straddled: ±tolerance, as on the path.
 //! - `Clear`: each point raised by the most the path rises above either
 //!   chord it joins (0 where neither gouges), so both ends of every chord
 //!   are at least that far above the exact path and no chord enters the
