@@ -86,6 +86,7 @@ fn main() {
         max_step: None,
         lin_angle: None,
         retract: 0.5,
+        chords: lensc_runtime::plan::chords::ChordPlacement::OnPath,
     };
     let tool = RasterTool::Ball { radius: BALL };
     let aperture = Domain::Circle { radius: APERTURE };

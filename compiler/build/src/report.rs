@@ -228,6 +228,10 @@ pub struct ProfileTurning {
     pub seams: Vec<Seam>,
     /// What optimisation (arcs, merged lines) did to the program.
     pub optimisation: Optimisation,
+    /// Where the finish pass's points sit across the curve of the path:
+    /// `on_path`, `straddle` or `clear` (the strategy's `chords`, or the
+    /// default the job's `max_gouge` chose).
+    pub chords: String,
 }
 
 impl ProfileTurning {
@@ -277,6 +281,7 @@ impl ProfileTurning {
                 })
                 .collect(),
             optimisation: optimised.into(),
+            chords: job.strategy.chords.word().to_string(),
         }
     }
 }
@@ -568,6 +573,10 @@ pub struct Raster {
     /// The smallest concave radius of curvature along the cut (mm) and
     /// where, or null if there is none.
     pub min_concave_radius_along_mm: Option<AtPoint>,
+    /// Where the points sit across the curve of each pass: `on_path`,
+    /// `straddle` or `clear` (the strategy's `chords`, or the default the
+    /// job's `max_gouge` chose).
+    pub chords: String,
 }
 
 impl Raster {
@@ -595,6 +604,7 @@ impl Raster {
                 .min_concave_radius_along
                 .as_ref()
                 .map(|e| AtPoint::of(e, 1.0)),
+            chords: raster.chords.word().to_string(),
         }
     }
 }

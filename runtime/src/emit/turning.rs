@@ -3,7 +3,8 @@
 use super::{Emitted, optimisation_words, tolerance_words, x_word};
 use crate::moves::Move;
 use crate::moves::{self, Position, Start};
-use crate::plan::optimise::{self, optimise};
+use crate::plan::chords::ChordPlacement;
+use crate::plan::optimise;
 use crate::plan::turning::{Feed, PassRates, Toolpath, TurningJob};
 use crate::post::header::{Provenance, duration, exact, exact_in, num};
 use crate::post::{ProgramError, ProgramWriter, Setup};
@@ -65,10 +66,12 @@ pub fn emit(
         format!("estimated cutting time {}", duration(path.cutting_time())),
     ];
     let tolerance = job.strategy.chord_tolerance;
-    let (stream, summary) = optimise(
+    // Points placed clear of the material are not fitted back into it.
+    let (stream, summary) = optimise::optimise_within(
         &turning_moves(job, path),
         tolerance * optimise::FIT_SHARE,
         &job.machine.dialect.arc_planes,
+        matches!(job.strategy.chords, ChordPlacement::Clear { .. }),
     );
     let mut header = header.to_vec();
     header.push(optimisation_words(&summary));

@@ -15,7 +15,11 @@
 //!   sag (the mean of the two chords it joins), so a chord errs by about
 //!   +s/2 at its ends and −s/2 at its middle: ±tolerance/2 for the same
 //!   points (on a concave stretch the points move into the material, by
-//!   half the sag there).
+//!   half the sag there). Where a chord bending one way meets one bending
+//!   the other no shared offset splits both, so `straddle` splits the
+//!   chords left beyond ±tolerance/2 until none is.
+//! - `StraddleLong`: the chords sampled to twice the tolerance (about √2
+//!   longer, fewer points), then straddled: ±tolerance, as on the path.
 //! - `Clear`: each point raised by the most the path rises above either
 //!   chord it joins (0 where neither gouges), so both ends of every chord
 //!   are at least that far above the exact path and no chord enters the
@@ -31,6 +35,10 @@ pub enum ChordPlacement {
     OnPath,
     /// Off the path by half the sag: every chord within ±tolerance/2.
     Straddle,
+    /// Chords sampled to twice the sag (about √2 longer, fewer points),
+    /// straddling: every chord within ±tolerance, the largest error of
+    /// points on the path, with about 1/√2 of their number.
+    StraddleLong,
     /// Above the path by the sag and `margin` (mm): no chord enters the
     /// material, even once the points are rounded to the resolution.
     Clear { margin: f64 },
@@ -42,6 +50,7 @@ impl ChordPlacement {
         match self {
             ChordPlacement::OnPath => "on_path",
             ChordPlacement::Straddle => "straddle",
+            ChordPlacement::StraddleLong => "straddle_long",
             ChordPlacement::Clear { .. } => "clear",
         }
     }
@@ -51,17 +60,38 @@ impl ChordPlacement {
         match word {
             "on_path" => Some(ChordPlacement::OnPath),
             "straddle" => Some(ChordPlacement::Straddle),
+            "straddle_long" => Some(ChordPlacement::StraddleLong),
             "clear" => Some(ChordPlacement::Clear { margin }),
             _ => None,
         }
     }
 
-    /// The deepest a chord of sag up to `sag` cuts below the exact path
-    /// (mm) with this placement: the sag, half of it, or nothing.
+    /// How many times the chords' share its chords are sampled to: 2 for
+    /// `StraddleLong`, else 1.
+    pub fn sag_factor(self) -> f64 {
+        if self == ChordPlacement::StraddleLong {
+            2.0
+        } else {
+            1.0
+        }
+    }
+
+    /// Whether the points straddle the path (`chords::straddle`).
+    pub fn straddles(self) -> bool {
+        matches!(
+            self,
+            ChordPlacement::Straddle | ChordPlacement::StraddleLong
+        )
+    }
+
+    /// The deepest a chord cuts below the exact path (mm) with this
+    /// placement when the chords' share is `sag`: the sag, half of it, the
+    /// sag again (twice the sag, halved), or nothing.
     pub fn promised_gouge(self, sag: f64) -> f64 {
         match self {
             ChordPlacement::OnPath => sag,
             ChordPlacement::Straddle => 0.5 * sag,
+            ChordPlacement::StraddleLong => sag,
             ChordPlacement::Clear { .. } => 0.0,
         }
     }
@@ -72,9 +102,17 @@ impl ChordPlacement {
     /// meets a job's `max_gouge` (`Clear` with `margin` when nothing else
     /// does).
     pub fn least_for(sag: f64, max_gouge: f64, margin: f64) -> ChordPlacement {
+        ChordPlacement::least_for_fitted(sag, 0.0, max_gouge, margin)
+    }
+
+    /// `least_for`, for a path whose lines and arcs are then fitted within
+    /// `fit` (mm) of the placed points (`plan::optimise`): on the path or
+    /// straddling, a fit may pass that much further into the material;
+    /// clear, no fit passes below the placed points.
+    pub fn least_for_fitted(sag: f64, fit: f64, max_gouge: f64, margin: f64) -> ChordPlacement {
         [ChordPlacement::OnPath, ChordPlacement::Straddle]
             .into_iter()
-            .find(|p| p.promised_gouge(sag) <= max_gouge)
+            .find(|p| p.promised_gouge(sag) + fit <= max_gouge)
             .unwrap_or(ChordPlacement::Clear { margin })
     }
 
@@ -90,10 +128,194 @@ impl ChordPlacement {
         let (hi, lo) = both.fold((0.0f64, 0.0f64), |(h, l), b| (h.max(b.hi), l.min(b.lo)));
         match self {
             ChordPlacement::OnPath => 0.0,
-            ChordPlacement::Straddle => 0.5 * (hi + lo),
+            ChordPlacement::Straddle | ChordPlacement::StraddleLong => 0.5 * (hi + lo),
             ChordPlacement::Clear { margin } => hi + margin,
         }
     }
+}
+
+/// Moves each point of a path that is a graph z(u) (`pts`, its points
+/// (u, z) in order) out of the material by its placement's offset, given
+/// the band of each chord (`bands[j]` of the chord from point j to j + 1).
+/// The path's first and last points have one chord each.
+pub fn place_graph(placement: ChordPlacement, pts: &mut [(f64, f64)], bands: &[Band]) {
+    if placement == ChordPlacement::OnPath {
+        return;
+    }
+    let offsets: Vec<f64> = (0..pts.len())
+        .map(|i| {
+            let before = i.checked_sub(1).and_then(|j| bands.get(j)).copied();
+            placement.offset(before, bands.get(i).copied())
+        })
+        .collect();
+    for (p, o) in pts.iter_mut().zip(offsets) {
+        p.1 += o;
+    }
+}
+
+/// A programmed point of a path that is a graph z(u): at parameter `s`
+/// of the exact path, at (u, z).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Knot {
+    pub s: f64,
+    pub u: f64,
+    pub z: f64,
+}
+
+/// How many heights `Band::samples` reads along a chord.
+const SAMPLES: usize = 34;
+
+/// A chord between two knots, with the exact path at a quarter, half and
+/// three quarters of the way between their parameters, the heights read
+/// off the quartic through them, and the last check of its error.
+#[derive(Clone, Copy, Debug)]
+struct Span {
+    inner: [Knot; 3],
+    band: Band,
+    samples: [(f64, f64); SAMPLES],
+    /// The end offsets last checked and the error they gave.
+    checked: Option<(f64, f64, f64)>,
+}
+
+impl Span {
+    fn new(a: &Knot, b: &Knot, inner: [Knot; 3]) -> Span {
+        let samples = Band::samples((a.u, a.z), (b.u, b.z), inner.map(|k| (k.u, k.z)));
+        Span {
+            inner,
+            band: Band::of(&samples.map(|s| s.1)),
+            samples,
+            checked: None,
+        }
+    }
+
+    /// The largest error either way of the chord with its ends moved up by
+    /// `o0` and `o1`: the path's height above it, read off the quartic
+    /// through the three inner points and the ends.
+    fn worst(&mut self, o0: f64, o1: f64) -> f64 {
+        if let Some((c0, c1, e)) = self.checked
+            && c0 == o0
+            && c1 == o1
+        {
+            return e;
+        }
+        let e = self
+            .samples
+            .iter()
+            .map(|&(t, d)| (d - ((1.0 - t) * o0 + t * o1)).abs())
+            .fold(o0.abs().max(o1.abs()), f64::max);
+        self.checked = Some((o0, o1, e));
+        e
+    }
+}
+
+/// What straddling a path did: the chords split where their neighbours
+/// bent the other way, and the largest error left either way (mm).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Straddled {
+    pub splits: usize,
+    pub worst: f64,
+}
+
+/// Rounds of splitting before straddling gives up on a chord (each halves
+/// the chords it splits, quartering their sag).
+const SPLIT_ROUNDS: usize = 24;
+
+/// Places the knots of a path (on the exact path, in order) so that every
+/// chord errs by at most `bound` (mm) either way: each knot moved up by the
+/// middle of the band its chords span together (`ChordPlacement::offset`),
+/// the first and last by `pins` where given (a knot another run shares).
+/// Where chords bending opposite ways meet, no shared offset splits both
+/// (a chord of sag s beside one of sag −s needs its end at +s/2 and −s/2
+/// at once): each chord left beyond the bound is split at its middle, as
+/// is any neighbour whose band exceeds the bound, and the offsets are found
+/// again, until every chord is within it or `can_split` refuses (a servo's
+/// data period). `exact(s)` is the exact path's (u, z) at parameter s.
+pub fn straddle(
+    knots: &[Knot],
+    pins: (Option<f64>, Option<f64>),
+    bound: f64,
+    exact: &mut dyn FnMut(f64) -> (f64, f64),
+    can_split: &dyn Fn(&Knot, &Knot) -> bool,
+) -> (Vec<Knot>, Straddled) {
+    let mut at = |s: f64| {
+        let (u, z) = exact(s);
+        Knot { s, u, z }
+    };
+    let mut knots = knots.to_vec();
+    if knots.len() < 2 {
+        return (knots, Straddled::default());
+    }
+    let quarters = |a: &Knot, b: &Knot, at: &mut dyn FnMut(f64) -> Knot| {
+        [0.25, 0.5, 0.75].map(|f| at(a.s + f * (b.s - a.s)))
+    };
+    let mut spans: Vec<Span> = knots
+        .windows(2)
+        .map(|w| Span::new(&w[0], &w[1], quarters(&w[0], &w[1], &mut at)))
+        .collect();
+    let mut summary = Straddled::default();
+    let mut offsets = Vec::new();
+    for round in 0..=SPLIT_ROUNDS {
+        let n = knots.len();
+        offsets = (0..n)
+            .map(|i| {
+                let before = i.checked_sub(1).map(|j| spans[j].band);
+                let after = spans.get(i).map(|sp| sp.band);
+                match (i, pins) {
+                    (0, (Some(o), _)) => o,
+                    (i, (_, Some(o))) if i == n - 1 => o,
+                    _ => ChordPlacement::Straddle.offset(before, after),
+                }
+            })
+            .collect();
+        let errors: Vec<f64> = (0..n - 1)
+            .map(|j| spans[j].worst(offsets[j], offsets[j + 1]))
+            .collect();
+        let over = |e: f64| e > bound * (1.0 + 1e-9);
+        let wide = |b: Band| over(b.hi.max(-b.lo));
+        let mut split = vec![false; n - 1];
+        for j in (0..n - 1).filter(|&j| over(errors[j])) {
+            split[j] = true;
+            if j > 0 && wide(spans[j - 1].band) {
+                split[j - 1] = true;
+            }
+            if j + 2 < n && wide(spans[j + 1].band) {
+                split[j + 1] = true;
+            }
+        }
+        for (j, s) in split.iter_mut().enumerate() {
+            *s = *s && can_split(&knots[j], &knots[j + 1]);
+        }
+        if round == SPLIT_ROUNDS || !split.contains(&true) {
+            summary.worst = errors.into_iter().fold(0.0, f64::max);
+            break;
+        }
+        let mut new_knots = Vec::with_capacity(n + 8);
+        let mut new_spans = Vec::with_capacity(n + 8);
+        for j in 0..n - 1 {
+            let (a, b) = (knots[j], knots[j + 1]);
+            new_knots.push(a);
+            if split[j] {
+                let sp = spans[j];
+                let mid = sp.inner[1];
+                let eighth = |f: f64, at: &mut dyn FnMut(f64) -> Knot| at(a.s + f * (b.s - a.s));
+                let left = [eighth(0.125, &mut at), sp.inner[0], eighth(0.375, &mut at)];
+                let right = [eighth(0.625, &mut at), sp.inner[2], eighth(0.875, &mut at)];
+                new_spans.push(Span::new(&a, &mid, left));
+                new_knots.push(mid);
+                new_spans.push(Span::new(&mid, &b, right));
+                summary.splits += 1;
+            } else {
+                new_spans.push(spans[j]);
+            }
+        }
+        new_knots.push(knots[n - 1]);
+        knots = new_knots;
+        spans = new_spans;
+    }
+    for (k, o) in knots.iter_mut().zip(offsets) {
+        k.z += o;
+    }
+    (knots, summary)
 }
 
 /// How far the exact path lies above a chord (mm): at most `hi`, at least
@@ -129,6 +351,64 @@ impl Band {
         };
         let d: Vec<f64> = (1..32).map(|k| at(k as f64 / 32.0)).chain(q).collect();
         Band::of(&d)
+    }
+
+    /// The band of the chord from `a` to `b`, points (u, z) of a path
+    /// that is a graph z(u), given three points of the exact path between
+    /// them in order along u: each one's height above the chord at its own
+    /// u, read off the quartic through those and the chord's ends (zero
+    /// there) at 33 points. Where the points do not advance along u (a
+    /// chord standing upright), their heights alone.
+    pub fn between(a: (f64, f64), b: (f64, f64), inner: [(f64, f64); 3]) -> Band {
+        Band::of(&Band::samples(a, b, inner).map(|s| s.1))
+    }
+
+    /// The heights (t, d) `between` reads: the fraction t of the chord
+    /// along u and the path's height d above it there.
+    fn samples(a: (f64, f64), b: (f64, f64), inner: [(f64, f64); 3]) -> [(f64, f64); SAMPLES] {
+        let span = b.0 - a.0;
+        let t = inner.map(|p| (p.0 - a.0) / span);
+        let d: [f64; 3] = std::array::from_fn(|k| inner[k].1 - (a.1 + t[k] * (b.1 - a.1)));
+        let nodes = [0.0, t[0], t[1], t[2], 1.0];
+        let values = [0.0, d[0], d[1], d[2], 0.0];
+        let advancing = span != 0.0
+            && span.is_finite()
+            && nodes.windows(2).all(|w| w[1] > w[0])
+            && d.iter().all(|v| v.is_finite());
+        // The chord's ends (the path on them) fill what is not read.
+        let mut out = [(0.0, 0.0); SAMPLES];
+        if !advancing {
+            for k in 0..3 {
+                let tk = if t[k].is_finite() {
+                    t[k].clamp(0.0, 1.0)
+                } else {
+                    0.5
+                };
+                out[k] = (tk, if d[k].is_finite() { d[k] } else { 0.0 });
+            }
+            return out;
+        }
+        let at = |x: f64| {
+            let mut sum = 0.0;
+            for k in 1..4 {
+                let mut w = values[k];
+                for m in 0..5 {
+                    if m != k {
+                        w *= (x - nodes[m]) / (nodes[k] - nodes[m]);
+                    }
+                }
+                sum += w;
+            }
+            sum
+        };
+        for k in 1..32 {
+            let x = k as f64 / 32.0;
+            out[k - 1] = (x, at(x));
+        }
+        for k in 0..3 {
+            out[31 + k] = (t[k], d[k]);
+        }
+        out
     }
 
     /// The larger of two bands (`hi` the higher, `lo` the lower): one
@@ -225,6 +505,97 @@ mod tests {
             (band.lo - fine.lo).abs() < 0.01 * -fine.lo,
             "{band:?} {fine:?}"
         );
+    }
+
+    /// The largest error either way of the chords between `knots` against
+    /// the exact path `z(u)`, at 201 points along each.
+    fn graph_errors(knots: &[Knot], z: impl Fn(f64) -> f64) -> f64 {
+        knots
+            .windows(2)
+            .flat_map(|w| {
+                (0..=200).map(move |k| {
+                    let t = k as f64 / 200.0;
+                    let u = w[0].u + t * (w[1].u - w[0].u);
+                    (w[0].z + t * (w[1].z - w[0].z), u)
+                })
+            })
+            .map(|(chord, u)| (chord - z(u)).abs())
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn straddling_holds_half_the_sag_through_inflections() {
+        // A sine 1 µm high, sampled as the planners sample: chords halved
+        // until their middles are within 40 nm, so around the inflections,
+        // where the sine is nearly straight, they are long and sag as much
+        // as at the crests, one way beside the other.
+        let amp = 1e-3;
+        let z = |u: f64| amp * u.sin();
+        let sag = 40e-6;
+        let mut knots = vec![Knot {
+            s: 0.0,
+            u: 0.0,
+            z: 0.0,
+        }];
+        // Seeds twice the crests' chord apart (√(8 · sag / amp) = 0.566).
+        let width = 2.0 * (8.0 * sag / amp).sqrt() * 0.999;
+        for seed in 0..18 {
+            let a = seed as f64 * width;
+            let mut stack = vec![(a, a + width)];
+            while let Some((a, b)) = stack.pop() {
+                let m = 0.5 * (a + b);
+                if (z(m) - 0.5 * (z(a) + z(b))).abs() > sag {
+                    stack.push((m, b));
+                    stack.push((a, m));
+                } else {
+                    knots.push(Knot {
+                        s: b,
+                        u: b,
+                        z: z(b),
+                    });
+                }
+            }
+        }
+        assert!(graph_errors(&knots, z) > 0.9 * sag);
+        // Each point moved by the middle of its chords' band alone: beyond
+        // half the sag at the inflections (22.3 nm, 0.56 of it).
+        let bands: Vec<Band> = knots
+            .windows(2)
+            .map(|w| {
+                let inner = [0.25, 0.5, 0.75].map(|f| {
+                    let u = w[0].u + f * (w[1].u - w[0].u);
+                    (u, z(u))
+                });
+                Band::between((w[0].u, w[0].z), (w[1].u, w[1].z), inner)
+            })
+            .collect();
+        let mut graph: Vec<(f64, f64)> = knots.iter().map(|k| (k.u, k.z)).collect();
+        place_graph(ChordPlacement::Straddle, &mut graph, &bands);
+        let moved: Vec<Knot> = graph.iter().map(|&(u, z)| Knot { s: u, u, z }).collect();
+        let unsplit = graph_errors(&moved, z);
+        assert!(unsplit > 0.55 * sag, "{unsplit}");
+        // Straddled, chords split where that cannot hold: within half the
+        // sag everywhere.
+        let mut exact = |s: f64| (s, z(s));
+        let (placed, summary) = straddle(&knots, (None, None), 0.5 * sag, &mut exact, &|_, _| true);
+        let err = graph_errors(&placed, z);
+        assert!(err <= 0.5 * sag * 1.001, "{err} {summary:?}");
+        assert!(
+            (summary.worst - err).abs() < 0.01 * sag,
+            "{err} {summary:?}"
+        );
+        assert!(summary.splits > 0 && placed.len() == knots.len() + summary.splits);
+        // Pinned ends stay where they are pinned.
+        let (pinned, _) = straddle(
+            &knots,
+            (Some(0.0), Some(0.0)),
+            0.5 * sag,
+            &mut exact,
+            &|_, _| true,
+        );
+        assert_eq!(pinned[0], knots[0]);
+        assert_eq!(pinned[pinned.len() - 1], knots[knots.len() - 1]);
+        assert!(graph_errors(&pinned, z) <= 0.5 * sag * 1.001);
     }
 
     #[test]

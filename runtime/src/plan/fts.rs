@@ -26,7 +26,7 @@
 
 use std::ops::ControlFlow;
 
-use crate::plan::chords::{Band, ChordPlacement};
+use crate::plan::chords::{self, Band, ChordPlacement};
 use crate::plan::envelope;
 use crate::surface::ir::SurfaceFn;
 use crate::surface::{Profile, ProfilePoint};
@@ -376,7 +376,57 @@ impl Planner<'_> {
                 q.2 = q.2.union(p.2);
             }
         }
+        if self.spiral.chords.straddles() {
+            kept = self.straddled(&kept, c1);
+        }
         (kept, over)
+    }
+
+    /// The revolution's points `pts`, up to the next revolution's first at
+    /// `c1`, moved in W to straddle the exact path (`plan::chords`): each
+    /// chord within half the chords' share either way, chords split where
+    /// their neighbours bend the other way (down to the servo's data
+    /// period). Its first point, which the revolution before shares, and
+    /// the next revolution's first stay on the path, so every revolution
+    /// is placed on its own, in parallel.
+    fn straddled(&self, pts: &[(f64, f64, Band)], c1: f64) -> Vec<(f64, f64, Band)> {
+        let share = self.spiral.chord_tolerance
+            * crate::plan::optimise::UNOPTIMISED_CHORD_SHARE
+            * self.spiral.chords.sag_factor();
+        let knot = |c: f64, w: f64| chords::Knot { s: c, u: c, z: w };
+        let mut knots: Vec<chords::Knot> = pts.iter().map(|p| knot(p.0, p.1)).collect();
+        let mut hint = None;
+        let mut exact = |c: f64| {
+            let (w, h) = self.centre_near(c, hint);
+            hint = Some(h);
+            (c, w)
+        };
+        let last = knots.last().map(|k| k.s);
+        if last.is_some_and(|l| c1 > l) {
+            knots.push(knot(c1, exact(c1).1));
+        }
+        let min_interval = self.spiral.min_interval;
+        let speed = self.spiral.speed;
+        // Not below the servo's data period, nor where the nose cuts air
+        // (both ends above the part's top: a settling plateau's corners).
+        let air = self.bounds.part_top + self.nose_radius - 1e-9;
+        let can_split = |a: &chords::Knot, b: &chords::Knot| {
+            b.s - a.s > 2.0 * speed.at(self.radius(b.s)) * min_interval && a.z.min(b.z) < air
+        };
+        let (mut placed, _) = chords::straddle(
+            &knots,
+            (Some(0.0), Some(0.0)),
+            0.5 * share,
+            &mut exact,
+            &can_split,
+        );
+        if last.is_some_and(|l| c1 > l) {
+            placed.pop();
+        }
+        placed
+            .into_iter()
+            .map(|k| (k.s, k.z, Band::default()))
+            .collect()
     }
 
     /// Samples [c0, c1) into `out`: seeds a seed arc apart, each interval
@@ -389,7 +439,9 @@ impl Planner<'_> {
         out: &mut Vec<(f64, f64, Band)>,
         over: &mut Option<ChordShortfall>,
     ) {
-        let tol = self.spiral.chord_tolerance * crate::plan::optimise::UNOPTIMISED_CHORD_SHARE;
+        let tol = self.spiral.chord_tolerance
+            * crate::plan::optimise::UNOPTIMISED_CHORD_SHARE
+            * self.spiral.chords.sag_factor();
         let r = self.radius(c0).max(self.spiral.seed_arc);
         let seeds = (((c1 - c0) * r / self.spiral.seed_arc).ceil() as usize).max(2);
         // The contact's offset along the ray at the last point computed:
@@ -450,7 +502,12 @@ impl Planner<'_> {
         right: (f64, f64),
         hint: &mut f64,
     ) -> Band {
-        if self.spiral.chords == ChordPlacement::OnPath {
+        // Straddling measures its chords itself, once the revolution is
+        // sampled (`straddled`).
+        if matches!(
+            self.spiral.chords,
+            ChordPlacement::OnPath | ChordPlacement::Straddle | ChordPlacement::StraddleLong
+        ) {
             return Band::default();
         }
         let mut above = |t: f64| {

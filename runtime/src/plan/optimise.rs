@@ -52,10 +52,28 @@ pub struct Summary {
     pub tolerance: f64,
 }
 
+/// How far below the polyline (mm, towards −Z, into the material) a fit
+/// held above it may pass: the rounding of its own arithmetic.
+pub const ABOVE_SLACK: f64 = 1e-12;
+
 /// Optimises `stream` with fits held to `tolerance` (mm), arcs only in
 /// `arc_planes`. Rapids, spindle moves, moves with C, inverse-time moves
 /// and feed changes are kept as they are and break runs.
 pub fn optimise(stream: &[Move], tolerance: f64, arc_planes: &[Plane]) -> (Vec<Move>, Summary) {
+    optimise_within(stream, tolerance, arc_planes, false)
+}
+
+/// `optimise`, and with `above` every fitted line or arc also kept on or
+/// above the polyline it replaces (+Z, out of the material; within
+/// `ABOVE_SLACK`): points placed clear of the material (`chords: clear`)
+/// are not fitted back into it. Arcs in a plane without Z are then not
+/// fitted.
+pub fn optimise_within(
+    stream: &[Move],
+    tolerance: f64,
+    arc_planes: &[Plane],
+    above: bool,
+) -> (Vec<Move>, Summary) {
     let mut out = Vec::with_capacity(stream.len());
     let mut summary = Summary {
         moves_before: stream.len(),
@@ -100,7 +118,7 @@ pub fn optimise(stream: &[Move], tolerance: f64, arc_planes: &[Plane]) -> (Vec<M
                 template.c,
                 (first_feed, rest_feed),
                 arc_planes,
-                tolerance,
+                Sides { tolerance, above },
                 &mut out,
                 &mut summary,
             );
@@ -170,6 +188,14 @@ fn run_length(stream: &[Move], i: usize, at: &[f64; 4], feed_in_force: Option<Fe
     j
 }
 
+/// The tolerance a fit is held to, and whether it must also stay on or
+/// above the polyline it replaces.
+#[derive(Clone, Copy, Debug)]
+struct Sides {
+    tolerance: f64,
+    above: bool,
+}
+
 /// Fits lines and arcs to the polyline `points` (X, Y, Z; NaN on axes the
 /// run does not move; C held at `c`) and appends the moves that replace
 /// it, the first with `feeds.0`, the others with `feeds.1`.
@@ -178,10 +204,12 @@ fn fit_run(
     c: f64,
     feeds: (Option<Feed>, Option<Feed>),
     arc_planes: &[Plane],
-    tol: f64,
+    sides: Sides,
     out: &mut Vec<Move>,
     summary: &mut Summary,
 ) {
+    let tol = sides.tolerance;
+    let above = sides.above;
     // The plane of the run: the axis off it does not change.
     let plane = [Plane::Zx, Plane::Xy, Plane::Yz].into_iter().find(|p| {
         let (a, b) = p.axes();
@@ -201,13 +229,15 @@ fn fit_run(
     let mut i = 0;
     while i < n {
         let feed = if i == 0 { feeds.0 } else { feeds.1 };
-        let line_to = longest(i, n, |j| line_fits(&points[i..=j], tol));
+        let line_to = longest(i, n, |j| {
+            line_fits(&points[i..=j], tol) && (!above || line_above(&points[i..=j]))
+        });
         let arc = plane.and_then(|p| {
             let j = longest(i, n, |j| {
-                j >= i + 2 && arc_fit(&points[i..=j], p, tol).is_some()
+                j >= i + 2 && arc_fit(&points[i..=j], p, tol, above).is_some()
             });
             (j >= i + 2 && j > line_to)
-                .then(|| arc_fit(&points[i..=j], p, tol).map(|fit| (j, p, fit)))
+                .then(|| arc_fit(&points[i..=j], p, tol, above).map(|fit| (j, p, fit)))
                 .flatten()
         });
         match arc {
@@ -313,6 +343,29 @@ fn line_fits(pts: &[[f64; 3]], tol: f64) -> bool {
     pts.len() <= 2 || line_deviation(pts).is_some_and(|d| d <= tol)
 }
 
+/// Whether the straight line between the polyline's ends is nowhere below
+/// it: no inner point above the line by more than `ABOVE_SLACK` (the
+/// polyline is straight between its points, so its points decide).
+fn line_above(pts: &[[f64; 3]]) -> bool {
+    let (a, b) = (&pts[0], &pts[pts.len() - 1]);
+    let ab = sub(b, a);
+    let len2 = dot(&ab, &ab);
+    if len2 == 0.0 {
+        return pts.len() <= 2;
+    }
+    pts[1..pts.len() - 1].iter().all(|p| {
+        let ap = sub(p, a);
+        let t = dot(&ap, &ab) / len2;
+        // The point's rise above its foot on the line, along Z.
+        let rise = if ap[2].is_nan() {
+            0.0
+        } else {
+            ap[2] - t * ab[2]
+        };
+        rise <= ABOVE_SLACK
+    })
+}
+
 /// A circle fitted to a run of points.
 #[derive(Clone, Copy, Debug)]
 struct ArcFit {
@@ -326,9 +379,20 @@ struct ArcFit {
 /// The circle through the first, middle and last of `pts` in `plane`, if
 /// every point and every chord between them lies within `tol` of it, the
 /// points advance monotonically around it and it turns less than half a
-/// revolution.
-fn arc_fit(pts: &[[f64; 3]], plane: Plane, tol: f64) -> Option<ArcFit> {
+/// revolution; with `above`, only if the arc is also nowhere below the
+/// polyline (towards −Z, beyond `ABOVE_SLACK`), and never in a plane
+/// without Z.
+fn arc_fit(pts: &[[f64; 3]], plane: Plane, tol: f64, above: bool) -> Option<ArcFit> {
     let (ia, ib) = plane.axes();
+    // Which of the plane's two axes is Z, if either.
+    let up = match (ia, ib) {
+        (2, _) => Some(0),
+        (_, 2) => Some(1),
+        _ => None,
+    };
+    if above && up.is_none() {
+        return None;
+    }
     let p2 = |q: &[f64; 3]| (q[ia], q[ib]);
     let (a, m, b) = (
         p2(&pts[0]),
@@ -366,6 +430,21 @@ fn arc_fit(pts: &[[f64; 3]], plane: Plane, tol: f64) -> Option<ArcFit> {
         return None;
     }
     let dist = |p: (f64, f64)| ((p.0 - centre.0).powi(2) + (p.1 - centre.1).powi(2)).sqrt();
+    // With `above`: whether leaving the circle outwards is going up, at
+    // the arc's middle (the arc turns less than half a revolution, and
+    // one that stands upright there is not fitted).
+    let outward_up = if above {
+        let rise = match up {
+            Some(0) => m.0 - centre.0,
+            _ => m.1 - centre.1,
+        };
+        if rise == 0.0 {
+            return None;
+        }
+        rise > 0.0
+    } else {
+        true
+    };
     let mut last = 0.0;
     let mut worst: f64 = 0.0;
     for w in pts.windows(2) {
@@ -380,9 +459,26 @@ fn arc_fit(pts: &[[f64; 3]], plane: Plane, tol: f64) -> Option<ArcFit> {
         let (dx, dy) = (q.0 - p.0, q.1 - p.1);
         let len2 = dx * dx + dy * dy;
         let mut dev = (dist(p) - r).abs().max((dist(q) - r).abs());
+        // The chord's nearest approach to the centre, its radial offset.
+        let mut nearest = (dist(p) - r).min(dist(q) - r);
         if len2 > 0.0 {
             let s = (((centre.0 - p.0) * dx + (centre.1 - p.1) * dy) / len2).clamp(0.0, 1.0);
-            dev = dev.max((dist((p.0 + s * dx, p.1 + s * dy)) - r).abs());
+            let foot = dist((p.0 + s * dx, p.1 + s * dy)) - r;
+            dev = dev.max(foot.abs());
+            nearest = nearest.min(foot);
+        }
+        if above {
+            // The polyline above the arc: outside it where outward is up
+            // (its points decide, the disc being convex), inside it where
+            // outward is down (its chords' nearest approach decides).
+            let below_by = if outward_up {
+                (dist(p) - r).max(dist(q) - r)
+            } else {
+                -nearest
+            };
+            if below_by > ABOVE_SLACK {
+                return None;
+            }
         }
         worst = worst.max(dev);
         if worst > tol {

@@ -27,6 +27,7 @@
 //!
 //! Units: mm and rad. +z points out of the material, towards the tool.
 
+use crate::plan::chords::{self, Band, ChordPlacement};
 use crate::surface::analysis::{Domain, Extremum};
 use crate::surface::ir::SurfaceFn;
 
@@ -59,6 +60,9 @@ pub struct Raster {
     pub lin_angle: Option<f64>,
     /// Height (mm) of the rapid plane above the highest tool-centre point.
     pub retract: f64,
+    /// Where the points sit across the curve of each pass (`plan::chords`),
+    /// each moved along Z by the bands of its chords.
+    pub chords: ChordPlacement,
 }
 
 /// The cutter, referenced at the centre of its nose circle or ball.
@@ -408,11 +412,13 @@ pub fn plan_raster(
         let mut line = Vec::with_capacity(spans.len());
         for &(a, b) in spans {
             let pts = cutter.sample(r, *v, a, b, &mut budget, &mut summary)?;
-            line.push(
-                pts.iter()
-                    .map(|c| cutter.centre_xyz(*v, c))
-                    .collect::<Vec<_>>(),
-            );
+            let mut centres: Vec<[f64; 3]> = pts.iter().map(|c| cutter.centre_xyz(*v, c)).collect();
+            if r.chords != ChordPlacement::OnPath {
+                let share =
+                    r.chord_tolerance * crate::plan::optimise::CHORD_SHARE * r.chords.sag_factor();
+                centres = cutter.place(r.chords, *v, &pts, &centres, share)?;
+            }
+            line.push(centres);
         }
         if r.zigzag && j % 2 == 1 {
             line.reverse();
@@ -1072,6 +1078,74 @@ impl<'a> Cutter<'a> {
         Ok(scan)
     }
 
+    /// The centres `centres` of the pass's contacts `pts` on the plane at
+    /// `plane`, moved along Z by `placement`'s offset for the bands of the
+    /// chords each joins (`plan::chords`): the exact centre path's height
+    /// above each chord at the centres of the contacts a quarter, half and
+    /// three quarters of the way along it. Straddling, every chord is held
+    /// within half the chords' share `share`, chords split where that takes
+    /// more points.
+    fn place(
+        &self,
+        placement: ChordPlacement,
+        plane: f64,
+        pts: &[Contact],
+        centres: &[[f64; 3]],
+        share: f64,
+    ) -> Result<Vec<[f64; 3]>, RasterError> {
+        if placement.straddles() {
+            let knots: Vec<chords::Knot> = pts
+                .iter()
+                .map(|c| chords::Knot {
+                    s: c.u,
+                    u: c.c[0],
+                    z: c.c[1],
+                })
+                .collect();
+            let mut guess = pts.first().map_or(plane, |c| c.v);
+            let mut failed = None;
+            let mut exact = |s: f64| match self.contact(plane, s, guess) {
+                Ok(q) => {
+                    guess = q.v;
+                    (q.c[0], q.c[1])
+                }
+                Err(e) => {
+                    failed.get_or_insert(e);
+                    (f64::NAN, f64::NAN)
+                }
+            };
+            let (knots, _) =
+                chords::straddle(&knots, (None, None), 0.5 * share, &mut exact, &|_, _| true);
+            if let Some(e) = failed {
+                return Err(e);
+            }
+            return Ok(knots
+                .iter()
+                .map(|k| {
+                    let (x, y) = xy(self.along, k.u, plane);
+                    [x, y, k.z]
+                })
+                .collect());
+        }
+        let mut bands = Vec::with_capacity(pts.len().saturating_sub(1));
+        for w in pts.windows(2) {
+            let (c0, c1) = (&w[0], &w[1]);
+            let mut inner = [(0.0, 0.0); 3];
+            for (k, f) in [0.25, 0.5, 0.75].into_iter().enumerate() {
+                let q = self.contact(plane, c0.u + f * (c1.u - c0.u), c0.v + f * (c1.v - c0.v))?;
+                inner[k] = (q.c[0], q.c[1]);
+            }
+            bands.push(Band::between((c0.c[0], c0.c[1]), (c1.c[0], c1.c[1]), inner));
+        }
+        let mut graph: Vec<(f64, f64)> = pts.iter().map(|c| (c.c[0], c.c[1])).collect();
+        chords::place_graph(placement, &mut graph, &bands);
+        Ok(centres
+            .iter()
+            .zip(graph)
+            .map(|(c, (_, z))| [c[0], c[1], z])
+            .collect())
+    }
+
     /// The contacts of one pass from `a` to `b` (increasing u): bisection
     /// until every chord between consecutive centres meets the tolerance and
     /// the step caps.
@@ -1148,7 +1222,7 @@ impl<'a> Cutter<'a> {
             let f = foot_on_segment(q.c, p0, p1);
             quick[i] = ((f[0] - q.c[0]).powi(2) + (f[1] - q.c[1]).powi(2)).sqrt();
         }
-        let limit = r.chord_tolerance * crate::plan::optimise::CHORD_SHARE;
+        let limit = r.chord_tolerance * crate::plan::optimise::CHORD_SHARE * r.chords.sag_factor();
         // The distances by √(dx² + dy²), within a few ulps of `hypot`'s,
         // settle almost every chord; one those ulps could turn is measured
         // again with `hypot`, so each decision is the one its distances give.

@@ -7,6 +7,7 @@ use nalgebra::Vector2;
 use crate::machine::Lathe;
 use crate::machine::tool::RoundNoseTool;
 use crate::moves::{Move, Position};
+use crate::plan::chords::{self, Band, ChordPlacement};
 use crate::plan::envelope::{self, Pieces};
 use crate::surface::Profile;
 use crate::surface::SurfaceInfo;
@@ -61,6 +62,9 @@ pub struct ProfileTurning {
     pub location: ToolLocation,
     /// Roughing passes before the finish pass, if the stock is given.
     pub roughing: Option<Roughing>,
+    /// Where the finish pass's points sit across the curve of the path
+    /// (`plan::chords`), each moved along Z by the bands of its chords.
+    pub chords: ChordPlacement,
 }
 
 /// What the part is before cutting, and how much each pass removes.
@@ -507,6 +511,7 @@ fn roughing_passes(
         }
         let exact = ProfileTurning {
             location: ToolLocation::Exact,
+            chords: ChordPlacement::OnPath,
             ..strat.clone()
         };
         cut_path(section, rho + allowance, &exact)
@@ -558,15 +563,24 @@ struct Section<'a> {
 }
 
 /// The nose-centre points of the cut, within the chord tolerance of the
-/// curve the chosen tool location gives.
+/// curve the chosen tool location gives, placed across it as the
+/// strategy's `chords` says.
 fn cut_path(section: &Section, rho: f64, strat: &ProfileTurning) -> Vec<Vector2<f64>> {
+    let placement = strat.chords;
+    let sample = |c: &dyn Fn(f64) -> Vector2<f64>, a: f64, b: f64, tol: f64| {
+        if placement == ChordPlacement::OnPath {
+            return sample_offset_curve(c, a, b, tol);
+        }
+        let (pts, params) = sample_offset_curve_at(c, a, b, tol);
+        placed(placement, c, &pts, &params, tol)
+    };
     let Section {
         profile,
         pieces,
         start,
         end,
     } = *section;
-    let tol = strat.chord_tolerance * crate::plan::optimise::CHORD_SHARE;
+    let tol = strat.chord_tolerance * crate::plan::optimise::CHORD_SHARE * placement.sag_factor();
     // The ends of the cut in the tool's x: the normal offsets of its ends.
     let (x0, x1) = (
         tool_centre(profile, rho, start).x,
@@ -585,19 +599,19 @@ fn cut_path(section: &Section, rho: f64, strat: &ProfileTurning) -> Vec<Vector2<
     match strat.location {
         ToolLocation::Exact if pieces.corners.is_empty() => {
             let centre = |r: f64| tool_centre(profile, rho, r);
-            sample_offset_curve(&centre, start, end, tol)
+            sample(&centre, start, end, tol)
         }
         ToolLocation::Exact => {
             let centre =
                 |x: f64| Vector2::new(x, envelope::centre_height(profile, pieces, rho, x).0);
-            sample_offset_curve(&centre, x0, x1, tol)
+            sample(&centre, x0, x1, tol)
         }
         ToolLocation::Sequential { spacing, step } => {
             let pts = discretised(spacing);
             let top = pts.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max) + rho;
             let centre =
                 |x: f64| Vector2::new(x, envelope::sequential_search(&pts, rho, x, top, step));
-            sample_offset_curve(&centre, x0, x1, tol)
+            sample(&centre, x0, x1, tol)
         }
         ToolLocation::Binary { spacing, tolerance } => {
             let pts = discretised(spacing);
@@ -605,7 +619,7 @@ fn cut_path(section: &Section, rho: f64, strat: &ProfileTurning) -> Vec<Vector2<
                 let near = envelope::points_near(&pts, x, rho);
                 Vector2::new(x, envelope::binary_search(near, rho, x, tolerance))
             };
-            sample_offset_curve(&centre, x0, x1, tol)
+            sample(&centre, x0, x1, tol)
         }
     }
 }
@@ -645,9 +659,62 @@ pub fn sample_offset_curve(
     b: f64,
     tol: f64,
 ) -> Vec<Vector2<f64>> {
+    sample_offset_curve_at(c, a, b, tol).0
+}
+
+/// The points (X, Z) `pts` of the curve `c`, at parameters `params`, each
+/// moved along Z by `placement`'s offset for the bands of the chords it
+/// joins (`plan::chords`): the curve's height above each chord measured
+/// at three points between its ends. Straddling, every chord is held
+/// within half the chords' share `share` (chords split where that takes
+/// more points).
+fn placed(
+    placement: ChordPlacement,
+    c: &dyn Fn(f64) -> Vector2<f64>,
+    pts: &[Vector2<f64>],
+    params: &[f64],
+    share: f64,
+) -> Vec<Vector2<f64>> {
+    if placement.straddles() {
+        let knots: Vec<chords::Knot> = pts
+            .iter()
+            .zip(params)
+            .map(|(p, &s)| chords::Knot { s, u: p.x, z: p.y })
+            .collect();
+        let mut exact = |s: f64| {
+            let q = c(s);
+            (q.x, q.y)
+        };
+        let (knots, _) =
+            chords::straddle(&knots, (None, None), 0.5 * share, &mut exact, &|_, _| true);
+        return knots.iter().map(|k| Vector2::new(k.u, k.z)).collect();
+    }
+    let bands: Vec<Band> = (0..pts.len().saturating_sub(1))
+        .map(|j| {
+            let (s0, s1) = (params[j], params[j + 1]);
+            let inner = [0.25, 0.5, 0.75].map(|f| {
+                let q = c(s0 + f * (s1 - s0));
+                (q.x, q.y)
+            });
+            Band::between((pts[j].x, pts[j].y), (pts[j + 1].x, pts[j + 1].y), inner)
+        })
+        .collect();
+    let mut graph: Vec<(f64, f64)> = pts.iter().map(|p| (p.x, p.y)).collect();
+    chords::place_graph(placement, &mut graph, &bands);
+    graph.into_iter().map(|(x, z)| Vector2::new(x, z)).collect()
+}
+
+/// `sample_offset_curve`, with the parameter of each point.
+fn sample_offset_curve_at(
+    c: &dyn Fn(f64) -> Vector2<f64>,
+    a: f64,
+    b: f64,
+    tol: f64,
+) -> (Vec<Vector2<f64>>, Vec<f64>) {
     const SEEDS: usize = 32;
     const MAX_DEPTH: u32 = 40;
     let mut out = vec![c(a)];
+    let mut params = vec![a];
     for i in 0..SEEDS {
         let t0 = a + (b - a) * i as f64 / SEEDS as f64;
         let t1 = a + (b - a) * (i + 1) as f64 / SEEDS as f64;
@@ -665,10 +732,11 @@ pub fn sample_offset_curve(
                 stack.push((s0, p0, sm, pm, depth + 1));
             } else {
                 out.push(p1);
+                params.push(s1);
             }
         }
     }
-    out
+    (out, params)
 }
 
 fn distance_to_segment(q: Vector2<f64>, a: Vector2<f64>, b: Vector2<f64>) -> f64 {

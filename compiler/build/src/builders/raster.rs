@@ -49,10 +49,15 @@ pub fn build(spec: &RasterSpec, prov: &Provenance) -> Result<Built, Vec<Diagnost
     if !errors.is_empty() {
         return Err(errors);
     }
-    let (moves, optimised) = lensc_runtime::plan::optimise::optimise(
+    // Points placed clear of the material are not fitted back into it.
+    let (moves, optimised) = lensc_runtime::plan::optimise::optimise_within(
         &moves,
         raster.chord_tolerance * lensc_runtime::plan::optimise::FIT_SHARE,
         &dialect.arc_planes,
+        matches!(
+            raster.chords,
+            lensc_runtime::plan::chords::ChordPlacement::Clear { .. }
+        ),
     );
     let resolution = head.resolution;
     let text = lensc_runtime::emit::raster::emit_mill(

@@ -18,6 +18,13 @@ const CHORD_TOLERANCE: Param = opt(
 );
 const CHORDS: Param = opt(
     "chords",
+    Ty::Word(&["on_path", "straddle", "straddle_long", "clear"]),
+    Check::Any,
+    "where the points sit across the curve: `on_path` (convex stretches gouge by up to the chords' sag), `straddle` (moved off the path so each chord errs by at most ±half the sag), `straddle_long` (chords sampled to twice the sag, about 1/√2 the points, each within ±the sag), `clear` (raised so no chord enters the material); default the first of on_path, straddle, clear whose gouge meets the job's `max_gouge`",
+);
+/// A roller helix's points are a fixed C step apart: no `straddle_long`.
+const ROLLER_CHORDS: Param = opt(
+    "chords",
     Ty::Word(&["on_path", "straddle", "clear"]),
     Check::Any,
     "where the points sit across the curve: `on_path` (convex stretches gouge by up to the chords' sag), `straddle` (moved off the path so each chord errs by at most ±half the sag), `clear` (raised so no chord enters the material); default the first of these whose gouge meets the job's `max_gouge`",
@@ -161,7 +168,7 @@ pub(super) const ROLLER_HELIX: Kind = Kind {
             Check::Any,
             "the finish pass (Liu et al.: 0.1° and 5 µm)",
         ),
-        CHORDS,
+        ROLLER_CHORDS,
         opt(
             "z",
             Ty::Range(Dim::LENGTH),
@@ -211,6 +218,7 @@ pub(super) const RASTER: Kind = Kind {
             "distance between passes",
         ),
         CHORD_TOLERANCE,
+        CHORDS,
         opt(
             "max_step",
             LENGTH,
@@ -310,6 +318,7 @@ pub(super) const PROFILE_TURNING: Kind = Kind {
             Check::Positive,
             "the path's tolerance: the most the program, as the machine runs it, may stray from the exact tool-centre path; default 10 nm",
         ),
+        CHORDS,
         opt(
             "from",
             LENGTH,

@@ -353,21 +353,25 @@ fn each_chord_placement_errs_as_it_promises() {
     let [on, straddle, clear] = figures[..] else {
         unreachable!()
     };
-    // The same points, moved.
-    assert!(on.1 == straddle.1 && on.1 == clear.1);
+    // Clear moves the same points; straddling splits the chords where a
+    // chord bending one way meets one bending the other (their shared
+    // point cannot split both): 2,959 points on the path, 3,036 straddling.
+    assert!(on.1 == clear.1, "{on:?} {clear:?}");
+    assert!(
+        straddle.1 > on.1 && straddle.1 <= on.1 + on.1 / 20,
+        "{straddle:?} {on:?}"
+    );
     // On the path the chords gouge by up to their share (a little more,
     // 2.59 nm of 2.5: the bisection tests each chord's middle only).
-    // Straddling, by about half as much either way: exactly half where a
-    // chord's neighbours bend the same way, up to 0.65 of the share here
-    // (1.64 nm) where a chord bending one way meets one bending the other
-    // and their shared point cannot split both. Clear: not at all (0.05 pm
-    // here, the path's quartic fit between the quarters).
+    // Straddling, by at most half of it either way, inflections included
+    // (1.2495 nm both ways, measured at nine points of every chord against
+    // the exact path; 1.64 nm before chords were split there). Clear: not
+    // at all (0.05 pm here, the path's quartic fit between the quarters).
     assert!(on.2 > 0.5 * share && on.2 <= 1.05 * share, "{on:?}");
     assert!(
-        straddle.2 <= 0.7 * share && straddle.3 <= 0.7 * share,
+        straddle.2 <= 0.5 * share * 1.001 && straddle.3 <= 0.5 * share * 1.001,
         "{straddle:?}"
     );
-    assert!(straddle.2 < 0.7 * on.2, "{straddle:?} {on:?}");
     assert!(clear.2 <= 1e-9, "{clear:?}");
     assert!(clear.3 <= 1.3 * share, "{clear:?}");
 }

@@ -211,3 +211,58 @@ fn rapids_spindle_and_inverse_time_moves_are_kept() {
     assert_eq!(format!("{out:?}"), format!("{stream:?}"));
     assert_eq!(s.arcs + s.merged_lines, 0);
 }
+
+/// The largest depth (mm) by which the optimised path, sampled, passes
+/// below the polyline through `pts` (X, Z; X increasing), in Z at the
+/// same X.
+fn deepest_below(pts: &[(f64, f64)], out: &[Move]) -> f64 {
+    let polyline = |x: f64| {
+        let i = pts.partition_point(|p| p.0 <= x).clamp(1, pts.len() - 1);
+        let (a, b) = (pts[i - 1], pts[i]);
+        a.1 + (x - a.0) / (b.0 - a.0) * (b.1 - a.1)
+    };
+    let mut from = pts[0];
+    let mut deepest: f64 = 0.0;
+    for m in out
+        .iter()
+        .skip_while(|m| !matches!(m, Move::Linear { .. }))
+        .skip(1)
+    {
+        if !matches!(m, Move::Linear { .. } | Move::Arc { .. }) {
+            continue;
+        }
+        for k in 0..=200 {
+            let p = along(from, m, k as f64 / 200.0);
+            deepest = deepest.max(polyline(p.0) - p.1);
+        }
+        from = along(from, m, 1.0);
+    }
+    deepest
+}
+
+#[test]
+fn fits_held_above_stay_on_or_above_the_polyline() {
+    // A convex arc (centre below) whose points alternate 1 µm above and
+    // on it: fitted both ways, arcs pass below the raised points; held
+    // above, nothing passes below the polyline.
+    let r = 3.0;
+    let pts: Vec<(f64, f64)> = (0..=400)
+        .map(|k| {
+            let x = 1.5 * k as f64 / 400.0;
+            let lift = if k % 2 == 1 { 1e-6 } else { 0.0 };
+            (x, (r * r - x * x).sqrt() + lift)
+        })
+        .collect();
+    let (both, _) = optimise(&lathe_stream(&pts), TOL, &[Plane::Zx]);
+    assert!(deepest_below(&pts, &both) > 0.5e-6);
+    let (above, s) = optimise_within(&lathe_stream(&pts), TOL, &[Plane::Zx], true);
+    assert!(s.moves_after < s.moves_before, "{s:?}");
+    let depth = deepest_below(&pts, &above);
+    assert!(depth <= 1e-9, "{depth}");
+    assert!(hausdorff(&pts, &above) <= TOL);
+    // A concave arc (centre above) likewise.
+    let pts: Vec<(f64, f64)> = pts.iter().map(|&(x, z)| (x, -z + 2e-6)).collect();
+    let (above, _) = optimise_within(&lathe_stream(&pts), TOL, &[Plane::Zx], true);
+    let depth = deepest_below(&pts, &above);
+    assert!(depth <= 1e-9, "{depth}");
+}

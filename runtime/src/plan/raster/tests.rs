@@ -74,6 +74,7 @@ fn raster(along: Axis, stepover: f64, tol: f64) -> Raster {
         max_step: None,
         lin_angle: None,
         retract: 0.5,
+        chords: crate::plan::chords::ChordPlacement::OnPath,
     }
 }
 

@@ -48,6 +48,7 @@ fn job(roughing: Roughing) -> (TurningJob, RotationalSurface) {
             retract: 1.0,
             location: ToolLocation::Exact,
             roughing: Some(roughing),
+            chords: crate::plan::chords::ChordPlacement::OnPath,
         },
     };
     (job, s)

@@ -17,6 +17,13 @@ use crate::value;
 /// criterion; a job with no stated `max_gouge` keeps its points on the
 /// path (the default limit is never below the chord tolerance).
 pub(super) fn placement(p: &Parts, sag: f64) -> ChordPlacement {
+    fitted_placement(p, sag, 0.0)
+}
+
+/// `placement`, for a path whose lines and arcs are then fitted within
+/// `fit` (mm) of the placed points: on the path or straddling a fit may
+/// pass that much further into the material, clear it may not.
+pub(super) fn fitted_placement(p: &Parts, sag: f64, fit: f64) -> ChordPlacement {
     let margin = 0.5 * value::num(&p.machine.fields, "resolution").expect("required");
     if let Some(stated) = value::word(&p.strategy.fields, "chords") {
         // The checker has allowed only the three words.
@@ -24,7 +31,7 @@ pub(super) fn placement(p: &Parts, sag: f64) -> ChordPlacement {
     }
     let accept = super::accept::lower(p.job).unwrap_or_default();
     match accept.stated(Criterion::MaxGouge) {
-        Some(limit) => ChordPlacement::least_for(sag, limit.value, margin),
+        Some(limit) => ChordPlacement::least_for_fitted(sag, fit, limit.value, margin),
         None => ChordPlacement::OnPath,
     }
 }

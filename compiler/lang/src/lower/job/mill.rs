@@ -5,7 +5,9 @@
 //! concave radius, the knife's clearance against the steepest slope).
 
 use lensc_grammar::Diagnostic;
+use lensc_runtime::plan::chords::ChordPlacement;
 use lensc_runtime::plan::grinding::{ProfileGrinding, check_profile_grinding};
+use lensc_runtime::plan::optimise;
 use lensc_runtime::plan::raster::{Axis, Raster, RasterTool, check_clearance, check_raster};
 use lensc_runtime::post::Dialect;
 use lensc_runtime::surface::SectionAlongX;
@@ -51,7 +53,7 @@ pub(super) fn lower_raster(
 ) -> Result<RasterSpec, Vec<Diagnostic>> {
     p.needs_kinds("raster", &["mill_3axis"], &["microshaper", "ball_end"])?;
     let (st, t) = (&p.strategy.fields, &p.tool.fields);
-    let raster = Raster {
+    let mut raster = Raster {
         along: if value::word(st, "along") == Some("y") {
             Axis::Y
         } else {
@@ -63,7 +65,15 @@ pub(super) fn lower_raster(
         max_step: value::num(st, "max_step"),
         lin_angle: value::num(st, "lin_angle"),
         retract: value::num(st, "retract").unwrap_or(1.0),
+        chords: ChordPlacement::OnPath,
     };
+    // The chords take their share of the tolerance, the fitted lines and
+    // arcs theirs (`plan::optimise`).
+    raster.chords = super::chords::fitted_placement(
+        p,
+        raster.chord_tolerance * optimise::CHORD_SHARE,
+        raster.chord_tolerance * optimise::FIT_SHARE,
+    );
     let (tool, tool_words) = match p.tool.kind.name {
         "ball_end" => {
             let d = value::num(t, "diameter").expect("required");

@@ -5,6 +5,7 @@
 use lensc_grammar::Diagnostic;
 use lensc_runtime::machine::Lathe;
 use lensc_runtime::machine::tool::RoundNoseTool;
+use lensc_runtime::plan::optimise;
 use lensc_runtime::plan::turning::{
     Feed, ProfileTurning, Roughing, Stock, ToolLocation, TurningJob, check_profile_turning,
 };
@@ -122,7 +123,7 @@ fn turning_job(p: &Parts, dialect: Dialect) -> Result<TurningJob, Vec<Diagnostic
         tool_name: name_of(p, "tool", tool),
         machine_name: name_of(p, "machine", machine),
         strategy_name: name_of(p, "strategy", strategy),
-        strategy: profile_turning(f, surface, p.max_spindle_speed()),
+        strategy: profile_turning(p, f, surface, p.max_spindle_speed()),
         surface: surf,
         tool: round_nose(&tool.fields),
         machine: lathe(&machine.fields, dialect),
@@ -146,9 +147,17 @@ fn feed_of(f: &[Field], name: &str) -> Option<Feed> {
     }
 }
 
-fn profile_turning(f: &[Field], surface: &Object, max_spindle: f64) -> ProfileTurning {
+fn profile_turning(p: &Parts, f: &[Field], surface: &Object, max_spindle: f64) -> ProfileTurning {
     let feed = feed_of(f, "feed").expect("feed is required and checked");
+    let tolerance = value::num(f, "chord_tolerance").unwrap_or(super::DEFAULT_PATH_TOLERANCE);
     ProfileTurning {
+        // The chords take their share of the tolerance, the fitted lines
+        // and arcs theirs (`plan::optimise`).
+        chords: super::chords::fitted_placement(
+            p,
+            tolerance * optimise::CHORD_SHARE,
+            tolerance * optimise::FIT_SHARE,
+        ),
         feed,
         // Under constant surface speed the spindle speed is its cap.
         spindle_speed: value::num(f, "spindle_speed")
