@@ -35,8 +35,8 @@ use cranelift_codegen::Context;
 use cranelift_codegen::ir::condcodes::{FloatCC, IntCC};
 use cranelift_codegen::ir::immediates::Ieee64;
 use cranelift_codegen::ir::{
-    AbiParam, FuncRef, InstBuilder, MemFlagsData, StackSlotData, StackSlotKind, Type, UserFuncName,
-    Value, types,
+    AbiParam, Endianness, FuncRef, InstBuilder, MemFlagsData, StackSlotData, StackSlotKind, Type,
+    UserFuncName, Value, types,
 };
 use cranelift_codegen::isa::OwnedTargetIsa;
 use cranelift_codegen::settings::{self, Configurable};
@@ -234,6 +234,7 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
         imports: HashMap::new(),
         twins: HashMap::new(),
         trig: HashMap::new(),
+        negative: HashMap::new(),
     };
 
     let entry = b.create_block();
@@ -296,6 +297,9 @@ struct Emitter<'m> {
     twins: HashMap<Twin, FuncRef>,
     /// sin and cos of each argument already reduced in this pass.
     trig: HashMap<Id, (Value, Value)>,
+    /// The comparison `a < 0` of each node already tested in this pass (a
+    /// lenslet array's outputs are all selected by one test).
+    negative: HashMap<Id, Value>,
 }
 
 impl Emitter<'_> {
@@ -318,7 +322,9 @@ impl Emitter<'_> {
         let x = b.ins().load(lanes.ty(), load, cx, 0);
         let y = b.ins().load(lanes.ty(), load, cy, 0);
         self.trig.clear();
+        self.negative.clear();
         let mut val: Vec<Option<Value>> = vec![None; tape.graph.len()];
+        let graph = &tape.graph;
         for id in tape.live_nodes() {
             let get =
                 |i: Id| val[i.0 as usize].expect("operands come before their node in the tape");
@@ -331,41 +337,83 @@ impl Emitter<'_> {
                     if op == Unary::Sin { sin } else { cos }
                 }
                 Node::Unary(op, a) => self.unary(b, lanes, op, get(a))?,
+                Node::Binary(op @ (Binary::Min | Binary::Max), l, r) => {
+                    let l = (get(l), graph.constant(l));
+                    let r = (get(r), graph.constant(r));
+                    min_max(b, lanes, op, l, r)
+                }
                 Node::Binary(op, a, c) => self.binary(b, lanes, op, get(a), get(c))?,
                 Node::PowI(a, k) => powi(b, lanes, get(a), k),
                 Node::Step(a) => {
                     // 1 where a < 0 (false for NaN), else 0.
                     let zero = constant(b, lanes, 0f64.to_bits());
                     let one = constant(b, lanes, 1f64.to_bits());
-                    let neg = b.ins().fcmp(FloatCC::LessThan, get(a), zero);
-                    select(b, lanes, neg, one, zero)
+                    let neg = self.negative(b, lanes, a, get(a));
+                    select_known(b, lanes, neg, (one, Some(1.0)), (zero, Some(0.0)))
                 }
                 Node::Select(c, t, f) => {
                     // t where c < 0 (false for NaN), else f.
-                    let zero = constant(b, lanes, 0f64.to_bits());
-                    let neg = b.ins().fcmp(FloatCC::LessThan, get(c), zero);
-                    select(b, lanes, neg, get(t), get(f))
+                    let neg = self.negative(b, lanes, c, get(c));
+                    let t = (get(t), graph.constant(t));
+                    let f = (get(f), graph.constant(f));
+                    select_known(b, lanes, neg, t, f)
                 }
             };
             val[id.0 as usize] = Some(v);
         }
-        let mem = MemFlagsData::trusted();
-        for (k, o) in tape.outputs.iter().enumerate() {
-            let v = val[o.0 as usize].expect("outputs are live");
-            let off = 8 * k as i32;
-            match lanes {
-                Lanes::One => {
-                    b.ins().store(mem, v, co, off);
+        let outputs = tape
+            .outputs
+            .map(|o| val[o.0 as usize].expect("outputs are live"));
+        match lanes {
+            Lanes::One => {
+                for (k, &v) in outputs.iter().enumerate() {
+                    b.ins().store(MemFlagsData::trusted(), v, co, 8 * k as i32);
                 }
-                Lanes::Two => {
-                    let lo = b.ins().extractlane(v, 0);
-                    let hi = b.ins().extractlane(v, 1);
-                    b.ins().store(mem, lo, co, off);
-                    b.ins().store(mem, hi, co, off + 48);
+            }
+            Lanes::Two => {
+                // Outputs k and k + 1 of the first point side by side, then
+                // of the second: three 16-byte stores per point rather
+                // than six 8-byte ones and six lane extractions.
+                let bytes = |v: Value, b: &mut FunctionBuilder| {
+                    b.ins().bitcast(
+                        types::I8X16,
+                        MemFlagsData::new().with_endianness(Endianness::Little),
+                        v,
+                    )
+                };
+                // Slices of f64 are 8-aligned, so a pair is not always
+                // 16-aligned.
+                let mem = MemFlagsData::new().with_notrap();
+                let mask = |b: &mut FunctionBuilder, lanes: [std::ops::Range<u8>; 2]| {
+                    let [first, second] = lanes;
+                    let bytes: Vec<u8> = first.chain(second).collect();
+                    b.func.dfg.immediates.push(bytes.into())
+                };
+                // The first lane of each vector; the second.
+                let low = mask(b, [0..8, 16..24]);
+                let high = mask(b, [8..16, 24..32]);
+                for k in (0..6).step_by(2) {
+                    let (a, c) = (bytes(outputs[k], b), bytes(outputs[k + 1], b));
+                    let first = b.ins().shuffle(a, c, low);
+                    let second = b.ins().shuffle(a, c, high);
+                    b.ins().store(mem, first, co, 8 * k as i32);
+                    b.ins().store(mem, second, co, 48 + 8 * k as i32);
                 }
             }
         }
         Ok(())
+    }
+
+    /// The cached test `a < 0` (false for NaN) of node `id`: a flag with
+    /// one lane, a lane mask with two.
+    fn negative(&mut self, b: &mut FunctionBuilder, lanes: Lanes, id: Id, a: Value) -> Value {
+        if let Some(&neg) = self.negative.get(&id) {
+            return neg;
+        }
+        let zero = constant(b, lanes, 0f64.to_bits());
+        let neg = b.ins().fcmp(FloatCC::LessThan, a, zero);
+        self.negative.insert(id, neg);
+        neg
     }
 
     /// sin a and cos a on both lanes (node `arg`, value `a`), reduced once
@@ -499,21 +547,7 @@ impl Emitter<'_> {
             Binary::Div => b.ins().fdiv(l, r),
             Binary::Pow => self.call(b, lanes, Libm::Pow, &[l, r])?,
             Binary::Atan2 => self.call(b, lanes, Libm::Atan2, &[l, r])?,
-            // Rust's f64::min/max (LLVM minnum/maxnum on x86-64):
-            // l is NaN → r; else r if r is strictly smaller (greater), else l.
-            // So a NaN r yields l, and equal operands (±0) yield l.
-            // cranelift's fmin/fmax propagate NaN and order −0 < +0 instead.
-            Binary::Min | Binary::Max => {
-                let cc = if op == Binary::Min {
-                    FloatCC::LessThan
-                } else {
-                    FloatCC::GreaterThan
-                };
-                let r_wins = b.ins().fcmp(cc, r, l);
-                let m = select(b, lanes, r_wins, r, l);
-                let l_nan = b.ins().fcmp(FloatCC::Unordered, l, l);
-                select(b, lanes, l_nan, r, m)
-            }
+            Binary::Min | Binary::Max => min_max(b, lanes, op, (l, None), (r, None)),
         })
     }
 
@@ -578,11 +612,90 @@ fn constant(b: &mut FunctionBuilder, lanes: Lanes, bits: u64) -> Value {
 /// `cond ? t : f` lane by lane, for a condition from `fcmp` or `icmp`: a
 /// flag with one lane, a lane mask with two.
 fn select(b: &mut FunctionBuilder, lanes: Lanes, cond: Value, t: Value, f: Value) -> Value {
+    select_known(b, lanes, cond, (t, None), (f, None))
+}
+
+/// `select` where either operand may be a known constant: with two lanes a
+/// +0 operand makes the blend a bitwise and (the mask's lanes are all ones
+/// or all zeros, and +0 is all zero bits).
+fn select_known(
+    b: &mut FunctionBuilder,
+    lanes: Lanes,
+    cond: Value,
+    (t, tc): (Value, Option<f64>),
+    (f, fc): (Value, Option<f64>),
+) -> Value {
+    let plus_zero = |c: Option<f64>| c.is_some_and(|c| c.to_bits() == 0);
     match lanes {
         Lanes::One => b.ins().select(cond, t, f),
         Lanes::Two => {
             let mask = b.ins().bitcast(types::F64X2, MemFlagsData::new(), cond);
-            b.ins().bitselect(mask, t, f)
+            if plus_zero(fc) {
+                b.ins().band(mask, t)
+            } else if plus_zero(tc) {
+                b.ins().band_not(f, mask)
+            } else {
+                b.ins().bitselect(mask, t, f)
+            }
+        }
+    }
+}
+
+/// Rust's `l.min(r)` / `l.max(r)` (LLVM minnum/maxnum on x86-64): l is
+/// NaN → r; else r if r is strictly smaller (greater), else l. So a NaN r
+/// yields l, and equal operands (±0) yield l. cranelift's fmin/fmax
+/// propagate NaN and order −0 < +0 instead, so this is a select sequence;
+/// with a constant operand (`Some(value)`), a shorter one that gives the
+/// same bits for every other operand. Each select whose condition is `x <
+/// y` and whose operands are x and y is a single `minpd`/`maxpd` on two
+/// lanes (x if x < y, else y).
+fn min_max(
+    b: &mut FunctionBuilder,
+    lanes: Lanes,
+    op: Binary,
+    (l, lc): (Value, Option<f64>),
+    (r, rc): (Value, Option<f64>),
+) -> Value {
+    let min = op == Binary::Min;
+    match (lc, rc) {
+        // A non-NaN constant c on the right: c where l is NaN or c is
+        // strictly smaller (greater), else l.
+        (_, Some(c)) if !c.is_nan() => {
+            if c != 0.0 {
+                // Equal operands have the same bits, so "l where l < c
+                // (> c), else c" is the same: one minpd (maxpd).
+                let l_wins = if min {
+                    b.ins().fcmp(FloatCC::LessThan, l, r)
+                } else {
+                    b.ins().fcmp(FloatCC::LessThan, r, l)
+                };
+                select(b, lanes, l_wins, l, r)
+            } else {
+                // ±0: equal is not the same bits; keep l on a tie.
+                let cc = if min {
+                    FloatCC::UnorderedOrGreaterThan
+                } else {
+                    FloatCC::UnorderedOrLessThan
+                };
+                let r_wins = b.ins().fcmp(cc, l, r);
+                select_known(b, lanes, r_wins, (r, rc), (l, lc))
+            }
+        }
+        _ => {
+            // r where r is strictly smaller (greater), else l: one
+            // minpd (maxpd); a NaN r yields l.
+            let r_wins = if min {
+                b.ins().fcmp(FloatCC::LessThan, r, l)
+            } else {
+                b.ins().fcmp(FloatCC::LessThan, l, r)
+            };
+            let m = select(b, lanes, r_wins, r, l);
+            if lc.is_some_and(|c| !c.is_nan()) {
+                // l is no NaN.
+                return m;
+            }
+            let l_nan = b.ins().fcmp(FloatCC::Unordered, l, l);
+            select(b, lanes, l_nan, r, m)
         }
     }
 }
