@@ -370,8 +370,8 @@ impl Emitter<'_> {
                 Node::Const(bits) => constant(b, lanes, bits),
                 Node::Var(Var::X) => x,
                 Node::Var(Var::Y) => y,
-                Node::Unary(op @ (Unary::Sin | Unary::Cos), a) if lanes == Lanes::Two => {
-                    let (sin, cos) = self.sin_cos(b, a, get(a));
+                Node::Unary(op @ (Unary::Sin | Unary::Cos), a) => {
+                    let (sin, cos) = self.sin_cos(b, lanes, a, get(a))?;
                     if op == Unary::Sin { sin } else { cos }
                 }
                 Node::Unary(op, a) => self.unary(b, lanes, op, get(a))?,
@@ -416,16 +416,46 @@ impl Emitter<'_> {
         neg
     }
 
-    /// sin a and cos a on both lanes (node `arg`, value `a`), reduced once
-    /// per argument; the mask of the lanes they cover joins `covered`.
-    fn sin_cos(&mut self, b: &mut FunctionBuilder, arg: Id, a: Value) -> (Value, Value) {
+    /// sin a and cos a (node `arg`, value `a`), reduced once per argument:
+    /// inline on two lanes, the mask of the lanes they cover joining
+    /// `covered`; one call on one lane.
+    fn sin_cos(
+        &mut self,
+        b: &mut FunctionBuilder,
+        lanes: Lanes,
+        arg: Id,
+        a: Value,
+    ) -> Result<(Value, Value), JitError> {
         if let Some(&pair) = self.trig.get(&arg) {
-            return pair;
+            return Ok(pair);
         }
-        let (sin, cos, ok) = vecmath::sin_cos(b, a);
-        self.covered.push(ok);
-        self.trig.insert(arg, (sin, cos));
-        (sin, cos)
+        let pair = self.sin_cos_of(b, lanes, a)?;
+        self.trig.insert(arg, pair);
+        Ok(pair)
+    }
+
+    /// sin a and cos a, computed here.
+    fn sin_cos_of(
+        &mut self,
+        b: &mut FunctionBuilder,
+        lanes: Lanes,
+        a: Value,
+    ) -> Result<(Value, Value), JitError> {
+        Ok(match lanes {
+            Lanes::Two => {
+                let (sin, cos, ok) = vecmath::sin_cos(b, a);
+                self.covered.push(ok);
+                (sin, cos)
+            }
+            Lanes::One => {
+                let fref = self.import(b, Libm::SinCos)?;
+                let call = b.ins().call(fref, &[a]);
+                let &[sin, cos] = b.inst_results(call) else {
+                    unreachable!("sin_cos returns two values")
+                };
+                (sin, cos)
+            }
+        })
     }
 
     fn unary(
@@ -445,11 +475,12 @@ impl Emitter<'_> {
                 self.covered.push(ok);
                 e
             }
-            // The scalar pass calls the twins of the inline code; `pass`
-            // gives sin and cos of one argument one inline reduction.
+            // The scalar pass calls the twins of the inline code.
             Unary::Exp => self.call(b, lanes, Libm::Exp, &[a])?,
-            Unary::Sin => self.call(b, lanes, Libm::Sin, &[a])?,
-            Unary::Cos => self.call(b, lanes, Libm::Cos, &[a])?,
+            Unary::Sin | Unary::Cos => {
+                let (sin, cos) = self.sin_cos_of(b, lanes, a)?;
+                if op == Unary::Sin { sin } else { cos }
+            }
             Unary::Tan => self.call(b, lanes, Libm::Tan, &[a])?,
             Unary::Asin => self.call(b, lanes, Libm::Asin, &[a])?,
             Unary::Acos => self.call(b, lanes, Libm::Acos, &[a])?,
@@ -477,6 +508,27 @@ impl Emitter<'_> {
         })
     }
 
+    /// The import of a wrapper, declared once.
+    fn import(&mut self, b: &mut FunctionBuilder, f: Libm) -> Result<FuncRef, JitError> {
+        if let Some(&r) = self.imports.get(&f) {
+            return Ok(r);
+        }
+        let mut sig = self.module.make_signature();
+        for _ in 0..f.arity() {
+            sig.params.push(AbiParam::new(types::F64));
+        }
+        for _ in 0..f.results() {
+            sig.returns.push(AbiParam::new(types::F64));
+        }
+        let fid = self
+            .module
+            .declare_function(f.symbol(), Linkage::Import, &sig)
+            .map_err(|e| JitError(format!("declaring {}: {e}", f.symbol())))?;
+        let r = self.module.declare_func_in_func(fid, b.func);
+        self.imports.insert(f, r);
+        Ok(r)
+    }
+
     /// Calls a scalar wrapper, once per lane.
     fn call(
         &mut self,
@@ -485,23 +537,7 @@ impl Emitter<'_> {
         f: Libm,
         args: &[Value],
     ) -> Result<Value, JitError> {
-        let fref = match self.imports.get(&f) {
-            Some(&r) => r,
-            None => {
-                let mut sig = self.module.make_signature();
-                for _ in 0..f.arity() {
-                    sig.params.push(AbiParam::new(types::F64));
-                }
-                sig.returns.push(AbiParam::new(types::F64));
-                let fid = self
-                    .module
-                    .declare_function(f.symbol(), Linkage::Import, &sig)
-                    .map_err(|e| JitError(format!("declaring {}: {e}", f.symbol())))?;
-                let r = self.module.declare_func_in_func(fid, b.func);
-                self.imports.insert(f, r);
-                r
-            }
-        };
+        let fref = self.import(b, f)?;
         let call = |b: &mut FunctionBuilder, args: &[Value]| {
             let inst = b.ins().call(fref, args);
             b.inst_results(inst)[0]
@@ -702,8 +738,8 @@ fn powi(b: &mut FunctionBuilder, lanes: Lanes, a: Value, n: i32) -> Value {
 /// The functions the kernel calls rather than inlines.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 enum Libm {
-    Sin,
-    Cos,
+    /// sin and cos of one argument, two results.
+    SinCos,
     Tan,
     Asin,
     Acos,
@@ -715,9 +751,8 @@ enum Libm {
 }
 
 impl Libm {
-    const ALL: [Libm; 10] = [
-        Libm::Sin,
-        Libm::Cos,
+    const ALL: [Libm; 9] = [
+        Libm::SinCos,
         Libm::Tan,
         Libm::Asin,
         Libm::Acos,
@@ -730,8 +765,7 @@ impl Libm {
 
     fn symbol(self) -> &'static str {
         match self {
-            Libm::Sin => "lensc_jit_sin",
-            Libm::Cos => "lensc_jit_cos",
+            Libm::SinCos => "lensc_jit_sin_cos",
             Libm::Tan => "lensc_jit_tan",
             Libm::Asin => "lensc_jit_asin",
             Libm::Acos => "lensc_jit_acos",
@@ -750,12 +784,18 @@ impl Libm {
         }
     }
 
+    fn results(self) -> usize {
+        match self {
+            Libm::SinCos => 2,
+            _ => 1,
+        }
+    }
+
     fn address(self) -> *const u8 {
         type F1 = extern "C" fn(f64) -> f64;
         type F2 = extern "C" fn(f64, f64) -> f64;
         match self {
-            Libm::Sin => lensc_jit_sin as F1 as *const u8,
-            Libm::Cos => lensc_jit_cos as F1 as *const u8,
+            Libm::SinCos => lensc_jit_sin_cos as extern "C" fn(f64) -> Pair as *const u8,
             Libm::Tan => lensc_jit_tan as F1 as *const u8,
             Libm::Asin => lensc_jit_asin as F1 as *const u8,
             Libm::Acos => lensc_jit_acos as F1 as *const u8,
@@ -782,12 +822,14 @@ macro_rules! libm_entries {
     (@apply Binary::$op:ident, $a:ident, $b:ident) => { apply_binary(Binary::$op, $a, $b) };
 }
 
-extern "C" fn lensc_jit_sin(a: f64) -> f64 {
-    crate::surface::fdlibm::sin(a)
-}
+/// Two doubles returned in registers (xmm0, xmm1 in the C ABI of
+/// x86-64), as cranelift returns two `F64` results.
+#[repr(C)]
+struct Pair(f64, f64);
 
-extern "C" fn lensc_jit_cos(a: f64) -> f64 {
-    crate::surface::fdlibm::cos(a)
+extern "C" fn lensc_jit_sin_cos(a: f64) -> Pair {
+    let (sin, cos) = crate::surface::fdlibm::sin_cos(a);
+    Pair(sin, cos)
 }
 
 extern "C" fn lensc_jit_exp(a: f64) -> f64 {
