@@ -51,6 +51,9 @@ pub(crate) const P5: u64 = 0x3E66_3769_72BE_A4D0;
 /// Below this |x| both exp(x) and 2^k are normal numbers; beyond it
 /// (overflow, underflow, subnormal results) libm answers.
 pub(crate) const EXP_LIMIT: f64 = 708.0;
+/// Below this, e^a rounds to +0 (a < −1075 ln 2 ≈ −745.133): libm's value,
+/// which the kernel's inline exp gives without leaving the vector pass.
+pub(crate) const EXP_ZERO_BELOW: f64 = -746.0;
 
 /// sin a and cos a, from one reduction: the same bits as `sin` and `cos`.
 pub fn sin_cos(a: f64) -> (f64, f64) {
