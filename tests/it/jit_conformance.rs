@@ -313,6 +313,117 @@ fn min_max_signed_zero_and_nan_bit_identical() {
     }
 }
 
+/// Interpreter and JIT outputs at the points, bit for bit (NaN equal to
+/// NaN), for the one-pass and the two-lane pass alike (odd and even
+/// batches).
+fn bit_identical(t: &SurfaceTape, xs: &[f64], ys: &[f64], what: &str) {
+    let interp = Interpreter::new(t);
+    let jit = JitSurface::compile(t).expect("compiles");
+    for n in [xs.len(), xs.len() - 1] {
+        let mut want = vec![0.0; 6 * n];
+        let mut got = vec![0.0; 6 * n];
+        interp.eval_batch(&xs[..n], &ys[..n], &mut want);
+        jit.eval_batch(&xs[..n], &ys[..n], &mut got);
+        for (k, (w, j)) in want.iter().zip(&got).enumerate() {
+            assert!(
+                w.to_bits() == j.to_bits() || (w.is_nan() && j.is_nan()),
+                "{what}, output {} at ({}, {}): {w:e} vs JIT {j:e}",
+                k % 6,
+                xs[k / 6],
+                ys[k / 6]
+            );
+        }
+    }
+}
+
+/// min/max with a constant operand on either side (the JIT's shorter
+/// forms): zeros of both signs, NaN, ties with the constant and infinities
+/// give the interpreter's bits.
+#[test]
+fn min_max_with_a_constant_bit_identical() {
+    let constants = [
+        0.0,
+        -0.0,
+        1.5,
+        -2.0,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NAN,
+    ];
+    for op in [Binary::Min, Binary::Max] {
+        for c in constants {
+            for constant_first in [false, true] {
+                let t = tape(|g| {
+                    // Operands are ordered by node: the constant made first
+                    // is the left one.
+                    let k = constant_first.then(|| g.constant_node(c));
+                    let (x, y) = (g.x(), g.y());
+                    let k = k.unwrap_or_else(|| g.constant_node(c));
+                    let m = g.binary(op, x, k);
+                    // The sign of a zero shows in 1/m; y keeps a second lane
+                    // busy with something else.
+                    let one = g.constant_node(1.0);
+                    let inv = g.div(one, m);
+                    let my = g.mul(m, y);
+                    g.add(inv, my)
+                });
+                let mut xs = vec![0.0, -0.0, 1.5, -1.5, -2.0, 2.0, 3.0, -3.0];
+                xs.extend([f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e-300, -1e-300]);
+                xs.extend([1.5f64.next_up(), 1.5f64.next_down(), (-2f64).next_up()]);
+                let ys: Vec<f64> = (0..xs.len()).map(|i| 0.25 * i as f64 - 1.0).collect();
+                bit_identical(
+                    &t,
+                    &xs,
+                    &ys,
+                    &format!("{op:?}(x, {c}) constant first: {constant_first}"),
+                );
+            }
+        }
+    }
+}
+
+/// Selects and steps against constant branches (+0, −0, others) and one
+/// condition shared by several selects, bit for bit.
+#[test]
+fn selects_with_constant_branches_bit_identical() {
+    for (t_const, f_const) in [
+        (None, Some(0.0)),
+        (Some(0.0), None),
+        (None, Some(-0.0)),
+        (Some(-0.0), None),
+        (Some(2.5), Some(0.0)),
+        (None, None),
+    ] {
+        let t = tape(|g| {
+            let (x, y) = (g.x(), g.y());
+            let c = g.sub(x, y);
+            let sy = g.sqrt(y); // NaN for y < 0, hidden where not selected
+            let branch = |g: &mut Graph, k: Option<f64>, v: Id| k.map_or(v, |k| g.constant_node(k));
+            let tv = branch(g, t_const, sy);
+            let fv = branch(g, f_const, x);
+            let a = g.select(c, tv, fv);
+            let x2 = g.powi(x, 2);
+            let b = g.select(c, x2, fv);
+            let s = g.binary(Binary::Max, c, x); // its derivative steps on c
+            let ab = g.add(a, b);
+            let z = g.add(ab, s);
+            let one = g.constant_node(1.0);
+            let inv = g.div(one, a); // the sign of a zero selected
+            g.add(z, inv)
+        });
+        let mut xs = vec![0.0, -0.0, 1.0, -1.0, 2.0, 0.5, f64::NAN, 3.0, -3.0];
+        let mut ys = vec![0.0, 0.0, 2.0, -4.0, 1.0, 0.5, 1.0, f64::NAN, -1.0];
+        xs.extend([0.25, f64::INFINITY, -0.0]);
+        ys.extend([0.0, 1.0, -0.0]);
+        bit_identical(
+            &t,
+            &xs,
+            &ys,
+            &format!("select(c, {t_const:?}, {f_const:?})"),
+        );
+    }
+}
+
 /// A chain 400 operations deep (each step depends on the previous one),
 /// with its first and second derivatives.
 #[test]

@@ -7,20 +7,67 @@
 //!   JIT batch   — the cranelift kernel called once for 10^5 points
 //!   hand-written — a Rust function with the derivatives written out by
 //!                  hand, `#[inline(never)]`, over the same batch
-//! plus the JIT compile time per surface.
+//! plus the JIT compile time per surface, and of every surface the
+//! examples declare.
 //!
-//! Run: cargo bench -p lensc --bench surface_eval
-//! A plain harness: best of N runs with `Instant`, ratios from one process.
+//! Run: cargo bench -p lensc-build --bench surface_eval
+//! A plain harness: best of N runs, ratios from one process; each time is
+//! given as wall time (`Instant`) and as the thread's CPU time
+//! (`CLOCK_THREAD_CPUTIME_ID`), each the best of its runs: where the two
+//! differ much, other load took the core.
 
 use std::hint::black_box;
-use std::time::Duration;
+use std::time::Instant;
 
 use lensc_runtime::surface::ir::{Graph, Interpreter, SurfaceFn, SurfaceTape};
 use lensc_runtime::surface::jit::JitSurface;
 
-#[path = "../../../runtime/benches/support/timing.rs"]
-mod timing;
-use timing::best_of;
+/// The CPU time this thread has used (s).
+fn thread_cpu_seconds() -> f64 {
+    let mut t = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `t` is a valid, writable timespec.
+    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut t) };
+    if rc != 0 {
+        return f64::NAN;
+    }
+    t.tv_sec as f64 + t.tv_nsec as f64 * 1e-9
+}
+
+/// A time measured both ways: the best wall time of the runs and the best
+/// CPU time (s).
+#[derive(Clone, Copy)]
+struct Time {
+    wall: f64,
+    cpu: f64,
+}
+
+impl Time {
+    fn per(self, n: usize, unit: f64) -> Time {
+        Time {
+            wall: self.wall * unit / n as f64,
+            cpu: self.cpu * unit / n as f64,
+        }
+    }
+}
+
+/// Best of `runs` runs of `f`, wall and CPU time each.
+fn best_of(runs: usize, mut f: impl FnMut()) -> Time {
+    let mut best = Time {
+        wall: f64::INFINITY,
+        cpu: f64::INFINITY,
+    };
+    for _ in 0..runs {
+        let (t, c) = (Instant::now(), thread_cpu_seconds());
+        f();
+        let (w, c) = (t.elapsed().as_secs_f64(), thread_cpu_seconds() - c);
+        best.wall = best.wall.min(w);
+        best.cpu = best.cpu.min(c);
+    }
+    best
+}
 
 const POINTS: usize = 100_000;
 const RUNS: usize = 15;
@@ -198,11 +245,11 @@ fn array_points() -> (Vec<f64>, Vec<f64>) {
 
 struct Row {
     name: &'static str,
-    interp: f64,
-    scalar: f64,
-    batch: f64,
-    hand: f64,
-    compile_us: f64,
+    interp: Time,
+    scalar: Time,
+    batch: Time,
+    hand: Time,
+    compile_us: Time,
     max_rel_dev: f64,
 }
 
@@ -211,7 +258,7 @@ type HandFn = fn(&[f64], &[f64], &mut [f64]);
 fn measure(name: &'static str, tape: &SurfaceTape, pts: (Vec<f64>, Vec<f64>), hand: HandFn) -> Row {
     let (xs, ys) = pts;
     let n = xs.len();
-    let ns = |d: Duration| d.as_secs_f64() * 1e9 / n as f64;
+    let ns = |t: Time| t.per(n, 1e9);
 
     let compile = best_of(COMPILES, || {
         black_box(JitSurface::compile(black_box(tape)).expect("compiles"));
@@ -257,7 +304,7 @@ fn measure(name: &'static str, tape: &SurfaceTape, pts: (Vec<f64>, Vec<f64>), ha
         scalar: ns(scalar_t),
         batch: ns(batch_t),
         hand: ns(hand_t),
-        compile_us: compile.as_secs_f64() * 1e6,
+        compile_us: compile.per(1, 1e6),
         max_rel_dev,
     }
 }
@@ -285,30 +332,35 @@ fn main() {
         ),
         measure("10x10 array", &array, array_points(), array_by_hand),
     ];
-    println!();
-    println!(
-        "{:<15} {:>12} {:>12} {:>12} {:>12} | {:>10} {:>12} | {:>11}",
-        "ns/point",
-        "interpreter",
-        "JIT scalar",
-        "JIT batch",
-        "hand-written",
-        "JIT/hand",
-        "interp/JIT",
-        "compile µs"
-    );
-    for r in &rows {
+    for (what, get) in [
+        ("wall", (|t: Time| t.wall) as fn(Time) -> f64),
+        ("CPU", |t: Time| t.cpu),
+    ] {
+        println!();
         println!(
-            "{:<15} {:>12.2} {:>12.2} {:>12.2} {:>12.2} | {:>9.2}× {:>11.2}× | {:>11.1}",
-            r.name,
-            r.interp,
-            r.scalar,
-            r.batch,
-            r.hand,
-            r.batch / r.hand,
-            r.interp / r.batch,
-            r.compile_us
+            "{:<15} {:>12} {:>12} {:>12} {:>12} | {:>10} {:>12} | {:>11}",
+            format!("ns/point {what}"),
+            "interpreter",
+            "JIT scalar",
+            "JIT batch",
+            "hand-written",
+            "JIT/hand",
+            "interp/JIT",
+            "compile µs"
         );
+        for r in &rows {
+            println!(
+                "{:<15} {:>12.2} {:>12.2} {:>12.2} {:>12.2} | {:>9.2}× {:>11.2}× | {:>11.1}",
+                r.name,
+                get(r.interp),
+                get(r.scalar),
+                get(r.batch),
+                get(r.hand),
+                get(r.batch) / get(r.hand),
+                get(r.interp) / get(r.batch),
+                get(r.compile_us)
+            );
+        }
     }
     println!();
     for r in &rows {
@@ -325,9 +377,64 @@ fn main() {
     };
     let fixed = best_of(COMPILES, || {
         black_box(JitSurface::compile(black_box(&trivial)).expect("compiles"));
-    });
+    })
+    .per(1, 1e6);
     println!(
-        "compile of z = x (fixed cost): {:.1} µs",
-        fixed.as_secs_f64() * 1e6
+        "compile of z = x (fixed cost): {:.1} µs wall, {:.1} µs CPU",
+        fixed.wall, fixed.cpu
     );
+    every_example_surface();
+}
+
+/// The compile time of every surface the examples declare (best of
+/// `COMPILES` each), slowest first.
+fn every_example_surface() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .expect("examples/ is readable")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "lens"))
+        .collect();
+    files.sort();
+    let mut rows: Vec<(String, usize, Time)> = Vec::new();
+    for path in files {
+        let Ok(c) = lensc_build::driver::check_path(&lensc_lang::loader::RealFs, &path) else {
+            continue;
+        };
+        let mut names: Vec<&String> = c
+            .checked
+            .declarations
+            .iter()
+            .filter(|(_, o)| o.kind.category == lensc_lang::schema::Category::Surface)
+            .map(|(n, _)| n)
+            .collect();
+        names.sort();
+        let file = path
+            .file_stem()
+            .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+        for name in names {
+            let Ok(lowered) = lensc_build::driver::declared_surface(&c, name) else {
+                continue;
+            };
+            let tape = lowered.tape;
+            let t = best_of(COMPILES, || {
+                black_box(JitSurface::compile(black_box(&tape)).expect("compiles"));
+            })
+            .per(1, 1e6);
+            rows.push((format!("{file}: {name}"), tape.live_nodes().len(), t));
+        }
+    }
+    rows.sort_by(|a, b| b.2.cpu.total_cmp(&a.2.cpu));
+    println!();
+    println!(
+        "JIT compile of every surface the examples declare ({} surfaces, best of {COMPILES} each)",
+        rows.len()
+    );
+    println!(
+        "{:<50} {:>10} {:>12} {:>12}",
+        "surface", "live nodes", "µs wall", "µs CPU"
+    );
+    for (name, nodes, t) in &rows {
+        println!("{name:<50} {nodes:>10} {:>12.1} {:>12.1}", t.wall, t.cpu);
+    }
 }

@@ -51,10 +51,19 @@ pub(crate) const P5: u64 = 0x3E66_3769_72BE_A4D0;
 /// Below this |x| both exp(x) and 2^k are normal numbers; beyond it
 /// (overflow, underflow, subnormal results) libm answers.
 pub(crate) const EXP_LIMIT: f64 = 708.0;
+/// Below this, e^a rounds to +0 (a < −1075 ln 2 ≈ −745.133): libm's value,
+/// which the kernel's inline exp gives without leaving the vector pass.
+pub(crate) const EXP_ZERO_BELOW: f64 = -746.0;
 
-/// sin a and cos a.
+/// sin a and cos a, from one reduction: the same bits as `sin` and `cos`.
 pub fn sin_cos(a: f64) -> (f64, f64) {
-    (sin(a), cos(a))
+    let Some((q, y0, y1)) = reduce(a) else {
+        return (a.sin(), a.cos());
+    };
+    let (odd, half) = (q & 1 != 0, q & 2 != 0);
+    let (s, c) = (sin_poly(y0, y1), cos_poly(y0, y1));
+    let (s, c) = if odd { (c, s) } else { (s, c) };
+    (if half { -s } else { s }, if odd != half { -c } else { c })
 }
 
 /// sin a (only the polynomial it needs).
@@ -152,4 +161,29 @@ pub fn exp(a: f64) -> f64 {
         .wrapping_add((1023 - TO_INT.to_bits() as i64) as u64)
         << 52;
     y * f64::from_bits(e)
+}
+
+#[cfg(test)]
+mod tests {
+    /// `sin_cos` shares one reduction and gives `sin`'s and `cos`'s bits:
+    /// every quadrant, both signs, the libm cases beyond the bound.
+    #[test]
+    fn sin_cos_is_sin_and_cos() {
+        let mut args = vec![0.0, -0.0, f64::NAN, f64::INFINITY, -f64::INFINITY, 1e300];
+        args.extend([super::TRIG_LIMIT, -super::TRIG_LIMIT, 5e-324, 1e-8]);
+        let mut w: u64 = 0x2545_F491_4F6C_DD1D;
+        for i in 0..200_000 {
+            w ^= w << 13;
+            w ^= w >> 7;
+            w ^= w << 17;
+            let u = (w >> 11) as f64 / (1u64 << 53) as f64;
+            args.push((2.0 * u - 1.0) * [4.0, 100.0, 1e6, 2e6][i % 4]);
+        }
+        for a in args {
+            let (s, c) = super::sin_cos(a);
+            let same = |x: f64, y: f64| x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan());
+            assert!(same(s, super::sin(a)), "sin {a:e}");
+            assert!(same(c, super::cos(a)), "cos {a:e}");
+        }
+    }
 }

@@ -9,7 +9,9 @@
 //! throughput of one lane on arithmetic-heavy tapes, as measured by
 //! `benches/surface_eval.rs`) and an odd last point in a scalar pass; both
 //! passes compute the same bits for a point (the same IEEE operations, and
-//! a lane never depends on its neighbour).
+//! a lane never depends on its neighbour). The vector pass calls nothing
+//! for sin, cos and exp: a pair with a lane their inline code does not
+//! cover is taken again point by point (`define_kernel`).
 //!
 //! Arithmetic, `sqrt`, `abs` and negation are native instructions
 //! (IEEE-exact, as in Rust); `min`/`max` are a select sequence with Rust's
@@ -17,8 +19,9 @@
 //! first operand); whole powers are expanded by repeated squaring in the
 //! order compiler-rt's `__powidf2` (Rust's `f64::powi`) multiplies; sin,
 //! cos and exp are inline on both lanes (`vecmath`, within 1 ulp of libm;
-//! sin and cos of one argument share its reduction), lanes they do not
-//! cover (huge, infinite or NaN arguments) going to libm; everything else
+//! sin and cos of one argument share its reduction), points they do not
+//! cover (huge, infinite or NaN arguments) going to the scalar pass, which
+//! calls `fdlibm` (libm beyond its bounds); everything else
 //! (tan … ln, pow, atan2) calls the interpreter's own
 //! `apply_unary`/`apply_binary` through `extern "C"` wrappers registered as
 //! JIT symbols, once per lane.
@@ -27,7 +30,6 @@ use std::collections::HashMap;
 use std::fmt;
 use std::sync::OnceLock;
 
-use crate::surface::fdlibm;
 use crate::surface::ir::{
     Binary, Id, Node, SurfaceFn, SurfaceTape, Unary, Var, apply_binary, apply_unary,
 };
@@ -35,8 +37,7 @@ use cranelift_codegen::Context;
 use cranelift_codegen::ir::condcodes::{FloatCC, IntCC};
 use cranelift_codegen::ir::immediates::Ieee64;
 use cranelift_codegen::ir::{
-    AbiParam, FuncRef, InstBuilder, MemFlagsData, StackSlotData, StackSlotKind, Type, UserFuncName,
-    Value, types,
+    AbiParam, Endianness, FuncRef, InstBuilder, MemFlagsData, Type, UserFuncName, Value, types,
 };
 use cranelift_codegen::isa::OwnedTargetIsa;
 use cranelift_codegen::settings::{self, Configurable};
@@ -107,9 +108,6 @@ impl JitSurface {
         let mut jb = JITBuilder::with_isa(host_isa()?, default_libcall_names());
         for f in Libm::ALL {
             jb.symbol(f.symbol(), f.address());
-        }
-        for t in Twin::ALL {
-            jb.symbol(t.symbol(), t.address());
         }
         // From here on, an early return frees whatever was allocated.
         let mut guard = ModuleGuard(Some(JITModule::new(jb)));
@@ -208,12 +206,22 @@ impl Lanes {
 /// Builds and defines the kernel function in `module`.
 ///
 /// ```text
-/// entry: end = xs + 8·(n & !1); if n < 2 goto tail
-/// main:  the tape on F64X2 for points (px[0], py[0]) and (px[1], py[1]);
-///        advance the cursors by two points; loop until px == end
-/// tail:  if n is odd: the tape on F64 for the last point
-/// exit:  return
+/// entry:  end = xs + 8n; goto head
+/// head:   if at least two points are left goto pair, else goto tail
+/// pair:   the tape on F64X2 for the points at (px, py), px[0] and px[1];
+///         if a lane fell outside the inline sin, cos or exp goto single
+/// store:  store both points' outputs; advance by two points; goto head
+/// tail:   if px == end goto exit
+/// single: the tape on F64 for the point at px (its libm calls made);
+///         store; advance by one point; goto head
+/// exit:   return
 /// ```
+///
+/// The vector pass makes no call: a pair with a lane the inline code does
+/// not cover (a huge, infinite or NaN argument, exp's overflow) stores
+/// nothing and is taken again one point at a time, by the scalar pass
+/// for its first point and the vector pass for what follows. The scalar
+/// pass computes the same bits as the vector pass where both hold.
 fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, JitError> {
     let ptr = module.target_config().pointer_type();
     let mut sig = module.make_signature();
@@ -229,17 +237,13 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
     ctx.func.name = UserFuncName::user(0, id.as_u32());
     let mut fctx = FunctionBuilderContext::new();
     let mut b = FunctionBuilder::new(&mut ctx.func, &mut fctx);
-    let mut emit = Emitter {
-        module,
-        imports: HashMap::new(),
-        twins: HashMap::new(),
-        trig: HashMap::new(),
-    };
 
     let entry = b.create_block();
-    let main = b.create_block();
+    let head = b.create_block();
+    let pair = b.create_block();
+    let store = b.create_block();
     let tail = b.create_block();
-    let last = b.create_block();
+    let single = b.create_block();
     let exit = b.create_block();
 
     b.append_block_params_for_function_params(entry);
@@ -247,35 +251,66 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
     let &[xs, ys, out, n] = b.block_params(entry) else {
         unreachable!("the kernel has four parameters")
     };
+    let mut emit = Emitter {
+        module,
+        imports: HashMap::new(),
+        trig: HashMap::new(),
+        negative: HashMap::new(),
+        covered: Vec::new(),
+    };
     let [px, py, po] = [(); 3].map(|_| b.declare_var(ptr));
     b.def_var(px, xs);
     b.def_var(py, ys);
     b.def_var(po, out);
-    let even = b.ins().band_imm_s(n, -2);
-    let bytes = b.ins().ishl_imm_u(even, 3);
+    let bytes = b.ins().ishl_imm_u(n, 3);
     let end = b.ins().iadd(xs, bytes);
-    b.ins().brif(even, main, &[], tail, &[]);
+    b.ins().jump(head, &[]);
 
-    b.switch_to_block(main);
+    // Two points left or more: px + 8 < end.
+    b.switch_to_block(head);
+    let cx = b.use_var(px);
+    let second = b.ins().iadd_imm_u(cx, 8);
+    let two = b.ins().icmp(IntCC::UnsignedLessThan, second, end);
+    b.ins().brif(two, pair, &[], tail, &[]);
+
+    b.switch_to_block(pair);
     let (cx, cy, co) = (b.use_var(px), b.use_var(py), b.use_var(po));
-    emit.pass(&mut b, tape, Lanes::Two, cx, cy, co)?;
+    let outputs = emit.pass(&mut b, tape, Lanes::Two, cx, cy)?;
+    match emit.covered.split_first() {
+        None => b.ins().jump(store, &[]),
+        Some((&first, rest)) => {
+            let all = rest.iter().fold(first, |acc, &m| b.ins().band(acc, m));
+            let covered = b.ins().vall_true(all);
+            b.ins().brif(covered, store, &[], single, &[])
+        }
+    };
+
+    b.switch_to_block(store);
+    store_outputs(&mut b, Lanes::Two, outputs, co);
     let nx = b.ins().iadd_imm_u(cx, 16);
     let ny = b.ins().iadd_imm_u(cy, 16);
     let no = b.ins().iadd_imm_u(co, 96);
     b.def_var(px, nx);
     b.def_var(py, ny);
     b.def_var(po, no);
-    let more = b.ins().icmp(IntCC::NotEqual, nx, end);
-    b.ins().brif(more, main, &[], tail, &[]);
+    b.ins().jump(head, &[]);
 
     b.switch_to_block(tail);
-    let odd = b.ins().band_imm_u(n, 1);
-    b.ins().brif(odd, last, &[], exit, &[]);
+    let cx = b.use_var(px);
+    let more = b.ins().icmp(IntCC::NotEqual, cx, end);
+    b.ins().brif(more, single, &[], exit, &[]);
 
-    b.switch_to_block(last);
+    b.switch_to_block(single);
     let (cx, cy, co) = (b.use_var(px), b.use_var(py), b.use_var(po));
-    emit.pass(&mut b, tape, Lanes::One, cx, cy, co)?;
-    b.ins().jump(exit, &[]);
+    let outputs = emit.pass(&mut b, tape, Lanes::One, cx, cy)?;
+    store_outputs(&mut b, Lanes::One, outputs, co);
+    let nx = b.ins().iadd_imm_u(cx, 8);
+    let ny = b.ins().iadd_imm_u(cy, 8);
+    let no = b.ins().iadd_imm_u(co, 48);
+    b.def_var(px, nx);
+    b.def_var(py, ny);
+    b.def_var(po, no);
+    b.ins().jump(head, &[]);
 
     b.switch_to_block(exit);
     b.ins().return_(&[]);
@@ -293,14 +328,21 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
 struct Emitter<'m> {
     module: &'m mut JITModule,
     imports: HashMap<Libm, FuncRef>,
-    twins: HashMap<Twin, FuncRef>,
     /// sin and cos of each argument already reduced in this pass.
     trig: HashMap<Id, (Value, Value)>,
+    /// The comparison `a < 0` of each node already tested in this pass (a
+    /// lenslet array's outputs are all selected by one test).
+    negative: HashMap<Id, Value>,
+    /// The lane masks of where the inline sin, cos and exp of this (vector)
+    /// pass hold.
+    covered: Vec<Value>,
 }
 
 impl Emitter<'_> {
     /// One pass of the live tape for the point(s) at the cursors: loads x
-    /// and y, evaluates every node, stores the six outputs of each point.
+    /// and y, evaluates every node, returns the six outputs (on two lanes,
+    /// with the masks of where the inline sin, cos and exp hold in
+    /// `covered`).
     fn pass(
         &mut self,
         b: &mut FunctionBuilder,
@@ -308,8 +350,7 @@ impl Emitter<'_> {
         lanes: Lanes,
         cx: Value,
         cy: Value,
-        co: Value,
-    ) -> Result<(), JitError> {
+    ) -> Result<[Value; 6], JitError> {
         // Slices of f64 are 8-aligned, so a pair is not always 16-aligned.
         let load = match lanes {
             Lanes::One => MemFlagsData::trusted(),
@@ -318,141 +359,103 @@ impl Emitter<'_> {
         let x = b.ins().load(lanes.ty(), load, cx, 0);
         let y = b.ins().load(lanes.ty(), load, cy, 0);
         self.trig.clear();
+        self.negative.clear();
+        self.covered.clear();
         let mut val: Vec<Option<Value>> = vec![None; tape.graph.len()];
+        let graph = &tape.graph;
         for id in tape.live_nodes() {
             let get =
                 |i: Id| val[i.0 as usize].expect("operands come before their node in the tape");
-            let v = match tape.graph.node(id) {
+            let v = match graph.node(id) {
                 Node::Const(bits) => constant(b, lanes, bits),
                 Node::Var(Var::X) => x,
                 Node::Var(Var::Y) => y,
-                Node::Unary(op @ (Unary::Sin | Unary::Cos), a) if lanes == Lanes::Two => {
-                    let (sin, cos) = self.sin_cos(b, a, get(a))?;
+                Node::Unary(op @ (Unary::Sin | Unary::Cos), a) => {
+                    let (sin, cos) = self.sin_cos(b, lanes, a, get(a))?;
                     if op == Unary::Sin { sin } else { cos }
                 }
                 Node::Unary(op, a) => self.unary(b, lanes, op, get(a))?,
+                Node::Binary(op @ (Binary::Min | Binary::Max), l, r) => {
+                    let l = (get(l), graph.constant(l));
+                    let r = (get(r), graph.constant(r));
+                    min_max(b, lanes, op, l, r)
+                }
                 Node::Binary(op, a, c) => self.binary(b, lanes, op, get(a), get(c))?,
                 Node::PowI(a, k) => powi(b, lanes, get(a), k),
                 Node::Step(a) => {
                     // 1 where a < 0 (false for NaN), else 0.
+                    let neg = self.negative(b, lanes, a, get(a));
                     let zero = constant(b, lanes, 0f64.to_bits());
                     let one = constant(b, lanes, 1f64.to_bits());
-                    let neg = b.ins().fcmp(FloatCC::LessThan, get(a), zero);
-                    select(b, lanes, neg, one, zero)
+                    select_known(b, lanes, neg, (one, Some(1.0)), (zero, Some(0.0)))
                 }
                 Node::Select(c, t, f) => {
                     // t where c < 0 (false for NaN), else f.
-                    let zero = constant(b, lanes, 0f64.to_bits());
-                    let neg = b.ins().fcmp(FloatCC::LessThan, get(c), zero);
-                    select(b, lanes, neg, get(t), get(f))
+                    let neg = self.negative(b, lanes, c, get(c));
+                    let t = (get(t), graph.constant(t));
+                    let f = (get(f), graph.constant(f));
+                    select_known(b, lanes, neg, t, f)
                 }
             };
             val[id.0 as usize] = Some(v);
         }
-        let mem = MemFlagsData::trusted();
-        for (k, o) in tape.outputs.iter().enumerate() {
-            let v = val[o.0 as usize].expect("outputs are live");
-            let off = 8 * k as i32;
-            match lanes {
-                Lanes::One => {
-                    b.ins().store(mem, v, co, off);
-                }
-                Lanes::Two => {
-                    let lo = b.ins().extractlane(v, 0);
-                    let hi = b.ins().extractlane(v, 1);
-                    b.ins().store(mem, lo, co, off);
-                    b.ins().store(mem, hi, co, off + 48);
-                }
-            }
-        }
-        Ok(())
+        Ok(tape
+            .outputs
+            .map(|o| val[o.0 as usize].expect("outputs are live")))
     }
 
-    /// sin a and cos a on both lanes (node `arg`, value `a`), reduced once
-    /// per argument; should a lane fall outside the inline code, the twin
-    /// answers.
+    /// The cached test `a < 0` (false for NaN) of node `id`: a flag with
+    /// one lane, a lane mask with two.
+    fn negative(&mut self, b: &mut FunctionBuilder, lanes: Lanes, id: Id, a: Value) -> Value {
+        if let Some(&neg) = self.negative.get(&id) {
+            return neg;
+        }
+        let zero = constant(b, lanes, 0f64.to_bits());
+        let neg = b.ins().fcmp(FloatCC::LessThan, a, zero);
+        self.negative.insert(id, neg);
+        neg
+    }
+
+    /// sin a and cos a (node `arg`, value `a`), reduced once per argument:
+    /// inline on two lanes, the mask of the lanes they cover joining
+    /// `covered`; one call on one lane.
     fn sin_cos(
         &mut self,
         b: &mut FunctionBuilder,
+        lanes: Lanes,
         arg: Id,
         a: Value,
     ) -> Result<(Value, Value), JitError> {
         if let Some(&pair) = self.trig.get(&arg) {
             return Ok(pair);
         }
-        let (sin, cos, ok) = vecmath::sin_cos(b, a);
-        let got = self.guard(b, ok, a, Twin::SinCos, &[sin, cos])?;
-        let (sin, cos) = (got[0], got[1]);
-        self.trig.insert(arg, (sin, cos));
-        Ok((sin, cos))
+        let pair = self.sin_cos_of(b, lanes, a)?;
+        self.trig.insert(arg, pair);
+        Ok(pair)
     }
 
-    /// The inline values where `ok` holds in both lanes (the common case:
-    /// one branch, no call); otherwise the twins' values for both lanes
-    /// (one call), which are the same bits where `ok` holds and libm's
-    /// where it does not. `fast` are the inline results in the order the
-    /// twin writes them.
-    fn guard(
+    /// sin a and cos a, computed here.
+    fn sin_cos_of(
         &mut self,
         b: &mut FunctionBuilder,
-        ok: Value,
+        lanes: Lanes,
         a: Value,
-        twin: Twin,
-        fast: &[Value],
-    ) -> Result<Vec<Value>, JitError> {
-        let cold = b.create_block();
-        let join = b.create_block();
-        for _ in fast {
-            b.append_block_param(join, types::F64X2);
-        }
-        b.set_cold_block(cold);
-        let all = b.ins().vall_true(ok);
-        let fast_args: Vec<_> = fast.iter().map(|&v| v.into()).collect();
-        b.ins().brif(all, join, &fast_args, cold, &[]);
-
-        b.switch_to_block(cold);
-        let slot = b.create_sized_stack_slot(StackSlotData::new(
-            StackSlotKind::ExplicitSlot,
-            16 * twin.outputs(),
-            4,
-        ));
-        let ptr = self.module.target_config().pointer_type();
-        let at = b.ins().stack_addr(ptr, slot, 0);
-        let lo = b.ins().extractlane(a, 0);
-        let hi = b.ins().extractlane(a, 1);
-        let fref = self.twin(b, twin)?;
-        b.ins().call(fref, &[lo, hi, at]);
-        let slow: Vec<_> = (0..fast.len())
-            .map(|k| {
-                let v = b
-                    .ins()
-                    .load(types::F64X2, MemFlagsData::trusted(), at, 16 * k as i32);
-                v.into()
-            })
-            .collect();
-        b.ins().jump(join, &slow);
-
-        b.switch_to_block(join);
-        Ok(b.block_params(join).to_vec())
-    }
-
-    /// The import of a twin, declared once.
-    fn twin(&mut self, b: &mut FunctionBuilder, twin: Twin) -> Result<FuncRef, JitError> {
-        if let Some(&r) = self.twins.get(&twin) {
-            return Ok(r);
-        }
-        let mut sig = self.module.make_signature();
-        sig.params.push(AbiParam::new(types::F64));
-        sig.params.push(AbiParam::new(types::F64));
-        sig.params
-            .push(AbiParam::new(self.module.target_config().pointer_type()));
-        let fid = self
-            .module
-            .declare_function(twin.symbol(), Linkage::Import, &sig)
-            .map_err(|e| JitError(format!("declaring {}: {e}", twin.symbol())))?;
-        let r = self.module.declare_func_in_func(fid, b.func);
-        self.twins.insert(twin, r);
-        Ok(r)
+    ) -> Result<(Value, Value), JitError> {
+        Ok(match lanes {
+            Lanes::Two => {
+                let (sin, cos, ok) = vecmath::sin_cos(b, a);
+                self.covered.push(ok);
+                (sin, cos)
+            }
+            Lanes::One => {
+                let fref = self.import(b, Libm::SinCos)?;
+                let call = b.ins().call(fref, &[a]);
+                let &[sin, cos] = b.inst_results(call) else {
+                    unreachable!("sin_cos returns two values")
+                };
+                (sin, cos)
+            }
+        })
     }
 
     fn unary(
@@ -469,13 +472,15 @@ impl Emitter<'_> {
             Unary::Floor => b.ins().floor(a),
             Unary::Exp if lanes == Lanes::Two => {
                 let (e, ok) = vecmath::exp(b, a);
-                self.guard(b, ok, a, Twin::Exp, &[e])?[0]
+                self.covered.push(ok);
+                e
             }
-            // The scalar pass calls the twins of the inline code; `pass`
-            // gives sin and cos of one argument one inline reduction.
+            // The scalar pass calls the twins of the inline code.
             Unary::Exp => self.call(b, lanes, Libm::Exp, &[a])?,
-            Unary::Sin => self.call(b, lanes, Libm::Sin, &[a])?,
-            Unary::Cos => self.call(b, lanes, Libm::Cos, &[a])?,
+            Unary::Sin | Unary::Cos => {
+                let (sin, cos) = self.sin_cos_of(b, lanes, a)?;
+                if op == Unary::Sin { sin } else { cos }
+            }
             Unary::Tan => self.call(b, lanes, Libm::Tan, &[a])?,
             Unary::Asin => self.call(b, lanes, Libm::Asin, &[a])?,
             Unary::Acos => self.call(b, lanes, Libm::Acos, &[a])?,
@@ -499,22 +504,29 @@ impl Emitter<'_> {
             Binary::Div => b.ins().fdiv(l, r),
             Binary::Pow => self.call(b, lanes, Libm::Pow, &[l, r])?,
             Binary::Atan2 => self.call(b, lanes, Libm::Atan2, &[l, r])?,
-            // Rust's f64::min/max (LLVM minnum/maxnum on x86-64):
-            // l is NaN → r; else r if r is strictly smaller (greater), else l.
-            // So a NaN r yields l, and equal operands (±0) yield l.
-            // cranelift's fmin/fmax propagate NaN and order −0 < +0 instead.
-            Binary::Min | Binary::Max => {
-                let cc = if op == Binary::Min {
-                    FloatCC::LessThan
-                } else {
-                    FloatCC::GreaterThan
-                };
-                let r_wins = b.ins().fcmp(cc, r, l);
-                let m = select(b, lanes, r_wins, r, l);
-                let l_nan = b.ins().fcmp(FloatCC::Unordered, l, l);
-                select(b, lanes, l_nan, r, m)
-            }
+            Binary::Min | Binary::Max => min_max(b, lanes, op, (l, None), (r, None)),
         })
+    }
+
+    /// The import of a wrapper, declared once.
+    fn import(&mut self, b: &mut FunctionBuilder, f: Libm) -> Result<FuncRef, JitError> {
+        if let Some(&r) = self.imports.get(&f) {
+            return Ok(r);
+        }
+        let mut sig = self.module.make_signature();
+        for _ in 0..f.arity() {
+            sig.params.push(AbiParam::new(types::F64));
+        }
+        for _ in 0..f.results() {
+            sig.returns.push(AbiParam::new(types::F64));
+        }
+        let fid = self
+            .module
+            .declare_function(f.symbol(), Linkage::Import, &sig)
+            .map_err(|e| JitError(format!("declaring {}: {e}", f.symbol())))?;
+        let r = self.module.declare_func_in_func(fid, b.func);
+        self.imports.insert(f, r);
+        Ok(r)
     }
 
     /// Calls a scalar wrapper, once per lane.
@@ -525,23 +537,7 @@ impl Emitter<'_> {
         f: Libm,
         args: &[Value],
     ) -> Result<Value, JitError> {
-        let fref = match self.imports.get(&f) {
-            Some(&r) => r,
-            None => {
-                let mut sig = self.module.make_signature();
-                for _ in 0..f.arity() {
-                    sig.params.push(AbiParam::new(types::F64));
-                }
-                sig.returns.push(AbiParam::new(types::F64));
-                let fid = self
-                    .module
-                    .declare_function(f.symbol(), Linkage::Import, &sig)
-                    .map_err(|e| JitError(format!("declaring {}: {e}", f.symbol())))?;
-                let r = self.module.declare_func_in_func(fid, b.func);
-                self.imports.insert(f, r);
-                r
-            }
-        };
+        let fref = self.import(b, f)?;
         let call = |b: &mut FunctionBuilder, args: &[Value]| {
             let inst = b.ins().call(fref, args);
             b.inst_results(inst)[0]
@@ -562,6 +558,47 @@ impl Emitter<'_> {
     }
 }
 
+/// Stores the six outputs of the point(s) of a pass at `co`.
+fn store_outputs(b: &mut FunctionBuilder, lanes: Lanes, outputs: [Value; 6], co: Value) {
+    match lanes {
+        Lanes::One => {
+            for (k, &v) in outputs.iter().enumerate() {
+                b.ins().store(MemFlagsData::trusted(), v, co, 8 * k as i32);
+            }
+        }
+        Lanes::Two => {
+            // Outputs k and k + 1 of the first point side by side, then
+            // of the second: three 16-byte stores per point rather
+            // than six 8-byte ones and six lane extractions.
+            let bytes = |v: Value, b: &mut FunctionBuilder| {
+                b.ins().bitcast(
+                    types::I8X16,
+                    MemFlagsData::new().with_endianness(Endianness::Little),
+                    v,
+                )
+            };
+            // Slices of f64 are 8-aligned, so a pair is not always
+            // 16-aligned.
+            let mem = MemFlagsData::new().with_notrap();
+            let mask = |b: &mut FunctionBuilder, lanes: [std::ops::Range<u8>; 2]| {
+                let [first, second] = lanes;
+                let bytes: Vec<u8> = first.chain(second).collect();
+                b.func.dfg.immediates.push(bytes.into())
+            };
+            // The first lane of each vector; the second.
+            let low = mask(b, [0..8, 16..24]);
+            let high = mask(b, [8..16, 24..32]);
+            for k in (0..6).step_by(2) {
+                let (a, c) = (bytes(outputs[k], b), bytes(outputs[k + 1], b));
+                let first = b.ins().shuffle(a, c, low);
+                let second = b.ins().shuffle(a, c, high);
+                b.ins().store(mem, first, co, 8 * k as i32);
+                b.ins().store(mem, second, co, 48 + 8 * k as i32);
+            }
+        }
+    }
+}
+
 /// A constant, in every lane.
 fn constant(b: &mut FunctionBuilder, lanes: Lanes, bits: u64) -> Value {
     match lanes {
@@ -578,11 +615,90 @@ fn constant(b: &mut FunctionBuilder, lanes: Lanes, bits: u64) -> Value {
 /// `cond ? t : f` lane by lane, for a condition from `fcmp` or `icmp`: a
 /// flag with one lane, a lane mask with two.
 fn select(b: &mut FunctionBuilder, lanes: Lanes, cond: Value, t: Value, f: Value) -> Value {
+    select_known(b, lanes, cond, (t, None), (f, None))
+}
+
+/// `select` where either operand may be a known constant: with two lanes a
+/// +0 operand makes the blend a bitwise and (the mask's lanes are all ones
+/// or all zeros, and +0 is all zero bits).
+fn select_known(
+    b: &mut FunctionBuilder,
+    lanes: Lanes,
+    cond: Value,
+    (t, tc): (Value, Option<f64>),
+    (f, fc): (Value, Option<f64>),
+) -> Value {
+    let plus_zero = |c: Option<f64>| c.is_some_and(|c| c.to_bits() == 0);
     match lanes {
         Lanes::One => b.ins().select(cond, t, f),
         Lanes::Two => {
             let mask = b.ins().bitcast(types::F64X2, MemFlagsData::new(), cond);
-            b.ins().bitselect(mask, t, f)
+            if plus_zero(fc) {
+                b.ins().band(mask, t)
+            } else if plus_zero(tc) {
+                b.ins().band_not(f, mask)
+            } else {
+                b.ins().bitselect(mask, t, f)
+            }
+        }
+    }
+}
+
+/// Rust's `l.min(r)` / `l.max(r)` (LLVM minnum/maxnum on x86-64): l is
+/// NaN → r; else r if r is strictly smaller (greater), else l. So a NaN r
+/// yields l, and equal operands (±0) yield l. cranelift's fmin/fmax
+/// propagate NaN and order −0 < +0 instead, so this is a select sequence;
+/// with a constant operand (`Some(value)`), a shorter one that gives the
+/// same bits for every other operand. Each select whose condition is `x <
+/// y` and whose operands are x and y is a single `minpd`/`maxpd` on two
+/// lanes (x if x < y, else y).
+fn min_max(
+    b: &mut FunctionBuilder,
+    lanes: Lanes,
+    op: Binary,
+    (l, lc): (Value, Option<f64>),
+    (r, rc): (Value, Option<f64>),
+) -> Value {
+    let min = op == Binary::Min;
+    match (lc, rc) {
+        // A non-NaN constant c on the right: c where l is NaN or c is
+        // strictly smaller (greater), else l.
+        (_, Some(c)) if !c.is_nan() => {
+            if c != 0.0 {
+                // Equal operands have the same bits, so "l where l < c
+                // (> c), else c" is the same: one minpd (maxpd).
+                let l_wins = if min {
+                    b.ins().fcmp(FloatCC::LessThan, l, r)
+                } else {
+                    b.ins().fcmp(FloatCC::LessThan, r, l)
+                };
+                select(b, lanes, l_wins, l, r)
+            } else {
+                // ±0: equal is not the same bits; keep l on a tie.
+                let cc = if min {
+                    FloatCC::UnorderedOrGreaterThan
+                } else {
+                    FloatCC::UnorderedOrLessThan
+                };
+                let r_wins = b.ins().fcmp(cc, l, r);
+                select_known(b, lanes, r_wins, (r, rc), (l, lc))
+            }
+        }
+        _ => {
+            // r where r is strictly smaller (greater), else l: one
+            // minpd (maxpd); a NaN r yields l.
+            let r_wins = if min {
+                b.ins().fcmp(FloatCC::LessThan, r, l)
+            } else {
+                b.ins().fcmp(FloatCC::LessThan, l, r)
+            };
+            let m = select(b, lanes, r_wins, r, l);
+            if lc.is_some_and(|c| !c.is_nan()) {
+                // l is no NaN.
+                return m;
+            }
+            let l_nan = b.ins().fcmp(FloatCC::Unordered, l, l);
+            select(b, lanes, l_nan, r, m)
         }
     }
 }
@@ -619,64 +735,11 @@ fn powi(b: &mut FunctionBuilder, lanes: Lanes, a: Value, n: i32) -> Value {
     }
 }
 
-/// The twins of the inline sin, cos and exp for both lanes at once, called
-/// where a lane falls outside the inline code: `f(a0, a1, out)` writes
-/// each result for both lanes to `out`, 16 bytes apiece.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-enum Twin {
-    /// sin a0, sin a1, cos a0, cos a1.
-    SinCos,
-    /// exp a0, exp a1.
-    Exp,
-}
-
-impl Twin {
-    const ALL: [Twin; 2] = [Twin::SinCos, Twin::Exp];
-
-    fn outputs(self) -> u32 {
-        match self {
-            Twin::SinCos => 2,
-            Twin::Exp => 1,
-        }
-    }
-
-    fn symbol(self) -> &'static str {
-        match self {
-            Twin::SinCos => "lensc_jit_sin_cos_pair",
-            Twin::Exp => "lensc_jit_exp_pair",
-        }
-    }
-
-    fn address(self) -> *const u8 {
-        type F = unsafe extern "C" fn(f64, f64, *mut f64);
-        match self {
-            Twin::SinCos => lensc_jit_sin_cos_pair as F as *const u8,
-            Twin::Exp => lensc_jit_exp_pair as F as *const u8,
-        }
-    }
-}
-
-/// # Safety
-/// `out` points to four writable doubles.
-unsafe extern "C" fn lensc_jit_sin_cos_pair(a0: f64, a1: f64, out: *mut f64) {
-    let ((s0, c0), (s1, c1)) = (fdlibm::sin_cos(a0), fdlibm::sin_cos(a1));
-    // SAFETY: the kernel passes a 32-byte stack slot (`Emitter::guard`).
-    unsafe { out.cast::<[f64; 4]>().write_unaligned([s0, s1, c0, c1]) }
-}
-
-/// # Safety
-/// `out` points to two writable doubles.
-unsafe extern "C" fn lensc_jit_exp_pair(a0: f64, a1: f64, out: *mut f64) {
-    let pair = [fdlibm::exp(a0), fdlibm::exp(a1)];
-    // SAFETY: the kernel passes a 16-byte stack slot (`Emitter::guard`).
-    unsafe { out.cast::<[f64; 2]>().write_unaligned(pair) }
-}
-
 /// The functions the kernel calls rather than inlines.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 enum Libm {
-    Sin,
-    Cos,
+    /// sin and cos of one argument, two results.
+    SinCos,
     Tan,
     Asin,
     Acos,
@@ -688,9 +751,8 @@ enum Libm {
 }
 
 impl Libm {
-    const ALL: [Libm; 10] = [
-        Libm::Sin,
-        Libm::Cos,
+    const ALL: [Libm; 9] = [
+        Libm::SinCos,
         Libm::Tan,
         Libm::Asin,
         Libm::Acos,
@@ -703,8 +765,7 @@ impl Libm {
 
     fn symbol(self) -> &'static str {
         match self {
-            Libm::Sin => "lensc_jit_sin",
-            Libm::Cos => "lensc_jit_cos",
+            Libm::SinCos => "lensc_jit_sin_cos",
             Libm::Tan => "lensc_jit_tan",
             Libm::Asin => "lensc_jit_asin",
             Libm::Acos => "lensc_jit_acos",
@@ -723,12 +784,18 @@ impl Libm {
         }
     }
 
+    fn results(self) -> usize {
+        match self {
+            Libm::SinCos => 2,
+            _ => 1,
+        }
+    }
+
     fn address(self) -> *const u8 {
         type F1 = extern "C" fn(f64) -> f64;
         type F2 = extern "C" fn(f64, f64) -> f64;
         match self {
-            Libm::Sin => lensc_jit_sin as F1 as *const u8,
-            Libm::Cos => lensc_jit_cos as F1 as *const u8,
+            Libm::SinCos => lensc_jit_sin_cos as extern "C" fn(f64) -> Pair as *const u8,
             Libm::Tan => lensc_jit_tan as F1 as *const u8,
             Libm::Asin => lensc_jit_asin as F1 as *const u8,
             Libm::Acos => lensc_jit_acos as F1 as *const u8,
@@ -755,12 +822,14 @@ macro_rules! libm_entries {
     (@apply Binary::$op:ident, $a:ident, $b:ident) => { apply_binary(Binary::$op, $a, $b) };
 }
 
-extern "C" fn lensc_jit_sin(a: f64) -> f64 {
-    crate::surface::fdlibm::sin(a)
-}
+/// Two doubles returned in registers (xmm0, xmm1 in the C ABI of
+/// x86-64), as cranelift returns two `F64` results.
+#[repr(C)]
+struct Pair(f64, f64);
 
-extern "C" fn lensc_jit_cos(a: f64) -> f64 {
-    crate::surface::fdlibm::cos(a)
+extern "C" fn lensc_jit_sin_cos(a: f64) -> Pair {
+    let (sin, cos) = crate::surface::fdlibm::sin_cos(a);
+    Pair(sin, cos)
 }
 
 extern "C" fn lensc_jit_exp(a: f64) -> f64 {

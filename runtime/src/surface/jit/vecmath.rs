@@ -12,16 +12,17 @@
 //!
 //! Each emitter returns its value and a lane mask of the arguments it
 //! covers (|a| below a bound, never NaN or infinite); where a lane falls
-//! outside, the caller calls the twins for both lanes (`jit.rs`,
-//! `Emitter::guard`), and they hand such arguments to libm, so NaN,
-//! infinities, huge arguments and exp's overflow and underflow are libm's
-//! own.
+//! outside, the kernel takes the pair again point by point in its scalar
+//! pass (`jit.rs`, `define_kernel`), whose `fdlibm` calls hand such
+//! arguments to libm, so NaN, infinities, huge arguments and exp's
+//! overflow and subnormal results are libm's own (exp's +0 far below the
+//! range is inline: the same bits).
 
 use cranelift_codegen::ir::condcodes::{FloatCC, IntCC};
 use cranelift_codegen::ir::{InstBuilder, MemFlagsData, Value, types};
 use cranelift_frontend::FunctionBuilder;
 
-use super::{Lanes, constant, select};
+use super::{Lanes, constant};
 
 use crate::surface::fdlibm::*;
 
@@ -35,7 +36,7 @@ impl Ops<'_, '_> {
         constant(self.b, Lanes::Two, bits)
     }
     fn f(&mut self, v: f64) -> Value {
-        constant(self.b, Lanes::Two, v.to_bits())
+        self.k(v.to_bits())
     }
     fn add(&mut self, a: Value, c: Value) -> Value {
         self.b.ins().fadd(a, c)
@@ -73,21 +74,6 @@ impl Ops<'_, '_> {
         let c = self.b.func.dfg.constants.insert(bytes.into());
         self.b.ins().vconst(types::I64X2, c)
     }
-    /// Where the integer `i` has a bit of `mask` set, lane by lane.
-    fn bit_set(&mut self, i: Value, mask: i64) -> Value {
-        let m = self.int(mask);
-        let z = self.int(0);
-        let and = self.b.ins().band(i, m);
-        self.b.ins().icmp(IntCC::NotEqual, and, z)
-    }
-    /// `−v` where `cond` holds, else `v`, lane by lane.
-    fn negate_where(&mut self, cond: Value, v: Value) -> Value {
-        let n = self.b.ins().fneg(v);
-        self.select(cond, n, v)
-    }
-    fn select(&mut self, cond: Value, t: Value, f: Value) -> Value {
-        select(self.b, Lanes::Two, cond, t, f)
-    }
 }
 
 /// sin a and cos a on both lanes, and the lane mask of where they hold.
@@ -121,16 +107,24 @@ pub(super) fn sin_cos(b: &mut FunctionBuilder, a: Value) -> (Value, Value, Value
     let cos = kernel_cos(&mut l, y0, y1, z, zz);
 
     // Quadrant n mod 4: sin = (sin, cos, −sin, −cos)[n], cos = (cos, −sin,
-    // −cos, sin)[n].
+    // −cos, sin)[n]. On the bits, lane by lane: swap where bit 0 of n is
+    // set; flip sin's sign bit by bit 1 of n, cos's by bit 0 xor bit 1.
     let ti = l.bits(t);
-    let odd = l.bit_set(ti, 1);
-    let half = l.bit_set(ti, 2);
-    let s = l.select(odd, cos, sin);
-    let c = l.select(odd, sin, cos);
-    let s = l.negate_where(half, s);
-    let flip = l.b.ins().bxor(odd, half);
-    let c = l.negate_where(flip, c);
-    (s, c, ok)
+    let one = l.int(1);
+    let low = l.b.ins().band(ti, one);
+    let odd = l.b.ins().icmp(IntCC::Equal, low, one);
+    let (si, ci) = (l.bits(sin), l.bits(cos));
+    let s = l.b.ins().bitselect(odd, ci, si);
+    let c = l.b.ins().bitselect(odd, si, ci);
+    let sign = l.int(i64::MIN);
+    let bit1 = l.b.ins().ishl_imm_u(ti, 62);
+    let s_flip = l.b.ins().band(bit1, sign);
+    let bit0 = l.b.ins().ishl_imm_u(ti, 63);
+    let both = l.b.ins().bxor(bit0, bit1);
+    let c_flip = l.b.ins().band(both, sign);
+    let s = l.b.ins().bxor(s, s_flip);
+    let c = l.b.ins().bxor(c, c_flip);
+    (l.double(s), l.double(c), ok)
 }
 
 /// One round of the reduction: r − n·head, and what its rounding lost
@@ -237,7 +231,14 @@ pub(super) fn exp(b: &mut FunctionBuilder, a: Value) -> (Value, Value) {
     let e = l.b.ins().iadd(ti, bias);
     let e = l.b.ins().ishl_imm_u(e, 52);
     let scale = l.double(e);
-    (l.mul(y, scale), ok)
+    let e = l.mul(y, scale);
+    // Far below the range, libm's +0 (seen where a Gaussian has decayed
+    // away): covered here rather than sending the pair to libm.
+    let floor = l.f(EXP_ZERO_BELOW);
+    let zero = l.b.ins().fcmp(FloatCC::LessThan, a, floor);
+    let ok = l.b.ins().bor(ok, zero);
+    let zero = l.double(zero);
+    (l.b.ins().band_not(e, zero), ok)
 }
 
 #[cfg(test)]
@@ -471,15 +472,26 @@ mod tests {
             0.0,
             710.0,
             -746.0,
+            -746.5,
+            -800.0,
+            -1e300,
+            -745.2,
         ] {
-            let o = f.eval(a, a);
-            for (k, want) in [a.sin(), a.cos(), a.exp()].into_iter().enumerate() {
-                assert!(
-                    o[k].to_bits() == want.to_bits() || (o[k].is_nan() && want.is_nan()),
-                    "output {k} at {a}: {} vs {want}",
-                    o[k]
-                );
+            // Alone (the scalar pass) and in both lanes of a pair (the
+            // vector pass, or the pair taken again point by point).
+            let mut pair = [0.0; 12];
+            f.eval_batch(&[a, a], &[0.5, 0.5], &mut pair);
+            for o in [f.eval(a, a), pair[..6].try_into().expect("six")] {
+                for (k, want) in [a.sin(), a.cos(), a.exp()].into_iter().enumerate() {
+                    assert!(
+                        o[k].to_bits() == want.to_bits() || (o[k].is_nan() && want.is_nan()),
+                        "output {k} at {a}: {} vs {want}",
+                        o[k]
+                    );
+                }
             }
+            let bits = |o: &[f64]| o.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&pair[..6]), bits(&pair[6..]), "both lanes at {a}");
         }
     }
 }
