@@ -98,19 +98,20 @@ fn build(source: &str, job: &str) -> Figures {
     figures
 }
 
+/// Job `job` of `source(", chords: WORD")` built on the path, straddling
+/// and clear, each report stating the placement it was given.
+fn each_placement(job: &str, source: impl Fn(&str) -> String) -> [Figures; 3] {
+    let built =
+        ["on_path", "straddle", "clear"].map(|w| build(&source(&format!(", chords: {w}")), job));
+    let words = built.each_ref().map(|f| f.chords.as_str());
+    assert_eq!(words, ["on_path", "straddle", "clear"]);
+    built
+}
+
 /// Each placement against its promise, for chords that sag up to `sag`
 /// (nm) on the path.
 fn each_meets_its_promise(sag: f64, job: &str, source: impl Fn(&str) -> String) {
-    let [on, straddle, clear] =
-        ["on_path", "straddle", "clear"].map(|w| build(&source(&format!(", chords: {w}")), job));
-    assert_eq!(
-        (
-            on.chords.as_str(),
-            straddle.chords.as_str(),
-            clear.chords.as_str()
-        ),
-        ("on_path", "straddle", "clear")
-    );
+    let [on, straddle, clear] = each_placement(job, |chords| source(chords));
     // Clear moves the same points; straddling splits the chords where a
     // chord bending one way meets one bending the other (on the waves
     // 3,779 points against 3,528; on the ripples, whose C step is fixed,
@@ -271,16 +272,7 @@ fn rastered_dome(chords: &str, lines: bool, accept: &str) -> String {
 /// half of it either way; clear, not at all.
 fn optimised_meet_their_promises(source: impl Fn(&str, bool, &str) -> String) {
     let sag = 40.0;
-    let [on, straddle, clear] = ["on_path", "straddle", "clear"]
-        .map(|w| build(&source(&format!(", chords: {w}"), true, "none"), "dome"));
-    assert_eq!(
-        (
-            on.chords.as_str(),
-            straddle.chords.as_str(),
-            clear.chords.as_str()
-        ),
-        ("on_path", "straddle", "clear")
-    );
+    let [on, straddle, clear] = each_placement("dome", |chords| source(chords, true, "none"));
     assert!(on.points == clear.points, "{on:?} {clear:?}");
     assert!(
         on.gouge > 0.5 * sag && on.gouge <= sag + RESOLUTION_NM,
