@@ -6,8 +6,8 @@
 //! straddling long chords, within ±the sag with fewer points; clear, no
 //! gouge beyond the machine's resolution (the points are raised half of it
 //! more, so rounding cannot cut either). For spirals, helices, rasters and
-//! profile turning. And the default: the least displacement that meets the
-//! job's `max_gouge`.
+//! profile turning. And the default: the fewest points whose promise meets
+//! the job's criteria.
 
 use crate::common::{lensc, text};
 
@@ -185,18 +185,45 @@ fn on_a_roller_helix_each_placement_meets_its_promise() {
 }
 
 #[test]
-fn by_default_the_least_displacement_that_meets_max_gouge() {
+fn by_default_the_fewest_points_whose_promise_meets_the_criteria() {
     let chosen = |accept: &str| build(&waves("", accept), "waves");
-    // Chords sag up to 50 nm on the path: a 60 nm limit keeps them there,
-    // 30 nm needs them straddled (25 nm), 0 nm clear; with no limit
-    // stated they stay on the path.
-    assert_eq!(chosen("").chords, "on_path");
-    assert_eq!(chosen(", accept: { max_gouge: 60 nm }").chords, "on_path");
+    // Chords sag up to 50 nm on the path. At the default limits (the
+    // 200 nm tolerance and the 1 nm resolution: gouge and residual 201 nm,
+    // PV 402, RMS 100.5) and with a 60 nm gouge limit, long straddled
+    // chords promise ±50 nm with fewer points; a 30 nm limit needs every
+    // point, straddled (±25 nm); 0 nm, clear.
+    let by_default = chosen("");
+    assert_eq!(by_default.chords, "straddle_long");
+    let on_path = build(&waves(", chords: on_path", ""), "waves");
+    assert!(
+        (by_default.points as f64) < 0.8 * on_path.points as f64,
+        "{by_default:?} {on_path:?}"
+    );
+    // What long straddled chords promise: within ±the sag.
+    assert!(
+        by_default.gouge <= 50.0 + RESOLUTION_NM && by_default.residual <= 50.0 + RESOLUTION_NM,
+        "{by_default:?}"
+    );
+    assert_eq!(
+        chosen(", accept: { max_gouge: 60 nm }").chords,
+        "straddle_long"
+    );
     assert_eq!(chosen(", accept: { max_gouge: 30 nm }").chords, "straddle");
+    // A 25 nm RMS: only straddling promises it (half its ±25 nm band).
+    assert_eq!(chosen(", accept: { form_rms: 25 nm }").chords, "straddle");
     // `max_gouge: 0` passes the gate: nothing cut below the design.
     let clear = chosen(", accept: { max_gouge: 0 nm }");
     assert_eq!(clear.chords, "clear");
     assert_eq!(clear.gouge, 0.0, "{clear:?}");
+}
+
+#[test]
+fn a_roller_helix_by_default_keeps_every_point() {
+    // Its points are a fixed C step apart, so long chords are not offered:
+    // on the path its 12 nm chords promise ±12 nm, within the job's
+    // stated 200 nm limits.
+    let chosen = build(&ripples(""), "ripples");
+    assert_eq!(chosen.chords, "on_path");
 }
 
 /// LinuxCNC's dialect with no arc planes: the optimiser writes only

@@ -15,7 +15,7 @@ use lensc_grammar::{Diagnostic, FileId, Span};
 use lensc_lang::check::trim_num;
 use lensc_lang::codes;
 use lensc_lang::lower::job::JobSpec;
-use lensc_lang::lower::job::accept::{Accept, Criterion};
+use lensc_lang::lower::job::accept::{self, Accept, Criterion};
 
 use crate::output::Built;
 use crate::report::{
@@ -32,10 +32,7 @@ pub enum Mode {
     Warn,
 }
 
-/// The path tolerance the defaults are derived from for a strategy that
-/// plans to none of its own (roller helix, profile grinding): the default
-/// `chord_tolerance` of the others (mm).
-pub const DEFAULT_TOLERANCE: f64 = 10e-6;
+use lensc_lang::lower::job::accept::DEFAULT_TOLERANCE;
 
 /// Runs the gate on `built` (lowered as `spec`): fills the report's
 /// `acceptance` and returns a diagnostic per criterion missed or not
@@ -109,34 +106,27 @@ struct Limit {
 }
 
 /// The default limit of `c` for a strategy planned to `tolerance` (mm;
-/// `None`: it has none of its own) on a machine of `resolution` (mm):
-/// the path's chords stray up to the tolerance from the exact path, and
-/// the printed coordinates up to half the resolution on each axis, so
-/// the form error lies within ±(tolerance + resolution): PV twice that,
-/// RMS a quarter of the PV, a gouge or a residual at most that. Nothing
-/// is left uncut. The following error and the cutting time have no
-/// default (a job states them).
+/// `None`: it has none of its own) on a machine of `resolution` (mm)
+/// (`accept::default_limit`: the form error lies within ±(tolerance +
+/// resolution)), with the rule that derives it in words.
 fn default_limit(c: Criterion, tolerance: Option<f64>, resolution: f64) -> Option<Limit> {
-    let (t, t_words) = match tolerance {
-        Some(t) => (t, format!("the path tolerance {} nm", trim_num(t * 1e6))),
-        None => (
-            DEFAULT_TOLERANCE,
-            format!(
-                "{} nm (the strategy has no path tolerance: the default chord_tolerance)",
-                trim_num(DEFAULT_TOLERANCE * 1e6)
-            ),
+    let value = accept::default_limit(c, tolerance, resolution)?;
+    let t_words = match tolerance {
+        Some(t) => format!("the path tolerance {} nm", trim_num(t * 1e6)),
+        None => format!(
+            "{} nm (the strategy has no path tolerance: the default chord_tolerance)",
+            trim_num(DEFAULT_TOLERANCE * 1e6)
         ),
     };
-    let band = t + resolution;
     let sum = format!(
         "{t_words} + the machine's resolution {} nm",
         trim_num(resolution * 1e6)
     );
-    let (value, rule) = match c {
-        Criterion::FormPv => (2.0 * band, format!("2 × ({sum})")),
-        Criterion::FormRms => (band / 2.0, format!("({sum}) / 2")),
-        Criterion::MaxGouge | Criterion::MaxResidual => (band, sum),
-        Criterion::UncutArea => (0.0, "none of the area simulated left uncut".into()),
+    let rule = match c {
+        Criterion::FormPv => format!("2 × ({sum})"),
+        Criterion::FormRms => format!("({sum}) / 2"),
+        Criterion::MaxGouge | Criterion::MaxResidual => sum,
+        Criterion::UncutArea => "none of the area simulated left uncut".into(),
         Criterion::MaxFollowingError | Criterion::MaxCuttingTime => return None,
     };
     Some(Limit {

@@ -84,16 +84,23 @@ impl ChordPlacement {
         )
     }
 
-    /// The deepest a chord cuts below the exact path (mm) with this
-    /// placement when the chords' share is `sag`: the sag, half of it, the
-    /// sag again (twice the sag, halved), or nothing.
-    pub fn promised_gouge(self, sag: f64) -> f64 {
-        match self {
-            ChordPlacement::OnPath => sag,
-            ChordPlacement::Straddle => 0.5 * sag,
-            ChordPlacement::StraddleLong => sag,
-            ChordPlacement::Clear { .. } => 0.0,
-        }
+    /// What this placement guarantees of the path it writes, for chords
+    /// whose sag on the exact path is at most `sag` (mm) and lines and
+    /// arcs then fitted within `fit` (mm) of the placed points
+    /// (`plan::optimise`; 0 where nothing is fitted). On the path a chord
+    /// cuts below it by its sag on a convex stretch and passes above it by
+    /// its sag on a concave one; straddling, half of that either way;
+    /// straddling long chords (sampled to twice the sag), the sag either
+    /// way; clear, nothing below and up to the sag and the margin above. A
+    /// fit may pass `fit` further either way, except that a clear path's
+    /// fits are held above its points.
+    pub fn promise(self, sag: f64, fit: f64) -> Promise {
+        let (below, above) = match self {
+            ChordPlacement::OnPath | ChordPlacement::StraddleLong => (sag + fit, sag + fit),
+            ChordPlacement::Straddle => (0.5 * sag + fit, 0.5 * sag + fit),
+            ChordPlacement::Clear { margin } => (0.0, sag + margin + fit),
+        };
+        Promise { below, above }
     }
 
     /// The first placement, in the order of least displacement, whose
@@ -112,8 +119,36 @@ impl ChordPlacement {
     pub fn least_for_fitted(sag: f64, fit: f64, max_gouge: f64, margin: f64) -> ChordPlacement {
         [ChordPlacement::OnPath, ChordPlacement::Straddle]
             .into_iter()
-            .find(|p| p.promised_gouge(sag) + fit <= max_gouge)
+            .find(|p| p.promise(sag, fit).below <= max_gouge)
             .unwrap_or(ChordPlacement::Clear { margin })
+    }
+
+    /// The default placement: the one with the fewest points whose promise
+    /// (`promise`) meets every one of `limits`. Straddling long chords
+    /// (where `long_chords` allows them: not on a roller helix, whose
+    /// points are a fixed C step apart) samples about 1/√2 of the points;
+    /// the other three sample the same points (straddling may split a few
+    /// at inflections) and are taken in the order of least displacement:
+    /// on the path, straddling, clear. Where no placement's promise meets
+    /// them all, the least displacement whose promise meets `max_gouge`
+    /// (the simulation then measures the rest, and the gate judges).
+    pub fn fewest_points_meeting(
+        sag: f64,
+        fit: f64,
+        limits: &FormLimits,
+        margin: f64,
+        long_chords: bool,
+    ) -> ChordPlacement {
+        let long = long_chords.then_some(ChordPlacement::StraddleLong);
+        let same_points = [
+            ChordPlacement::OnPath,
+            ChordPlacement::Straddle,
+            ChordPlacement::Clear { margin },
+        ];
+        long.into_iter()
+            .chain(same_points)
+            .find(|p| limits.met_by(&p.promise(sag, fit)))
+            .unwrap_or_else(|| ChordPlacement::least_for_fitted(sag, fit, limits.max_gouge, margin))
     }
 
     /// How far (mm, out of the material) to move a point that ends the
@@ -131,6 +166,54 @@ impl ChordPlacement {
             ChordPlacement::Straddle | ChordPlacement::StraddleLong => 0.5 * (hi + lo),
             ChordPlacement::Clear { margin } => hi + margin,
         }
+    }
+}
+
+/// What a placement guarantees of the path it writes (mm): how far below
+/// the exact path (into the material) and how far above it any point of
+/// its chords and fits can lie.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Promise {
+    /// The deepest below the path: the largest gouge.
+    pub below: f64,
+    /// The highest above it: the largest residual.
+    pub above: f64,
+}
+
+impl Promise {
+    /// The peak-to-valley of the error: at most the band's width.
+    pub fn pv(&self) -> f64 {
+        self.below + self.above
+    }
+
+    /// The RMS of the error about its mean: at most half the band's width
+    /// (Popoviciu's inequality: a quantity within [a, b] varies about its
+    /// mean by at most (b − a)/2), whatever the chords' lengths.
+    pub fn rms(&self) -> f64 {
+        0.5 * self.pv()
+    }
+}
+
+/// The limits a job holds its form to (mm), as the placement's promise is
+/// judged against them: `f64::INFINITY` where it sets none.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FormLimits {
+    pub max_gouge: f64,
+    pub max_residual: f64,
+    pub form_pv: f64,
+    pub form_rms: f64,
+}
+
+impl FormLimits {
+    /// Whether `promise` is within every limit (a figure equal to its
+    /// limit but for the last digits of the units' scaling, 25 nm against
+    /// `25 nm`, is within it).
+    pub fn met_by(&self, promise: &Promise) -> bool {
+        let within = |figure: f64, limit: f64| figure <= limit * (1.0 + 1e-12);
+        within(promise.below, self.max_gouge)
+            && within(promise.above, self.max_residual)
+            && within(promise.pv(), self.form_pv)
+            && within(promise.rms(), self.form_rms)
     }
 }
 
@@ -607,8 +690,89 @@ mod tests {
             least(2.5e-6, 0.0, 5e-7),
             ChordPlacement::Clear { margin: 5e-7 }
         );
-        for w in ["on_path", "straddle", "clear"] {
+        for w in ["on_path", "straddle", "straddle_long", "clear"] {
             assert_eq!(ChordPlacement::from_word(w, 0.0).unwrap().word(), w);
         }
+    }
+
+    /// Limits in nm, as `FormLimits` in mm.
+    fn limits_nm(gouge: f64, residual: f64, pv: f64, rms: f64) -> FormLimits {
+        FormLimits {
+            max_gouge: gouge * 1e-6,
+            max_residual: residual * 1e-6,
+            form_pv: pv * 1e-6,
+            form_rms: rms * 1e-6,
+        }
+    }
+
+    #[test]
+    fn each_promise_is_the_band_its_chords_keep_to() {
+        let nm = |p: Promise| [p.below, p.above, p.pv(), p.rms()].map(|v| v * 1e6);
+        let sag = 40e-6;
+        let fit = 60e-6;
+        let margin = 0.5e-6;
+        let close = |a: [f64; 4], b: [f64; 4]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-9);
+        assert!(close(
+            nm(ChordPlacement::OnPath.promise(sag, fit)),
+            [100.0, 100.0, 200.0, 100.0]
+        ));
+        assert!(close(
+            nm(ChordPlacement::Straddle.promise(sag, fit)),
+            [80.0, 80.0, 160.0, 80.0]
+        ));
+        assert!(close(
+            nm(ChordPlacement::StraddleLong.promise(sag, fit)),
+            [100.0, 100.0, 200.0, 100.0]
+        ));
+        assert!(close(
+            nm(ChordPlacement::Clear { margin }.promise(sag, fit)),
+            [0.0, 100.5, 100.5, 50.25]
+        ));
+    }
+
+    #[test]
+    fn the_default_is_the_fewest_points_whose_promise_meets_every_criterion() {
+        let choose = |limits: FormLimits, long| {
+            ChordPlacement::fewest_points_meeting(50e-6, 0.0, &limits, 5e-7, long)
+        };
+        // A servo spiral whose chords take 50 nm of a 200 nm tolerance, at
+        // the default limits (T + r = 201 nm): long straddled chords
+        // promise ±50 nm, within all of them.
+        let defaults = limits_nm(201.0, 201.0, 402.0, 100.5);
+        assert_eq!(choose(defaults, true), ChordPlacement::StraddleLong);
+        // Where they are not offered, the least displacement.
+        assert_eq!(choose(defaults, false), ChordPlacement::OnPath);
+        // A 30 nm gouge limit: only straddling (±25 nm) or clear meet it.
+        let gouge_30 = FormLimits {
+            max_gouge: 30e-6,
+            ..defaults
+        };
+        assert_eq!(choose(gouge_30, true), ChordPlacement::Straddle);
+        // A 25 nm RMS: half the band of ±25 nm, straddled; 20 nm, none
+        // promises it (clear's band is 50.5 nm), so on the path.
+        let rms = |nm: f64| FormLimits {
+            form_rms: nm * 1e-6,
+            ..defaults
+        };
+        assert_eq!(choose(rms(25.0), true), ChordPlacement::Straddle);
+        assert_eq!(choose(rms(20.0), true), ChordPlacement::OnPath);
+        // No gouge: clear, whose promise meets the rest too.
+        let no_gouge = FormLimits {
+            max_gouge: 0.0,
+            ..defaults
+        };
+        assert_eq!(
+            choose(no_gouge, true),
+            ChordPlacement::Clear { margin: 5e-7 }
+        );
+        // Seed 003's stated 5 nm PV, 1 nm RMS and 5 nm gouge on chords of
+        // 2.5 nm: no promise holds 1 nm RMS, so the least displacement
+        // whose gouge is within 5 nm, on the path (the simulation measures
+        // 0.36 nm RMS, and the gate judges).
+        let seed_003 = limits_nm(5.0, 11.0, 5.0, 1.0);
+        assert_eq!(
+            ChordPlacement::fewest_points_meeting(2.5e-6, 0.0, &seed_003, 5e-7, true),
+            ChordPlacement::OnPath
+        );
     }
 }

@@ -20,14 +20,14 @@ const CHORDS: Param = opt(
     "chords",
     Ty::Word(&["on_path", "straddle", "straddle_long", "clear"]),
     Check::Any,
-    "where the points sit across the curve: `on_path` (convex stretches gouge by up to the chords' sag), `straddle` (moved off the path so each chord errs by at most ±half the sag), `straddle_long` (chords sampled to twice the sag, about 1/√2 the points, each within ±the sag), `clear` (raised so no chord enters the material); default the first of on_path, straddle, clear whose gouge meets the job's `max_gouge`",
+    "where the points sit across the curve: `on_path` (convex stretches gouge by up to the chords' sag), `straddle` (moved off the path so each chord errs by at most ±half the sag), `straddle_long` (chords sampled to twice the sag, about 1/√2 the points, each within ±the sag), `clear` (raised so no chord enters the material); default the one with the fewest points whose promised gouge, residual, PV and RMS meet the job's acceptance criteria (stated or default): `straddle_long` where its promise meets them on a servo spiral, else the first of on_path, straddle, clear that meets them all, else the first whose gouge meets `max_gouge`",
 );
 /// A roller helix's points are a fixed C step apart: no `straddle_long`.
 const ROLLER_CHORDS: Param = opt(
     "chords",
     Ty::Word(&["on_path", "straddle", "clear"]),
     Check::Any,
-    "where the points sit across the curve: `on_path` (convex stretches gouge by up to the chords' sag), `straddle` (moved off the path so each chord errs by at most ±half the sag), `clear` (raised so no chord enters the material); default the first of these whose gouge meets the job's `max_gouge`",
+    "where the points sit across the curve: `on_path` (convex stretches gouge by up to the chords' sag), `straddle` (moved off the path so each chord errs by at most ±half the sag), `clear` (raised so no chord enters the material); default the first of these whose promised gouge, residual, PV and RMS meet the job's acceptance criteria (stated or default), else the first whose gouge meets `max_gouge`",
 );
 
 // The parameters both spiral strategies share.

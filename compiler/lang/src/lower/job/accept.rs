@@ -1,8 +1,9 @@
 //! A job's acceptance criteria, typed: the limits its `accept` block
 //! states (the checker has checked each one's dimension and sign), where
-//! each was written, or `accept: none`. The defaults for the criteria a
-//! job leaves out, and the comparison with the simulated part, are the
-//! build's (lensc-build `accept`): they need the simulation.
+//! each was written, or `accept: none`; and the defaults for the criteria
+//! a job leaves out (the lowering chooses a path's chord placement by
+//! them). The comparison with the simulated part is the build's
+//! (lensc-build `accept`): it needs the simulation.
 
 use lensc_grammar::{Diagnostic, FileId, Span};
 
@@ -90,6 +91,46 @@ impl Accept {
         match self {
             Accept::Stated { limits, .. } => limits.iter().find(|(k, _)| *k == c).map(|(_, l)| l),
             _ => None,
+        }
+    }
+}
+
+/// The path tolerance the defaults are derived from for a strategy that
+/// plans to none of its own (roller helix, profile grinding): the default
+/// `chord_tolerance` of the others (mm).
+pub const DEFAULT_TOLERANCE: f64 = super::DEFAULT_PATH_TOLERANCE;
+
+/// The default limit of `c` (in its base unit) for a strategy planned to
+/// `tolerance` (mm; `None`: it has none of its own, and
+/// `DEFAULT_TOLERANCE` stands in) on a machine of `resolution` (mm): the
+/// path's chords stray up to the tolerance from the exact path, and the
+/// printed coordinates up to half the resolution on each axis, so the form
+/// error lies within ±(tolerance + resolution): PV twice that, RMS a
+/// quarter of the PV, a gouge or a residual at most that. Nothing is left
+/// uncut. The following error and the cutting time have no default (a job
+/// states them).
+pub fn default_limit(c: Criterion, tolerance: Option<f64>, resolution: f64) -> Option<f64> {
+    let band = tolerance.unwrap_or(DEFAULT_TOLERANCE) + resolution;
+    match c {
+        Criterion::FormPv => Some(2.0 * band),
+        Criterion::FormRms => Some(band / 2.0),
+        Criterion::MaxGouge | Criterion::MaxResidual => Some(band),
+        Criterion::UncutArea => Some(0.0),
+        Criterion::MaxFollowingError | Criterion::MaxCuttingTime => None,
+    }
+}
+
+impl Accept {
+    /// The limit the gate holds `c` to (base unit): the one stated, else
+    /// its default (`default_limit`); none under `accept: none`. An uncut
+    /// area stated as a fraction is returned as that fraction.
+    pub fn limit(&self, c: Criterion, tolerance: Option<f64>, resolution: f64) -> Option<f64> {
+        match self {
+            Accept::Nothing => None,
+            _ => match self.stated(c) {
+                Some(l) => Some(l.value),
+                None => default_limit(c, tolerance, resolution),
+            },
         }
     }
 }

@@ -69,10 +69,15 @@ pub(super) fn lower_raster(
     };
     // The chords take their share of the tolerance, the fitted lines and
     // arcs theirs (`plan::optimise`).
-    raster.chords = super::chords::fitted_placement(
+    raster.chords = super::chords::placement(
         p,
-        raster.chord_tolerance * optimise::CHORD_SHARE,
-        raster.chord_tolerance * optimise::FIT_SHARE,
+        super::chords::ChordPath {
+            tolerance: Some(raster.chord_tolerance),
+            sag: raster.chord_tolerance * optimise::CHORD_SHARE,
+            fit: raster.chord_tolerance * optimise::FIT_SHARE,
+            // Fitted lines and arcs: fewest through points on the path.
+            long_chords: false,
+        },
     );
     let (tool, tool_words) = match p.tool.kind.name {
         "ball_end" => {

@@ -99,7 +99,15 @@ pub(super) fn lower(
     let finish_step = helix.passes.last().map_or(0.0, |f| f.c_step);
     let sag = chord_sag(kernel.as_ref(), &region, roller_radius * finish_step);
     let helix = RollerHelix {
-        chords: super::chords::placement(p, sag),
+        chords: super::chords::placement(
+            p,
+            super::chords::ChordPath {
+                tolerance: None,
+                sag,
+                fit: 0.0,
+                long_chords: false,
+            },
+        ),
         ..helix
     };
     let retract = value::num(st, "retract").unwrap_or(1.0);

@@ -165,7 +165,12 @@ pub(super) fn lower(
     // W's chords stray from the path by up to their share of the tolerance.
     spiral.chords = super::chords::placement(
         p,
-        spiral.chord_tolerance * lensc_runtime::plan::optimise::UNOPTIMISED_CHORD_SHARE,
+        super::chords::ChordPath {
+            tolerance: Some(spiral.chord_tolerance),
+            sag: spiral.chord_tolerance * lensc_runtime::plan::optimise::UNOPTIMISED_CHORD_SHARE,
+            fit: 0.0,
+            long_chords: true,
+        },
     );
     errors.extend(machine_limits(p, &spiral, travel));
     all_clear(errors)?;

@@ -153,10 +153,15 @@ fn profile_turning(p: &Parts, f: &[Field], surface: &Object, max_spindle: f64) -
     ProfileTurning {
         // The chords take their share of the tolerance, the fitted lines
         // and arcs theirs (`plan::optimise`).
-        chords: super::chords::fitted_placement(
+        chords: super::chords::placement(
             p,
-            tolerance * optimise::CHORD_SHARE,
-            tolerance * optimise::FIT_SHARE,
+            super::chords::ChordPath {
+                tolerance: Some(tolerance),
+                sag: tolerance * optimise::CHORD_SHARE,
+                fit: tolerance * optimise::FIT_SHARE,
+                // Fitted lines and arcs: fewest through points on the path.
+                long_chords: false,
+            },
         ),
         feed,
         // Under constant surface speed the spindle speed is its cap.
