@@ -108,6 +108,11 @@ pub(crate) struct State {
     ended: bool,
     /// A Klartext program's own reader, whose blocks become words.
     klartext: Option<Klartext>,
+    /// Storage reused from line to line: the block, and its G and M codes
+    /// with their groups (by index into its words).
+    scratch: Block,
+    groups: Vec<(GGroup, usize)>,
+    ms: Vec<(MCode, usize)>,
 }
 
 impl State {
@@ -176,21 +181,40 @@ impl State {
             ended: false,
             klartext: (lex.controller == Controller::HeidenhainKlartext).then(Klartext::default),
             lex,
+            scratch: Block::default(),
+            groups: Vec::new(),
+            ms: Vec::new(),
         }
     }
 
     /// Reads one line.
     pub fn line(&mut self, line: &str, out: &mut Vec<Found>) {
-        let b = match &mut self.klartext {
-            Some(k) => k.block(&self.lex, line, out),
-            None => self.lex.block(line, out),
-        };
+        let mut b = std::mem::take(&mut self.scratch);
+        match &mut self.klartext {
+            Some(k) => b = k.block(&self.lex, line, out),
+            None => self.lex.block_into(line, out, &mut b),
+        }
+        let mut groups = std::mem::take(&mut self.groups);
+        let mut ms = std::mem::take(&mut self.ms);
+        self.block(&b, line, out, &mut groups, &mut ms);
+        (self.scratch, self.groups, self.ms) = (b, groups, ms);
+    }
+
+    /// Runs one block: `groups` and `ms` are storage for its G and M codes.
+    fn block(
+        &mut self,
+        b: &Block,
+        line: &str,
+        out: &mut Vec<Found>,
+        groups: &mut Vec<(GGroup, usize)>,
+        ms: &mut Vec<(MCode, usize)>,
+    ) {
         for c in &b.comments {
             if let Some(a) = super::header::away_axis(c) {
                 self.away = a;
             }
         }
-        self.block_number(&b, line, out);
+        self.block_number(b, line, out);
         if b.is_empty() {
             return;
         }
@@ -203,18 +227,18 @@ impl State {
             ));
             return;
         }
-        self.repeated(&b, line, out);
-        let Some((groups, ms)) = self.classify(&b, line, out) else {
+        self.repeated(b, line, out);
+        if !self.classify(b, line, out, groups, ms) {
             return;
-        };
-        self.modes(&b, &groups, line, out);
-        self.spindle_and_tool(&b, &groups, &ms, line, out);
+        }
+        self.modes(b, groups, line, out);
+        self.spindle_and_tool(b, groups, ms, line, out);
         // G50 S and G4 take their own words; no move.
         if !groups
             .iter()
             .any(|(g, _)| matches!(g, GGroup::SpindleCap | GGroup::NonModal))
         {
-            self.move_block(&b, line, out);
+            self.move_block(b, line, out);
         }
         if ms.iter().any(|(m, _)| *m == MCode::End) {
             self.ended = true;
@@ -285,19 +309,21 @@ impl State {
         }
     }
 
-    /// The block's G and M codes with their groups; unknown codes and two
-    /// of one modal group are refused (`None`: the block is not run).
-    #[allow(clippy::type_complexity)]
-    fn classify<'b>(
+    /// The block's G and M codes with their groups, into `groups` and `ms`
+    /// (by index into the block's words); unknown codes and two of one
+    /// modal group are refused (`false`: the block is not run).
+    fn classify(
         &self,
-        b: &'b Block,
+        b: &Block,
         line: &str,
         out: &mut Vec<Found>,
-    ) -> Option<(Vec<(GGroup, &'b Word)>, Vec<(MCode, &'b Word)>)> {
+        groups: &mut Vec<(GGroup, usize)>,
+        ms: &mut Vec<(MCode, usize)>,
+    ) -> bool {
         let before = out.len();
-        let mut groups: Vec<(GGroup, &'b Word)> = Vec::new();
-        let mut ms: Vec<(MCode, &'b Word)> = Vec::new();
-        for w in &b.words {
+        groups.clear();
+        ms.clear();
+        for (i, w) in b.words.iter().enumerate() {
             let scaled = w.value * 10.0;
             let code = scaled.round() as i64;
             match w.letter {
@@ -307,21 +333,21 @@ impl State {
                 {
                     Some(g) => {
                         let siemens = self.lex.controller == Controller::Siemens;
-                        if let Some((_, o)) =
+                        if let Some(&(_, o)) =
                             groups.iter().find(|(o, _)| same_group(*o, g, siemens))
                         {
-                            out.push(conflict(w, o, line));
+                            out.push(conflict(w, &b.words[o], line));
                         }
-                        groups.push((g, w));
+                        groups.push((g, i));
                     }
                     None => out.push(unknown_code(w, line)),
                 },
                 'M' => match self.m_code(w.value as i64).filter(|_| !w.point) {
                     Some(m) => {
-                        if let Some((_, o)) = ms.iter().find(|(o, _)| same_m_group(*o, m)) {
-                            out.push(conflict(w, o, line));
+                        if let Some(&(_, o)) = ms.iter().find(|(o, _)| same_m_group(*o, m)) {
+                            out.push(conflict(w, &b.words[o], line));
                         }
-                        ms.push((m, w));
+                        ms.push((m, i));
                     }
                     None if w.point => {}
                     None => out.push(unknown_code(w, line)),
@@ -339,7 +365,7 @@ impl State {
                 )),
             }
         }
-        (out.len() == before).then_some((groups, ms))
+        out.len() == before
     }
 
     fn known_letter(&self, l: char) -> bool {
@@ -415,7 +441,7 @@ impl State {
     }
 
     /// Units, plane, distance, feed mode, diameter mode.
-    fn modes(&mut self, b: &Block, groups: &[(GGroup, &Word)], line: &str, out: &mut Vec<Found>) {
+    fn modes(&mut self, b: &Block, groups: &[(GGroup, usize)], line: &str, out: &mut Vec<Found>) {
         for (g, _) in groups {
             match *g {
                 GGroup::Units(m) => self.metric = Some(m),
@@ -470,8 +496,8 @@ impl State {
     fn spindle_and_tool(
         &mut self,
         b: &Block,
-        groups: &[(GGroup, &Word)],
-        ms: &[(MCode, &Word)],
+        groups: &[(GGroup, usize)],
+        ms: &[(MCode, usize)],
         line: &str,
         out: &mut Vec<Found>,
     ) {
@@ -508,13 +534,13 @@ impl State {
             }
         }
         if has(GGroup::SpindleMode(true)) && self.cap.is_none() {
-            let (_, w) = groups
+            let &(_, w) = groups
                 .iter()
                 .find(|(g, _)| *g == GGroup::SpindleMode(true))
                 .expect("found above");
             out.push((
                 Rule::NoSpeedCap,
-                w.span,
+                b.words[w].span,
                 "constant surface speed with no spindle speed limit: at the centre the spindle would run to its maximum".into(),
                 Some("set the limit first (LinuxCNC: G96 D…; Fanuc: G50 S…; Siemens: LIMS=…)".into()),
             ));
@@ -533,9 +559,9 @@ impl State {
                 _ => {}
             }
         }
-        for (m, w) in ms {
+        for &(m, w) in ms {
             match m {
-                MCode::SpindleOn => self.spindle_start(w, out),
+                MCode::SpindleOn => self.spindle_start(&b.words[w], out),
                 MCode::SpindleOff => self.spindle_on = false,
                 MCode::PositionOn | MCode::Orient => {
                     self.position_mode = true;
@@ -547,7 +573,7 @@ impl State {
         }
     }
 
-    fn tool(&mut self, b: &Block, ms: &[(MCode, &Word)]) {
+    fn tool(&mut self, b: &Block, ms: &[(MCode, usize)]) {
         let t = b.words.iter().any(|w| w.letter == 'T') || b.keywords.iter().any(|k| k.name == "T");
         if t {
             self.tool_selected = true;
