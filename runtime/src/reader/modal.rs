@@ -325,7 +325,7 @@ impl State {
         ms.clear();
         for (i, w) in b.words.iter().enumerate() {
             let scaled = w.value * 10.0;
-            let code = scaled.round() as i64;
+            let code = round_to_integer(scaled);
             match w.letter {
                 'G' => match ((scaled - code as f64).abs() < 1e-9)
                     .then(|| self.g_group(code))
@@ -369,14 +369,16 @@ impl State {
     }
 
     fn known_letter(&self, l: char) -> bool {
-        match self.lex.controller {
-            Controller::Fanuc => "XYZCIJKRFSTDHPQLNO".contains(l),
-            Controller::UltraPrecision => "XYZCWIJKRFSTDHPQLNO".contains(l),
-            Controller::LinuxCnc => "XYZABCUVWIJKRFSTDHPQLN".contains(l),
-            Controller::Siemens => "XYZABCIJKRFSTDHPLN".contains(l),
-            Controller::HeidenhainIso => "XYZABCIJKRFSTLPHN".contains(l),
-            Controller::HeidenhainKlartext => "XYZIJFSTN".contains(l),
-        }
+        let letters = match self.lex.controller {
+            Controller::Fanuc => "XYZCIJKRFSTDHPQLNO",
+            Controller::UltraPrecision => "XYZCWIJKRFSTDHPQLNO",
+            Controller::LinuxCnc => "XYZABCUVWIJKRFSTDHPQLN",
+            Controller::Siemens => "XYZABCIJKRFSTDHPLN",
+            Controller::HeidenhainIso => "XYZABCIJKRFSTLPHN",
+            Controller::HeidenhainKlartext => "XYZIJFSTN",
+        };
+        // Every letter listed is ASCII: a byte compare, not a char search.
+        l.is_ascii() && letters.as_bytes().contains(&(l as u8))
     }
 
     fn g_group(&self, code: i64) -> Option<GGroup> {
@@ -639,6 +641,21 @@ impl State {
     }
 }
 
+/// `v.round() as i64` (halves away from zero, saturating, NaN to 0)
+/// without a call into libm: the truncation and the fraction it drops
+/// are both exact in f64.
+fn round_to_integer(v: f64) -> i64 {
+    let t = v as i64;
+    let fraction = v - t as f64;
+    if fraction >= 0.5 {
+        t.saturating_add(1)
+    } else if fraction <= -0.5 {
+        t.saturating_sub(1)
+    } else {
+        t
+    }
+}
+
 /// Whether two G codes are of one modal group (`siemens`: G94 G95 G96
 /// G97 are one, group 15).
 fn same_group(a: GGroup, b: GGroup, siemens: bool) -> bool {
@@ -681,4 +698,58 @@ fn unknown_code(w: &Word, line: &str) -> Found {
         format!("`{}` is not a code this controller knows", w.text(line)),
         None,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::round_to_integer;
+
+    /// The same integer as `round() as i64` for halves, near-halves,
+    /// integers beyond 2^53 and 2^63, infinities, NaN and a spread of
+    /// bit patterns.
+    #[test]
+    fn rounds_as_round_does() {
+        let mut values = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.5,
+            -1.5,
+            2.5,
+            0.49999999999999994,
+            -0.49999999999999994,
+            4503599627370495.5,
+            -4503599627370495.5,
+            9007199254740993.0,
+            9.223372036854776e18,
+            -9.223372036854776e18,
+            1e30,
+            -1e30,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            f64::MIN_POSITIVE,
+            10.0 * 1.1,
+            10.0 * 96.9,
+        ];
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        for _ in 0..200_000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let v = f64::from_bits(state);
+            values.push(v);
+            // Tenths of codes as a program writes them (G1, G64.1, …).
+            values.push((state % 20_000) as f64 / 10.0 * 10.0);
+            values.push((state % 2_000_000) as f64 * 1e-3 - 1e3);
+        }
+        for v in values {
+            let x = v.next_up();
+            let y = v.next_down();
+            for w in [v, x, y] {
+                assert_eq!(round_to_integer(w), w.round() as i64, "{w:e}");
+            }
+        }
+    }
 }
