@@ -13,7 +13,18 @@ use crate::value::{self, Object};
 /// height) wins; outside every aperture, the land. Each point looks at its
 /// own cell and, where apertures reach past half a pitch, the neighbours.
 pub(super) fn array_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError> {
-    array_height_settled(g, o, x, y, None)
+    array_height_settled(g, o, x, y, None, Cells::NearestWhereItWins)
+}
+
+/// Which cells' lenslets an array's height looks at.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Cells {
+    /// The point's own cell alone where its lenslet always cuts deepest
+    /// (`nearest_wins`), else as `Reaching`.
+    NearestWhereItWins,
+    /// The own cell and every neighbour whose aperture may reach the
+    /// point (the reference the other is tested against).
+    Reaching,
 }
 
 /// An array's six outputs, the slopes and curvatures by the chain rule:
@@ -30,6 +41,16 @@ pub(super) fn array_outputs(
     x: Id,
     y: Id,
 ) -> Result<[Id; 6], LowerError> {
+    array_outputs_of(g, o, (x, y), Cells::NearestWhereItWins)
+}
+
+/// `array_outputs` looking at `cells`.
+pub(super) fn array_outputs_of(
+    g: &mut Graph,
+    o: &Object,
+    (x, y): (Id, Id),
+    cells: Cells,
+) -> Result<[Id; 6], LowerError> {
     let f = &o.fields;
     let lenslet =
         value::object(f, "lenslet").ok_or(LowerError::Unsupported("array without a lenslet"))?;
@@ -37,7 +58,7 @@ pub(super) fn array_outputs(
         .map_err(LowerError::Aperture)?;
     let own = super::lower_surface(lenslet)?.tape;
     let rim = rim_height(lenslet, &ap)?;
-    let nearest = nearest_wins(lenslet, &ap);
+    let nearest = cells == Cells::NearestWhereItWins && nearest_wins(lenslet, &ap);
     let candidates = match o.kind.name {
         "grid" | "linear_array" => grid_cells(g, o, (x, y), half_extent(&ap), nearest)?,
         _ => hex_cells(g, o, (x, y), half_extent(&ap))?,
@@ -88,7 +109,7 @@ pub fn lower_trajectory(o: &Object, settle: f64) -> Result<LoweredSurface, Lower
     let domain = surface_domain(o).ok_or(LowerError::Aperture("no aperture or domain"))?;
     let mut g = Graph::new();
     let (x, y) = (g.x(), g.y());
-    let z = array_height_settled(&mut g, o, x, y, Some(settle))?;
+    let z = array_height_settled(&mut g, o, x, y, Some(settle), Cells::Reaching)?;
     Ok(LoweredSurface {
         tape: SurfaceTape::new(g, z),
         domain,
@@ -148,12 +169,13 @@ pub fn array_lenslet(o: &Object) -> Option<(LoweredSurface, f64)> {
     ))
 }
 
-fn array_height_settled(
+pub(super) fn array_height_settled(
     g: &mut Graph,
     o: &Object,
     x: Id,
     y: Id,
     settle: Option<f64>,
+    cells: Cells,
 ) -> Result<Id, LowerError> {
     let f = &o.fields;
     let lenslet =
@@ -171,7 +193,8 @@ fn array_height_settled(
     // Cell centres: (i, j) → (cx, cy) as nodes; candidate cells per point.
     // A continued lenslet is no longer held to its aperture: the nearest
     // cell's need not win.
-    let nearest = settle.is_none() && nearest_wins(lenslet, &ap);
+    let nearest =
+        cells == Cells::NearestWhereItWins && settle.is_none() && nearest_wins(lenslet, &ap);
     let candidates = match o.kind.name {
         "grid" | "linear_array" => grid_cells(g, o, (x, y), (hx, hy), nearest)?,
         _ => hex_cells(g, o, (x, y), (hx, hy))?,
