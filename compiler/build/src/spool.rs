@@ -202,7 +202,11 @@ mod tests {
         let program = "G1 X3.071257 Z-2.999999 C0.025 F864000.\n".repeat(300);
         let mut texts = vec![String::new(), "\n".repeat(1000), "x".repeat(1000), program];
         for n in [1, 254, 255, 256, 509, 510, 511, 766] {
-            texts.push((0..n).map(|i| if i % 3 == 0 { '\n' } else { 'G' }).collect());
+            texts.push(
+                (0..n)
+                    .map(|i| if i % 3 == 0 { '\n' } else { 'G' })
+                    .collect(),
+            );
             texts.push("\n".repeat(n));
         }
         for t in texts {
