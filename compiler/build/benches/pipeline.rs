@@ -145,7 +145,8 @@ fn plan_roller(spec: &JobSpec, keep: Option<&mut Vec<Vec<[f64; 3]>>>) -> usize {
     let (section, _) = lensc_build::evaluate::evaluator(&tape.axial_section());
     let mut n = 0;
     let resolution = s.head.resolution;
-    let printed = |v: f64| lensc_runtime::verify::simulate::as_printed(v, resolution);
+    let printed_at = lensc_runtime::verify::simulate::Printed::new(resolution);
+    let printed = |v: f64| printed_at.round(v);
     let mut keep = keep;
     lensc_runtime::plan::roller::plan_roller_helix_sectioned(
         &s.helix,

@@ -238,7 +238,8 @@ impl Frame for RollerFrame<'_> {
 /// lift the tool; straight moves and arcs in the plane of the cut are
 /// followed.
 pub fn sweep_mill_moves(sweep: &mut dyn NosePath, moves: &[Move], along_x: bool, resolution: f64) {
-    let printed = |v: f64| lensc_runtime::verify::simulate::as_printed(v, resolution);
+    let printed = lensc_runtime::verify::simulate::Printed::new(resolution);
+    let printed = |v: f64| printed.round(v);
     let mut at = [f64::NAN; 3];
     let to_here = |to: &lensc_runtime::moves::Position, at: &mut [f64; 3]| {
         for (a, v) in at.iter_mut().zip([to.x, to.y, to.z]) {

@@ -50,6 +50,16 @@ pub(crate) struct Block {
 }
 
 impl Block {
+    /// No words, keywords or comments, as `Block::default()`, keeping the
+    /// storage.
+    pub fn clear(&mut self) {
+        self.number = None;
+        self.words.clear();
+        self.keywords.clear();
+        self.comments.clear();
+        self.percent = false;
+    }
+
     pub fn is_empty(&self) -> bool {
         self.words.is_empty() && self.keywords.is_empty()
     }
@@ -80,13 +90,14 @@ impl Lexer {
         }
     }
 
-    /// Splits `line` (without its line break) into a block.
-    pub fn block(&self, line: &str, out: &mut Vec<Found>) -> Block {
-        let mut b = Block::default();
+    /// Splits `line` (without its line break) into the block `b`, emptied
+    /// first (a reader reuses one block's storage for every line).
+    pub fn block_into(&self, line: &str, out: &mut Vec<Found>, b: &mut Block) {
+        b.clear();
         self.line_length(line, out);
         let mut code = line.trim_end();
         if code.trim().is_empty() {
-            return b;
+            return;
         }
         if !self.block_end.is_empty() {
             match code.strip_suffix(self.block_end.as_str()) {
@@ -99,9 +110,8 @@ impl Lexer {
                 )),
             }
         }
-        let code = self.strip_comments(code, &mut b, out);
-        self.words(&code, &mut b, out);
-        b
+        let code = self.strip_comments(code, b, out);
+        self.words(&code, b, out);
     }
 
     /// The dialect's line-length limit.
@@ -333,6 +343,10 @@ impl Lexer {
                 ),
                 None,
             ));
+        }
+        if self.max_digits.is_none() && format.is_none() {
+            // No limit on the digits to hold them against.
+            return;
         }
         // The digits after the letters, `=`, the sign and leading zeros
         // (byte by byte: every one of those characters is ASCII).

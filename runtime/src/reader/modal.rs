@@ -108,6 +108,11 @@ pub(crate) struct State {
     ended: bool,
     /// A Klartext program's own reader, whose blocks become words.
     klartext: Option<Klartext>,
+    /// Storage reused from line to line: the block, and its G and M codes
+    /// with their groups (by index into its words).
+    scratch: Block,
+    groups: Vec<(GGroup, usize)>,
+    ms: Vec<(MCode, usize)>,
 }
 
 impl State {
@@ -176,21 +181,40 @@ impl State {
             ended: false,
             klartext: (lex.controller == Controller::HeidenhainKlartext).then(Klartext::default),
             lex,
+            scratch: Block::default(),
+            groups: Vec::new(),
+            ms: Vec::new(),
         }
     }
 
     /// Reads one line.
     pub fn line(&mut self, line: &str, out: &mut Vec<Found>) {
-        let b = match &mut self.klartext {
-            Some(k) => k.block(&self.lex, line, out),
-            None => self.lex.block(line, out),
-        };
+        let mut b = std::mem::take(&mut self.scratch);
+        match &mut self.klartext {
+            Some(k) => b = k.block(&self.lex, line, out),
+            None => self.lex.block_into(line, out, &mut b),
+        }
+        let mut groups = std::mem::take(&mut self.groups);
+        let mut ms = std::mem::take(&mut self.ms);
+        self.block(&b, line, out, &mut groups, &mut ms);
+        (self.scratch, self.groups, self.ms) = (b, groups, ms);
+    }
+
+    /// Runs one block: `groups` and `ms` are storage for its G and M codes.
+    fn block(
+        &mut self,
+        b: &Block,
+        line: &str,
+        out: &mut Vec<Found>,
+        groups: &mut Vec<(GGroup, usize)>,
+        ms: &mut Vec<(MCode, usize)>,
+    ) {
         for c in &b.comments {
             if let Some(a) = super::header::away_axis(c) {
                 self.away = a;
             }
         }
-        self.block_number(&b, line, out);
+        self.block_number(b, line, out);
         if b.is_empty() {
             return;
         }
@@ -203,18 +227,18 @@ impl State {
             ));
             return;
         }
-        self.repeated(&b, line, out);
-        let Some((groups, ms)) = self.classify(&b, line, out) else {
+        self.repeated(b, line, out);
+        if !self.classify(b, line, out, groups, ms) {
             return;
-        };
-        self.modes(&b, &groups, line, out);
-        self.spindle_and_tool(&b, &groups, &ms, line, out);
+        }
+        self.modes(b, groups, line, out);
+        self.spindle_and_tool(b, groups, ms, line, out);
         // G50 S and G4 take their own words; no move.
         if !groups
             .iter()
             .any(|(g, _)| matches!(g, GGroup::SpindleCap | GGroup::NonModal))
         {
-            self.move_block(&b, line, out);
+            self.move_block(b, line, out);
         }
         if ms.iter().any(|(m, _)| *m == MCode::End) {
             self.ended = true;
@@ -285,21 +309,23 @@ impl State {
         }
     }
 
-    /// The block's G and M codes with their groups; unknown codes and two
-    /// of one modal group are refused (`None`: the block is not run).
-    #[allow(clippy::type_complexity)]
-    fn classify<'b>(
+    /// The block's G and M codes with their groups, into `groups` and `ms`
+    /// (by index into the block's words); unknown codes and two of one
+    /// modal group are refused (`false`: the block is not run).
+    fn classify(
         &self,
-        b: &'b Block,
+        b: &Block,
         line: &str,
         out: &mut Vec<Found>,
-    ) -> Option<(Vec<(GGroup, &'b Word)>, Vec<(MCode, &'b Word)>)> {
+        groups: &mut Vec<(GGroup, usize)>,
+        ms: &mut Vec<(MCode, usize)>,
+    ) -> bool {
         let before = out.len();
-        let mut groups: Vec<(GGroup, &'b Word)> = Vec::new();
-        let mut ms: Vec<(MCode, &'b Word)> = Vec::new();
-        for w in &b.words {
+        groups.clear();
+        ms.clear();
+        for (i, w) in b.words.iter().enumerate() {
             let scaled = w.value * 10.0;
-            let code = scaled.round() as i64;
+            let code = round_to_integer(scaled);
             match w.letter {
                 'G' => match ((scaled - code as f64).abs() < 1e-9)
                     .then(|| self.g_group(code))
@@ -307,21 +333,21 @@ impl State {
                 {
                     Some(g) => {
                         let siemens = self.lex.controller == Controller::Siemens;
-                        if let Some((_, o)) =
+                        if let Some(&(_, o)) =
                             groups.iter().find(|(o, _)| same_group(*o, g, siemens))
                         {
-                            out.push(conflict(w, o, line));
+                            out.push(conflict(w, &b.words[o], line));
                         }
-                        groups.push((g, w));
+                        groups.push((g, i));
                     }
                     None => out.push(unknown_code(w, line)),
                 },
                 'M' => match self.m_code(w.value as i64).filter(|_| !w.point) {
                     Some(m) => {
-                        if let Some((_, o)) = ms.iter().find(|(o, _)| same_m_group(*o, m)) {
-                            out.push(conflict(w, o, line));
+                        if let Some(&(_, o)) = ms.iter().find(|(o, _)| same_m_group(*o, m)) {
+                            out.push(conflict(w, &b.words[o], line));
                         }
-                        ms.push((m, w));
+                        ms.push((m, i));
                     }
                     None if w.point => {}
                     None => out.push(unknown_code(w, line)),
@@ -339,18 +365,20 @@ impl State {
                 )),
             }
         }
-        (out.len() == before).then_some((groups, ms))
+        out.len() == before
     }
 
     fn known_letter(&self, l: char) -> bool {
-        match self.lex.controller {
-            Controller::Fanuc => "XYZCIJKRFSTDHPQLNO".contains(l),
-            Controller::UltraPrecision => "XYZCWIJKRFSTDHPQLNO".contains(l),
-            Controller::LinuxCnc => "XYZABCUVWIJKRFSTDHPQLN".contains(l),
-            Controller::Siemens => "XYZABCIJKRFSTDHPLN".contains(l),
-            Controller::HeidenhainIso => "XYZABCIJKRFSTLPHN".contains(l),
-            Controller::HeidenhainKlartext => "XYZIJFSTN".contains(l),
-        }
+        let letters = match self.lex.controller {
+            Controller::Fanuc => "XYZCIJKRFSTDHPQLNO",
+            Controller::UltraPrecision => "XYZCWIJKRFSTDHPQLNO",
+            Controller::LinuxCnc => "XYZABCUVWIJKRFSTDHPQLN",
+            Controller::Siemens => "XYZABCIJKRFSTDHPLN",
+            Controller::HeidenhainIso => "XYZABCIJKRFSTLPHN",
+            Controller::HeidenhainKlartext => "XYZIJFSTN",
+        };
+        // Every letter listed is ASCII: a byte compare, not a char search.
+        l.is_ascii() && letters.as_bytes().contains(&(l as u8))
     }
 
     fn g_group(&self, code: i64) -> Option<GGroup> {
@@ -415,7 +443,7 @@ impl State {
     }
 
     /// Units, plane, distance, feed mode, diameter mode.
-    fn modes(&mut self, b: &Block, groups: &[(GGroup, &Word)], line: &str, out: &mut Vec<Found>) {
+    fn modes(&mut self, b: &Block, groups: &[(GGroup, usize)], line: &str, out: &mut Vec<Found>) {
         for (g, _) in groups {
             match *g {
                 GGroup::Units(m) => self.metric = Some(m),
@@ -470,8 +498,8 @@ impl State {
     fn spindle_and_tool(
         &mut self,
         b: &Block,
-        groups: &[(GGroup, &Word)],
-        ms: &[(MCode, &Word)],
+        groups: &[(GGroup, usize)],
+        ms: &[(MCode, usize)],
         line: &str,
         out: &mut Vec<Found>,
     ) {
@@ -508,13 +536,13 @@ impl State {
             }
         }
         if has(GGroup::SpindleMode(true)) && self.cap.is_none() {
-            let (_, w) = groups
+            let &(_, w) = groups
                 .iter()
                 .find(|(g, _)| *g == GGroup::SpindleMode(true))
                 .expect("found above");
             out.push((
                 Rule::NoSpeedCap,
-                w.span,
+                b.words[w].span,
                 "constant surface speed with no spindle speed limit: at the centre the spindle would run to its maximum".into(),
                 Some("set the limit first (LinuxCNC: G96 D…; Fanuc: G50 S…; Siemens: LIMS=…)".into()),
             ));
@@ -533,9 +561,9 @@ impl State {
                 _ => {}
             }
         }
-        for (m, w) in ms {
+        for &(m, w) in ms {
             match m {
-                MCode::SpindleOn => self.spindle_start(w, out),
+                MCode::SpindleOn => self.spindle_start(&b.words[w], out),
                 MCode::SpindleOff => self.spindle_on = false,
                 MCode::PositionOn | MCode::Orient => {
                     self.position_mode = true;
@@ -547,7 +575,7 @@ impl State {
         }
     }
 
-    fn tool(&mut self, b: &Block, ms: &[(MCode, &Word)]) {
+    fn tool(&mut self, b: &Block, ms: &[(MCode, usize)]) {
         let t = b.words.iter().any(|w| w.letter == 'T') || b.keywords.iter().any(|k| k.name == "T");
         if t {
             self.tool_selected = true;
@@ -613,6 +641,21 @@ impl State {
     }
 }
 
+/// `v.round() as i64` (halves away from zero, saturating, NaN to 0)
+/// without a call into libm: the truncation and the fraction it drops
+/// are both exact in f64.
+fn round_to_integer(v: f64) -> i64 {
+    let t = v as i64;
+    let fraction = v - t as f64;
+    if fraction >= 0.5 {
+        t.saturating_add(1)
+    } else if fraction <= -0.5 {
+        t.saturating_sub(1)
+    } else {
+        t
+    }
+}
+
 /// Whether two G codes are of one modal group (`siemens`: G94 G95 G96
 /// G97 are one, group 15).
 fn same_group(a: GGroup, b: GGroup, siemens: bool) -> bool {
@@ -655,4 +698,58 @@ fn unknown_code(w: &Word, line: &str) -> Found {
         format!("`{}` is not a code this controller knows", w.text(line)),
         None,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::round_to_integer;
+
+    /// The same integer as `round() as i64` for halves, near-halves,
+    /// integers beyond 2^53 and 2^63, infinities, NaN and a spread of
+    /// bit patterns.
+    #[test]
+    fn rounds_as_round_does() {
+        let mut values = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.5,
+            -1.5,
+            2.5,
+            0.49999999999999994,
+            -0.49999999999999994,
+            4503599627370495.5,
+            -4503599627370495.5,
+            9007199254740993.0,
+            9.223372036854776e18,
+            -9.223372036854776e18,
+            1e30,
+            -1e30,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            f64::MIN_POSITIVE,
+            10.0 * 1.1,
+            10.0 * 96.9,
+        ];
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        for _ in 0..200_000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let v = f64::from_bits(state);
+            values.push(v);
+            // Tenths of codes as a program writes them (G1, G64.1, …).
+            values.push((state % 20_000) as f64 / 10.0 * 10.0);
+            values.push((state % 2_000_000) as f64 * 1e-3 - 1e3);
+        }
+        for v in values {
+            let x = v.next_up();
+            let y = v.next_down();
+            for w in [v, x, y] {
+                assert_eq!(round_to_integer(w), w.round() as i64, "{w:e}");
+            }
+        }
+    }
 }

@@ -38,11 +38,6 @@ const AXIS: [&str; 4] = ["X", "Y", "Z", "C"];
 impl State {
     /// The block's move, if it has one.
     pub(crate) fn move_block(&mut self, b: &Block, line: &str, out: &mut Vec<Found>) {
-        let axes: Vec<&Word> = b
-            .words
-            .iter()
-            .filter(|w| LETTERS.contains(&w.letter))
-            .collect();
         let centre: Vec<&Word> = b
             .words
             .iter()
@@ -51,7 +46,10 @@ impl State {
         // Centre words alone make a move only in an arc mode (a full
         // circle); elsewhere they belong to their block (`M19 R0`).
         let arc_mode = matches!(self.motion, Some(Motion::Cw | Motion::Ccw));
-        let Some(first) = axes.first().or(centre.first().filter(|_| arc_mode)) else {
+        let Some(first) = axes(b)
+            .next()
+            .or(centre.first().copied().filter(|_| arc_mode))
+        else {
             return;
         };
         let last = b.words.last().expect("a word");
@@ -70,12 +68,12 @@ impl State {
         };
         self.stated(span, out);
         let start = self.pos;
-        let end = self.end_point(&axes);
-        if self.lex.controller == Controller::LinuxCnc && axes.iter().any(|w| w.letter == 'C') {
+        let end = self.end_point(b);
+        if self.lex.controller == Controller::LinuxCnc && axes(b).any(|w| w.letter == 'C') {
             // LinuxCNC drives the spindle as the rotary axis C.
             self.position_mode = true;
         }
-        self.travel(&end, &axes, out);
+        self.travel(&end, b, out);
         let path = match motion {
             Motion::Rapid => {
                 self.rapid(&start, &end, span, out);
@@ -115,14 +113,14 @@ impl State {
         }
     }
 
-    fn end_point(&self, axes: &[&Word]) -> [Option<f64>; 4] {
+    fn end_point(&self, b: &Block) -> [Option<f64>; 4] {
         let mut end = self.pos;
         let unit = if self.metric == Some(false) {
             25.4
         } else {
             1.0
         };
-        for w in axes {
+        for w in axes(b) {
             let i = LETTERS
                 .iter()
                 .position(|l| *l == w.letter)
@@ -143,11 +141,8 @@ impl State {
         end
     }
 
-    fn travel(&self, end: &[Option<f64>; 4], axes: &[&Word], out: &mut Vec<Found>) {
-        for (i, w) in axes
-            .iter()
-            .map(|w| (LETTERS.iter().position(|l| *l == w.letter), w))
-        {
+    fn travel(&self, end: &[Option<f64>; 4], b: &Block, out: &mut Vec<Found>) {
+        for (i, w) in axes(b).map(|w| (LETTERS.iter().position(|l| *l == w.letter), w)) {
             let i = i.expect("an axis");
             let (Some(v), Some((lo, hi))) = (end[i], self.machine.travel[i]) else {
                 continue;
@@ -528,6 +523,11 @@ impl State {
             ));
         }
     }
+}
+
+/// The block's axis words (X, Y, Z, C), in order.
+fn axes(b: &Block) -> impl Iterator<Item = &Word> {
+    b.words.iter().filter(|w| LETTERS.contains(&w.letter))
 }
 
 fn chord(start: &[Option<f64>; 4], end: &[Option<f64>; 4]) -> Option<f64> {

@@ -25,7 +25,7 @@
 
 use super::figures::ErrorStats;
 use crate::moves::{Move, Plane};
-use crate::post::format::{decimals_for, fixed_units};
+use crate::post::format::decimals_for;
 use crate::reader::{Executed, Path};
 use std::f64::consts::PI;
 
@@ -81,16 +81,42 @@ enum Piece {
 
 /// Rounds `v` (mm) as a writer with `resolution` prints it.
 pub fn as_printed(v: f64, resolution: f64) -> f64 {
-    let d = decimals_for(resolution);
-    match fixed_units(v, d) {
-        Some(n) => n as f64 / 10f64.powi(d as i32),
-        None => v,
+    Printed::new(resolution).round(v)
+}
+
+/// `as_printed` for one resolution, its decimals and their scale worked
+/// out once: for a stream of millions of coordinates (the same values,
+/// bit for bit, as `as_printed`).
+#[derive(Clone, Copy, Debug)]
+pub struct Printed {
+    units: crate::post::format::Decimals,
+    /// 10^decimals.
+    scale: f64,
+}
+
+impl Printed {
+    pub fn new(resolution: f64) -> Printed {
+        let d = decimals_for(resolution);
+        Printed {
+            units: crate::post::format::Decimals::new(d),
+            scale: 10f64.powi(d as i32),
+        }
+    }
+
+    /// `v` (mm) as printed.
+    #[inline]
+    pub fn round(&self, v: f64) -> f64 {
+        match self.units.units(v) {
+            Some(n) => n as f64 / self.scale,
+            None => v,
+        }
     }
 }
 
 /// The cutting moves of a lathe stream (X, Z; arcs in G18) as printed.
 fn pieces(stream: &[Move], resolution: f64) -> Vec<Piece> {
-    let p = |v: f64| as_printed(v, resolution);
+    let printed = Printed::new(resolution);
+    let p = |v: f64| printed.round(v);
     let mut at = (f64::NAN, f64::NAN);
     let mut out = Vec::new();
     for m in stream {

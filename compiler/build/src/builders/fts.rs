@@ -103,7 +103,8 @@ pub fn build(
     );
     let mut printed = Vec::new();
     let planned = Prepared::of(spec).planner().plan(&p.fast_axis, |pts| {
-        let as_printed = |v: f64| lensc_runtime::verify::simulate::as_printed(v, head.resolution);
+        let printed_at = lensc_runtime::verify::simulate::Printed::new(head.resolution);
+        let as_printed = |v: f64| printed_at.round(v);
         printed.clear();
         printed.extend(pts.iter().map(|q| lensc_runtime::plan::fts::SpiralPoint {
             x: as_printed(q.x),

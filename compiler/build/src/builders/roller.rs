@@ -41,6 +41,7 @@ pub fn build(
     // The contact searches need z, ∂z/∂x and ∂²z/∂x² only.
     let (section, _) = evaluator(&lowered.tape.axial_section());
     let resolution = head.resolution;
+    let printed_at = lensc_runtime::verify::simulate::Printed::new(resolution);
     let mut program = RollerProgram::new(
         &head.dialect,
         &head.name,
@@ -78,7 +79,7 @@ pub fn build(
                 sweep.path().lift();
                 current_pass = pass;
             }
-            let printed = |v: f64| lensc_runtime::verify::simulate::as_printed(v, resolution);
+            let printed = |v: f64| printed_at.round(v);
             for q in pts {
                 sweep.path().point(q.c, printed(q.z), printed(q.x));
             }

@@ -244,3 +244,46 @@ fn the_program_cut_of_a_blended_arc_follows_the_spiral_not_the_start_circle() {
     let circle_cut = cut_of(&circle, RHO, &envelope, (-1.5, 1.5), 61);
     assert!(circle_cut.pv > 0.5 * delta, "{}", circle_cut.pv);
 }
+
+/// `Printed` rounds as the writer's own `fixed_units` scaled back, for
+/// every resolution the machines use and values of every magnitude,
+/// halves and non-finite ones included.
+#[test]
+fn printed_rounds_as_the_writer_prints() {
+    use crate::post::format::{decimals_for, fixed_units};
+    let mut values = vec![
+        0.0,
+        -0.0,
+        3.0717655,
+        -2.9999995,
+        0.0000005,
+        1e17,
+        1e30,
+        f64::NAN,
+        f64::INFINITY,
+    ];
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    for _ in 0..20_000 {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        values.push((state % 20_000_000_000) as f64 * 1e-9 - 10.0);
+        values.push(f64::from_bits(state));
+    }
+    for resolution in [1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1.0, 5e-7, 1e-9] {
+        let d = decimals_for(resolution);
+        let p = Printed::new(resolution);
+        for &v in &values {
+            let expected = match fixed_units(v, d) {
+                Some(n) => n as f64 / 10f64.powi(d as i32),
+                None => v,
+            };
+            let got = p.round(v);
+            assert!(
+                got.to_bits() == expected.to_bits() || (got.is_nan() && expected.is_nan()),
+                "{v:e} at {resolution:e}: {got:e} vs {expected:e}"
+            );
+            assert!(got.to_bits() == as_printed(v, resolution).to_bits() || got.is_nan());
+        }
+    }
+}

@@ -13,7 +13,18 @@ use crate::value::{self, Object};
 /// height) wins; outside every aperture, the land. Each point looks at its
 /// own cell and, where apertures reach past half a pitch, the neighbours.
 pub(super) fn array_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError> {
-    array_height_settled(g, o, x, y, None)
+    array_height_settled(g, o, x, y, None, Cells::NearestWhereItWins)
+}
+
+/// Which cells' lenslets an array's height looks at.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Cells {
+    /// The point's own cell alone where its lenslet always cuts deepest
+    /// (`nearest_wins`), else as `Reaching`.
+    NearestWhereItWins,
+    /// The own cell and every neighbour whose aperture may reach the
+    /// point (the reference the other is tested against).
+    Reaching,
 }
 
 /// An array's six outputs, the slopes and curvatures by the chain rule:
@@ -30,6 +41,16 @@ pub(super) fn array_outputs(
     x: Id,
     y: Id,
 ) -> Result<[Id; 6], LowerError> {
+    array_outputs_of(g, o, (x, y), Cells::NearestWhereItWins)
+}
+
+/// `array_outputs` looking at `cells`.
+pub(super) fn array_outputs_of(
+    g: &mut Graph,
+    o: &Object,
+    (x, y): (Id, Id),
+    cells: Cells,
+) -> Result<[Id; 6], LowerError> {
     let f = &o.fields;
     let lenslet =
         value::object(f, "lenslet").ok_or(LowerError::Unsupported("array without a lenslet"))?;
@@ -37,8 +58,9 @@ pub(super) fn array_outputs(
         .map_err(LowerError::Aperture)?;
     let own = super::lower_surface(lenslet)?.tape;
     let rim = rim_height(lenslet, &ap)?;
+    let nearest = cells == Cells::NearestWhereItWins && nearest_wins(lenslet, &ap);
     let candidates = match o.kind.name {
-        "grid" | "linear_array" => grid_cells(g, o, (x, y), half_extent(&ap))?,
+        "grid" | "linear_array" => grid_cells(g, o, (x, y), half_extent(&ap), nearest)?,
         _ => hex_cells(g, o, (x, y), half_extent(&ap))?,
     };
     let big = g.constant_node(BIG);
@@ -87,7 +109,7 @@ pub fn lower_trajectory(o: &Object, settle: f64) -> Result<LoweredSurface, Lower
     let domain = surface_domain(o).ok_or(LowerError::Aperture("no aperture or domain"))?;
     let mut g = Graph::new();
     let (x, y) = (g.x(), g.y());
-    let z = array_height_settled(&mut g, o, x, y, Some(settle))?;
+    let z = array_height_settled(&mut g, o, x, y, Some(settle), Cells::Reaching)?;
     Ok(LoweredSurface {
         tape: SurfaceTape::new(g, z),
         domain,
@@ -147,12 +169,13 @@ pub fn array_lenslet(o: &Object) -> Option<(LoweredSurface, f64)> {
     ))
 }
 
-fn array_height_settled(
+pub(super) fn array_height_settled(
     g: &mut Graph,
     o: &Object,
     x: Id,
     y: Id,
     settle: Option<f64>,
+    cells: Cells,
 ) -> Result<Id, LowerError> {
     let f = &o.fields;
     let lenslet =
@@ -168,8 +191,12 @@ fn array_height_settled(
     };
     let rim = rim_height(lenslet, &ap)?;
     // Cell centres: (i, j) → (cx, cy) as nodes; candidate cells per point.
+    // A continued lenslet is no longer held to its aperture: the nearest
+    // cell's need not win.
+    let nearest =
+        cells == Cells::NearestWhereItWins && settle.is_none() && nearest_wins(lenslet, &ap);
     let candidates = match o.kind.name {
-        "grid" | "linear_array" => grid_cells(g, o, (x, y), (hx, hy))?,
+        "grid" | "linear_array" => grid_cells(g, o, (x, y), (hx, hy), nearest)?,
         _ => hex_cells(g, o, (x, y), (hx, hy))?,
     };
     // min over the candidates that contain the point; +BIG where none do.
@@ -220,14 +247,58 @@ fn rim_height(lenslet: &Object, ap: &Domain) -> Result<f64, LowerError> {
     Ok(lensc_runtime::surface::ir::SurfaceFn::eval(&f, at.0, at.1)[0])
 }
 
+/// Whether, in a rectangular grid of this lenslet, the lenslet of the cell
+/// a point lies in always cuts at least as deep there as any other whose
+/// aperture holds the point, so that the deepest cut is the own cell's.
+///
+/// So it is when the aperture is centred on the lenslet (a circle, or a
+/// rectangle symmetric about its centre) and the height never falls as
+/// |u| or |v| grows: the own cell's centre is the nearest along x and
+/// along y (cells are the grid's rectangles), so wherever a neighbour's
+/// aperture holds the point the own one does too, at a height no higher.
+/// The height is then non-decreasing in |u| and |v| in floating point as
+/// well, every operation on the way being monotonic: a concave ellipsoid,
+/// z = c (1 − sqrt(1 − u²/a² − v²/b²)) with c > 0, and a concave sphere or
+/// conic without aspheric terms and with (1 + k) ≥ 0, z = c s / (1 +
+/// sqrt(1 − (1 + k) c² s)) with s = u² + v² and c > 0 (with a negative
+/// (1 + k) its denominator would grow too).
+fn nearest_wins(lenslet: &Object, aperture: &Domain) -> bool {
+    let centred = match *aperture {
+        Domain::Circle { .. } => true,
+        Domain::Rect { x, y } => x.0 == -x.1 && y.0 == -y.1,
+        Domain::Annulus { .. } => false,
+    };
+    let f = &lenslet.fields;
+    let side = super::Side::of(f);
+    let rising = match lenslet.kind.name {
+        "ellipsoid" => {
+            let axis = |name: &str| value::num(f, name).unwrap_or(1.0);
+            let usable = |v: f64| v.is_finite() && v != 0.0;
+            usable(axis("a")) && usable(axis("b")) && axis("c") * side.sigma > 0.0
+        }
+        "sphere" | "conic" => match value::num(f, "radius") {
+            Some(radius) => {
+                let c = side.curvature(radius) * side.sigma;
+                let k = value::num(f, "conic").unwrap_or(0.0);
+                c > 0.0 && c.is_finite() && 1.0 + k >= 0.0 && super::power_terms(f).is_empty()
+            }
+            None => false,
+        },
+        _ => false,
+    };
+    centred && rising
+}
+
 /// The centres of the cells of a rectangular grid or a linear array a
 /// point may lie in: its own and, where apertures reach past half a
-/// pitch, its neighbours.
+/// pitch, its neighbours — unless the own cell's lenslet is known to cut
+/// deepest (`nearest`, see `nearest_wins`): then its own alone.
 fn grid_cells(
     g: &mut Graph,
     o: &Object,
     (x, y): (Id, Id),
     (hx, hy): (f64, f64),
+    nearest: bool,
 ) -> Result<Vec<(Id, Id)>, LowerError> {
     let f = &o.fields;
     let num = |name: &str| value::num(f, name).unwrap_or(1.0);
@@ -253,6 +324,7 @@ fn grid_cells(
         }
     };
     let (kx, ky) = match (reach(hx, px), reach(hy, py)) {
+        _ if nearest && hx <= 1.5 * px && hy <= 1.5 * py => (0, 0),
         (Some(a), Some(b)) => (a, b),
         _ => {
             return Err(LowerError::Aperture(

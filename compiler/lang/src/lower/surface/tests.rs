@@ -500,3 +500,104 @@ surface u = tilt(s, about: x, angle: -7 deg, aperture: circle(radius: 1.5 mm))";
     let d = (25.0 - x * x - (y - yc) * (y - yc)).sqrt();
     assert!(close(eval_surface(src, "u", x, y)[0], zc - d));
 }
+
+/// Seed 002's grid of overlapping concave ellipsoids (each aperture
+/// reaches into eight neighbours) evaluated at the point's own cell alone
+/// against every cell that may reach it: the same height, bit for bit,
+/// except within rounding of the ridges where two dimples are equally
+/// deep; slopes and curvatures the same up to the rounding the reference
+/// adds where it folds a losing neighbour into its minimum's derivative;
+/// and the flat array's selected slopes bit for bit. A convex lenslet
+/// keeps every candidate (the farther bump is the lower there).
+#[test]
+fn a_grid_of_dimples_cuts_at_its_own_cell_alone() {
+    use super::arrays::{Cells, array_height_settled, array_outputs_of};
+    let src = "surface dimple = ellipsoid { a: 0.505 mm, b: 0.505 mm, c: 1.01 mm, sense: concave, aperture: circle(radius: 0.12 mm) }
+surface microlenses = grid(dimple, pitch_x: 0.1 mm, pitch_y: 0.19634954084936207 mm, count_x: 60, count_y: 96)";
+    let c = crate::check_text(&crate::loader::RealFs, "t.lens", src.as_bytes());
+    assert!(!c.has_errors(), "{:?}", c.diags());
+    let o = c.checked.declarations.get("microlenses").expect("surface");
+    let tapes = |cells: Cells| {
+        let mut g = Graph::new();
+        let (x, y) = (g.x(), g.y());
+        let z = array_height_settled(&mut g, o, x, y, None, cells).expect("lowers");
+        let height = SurfaceTape::new(g, z);
+        let mut g = Graph::new();
+        let (x, y) = (g.x(), g.y());
+        let outputs = array_outputs_of(&mut g, o, (x, y), cells).expect("lowers");
+        (height, SurfaceTape::with_outputs(g, outputs))
+    };
+    let (own, own_flat) = tapes(Cells::NearestWhereItWins);
+    let (every, every_flat) = tapes(Cells::Reaching);
+    assert!(
+        own.live_nodes().len() * 4 < every.live_nodes().len(),
+        "one lenslet, not nine: {} vs {} nodes",
+        own.live_nodes().len(),
+        every.live_nodes().len()
+    );
+    let (own, every) = (Interpreter::new(&own), Interpreter::new(&every));
+    let (own_flat, every_flat) = (Interpreter::new(&own_flat), Interpreter::new(&every_flat));
+    let (px, py) = (0.1, 0.19634954084936207);
+    // Three cells each way around an inner one and the grid's corner, at
+    // 1 µm steps, on the ridges and a few ulps either side of them.
+    let mut xs: Vec<f64> = (-150..=150).map(|i| 0.001 * f64::from(i)).collect();
+    let mut ys: Vec<f64> = (-150..=150).map(|i| py / 100.0 * f64::from(i)).collect();
+    for k in -2..=2 {
+        // Both counts are even: the cells' edges are whole pitches.
+        let (ex, ey) = (f64::from(k) * px, f64::from(k) * py);
+        for (v, list) in [(ex, &mut xs), (ey, &mut ys)] {
+            let mut t = v;
+            for _ in 0..4 {
+                t = t.next_down();
+            }
+            for _ in 0..9 {
+                list.push(t);
+                t = t.next_up();
+            }
+        }
+    }
+    let corner = (30.0 * px, 48.0 * py);
+    xs.extend((0..40).map(|i| corner.0 - 0.15 + 0.01 * f64::from(i)));
+    ys.extend((0..40).map(|i| corner.1 - 0.3 + 0.02 * f64::from(i)));
+    let on_ridge = |t: f64, p: f64| {
+        let f = (t / p).rem_euclid(1.0);
+        f.min(1.0 - f) < 1e-9
+    };
+    let (mut compared, mut ridges) = (0, 0);
+    for &x in &xs {
+        for &y in &ys {
+            let (a, b) = (own.eval(x, y), every.eval(x, y));
+            let (fa, fb) = (own_flat.eval(x, y), every_flat.eval(x, y));
+            if on_ridge(x, px) || on_ridge(y, py) {
+                ridges += 1;
+                assert!((a[0] - b[0]).abs() <= 1e-15, "z at ridge ({x}, {y})");
+                continue;
+            }
+            compared += 1;
+            assert_eq!(a[0].to_bits(), b[0].to_bits(), "z at ({x}, {y})");
+            assert_eq!(fa, fb, "flat array's outputs at ({x}, {y})");
+            for k in 1..6 {
+                let tol = 1e-13 * (1.0 + b[k].abs());
+                assert!(
+                    (a[k] - b[k]).abs() <= tol,
+                    "output {k} at ({x}, {y}): {} vs {}",
+                    a[k],
+                    b[k]
+                );
+            }
+        }
+    }
+    assert!(compared > 100_000 && ridges > 1000, "{compared} {ridges}");
+
+    // Convex bumps: the own cell's is the higher one, so all are kept.
+    let convex = src.replace("concave", "convex");
+    let c = crate::check_text(&crate::loader::RealFs, "t.lens", convex.as_bytes());
+    let o = c.checked.declarations.get("microlenses").expect("surface");
+    let nodes = |cells: Cells| {
+        let mut g = Graph::new();
+        let (x, y) = (g.x(), g.y());
+        let z = array_height_settled(&mut g, o, x, y, None, cells).expect("lowers");
+        SurfaceTape::new(g, z).live_nodes().len()
+    };
+    assert_eq!(nodes(Cells::NearestWhereItWins), nodes(Cells::Reaching));
+}
