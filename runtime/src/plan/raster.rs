@@ -747,6 +747,10 @@ struct Cutter<'a> {
     along: Axis,
     radius: f64,
     ball: bool,
+    /// Whether a split chord's halves take their parent's probes
+    /// (`too_coarse`); off only in the test that holds it to solving
+    /// every probe.
+    reuse_probes: bool,
 }
 
 impl<'a> Cutter<'a> {
@@ -756,6 +760,7 @@ impl<'a> Cutter<'a> {
             along,
             radius: tool.radius(),
             ball: matches!(tool, RasterTool::Ball { .. }),
+            reuse_probes: true,
         }
     }
 
@@ -1217,7 +1222,9 @@ impl<'a> Cutter<'a> {
         let mut probes = ProbeSet::EMPTY;
         let mut stack = vec![(a, b, 0u32, None)];
         while let Some((c0, c1, depth, parent)) = stack.pop() {
-            let parent = parent.map(|(k, side)| (&split[k], side));
+            let parent = parent
+                .filter(|_| self.reuse_probes)
+                .map(|(k, side)| (&split[k], side));
             let (coarse, probed) =
                 self.too_coarse(r, plane, &c0, &c1, parent, &mut probes, summary)?;
             if coarse {
@@ -1232,7 +1239,8 @@ impl<'a> Cutter<'a> {
                 let (t, guess) = (0.5 * (c0.u + c1.u), 0.5 * (c0.v + c1.v));
                 // The chord's middle probe, if it was asked for at this
                 // very t and guess, is this contact.
-                let mid = match probed.then(|| probes.same(PROBES / 2 - 1, t, guess)) {
+                let reused = probed && self.reuse_probes;
+                let mid = match reused.then(|| probes.same(PROBES / 2 - 1, t, guess)) {
                     Some(Some(c)) => c,
                     _ => {
                         let mid = self.contact(plane, t, guess)?;
