@@ -813,6 +813,17 @@ impl<'a> Cutter<'a> {
         plane: f64,
         mut solves: [Solve; N],
     ) -> [Result<Contact, RasterError>; N] {
+        self.run_side_by_side(plane, &mut solves);
+        solves.map(|s| match s.stage {
+            Stage::Done(c) => c,
+            _ => unreachable!("a solve asks for points until it is done"),
+        })
+    }
+
+    /// Runs `solves` to their ends side by side, in place (each then
+    /// `Stage::Done`).
+    #[inline(always)]
+    fn run_side_by_side<const N: usize>(&self, plane: f64, solves: &mut [Solve; N]) {
         const { assert!(N <= MAX_BATCH, "a batch of contacts fits the buffers") };
         let (mut xs, mut ys) = ([0.0; MAX_BATCH], [0.0; MAX_BATCH]);
         let mut out = [0.0; 6 * MAX_BATCH];
@@ -836,10 +847,6 @@ impl<'a> Cutter<'a> {
                 self.advance(plane, &mut solves[asked[j]], l);
             }
         }
-        solves.map(|s| match s.stage {
-            Stage::Done(c) => c,
-            _ => unreachable!("a solve asks for points until it is done"),
-        })
     }
 
     /// The slope along the cut that tilts the tool's normal: the ball's
@@ -1308,7 +1315,7 @@ impl<'a> Cutter<'a> {
         // parent: the parent's probe (k + 1)/2 − 1 for the first half,
         // 3 + (k + 1)/2 for the second, when k + 1 is even.
         let mut known = 0u8;
-        let solves: [Solve; PROBES - 1] = std::array::from_fn(|k| {
+        let mut solves: [Solve; PROBES - 1] = std::array::from_fn(|k| {
             let (t, guess) = at[k];
             let j = match parent {
                 Some((_, Half::First)) if k % 2 == 1 => Some((k + 1) / 2 - 1),
@@ -1331,8 +1338,13 @@ impl<'a> Cutter<'a> {
             }
         });
         set.at = at;
-        for (i, q) in (1..PROBES).zip(self.solve_side_by_side(plane, solves)) {
-            let q = q?;
+        self.run_side_by_side(plane, &mut solves);
+        for (i, s) in (1..PROBES).zip(&solves) {
+            let q = match &s.stage {
+                Stage::Done(Ok(q)) => *q,
+                Stage::Done(Err(e)) => return Err(e.clone()),
+                _ => unreachable!("a solve asks for points until it is done"),
+            };
             // A contact known from the parent has been seen already.
             if known & 1 << (i - 1) == 0 {
                 summary.see(&q, self);
