@@ -643,8 +643,9 @@ struct Contact {
 const MAX_STEPS: u32 = 60;
 /// Most halvings of one Newton step before the solve gives up.
 const MAX_HALVINGS: u32 = 40;
-/// Most contacts solved side by side (`Cutter::contacts`).
-const MAX_BATCH: usize = PROBES;
+/// Most contacts solved side by side (`Cutter::contacts`): a chord's
+/// interior probes.
+const MAX_BATCH: usize = PROBES - 1;
 
 /// A contact solve's point: the surface there, g(v), W² and W
 /// (`Cutter::newton_at`).
