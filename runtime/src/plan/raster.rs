@@ -643,8 +643,9 @@ struct Contact {
 const MAX_STEPS: u32 = 60;
 /// Most halvings of one Newton step before the solve gives up.
 const MAX_HALVINGS: u32 = 40;
-/// Most contacts solved side by side (`Cutter::contacts`).
-const MAX_BATCH: usize = PROBES;
+/// Most contacts solved side by side (`Cutter::contacts`): a chord's
+/// interior probes.
+const MAX_BATCH: usize = PROBES - 1;
 
 /// A contact solve's point: the surface there, g(v), W² and W
 /// (`Cutter::newton_at`).
@@ -690,6 +691,48 @@ impl Solve {
     }
 }
 
+/// A chord's probe contacts (`Cutter::too_coarse`), each with the t and
+/// guess its solve was given.
+#[derive(Clone, Copy)]
+struct ProbeSet {
+    at: [(f64, f64); PROBES - 1],
+    contacts: [Contact; PROBES - 1],
+}
+
+impl ProbeSet {
+    const EMPTY: ProbeSet = ProbeSet {
+        at: [(f64::NAN, f64::NAN); PROBES - 1],
+        contacts: [Contact {
+            u: f64::NAN,
+            v: f64::NAN,
+            l: Local {
+                z: f64::NAN,
+                zu: f64::NAN,
+                zv: f64::NAN,
+                zuu: f64::NAN,
+                zuv: f64::NAN,
+                zvv: f64::NAN,
+            },
+            c: [f64::NAN; 2],
+        }; PROBES - 1],
+    };
+
+    /// Probe `j`'s contact if it was solved from this very t and guess
+    /// (bit for bit: a solve is a function of its plane, t and guess).
+    #[inline(always)]
+    fn same(&self, j: usize, t: f64, guess: f64) -> Option<Contact> {
+        let (pt, pg) = self.at[j];
+        (pt.to_bits() == t.to_bits() && pg.to_bits() == guess.to_bits()).then_some(self.contacts[j])
+    }
+}
+
+/// Which half of a split chord.
+#[derive(Clone, Copy)]
+enum Half {
+    First,
+    Second,
+}
+
 /// One point of a ball plane's scan.
 enum Probe {
     /// The contact lies in the aperture.
@@ -705,6 +748,10 @@ struct Cutter<'a> {
     along: Axis,
     radius: f64,
     ball: bool,
+    /// Whether a split chord's halves take their parent's probes
+    /// (`too_coarse`); off only in the test that holds it to solving
+    /// every probe.
+    reuse_probes: bool,
 }
 
 impl<'a> Cutter<'a> {
@@ -714,6 +761,7 @@ impl<'a> Cutter<'a> {
             along,
             radius: tool.radius(),
             ball: matches!(tool, RasterTool::Ball { .. }),
+            reuse_probes: true,
         }
     }
 
@@ -749,14 +797,35 @@ impl<'a> Cutter<'a> {
         plane: f64,
         at: [(f64, f64); N],
     ) -> [Result<Contact, RasterError>; N] {
-        const { assert!(N <= MAX_BATCH, "a batch of contacts fits the buffers") };
-        let mut solves = at.map(|(t, guess)| Solve {
+        let solves = at.map(|(t, guess)| Solve {
             t,
             v: if guess.is_finite() { guess } else { plane },
             at: Newton::default(),
             steps: 0,
             stage: Stage::Start,
         });
+        self.solve_side_by_side(plane, solves)
+    }
+
+    /// Runs `solves` to their ends side by side (`contacts`).
+    #[inline(always)]
+    fn solve_side_by_side<const N: usize>(
+        &self,
+        plane: f64,
+        mut solves: [Solve; N],
+    ) -> [Result<Contact, RasterError>; N] {
+        self.run_side_by_side(plane, &mut solves);
+        solves.map(|s| match s.stage {
+            Stage::Done(c) => c,
+            _ => unreachable!("a solve asks for points until it is done"),
+        })
+    }
+
+    /// Runs `solves` to their ends side by side, in place (each then
+    /// `Stage::Done`).
+    #[inline(always)]
+    fn run_side_by_side<const N: usize>(&self, plane: f64, solves: &mut [Solve; N]) {
+        const { assert!(N <= MAX_BATCH, "a batch of contacts fits the buffers") };
         let (mut xs, mut ys) = ([0.0; MAX_BATCH], [0.0; MAX_BATCH]);
         let mut out = [0.0; 6 * MAX_BATCH];
         let mut asked = [0; MAX_BATCH];
@@ -779,10 +848,6 @@ impl<'a> Cutter<'a> {
                 self.advance(plane, &mut solves[asked[j]], l);
             }
         }
-        solves.map(|s| match s.stage {
-            Stage::Done(c) => c,
-            _ => unreachable!("a solve asks for points until it is done"),
-        })
     }
 
     /// The slope along the cut that tilts the tool's normal: the ball's
@@ -1159,9 +1224,18 @@ impl<'a> Cutter<'a> {
         summary: &mut Summary,
     ) -> Result<Vec<Contact>, RasterError> {
         let mut out = vec![a];
-        let mut stack = vec![(a, b, 0u32)];
-        while let Some((c0, c1, depth)) = stack.pop() {
-            if self.too_coarse(r, plane, &c0, &c1, summary)? {
+        // The probes of every chord split so far: a half's probes at 2/8,
+        // 4/8 and 6/8 may be its parent's (`Halves`).
+        let mut split: Vec<ProbeSet> = Vec::new();
+        let mut probes = ProbeSet::EMPTY;
+        let mut stack = vec![(a, b, 0u32, None)];
+        while let Some((c0, c1, depth, parent)) = stack.pop() {
+            let parent = parent
+                .filter(|_| self.reuse_probes)
+                .map(|(k, side)| (&split[k], side));
+            let (coarse, probed) =
+                self.too_coarse(r, plane, &c0, &c1, parent, &mut probes, summary)?;
+            if coarse {
                 if depth >= MAX_DEPTH {
                     let (x, y) = xy(self.along, c0.u, c0.v);
                     return Err(RasterError::ToleranceUnreachable {
@@ -1170,10 +1244,24 @@ impl<'a> Cutter<'a> {
                         tolerance: r.chord_tolerance,
                     });
                 }
-                let mid = self.contact(plane, 0.5 * (c0.u + c1.u), 0.5 * (c0.v + c1.v))?;
-                summary.see(&mid, self);
-                stack.push((mid, c1, depth + 1));
-                stack.push((c0, mid, depth + 1));
+                let (t, guess) = (0.5 * (c0.u + c1.u), 0.5 * (c0.v + c1.v));
+                // The chord's middle probe, if it was asked for at this
+                // very t and guess, is this contact.
+                let reused = probed && self.reuse_probes;
+                let mid = match reused.then(|| probes.same(PROBES / 2 - 1, t, guess)) {
+                    Some(Some(c)) => c,
+                    _ => {
+                        let mid = self.contact(plane, t, guess)?;
+                        summary.see(&mid, self);
+                        mid
+                    }
+                };
+                let halves = probed.then(|| {
+                    split.push(probes);
+                    split.len() - 1
+                });
+                stack.push((mid, c1, depth + 1, halves.map(|k| (k, Half::Second))));
+                stack.push((c0, mid, depth + 1, halves.map(|k| (k, Half::First))));
             } else {
                 if *budget == 0 {
                     return Err(RasterError::TooManyPoints { limit: MAX_POINTS });
@@ -1189,24 +1277,33 @@ impl<'a> Cutter<'a> {
     /// caps, or straying more than the tolerance from the exact curve
     /// (probed at PROBES − 1 interior points, the peak estimated by a
     /// parabola through the largest probe and its neighbours).
+    /// Its probes, with their t and guesses, are left in `set` (and
+    /// whether it was probed comes back with the decision: not when a
+    /// step cap decided it); `parent`, the probes of the
+    /// chord this is a half of, gives the contacts asked for again at
+    /// the same t and guess (the half's probes at 2/8, 4/8 and 6/8 fall
+    /// on its parent's, often to the last bit) without solving them
+    /// again: the same contacts, so the same decision.
     fn too_coarse(
         &self,
         r: &Raster,
         plane: f64,
         c0: &Contact,
         c1: &Contact,
+        parent: Option<(&ProbeSet, Half)>,
+        set: &mut ProbeSet,
         summary: &mut Summary,
-    ) -> Result<bool, RasterError> {
+    ) -> Result<(bool, bool), RasterError> {
         let (p0, p1) = (c0.c, c1.c);
         if let Some(m) = r.max_step
             && distance2(p0, p1) > m
         {
-            return Ok(true);
+            return Ok((true, false));
         }
         if let Some(alpha) = r.lin_angle {
             let cap = |c: &Contact| lin_step(section_radius(c.l.zu, c.l.zuu), alpha, c.l.zu);
             if (c1.u - c0.u).abs() > cap(c0).min(cap(c1)) {
-                return Ok(true);
+                return Ok((true, false));
             }
         }
         let mut probes = [[0.0; 2]; PROBES + 1];
@@ -1215,9 +1312,45 @@ impl<'a> Cutter<'a> {
             let s = (k + 1) as f64 / PROBES as f64;
             (c0.u + s * (c1.u - c0.u), c0.v + s * (c1.v - c0.v))
         });
-        for (i, q) in (1..PROBES).zip(self.contacts(plane, at)) {
-            let q = q?;
-            summary.see(&q, self);
+        // Probe k + 1 at (k + 1)/8 of a half is at (k + 1)/16 of its
+        // parent: the parent's probe (k + 1)/2 − 1 for the first half,
+        // 3 + (k + 1)/2 for the second, when k + 1 is even.
+        let mut known = 0u8;
+        let mut solves: [Solve; PROBES - 1] = std::array::from_fn(|k| {
+            let (t, guess) = at[k];
+            let j = match parent {
+                Some((_, Half::First)) if k % 2 == 1 => Some((k + 1) / 2 - 1),
+                Some((_, Half::Second)) if k % 2 == 1 => Some(PROBES / 2 - 1 + (k + 1) / 2),
+                _ => None,
+            };
+            let stage = match parent.zip(j).and_then(|((p, _), j)| p.same(j, t, guess)) {
+                Some(c) => {
+                    known |= 1 << k;
+                    Stage::Done(Ok(c))
+                }
+                None => Stage::Start,
+            };
+            Solve {
+                t,
+                v: if guess.is_finite() { guess } else { plane },
+                at: Newton::default(),
+                steps: 0,
+                stage,
+            }
+        });
+        set.at = at;
+        self.run_side_by_side(plane, &mut solves);
+        for (i, s) in (1..PROBES).zip(&solves) {
+            let q = match &s.stage {
+                Stage::Done(Ok(q)) => *q,
+                Stage::Done(Err(e)) => return Err(e.clone()),
+                _ => unreachable!("a solve asks for points until it is done"),
+            };
+            // A contact known from the parent has been seen already.
+            if known & 1 << (i - 1) == 0 {
+                summary.see(&q, self);
+            }
+            set.contacts[i - 1] = q;
             probes[i] = q.c;
             let f = foot_on_segment(q.c, p0, p1);
             quick[i] = ((f[0] - q.c[0]).powi(2) + (f[1] - q.c[1]).powi(2)).sqrt();
@@ -1227,13 +1360,13 @@ impl<'a> Cutter<'a> {
         // settle almost every chord; one those ulps could turn is measured
         // again with `hypot`, so each decision is the one its distances give.
         if let Some(split) = clear_decision(&quick, limit) {
-            return Ok(split);
+            return Ok((split, true));
         }
         let mut d = [0.0; PROBES + 1];
         for i in 1..PROBES {
             d[i] = distance_to_segment(probes[i], p0, p1);
         }
-        Ok(chord_peak(&d) > limit)
+        Ok((chord_peak(&d) > limit, true))
     }
 }
 

@@ -140,10 +140,15 @@ impl Decimals {
 /// and without a branch on the digits (which way a value rounds is a coin
 /// toss a branch predictor loses): below 2^52 a double's distance from its
 /// truncation is exact, so the comparison with one half is too; from 2^52
-/// on, every double is whole and the distance is zero.
+/// on, every double is whole and the distance is zero. The truncation is
+/// one instruction: `as` would guard against NaN and values past `i64`'s
+/// range, which the caller's range test has already ruled out.
 #[inline]
 fn round_half_away(scaled: f64) -> i64 {
-    let t = scaled as i64;
+    debug_assert!(scaled.abs() < 1e18);
+    // SAFETY: the caller (`units`) passes only |scaled| < 1e18, a finite
+    // value whose truncation fits in an i64 (< 2^63 ≈ 9.2e18).
+    let t = unsafe { scaled.to_int_unchecked::<i64>() };
     let rest = scaled - t as f64;
     t + (rest >= 0.5) as i64 - (rest <= -0.5) as i64
 }
@@ -237,7 +242,9 @@ fn digits_before(buf: &mut [u8], end: usize, mut v: u64) {
 /// The eight decimal digits of `v` (below 10^8), leading zeros included,
 /// one a byte, the first in the lowest byte (as they are stored): split
 /// into halves, quarters and digits in every lane at once, dividing by
-/// multiplying (exact in these ranges).
+/// multiplying (exact in these ranges). The printer's own on machines
+/// without SSE2; on x86-64 the reference `sixteen_digits` is tested against.
+#[cfg(any(test, not(all(target_arch = "x86_64", target_feature = "sse2"))))]
 #[inline]
 fn eight_digits(v: u32) -> u64 {
     let x = (v / 10_000) as u64 | (((v % 10_000) as u64) << 32);
@@ -247,6 +254,54 @@ fn eight_digits(v: u32) -> u64 {
     // Each 16-bit lane (below 100): /10 as *103 >> 10.
     let tens = ((x * 103) >> 10) & 0x000f_000f_000f_000f;
     tens | ((x - tens * 10) << 8)
+}
+
+/// The digits of `whole` and of `frac8` (each below 10^8, leading zeros
+/// included), one a byte, the first in the lowest byte: the integer
+/// part's eight in the first word, the decimals' in the second.
+#[cfg(not(all(target_arch = "x86_64", target_feature = "sse2")))]
+#[inline(always)]
+fn sixteen_digits(whole: u32, frac8: u32) -> (u64, u64) {
+    (eight_digits(whole), eight_digits(frac8))
+}
+
+/// The digits of `whole` and of `frac8` (each below 10^8, leading zeros
+/// included), one a byte, the first in the lowest byte: the integer
+/// part's eight in the first word, the decimals' in the second. Both
+/// numbers in one SSE2 register (always there on x86-64), split as
+/// `eight_digits` splits one, every lane at once: into halves (below
+/// 10^4) by a 32-bit multiply, quarters (below 100) and digits by
+/// 16-bit high multiplies, all exact in these ranges (checked value by
+/// value against `eight_digits` by `sixteen_digits_are_eight_and_eight`).
+#[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
+#[inline(always)]
+fn sixteen_digits(whole: u32, frac8: u32) -> (u64, u64) {
+    use std::arch::x86_64::*;
+    // SAFETY: these intrinsics only need SSE2, which this build targets
+    // (the `cfg` above; it is part of x86-64 itself); they touch no memory.
+    unsafe {
+        // [whole, frac8] as 64-bit lanes.
+        let v = _mm_set_epi64x(frac8 as i64, whole as i64);
+        // /10^4 as ·0xd1b71759 >> 45, exact below 2^32.
+        let high = _mm_srli_epi64::<45>(_mm_mul_epu32(v, _mm_set1_epi32(0xd1b7_1759_u32 as i32)));
+        let low = _mm_sub_epi32(v, _mm_mul_epu32(high, _mm_set1_epi32(10_000)));
+        // 32-bit lanes [whole / 10^4, whole % 10^4, frac / 10^4, frac % 10^4].
+        let halves = _mm_or_si128(high, _mm_slli_epi64::<32>(low));
+        // Each half's hundreds (/100 as ·5243 >> 19, exact below 43699)
+        // and the rest, side by side in 16-bit lanes.
+        let hundreds = _mm_srli_epi16::<3>(_mm_mulhi_epu16(halves, _mm_set1_epi16(5243)));
+        let rest = _mm_sub_epi16(halves, _mm_mullo_epi16(hundreds, _mm_set1_epi16(100)));
+        let pairs = _mm_or_si128(hundreds, _mm_slli_epi32::<16>(rest));
+        // Each pair's tens (/10 as ·6554 >> 16, exact below 16389) and
+        // units, side by side in bytes.
+        let tens = _mm_mulhi_epu16(pairs, _mm_set1_epi16(6554));
+        let units = _mm_sub_epi16(pairs, _mm_mullo_epi16(tens, _mm_set1_epi16(10)));
+        let digits = _mm_or_si128(tens, _mm_slli_epi16::<8>(units));
+        (
+            _mm_cvtsi128_si64(digits) as u64,
+            _mm_cvtsi128_si64(_mm_unpackhi_epi64(digits, digits)) as u64,
+        )
+    }
 }
 
 /// A number with at most 8 integer digits and 8 decimals: each part
@@ -260,20 +315,10 @@ fn print_short(
     frac8: u32,
 ) -> (usize, usize) {
     const ZEROS: u64 = 0x3030_3030_3030_3030;
-    // Most integer parts are short (a radius, a height): up to two
-    // digits come straight from the table.
-    let (w, whole_digits) = if whole < 100 {
-        let pair = whole as usize * 2;
-        let short = (whole >= 10) as usize;
-        let word = u16::from_le_bytes([PAIRS[pair], PAIRS[pair + 1]]) as u64 & !ZEROS;
-        (word >> (8 * (1 - short)), 1 + short)
-    } else {
-        let w = eight_digits(whole);
-        // Leading zeros are the low bytes; the last digit is always shown.
-        let digits = 8 - w.trailing_zeros() as usize / 8;
-        (w >> (8 * (8 - digits)), digits)
-    };
-    let f = eight_digits(frac8);
+    let (w, f) = sixteen_digits(whole, frac8);
+    // Leading zeros are the low bytes; the last digit is always shown.
+    let whole_digits = 8 - (w | 1 << 56).trailing_zeros() as usize / 8;
+    let w = w >> (8 * (8 - whole_digits));
     // Trailing zeros are the high bytes; all zero: no decimals at all.
     let shown = 8 - f.leading_zeros() as usize / 8;
     let minus = negative as usize;

@@ -118,6 +118,10 @@ pub struct ProgramWriter {
     feed_decimals: u32,
     /// The same, ready to round and print with.
     feed_format: Decimals,
+    /// The unit counts (of feeds per minute or per revolution, and of
+    /// inverse time) from which F has more digits before the point than
+    /// its format allows (`u64::MAX`: no limit).
+    feed_unit_limits: [u64; 2],
     /// Klartext: the circle centre `CC` last written, in units of the
     /// axes' last decimal.
     circle_centre: Option<(i64, i64)>,
@@ -269,6 +273,8 @@ impl ProgramWriter {
             integer_limit: limits,
             feed_decimals,
             feed_format: Decimals::new(feed_decimals),
+            feed_unit_limits: [feed_decimals, INVERSE_TIME_DECIMALS]
+                .map(|d| limits[letter_index('F')].saturating_mul(pow10(d))),
             circle_centre: None,
             moves: 0,
             zeroed: 0,
@@ -676,13 +682,29 @@ impl ProgramWriter {
         }
         let start = self.text.len();
         self.begin_block();
+        let [per_unit_limit, inverse_unit_limit] = self.feed_unit_limits;
         let mode = feed.map(|f| match f {
-            F::PerTime(v) => (FeedMode::PerMinute, v * 60.0, self.feed_format),
-            F::PerRevolution(v) => (FeedMode::PerRevolution, v * 2.0 * PI, self.feed_format),
-            F::InverseTime(t) => (FeedMode::InverseTime, 60.0 / t, INVERSE_TIME_FORMAT),
+            F::PerTime(v) => (
+                FeedMode::PerMinute,
+                v * 60.0,
+                self.feed_format,
+                per_unit_limit,
+            ),
+            F::PerRevolution(v) => (
+                FeedMode::PerRevolution,
+                v * 2.0 * PI,
+                self.feed_format,
+                per_unit_limit,
+            ),
+            F::InverseTime(t) => (
+                FeedMode::InverseTime,
+                60.0 / t,
+                INVERSE_TIME_FORMAT,
+                inverse_unit_limit,
+            ),
         });
-        let mode_changes = mode.is_some_and(|(m, _, _)| self.mode != Some(m));
-        if let Some((m, _, _)) = mode
+        let mode_changes = mode.is_some_and(|(m, ..)| self.mode != Some(m));
+        if let Some((m, ..)) = mode
             && mode_changes
         {
             let w = self.feed_mode_word(m)?.to_string();
@@ -780,8 +802,7 @@ impl ProgramWriter {
                 && refusal.is_none()
             {
                 let modal = (&mut self.last_feed, &mut self.mode);
-                let limit = self.integer_limit[letter_index('F')];
-                match feed_word(room, pos, mode, mode_changes, modal, max_digits, limit) {
+                match feed_word(room, pos, mode, mode_changes, modal, max_digits) {
                     Ok(p) => pos = p,
                     Err(r) => refusal = Some(r),
                 }
@@ -1176,30 +1197,34 @@ impl WordHead {
     }
 }
 
+/// The feed word's head.
+const FEED_HEAD: WordHead = WordHead {
+    bytes: *b" F      ",
+    len: 2,
+};
+
 /// The feed word, printed at `pos` of the block's room: written when the
 /// mode or the printed feed changes, and on every move in inverse time;
-/// the last printed feed and mode (`modal`) become this one's. `limit` is
-/// 10 to the most digits F takes before the point. Its end, or why it is
+/// the last printed feed and mode (`modal`) become this one's. The mode
+/// comes with the feed's value, its decimals and the unit count from
+/// which it has too many digits before the point. Its end, or why it is
 /// refused.
 #[inline(always)]
 fn feed_word(
     room: &mut [u8; BLOCK_ROOM],
     pos: usize,
-    (m, value, format): (FeedMode, f64, Decimals),
+    (m, value, format, unit_limit): (FeedMode, f64, Decimals, u64),
     mode_changes: bool,
     (last_feed, mode): (&mut Option<i64>, &mut Option<FeedMode>),
     max_digits: usize,
-    limit: u64,
 ) -> Result<usize, Refusal> {
     let Some(n) = format.units(value).filter(|&n| n > 0) else {
         return Err(Refusal::Unprintable('F', value));
     };
     let mut end = pos;
     if mode_changes || m == FeedMode::InverseTime || *last_feed != Some(n) {
-        let unit_limit = limit.saturating_mul(pow10(format.places()));
-        let head = WordHead::new('F');
         end = print_word(
-            room, pos, &head, 'F', value, n, &format, max_digits, unit_limit,
+            room, pos, &FEED_HEAD, 'F', value, n, &format, max_digits, unit_limit,
         )?;
     }
     *last_feed = Some(n);

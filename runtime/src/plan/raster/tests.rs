@@ -1028,3 +1028,93 @@ fn contacts_solved_side_by_side_are_those_solved_alone() {
         "{solved} solved, {refused} refused"
     );
 }
+
+/// Counts the points a planner asks a surface for.
+struct Counting<'a> {
+    inner: &'a dyn SurfaceFn,
+    points: std::cell::Cell<usize>,
+}
+
+impl SurfaceFn for Counting<'_> {
+    fn eval_batch(&self, xs: &[f64], ys: &[f64], out: &mut [f64]) {
+        self.points.set(self.points.get() + xs.len());
+        self.inner.eval_batch(xs, ys, out);
+    }
+}
+
+/// A split chord's halves taking their parent's probe contacts (where
+/// asked for at the same t and guess) sample the same contacts, to the
+/// last bit, and see the same summary as solving every probe; and they
+/// do take some (fewer surface evaluations).
+#[test]
+fn halves_reusing_their_parents_probes_sample_what_solving_every_probe_samples() {
+    let surfaces = [
+        convex(3.0, 10.0),
+        convex(1.0, -1.0),
+        convex(1.0, -20.0),
+        Conic {
+            radius: 4.0,
+            k: 0.0,
+            s: 1.0,
+        },
+    ];
+    let tools = [RasterTool::Ball { radius: 0.2 }, KNIFE];
+    let (mut with, mut without) = (0, 0);
+    for surface in &surfaces {
+        for along in [Axis::X, Axis::Y] {
+            for tool in &tools {
+                for lin_angle in [None, Some(5f64.to_radians())] {
+                    let r = Raster {
+                        along,
+                        zigzag: false,
+                        stepover: 0.01,
+                        chord_tolerance: 2e-7,
+                        max_step: None,
+                        lin_angle,
+                        retract: 0.5,
+                        chords: ChordPlacement::OnPath,
+                    };
+                    for plane in [-0.31, 0.0, 0.17] {
+                        let runs = [true, false].map(|reuse| {
+                            let counting = Counting {
+                                inner: surface,
+                                points: std::cell::Cell::new(0),
+                            };
+                            let mut cutter = Cutter::new(tool, &counting, along);
+                            cutter.reuse_probes = reuse;
+                            let mut summary = Summary::new(along);
+                            let a = cutter.contact(plane, -0.35, plane).expect("a contact");
+                            let b = cutter.contact(plane, 0.35, plane).expect("a contact");
+                            let mut budget = MAX_POINTS;
+                            let pts = cutter
+                                .sample(&r, plane, a, b, &mut budget, &mut summary)
+                                .expect("samples");
+                            let bits: Vec<[u64; 4]> = pts
+                                .iter()
+                                .map(|c| [c.u, c.v, c.c[0], c.c[1]].map(f64::to_bits))
+                                .collect();
+                            let seen = format!(
+                                "{:?} {:?} {:?} {:?}",
+                                summary.slope_along,
+                                summary.slope_across,
+                                summary.concave_along,
+                                summary.tool_limit
+                            );
+                            (bits, seen, counting.points.get())
+                        });
+                        let [(bits, seen, n), (bits_all, seen_all, n_all)] = &runs;
+                        assert!(bits.len() > 2, "the pass is split");
+                        assert_eq!(bits, bits_all, "plane {plane}, {along:?}, {tool:?}");
+                        assert_eq!(seen, seen_all, "plane {plane}, {along:?}, {tool:?}");
+                        with += *n;
+                        without += *n_all;
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        (with as f64) < 0.9 * without as f64,
+        "{with} evaluations reusing probes, {without} solving every one"
+    );
+}

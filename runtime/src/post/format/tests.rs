@@ -182,3 +182,36 @@ proptest::proptest! {
         check_printed(n, d)?;
     }
 }
+
+/// The digits of `v` (below 10^8) by division, one a byte, the first in
+/// the lowest byte.
+fn digits_by_division(mut v: u32) -> u64 {
+    let mut word = 0u64;
+    for i in (0..8).rev() {
+        word |= u64::from(v % 10) << (8 * i);
+        v /= 10;
+    }
+    word
+}
+
+#[test]
+fn eight_digits_are_the_decimal_digits() {
+    let edges = (0..10_000).chain((0..10_000).map(|k| 99_999_999 - k));
+    for v in edges.chain((0..100_000_000).step_by(997)) {
+        assert_eq!(eight_digits(v), digits_by_division(v), "{v}");
+    }
+}
+
+#[test]
+fn sixteen_digits_are_eight_and_eight() {
+    // Every value below 10^8, as the integer part and as the decimals
+    // (each paired with a different other half).
+    for v in 0..100_000_000u32 {
+        let other = 99_999_999 - v;
+        assert_eq!(
+            sixteen_digits(v, other),
+            (eight_digits(v), eight_digits(other)),
+            "{v}"
+        );
+    }
+}
