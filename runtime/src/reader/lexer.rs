@@ -144,7 +144,9 @@ impl Lexer {
             self.comment == CommentStyle::Semicolon || self.controller == Controller::LinuxCnc;
         // Every byte looked at (no early exit), so the scan runs on whole
         // vectors of bytes: most lines have no comment.
-        let marks = code.bytes().fold(false, |seen, c| seen | (c == b'(') | (c == b';'));
+        let marks = code
+            .bytes()
+            .fold(false, |seen, c| seen | (c == b'(') | (c == b';'));
         if !marks {
             return code.into();
         }
