@@ -142,7 +142,12 @@ impl Lexer {
     ) -> std::borrow::Cow<'c, str> {
         let semicolon =
             self.comment == CommentStyle::Semicolon || self.controller == Controller::LinuxCnc;
-        if !code.bytes().any(|c| c == b'(' || c == b';') {
+        // Every byte looked at (no early exit), so the scan runs on whole
+        // vectors of bytes: most lines have no comment.
+        let marks = code
+            .bytes()
+            .fold(false, |seen, c| seen | (c == b'(') | (c == b';'));
+        if !marks {
             return code.into();
         }
         let mut kept = String::with_capacity(code.len());
