@@ -1234,7 +1234,7 @@ impl<'a> Cutter<'a> {
                 .filter(|_| self.reuse_probes)
                 .map(|(k, side)| (&split[k], side));
             let (coarse, probed) =
-                self.too_coarse(r, plane, &c0, &c1, parent, &mut probes, summary)?;
+                self.too_coarse(r, plane, (&c0, &c1), parent, &mut probes, summary)?;
             if coarse {
                 if depth >= MAX_DEPTH {
                     let (x, y) = xy(self.along, c0.u, c0.v);
@@ -1288,8 +1288,7 @@ impl<'a> Cutter<'a> {
         &self,
         r: &Raster,
         plane: f64,
-        c0: &Contact,
-        c1: &Contact,
+        (c0, c1): (&Contact, &Contact),
         parent: Option<(&ProbeSet, Half)>,
         set: &mut ProbeSet,
         summary: &mut Summary,
@@ -1318,9 +1317,11 @@ impl<'a> Cutter<'a> {
         let mut known = 0u8;
         let mut solves: [Solve; PROBES - 1] = std::array::from_fn(|k| {
             let (t, guess) = at[k];
+            // Probe p = k + 1, at p/8 of the half.
+            let p = k + 1;
             let j = match parent {
-                Some((_, Half::First)) if k % 2 == 1 => Some((k + 1) / 2 - 1),
-                Some((_, Half::Second)) if k % 2 == 1 => Some(PROBES / 2 - 1 + (k + 1) / 2),
+                Some((_, Half::First)) if p % 2 == 0 => Some(p / 2 - 1),
+                Some((_, Half::Second)) if p % 2 == 0 => Some(PROBES / 2 - 1 + p / 2),
                 _ => None,
             };
             let stage = match parent.zip(j).and_then(|((p, _), j)| p.same(j, t, guess)) {

@@ -479,6 +479,12 @@ impl ProgramWriter {
     /// Writes one move, straight into the text (no allocation per move:
     /// a move that changes no printed axis is written and then cut off).
     pub fn write(&mut self, m: &crate::moves::Move) -> Result<(), ProgramError> {
+        self.write_move(m)
+    }
+
+    /// `write`, inlined into the loop of `write_all`.
+    #[inline(always)]
+    fn write_move(&mut self, m: &crate::moves::Move) -> Result<(), ProgramError> {
         use crate::moves::Move as M;
         if self.start.is_none() {
             return Err(ProgramError::Unsupported(
@@ -977,7 +983,7 @@ impl ProgramWriter {
         &mut self,
         moves: impl IntoIterator<Item = &'a crate::moves::Move>,
     ) -> Result<(), ProgramError> {
-        moves.into_iter().try_for_each(|m| self.write(m))
+        moves.into_iter().try_for_each(|m| self.write_move(m))
     }
 
     /// The text written since the last call (for streaming to a file),

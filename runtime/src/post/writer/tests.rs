@@ -373,6 +373,38 @@ fn an_integer_s_word_has_no_point_and_a_constant_rpm_start_cancels_g96() {
     assert!(text.contains("G50 S3000\nG96 S120\nM3\n"), "{text}");
 }
 
+/// An inverse-time F (three decimals) is held to its format's integer
+/// digits as a feed per minute is (here five decimals, the format's):
+/// each mode's limit in units of its own last decimal.
+#[test]
+fn feeds_are_held_to_their_integer_digits_in_each_mode() {
+    let mut dialect = Dialect::linuxcnc();
+    dialect
+        .word_formats
+        .push(WordFormat::parse("F3.5").expect("a format"));
+    let mut w = ProgramWriter::new(&dialect, Setup::Lathe, "t", &[], "XZC", 1e-6, 1e-5)
+        .expect("a lathe program");
+    w.call_tool(&Start::default()).expect("tool 1");
+    let mut at = 0.0;
+    let mut feed = |w: &mut ProgramWriter, f: F| {
+        at += 1.0;
+        w.write(&M::Linear {
+            to: P::xzc(at, 0.5, 0.0),
+            feed: Some(f),
+        })
+    };
+    // 60 / 0.0601 s = 998.336 a minute: three digits before the point.
+    assert!(feed(&mut w, F::InverseTime(0.0601)).is_ok());
+    // 60 / 0.06 s = 1000: four.
+    assert!(feed(&mut w, F::InverseTime(0.06)).is_err());
+    // 16.65 mm/s = 999 mm/min; 16.67 mm/s = 1000.2 mm/min.
+    assert!(feed(&mut w, F::PerTime(16.65)).is_ok());
+    assert!(feed(&mut w, F::PerTime(16.67)).is_err());
+    let text = w.take_text().expect("text");
+    assert!(text.contains(" F998.336\n"), "{text}");
+    assert!(text.contains(" F999.\n"), "{text}");
+}
+
 #[test]
 fn word_formats_refuse_a_point_in_an_integer_word_and_too_many_digits() {
     let d = fanuc_like();
