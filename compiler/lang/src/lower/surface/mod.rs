@@ -105,6 +105,13 @@ pub fn lower_surface(o: &Object) -> Result<LoweredSurface, LowerError> {
             domain,
         });
     }
+    if o.kind.name == "tilt" {
+        let outputs = derived::tilted_outputs(&mut g, o, x, y)?;
+        return Ok(LoweredSurface {
+            tape: SurfaceTape::with_outputs(g, outputs),
+            domain,
+        });
+    }
     let z = height(&mut g, o, x, y)?;
     Ok(LoweredSurface {
         tape: SurfaceTape::new(g, z),
