@@ -1,7 +1,7 @@
 //! Surfaces built from another at moved coordinates: a design wrapped
 //! onto a roller, a profile revolved, an off-axis section, a tilted surface.
 
-use lensc_runtime::surface::ir::{Graph, Id, SurfaceTape, Var};
+use lensc_runtime::surface::ir::{Graph, Id, SurfaceTape, Unary, Var};
 
 use super::{LowerError, height, radius_squared};
 use crate::value::{self, Object};
@@ -27,6 +27,105 @@ pub(super) fn revolve_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<
     let u = g.add(start, r);
     let zero = g.constant_node(0.0);
     height(g, profile, u, zero)
+}
+
+/// The six outputs of a revolved profile (the order of
+/// `SurfaceTape::outputs`) by the chain rule through u = start + r: with
+/// the profile's f, f′ and f″ along its own x at (u, 0) — an array's from
+/// its closed forms (`arrays::array_outputs`), any other profile's
+/// differentiated in a scratch graph — and (a, b) = (x, y)/r,
+///
+/// ```text
+/// z_x = f′ a    z_xx = f″ a² + f′ b²/r    z_xy = (f″ − f′/r) a b
+/// z_y = f′ b    z_yy = f″ b² + f′ a²/r
+/// ```
+///
+/// rather than differentiating the profile's height through the square
+/// root twice (the rings of `examples/lei2021_cylinder_array.lens`: 174 →
+/// 107 live nodes). z is `revolve_height`'s, node for node. On the axis
+/// (r = 0) the limits where the profile is level there (slopes 0, both
+/// curvatures f″; a land's all 0, as the graph's selects gave) and NaN
+/// where it is not, as at a cone's tip.
+pub(super) fn revolved_outputs(
+    g: &mut Graph,
+    o: &Object,
+    x: Id,
+    y: Id,
+) -> Result<[Id; 6], LowerError> {
+    let f = &o.fields;
+    let profile =
+        value::object(f, "profile").ok_or(LowerError::Unsupported("revolve without a profile"))?;
+    let start = g.constant_node(value::num(f, "start").unwrap_or(0.0));
+    let r2 = radius_squared(g, x, y);
+    let r = g.sqrt(r2);
+    let u = g.add(start, r);
+    let zero = g.constant_node(0.0);
+    // The profile over (u, v), in a scratch graph, at v = 0.
+    let mut h = Graph::new();
+    let (hu, hv) = (h.x(), h.constant_node(0.0));
+    let (hz, hzu, hzuu) = if matches!(profile.kind.name, "grid" | "hex_grid" | "linear_array") {
+        let [z, zu, _, zuu, _, _] = super::arrays::array_outputs(&mut h, profile, hu, hv)?;
+        (z, zu, zuu)
+    } else {
+        let z = height(&mut h, profile, hu, hv)?;
+        let zu = h.derivative(z, Var::X);
+        let zuu = h.derivative(zu, Var::X);
+        (z, zu, zuu)
+    };
+    let map = g.import(&h, u, zero);
+    let (z, f1, f2) = (
+        map[hz.0 as usize],
+        map[hzu.0 as usize],
+        map[hzuu.0 as usize],
+    );
+    // Off the axis (−r < 0) the closed forms; on it, the limits where the
+    // profile is level there (f′ = 0: slopes 0, both curvatures f″) and
+    // NaN where it is not (a cone's tip has no slope).
+    let off_axis = g.neg(r);
+    let level = {
+        let m = g.unary(Unary::Abs, f1);
+        g.neg(m)
+    };
+    let nan = g.constant_node(f64::NAN);
+    let tip = g.select(level, nan, zero);
+    let a = {
+        let q = g.div(x, r);
+        g.select(off_axis, q, tip)
+    };
+    let b = {
+        let q = g.div(y, r);
+        g.select(off_axis, q, tip)
+    };
+    let zx = g.mul(f1, a);
+    let zy = g.mul(f1, b);
+    let f1r = {
+        let q = g.div(f1, r);
+        g.select(off_axis, q, f2)
+    };
+    // On the axis a² = 1, b² = 0 (so z_xx = z_yy = f″), or NaN at a tip.
+    let a2 = {
+        let q = g.mul(a, a);
+        let one = g.constant_node(1.0);
+        let tip_one = g.select(level, nan, one);
+        g.select(off_axis, q, tip_one)
+    };
+    let b2 = g.mul(b, b);
+    let ab = g.mul(a, b);
+    let zxx = {
+        let t = g.mul(f2, a2);
+        let s = g.mul(f1r, b2);
+        g.add(t, s)
+    };
+    let zyy = {
+        let t = g.mul(f2, b2);
+        let s = g.mul(f1r, a2);
+        g.add(t, s)
+    };
+    let zxy = {
+        let d = g.sub(f2, f1r);
+        g.mul(d, ab)
+    };
+    Ok([z, zx, zy, zxx, zxy, zyy])
 }
 
 /// An off-axis section: the parent moved to the section's centre, less

@@ -597,3 +597,71 @@ surface tx = tilt(p, about: x, angle: -8 deg, aperture: circle(radius: 1.5 mm))"
 fn closed_nodes(o: &crate::value::Object) -> usize {
     lower_surface(o).expect("lowers").tape.live_nodes().len()
 }
+
+#[test]
+fn revolved_derivatives_agree_with_the_graph_s() {
+    // A revolved array of cylinders (seed 004's rings, three of them) and
+    // a revolved cylinder: the closed forms against the graph's
+    // derivatives of the height through u = start + r.
+    let src = "surface cyl = cylinder { radius: 0.788 mm, axis: y, sense: convex, aperture: rect(x: -0.267 mm .. 0.267 mm, y: -1 mm .. 1 mm) }
+surface row = linear_array(cyl, pitch: 0.554 mm, count: 3, axis: x)
+surface rings = revolve(row, start: -0.831 mm, aperture: circle(radius: 1.662 mm))
+surface dome = revolve(cyl, start: 0 mm, aperture: circle(radius: 0.25 mm))
+surface tip = revolve(cyl, start: 0.1 mm, aperture: circle(radius: 0.15 mm))";
+    let c = crate::check_text(&crate::loader::RealFs, "t.lens", src.as_bytes());
+    assert!(!c.has_errors(), "{:?}", c.diags());
+    let decl = |name: &str| c.checked.declarations.get(name).expect("surface");
+    let closed = |name: &str| Interpreter::new(&lower_surface(decl(name)).expect("lowers").tape);
+    let through = |name: &str| {
+        let mut g = Graph::new();
+        let (x, y) = (g.x(), g.y());
+        let z = derived::revolve_height(&mut g, decl(name), x, y).expect("lowers");
+        SurfaceTape::new(g, z)
+    };
+    for name in ["rings", "dome", "tip"] {
+        let (a, b) = (closed(name), Interpreter::new(&through(name)));
+        assert!(
+            closed_nodes(decl(name)) < through(name).live_nodes().len(),
+            "{name}: the closed forms are the smaller tape"
+        );
+        let pts = [
+            (0.2, 0.1),
+            (0.13, -0.05),
+            (-0.07, 0.11),
+            (0.9, -0.6),
+            (-1.1, 0.4),
+        ];
+        for (x, y) in pts
+            .into_iter()
+            .filter(|&(x, y)| name == "rings" || x * x + y * y < 0.02)
+        {
+            let (a, b) = (a.eval(x, y), b.eval(x, y));
+            assert_eq!(
+                a[0].to_bits(),
+                b[0].to_bits(),
+                "{name}: z is the same nodes"
+            );
+            for k in 1..6 {
+                assert!(
+                    (a[k] - b[k]).abs() <= 1e-13 * (1.0 + b[k].abs()),
+                    "{name} output {k} at ({x}, {y}): {} vs {}",
+                    a[k],
+                    b[k]
+                );
+            }
+        }
+    }
+    // On the axis: the rings start on the land (all derivatives 0, as the
+    // graph's selects give); the dome is level there (slopes 0, both
+    // curvatures the profile's); the tip is a cone's (no slope: NaN).
+    assert_eq!(closed("rings").eval(0.0, 0.0), [0.0; 6]);
+    let profile = closed("cyl").eval(0.0, 0.0);
+    let dome = closed("dome").eval(0.0, 0.0);
+    assert_eq!(dome, [profile[0], 0.0, 0.0, profile[3], 0.0, profile[3]]);
+    assert!(profile[3] != 0.0);
+    let tip = closed("tip").eval(0.0, 0.0);
+    assert!(
+        tip[0].is_finite() && tip[1..].iter().all(|v| v.is_nan()),
+        "{tip:?}"
+    );
+}
