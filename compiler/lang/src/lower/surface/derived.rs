@@ -1,7 +1,7 @@
 //! Surfaces built from another at moved coordinates: a design wrapped
 //! onto a roller, a profile revolved, an off-axis section, a tilted surface.
 
-use lensc_runtime::surface::ir::{Graph, Id, SurfaceTape};
+use lensc_runtime::surface::ir::{Graph, Id, SurfaceTape, Unary, Var};
 
 use super::{LowerError, height, radius_squared};
 use crate::value::{self, Object};
@@ -27,6 +27,105 @@ pub(super) fn revolve_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<
     let u = g.add(start, r);
     let zero = g.constant_node(0.0);
     height(g, profile, u, zero)
+}
+
+/// The six outputs of a revolved profile (the order of
+/// `SurfaceTape::outputs`) by the chain rule through u = start + r: with
+/// the profile's f, f′ and f″ along its own x at (u, 0) — an array's from
+/// its closed forms (`arrays::array_outputs`), any other profile's
+/// differentiated in a scratch graph — and (a, b) = (x, y)/r,
+///
+/// ```text
+/// z_x = f′ a    z_xx = f″ a² + f′ b²/r    z_xy = (f″ − f′/r) a b
+/// z_y = f′ b    z_yy = f″ b² + f′ a²/r
+/// ```
+///
+/// rather than differentiating the profile's height through the square
+/// root twice (the rings of `examples/lei2021_cylinder_array.lens`: 174 →
+/// 107 live nodes). z is `revolve_height`'s, node for node. On the axis
+/// (r = 0) the limits where the profile is level there (slopes 0, both
+/// curvatures f″; a land's all 0, as the graph's selects gave) and NaN
+/// where it is not, as at a cone's tip.
+pub(super) fn revolved_outputs(
+    g: &mut Graph,
+    o: &Object,
+    x: Id,
+    y: Id,
+) -> Result<[Id; 6], LowerError> {
+    let f = &o.fields;
+    let profile =
+        value::object(f, "profile").ok_or(LowerError::Unsupported("revolve without a profile"))?;
+    let start = g.constant_node(value::num(f, "start").unwrap_or(0.0));
+    let r2 = radius_squared(g, x, y);
+    let r = g.sqrt(r2);
+    let u = g.add(start, r);
+    let zero = g.constant_node(0.0);
+    // The profile over (u, v), in a scratch graph, at v = 0.
+    let mut h = Graph::new();
+    let (hu, hv) = (h.x(), h.constant_node(0.0));
+    let (hz, hzu, hzuu) = if matches!(profile.kind.name, "grid" | "hex_grid" | "linear_array") {
+        let [z, zu, _, zuu, _, _] = super::arrays::array_outputs(&mut h, profile, hu, hv)?;
+        (z, zu, zuu)
+    } else {
+        let z = height(&mut h, profile, hu, hv)?;
+        let zu = h.derivative(z, Var::X);
+        let zuu = h.derivative(zu, Var::X);
+        (z, zu, zuu)
+    };
+    let map = g.import(&h, u, zero);
+    let (z, f1, f2) = (
+        map[hz.0 as usize],
+        map[hzu.0 as usize],
+        map[hzuu.0 as usize],
+    );
+    // Off the axis (−r < 0) the closed forms; on it, the limits where the
+    // profile is level there (f′ = 0: slopes 0, both curvatures f″) and
+    // NaN where it is not (a cone's tip has no slope).
+    let off_axis = g.neg(r);
+    let level = {
+        let m = g.unary(Unary::Abs, f1);
+        g.neg(m)
+    };
+    let nan = g.constant_node(f64::NAN);
+    let tip = g.select(level, nan, zero);
+    let a = {
+        let q = g.div(x, r);
+        g.select(off_axis, q, tip)
+    };
+    let b = {
+        let q = g.div(y, r);
+        g.select(off_axis, q, tip)
+    };
+    let zx = g.mul(f1, a);
+    let zy = g.mul(f1, b);
+    let f1r = {
+        let q = g.div(f1, r);
+        g.select(off_axis, q, f2)
+    };
+    // On the axis a² = 1, b² = 0 (so z_xx = z_yy = f″), or NaN at a tip.
+    let a2 = {
+        let q = g.mul(a, a);
+        let one = g.constant_node(1.0);
+        let tip_one = g.select(level, nan, one);
+        g.select(off_axis, q, tip_one)
+    };
+    let b2 = g.mul(b, b);
+    let ab = g.mul(a, b);
+    let zxx = {
+        let t = g.mul(f2, a2);
+        let s = g.mul(f1r, b2);
+        g.add(t, s)
+    };
+    let zyy = {
+        let t = g.mul(f2, b2);
+        let s = g.mul(f1r, a2);
+        g.add(t, s)
+    };
+    let zxy = {
+        let d = g.sub(f2, f1r);
+        g.mul(d, ab)
+    };
+    Ok([z, zx, zy, zxx, zxy, zyy])
 }
 
 /// An off-axis section: the parent moved to the section's centre, less
@@ -69,46 +168,151 @@ pub(super) fn off_axis_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result
 /// the parent coordinate p solves p cosθ + z(p, q) sinθ = P: Newton's
 /// method, unrolled six times in the graph from p = P cosθ, converges
 /// quadratically to machine precision for the gentle tilts allowed
-/// (|θ| < 45°), and the derivatives flow through the iterations.
+/// (|θ| < 45°), and the derivatives flow through the iterations (used
+/// where the tilt is part of another surface; a tilted surface of its own
+/// has its derivatives in closed form, `tilted_outputs`).
 pub(super) fn tilted_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError> {
-    let f = &o.fields;
-    let parent =
-        value::object(f, "parent").ok_or(LowerError::Unsupported("tilt without a parent"))?;
-    let theta = value::num(f, "angle").unwrap_or(0.0);
-    let about_x = value::word(f, "about") == Some("x");
-    // Turning about y moves x; about x moves y, with the sign of the
-    // right-hand rule (a positive turn about x lifts +y).
-    let (cos, sin) = (
-        theta.cos(),
-        if about_x { -theta.sin() } else { theta.sin() },
-    );
-    // The parent and its slope along the turning direction, in a scratch
-    // graph over (p, q) = (turning coordinate, the other one).
-    let mut h = Graph::new();
-    let (hp, hq) = (h.x(), h.y());
-    let (hx, hy) = if about_x { (hq, hp) } else { (hp, hq) };
-    let hz = height(&mut h, parent, hx, hy)?;
-    let hzp = h.derivative(hz, lensc_runtime::surface::ir::Var::X);
-    let (big_p, q) = if about_x { (y, x) } else { (x, y) };
-    let c = g.constant_node(cos);
-    let sn = g.constant_node(sin);
-    let mut p = g.mul(big_p, c);
-    for _ in 0..6 {
-        let map = g.import(&h, p, q);
-        let (z, zp) = (map[hz.0 as usize], map[hzp.0 as usize]);
-        // F = p cosθ + z sinθ − P, F′ = cosθ + z_p sinθ
-        let pc = g.mul(p, c);
-        let zs = g.mul(z, sn);
-        let sum = g.add(pc, zs);
-        let res = g.sub(sum, big_p);
-        let zps = g.mul(zp, sn);
-        let der = g.add(c, zps);
-        let step = g.div(res, der);
-        p = g.sub(p, step);
+    let t = Tilt::solve(g, o, x, y)?;
+    Ok(t.height(g))
+}
+
+/// The six outputs of a tilted surface (z, its slopes and curvatures, in
+/// the order of `SurfaceTape::outputs`): z is `tilted_height`'s, the same
+/// nodes; the derivatives are the implicit function theorem's at the
+/// solved parent point rather than derivatives of the six Newton steps.
+/// With D = cosθ + z_p sinθ (the residual's slope, never small for
+/// |θ| < 45° and slopes under 45°) and the parent's derivatives at (p, q):
+///
+/// ```text
+/// Z_P = (z_p cosθ − sinθ) / D        Z_q = z_q / D
+/// Z_PP = z_pp / D³                   Z_Pq = m / D²,  m = z_pp p_q + z_pq
+/// Z_qq = ((z_pq p_q + z_qq) D − z_q sinθ m) / D²,  p_q = −z_q sinθ / D
+/// ```
+///
+/// (P is x for a turn about y, y for a turn about x.) The same values as
+/// the derivatives through the converged iterations to within rounding,
+/// from about a tenth of the nodes (the tilted lens of
+/// `examples/off_axis_and_tilt.lens`: 1760 live nodes → ~200), so a
+/// fraction of the compile and evaluation time.
+pub(super) fn tilted_outputs(
+    g: &mut Graph,
+    o: &Object,
+    x: Id,
+    y: Id,
+) -> Result<[Id; 6], LowerError> {
+    let mut t = Tilt::solve(g, o, x, y)?;
+    let z = t.height(g);
+    let h = &mut t.parent;
+    let hzq = h.derivative(t.hz, Var::Y);
+    let hzpp = h.derivative(t.hzp, Var::X);
+    let hzpq = h.derivative(t.hzp, Var::Y);
+    let hzqq = h.derivative(hzq, Var::Y);
+    let map = g.import(h, t.p, t.q);
+    let at = |i: Id| map[i.0 as usize];
+    let (zp, zq, zpp, zpq, zqq) = (at(t.hzp), at(hzq), at(hzpp), at(hzpq), at(hzqq));
+    let (c, s) = (t.cos, t.sin);
+    // D = cosθ + z_p sinθ, as the Newton steps write it.
+    let zps = g.mul(zp, s);
+    let d = g.add(c, zps);
+    let d2 = g.mul(d, d);
+    let d3 = g.mul(d2, d);
+    let zpc = g.mul(zp, c);
+    let a = g.sub(zpc, s);
+    let z_big_p = g.div(a, d);
+    let z_q = g.div(zq, d);
+    let z_pp = g.div(zpp, d3);
+    // p_q = −z_q sinθ / D; m = z_pp p_q + z_pq.
+    let zqs = g.mul(zq, s);
+    let ratio = g.div(zqs, d);
+    let p_q = g.neg(ratio);
+    let zpp_pq = g.mul(zpp, p_q);
+    let m = g.add(zpp_pq, zpq);
+    let z_pq = g.div(m, d2);
+    let zpq_pq = g.mul(zpq, p_q);
+    let n = g.add(zpq_pq, zqq);
+    let nd = g.mul(n, d);
+    let zqsm = g.mul(zqs, m);
+    let num = g.sub(nd, zqsm);
+    let z_qq = g.div(num, d2);
+    Ok(if t.about_x {
+        // P = y, q = x.
+        [z, z_q, z_big_p, z_qq, z_pq, z_pp]
+    } else {
+        [z, z_big_p, z_q, z_pp, z_pq, z_qq]
+    })
+}
+
+/// A tilt's parent coordinate solved by Newton's method in a graph.
+struct Tilt {
+    /// The parent's height over (p, q) = (turning coordinate, the other
+    /// one), in a scratch graph, with its slope along p.
+    parent: Graph,
+    hz: Id,
+    hzp: Id,
+    /// The solved parent coordinates, nodes of the surface's graph.
+    p: Id,
+    q: Id,
+    /// cosθ and sinθ (signed for the turning direction), constant nodes.
+    cos: Id,
+    sin: Id,
+    about_x: bool,
+}
+
+impl Tilt {
+    fn solve(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Tilt, LowerError> {
+        let f = &o.fields;
+        let parent =
+            value::object(f, "parent").ok_or(LowerError::Unsupported("tilt without a parent"))?;
+        let theta = value::num(f, "angle").unwrap_or(0.0);
+        let about_x = value::word(f, "about") == Some("x");
+        // Turning about y moves x; about x moves y, with the sign of the
+        // right-hand rule (a positive turn about x lifts +y).
+        let (cos, sin) = (
+            theta.cos(),
+            if about_x { -theta.sin() } else { theta.sin() },
+        );
+        // The parent and its slope along the turning direction, in a
+        // scratch graph over (p, q) = (turning coordinate, the other one).
+        let mut h = Graph::new();
+        let (hp, hq) = (h.x(), h.y());
+        let (hx, hy) = if about_x { (hq, hp) } else { (hp, hq) };
+        let hz = height(&mut h, parent, hx, hy)?;
+        let hzp = h.derivative(hz, Var::X);
+        let (big_p, q) = if about_x { (y, x) } else { (x, y) };
+        let c = g.constant_node(cos);
+        let sn = g.constant_node(sin);
+        let mut p = g.mul(big_p, c);
+        for _ in 0..6 {
+            let map = g.import(&h, p, q);
+            let (z, zp) = (map[hz.0 as usize], map[hzp.0 as usize]);
+            // F = p cosθ + z sinθ − P, F′ = cosθ + z_p sinθ
+            let pc = g.mul(p, c);
+            let zs = g.mul(z, sn);
+            let sum = g.add(pc, zs);
+            let res = g.sub(sum, big_p);
+            let zps = g.mul(zp, sn);
+            let der = g.add(c, zps);
+            let step = g.div(res, der);
+            p = g.sub(p, step);
+        }
+        Ok(Tilt {
+            parent: h,
+            hz,
+            hzp,
+            p,
+            q,
+            cos: c,
+            sin: sn,
+            about_x,
+        })
     }
-    let map = g.import(&h, p, q);
-    let z = map[hz.0 as usize];
-    let ps = g.mul(p, sn);
-    let zc = g.mul(z, c);
-    Ok(g.sub(zc, ps))
+
+    /// Z = −p sinθ + z(p, q) cosθ at the solved point.
+    fn height(&self, g: &mut Graph) -> Id {
+        let map = g.import(&self.parent, self.p, self.q);
+        let z = map[self.hz.0 as usize];
+        let ps = g.mul(self.p, self.sin);
+        let zc = g.mul(z, self.cos);
+        g.sub(zc, ps)
+    }
 }

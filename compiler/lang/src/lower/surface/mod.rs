@@ -105,6 +105,18 @@ pub fn lower_surface(o: &Object) -> Result<LoweredSurface, LowerError> {
             domain,
         });
     }
+    let closed_forms = match o.kind.name {
+        "tilt" => Some(derived::tilted_outputs as fn(&mut Graph, &Object, Id, Id) -> _),
+        "revolve" => Some(derived::revolved_outputs as _),
+        _ => None,
+    };
+    if let Some(outputs_of) = closed_forms {
+        let outputs = outputs_of(&mut g, o, x, y)?;
+        return Ok(LoweredSurface {
+            tape: SurfaceTape::with_outputs(g, outputs),
+            domain,
+        });
+    }
     let z = height(&mut g, o, x, y)?;
     Ok(LoweredSurface {
         tape: SurfaceTape::new(g, z),

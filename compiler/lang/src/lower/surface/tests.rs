@@ -601,3 +601,168 @@ surface microlenses = grid(dimple, pitch_x: 0.1 mm, pitch_y: 0.19634954084936207
     };
     assert_eq!(nodes(Cells::NearestWhereItWins), nodes(Cells::Reaching));
 }
+
+#[test]
+fn tilted_curvatures_are_the_turned_sphere_s() {
+    // The tilted sphere of `tilted_sphere_is_the_sphere_with_its_centre_turned`:
+    // z = z_c − d, d = √(25 − u² − v²) with (u, v) the point less the
+    // turned centre, so z_uu = 1/d + u²/d³, z_uv = u v/d³, z_vv = 1/d + v²/d³
+    // — the closed-form curvatures of a tilted surface of its own.
+    let src = "surface s = sphere { radius: 5 mm, sense: concave, aperture: circle(radius: 2 mm) }
+surface t = tilt(s, about: y, angle: 10 deg, aperture: circle(radius: 1.5 mm))
+surface u = tilt(s, about: x, angle: -7 deg, aperture: circle(radius: 1.5 mm))";
+    let th = 10f64.to_radians();
+    let ph = (-7f64).to_radians();
+    // (surface, centre (x, y, z) after the turn)
+    let cases = [
+        ("t", (5.0 * th.sin(), 0.0, 5.0 * th.cos())),
+        ("u", (0.0, -5.0 * ph.sin(), 5.0 * ph.cos())),
+    ];
+    for (name, (xc, yc, zc)) in cases {
+        for (x, y) in [(0.0, 0.0), (0.7, -0.4), (-1.1, 0.9), (1.2, 0.6)] {
+            let (u, v) = (x - xc, y - yc);
+            let d = (25.0 - u * u - v * v).sqrt();
+            let d3 = d * d * d;
+            let want = [
+                zc - d,
+                u / d,
+                v / d,
+                1.0 / d + u * u / d3,
+                u * v / d3,
+                1.0 / d + v * v / d3,
+            ];
+            let got = eval_surface(src, name, x, y);
+            for k in 0..6 {
+                assert!(
+                    close(got[k], want[k]),
+                    "{name} output {k} at ({x}, {y}): {} vs {}",
+                    got[k],
+                    want[k]
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn tilted_derivatives_agree_with_those_through_the_newton_steps() {
+    // The closed forms against the graph's derivatives of the six Newton
+    // steps (how a tilt inside another surface is differentiated), for an
+    // asphere with an odd term, turned either way: the same values to
+    // within rounding.
+    let src = "surface p = asphere { radius: 9 mm, conic: -0.6, sense: concave, aperture: circle(radius: 3 mm), A4: 1e-4 mm^-3, A3: -2e-4 mm^-2 }
+surface ty = tilt(p, about: y, angle: 12 deg, aperture: circle(radius: 1.5 mm))
+surface tx = tilt(p, about: x, angle: -8 deg, aperture: circle(radius: 1.5 mm))";
+    let c = crate::check_text(&crate::loader::RealFs, "t.lens", src.as_bytes());
+    assert!(!c.has_errors(), "{:?}", c.diags());
+    for name in ["ty", "tx"] {
+        let o = c.checked.declarations.get(name).expect("surface");
+        let closed = Interpreter::new(&lower_surface(o).expect("lowers").tape);
+        let mut g = Graph::new();
+        let (x, y) = (g.x(), g.y());
+        let z = derived::tilted_height(&mut g, o, x, y).expect("lowers");
+        let through = SurfaceTape::new(g, z);
+        let steps = Interpreter::new(&through);
+        assert!(
+            closed_nodes(o) * 4 < through.live_nodes().len(),
+            "{name}: the closed forms are the smaller tape"
+        );
+        // (Away from the parent's vertex, where the A3 term's curvature is
+        // not defined.)
+        for (x, y) in [
+            (0.2, 0.1),
+            (0.9, -0.3),
+            (-1.2, 0.8),
+            (0.4, 1.4),
+            (-1.0, -1.0),
+        ] {
+            let (a, b) = (closed.eval(x, y), steps.eval(x, y));
+            assert_eq!(
+                a[0].to_bits(),
+                b[0].to_bits(),
+                "{name}: z is the same nodes"
+            );
+            for k in 1..6 {
+                assert!(
+                    (a[k] - b[k]).abs() <= 1e-13 * (1.0 + b[k].abs()),
+                    "{name} output {k} at ({x}, {y}): {} vs {}",
+                    a[k],
+                    b[k]
+                );
+            }
+        }
+    }
+}
+
+/// The live nodes of a surface's lowered tape.
+fn closed_nodes(o: &crate::value::Object) -> usize {
+    lower_surface(o).expect("lowers").tape.live_nodes().len()
+}
+
+#[test]
+fn revolved_derivatives_agree_with_the_graph_s() {
+    // A revolved array of cylinders (seed 004's rings, three of them) and
+    // a revolved cylinder: the closed forms against the graph's
+    // derivatives of the height through u = start + r.
+    let src = "surface cyl = cylinder { radius: 0.788 mm, axis: y, sense: convex, aperture: rect(x: -0.267 mm .. 0.267 mm, y: -1 mm .. 1 mm) }
+surface row = linear_array(cyl, pitch: 0.554 mm, count: 3, axis: x)
+surface rings = revolve(row, start: -0.831 mm, aperture: circle(radius: 1.662 mm))
+surface dome = revolve(cyl, start: 0 mm, aperture: circle(radius: 0.25 mm))
+surface tip = revolve(cyl, start: 0.1 mm, aperture: circle(radius: 0.15 mm))";
+    let c = crate::check_text(&crate::loader::RealFs, "t.lens", src.as_bytes());
+    assert!(!c.has_errors(), "{:?}", c.diags());
+    let decl = |name: &str| c.checked.declarations.get(name).expect("surface");
+    let closed = |name: &str| Interpreter::new(&lower_surface(decl(name)).expect("lowers").tape);
+    let through = |name: &str| {
+        let mut g = Graph::new();
+        let (x, y) = (g.x(), g.y());
+        let z = derived::revolve_height(&mut g, decl(name), x, y).expect("lowers");
+        SurfaceTape::new(g, z)
+    };
+    for name in ["rings", "dome", "tip"] {
+        let (a, b) = (closed(name), Interpreter::new(&through(name)));
+        assert!(
+            closed_nodes(decl(name)) < through(name).live_nodes().len(),
+            "{name}: the closed forms are the smaller tape"
+        );
+        let pts = [
+            (0.2, 0.1),
+            (0.13, -0.05),
+            (-0.07, 0.11),
+            (0.9, -0.6),
+            (-1.1, 0.4),
+        ];
+        for (x, y) in pts
+            .into_iter()
+            .filter(|&(x, y)| name == "rings" || x * x + y * y < 0.02)
+        {
+            let (a, b) = (a.eval(x, y), b.eval(x, y));
+            assert_eq!(
+                a[0].to_bits(),
+                b[0].to_bits(),
+                "{name}: z is the same nodes"
+            );
+            for k in 1..6 {
+                assert!(
+                    (a[k] - b[k]).abs() <= 1e-13 * (1.0 + b[k].abs()),
+                    "{name} output {k} at ({x}, {y}): {} vs {}",
+                    a[k],
+                    b[k]
+                );
+            }
+        }
+    }
+    // On the axis: the rings start on the land (all derivatives 0, as the
+    // graph's selects give); the dome is level there (slopes 0, both
+    // curvatures the profile's); the tip is a cone's (no slope: NaN).
+    assert_eq!(closed("rings").eval(0.0, 0.0), [0.0; 6]);
+    let profile = closed("cyl").eval(0.0, 0.0);
+    let dome = closed("dome").eval(0.0, 0.0);
+    assert_eq!(dome, [profile[0], 0.0, 0.0, profile[3], 0.0, profile[3]]);
+    assert!(profile[3] != 0.0);
+    let tip = closed("tip").eval(0.0, 0.0);
+    assert!(
+        tip[0].is_finite() && tip[1..].iter().all(|v| v.is_nan()),
+        "{tip:?}"
+    );
+}
