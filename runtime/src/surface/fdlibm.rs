@@ -53,6 +53,8 @@ pub(crate) const P5: u64 = 0x3E66_3769_72BE_A4D0;
 pub(crate) const EXP_LIMIT: f64 = 708.0;
 /// Below this, e^a rounds to +0 (a < −1075 ln 2 ≈ −745.133): libm's value,
 /// which the kernel's inline exp gives without leaving the vector pass.
+/// (Read only by the JIT's vector pass.)
+#[cfg_attr(not(feature = "jit"), allow(dead_code))]
 pub(crate) const EXP_ZERO_BELOW: f64 = -746.0;
 
 /// sin a and cos a, from one reduction: the same bits as `sin` and `cos`.

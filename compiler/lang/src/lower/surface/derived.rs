@@ -18,6 +18,25 @@ pub(super) fn wrap_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id,
 
 /// A profile revolved about z: its height at u = start + r, v = 0.
 pub(super) fn revolve_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError> {
+    let at = revolved_at(g, o, x, y)?;
+    height(g, at.profile, at.u, at.zero)
+}
+
+/// Where a revolved profile is read at (x, y): the profile, r, u = start +
+/// r and the constant 0 (its v).
+struct RevolvedAt<'o> {
+    profile: &'o Object,
+    r: Id,
+    u: Id,
+    zero: Id,
+}
+
+fn revolved_at<'o>(
+    g: &mut Graph,
+    o: &'o Object,
+    x: Id,
+    y: Id,
+) -> Result<RevolvedAt<'o>, LowerError> {
     let f = &o.fields;
     let profile =
         value::object(f, "profile").ok_or(LowerError::Unsupported("revolve without a profile"))?;
@@ -26,7 +45,12 @@ pub(super) fn revolve_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<
     let r = g.sqrt(r2);
     let u = g.add(start, r);
     let zero = g.constant_node(0.0);
-    height(g, profile, u, zero)
+    Ok(RevolvedAt {
+        profile,
+        r,
+        u,
+        zero,
+    })
 }
 
 /// The six outputs of a revolved profile (the order of
@@ -52,14 +76,12 @@ pub(super) fn revolved_outputs(
     x: Id,
     y: Id,
 ) -> Result<[Id; 6], LowerError> {
-    let f = &o.fields;
-    let profile =
-        value::object(f, "profile").ok_or(LowerError::Unsupported("revolve without a profile"))?;
-    let start = g.constant_node(value::num(f, "start").unwrap_or(0.0));
-    let r2 = radius_squared(g, x, y);
-    let r = g.sqrt(r2);
-    let u = g.add(start, r);
-    let zero = g.constant_node(0.0);
+    let RevolvedAt {
+        profile,
+        r,
+        u,
+        zero,
+    } = revolved_at(g, o, x, y)?;
     // The profile over (u, v), in a scratch graph, at v = 0.
     let mut h = Graph::new();
     let (hu, hv) = (h.x(), h.constant_node(0.0));
