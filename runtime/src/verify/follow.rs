@@ -118,6 +118,62 @@ impl RadialBins {
     }
 }
 
+/// The lenslets by cell of the grid that finds the one under the tool: a
+/// hash map keyed by the cell's indices, hashed by a multiply and a
+/// rotate (a few dozen cells; looked up once per move).
+type CellMap =
+    std::collections::HashMap<(i64, i64), Vec<usize>, std::hash::BuildHasherDefault<CellHash>>;
+
+/// [`CellMap`]'s hash: each word mixed in by a multiply and a rotate.
+#[derive(Default)]
+struct CellHash(u64);
+
+impl std::hash::Hasher for CellHash {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(b as u64);
+        }
+    }
+    fn write_u64(&mut self, word: u64) {
+        self.0 = (self.0 ^ word)
+            .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            .rotate_left(29);
+    }
+    fn write_i64(&mut self, word: i64) {
+        self.write_u64(word as u64);
+    }
+}
+
+/// A new largest following error `error` (mm), at `radius` (mm).
+#[cold]
+#[inline(never)]
+fn new_peak(error: f64, radius: f64) -> (f64, f64) {
+    (error.abs(), radius)
+}
+
+/// One move's ends and rates.
+struct Move {
+    q: SpiralPoint,
+    p: SpiralPoint,
+    /// 1 / the move's duration (1/s).
+    per_second: f64,
+    /// The tool's travel over the part in one sample (mm).
+    step: f64,
+}
+
+/// What one move's samples add: to its lenslet, and to its one bin of
+/// radius (count, least and largest error).
+struct MoveAcc {
+    samples: usize,
+    max: f64,
+    sum2: f64,
+    slope2: f64,
+    bin: (u64, f64, f64),
+}
+
 struct Acc {
     samples: usize,
     max: f64,
@@ -136,12 +192,15 @@ pub struct FollowingSimulation {
     next: f64,
     k: u64,
     last: Option<SpiralPoint>,
+    /// The last point in part coordinates (x cos c, x sin c; mm), worked
+    /// out once per point.
+    last_xy: (f64, f64),
     last_error: Option<f64>,
     features: Vec<(f64, f64, f64)>,
     /// Features by cell of a uniform grid (cell size the largest
     /// diameter), for finding the lenslet under the tool.
     cell: f64,
-    grid: std::collections::HashMap<(i64, i64), Vec<usize>>,
+    grid: CellMap,
     acc: Vec<Acc>,
     max_error: f64,
     max_error_at: f64,
@@ -165,7 +224,7 @@ impl FollowingSimulation {
             .map(|f| 2.0 * f.2)
             .fold(0.0, f64::max)
             .max(1e-3);
-        let mut grid: std::collections::HashMap<(i64, i64), Vec<usize>> = Default::default();
+        let mut grid = CellMap::default();
         for (i, f) in features.iter().enumerate() {
             let lo = (
                 ((f.0 - f.2) / cell).floor() as i64,
@@ -190,6 +249,7 @@ impl FollowingSimulation {
             next: 0.0,
             k: 0,
             last: None,
+            last_xy: (0.0, 0.0),
             last_error: None,
             features: features.to_vec(),
             cell,
@@ -223,92 +283,144 @@ impl FollowingSimulation {
     /// Runs the servo over the next points of the spiral.
     pub fn extend(&mut self, points: &[SpiralPoint]) {
         for &p in points {
+            let xy = (p.x * p.c.cos(), p.x * p.c.sin());
             let Some(q) = self.last else {
                 self.state = Some(Vector2::new(p.w, 0.0));
                 self.t0 = p.t;
                 self.next = p.t;
                 self.last = Some(p);
+                self.last_xy = xy;
                 continue;
             };
-            let span = p.t - q.t;
-            if span > 0.0 {
-                // Per move, not per sample: the tool's speed over the part
-                // (mm/s) and the lenslet under the move's middle.
-                let (xq, yq) = (q.x * q.c.cos(), q.x * q.c.sin());
-                let (xp, yp) = (p.x * p.c.cos(), p.x * p.c.sin());
-                let chord = (xp - xq).hypot(yp - yq);
-                let arc = 0.5 * (p.x + q.x).abs() * (p.c - q.c).abs();
-                let step = chord.max(arc).max(1e-12) / span * self.dt;
-                let cm = 0.5 * (p.c + q.c);
-                let xm = 0.5 * (p.x + q.x);
-                let lenslet = self.lenslet_at(xm * cm.cos(), xm * cm.sin());
-                let mut state = self.state.expect("started");
-                let (p00, p01, p10, p11) = (
-                    self.phi[(0, 0)],
-                    self.phi[(0, 1)],
-                    self.phi[(1, 0)],
-                    self.phi[(1, 1)],
-                );
-                let (g0, g1) = (self.gamma[0], self.gamma[1]);
-                let (mut pos, mut vel) = (state.x, state.y);
-                let per_second = 1.0 / span;
-                let dw = p.w - q.w;
-                let mut acc = lenslet.map(|i| (i, 0usize, 0.0f64, 0.0f64, 0.0f64));
-                // A move whose ends lie in one bin of radius (on one side
-                // of the axis, the radius runs straight between them) has
-                // every sample there: its extremes are gathered here and
-                // counted once.
-                let bin = self.by_radius.index(q.x.abs());
-                let one_bin = q.x * p.x >= 0.0 && self.by_radius.index(p.x.abs()) == bin;
-                let (mut n, mut lo, mut hi) = (0u64, f64::INFINITY, f64::NEG_INFINITY);
-                while self.next < p.t {
-                    let f = (self.next - q.t) * per_second;
-                    let command = q.w + f * dw;
-                    let error = pos - command;
-                    let radius = || (q.x + f * (p.x - q.x)).abs();
-                    if error.abs() > self.max_error {
-                        self.max_error = error.abs();
-                        self.max_error_at = radius();
-                    }
-                    if one_bin {
-                        n += 1;
-                        lo = lo.min(error);
-                        hi = hi.max(error);
-                    } else {
-                        self.by_radius.add(radius(), error);
-                    }
-                    if let Some((_, n, max, sum2, slope2)) = acc.as_mut() {
-                        *n += 1;
-                        *max = max.max(error.abs());
-                        *sum2 += error * error;
-                        if let Some(e0) = self.last_error {
-                            let slope = (error - e0) / step;
-                            *slope2 += slope * slope;
-                        }
-                    }
-                    self.last_error = Some(error);
-                    (pos, vel) = (
-                        p00 * pos + p01 * vel + g0 * command,
-                        p10 * pos + p11 * vel + g1 * command,
-                    );
-                    self.k += 1;
-                    self.next = self.t0 + self.k as f64 * self.dt;
-                }
-                if n > 0 {
-                    self.by_radius.add_many(bin, n, lo, hi);
-                }
-                if let Some((i, n, max, sum2, slope2)) = acc {
-                    let a = &mut self.acc[i];
-                    a.samples += n;
-                    a.max = a.max.max(max);
-                    a.sum2 += sum2;
-                    a.slope2 += slope2;
-                }
-                state = Vector2::new(pos, vel);
-                self.state = Some(state);
+            if p.t - q.t > 0.0 {
+                self.run_move(q, self.last_xy, p, xy);
             }
             self.last = Some(p);
+            self.last_xy = xy;
         }
+    }
+
+    /// The servo's samples over one move from `q` to `p` (later than `q`),
+    /// at `(xq, yq)` and `(xp, yp)` on the part (mm).
+    fn run_move(
+        &mut self,
+        q: SpiralPoint,
+        (xq, yq): (f64, f64),
+        p: SpiralPoint,
+        (xp, yp): (f64, f64),
+    ) {
+        let span = p.t - q.t;
+        // Per move, not per sample: the tool's speed over the part
+        // (mm/s) and the lenslet under the move's middle.
+        let chord = (xp - xq).hypot(yp - yq);
+        let arc = 0.5 * (p.x + q.x).abs() * (p.c - q.c).abs();
+        let step = chord.max(arc).max(1e-12) / span * self.dt;
+        let cm = 0.5 * (p.c + q.c);
+        let xm = 0.5 * (p.x + q.x);
+        let lenslet = self.lenslet_at(xm * cm.cos(), xm * cm.sin());
+        // A move whose ends lie in one bin of radius (on one side of the
+        // axis, the radius runs straight between them) has every sample
+        // there: its extremes are gathered here and counted once.
+        let bin = self.by_radius.index(q.x.abs());
+        let one_bin = q.x * p.x >= 0.0 && self.by_radius.index(p.x.abs()) == bin;
+        let mv = Move {
+            q,
+            p,
+            per_second: 1.0 / span,
+            step,
+        };
+        // The four kinds of move get a loop each, so the per-sample work
+        // carries no test that cannot change within the move.
+        let acc = match (one_bin, lenslet.is_some()) {
+            (true, true) => self.samples::<true, true>(&mv),
+            (true, false) => self.samples::<true, false>(&mv),
+            (false, true) => self.samples::<false, true>(&mv),
+            (false, false) => self.samples::<false, false>(&mv),
+        };
+        if acc.bin.0 > 0 {
+            self.by_radius
+                .add_many(bin, acc.bin.0, acc.bin.1, acc.bin.2);
+        }
+        if let Some(i) = lenslet {
+            let a = &mut self.acc[i];
+            a.samples += acc.samples;
+            a.max = a.max.max(acc.max);
+            a.sum2 += acc.sum2;
+            a.slope2 += acc.slope2;
+        }
+    }
+
+    /// Steps the servo over the samples of one move, gathering the errors
+    /// in the move's one bin of radius (`ONE_BIN`, else each in its own)
+    /// and, `IN_LENSLET`, for the lenslet under it.
+    #[inline(always)]
+    fn samples<const ONE_BIN: bool, const IN_LENSLET: bool>(&mut self, mv: &Move) -> MoveAcc {
+        let Move {
+            q,
+            p,
+            per_second,
+            step,
+        } = *mv;
+        let (p00, p01, p10, p11) = (
+            self.phi[(0, 0)],
+            self.phi[(0, 1)],
+            self.phi[(1, 0)],
+            self.phi[(1, 1)],
+        );
+        let (g0, g1) = (self.gamma[0], self.gamma[1]);
+        let state = self.state.expect("started");
+        let (mut pos, mut vel) = (state.x, state.y);
+        let dw = p.w - q.w;
+        let (t0, dt) = (self.t0, self.dt);
+        let (mut k, mut next) = (self.k, self.next);
+        let (mut max_error, mut max_error_at) = (self.max_error, self.max_error_at);
+        let mut last_error = self.last_error;
+        let mut acc = MoveAcc {
+            samples: 0,
+            max: 0.0,
+            sum2: 0.0,
+            slope2: 0.0,
+            bin: (0, f64::INFINITY, f64::NEG_INFINITY),
+        };
+        while next < p.t {
+            let f = (next - q.t) * per_second;
+            let command = q.w + f * dw;
+            let error = pos - command;
+            let radius = || (q.x + f * (p.x - q.x)).abs();
+            if error.abs() > max_error {
+                // Rare once the spiral is under way: a branch, not a
+                // select the peak's radius would be computed for.
+                (max_error, max_error_at) = new_peak(error, radius());
+            }
+            if ONE_BIN {
+                acc.bin.0 += 1;
+                acc.bin.1 = acc.bin.1.min(error);
+                acc.bin.2 = acc.bin.2.max(error);
+            } else {
+                self.by_radius.add(radius(), error);
+            }
+            if IN_LENSLET {
+                acc.samples += 1;
+                acc.max = acc.max.max(error.abs());
+                acc.sum2 += error * error;
+                if let Some(e0) = last_error {
+                    let slope = (error - e0) / step;
+                    acc.slope2 += slope * slope;
+                }
+            }
+            last_error = Some(error);
+            (pos, vel) = (
+                p00 * pos + p01 * vel + g0 * command,
+                p10 * pos + p11 * vel + g1 * command,
+            );
+            k += 1;
+            next = t0 + k as f64 * dt;
+        }
+        self.state = Some(Vector2::new(pos, vel));
+        (self.k, self.next) = (k, next);
+        (self.max_error, self.max_error_at) = (max_error, max_error_at);
+        self.last_error = last_error;
+        acc
     }
 
     /// What the servo did.

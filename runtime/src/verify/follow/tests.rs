@@ -146,3 +146,134 @@ fn errors_are_gathered_by_the_lenslet_under_the_tool() {
     assert_eq!(binned as usize, f.samples);
     assert_eq!(f.by_radius.bins[5].samples, binned, "all at r = 5 mm");
 }
+
+/// The per-sample loop as it was before the moves were split by kind
+/// (one loop testing every condition per sample): the reference the
+/// split loops must match bit for bit.
+fn extend_one_loop(sim: &mut FollowingSimulation, points: &[SpiralPoint]) {
+    for &p in points {
+        let Some(q) = sim.last else {
+            sim.state = Some(Vector2::new(p.w, 0.0));
+            sim.t0 = p.t;
+            sim.next = p.t;
+            sim.last = Some(p);
+            continue;
+        };
+        let span = p.t - q.t;
+        if span > 0.0 {
+            let (xq, yq) = (q.x * q.c.cos(), q.x * q.c.sin());
+            let (xp, yp) = (p.x * p.c.cos(), p.x * p.c.sin());
+            let chord = (xp - xq).hypot(yp - yq);
+            let arc = 0.5 * (p.x + q.x).abs() * (p.c - q.c).abs();
+            let step = chord.max(arc).max(1e-12) / span * sim.dt;
+            let cm = 0.5 * (p.c + q.c);
+            let xm = 0.5 * (p.x + q.x);
+            let lenslet = sim.lenslet_at(xm * cm.cos(), xm * cm.sin());
+            let (mut pos, mut vel) = (sim.state.unwrap().x, sim.state.unwrap().y);
+            let per_second = 1.0 / span;
+            let dw = p.w - q.w;
+            let mut acc = lenslet.map(|i| (i, 0usize, 0.0f64, 0.0f64, 0.0f64));
+            let bin = sim.by_radius.index(q.x.abs());
+            let one_bin = q.x * p.x >= 0.0 && sim.by_radius.index(p.x.abs()) == bin;
+            let (mut n, mut lo, mut hi) = (0u64, f64::INFINITY, f64::NEG_INFINITY);
+            while sim.next < p.t {
+                let f = (sim.next - q.t) * per_second;
+                let command = q.w + f * dw;
+                let error = pos - command;
+                let radius = || (q.x + f * (p.x - q.x)).abs();
+                if error.abs() > sim.max_error {
+                    sim.max_error = error.abs();
+                    sim.max_error_at = radius();
+                }
+                if one_bin {
+                    n += 1;
+                    lo = lo.min(error);
+                    hi = hi.max(error);
+                } else {
+                    sim.by_radius.add(radius(), error);
+                }
+                if let Some((_, n, max, sum2, slope2)) = acc.as_mut() {
+                    *n += 1;
+                    *max = max.max(error.abs());
+                    *sum2 += error * error;
+                    if let Some(e0) = sim.last_error {
+                        let slope = (error - e0) / step;
+                        *slope2 += slope * slope;
+                    }
+                }
+                sim.last_error = Some(error);
+                (pos, vel) = (
+                    sim.phi[(0, 0)] * pos + sim.phi[(0, 1)] * vel + sim.gamma[0] * command,
+                    sim.phi[(1, 0)] * pos + sim.phi[(1, 1)] * vel + sim.gamma[1] * command,
+                );
+                sim.k += 1;
+                sim.next = sim.t0 + sim.k as f64 * sim.dt;
+            }
+            if n > 0 {
+                sim.by_radius.add_many(bin, n, lo, hi);
+            }
+            if let Some((i, n, max, sum2, slope2)) = acc {
+                let a = &mut sim.acc[i];
+                a.samples += n;
+                a.max = a.max.max(max);
+                a.sum2 += sum2;
+                a.slope2 += slope2;
+            }
+            sim.state = Some(Vector2::new(pos, vel));
+        }
+        sim.last = Some(p);
+    }
+}
+
+#[test]
+fn the_loops_by_kind_of_move_match_one_loop_bit_for_bit() {
+    // A spiral crossing the axis over a ring of lenslets, its points at
+    // uneven times (moves shorter and longer than a sample, some of no
+    // duration), a command wobbling over the lenslets: every kind of
+    // move (in one bin of radius or across bins, over a lenslet or
+    // not) occurs, and every figure must be the same bits.
+    let feats: Vec<(f64, f64, f64)> = (0..12)
+        .map(|i| {
+            let a = i as f64 * std::f64::consts::PI / 6.0;
+            let r = 1.0 + 0.25 * (i % 3) as f64;
+            (r * a.cos(), r * a.sin(), 0.3)
+        })
+        .collect();
+    let mut t = 0.0;
+    let pts: Vec<SpiralPoint> = (0..40_000)
+        .map(|k| {
+            let s = k as f64 / 40_000.0;
+            // Times from 0.2 to 3 samples apart, some repeated.
+            t += if k % 97 == 0 {
+                0.0
+            } else {
+                (0.2 + 2.8 * ((k * 7919) % 101) as f64 / 100.0) / 20e3
+            };
+            let x = 1.6 - 1.9 * s;
+            let c = 40.0 * std::f64::consts::PI * s;
+            let (px, py) = (x * c.cos(), x * c.sin());
+            let over = feats
+                .iter()
+                .map(|f| (px - f.0).hypot(py - f.1))
+                .fold(f64::INFINITY, f64::min);
+            let w = if over < 0.3 {
+                0.002 * (over * 40.0).cos()
+            } else {
+                0.0
+            };
+            SpiralPoint { x, c, w, t }
+        })
+        .collect();
+    let bins = RadialBins::new(0.0, 1.7, 37);
+    let mut by_kind = FollowingSimulation::new(&servo(), 20e3, &feats, bins.clone()).unwrap();
+    let mut one_loop = FollowingSimulation::new(&servo(), 20e3, &feats, bins).unwrap();
+    for chunk in pts.chunks(1013) {
+        by_kind.extend(chunk);
+        extend_one_loop(&mut one_loop, chunk);
+    }
+    let (a, b) = (by_kind.finish(), one_loop.finish());
+    assert!(a.samples > 50_000 && a.lenslets.iter().all(|l| l.samples > 0));
+    assert!(a.by_radius.bins.iter().filter(|b| b.samples > 0).count() > 30);
+    // Debug prints each float's shortest round trip: equal text, equal bits.
+    assert_eq!(format!("{a:?}"), format!("{b:?}"));
+}
