@@ -79,13 +79,9 @@ pub fn exact_in(v: f64, size: f64) -> String {
     }
     let shown = v / size;
     let reads_back = |d: f64| d * size == v;
-    if reads_back(shown) {
-        // Often already the shortest (v = 2 mm shown in um is 2000).
-        let s = exact(shown);
-        if s.parse::<f64>().is_ok_and(reads_back) {
-            return s;
-        }
-    }
+    // The fewest significant digits first: `v / size` may read back and
+    // still be longer than need be (0.00025 mm / 1e-6 is
+    // 250.00000000000003 nm, and 250 nm reads back too).
     (0..17)
         .filter_map(|digits| format!("{shown:.digits$e}").parse::<f64>().ok())
         .find(|&d| reads_back(d))
@@ -161,5 +157,23 @@ mod tests {
             assert_eq!((d * size).to_bits(), v.to_bits(), "{s}");
         }
         assert_eq!(exact_in(3.0 * deg, deg), "3");
+    }
+
+    #[test]
+    fn exact_in_a_unit_is_the_fewest_digits_that_read_back() {
+        // 0.5 um in nm: 0.0005 mm / 1e-6 is 500.00000000000006, which
+        // reads back, but so does 500.
+        let (nm, um) = (1e-6, 1e-3);
+        for (written, size, unit, want) in [
+            (0.5, um, nm, "500"),
+            (0.25, um, nm, "250"),
+            (0.37, um, nm, "370"),
+            (10.0, nm, nm, "10"),
+        ] {
+            let v = written * size;
+            let s = exact_in(v, unit);
+            assert_eq!(s, want);
+            assert_eq!(s.parse::<f64>().unwrap() * unit, v, "{s}");
+        }
     }
 }
