@@ -232,6 +232,14 @@ impl Reader {
         }
     }
 
+    /// Whether the common block (`G1 X… Z… C… F…`) is read in one pass
+    /// (on by default): off, every line goes the whole way through the
+    /// lexer and the modal state. The findings are the same either way;
+    /// the switch is for the benchmark and the tests that compare them.
+    pub fn set_fast_path(&mut self, on: bool) {
+        self.state.fast_on = on;
+    }
+
     /// Reads one line (with or without its line break) that starts at
     /// byte `offset` of the program.
     pub fn line(&mut self, line: &str, offset: usize) {
