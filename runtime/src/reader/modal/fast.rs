@@ -70,7 +70,8 @@ impl State {
         if self.ended || rules.max_line_length.is_some_and(|max| line.len() > max) {
             return false;
         }
-        // The words: each letter once, each number as the lexer reads it.
+        // The words: each letter once, each number as the lexer reads it
+        // (and ending where it does: `X1C2` is two words to it too).
         let bytes = line.as_bytes();
         let mut values = [0.0f64; 6];
         let mut seen = 0u8;
@@ -97,9 +98,6 @@ impl State {
             let (Some((value, point, decimals)), end) = number(line, i + 1) else {
                 return false;
             };
-            if end < bytes.len() && bytes[end] != b' ' {
-                return false;
-            }
             if !rules.limits[k].allow(&bytes[i..end], point, decimals) {
                 return false;
             }
