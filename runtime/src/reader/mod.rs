@@ -176,7 +176,22 @@ pub fn read_moves(
     dialect: &Dialect,
     machine: &MachineLimits,
 ) -> (Vec<Finding>, Vec<Executed>) {
+    read_moves_by(text, dialect, machine, true)
+}
+
+/// [`read_moves`] with the common block read in one pass (`fast`, as
+/// every other reading does) or whole, line by line: the same findings
+/// and moves either way, which the integration tests check on every
+/// program lensc writes.
+#[doc(hidden)]
+pub fn read_moves_by(
+    text: &str,
+    dialect: &Dialect,
+    machine: &MachineLimits,
+    fast: bool,
+) -> (Vec<Finding>, Vec<Executed>) {
     let mut r = Reader::new(dialect, machine);
+    r.set_fast_path(fast);
     r.state.moves = Some(Vec::new());
     let mut offset = 0;
     for line in text.split_inclusive('\n') {
