@@ -481,6 +481,7 @@ fn unknown(span: (usize, usize), message: &str) -> Found {
 
 /// A number at `code[i..]`: sign, digits, a point, digits (at least one
 /// digit). Returns (value, has a point, decimals) and where it ends.
+#[inline(always)]
 pub(crate) fn number(code: &str, mut i: usize) -> (Option<(f64, bool, usize)>, usize) {
     let bytes = code.as_bytes();
     let start = i;
@@ -516,7 +517,12 @@ pub(crate) fn number(code: &str, mut i: usize) -> (Option<(f64, bool, usize)>, u
         // Both exact in f64, so the one division rounds the quotient
         // correctly: the value `parse` gives (Clinger's fast path, which
         // `parse` takes for these too).
-        let v = mantissa as f64 / POWERS_OF_TEN[decimals];
+        // (A whole number is its own quotient by 10^0.)
+        let v = if decimals == 0 {
+            mantissa as f64
+        } else {
+            mantissa as f64 / POWERS_OF_TEN[decimals]
+        };
         Some(if negative { -v } else { v })
     } else {
         code[start..i].parse::<f64>().ok()
