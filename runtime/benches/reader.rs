@@ -91,15 +91,11 @@ fn spiral() -> String {
     t + "G0 Z1.499719\nM2\n"
 }
 
-/// Reads `text` line by line as the build's read-back does.
+/// Reads `text` line by line as the build's read-back does (`ReadAlong`).
 fn read(text: &str, machine: &MachineLimits, fast: bool) -> Vec<Finding> {
     let mut r = Reader::new(&Dialect::linuxcnc(), machine);
     r.set_fast_path(fast);
-    let mut offset = 0;
-    for line in text.split_inclusive('\n') {
-        r.line(line, offset);
-        offset += line.len();
-    }
+    r.lines(text, 0);
     r.finish()
 }
 

@@ -424,6 +424,7 @@ impl WordLimits {
     /// Whether a word of this letter written `text` (letter and number),
     /// with or without a `point` and with `decimals` digits after it,
     /// breaks none of the limits: `Lexer::number_format` finds nothing.
+    #[inline]
     pub fn allow(&self, text: &[u8], point: bool, decimals: usize) -> bool {
         if point && !self.point {
             return false;
