@@ -126,7 +126,10 @@ fn main() {
         if std::env::var("READER_ONLY").is_ok_and(|o| o == "fast") {
             // For a profiler: the fast path alone.
             let (fast, _) = best_run(runs, || read(black_box(text), &machine, true));
-            println!("{name}: fast path {:.1} ns/line", fast.as_secs_f64() * 1e9 / lines);
+            println!(
+                "{name}: fast path {:.1} ns/line",
+                fast.as_secs_f64() * 1e9 / lines
+            );
             continue;
         }
         let cpu = cpu_seconds();

@@ -234,7 +234,11 @@ fn every_program_reads_the_same_on_the_fast_path() {
             found += fast.0.len();
             assert_eq!(fast.1.len(), whole.1.len(), "{name} {what}: the moves");
             for (k, (a, b)) in fast.1.iter().zip(&whole.1).enumerate() {
-                assert_eq!(format!("{a:?}"), format!("{b:?}"), "{name} {what}: move {k}");
+                assert_eq!(
+                    format!("{a:?}"),
+                    format!("{b:?}"),
+                    "{name} {what}: move {k}"
+                );
             }
         }
         read += 1;

@@ -352,7 +352,7 @@ impl State {
         start: &[Option<f64>; 4],
         end: &[Option<f64>; 4],
         length: f64,
-    ) -> (Option<(f64, f64)>, Option<(f64, f64)>) {
+    ) -> (Over, Over) {
         let (Some(f), Some(mode)) = (feed, self.feed_mode) else {
             return (None, None);
         };
@@ -559,6 +559,9 @@ impl State {
         }
     }
 }
+
+/// A figure above its limit, with the limit.
+pub(super) type Over = Option<(f64, f64)>;
 
 /// The block's axis words (X, Y, Z, C), in order.
 fn axes(b: &Block) -> impl Iterator<Item = &Word> {

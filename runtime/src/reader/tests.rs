@@ -207,7 +207,9 @@ fn lines_are_split_as_split_inclusive_splits_them() {
         "\u{b}\t\u{9}\n\u{8a}é\n€\n\r\n".into(),
     ];
     let mut r: u64 = 0x9e37_79b9_7f4a_7c15;
-    let alphabet = ['\n', '\n', 'G', '1', ' ', '\t', '\u{b}', '\r', 'é', '\u{10a}', 'X'];
+    let alphabet = [
+        '\n', '\n', 'G', '1', ' ', '\t', '\u{b}', '\r', 'é', '\u{10a}', 'X',
+    ];
     for _ in 0..20_000 {
         r ^= r << 13;
         r ^= r >> 7;

@@ -50,7 +50,9 @@ impl Gen {
     fn number(&mut self) -> String {
         match self.below(40) {
             0 => String::new(),
-            1 => self.pick(&["-", "+", ".", "-.", "+.", "..", "-0", "+0", "-0.", "0.0"]).into(),
+            1 => self
+                .pick(&["-", "+", ".", "-.", "+.", "..", "-0", "+0", "-0.", "0.0"])
+                .into(),
             2 => format!("{}{}", self.pick(&["", "-"]), self.some_digits(16, 8)),
             3 => format!("{}.{}", self.some_digits(1, 9), self.some_digits(8, 10)),
             4 => format!("00{}.{}", self.digits(2), self.digits(3)),
@@ -77,8 +79,18 @@ impl Gen {
     /// A G word's number: mostly G1 in its spellings.
     fn g_number(&mut self) -> String {
         if self.chance(80) {
-            self.pick(&["1", "1", "1", "01", "1.", "1.0", "001", "+1", "1.00000000001"])
-                .into()
+            self.pick(&[
+                "1",
+                "1",
+                "1",
+                "01",
+                "1.",
+                "1.0",
+                "001",
+                "+1",
+                "1.00000000001",
+            ])
+            .into()
         } else {
             self.pick(&[
                 "0",
@@ -110,8 +122,16 @@ impl Gen {
             60..=79 => format!("C{}", self.number()),
             80..=91 => {
                 let f = if self.chance(60) {
-                    self.pick(&["864000.", "60.", "32.155", "1000", "0.5", "1500", "1500.0000001"])
-                        .to_string()
+                    self.pick(&[
+                        "864000.",
+                        "60.",
+                        "32.155",
+                        "1000",
+                        "0.5",
+                        "1500",
+                        "1500.0000001",
+                    ])
+                    .to_string()
                 } else {
                     self.number()
                 };
@@ -119,9 +139,32 @@ impl Gen {
             }
             _ => self
                 .pick(&[
-                    "x1.5", "g1", "f100", "I-1", "K0.5", "R2", "S500", "M3", "M5", "T1", "N10",
-                    "E3", "(a comment)", "(open", "; note", "%", "DIAMON", "LIMS=3000", "G93",
-                    "G94", "G0", "Q1", "#", "é", "X=1", "C=2",
+                    "x1.5",
+                    "g1",
+                    "f100",
+                    "I-1",
+                    "K0.5",
+                    "R2",
+                    "S500",
+                    "M3",
+                    "M5",
+                    "T1",
+                    "N10",
+                    "E3",
+                    "(a comment)",
+                    "(open",
+                    "; note",
+                    "%",
+                    "DIAMON",
+                    "LIMS=3000",
+                    "G93",
+                    "G94",
+                    "G0",
+                    "Q1",
+                    "#",
+                    "é",
+                    "X=1",
+                    "C=2",
                 ])
                 .into(),
         }
@@ -362,11 +405,18 @@ fn machines() -> Vec<MachineLimits> {
 /// tool, spindle or position mode, feed mode and a feed.
 fn opening(g: &mut Gen) -> Vec<String> {
     let mut lines: Vec<String> = vec![
-        g.pick(&["G18 G21 G90 G8 G40 G49 G80 G94", "G18 G71 G90", "G17 G20 G91"])
-            .into(),
+        g.pick(&[
+            "G18 G21 G90 G8 G40 G49 G80 G94",
+            "G18 G71 G90",
+            "G17 G20 G91",
+        ])
+        .into(),
         g.pick(&["T1 M6 G43", "T0101", "T1", "T1 M6"]).into(),
     ];
-    lines.push(g.pick(&["G97 S500 M3", "M19", "G0 X3 C0", "S500 M3"]).into());
+    lines.push(
+        g.pick(&["G97 S500 M3", "M19", "G0 X3 C0", "S500 M3"])
+            .into(),
+    );
     lines.push(
         g.pick(&[
             "G93 G1 X3.071765 F60.",
@@ -430,7 +480,10 @@ fn generated_programs_read_the_same_both_ways() {
                 // on LinuxCNC about a fifth of the lines are read fast,
                 // under tight number formats and line lengths one to three in 100.
                 println!("{name}, machine {k}: {taken} of {lines} lines read fast");
-                assert!(taken * 100 > lines, "{name}, machine {k}: {taken} of {lines}");
+                assert!(
+                    taken * 100 > lines,
+                    "{name}, machine {k}: {taken} of {lines}"
+                );
             }
         }
     }
