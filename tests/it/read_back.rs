@@ -124,3 +124,126 @@ fn a_build_reading_back_writes_only_what_reads_clean() {
         }
     }
 }
+
+/// The machine and dialect `program`'s header names, declared in its
+/// source (relative to the repository) or the standard library, as
+/// `lensc verify` finds them.
+fn machine_and_dialect(
+    program: &str,
+) -> Option<(
+    lensc_runtime::reader::MachineLimits,
+    lensc_runtime::dialect::Dialect,
+)> {
+    use lensc_lang::loader::RealFs;
+    use lensc_lang::lower::read_back::{dialect_named, machine_named};
+    use lensc_runtime::reader::{header_names, header_source};
+    let names = header_names(program)?;
+    let mut declarations = std::collections::HashMap::new();
+    if let Some(source) = header_source(program)
+        && let Ok(c) = lensc_lang::check_path(&RealFs, &root().join(source))
+        && !c.has_errors()
+    {
+        declarations = c.checked.declarations;
+    }
+    for (module, name) in [("machines", &names.machine), ("dialects", &names.dialect)] {
+        if !declarations.contains_key(name) {
+            let uses = format!("use std::{module}::{name}\n");
+            let c = lensc_lang::check_text(&RealFs, "<standard library>", uses.as_bytes());
+            declarations.extend(c.checked.declarations);
+        }
+    }
+    let (limits, _) = machine_named(&declarations, &names.machine)?;
+    Some((limits, dialect_named(&declarations, &names.dialect)?))
+}
+
+/// `program` with every 37th line changed by one byte (a digit doubled,
+/// a letter lowered, a space dropped, in turn): lines the fast path must
+/// refuse or read as the whole path does.
+fn damaged(program: &str) -> String {
+    program
+        .split_inclusive('\n')
+        .enumerate()
+        .map(|(n, line)| {
+            if n % 37 != 36 {
+                return line.to_string();
+            }
+            let at = line.len() / 2;
+            let mut b = line.as_bytes().to_vec();
+            if at < b.len() && b[at].is_ascii() {
+                match n % 3 {
+                    0 => b.insert(at, b[at]),
+                    1 => b[at] = b[at].to_ascii_lowercase(),
+                    _ => {
+                        b.remove(at);
+                    }
+                }
+            }
+            String::from_utf8_lossy(&b).into_owned()
+        })
+        .collect()
+}
+
+/// Every program lensc writes — each snapshot (programs and dialects)
+/// and each example's own — reads with the same findings and the same
+/// moves with the common block read in one pass as read whole; so does
+/// each with lines damaged, and each on a machine of a tenth of the feed
+/// and half the travel (findings on many lines).
+#[test]
+fn every_program_reads_the_same_on_the_fast_path() {
+    use lensc_runtime::reader::read_moves_by;
+    let mut programs: Vec<(String, String)> = Vec::new();
+    for dir in ["programs", "dialects"] {
+        for e in std::fs::read_dir(root().join("tests/snapshots").join(dir)).expect("snapshots") {
+            let path = e.expect("entry").path();
+            if path.extension().is_some_and(|e| e == "snap") {
+                let all = std::fs::read_to_string(&path).expect("read");
+                let program: String = all.split_inclusive('\n').skip(3).collect();
+                programs.push((path.display().to_string(), program));
+            }
+        }
+    }
+    for b in built_examples() {
+        for (name, file) in &b.files {
+            if let Written::Whole(bytes) = file
+                && !name.ends_with(".json")
+                && !name.ends_with(".fts")
+            {
+                programs.push((format!("{} {name}", b.example), text(bytes)));
+            }
+        }
+    }
+    programs.sort();
+    let (mut read, mut found) = (0, 0);
+    for (name, program) in &programs {
+        let Some((machine, dialect)) = machine_and_dialect(program) else {
+            continue;
+        };
+        let mut tight = machine.clone();
+        tight.max_feed = tight.max_feed.map(|f| f / 10.0);
+        for t in &mut tight.travel {
+            *t = t.map(|(lo, hi)| (lo / 2.0, hi / 2.0));
+        }
+        for (what, text, m) in [
+            ("as written", program.clone(), &machine),
+            ("damaged", damaged(program), &machine),
+            ("on a tight machine", program.clone(), &tight),
+        ] {
+            let fast = read_moves_by(&text, &dialect, m, true);
+            let whole = read_moves_by(&text, &dialect, m, false);
+            assert_eq!(fast.0, whole.0, "{name} {what}: the findings");
+            found += fast.0.len();
+            assert_eq!(fast.1.len(), whole.1.len(), "{name} {what}: the moves");
+            for (k, (a, b)) in fast.1.iter().zip(&whole.1).enumerate() {
+                assert_eq!(
+                    format!("{a:?}"),
+                    format!("{b:?}"),
+                    "{name} {what}: move {k}"
+                );
+            }
+        }
+        read += 1;
+    }
+    assert!(read >= 60, "{read} of {} programs read", programs.len());
+    // The damaged programs and the tight machine are refused, often.
+    assert!(found >= 2 * read, "{found} findings in {read} programs");
+}

@@ -132,14 +132,10 @@ impl ReadAlong {
                     offset += partial.len();
                     partial.clear();
                 }
-                for line in rest.split_inclusive('\n') {
-                    if line.ends_with('\n') {
-                        r.line(line, offset);
-                        offset += line.len();
-                    } else {
-                        partial.push_str(line);
-                    }
-                }
+                // The whole lines; the last one's end is in a later piece.
+                let whole = rest.rfind('\n').map_or(0, |end| end + 1);
+                offset = r.lines(&rest[..whole], offset);
+                partial.push_str(&rest[whole..]);
             }
             if !partial.is_empty() {
                 r.line(&partial, offset);

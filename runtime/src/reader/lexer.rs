@@ -114,6 +114,17 @@ impl Lexer {
         self.words(&code, b, out);
     }
 
+    /// Whether a block needs nothing closing it (no `*` end to strip).
+    pub(crate) fn open_ended(&self) -> bool {
+        self.block_end.is_empty()
+    }
+
+    /// The longest line the controller reads, in bytes: a line no longer
+    /// has no more characters either.
+    pub(crate) fn max_line_length(&self) -> Option<usize> {
+        self.max_line_length
+    }
+
     /// The dialect's line-length limit.
     pub(crate) fn line_length(&self, line: &str, out: &mut Vec<Found>) {
         if let Some(max) = self.max_line_length
@@ -313,14 +324,28 @@ impl Lexer {
         i
     }
 
+    /// What the dialect's number format allows a word of `letter`.
+    pub(crate) fn limits(&self, letter: char) -> WordLimits {
+        let format = self.formats.iter().find(|f| f.letter == letter);
+        let whole = format.is_some_and(|f| f.decimals.is_none());
+        WordLimits {
+            point: !(whole || integer_only(self.controller, letter)),
+            integer_only: integer_only(self.controller, letter),
+            max_decimals: format.and_then(|f| f.decimals).or(self.max_decimals),
+            // No limit on the digits to hold them against: not counted.
+            digits_counted: self.max_digits.is_some() || format.is_some(),
+            max_digits: self.max_digits,
+            integer_digits: format.map(|f| f.integer_digits),
+        }
+    }
+
     /// Digits, decimals and the decimal point of a word against the
     /// dialect's number format.
     pub(crate) fn number_format(&self, w: &Word, code: &str, out: &mut Vec<Found>) {
         let text = &code[w.span.0..w.span.1];
-        let format = self.formats.iter().find(|f| f.letter == w.letter);
-        let whole = format.is_some_and(|f| f.decimals.is_none());
-        if w.point && (whole || integer_only(self.controller, w.letter)) {
-            let whose = if integer_only(self.controller, w.letter) {
+        let limits = self.limits(w.letter);
+        if w.point && !limits.point {
+            let whose = if limits.integer_only {
                 "this controller reads"
             } else {
                 "the dialect's format gives"
@@ -335,8 +360,7 @@ impl Lexer {
                 Some(format!("write {}{}", w.letter, w.value.trunc())),
             ));
         }
-        let max_decimals = format.and_then(|f| f.decimals).or(self.max_decimals);
-        if let Some(max) = max_decimals
+        if let Some(max) = limits.max_decimals
             && w.decimals > max as usize
         {
             out.push((
@@ -349,22 +373,11 @@ impl Lexer {
                 None,
             ));
         }
-        if self.max_digits.is_none() && format.is_none() {
-            // No limit on the digits to hold them against.
+        if !limits.digits_counted {
             return;
         }
-        // The digits after the letters, `=`, the sign and leading zeros
-        // (byte by byte: every one of those characters is ASCII).
-        let t = text.as_bytes();
-        let mut i = 0;
-        while i < t.len() && (t[i].is_ascii_alphabetic() || matches!(t[i], b'=' | b'-' | b'+')) {
-            i += 1;
-        }
-        while i < t.len() && t[i] == b'0' {
-            i += 1;
-        }
-        let digits = t[i..].iter().filter(|b| b.is_ascii_digit()).count();
-        if let Some(max) = self.max_digits
+        let digits = significant_digits(text.as_bytes());
+        if let Some(max) = limits.max_digits
             && digits > max as usize
         {
             out.push((
@@ -375,20 +388,72 @@ impl Lexer {
             ));
         }
         let before = digits.saturating_sub(w.decimals);
-        if let Some(f) = format
-            && before > f.integer_digits as usize
+        if let Some(most) = limits.integer_digits
+            && before > most as usize
         {
             out.push((
                 Rule::TooManyDigits,
                 w.span,
                 format!(
-                    "`{text}` has {before} digits before the point; the dialect's {} words have at most {}",
-                    w.letter, f.integer_digits
+                    "`{text}` has {before} digits before the point; the dialect's {} words have at most {most}",
+                    w.letter
                 ),
                 None,
             ));
         }
     }
+}
+
+/// What a dialect's number format allows one word letter (`Lexer::limits`).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct WordLimits {
+    /// A decimal point may be written.
+    pub point: bool,
+    /// The controller reads the letter as a whole number only.
+    integer_only: bool,
+    pub max_decimals: Option<u32>,
+    /// Whether any limit on the digits applies (`max_digits` or the
+    /// word's own format).
+    pub digits_counted: bool,
+    pub max_digits: Option<u32>,
+    /// The most digits before the point, by the word's own format.
+    pub integer_digits: Option<u32>,
+}
+
+impl WordLimits {
+    /// Whether a word of this letter written `text` (letter and number),
+    /// with or without a `point` and with `decimals` digits after it,
+    /// breaks none of the limits: `Lexer::number_format` finds nothing.
+    #[inline]
+    pub fn allow(&self, text: &[u8], point: bool, decimals: usize) -> bool {
+        if point && !self.point {
+            return false;
+        }
+        if self.max_decimals.is_some_and(|max| decimals > max as usize) {
+            return false;
+        }
+        if !self.digits_counted {
+            return true;
+        }
+        let digits = significant_digits(text);
+        !(self.max_digits.is_some_and(|max| digits > max as usize)
+            || self
+                .integer_digits
+                .is_some_and(|most| digits.saturating_sub(decimals) > most as usize))
+    }
+}
+
+/// The digits of a word after its letters, `=`, the sign and leading
+/// zeros (byte by byte: every one of those characters is ASCII).
+fn significant_digits(t: &[u8]) -> usize {
+    let mut i = 0;
+    while i < t.len() && (t[i].is_ascii_alphabetic() || matches!(t[i], b'=' | b'-' | b'+')) {
+        i += 1;
+    }
+    while i < t.len() && t[i] == b'0' {
+        i += 1;
+    }
+    t[i..].iter().filter(|b| b.is_ascii_digit()).count()
 }
 
 /// Siemens keywords the reader knows (840D sl programming manual): the
@@ -417,6 +482,7 @@ fn unknown(span: (usize, usize), message: &str) -> Found {
 
 /// A number at `code[i..]`: sign, digits, a point, digits (at least one
 /// digit). Returns (value, has a point, decimals) and where it ends.
+#[inline(always)]
 pub(crate) fn number(code: &str, mut i: usize) -> (Option<(f64, bool, usize)>, usize) {
     let bytes = code.as_bytes();
     let start = i;
@@ -452,7 +518,12 @@ pub(crate) fn number(code: &str, mut i: usize) -> (Option<(f64, bool, usize)>, u
         // Both exact in f64, so the one division rounds the quotient
         // correctly: the value `parse` gives (Clinger's fast path, which
         // `parse` takes for these too).
-        let v = mantissa as f64 / POWERS_OF_TEN[decimals];
+        // (A whole number is its own quotient by 10^0.)
+        let v = if decimals == 0 {
+            mantissa as f64
+        } else {
+            mantissa as f64 / POWERS_OF_TEN[decimals]
+        };
         Some(if negative { -v } else { v })
     } else {
         code[start..i].parse::<f64>().ok()

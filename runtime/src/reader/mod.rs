@@ -160,11 +160,7 @@ pub enum Path {
 /// broken, the first line breaking each, in order of their lines.
 pub fn read(text: &str, dialect: &Dialect, machine: &MachineLimits) -> Vec<Finding> {
     let mut r = Reader::new(dialect, machine);
-    let mut offset = 0;
-    for line in text.split_inclusive('\n') {
-        r.line(line, offset);
-        offset += line.len();
-    }
+    r.lines(text, 0);
     r.finish()
 }
 
@@ -176,13 +172,24 @@ pub fn read_moves(
     dialect: &Dialect,
     machine: &MachineLimits,
 ) -> (Vec<Finding>, Vec<Executed>) {
+    read_moves_by(text, dialect, machine, true)
+}
+
+/// [`read_moves`] with the common block read in one pass (`fast`, as
+/// every other reading does) or whole, line by line: the same findings
+/// and moves either way, which the integration tests check on every
+/// program lensc writes.
+#[doc(hidden)]
+pub fn read_moves_by(
+    text: &str,
+    dialect: &Dialect,
+    machine: &MachineLimits,
+    fast: bool,
+) -> (Vec<Finding>, Vec<Executed>) {
     let mut r = Reader::new(dialect, machine);
+    r.set_fast_path(fast);
     r.state.moves = Some(Vec::new());
-    let mut offset = 0;
-    for line in text.split_inclusive('\n') {
-        r.line(line, offset);
-        offset += line.len();
-    }
+    r.lines(text, 0);
     let moves = r.state.moves.take().unwrap_or_default();
     (r.finish(), moves)
 }
@@ -232,11 +239,35 @@ impl Reader {
         }
     }
 
+    /// Whether the common block (`G1 X… Z… C… F…`) is read in one pass
+    /// (on by default): off, every line goes the whole way through the
+    /// lexer and the modal state. The findings are the same either way;
+    /// the switch is for the benchmark and the tests that compare them.
+    pub fn set_fast_path(&mut self, on: bool) {
+        self.state.fast_on = on;
+    }
+
+    /// Reads every line of `text`, which starts at byte `offset` of the
+    /// program, as `line` would be given each (the pieces
+    /// `split_inclusive('\n')` makes: a last line without its break is
+    /// read as it is); returns the offset after the text.
+    pub fn lines(&mut self, text: &str, offset: usize) -> usize {
+        for (start, line) in pieces(text) {
+            self.line(line, offset + start);
+        }
+        offset + text.len()
+    }
+
     /// Reads one line (with or without its line break) that starts at
     /// byte `offset` of the program.
     pub fn line(&mut self, line: &str, offset: usize) {
         self.line_no += 1;
-        let text = line.trim_end_matches(['\n', '\r']);
+        // `trim_end_matches(['\n', '\r'])`, byte by byte (both ASCII).
+        let mut end = line.len();
+        while end > 0 && matches!(line.as_bytes()[end - 1], b'\n' | b'\r') {
+            end -= 1;
+        }
+        let text = &line[..end];
         self.last_span = (offset, offset + text.len());
         let mut out = Vec::new();
         self.state.line(text, &mut out);
@@ -284,6 +315,42 @@ impl Reader {
         self.findings.sort_by_key(|f| f.line);
         self.findings
     }
+}
+
+/// The lines of `text` with their line breaks, and where each starts: the
+/// pieces of `split_inclusive('\n')`.
+fn pieces(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    let mut start = 0;
+    std::iter::from_fn(move || {
+        if start == text.len() {
+            return None;
+        }
+        let from = start;
+        start = line_end(&text.as_bytes()[from..]).map_or(text.len(), |k| from + k + 1);
+        // A line break is ASCII: `start` is a character boundary.
+        Some((from, &text[from..start]))
+    })
+}
+
+/// Where the first line break (`\n`) in `bytes` is, looked for eight
+/// bytes at a time: a byte equal to the break is a zero byte of the word
+/// XOR eight breaks, and the lowest zero byte of a word is the lowest
+/// byte whose `(w - 0x01…01) & !w & 0x80…80` bit is set (a borrow can
+/// set bits only above a zero byte).
+fn line_end(bytes: &[u8]) -> Option<usize> {
+    const BREAKS: u64 = u64::from_ne_bytes([b'\n'; 8]);
+    const ONES: u64 = u64::from_ne_bytes([0x01; 8]);
+    const HIGHS: u64 = u64::from_ne_bytes([0x80; 8]);
+    let mut i = 0;
+    while let Some(chunk) = bytes.get(i..i + 8) {
+        let w = u64::from_le_bytes(chunk.try_into().expect("eight bytes")) ^ BREAKS;
+        let zero = w.wrapping_sub(ONES) & !w & HIGHS;
+        if zero != 0 {
+            return Some(i + (zero.trailing_zeros() / 8) as usize);
+        }
+        i += 8;
+    }
+    bytes[i..].iter().position(|&b| b == b'\n').map(|k| i + k)
 }
 
 #[cfg(test)]

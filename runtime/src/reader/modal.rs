@@ -11,6 +11,8 @@ use super::{Controller, MachineLimits, Rule};
 use crate::dialect::Dialect;
 use crate::moves::Plane;
 
+mod fast;
+
 /// How F is read.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum FeedMode {
@@ -113,6 +115,14 @@ pub(crate) struct State {
     scratch: Block,
     groups: Vec<(GGroup, usize)>,
     ms: Vec<(MCode, usize)>,
+    /// The common block's one-pass reading (`fast`), where the dialect
+    /// allows it, and whether it is used (off: every line is read whole,
+    /// for the tests and benchmarks that compare the two).
+    fast: Option<fast::FastRules>,
+    pub fast_on: bool,
+    /// Lines the fast path has read.
+    #[cfg(test)]
+    fast_taken: usize,
 }
 
 impl State {
@@ -146,7 +156,7 @@ impl State {
         ] {
             feed_codes.extend(code(w).map(|c| (c, m)));
         }
-        State {
+        let mut state = State {
             machine: machine.clone(),
             arc_tolerance: d.arc_radius_tolerance,
             arc_planes: d.arc_planes.clone(),
@@ -184,11 +194,20 @@ impl State {
             scratch: Block::default(),
             groups: Vec::new(),
             ms: Vec::new(),
-        }
+            fast: None,
+            fast_on: true,
+            #[cfg(test)]
+            fast_taken: 0,
+        };
+        state.fast = fast::FastRules::of(&state.lex, state.numbered, |l| state.known_letter(l));
+        state
     }
 
     /// Reads one line.
     pub fn line(&mut self, line: &str, out: &mut Vec<Found>) {
+        if self.fast_line(line) {
+            return;
+        }
         let mut b = std::mem::take(&mut self.scratch);
         match &mut self.klartext {
             Some(k) => b = k.block(&self.lex, line, out),

@@ -144,15 +144,7 @@ impl State {
     fn travel(&self, end: &[Option<f64>; 4], b: &Block, out: &mut Vec<Found>) {
         for (i, w) in axes(b).map(|w| (LETTERS.iter().position(|l| *l == w.letter), w)) {
             let i = i.expect("an axis");
-            let (Some(v), Some((lo, hi))) = (end[i], self.machine.travel[i]) else {
-                continue;
-            };
-            let (v, lo, hi, unit) = if i == 3 {
-                (v, lo.to_degrees(), hi.to_degrees(), "°")
-            } else {
-                (v, lo, hi, " mm")
-            };
-            if v < lo - 1e-9 || v > hi + 1e-9 {
+            if let Some((v, lo, hi, unit)) = self.outside_travel(i, end[i]) {
                 out.push((
                     Rule::OutsideTravel,
                     w.span,
@@ -167,6 +159,25 @@ impl State {
                 ));
             }
         }
+    }
+
+    /// Where axis `i` ends (`v`) if that is outside the machine's travel:
+    /// the end and the travel as a message gives them (C in degrees), and
+    /// their unit.
+    pub(super) fn outside_travel(
+        &self,
+        i: usize,
+        v: Option<f64>,
+    ) -> Option<(f64, f64, f64, &'static str)> {
+        let (Some(v), Some((lo, hi))) = (v, self.machine.travel[i]) else {
+            return None;
+        };
+        let (v, lo, hi, unit) = if i == 3 {
+            (v, lo.to_degrees(), hi.to_degrees(), "°")
+        } else {
+            (v, lo, hi, " mm")
+        };
+        (v < lo - 1e-9 || v > hi + 1e-9).then_some((v, lo, hi, unit))
     }
 
     /// A rapid may not cross or plunge into the material cut so far.
@@ -296,27 +307,16 @@ impl State {
         span: (usize, usize),
         out: &mut Vec<Found>,
     ) {
-        let (Some(f), Some(mode)) = (self.feed, self.feed_mode) else {
+        let (feed, turning) = self.over_limits(self.feed, start, end, length);
+        if feed.is_none() && turning.is_none() {
             return;
-        };
-        let unit = if self.metric == Some(false) {
-            25.4
-        } else {
-            1.0
-        };
-        let rate = match mode {
-            FeedMode::PerMinute => Some(f * unit),
-            FeedMode::InverseTime => Some(length * f),
-            FeedMode::PerRevolution => self.revolutions(start, end).map(|rpm| f * unit * rpm),
-        };
+        }
         let fspan = b
             .words
             .iter()
             .find(|w| w.letter == 'F')
             .map_or(span, |w| w.span);
-        if let (Some(rate), Some(max)) = (rate, self.machine.max_feed)
-            && rate > max * (1.0 + 1e-9)
-        {
+        if let Some((rate, max)) = feed {
             out.push((
                 Rule::FeedTooHigh,
                 fspan,
@@ -328,24 +328,59 @@ impl State {
                 None,
             ));
         }
+        if let Some((rpm, max)) = turning {
+            out.push((
+                Rule::SpindleTooFast,
+                fspan,
+                format!(
+                    "this move turns C at {} rpm, above the spindle's {} rpm",
+                    num(rpm),
+                    num(max)
+                ),
+                None,
+            ));
+        }
+    }
+
+    /// A move of `length` (mm) at `feed` in the feed mode in force: its
+    /// feed (mm/min) where it is above the machine's, and in inverse time
+    /// C's speed (rpm) where it is above the spindle's, each with the
+    /// limit.
+    pub(super) fn over_limits(
+        &self,
+        feed: Option<f64>,
+        start: &[Option<f64>; 4],
+        end: &[Option<f64>; 4],
+        length: f64,
+    ) -> (Over, Over) {
+        let (Some(f), Some(mode)) = (feed, self.feed_mode) else {
+            return (None, None);
+        };
+        let unit = if self.metric == Some(false) {
+            25.4
+        } else {
+            1.0
+        };
+        let rate = match mode {
+            FeedMode::PerMinute => Some(f * unit),
+            FeedMode::InverseTime => Some(length * f),
+            FeedMode::PerRevolution => self.revolutions(start, end).map(|rpm| f * unit * rpm),
+        };
+        let feed = match (rate, self.machine.max_feed) {
+            (Some(rate), Some(max)) if rate > max * (1.0 + 1e-9) => Some((rate, max)),
+            _ => None,
+        };
+        let mut turning = None;
         if mode == FeedMode::InverseTime
             && let (Some(c0), Some(c1), Some(max)) =
                 (start[3], end[3], self.machine.max_spindle_rpm)
         {
             let rpm = (c1 - c0).abs() * f / 360.0;
             if rpm > max * (1.0 + 1e-9) {
-                out.push((
-                    Rule::SpindleTooFast,
-                    fspan,
-                    format!(
-                        "this move turns C at {} rpm, above the spindle's {} rpm",
-                        num(rpm),
-                        num(max)
-                    ),
-                    None,
-                ));
+                turning = Some((rpm, max));
             }
         }
+        (feed, turning)
     }
 
     /// The spindle's speed (rpm) over a move: the stated rpm, or at
@@ -525,12 +560,15 @@ impl State {
     }
 }
 
+/// A figure above its limit, with the limit.
+pub(super) type Over = Option<(f64, f64)>;
+
 /// The block's axis words (X, Y, Z, C), in order.
 fn axes(b: &Block) -> impl Iterator<Item = &Word> {
     b.words.iter().filter(|w| LETTERS.contains(&w.letter))
 }
 
-fn chord(start: &[Option<f64>; 4], end: &[Option<f64>; 4]) -> Option<f64> {
+pub(super) fn chord(start: &[Option<f64>; 4], end: &[Option<f64>; 4]) -> Option<f64> {
     let mut sum = 0.0;
     for i in 0..3 {
         match (start[i], end[i]) {

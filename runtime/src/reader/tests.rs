@@ -191,3 +191,46 @@ fn the_moves_are_handed_over_in_machine_coordinates() {
     assert_eq!(moves[2].to, [Some(0.0), None, Some(0.4693), None]);
     assert_eq!(paths[3], Path::Rapid);
 }
+
+/// `Reader::lines` hands `line` the pieces `split_inclusive('\n')` makes,
+/// at their offsets: breaks at every position of the eight-byte words,
+/// several together, none, a last line without one, bytes that look
+/// like a break plus or minus one, and text that is not ASCII.
+#[test]
+fn lines_are_split_as_split_inclusive_splits_them() {
+    let mut texts: Vec<String> = vec![
+        String::new(),
+        "\n".into(),
+        "\n\n\n".into(),
+        "no break".into(),
+        "G1 X1\nG1 X2".into(),
+        "\u{b}\t\u{9}\n\u{8a}é\n€\n\r\n".into(),
+    ];
+    let mut r: u64 = 0x9e37_79b9_7f4a_7c15;
+    let alphabet = [
+        '\n', '\n', 'G', '1', ' ', '\t', '\u{b}', '\r', 'é', '\u{10a}', 'X',
+    ];
+    for _ in 0..20_000 {
+        r ^= r << 13;
+        r ^= r >> 7;
+        r ^= r << 17;
+        let n = (r % 40) as usize;
+        let mut t = String::new();
+        let mut s = r;
+        for _ in 0..n {
+            s = s.rotate_left(5) ^ 0x5851_f42d_4c95_7f2d;
+            t.push(alphabet[(s % alphabet.len() as u64) as usize]);
+        }
+        texts.push(t);
+    }
+    for text in &texts {
+        let mut want = Vec::new();
+        let mut offset = 0;
+        for line in text.split_inclusive('\n') {
+            want.push((offset, line.to_string()));
+            offset += line.len();
+        }
+        let got: Vec<(usize, String)> = pieces(text).map(|(o, l)| (o, l.to_string())).collect();
+        assert_eq!(got, want, "{text:?}");
+    }
+}
