@@ -203,17 +203,24 @@ pub fn read_from(
     machine: &MachineLimits,
 ) -> std::io::Result<Vec<Finding>> {
     let mut r = Reader::new(dialect, machine);
-    let mut buf = Vec::new();
+    // The text read but not yet handed over: the start of a line whose
+    // end has not been read.
+    let mut pending: Vec<u8> = Vec::new();
     let mut offset = 0;
     loop {
-        buf.clear();
-        let n = input.read_until(b'\n', &mut buf)?;
-        if n == 0 {
+        let chunk = input.fill_buf()?;
+        if chunk.is_empty() {
             break;
         }
-        r.line(&String::from_utf8_lossy(&buf), offset);
-        offset += n;
+        pending.extend_from_slice(chunk);
+        let n = chunk.len();
+        input.consume(n);
+        if let Some(last) = pending.iter().rposition(|&b| b == b'\n') {
+            offset = r.bytes(&pending[..=last], offset);
+            pending.drain(..=last);
+        }
     }
+    r.bytes(&pending, offset);
     Ok(r.finish())
 }
 
@@ -256,6 +263,20 @@ impl Reader {
             self.line(line, offset + start);
         }
         offset + text.len()
+    }
+
+    /// Reads every line of `bytes` as `lines` does where they are UTF-8;
+    /// where they are not, line by line, each line's bytes that are not
+    /// read as `�` (the offsets still count the bytes).
+    fn bytes(&mut self, bytes: &[u8], mut offset: usize) -> usize {
+        if let Ok(text) = std::str::from_utf8(bytes) {
+            return self.lines(text, offset);
+        }
+        for line in bytes.split_inclusive(|&b| b == b'\n') {
+            self.line(&String::from_utf8_lossy(line), offset);
+            offset += line.len();
+        }
+        offset
     }
 
     /// Reads one line (with or without its line break) that starts at

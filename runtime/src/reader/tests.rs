@@ -234,3 +234,48 @@ fn lines_are_split_as_split_inclusive_splits_them() {
         assert_eq!(got, want, "{text:?}");
     }
 }
+
+/// `read_from` finds what reading line by line with `read_until` found
+/// (each line's bytes that are not UTF-8 read as `�`, the offsets in
+/// bytes), whatever the reader's buffer holds at a time: programs with
+/// findings, bytes that are not UTF-8 (alone, in a line with a finding,
+/// in a comment), no last line break, CR LF.
+#[test]
+fn a_program_read_from_a_stream_reads_as_line_by_line() {
+    use std::io::BufRead as _;
+    let d = Dialect::linuxcnc();
+    let m = lathe();
+    let base = GOOD.replace("G0 X3 Z1.5\n", "G0 X3 Z151.5 E3\r\n");
+    let mut texts: Vec<Vec<u8>> = vec![
+        GOOD.as_bytes().to_vec(),
+        base.as_bytes().to_vec(),
+        base.trim_end().as_bytes().to_vec(),
+        Vec::new(),
+    ];
+    for (at, bad) in [(3, 0xff_u8), (40, 0xc3), (70, 0x80), (85, 0xe2)] {
+        let mut t = base.as_bytes().to_vec();
+        t.insert(at.min(t.len()), bad);
+        texts.push(t);
+    }
+    for text in &texts {
+        // The reading before chunks: line by line.
+        let mut r = Reader::new(&d, &m);
+        let mut input = std::io::Cursor::new(text);
+        let (mut buf, mut offset) = (Vec::new(), 0);
+        loop {
+            buf.clear();
+            let n = input.read_until(b'\n', &mut buf).expect("read");
+            if n == 0 {
+                break;
+            }
+            r.line(&String::from_utf8_lossy(&buf), offset);
+            offset += n;
+        }
+        let want = r.finish();
+        for capacity in [1, 2, 3, 7, 16, 64, 8192] {
+            let input = std::io::BufReader::with_capacity(capacity, text.as_slice());
+            let got = read_from(input, &d, &m).expect("read");
+            assert_eq!(got, want, "{capacity}: {:?}", String::from_utf8_lossy(text));
+        }
+    }
+}
