@@ -1,13 +1,17 @@
 //! The writer's common block in one pass: a rapid or a linear move in a
-//! G-code dialect that numbers no blocks, in the feed mode already set,
-//! printed straight into one room at the text's end with no per-word
-//! dispatch and no refusal to build. Anything else (an arc, a feed mode
-//! to state, a C axis to switch on, a word a limit refuses, a line too
-//! long, a value that cannot print) is left to the general path
+//! G-code dialect that numbers no blocks, in the feed mode already set.
+//! Every number is rounded first, then every number's digits are worked
+//! out side by side, then the words are stored into one room at the
+//! text's end: each number is a long chain of dependent operations, and
+//! worked out together their chains overlap, where word after word they
+//! ran one after the other. Anything else (an arc, a feed mode to state,
+//! a C axis to switch on, a word a limit refuses, a line too long, a
+//! value that cannot print) is left to the general path
 //! (`ProgramWriter::motion`), which starts over from the same state: this
-//! path changes nothing it does not write. It prints through the same
-//! formatter (`Decimals::units`, `Decimals::print`) with the same words,
-//! so the bytes are those of the general path;
+//! path keeps nothing unless it writes the block. It prints through the
+//! same formatter (`Decimals::units`, `Decimals::digits`,
+//! `Digits::store`: what `Decimals::print` is) with the same words, so
+//! the bytes are those of the general path;
 //! `the_common_block_is_the_general_paths` holds the two to that.
 
 use super::{
