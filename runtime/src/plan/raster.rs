@@ -676,7 +676,11 @@ enum Stage {
     /// Waiting for the surface at v + `step`, the Newton step halved
     /// `halvings` times.
     Step { step: f64, halvings: u32 },
-    /// Solved, or refused.
+    /// Solved: the contact is at t and v, the surface there `at`
+    /// (`Cutter::solved`, which works out the tool centre when the
+    /// contact is read, long after the surface's values were stored).
+    Solved,
+    /// Refused, or a contact known before the solve began.
     Done(Result<Contact, RasterError>),
 }
 
@@ -686,7 +690,7 @@ impl Solve {
         match self.stage {
             Stage::Start => Some(self.v),
             Stage::Step { step, .. } => Some(self.v + step),
-            Stage::Done(_) => None,
+            Stage::Solved | Stage::Done(_) => None,
         }
     }
 }
@@ -816,13 +820,14 @@ impl<'a> Cutter<'a> {
     ) -> [Result<Contact, RasterError>; N] {
         self.run_side_by_side(plane, &mut solves);
         solves.map(|s| match s.stage {
+            Stage::Solved => Ok(self.solved(&s)),
             Stage::Done(c) => c,
             _ => unreachable!("a solve asks for points until it is done"),
         })
     }
 
     /// Runs `solves` to their ends side by side, in place (each then
-    /// `Stage::Done`).
+    /// `Stage::Solved` or `Stage::Done`).
     #[inline(always)]
     fn run_side_by_side<const N: usize>(&self, plane: f64, solves: &mut [Solve; N]) {
         const { assert!(N <= MAX_BATCH, "a batch of contacts fits the buffers") };
@@ -906,7 +911,7 @@ impl<'a> Cutter<'a> {
                     self.conclude(plane, s);
                 }
             }
-            Stage::Done(_) => {}
+            Stage::Solved | Stage::Done(_) => {}
         }
     }
 
@@ -946,21 +951,29 @@ impl<'a> Cutter<'a> {
         };
     }
 
-    /// The contact solve `s` has reached, or why there is none.
+    /// The end solve `s` has reached: solved, or why there is no contact.
     fn conclude(&self, plane: f64, s: &mut Solve) {
-        let rho = self.radius;
-        let scale = 1.0 + plane.abs() + rho;
-        let Newton { l, g, w, .. } = s.at;
-        s.stage = Stage::Done(if g.is_nan() || g.abs() > 1e-13 * scale {
-            Err(self.error_at(s.t, s.v, true))
+        let scale = 1.0 + plane.abs() + self.radius;
+        let g = s.at.g;
+        s.stage = if g.is_nan() || g.abs() > 1e-13 * scale {
+            Stage::Done(Err(self.error_at(s.t, s.v, true)))
         } else {
-            Ok(Contact {
-                u: s.t,
-                v: s.v,
-                l,
-                c: [s.t - rho * self.lean(&l) / w, l.z + rho / w],
-            })
-        });
+            Stage::Solved
+        };
+    }
+
+    /// The contact of a solve that has ended `Stage::Solved`: at its t and
+    /// v, the tool centre offset along the normal there.
+    #[inline(always)]
+    fn solved(&self, s: &Solve) -> Contact {
+        let rho = self.radius;
+        let Newton { l, w, .. } = s.at;
+        Contact {
+            u: s.t,
+            v: s.v,
+            l,
+            c: [s.t - rho * self.lean(&l) / w, l.z + rho / w],
+        }
     }
 
     /// Where the surface stops being defined on the plane at v, between
@@ -1343,6 +1356,7 @@ impl<'a> Cutter<'a> {
         self.run_side_by_side(plane, &mut solves);
         for (i, s) in (1..PROBES).zip(&solves) {
             let q = match &s.stage {
+                Stage::Solved => self.solved(s),
                 Stage::Done(Ok(q)) => *q,
                 Stage::Done(Err(e)) => return Err(e.clone()),
                 _ => unreachable!("a solve asks for points until it is done"),
@@ -1353,8 +1367,12 @@ impl<'a> Cutter<'a> {
             }
             set.contacts[i - 1] = q;
             probes[i] = q.c;
-            let f = foot_on_segment(q.c, p0, p1);
-            quick[i] = ((f[0] - q.c[0]).powi(2) + (f[1] - q.c[1]).powi(2)).sqrt();
+        }
+        // The probes' distances from the chord, in a loop of their own:
+        // its divisions and square roots overlap.
+        for (q, d) in probes[1..PROBES].iter().zip(&mut quick[1..PROBES]) {
+            let f = foot_on_segment(*q, p0, p1);
+            *d = ((f[0] - q[0]).powi(2) + (f[1] - q[1]).powi(2)).sqrt();
         }
         let limit = r.chord_tolerance * crate::plan::optimise::CHORD_SHARE * r.chords.sag_factor();
         // The distances by √(dx² + dy²), within a few ulps of `hypot`'s,

@@ -117,21 +117,68 @@ impl Decimals {
     /// (bytes of `room` after the number are left as filler).
     #[inline(always)]
     pub fn print(&self, room: &mut [u8; PRINTED_ROOM], n: i64) -> (usize, usize) {
+        self.digits(n).store(room)
+    }
+
+    /// `n` units' digits worked out, to be stored later (`Digits::store`):
+    /// a block works out all its numbers' digits side by side before it
+    /// stores any, so their chains of multiplies overlap.
+    #[inline(always)]
+    pub fn digits(&self, n: i64) -> Digits {
         let mag = n.unsigned_abs();
         if mag < self.short_below {
             // At most 8 digits either side of the point: scaled to 8
             // decimals it splits at a constant (a multiply, where 10^d
             // would divide).
             let m8 = mag * self.to_eighths;
-            print_short(
-                room,
-                n < 0,
-                (m8 / 100_000_000) as u32,
-                (m8 % 100_000_000) as u32,
-            )
+            short_digits(n < 0, (m8 / 100_000_000) as u32, (m8 % 100_000_000) as u32)
         } else {
-            let p = POW10[self.d as usize];
-            print_long(room, n < 0, mag / p, mag % p, self.d as usize)
+            Digits {
+                whole: mag,
+                negative: n < 0,
+                long: Some(self.d),
+                ..Digits::default()
+            }
+        }
+    }
+}
+
+/// A number's digits, worked out and not yet stored (`Decimals::digits`).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Digits {
+    /// At most eight integer digits: their ASCII, the first in the
+    /// lowest byte ('0' after the last); a longer number's magnitude in
+    /// units.
+    whole: u64,
+    /// The eight decimals' ASCII, the first in the lowest byte.
+    frac: u64,
+    /// How many integer digits and decimals are shown.
+    whole_digits: usize,
+    shown: usize,
+    negative: bool,
+    /// A number with more than eight digits either side: its decimals
+    /// (printed digit pair by digit pair when stored).
+    long: Option<u32>,
+}
+
+impl Digits {
+    /// Stores the number into `room`, whatever it held; returns its
+    /// length and its count of digits (bytes of `room` after the number
+    /// are left as filler).
+    #[inline(always)]
+    pub fn store(&self, room: &mut [u8; PRINTED_ROOM]) -> (usize, usize) {
+        match self.long {
+            None => store_short(room, self),
+            Some(d) => {
+                let p = POW10[d as usize];
+                print_long(
+                    room,
+                    self.negative,
+                    self.whole / p,
+                    self.whole % p,
+                    d as usize,
+                )
+            }
         }
     }
 }
@@ -305,15 +352,10 @@ fn sixteen_digits(whole: u32, frac8: u32) -> (u64, u64) {
 }
 
 /// A number with at most 8 integer digits and 8 decimals: each part
-/// printed as one 8-byte word, its zeros counted from the word's bits.
-/// `frac8` is the decimals scaled to eight places.
+/// split into digits as one 8-byte word, its zeros counted from the
+/// word's bits. `frac8` is the decimals scaled to eight places.
 #[inline(always)]
-fn print_short(
-    room: &mut [u8; PRINTED_ROOM],
-    negative: bool,
-    whole: u32,
-    frac8: u32,
-) -> (usize, usize) {
+fn short_digits(negative: bool, whole: u32, frac8: u32) -> Digits {
     const ZEROS: u64 = 0x3030_3030_3030_3030;
     let (w, f) = sixteen_digits(whole, frac8);
     // Leading zeros are the low bytes; the last digit is always shown.
@@ -321,14 +363,27 @@ fn print_short(
     let w = w >> (8 * (8 - whole_digits));
     // Trailing zeros are the high bytes; all zero: no decimals at all.
     let shown = 8 - f.leading_zeros() as usize / 8;
-    let minus = negative as usize;
-    let point = minus + whole_digits;
+    Digits {
+        whole: w | ZEROS,
+        frac: f | ZEROS,
+        whole_digits,
+        shown,
+        negative,
+        long: None,
+    }
+}
+
+/// Stores a short number (`short_digits`): each part as one 8-byte word.
+#[inline(always)]
+fn store_short(room: &mut [u8; PRINTED_ROOM], d: &Digits) -> (usize, usize) {
+    let minus = d.negative as usize;
+    let point = minus + d.whole_digits;
     // A positive number's digits overwrite the '0' put where a minus goes.
-    room[0] = if negative { b'-' } else { b'0' };
-    room[minus..minus + 8].copy_from_slice(&(w | ZEROS).to_le_bytes());
+    room[0] = if d.negative { b'-' } else { b'0' };
+    room[minus..minus + 8].copy_from_slice(&d.whole.to_le_bytes());
     room[point] = b'.';
-    room[point + 1..point + 9].copy_from_slice(&(f | ZEROS).to_le_bytes());
-    (point + 1 + shown, whole_digits + shown)
+    room[point + 1..point + 9].copy_from_slice(&d.frac.to_le_bytes());
+    (point + 1 + d.shown, d.whole_digits + d.shown)
 }
 
 /// Any other number: digits two at a time from a table.

@@ -129,6 +129,12 @@ pub struct ProgramWriter {
     /// The text's capacity when its spare capacity was last zeroed (0:
     /// not since its allocation): see `room`.
     zeroed: usize,
+    /// Whether rapids and lines may go the one-pass way
+    /// (`common_block`): the dialect allows it.
+    common_blocks: bool,
+    /// How many blocks went the one-pass way (for the tests).
+    #[cfg(test)]
+    common_written: usize,
 }
 
 /// The spindle's state as the program has set it.
@@ -225,7 +231,7 @@ impl ProgramWriter {
             has('Z'),
             has('C').map(|_| dialect.c_letter),
         ];
-        ProgramWriter {
+        let mut w = ProgramWriter {
             text: Vec::new(),
             dialect: dialect.clone(),
             decimals,
@@ -278,7 +284,12 @@ impl ProgramWriter {
             circle_centre: None,
             moves: 0,
             zeroed: 0,
-        }
+            common_blocks: false,
+            #[cfg(test)]
+            common_written: 0,
+        };
+        w.common_blocks = w.common_blocks_apply();
+        w
     }
 
     /// Calls the tool and sets the coolant: the dialect's tool-call blocks
@@ -486,6 +497,14 @@ impl ProgramWriter {
     #[inline(always)]
     fn write_move(&mut self, m: &crate::moves::Move) -> Result<(), ProgramError> {
         use crate::moves::Move as M;
+        let common = match *m {
+            M::Linear { to, feed } => self.common_block(Word::Linear, to, feed),
+            M::Rapid(to) => self.common_block(Word::Rapid, to, None),
+            _ => false,
+        };
+        if common {
+            return Ok(());
+        }
         if self.start.is_none() {
             return Err(ProgramError::Unsupported(
                 "a move before the tool is called (the writer's `call_tool`)".into(),
@@ -1535,6 +1554,7 @@ pub(crate) fn check_number(num: &[u8]) -> Result<(), &'static str> {
     Ok(())
 }
 
+mod common_block;
 mod klartext;
 #[cfg(test)]
 mod tests;

@@ -618,3 +618,212 @@ proptest::proptest! {
         }
     }
 }
+
+/// A coordinate for the common block's differential test: anywhere, a
+/// step of a unit or less from a few fixed values (so words repeat), a
+/// rounding tie, an axis left where it is, a value no word can print,
+/// or one at the edge of four integer digits.
+fn coordinate() -> impl proptest::strategy::Strategy<Value = f64> {
+    use proptest::prelude::*;
+    prop_oneof![
+        4 => -500.0f64..500.0,
+        4 => (0u8..3, -3i64..3).prop_map(|(k, j)| k as f64 * 7.25 + j as f64 * 4e-7),
+        1 => (-100_000i64..100_000).prop_map(|k| (k as f64 + 0.5) * 1e-4),
+        2 => Just(f64::NAN),
+        1 => prop_oneof![Just(1e19), Just(-2e18), Just(f64::INFINITY)],
+        1 => (-3i64..3, any::<bool>())
+            .prop_map(|(k, neg)| (1e4 + k as f64 * 5e-5) * if neg { -1.0 } else { 1.0 }),
+    ]
+}
+
+/// A move's end for the differential test.
+fn position() -> impl proptest::strategy::Strategy<Value = P> {
+    use proptest::prelude::*;
+    (coordinate(), coordinate(), coordinate(), coordinate()).prop_map(|(x, y, z, c)| P {
+        x,
+        y,
+        z,
+        c,
+    })
+}
+
+/// A feed for the differential test, in any mode: one that prints as
+/// zero or not at all among them.
+fn feed() -> impl proptest::strategy::Strategy<Value = Option<F>> {
+    use proptest::prelude::*;
+    prop_oneof![
+        Just(None),
+        (1e-4f64..50.0).prop_map(|v| Some(F::PerTime(v))),
+        (1e-5f64..0.1).prop_map(|v| Some(F::PerRevolution(v))),
+        (1e-7f64..10.0).prop_map(|t| Some(F::InverseTime(t))),
+        prop_oneof![Just(0.0), Just(1e-12), Just(f64::NAN), Just(1e30)]
+            .prop_map(|v| Some(F::PerTime(v))),
+    ]
+}
+
+/// A move for the differential test: mostly rapids and lines in every
+/// feed mode (a feed that prints as zero or not at all among them), now
+/// and then an arc, or the spindle stopped or started.
+fn any_move() -> impl proptest::strategy::Strategy<Value = M> {
+    use proptest::prelude::*;
+    prop_oneof![
+        8 => (position(), feed()).prop_map(|(to, feed)| M::Linear { to, feed }),
+        3 => position().prop_map(M::Rapid),
+        1 => (position(), -10.0f64..10.0, -10.0f64..10.0, any::<bool>(), feed()).prop_map(
+            |(to, i, k, ccw, feed)| M::Arc {
+                to,
+                centre: P::xz(i, k),
+                plane: Plane::Zx,
+                ccw,
+                feed,
+            }
+        ),
+        1 => Just(M::SpindleOff),
+        1 => Just(M::SpindleOn(RPM_1000)),
+    ]
+}
+
+/// The dialects of the differential test: LinuxCNC as it is, with word
+/// formats and a digit limit, with a line limit that some blocks reach
+/// (`line_limit`), with block
+/// numbers, with a motion word and a block end too long for the common
+/// block's fixed copies, and the Fanuc-like lathe.
+fn differential_dialect(
+    k: u8,
+    max_digits: Option<u32>,
+    line_limit: usize,
+) -> (Dialect, Setup, &'static str) {
+    let mut d = Dialect::linuxcnc();
+    let (setup, axes) = match k % 3 {
+        0 => (Setup::Lathe, "XZC"),
+        1 => (Setup::Mill, "XYZ"),
+        _ => (Setup::Mill, "XYZC"),
+    };
+    match k / 3 {
+        0 => {}
+        1 => {
+            d.max_digits = max_digits;
+            for f in ["X4.6", "Y3.6", "Z2.6", "F5.3", "C5.5"] {
+                d.word_formats.push(WordFormat::parse(f).expect("a format"));
+            }
+        }
+        2 => d.max_line_length = Some(line_limit),
+        3 => d.line_numbers = Some(10),
+        4 => {
+            d.linear = "G1 G64 P0.001 Q0.001".into();
+            d.block_end = " ; a block end of twenty".into();
+        }
+        _ => return (fanuc_like(), Setup::Lathe, "XZ"),
+    }
+    (d, setup, axes)
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(300))]
+
+    /// The common block (one pass) against the general path alone,
+    /// move by move over random streams and dialects: the same text
+    /// after every move, the same refusals, the same program at the end.
+    #[test]
+    fn the_common_block_is_the_general_paths(
+        dialect in 0u8..18,
+        resolution in proptest::sample::select(vec![1e-3, 1e-4, 1e-6]),
+        max_digits in proptest::option::of(5u32..13),
+        line_limit in 20usize..50,
+        stream in proptest::collection::vec(any_move(), 1..80),
+    ) {
+        let (d, setup, axes) = differential_dialect(dialect, max_digits, line_limit);
+        let start = |common: bool| {
+            let mut w = ProgramWriter::new(&d, setup, "t", &[], axes, resolution, 1e-3)?;
+            w.common_blocks &= common;
+            w.call_tool(&Start::default())?;
+            w.write(&M::SpindleOn(RPM_1000))?;
+            Ok::<_, ProgramError>(w)
+        };
+        let (Ok(mut one_pass), Ok(mut general)) = (start(true), start(false)) else {
+            // A dialect this resolution does not fit: refused alike.
+            proptest::prop_assert_eq!(
+                format!("{:?}", start(true).err()),
+                format!("{:?}", start(false).err())
+            );
+            return Ok(());
+        };
+        proptest::prop_assert!(!general.common_blocks);
+        for m in &stream {
+            let a = one_pass.write(m).and_then(|()| one_pass.take_text());
+            let b = general.write(m).and_then(|()| general.take_text());
+            // Compared as printed: a refused NaN is not equal to itself.
+            proptest::prop_assert_eq!(format!("{a:?}"), format!("{b:?}"), "after {:?}", m);
+        }
+        proptest::prop_assert_eq!(general.common_written, 0);
+        proptest::prop_assert_eq!(
+            format!("{:?}", one_pass.finish()),
+            format!("{:?}", general.finish())
+        );
+    }
+}
+
+/// The emission bench's spiral (X, Z and C on every move, inverse time)
+/// goes the one-pass way block for block, and so does a mill's feed per
+/// minute; a dialect that numbers its blocks does not.
+#[test]
+fn common_blocks_are_the_common_path() {
+    let spiral: Vec<M> = (0..2000)
+        .map(|i| {
+            let c = i as f64 * 0.0021;
+            M::Linear {
+                to: P::xzc(
+                    24.0 - 0.002 * c / std::f64::consts::TAU,
+                    0.4997 + 0.018 * (7.0 * c).sin().powi(2),
+                    c,
+                ),
+                feed: Some(F::InverseTime(0.00058 + 1e-7 * (i % 13) as f64)),
+            }
+        })
+        .collect();
+    let mut w = ProgramWriter::new(
+        &Dialect::linuxcnc(),
+        Setup::Lathe,
+        "t",
+        &[],
+        "XZC",
+        1e-6,
+        1e-5,
+    )
+    .expect("a lathe program");
+    w.call_tool(&Start::default()).expect("tool 1");
+    w.write_all(&spiral).expect("printable");
+    let text = w.take_text().expect("checked");
+    let blocks = text.lines().filter(|l| l.starts_with("G1 ")).count();
+    // The first move states the feed mode (`G93 G1 …`): the general way.
+    assert_eq!(w.common_written, blocks);
+    assert_eq!(blocks, 1999);
+    let mill: Vec<M> = (0..100)
+        .map(|i| M::Linear {
+            to: P::xyz(i as f64 * 0.01, 1.0, -0.5),
+            feed: Some(F::PerTime(10.0)),
+        })
+        .collect();
+    let mut w = ProgramWriter::new(
+        &Dialect::linuxcnc(),
+        Setup::Mill,
+        "t",
+        &[],
+        "XYZ",
+        1e-3,
+        1e-3,
+    )
+    .expect("a mill program");
+    w.call_tool(&Start::default()).expect("tool 1");
+    w.write(&M::SpindleOn(RPM_1000)).expect("spindle");
+    w.write_all(&mill).expect("printable");
+    assert_eq!(w.common_written, 99);
+    let mut numbered = Dialect::linuxcnc();
+    numbered.line_numbers = Some(10);
+    let mut w = ProgramWriter::new(&numbered, Setup::Mill, "t", &[], "XYZ", 1e-3, 1e-3)
+        .expect("a mill program");
+    w.call_tool(&Start::default()).expect("tool 1");
+    w.write(&M::SpindleOn(RPM_1000)).expect("spindle");
+    w.write_all(&mill).expect("printable");
+    assert_eq!(w.common_written, 0);
+}
