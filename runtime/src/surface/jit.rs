@@ -457,41 +457,80 @@ fn pressure_schedule(tape: &SurfaceTape, live: &[Id], ahead: Ahead) -> Vec<Id> {
     }
     // Uses not yet emitted; an output is never released.
     let mut uses = vec![0u32; n];
-    let mut users: Vec<Vec<Id>> = vec![Vec::new(); n];
     let mut unready = vec![0u32; n];
     let mut ready = Vec::new();
     for &id in live {
         for o in operands(node(id)) {
             uses[o.0 as usize] += 1;
-            users[o.0 as usize].push(id);
             unready[id.0 as usize] += 1;
         }
         if unready[id.0 as usize] == 0 {
             ready.push(id);
         }
     }
+    // The users of node i, in tape order, are users[first[i]..first[i + 1]]
+    // (one list for all: a vector per node made allocation most of the
+    // schedule's time).
+    let mut first = vec![0u32; n + 1];
+    for i in 0..n {
+        first[i + 1] = first[i] + uses[i];
+    }
+    let mut filled = first.clone();
+    let mut users = vec![Id(0); first[n] as usize];
+    for &id in live {
+        for o in operands(node(id)) {
+            let slot = &mut filled[o.0 as usize];
+            users[*slot as usize] = id;
+            *slot += 1;
+        }
+    }
     for o in tape.outputs {
         uses[o.0 as usize] = u32::MAX / 2;
     }
+    // The values each ready node is the last use of, kept up to date as
+    // nodes are placed (recounted for every ready node at every step, this
+    // was most of the schedule's time).
+    let last_uses = |id: Id, uses: &[u32]| {
+        operands(node(id))
+            .filter(|o| uses[o.0 as usize] == 1)
+            .count() as u32
+    };
+    let mut kills = vec![0u32; n];
+    for &id in &ready {
+        kills[id.0 as usize] = last_uses(id, &uses);
+    }
+    let mut placed = vec![false; n];
     let mut order = Vec::with_capacity(live.len());
     while !ready.is_empty() {
         let key = |id: Id| {
-            let kills = operands(node(id))
-                .filter(|o| uses[o.0 as usize] == 1)
-                .count();
-            (std::cmp::Reverse(kills), level[id.0 as usize], id.0)
+            let i = id.0 as usize;
+            (std::cmp::Reverse(kills[i]), level[i], id.0)
         };
         let next = (0..ready.len())
             .min_by_key(|&k| key(ready[k]))
             .expect("ready is not empty");
         let id = ready.swap_remove(next);
         order.push(id);
+        placed[id.0 as usize] = true;
         for o in operands(node(id)) {
-            uses[o.0 as usize] -= 1;
+            let o = o.0 as usize;
+            uses[o] -= 1;
+            if uses[o] == 1 {
+                // Its one user left now frees it, if that user is ready
+                // (one not yet ready counts it when it becomes ready).
+                let left = users[first[o] as usize..first[o + 1] as usize]
+                    .iter()
+                    .find(|u| !placed[u.0 as usize]);
+                if let Some(&u) = left.filter(|u| unready[u.0 as usize] == 0) {
+                    kills[u.0 as usize] += 1;
+                }
+            }
         }
-        for &u in &users[id.0 as usize] {
+        let i = id.0 as usize;
+        for &u in &users[first[i] as usize..first[i + 1] as usize] {
             unready[u.0 as usize] -= 1;
             if unready[u.0 as usize] == 0 {
+                kills[u.0 as usize] = last_uses(u, &uses);
                 ready.push(u);
             }
         }
