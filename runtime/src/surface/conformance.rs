@@ -401,11 +401,11 @@ impl<B: Backend> Conformance<B> {
         check_against_finite_differences::<B>(&tape(every_other_operation), &pts);
     }
 
-    /// Batches of 0, 1, 2, 3, 7 and 1000 points give, bit for bit, what
+    /// Batches of 0, 1, 2, 3, 7, 17 and 1000 points give, bit for bit, what
     /// the points give one at a time, whatever `out` held before.
     pub fn batches_of_every_length_agree_with_single_points() {
         let f = B::build(&tape(every_other_operation));
-        for n in [0, 1, 2, 3, 7, 1000] {
+        for n in [0, 1, 2, 3, 7, 17, 1000] {
             let (xs, ys): (Vec<f64>, Vec<f64>) = points(n).into_iter().unzip();
             let mut poisoned = vec![f64::from_bits(0x7ff4_dead_beef_0001); 6 * n];
             let mut filled = vec![-12345.678; 6 * n];
