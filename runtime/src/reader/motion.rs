@@ -125,20 +125,27 @@ impl State {
                 .iter()
                 .position(|l| *l == w.letter)
                 .expect("an axis");
-            let mut v = w.value;
-            if i != 3 {
-                v *= unit;
-            }
-            if i == 0 && self.diameter {
-                v /= 2.0;
-            }
-            end[i] = if self.absolute == Some(false) {
-                self.pos[i].map(|p| p + v)
-            } else {
-                Some(v)
-            };
+            end[i] = self.axis_end(i, w.value, unit);
         }
         end
+    }
+
+    /// Where axis `i` (X Y Z C) ends for a word's `value` in the program's
+    /// `unit` (mm per unit; C in degrees): a diameter halved to a radius,
+    /// an incremental value added to where the axis is (unknown if it is).
+    pub(super) fn axis_end(&self, i: usize, value: f64, unit: f64) -> Option<f64> {
+        let mut v = value;
+        if i != 3 {
+            v *= unit;
+        }
+        if i == 0 && self.diameter {
+            v /= 2.0;
+        }
+        if self.absolute == Some(false) {
+            self.pos[i].map(|p| p + v)
+        } else {
+            Some(v)
+        }
     }
 
     fn travel(&self, end: &[Option<f64>; 4], b: &Block, out: &mut Vec<Found>) {

@@ -138,18 +138,7 @@ impl State {
             if seen & (2 << axis) == 0 {
                 continue;
             }
-            let mut v = values[axis + 1];
-            if axis != 3 {
-                v *= unit;
-            }
-            if axis == 0 && self.diameter {
-                v /= 2.0;
-            }
-            end[axis] = if self.absolute == Some(false) {
-                self.pos[axis].map(|p| p + v)
-            } else {
-                Some(v)
-            };
+            end[axis] = self.axis_end(axis, values[axis + 1], unit);
             if self.outside_travel(axis, end[axis]).is_some() {
                 return false;
             }
