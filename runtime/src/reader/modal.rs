@@ -343,13 +343,8 @@ impl State {
         groups.clear();
         ms.clear();
         for (i, w) in b.words.iter().enumerate() {
-            let scaled = w.value * 10.0;
-            let code = round_to_integer(scaled);
             match w.letter {
-                'G' => match ((scaled - code as f64).abs() < 1e-9)
-                    .then(|| self.g_group(code))
-                    .flatten()
-                {
+                'G' => match g_tenths(w.value).and_then(|code| self.g_group(code)) {
                     Some(g) => {
                         let siemens = self.lex.controller == Controller::Siemens;
                         if let Some(&(_, o)) =
@@ -663,6 +658,14 @@ impl State {
 /// `v.round() as i64` (halves away from zero, saturating, NaN to 0)
 /// without a call into libm: the truncation and the fraction it drops
 /// are both exact in f64.
+/// A G word's code in tenths (`G1` is 10, `G64.1` 641), if its value is
+/// one within 1e-9 of a tenth.
+pub(super) fn g_tenths(value: f64) -> Option<i64> {
+    let scaled = value * 10.0;
+    let code = round_to_integer(scaled);
+    ((scaled - code as f64).abs() < 1e-9).then_some(code)
+}
+
 fn round_to_integer(v: f64) -> i64 {
     let t = v as i64;
     let fraction = v - t as f64;

@@ -115,28 +115,33 @@ impl State {
 
     fn end_point(&self, b: &Block) -> [Option<f64>; 4] {
         let mut end = self.pos;
-        let unit = if self.metric == Some(false) {
-            25.4
-        } else {
-            1.0
-        };
         for w in axes(b) {
             let i = LETTERS
                 .iter()
                 .position(|l| *l == w.letter)
                 .expect("an axis");
-            end[i] = self.axis_end(i, w.value, unit);
+            end[i] = self.axis_end(i, w.value);
         }
         end
     }
 
+    /// Millimetres per unit of the program's lengths: 25.4 after G20
+    /// (inch), else 1.
+    pub(super) fn mm_per_unit(&self) -> f64 {
+        if self.metric == Some(false) {
+            25.4
+        } else {
+            1.0
+        }
+    }
+
     /// Where axis `i` (X Y Z C) ends for a word's `value` in the program's
-    /// `unit` (mm per unit; C in degrees): a diameter halved to a radius,
-    /// an incremental value added to where the axis is (unknown if it is).
-    pub(super) fn axis_end(&self, i: usize, value: f64, unit: f64) -> Option<f64> {
+    /// units (C in degrees): a diameter halved to a radius, an incremental
+    /// value added to where the axis is (unknown if it is).
+    pub(super) fn axis_end(&self, i: usize, value: f64) -> Option<f64> {
         let mut v = value;
         if i != 3 {
-            v *= unit;
+            v *= self.mm_per_unit();
         }
         if i == 0 && self.diameter {
             v /= 2.0;
@@ -363,11 +368,7 @@ impl State {
         let (Some(f), Some(mode)) = (feed, self.feed_mode) else {
             return (None, None);
         };
-        let unit = if self.metric == Some(false) {
-            25.4
-        } else {
-            1.0
-        };
+        let unit = self.mm_per_unit();
         let rate = match mode {
             FeedMode::PerMinute => Some(f * unit),
             FeedMode::InverseTime => Some(length * f),
@@ -458,11 +459,7 @@ impl State {
         let (Some(sa), Some(sb), Some(ea), Some(eb)) = (start[a], start[b], end[a], end[b]) else {
             return None;
         };
-        let unit = if self.metric == Some(false) {
-            25.4
-        } else {
-            1.0
-        };
+        let unit = self.mm_per_unit();
         let word = |l: char| {
             centre
                 .iter()

@@ -18,7 +18,7 @@
 use super::super::lexer::{Lexer, WordLimits, number};
 use super::super::motion::chord;
 use super::super::{Controller, Executed, Path};
-use super::{Motion, State, round_to_integer};
+use super::{Motion, State, g_tenths};
 
 /// The letters read here, by their index: G, the axes X Y Z C (axis
 /// `index - 1`), F.
@@ -110,9 +110,7 @@ impl State {
         }
         // The motion: G1 (as `classify` finds its group), or G1 in force.
         if seen & (1 << G) != 0 {
-            let scaled = values[G] * 10.0;
-            let code = round_to_integer(scaled);
-            if code != 10 || (scaled - code as f64).abs() >= 1e-9 {
+            if g_tenths(values[G]) != Some(10) {
                 return false;
             }
         } else if self.motion != Some(Motion::Linear) {
@@ -129,16 +127,11 @@ impl State {
         }
         let start = self.pos;
         let mut end = self.pos;
-        let unit = if self.metric == Some(false) {
-            25.4
-        } else {
-            1.0
-        };
         for axis in 0..4 {
             if seen & (2 << axis) == 0 {
                 continue;
             }
-            end[axis] = self.axis_end(axis, values[axis + 1], unit);
+            end[axis] = self.axis_end(axis, values[axis + 1]);
             if self.outside_travel(axis, end[axis]).is_some() {
                 return false;
             }
