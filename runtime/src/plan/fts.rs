@@ -637,6 +637,8 @@ impl Planner<'_> {
         // The band of the chord into the next point, from the revolution
         // before (`plan::chords`).
         let mut band_before = None;
+        // The least and greatest nonzero |acceleration| (`account`).
+        let mut nonzero = (f64::INFINITY, 0.0);
         let take = |(pts, over): Revolution| {
             ChordShortfall::merge(&mut summary.chords_over_tolerance, over);
             buffer.clear();
@@ -658,7 +660,8 @@ impl Planner<'_> {
                     }
                 };
                 let point = SpiralPoint { x, c, w, t };
-                self.account(&mut summary, &last, point, fast_axis);
+                let spin = s.speed.at(point.x);
+                Self::account(&mut summary, &mut nonzero, &last, point, spin);
                 if last.len() == 2 {
                     last.remove(0);
                 }
@@ -683,6 +686,8 @@ impl Planner<'_> {
             return Err(e);
         }
         summary.time = last.last().map_or(0.0, |p| p.t);
+        summary.highest_allowed_speed =
+            highest_allowed_speed(self.speed_now(), fast_axis.max_acceleration, nonzero);
         let range = summary.w_max - summary.w_min;
         if range > fast_axis.stroke {
             return Err(FtsError::StrokeExceeded {
@@ -701,12 +706,19 @@ impl Planner<'_> {
     }
 
     /// Folds one point into the summary: counts, W range, spindle speed,
-    /// acceleration (second divided difference with the two before it).
-    fn account(&self, sum: &mut FtsSummary, last: &[SpiralPoint], p: SpiralPoint, fa: &FastAxis) {
+    /// acceleration (second divided difference with the two before it) and
+    /// the least and greatest nonzero |acceleration| (`nonzero`), from which
+    /// `highest_allowed_speed` follows.
+    fn account(
+        sum: &mut FtsSummary,
+        nonzero: &mut (f64, f64),
+        last: &[SpiralPoint],
+        p: SpiralPoint,
+        spin: f64,
+    ) {
         sum.points += 1;
         sum.w_min = sum.w_min.min(p.w);
         sum.w_max = sum.w_max.max(p.w);
-        let spin = self.spiral.speed.at(p.x);
         sum.max_spindle_speed = sum.max_spindle_speed.max(spin);
         for v in [p.x, p.c, p.w] {
             for b in v.to_bits().to_le_bytes() {
@@ -722,18 +734,38 @@ impl Planner<'_> {
                     sum.max_acceleration = acc.abs();
                     sum.max_acceleration_at = b.x;
                 }
-                if acc != 0.0 {
-                    // Acceleration scales with the square of the speed.
-                    let scale = (fa.max_acceleration / acc.abs()).sqrt();
-                    let now = match self.spiral.speed {
-                        SpindleSpeed::Constant(w) => w,
-                        SpindleSpeed::SurfaceSpeed { speed, .. } => speed,
-                    };
-                    sum.highest_allowed_speed = sum.highest_allowed_speed.min(now * scale);
+                if acc != 0.0 && !acc.is_nan() {
+                    let (low, high) = nonzero;
+                    *low = low.min(acc.abs());
+                    *high = high.max(acc.abs());
                 }
             }
         }
     }
+
+    /// The speed now: spindle speed (constant) or surface speed.
+    fn speed_now(&self) -> f64 {
+        match self.spiral.speed {
+            SpindleSpeed::Constant(w) => w,
+            SpindleSpeed::SurfaceSpeed { speed, .. } => speed,
+        }
+    }
+}
+
+/// The highest spindle speed (or surface speed) at which every point's
+/// acceleration stays within `limit`: acceleration scales with the square
+/// of the speed, so `now` times sqrt(limit / |acc|), least over the points
+/// (a NaN passed over). Each step (a division, a square root and a product,
+/// each rounded once) is monotone in |acc|, so that least value is the one
+/// at the least or the greatest nonzero |acc| (`nonzero`), bit for bit: two
+/// evaluations, not one a point.
+fn highest_allowed_speed(now: f64, limit: f64, nonzero: (f64, f64)) -> f64 {
+    let (low, high) = nonzero;
+    if low > high {
+        return f64::INFINITY;
+    }
+    let at = |acc: f64| now * (limit / acc).sqrt();
+    f64::INFINITY.min(at(low)).min(at(high))
 }
 
 /// The settling offset h (mm) for a lenslet whose height along its radius

@@ -375,3 +375,42 @@ fn each_chord_placement_errs_as_it_promises() {
     assert!(clear.2 <= 1e-9, "{clear:?}");
     assert!(clear.3 <= 1.3 * share, "{clear:?}");
 }
+
+proptest::proptest! {
+    /// The highest allowed speed worked out from the least and greatest
+    /// nonzero |acceleration| is, bit for bit, the fold over every point
+    /// that `account` used to do: any speed (negative, zero, infinite, NaN)
+    /// and any accelerations (tiny, huge, infinite, NaN).
+    #[test]
+    fn highest_allowed_speed_is_the_fold_over_every_point(
+        now in proptest::prop_oneof![
+            proptest::num::f64::ANY,
+            -1e3..1e3f64,
+            proptest::strategy::Just(0.0),
+        ],
+        limit in proptest::prop_oneof![proptest::num::f64::ANY, 1.0..1e7f64],
+        accs in proptest::collection::vec(
+            proptest::prop_oneof![
+                proptest::num::f64::ANY,
+                -1e6..1e6f64,
+                -1e-300..1e-300f64,
+                proptest::strategy::Just(0.0),
+            ],
+            0..40,
+        ),
+    ) {
+        let mut fold = f64::INFINITY;
+        let mut nonzero = (f64::INFINITY, 0.0);
+        for acc in accs {
+            if acc != 0.0 {
+                fold = fold.min(now * (limit / acc.abs()).sqrt());
+            }
+            if acc != 0.0 && !acc.is_nan() {
+                nonzero.0 = f64::min(nonzero.0, acc.abs());
+                nonzero.1 = f64::max(nonzero.1, acc.abs());
+            }
+        }
+        let ours = highest_allowed_speed(now, limit, nonzero);
+        proptest::prop_assert_eq!(ours.to_bits(), fold.to_bits(), "{} against {}", ours, fold);
+    }
+}
