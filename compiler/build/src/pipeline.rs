@@ -70,6 +70,22 @@ pub fn lower(
     }
 }
 
+/// The warnings a lowered job earns before any planning, which `check`
+/// reports beside the lowering's errors (`build` finds the same ones on
+/// its way): a wrapped design that does not close around its roller
+/// (W0006).
+pub fn warnings_before_planning(spec: &JobSpec) -> Vec<Diagnostic> {
+    match spec {
+        JobSpec::Roller(s) => {
+            let (design, _) = evaluator(&s.head.surface.lowered.tape);
+            builders::roller::seam_warning(s, design.as_ref())
+                .into_iter()
+                .collect()
+        }
+        _ => Vec::new(),
+    }
+}
+
 /// Builds programs and reports (without writing them) for the checked
 /// jobs. Returns them and any further diagnostics. Large programs are
 /// spooled into `spool_dir` (the output directory) when one is given.

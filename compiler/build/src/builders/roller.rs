@@ -147,7 +147,7 @@ pub fn build(
 /// W0006: where the roller closes, the design's last row meets its first
 /// (design y = y_start + 2πR against y_start); a step there higher than
 /// the machine's resolution is cut as a step, all along the helix.
-fn seam_warning(
+pub fn seam_warning(
     spec: &RollerSpec,
     design: &dyn lensc_runtime::surface::ir::SurfaceFn,
 ) -> Option<Diagnostic> {

@@ -1,7 +1,7 @@
 //! `lensc check`: check files for errors without building anything: the
 //! checker's findings and, once a file checks, every job lowered as `build`
 //! lowers it (everything knowable without planning, the limits on its
-//! points and program size included).
+//! points and program size and the warnings before planning included).
 
 use crate::output::{Output, load};
 
@@ -22,13 +22,14 @@ pub fn run(out: &Output, files: &[std::path::PathBuf], max_program_size: u64) ->
         // checks.
         let mut diags = c.diags().to_vec();
         if !c.has_errors() {
-            diags.extend(
-                c.checked
-                    .jobs
-                    .iter()
-                    .filter_map(|j| lensc_build::pipeline::lower(j, None, &limits).err())
-                    .flatten(),
-            );
+            for j in &c.checked.jobs {
+                match lensc_build::pipeline::lower(j, None, &limits) {
+                    Ok((spec, _)) => {
+                        diags.extend(lensc_build::pipeline::warnings_before_planning(&spec));
+                    }
+                    Err(refused) => diags.extend(refused),
+                }
+            }
         }
         out.diagnostics(&c, &diags);
         if diags.iter().any(|d| d.is_error()) {
