@@ -392,3 +392,81 @@ fn an_editor_session() {
     let status = c.child.wait().expect("wait");
     assert!(status.success(), "{status}");
 }
+
+/// What `lensc check` finds only by lowering the jobs (here W0006, a
+/// wrapped design open at the roller's seam) shows when the document is
+/// opened and saved, not while it is being edited (its places would be
+/// stale), and goes with the edit that mends it, once saved.
+#[test]
+fn lowering_findings_show_on_open_and_save() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let work = dir.path().canonicalize().expect("dir").join("work");
+    let cache = dir.path().join("cache");
+    std::fs::create_dir_all(&work).expect("mkdir");
+    let open =
+        std::fs::read_to_string(root().join("tests/bad_builds/roller_design_open_at_seam.lens"))
+            .expect("the bad build");
+    std::fs::write(work.join("seam.lens"), &open).expect("write");
+    let uri = uri_of(&work.join("seam.lens"));
+    let codes = |d: &[Value]| -> Vec<String> {
+        d.iter()
+            .map(|v| v["code"].as_str().expect("a code").to_string())
+            .collect()
+    };
+
+    let mut c = Client::start(&work, &cache);
+    let init = c.request(
+        "initialize",
+        json!({"processId": null, "rootUri": uri_of(&work), "capabilities": {}}),
+    );
+    assert_eq!(
+        init["capabilities"]["textDocumentSync"]["save"],
+        json!(true),
+        "{init}"
+    );
+    c.notify("initialized", json!({}));
+    c.notify(
+        "textDocument/didOpen",
+        json!({"textDocument": {"uri": uri, "languageId": "lens", "version": 1, "text": open}}),
+    );
+    let d = c.diagnostics(&uri);
+    assert_eq!(codes(&d), ["W0006"], "{d:?}");
+    assert_eq!(d[0]["severity"], 2);
+    let job = pos(&open, "j {", 0, 0);
+    assert_eq!(d[0]["range"]["start"], job);
+
+    // Typing: the checker's findings only (none).
+    let typed = format!("// edited\n{open}");
+    c.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": uri, "version": 2}, "contentChanges": [{"text": typed}]}),
+    );
+    assert_eq!(codes(&c.diagnostics(&uri)), Vec::<String>::new());
+    // Saved: lowered again, at the job's new place.
+    c.notify(
+        "textDocument/didSave",
+        json!({"textDocument": {"uri": uri}}),
+    );
+    let d = c.diagnostics(&uri);
+    assert_eq!(codes(&d), ["W0006"], "{d:?}");
+    assert_eq!(d[0]["range"]["start"], pos(&typed, "j {", 0, 0));
+
+    // A whole number of periods around the roller: saved, nothing left.
+    let closed = typed.replace("sin(1 rad/mm * y)", "sin(1.0471975511965976 rad/mm * y)");
+    assert_ne!(closed, typed);
+    c.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": uri, "version": 3}, "contentChanges": [{"text": closed}]}),
+    );
+    c.diagnostics(&uri);
+    c.notify(
+        "textDocument/didSave",
+        json!({"textDocument": {"uri": uri}}),
+    );
+    assert_eq!(codes(&c.diagnostics(&uri)), Vec::<String>::new());
+
+    let r = c.request("shutdown", Value::Null);
+    assert_eq!(r, Value::Null);
+    c.notify("exit", Value::Null);
+    assert!(c.child.wait().expect("wait").success());
+}

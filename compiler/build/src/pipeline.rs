@@ -70,6 +70,26 @@ pub fn lower(
     }
 }
 
+/// What `lensc check` reports of a checked file beyond the checker's own
+/// findings: once the file checks, each job lowered as `build` lowers it
+/// (in its machine's own dialect), with its refusals (the limits on its
+/// points and program size among them) or the warnings it earns before
+/// planning. Nothing while the file has errors. `lensc lsp` shows the
+/// same for a saved document.
+pub fn findings_before_planning(c: &Checked, limits: &Limits) -> Vec<Diagnostic> {
+    if c.has_errors() {
+        return Vec::new();
+    }
+    let mut found = Vec::new();
+    for j in &c.checked.jobs {
+        match lower(j, None, limits) {
+            Ok((spec, _)) => found.extend(warnings_before_planning(&spec)),
+            Err(refused) => found.extend(refused),
+        }
+    }
+    found
+}
+
 /// The warnings a lowered job earns before any planning, which `check`
 /// reports beside the lowering's errors (`build` finds the same ones on
 /// its way): a wrapped design that does not close around its roller

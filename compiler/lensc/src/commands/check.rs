@@ -18,19 +18,9 @@ pub fn run(out: &Output, files: &[std::path::PathBuf], max_program_size: u64) ->
             continue;
         };
         // Everything knowable without planning: each job lowered as
-        // `build` lowers it (in its machine's own dialect), once the file
-        // checks.
+        // `build` lowers it, once the file checks.
         let mut diags = c.diags().to_vec();
-        if !c.has_errors() {
-            for j in &c.checked.jobs {
-                match lensc_build::pipeline::lower(j, None, &limits) {
-                    Ok((spec, _)) => {
-                        diags.extend(lensc_build::pipeline::warnings_before_planning(&spec));
-                    }
-                    Err(refused) => diags.extend(refused),
-                }
-            }
-        }
+        diags.extend(lensc_build::pipeline::findings_before_planning(&c, &limits));
         out.diagnostics(&c, &diags);
         if diags.iter().any(|d| d.is_error()) {
             code = 1;

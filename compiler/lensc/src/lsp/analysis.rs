@@ -1,7 +1,8 @@
 //! The open documents and what the checker makes of each: the texts the
 //! editor holds (read in place of the files on disk, so a `use` of an
 //! unsaved file sees its unsaved text), each document checked as `lensc
-//! check` checks a file, its diagnostics in the protocol's terms, where a
+//! check` checks a file (its jobs lowered too when opened or saved), its
+//! diagnostics in the protocol's terms, where a
 //! name is declared, and the standard library's embedded files written out
 //! to a cache directory so an editor can open them.
 
@@ -48,6 +49,11 @@ impl FileSystem for Overlay<'_> {
 /// One document checked.
 pub struct Analysis {
     pub checked: lensc_lang::Checked,
+    /// What `lensc check` finds beyond the checker once the file checks
+    /// (each job lowered: refusals, limits, warnings before planning),
+    /// worked out when the document is opened or saved (`lower_jobs`);
+    /// empty after a change, until the next save.
+    pub before_planning: Vec<Diagnostic>,
     /// Why the document could not be checked at all (outside the root).
     pub refused: Option<String>,
 }
@@ -61,6 +67,7 @@ pub fn analyse(docs: &Docs, root: Option<&Path>, uri: &str) -> Option<Analysis> 
         let c = lensc_lang::check_text(&fs, uri, doc.text.as_bytes());
         return Some(Analysis {
             checked: c,
+            before_planning: Vec::new(),
             refused: None,
         });
     };
@@ -70,12 +77,29 @@ pub fn analyse(docs: &Docs, root: Option<&Path>, uri: &str) -> Option<Analysis> 
     match lensc_lang::check_path_in(&fs, path, root.as_deref()) {
         Ok(c) => Some(Analysis {
             checked: c,
+            before_planning: Vec::new(),
             refused: None,
         }),
         Err(e) => Some(Analysis {
             checked: lensc_lang::check_text(&fs, uri, b"let unchecked = 0"),
+            before_planning: Vec::new(),
             refused: Some(e.to_string()),
         }),
+    }
+}
+
+impl Analysis {
+    /// Lowers the document's jobs as `lensc check` does (the default
+    /// limits), for what only lowering finds: it plans nothing, but takes
+    /// longer than checking (a raster's contact search, a spiral's
+    /// estimate), so it runs when a document is opened or saved, not on
+    /// every keystroke.
+    pub fn lower_jobs(&mut self) {
+        if self.refused.is_none() {
+            let limits = lensc_lang::lower::job::Limits::default();
+            self.before_planning =
+                lensc_build::pipeline::findings_before_planning(&self.checked, &limits);
+        }
     }
 }
 
@@ -196,6 +220,7 @@ pub fn diagnostics(a: &Analysis, doc_uri: &Uri, text: &str) -> Vec<lsp::Diagnost
     a.checked
         .diags()
         .iter()
+        .chain(&a.before_planning)
         .map(|d| to_lsp(a, doc_uri, &ix, d))
         .collect()
 }

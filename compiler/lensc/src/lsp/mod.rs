@@ -1,7 +1,9 @@
 //! `lensc lsp`: a language server over stdin and stdout (JSON-RPC, the
 //! Language Server Protocol; transport `lsp-server`, types `lsp-types`).
 //! It keeps the documents the editor has open, checks each as it changes
-//! and publishes the checker's diagnostics with their codes, and answers
+//! and publishes the checker's diagnostics with their codes (and, when a
+//! document is opened or saved, what lowering its jobs finds, as `lensc
+//! check` reports it), and answers
 //! hover, completion, go to definition and formatting (`lensc fmt`'s
 //! layout). Positions are the protocol's UTF-16 columns (`text`); what the
 //! cursor is on is read from the text (`context`) and the checker's own
@@ -50,8 +52,13 @@ pub fn run() -> u8 {
 fn capabilities() -> lsp::ServerCapabilities {
     lsp::ServerCapabilities {
         position_encoding: Some(lsp::PositionEncodingKind::UTF16),
-        text_document_sync: Some(lsp::TextDocumentSyncCapability::Kind(
-            lsp::TextDocumentSyncKind::INCREMENTAL,
+        text_document_sync: Some(lsp::TextDocumentSyncCapability::Options(
+            lsp::TextDocumentSyncOptions {
+                open_close: Some(true),
+                change: Some(lsp::TextDocumentSyncKind::INCREMENTAL),
+                save: Some(lsp::TextDocumentSyncSaveOptions::Supported(true)),
+                ..Default::default()
+            },
         )),
         hover_provider: Some(lsp::HoverProviderCapability::Simple(true)),
         completion_provider: Some(lsp::CompletionOptions {
@@ -135,6 +142,11 @@ struct Server {
 
 impl Server {
     fn notification(&mut self, n: Notification) -> Vec<Notification> {
+        // Opening or saving lowers the jobs too (`Analysis::lower_jobs`).
+        let lower = matches!(
+            n.method.as_str(),
+            note::DidOpenTextDocument::METHOD | note::DidSaveTextDocument::METHOD
+        );
         let changed = match n.method.as_str() {
             note::DidOpenTextDocument::METHOD => params::<lsp::DidOpenTextDocumentParams>(n.params)
                 .map(|p| {
@@ -158,6 +170,8 @@ impl Server {
                     Some(())
                 })
             }
+            note::DidSaveTextDocument::METHOD => params::<lsp::DidSaveTextDocumentParams>(n.params)
+                .and_then(|p| self.docs.get(p.text_document.uri.as_str()).map(|_| ())),
             note::DidCloseTextDocument::METHOD => {
                 if let Some(p) = params::<lsp::DidCloseTextDocumentParams>(n.params) {
                     self.docs.remove(p.text_document.uri.as_str());
@@ -173,11 +187,15 @@ impl Server {
         }
         // A change can change what every other open document sees through
         // its `use`s: all are checked again (a handful, each in
-        // milliseconds).
+        // milliseconds; lowered, when opening or saving, in at most a
+        // few tenths of a second).
         let keys: Vec<String> = self.docs.keys().cloned().collect();
         let mut out = Vec::new();
         for k in keys {
-            if let Some(a) = analysis::analyse(&self.docs, self.root.as_deref(), &k) {
+            if let Some(mut a) = analysis::analyse(&self.docs, self.root.as_deref(), &k) {
+                if lower {
+                    a.lower_jobs();
+                }
                 let doc = &self.docs[&k];
                 let diags = analysis::diagnostics(&a, &doc.uri, &doc.text);
                 out.push(publish(doc.uri.clone(), diags));
