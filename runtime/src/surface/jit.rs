@@ -266,8 +266,9 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
         negative: HashMap::new(),
         covered: Vec::new(),
     };
-    let vector_order = emission_order(tape, Lanes::Two);
-    let scalar_order = emission_order(tape, Lanes::One);
+    let loops = Loops::of(tape, &tape.live_nodes());
+    let vector_order = emission_order(tape, &loops, Lanes::Two);
+    let scalar_order = emission_order(tape, &loops, Lanes::One);
     let [px, py, po] = [(); 3].map(|_| b.declare_var(ptr));
     b.def_var(px, xs);
     b.def_var(py, ys);
@@ -285,7 +286,7 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
 
     b.switch_to_block(pair);
     let (cx, cy, co) = (b.use_var(px), b.use_var(py), b.use_var(po));
-    let outputs = emit.pass(&mut b, tape, &vector_order, Lanes::Two, cx, cy)?;
+    let outputs = emit.pass(&mut b, tape, (&vector_order, &loops), Lanes::Two, cx, cy)?;
     match emit.covered.split_first() {
         None => b.ins().jump(store, &[]),
         Some((&first, rest)) => {
@@ -312,7 +313,7 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
 
     b.switch_to_block(single);
     let (cx, cy, co) = (b.use_var(px), b.use_var(py), b.use_var(po));
-    let outputs = emit.pass(&mut b, tape, &scalar_order, Lanes::One, cx, cy)?;
+    let outputs = emit.pass(&mut b, tape, (&scalar_order, &loops), Lanes::One, cx, cy)?;
     store_outputs(&mut b, Lanes::One, outputs, co);
     let nx = b.ins().iadd_imm_u(cx, 8);
     let ny = b.ins().iadd_imm_u(cy, 8);
@@ -337,7 +338,10 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
 /// The operands of a node, each once (`x · x` reads x once).
 fn operands(node: Node) -> impl Iterator<Item = Id> {
     let (a, b, c) = match node {
-        Node::Const(_) | Node::Var(_) => (None, None, None),
+        // A loop's operands are its inputs (`Loops`).
+        Node::Const(_) | Node::Var(_) | Node::Carried(_) | Node::Repeat { .. } => {
+            (None, None, None)
+        }
         Node::Unary(_, a) | Node::PowI(a, _) | Node::Step(a) => (Some(a), None, None),
         Node::Binary(_, a, b) => (Some(a), Some(b).filter(|&b| b != a), None),
         Node::Select(c, a, b) => (
@@ -347,6 +351,76 @@ fn operands(node: Node) -> impl Iterator<Item = Id> {
         ),
     };
     [a, b, c].into_iter().flatten()
+}
+
+/// The loops of a tape's live part (`Node::Repeat`): each is emitted as
+/// one block that branches back to itself, its body once, and is
+/// scheduled outside as one node that reads its inputs.
+struct Loops {
+    /// The body of each live loop, in the order it is emitted (the tape's).
+    bodies: HashMap<Id, Vec<Id>>,
+    /// Indexed by node (empty where the tape has no loop): what each loop
+    /// reads from outside its body, its initial value first, each once.
+    inputs: Vec<Vec<Id>>,
+    /// Indexed by node (empty where the tape has no loop): whether it is
+    /// in a body or is a loop's estimate, emitted inside its loop.
+    inside: Vec<bool>,
+}
+
+impl Loops {
+    fn of(tape: &SurfaceTape, live: &[Id]) -> Loops {
+        let graph = &tape.graph;
+        let mut loops = Loops {
+            bodies: HashMap::new(),
+            inputs: Vec::new(),
+            inside: Vec::new(),
+        };
+        for &id in live {
+            let Node::Repeat {
+                carried,
+                init,
+                next,
+                ..
+            } = graph.node(id)
+            else {
+                continue;
+            };
+            if loops.inside.is_empty() {
+                loops.inside = vec![false; graph.len()];
+                loops.inputs = vec![Vec::new(); graph.len()];
+            }
+            let body = graph.loop_body(carried, next);
+            loops.inside[carried.0 as usize] = true;
+            for &i in &body {
+                loops.inside[i.0 as usize] = true;
+            }
+            let mut inputs = vec![init];
+            for &i in &body {
+                for o in operands(graph.node(i)) {
+                    let outside = o != carried && body.binary_search(&o).is_err();
+                    if outside && !inputs.contains(&o) {
+                        inputs.push(o);
+                    }
+                }
+            }
+            loops.inputs[id.0 as usize] = inputs;
+            loops.bodies.insert(id, body);
+        }
+        loops
+    }
+
+    /// The nodes `id` reads, each once: its operands, or a loop's inputs.
+    fn deps(&self, tape: &SurfaceTape, id: Id) -> impl Iterator<Item = Id> {
+        let inputs = self
+            .inputs
+            .get(id.0 as usize)
+            .map_or(&[][..], Vec::as_slice);
+        operands(tape.graph.node(id)).chain(inputs.iter().copied())
+    }
+
+    fn is_inside(&self, id: Id) -> bool {
+        self.inside.get(id.0 as usize).copied().unwrap_or(false)
+    }
 }
 
 /// The largest live tape `emission_order` schedules (the examples' largest
@@ -360,8 +434,14 @@ const SCHEDULED_NODES: usize = 4096;
 /// changes how many values the register allocator must keep at once,
 /// which is most of the compile time of a big tape and the spills of its
 /// code, and how much of a pass the core can overlap.
-fn emission_order(tape: &SurfaceTape, lanes: Lanes) -> Vec<Id> {
-    let live = tape.live_nodes();
+/// Loops' bodies are emitted inside them in the tape's order; outside, a
+/// loop is one node.
+fn emission_order(tape: &SurfaceTape, loops: &Loops, lanes: Lanes) -> Vec<Id> {
+    let live: Vec<Id> = tape
+        .live_nodes()
+        .into_iter()
+        .filter(|&id| !loops.is_inside(id))
+        .collect();
     // The schedule scans the ready nodes for each node it places: bounded
     // here so that a huge tape costs no quadratic time before cranelift.
     if live.len() > SCHEDULED_NODES {
@@ -371,8 +451,8 @@ fn emission_order(tape: &SurfaceTape, lanes: Lanes) -> Vec<Id> {
         Lanes::One => Ahead::Operations,
         Lanes::Two => Ahead::Latency,
     };
-    let scheduled = pressure_schedule(tape, &live, ahead);
-    if waiting(tape, &scheduled) < waiting(tape, &live) {
+    let scheduled = pressure_schedule(tape, loops, &live, ahead);
+    if waiting(tape, loops, &scheduled) < waiting(tape, loops, &live) {
         scheduled
     } else {
         live
@@ -381,10 +461,10 @@ fn emission_order(tape: &SurfaceTape, lanes: Lanes) -> Vec<Id> {
 
 /// How long the values of an order wait, in nodes, from their definition
 /// to their last use (the outputs are used at the end of the pass).
-fn waiting(tape: &SurfaceTape, order: &[Id]) -> usize {
+fn waiting(tape: &SurfaceTape, loops: &Loops, order: &[Id]) -> usize {
     let mut last = vec![0usize; tape.graph.len()];
     for (i, &id) in order.iter().enumerate() {
-        for o in operands(tape.graph.node(id)) {
+        for o in loops.deps(tape, id) {
             last[o.0 as usize] = i;
         }
     }
@@ -418,7 +498,10 @@ enum Ahead {
 /// the inline or called functions weigh more than an add.
 fn latency(node: Node) -> i32 {
     match node {
-        Node::Const(_) | Node::Var(_) => 0,
+        Node::Const(_) | Node::Var(_) | Node::Carried(_) => 0,
+        // Each step a chain of several long operations (a Newton step:
+        // the function, its slope, a division).
+        Node::Repeat { steps, .. } => 60 * steps.min(1000) as i32,
         Node::Unary(Unary::Neg | Unary::Abs, _) => 1,
         Node::Unary(Unary::Sqrt, _) => 20,
         Node::Unary(Unary::Floor, _) | Node::Step(_) | Node::Select(..) => 3,
@@ -440,9 +523,10 @@ fn latency(node: Node) -> i32 {
 /// output (`ahead`), then the earliest in the tape. A differentiated tape
 /// lists a value's whole chain before the derivatives that reuse its
 /// intermediates; this interleaves them.
-fn pressure_schedule(tape: &SurfaceTape, live: &[Id], ahead: Ahead) -> Vec<Id> {
+fn pressure_schedule(tape: &SurfaceTape, loops: &Loops, live: &[Id], ahead: Ahead) -> Vec<Id> {
     let n = tape.graph.len();
     let node = |id: Id| tape.graph.node(id);
+    let deps = |id: Id| loops.deps(tape, id);
     // Work to the furthest output, negated: smaller is needed sooner.
     let mut level = vec![0i32; n];
     for &id in live.iter().rev() {
@@ -451,7 +535,7 @@ fn pressure_schedule(tape: &SurfaceTape, live: &[Id], ahead: Ahead) -> Vec<Id> {
             Ahead::Operations => 1,
             Ahead::Latency => latency(node(id)),
         };
-        for o in operands(node(id)) {
+        for o in deps(id) {
             level[o.0 as usize] = level[o.0 as usize].min(h - step);
         }
     }
@@ -460,7 +544,7 @@ fn pressure_schedule(tape: &SurfaceTape, live: &[Id], ahead: Ahead) -> Vec<Id> {
     let mut unready = vec![0u32; n];
     let mut ready = Vec::new();
     for &id in live {
-        for o in operands(node(id)) {
+        for o in deps(id) {
             uses[o.0 as usize] += 1;
             unready[id.0 as usize] += 1;
         }
@@ -478,7 +562,7 @@ fn pressure_schedule(tape: &SurfaceTape, live: &[Id], ahead: Ahead) -> Vec<Id> {
     let mut filled = first.clone();
     let mut users = vec![Id(0); first[n] as usize];
     for &id in live {
-        for o in operands(node(id)) {
+        for o in deps(id) {
             let slot = &mut filled[o.0 as usize];
             users[*slot as usize] = id;
             *slot += 1;
@@ -490,11 +574,8 @@ fn pressure_schedule(tape: &SurfaceTape, live: &[Id], ahead: Ahead) -> Vec<Id> {
     // The values each ready node is the last use of, kept up to date as
     // nodes are placed (recounted for every ready node at every step, this
     // was most of the schedule's time).
-    let last_uses = |id: Id, uses: &[u32]| {
-        operands(node(id))
-            .filter(|o| uses[o.0 as usize] == 1)
-            .count() as u32
-    };
+    let last_uses =
+        |id: Id, uses: &[u32]| deps(id).filter(|o| uses[o.0 as usize] == 1).count() as u32;
     let mut kills = vec![0u32; n];
     for &id in &ready {
         kills[id.0 as usize] = last_uses(id, &uses);
@@ -512,7 +593,7 @@ fn pressure_schedule(tape: &SurfaceTape, live: &[Id], ahead: Ahead) -> Vec<Id> {
         let id = ready.swap_remove(next);
         order.push(id);
         placed[id.0 as usize] = true;
-        for o in operands(node(id)) {
+        for o in deps(id) {
             let o = o.0 as usize;
             uses[o] -= 1;
             if uses[o] == 1 {
@@ -538,6 +619,16 @@ fn pressure_schedule(tape: &SurfaceTape, live: &[Id], ahead: Ahead) -> Vec<Id> {
     order
 }
 
+/// A loop to emit: its node's fields and its body (`Loops`).
+#[derive(Clone, Copy)]
+struct Loop<'a> {
+    carried: Id,
+    init: Id,
+    next: Id,
+    steps: u32,
+    body: &'a [Id],
+}
+
 /// Emits operations, importing each libm wrapper at most once.
 struct Emitter<'m> {
     module: &'m mut JITModule,
@@ -561,7 +652,7 @@ impl Emitter<'_> {
         &mut self,
         b: &mut FunctionBuilder,
         tape: &SurfaceTape,
-        order: &[Id],
+        (order, loops): (&[Id], &Loops),
         lanes: Lanes,
         cx: Value,
         cy: Value,
@@ -577,46 +668,167 @@ impl Emitter<'_> {
         self.negative.clear();
         self.covered.clear();
         let mut val: Vec<Option<Value>> = vec![None; tape.graph.len()];
-        let graph = &tape.graph;
         for &id in order {
-            let get =
-                |i: Id| val[i.0 as usize].expect("operands come before their node in the tape");
-            let v = match graph.node(id) {
-                Node::Const(bits) => constant(b, lanes, bits),
-                Node::Var(Var::X) => x,
-                Node::Var(Var::Y) => y,
-                Node::Unary(op @ (Unary::Sin | Unary::Cos), a) => {
-                    let (sin, cos) = self.sin_cos(b, lanes, a, get(a))?;
-                    if op == Unary::Sin { sin } else { cos }
+            let v = match tape.graph.node(id) {
+                Node::Repeat {
+                    carried,
+                    init,
+                    next,
+                    steps,
+                } => {
+                    let body = loops.bodies.get(&id).map_or(&[][..], Vec::as_slice);
+                    let l = Loop {
+                        carried,
+                        init,
+                        next,
+                        steps,
+                        body,
+                    };
+                    self.repeat(b, tape, lanes, l, &mut val, (x, y))?
                 }
-                Node::Unary(op, a) => self.unary(b, lanes, op, get(a))?,
-                Node::Binary(op @ (Binary::Min | Binary::Max), l, r) => {
-                    let l = (get(l), graph.constant(l));
-                    let r = (get(r), graph.constant(r));
-                    min_max(b, lanes, op, l, r)
-                }
-                Node::Binary(op, a, c) => self.binary(b, lanes, op, get(a), get(c))?,
-                Node::PowI(a, k) => powi(b, lanes, get(a), k),
-                Node::Step(a) => {
-                    // 1 where a < 0 (false for NaN), else 0.
-                    let neg = self.negative(b, lanes, a, get(a));
-                    let zero = constant(b, lanes, 0f64.to_bits());
-                    let one = constant(b, lanes, 1f64.to_bits());
-                    select_known(b, lanes, neg, (one, Some(1.0)), (zero, Some(0.0)))
-                }
-                Node::Select(c, t, f) => {
-                    // t where c < 0 (false for NaN), else f.
-                    let neg = self.negative(b, lanes, c, get(c));
-                    let t = (get(t), graph.constant(t));
-                    let f = (get(f), graph.constant(f));
-                    select_known(b, lanes, neg, t, f)
-                }
+                _ => self.node(b, tape, lanes, id, &val, (x, y))?,
             };
             val[id.0 as usize] = Some(v);
         }
         Ok(tape
             .outputs
             .map(|o| val[o.0 as usize].expect("outputs are live")))
+    }
+
+    /// The value of node `id` (no loop) from the values `val` so far.
+    fn node(
+        &mut self,
+        b: &mut FunctionBuilder,
+        tape: &SurfaceTape,
+        lanes: Lanes,
+        id: Id,
+        val: &[Option<Value>],
+        (x, y): (Value, Value),
+    ) -> Result<Value, JitError> {
+        let graph = &tape.graph;
+        // Operands come before their node in the order; should one not,
+        // the kernel is not built (no panic).
+        let get = |i: Id| {
+            val[i.0 as usize]
+                .ok_or_else(|| JitError(format!("node {} used before it is computed", i.0)))
+        };
+        Ok(match graph.node(id) {
+            Node::Const(bits) => constant(b, lanes, bits),
+            Node::Var(Var::X) => x,
+            Node::Var(Var::Y) => y,
+            Node::Unary(op @ (Unary::Sin | Unary::Cos), a) => {
+                let (sin, cos) = self.sin_cos(b, lanes, a, get(a)?)?;
+                if op == Unary::Sin { sin } else { cos }
+            }
+            Node::Unary(op, a) => self.unary(b, lanes, op, get(a)?)?,
+            Node::Binary(op @ (Binary::Min | Binary::Max), l, r) => {
+                let l = (get(l)?, graph.constant(l));
+                let r = (get(r)?, graph.constant(r));
+                min_max(b, lanes, op, l, r)
+            }
+            Node::Binary(op, a, c) => self.binary(b, lanes, op, get(a)?, get(c)?)?,
+            Node::PowI(a, k) => powi(b, lanes, get(a)?, k),
+            Node::Step(a) => {
+                // 1 where a < 0 (false for NaN), else 0.
+                let neg = self.negative(b, lanes, a, get(a)?);
+                let zero = constant(b, lanes, 0f64.to_bits());
+                let one = constant(b, lanes, 1f64.to_bits());
+                select_known(b, lanes, neg, (one, Some(1.0)), (zero, Some(0.0)))
+            }
+            Node::Select(c, t, f) => {
+                // t where c < 0 (false for NaN), else f.
+                let neg = self.negative(b, lanes, c, get(c)?);
+                let t = (get(t)?, graph.constant(t));
+                let f = (get(f)?, graph.constant(f));
+                select_known(b, lanes, neg, t, f)
+            }
+            // A loop's estimate is defined by its loop (`repeat`); loops
+            // are not nested (`Graph::repeat`).
+            Node::Carried(_) | Node::Repeat { .. } => get(id)?,
+        })
+    }
+
+    /// A loop: one block that runs the body once per step and branches
+    /// back to itself, the estimate and the count of steps its
+    /// parameters (cranelift variables):
+    ///
+    /// ```text
+    /// p = init; k = 0; goto step
+    /// step: the body, over p; p = next; k += 1; if k < steps goto step
+    /// after: the value is p
+    /// ```
+    ///
+    /// The body's values from the last step remain visible after it (the
+    /// block dominates what follows), which the caches rely on. On two
+    /// lanes, the masks of where the body's inline sin, cos and exp hold
+    /// are joined over every step.
+    fn repeat(
+        &mut self,
+        b: &mut FunctionBuilder,
+        tape: &SurfaceTape,
+        lanes: Lanes,
+        l: Loop,
+        val: &mut [Option<Value>],
+        xy: (Value, Value),
+    ) -> Result<Value, JitError> {
+        let init = val[l.init.0 as usize]
+            .ok_or_else(|| JitError("a loop's initial value is not computed".into()))?;
+        if l.steps == 0 {
+            return Ok(init);
+        }
+        let estimate = b.declare_var(lanes.ty());
+        b.def_var(estimate, init);
+        let count = b.declare_var(types::I32);
+        let zero = b.ins().iconst(types::I32, 0);
+        b.def_var(count, zero);
+        let masked = lanes == Lanes::Two
+            && l.body.iter().any(|&i| {
+                matches!(
+                    tape.graph.node(i),
+                    Node::Unary(Unary::Sin | Unary::Cos | Unary::Exp, _)
+                )
+            });
+        let covered = b.declare_var(types::I64X2);
+        if masked {
+            let ones = b.func.dfg.constants.insert(vec![0xffu8; 16].into());
+            let all = b.ins().vconst(types::I64X2, ones);
+            b.def_var(covered, all);
+        }
+        let step = b.create_block();
+        let after = b.create_block();
+        b.ins().jump(step, &[]);
+
+        b.switch_to_block(step);
+        val[l.carried.0 as usize] = Some(b.use_var(estimate));
+        let masks_before = self.covered.len();
+        for &i in l.body {
+            let v = self.node(b, tape, lanes, i, val, xy)?;
+            val[i.0 as usize] = Some(v);
+        }
+        if masked {
+            let mut all = b.use_var(covered);
+            for m in self.covered.split_off(masks_before) {
+                all = b.ins().band(all, m);
+            }
+            b.def_var(covered, all);
+        }
+        let next = val[l.next.0 as usize]
+            .ok_or_else(|| JitError("a loop's body gives no value".into()))?;
+        b.def_var(estimate, next);
+        let k = b.use_var(count);
+        let k = b.ins().iadd_imm_u(k, 1);
+        b.def_var(count, k);
+        let more = b
+            .ins()
+            .icmp_imm_u(IntCC::UnsignedLessThan, k, i64::from(l.steps));
+        b.ins().brif(more, step, &[], after, &[]);
+
+        b.switch_to_block(after);
+        if masked {
+            let all = b.use_var(covered);
+            self.covered.push(all);
+        }
+        Ok(b.use_var(estimate))
     }
 
     /// The cached test `a < 0` (false for NaN) of node `id`: a flag with
