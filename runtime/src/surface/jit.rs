@@ -265,10 +265,13 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
         trig: HashMap::new(),
         negative: HashMap::new(),
         covered: Vec::new(),
+        sign: None,
     };
     let loops = Loops::of(tape, &tape.live_nodes());
     let vector_order = emission_order(tape, &loops, Lanes::Two);
     let scalar_order = emission_order(tape, &loops, Lanes::One);
+    let vector_bodies = body_orders(tape, &loops, Lanes::Two);
+    let scalar_bodies = body_orders(tape, &loops, Lanes::One);
     let [px, py, po] = [(); 3].map(|_| b.declare_var(ptr));
     b.def_var(px, xs);
     b.def_var(py, ys);
@@ -286,7 +289,14 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
 
     b.switch_to_block(pair);
     let (cx, cy, co) = (b.use_var(px), b.use_var(py), b.use_var(po));
-    let outputs = emit.pass(&mut b, tape, (&vector_order, &loops), Lanes::Two, cx, cy)?;
+    let outputs = emit.pass(
+        &mut b,
+        tape,
+        (&vector_order, &vector_bodies),
+        Lanes::Two,
+        cx,
+        cy,
+    )?;
     match emit.covered.split_first() {
         None => b.ins().jump(store, &[]),
         Some((&first, rest)) => {
@@ -313,7 +323,14 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
 
     b.switch_to_block(single);
     let (cx, cy, co) = (b.use_var(px), b.use_var(py), b.use_var(po));
-    let outputs = emit.pass(&mut b, tape, (&scalar_order, &loops), Lanes::One, cx, cy)?;
+    let outputs = emit.pass(
+        &mut b,
+        tape,
+        (&scalar_order, &scalar_bodies),
+        Lanes::One,
+        cx,
+        cy,
+    )?;
     store_outputs(&mut b, Lanes::One, outputs, co);
     let nx = b.ins().iadd_imm_u(cx, 8);
     let ny = b.ins().iadd_imm_u(cy, 8);
@@ -434,8 +451,8 @@ const SCHEDULED_NODES: usize = 4096;
 /// changes how many values the register allocator must keep at once,
 /// which is most of the compile time of a big tape and the spills of its
 /// code, and how much of a pass the core can overlap.
-/// Loops' bodies are emitted inside them in the tape's order; outside, a
-/// loop is one node.
+/// Outside its loop, a loop is one node; its body is ordered the same way
+/// on its own (`body_orders`).
 fn emission_order(tape: &SurfaceTape, loops: &Loops, lanes: Lanes) -> Vec<Id> {
     let live: Vec<Id> = tape
         .live_nodes()
@@ -457,6 +474,30 @@ fn emission_order(tape: &SurfaceTape, loops: &Loops, lanes: Lanes) -> Vec<Id> {
     } else {
         live
     }
+}
+
+/// The order each loop's body is emitted in, by the rule of
+/// `emission_order`.
+fn body_orders(tape: &SurfaceTape, loops: &Loops, lanes: Lanes) -> HashMap<Id, Vec<Id>> {
+    let ahead = match lanes {
+        Lanes::One => Ahead::Operations,
+        Lanes::Two => Ahead::Latency,
+    };
+    loops
+        .bodies
+        .iter()
+        .map(|(&id, body)| {
+            let scheduled = pressure_schedule(tape, loops, body, ahead);
+            let order = if body.len() <= SCHEDULED_NODES
+                && waiting(tape, loops, &scheduled) < waiting(tape, loops, body)
+            {
+                scheduled
+            } else {
+                body.clone()
+            };
+            (id, order)
+        })
+        .collect()
 }
 
 /// How long the values of an order wait, in nodes, from their definition
@@ -526,7 +567,13 @@ fn latency(node: Node) -> i32 {
 fn pressure_schedule(tape: &SurfaceTape, loops: &Loops, live: &[Id], ahead: Ahead) -> Vec<Id> {
     let n = tape.graph.len();
     let node = |id: Id| tape.graph.node(id);
-    let deps = |id: Id| loops.deps(tape, id);
+    // What the list reads from outside it (a loop body's inputs) is there
+    // all along.
+    let mut listed = vec![false; n];
+    for &id in live {
+        listed[id.0 as usize] = true;
+    }
+    let deps = |id: Id| loops.deps(tape, id).filter(|o| listed[o.0 as usize]);
     // Work to the furthest output, negated: smaller is needed sooner.
     let mut level = vec![0i32; n];
     for &id in live.iter().rev() {
@@ -641,6 +688,9 @@ struct Emitter<'m> {
     /// The lane masks of where the inline sin, cos and exp of this (vector)
     /// pass hold.
     covered: Vec<Value>,
+    /// −0 in every lane (the sign bit alone) once a negation of this pass
+    /// needed it.
+    sign: Option<Value>,
 }
 
 impl Emitter<'_> {
@@ -652,7 +702,7 @@ impl Emitter<'_> {
         &mut self,
         b: &mut FunctionBuilder,
         tape: &SurfaceTape,
-        (order, loops): (&[Id], &Loops),
+        (order, bodies): (&[Id], &HashMap<Id, Vec<Id>>),
         lanes: Lanes,
         cx: Value,
         cy: Value,
@@ -667,6 +717,7 @@ impl Emitter<'_> {
         self.trig.clear();
         self.negative.clear();
         self.covered.clear();
+        self.sign = None;
         let mut val: Vec<Option<Value>> = vec![None; tape.graph.len()];
         for &id in order {
             let v = match tape.graph.node(id) {
@@ -676,7 +727,7 @@ impl Emitter<'_> {
                     next,
                     steps,
                 } => {
-                    let body = loops.bodies.get(&id).map_or(&[][..], Vec::as_slice);
+                    let body = bodies.get(&id).map_or(&[][..], Vec::as_slice);
                     let l = Loop {
                         carried,
                         init,
@@ -893,7 +944,16 @@ impl Emitter<'_> {
         a: Value,
     ) -> Result<Value, JitError> {
         Ok(match op {
-            Unary::Neg => b.ins().fneg(a),
+            // The sign bit flipped, as `fneg` does, by one xor with a
+            // constant shared by the pass (cranelift's `fneg` builds its
+            // mask anew each time: three or four instructions and a
+            // register).
+            Unary::Neg => {
+                let sign = *self
+                    .sign
+                    .get_or_insert_with(|| constant(b, lanes, (-0f64).to_bits()));
+                b.ins().bxor(a, sign)
+            }
             Unary::Sqrt => b.ins().sqrt(a),
             Unary::Abs => b.ins().fabs(a),
             Unary::Floor => b.ins().floor(a),
