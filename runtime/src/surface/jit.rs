@@ -267,9 +267,11 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
         covered: Vec::new(),
         sign: None,
     };
-    let loops = Loops::of(tape, &tape.live_nodes());
-    let vector_order = emission_order(tape, &loops, Lanes::Two);
-    let scalar_order = emission_order(tape, &loops, Lanes::One);
+    let live = tape.live_nodes();
+    let loops = Loops::of(tape, &live);
+    let pending = pending_negations(tape, &live);
+    let vector_order = emission_order(tape, &live, &loops, Lanes::Two);
+    let scalar_order = emission_order(tape, &live, &loops, Lanes::One);
     let vector_bodies = body_orders(tape, &loops, Lanes::Two);
     let scalar_bodies = body_orders(tape, &loops, Lanes::One);
     let [px, py, po] = [(); 3].map(|_| b.declare_var(ptr));
@@ -292,7 +294,7 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
     let outputs = emit.pass(
         &mut b,
         tape,
-        (&vector_order, &vector_bodies),
+        (&vector_order, &vector_bodies, &pending),
         Lanes::Two,
         cx,
         cy,
@@ -326,7 +328,7 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
     let outputs = emit.pass(
         &mut b,
         tape,
-        (&scalar_order, &scalar_bodies),
+        (&scalar_order, &scalar_bodies, &pending),
         Lanes::One,
         cx,
         cy,
@@ -453,10 +455,10 @@ const SCHEDULED_NODES: usize = 4096;
 /// code, and how much of a pass the core can overlap.
 /// Outside its loop, a loop is one node; its body is ordered the same way
 /// on its own (`body_orders`).
-fn emission_order(tape: &SurfaceTape, loops: &Loops, lanes: Lanes) -> Vec<Id> {
-    let live: Vec<Id> = tape
-        .live_nodes()
-        .into_iter()
+fn emission_order(tape: &SurfaceTape, live: &[Id], loops: &Loops, lanes: Lanes) -> Vec<Id> {
+    let live: Vec<Id> = live
+        .iter()
+        .copied()
         .filter(|&id| !loops.is_inside(id))
         .collect();
     // The schedule scans the ready nodes for each node it places: bounded
@@ -666,6 +668,49 @@ fn pressure_schedule(tape: &SurfaceTape, loops: &Loops, live: &[Id], ahead: Ahea
     order
 }
 
+/// The values of a pass's nodes so far. A negation emits nothing: its
+/// node holds its operand's value with `negated` set, and its users take
+/// the sign in (`Emitter::node`) or apply it (`Emitter::plain`).
+struct Values {
+    val: Vec<Option<Value>>,
+    /// Whether the value held is the negation of the node's.
+    negated: Vec<bool>,
+    /// Whether a node's value may be held with its negation pending
+    /// (`pending_negations`).
+    pending: Vec<bool>,
+}
+
+/// Where a negation may stay pending: at a node with one user, or whose
+/// users are all sums and differences. Those never pass a negation on, so
+/// each negation the tape writes is applied at most once (at the one
+/// user, or where a difference needs it: `Emitter::plain` keeps the
+/// result), never more often than the tape's own negations; a value with
+/// several users of other kinds is negated once, where it is computed.
+fn pending_negations(tape: &SurfaceTape, live: &[Id]) -> Vec<bool> {
+    let n = tape.graph.len();
+    let mut users = vec![0u32; n];
+    let mut sums_only = vec![true; n];
+    for &id in live {
+        let node = tape.graph.node(id);
+        let sum = matches!(node, Node::Binary(Binary::Add | Binary::Sub, _, _));
+        for o in operands(node) {
+            users[o.0 as usize] += 1;
+            sums_only[o.0 as usize] &= sum;
+        }
+        if let Node::Repeat { init, next, .. } = node {
+            for o in [init, next] {
+                users[o.0 as usize] += 1;
+                sums_only[o.0 as usize] = false;
+            }
+        }
+    }
+    for o in tape.outputs {
+        users[o.0 as usize] += 1;
+        sums_only[o.0 as usize] = false;
+    }
+    (0..n).map(|i| users[i] == 1 || sums_only[i]).collect()
+}
+
 /// A loop to emit: its node's fields and its body (`Loops`).
 #[derive(Clone, Copy)]
 struct Loop<'a> {
@@ -702,7 +747,7 @@ impl Emitter<'_> {
         &mut self,
         b: &mut FunctionBuilder,
         tape: &SurfaceTape,
-        (order, bodies): (&[Id], &HashMap<Id, Vec<Id>>),
+        (order, bodies, pending): (&[Id], &HashMap<Id, Vec<Id>>, &[bool]),
         lanes: Lanes,
         cx: Value,
         cy: Value,
@@ -718,9 +763,13 @@ impl Emitter<'_> {
         self.negative.clear();
         self.covered.clear();
         self.sign = None;
-        let mut val: Vec<Option<Value>> = vec![None; tape.graph.len()];
+        let mut vals = Values {
+            val: vec![None; tape.graph.len()],
+            negated: vec![false; tape.graph.len()],
+            pending: pending.to_vec(),
+        };
         for &id in order {
-            let v = match tape.graph.node(id) {
+            let (v, negated) = match tape.graph.node(id) {
                 Node::Repeat {
                     carried,
                     init,
@@ -735,19 +784,160 @@ impl Emitter<'_> {
                         steps,
                         body,
                     };
-                    self.repeat(b, tape, lanes, l, &mut val, (x, y))?
+                    (self.repeat(b, tape, lanes, l, &mut vals, (x, y))?, false)
                 }
-                _ => self.node(b, tape, lanes, id, &val, (x, y))?,
+                _ => self.node(b, tape, lanes, id, &mut vals, (x, y))?,
             };
-            val[id.0 as usize] = Some(v);
+            self.keep(b, lanes, &mut vals, id, (v, negated));
         }
-        Ok(tape
-            .outputs
-            .map(|o| val[o.0 as usize].expect("outputs are live")))
+        let mut outputs = [x; 6];
+        for (k, &o) in tape.outputs.iter().enumerate() {
+            outputs[k] = self.plain(b, lanes, &mut vals, o)?;
+        }
+        Ok(outputs)
     }
 
-    /// The value of node `id` (no loop) from the values `val` so far.
+    /// Records node `id`'s value; a pending negation stays pending only
+    /// where `Values::pending` allows, else it is applied now.
+    fn keep(
+        &mut self,
+        b: &mut FunctionBuilder,
+        lanes: Lanes,
+        vals: &mut Values,
+        id: Id,
+        (v, negated): (Value, bool),
+    ) {
+        let i = id.0 as usize;
+        let (v, negated) = if negated && !vals.pending[i] {
+            (self.negate(b, lanes, v), false)
+        } else {
+            (v, negated)
+        };
+        vals.val[i] = Some(v);
+        vals.negated[i] = negated;
+    }
+
+    /// The value of node `i` as computed, and whether it is the node's
+    /// negation (`Values`).
+    fn raw(vals: &Values, i: Id) -> Result<(Value, bool), JitError> {
+        let v = vals.val[i.0 as usize]
+            .ok_or_else(|| JitError(format!("node {} used before it is computed", i.0)))?;
+        Ok((v, vals.negated[i.0 as usize]))
+    }
+
+    /// The value of node `i`, its pending negation applied (once: the
+    /// result replaces it).
+    fn plain(
+        &mut self,
+        b: &mut FunctionBuilder,
+        lanes: Lanes,
+        vals: &mut Values,
+        i: Id,
+    ) -> Result<Value, JitError> {
+        let (v, negated) = Self::raw(vals, i)?;
+        if !negated {
+            return Ok(v);
+        }
+        let v = self.negate(b, lanes, v);
+        vals.val[i.0 as usize] = Some(v);
+        vals.negated[i.0 as usize] = false;
+        Ok(v)
+    }
+
+    /// −a: the sign bit flipped, as `fneg` does, by one xor with a
+    /// constant shared by the pass (cranelift's `fneg` builds its mask
+    /// anew each time: three or four instructions and a register).
+    fn negate(&mut self, b: &mut FunctionBuilder, lanes: Lanes, a: Value) -> Value {
+        let sign = *self
+            .sign
+            .get_or_insert_with(|| constant(b, lanes, (-0f64).to_bits()));
+        b.ins().bxor(a, sign)
+    }
+
+    /// The value of node `id` (no loop) from the values so far, and
+    /// whether it is the node's negation (`Values`): a negation emits
+    /// nothing, and products, quotients, sums and differences take their
+    /// operands' pending negations in, where the identity is exact.
     fn node(
+        &mut self,
+        b: &mut FunctionBuilder,
+        tape: &SurfaceTape,
+        lanes: Lanes,
+        id: Id,
+        vals: &mut Values,
+        (x, y): (Value, Value),
+    ) -> Result<(Value, bool), JitError> {
+        let graph = &tape.graph;
+        Ok(match graph.node(id) {
+            Node::Unary(Unary::Neg, a) => {
+                let (v, negated) = Self::raw(vals, a)?;
+                (v, !negated)
+            }
+            // (−a)·b = a·(−b) = −(a·b) and likewise for a quotient, bit
+            // for bit: rounding to nearest is symmetric about zero, and
+            // the sign of a product or quotient (of zero too) is the
+            // exclusive or of its operands' signs.
+            Node::Binary(op @ (Binary::Mul | Binary::Div), l, r) => {
+                let ((vl, nl), (vr, nr)) = (Self::raw(vals, l)?, Self::raw(vals, r)?);
+                let v = if op == Binary::Mul {
+                    b.ins().fmul(vl, vr)
+                } else {
+                    b.ins().fdiv(vl, vr)
+                };
+                (v, nl != nr)
+            }
+            // a − b is a + (−b) in IEEE 754, and a sum does not depend on
+            // the order of its operands: with −a or −b pending, a + b, a −
+            // b, b − a serve exactly. Where the result would be −(a + b)
+            // (which differs in the sign of a zero sum), the left
+            // operand's negation is applied instead.
+            Node::Binary(op @ (Binary::Add | Binary::Sub), l, r) => {
+                let (nl, nr) = (Self::raw(vals, l)?.1, Self::raw(vals, r)?.1);
+                let add = op == Binary::Add;
+                // The result is l + (±vr): vr enters negated where it is
+                // added with its negation pending or subtracted without.
+                let r_minus = add == nr;
+                let vr = Self::raw(vals, r)?.0;
+                if nl && r_minus {
+                    // −vl − vr would be −(vl + vr): apply l's negation.
+                    let vl = self.plain(b, lanes, vals, l)?;
+                    (b.ins().fsub(vl, vr), false)
+                } else if nl {
+                    // −vl + vr = vr − vl.
+                    let vl = Self::raw(vals, l)?.0;
+                    (b.ins().fsub(vr, vl), false)
+                } else {
+                    let vl = Self::raw(vals, l)?.0;
+                    let v = if r_minus {
+                        b.ins().fsub(vl, vr)
+                    } else {
+                        b.ins().fadd(vl, vr)
+                    };
+                    (v, false)
+                }
+            }
+            // (−a)^n is a^n for even n and −(a^n) for odd n, bit for bit:
+            // the squarings of the expansion lose the sign and each
+            // product (or the reciprocal of a negative n) keeps it.
+            Node::PowI(a, k) => {
+                let (v, negated) = Self::raw(vals, a)?;
+                (powi(b, lanes, v, k), negated && k % 2 != 0)
+            }
+            _ => {
+                for o in operands(graph.node(id)) {
+                    self.plain(b, lanes, vals, o)?;
+                }
+                (
+                    self.node_plain(b, tape, lanes, id, &vals.val, (x, y))?,
+                    false,
+                )
+            }
+        })
+    }
+
+    /// The value of node `id` from its operands' values `val` (no pending
+    /// negation among them).
+    fn node_plain(
         &mut self,
         b: &mut FunctionBuilder,
         tape: &SurfaceTape,
@@ -819,11 +1009,10 @@ impl Emitter<'_> {
         tape: &SurfaceTape,
         lanes: Lanes,
         l: Loop,
-        val: &mut [Option<Value>],
+        vals: &mut Values,
         xy: (Value, Value),
     ) -> Result<Value, JitError> {
-        let init = val[l.init.0 as usize]
-            .ok_or_else(|| JitError("a loop's initial value is not computed".into()))?;
+        let init = self.plain(b, lanes, vals, l.init)?;
         if l.steps == 0 {
             return Ok(init);
         }
@@ -850,11 +1039,12 @@ impl Emitter<'_> {
         b.ins().jump(step, &[]);
 
         b.switch_to_block(step);
-        val[l.carried.0 as usize] = Some(b.use_var(estimate));
+        vals.val[l.carried.0 as usize] = Some(b.use_var(estimate));
+        vals.negated[l.carried.0 as usize] = false;
         let masks_before = self.covered.len();
         for &i in l.body {
-            let v = self.node(b, tape, lanes, i, val, xy)?;
-            val[i.0 as usize] = Some(v);
+            let value = self.node(b, tape, lanes, i, vals, xy)?;
+            self.keep(b, lanes, vals, i, value);
         }
         if masked {
             let mut all = b.use_var(covered);
@@ -863,8 +1053,7 @@ impl Emitter<'_> {
             }
             b.def_var(covered, all);
         }
-        let next = val[l.next.0 as usize]
-            .ok_or_else(|| JitError("a loop's body gives no value".into()))?;
+        let next = self.plain(b, lanes, vals, l.next)?;
         b.def_var(estimate, next);
         let k = b.use_var(count);
         let k = b.ins().iadd_imm_u(k, 1);
@@ -944,16 +1133,7 @@ impl Emitter<'_> {
         a: Value,
     ) -> Result<Value, JitError> {
         Ok(match op {
-            // The sign bit flipped, as `fneg` does, by one xor with a
-            // constant shared by the pass (cranelift's `fneg` builds its
-            // mask anew each time: three or four instructions and a
-            // register).
-            Unary::Neg => {
-                let sign = *self
-                    .sign
-                    .get_or_insert_with(|| constant(b, lanes, (-0f64).to_bits()));
-                b.ins().bxor(a, sign)
-            }
+            Unary::Neg => self.negate(b, lanes, a),
             Unary::Sqrt => b.ins().sqrt(a),
             Unary::Abs => b.ins().fabs(a),
             Unary::Floor => b.ins().floor(a),
