@@ -440,7 +440,7 @@ impl<B: Backend> Conformance<B> {
         let values = |looped: bool, steps: u32| {
             let mut g = Graph::new();
             let z = newton_like(&mut g, steps, looped);
-            let (x, y) = (g.x(), g.y());
+            let x = g.x();
             let zx = g.mul(z, x);
             let s = g.unary(Unary::Sin, z);
             let zz = g.powi(z, 2);
