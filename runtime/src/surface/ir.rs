@@ -6,6 +6,8 @@
 //! nodes, so the arena is a topologically ordered tape: evaluating it front
 //! to back computes every node after its operands. Backends (the
 //! interpreter here, cranelift JIT in the compiler) walk the same tape.
+//! A loop (`Node::Repeat`) is the one place the walk goes back: its body,
+//! in the tape once, is run for each of its steps.
 
 use std::collections::HashMap;
 

@@ -21,6 +21,11 @@
 //! it (a square root or a division early, so that the core overlaps it
 //! with the rest), the scalar pass the one with the most operations ahead.
 //!
+//! A loop of the tape (`Node::Repeat`) is one block that branches back to
+//! itself, its body emitted once. A negation is mostly taken into the
+//! product, quotient, sum or difference that reads it, where the identity
+//! is exact (`Emitter::node`), else one xor with a sign mask.
+//!
 //! Arithmetic, `sqrt`, `abs` and negation are native instructions
 //! (IEEE-exact, as in Rust); `min`/`max` are a select sequence with Rust's
 //! `f64::min`/`max` behaviour (the non-NaN operand wins, ties return the
