@@ -224,7 +224,19 @@ pub(super) fn tilted_outputs(
     x: Id,
     y: Id,
 ) -> Result<[Id; 6], LowerError> {
-    let mut t = Tilt::solve(g, o, x, y, Steps::Loop)?;
+    tilted_outputs_with(g, o, x, y, Steps::Loop)
+}
+
+/// `tilted_outputs` with the Newton steps put in the graph as `steps`
+/// says (the same values either way).
+pub(super) fn tilted_outputs_with(
+    g: &mut Graph,
+    o: &Object,
+    x: Id,
+    y: Id,
+    steps: Steps,
+) -> Result<[Id; 6], LowerError> {
+    let mut t = Tilt::solve(g, o, x, y, steps)?;
     let z = t.height(g);
     let h = &mut t.parent;
     let hzq = h.derivative(t.hz, Var::Y);
@@ -269,7 +281,7 @@ pub(super) fn tilted_outputs(
 /// How a tilt's Newton steps are put in the graph; either way the same
 /// operations in the same order, so the same bits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Steps {
+pub(super) enum Steps {
     /// One after another, each a copy: what a derivative of the height
     /// goes through (a tilt inside another surface).
     WrittenOut,
