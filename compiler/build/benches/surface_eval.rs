@@ -387,7 +387,9 @@ fn main() {
 }
 
 /// The compile time of every surface the examples declare (best of
-/// `COMPILES` each), slowest first.
+/// `COMPILES` each), slowest first, and the JIT batch's time per point
+/// over a 100 × 100 grid of the surface's domain (points inside it only;
+/// best of `RUNS`).
 fn every_example_surface() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
     let mut files: Vec<_> = std::fs::read_dir(&dir)
@@ -396,7 +398,7 @@ fn every_example_surface() {
         .filter(|p| p.extension().is_some_and(|e| e == "lens"))
         .collect();
     files.sort();
-    let mut rows: Vec<(String, usize, Time)> = Vec::new();
+    let mut rows: Vec<(String, usize, Time, Time)> = Vec::new();
     for path in files {
         let Ok(c) = lensc_build::driver::check_path(&lensc_lang::loader::RealFs, &path) else {
             continue;
@@ -421,7 +423,26 @@ fn every_example_surface() {
                 black_box(JitSurface::compile(black_box(&tape)).expect("compiles"));
             })
             .per(1, 1e6);
-            rows.push((format!("{file}: {name}"), tape.live_nodes().len(), t));
+            let kernel = JitSurface::compile(&tape).expect("compiles");
+            let ((x0, x1), (y0, y1)) = lowered.domain.bounds();
+            let (mut xs, mut ys) = (Vec::new(), Vec::new());
+            for i in 0..100 {
+                for j in 0..100 {
+                    let x = x0 + (x1 - x0) * (f64::from(i) + 0.5) / 100.0;
+                    let y = y0 + (y1 - y0) * (f64::from(j) + 0.5) / 100.0;
+                    if lowered.domain.contains(x, y) {
+                        xs.push(x);
+                        ys.push(y);
+                    }
+                }
+            }
+            let mut out = vec![0.0; 6 * xs.len()];
+            let run = best_of(RUNS, || {
+                kernel.eval_batch(black_box(&xs), black_box(&ys), &mut out);
+                black_box(&out);
+            })
+            .per(xs.len().max(1), 1e9);
+            rows.push((format!("{file}: {name}"), tape.live_nodes().len(), t, run));
         }
     }
     rows.sort_by(|a, b| b.2.cpu.total_cmp(&a.2.cpu));
@@ -431,10 +452,13 @@ fn every_example_surface() {
         rows.len()
     );
     println!(
-        "{:<50} {:>10} {:>12} {:>12}",
-        "surface", "live nodes", "µs wall", "µs CPU"
+        "{:<50} {:>10} {:>12} {:>12} | {:>12}",
+        "surface", "live nodes", "µs wall", "µs CPU", "ns/point CPU"
     );
-    for (name, nodes, t) in &rows {
-        println!("{name:<50} {nodes:>10} {:>12.1} {:>12.1}", t.wall, t.cpu);
+    for (name, nodes, t, run) in &rows {
+        println!(
+            "{name:<50} {nodes:>10} {:>12.1} {:>12.1} | {:>12.2}",
+            t.wall, t.cpu, run.cpu
+        );
     }
 }

@@ -428,6 +428,91 @@ impl<B: Backend> Conformance<B> {
         }
     }
 
+    /// A loop (`Graph::repeat`) gives bit for bit what its steps written
+    /// out give, in batches of every length (both lanes, the odd point,
+    /// and pairs with a lane outside the inline sin, cos and exp in some
+    /// step), its derivatives (through the steps written out) too.
+    pub fn loops_give_the_bits_of_their_steps_written_out() {
+        let same = |a: f64, b: f64| a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan());
+        // The values alone (six functions of the loop's result, no
+        // derivative: the loop is all the tape has), and z with its
+        // derivatives (which go through the steps written out).
+        let values = |looped: bool, steps: u32| {
+            let mut g = Graph::new();
+            let z = newton_like(&mut g, steps, looped);
+            let x = g.x();
+            let zx = g.mul(z, x);
+            let s = g.unary(Unary::Sin, z);
+            let zz = g.powi(z, 2);
+            // A second loop, q ← q/2 + 10⁻³/(1 + e^(100 q)) from q = 4x:
+            // e^(100 q) overflows (outside the inline exp) in the first
+            // steps where x > 1.77 and not in the last, and where it does,
+            // the term is 0.
+            let halving = |g: &mut Graph, q: Id| {
+                let half = g.constant_node(0.5);
+                let h = g.mul(q, half);
+                let k = g.constant_node(100.0);
+                let a = g.mul(q, k);
+                let e = g.unary(Unary::Exp, a);
+                let one = g.constant_node(1.0);
+                let d = g.add(one, e);
+                let small = g.constant_node(1e-3);
+                let t = g.div(small, d);
+                g.add(h, t)
+            };
+            let four = g.constant_node(4.0);
+            let start = g.mul(x, four);
+            let q = if looped {
+                let q = g.carried();
+                let next = halving(&mut g, q);
+                g.repeat(q, start, next, steps)
+            } else {
+                (0..steps).fold(start, |q, _| halving(&mut g, q))
+            };
+            SurfaceTape::with_outputs(g, [z, zx, s, zz, q, x])
+        };
+        let cases = [1, 2, 6].into_iter().flat_map(|steps| {
+            [
+                (steps, values(true, steps), values(false, steps)),
+                (
+                    steps,
+                    tape(|g| newton_like(g, steps, true)),
+                    tape(|g| newton_like(g, steps, false)),
+                ),
+            ]
+        });
+        for (k, (steps, looped, written)) in cases.enumerate() {
+            assert!(
+                k % 2 == 1 || steps == 1 || looped.live_nodes().len() < written.live_nodes().len(),
+                "{steps} steps: the loop's body is written once"
+            );
+            let (l, w) = (B::build(&looped), B::build(&written));
+            for n in [1, 2, 7, 100] {
+                let (mut xs, ys): (Vec<f64>, Vec<f64>) = points(n).into_iter().unzip();
+                // Estimates the inline code does not cover in a later step
+                // (exp's overflow, huge sines), and NaN.
+                if n == 100 {
+                    for (i, x) in [(3, 1e3), (10, 40.0), (11, 1e7), (50, f64::NAN), (51, 1e20)] {
+                        xs[i] = x;
+                    }
+                }
+                let (mut a, mut b) = (vec![0.0; 6 * n], vec![0.0; 6 * n]);
+                l.eval_batch(&xs, &ys, &mut a);
+                w.eval_batch(&xs, &ys, &mut b);
+                for i in 0..6 * n {
+                    assert!(
+                        same(a[i], b[i]),
+                        "{steps} steps, batch of {n}, point {}, output {}: {:e} looped, {:e} written out",
+                        i / 6,
+                        i % 6,
+                        a[i],
+                        b[i]
+                    );
+                }
+            }
+        }
+    }
+
     /// A tape's axial section (`SurfaceTape::axial_section`) gives z,
     /// ∂z/∂x and ∂²z/∂x² bit for bit as the whole tape does, in batches
     /// of every length (both lanes and the odd point), and NaN for the
@@ -458,6 +543,70 @@ impl<B: Backend> Conformance<B> {
             }
         }
     }
+}
+
+/// One Newton-like step over the estimate `p`, with every kind of
+/// operation a kernel inlines (sin, cos, exp, sqrt, a select, min, max,
+/// whole powers) and one it calls (atan), reading x and y and values
+/// computed outside the loop.
+fn newton_like_step(g: &mut Graph, p: Id) -> Id {
+    let (x, y) = (g.x(), g.y());
+    let xy = g.mul(x, y);
+    let s = g.unary(Unary::Sin, p);
+    let c = g.unary(Unary::Cos, p);
+    let px = g.mul(p, x);
+    let e = {
+        let q = g.mul(px, xy);
+        let tenth = g.constant_node(0.1);
+        let small = g.mul(q, tenth);
+        g.unary(Unary::Exp, small)
+    };
+    // A fast wobble whose argument leaves the inline sine's range
+    // (2^20 π/2) where |p| > 1.65, as it may in one step and not the next.
+    let wobble = {
+        let fast = g.constant_node(1e6);
+        let a = g.mul(p, fast);
+        let w = g.unary(Unary::Sin, a);
+        let small = g.constant_node(1e-3);
+        g.mul(w, small)
+    };
+    let f = {
+        let a = g.add(s, e);
+        let b = g.add(a, wobble);
+        g.sub(b, y)
+    };
+    let slope = {
+        let two = g.constant_node(2.0);
+        let c2 = g.add(c, two);
+        let p2 = g.powi(p, 2);
+        let r = g.add(p2, two);
+        let root = g.sqrt(r);
+        let m = g.binary(Binary::Min, c2, root);
+        let half = g.constant_node(0.5);
+        g.binary(Binary::Max, m, half)
+    };
+    let step = g.div(f, slope);
+    let damped = {
+        let d = g.sub(p, x);
+        let a = g.unary(Unary::Atan, step);
+        g.select(d, step, a)
+    };
+    g.sub(p, damped)
+}
+
+/// A loop of `newton_like_step` from p = x y, `steps` steps, as a loop
+/// (`looped`) or written out; z = the result plus y.
+fn newton_like(g: &mut Graph, steps: u32, looped: bool) -> Id {
+    let (x, y) = (g.x(), g.y());
+    let start = g.mul(x, y);
+    let p = if looped {
+        let p = g.carried();
+        let next = newton_like_step(g, p);
+        g.repeat(p, start, next, steps)
+    } else {
+        (0..steps).fold(start, |p, _| newton_like_step(g, p))
+    };
+    g.add(p, y)
 }
 
 /// z = sin x + cos y + tan x + exp(xy).
@@ -577,6 +726,10 @@ macro_rules! surface_fn_tests {
         );
         $crate::surface::conformance::surface_fn_test!(
             axial_sections_keep_the_x_outputs_bit_for_bit,
+            $backend
+        );
+        $crate::surface::conformance::surface_fn_test!(
+            loops_give_the_bits_of_their_steps_written_out,
             $backend
         );
     };

@@ -21,6 +21,11 @@
 //! it (a square root or a division early, so that the core overlaps it
 //! with the rest), the scalar pass the one with the most operations ahead.
 //!
+//! A loop of the tape (`Node::Repeat`) is one block that branches back to
+//! itself, its body emitted once. A negation is mostly taken into the
+//! product, quotient, sum or difference that reads it, where the identity
+//! is exact (`Emitter::node`), else one xor with a sign mask.
+//!
 //! Arithmetic, `sqrt`, `abs` and negation are native instructions
 //! (IEEE-exact, as in Rust); `min`/`max` are a select sequence with Rust's
 //! `f64::min`/`max` behaviour (the non-NaN operand wins, ties return the
@@ -265,9 +270,15 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
         trig: HashMap::new(),
         negative: HashMap::new(),
         covered: Vec::new(),
+        sign: None,
     };
-    let vector_order = emission_order(tape, Lanes::Two);
-    let scalar_order = emission_order(tape, Lanes::One);
+    let live = tape.live_nodes();
+    let loops = Loops::of(tape, &live);
+    let pending = pending_negations(tape, &live);
+    let vector_order = emission_order(tape, &live, &loops, Lanes::Two);
+    let scalar_order = emission_order(tape, &live, &loops, Lanes::One);
+    let vector_bodies = body_orders(tape, &loops, Lanes::Two);
+    let scalar_bodies = body_orders(tape, &loops, Lanes::One);
     let [px, py, po] = [(); 3].map(|_| b.declare_var(ptr));
     b.def_var(px, xs);
     b.def_var(py, ys);
@@ -285,7 +296,14 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
 
     b.switch_to_block(pair);
     let (cx, cy, co) = (b.use_var(px), b.use_var(py), b.use_var(po));
-    let outputs = emit.pass(&mut b, tape, &vector_order, Lanes::Two, cx, cy)?;
+    let outputs = emit.pass(
+        &mut b,
+        tape,
+        (&vector_order, &vector_bodies, &pending),
+        Lanes::Two,
+        cx,
+        cy,
+    )?;
     match emit.covered.split_first() {
         None => b.ins().jump(store, &[]),
         Some((&first, rest)) => {
@@ -312,7 +330,14 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
 
     b.switch_to_block(single);
     let (cx, cy, co) = (b.use_var(px), b.use_var(py), b.use_var(po));
-    let outputs = emit.pass(&mut b, tape, &scalar_order, Lanes::One, cx, cy)?;
+    let outputs = emit.pass(
+        &mut b,
+        tape,
+        (&scalar_order, &scalar_bodies, &pending),
+        Lanes::One,
+        cx,
+        cy,
+    )?;
     store_outputs(&mut b, Lanes::One, outputs, co);
     let nx = b.ins().iadd_imm_u(cx, 8);
     let ny = b.ins().iadd_imm_u(cy, 8);
@@ -337,7 +362,10 @@ fn define_kernel(module: &mut JITModule, tape: &SurfaceTape) -> Result<FuncId, J
 /// The operands of a node, each once (`x · x` reads x once).
 fn operands(node: Node) -> impl Iterator<Item = Id> {
     let (a, b, c) = match node {
-        Node::Const(_) | Node::Var(_) => (None, None, None),
+        // A loop's operands are its inputs (`Loops`).
+        Node::Const(_) | Node::Var(_) | Node::Carried(_) | Node::Repeat { .. } => {
+            (None, None, None)
+        }
         Node::Unary(_, a) | Node::PowI(a, _) | Node::Step(a) => (Some(a), None, None),
         Node::Binary(_, a, b) => (Some(a), Some(b).filter(|&b| b != a), None),
         Node::Select(c, a, b) => (
@@ -347,6 +375,76 @@ fn operands(node: Node) -> impl Iterator<Item = Id> {
         ),
     };
     [a, b, c].into_iter().flatten()
+}
+
+/// The loops of a tape's live part (`Node::Repeat`): each is emitted as
+/// one block that branches back to itself, its body once, and is
+/// scheduled outside as one node that reads its inputs.
+struct Loops {
+    /// The body of each live loop, in the order it is emitted (the tape's).
+    bodies: HashMap<Id, Vec<Id>>,
+    /// Indexed by node (empty where the tape has no loop): what each loop
+    /// reads from outside its body, its initial value first, each once.
+    inputs: Vec<Vec<Id>>,
+    /// Indexed by node (empty where the tape has no loop): whether it is
+    /// in a body or is a loop's estimate, emitted inside its loop.
+    inside: Vec<bool>,
+}
+
+impl Loops {
+    fn of(tape: &SurfaceTape, live: &[Id]) -> Loops {
+        let graph = &tape.graph;
+        let mut loops = Loops {
+            bodies: HashMap::new(),
+            inputs: Vec::new(),
+            inside: Vec::new(),
+        };
+        for &id in live {
+            let Node::Repeat {
+                carried,
+                init,
+                next,
+                ..
+            } = graph.node(id)
+            else {
+                continue;
+            };
+            if loops.inside.is_empty() {
+                loops.inside = vec![false; graph.len()];
+                loops.inputs = vec![Vec::new(); graph.len()];
+            }
+            let body = graph.loop_body(carried, next);
+            loops.inside[carried.0 as usize] = true;
+            for &i in &body {
+                loops.inside[i.0 as usize] = true;
+            }
+            let mut inputs = vec![init];
+            for &i in &body {
+                for o in operands(graph.node(i)) {
+                    let outside = o != carried && body.binary_search(&o).is_err();
+                    if outside && !inputs.contains(&o) {
+                        inputs.push(o);
+                    }
+                }
+            }
+            loops.inputs[id.0 as usize] = inputs;
+            loops.bodies.insert(id, body);
+        }
+        loops
+    }
+
+    /// The nodes `id` reads, each once: its operands, or a loop's inputs.
+    fn deps(&self, tape: &SurfaceTape, id: Id) -> impl Iterator<Item = Id> {
+        let inputs = self
+            .inputs
+            .get(id.0 as usize)
+            .map_or(&[][..], Vec::as_slice);
+        operands(tape.graph.node(id)).chain(inputs.iter().copied())
+    }
+
+    fn is_inside(&self, id: Id) -> bool {
+        self.inside.get(id.0 as usize).copied().unwrap_or(false)
+    }
 }
 
 /// The largest live tape `emission_order` schedules (the examples' largest
@@ -360,8 +458,14 @@ const SCHEDULED_NODES: usize = 4096;
 /// changes how many values the register allocator must keep at once,
 /// which is most of the compile time of a big tape and the spills of its
 /// code, and how much of a pass the core can overlap.
-fn emission_order(tape: &SurfaceTape, lanes: Lanes) -> Vec<Id> {
-    let live = tape.live_nodes();
+/// Outside its loop, a loop is one node; its body is ordered the same way
+/// on its own (`body_orders`).
+fn emission_order(tape: &SurfaceTape, live: &[Id], loops: &Loops, lanes: Lanes) -> Vec<Id> {
+    let live: Vec<Id> = live
+        .iter()
+        .copied()
+        .filter(|&id| !loops.is_inside(id))
+        .collect();
     // The schedule scans the ready nodes for each node it places: bounded
     // here so that a huge tape costs no quadratic time before cranelift.
     if live.len() > SCHEDULED_NODES {
@@ -371,20 +475,44 @@ fn emission_order(tape: &SurfaceTape, lanes: Lanes) -> Vec<Id> {
         Lanes::One => Ahead::Operations,
         Lanes::Two => Ahead::Latency,
     };
-    let scheduled = pressure_schedule(tape, &live, ahead);
-    if waiting(tape, &scheduled) < waiting(tape, &live) {
+    let scheduled = pressure_schedule(tape, loops, &live, ahead);
+    if waiting(tape, loops, &scheduled) < waiting(tape, loops, &live) {
         scheduled
     } else {
         live
     }
 }
 
+/// The order each loop's body is emitted in, by the rule of
+/// `emission_order`.
+fn body_orders(tape: &SurfaceTape, loops: &Loops, lanes: Lanes) -> HashMap<Id, Vec<Id>> {
+    let ahead = match lanes {
+        Lanes::One => Ahead::Operations,
+        Lanes::Two => Ahead::Latency,
+    };
+    loops
+        .bodies
+        .iter()
+        .map(|(&id, body)| {
+            let scheduled = pressure_schedule(tape, loops, body, ahead);
+            let order = if body.len() <= SCHEDULED_NODES
+                && waiting(tape, loops, &scheduled) < waiting(tape, loops, body)
+            {
+                scheduled
+            } else {
+                body.clone()
+            };
+            (id, order)
+        })
+        .collect()
+}
+
 /// How long the values of an order wait, in nodes, from their definition
 /// to their last use (the outputs are used at the end of the pass).
-fn waiting(tape: &SurfaceTape, order: &[Id]) -> usize {
+fn waiting(tape: &SurfaceTape, loops: &Loops, order: &[Id]) -> usize {
     let mut last = vec![0usize; tape.graph.len()];
     for (i, &id) in order.iter().enumerate() {
-        for o in operands(tape.graph.node(id)) {
+        for o in loops.deps(tape, id) {
             last[o.0 as usize] = i;
         }
     }
@@ -418,7 +546,10 @@ enum Ahead {
 /// the inline or called functions weigh more than an add.
 fn latency(node: Node) -> i32 {
     match node {
-        Node::Const(_) | Node::Var(_) => 0,
+        Node::Const(_) | Node::Var(_) | Node::Carried(_) => 0,
+        // Each step a chain of several long operations (a Newton step:
+        // the function, its slope, a division).
+        Node::Repeat { steps, .. } => 60 * steps.min(1000) as i32,
         Node::Unary(Unary::Neg | Unary::Abs, _) => 1,
         Node::Unary(Unary::Sqrt, _) => 20,
         Node::Unary(Unary::Floor, _) | Node::Step(_) | Node::Select(..) => 3,
@@ -440,9 +571,16 @@ fn latency(node: Node) -> i32 {
 /// output (`ahead`), then the earliest in the tape. A differentiated tape
 /// lists a value's whole chain before the derivatives that reuse its
 /// intermediates; this interleaves them.
-fn pressure_schedule(tape: &SurfaceTape, live: &[Id], ahead: Ahead) -> Vec<Id> {
+fn pressure_schedule(tape: &SurfaceTape, loops: &Loops, live: &[Id], ahead: Ahead) -> Vec<Id> {
     let n = tape.graph.len();
     let node = |id: Id| tape.graph.node(id);
+    // What the list reads from outside it (a loop body's inputs) is there
+    // all along.
+    let mut listed = vec![false; n];
+    for &id in live {
+        listed[id.0 as usize] = true;
+    }
+    let deps = |id: Id| loops.deps(tape, id).filter(|o| listed[o.0 as usize]);
     // Work to the furthest output, negated: smaller is needed sooner.
     let mut level = vec![0i32; n];
     for &id in live.iter().rev() {
@@ -451,7 +589,7 @@ fn pressure_schedule(tape: &SurfaceTape, live: &[Id], ahead: Ahead) -> Vec<Id> {
             Ahead::Operations => 1,
             Ahead::Latency => latency(node(id)),
         };
-        for o in operands(node(id)) {
+        for o in deps(id) {
             level[o.0 as usize] = level[o.0 as usize].min(h - step);
         }
     }
@@ -460,7 +598,7 @@ fn pressure_schedule(tape: &SurfaceTape, live: &[Id], ahead: Ahead) -> Vec<Id> {
     let mut unready = vec![0u32; n];
     let mut ready = Vec::new();
     for &id in live {
-        for o in operands(node(id)) {
+        for o in deps(id) {
             uses[o.0 as usize] += 1;
             unready[id.0 as usize] += 1;
         }
@@ -478,7 +616,7 @@ fn pressure_schedule(tape: &SurfaceTape, live: &[Id], ahead: Ahead) -> Vec<Id> {
     let mut filled = first.clone();
     let mut users = vec![Id(0); first[n] as usize];
     for &id in live {
-        for o in operands(node(id)) {
+        for o in deps(id) {
             let slot = &mut filled[o.0 as usize];
             users[*slot as usize] = id;
             *slot += 1;
@@ -490,11 +628,8 @@ fn pressure_schedule(tape: &SurfaceTape, live: &[Id], ahead: Ahead) -> Vec<Id> {
     // The values each ready node is the last use of, kept up to date as
     // nodes are placed (recounted for every ready node at every step, this
     // was most of the schedule's time).
-    let last_uses = |id: Id, uses: &[u32]| {
-        operands(node(id))
-            .filter(|o| uses[o.0 as usize] == 1)
-            .count() as u32
-    };
+    let last_uses =
+        |id: Id, uses: &[u32]| deps(id).filter(|o| uses[o.0 as usize] == 1).count() as u32;
     let mut kills = vec![0u32; n];
     for &id in &ready {
         kills[id.0 as usize] = last_uses(id, &uses);
@@ -512,7 +647,7 @@ fn pressure_schedule(tape: &SurfaceTape, live: &[Id], ahead: Ahead) -> Vec<Id> {
         let id = ready.swap_remove(next);
         order.push(id);
         placed[id.0 as usize] = true;
-        for o in operands(node(id)) {
+        for o in deps(id) {
             let o = o.0 as usize;
             uses[o] -= 1;
             if uses[o] == 1 {
@@ -538,6 +673,59 @@ fn pressure_schedule(tape: &SurfaceTape, live: &[Id], ahead: Ahead) -> Vec<Id> {
     order
 }
 
+/// The values of a pass's nodes so far. A negation emits nothing: its
+/// node holds its operand's value with `negated` set, and its users take
+/// the sign in (`Emitter::node`) or apply it (`Emitter::plain`).
+struct Values {
+    val: Vec<Option<Value>>,
+    /// Whether the value held is the negation of the node's.
+    negated: Vec<bool>,
+    /// Whether a node's value may be held with its negation pending
+    /// (`pending_negations`).
+    pending: Vec<bool>,
+}
+
+/// Where a negation may stay pending: at a node with one user, or whose
+/// users are all sums and differences. Those never pass a negation on, so
+/// each negation the tape writes is applied at most once (at the one
+/// user, or where a difference needs it: `Emitter::plain` keeps the
+/// result), never more often than the tape's own negations; a value with
+/// several users of other kinds is negated once, where it is computed.
+fn pending_negations(tape: &SurfaceTape, live: &[Id]) -> Vec<bool> {
+    let n = tape.graph.len();
+    let mut users = vec![0u32; n];
+    let mut sums_only = vec![true; n];
+    for &id in live {
+        let node = tape.graph.node(id);
+        let sum = matches!(node, Node::Binary(Binary::Add | Binary::Sub, _, _));
+        for o in operands(node) {
+            users[o.0 as usize] += 1;
+            sums_only[o.0 as usize] &= sum;
+        }
+        if let Node::Repeat { init, next, .. } = node {
+            for o in [init, next] {
+                users[o.0 as usize] += 1;
+                sums_only[o.0 as usize] = false;
+            }
+        }
+    }
+    for o in tape.outputs {
+        users[o.0 as usize] += 1;
+        sums_only[o.0 as usize] = false;
+    }
+    (0..n).map(|i| users[i] == 1 || sums_only[i]).collect()
+}
+
+/// A loop to emit: its node's fields and its body (`Loops`).
+#[derive(Clone, Copy)]
+struct Loop<'a> {
+    carried: Id,
+    init: Id,
+    next: Id,
+    steps: u32,
+    body: &'a [Id],
+}
+
 /// Emits operations, importing each libm wrapper at most once.
 struct Emitter<'m> {
     module: &'m mut JITModule,
@@ -550,6 +738,9 @@ struct Emitter<'m> {
     /// The lane masks of where the inline sin, cos and exp of this (vector)
     /// pass hold.
     covered: Vec<Value>,
+    /// −0 in every lane (the sign bit alone) once a negation of this pass
+    /// needed it.
+    sign: Option<Value>,
 }
 
 impl Emitter<'_> {
@@ -561,7 +752,7 @@ impl Emitter<'_> {
         &mut self,
         b: &mut FunctionBuilder,
         tape: &SurfaceTape,
-        order: &[Id],
+        (order, bodies, pending): (&[Id], &HashMap<Id, Vec<Id>>, &[bool]),
         lanes: Lanes,
         cx: Value,
         cy: Value,
@@ -576,47 +767,313 @@ impl Emitter<'_> {
         self.trig.clear();
         self.negative.clear();
         self.covered.clear();
-        let mut val: Vec<Option<Value>> = vec![None; tape.graph.len()];
-        let graph = &tape.graph;
+        self.sign = None;
+        let mut vals = Values {
+            val: vec![None; tape.graph.len()],
+            negated: vec![false; tape.graph.len()],
+            pending: pending.to_vec(),
+        };
         for &id in order {
-            let get =
-                |i: Id| val[i.0 as usize].expect("operands come before their node in the tape");
-            let v = match graph.node(id) {
-                Node::Const(bits) => constant(b, lanes, bits),
-                Node::Var(Var::X) => x,
-                Node::Var(Var::Y) => y,
-                Node::Unary(op @ (Unary::Sin | Unary::Cos), a) => {
-                    let (sin, cos) = self.sin_cos(b, lanes, a, get(a))?;
-                    if op == Unary::Sin { sin } else { cos }
+            let (v, negated) = match tape.graph.node(id) {
+                Node::Repeat {
+                    carried,
+                    init,
+                    next,
+                    steps,
+                } => {
+                    let body = bodies.get(&id).map_or(&[][..], Vec::as_slice);
+                    let l = Loop {
+                        carried,
+                        init,
+                        next,
+                        steps,
+                        body,
+                    };
+                    (self.repeat(b, tape, lanes, l, &mut vals, (x, y))?, false)
                 }
-                Node::Unary(op, a) => self.unary(b, lanes, op, get(a))?,
-                Node::Binary(op @ (Binary::Min | Binary::Max), l, r) => {
-                    let l = (get(l), graph.constant(l));
-                    let r = (get(r), graph.constant(r));
-                    min_max(b, lanes, op, l, r)
-                }
-                Node::Binary(op, a, c) => self.binary(b, lanes, op, get(a), get(c))?,
-                Node::PowI(a, k) => powi(b, lanes, get(a), k),
-                Node::Step(a) => {
-                    // 1 where a < 0 (false for NaN), else 0.
-                    let neg = self.negative(b, lanes, a, get(a));
-                    let zero = constant(b, lanes, 0f64.to_bits());
-                    let one = constant(b, lanes, 1f64.to_bits());
-                    select_known(b, lanes, neg, (one, Some(1.0)), (zero, Some(0.0)))
-                }
-                Node::Select(c, t, f) => {
-                    // t where c < 0 (false for NaN), else f.
-                    let neg = self.negative(b, lanes, c, get(c));
-                    let t = (get(t), graph.constant(t));
-                    let f = (get(f), graph.constant(f));
-                    select_known(b, lanes, neg, t, f)
-                }
+                _ => self.node(b, tape, lanes, id, &mut vals, (x, y))?,
             };
-            val[id.0 as usize] = Some(v);
+            self.keep(b, lanes, &mut vals, id, (v, negated));
         }
-        Ok(tape
-            .outputs
-            .map(|o| val[o.0 as usize].expect("outputs are live")))
+        let mut outputs = [x; 6];
+        for (k, &o) in tape.outputs.iter().enumerate() {
+            outputs[k] = self.plain(b, lanes, &mut vals, o)?;
+        }
+        Ok(outputs)
+    }
+
+    /// Records node `id`'s value; a pending negation stays pending only
+    /// where `Values::pending` allows, else it is applied now.
+    fn keep(
+        &mut self,
+        b: &mut FunctionBuilder,
+        lanes: Lanes,
+        vals: &mut Values,
+        id: Id,
+        (v, negated): (Value, bool),
+    ) {
+        let i = id.0 as usize;
+        let (v, negated) = if negated && !vals.pending[i] {
+            (self.negate(b, lanes, v), false)
+        } else {
+            (v, negated)
+        };
+        vals.val[i] = Some(v);
+        vals.negated[i] = negated;
+    }
+
+    /// The value of node `i` as computed, and whether it is the node's
+    /// negation (`Values`).
+    fn raw(vals: &Values, i: Id) -> Result<(Value, bool), JitError> {
+        let v = vals.val[i.0 as usize]
+            .ok_or_else(|| JitError(format!("node {} used before it is computed", i.0)))?;
+        Ok((v, vals.negated[i.0 as usize]))
+    }
+
+    /// The value of node `i`, its pending negation applied (once: the
+    /// result replaces it).
+    fn plain(
+        &mut self,
+        b: &mut FunctionBuilder,
+        lanes: Lanes,
+        vals: &mut Values,
+        i: Id,
+    ) -> Result<Value, JitError> {
+        let (v, negated) = Self::raw(vals, i)?;
+        if !negated {
+            return Ok(v);
+        }
+        let v = self.negate(b, lanes, v);
+        vals.val[i.0 as usize] = Some(v);
+        vals.negated[i.0 as usize] = false;
+        Ok(v)
+    }
+
+    /// −a: the sign bit flipped, as `fneg` does, by one xor with a
+    /// constant shared by the pass (cranelift's `fneg` builds its mask
+    /// anew each time: three or four instructions and a register).
+    fn negate(&mut self, b: &mut FunctionBuilder, lanes: Lanes, a: Value) -> Value {
+        let sign = *self
+            .sign
+            .get_or_insert_with(|| constant(b, lanes, (-0f64).to_bits()));
+        b.ins().bxor(a, sign)
+    }
+
+    /// The value of node `id` (no loop) from the values so far, and
+    /// whether it is the node's negation (`Values`): a negation emits
+    /// nothing, and products, quotients, sums and differences take their
+    /// operands' pending negations in, where the identity is exact.
+    fn node(
+        &mut self,
+        b: &mut FunctionBuilder,
+        tape: &SurfaceTape,
+        lanes: Lanes,
+        id: Id,
+        vals: &mut Values,
+        (x, y): (Value, Value),
+    ) -> Result<(Value, bool), JitError> {
+        let graph = &tape.graph;
+        Ok(match graph.node(id) {
+            Node::Unary(Unary::Neg, a) => {
+                let (v, negated) = Self::raw(vals, a)?;
+                (v, !negated)
+            }
+            // (−a)·b = a·(−b) = −(a·b) and likewise for a quotient, bit
+            // for bit: rounding to nearest is symmetric about zero, and
+            // the sign of a product or quotient (of zero too) is the
+            // exclusive or of its operands' signs.
+            Node::Binary(op @ (Binary::Mul | Binary::Div), l, r) => {
+                let ((vl, nl), (vr, nr)) = (Self::raw(vals, l)?, Self::raw(vals, r)?);
+                let v = if op == Binary::Mul {
+                    b.ins().fmul(vl, vr)
+                } else {
+                    b.ins().fdiv(vl, vr)
+                };
+                (v, nl != nr)
+            }
+            // a − b is a + (−b) in IEEE 754, and a sum does not depend on
+            // the order of its operands: with −a or −b pending, a + b, a −
+            // b, b − a serve exactly. Where the result would be −(a + b)
+            // (which differs in the sign of a zero sum), the left
+            // operand's negation is applied instead.
+            Node::Binary(op @ (Binary::Add | Binary::Sub), l, r) => {
+                let (nl, nr) = (Self::raw(vals, l)?.1, Self::raw(vals, r)?.1);
+                let add = op == Binary::Add;
+                // The result is l + (±vr): vr enters negated where it is
+                // added with its negation pending or subtracted without.
+                let r_minus = add == nr;
+                let vr = Self::raw(vals, r)?.0;
+                if nl && r_minus {
+                    // −vl − vr would be −(vl + vr): apply l's negation.
+                    let vl = self.plain(b, lanes, vals, l)?;
+                    (b.ins().fsub(vl, vr), false)
+                } else if nl {
+                    // −vl + vr = vr − vl.
+                    let vl = Self::raw(vals, l)?.0;
+                    (b.ins().fsub(vr, vl), false)
+                } else {
+                    let vl = Self::raw(vals, l)?.0;
+                    let v = if r_minus {
+                        b.ins().fsub(vl, vr)
+                    } else {
+                        b.ins().fadd(vl, vr)
+                    };
+                    (v, false)
+                }
+            }
+            // (−a)^n is a^n for even n and −(a^n) for odd n, bit for bit:
+            // the squarings of the expansion lose the sign and each
+            // product (or the reciprocal of a negative n) keeps it.
+            Node::PowI(a, k) => {
+                let (v, negated) = Self::raw(vals, a)?;
+                (powi(b, lanes, v, k), negated && k % 2 != 0)
+            }
+            _ => {
+                for o in operands(graph.node(id)) {
+                    self.plain(b, lanes, vals, o)?;
+                }
+                (
+                    self.node_plain(b, tape, lanes, id, &vals.val, (x, y))?,
+                    false,
+                )
+            }
+        })
+    }
+
+    /// The value of node `id` from its operands' values `val` (no pending
+    /// negation among them).
+    fn node_plain(
+        &mut self,
+        b: &mut FunctionBuilder,
+        tape: &SurfaceTape,
+        lanes: Lanes,
+        id: Id,
+        val: &[Option<Value>],
+        (x, y): (Value, Value),
+    ) -> Result<Value, JitError> {
+        let graph = &tape.graph;
+        // Operands come before their node in the order; should one not,
+        // the kernel is not built (no panic).
+        let get = |i: Id| {
+            val[i.0 as usize]
+                .ok_or_else(|| JitError(format!("node {} used before it is computed", i.0)))
+        };
+        Ok(match graph.node(id) {
+            Node::Const(bits) => constant(b, lanes, bits),
+            Node::Var(Var::X) => x,
+            Node::Var(Var::Y) => y,
+            Node::Unary(op @ (Unary::Sin | Unary::Cos), a) => {
+                let (sin, cos) = self.sin_cos(b, lanes, a, get(a)?)?;
+                if op == Unary::Sin { sin } else { cos }
+            }
+            Node::Unary(op, a) => self.unary(b, lanes, op, get(a)?)?,
+            Node::Binary(op @ (Binary::Min | Binary::Max), l, r) => {
+                let l = (get(l)?, graph.constant(l));
+                let r = (get(r)?, graph.constant(r));
+                min_max(b, lanes, op, l, r)
+            }
+            Node::Binary(op, a, c) => self.binary(b, lanes, op, get(a)?, get(c)?)?,
+            Node::PowI(a, k) => powi(b, lanes, get(a)?, k),
+            Node::Step(a) => {
+                // 1 where a < 0 (false for NaN), else 0.
+                let neg = self.negative(b, lanes, a, get(a)?);
+                let zero = constant(b, lanes, 0f64.to_bits());
+                let one = constant(b, lanes, 1f64.to_bits());
+                select_known(b, lanes, neg, (one, Some(1.0)), (zero, Some(0.0)))
+            }
+            Node::Select(c, t, f) => {
+                // t where c < 0 (false for NaN), else f.
+                let neg = self.negative(b, lanes, c, get(c)?);
+                let t = (get(t)?, graph.constant(t));
+                let f = (get(f)?, graph.constant(f));
+                select_known(b, lanes, neg, t, f)
+            }
+            // A loop's estimate is defined by its loop (`repeat`); loops
+            // are not nested (`Graph::repeat`).
+            Node::Carried(_) | Node::Repeat { .. } => get(id)?,
+        })
+    }
+
+    /// A loop: one block that runs the body once per step and branches
+    /// back to itself, the estimate and the count of steps its
+    /// parameters (cranelift variables):
+    ///
+    /// ```text
+    /// p = init; k = 0; goto step
+    /// step: the body, over p; p = next; k += 1; if k < steps goto step
+    /// after: the value is p
+    /// ```
+    ///
+    /// The body's values from the last step remain visible after it (the
+    /// block dominates what follows), which the caches rely on. On two
+    /// lanes, the masks of where the body's inline sin, cos and exp hold
+    /// are joined over every step.
+    fn repeat(
+        &mut self,
+        b: &mut FunctionBuilder,
+        tape: &SurfaceTape,
+        lanes: Lanes,
+        l: Loop,
+        vals: &mut Values,
+        xy: (Value, Value),
+    ) -> Result<Value, JitError> {
+        let init = self.plain(b, lanes, vals, l.init)?;
+        if l.steps == 0 {
+            return Ok(init);
+        }
+        let estimate = b.declare_var(lanes.ty());
+        b.def_var(estimate, init);
+        let count = b.declare_var(types::I32);
+        let zero = b.ins().iconst(types::I32, 0);
+        b.def_var(count, zero);
+        let masked = lanes == Lanes::Two
+            && l.body.iter().any(|&i| {
+                matches!(
+                    tape.graph.node(i),
+                    Node::Unary(Unary::Sin | Unary::Cos | Unary::Exp, _)
+                )
+            });
+        let covered = b.declare_var(types::I64X2);
+        if masked {
+            let ones = b.func.dfg.constants.insert(vec![0xffu8; 16].into());
+            let all = b.ins().vconst(types::I64X2, ones);
+            b.def_var(covered, all);
+        }
+        let step = b.create_block();
+        let after = b.create_block();
+        b.ins().jump(step, &[]);
+
+        b.switch_to_block(step);
+        vals.val[l.carried.0 as usize] = Some(b.use_var(estimate));
+        vals.negated[l.carried.0 as usize] = false;
+        let masks_before = self.covered.len();
+        for &i in l.body {
+            let value = self.node(b, tape, lanes, i, vals, xy)?;
+            self.keep(b, lanes, vals, i, value);
+        }
+        if masked {
+            let mut all = b.use_var(covered);
+            for m in self.covered.split_off(masks_before) {
+                all = b.ins().band(all, m);
+            }
+            b.def_var(covered, all);
+        }
+        let next = self.plain(b, lanes, vals, l.next)?;
+        b.def_var(estimate, next);
+        let k = b.use_var(count);
+        let k = b.ins().iadd_imm_u(k, 1);
+        b.def_var(count, k);
+        let more = b
+            .ins()
+            .icmp_imm_u(IntCC::UnsignedLessThan, k, i64::from(l.steps));
+        b.ins().brif(more, step, &[], after, &[]);
+
+        b.switch_to_block(after);
+        if masked {
+            let all = b.use_var(covered);
+            self.covered.push(all);
+        }
+        Ok(b.use_var(estimate))
     }
 
     /// The cached test `a < 0` (false for NaN) of node `id`: a flag with
@@ -681,7 +1138,7 @@ impl Emitter<'_> {
         a: Value,
     ) -> Result<Value, JitError> {
         Ok(match op {
-            Unary::Neg => b.ins().fneg(a),
+            Unary::Neg => self.negate(b, lanes, a),
             Unary::Sqrt => b.ins().sqrt(a),
             Unary::Abs => b.ins().fabs(a),
             Unary::Floor => b.ins().floor(a),

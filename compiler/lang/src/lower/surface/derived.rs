@@ -194,7 +194,7 @@ pub(super) fn off_axis_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result
 /// where the tilt is part of another surface; a tilted surface of its own
 /// has its derivatives in closed form, `tilted_outputs`).
 pub(super) fn tilted_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError> {
-    let t = Tilt::solve(g, o, x, y)?;
+    let t = Tilt::solve(g, o, x, y, Steps::WrittenOut)?;
     Ok(t.height(g))
 }
 
@@ -215,14 +215,28 @@ pub(super) fn tilted_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<I
 /// the derivatives through the converged iterations to within rounding,
 /// from about a tenth of the nodes (the tilted lens of
 /// `examples/off_axis_and_tilt.lens`: 1760 live nodes → ~200), so a
-/// fraction of the compile and evaluation time.
+/// fraction of the compile and evaluation time. Nothing differentiates
+/// the steps here, so they are one loop (`Steps::Loop`), its body in the
+/// graph once: the same values, a sixth of Newton's nodes.
 pub(super) fn tilted_outputs(
     g: &mut Graph,
     o: &Object,
     x: Id,
     y: Id,
 ) -> Result<[Id; 6], LowerError> {
-    let mut t = Tilt::solve(g, o, x, y)?;
+    tilted_outputs_with(g, o, x, y, Steps::Loop)
+}
+
+/// `tilted_outputs` with the Newton steps put in the graph as `steps`
+/// says (the same values either way).
+pub(super) fn tilted_outputs_with(
+    g: &mut Graph,
+    o: &Object,
+    x: Id,
+    y: Id,
+    steps: Steps,
+) -> Result<[Id; 6], LowerError> {
+    let mut t = Tilt::solve(g, o, x, y, steps)?;
     let z = t.height(g);
     let h = &mut t.parent;
     let hzq = h.derivative(t.hz, Var::Y);
@@ -264,6 +278,22 @@ pub(super) fn tilted_outputs(
     })
 }
 
+/// How a tilt's Newton steps are put in the graph; either way the same
+/// operations in the same order, so the same bits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Steps {
+    /// One after another, each a copy: what a derivative of the height
+    /// goes through (a tilt inside another surface).
+    WrittenOut,
+    /// One loop (`Graph::repeat`), the body once: a surface of its own,
+    /// whose derivatives are in closed form.
+    Loop,
+}
+
+/// The Newton steps of a tilt (|θ| < 45°, from p = P cosθ: converged to
+/// machine precision).
+const NEWTON_STEPS: u32 = 6;
+
 /// A tilt's parent coordinate solved by Newton's method in a graph.
 struct Tilt {
     /// The parent's height over (p, q) = (turning coordinate, the other
@@ -281,7 +311,7 @@ struct Tilt {
 }
 
 impl Tilt {
-    fn solve(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Tilt, LowerError> {
+    fn solve(g: &mut Graph, o: &Object, x: Id, y: Id, steps: Steps) -> Result<Tilt, LowerError> {
         let f = &o.fields;
         let parent =
             value::object(f, "parent").ok_or(LowerError::Unsupported("tilt without a parent"))?;
@@ -303,8 +333,7 @@ impl Tilt {
         let (big_p, q) = if about_x { (y, x) } else { (x, y) };
         let c = g.constant_node(cos);
         let sn = g.constant_node(sin);
-        let mut p = g.mul(big_p, c);
-        for _ in 0..6 {
+        let newton = |g: &mut Graph, p: Id| {
             let map = g.import(&h, p, q);
             let (z, zp) = (map[hz.0 as usize], map[hzp.0 as usize]);
             // F = p cosθ + z sinθ − P, F′ = cosθ + z_p sinθ
@@ -315,8 +344,18 @@ impl Tilt {
             let zps = g.mul(zp, sn);
             let der = g.add(c, zps);
             let step = g.div(res, der);
-            p = g.sub(p, step);
-        }
+            g.sub(p, step)
+        };
+        let start = g.mul(big_p, c);
+        // No turn (sin θ = 0): the steps written out fold to p = P, which
+        // a loop's body, over an unknown estimate, could not.
+        let p = if steps == Steps::Loop && sin != 0.0 {
+            let estimate = g.carried();
+            let next = newton(g, estimate);
+            g.repeat(estimate, start, next, NEWTON_STEPS)
+        } else {
+            (0..NEWTON_STEPS).fold(start, |p, _| newton(g, p))
+        };
         Ok(Tilt {
             parent: h,
             hz,

@@ -681,6 +681,62 @@ surface tx = tilt(p, about: x, angle: -8 deg, aperture: circle(radius: 1.5 mm))"
     }
 }
 
+#[test]
+fn a_tilt_s_newton_steps_are_one_loop_with_the_bits_of_the_steps_written_out() {
+    // A tilted surface of its own holds its six Newton steps as one loop
+    // (`Node::Repeat`, the body once), and all six outputs are bit for bit
+    // those of the steps written out; with no turn there is no loop (the
+    // steps written out fold to p = P, which a loop's body could not).
+    let src = "surface p = asphere { radius: 9 mm, conic: -0.6, sense: concave, aperture: circle(radius: 3 mm), A4: 1e-4 mm^-3, A3: -2e-4 mm^-2 }
+surface ty = tilt(p, about: y, angle: 12 deg, aperture: circle(radius: 1.5 mm))
+surface tx = tilt(p, about: x, angle: -8 deg, aperture: circle(radius: 1.5 mm))
+surface t0 = tilt(p, about: y, angle: 0 deg, aperture: circle(radius: 1.5 mm))";
+    let c = crate::check_text(&crate::loader::RealFs, "t.lens", src.as_bytes());
+    assert!(!c.has_errors(), "{:?}", c.diags());
+    for (name, loops) in [("ty", 1), ("tx", 1), ("t0", 0)] {
+        let o = c.checked.declarations.get(name).expect("surface");
+        let looped = lower_surface(o).expect("lowers").tape;
+        let repeats = looped
+            .live_nodes()
+            .into_iter()
+            .filter(|&i| {
+                matches!(
+                    looped.graph.node(i),
+                    lensc_runtime::surface::ir::Node::Repeat { .. }
+                )
+            })
+            .count();
+        assert_eq!(repeats, loops, "{name}: loops in the tape");
+        let mut g = Graph::new();
+        let (x, y) = (g.x(), g.y());
+        let outputs = derived::tilted_outputs_with(&mut g, o, x, y, derived::Steps::WrittenOut)
+            .expect("lowers");
+        let written = SurfaceTape::with_outputs(g, outputs);
+        if loops == 1 {
+            assert!(
+                looped.live_nodes().len() * 3 < written.live_nodes().len() * 2,
+                "{name}: the body is written once"
+            );
+        }
+        let (a, b) = (Interpreter::new(&looped), Interpreter::new(&written));
+        for i in 0..=20 {
+            for j in 0..=20 {
+                let (px, py) = (-1.5 + 0.15 * f64::from(i), -1.5 + 0.15 * f64::from(j));
+                let (oa, ob) = (a.eval(px, py), b.eval(px, py));
+                for k in 0..6 {
+                    assert_eq!(
+                        oa[k].to_bits(),
+                        ob[k].to_bits(),
+                        "{name} output {k} at ({px}, {py}): {} looped, {} written out",
+                        oa[k],
+                        ob[k]
+                    );
+                }
+            }
+        }
+    }
+}
+
 /// Closed-form outputs `a` against the graph's `b` at `at`: z bit for bit
 /// (the same nodes), the slopes and curvatures within 1e-13 relative.
 fn same_z_close_derivatives(name: &str, at: (f64, f64), a: [f64; 6], b: [f64; 6]) {
