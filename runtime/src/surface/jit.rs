@@ -685,35 +685,46 @@ struct Values {
     pending: Vec<bool>,
 }
 
-/// Where a negation may stay pending: at a node with one user, or whose
-/// users are all sums and differences. Those never pass a negation on, so
-/// each negation the tape writes is applied at most once (at the one
-/// user, or where a difference needs it: `Emitter::plain` keeps the
-/// result), never more often than the tape's own negations; a value with
-/// several users of other kinds is negated once, where it is computed.
+/// Where a negation may stay pending: at a node with one user (which
+/// takes it in, or applies it in place of the node), or whose users all
+/// take it in for free — sums and differences, even powers, and products,
+/// quotients, odd powers and negations whose own pending negation is free
+/// in the same sense. A difference may still apply it once (`Emitter::plain`
+/// keeps the result). So no more negations are applied than the tape
+/// writes; a value with several users of other kinds is negated once,
+/// where it is computed.
 fn pending_negations(tape: &SurfaceTape, live: &[Id]) -> Vec<bool> {
     let n = tape.graph.len();
     let mut users = vec![0u32; n];
-    let mut sums_only = vec![true; n];
-    for &id in live {
+    let mut free = vec![true; n];
+    for o in tape.outputs {
+        users[o.0 as usize] += 1;
+        free[o.0 as usize] = false;
+    }
+    // Users come after their operands: backwards, each node's own
+    // freedom is settled before its operands are judged by it.
+    for &id in live.iter().rev() {
         let node = tape.graph.node(id);
-        let sum = matches!(node, Node::Binary(Binary::Add | Binary::Sub, _, _));
+        let takes_in = match node {
+            Node::Binary(Binary::Add | Binary::Sub, _, _) => true,
+            Node::PowI(_, k) if k % 2 == 0 => true,
+            Node::Binary(Binary::Mul | Binary::Div, _, _)
+            | Node::PowI(_, _)
+            | Node::Unary(Unary::Neg, _) => free[id.0 as usize],
+            _ => false,
+        };
         for o in operands(node) {
             users[o.0 as usize] += 1;
-            sums_only[o.0 as usize] &= sum;
+            free[o.0 as usize] &= takes_in;
         }
         if let Node::Repeat { init, next, .. } = node {
             for o in [init, next] {
                 users[o.0 as usize] += 1;
-                sums_only[o.0 as usize] = false;
+                free[o.0 as usize] = false;
             }
         }
     }
-    for o in tape.outputs {
-        users[o.0 as usize] += 1;
-        sums_only[o.0 as usize] = false;
-    }
-    (0..n).map(|i| users[i] == 1 || sums_only[i]).collect()
+    (0..n).map(|i| users[i] == 1 || free[i]).collect()
 }
 
 /// A loop to emit: its node's fields and its body (`Loops`).
