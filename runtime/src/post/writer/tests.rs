@@ -648,11 +648,14 @@ fn position() -> impl proptest::strategy::Strategy<Value = P> {
 }
 
 /// A feed for the differential test, in any mode: one that prints as
-/// zero or not at all among them.
+/// zero or not at all among them, and a few that repeat (so the feed
+/// word is left out now and then).
 fn feed() -> impl proptest::strategy::Strategy<Value = Option<F>> {
     use proptest::prelude::*;
     prop_oneof![
         Just(None),
+        (0u8..2).prop_map(|k| Some(F::PerTime(1.0 + k as f64))),
+        (0u8..2).prop_map(|k| Some(F::PerRevolution(0.01 + k as f64 * 0.01))),
         (1e-4f64..50.0).prop_map(|v| Some(F::PerTime(v))),
         (1e-5f64..0.1).prop_map(|v| Some(F::PerRevolution(v))),
         (1e-7f64..10.0).prop_map(|t| Some(F::InverseTime(t))),
@@ -721,9 +724,10 @@ fn differential_dialect(
 proptest::proptest! {
     #![proptest_config(proptest::prelude::ProptestConfig::with_cases(300))]
 
-    /// The common block (one pass) against the general path alone,
-    /// move by move over random streams and dialects: the same text
-    /// after every move, the same refusals, the same program at the end.
+    /// The common block (one pass, and two at a time in `write_all`)
+    /// against the general path alone over random streams and dialects:
+    /// the same text after every chunk of moves, the same refusals, the
+    /// same program at the end.
     #[test]
     fn the_common_block_is_the_general_paths(
         dialect in 0u8..18,
@@ -731,6 +735,7 @@ proptest::proptest! {
         max_digits in proptest::option::of(5u32..13),
         line_limit in 20usize..50,
         stream in proptest::collection::vec(any_move(), 1..80),
+        chunks in proptest::collection::vec(1usize..8, 1..6),
     ) {
         let (d, setup, axes) = differential_dialect(dialect, max_digits, line_limit);
         let start = |common: bool| {
@@ -749,11 +754,30 @@ proptest::proptest! {
             return Ok(());
         };
         proptest::prop_assert!(!general.common_blocks);
-        for m in &stream {
-            let a = one_pass.write(m).and_then(|()| one_pass.take_text());
-            let b = general.write(m).and_then(|()| general.take_text());
+        // The one-pass writer takes the stream in chunks through
+        // `write_all` (odd and even lengths: pairs of common blocks and a
+        // move left over), the general one move by move, stopping where
+        // the chunk stops (at its first refusal).
+        let mut at = 0;
+        let mut chunks = chunks.iter().cycle();
+        while at < stream.len() {
+            let n = (*chunks.next().unwrap_or(&1)).min(stream.len() - at);
+            let chunk = &stream[at..at + n];
+            at += n;
+            let a = one_pass.write_all(chunk).and_then(|()| one_pass.take_text());
+            let b = chunk
+                .iter()
+                .try_for_each(|m| general.write(m))
+                .and_then(|()| general.take_text());
             // Compared as printed: a refused NaN is not equal to itself.
-            proptest::prop_assert_eq!(format!("{a:?}"), format!("{b:?}"), "after {:?}", m);
+            proptest::prop_assert_eq!(format!("{a:?}"), format!("{b:?}"), "after {:?}", chunk);
+            if a.is_err() {
+                // What the refused chunk wrote before its refusal.
+                proptest::prop_assert_eq!(
+                    format!("{:?}", one_pass.take_text()),
+                    format!("{:?}", general.take_text())
+                );
+            }
         }
         proptest::prop_assert_eq!(general.common_written, 0);
         proptest::prop_assert_eq!(
@@ -795,9 +819,11 @@ fn common_blocks_are_the_common_path() {
     w.write_all(&spiral).expect("printable");
     let text = w.take_text().expect("checked");
     let blocks = text.lines().filter(|l| l.starts_with("G1 ")).count();
-    // The first move states the feed mode (`G93 G1 …`): the general way.
+    // The first move states the feed mode (`G93 G1 …`): the general way,
+    // and the second on its own; every other two at a time.
     assert_eq!(w.common_written, blocks);
     assert_eq!(blocks, 1999);
+    assert_eq!(w.common_pairs, 999);
     let mill: Vec<M> = (0..100)
         .map(|i| M::Linear {
             to: P::xyz(i as f64 * 0.01, 1.0, -0.5),
