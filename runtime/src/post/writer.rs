@@ -132,12 +132,9 @@ pub struct ProgramWriter {
     /// Whether rapids and lines may go the one-pass way
     /// (`common_block`): the dialect allows it.
     common_blocks: bool,
-    /// How many blocks went the one-pass way, and how many pairs of
-    /// them two at a time (for the tests).
+    /// How many blocks went the one-pass way (for the tests).
     #[cfg(test)]
     common_written: usize,
-    #[cfg(test)]
-    common_pairs: usize,
 }
 
 /// The spindle's state as the program has set it.
@@ -290,8 +287,6 @@ impl ProgramWriter {
             common_blocks: false,
             #[cfg(test)]
             common_written: 0,
-            #[cfg(test)]
-            common_pairs: 0,
         };
         w.common_blocks = w.common_blocks_apply();
         w
@@ -502,7 +497,12 @@ impl ProgramWriter {
     #[inline(always)]
     fn write_move(&mut self, m: &crate::moves::Move) -> Result<(), ProgramError> {
         use crate::moves::Move as M;
-        if self.common_blocks([m, m], 1) {
+        let common = match *m {
+            M::Linear { to, feed } => self.common_block(Word::Linear, to, feed),
+            M::Rapid(to) => self.common_block(Word::Rapid, to, None),
+            _ => false,
+        };
+        if common {
             return Ok(());
         }
         if self.start.is_none() {
@@ -761,7 +761,7 @@ impl ProgramWriter {
         // before the room is taken, printed after the axes' words.
         let centre = arc.map(|(plane, centre)| self.centre_words(plane, to, centre));
         let at = self.text.len();
-        let room = block_room::<BLOCK_ROOM>(&mut self.text, &mut self.zeroed);
+        let room = block_room(&mut self.text, &mut self.zeroed);
         let mut pos = 0;
         if motion_word.len <= SNIPPET_ROOM {
             room[..SNIPPET_ROOM].copy_from_slice(&motion_word.room);
@@ -997,23 +997,12 @@ impl ProgramWriter {
         Ok(())
     }
 
-    /// Writes every move of a stream: two at a time as a pair of common
-    /// blocks where both are (`common_pair`), else one by one.
+    /// Writes every move of a stream.
     pub fn write_all<'a>(
         &mut self,
         moves: impl IntoIterator<Item = &'a crate::moves::Move>,
     ) -> Result<(), ProgramError> {
-        let mut moves = moves.into_iter();
-        while let Some(a) = moves.next() {
-            let Some(b) = moves.next() else {
-                return self.write_move(a);
-            };
-            if !self.common_blocks([a, b], 2) {
-                self.write_move(a)?;
-                self.write_move(b)?;
-            }
-        }
-        Ok(())
+        moves.into_iter().try_for_each(|m| self.write_move(m))
     }
 
     /// The text written since the last call (for streaming to a file),
@@ -1118,35 +1107,34 @@ const BLOCK_ROOM: usize = SNIPPET_ROOM + 7 * WORD_ROOM + SNIPPET_ROOM;
 /// head's fixed-size copy ending within it.
 const WORD_ROOM: usize = 5 + PRINTED_ROOM;
 
-/// `N` bytes (`BLOCK_ROOM`, or two blocks' worth for a pair of common
-/// blocks) added at the end of `text` for blocks to be printed into (the
-/// caller cuts the text back to what it printed): bytes of its spare
-/// capacity, zeroed once per allocation (`zeroed`: the capacity when
-/// they were), not byte by byte each block.
+/// `BLOCK_ROOM` bytes added at the end of `text` for a block to be
+/// printed into (the caller cuts the text back to what it printed): bytes
+/// of its spare capacity, zeroed once per allocation (`zeroed`: the
+/// capacity when they were), not byte by byte each block.
 #[inline(always)]
-fn block_room<'t, const N: usize>(text: &'t mut Vec<u8>, zeroed: &mut usize) -> &'t mut [u8; N] {
+fn block_room<'t>(text: &'t mut Vec<u8>, zeroed: &mut usize) -> &'t mut [u8; BLOCK_ROOM] {
     let at = text.len();
-    if text.capacity() - at < N || *zeroed != text.capacity() {
-        zero_spare_capacity(text, zeroed, N);
+    if text.capacity() - at < BLOCK_ROOM || *zeroed != text.capacity() {
+        zero_spare_capacity(text, zeroed);
     }
-    // SAFETY: `at + N` is within the capacity, and every byte of
+    // SAFETY: `at + BLOCK_ROOM` is within the capacity, and every byte of
     // the spare capacity is initialised: it was zeroed when `zeroed` was
     // set to the capacity, and the allocation is still that one (a `Vec`
     // only reallocates to a larger capacity; the writer replaces its text
     // only in `take_text`, which resets `zeroed`, and `finish`); a `Vec`
     // never de-initialises bytes beyond its length.
-    unsafe { text.set_len(at + N) };
-    match text.last_chunk_mut::<N>() {
+    unsafe { text.set_len(at + BLOCK_ROOM) };
+    match text.last_chunk_mut::<BLOCK_ROOM>() {
         Some(room) => room,
         None => unreachable!("the room was just added"),
     }
 }
 
-/// Room for `n` bytes at the end of `text`, and its whole spare capacity
+/// Room for a block at the end of `text`, and its whole spare capacity
 /// zeroed (once per allocation: `block_room`).
 #[cold]
-fn zero_spare_capacity(text: &mut Vec<u8>, zeroed: &mut usize, n: usize) {
-    text.reserve(n);
+fn zero_spare_capacity(text: &mut Vec<u8>, zeroed: &mut usize) {
+    text.reserve(BLOCK_ROOM);
     text.spare_capacity_mut()
         .fill(std::mem::MaybeUninit::new(0));
     *zeroed = text.capacity();

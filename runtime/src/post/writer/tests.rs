@@ -724,10 +724,11 @@ fn differential_dialect(
 proptest::proptest! {
     #![proptest_config(proptest::prelude::ProptestConfig::with_cases(300))]
 
-    /// The common block (one pass, and two at a time in `write_all`)
-    /// against the general path alone over random streams and dialects:
-    /// the same text after every chunk of moves, the same refusals, the
-    /// same program at the end.
+    /// The common block (one pass) against the general path alone over
+    /// random streams and dialects, the one-pass writer given them in
+    /// chunks through `write_all`, the general one move by move: the same
+    /// text after every chunk, the same refusals, the same program at
+    /// the end.
     #[test]
     fn the_common_block_is_the_general_paths(
         dialect in 0u8..18,
@@ -819,11 +820,9 @@ fn common_blocks_are_the_common_path() {
     w.write_all(&spiral).expect("printable");
     let text = w.take_text().expect("checked");
     let blocks = text.lines().filter(|l| l.starts_with("G1 ")).count();
-    // The first move states the feed mode (`G93 G1 …`): the general way,
-    // and the second on its own; every other two at a time.
+    // The first move states the feed mode (`G93 G1 …`): the general way.
     assert_eq!(w.common_written, blocks);
     assert_eq!(blocks, 1999);
-    assert_eq!(w.common_pairs, 999);
     let mill: Vec<M> = (0..100)
         .map(|i| M::Linear {
             to: P::xyz(i as f64 * 0.01, 1.0, -0.5),
