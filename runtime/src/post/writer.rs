@@ -93,8 +93,9 @@ pub struct ProgramWriter {
     max_digits: usize,
     /// The dialect's line-length limit (none: `usize::MAX`).
     max_line_length: usize,
-    /// The last value printed per axis, in units of its last decimal.
-    last: [Option<i64>; 4],
+    /// The last value printed per axis, in units of its last decimal
+    /// (`NOT_PRINTED`: none yet).
+    last: [i64; 4],
     /// Where the axes are (mm, rad; the stream's values).
     at: [f64; 4],
     plane: Plane,
@@ -151,6 +152,11 @@ enum FeedMode {
     PerRevolution,
     InverseTime,
 }
+
+/// `ProgramWriter::last` of an axis not printed yet: no unit count is
+/// (every printed one is below 10^18 in magnitude), so the first value
+/// is always written.
+const NOT_PRINTED: i64 = i64::MIN;
 
 /// Decimals of feeds per minute and per revolution, and of inverse time.
 const FEED_DECIMALS: u32 = 6;
@@ -254,7 +260,7 @@ impl ProgramWriter {
             line_end: Snippet::new(&format!("{}\n", dialect.block_end)),
             max_digits: dialect.max_digits.map_or(usize::MAX, |m| m as usize),
             max_line_length: dialect.max_line_length.unwrap_or(usize::MAX),
-            last: [None; 4],
+            last: [NOT_PRINTED; 4],
             at: [f64::NAN; 4],
             plane: match setup {
                 Setup::Lathe => Plane::Zx,
@@ -783,7 +789,7 @@ impl ProgramWriter {
                 break;
             };
             // Modal: a word whose printed value has not changed is left out.
-            if self.last[i] == Some(n) {
+            if self.last[i] == n {
                 continue;
             }
             let unit_limit = self.axis_unit_limits[i];
@@ -865,7 +871,7 @@ impl ProgramWriter {
     fn moved(&mut self, printed: &[i64], changed: u8, axes: [f64; 4]) {
         for (i, &n) in printed.iter().enumerate() {
             if changed & 1 << i != 0 {
-                self.last[i] = Some(n);
+                self.last[i] = n;
             }
         }
         for (at, v) in self.at.iter_mut().zip(axes) {
