@@ -788,6 +788,53 @@ proptest::proptest! {
     }
 }
 
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(200))]
+
+    /// `write_all` compiled for AVX2 (`write_all_avx2`, taken when the
+    /// processor has it) against the same code compiled for any x86-64,
+    /// over the differential test's random streams and dialects, in
+    /// chunks: the same text after every chunk, the same refusals, the
+    /// same end. On a processor without AVX2 there is nothing to compare
+    /// (both writers take the plain code).
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn write_all_for_avx2_writes_what_it_writes_for_any_x86_64(
+        dialect in 0u8..18,
+        resolution in proptest::sample::select(vec![1e-3, 1e-4, 1e-6]),
+        max_digits in proptest::option::of(5u32..13),
+        line_limit in 20usize..50,
+        stream in proptest::collection::vec(any_move(), 1..80),
+        chunks in proptest::collection::vec(1usize..8, 1..6),
+    ) {
+        let (d, setup, axes) = differential_dialect(dialect, max_digits, line_limit);
+        let start = |avx2: bool| {
+            let mut w = ProgramWriter::new(&d, setup, "t", &[], axes, resolution, 1e-3)?;
+            w.avx2 &= avx2;
+            w.call_tool(&Start::default())?;
+            w.write(&M::SpindleOn(RPM_1000))?;
+            Ok::<_, ProgramError>(w)
+        };
+        let (Ok(mut fast), Ok(mut plain)) = (start(true), start(false)) else {
+            return Ok(());
+        };
+        proptest::prop_assert!(!plain.avx2);
+        proptest::prop_assert_eq!(fast.avx2, has_avx2());
+        let mut at = 0;
+        let mut chunks = chunks.iter().cycle();
+        while at < stream.len() {
+            let n = (*chunks.next().unwrap_or(&1)).min(stream.len() - at);
+            let chunk = &stream[at..at + n];
+            at += n;
+            let a = fast.write_all(chunk).and_then(|()| fast.take_text());
+            let b = plain.write_all(chunk).and_then(|()| plain.take_text());
+            proptest::prop_assert_eq!(format!("{a:?}"), format!("{b:?}"), "after {:?}", chunk);
+        }
+        proptest::prop_assert_eq!(fast.common_written, plain.common_written);
+        proptest::prop_assert_eq!(format!("{:?}", fast.finish()), format!("{:?}", plain.finish()));
+    }
+}
+
 /// The emission bench's spiral (X, Z and C on every move, inverse time)
 /// goes the one-pass way block for block, and so does a mill's feed per
 /// minute; a dialect that numbers its blocks does not.
