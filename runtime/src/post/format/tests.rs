@@ -215,3 +215,80 @@ fn sixteen_digits_are_eight_and_eight() {
         );
     }
 }
+
+/// The rounding's shortcut (add the largest double below one half, with
+/// the value's sign, and truncate) is `f64::round`, half away from zero,
+/// at every tie k + 1/2 and the doubles on either side of it, in every
+/// binade up to 2^53 and past it, both signs, and at whole numbers and
+/// their neighbours.
+#[test]
+fn round_half_away_is_f64_round() {
+    let reference = |x: f64| x.round() as i64;
+    let mut checked = 0;
+    for e in 0..=60 {
+        let base = 2f64.powi(e);
+        for k in [0.0, 1.0, 2.0, 3.0, 7.0, 1e3] {
+            for frac in [0.0, 0.25, 0.5, 0.75] {
+                let v = base + k + frac;
+                for x in [v, v.next_up(), v.next_down()] {
+                    for x in [x, -x] {
+                        if x.abs() < 1e18 {
+                            assert_eq!(round_half_away(x), reference(x), "{x:e}");
+                            checked += 1;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    // Below one: zero, one half and its neighbours, the smallest values.
+    for x in [
+        0.0,
+        -0.0,
+        0.5,
+        0.5f64.next_up(),
+        0.5f64.next_down(),
+        BELOW_HALF,
+        f64::MIN_POSITIVE,
+        5e-324,
+        1.5,
+        2.5,
+        1e18f64.next_down(),
+    ] {
+        for x in [x, -x] {
+            assert_eq!(round_half_away(x), reference(x), "{x:e}");
+            checked += 1;
+        }
+    }
+    assert!(checked > 4000);
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(20_000))]
+
+    /// The same at random doubles below 1e18 and at random ties and
+    /// their neighbours.
+    #[test]
+    fn round_half_away_is_f64_round_anywhere(
+        x in proptest::prop_oneof![
+            // Any finite double, taken below 1e18 by the remainder
+            // (exact, and the double itself when it is below already).
+            proptest::strategy::Strategy::prop_map(proptest::num::f64::ANY, |x| {
+                if x.is_finite() { x % 1e18 } else { 0.5 }
+            }),
+            proptest::strategy::Strategy::prop_map(
+                (-1_000_000_000_000i64..1_000_000_000_000, -1i32..=1),
+                |(k, step)| {
+                    let tie = k as f64 + 0.5;
+                    match step {
+                        -1 => tie.next_down(),
+                        1 => tie.next_up(),
+                        _ => tie,
+                    }
+                },
+            ),
+        ]
+    ) {
+        proptest::prop_assert_eq!(round_half_away(x), x.round() as i64, "{:e}", x);
+    }
+}

@@ -84,7 +84,7 @@ impl ProgramWriter {
                 return false;
             }
             units[i] = n;
-            changed |= ((self.last[i] != Some(n)) as u8) << i;
+            changed |= ((self.last[i] != n) as u8) << i;
         }
         if changed == 0 {
             // No printed axis changes: no block, nothing kept.

@@ -100,7 +100,7 @@ impl ProgramWriter {
             let (Some(letter), Some(n)) = (self.letters[i], fixed_units(v, d)) else {
                 return Err(self.not_printable(i, v));
             };
-            if self.last[i] == Some(n) {
+            if self.last[i] == n {
                 continue;
             }
             self.text.extend_from_slice(&[b' ', letter as u8]);

@@ -648,11 +648,14 @@ fn position() -> impl proptest::strategy::Strategy<Value = P> {
 }
 
 /// A feed for the differential test, in any mode: one that prints as
-/// zero or not at all among them.
+/// zero or not at all among them, and a few that repeat (so the feed
+/// word is left out now and then).
 fn feed() -> impl proptest::strategy::Strategy<Value = Option<F>> {
     use proptest::prelude::*;
     prop_oneof![
         Just(None),
+        (0u8..2).prop_map(|k| Some(F::PerTime(1.0 + k as f64))),
+        (0u8..2).prop_map(|k| Some(F::PerRevolution(0.01 + k as f64 * 0.01))),
         (1e-4f64..50.0).prop_map(|v| Some(F::PerTime(v))),
         (1e-5f64..0.1).prop_map(|v| Some(F::PerRevolution(v))),
         (1e-7f64..10.0).prop_map(|t| Some(F::InverseTime(t))),
@@ -721,9 +724,11 @@ fn differential_dialect(
 proptest::proptest! {
     #![proptest_config(proptest::prelude::ProptestConfig::with_cases(300))]
 
-    /// The common block (one pass) against the general path alone,
-    /// move by move over random streams and dialects: the same text
-    /// after every move, the same refusals, the same program at the end.
+    /// The common block (one pass) against the general path alone over
+    /// random streams and dialects, the one-pass writer given them in
+    /// chunks through `write_all`, the general one move by move: the same
+    /// text after every chunk, the same refusals, the same program at
+    /// the end.
     #[test]
     fn the_common_block_is_the_general_paths(
         dialect in 0u8..18,
@@ -731,6 +736,7 @@ proptest::proptest! {
         max_digits in proptest::option::of(5u32..13),
         line_limit in 20usize..50,
         stream in proptest::collection::vec(any_move(), 1..80),
+        chunks in proptest::collection::vec(1usize..8, 1..6),
     ) {
         let (d, setup, axes) = differential_dialect(dialect, max_digits, line_limit);
         let start = |common: bool| {
@@ -749,17 +755,83 @@ proptest::proptest! {
             return Ok(());
         };
         proptest::prop_assert!(!general.common_blocks);
-        for m in &stream {
-            let a = one_pass.write(m).and_then(|()| one_pass.take_text());
-            let b = general.write(m).and_then(|()| general.take_text());
+        // The one-pass writer takes the stream in chunks through
+        // `write_all` (odd and even lengths: pairs of common blocks and a
+        // move left over), the general one move by move, stopping where
+        // the chunk stops (at its first refusal).
+        let mut at = 0;
+        let mut chunks = chunks.iter().cycle();
+        while at < stream.len() {
+            let n = (*chunks.next().unwrap_or(&1)).min(stream.len() - at);
+            let chunk = &stream[at..at + n];
+            at += n;
+            let a = one_pass.write_all(chunk).and_then(|()| one_pass.take_text());
+            let b = chunk
+                .iter()
+                .try_for_each(|m| general.write(m))
+                .and_then(|()| general.take_text());
             // Compared as printed: a refused NaN is not equal to itself.
-            proptest::prop_assert_eq!(format!("{a:?}"), format!("{b:?}"), "after {:?}", m);
+            proptest::prop_assert_eq!(format!("{a:?}"), format!("{b:?}"), "after {:?}", chunk);
+            if a.is_err() {
+                // What the refused chunk wrote before its refusal.
+                proptest::prop_assert_eq!(
+                    format!("{:?}", one_pass.take_text()),
+                    format!("{:?}", general.take_text())
+                );
+            }
         }
         proptest::prop_assert_eq!(general.common_written, 0);
         proptest::prop_assert_eq!(
             format!("{:?}", one_pass.finish()),
             format!("{:?}", general.finish())
         );
+    }
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(200))]
+
+    /// `write_all` compiled for AVX2 (`write_all_avx2`, taken when the
+    /// processor has it) against the same code compiled for any x86-64,
+    /// over the differential test's random streams and dialects, in
+    /// chunks: the same text after every chunk, the same refusals, the
+    /// same end. On a processor without AVX2 there is nothing to compare
+    /// (both writers take the plain code).
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn write_all_for_avx2_writes_what_it_writes_for_any_x86_64(
+        dialect in 0u8..18,
+        resolution in proptest::sample::select(vec![1e-3, 1e-4, 1e-6]),
+        max_digits in proptest::option::of(5u32..13),
+        line_limit in 20usize..50,
+        stream in proptest::collection::vec(any_move(), 1..80),
+        chunks in proptest::collection::vec(1usize..8, 1..6),
+    ) {
+        let (d, setup, axes) = differential_dialect(dialect, max_digits, line_limit);
+        let start = |avx2: bool| {
+            let mut w = ProgramWriter::new(&d, setup, "t", &[], axes, resolution, 1e-3)?;
+            w.avx2 &= avx2;
+            w.call_tool(&Start::default())?;
+            w.write(&M::SpindleOn(RPM_1000))?;
+            Ok::<_, ProgramError>(w)
+        };
+        let (Ok(mut fast), Ok(mut plain)) = (start(true), start(false)) else {
+            return Ok(());
+        };
+        proptest::prop_assert!(!plain.avx2);
+        proptest::prop_assert_eq!(fast.avx2, has_avx2());
+        let mut at = 0;
+        let mut chunks = chunks.iter().cycle();
+        while at < stream.len() {
+            let n = (*chunks.next().unwrap_or(&1)).min(stream.len() - at);
+            let chunk = &stream[at..at + n];
+            at += n;
+            let a = fast.write_all(chunk).and_then(|()| fast.take_text());
+            let b = plain.write_all(chunk).and_then(|()| plain.take_text());
+            proptest::prop_assert_eq!(format!("{a:?}"), format!("{b:?}"), "after {:?}", chunk);
+        }
+        proptest::prop_assert_eq!(fast.common_written, plain.common_written);
+        proptest::prop_assert_eq!(format!("{:?}", fast.finish()), format!("{:?}", plain.finish()));
     }
 }
 
