@@ -127,9 +127,8 @@ pub struct ProgramWriter {
     /// axes' last decimal.
     circle_centre: Option<(i64, i64)>,
     pub moves: usize,
-    /// The text's capacity when its spare capacity was last zeroed (0:
-    /// not since its allocation): see `room`.
-    zeroed: usize,
+    /// How far the text's spare capacity is zeroed: see `block_room`.
+    zeroed: Zeroed,
     /// Whether rapids and lines may go the one-pass way
     /// (`common_block`): the dialect allows it.
     common_blocks: bool,
@@ -293,7 +292,7 @@ impl ProgramWriter {
                 .map(|d| limits[letter_index('F')].saturating_mul(pow10(d))),
             circle_centre: None,
             moves: 0,
-            zeroed: 0,
+            zeroed: Zeroed::default(),
             common_blocks: false,
             #[cfg(target_arch = "x86_64")]
             avx2: has_avx2(),
@@ -1046,7 +1045,7 @@ impl ProgramWriter {
     /// next chunk starts with room for as much again.
     pub fn take_text(&mut self) -> Result<String, ProgramError> {
         let room = self.text.len() + BLOCK_ROOM;
-        self.zeroed = 0;
+        self.zeroed = Zeroed::default();
         let text = std::mem::replace(&mut self.text, Vec::with_capacity(room));
         #[cfg(target_arch = "x86_64")]
         if self.avx2 {
@@ -1196,20 +1195,24 @@ const WORD_ROOM: usize = 5 + PRINTED_ROOM;
 
 /// `BLOCK_ROOM` bytes added at the end of `text` for a block to be
 /// printed into (the caller cuts the text back to what it printed): bytes
-/// of its spare capacity, zeroed once per allocation (`zeroed`: the
-/// capacity when they were), not byte by byte each block.
+/// of its spare capacity, zeroed a step (`ZERO_STEP`) ahead of the
+/// blocks (`zeroed`), not byte by byte each block, and not the whole
+/// spare capacity at once (a chunk's worth of zeros written out of the
+/// first-level cache before the blocks write over them).
 #[inline(always)]
-fn block_room<'t>(text: &'t mut Vec<u8>, zeroed: &mut usize) -> &'t mut [u8; BLOCK_ROOM] {
+fn block_room<'t>(text: &'t mut Vec<u8>, zeroed: &mut Zeroed) -> &'t mut [u8; BLOCK_ROOM] {
     let at = text.len();
-    if text.capacity() - at < BLOCK_ROOM || *zeroed != text.capacity() {
-        zero_spare_capacity(text, zeroed);
+    if zeroed.to < at + BLOCK_ROOM || zeroed.capacity != text.capacity() {
+        zero_ahead(text, zeroed);
     }
-    // SAFETY: `at + BLOCK_ROOM` is within the capacity, and every byte of
-    // the spare capacity is initialised: it was zeroed when `zeroed` was
-    // set to the capacity, and the allocation is still that one (a `Vec`
-    // only reallocates to a larger capacity; the writer replaces its text
-    // only in `take_text`, which resets `zeroed`, and `finish`); a `Vec`
-    // never de-initialises bytes beyond its length.
+    // SAFETY: `at + BLOCK_ROOM` is within the capacity (`zeroed.to` is,
+    // and `zero_ahead` leaves it at least there), and every byte of the
+    // allocation up to `zeroed.to` is initialised: below the length, as
+    // a `Vec`'s are; from it, zeroed by `zero_ahead` while the
+    // allocation was this one (`zeroed.capacity` is its capacity, and a
+    // `Vec` only reallocates to a larger one; the writer replaces its
+    // text only in `take_text`, which resets `zeroed`, and `finish`); a
+    // `Vec` never de-initialises bytes beyond its length.
     unsafe { text.set_len(at + BLOCK_ROOM) };
     match text.last_chunk_mut::<BLOCK_ROOM>() {
         Some(room) => room,
@@ -1217,14 +1220,40 @@ fn block_room<'t>(text: &'t mut Vec<u8>, zeroed: &mut usize) -> &'t mut [u8; BLO
     }
 }
 
-/// Room for a block at the end of `text`, and its whole spare capacity
-/// zeroed (once per allocation: `block_room`).
+/// How much of the text's allocation `block_room` may hand out: the
+/// allocation's `capacity` when its bytes were zeroed up `to` (from its
+/// length then); any other capacity, a new allocation: nothing.
+#[derive(Clone, Copy, Debug, Default)]
+struct Zeroed {
+    capacity: usize,
+    to: usize,
+}
+
+/// Bytes zeroed ahead of the blocks at a time: a few pages' worth, so
+/// the zeros are still in the first-level cache when blocks are printed
+/// over them.
+const ZERO_STEP: usize = 8192;
+
+/// Room for a block at the end of `text`, and its spare capacity zeroed
+/// from the length (or where it was zeroed to) for `ZERO_STEP` bytes, or
+/// to its end (`block_room`).
 #[cold]
-fn zero_spare_capacity(text: &mut Vec<u8>, zeroed: &mut usize) {
+fn zero_ahead(text: &mut Vec<u8>, zeroed: &mut Zeroed) {
     text.reserve(BLOCK_ROOM);
-    text.spare_capacity_mut()
-        .fill(std::mem::MaybeUninit::new(0));
-    *zeroed = text.capacity();
+    let len = text.len();
+    if zeroed.capacity != text.capacity() {
+        // A new allocation: nothing of its spare capacity is known.
+        *zeroed = Zeroed {
+            capacity: text.capacity(),
+            to: len,
+        };
+    }
+    let from = zeroed.to.max(len) - len;
+    let to = (len + ZERO_STEP).min(text.capacity());
+    if let Some(spare) = text.spare_capacity_mut().get_mut(from..to - len) {
+        spare.fill(std::mem::MaybeUninit::new(0));
+    }
+    zeroed.to = zeroed.to.max(to);
 }
 
 /// Why a word cannot go into a block, found while the block is printed

@@ -949,3 +949,50 @@ fn text_that_is_not_ascii_is_still_taken_whole() {
     }
     assert!(utf8(vec![b'X', 0xc3]).is_err());
 }
+
+#[test]
+fn the_text_is_the_same_however_often_it_is_taken() {
+    // Blocks printed into rooms zeroed a step ahead (`zero_ahead`): long
+    // texts cross many steps, long comments push the text past what is
+    // zeroed, and taking the text starts a new allocation; the text is
+    // the same taken after every move as taken once at the end.
+    let stream: Vec<M> = (0..3000)
+        .map(|i| {
+            let c = i as f64 * 0.01;
+            M::Linear {
+                to: P::xzc(20.0 - c * 1e-3, 0.5 + 0.01 * (3.0 * c).sin(), c),
+                feed: Some(F::InverseTime(0.001 + 1e-6 * (i % 7) as f64)),
+            }
+        })
+        .collect();
+    let long_comment = "a comment, long ".repeat(700);
+    let write = |take_every: usize| {
+        let mut w = ProgramWriter::new(
+            &Dialect::linuxcnc(),
+            Setup::Lathe,
+            "t1",
+            &[],
+            "XZC",
+            1e-6,
+            1e-5,
+        )
+        .expect("writer");
+        w.call_tool(&Start::default()).expect("tool");
+        let mut text = String::new();
+        for (i, m) in stream.iter().enumerate() {
+            if i % 1000 == 500 {
+                w.comment(&long_comment);
+            }
+            w.write_all([m]).expect("printable");
+            if (i + 1) % take_every == 0 {
+                text += &w.take_text().expect("text");
+            }
+        }
+        text + &w.finish().expect("text")
+    };
+    let once = write(usize::MAX);
+    assert!(once.len() > 3 * ZERO_STEP * 4, "{}", once.len());
+    for every in [1, 7, 333] {
+        assert_eq!(write(every), once, "taken every {every} moves");
+    }
+}
