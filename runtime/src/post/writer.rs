@@ -71,6 +71,8 @@ pub struct ProgramWriter {
     decimals: u32,
     /// Letters of the machine's axes among X, Y, Z, C (others are refused).
     letters: [Option<char>; 4],
+    /// The axes with a letter, bit i for axis i (`letters`).
+    lettered_axes: u8,
     /// Decimals of each axis: the resolution's, C's own for C.
     axis_decimals: [u32; 4],
     /// Factor from the move stream's value to the printed one per axis:
@@ -245,6 +247,7 @@ impl ProgramWriter {
             dialect: dialect.clone(),
             decimals,
             letters,
+            lettered_axes: (0..4).fold(0, |m, i| m | (letters[i].is_some() as u8) << i),
             axis_decimals,
             axis_scale: [x_scale, 1.0, 1.0, 180.0 / PI],
             axis_formats: axis_decimals.map(Decimals::new),
