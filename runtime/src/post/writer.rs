@@ -71,6 +71,8 @@ pub struct ProgramWriter {
     decimals: u32,
     /// Letters of the machine's axes among X, Y, Z, C (others are refused).
     letters: [Option<char>; 4],
+    /// The axes with a letter, bit i for axis i (`letters`).
+    lettered_axes: u8,
     /// Decimals of each axis: the resolution's, C's own for C.
     axis_decimals: [u32; 4],
     /// Factor from the move stream's value to the printed one per axis:
@@ -127,9 +129,8 @@ pub struct ProgramWriter {
     /// axes' last decimal.
     circle_centre: Option<(i64, i64)>,
     pub moves: usize,
-    /// The text's capacity when its spare capacity was last zeroed (0:
-    /// not since its allocation): see `room`.
-    zeroed: usize,
+    /// How far the text's spare capacity is zeroed: see `block_room`.
+    zeroed: Zeroed,
     /// Whether rapids and lines may go the one-pass way
     /// (`common_block`): the dialect allows it.
     common_blocks: bool,
@@ -246,6 +247,7 @@ impl ProgramWriter {
             dialect: dialect.clone(),
             decimals,
             letters,
+            lettered_axes: (0..4).fold(0, |m, i| m | (letters[i].is_some() as u8) << i),
             axis_decimals,
             axis_scale: [x_scale, 1.0, 1.0, 180.0 / PI],
             axis_formats: axis_decimals.map(Decimals::new),
@@ -293,7 +295,7 @@ impl ProgramWriter {
                 .map(|d| limits[letter_index('F')].saturating_mul(pow10(d))),
             circle_centre: None,
             moves: 0,
-            zeroed: 0,
+            zeroed: Zeroed::default(),
             common_blocks: false,
             #[cfg(target_arch = "x86_64")]
             avx2: has_avx2(),
@@ -1042,12 +1044,22 @@ impl ProgramWriter {
 
     /// The text written since the last call (for streaming to a file),
     /// every number and dialect line in it checked as it was written (see
-    /// `ProgramWriter`); the
-    /// next chunk starts with room for as much again.
+    /// `ProgramWriter`); the next chunk starts with room for as much
+    /// again and an eighth more (the same moves a chunk make a little
+    /// more text as numbers grow a digit: room for exactly as much had
+    /// one chunk in five of the emission bench outgrow it, its text
+    /// copied into an allocation twice the size).
     pub fn take_text(&mut self) -> Result<String, ProgramError> {
-        let room = self.text.len() + BLOCK_ROOM;
-        self.zeroed = 0;
-        utf8(std::mem::replace(&mut self.text, Vec::with_capacity(room)))
+        let len = self.text.len();
+        let room = len + len / 8 + BLOCK_ROOM;
+        self.zeroed = Zeroed::default();
+        let text = std::mem::replace(&mut self.text, Vec::with_capacity(room));
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: the processor has AVX2 (`blank` asked it).
+            return unsafe { utf8_avx2(text) };
+        }
+        utf8(text)
     }
 
     /// Ends the program; the text not yet taken, checked.
@@ -1097,9 +1109,45 @@ fn has_avx2() -> bool {
 /// The writer's text as a `String`: it only ever appends `str`s and
 /// ASCII, so this holds; were it ever not so, the text is refused, not
 /// handed out.
+///
+/// Text that is all ASCII (a program's usual text) is told so by one
+/// pass of wide ORs (`all_ascii`), not the UTF-8 decoder's byte-pair
+/// steps; any other text goes through the decoder.
+#[inline(always)]
 fn utf8(text: Vec<u8>) -> Result<String, ProgramError> {
+    if all_ascii(&text) {
+        // SAFETY: every byte was just found to be ASCII, and ASCII text
+        // is UTF-8.
+        return Ok(unsafe { String::from_utf8_unchecked(text) });
+    }
     String::from_utf8(text)
         .map_err(|_| ProgramError::Unsupported("program text that is not UTF-8".into()))
+}
+
+/// `utf8` compiled for AVX2 (`all_ascii` 32 bytes an instruction).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn utf8_avx2(text: Vec<u8>) -> Result<String, ProgramError> {
+    utf8(text)
+}
+
+/// Whether every byte of `bytes` is ASCII (below 0x80): the bytes ORed
+/// together in 64-byte blocks, eight words a block (a loop the compiler
+/// turns into vector ORs), the top bits of the result tested once.
+#[inline(always)]
+fn all_ascii(bytes: &[u8]) -> bool {
+    const TOP_BITS: u64 = 0x8080_8080_8080_8080;
+    let mut blocks = bytes.chunks_exact(64);
+    let mut any = [0u64; 8];
+    for block in &mut blocks {
+        for (a, word) in any.iter_mut().zip(block.chunks_exact(8)) {
+            let mut w = [0; 8];
+            w.copy_from_slice(word);
+            *a |= u64::from_le_bytes(w);
+        }
+    }
+    let rest = blocks.remainder().iter().fold(0u8, |a, &b| a | b);
+    any.iter().fold(0, |a, &w| a | w) & TOP_BITS == 0 && rest.is_ascii()
 }
 
 /// A short piece of program text (a word's letter, a motion word, a
@@ -1154,20 +1202,24 @@ const WORD_ROOM: usize = 5 + PRINTED_ROOM;
 
 /// `BLOCK_ROOM` bytes added at the end of `text` for a block to be
 /// printed into (the caller cuts the text back to what it printed): bytes
-/// of its spare capacity, zeroed once per allocation (`zeroed`: the
-/// capacity when they were), not byte by byte each block.
+/// of its spare capacity, zeroed a step (`ZERO_STEP`) ahead of the
+/// blocks (`zeroed`), not byte by byte each block, and not the whole
+/// spare capacity at once (a chunk's worth of zeros written out of the
+/// first-level cache before the blocks write over them).
 #[inline(always)]
-fn block_room<'t>(text: &'t mut Vec<u8>, zeroed: &mut usize) -> &'t mut [u8; BLOCK_ROOM] {
+fn block_room<'t>(text: &'t mut Vec<u8>, zeroed: &mut Zeroed) -> &'t mut [u8; BLOCK_ROOM] {
     let at = text.len();
-    if text.capacity() - at < BLOCK_ROOM || *zeroed != text.capacity() {
-        zero_spare_capacity(text, zeroed);
+    if zeroed.to < at + BLOCK_ROOM || zeroed.capacity != text.capacity() {
+        zero_ahead(text, zeroed);
     }
-    // SAFETY: `at + BLOCK_ROOM` is within the capacity, and every byte of
-    // the spare capacity is initialised: it was zeroed when `zeroed` was
-    // set to the capacity, and the allocation is still that one (a `Vec`
-    // only reallocates to a larger capacity; the writer replaces its text
-    // only in `take_text`, which resets `zeroed`, and `finish`); a `Vec`
-    // never de-initialises bytes beyond its length.
+    // SAFETY: `at + BLOCK_ROOM` is within the capacity (`zeroed.to` is,
+    // and `zero_ahead` leaves it at least there), and every byte of the
+    // allocation up to `zeroed.to` is initialised: below the length, as
+    // a `Vec`'s are; from it, zeroed by `zero_ahead` while the
+    // allocation was this one (`zeroed.capacity` is its capacity, and a
+    // `Vec` only reallocates to a larger one; the writer replaces its
+    // text only in `take_text`, which resets `zeroed`, and `finish`); a
+    // `Vec` never de-initialises bytes beyond its length.
     unsafe { text.set_len(at + BLOCK_ROOM) };
     match text.last_chunk_mut::<BLOCK_ROOM>() {
         Some(room) => room,
@@ -1175,14 +1227,40 @@ fn block_room<'t>(text: &'t mut Vec<u8>, zeroed: &mut usize) -> &'t mut [u8; BLO
     }
 }
 
-/// Room for a block at the end of `text`, and its whole spare capacity
-/// zeroed (once per allocation: `block_room`).
+/// How much of the text's allocation `block_room` may hand out: the
+/// allocation's `capacity` when its bytes were zeroed up `to` (from its
+/// length then); any other capacity, a new allocation: nothing.
+#[derive(Clone, Copy, Debug, Default)]
+struct Zeroed {
+    capacity: usize,
+    to: usize,
+}
+
+/// Bytes zeroed ahead of the blocks at a time: a few pages' worth, so
+/// the zeros are still in the first-level cache when blocks are printed
+/// over them.
+const ZERO_STEP: usize = 8192;
+
+/// Room for a block at the end of `text`, and its spare capacity zeroed
+/// from the length (or where it was zeroed to) for `ZERO_STEP` bytes, or
+/// to its end (`block_room`).
 #[cold]
-fn zero_spare_capacity(text: &mut Vec<u8>, zeroed: &mut usize) {
+fn zero_ahead(text: &mut Vec<u8>, zeroed: &mut Zeroed) {
     text.reserve(BLOCK_ROOM);
-    text.spare_capacity_mut()
-        .fill(std::mem::MaybeUninit::new(0));
-    *zeroed = text.capacity();
+    let len = text.len();
+    if zeroed.capacity != text.capacity() {
+        // A new allocation: nothing of its spare capacity is known.
+        *zeroed = Zeroed {
+            capacity: text.capacity(),
+            to: len,
+        };
+    }
+    let from = zeroed.to.max(len) - len;
+    let to = (len + ZERO_STEP).min(text.capacity());
+    if let Some(spare) = text.spare_capacity_mut().get_mut(from..to - len) {
+        spare.fill(std::mem::MaybeUninit::new(0));
+    }
+    zeroed.to = zeroed.to.max(to);
 }
 
 /// Why a word cannot go into a block, found while the block is printed

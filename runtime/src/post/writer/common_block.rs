@@ -80,11 +80,13 @@ impl ProgramWriter {
             let Some(n) = self.axis_formats[i].units(v * self.axis_scale[i]) else {
                 return false;
             };
-            if self.letters[i].is_none() {
-                return false;
-            }
             units[i] = n;
             changed |= ((self.last[i] != n) as u8) << i;
+        }
+        // An axis the machine has no letter for goes the general way (a
+        // refusal): one test for all four.
+        if changed & !self.lettered_axes != 0 {
+            return false;
         }
         if changed == 0 {
             // No printed axis changes: no block, nothing kept.

@@ -899,3 +899,100 @@ fn common_blocks_are_the_common_path() {
     w.write_all(&mill).expect("printable");
     assert_eq!(w.common_written, 0);
 }
+
+#[test]
+fn all_ascii_finds_any_byte_above_0x7f_anywhere() {
+    // Lengths around the 64-byte blocks; one high byte at each place, of
+    // each kind (0x80, a UTF-8 lead byte, 0xff), in the blocks and in the
+    // remainder.
+    for len in [0, 1, 7, 8, 63, 64, 65, 127, 128, 129, 200] {
+        let ascii: Vec<u8> = (0..len).map(|i| b' ' + (i % 90) as u8).collect();
+        assert!(all_ascii(&ascii), "{len} ASCII bytes");
+        for at in 0..len {
+            for high in [0x80, 0xc3, 0xff] {
+                let mut b = ascii.clone();
+                b[at] = high;
+                assert!(!all_ascii(&b), "{high:#x} at {at} of {len}");
+            }
+        }
+    }
+}
+
+#[test]
+fn text_that_is_not_ascii_is_still_taken_whole() {
+    // A comment's non-ASCII letters go through the UTF-8 decoder, not
+    // the ASCII pass: the same text comes out.
+    let mut w = ProgramWriter::new(
+        &Dialect::linuxcnc(),
+        Setup::Mill,
+        "t1",
+        &[],
+        "XYZ",
+        1e-3,
+        1e-3,
+    )
+    .expect("writer");
+    w.call_tool(&Start::default()).expect("tool");
+    w.take_text().expect("header");
+    w.comment("Glasschliff für Linse Ø 12, Mikrometer µm");
+    w.write(&M::Rapid(P::xyz(1.0, 2.0, 5.0))).expect("rapid");
+    let text = w.take_text().expect("UTF-8 text");
+    assert!(text.contains("für Linse Ø 12"), "{text}");
+    assert!(text.ends_with("G0 X1. Y2. Z5.\n"), "{text}");
+    #[cfg(target_arch = "x86_64")]
+    if has_avx2() {
+        // SAFETY: the processor has AVX2.
+        let t = unsafe { utf8_avx2("Ø µ".as_bytes().to_vec()) };
+        assert_eq!(t.expect("UTF-8"), "Ø µ");
+        let t = unsafe { utf8_avx2(vec![b'G'; 70].into_iter().chain([0xff]).collect()) };
+        assert!(t.is_err());
+    }
+    assert!(utf8(vec![b'X', 0xc3]).is_err());
+}
+
+#[test]
+fn the_text_is_the_same_however_often_it_is_taken() {
+    // Blocks printed into rooms zeroed a step ahead (`zero_ahead`): long
+    // texts cross many steps, long comments push the text past what is
+    // zeroed, and taking the text starts a new allocation; the text is
+    // the same taken after every move as taken once at the end.
+    let stream: Vec<M> = (0..3000)
+        .map(|i| {
+            let c = i as f64 * 0.01;
+            M::Linear {
+                to: P::xzc(20.0 - c * 1e-3, 0.5 + 0.01 * (3.0 * c).sin(), c),
+                feed: Some(F::InverseTime(0.001 + 1e-6 * (i % 7) as f64)),
+            }
+        })
+        .collect();
+    let long_comment = "a comment, long ".repeat(700);
+    let write = |take_every: usize| {
+        let mut w = ProgramWriter::new(
+            &Dialect::linuxcnc(),
+            Setup::Lathe,
+            "t1",
+            &[],
+            "XZC",
+            1e-6,
+            1e-5,
+        )
+        .expect("writer");
+        w.call_tool(&Start::default()).expect("tool");
+        let mut text = String::new();
+        for (i, m) in stream.iter().enumerate() {
+            if i % 1000 == 500 {
+                w.comment(&long_comment);
+            }
+            w.write_all([m]).expect("printable");
+            if (i + 1) % take_every == 0 {
+                text += &w.take_text().expect("text");
+            }
+        }
+        text + &w.finish().expect("text")
+    };
+    let once = write(usize::MAX);
+    assert!(once.len() > 3 * ZERO_STEP * 4, "{}", once.len());
+    for every in [1, 7, 333] {
+        assert_eq!(write(every), once, "taken every {every} moves");
+    }
+}
