@@ -41,6 +41,16 @@ pub enum SpindleSpeed {
 }
 
 impl SpindleSpeed {
+    /// The speed as the job states it: the spindle speed (rad/s) of a
+    /// constant speed, the surface speed (mm/s) of a constant surface
+    /// speed.
+    pub fn stated(self) -> f64 {
+        match self {
+            SpindleSpeed::Constant(w) => w,
+            SpindleSpeed::SurfaceSpeed { speed, .. } => speed,
+        }
+    }
+
     /// Spindle speed (rad/s) with the tool at radius `r` (mm).
     pub fn at(self, r: f64) -> f64 {
         match self {
@@ -687,7 +697,7 @@ impl Planner<'_> {
         }
         summary.time = last.last().map_or(0.0, |p| p.t);
         summary.highest_allowed_speed =
-            highest_allowed_speed(self.speed_now(), fast_axis.max_acceleration, nonzero);
+            highest_allowed_speed(s.speed.stated(), fast_axis.max_acceleration, nonzero);
         let range = summary.w_max - summary.w_min;
         if range > fast_axis.stroke {
             return Err(FtsError::StrokeExceeded {
@@ -740,14 +750,6 @@ impl Planner<'_> {
                     *high = high.max(acc.abs());
                 }
             }
-        }
-    }
-
-    /// The speed now: spindle speed (constant) or surface speed.
-    fn speed_now(&self) -> f64 {
-        match self.spiral.speed {
-            SpindleSpeed::Constant(w) => w,
-            SpindleSpeed::SurfaceSpeed { speed, .. } => speed,
         }
     }
 }

@@ -165,10 +165,7 @@ impl Unit {
 
     /// The job's speed in the unit.
     fn shown(self, speed: SpindleSpeed) -> f64 {
-        match speed {
-            SpindleSpeed::Constant(w) => w / self.factor(),
-            SpindleSpeed::SurfaceSpeed { speed, .. } => speed / self.factor(),
-        }
+        speed.stated() / self.factor()
     }
 
     /// The job's speed with its value `written` in the unit (a surface
