@@ -120,3 +120,98 @@ pub fn range(fields: &[Field], name: &str) -> Option<(f64, f64)> {
         _ => None,
     }
 }
+
+/// A checked object's (or block's) fields read by name into a typed
+/// struct, once. Each kind's `read`, declared beside its schema entry, is
+/// the only place a parameter is looked up by its name; nothing after
+/// lowering does. A parameter the schema requires that is missing anyway
+/// (the checker rejects that, so only a checker bug gets here) is
+/// recorded rather than unwrapped, and `finish` turns it into E0121: bad
+/// input never panics.
+pub struct Reader<'a> {
+    fields: &'a [Field],
+    missing: Vec<String>,
+}
+
+impl<'a> Reader<'a> {
+    pub fn new(fields: &'a [Field]) -> Reader<'a> {
+        Reader {
+            fields,
+            missing: Vec::new(),
+        }
+    }
+    /// The field itself, with where it was written.
+    pub fn field(&self, name: &str) -> Option<&'a Field> {
+        field(self.fields, name)
+    }
+    /// Whether the file states this parameter.
+    pub fn has(&self, name: &str) -> bool {
+        self.field(name).is_some()
+    }
+    pub fn num(&self, name: &str) -> Option<f64> {
+        num(self.fields, name)
+    }
+    /// A required quantity (NaN, recorded as missing, if it is not there).
+    pub fn required_num(&mut self, name: &str) -> f64 {
+        self.num(name).unwrap_or_else(|| {
+            self.missing.push(name.to_string());
+            f64::NAN
+        })
+    }
+    pub fn word(&self, name: &str) -> Option<&'a str> {
+        word(self.fields, name)
+    }
+    pub fn object(&self, name: &str) -> Option<&'a Rc<Object>> {
+        object(self.fields, name)
+    }
+    pub fn range(&self, name: &str) -> Option<(f64, f64)> {
+        range(self.fields, name)
+    }
+    /// A nested block read by `read`, if the file states it.
+    pub fn block<T>(&mut self, name: &str, read: impl FnOnce(&mut Reader<'a>) -> T) -> Option<T> {
+        let fields = block(self.fields, name)?;
+        let mut inner = Reader::new(fields);
+        let value = read(&mut inner);
+        self.missing
+            .extend(inner.missing.into_iter().map(|m| format!("{name}.{m}")));
+        Some(value)
+    }
+    /// A required nested block read by `read` (read from no fields, and
+    /// recorded as missing, if it is not there).
+    pub fn required_block<T>(&mut self, name: &str, read: impl FnOnce(&mut Reader<'a>) -> T) -> T {
+        if !self.has(name) || block(self.fields, name).is_none() {
+            self.missing.push(name.to_string());
+        }
+        let fields = block(self.fields, name).unwrap_or(&[]);
+        let mut inner = Reader::new(fields);
+        let value = read(&mut inner);
+        self.missing
+            .extend(inner.missing.into_iter().map(|m| format!("{name}.{m}")));
+        value
+    }
+    /// E0121 at `site` (the object's kind, `what`) for every required
+    /// parameter that was missing.
+    pub fn finish(
+        self,
+        what: &str,
+        (file, span): (FileId, Span),
+    ) -> Result<(), lensc_grammar::Diagnostic> {
+        if self.missing.is_empty() {
+            return Ok(());
+        }
+        Err(lensc_grammar::Diagnostic::error(
+            crate::codes::MISSING_PARAMETER,
+            format!(
+                "`{what}` is missing {}",
+                self.missing
+                    .iter()
+                    .map(|m| format!("`{m}`"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+            file,
+            span,
+        )
+        .with_label("here"))
+    }
+}

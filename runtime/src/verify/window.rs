@@ -12,7 +12,7 @@ use crate::verify::heightmap::Grid;
 
 /// The most cells a simulation may have. Tiles bound its memory, not its
 /// time: about 0.1 µs a cell on one core (measured by
-/// `compiler/build/benches/whole_part.rs`), so this is minutes on two.
+/// `compiler/builder/benches/whole_part.rs`), so this is minutes on two.
 pub const MAX_CELLS: usize = 2_000_000_000;
 /// A tile's most cells (its errors are 8 bytes each; each of its columns
 /// also holds every pass within the nose's reach of its rows): a tile is
