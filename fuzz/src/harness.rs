@@ -7,9 +7,9 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use lensc_build::driver;
+use lensc_build::job::Limits;
 use lensc_grammar::Diagnostic;
 use lensc_lang::loader::FileSystem;
-use lensc_lang::lower::job::Limits;
 use lensc_lang::sandbox::ReadError;
 use lensc_lang::source::SourceMap;
 

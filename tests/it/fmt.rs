@@ -71,7 +71,7 @@ fn meaning(c: &Checked) -> String {
         write!(s, "declaration {n} = ").unwrap();
         value(&mut s, &Value::Object(c.checked.declarations[n].clone()), 1);
     }
-    let limits = lensc_lang::lower::job::Limits::default();
+    let limits = lensc_build::job::Limits::default();
     for j in &c.checked.jobs {
         let mut parts: Vec<_> = j.part_names.iter().collect();
         parts.sort();

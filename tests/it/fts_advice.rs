@@ -8,12 +8,12 @@
 use std::path::Path;
 
 use crate::common::{examples, root};
-use lensc_build::builders::fts::{Prepared, advice};
 use lensc_build::driver::{Request, check_path, plan_and_emit};
+use lensc_build::job::JobSpec;
+use lensc_build::strategy::spiral::{Prepared, advice};
 use lensc_lang::check::trim_num;
 use lensc_lang::loader::RealFs;
-use lensc_lang::lower::job::JobSpec;
-use lensc_runtime::plan::fts::{FtsError, SpeedAdvice};
+use lensc_runtime::plan::spiral::{FtsError, SpeedAdvice};
 
 /// The fast tool servo the examples use, with `max_acceleration` weakened.
 const WEAK_FTS5000: &str = "machine nanoform_x_fts5000 = fts_lathe {
@@ -26,7 +26,7 @@ const WEAK_FTS5000: &str = "machine nanoform_x_fts5000 = fts_lathe {
 }";
 
 /// The job's single spiral, lowered as a build lowers it.
-fn spiral_of(file: &Path) -> lensc_lang::lower::job::SpiralSpec {
+fn spiral_of(file: &Path) -> lensc_build::strategy::spiral::SpiralSpec {
     let checked = check_path(&RealFs, file).expect("readable");
     assert!(!checked.has_errors(), "{}", file.display());
     let job = &checked.checked.jobs[0];

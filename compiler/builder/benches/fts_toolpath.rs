@@ -22,13 +22,13 @@ fn main() {
     assert!(!c.has_errors(), "the example checks");
     let job = &c.checked.jobs[0];
     let t = Instant::now();
-    let limits = lensc_lang::lower::job::Limits::default();
-    let Ok((lensc_lang::lower::job::JobSpec::Spiral(spec), _)) =
+    let limits = lensc_build::job::Limits::default();
+    let Ok((lensc_build::job::JobSpec::Spiral(spec), _)) =
         lensc_build::pipeline::lower(job, None, &limits)
     else {
         panic!("lowers to a spiral")
     };
-    let prepared = lensc_build::builders::fts::Prepared::of(&spec);
+    let prepared = lensc_build::strategy::spiral::Prepared::of(&spec);
     let prepare = t.elapsed();
     let planner = prepared.planner();
     let run = || {

@@ -28,9 +28,9 @@ mod timing;
 use std::path::Path;
 use std::time::Instant;
 
+use lensc_build::job::{JobSpec, Limits};
 use lensc_build::output::Destination;
 use lensc_lang::Checked;
-use lensc_lang::lower::job::{JobSpec, Limits};
 use lensc_runtime::post::Provenance;
 
 /// Wall and CPU time (s) of one run.
@@ -124,7 +124,7 @@ fn plan_spiral(spec: &JobSpec) -> usize {
     let JobSpec::Spiral(s) = spec else {
         panic!("a spiral")
     };
-    let prepared = lensc_build::builders::fts::Prepared::of(s);
+    let prepared = lensc_build::strategy::spiral::Prepared::of(s);
     let mut n = 0;
     prepared
         .planner()

@@ -11,11 +11,11 @@
 //! place every strategy's simulation lands), so a criterion is measured
 //! the same way for every strategy.
 
+use crate::job::JobSpec;
+use crate::job::accept::{self, Accept, Criterion};
 use lensc_grammar::{Diagnostic, FileId, Span};
 use lensc_lang::check::trim_num;
 use lensc_lang::codes;
-use lensc_lang::lower::job::JobSpec;
-use lensc_lang::lower::job::accept::{self, Accept, Criterion};
 
 use crate::output::Built;
 use crate::report::{
@@ -32,7 +32,7 @@ pub enum Mode {
     Warn,
 }
 
-use lensc_lang::lower::job::accept::DEFAULT_TOLERANCE;
+use crate::job::accept::DEFAULT_TOLERANCE;
 
 /// Runs the gate on `built` (lowered as `spec`): fills the report's
 /// `acceptance` and returns a diagnostic per criterion missed or not

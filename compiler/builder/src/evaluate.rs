@@ -68,7 +68,7 @@ pub fn declared_surface(
     lensc_lang::lower::surface::lower_surface(obj).map_err(|e| {
         format!(
             "`{name}` cannot be evaluated yet: {}",
-            lensc_lang::lower::diagnostics::lowering_words(&e)
+            crate::diagnostics::lowering_words(&e)
         )
     })
 }

@@ -18,10 +18,10 @@ use lensc_runtime::verify::tiles::{Recorder, simulate};
 use lensc_runtime::verify::window::Tile;
 use std::f64::consts::TAU;
 
+use crate::job::JobHead;
 use lensc_lang::check::trim_num;
-use lensc_lang::lower::job::JobHead;
 
-pub use lensc_lang::lower::job::window::{domain_extent, roller_extent};
+pub use crate::job::window::{domain_extent, roller_extent};
 pub use lensc_runtime::verify::window::Window;
 
 /// The window a job simulates: the one its `simulate` block gives, a
@@ -29,7 +29,7 @@ pub use lensc_runtime::verify::window::Window;
 /// checked by lowering), or the default one about `centre`, which is
 /// small enough for every grid.
 pub fn window(head: &JobHead, centre: (f64, f64), extent: ((f64, f64), (f64, f64))) -> Window {
-    lensc_lang::lower::job::window::simulated(head, extent).unwrap_or_else(|| Window::about(centre))
+    crate::job::window::simulated(head, extent).unwrap_or_else(|| Window::about(centre))
 }
 
 /// A height-map simulation under way: the path kept as it is planned

@@ -1,23 +1,27 @@
 //! lensc-build: checked jobs to programs. The driver loads and checks a
 //! file through `lensc-lang`; the pipeline lowers each job to its typed
-//! `JobSpec` and hands it to its strategy's builder (`builders/`), which
-//! plans with `lensc-runtime`, emits the program (spooled and written
+//! `JobSpec` with its strategy (`strategy/`, one folder each behind one
+//! trait, with the shared head and checks in `job`) and builds it with
+//! the same strategy in a `context::BuildContext`: it plans with
+//! `lensc-runtime`, emits the program (spooled and written
 //! atomically, once read back by the controllers' rules: `read_back`),
 //! simulates what it will cut and fills the build report; the acceptance
 //! gate (`accept`) holds the simulated part to the job's criteria; plots
 //! draw that report.
 
 pub mod accept;
-pub mod builders;
+pub mod context;
+pub mod diagnostics;
 pub mod driver;
 pub mod evaluate;
 pub mod height_map;
+pub mod job;
 pub mod output;
-pub(crate) mod parts;
 pub mod pipeline;
 pub mod plots;
 pub mod progress;
 pub mod read_back;
 pub mod report;
 pub(crate) mod spool;
+pub mod strategy;
 pub mod temps;

@@ -5,14 +5,14 @@
 
 use std::path::Path;
 
+use crate::context::BuildContext;
+use crate::job::{Estimate, JobSpec, Limits, lower_job};
 use lensc_grammar::Diagnostic;
 use lensc_lang::Checked;
 use lensc_lang::check::CheckedJob;
-use lensc_lang::lower::job::{Estimate, JobSpec, Limits, lower_job};
 use lensc_runtime::post::Provenance;
 use lensc_runtime::surface::ir::{SurfaceFn, SurfaceTape};
 
-use crate::builders;
 use crate::evaluate::evaluator;
 use crate::output::{Built, Destination};
 use crate::progress::{Event, Meter, Observer, Phase};
@@ -61,8 +61,8 @@ pub fn lower(
     limits: &Limits,
 ) -> Result<(JobSpec, Estimate), Vec<Diagnostic>> {
     let spec = lower_job(job, dialect, &evaluate)?;
-    let estimate = lensc_lang::lower::job::estimate(&spec, &evaluate);
-    let refused = lensc_lang::lower::job::refusals(&spec, &estimate, limits);
+    let estimate = crate::job::estimate(&spec, &evaluate);
+    let refused = crate::job::refusals(&spec, &estimate, limits);
     if refused.is_empty() {
         Ok((spec, estimate))
     } else {
@@ -83,27 +83,11 @@ pub fn findings_before_planning(c: &Checked, limits: &Limits) -> Vec<Diagnostic>
     let mut found = Vec::new();
     for j in &c.checked.jobs {
         match lower(j, None, limits) {
-            Ok((spec, _)) => found.extend(warnings_before_planning(&spec)),
+            Ok((spec, _)) => found.extend(spec.warnings_before_planning()),
             Err(refused) => found.extend(refused),
         }
     }
     found
-}
-
-/// The warnings a lowered job earns before any planning, which `check`
-/// reports beside the lowering's errors (`build` finds the same ones on
-/// its way): a wrapped design that does not close around its roller
-/// (W0006).
-pub fn warnings_before_planning(spec: &JobSpec) -> Vec<Diagnostic> {
-    match spec {
-        JobSpec::Roller(s) => {
-            let (design, _) = evaluator(&s.head.surface.lowered.tape);
-            builders::roller::seam_warning(s, design.as_ref())
-                .into_iter()
-                .collect()
-        }
-        _ => Vec::new(),
-    }
 }
 
 /// Builds programs and reports (without writing them) for the checked
@@ -273,13 +257,12 @@ fn build_metered(
     meter: Meter,
     read: Option<&ReadBack>,
 ) -> Result<Built, Vec<Diagnostic>> {
-    match spec {
-        JobSpec::Turning(s) => builders::turning::build(s, prov),
-        JobSpec::Spiral(s) => builders::fts::build(s, prov, to, meter, read),
-        JobSpec::Raster(s) => builders::raster::build(s, prov),
-        JobSpec::Grinding(s) => builders::grinding::build(s, prov),
-        JobSpec::Roller(s) => builders::roller::build(s, prov, to, meter, read),
-    }
+    spec.build(&BuildContext {
+        prov,
+        to,
+        meter,
+        read,
+    })
 }
 
 /// FNV-1a 64 over every loaded source, in load order.

@@ -12,9 +12,9 @@ use std::io::BufReader;
 use std::sync::mpsc::{SyncSender, sync_channel};
 use std::thread::JoinHandle;
 
+use crate::job::JobHead;
 use lensc_grammar::Diagnostic;
 use lensc_lang::check::CheckedJob;
-use lensc_lang::lower::job::JobHead;
 use lensc_lang::lower::read_back::job_machine;
 use lensc_runtime::dialect::Dialect;
 use lensc_runtime::reader::{self, Finding, MachineLimits, Reader};

@@ -4,8 +4,8 @@
 //! nowhere (`lensc report` formats none); and the first error met writing
 //! it, kept until the program is done.
 
+use crate::job::JobHead;
 use lensc_grammar::{Diagnostic, FileId, Span};
-use lensc_lang::lower::job::JobHead;
 use lensc_runtime::post::ProgramError;
 
 use crate::output::{Destination, ProgramText};
@@ -177,7 +177,7 @@ impl<'a> ProgramSink<'a> {
     /// met writing it.
     pub(crate) fn written(self, head: &JobHead) -> Result<Sink, Vec<Diagnostic>> {
         match self.error {
-            Some(e) => Err(vec![crate::parts::not_printable(head, e)]),
+            Some(e) => Err(vec![crate::context::not_printable(head, e)]),
             None => Ok(self.sink),
         }
     }
@@ -185,7 +185,7 @@ impl<'a> ProgramSink<'a> {
 
 /// E0151: the spool file could not be written.
 fn cannot_spool(e: &std::io::Error, site: (FileId, Span)) -> Diagnostic {
-    lensc_lang::lower::diagnostics::RuntimeError::Spool(e).at(site)
+    crate::diagnostics::RuntimeError::Spool(e).at(site)
 }
 
 #[cfg(test)]

@@ -41,6 +41,9 @@ pub const UNSUPPORTED_COMBINATION: &str = "E0131";
 pub const EMPTY_FILE: &str = "E0132";
 pub const OUTSIDE_APERTURE: &str = "E0133";
 pub const WRAP_OVERLAP: &str = "E0134";
+/// A strategy kind that no planner builds (the registry of strategies
+/// lists no folder for it).
+pub const NO_SUCH_STRATEGY: &str = "E0135";
 pub const NOSE_TOO_LARGE: &str = "E0140";
 pub const OUT_OF_TRAVEL: &str = "E0141";
 pub const FEED_TOO_HIGH: &str = "E0142";
@@ -259,6 +262,7 @@ pub const ALL: &[&str] = &[
     EMPTY_FILE,
     OUTSIDE_APERTURE,
     WRAP_OVERLAP,
+    NO_SUCH_STRATEGY,
     WRAP_GAP,
     NOSE_TOO_LARGE,
     OUT_OF_TRAVEL,

@@ -2,10 +2,10 @@
 //! a program: the adapters between `plan/` and `post/`, one file per
 //! strategy, and the header words they share.
 
-pub mod fts;
 pub mod grinding;
 pub mod raster;
 pub mod roller;
+pub mod spiral;
 pub mod turning;
 
 use crate::dialect::Dialect;

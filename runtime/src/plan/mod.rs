@@ -4,10 +4,10 @@
 
 pub mod chords;
 pub mod envelope;
-pub mod fts;
 pub mod grinding;
 pub mod optimise;
 pub mod raster;
 pub mod roller;
+pub mod spiral;
 pub mod stream;
 pub mod turning;

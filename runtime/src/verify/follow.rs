@@ -12,7 +12,7 @@
 //! over: the simulation keeps only the servo's state.
 
 use crate::machine::servo::SecondOrderServo;
-use crate::plan::fts::SpiralPoint;
+use crate::plan::spiral::SpiralPoint;
 use nalgebra::{Matrix2, Vector2};
 
 /// What the servo does over one lenslet.

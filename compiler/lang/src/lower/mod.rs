@@ -1,10 +1,9 @@
-//! Lowering: checked values to what the runtime reads. `job` turns a
-//! checked job into its typed `JobSpec` (with every check that needs
-//! several parts at once); `surface` turns a surface into IR. Here too:
-//! the dialect a job is written in, and a surface described in words.
+//! Lowering: checked values to what the runtime reads. `surface` turns a
+//! surface into IR; `read_back` finds what a program is read back
+//! against. Here too: the dialect a job is written in, and a surface
+//! described in words. (A whole job is lowered to its typed `JobSpec` by
+//! its strategy, in lensc-build.)
 
-pub mod diagnostics;
-pub mod job;
 pub mod read_back;
 pub mod surface;
 

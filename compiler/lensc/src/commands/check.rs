@@ -7,7 +7,7 @@ use crate::output::{Output, load};
 
 /// Runs the subcommand; returns the exit code.
 pub fn run(out: &Output, files: &[std::path::PathBuf], max_program_size: u64) -> u8 {
-    let limits = lensc_lang::lower::job::Limits {
+    let limits = lensc_build::job::Limits {
         max_program_size,
         ..Default::default()
     };

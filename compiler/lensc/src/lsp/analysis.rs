@@ -96,7 +96,7 @@ impl Analysis {
     /// every keystroke.
     pub fn lower_jobs(&mut self) {
         if self.refused.is_none() {
-            let limits = lensc_lang::lower::job::Limits::default();
+            let limits = lensc_build::job::Limits::default();
             self.before_planning =
                 lensc_build::pipeline::findings_before_planning(&self.checked, &limits);
         }

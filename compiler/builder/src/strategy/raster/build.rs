@@ -1,0 +1,171 @@
+//! Building an iso-plane raster job on a 3-axis mill (seed 000): the
+//! raster planned over the surface, the knife's clearance checked against
+//! the planner's steepest slope along the cut, the moves kept within the
+//! travel, the program written, and the cut simulated as a height map.
+
+use super::RasterSpec;
+use lensc_grammar::Diagnostic;
+use lensc_lang::lower::exact_in;
+use lensc_runtime::plan::optimise::Summary;
+use lensc_runtime::plan::raster::{Axis, RasterPath, RasterTool, check_clearance};
+use lensc_runtime::post::Provenance;
+use lensc_runtime::verify::heightmap::Cutter;
+
+use crate::context::{self as parts, BuildContext};
+use crate::evaluate::evaluator;
+use crate::height_map::{self, Simulation, domain_centre};
+use crate::output::{Built, ProgramText};
+use crate::report;
+use lensc_runtime::verify::window::split;
+
+/// Builds a `raster` job on a `mill_3axis`.
+pub(super) fn build(spec: &RasterSpec, cx: &BuildContext) -> Result<Built, Vec<Diagnostic>> {
+    let prov = cx.prov;
+    let (head, raster, tool) = (&spec.head, &spec.raster, spec.tool);
+    let dialect = &head.dialect;
+    let lowered = &head.surface.lowered;
+    let (kernel, _) = evaluator(&lowered.tape);
+    let path =
+        lensc_runtime::plan::raster::plan_raster(raster, &tool, kernel.as_ref(), &lowered.domain)
+            .map_err(|e| vec![super::errors::error(e, head.site)])?;
+    let mut errors = Vec::new();
+    // The knife's flank must clear the steepest slope along the cut, as
+    // lowering found it on the planes and now on every planned contact.
+    if let Some(clearance) = spec.clearance
+        && let Err(e) = check_clearance(clearance, path.max_slope_along)
+    {
+        errors.push(super::errors::error(e, head.site));
+    }
+    let feed = spec.feed;
+    let moves = lensc_runtime::emit::raster::raster_moves(
+        &path,
+        lensc_runtime::emit::raster::RasterCut {
+            feed,
+            spindle_speed: spec.spindle_speed,
+            zigzag: raster.zigzag,
+        },
+    );
+    errors.extend(parts::travel_error(head, &moves));
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+    // Points placed clear of the material are not fitted back into it.
+    let (moves, optimised) = lensc_runtime::plan::optimise::optimise_within(
+        &moves,
+        raster.chord_tolerance * lensc_runtime::plan::optimise::FIT_SHARE,
+        &dialect.arc_planes,
+        matches!(
+            raster.chords,
+            lensc_runtime::plan::chords::ChordPlacement::Clear { .. }
+        ),
+    );
+    let resolution = head.resolution;
+    let text = lensc_runtime::emit::raster::emit_mill(
+        dialect,
+        &head.name,
+        &header_lines(spec, prov, &path, &optimised),
+        &moves,
+        (resolution, raster.chord_tolerance),
+        &head.start,
+    )
+    .map_err(|e| vec![parts::not_printable(head, e)])?;
+    let section = report::Raster::new(&path, raster, feed, &optimised);
+    let time = section.cutting_time_s;
+    let toolpath = report::Toolpath::Raster(section);
+    let mut plots = crate::plots::PlotSeries::default();
+    // The knife's edge lies across the cut; a ball reaches its radius
+    // along the path too (see lensc_runtime::verify::heightmap).
+    let (cutter, edge) = match tool {
+        RasterTool::Knife { nose_radius } => (
+            Cutter::Nose {
+                radius: nose_radius,
+            },
+            "the knife's edge in its rake face, across the cut, as the planner places it",
+        ),
+        RasterTool::Ball { radius } => (
+            Cutter::Ball { radius },
+            "the ball swept along the path: every point within its radius of the centre's printed path",
+        ),
+    };
+    let along_x = raster.along == Axis::X;
+    let window = height_map::window(
+        head,
+        domain_centre(&lowered.domain),
+        height_map::domain_extent(&lowered.domain),
+    );
+    let grid = window.cartesian(along_x);
+    let mut sweep = Simulation::of(grid, split(&grid, None), cutter);
+    // The program as written: its text read as the controller reads it.
+    let executed = parts::executed_moves(head, &text, false);
+    height_map::sweep_mill_program(sweep.path(), &executed, along_x);
+    let frame = height_map::RasterFrame {
+        kernel: kernel.as_ref(),
+        along_x,
+        window,
+        domain: lowered.domain,
+    };
+    let (map, errors) = sweep.finish(&frame, &window, window.spacing);
+    plots.form_error = Some(height_map::form_error_series(
+        errors,
+        &window,
+        ("x (mm)", "y (mm)"),
+    ));
+    let coordinates = if along_x {
+        "columns along x, rows along y"
+    } else {
+        "columns along y, rows along x"
+    };
+    let mut height_map = report::HeightMap::new(&map, &window, coordinates, raster.stepover);
+    // The path's own error apart from the machine's resolution: the
+    // same moves swept as computed (rounded to a picometre only).
+    let mut unrounded = Simulation::of(grid, split(&grid, None), cutter);
+    height_map::sweep_mill_moves(unrounded.path(), &moves, along_x, 1e-9);
+    height_map.raster = Some(report::RasterEdge {
+        edge,
+        contact_unrounded: unrounded
+            .finish(&frame, &window, window.spacing)
+            .0
+            .contact
+            .as_ref()
+            .map(report::Figures::from),
+    });
+    let simulation = report::Simulation::HeightMap(report::HeightMapOnly { height_map });
+    let text = ProgramText::Memory(text);
+    let cut = (path.point_count, time);
+    Ok(parts::built(
+        head, prov, text, toolpath, simulation, plots, cut,
+    ))
+}
+
+/// The program's header: provenance, units, surface, the tool, the raster
+/// and its optimisation, and the machine in words.
+fn header_lines(
+    spec: &RasterSpec,
+    prov: &Provenance,
+    path: &RasterPath,
+    optimised: &Summary,
+) -> Vec<String> {
+    let (head, raster) = (&spec.head, &spec.raster);
+    let mut header = parts::header(
+        head,
+        prov,
+        "units mm; X Y Z of the tool centre, +Z out of the material; no cutter compensation",
+    );
+    header.push(format!("tool {}: {}", head.names.tool, spec.tool_words));
+    header.push(format!(
+        "strategy {}: raster along {}, {}, stepover {} um, {}, {} passes, {} points",
+        head.names.strategy,
+        if raster.along == Axis::X { "x" } else { "y" },
+        if raster.zigzag { "zigzag" } else { "one way" },
+        exact_in(raster.stepover, "um"),
+        lensc_runtime::emit::tolerance_words(raster.chord_tolerance),
+        path.pass_count,
+        path.point_count
+    ));
+    header.push(lensc_runtime::emit::optimisation_words(optimised));
+    header.push(format!(
+        "machine {}: {} 3-axis mill",
+        head.names.machine, head.dialect.name
+    ));
+    header
+}

@@ -1,0 +1,207 @@
+//! The advice of a spiral refused for its fast axis's acceleration
+//! (E0147): the highest speed that passes, found by planning the real
+//! check at trial speeds, a bounded number of them.
+//!
+//! No scaling law gives it. Were the points and the trajectory fixed,
+//! every second divided difference in time would scale with the square
+//! of the speed; but where the trajectory has a corner (a lenslet's
+//! continuation meeting the settling plateau, a rim on the land) the
+//! sampler splits down to the servo's data period, a time, and there the
+//! acceleration (a jump in slope over one period) scales with the speed
+//! itself; and the settling offset, so the trajectory, grows with the
+//! surface speed. So each trial speed is planned (`Planner::check`, which
+//! stops at the first revolution over the limit) and the advice is the
+//! fastest trial that passed: building at it passes. Trial speeds are
+//! decimals of four significant figures in the job's own unit, parsed
+//! as the checker parses them, so the speed a user copies from the help
+//! is the one that was checked.
+
+use super::SpiralSpec;
+use lensc_lang::check::trim_num;
+use lensc_lang::units;
+use lensc_runtime::plan::spiral::{FtsError, Planner, SpeedAdvice, SpindleSpeed};
+
+use crate::evaluate::evaluator;
+
+/// Most plans a search makes: failing ones stop early, passing ones run
+/// the whole spiral.
+const MAX_TRIALS: usize = 14;
+
+/// The search stops once the fastest pass is within this ratio of the
+/// slowest failure above it.
+const PRECISION: f64 = 1.02;
+
+/// The highest speed that passes, below the job's own, which accelerated
+/// at `acceleration` (mm/s²).
+pub fn search(spec: &SpiralSpec, acceleration: f64) -> SpeedAdvice {
+    let unit = Unit::of(spec.spiral.speed);
+    let max = spec.fast_axis.max_acceleration;
+    // The slowest failure so far (in the job's unit) and its acceleration.
+    let mut fails = (unit.shown(spec.spiral.speed), acceleration);
+    let mut passes: Option<f64> = None;
+    let mut trials = 0;
+    // Bracket: step down assuming acceleration ∝ speed^p, p = 1 (a
+    // corner's law, more cautious than the square) until the last two
+    // failures measure it; where it hardly falls with the speed (or
+    // rises: another corner takes over), by a fifth.
+    let mut p: Option<f64> = Some(1.0);
+    while passes.is_none() && trials < MAX_TRIALS {
+        let (s, a) = fails;
+        let ratio = p.map_or(0.8, |p| (max / a).powf(1.0 / p).clamp(0.5, 0.99));
+        let guess = s * ratio;
+        let Some(trial) = decimal(guess).filter(|&t| t < s && t > 0.0) else {
+            break;
+        };
+        trials += 1;
+        match check(spec, unit, trial) {
+            Verdict::Passes => passes = Some(trial),
+            Verdict::Fails(at) => {
+                let measured = (a / at).ln() / (s / trial).ln();
+                p = (measured.is_finite() && measured > 0.25).then(|| measured.min(2.0));
+                fails = (trial, at);
+            }
+        }
+    }
+    let Some(mut lo) = passes else {
+        return SpeedAdvice::NotFound {
+            lowest_tried: unit.value(fails.0),
+        };
+    };
+    // Bisect (geometrically) between the fastest pass and the slowest
+    // failure.
+    let mut hi = fails.0;
+    while trials < MAX_TRIALS && hi / lo > PRECISION {
+        let Some(m) = decimal((lo * hi).sqrt()).filter(|&m| m > lo && m < hi) else {
+            break;
+        };
+        trials += 1;
+        match check(spec, unit, m) {
+            Verdict::Passes => lo = m,
+            Verdict::Fails(_) => hi = m,
+        }
+    }
+    SpeedAdvice::Found {
+        passes: unit.value(lo),
+        fails: unit.value(hi),
+    }
+}
+
+enum Verdict {
+    Passes,
+    /// Refused; the acceleration (mm/s²) if that was why (else infinite).
+    Fails(f64),
+}
+
+/// Plans the job at `speed` (in its own unit) up to its first refusal.
+fn check(spec: &SpiralSpec, unit: Unit, speed: f64) -> Verdict {
+    let speed = unit.speed(spec.spiral.speed, speed);
+    let Ok(at) = spec.at_speed(speed, &|tape| evaluator(tape).0) else {
+        return Verdict::Fails(f64::INFINITY);
+    };
+    let (trajectory, bounds) = match &at.trajectory {
+        Some((t, b)) => (t, b.clone()),
+        None => (&spec.trajectory, spec.bounds.clone()),
+    };
+    let kernel = evaluator(&trajectory.tape).0;
+    let planner = Planner {
+        spiral: &at.spiral,
+        surface: kernel.as_ref(),
+        nose_radius: spec.nose_radius,
+        bounds,
+    };
+    match planner.check(&spec.fast_axis) {
+        Ok(_) => Verdict::Passes,
+        Err(FtsError::AccelerationExceeded { acceleration, .. }) => Verdict::Fails(acceleration),
+        Err(_) => Verdict::Fails(f64::INFINITY),
+    }
+}
+
+/// `v` rounded down to four significant figures, as the decimal the help
+/// prints and a user would write.
+fn decimal(v: f64) -> Option<f64> {
+    if !(v.is_finite() && v > 0.0) {
+        return None;
+    }
+    let step = 10f64.powi(v.log10().floor() as i32 - 3);
+    let rounded = (v / step).floor() * step;
+    trim_num(rounded).parse().ok().filter(|&d: &f64| d > 0.0)
+}
+
+/// The unit the job states its speed in: rpm, or m/min for a constant
+/// surface speed.
+#[derive(Clone, Copy)]
+enum Unit {
+    Rpm,
+    MetresPerMinute,
+}
+
+impl Unit {
+    fn of(speed: SpindleSpeed) -> Unit {
+        match speed {
+            SpindleSpeed::Constant(_) => Unit::Rpm,
+            SpindleSpeed::SurfaceSpeed { .. } => Unit::MetresPerMinute,
+        }
+    }
+
+    /// The factor from the unit to rad/s or mm/s, multiplied up as the
+    /// checker does a written unit's parts.
+    fn factor(self) -> f64 {
+        let parts: &[(&str, i32)] = match self {
+            Unit::Rpm => &[("rpm", 1)],
+            Unit::MetresPerMinute => &[("m", 1), ("min", -1)],
+        };
+        parts.iter().fold(1.0, |f, &(name, power)| {
+            f * units::lookup(name)
+                .expect("a known unit")
+                .factor
+                .powi(power)
+        })
+    }
+
+    /// A speed written in the unit, in rad/s or mm/s.
+    fn value(self, written: f64) -> f64 {
+        written * self.factor()
+    }
+
+    /// The job's speed in the unit.
+    fn shown(self, speed: SpindleSpeed) -> f64 {
+        speed.stated() / self.factor()
+    }
+
+    /// The job's speed with its value `written` in the unit (a surface
+    /// speed keeps its spindle cap).
+    fn speed(self, like: SpindleSpeed, written: f64) -> SpindleSpeed {
+        match like {
+            SpindleSpeed::Constant(_) => SpindleSpeed::Constant(self.value(written)),
+            SpindleSpeed::SurfaceSpeed { max, .. } => SpindleSpeed::SurfaceSpeed {
+                speed: self.value(written),
+                max,
+            },
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn decimals_round_down_to_four_figures() {
+        assert_eq!(decimal(198.987), Some(198.9));
+        assert_eq!(decimal(4.56789), Some(4.567));
+        assert_eq!(decimal(1000.0), Some(1000.0));
+        assert_eq!(decimal(0.012345), Some(0.01234));
+        assert_eq!(decimal(0.0), None);
+        assert_eq!(decimal(f64::NAN), None);
+    }
+
+    #[test]
+    fn units_convert_as_the_checker_does() {
+        let rpm = Unit::Rpm.value(300.0);
+        assert!((rpm - 300.0 * 2.0 * std::f64::consts::PI / 60.0).abs() < 1e-12);
+        let v = Unit::MetresPerMinute.value(5.0);
+        assert!((v - 5000.0 / 60.0).abs() < 1e-12);
+        let back = Unit::Rpm.shown(SpindleSpeed::Constant(rpm));
+        assert!((back - 300.0).abs() < 1e-9);
+    }
+}

@@ -1,0 +1,351 @@
+//! Building a spiral turning job, with a fast tool servo (`fts_spiral` on
+//! an `fts_lathe`, seed 003) or a slow one (`spiral_turning` on an
+//! `sts_lathe`, Z carrying the surface): the lowered spiral (its settling
+//! offset and tool checks were made in lowering) planned and streamed into
+//! the program, the servo's following and the cut simulated as it is
+//! written, and the report of what it makes.
+
+use super::SpiralSpec;
+use lensc_grammar::Diagnostic;
+use lensc_lang::check::trim_num;
+use lensc_lang::codes;
+use lensc_lang::lower::exact_in;
+use lensc_runtime::emit::spiral::FtsProgram;
+use lensc_runtime::plan::spiral::{FtsError, FtsSummary, Planner, SpindleSpeed};
+use lensc_runtime::post::Provenance;
+use lensc_runtime::surface::ir::SurfaceFn;
+use lensc_runtime::verify::heightmap::NosePath;
+
+use crate::context::{self as parts, BuildContext};
+use crate::evaluate::evaluator;
+use crate::height_map::{self, LatheFrame, Simulation, Window};
+use crate::output::Built;
+use crate::report;
+use crate::spool::Sink;
+
+/// A spiral job ready to plan: its spec and the trajectory's kernel.
+pub struct Prepared<'s> {
+    pub spec: &'s SpiralSpec,
+    pub kernel: Box<dyn SurfaceFn + Sync>,
+}
+
+impl<'s> Prepared<'s> {
+    /// Compiles the trajectory the nose centre follows.
+    pub fn of(spec: &'s SpiralSpec) -> Prepared<'s> {
+        Prepared {
+            spec,
+            kernel: evaluator(&spec.trajectory.tape).0,
+        }
+    }
+    pub fn planner(&self) -> Planner<'_> {
+        Planner {
+            spiral: &self.spec.spiral,
+            surface: self.kernel.as_ref(),
+            nose_radius: self.spec.nose_radius,
+            bounds: self.spec.bounds.clone(),
+        }
+    }
+}
+
+/// Builds one `fts_spiral` job, or says why it cannot be built. Spooled
+/// (`to`), the program goes to a temporary file as it is written, so
+/// memory stays bounded however long it is, and is read back (`read`) on
+/// a thread of its own as it goes.
+pub(super) fn build(spec: &SpiralSpec, cx: &BuildContext) -> Result<Built, Vec<Diagnostic>> {
+    let (prov, to) = (cx.prov, cx.to);
+    let (p, head) = (spec, &spec.head);
+    let site = head.site;
+    let not_printable = |e| vec![parts::not_printable(head, e)];
+    let table_name = table_name(spec);
+    let header = header_lines(spec, prov, table_name.as_deref());
+    let mut program = FtsProgram::new(
+        &head.dialect,
+        &head.name,
+        &header,
+        head.resolution,
+        p.spiral.chord_tolerance,
+        p.safe_w,
+        table_name.as_deref(),
+    )
+    .map_err(not_printable)?;
+    program.hold_spindle_under(spec.max_spindle_speed);
+    program.call_tool(&head.start).map_err(not_printable)?;
+    let mut sink = cx.sink(head)?;
+    let mut table_sink = match table_name {
+        Some(_) => Some(Sink::new(to, site)?),
+        None => None,
+    };
+    // The fast axis's servo, run on the commands as printed as they are
+    // planned (a slow tool servo's Z has no servo model here).
+    let data_rate = 1.0 / p.spiral.min_interval;
+    let mut following = following(spec, data_rate);
+    // The height map over the window, from the same printed points.
+    let domain = &head.surface.lowered.domain;
+    let window = height_map::window(
+        head,
+        height_map::lathe_centre(domain, &p.lenslets),
+        height_map::domain_extent(domain),
+    );
+    let mut sweep = Simulation::new(
+        window.polar(),
+        window.polar_tiles(&p.lenslets),
+        p.nose_radius,
+    );
+    let mut printed = Vec::new();
+    let planned = Prepared::of(spec).planner().plan(&p.fast_axis, |pts| {
+        let printed_at = lensc_runtime::verify::simulate::Printed::new(head.resolution);
+        let as_printed = |v: f64| printed_at.round(v);
+        printed.clear();
+        printed.extend(
+            pts.iter()
+                .map(|q| lensc_runtime::plan::spiral::SpiralPoint {
+                    x: as_printed(q.x),
+                    w: as_printed(q.w),
+                    ..*q
+                }),
+        );
+        for q in &printed {
+            sweep.path().point(q.c, q.x, q.w);
+        }
+        if let Some(sim) = following.as_mut() {
+            sim.extend(&printed);
+        }
+        sink.extend(|| program.extend(pts));
+        sink.push(program.take_text());
+        sink.planned(pts.len());
+        if let Some(t) = table_sink.as_mut() {
+            t.push(program.take_table_text());
+        }
+    });
+    let summary = planned.map_err(|error| {
+        let advice = match error {
+            FtsError::AccelerationExceeded { acceleration, .. } => {
+                Some(super::advice::search(spec, acceleration))
+            }
+            _ => None,
+        };
+        vec![super::errors::error(
+            error,
+            &p.spiral.speed,
+            axis_words(spec),
+            advice,
+            site,
+        )]
+    })?;
+    let mut sink = sink.written(head)?;
+    if let Some(t) = table_sink.as_mut() {
+        t.push(program.take_table_text());
+    }
+    sink.push(program.finish().map_err(not_printable)?);
+    let mut beside = Vec::new();
+    if let (Some(name), Some(t)) = (table_name, table_sink) {
+        beside.push((name, t.finish(site)?));
+    }
+    let text = sink.finish(site)?;
+    let mut plots = crate::plots::PlotSeries::default();
+    let height_map = simulated_height_map(spec, sweep, window, &mut plots);
+    let simulation = simulation(following, height_map, data_rate, p.slow, &mut plots);
+    let toolpath = toolpath(spec, &summary);
+    let cut = (summary.points, summary.time);
+    let mut built = parts::built(head, prov, text, toolpath, simulation, plots, cut);
+    if let Some((name, table)) = beside.first() {
+        built.report.program.fts_table = Some(report::FtsTable {
+            file: name.clone(),
+            rows: table.lines().saturating_sub(2),
+        });
+    }
+    built.beside = beside;
+    built.warnings = chords_warning(spec, &summary, data_rate)
+        .into_iter()
+        .collect();
+    Ok(built)
+}
+
+/// The table a fast tool servo's controller reads its motion from
+/// (`JOB.EXT`), if its dialect takes one: the program then moves X and C a
+/// revolution a block.
+fn table_name(spec: &SpiralSpec) -> Option<String> {
+    match &spec.head.dialect.fts_table {
+        Some(ext) if !spec.slow => Some(format!("{}.{ext}", spec.head.name)),
+        _ => None,
+    }
+}
+
+/// The axis that carries the surface, in words.
+fn axis_words(spec: &SpiralSpec) -> &'static str {
+    if spec.slow { "Z" } else { "the fast axis" }
+}
+
+/// The fast axis's servo following, simulated over radial bins of the
+/// spiral, where it has a servo model.
+fn following(
+    spec: &SpiralSpec,
+    data_rate: f64,
+) -> Option<lensc_runtime::verify::follow::FollowingSimulation> {
+    use lensc_runtime::verify::follow::{FollowingSimulation, RadialBins};
+    let servo = spec.servo.as_ref().filter(|_| !spec.slow)?;
+    let (r0, r1) = (spec.spiral.start_radius.abs(), spec.spiral.end_radius.abs());
+    FollowingSimulation::new(
+        servo,
+        data_rate,
+        spec.bounds.features.as_deref().unwrap_or_default(),
+        RadialBins::new(r0.min(r1), r0.max(r1), crate::plots::FOLLOWING_BINS),
+    )
+}
+
+/// The spiral's section of the report: a fast or a slow tool servo's.
+fn toolpath(spec: &SpiralSpec, summary: &FtsSummary) -> report::Toolpath {
+    let spiral = report::Spiral::new(
+        summary,
+        &spec.spiral,
+        spec.settling.as_ref(),
+        spec.servo.as_ref(),
+        spec.nose_radius,
+    );
+    if spec.slow {
+        report::Toolpath::SpiralTurning(spiral)
+    } else {
+        report::Toolpath::FtsSpiral(spiral)
+    }
+}
+
+/// The height map the swept nose leaves over the window, for the report,
+/// and its form error for the plots.
+fn simulated_height_map(
+    spec: &SpiralSpec,
+    sweep: Simulation,
+    window: Window,
+    plots: &mut crate::plots::PlotSeries,
+) -> report::HeightMap {
+    let lowered = &spec.head.surface.lowered;
+    let design = evaluator(&lowered.tape).0;
+    let frame = LatheFrame::new(design.as_ref(), window, lowered.domain, &spec.lenslets);
+    // A polar grid's cells lie askew to the raster's blocks: √2 times the
+    // spacing puts a cell in every block (1.5 for margin).
+    let (map, raster) = sweep.finish(&frame, &window, 1.5 * window.spacing);
+    plots.form_error = Some(height_map::form_error_series(
+        raster,
+        &window,
+        ("x (mm)", "y (mm)"),
+    ));
+    report::HeightMap::new(
+        &map,
+        &window,
+        "columns at spindle angles (column step in rad), rows at radii",
+        spec.spiral.feed_per_rev,
+    )
+}
+
+/// W: chords the data period kept from their share of the tolerance.
+fn chords_warning(spec: &SpiralSpec, summary: &FtsSummary, data_rate: f64) -> Option<Diagnostic> {
+    let share =
+        spec.spiral.chord_tolerance * lensc_runtime::plan::optimise::UNOPTIMISED_CHORD_SHARE;
+    let (file, span) = spec.head.site;
+    summary.chords_over_tolerance.map(|o| {
+        Diagnostic::warning(
+            codes::CHORDS_OVER_TOLERANCE,
+            format!(
+                "{} chords of the spiral stray up to {} nm from the exact path (their share of the tolerance is {} nm), the worst at r = {} mm: {} may not be commanded faster than its data rate ({} Hz) allows",
+                o.count,
+                trim_num(o.deviation * 1e6),
+                trim_num(share * 1e6),
+                trim_num(o.at_radius),
+                axis_words(spec),
+                trim_num(data_rate)
+            ),
+            file,
+            span,
+        )
+        .with_label("this job")
+        .with_help("lower the spindle or surface speed, or give the axis a higher `data_rate`; the report's `chords_over_tolerance` says how many and where")
+    })
+}
+
+/// A spiral's simulation for its report: the fast axis's following where
+/// it has a servo model (at `data_rate`, Hz; its series go into `plots`),
+/// and the height map either way.
+fn simulation(
+    following: Option<lensc_runtime::verify::follow::FollowingSimulation>,
+    height_map: report::HeightMap,
+    data_rate: f64,
+    slow: bool,
+    plots: &mut crate::plots::PlotSeries,
+) -> report::Simulation {
+    let Some(sim) = following else {
+        return report::Simulation::Skipped(report::Skipped {
+            skipped: if slow {
+                "slow tool servo: Z is a machine axis, with no servo model here"
+            } else {
+                "the fast axis has no servo model"
+            },
+            height_map: Some(height_map),
+        });
+    };
+    let f = sim.finish();
+    let following = report::Following::new(&f, data_rate, height_map);
+    plots.following = Some(crate::plots::FollowingSeries {
+        by_radius: f.by_radius,
+        samples: f.samples,
+        data_rate_hz: data_rate,
+        max_error: (f.max_error, f.max_error_at),
+    });
+    report::Simulation::Following(following)
+}
+
+/// The program's header: provenance, units, the surface, tool, spiral
+/// and machine in words, and the settling offset.
+fn header_lines(spec: &SpiralSpec, prov: &Provenance, table: Option<&str>) -> Vec<String> {
+    let (head, spiral, slow) = (&spec.head, &spec.spiral, spec.slow);
+    let settling = spec.settling.as_ref();
+    let table_words;
+    let (servo_words, axis_words) = if slow {
+        ("slow-tool-servo", "Z carries the surface")
+    } else if let Some(table) = table {
+        table_words = format!(
+            "Z held at 0 while the fast tool servo follows the table {table} [rows C X W, one per point]"
+        );
+        ("fast-tool-servo", table_words.as_str())
+    } else {
+        ("fast-tool-servo", "Z the fast tool servo's axis")
+    };
+    let speed = match spiral.speed {
+        SpindleSpeed::Constant(w) => format!("constant spindle speed {} rpm", exact_in(w, "rpm")),
+        SpindleSpeed::SurfaceSpeed { speed, max } => format!(
+            "constant surface speed {} m/min capped at {} rpm",
+            exact_in(speed, "m/min"),
+            exact_in(max, "rpm")
+        ),
+    };
+    let units = format!(
+        "units mm; X is {}, C the spindle angle in degrees counted on from the start, {axis_words}, +Z out of the material",
+        lensc_runtime::emit::x_word(&head.dialect)
+    );
+    let mut lines = parts::nose_centre_header(head, prov, &units, spec.nose_radius);
+    lines.push(format!(
+        "strategy {}: {servo_words} spiral from r = {} mm, feed {} um/rev, {speed}, path tolerance {} nm [chords {}, blending {} nm]",
+        head.names.strategy,
+        exact_in(spiral.start_radius, "mm"),
+        exact_in(spiral.feed_per_rev, "um"),
+        exact_in(spiral.chord_tolerance, "nm"),
+        trim_num(
+            spiral.chord_tolerance * lensc_runtime::plan::optimise::UNOPTIMISED_CHORD_SHARE * 1e6
+        ),
+        trim_num(spiral.chord_tolerance * lensc_runtime::plan::optimise::BLEND_SHARE * 1e6)
+    ));
+    lines.push(format!(
+        "machine {}: {} {servo_words} lathe",
+        head.names.machine, head.dialect.name
+    ));
+    match settling {
+        None if slow => {}
+        Some(s) => lines.push(format!(
+            "settling: tool held {} um above the land, lenslets continued {} um past their rims [settling time {} ms at {} m/min]",
+            exact_in(s.offset, "um"),
+            exact_in(s.d_traj, "um"),
+            exact_in(s.time, "ms"),
+            exact_in(s.surface_speed, "m/min")
+        )),
+        None => lines.push("settling: none, the tool follows the surface".into()),
+    }
+    lines
+}

@@ -1,0 +1,86 @@
+//! The spiral planner's errors in the words a user reads: the help names
+//! speeds in the kind the job gives them, and a refused acceleration
+//! carries what a search over the real check found (`advice`).
+use lensc_grammar::{Diagnostic, FileId, Span};
+use lensc_lang::check::trim_num;
+use lensc_lang::codes;
+
+use crate::diagnostics::{Coded, coded, rpm, um};
+use lensc_runtime::plan::spiral::{FtsError, SpeedAdvice, SpindleSpeed};
+
+/// A spiral planner error as its diagnostic at `site`. `speed` is how the
+/// job gives its spindle speed, `axis` names the axis that carries the
+/// surface, `advice` what a search for a speed that passes found.
+pub(crate) fn error(
+    e: FtsError,
+    speed: &SpindleSpeed,
+    axis: &str,
+    advice: Option<SpeedAdvice>,
+    site: (FileId, Span),
+) -> Diagnostic {
+    coded_error(e, speed, axis, advice).at(site)
+}
+
+fn coded_error(
+    e: FtsError,
+    speed: &SpindleSpeed,
+    axis: &str,
+    advice: Option<SpeedAdvice>,
+) -> Coded {
+    match e {
+        FtsError::Undefined { x, c } => coded(
+            codes::UNDEFINED_ON_PATH,
+            format!(
+                "the surface is undefined where the nose must go (r = {} mm, C = {}°)",
+                trim_num(x),
+                trim_num(c.to_degrees() % 360.0)
+            ),
+        ),
+        FtsError::StrokeExceeded { range, stroke } => coded(
+            codes::STROKE_EXCEEDED,
+            format!(
+                "{axis} must travel {} um, more than its {} um stroke",
+                um(range),
+                um(stroke)
+            ),
+        )
+        .help("use a fast axis with a longer `stroke`, or a surface whose height varies less around each turn"),
+        FtsError::AccelerationExceeded {
+            acceleration,
+            max,
+            at_radius,
+        } => {
+            let words = |v: f64| match speed {
+                SpindleSpeed::Constant(_) => format!("{} rpm", rpm(v)),
+                SpindleSpeed::SurfaceSpeed { .. } => format!("{} m/min", trim_num(v * 0.06)),
+            };
+            let kind = match speed {
+                SpindleSpeed::Constant(_) => "spindle speed",
+                SpindleSpeed::SurfaceSpeed { .. } => "surface speed",
+            };
+            let help = match advice {
+                Some(SpeedAdvice::Found { passes, fails }) => format!(
+                    "the highest speed found that respects it is a {kind} of {} (planned and checked; {} is refused)",
+                    words(passes),
+                    words(fails)
+                ),
+                Some(SpeedAdvice::NotFound { lowest_tried }) => format!(
+                    "no {kind} tried respects it, down to {}: the acceleration does not fall with the speed there (a spindle cap, or the path itself)",
+                    words(lowest_tried)
+                ),
+                None => format!("lower the {kind}"),
+            };
+            coded(
+                codes::ACCELERATION_EXCEEDED,
+                format!(
+                    "{axis} would accelerate at {} m/s² (at r = {} mm), above its {} m/s² limit",
+                    trim_num(acceleration / 1000.0),
+                    trim_num(at_radius),
+                    trim_num(max / 1000.0)
+                ),
+            )
+            .help(help)
+        }
+        FtsError::Invalid(why) => coded(codes::UNSUPPORTED_COMBINATION, why.to_string()),
+    }
+}

@@ -1,0 +1,535 @@
+//! Lowering a spiral turning job, with a fast tool servo (`fts_spiral` on
+//! an `fts_lathe`) or a slow one (`spiral_turning` on an `sts_lathe`, Z
+//! carrying the surface): the servo model, the settling offset worked out
+//! from it, the tool trajectory, the spiral and its bounds, and the checks
+//! of the tool against the design (nose radius, clearance, included
+//! angle), the spindle and the travel, all before the spiral is planned.
+
+pub mod advice;
+mod build;
+pub(crate) mod errors;
+pub mod report;
+pub use build::Prepared;
+mod estimate;
+
+use lensc_grammar::Diagnostic;
+use lensc_runtime::machine::servo::SecondOrderServo;
+use lensc_runtime::plan::chords::ChordPlacement;
+use lensc_runtime::plan::spiral::{FastAxis, FtsSpiral, SpindleSpeed, TrajectoryBounds};
+use lensc_runtime::post::Dialect;
+use lensc_runtime::surface::analysis::Domain;
+use lensc_runtime::surface::ir::SurfaceFn;
+
+use crate::diagnostics::RuntimeError;
+use crate::job::{Evaluate, JobHead, Parts, all_clear};
+use lensc_lang::check::trim_num;
+use lensc_lang::codes;
+use lensc_lang::lower::surface::{LowerError, LoweredSurface};
+use lensc_lang::value::{self, Object};
+
+/// A spiral job, typed: what the spiral planner needs.
+pub struct SpiralSpec {
+    pub head: JobHead,
+    /// Slow tool servo: Z itself carries the surface.
+    pub slow: bool,
+    pub spiral: FtsSpiral,
+    pub bounds: TrajectoryBounds,
+    pub nose_radius: f64,
+    pub fast_axis: FastAxis,
+    /// The surface the nose centre follows: the design, or with a
+    /// settling offset its lenslets continued and lifted over the land.
+    pub trajectory: LoweredSurface,
+    /// The fast axis's servo model (none for a slow tool servo).
+    pub servo: Option<SecondOrderServo>,
+    pub settling: Option<Settling>,
+    /// The fast axis's position (mm) clear of the part.
+    pub safe_w: f64,
+    /// The lenslets' own apertures (centre x, y and rim radius, mm), if
+    /// the surface is an array.
+    pub lenslets: Vec<(f64, f64, f64)>,
+    /// The surface as declared: what the trajectory is made from again
+    /// at another speed (`at_speed`).
+    pub surface_object: Object,
+    /// The machine's spindle limit (rad/s): no move of the program may
+    /// turn C faster, as printed.
+    pub max_spindle_speed: f64,
+}
+
+/// A spiral job at another speed: what a search for the highest speed
+/// its fast axis allows plans.
+pub struct AtSpeed {
+    pub spiral: FtsSpiral,
+    /// The trajectory and its bounds, where they change with speed (a
+    /// settling offset); `None`: the job's own.
+    pub trajectory: Option<(LoweredSurface, TrajectoryBounds)>,
+}
+
+impl SpiralSpec {
+    /// The job were the strategy's speed `speed` instead: the settling
+    /// offset follows the fastest surface speed, and with it the
+    /// trajectory the nose centre follows.
+    pub fn at_speed(&self, speed: SpindleSpeed, evaluate: Evaluate) -> Result<AtSpeed, LowerError> {
+        let spiral = FtsSpiral {
+            speed,
+            ..self.spiral.clone()
+        };
+        let Some(settling) = self.settling else {
+            return Ok(AtSpeed {
+                spiral,
+                trajectory: None,
+            });
+        };
+        let v = fastest(speed, spiral.start_radius);
+        let settling = settling_at(&self.surface_object, settling.time, settling.band, v)
+            .ok_or(LowerError::Unsupported("no settling offset at this speed"))?;
+        let (trajectory, bounds) = settled_trajectory(
+            &self.surface_object,
+            Some(&settling),
+            &self.head.surface.lowered.domain,
+            self.bounds.part_top,
+            evaluate,
+        )?;
+        Ok(AtSpeed {
+            spiral,
+            trajectory: Some((trajectory, bounds)),
+        })
+    }
+}
+
+/// The settling offset and how it was found.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settling {
+    /// The servo's settling time (s).
+    pub time: f64,
+    /// The band it settles into, when the time came from the model.
+    pub band: Option<f64>,
+    /// The fastest surface speed (mm/s) the job reaches.
+    pub surface_speed: f64,
+    /// The path covered while settling (mm).
+    pub d_traj: f64,
+    /// How far the tool is held above the land (mm).
+    pub offset: f64,
+}
+
+impl crate::strategy::Strategy for SpiralSpec {
+    const NAMES: &'static [&'static str] = &["fts_spiral", "spiral_turning"];
+    const SETUP: lensc_runtime::post::Setup = lensc_runtime::post::Setup::Lathe;
+    const WINDOWED: bool = true;
+    fn lower(p: &Parts, dialect: Dialect, evaluate: Evaluate) -> Result<Self, Vec<Diagnostic>> {
+        lower(p, dialect, evaluate)
+    }
+    fn head(&self) -> &JobHead {
+        &self.head
+    }
+    fn path_tolerance(&self) -> Option<f64> {
+        Some(self.spiral.chord_tolerance)
+    }
+    fn estimate(&self, evaluate: Evaluate) -> crate::job::Estimate {
+        estimate::estimate(self, evaluate)
+    }
+    fn tiles(
+        &self,
+        window: &lensc_runtime::verify::window::Window,
+    ) -> Option<Vec<lensc_runtime::verify::window::Tile>> {
+        Some(window.polar_tiles(&self.lenslets))
+    }
+    fn build(
+        &self,
+        cx: &crate::context::BuildContext,
+    ) -> Result<crate::output::Built, Vec<Diagnostic>> {
+        build::build(self, cx)
+    }
+}
+
+pub(crate) fn lower(
+    p: &Parts,
+    dialect: Dialect,
+    evaluate: Evaluate,
+) -> Result<SpiralSpec, Vec<Diagnostic>> {
+    let (surface, strategy) = (p.surface, p.strategy);
+    let slow = strategy.kind.name == "spiral_turning";
+    let (lathe, what) = if slow {
+        ("sts_lathe", "slow-tool-servo spiral turning")
+    } else {
+        ("fts_lathe", "fast-tool-servo turning")
+    };
+    all_clear(p.needs_servo_lathe(what, lathe, ""))?;
+    let (m, t, st) = (&p.machine.fields, &p.tool.fields, &strategy.fields);
+    let travel = value::block(m, "travel").expect("required");
+    // The axis that carries the surface: the servo, or Z itself.
+    let fast = value::block(m, if slow { "z_axis" } else { "fast_axis" }).expect("required");
+    let rho = value::num(t, "nose_radius").expect("required");
+    let servo = if slow {
+        None
+    } else {
+        servo_model(fast).map_err(|()| {
+            vec![p.error(
+                codes::MISSING_PARAMETER,
+                "the fast axis's servo model needs either `resonance` and `resonant_peak`, or `natural_frequency` and `damping`".into(),
+            )]
+        })?
+    };
+    let fast_axis = fast_axis(slow, travel, fast);
+    let speed = spindle_speed(st, p.max_spindle_speed());
+
+    let lowered = p.lowered().map_err(|d| vec![d])?;
+    // The spiral starts where the surface's farthest point from the axis is.
+    let start = value::num(st, "from").unwrap_or(outer_radius(&lowered.domain));
+    let settling = settling_offset(p, slow, servo, fast, fastest(speed, start))?;
+    let design_kernel = evaluate(&lowered.tape);
+    let design =
+        lensc_runtime::surface::analysis::analyse(design_kernel.as_ref(), &lowered.domain, 201);
+    let (trajectory, bounds) = settled_trajectory(
+        surface,
+        settling.as_ref(),
+        &lowered.domain,
+        design.sag_max.value,
+        evaluate,
+    )
+    .map_err(|e| vec![RuntimeError::Trajectory(e).at(p.site())])?;
+    let mut errors = tool_checks(p, design_kernel.as_ref(), &lowered, &design);
+
+    let mut spiral = FtsSpiral {
+        feed_per_rev: value::num(st, "feed").expect("required") * 2.0 * std::f64::consts::PI,
+        speed,
+        chord_tolerance: value::num(st, "chord_tolerance")
+            .unwrap_or(crate::job::DEFAULT_PATH_TOLERANCE),
+        seed_arc: value::num(st, "seed_arc").unwrap_or(0.1),
+        min_interval: 1.0 / value::num(fast, "data_rate").unwrap_or(if slow { 1e3 } else { 20e3 }),
+        start_radius: start,
+        end_radius: 0.0,
+        chords: ChordPlacement::OnPath,
+    };
+    // W's chords stray from the path by up to their share of the tolerance.
+    spiral.chords = crate::job::chords::placement(
+        p,
+        crate::job::chords::ChordPath {
+            tolerance: Some(spiral.chord_tolerance),
+            sag: spiral.chord_tolerance * lensc_runtime::plan::optimise::UNOPTIMISED_CHORD_SHARE,
+            fit: 0.0,
+            long_chords: true,
+        },
+    );
+    errors.extend(machine_limits(p, &spiral, travel));
+    all_clear(errors)?;
+
+    let retract = value::num(st, "retract").unwrap_or(1.0);
+    let safe_w = bounds.z_max + rho + retract;
+    Ok(SpiralSpec {
+        head: p.head(dialect, lowered),
+        slow,
+        spiral,
+        bounds,
+        nose_radius: rho,
+        fast_axis,
+        trajectory,
+        servo,
+        settling,
+        safe_w,
+        lenslets: lenslets(surface),
+        surface_object: surface.clone(),
+        max_spindle_speed: p.max_spindle_speed(),
+    })
+}
+
+/// The fastest surface speed (mm/s) a spiral from `start` (mm) reaches:
+/// what the settling path d_traj is made of.
+fn fastest(speed: SpindleSpeed, start: f64) -> f64 {
+    match speed {
+        SpindleSpeed::SurfaceSpeed { speed, .. } => speed,
+        SpindleSpeed::Constant(w) => w * start,
+    }
+}
+
+/// The surface the nose centre follows (the design, or with a settling
+/// offset its lenslets continued and lifted over the land) and what the
+/// planner knows of it beforehand; `part_top` is the design's highest.
+fn settled_trajectory(
+    surface: &Object,
+    settling: Option<&Settling>,
+    domain: &Domain,
+    part_top: f64,
+    evaluate: Evaluate,
+) -> Result<(LoweredSurface, TrajectoryBounds), LowerError> {
+    let trajectory = match settling {
+        Some(s) => lensc_lang::lower::surface::lower_trajectory(surface, s.offset)?,
+        None => lensc_lang::lower::surface::lower_surface(surface)?,
+    };
+    let analysis = {
+        let k = evaluate(&trajectory.tape);
+        lensc_runtime::surface::analysis::analyse(k.as_ref(), domain, 201)
+    };
+    let bounds = TrajectoryBounds {
+        z_max: analysis.sag_max.value,
+        // Margin over the sampled steepest slope: the contact search
+        // window must contain the contact.
+        max_slope: (analysis.max_slope.value * 1.1).min(1.5),
+        features: settling.and_then(|s| settled_features(surface, s)),
+        part_top,
+    };
+    Ok((trajectory, bounds))
+}
+
+/// What the axis carrying the surface can do: the fast tool servo's
+/// stroke, or a slow tool servo's Z travel, and its acceleration.
+fn fast_axis(slow: bool, travel: &[value::Field], fast: &[value::Field]) -> FastAxis {
+    FastAxis {
+        stroke: if slow {
+            let (lo, hi) = value::range(travel, "z").expect("required");
+            hi - lo
+        } else {
+            value::num(fast, "stroke").expect("required")
+        },
+        max_acceleration: value::num(fast, "max_acceleration").expect("required"),
+    }
+}
+
+/// The strategy's spindle speed: a constant surface speed capped (by the
+/// strategy or the machine's limit, rad/s), or a constant spindle speed.
+fn spindle_speed(st: &[value::Field], max_spindle: f64) -> SpindleSpeed {
+    match value::num(st, "surface_speed") {
+        Some(v) => SpindleSpeed::SurfaceSpeed {
+            speed: v,
+            max: value::num(st, "spindle_cap").unwrap_or(max_spindle),
+        },
+        None => SpindleSpeed::Constant(value::num(st, "spindle_speed").expect("one of them")),
+    }
+}
+
+/// The lenslets' own apertures, if the surface is an array (the planner's
+/// features reach on to where the trajectory meets the settling plateau).
+fn lenslets(surface: &Object) -> Vec<(f64, f64, f64)> {
+    lensc_lang::lower::surface::array_lenslet(surface)
+        .zip(lensc_lang::lower::surface::array_centres(surface))
+        .map(|((_, rim), centres)| centres.into_iter().map(|(x, y)| (x, y, rim)).collect())
+        .unwrap_or_default()
+}
+
+/// How far from the spindle axis the surface's farthest point lies (mm).
+fn outer_radius(domain: &Domain) -> f64 {
+    match *domain {
+        Domain::Circle { radius } | Domain::Annulus { outer: radius, .. } => radius,
+        Domain::Rect { x, y } => [x.0, x.1]
+            .iter()
+            .flat_map(|a| [y.0, y.1].map(|b| a.hypot(b)))
+            .fold(0.0, f64::max),
+    }
+}
+
+/// The settling offset, where the strategy asks for one (`settle`, not on
+/// a slow tool servo) and the surface is an array of dimples; an error if
+/// `settle: auto` finds none.
+fn settling_offset(
+    p: &Parts,
+    slow: bool,
+    servo: Option<SecondOrderServo>,
+    fast: &[value::Field],
+    fastest: f64,
+) -> Result<Option<Settling>, Vec<Diagnostic>> {
+    let st = &p.strategy.fields;
+    let settle_word = value::word(st, "settle");
+    let settling = if slow || settle_word == Some("none") {
+        None
+    } else {
+        settling(p.surface, st, servo, fast, fastest)
+    };
+    if settle_word == Some("auto") && settling.is_none() {
+        return Err(vec![
+            p.error(
+                codes::UNSUPPORTED_COMBINATION,
+                "`settle: auto` needs an array of concave lenslets with circular apertures, whose continuation rises above the land".into(),
+            )
+            .with_help("use `settle: none` to follow the surface as it is"),
+        ]);
+    }
+    Ok(settling)
+}
+
+/// The planner's features with a settling offset: the trajectory is level
+/// outside each lenslet's continuation, which meets the plateau d_traj
+/// past the rim.
+fn settled_features(surface: &Object, s: &Settling) -> Option<Vec<(f64, f64, f64)>> {
+    let (_, rim) = lensc_lang::lower::surface::array_lenslet(surface)?;
+    let centres = lensc_lang::lower::surface::array_centres(surface)?;
+    Some(
+        centres
+            .into_iter()
+            .map(|(x, y)| (x, y, rim + s.d_traj))
+            .collect(),
+    )
+}
+
+/// The spindle's speed and the X travel against the spiral: if it
+/// turns faster than the machine allows (E0143), E0141 if it runs outside X.
+fn machine_limits(p: &Parts, spiral: &FtsSpiral, travel: &[value::Field]) -> Vec<Diagnostic> {
+    let spin_max = match spiral.speed {
+        SpindleSpeed::Constant(w) => w,
+        // The spiral runs in to the axis, where the cap is reached.
+        SpindleSpeed::SurfaceSpeed { max, .. } => max,
+    };
+    let start = spiral.start_radius;
+    let mut errors: Vec<Diagnostic> = p.spindle_limit(spin_max).into_iter().collect();
+    let (tx0, tx1) = value::range(travel, "x").expect("required");
+    if start > tx1 || tx0 > 0.0 {
+        errors.push(p.error(
+            codes::OUT_OF_TRAVEL,
+            format!(
+                "the spiral moves X from {} mm to 0, outside the machine's travel {} .. {} mm",
+                trim_num(start),
+                trim_num(tx0),
+                trim_num(tx1)
+            ),
+        ));
+    }
+    errors
+}
+
+/// The fast axis's second-order servo model, from its resonance and peak
+/// or its natural frequency and damping (`None` if those make no servo);
+/// an error if neither pair is given.
+fn servo_model(fast: &[value::Field]) -> Result<Option<SecondOrderServo>, ()> {
+    let num = |k: &str| value::num(fast, k);
+    match (
+        num("resonance"),
+        num("resonant_peak"),
+        num("natural_frequency"),
+        num("damping"),
+    ) {
+        (Some(f), Some(peak), None, None) => Ok(SecondOrderServo::from_resonance(f, peak)),
+        (None, None, Some(f), Some(zeta)) => Ok(SecondOrderServo::from_natural(f, zeta)),
+        _ => Err(()),
+    }
+}
+
+/// The tool against the design surface: the nose radius against the
+/// smallest concave radius of curvature; the flank follows the cut around
+/// the spindle, so the clearance angle must exceed the steepest slope
+/// around (circumferential); the edge meets the slope across (radial), so
+/// half its included angle must exceed it.
+fn tool_checks(
+    p: &Parts,
+    design_kernel: &dyn SurfaceFn,
+    lowered: &LoweredSurface,
+    design: &lensc_runtime::surface::analysis::SurfaceAnalysis,
+) -> Vec<Diagnostic> {
+    let t = &p.tool.fields;
+    let rho = value::num(t, "nose_radius").expect("required");
+    let clearance = value::num(t, "clearance").expect("required");
+    let err = |code: &'static str, msg: String| p.error(code, msg);
+    let mut errors = Vec::new();
+    if let Some(r) = [design.min_radius_concave_x, design.min_radius_concave_y]
+        .into_iter()
+        .flatten()
+        .min_by(|a, b| a.value.total_cmp(&b.value))
+        && rho > r.value
+    {
+        errors.push(err(
+            codes::NOSE_TOO_LARGE,
+            format!(
+                "the tool's nose radius ({} um) is larger than the surface's smallest concave radius of curvature ({} um, at ({}, {}) mm): the tool would gouge",
+                trim_num(rho * 1000.0),
+                trim_num(r.value * 1000.0),
+                trim_num(r.x),
+                trim_num(r.y)
+            ),
+        ).with_help(format!("use a tool whose `nose_radius` is below {} um", trim_num(r.value * 1000.0))));
+    }
+    let (around, across) = polar_slopes(design_kernel, &lowered.domain, 201);
+    if clearance <= around.0 {
+        errors.push(err(
+            codes::CLEARANCE_TOO_SMALL,
+            format!(
+                "the clearance angle ({}°) is not above the surface's steepest slope in the cutting direction, around the spindle ({}°, at ({}, {}) mm): the flank would rub",
+                trim_num(clearance.to_degrees()),
+                trim_num(around.0.to_degrees()),
+                trim_num(around.1),
+                trim_num(around.2)
+            ),
+        ).with_help(format!("use a tool whose `clearance` is above {}°", trim_num(around.0.to_degrees()))));
+    }
+    if let Some(included) = value::num(t, "included_angle")
+        && included / 2.0 <= across.0
+    {
+        errors.push(err(
+            codes::CLEARANCE_TOO_SMALL,
+            format!(
+                "half the tool's included angle ({}°) is not above the surface's steepest slope across the cut, along the radius ({}°, at ({}, {}) mm): the edge's side would cut",
+                trim_num(included.to_degrees() / 2.0),
+                trim_num(across.0.to_degrees()),
+                trim_num(across.1),
+                trim_num(across.2)
+            ),
+        ).with_help(format!("use a tool whose `included_angle` is above {}°", trim_num(2.0 * across.0.to_degrees()))));
+    }
+    errors
+}
+
+/// The steepest slopes (rad) around the spindle axis and along the radius,
+/// each with where (x, y), over an n × n grid of the domain.
+fn polar_slopes(
+    f: &dyn SurfaceFn,
+    domain: &Domain,
+    n: usize,
+) -> ((f64, f64, f64), (f64, f64, f64)) {
+    let (xs, ys, out) = lensc_runtime::surface::analysis::grid(f, domain, n);
+    let mut around = (0.0, 0.0, 0.0);
+    let mut across = (0.0, 0.0, 0.0);
+    for (i, (&x, &y)) in xs.iter().zip(&ys).enumerate() {
+        let r = x.hypot(y);
+        let (zx, zy) = (out[6 * i + 1], out[6 * i + 2]);
+        if r == 0.0 || !(zx.is_finite() && zy.is_finite()) {
+            continue;
+        }
+        let tangential = ((x * zy - y * zx) / r).abs().atan();
+        let radial = ((x * zx + y * zy) / r).abs().atan();
+        if tangential > around.0 {
+            around = (tangential, x, y);
+        }
+        if radial > across.0 {
+            across = (radial, x, y);
+        }
+    }
+    (around, across)
+}
+
+/// The settling offset for an array of concave lenslets: the servo's
+/// settling time (the strategy's, or the model's at its band), the path
+/// covered meanwhile at the fastest surface speed, and how far the
+/// lenslet's own surface rises over that path past its rim.
+fn settling(
+    surface: &Object,
+    st: &[value::Field],
+    servo: Option<SecondOrderServo>,
+    fast: &[value::Field],
+    surface_speed: f64,
+) -> Option<Settling> {
+    lensc_lang::lower::surface::array_lenslet(surface)?;
+    let band = value::num(fast, "settling_band").unwrap_or(0.002);
+    let (time, band) = match value::num(st, "settling_time") {
+        Some(t) => (t, None),
+        None => (servo?.settling_time(band)?, Some(band)),
+    };
+    settling_at(surface, time, band, surface_speed)
+}
+
+/// The settling offset for an array of concave lenslets whose servo
+/// settles in `time` (s; into `band`, when that came from its model) at
+/// the surface speed `surface_speed` (mm/s).
+fn settling_at(
+    surface: &Object,
+    time: f64,
+    band: Option<f64>,
+    surface_speed: f64,
+) -> Option<Settling> {
+    let (lenslet, rim) = lensc_lang::lower::surface::array_lenslet(surface)?;
+    let f = lensc_runtime::surface::ir::Interpreter::new(&lenslet.tape);
+    let along = |u: f64| f.eval(u, 0.0)[0];
+    let offset = lensc_runtime::plan::spiral::settling_offset(along, rim, surface_speed, time);
+    (offset.is_finite() && offset > 0.0).then_some(Settling {
+        time,
+        band,
+        surface_speed,
+        d_traj: surface_speed * time,
+        offset,
+    })
+}

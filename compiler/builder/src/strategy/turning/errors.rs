@@ -1,0 +1,62 @@
+//! The profile-turning planner's errors in the words a user reads.
+use lensc_grammar::{Diagnostic, FileId, Span};
+use lensc_lang::check::trim_num;
+use lensc_lang::codes;
+
+use crate::diagnostics::{Coded, coded, rpm, um};
+use lensc_runtime::plan::turning::PlanError;
+
+/// A profile-turning planner error as its diagnostic at `site`.
+pub(crate) fn error(e: PlanError, site: (FileId, Span)) -> Diagnostic {
+    coded_error(e).at(site)
+}
+
+fn coded_error(e: PlanError) -> Coded {
+    match e {
+        PlanError::NoseTooLarge { nose_radius, min_radius, at_radius } => coded(
+            codes::NOSE_TOO_LARGE,
+            format!(
+                "the tool's nose radius ({} um) is larger than the surface's smallest concave radius of curvature ({} um, at r = {} mm): the tool would gouge",
+                um(nose_radius),
+                um(min_radius),
+                trim_num(at_radius)
+            ),
+        )
+        .help("use a tool whose nose radius is below the smallest concave radius of curvature"),
+        PlanError::OutOfTravel { axis, value, min, max } => coded(
+            codes::OUT_OF_TRAVEL,
+            format!(
+                "the path moves {axis} to {} mm, outside the machine's travel {} .. {} mm",
+                trim_num(value),
+                trim_num(min),
+                trim_num(max)
+            ),
+        )
+        .help("check the machine's travel, the aperture and the retract height"),
+        PlanError::FeedTooHigh { feed, max } => coded(
+            codes::FEED_TOO_HIGH,
+            format!(
+                "the cutting feed ({} mm/min) is above the machine's maximum ({} mm/min)",
+                trim_num(feed * 60.0),
+                trim_num(max * 60.0)
+            ),
+        )
+        .help("lower the feed or the spindle speed"),
+        PlanError::SpindleTooFast { speed, max } => coded(
+            codes::SPINDLE_TOO_FAST,
+            format!(
+                "the spindle speed ({} rpm) is above the machine's maximum ({} rpm)",
+                rpm(speed),
+                rpm(max)
+            ),
+        )
+        .help(format!("lower `spindle_speed` to at most {} rpm (with `surface_speed`, cap it with `spindle_cap`)", rpm(max))),
+        PlanError::Undefined { at_radius } => coded(
+            codes::UNDEFINED_ON_PATH,
+            format!(
+                "the surface or the tool path is undefined at r = {} mm",
+                trim_num(at_radius)
+            ),
+        ),
+    }
+}
