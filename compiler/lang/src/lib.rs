@@ -24,6 +24,7 @@ pub mod format;
 pub mod import;
 pub mod loader;
 pub mod lower;
+pub mod reference;
 pub mod sandbox;
 pub mod schema;
 pub mod source;
