@@ -1,5 +1,5 @@
 //! `lensc list`: the kinds and the standard library as a person reads them
-//! (snapshots) and as a tool reads them (the JSON shape README documents),
+//! (snapshots) and as a tool reads them (the JSON shape docs/usage/list-and-explain.md documents),
 //! both drawn from the checker's schema and the stdlib's doc comments.
 
 use crate::common::{lensc, root, text};

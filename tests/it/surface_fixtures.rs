@@ -19,7 +19,7 @@
 //!
 //! optiland (like Zemax and Code V) measures sag along the light, +z into the
 //! glass, with a signed radius (R > 0: centre of curvature at +z). lensc's
-//! +z points out of the material towards the tool (README, "Sign rule"):
+//! +z points out of the material towards the tool (docs/language/sign-rule.md):
 //!
 //! - `convention: optical` with optiland's signed radii and coefficients:
 //!   z_lensc(x, y) = −z_optiland(x, y), and both slopes change sign (x and y
@@ -286,7 +286,7 @@ fn asphere_even_and_odd_terms() {
         );
     }
     // The optical convention: the designer's signed R and coefficients,
-    // the whole sag negated (README, "Sign rule").
+    // the whole sag negated (docs/language/sign-rule.md).
     let src = format!(
         "surface a = asphere {{ radius: -4.254 mm, conic: -3.359, convention: optical, aperture: circle(radius: 1.5 mm), {coeffs} }}"
     );
@@ -820,8 +820,8 @@ fn freeform_is_its_formula() {
 
 /// An array written out lenslet by lenslet: at each point, the lowest of the
 /// lenslets whose aperture holds it, each less its rim height (its height at
-/// the aperture's edge along +x), or the land (0) where none does (README,
-/// "Apertures"). Returns z and the slopes of the lenslet that wins.
+/// the aperture's edge along +x), or the land (0) where none does
+/// (docs/language/surfaces.md). Returns z and the slopes of the lenslet that wins.
 fn array_by_hand(
     centres: &[(f64, f64)],
     lenslet: impl Fn(f64, f64) -> Want,
@@ -884,7 +884,7 @@ surface a = grid(l, pitch_x: 1 mm, pitch_y: 1.2 mm, count_x: 3, count_y: 2)";
 #[test]
 fn hex_grid_rows_shift_by_half_a_pitch() {
     // Rows along x, every other row shifted half a pitch, centred on the
-    // origin (README): row spacing p·√3/2, row j's centres at
+    // origin (docs/language/surfaces.md): row spacing p·√3/2, row j's centres at
     // (i − (n_x − 1)/2) p ∓ p/4 (even rows −, odd rows +).
     let src = "surface l = conic { radius: 3 mm, conic: -0.5, sense: convex, aperture: circle(radius: 0.45 mm) }
 surface h = hex_grid(l, pitch: 1 mm, count_x: 4, count_y: 3)";
@@ -1048,7 +1048,7 @@ surface tx = tilt(p, about: x, angle: -8 deg, aperture: circle(radius: 1.5 mm))"
 
 /// Compares lensc with optiland rows [x, y, z, z_x, z_y]: `sign` = −1 for
 /// `convention: optical` (z_lensc = −z_optiland), +1 for the `sense` form
-/// with R_optiland = s·|R| (README "Sign rule"; see the module's notes).
+/// with R_optiland = s·|R| (docs/language/sign-rule.md; see the module's notes).
 fn against_optiland(src: &str, name: &str, rows: &[[f64; 5]], sign: f64, source: &str) {
     let pts: Vec<(f64, f64)> = rows.iter().map(|r| (r[0], r[1])).collect();
     surface(src, name).expect(

@@ -12,7 +12,9 @@
 //! surfaces are lowered to what the runtime plans (`lower`, with
 //! `lower::surface` one file per surface family, `domain` the apertures both
 //! share); `format` is `lensc fmt`'s canonical layout; `import` reads lens
-//! designers' prescriptions (Zemax, optiland) and writes them as `.lens` text. Errors are data
+//! designers' prescriptions (Zemax, optiland) and writes them as `.lens` text;
+//! `reference` renders the book's language reference (docs/reference/) from
+//! the schema, the standard library and the codes' explanations. Errors are data
 //! (`Diagnostic`s with codes and spans; `lower::diagnostics` maps every runtime
 //! error to one); nothing here plans, writes or renders.
 
@@ -24,6 +26,7 @@ pub mod format;
 pub mod import;
 pub mod loader;
 pub mod lower;
+pub mod reference;
 pub mod sandbox;
 pub mod schema;
 pub mod source;

@@ -4,6 +4,9 @@
 //! subcommand under `commands/`), calls `lensc-build` and `lensc-lang`,
 //! and renders what they return; this library half holds the rendering of
 //! diagnostics (ariadne for people, JSON lines for tools), so the tests
-//! can render as the binary does.
+//! can render as the binary does, and the command line's clap definition
+//! (`cli`) with the book's page rendered from it (`cli_page`).
 
+pub mod cli;
+pub mod cli_page;
 pub mod render;

@@ -155,7 +155,7 @@ impl Progress for Reporter {
     }
 }
 
-/// The JSON line of one build event (the shape README documents).
+/// The JSON line of one build event (the shape docs/usage/build.md documents).
 fn event_json(e: Event<'_>) -> serde_json::Value {
     match e {
         Event::Job { job, index, jobs } => {

@@ -297,13 +297,13 @@ pub static JOB_PARAMS: &[Param] = &[
         "accept",
         Ty::BlockOr(ACCEPT_PARAMS, &["none"]),
         Check::Any,
-        "the acceptance criteria the simulated part must meet for the program to be written, or `none`; each left out has a default derived from the strategy's tolerance (README, \"Acceptance\")",
+        "the acceptance criteria the simulated part must meet for the program to be written, or `none`; each left out has a default derived from the strategy's tolerance (docs/language/acceptance.md)",
     ),
 ];
 
 /// The criteria of a job's `accept` block: each a limit on a figure of
-/// the simulated part (README, "Acceptance", says how each is measured
-/// and how its default is derived).
+/// the simulated part (docs/language/acceptance.md says how each is
+/// measured and how its default is derived).
 pub static ACCEPT_PARAMS: &[Param] = &[
     opt(
         "form_pv",

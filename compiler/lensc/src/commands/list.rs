@@ -8,51 +8,11 @@
 
 use std::fmt::Write as _;
 
+use lensc::cli::Listed;
 use lensc_lang::loader::RealFs;
-use lensc_lang::schema::{self, Category, Check, Kind, Param, Ty};
+use lensc_lang::schema::{self, Category, Kind, Param, Ty};
 use lensc_lang::value::{Field, Value};
 use serde::Serialize;
-
-/// The categories `lensc list` knows, with the kinds each holds.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum Listed {
-    Machines,
-    Tools,
-    Dialects,
-    Strategies,
-    /// Surfaces, with the apertures and rollers they are made with.
-    Surfaces,
-}
-
-impl Listed {
-    const ALL: [Listed; 5] = [
-        Listed::Machines,
-        Listed::Tools,
-        Listed::Dialects,
-        Listed::Strategies,
-        Listed::Surfaces,
-    ];
-    fn name(self) -> &'static str {
-        match self {
-            Listed::Machines => "machines",
-            Listed::Tools => "tools",
-            Listed::Dialects => "dialects",
-            Listed::Strategies => "strategies",
-            Listed::Surfaces => "surfaces",
-        }
-    }
-    fn holds(self, c: Category) -> bool {
-        match self {
-            Listed::Machines => c == Category::Machine,
-            Listed::Tools => c == Category::Tool,
-            Listed::Dialects => c == Category::Dialect,
-            Listed::Strategies => c == Category::Strategy,
-            Listed::Surfaces => {
-                matches!(c, Category::Surface | Category::Aperture | Category::Roller)
-            }
-        }
-    }
-}
 
 /// One category: its kinds and its standard-library items. The JSON shape
 /// of `lensc list --format json` is `{"categories": [Section…]}`.
@@ -232,77 +192,20 @@ pub(crate) fn kind_doc(k: &'static Kind) -> KindDoc {
 }
 
 pub(crate) fn param_doc(p: &Param) -> ParamDoc {
-    let (doc, default) = split_default(p.doc);
-    let (takes, unit, range) = match p.ty {
-        Ty::Quantity(dims) => {
-            let (unit, factor) = dims[0].display_unit();
-            let takes = dims.iter().map(|d| d.to_string()).collect::<Vec<_>>();
-            let unit = (!unit.is_empty()).then_some(unit);
-            // A range is shown in the first dimension's unit: only
-            // single-dimension parameters carry one.
-            (takes.join(" or "), unit, range_text(p.check, factor))
-        }
-        Ty::Word(words) => (format!("one of {}", words.join(", ")), None, None),
-        Ty::Object(c) => (c.noun().to_string(), None, None),
-        Ty::Objects(c) => (format!("a list, each {}", c.noun()), None, None),
-        Ty::Text => ("a string".into(), None, None),
-        Ty::Texts => ("a list of strings".into(), None, None),
-        Ty::Block(_) => ("a block { … }".into(), None, None),
-        Ty::BlockOr(_, words) => (
-            format!("a block {{ … }} or one of {}", words.join(", ")),
-            None,
-            None,
-        ),
-        Ty::Range(d) => (
-            format!("a range lo .. hi, each {d}"),
-            Some(d.display_unit().0),
-            None,
-        ),
-        Ty::Formula { coords, result } => (
-            format!("a formula z({}) giving {result}", coords.join(", ")),
-            None,
-            None,
-        ),
-    };
+    let t = lensc_lang::reference::describe(p);
     ParamDoc {
         name: p.name,
         required: p.required,
-        takes,
-        unit,
-        range,
-        default: default.filter(|_| !p.required),
-        doc,
+        takes: t.takes,
+        unit: t.unit,
+        range: t.range,
+        default: t.default,
+        doc: t.doc,
         params: match p.ty {
             Ty::Block(sub) | Ty::BlockOr(sub, _) => sub.iter().map(param_doc).collect(),
             _ => Vec::new(),
         },
     }
-}
-
-/// The parameter's documentation and the default it states: `…; default
-/// 20 kHz`, or a word marked `` `x` (default)``.
-fn split_default(doc: &'static str) -> (&'static str, Option<String>) {
-    if let Some(at) = doc.rfind("; default ") {
-        return (&doc[..at], Some(doc[at + 10..].trim().to_string()));
-    }
-    if let Some(at) = doc.find("` (default)") {
-        let word = doc[..at].rsplit('`').next().unwrap_or("");
-        return (doc, Some(word.to_string()));
-    }
-    (doc, None)
-}
-
-/// The allowed values in the display unit (`factor` from base units).
-fn range_text(check: Check, factor: f64) -> Option<String> {
-    let n = |v: f64| lensc_lang::check::trim_num(v * factor);
-    Some(match check {
-        Check::Any => return None,
-        Check::Positive => "> 0".into(),
-        Check::NonNegative => "≥ 0".into(),
-        Check::HalfOpen(lo, hi) => format!("{} ≤ v < {}", n(lo), n(hi)),
-        Check::Open(lo, hi) => format!("{} < v < {}", n(lo), n(hi)),
-        Check::Count => "a whole number, 1 to 100000".into(),
-    })
 }
 
 pub(crate) fn value_text(v: &Value) -> String {
@@ -510,19 +413,6 @@ fn wrap(text: &str, width: usize) -> Vec<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn defaults_are_read_from_the_documentation() {
-        assert_eq!(
-            split_default("rake angle; default 0°"),
-            ("rake angle", Some("0°".to_string()))
-        );
-        assert_eq!(
-            split_default("`x` (default) or `y`").1.as_deref(),
-            Some("x")
-        );
-        assert_eq!(split_default("radius of the nose").1, None);
-    }
 
     #[test]
     fn every_kind_and_stdlib_item_is_listed_once() {

@@ -1,0 +1,311 @@
+//! The command line as clap defines it: every subcommand, argument and
+//! help text, in the library so that the book's CLI page (`cli_page`) is
+//! rendered from this very definition. `main.rs` parses with it and runs.
+
+use std::path::PathBuf;
+
+use clap::{Parser, Subcommand, ValueEnum};
+use lensc_lang::schema::Category;
+
+#[derive(Parser)]
+#[command(
+    name = "lensc",
+    version,
+    about = "Compile lens-machining jobs (.lens files) into machine programs"
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+    /// How diagnostics are printed: for people, or one JSON object per line on stdout.
+    #[arg(long, global = true, value_enum, default_value_t = MessageFormat::Human)]
+    pub message_format: MessageFormat,
+    /// Colour in human diagnostics.
+    #[arg(long, global = true, value_enum, default_value_t = ColorChoice::Auto)]
+    pub color: ColorChoice,
+    /// The project root: no file outside it is read on a job's behalf (a
+    /// `use` that resolves there is an error). Default: the directory of
+    /// the file given.
+    #[arg(long, global = true, value_name = "DIR")]
+    pub root: Option<PathBuf>,
+    /// Print every diagnostic: without it, after 100 of one code the rest
+    /// are counted in one summary line per code.
+    #[arg(long, global = true)]
+    pub all_diagnostics: bool,
+}
+
+#[derive(Subcommand)]
+pub enum Command {
+    /// Check files for errors without building anything.
+    Check {
+        /// The .lens files to check.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// The largest program to write, in bytes or with a unit (`500MB`,
+        /// `4GB`, `2GiB`): a job whose program is estimated larger is
+        /// refused before it is planned.
+        #[arg(long, value_name = "SIZE", default_value = "4GB", value_parser = parse_size)]
+        max_program_size: u64,
+    },
+    /// Check a file and write a program for each of its jobs.
+    Build {
+        /// The .lens file to build.
+        file: PathBuf,
+        /// Build only this job.
+        #[arg(long)]
+        job: Option<String>,
+        /// Write the program in this dialect, one the machine offers (its
+        /// `dialect` or one of its `other_dialects`).
+        #[arg(long)]
+        dialect: Option<String>,
+        /// Directory for the programs.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+        /// The largest program to write, in bytes or with a unit (`500MB`,
+        /// `4GB`, `2GiB`): a job whose program is estimated larger is
+        /// refused before it is planned.
+        #[arg(long, value_name = "SIZE", default_value = "4GB", value_parser = parse_size)]
+        max_program_size: u64,
+        /// What a job whose simulated part misses its acceptance criteria
+        /// (its `accept` block, or the defaults) is: `error` (no program
+        /// is written, exit 1) or `warn` (the program is written, for
+        /// exploration).
+        #[arg(long, value_enum, default_value_t = AcceptChoice::Error)]
+        accept: AcceptChoice,
+        /// No progress: neither the bar a terminal shows nor the JSON
+        /// progress events of `--message-format json`.
+        #[arg(long, short)]
+        quiet: bool,
+    },
+    /// Read a program back from its text as its controller would: modal
+    /// state block by block, and every rule it breaks (feed moves with the
+    /// spindle stopped or before a tool call, moves outside the travel or
+    /// over the machine's feed, rapids into the part, arcs the controller
+    /// refuses, number formats, comments, line lengths). Machine and
+    /// dialect default to those the program's header names.
+    Verify {
+        /// The program to read.
+        program: PathBuf,
+        /// The machine to read it for (default: the header's).
+        #[arg(long)]
+        machine: Option<String>,
+        /// The dialect to read it in (default: the header's).
+        #[arg(long)]
+        dialect: Option<String>,
+    },
+    /// Plan and simulate a file's jobs as `build` does and write SVG plots
+    /// of what each program will cut: `JOB.profile.svg` (profile jobs: the
+    /// design, the tool-centre path and the simulated cut, with the form
+    /// error in nm beneath), `JOB.form_error.svg` (raster, spiral and
+    /// roller jobs: the form error over the simulation window as a colour
+    /// map) and `JOB.following.svg` (fast-tool-servo jobs: the servo's
+    /// following error against radius). Writes no program or report (use
+    /// `build`); nothing is written if any job fails.
+    Report {
+        /// The .lens file to plot.
+        file: PathBuf,
+        /// Plot only this job.
+        #[arg(long)]
+        job: Option<String>,
+        /// Directory for the plots.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+        /// The largest program to write, in bytes or with a unit (`500MB`,
+        /// `4GB`, `2GiB`): a job whose program is estimated larger is
+        /// refused before it is planned.
+        #[arg(long, value_name = "SIZE", default_value = "4GB", value_parser = parse_size)]
+        max_program_size: u64,
+        /// No progress: neither the bar a terminal shows nor the JSON
+        /// progress events of `--message-format json`.
+        #[arg(long, short)]
+        quiet: bool,
+    },
+    /// Analyse a surface over its aperture: sag range, slopes and radii of
+    /// curvature with where they occur, as JSON on stdout.
+    Analyse {
+        /// The .lens file that declares the surface.
+        file: PathBuf,
+        /// The surface's name.
+        #[arg(long)]
+        surface: String,
+        /// Grid points per side before refinement.
+        #[arg(long, default_value_t = 201, value_name = "N")]
+        grid: usize,
+    },
+    /// Put .lens files in the one canonical layout (comments kept where
+    /// they were, meaning unchanged), rewriting each file that changes.
+    Fmt {
+        /// The .lens files to format.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Write nothing: list the files that would change and exit 1 if any would.
+        #[arg(long)]
+        check: bool,
+    },
+    /// Evaluate a surface: CSV on stdout with the header
+    /// x,y,z,dzdx,dzdy,curvature_x,curvature_y (mm and 1/mm).
+    #[command(group(clap::ArgGroup::new("at").required(true).args(["grid", "radial", "points"])))]
+    Sample {
+        /// The .lens file that declares the surface.
+        file: PathBuf,
+        /// The surface's name.
+        #[arg(long)]
+        surface: String,
+        /// N × N points over the aperture.
+        #[arg(long, value_name = "N")]
+        grid: Option<usize>,
+        /// N points from the centre to the edge along x.
+        #[arg(long, value_name = "N")]
+        radial: Option<usize>,
+        /// Points from a CSV file of x,y in mm (a header line is skipped).
+        #[arg(long, value_name = "FILE.csv")]
+        points: Option<PathBuf>,
+    },
+
+    /// List the kinds a file can build and the standard library's machines,
+    /// tools, dialects and strategies: documentation, parameters with their
+    /// dimension, range and default, and each item's values (a machine's
+    /// travel, feed, spindle, resolution and dialects).
+    List {
+        /// Only this category.
+        #[arg(value_enum)]
+        category: Option<Listed>,
+        /// Only this kind or item, in full.
+        name: Option<String>,
+        /// For people, or JSON (`{"categories": [...]}`, its shape in the book's
+        /// docs/usage/list-and-explain.md).
+        #[arg(long, value_enum, default_value_t = Format::Human)]
+        format: Format,
+    },
+    /// Import a lens designer's prescription (a Zemax OpticStudio `.zmx` or
+    /// an optiland JSON export) as a `.lens` file: one `surface` per optical
+    /// surface, the designer's signs kept with `convention: optical`, each
+    /// aperture from the semi-diameter. What is not imported is named in a
+    /// warning and a comment.
+    Import {
+        /// The `.zmx` or optiland `.json` file.
+        file: PathBuf,
+        /// Write the `.lens` file here (default: stdout).
+        #[arg(short = 'o', long = "output", value_name = "OUT.lens")]
+        output: Option<PathBuf>,
+    },
+    /// Explain a diagnostic code (`E0147`), with an example that causes it
+    /// and its fix.
+    Explain {
+        /// The code, as printed (`E0147`; `e147` and `147` work too).
+        code: Option<String>,
+        /// Every code with its title.
+        #[arg(long)]
+        list: bool,
+        /// For people (Markdown), or JSON.
+        #[arg(long, value_enum, default_value_t = Format::Human)]
+        format: Format,
+    },
+    /// Run a language server on stdin and stdout for an editor: diagnostics
+    /// as you type, hover, completion, go to definition and formatting
+    /// (editors/README.md says how to set one up).
+    Lsp,
+}
+
+/// How `list` and `explain` print.
+#[derive(Clone, Copy, ValueEnum, PartialEq)]
+pub enum Format {
+    Human,
+    Json,
+}
+
+#[derive(Clone, Copy, ValueEnum, PartialEq)]
+pub enum MessageFormat {
+    Human,
+    Json,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum AcceptChoice {
+    Error,
+    Warn,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum ColorChoice {
+    Auto,
+    Always,
+    Never,
+}
+
+/// The categories `lensc list` knows, with the kinds each holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Listed {
+    Machines,
+    Tools,
+    Dialects,
+    Strategies,
+    /// Surfaces, with the apertures and rollers they are made with.
+    Surfaces,
+}
+
+impl Listed {
+    pub const ALL: [Listed; 5] = [
+        Listed::Machines,
+        Listed::Tools,
+        Listed::Dialects,
+        Listed::Strategies,
+        Listed::Surfaces,
+    ];
+    pub fn name(self) -> &'static str {
+        match self {
+            Listed::Machines => "machines",
+            Listed::Tools => "tools",
+            Listed::Dialects => "dialects",
+            Listed::Strategies => "strategies",
+            Listed::Surfaces => "surfaces",
+        }
+    }
+    pub fn holds(self, c: Category) -> bool {
+        match self {
+            Listed::Machines => c == Category::Machine,
+            Listed::Tools => c == Category::Tool,
+            Listed::Dialects => c == Category::Dialect,
+            Listed::Strategies => c == Category::Strategy,
+            Listed::Surfaces => {
+                matches!(c, Category::Surface | Category::Aperture | Category::Roller)
+            }
+        }
+    }
+}
+
+/// A size in bytes: a whole number, optionally with a decimal (`kB`, `MB`,
+/// `GB`, `TB`) or binary (`KiB`, `MiB`, `GiB`, `TiB`) unit.
+pub fn parse_size(text: &str) -> Result<u64, String> {
+    let t = text.trim();
+    let split = t
+        .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .unwrap_or(t.len());
+    let (number, unit) = t.split_at(split);
+    let factor: f64 = match unit.trim().to_ascii_lowercase().as_str() {
+        "" | "b" => 1.0,
+        "kb" | "k" => 1e3,
+        "mb" | "m" => 1e6,
+        "gb" | "g" => 1e9,
+        "tb" | "t" => 1e12,
+        "kib" => 1024.0,
+        "mib" => 1024.0 * 1024.0,
+        "gib" => 1024.0 * 1024.0 * 1024.0,
+        "tib" => 1024.0 * 1024.0 * 1024.0 * 1024.0,
+        other => {
+            return Err(format!(
+                "unknown unit `{other}`: use B, kB, MB, GB, TB, KiB, MiB, GiB or TiB"
+            ));
+        }
+    };
+    let n: f64 = number.parse().map_err(|_| {
+        format!(
+            "`{text}` is not a size: write a number of bytes, or one with a unit (`500MB`, `4GB`)"
+        )
+    })?;
+    let bytes = n * factor;
+    if (1.0..1.8e19).contains(&bytes) {
+        Ok(bytes as u64)
+    } else {
+        Err(format!("`{text}` is not a size lensc can hold to"))
+    }
+}
