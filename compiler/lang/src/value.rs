@@ -121,6 +121,23 @@ pub fn range(fields: &[Field], name: &str) -> Option<(f64, f64)> {
     }
 }
 
+/// A parameter's value and where the file states it (for a message that
+/// points at it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stated<T> {
+    pub value: T,
+    pub site: (FileId, Span),
+}
+
+impl<T> Stated<T> {
+    fn at(value: T, f: &Field) -> Stated<T> {
+        Stated {
+            value,
+            site: (f.file, f.span),
+        }
+    }
+}
+
 /// A checked object's (or block's) fields read by name into a typed
 /// struct, once. Each kind's `read`, declared beside its schema entry, is
 /// the only place a parameter is looked up by its name; nothing after
@@ -150,6 +167,29 @@ impl<'a> Reader<'a> {
     }
     pub fn num(&self, name: &str) -> Option<f64> {
         num(self.fields, name)
+    }
+    /// A quantity with its dimension (a feed per revolution or per minute).
+    pub fn quantity(&self, name: &str) -> Option<(f64, Dim)> {
+        match self.field(name)?.value {
+            Value::Num(v, d) => Some((v, d)),
+            _ => None,
+        }
+    }
+    /// A quantity with where it was written (for a message about it).
+    pub fn stated_num(&self, name: &str) -> Option<Stated<f64>> {
+        let f = self.field(name)?;
+        let v = self.num(name)?;
+        Some(Stated::at(v, f))
+    }
+    /// A word with where it was written.
+    pub fn stated_word(&self, name: &str) -> Option<Stated<&'a str>> {
+        let f = self.field(name)?;
+        let w = self.word(name)?;
+        Some(Stated::at(w, f))
+    }
+    /// Where a parameter was written, if it was.
+    pub fn site(&self, name: &str) -> Option<(FileId, Span)> {
+        self.field(name).map(|f| (f.file, f.span))
     }
     /// A required quantity (NaN, recorded as missing, if it is not there).
     pub fn required_num(&mut self, name: &str) -> f64 {

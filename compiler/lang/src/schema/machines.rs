@@ -231,3 +231,79 @@ pub(super) const GRINDER_2AXIS: Kind = Kind {
     exclusive: &[],
     doc: "a 2-axis (X, Z) grinder with a spherical wheel",
 };
+
+/// A machine's checked parameters, read once (every machine kind; what a
+/// kind lacks is `None`): the limits every program must keep. The dialects
+/// are chosen by `lower::dialect`.
+#[derive(Clone, Debug)]
+pub struct MachineParams {
+    /// The machine's kind (`lathe`, `fts_lathe`, `mill_3axis`, …).
+    pub kind: &'static str,
+    /// Smallest programmable step (mm).
+    pub resolution: f64,
+    /// Fastest cutting feed (mm/s).
+    pub max_feed: f64,
+    /// The work spindle's (or a mill's cutter spindle's) limit (rad/s).
+    pub max_spindle_speed: f64,
+    /// X, Y, Z and C travel where the machine states one (mm, rad).
+    pub travel: [Option<(f64, f64)>; 4],
+    /// A fast-tool-servo lathe's W axis.
+    pub fast_axis: Option<FastAxisParams>,
+    /// A slow-tool-servo lathe's Z, which follows the surface.
+    pub z_axis: Option<ZAxisParams>,
+}
+
+/// A fast tool servo (`fast_axis { … }`) and its second-order model.
+#[derive(Clone, Copy, Debug)]
+pub struct FastAxisParams {
+    pub stroke: f64,
+    pub max_acceleration: f64,
+    pub resonance: Option<f64>,
+    pub resonant_peak: Option<f64>,
+    pub natural_frequency: Option<f64>,
+    pub damping: Option<f64>,
+    /// Rate at which the servo takes positions (Hz).
+    pub data_rate: Option<f64>,
+    /// Settling band as a fraction of the step.
+    pub settling_band: Option<f64>,
+}
+
+/// A slow tool servo's Z (`z_axis { … }`).
+#[derive(Clone, Copy, Debug)]
+pub struct ZAxisParams {
+    pub max_acceleration: f64,
+    /// Rate at which the controller takes positions (Hz).
+    pub data_rate: Option<f64>,
+}
+
+impl MachineParams {
+    /// Reads a checked machine (E0121 for a required parameter missing).
+    pub fn read(o: &crate::value::Object) -> Result<MachineParams, lensc_grammar::Diagnostic> {
+        let mut r = crate::value::Reader::new(&o.fields);
+        let m = MachineParams {
+            kind: o.kind.name,
+            resolution: r.required_num("resolution"),
+            max_feed: r.required_num("max_feed"),
+            max_spindle_speed: r.required_block("spindle", |s| s.required_num("max_speed")),
+            travel: r
+                .block("travel", |t| ["x", "y", "z", "c"].map(|a| t.range(a)))
+                .unwrap_or([None; 4]),
+            fast_axis: r.block("fast_axis", |f| FastAxisParams {
+                stroke: f.required_num("stroke"),
+                max_acceleration: f.required_num("max_acceleration"),
+                resonance: f.num("resonance"),
+                resonant_peak: f.num("resonant_peak"),
+                natural_frequency: f.num("natural_frequency"),
+                damping: f.num("damping"),
+                data_rate: f.num("data_rate"),
+                settling_band: f.num("settling_band"),
+            }),
+            z_axis: r.block("z_axis", |z| ZAxisParams {
+                max_acceleration: z.required_num("max_acceleration"),
+                data_rate: z.num("data_rate"),
+            }),
+        };
+        r.finish(o.kind.name, (o.file, o.head))?;
+        Ok(m)
+    }
+}

@@ -163,10 +163,10 @@ mod apertures;
 mod coefficients;
 mod composite;
 mod dialects;
-mod machines;
-mod strategies;
+pub mod machines;
+pub mod strategies;
 mod surfaces;
-mod tools;
+pub mod tools;
 
 pub use coefficients::{
     POWER_COEFFICIENTS, QBFS_COEFFICIENTS, QCON_COEFFICIENTS, XY_COEFFICIENTS,

@@ -400,3 +400,257 @@ pub(super) const PROFILE_TURNING: Kind = Kind {
     ],
     doc: "one facing pass along the profile with the nose centre offset along the normal",
 };
+
+// The strategies' checked parameters, read once, one struct per kind
+// (both spiral kinds share one). Each `read` is the only place its kind's
+// parameters are named; a required one missing is E0121 from `finish`.
+
+use crate::value::{Object, Reader, Stated};
+use lensc_grammar::Diagnostic;
+
+/// Where the points sit across the curve, and the path tolerance, as a
+/// strategy states them (both optional).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PathParams {
+    /// `chord_tolerance` (mm).
+    pub chord_tolerance: Option<Stated<f64>>,
+    /// `chords`: `on_path`, `straddle`, `straddle_long` or `clear`.
+    pub chords: Option<Stated<&'static str>>,
+}
+
+fn path(r: &Reader) -> PathParams {
+    PathParams {
+        chord_tolerance: r.stated_num("chord_tolerance"),
+        chords: r.stated_word("chords").map(|w| Stated {
+            value: static_word(CHORDS.ty, w.value),
+            site: w.site,
+        }),
+    }
+}
+
+/// The schema's own `&'static` spelling of a checked word.
+fn static_word(ty: Ty, word: &str) -> &'static str {
+    match ty {
+        Ty::Word(words) => words.iter().find(|w| **w == word).copied().unwrap_or(""),
+        _ => "",
+    }
+}
+
+fn finish<T>(r: Reader, o: &Object, value: T) -> Result<T, Diagnostic> {
+    r.finish(o.kind.name, (o.file, o.head))?;
+    Ok(value)
+}
+
+/// A feed as stated: per revolution (mm/rad) or per time (mm/s).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum StatedFeed {
+    PerRevolution(f64),
+    PerTime(f64),
+}
+
+fn feed(r: &Reader, name: &str) -> Option<StatedFeed> {
+    r.quantity(name).map(|(v, d)| {
+        if d == Dim::FEED_PER_REV {
+            StatedFeed::PerRevolution(v)
+        } else {
+            StatedFeed::PerTime(v)
+        }
+    })
+}
+
+/// `profile_turning`'s parameters.
+#[derive(Clone, Copy, Debug)]
+pub struct ProfileTurningParams {
+    pub feed: Option<StatedFeed>,
+    pub path: PathParams,
+    pub spindle_speed: Option<f64>,
+    pub surface_speed: Option<f64>,
+    pub spindle_cap: Option<f64>,
+    pub from: Option<Stated<f64>>,
+    pub to: Option<f64>,
+    pub retract: Option<f64>,
+    /// `search`: `exact`, `sequential` or `binary`.
+    pub search: Option<&'static str>,
+    pub search_spacing: Option<f64>,
+    pub search_step: Option<f64>,
+    pub stock_top: Option<f64>,
+    pub stock_allowance: Option<f64>,
+    pub depth_of_cut: Option<f64>,
+    pub finish_allowance: Option<f64>,
+    pub rough_feed: Option<StatedFeed>,
+    pub rough_spindle_speed: Option<f64>,
+}
+
+impl ProfileTurningParams {
+    pub fn read(o: &Object) -> Result<ProfileTurningParams, Diagnostic> {
+        let r = Reader::new(&o.fields);
+        let search_ty = PROFILE_TURNING.param("search").map(|p| p.ty);
+        let v = ProfileTurningParams {
+            feed: feed(&r, "feed"),
+            path: path(&r),
+            spindle_speed: r.num("spindle_speed"),
+            surface_speed: r.num("surface_speed"),
+            spindle_cap: r.num("spindle_cap"),
+            from: r.stated_num("from"),
+            to: r.num("to"),
+            retract: r.num("retract"),
+            search: r
+                .word("search")
+                .zip(search_ty)
+                .map(|(w, ty)| static_word(ty, w)),
+            search_spacing: r.num("search_spacing"),
+            search_step: r.num("search_step"),
+            stock_top: r.num("stock_top"),
+            stock_allowance: r.num("stock_allowance"),
+            depth_of_cut: r.num("depth_of_cut"),
+            finish_allowance: r.num("finish_allowance"),
+            rough_feed: feed(&r, "rough_feed"),
+            rough_spindle_speed: r.num("rough_spindle_speed"),
+        };
+        finish(r, o, v)
+    }
+}
+
+/// The spiral strategies' parameters (`fts_spiral`, `spiral_turning`).
+#[derive(Clone, Copy, Debug)]
+pub struct SpiralParams {
+    /// Radial feed per revolution (mm/rad).
+    pub feed: f64,
+    pub spindle_speed: Option<f64>,
+    pub surface_speed: Option<f64>,
+    pub spindle_cap: Option<f64>,
+    pub path: PathParams,
+    pub seed_arc: Option<f64>,
+    /// `settle` (`fts_spiral` only): `auto` or `none`.
+    pub settle: Option<&'static str>,
+    pub settling_time: Option<f64>,
+    pub from: Option<f64>,
+    pub retract: Option<f64>,
+}
+
+impl SpiralParams {
+    pub fn read(o: &Object) -> Result<SpiralParams, Diagnostic> {
+        let mut r = Reader::new(&o.fields);
+        let settle_ty = FTS_SPIRAL.param("settle").map(|p| p.ty);
+        let v = SpiralParams {
+            feed: r.required_num("feed"),
+            spindle_speed: r.num("spindle_speed"),
+            surface_speed: r.num("surface_speed"),
+            spindle_cap: r.num("spindle_cap"),
+            path: path(&r),
+            seed_arc: r.num("seed_arc"),
+            settle: r
+                .word("settle")
+                .zip(settle_ty)
+                .map(|(w, ty)| static_word(ty, w)),
+            settling_time: r.num("settling_time"),
+            from: r.num("from"),
+            retract: r.num("retract"),
+        };
+        finish(r, o, v)
+    }
+}
+
+/// `raster`'s parameters.
+#[derive(Clone, Copy, Debug)]
+pub struct RasterParams {
+    /// Along y (else along x).
+    pub along_y: bool,
+    pub zigzag: bool,
+    pub stepover: f64,
+    pub path: PathParams,
+    pub max_step: Option<f64>,
+    pub lin_angle: Option<f64>,
+    /// Cutting feed (mm/s).
+    pub feed: f64,
+    pub spindle_speed: Option<Stated<f64>>,
+    pub retract: Option<f64>,
+}
+
+impl RasterParams {
+    pub fn read(o: &Object) -> Result<RasterParams, Diagnostic> {
+        let mut r = Reader::new(&o.fields);
+        let v = RasterParams {
+            along_y: r.word("along") == Some("y"),
+            zigzag: r.word("direction") == Some("zigzag"),
+            stepover: r.required_num("stepover"),
+            path: path(&r),
+            max_step: r.num("max_step"),
+            lin_angle: r.num("lin_angle"),
+            feed: r.required_num("feed"),
+            spindle_speed: r.stated_num("spindle_speed"),
+            retract: r.num("retract"),
+        };
+        finish(r, o, v)
+    }
+}
+
+/// `profile_grinding`'s parameters.
+#[derive(Clone, Copy, Debug)]
+pub struct ProfileGrindingParams {
+    pub interval: f64,
+    /// Feed (mm/s).
+    pub feed: f64,
+    pub smoothness: f64,
+    pub spindle_speed: f64,
+    pub from: Option<f64>,
+    pub to: Option<f64>,
+    pub retract: Option<f64>,
+}
+
+impl ProfileGrindingParams {
+    pub fn read(o: &Object) -> Result<ProfileGrindingParams, Diagnostic> {
+        let mut r = Reader::new(&o.fields);
+        let v = ProfileGrindingParams {
+            interval: r.required_num("interval"),
+            feed: r.required_num("feed"),
+            smoothness: r.required_num("smoothness"),
+            spindle_speed: r.required_num("spindle_speed"),
+            from: r.num("from"),
+            to: r.num("to"),
+            retract: r.num("retract"),
+        };
+        finish(r, o, v)
+    }
+}
+
+/// One pass of a roller helix: its C step (rad) and pitch (mm per rev).
+#[derive(Clone, Copy, Debug)]
+pub struct HelixPassParams {
+    pub c_step: f64,
+    pub pitch: f64,
+}
+
+/// `roller_helix`'s parameters.
+#[derive(Clone, Copy, Debug)]
+pub struct RollerHelixParams {
+    /// The rough pass and the radial stock it leaves for the finish.
+    pub rough: Option<(HelixPassParams, f64)>,
+    pub finish: HelixPassParams,
+    pub path: PathParams,
+    /// Axial range of the cut (mm, the design's x).
+    pub z: Option<(f64, f64)>,
+    pub spindle_speed: f64,
+    pub blank_radius: Option<f64>,
+    pub retract: Option<f64>,
+}
+
+impl RollerHelixParams {
+    pub fn read(o: &Object) -> Result<RollerHelixParams, Diagnostic> {
+        let mut r = Reader::new(&o.fields);
+        let pass = |b: &mut Reader| HelixPassParams {
+            c_step: b.required_num("c_step"),
+            pitch: b.required_num("pitch"),
+        };
+        let v = RollerHelixParams {
+            rough: r.block("rough", |b| (pass(b), b.required_num("finish_allowance"))),
+            finish: r.required_block("finish", pass),
+            path: path(&r),
+            z: r.range("z"),
+            spindle_speed: r.required_num("spindle_speed"),
+            blank_radius: r.num("blank_radius"),
+            retract: r.num("retract"),
+        };
+        finish(r, o, v)
+    }
+}

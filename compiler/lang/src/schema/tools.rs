@@ -96,3 +96,50 @@ pub(super) const SPHERICAL_WHEEL: Kind = Kind {
     exclusive: &[],
     doc: "a spherical grinding wheel, referenced at its centre (seed 001)",
 };
+
+/// A tool's checked parameters, read once (every tool kind; what a kind
+/// lacks is `None`).
+#[derive(Clone, Copy, Debug)]
+pub struct ToolParams {
+    /// The tool's kind (`round_nose`, `microshaper`, `ball_end`, …).
+    pub kind: &'static str,
+    /// Radius of the cutting edge's nose (a round nose, a knife) (mm).
+    pub nose_radius: Option<f64>,
+    /// Diameter of a ball-end mill's ball or a wheel's tip (mm).
+    pub diameter: Option<f64>,
+    /// Clearance angle of the flank (rad).
+    pub clearance: Option<f64>,
+    /// Rake angle (rad).
+    pub rake: Option<f64>,
+    /// Opening angle of the cutting edge (rad).
+    pub included_angle: Option<f64>,
+    /// Height of the edge above the spindle axis as set (mm).
+    pub centre_height: Option<f64>,
+}
+
+impl ToolParams {
+    /// Reads a checked tool (E0121 for a required parameter missing).
+    pub fn read(o: &crate::value::Object) -> Result<ToolParams, lensc_grammar::Diagnostic> {
+        let mut r = crate::value::Reader::new(&o.fields);
+        // What the kind requires is read as required.
+        let mut need = |name: &str| {
+            let required = o.kind.param(name).is_some_and(|p| p.required);
+            if required {
+                Some(r.required_num(name))
+            } else {
+                r.num(name)
+            }
+        };
+        let t = ToolParams {
+            kind: o.kind.name,
+            nose_radius: need("nose_radius"),
+            diameter: need("diameter"),
+            clearance: need("clearance"),
+            rake: need("rake"),
+            included_angle: need("included_angle"),
+            centre_height: need("centre_height"),
+        };
+        r.finish(o.kind.name, (o.file, o.head))?;
+        Ok(t)
+    }
+}
