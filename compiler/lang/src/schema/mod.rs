@@ -181,6 +181,7 @@ pub use coefficients::{
     ZERNIKE_COEFFICIENTS, xy_powers,
 };
 pub use composite::{Array, Layout, OffAxis, Revolve, Roller, Tilt, Wrap};
+pub use dialects::{Gcode, Line, OfferedDialect, offered_dialects};
 pub use surfaces::{
     Axis, Base, Biconic, Conic, Cylinder, Ellipsoid, Facing, Forbes, Freeform, Ordering, Plane,
     Surface, Toroid, XyPolynomial, Zernike,
