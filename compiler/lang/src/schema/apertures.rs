@@ -78,9 +78,9 @@ impl Aperture {
                 x: super::required_range(&r, o, "x")?,
                 y: super::required_range(&r, o, "y")?,
             },
-            _ => return Err(super::not_a(o, Category::Aperture)),
+            _ => return Err(super::not_a(o, Category::Aperture.noun())),
         };
-        r.finish(o.kind.name, (o.file, o.head))?;
+        super::finish(r, o)?;
         Ok(aperture)
     }
 

@@ -315,7 +315,7 @@ impl Array {
                 count: r.required_num("count"),
                 axis: Axis::read(&r, "axis", Axis::X),
             },
-            _ => return Err(not_a(o, Category::Surface)),
+            _ => return Err(not_a(o, "an array of lenslets")),
         };
         let array = Array {
             lenslet: surface(&r, o, "lenslet")?,
@@ -408,7 +408,7 @@ pub struct Roller {
 impl Roller {
     pub fn read(o: &Object) -> Result<Roller, Diagnostic> {
         if o.kind.category != Category::Roller {
-            return Err(not_a(o, Category::Roller));
+            return Err(not_a(o, Category::Roller.noun()));
         }
         let mut r = Reader::new(&o.fields);
         let roller = Roller {

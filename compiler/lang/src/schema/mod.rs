@@ -200,16 +200,11 @@ fn missing(o: &Object, name: &str) -> Diagnostic {
     .with_label("here")
 }
 
-/// E0124: `o`, read as one of `category`, is not.
-fn not_a(o: &Object, category: Category) -> Diagnostic {
+/// E0124: `o`, read as `what` (`an aperture`), is not one.
+fn not_a(o: &Object, what: &str) -> Diagnostic {
     Diagnostic::error(
         crate::codes::WRONG_KIND,
-        format!(
-            "`{}` is {}, not {}",
-            o.kind.name,
-            o.kind.category.noun(),
-            category.noun()
-        ),
+        format!("`{}` is not {what}", o.kind.name),
         o.file,
         o.head,
     )

@@ -742,7 +742,7 @@ impl Surface {
             "revolve" => Surface::Revolve(Revolve::read(o)?),
             "grid" | "hex_grid" | "linear_array" => Surface::Array(Array::read(o)?),
             "tilt" => Surface::Tilt(Tilt::read(o)?),
-            _ => return Err(not_a(o, Category::Surface)),
+            _ => return Err(not_a(o, Category::Surface.noun())),
         })
     }
 
