@@ -13,7 +13,8 @@ use lensc_runtime::post::Dialect;
 
 use crate::check::CheckedJob;
 use crate::codes;
-use crate::value::{self, Object, Value};
+use crate::schema::{self, Gcode, OfferedDialect};
+use crate::value::{Object, Reader, Value};
 
 /// A surface in words: its kind and every parameter, nested surfaces in
 /// brackets, apertures included (a revolved profile's own aperture is what
@@ -44,18 +45,16 @@ pub fn describe(o: &Object) -> String {
 /// the one `requested` (by `lensc build --dialect`) among it and its
 /// `other_dialects`; E0148 if the machine offers no dialect of that name.
 pub fn dialect(job: &CheckedJob, requested: Option<&str>) -> Result<Dialect, Diagnostic> {
-    klartext_on_a_lathe(job)?;
-    let offered = offered(job);
+    let machine = machine_of(job)?;
+    klartext_on_a_lathe(machine)?;
+    let offered = schema::offered_dialects(machine);
     let chosen = match requested {
-        None => offered.first().copied(),
-        Some(r) => offered.iter().copied().find(|o| dialect_name(o) == r),
+        None => offered.first(),
+        Some(r) => offered.iter().find(|o| o.name() == r),
     };
     let Some(o) = chosen else {
         let (file, span) = job_site(job);
-        let names: Vec<String> = offered
-            .iter()
-            .map(|o| format!("`{}`", dialect_name(o)))
-            .collect();
+        let names: Vec<String> = offered.iter().map(|o| format!("`{}`", o.name())).collect();
         return Err(Diagnostic::error(
             codes::DIALECT_NOT_OFFERED,
             format!(
@@ -68,68 +67,62 @@ pub fn dialect(job: &CheckedJob, requested: Option<&str>) -> Result<Dialect, Dia
         .with_label("this job")
         .with_help(dialect_help(requested.unwrap_or(""), &offered, &names)));
     };
-    check_word_formats(o)?;
-    Ok(dialect_of(o, dialect_name(o)))
+    let gcode = Gcode::read(o.dialect);
+    check_word_formats(&gcode, &o.name())?;
+    Ok(dialect_from(gcode, o.name()))
+}
+
+/// The machine of a checked job; E0121 if it has none (one that did not
+/// check).
+fn machine_of(job: &CheckedJob) -> Result<&Object, Diagnostic> {
+    match Reader::new(&job.fields).object("machine") {
+        Some(machine) => Ok(machine),
+        None => Err(Diagnostic::error(
+            codes::MISSING_PARAMETER,
+            format!("job `{}` is missing `machine`", job.name.name),
+            job.file,
+            job.name.span,
+        )
+        .with_label("this job")),
+    }
 }
 
 /// E0174 where a machine that is not a mill names a Klartext dialect
 /// (as its `dialect` or among its `other_dialects`): Klartext is the TNC
 /// mills' language, with no lathe programs.
-fn klartext_on_a_lathe(job: &CheckedJob) -> Result<(), Diagnostic> {
-    let machine = value::object(&job.fields, "machine").expect("checked job part");
+fn klartext_on_a_lathe(machine: &Object) -> Result<(), Diagnostic> {
     if machine.kind.name == "mill_3axis" {
         return Ok(());
     }
-    let klartext = |o: &Object| value::word(&o.fields, "language") == Some("klartext");
-    let mut named = Vec::new();
-    if let Some(f) = value::field(&machine.fields, "dialect")
-        && let Value::Object(o) = &f.value
-    {
-        named.push((o.as_ref(), f.file, f.span));
-    }
-    if let Some(f) = value::field(&machine.fields, "other_dialects")
-        && let Value::List(items) = &f.value
-    {
-        for (v, span) in items {
-            if let Value::Object(o) = v {
-                named.push((o.as_ref(), f.file, *span));
-            }
-        }
-    }
-    let Some((o, file, span)) = named.into_iter().find(|(o, _, _)| klartext(o)) else {
+    let Some(o) = schema::offered_dialects(machine)
+        .into_iter()
+        .find(|o| Gcode::read(o.dialect).klartext)
+    else {
         return Ok(());
     };
     Err(Diagnostic::error(
         codes::KLARTEXT_ON_A_LATHE,
         format!(
             "`{}` is Heidenhain Klartext, a language for TNC mills; this machine is a `{}`",
-            dialect_name(o),
+            o.name(),
             machine.kind.name
         ),
-        file,
-        span,
+        o.file,
+        o.span,
     )
     .with_label("a Klartext dialect on a machine that is not a mill")
     .with_help("Klartext programs only mills: name a G-code dialect this machine's controller reads (`linuxcnc`, `fanuc_0i_lathe`, `siemens_840d_lathe`, `ultra_precision_lathe_gcode`)"))
 }
 
 /// E0172 at the first of a dialect's `word_formats` that does not read.
-fn check_word_formats(o: &Object) -> Result<(), Diagnostic> {
-    let Some(field) = value::field(&o.fields, "word_formats") else {
-        return Ok(());
-    };
-    let Value::List(items) = &field.value else {
-        return Ok(());
-    };
-    for (v, span) in items {
-        if let Value::Str(text) = v
-            && let Err(why) = lensc_runtime::dialect::WordFormat::parse(text)
-        {
+fn check_word_formats(gcode: &Gcode, name: &str) -> Result<(), Diagnostic> {
+    for format in &gcode.word_formats {
+        if let Err(why) = lensc_runtime::dialect::WordFormat::parse(&format.text) {
             return Err(Diagnostic::error(
                 codes::BAD_WORD_FORMAT,
-                format!("the dialect `{}` has a word format that does not read: {why}", dialect_name(o)),
-                field.file,
-                *span,
+                format!("the dialect `{name}` has a word format that does not read: {why}"),
+                format.file,
+                format.span,
             )
             .with_label("this format")
             .with_help("write a letter, the most digits before the point, and for a word with a point `.` and the most decimals: `S5`, `X4.4`"));
@@ -141,9 +134,9 @@ fn check_word_formats(o: &Object) -> Result<(), Diagnostic> {
 /// What to write instead of a dialect the machine does not offer: the
 /// nearest name it offers; else, for a dialect the standard library has,
 /// how to add it to the machine; else the nearest dialect there is.
-fn dialect_help(requested: &str, offered: &[&Object], names: &[String]) -> String {
+fn dialect_help(requested: &str, offered: &[OfferedDialect], names: &[String]) -> String {
     let offers = format!("its machine offers {}", names.join(", "));
-    let offered_names: Vec<String> = offered.iter().map(|o| dialect_name(o)).collect();
+    let offered_names: Vec<String> = offered.iter().map(OfferedDialect::name).collect();
     if let Some(s) = did_you_mean(requested, offered_names.iter().map(String::as_str)) {
         return format!("did you mean `--dialect {s}`? {}", capitalised(&offers));
     }
@@ -170,86 +163,59 @@ fn dialect_help(requested: &str, offered: &[&Object], names: &[String]) -> Strin
 
 /// The names of the dialects a job's machine offers, its own first.
 pub fn offered_dialects(job: &CheckedJob) -> Vec<String> {
-    offered(job).into_iter().map(dialect_name).collect()
-}
-
-fn dialect_name(o: &Object) -> String {
-    o.name.clone().unwrap_or_else(|| o.kind.name.to_string())
-}
-
-/// The machine's `dialect` and then its `other_dialects`.
-fn offered(job: &CheckedJob) -> Vec<&Object> {
-    let machine = value::object(&job.fields, "machine").expect("checked job part");
-    let mut offered: Vec<&Object> = value::object(&machine.fields, "dialect")
-        .map(|o| o.as_ref())
-        .into_iter()
-        .collect();
-    if let Some(Value::List(items)) =
-        value::field(&machine.fields, "other_dialects").map(|f| &f.value)
-    {
-        offered.extend(items.iter().filter_map(|(v, _)| match v {
-            Value::Object(o) => Some(o.as_ref()),
-            _ => None,
-        }));
-    }
-    offered
+    machine_of(job)
+        .map(|m| {
+            schema::offered_dialects(m)
+                .iter()
+                .map(OfferedDialect::name)
+                .collect()
+        })
+        .unwrap_or_default()
 }
 
 /// A checked `gcode { … }` dialect as the post-processor reads it.
 pub(crate) fn dialect_of(o: &Object, name: String) -> Dialect {
-    let f = &o.fields;
-    let text = |n: &str, default: &str| match value::field(f, n).map(|x| &x.value) {
-        Some(Value::Str(s)) => s.clone(),
-        _ => default.to_string(),
-    };
-    let opt_text = |n: &str| match value::field(f, n).map(|x| &x.value) {
-        Some(Value::Str(s)) => Some(s.clone()),
-        _ => None,
-    };
-    let lines = |n: &str| match value::field(f, n).map(|x| &x.value) {
-        Some(Value::List(items)) => items
-            .iter()
-            .filter_map(|(v, _)| match v {
-                Value::Str(s) => Some(s.clone()),
-                _ => None,
-            })
-            .collect(),
-        _ => Vec::new(),
-    };
-    let count = |n: &str| value::num(f, n).map(|v| v as u64);
+    dialect_from(Gcode::read(o), name)
+}
+
+/// A dialect's parameters, read, as the post-processor reads them.
+fn dialect_from(g: Gcode, name: String) -> Dialect {
     use lensc_runtime::moves::Plane;
     Dialect {
         name,
-        language: match value::word(f, "language") {
-            Some("klartext") => lensc_runtime::dialect::Language::Klartext,
-            _ => lensc_runtime::dialect::Language::GCode,
+        language: if g.klartext {
+            lensc_runtime::dialect::Language::Klartext
+        } else {
+            lensc_runtime::dialect::Language::GCode
         },
-        extension: text("extension", "nc"),
-        comment: match value::word(f, "comment") {
-            Some("semicolon") => lensc_runtime::post::CommentStyle::Semicolon,
-            _ => lensc_runtime::post::CommentStyle::Parentheses,
+        extension: g.extension,
+        comment: if g.semicolon_comments {
+            lensc_runtime::post::CommentStyle::Semicolon
+        } else {
+            lensc_runtime::post::CommentStyle::Parentheses
         },
-        start: lines("start"),
-        program_number: count("program_number").unwrap_or(1) as u32,
-        lathe_setup: lines("lathe_setup"),
-        mill_setup: lines("mill_setup"),
-        lathe_tool_call: lines("lathe_tool_call"),
-        mill_tool_call: lines("mill_tool_call"),
-        path_tolerance: lines("path_tolerance"),
-        c_axis_on: lines("c_axis_on"),
-        c_axis_off: lines("c_axis_off"),
-        surface_speed: lines("surface_speed"),
-        fts_table: opt_text("fts_table"),
-        fts_on: lines("fts_on"),
-        fts_off: lines("fts_off"),
-        end: lines("end"),
-        trailer: lines("trailer"),
-        lathe_x_diameter: value::word(f, "lathe_x") == Some("diameter"),
-        rapid: text("rapid", "G0"),
-        linear: text("linear", "G1"),
-        arc_cw: text("arc_cw", "G2"),
-        arc_ccw: text("arc_ccw", "G3"),
-        arc_planes: lines("arc_planes")
+        start: g.start,
+        program_number: g.program_number,
+        lathe_setup: g.lathe_setup,
+        mill_setup: g.mill_setup,
+        lathe_tool_call: g.lathe_tool_call,
+        mill_tool_call: g.mill_tool_call,
+        path_tolerance: g.path_tolerance,
+        c_axis_on: g.c_axis_on,
+        c_axis_off: g.c_axis_off,
+        surface_speed: g.surface_speed,
+        fts_table: g.fts_table,
+        fts_on: g.fts_on,
+        fts_off: g.fts_off,
+        end: g.end,
+        trailer: g.trailer,
+        lathe_x_diameter: g.lathe_x_diameter,
+        rapid: g.rapid,
+        linear: g.linear,
+        arc_cw: g.arc_cw,
+        arc_ccw: g.arc_ccw,
+        arc_planes: g
+            .arc_planes
             .iter()
             .filter_map(|p| match p.as_str() {
                 "xy" => Some(Plane::Xy),
@@ -258,32 +224,33 @@ pub(crate) fn dialect_of(o: &Object, name: String) -> Dialect {
                 _ => None,
             })
             .collect(),
-        arc_centre_absolute: value::word(f, "arc_centre") == Some("absolute"),
-        arc_radius_tolerance: value::num(f, "arc_radius_tolerance").unwrap_or(0.001),
-        per_minute: opt_text("per_minute"),
-        per_revolution: opt_text("per_revolution"),
-        inverse_time: opt_text("inverse_time"),
-        spindle_on: text("spindle_on", "M3"),
-        spindle_ccw: text("spindle_ccw", "M4"),
-        spindle_off: text("spindle_off", "M5"),
-        constant_rpm: opt_text("constant_rpm"),
-        spindle_orient: lines("spindle_orient"),
-        coolant_flood: opt_text("coolant_flood"),
-        coolant_mist: opt_text("coolant_mist"),
-        coolant_off: opt_text("coolant_off"),
+        arc_centre_absolute: g.arc_centre_absolute,
+        arc_radius_tolerance: g.arc_radius_tolerance,
+        per_minute: g.per_minute,
+        per_revolution: g.per_revolution,
+        inverse_time: g.inverse_time,
+        spindle_on: g.spindle_on,
+        spindle_ccw: g.spindle_ccw,
+        spindle_off: g.spindle_off,
+        constant_rpm: g.constant_rpm,
+        spindle_orient: g.spindle_orient,
+        coolant_flood: g.coolant_flood,
+        coolant_mist: g.coolant_mist,
+        coolant_off: g.coolant_off,
         // Checked by `word_formats` before the dialect is built.
-        word_formats: lines("word_formats")
+        word_formats: g
+            .word_formats
             .iter()
-            .filter_map(|t| lensc_runtime::dialect::WordFormat::parse(t).ok())
+            .filter_map(|w| lensc_runtime::dialect::WordFormat::parse(&w.text).ok())
             .collect(),
-        c_letter: text("c_letter", "C").chars().next().unwrap_or('C'),
-        c_decimals: count("c_decimals").unwrap_or(5) as u32,
-        max_decimals: count("max_decimals").map(|v| v as u32),
-        max_digits: count("max_digits").map(|v| v as u32),
-        max_line_length: count("max_line_length").map(|v| v as usize),
-        line_numbers: count("line_numbers"),
-        max_line_number: count("max_line_number"),
-        block_end: text("block_end", ""),
+        c_letter: g.c_letter,
+        c_decimals: g.c_decimals,
+        max_decimals: g.max_decimals,
+        max_digits: g.max_digits,
+        max_line_length: g.max_line_length,
+        line_numbers: g.line_numbers,
+        max_line_number: g.max_line_number,
+        block_end: g.block_end,
     }
 }
 

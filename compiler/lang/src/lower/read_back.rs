@@ -8,7 +8,8 @@ use lensc_runtime::post::Dialect;
 use lensc_runtime::reader::MachineLimits;
 
 use crate::check::CheckedJob;
-use crate::value::{self, Object, Value};
+use crate::schema::{OfferedDialect, offered_dialects};
+use crate::value::{self, Object};
 
 /// A checked machine's limits as the reader takes them (feeds in mm/min,
 /// spindle speeds in rpm).
@@ -44,16 +45,10 @@ pub fn machine_named(
     {
         return None;
     }
-    let mut offered: Vec<String> = value::object(&o.fields, "dialect")
-        .map(|d| dialect_name(d))
-        .into_iter()
+    let offered = offered_dialects(o)
+        .iter()
+        .map(OfferedDialect::name)
         .collect();
-    if let Some(Value::List(items)) = value::field(&o.fields, "other_dialects").map(|f| &f.value) {
-        offered.extend(items.iter().filter_map(|(v, _)| match v {
-            Value::Object(d) => Some(dialect_name(d)),
-            _ => None,
-        }));
-    }
     Some((machine_limits(o), offered))
 }
 
@@ -69,32 +64,13 @@ pub fn dialect_named(
         .cloned();
     if found.is_none() {
         for o in declarations.values() {
-            let candidates = value::object(&o.fields, "dialect")
-                .into_iter()
-                .cloned()
-                .chain(
-                    match value::field(&o.fields, "other_dialects").map(|f| &f.value) {
-                        Some(Value::List(items)) => items
-                            .iter()
-                            .filter_map(|(v, _)| match v {
-                                Value::Object(d) => Some(d.clone()),
-                                _ => None,
-                            })
-                            .collect(),
-                        _ => Vec::new(),
-                    },
-                );
-            if let Some(d) = candidates.into_iter().find(|d| dialect_name(d) == name) {
-                found = Some(d);
+            if let Some(d) = offered_dialects(o).into_iter().find(|d| d.name() == name) {
+                found = Some(d.dialect.clone());
                 break;
             }
         }
     }
     found.map(|o| crate::lower::dialect_of(&o, name.to_string()))
-}
-
-fn dialect_name(o: &Object) -> String {
-    o.name.clone().unwrap_or_else(|| o.kind.name.to_string())
 }
 
 /// A finding of the reader as a diagnostic over the program's text

@@ -1,8 +1,10 @@
 //! Families of coefficients named by a pattern (`A4`, `X2Y1`, `Z11`,
-//! `Q3`) and the dimension each name stands for.
+//! `Q3`) and the dimension each name stands for; and each family read from
+//! a checked surface, once, as (power or index, value) pairs.
 
 use super::{Check, Family, LENGTH, Param, Ty};
 use crate::units::Dim;
+use crate::value::{Field, Reader, Value};
 
 /// `A1` … `A20`: the coefficient of |r|^j (or |u|^j for a cylinder), in mm^(1−j).
 pub static POWER_COEFFICIENTS: Family = Family {
@@ -40,17 +42,84 @@ pub static ZERNIKE_COEFFICIENTS: Family = Family {
     param: |name| numbered_length(name, 'Z', 230, "Zj", "Zernike coefficient, a length"),
 };
 
+/// The highest order m of a Forbes coefficient `Qm`.
+pub const FORBES_TOP: usize = 20;
+
 /// `Q0` … `Q20`: Forbes Q-bfs coefficients (lengths).
 pub static QBFS_COEFFICIENTS: Family = Family {
     describe: "Forbes Q-bfs coefficients `Q0` … `Q20` (lengths)",
-    param: |name| numbered_length(name, 'Q', 20, "Qm", "Q-bfs coefficient a_m, a length"),
+    param: |name| {
+        numbered_length(
+            name,
+            'Q',
+            FORBES_TOP as u32,
+            "Qm",
+            "Q-bfs coefficient a_m, a length",
+        )
+    },
 };
 
 /// `Q0` … `Q20`: Forbes Q-con coefficients (lengths).
 pub static QCON_COEFFICIENTS: Family = Family {
     describe: "Forbes Q-con coefficients `Q0` … `Q20` (lengths)",
-    param: |name| numbered_length(name, 'Q', 20, "Qm", "Q-con coefficient a_m, a length"),
+    param: |name| {
+        numbered_length(
+            name,
+            'Q',
+            FORBES_TOP as u32,
+            "Qm",
+            "Q-con coefficient a_m, a length",
+        )
+    },
 };
+
+/// The `Aj` a surface states, by power j from 1 to 20, each looked up by
+/// its name `A{j}`.
+pub(super) fn power_terms(r: &Reader) -> Vec<(u32, f64)> {
+    (1..=20u32)
+        .filter_map(|j| r.num(&format!("A{j}")).map(|a| (j, a)))
+        .collect()
+}
+
+/// The `Qm` of a Forbes surface, by order m from 0 to `FORBES_TOP`, each
+/// looked up by its name `Q{m}`.
+pub(super) fn forbes_terms(r: &Reader) -> Vec<(usize, f64)> {
+    (0..=FORBES_TOP)
+        .filter_map(|m| r.num(&format!("Q{m}")).map(|a| (m, a)))
+        .collect()
+}
+
+/// The `XiYj` a surface states, as (i, j, value) in order of (i, j).
+pub(super) fn xy_terms(fields: &[Field]) -> Vec<(u32, u32, f64)> {
+    let mut terms: Vec<(u32, u32, f64)> = fields
+        .iter()
+        .filter_map(|fl| {
+            let (i, j) = xy_powers(&fl.name)?;
+            match fl.value {
+                Value::Num(v, _) => Some((i, j, v)),
+                _ => None,
+            }
+        })
+        .collect();
+    terms.sort_by_key(|t| (t.0, t.1));
+    terms
+}
+
+/// The `Zj` a surface states, as (j, value) in order of j.
+pub(super) fn zernike_terms(fields: &[Field]) -> Vec<(u32, f64)> {
+    let mut terms: Vec<(u32, f64)> = fields
+        .iter()
+        .filter_map(|fl| {
+            let j: u32 = fl.name.strip_prefix('Z')?.parse().ok()?;
+            match fl.value {
+                Value::Num(v, _) => Some((j, v)),
+                _ => None,
+            }
+        })
+        .collect();
+    terms.sort_by_key(|t| t.0);
+    terms
+}
 
 /// The parameter a name `<prefix>n` stands for, if n is at most `top`:
 /// a coefficient that is a length.

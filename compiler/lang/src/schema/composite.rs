@@ -1,8 +1,22 @@
 //! Surfaces made of other surfaces: a design wrapped onto a roller, an
-//! off-axis section, a profile revolved, arrays of lenslets, a tilted surface.
+//! off-axis section, a profile revolved, arrays of lenslets, a tilted
+//! surface; beside each, the struct its parameters are read into, the
+//! surfaces it is made of read with it.
 
-use super::surfaces::APERTURE;
-use super::{ANGLE, Category, Check, Kind, LENGTH, NUMBER, Param, Ty, opt, req};
+use lensc_grammar::Diagnostic;
+
+use super::apertures::Aperture;
+use super::surfaces::{APERTURE, Axis, Surface, aperture};
+use super::{
+    ANGLE, Category, Check, Kind, LENGTH, NUMBER, Param, Ty, finish, not_a, opt, req,
+    required_object,
+};
+use crate::value::{Object, Reader};
+
+/// The required surface `name` of `o`, read.
+fn surface(r: &Reader, o: &Object, name: &str) -> Result<Box<Surface>, Diagnostic> {
+    Surface::read(required_object(r, o, name)?).map(Box::new)
+}
 
 const LENSLET: Param = req(
     "lenslet",
@@ -40,6 +54,26 @@ pub(super) const WRAP: Kind = Kind {
     doc: "a flat design wrapped onto a roller: y becomes the arc length R·c around it",
 };
 
+/// `WRAP`'s parameters.
+#[derive(Clone, Debug)]
+pub struct Wrap {
+    /// The flat design.
+    pub surface: Box<Surface>,
+    pub onto: Roller,
+}
+
+impl Wrap {
+    pub fn read(o: &Object) -> Result<Wrap, Diagnostic> {
+        let r = Reader::new(&o.fields);
+        let wrap = Wrap {
+            surface: surface(&r, o, "surface")?,
+            onto: Roller::read(required_object(&r, o, "onto")?)?,
+        };
+        finish(r, o)?;
+        Ok(wrap)
+    }
+}
+
 pub(super) const OFF_AXIS: Kind = Kind {
     name: "off_axis",
     category: Category::Surface,
@@ -76,6 +110,33 @@ pub(super) const OFF_AXIS: Kind = Kind {
     doc: "an off-axis section of a parent surface, in coordinates centred on (x, y), its height zero there",
 };
 
+/// `OFF_AXIS`'s parameters.
+#[derive(Clone, Debug)]
+pub struct OffAxis {
+    pub parent: Box<Surface>,
+    /// The section's centre on the parent.
+    pub x: f64,
+    pub y: f64,
+    /// `tilt: remove`: the parent's slope at the centre taken off.
+    pub remove_tilt: bool,
+    pub aperture: Aperture,
+}
+
+impl OffAxis {
+    pub fn read(o: &Object) -> Result<OffAxis, Diagnostic> {
+        let mut r = Reader::new(&o.fields);
+        let section = OffAxis {
+            parent: surface(&r, o, "parent")?,
+            x: r.required_num("x"),
+            y: r.required_num("y"),
+            remove_tilt: r.word("tilt") == Some("remove"),
+            aperture: aperture(&r, o)?,
+        };
+        finish(r, o)?;
+        Ok(section)
+    }
+}
+
 pub(super) const REVOLVE: Kind = Kind {
     name: "revolve",
     category: Category::Surface,
@@ -99,6 +160,28 @@ pub(super) const REVOLVE: Kind = Kind {
     exclusive: &[],
     doc: "a surface of revolution: z(x, y) = profile(start + sqrt(x² + y²), 0), what a 2-axis lathe makes of a profile",
 };
+
+/// `REVOLVE`'s parameters.
+#[derive(Clone, Debug)]
+pub struct Revolve {
+    pub profile: Box<Surface>,
+    /// x on the profile that lies on the axis; 0 when not given.
+    pub start: f64,
+    pub aperture: Aperture,
+}
+
+impl Revolve {
+    pub fn read(o: &Object) -> Result<Revolve, Diagnostic> {
+        let r = Reader::new(&o.fields);
+        let revolved = Revolve {
+            profile: surface(&r, o, "profile")?,
+            start: r.num("start").unwrap_or(0.0),
+            aperture: aperture(&r, o)?,
+        };
+        finish(r, o)?;
+        Ok(revolved)
+    }
+}
 
 pub(super) const GRID: Kind = Kind {
     name: "grid",
@@ -179,6 +262,74 @@ pub(super) const LINEAR_ARRAY: Kind = Kind {
     doc: "a row of a lenslet (a cylinder, say) with seams between them",
 };
 
+/// How an array's cells are laid out: the parameters of `GRID`,
+/// `HEX_GRID` and `LINEAR_ARRAY` beyond the lenslet and aperture they
+/// share (counts are whole numbers, but for a hex grid's rows).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Layout {
+    Grid {
+        pitch_x: f64,
+        pitch_y: f64,
+        count_x: f64,
+        count_y: f64,
+    },
+    Hex {
+        pitch: f64,
+        count_x: f64,
+        count_y: f64,
+    },
+    Linear {
+        pitch: f64,
+        count: f64,
+        /// The direction the lenslets repeat along; x when not given.
+        axis: Axis,
+    },
+}
+
+/// The parameters of an array of lenslets.
+#[derive(Clone, Debug)]
+pub struct Array {
+    pub lenslet: Box<Surface>,
+    pub layout: Layout,
+    /// None: the rectangle around every cell.
+    pub aperture: Option<Aperture>,
+}
+
+impl Array {
+    pub fn read(o: &Object) -> Result<Array, Diagnostic> {
+        let mut r = Reader::new(&o.fields);
+        let layout = match o.kind.name {
+            "grid" => Layout::Grid {
+                pitch_x: r.required_num("pitch_x"),
+                pitch_y: r.required_num("pitch_y"),
+                count_x: r.required_num("count_x"),
+                count_y: r.required_num("count_y"),
+            },
+            "hex_grid" => Layout::Hex {
+                pitch: r.required_num("pitch"),
+                count_x: r.required_num("count_x"),
+                count_y: r.required_num("count_y"),
+            },
+            "linear_array" => Layout::Linear {
+                pitch: r.required_num("pitch"),
+                count: r.required_num("count"),
+                axis: Axis::read(&r, "axis", Axis::X),
+            },
+            _ => return Err(not_a(o, "an array of lenslets")),
+        };
+        let array = Array {
+            lenslet: surface(&r, o, "lenslet")?,
+            layout,
+            aperture: r
+                .object("aperture")
+                .map(|a| Aperture::read(a))
+                .transpose()?,
+        };
+        finish(r, o)?;
+        Ok(array)
+    }
+}
+
 pub(super) const TILT: Kind = Kind {
     name: "tilt",
     category: Category::Surface,
@@ -209,6 +360,30 @@ pub(super) const TILT: Kind = Kind {
     doc: "a surface turned about the x or y axis through its vertex, as a height over the machine's x–y plane",
 };
 
+/// `TILT`'s parameters.
+#[derive(Clone, Debug)]
+pub struct Tilt {
+    pub parent: Box<Surface>,
+    /// The axis through the vertex it turns about.
+    pub about: Axis,
+    pub angle: f64,
+    pub aperture: Aperture,
+}
+
+impl Tilt {
+    pub fn read(o: &Object) -> Result<Tilt, Diagnostic> {
+        let mut r = Reader::new(&o.fields);
+        let tilt = Tilt {
+            parent: surface(&r, o, "parent")?,
+            about: Axis::read(&r, "about", Axis::Y),
+            angle: r.required_num("angle"),
+            aperture: aperture(&r, o)?,
+        };
+        finish(r, o)?;
+        Ok(tilt)
+    }
+}
+
 pub(super) const ROLLER: Kind = Kind {
     name: "roller",
     category: Category::Roller,
@@ -223,3 +398,23 @@ pub(super) const ROLLER: Kind = Kind {
     exclusive: &[],
     doc: "a cylindrical roller to wrap a design onto",
 };
+
+/// `ROLLER`'s parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Roller {
+    pub radius: f64,
+}
+
+impl Roller {
+    pub fn read(o: &Object) -> Result<Roller, Diagnostic> {
+        if o.kind.category != Category::Roller {
+            return Err(not_a(o, Category::Roller.noun()));
+        }
+        let mut r = Reader::new(&o.fields);
+        let roller = Roller {
+            radius: r.required_num("radius"),
+        };
+        finish(r, o)?;
+        Ok(roller)
+    }
+}

@@ -1,7 +1,14 @@
 //! The `gcode` dialect kind: everything a post-processor needs to know
-//! about a controller, as data.
+//! about a controller, as data; `Gcode`, a dialect's parameters read once,
+//! and the dialects a machine offers.
+
+use std::rc::Rc;
+
+use lensc_grammar::FileId;
+use lensc_grammar::ast::Span;
 
 use super::{Category, Check, Kind, LENGTH, NUMBER, Param, Ty, opt, req};
+use crate::value::{Object, Reader, Value};
 
 const fn text(name: &'static str, doc: &'static str) -> Param {
     opt(name, Ty::Text, Check::Any, doc)
@@ -209,3 +216,199 @@ pub(super) const GCODE: Kind = Kind {
     exclusive: &[],
     doc: "a G-code (ISO 6983 family) program dialect: how one controller wants its programs written",
 };
+
+/// A line of a dialect's list as written, with where: what a message
+/// about it points at.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Line {
+    pub text: String,
+    pub file: FileId,
+    pub span: Span,
+}
+
+/// A checked `gcode { … }` dialect's parameters (`GCODE_PARAMS`), read
+/// once, with the defaults their docs state: the only place they are named.
+/// A text, word or list a declaration that did not check lacks reads as
+/// its default (the checker has reported it).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Gcode {
+    /// `language: klartext`.
+    pub klartext: bool,
+    pub extension: String,
+    /// `comment: semicolon` (else parentheses).
+    pub semicolon_comments: bool,
+    pub start: Vec<String>,
+    pub program_number: u32,
+    pub lathe_setup: Vec<String>,
+    pub mill_setup: Vec<String>,
+    pub lathe_tool_call: Vec<String>,
+    pub mill_tool_call: Vec<String>,
+    pub path_tolerance: Vec<String>,
+    pub c_axis_on: Vec<String>,
+    pub c_axis_off: Vec<String>,
+    pub end: Vec<String>,
+    pub trailer: Vec<String>,
+    /// `lathe_x: diameter` (else radius).
+    pub lathe_x_diameter: bool,
+    pub rapid: String,
+    pub linear: String,
+    pub arc_cw: String,
+    pub arc_ccw: String,
+    /// As written: `"xy"`, `"zx"`, `"yz"`.
+    pub arc_planes: Vec<String>,
+    /// `arc_centre: absolute` (else incremental).
+    pub arc_centre_absolute: bool,
+    pub surface_speed: Vec<String>,
+    pub fts_table: Option<String>,
+    pub fts_on: Vec<String>,
+    pub fts_off: Vec<String>,
+    pub arc_radius_tolerance: f64,
+    pub per_minute: Option<String>,
+    pub per_revolution: Option<String>,
+    pub inverse_time: Option<String>,
+    pub spindle_on: String,
+    pub spindle_ccw: String,
+    pub constant_rpm: Option<String>,
+    pub spindle_orient: Vec<String>,
+    pub coolant_flood: Option<String>,
+    pub coolant_mist: Option<String>,
+    pub coolant_off: Option<String>,
+    /// Each as written, with where (E0172 points at one that does not read).
+    pub word_formats: Vec<Line>,
+    pub spindle_off: String,
+    pub c_letter: char,
+    pub c_decimals: u32,
+    pub max_decimals: Option<u32>,
+    pub max_digits: Option<u32>,
+    pub max_line_length: Option<usize>,
+    pub line_numbers: Option<u64>,
+    pub max_line_number: Option<u64>,
+    pub block_end: String,
+}
+
+impl Gcode {
+    pub fn read(o: &Object) -> Gcode {
+        let r = Reader::new(&o.fields);
+        let opt_text = |n: &str| match r.field(n).map(|x| &x.value) {
+            Some(Value::Str(s)) => Some(s.clone()),
+            _ => None,
+        };
+        let text = |n: &str, default: &str| opt_text(n).unwrap_or_else(|| default.to_string());
+        let written = |n: &str| -> Vec<Line> {
+            match r.field(n) {
+                Some(f) => match &f.value {
+                    Value::List(items) => items
+                        .iter()
+                        .filter_map(|(v, span)| match v {
+                            Value::Str(s) => Some(Line {
+                                text: s.clone(),
+                                file: f.file,
+                                span: *span,
+                            }),
+                            _ => None,
+                        })
+                        .collect(),
+                    _ => Vec::new(),
+                },
+                None => Vec::new(),
+            }
+        };
+        let lines = |n: &str| -> Vec<String> { written(n).into_iter().map(|l| l.text).collect() };
+        let count = |n: &str| r.num(n).map(|v| v as u64);
+        Gcode {
+            klartext: r.word("language") == Some("klartext"),
+            extension: text("extension", "nc"),
+            semicolon_comments: r.word("comment") == Some("semicolon"),
+            start: lines("start"),
+            program_number: count("program_number").unwrap_or(1) as u32,
+            lathe_setup: lines("lathe_setup"),
+            mill_setup: lines("mill_setup"),
+            lathe_tool_call: lines("lathe_tool_call"),
+            mill_tool_call: lines("mill_tool_call"),
+            path_tolerance: lines("path_tolerance"),
+            c_axis_on: lines("c_axis_on"),
+            c_axis_off: lines("c_axis_off"),
+            end: lines("end"),
+            trailer: lines("trailer"),
+            lathe_x_diameter: r.word("lathe_x") == Some("diameter"),
+            rapid: text("rapid", "G0"),
+            linear: text("linear", "G1"),
+            arc_cw: text("arc_cw", "G2"),
+            arc_ccw: text("arc_ccw", "G3"),
+            arc_planes: lines("arc_planes"),
+            arc_centre_absolute: r.word("arc_centre") == Some("absolute"),
+            surface_speed: lines("surface_speed"),
+            fts_table: opt_text("fts_table"),
+            fts_on: lines("fts_on"),
+            fts_off: lines("fts_off"),
+            arc_radius_tolerance: r.num("arc_radius_tolerance").unwrap_or(0.001),
+            per_minute: opt_text("per_minute"),
+            per_revolution: opt_text("per_revolution"),
+            inverse_time: opt_text("inverse_time"),
+            spindle_on: text("spindle_on", "M3"),
+            spindle_ccw: text("spindle_ccw", "M4"),
+            constant_rpm: opt_text("constant_rpm"),
+            spindle_orient: lines("spindle_orient"),
+            coolant_flood: opt_text("coolant_flood"),
+            coolant_mist: opt_text("coolant_mist"),
+            coolant_off: opt_text("coolant_off"),
+            word_formats: written("word_formats"),
+            spindle_off: text("spindle_off", "M5"),
+            c_letter: text("c_letter", "C").chars().next().unwrap_or('C'),
+            c_decimals: count("c_decimals").unwrap_or(5) as u32,
+            max_decimals: count("max_decimals").map(|v| v as u32),
+            max_digits: count("max_digits").map(|v| v as u32),
+            max_line_length: count("max_line_length").map(|v| v as usize),
+            line_numbers: count("line_numbers"),
+            max_line_number: count("max_line_number"),
+            block_end: text("block_end", ""),
+        }
+    }
+}
+
+/// A dialect a machine offers, with where the machine names it.
+#[derive(Clone, Debug)]
+pub struct OfferedDialect<'a> {
+    pub dialect: &'a Rc<Object>,
+    pub file: FileId,
+    pub span: Span,
+}
+
+impl OfferedDialect<'_> {
+    /// The name it was declared under, or its kind's.
+    pub fn name(&self) -> String {
+        self.dialect
+            .name
+            .clone()
+            .unwrap_or_else(|| self.dialect.kind.name.to_string())
+    }
+}
+
+/// The dialects a machine offers: its `dialect`, then each of its
+/// `other_dialects` (the machine parameters that name dialects).
+pub fn offered_dialects(machine: &Object) -> Vec<OfferedDialect<'_>> {
+    let r = Reader::new(&machine.fields);
+    let mut offered = Vec::new();
+    if let Some(f) = r.field("dialect")
+        && let Value::Object(dialect) = &f.value
+    {
+        offered.push(OfferedDialect {
+            dialect,
+            file: f.file,
+            span: f.span,
+        });
+    }
+    if let Some(f) = r.field("other_dialects")
+        && let Value::List(items) = &f.value
+    {
+        offered.extend(items.iter().filter_map(|(v, span)| match v {
+            Value::Object(dialect) => Some(OfferedDialect {
+                dialect,
+                file: f.file,
+                span: *span,
+            }),
+            _ => None,
+        }));
+    }
+    offered
+}

@@ -3,17 +3,24 @@
 //! their dimension, whether they are required and what range is allowed.
 //! The checker validates every block against these tables.
 //!
+//! Beside each kind, the typed struct its parameters are read into, once
+//! (`Surface::read`, `Aperture::read`, `Gcode::read`): the only place a
+//! checked parameter is looked up by its name.
+//!
 //! This file holds the types of the tables and the lookups; the kinds live
 //! by category: `surfaces` (one formula each), `composite` (surfaces made
 //! of others), `coefficients` (the `A4`, `X2Y1`, `Z11`, `Q3` families),
 //! `apertures`, `tools`, `machines`, `dialects` and `strategies`.
 
 use std::collections::HashSet;
+use std::rc::Rc;
 use std::sync::OnceLock;
 
+use lensc_grammar::Diagnostic;
 use lensc_grammar::ast::DeclKind;
 
 use crate::units::Dim;
+use crate::value::{Object, Reader};
 
 /// What a kind makes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -168,10 +175,60 @@ pub mod strategies;
 mod surfaces;
 pub mod tools;
 
+pub use apertures::Aperture;
 pub use coefficients::{
-    POWER_COEFFICIENTS, QBFS_COEFFICIENTS, QCON_COEFFICIENTS, XY_COEFFICIENTS,
+    FORBES_TOP, POWER_COEFFICIENTS, QBFS_COEFFICIENTS, QCON_COEFFICIENTS, XY_COEFFICIENTS,
     ZERNIKE_COEFFICIENTS, xy_powers,
 };
+pub use composite::{Array, Layout, OffAxis, Revolve, Roller, Tilt, Wrap};
+pub use dialects::{Gcode, Line, OfferedDialect, offered_dialects};
+pub use surfaces::{
+    Axis, Base, Biconic, Conic, Cylinder, Ellipsoid, Facing, Forbes, Freeform, Ordering, Plane,
+    Surface, Toroid, XyPolynomial, Zernike,
+};
+
+/// E0121 for a required parameter `name` that `o` lacks (worded as
+/// `Reader::finish` words it): what a kind's `read` returns for a
+/// parameter the checker should have refused to leave out.
+fn missing(o: &Object, name: &str) -> Diagnostic {
+    Diagnostic::error(
+        crate::codes::MISSING_PARAMETER,
+        format!("`{}` is missing `{name}`", o.kind.name),
+        o.file,
+        o.head,
+    )
+    .with_label("here")
+}
+
+/// E0124: `o`, read as `what` (`an aperture`), is not one.
+fn not_a(o: &Object, what: &str) -> Diagnostic {
+    Diagnostic::error(
+        crate::codes::WRONG_KIND,
+        format!("`{}` is not {what}", o.kind.name),
+        o.file,
+        o.head,
+    )
+    .with_label("here")
+}
+
+/// E0121 for whatever required parameter `r` found missing in `o`.
+fn finish(r: Reader, o: &Object) -> Result<(), Diagnostic> {
+    r.finish(o.kind.name, (o.file, o.head))
+}
+
+/// The required object `name` of `o`, or its E0121.
+fn required_object<'a>(
+    r: &Reader<'a>,
+    o: &Object,
+    name: &str,
+) -> Result<&'a Rc<Object>, Diagnostic> {
+    r.object(name).ok_or_else(|| missing(o, name))
+}
+
+/// The required range `name` of `o`, or its E0121.
+fn required_range(r: &Reader, o: &Object, name: &str) -> Result<(f64, f64), Diagnostic> {
+    r.range(name).ok_or_else(|| missing(o, name))
+}
 
 /// Every kind, in the order messages list them.
 pub static KINDS: &[Kind] = &[

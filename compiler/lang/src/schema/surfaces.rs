@@ -1,12 +1,24 @@
 //! The surface kinds of one formula: plane, rotational (conic, asphere,
 //! Forbes), cylindrical, biconic and toric, ellipsoid, polynomial and
-//! Zernike, and freeform formulas.
+//! Zernike, and freeform formulas. Beside each, the struct its parameters
+//! are read into; at the end, `Surface`, any surface read once, those made
+//! of others (`composite`) included.
 
+use std::rc::Rc;
+
+use lensc_grammar::Diagnostic;
+
+use super::apertures::Aperture;
 use super::coefficients::{
-    POWER_COEFFICIENTS, QBFS_COEFFICIENTS, QCON_COEFFICIENTS, XY_COEFFICIENTS, ZERNIKE_COEFFICIENTS,
+    POWER_COEFFICIENTS, QBFS_COEFFICIENTS, QCON_COEFFICIENTS, XY_COEFFICIENTS,
+    ZERNIKE_COEFFICIENTS, forbes_terms, power_terms, xy_terms, zernike_terms,
 };
-use super::{Category, Check, Kind, LENGTH, NUMBER, Param, Ty, opt, req};
+use super::composite::{Array, OffAxis, Revolve, Tilt, Wrap};
+use super::{
+    Category, Check, Kind, LENGTH, NUMBER, Param, Ty, finish, not_a, opt, req, required_object,
+};
 use crate::units::Dim;
+use crate::value::{Formula, Object, Reader, Value};
 
 const SENSE: Param = opt(
     "sense",
@@ -26,6 +38,36 @@ pub(super) const APERTURE: Param = req(
     Check::Any,
     "the region to machine",
 );
+
+/// Which side of a surface is material, as it states it (`SENSE`,
+/// `CONVENTION`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Facing {
+    /// `convention: optical`: radii signed as in lens design.
+    Optical,
+    /// `sense: convex`.
+    Convex,
+    /// `sense: concave`, or no `sense` (what `convention: sense` means
+    /// without one).
+    Concave,
+}
+
+impl Facing {
+    pub fn read(r: &Reader) -> Facing {
+        if r.word("convention") == Some("optical") {
+            Facing::Optical
+        } else if r.word("sense") == Some("convex") {
+            Facing::Convex
+        } else {
+            Facing::Concave
+        }
+    }
+}
+
+/// The surface's required `aperture`, read.
+pub(super) fn aperture(r: &Reader, o: &Object) -> Result<Aperture, Diagnostic> {
+    Aperture::read(required_object(r, o, "aperture")?)
+}
 const VERTEX_RADIUS: Param = req(
     "radius",
     LENGTH,
@@ -39,12 +81,54 @@ const CONIC_CONSTANT: Param = opt(
     "conic constant k (0 sphere, -1 paraboloid, < -1 hyperboloid); default 0",
 );
 
+/// A vertex radius and conic constant (`VERTEX_RADIUS`, `CONIC_CONSTANT`):
+/// the base most surfaces add their terms to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Base {
+    /// A magnitude with `sense`, signed with `convention: optical`.
+    pub radius: f64,
+    /// k, 0 when not given (and for kinds without one).
+    pub conic: f64,
+}
+
+impl Base {
+    fn read(r: &mut Reader) -> Base {
+        Base {
+            radius: r.required_num("radius"),
+            conic: r.num("conic").unwrap_or(0.0),
+        }
+    }
+    /// A polynomial surface's base: none (a plane) without a `radius`.
+    fn read_optional(r: &Reader) -> Option<Base> {
+        let conic = r.num("conic").unwrap_or(0.0);
+        r.num("radius").map(|radius| Base { radius, conic })
+    }
+}
+
 const AXIS: Param = req(
     "axis",
     Ty::Word(&["x", "y"]),
     Check::Any,
     "the direction the profile is extruded along; the profile varies across it",
 );
+
+/// A word `x` or `y` naming an axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Axis {
+    X,
+    Y,
+}
+
+impl Axis {
+    /// The axis the word `name` names; `otherwise` if it names none.
+    pub(super) fn read(r: &Reader, name: &str, otherwise: Axis) -> Axis {
+        match r.word(name) {
+            Some("x") => Axis::X,
+            Some("y") => Axis::Y,
+            _ => otherwise,
+        }
+    }
+}
 
 pub(super) const PLANE: Kind = Kind {
     name: "plane",
@@ -55,6 +139,23 @@ pub(super) const PLANE: Kind = Kind {
     exclusive: &[],
     doc: "a flat surface at z = 0",
 };
+
+/// `PLANE`'s parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Plane {
+    pub aperture: Aperture,
+}
+
+impl Plane {
+    pub fn read(o: &Object) -> Result<Plane, Diagnostic> {
+        let r = Reader::new(&o.fields);
+        let plane = Plane {
+            aperture: aperture(&r, o)?,
+        };
+        finish(r, o)?;
+        Ok(plane)
+    }
+}
 
 pub(super) const SPHERE: Kind = Kind {
     name: "sphere",
@@ -86,6 +187,31 @@ pub(super) const ASPHERE: Kind = Kind {
     doc: "a conic plus Σ Aj |r|^j, each coefficient named by its power j",
 };
 
+/// The parameters of `SPHERE`, `CONIC` and `ASPHERE` (a sphere's conic
+/// constant is 0, and only an asphere has power terms).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Conic {
+    pub base: Base,
+    pub facing: Facing,
+    /// (j, Aj), by power.
+    pub terms: Vec<(u32, f64)>,
+    pub aperture: Aperture,
+}
+
+impl Conic {
+    pub fn read(o: &Object) -> Result<Conic, Diagnostic> {
+        let mut r = Reader::new(&o.fields);
+        let conic = Conic {
+            base: Base::read(&mut r),
+            facing: Facing::read(&r),
+            terms: power_terms(&r),
+            aperture: aperture(&r, o)?,
+        };
+        finish(r, o)?;
+        Ok(conic)
+    }
+}
+
 pub(super) const CYLINDER: Kind = Kind {
     name: "cylinder",
     category: Category::Surface,
@@ -112,6 +238,34 @@ pub(super) const ACYLINDER: Kind = Kind {
     exclusive: &[],
     doc: "an aspheric profile (conic plus Σ Aj |u|^j) across `axis`, extruded along it",
 };
+
+/// The parameters of `CYLINDER` and `ACYLINDER` (a cylinder's conic
+/// constant is 0 and it has no power terms).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Cylinder {
+    pub base: Base,
+    /// The direction the profile is extruded along.
+    pub axis: Axis,
+    pub facing: Facing,
+    /// (j, Aj), by power.
+    pub terms: Vec<(u32, f64)>,
+    pub aperture: Aperture,
+}
+
+impl Cylinder {
+    pub fn read(o: &Object) -> Result<Cylinder, Diagnostic> {
+        let mut r = Reader::new(&o.fields);
+        let cylinder = Cylinder {
+            base: Base::read(&mut r),
+            axis: Axis::read(&r, "axis", Axis::Y),
+            facing: Facing::read(&r),
+            terms: power_terms(&r),
+            aperture: aperture(&r, o)?,
+        };
+        finish(r, o)?;
+        Ok(cylinder)
+    }
+}
 
 pub(super) const BICONIC: Kind = Kind {
     name: "biconic",
@@ -151,6 +305,35 @@ pub(super) const BICONIC: Kind = Kind {
     doc: "z = (cx x² + cy y²) / (1 + sqrt(1 - (1+kx) cx² x² - (1+ky) cy² y²))",
 };
 
+/// `BICONIC`'s parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Biconic {
+    pub radius_x: f64,
+    pub radius_y: f64,
+    /// 0 when not given.
+    pub conic_x: f64,
+    /// 0 when not given.
+    pub conic_y: f64,
+    pub facing: Facing,
+    pub aperture: Aperture,
+}
+
+impl Biconic {
+    pub fn read(o: &Object) -> Result<Biconic, Diagnostic> {
+        let mut r = Reader::new(&o.fields);
+        let biconic = Biconic {
+            radius_x: r.required_num("radius_x"),
+            radius_y: r.required_num("radius_y"),
+            conic_x: r.num("conic_x").unwrap_or(0.0),
+            conic_y: r.num("conic_y").unwrap_or(0.0),
+            facing: Facing::read(&r),
+            aperture: aperture(&r, o)?,
+        };
+        finish(r, o)?;
+        Ok(biconic)
+    }
+}
+
 pub(super) const TOROID: Kind = Kind {
     name: "toroid",
     category: Category::Surface,
@@ -172,6 +355,33 @@ pub(super) const TOROID: Kind = Kind {
     exclusive: &[],
     doc: "a y–z profile (conic plus Σ Aj |y|^j) swept about an axis parallel to y at `rotation_radius`",
 };
+
+/// `TOROID`'s parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Toroid {
+    /// The y–z profile's.
+    pub base: Base,
+    pub rotation_radius: f64,
+    pub facing: Facing,
+    /// (j, Aj) of the profile, by power.
+    pub terms: Vec<(u32, f64)>,
+    pub aperture: Aperture,
+}
+
+impl Toroid {
+    pub fn read(o: &Object) -> Result<Toroid, Diagnostic> {
+        let mut r = Reader::new(&o.fields);
+        let toroid = Toroid {
+            base: Base::read(&mut r),
+            rotation_radius: r.required_num("rotation_radius"),
+            facing: Facing::read(&r),
+            terms: power_terms(&r),
+            aperture: aperture(&r, o)?,
+        };
+        finish(r, o)?;
+        Ok(toroid)
+    }
+}
 
 pub(super) const ELLIPSOID: Kind = Kind {
     name: "ellipsoid",
@@ -199,6 +409,32 @@ pub(super) const ELLIPSOID: Kind = Kind {
     doc: "the cap of an ellipsoid: z = c (1 - sqrt(1 - x²/a² - y²/b²))",
 };
 
+/// `ELLIPSOID`'s parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Ellipsoid {
+    pub a: f64,
+    pub b: f64,
+    pub c: f64,
+    /// Its `sense` (it has no `convention`).
+    pub facing: Facing,
+    pub aperture: Aperture,
+}
+
+impl Ellipsoid {
+    pub fn read(o: &Object) -> Result<Ellipsoid, Diagnostic> {
+        let mut r = Reader::new(&o.fields);
+        let ellipsoid = Ellipsoid {
+            a: r.required_num("a"),
+            b: r.required_num("b"),
+            c: r.required_num("c"),
+            facing: Facing::read(&r),
+            aperture: aperture(&r, o)?,
+        };
+        finish(r, o)?;
+        Ok(ellipsoid)
+    }
+}
+
 pub(super) const XY_POLYNOMIAL: Kind = Kind {
     name: "xy_polynomial",
     category: Category::Surface,
@@ -219,6 +455,31 @@ pub(super) const XY_POLYNOMIAL: Kind = Kind {
     exclusive: &[],
     doc: "a conic base plus Σ Cij x^i y^j, each coefficient named `XiYj`",
 };
+
+/// `XY_POLYNOMIAL`'s parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct XyPolynomial {
+    /// None: a plane.
+    pub base: Option<Base>,
+    pub facing: Facing,
+    /// (i, j, Cij), in order of (i, j).
+    pub terms: Vec<(u32, u32, f64)>,
+    pub aperture: Aperture,
+}
+
+impl XyPolynomial {
+    pub fn read(o: &Object) -> Result<XyPolynomial, Diagnostic> {
+        let r = Reader::new(&o.fields);
+        let polynomial = XyPolynomial {
+            base: Base::read_optional(&r),
+            facing: Facing::read(&r),
+            terms: xy_terms(&o.fields),
+            aperture: aperture(&r, o)?,
+        };
+        finish(r, o)?;
+        Ok(polynomial)
+    }
+}
 
 pub(super) const ZERNIKE: Kind = Kind {
     name: "zernike",
@@ -252,6 +513,46 @@ pub(super) const ZERNIKE: Kind = Kind {
     exclusive: &[],
     doc: "a conic base plus Zernike polynomials over the normalisation radius",
 };
+
+/// How a Zernike surface numbers its terms (`ordering`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Ordering {
+    Fringe,
+    Ansi,
+}
+
+/// `ZERNIKE`'s parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Zernike {
+    /// None: a plane.
+    pub base: Option<Base>,
+    pub facing: Facing,
+    pub norm_radius: f64,
+    pub ordering: Ordering,
+    /// (j, Zj), in order of j.
+    pub terms: Vec<(u32, f64)>,
+    pub aperture: Aperture,
+}
+
+impl Zernike {
+    pub fn read(o: &Object) -> Result<Zernike, Diagnostic> {
+        let mut r = Reader::new(&o.fields);
+        let zernike = Zernike {
+            base: Base::read_optional(&r),
+            facing: Facing::read(&r),
+            norm_radius: r.required_num("norm_radius"),
+            ordering: if r.word("ordering") == Some("ansi") {
+                Ordering::Ansi
+            } else {
+                Ordering::Fringe
+            },
+            terms: zernike_terms(&o.fields),
+            aperture: aperture(&r, o)?,
+        };
+        finish(r, o)?;
+        Ok(zernike)
+    }
+}
 
 pub(super) const QBFS: Kind = Kind {
     name: "qbfs",
@@ -306,6 +607,34 @@ pub(super) const QCON: Kind = Kind {
     doc: "Forbes Q-con: a conic plus u⁴ Σ a_m Q_m^con(u²), Q_m^con(x) = P_m^(0,4)(2x-1), u = ρ/ρ_max",
 };
 
+/// The parameters of `QBFS` and `QCON` (a Q-bfs's base is its best-fit
+/// sphere: conic constant 0).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Forbes {
+    pub base: Base,
+    pub facing: Facing,
+    /// ρ_max.
+    pub norm_radius: f64,
+    /// (m, a_m), by order.
+    pub terms: Vec<(usize, f64)>,
+    pub aperture: Aperture,
+}
+
+impl Forbes {
+    pub fn read(o: &Object) -> Result<Forbes, Diagnostic> {
+        let mut r = Reader::new(&o.fields);
+        let forbes = Forbes {
+            base: Base::read(&mut r),
+            facing: Facing::read(&r),
+            norm_radius: r.required_num("norm_radius"),
+            terms: forbes_terms(&r),
+            aperture: aperture(&r, o)?,
+        };
+        finish(r, o)?;
+        Ok(forbes)
+    }
+}
+
 pub(super) const FREEFORM: Kind = Kind {
     name: "freeform",
     category: Category::Surface,
@@ -337,3 +666,110 @@ pub(super) const FREEFORM: Kind = Kind {
     exclusive: &[],
     doc: "a height written as a formula of x and y",
 };
+
+/// `FREEFORM`'s parameters (its `sense` is the checker's alone: the
+/// formula's z is already signed).
+#[derive(Clone, Debug)]
+pub struct Freeform {
+    pub z: Rc<Formula>,
+    pub domain: Aperture,
+}
+
+impl Freeform {
+    pub fn read(o: &Object) -> Result<Freeform, Diagnostic> {
+        let r = Reader::new(&o.fields);
+        let z = match r.field("z").map(|f| &f.value) {
+            Some(Value::Formula(z)) => z.clone(),
+            _ => return Err(super::missing(o, "z")),
+        };
+        let freeform = Freeform {
+            z,
+            domain: Aperture::read(required_object(&r, o, "domain")?)?,
+        };
+        finish(r, o)?;
+        Ok(freeform)
+    }
+}
+
+/// A checked surface of any kind read once, with every surface it is made
+/// of: what lowering and the domain work from, no parameter looked up by
+/// its name after.
+#[derive(Clone, Debug)]
+pub enum Surface {
+    Plane(Plane),
+    Sphere(Conic),
+    Conic(Conic),
+    Asphere(Conic),
+    Cylinder(Cylinder),
+    Acylinder(Cylinder),
+    Biconic(Biconic),
+    Toroid(Toroid),
+    Ellipsoid(Ellipsoid),
+    XyPolynomial(XyPolynomial),
+    Zernike(Zernike),
+    Qbfs(Forbes),
+    Qcon(Forbes),
+    Freeform(Freeform),
+    Wrap(Wrap),
+    OffAxis(OffAxis),
+    Revolve(Revolve),
+    /// `grid`, `hex_grid` and `linear_array`, told apart by their layout.
+    Array(Array),
+    Tilt(Tilt),
+}
+
+impl Surface {
+    /// Reads a checked surface: E0121 for a parameter it (or a surface or
+    /// aperture in it) lacks, E0124 if `o` is not a surface.
+    pub fn read(o: &Object) -> Result<Surface, Diagnostic> {
+        Ok(match o.kind.name {
+            "plane" => Surface::Plane(Plane::read(o)?),
+            "sphere" => Surface::Sphere(Conic::read(o)?),
+            "conic" => Surface::Conic(Conic::read(o)?),
+            "asphere" => Surface::Asphere(Conic::read(o)?),
+            "cylinder" => Surface::Cylinder(Cylinder::read(o)?),
+            "acylinder" => Surface::Acylinder(Cylinder::read(o)?),
+            "biconic" => Surface::Biconic(Biconic::read(o)?),
+            "toroid" => Surface::Toroid(Toroid::read(o)?),
+            "ellipsoid" => Surface::Ellipsoid(Ellipsoid::read(o)?),
+            "xy_polynomial" => Surface::XyPolynomial(XyPolynomial::read(o)?),
+            "zernike" => Surface::Zernike(Zernike::read(o)?),
+            "qbfs" => Surface::Qbfs(Forbes::read(o)?),
+            "qcon" => Surface::Qcon(Forbes::read(o)?),
+            "freeform" => Surface::Freeform(Freeform::read(o)?),
+            "wrap" => Surface::Wrap(Wrap::read(o)?),
+            "off_axis" => Surface::OffAxis(OffAxis::read(o)?),
+            "revolve" => Surface::Revolve(Revolve::read(o)?),
+            "grid" | "hex_grid" | "linear_array" => Surface::Array(Array::read(o)?),
+            "tilt" => Surface::Tilt(Tilt::read(o)?),
+            _ => return Err(not_a(o, Category::Surface.noun())),
+        })
+    }
+
+    /// The region it is machined on, if it states one: its aperture, or a
+    /// freeform's domain (an array's aperture is optional; a wrapped
+    /// design has none of its own).
+    pub fn region(&self) -> Option<&Aperture> {
+        match self {
+            Surface::Plane(Plane { aperture })
+            | Surface::Sphere(Conic { aperture, .. })
+            | Surface::Conic(Conic { aperture, .. })
+            | Surface::Asphere(Conic { aperture, .. })
+            | Surface::Cylinder(Cylinder { aperture, .. })
+            | Surface::Acylinder(Cylinder { aperture, .. })
+            | Surface::Biconic(Biconic { aperture, .. })
+            | Surface::Toroid(Toroid { aperture, .. })
+            | Surface::Ellipsoid(Ellipsoid { aperture, .. })
+            | Surface::XyPolynomial(XyPolynomial { aperture, .. })
+            | Surface::Zernike(Zernike { aperture, .. })
+            | Surface::Qbfs(Forbes { aperture, .. })
+            | Surface::Qcon(Forbes { aperture, .. })
+            | Surface::OffAxis(OffAxis { aperture, .. })
+            | Surface::Revolve(Revolve { aperture, .. })
+            | Surface::Tilt(Tilt { aperture, .. }) => Some(aperture),
+            Surface::Freeform(Freeform { domain, .. }) => Some(domain),
+            Surface::Array(Array { aperture, .. }) => aperture.as_ref(),
+            Surface::Wrap(_) => None,
+        }
+    }
+}

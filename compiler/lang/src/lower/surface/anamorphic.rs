@@ -3,39 +3,33 @@
 
 use lensc_runtime::surface::ir::{Graph, Id};
 
-use super::{LowerError, Side, add_power_terms, conic_sag, power_terms};
-use crate::value::{self, Object};
+use super::{Side, add_power_terms, conic_sag};
+use crate::schema::{Axis, Biconic, Cylinder, Ellipsoid, Toroid};
 
 /// A cylinder or acylinder: the conic profile (with its power terms)
 /// across `axis`, extruded along it.
-pub(super) fn cylinder_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError> {
-    let f = &o.fields;
-    let side = Side::of(f);
-    let k = value::num(f, "conic").unwrap_or(0.0);
-    let c = side.curvature(value::num(f, "radius").ok_or(LowerError::Unsupported("radius"))?);
+pub(super) fn cylinder_height(g: &mut Graph, p: &Cylinder, x: Id, y: Id) -> Id {
+    let side = Side::from(p.facing);
+    let k = p.base.conic;
+    let c = side.curvature(p.base.radius);
     // Extruded along `axis`: the profile varies across it.
-    let u = if value::word(f, "axis") == Some("x") {
-        y
-    } else {
-        x
+    let u = match p.axis {
+        Axis::X => y,
+        Axis::Y => x,
     };
     let u2 = g.powi(u, 2);
     let sag = conic_sag(g, c, k, u2);
-    let sag = add_power_terms(g, sag, u2, &power_terms(f));
-    Ok(side.apply(g, sag))
+    let sag = add_power_terms(g, sag, u2, &p.terms);
+    side.apply(g, sag)
 }
 
 /// A biconic: conic sections of their own radius and conic constant in x
 /// and in y, in one sag formula.
-pub(super) fn biconic_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError> {
-    let f = &o.fields;
-    let side = Side::of(f);
-    let cx = side.curvature(value::num(f, "radius_x").ok_or(LowerError::Unsupported("radius_x"))?);
-    let cy = side.curvature(value::num(f, "radius_y").ok_or(LowerError::Unsupported("radius_y"))?);
-    let (kx, ky) = (
-        value::num(f, "conic_x").unwrap_or(0.0),
-        value::num(f, "conic_y").unwrap_or(0.0),
-    );
+pub(super) fn biconic_height(g: &mut Graph, p: &Biconic, x: Id, y: Id) -> Id {
+    let side = Side::from(p.facing);
+    let cx = side.curvature(p.radius_x);
+    let cy = side.curvature(p.radius_y);
+    let (kx, ky) = (p.conic_x, p.conic_y);
     let x2 = g.powi(x, 2);
     let y2 = g.powi(y, 2);
     let num = {
@@ -58,22 +52,21 @@ pub(super) fn biconic_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<
     let one = g.constant_node(1.0);
     let den = g.add(one, root);
     let sag = g.div(num, den);
-    Ok(side.apply(g, sag))
+    side.apply(g, sag)
 }
 
 /// A toroid: the y profile (conic and power terms) swept about an axis
 /// parallel to y at `rotation_radius`.
-pub(super) fn toroid_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError> {
-    let f = &o.fields;
-    let side = Side::of(f);
-    let k = value::num(f, "conic").unwrap_or(0.0);
-    let c = side.curvature(value::num(f, "radius").ok_or(LowerError::Unsupported("radius"))?);
-    let rr = value::num(f, "rotation_radius").ok_or(LowerError::Unsupported("rotation_radius"))?;
+pub(super) fn toroid_height(g: &mut Graph, p: &Toroid, x: Id, y: Id) -> Id {
+    let side = Side::from(p.facing);
+    let k = p.base.conic;
+    let c = side.curvature(p.base.radius);
+    let rr = p.rotation_radius;
     // The rotation axis lies on the profile's side of the vertex.
     let rr = if c < 0.0 { -rr } else { rr };
     let y2 = g.powi(y, 2);
     let zy = conic_sag(g, c, k, y2);
-    let zy = add_power_terms(g, zy, y2, &power_terms(f));
+    let zy = add_power_terms(g, zy, y2, &p.terms);
     let x2 = g.powi(x, 2);
     let r = g.constant_node(rr);
     let d = g.sub(r, zy);
@@ -92,18 +85,13 @@ pub(super) fn toroid_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<I
     let numerator = g.add(t, x2);
     let denominator = g.add(r, signed_root);
     let sag = g.div(numerator, denominator);
-    Ok(side.apply(g, sag))
+    side.apply(g, sag)
 }
 
 /// An ellipsoid cap: depth c·(1 − sqrt(1 − x²/a² − y²/b²)).
-pub(super) fn ellipsoid_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError> {
-    let f = &o.fields;
-    let side = Side::of(f);
-    let (a, b, c) = (
-        value::num(f, "a").unwrap_or(1.0),
-        value::num(f, "b").unwrap_or(1.0),
-        value::num(f, "c").unwrap_or(1.0),
-    );
+pub(super) fn ellipsoid_height(g: &mut Graph, p: &Ellipsoid, x: Id, y: Id) -> Id {
+    let side = Side::from(p.facing);
+    let (a, b, c) = (p.a, p.b, p.c);
     let x2 = g.powi(x, 2);
     let y2 = g.powi(y, 2);
     let ia = g.constant_node(1.0 / (a * a));
@@ -116,5 +104,5 @@ pub(super) fn ellipsoid_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Resul
     let root = g.sqrt(u);
     let depth = g.sub(one, root);
     let cc = g.constant_node(c * side.sigma);
-    Ok(g.mul(cc, depth))
+    g.mul(cc, depth)
 }

@@ -4,16 +4,17 @@
 use lensc_runtime::surface::analysis::Domain;
 use lensc_runtime::surface::ir::{Binary, Graph, Id, SurfaceTape};
 
-use super::{LowerError, LoweredSurface, height, radius_squared};
-use crate::domain::{domain_of, half_extent, region, surface_domain};
-use crate::value::{self, Object};
+use super::{LowerError, LoweredSurface, Side, height, radius_squared};
+use crate::domain::{aperture_domain, domain, half_extent};
+use crate::schema::{Array, Axis, Layout, Surface};
+use crate::value::Object;
 
 /// Arrays: each lenslet clipped to its own aperture with its rim at the
 /// land (z = 0); where apertures overlap, the deepest cut (the lowest
 /// height) wins; outside every aperture, the land. Each point looks at its
 /// own cell and, where apertures reach past half a pitch, the neighbours.
-pub(super) fn array_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError> {
-    array_height_settled(g, o, x, y, None, Cells::NearestWhereItWins)
+pub(super) fn array_height(g: &mut Graph, a: &Array, x: Id, y: Id) -> Result<Id, LowerError> {
+    array_height_settled(g, a, x, y, None, Cells::NearestWhereItWins)
 }
 
 /// Which cells' lenslets an array's height looks at.
@@ -35,34 +36,23 @@ pub(super) enum Cells {
 /// for node; each slope is the one of the lenslet whose height wins. Half
 /// the nodes of differentiating the height in x and y, and a tenth of its
 /// divisions.
-pub(super) fn array_outputs(
-    g: &mut Graph,
-    o: &Object,
-    x: Id,
-    y: Id,
-) -> Result<[Id; 6], LowerError> {
-    array_outputs_of(g, o, (x, y), Cells::NearestWhereItWins)
+pub(super) fn array_outputs(g: &mut Graph, a: &Array, x: Id, y: Id) -> Result<[Id; 6], LowerError> {
+    array_outputs_of(g, a, (x, y), Cells::NearestWhereItWins)
 }
 
 /// `array_outputs` looking at `cells`.
 pub(super) fn array_outputs_of(
     g: &mut Graph,
-    o: &Object,
+    a: &Array,
     (x, y): (Id, Id),
     cells: Cells,
 ) -> Result<[Id; 6], LowerError> {
-    let f = &o.fields;
-    let lenslet =
-        value::object(f, "lenslet").ok_or(LowerError::Unsupported("array without a lenslet"))?;
-    let ap = domain_of(region(lenslet).ok_or(LowerError::Aperture("lenslet without an aperture"))?)
-        .map_err(LowerError::Aperture)?;
-    let own = super::lower_surface(lenslet)?.tape;
+    let lenslet = &*a.lenslet;
+    let ap = lenslet_domain(lenslet)?;
+    let own = super::lower(lenslet)?.tape;
     let rim = rim_height(lenslet, &ap)?;
     let nearest = cells == Cells::NearestWhereItWins && nearest_wins(lenslet, &ap);
-    let candidates = match o.kind.name {
-        "grid" | "linear_array" => grid_cells(g, o, (x, y), half_extent(&ap), nearest)?,
-        _ => hex_cells(g, o, (x, y), half_extent(&ap))?,
-    };
+    let candidates = candidate_cells(g, &a.layout, (x, y), half_extent(&ap), nearest)?;
     let big = g.constant_node(BIG);
     let rim_c = g.constant_node(rim);
     let zero = g.constant_node(0.0);
@@ -101,15 +91,16 @@ const BIG: f64 = 1e6;
 /// settling offset h (Hashimoto & Yan, fig. 16): each lenslet continued
 /// past its rim until it rises h above the land, the land itself at h.
 pub fn lower_trajectory(o: &Object, settle: f64) -> Result<LoweredSurface, LowerError> {
-    if !matches!(o.kind.name, "grid" | "hex_grid" | "linear_array") {
+    let s = super::read(o)?;
+    let Surface::Array(a) = &s else {
         return Err(LowerError::Unsupported(
             "a settling offset needs an array of lenslets",
         ));
-    }
-    let domain = surface_domain(o).ok_or(LowerError::Aperture("no aperture or domain"))?;
+    };
+    let domain = domain(&s).ok_or(LowerError::Aperture("no aperture or domain"))?;
     let mut g = Graph::new();
     let (x, y) = (g.x(), g.y());
-    let z = array_height_settled(&mut g, o, x, y, Some(settle), Cells::Reaching)?;
+    let z = array_height_settled(&mut g, a, x, y, Some(settle), Cells::Reaching)?;
     Ok(LoweredSurface {
         tape: SurfaceTape::new(g, z),
         domain,
@@ -119,20 +110,27 @@ pub fn lower_trajectory(o: &Object, settle: f64) -> Result<LoweredSurface, Lower
 /// The centres of a rectangular grid's or a linear array's lenslets (mm);
 /// `None` for other surfaces.
 pub fn array_centres(o: &Object) -> Option<Vec<(f64, f64)>> {
-    let f = &o.fields;
-    let num = |name: &str| value::num(f, name);
-    let (px, py, nx, ny) = match o.kind.name {
-        "grid" => (
-            num("pitch_x")?,
-            num("pitch_y")?,
-            num("count_x")?,
-            num("count_y")?,
-        ),
-        "linear_array" if value::word(f, "axis") == Some("y") => {
-            (0.0, num("pitch")?, 1.0, num("count")?)
-        }
-        "linear_array" => (num("pitch")?, 0.0, num("count")?, 1.0),
-        _ => return None,
+    let Ok(Surface::Array(a)) = super::read(o) else {
+        return None;
+    };
+    let (px, py, nx, ny) = match a.layout {
+        Layout::Grid {
+            pitch_x,
+            pitch_y,
+            count_x,
+            count_y,
+        } => (pitch_x, pitch_y, count_x, count_y),
+        Layout::Linear {
+            pitch,
+            count,
+            axis: Axis::Y,
+        } => (0.0, pitch, 1.0, count),
+        Layout::Linear {
+            pitch,
+            count,
+            axis: Axis::X,
+        } => (pitch, 0.0, count, 1.0),
+        Layout::Hex { .. } => return None,
     };
     let (nx, ny) = (nx as usize, ny as usize);
     let mut centres = Vec::with_capacity(nx * ny);
@@ -150,16 +148,15 @@ pub fn array_centres(o: &Object) -> Option<Vec<(f64, f64)>> {
 /// The lenslet of an array as its own surface, with the radius of its
 /// circular aperture: what the settling offset is measured on.
 pub fn array_lenslet(o: &Object) -> Option<(LoweredSurface, f64)> {
-    if !matches!(o.kind.name, "grid" | "hex_grid" | "linear_array") {
+    let Ok(Surface::Array(a)) = super::read(o) else {
         return None;
-    }
-    let lenslet = value::object(&o.fields, "lenslet")?;
-    let Domain::Circle { radius } = domain_of(region(lenslet)?).ok()? else {
+    };
+    let Domain::Circle { radius } = aperture_domain(a.lenslet.region()?) else {
         return None;
     };
     let mut g = Graph::new();
     let (x, y) = (g.x(), g.y());
-    let z = height(&mut g, lenslet, x, y).ok()?;
+    let z = height(&mut g, &a.lenslet, x, y).ok()?;
     Some((
         LoweredSurface {
             tape: SurfaceTape::new(g, z),
@@ -171,17 +168,14 @@ pub fn array_lenslet(o: &Object) -> Option<(LoweredSurface, f64)> {
 
 pub(super) fn array_height_settled(
     g: &mut Graph,
-    o: &Object,
+    a: &Array,
     x: Id,
     y: Id,
     settle: Option<f64>,
     cells: Cells,
 ) -> Result<Id, LowerError> {
-    let f = &o.fields;
-    let lenslet =
-        value::object(f, "lenslet").ok_or(LowerError::Unsupported("array without a lenslet"))?;
-    let ap = domain_of(region(lenslet).ok_or(LowerError::Aperture("lenslet without an aperture"))?)
-        .map_err(LowerError::Aperture)?;
+    let lenslet = &*a.lenslet;
+    let ap = lenslet_domain(lenslet)?;
     let (hx, hy) = half_extent(&ap);
     // Continued lenslets reach past their apertures: look at neighbours.
     let (hx, hy) = if settle.is_some() {
@@ -195,10 +189,7 @@ pub(super) fn array_height_settled(
     // cell's need not win.
     let nearest =
         cells == Cells::NearestWhereItWins && settle.is_none() && nearest_wins(lenslet, &ap);
-    let candidates = match o.kind.name {
-        "grid" | "linear_array" => grid_cells(g, o, (x, y), (hx, hy), nearest)?,
-        _ => hex_cells(g, o, (x, y), (hx, hy))?,
-    };
+    let candidates = candidate_cells(g, &a.layout, (x, y), (hx, hy), nearest)?;
     // min over the candidates that contain the point; +BIG where none do.
     let big = g.constant_node(BIG);
     let half_big = g.constant_node(BIG / 2.0);
@@ -233,9 +224,17 @@ pub(super) fn array_height_settled(
     Ok(g.select(test, best, land))
 }
 
+/// The domain of an array's lenslet: its own aperture.
+fn lenslet_domain(lenslet: &Surface) -> Result<Domain, LowerError> {
+    lenslet
+        .region()
+        .map(aperture_domain)
+        .ok_or(LowerError::Aperture("lenslet without an aperture"))
+}
+
 /// The lenslet's height at the edge of its aperture along +x: the height
 /// the land is cut at.
-fn rim_height(lenslet: &Object, ap: &Domain) -> Result<f64, LowerError> {
+fn rim_height(lenslet: &Surface, ap: &Domain) -> Result<f64, LowerError> {
     let mut h = Graph::new();
     let (u, v) = (h.x(), h.y());
     let z = height(&mut h, lenslet, u, v)?;
@@ -262,58 +261,77 @@ fn rim_height(lenslet: &Object, ap: &Domain) -> Result<f64, LowerError> {
 /// conic without aspheric terms and with (1 + k) ≥ 0, z = c s / (1 +
 /// sqrt(1 − (1 + k) c² s)) with s = u² + v² and c > 0 (with a negative
 /// (1 + k) its denominator would grow too).
-fn nearest_wins(lenslet: &Object, aperture: &Domain) -> bool {
+fn nearest_wins(lenslet: &Surface, aperture: &Domain) -> bool {
     let centred = match *aperture {
         Domain::Circle { .. } => true,
         Domain::Rect { x, y } => x.0 == -x.1 && y.0 == -y.1,
         Domain::Annulus { .. } => false,
     };
-    let f = &lenslet.fields;
-    let side = super::Side::of(f);
-    let rising = match lenslet.kind.name {
-        "ellipsoid" => {
-            let axis = |name: &str| value::num(f, name).unwrap_or(1.0);
+    let rising = match lenslet {
+        Surface::Ellipsoid(e) => {
+            let side = Side::from(e.facing);
             let usable = |v: f64| v.is_finite() && v != 0.0;
-            usable(axis("a")) && usable(axis("b")) && axis("c") * side.sigma > 0.0
+            usable(e.a) && usable(e.b) && e.c * side.sigma > 0.0
         }
-        "sphere" | "conic" => match value::num(f, "radius") {
-            Some(radius) => {
-                let c = side.curvature(radius) * side.sigma;
-                let k = value::num(f, "conic").unwrap_or(0.0);
-                c > 0.0 && c.is_finite() && 1.0 + k >= 0.0 && super::power_terms(f).is_empty()
-            }
-            None => false,
-        },
+        Surface::Sphere(p) | Surface::Conic(p) => {
+            let side = Side::from(p.facing);
+            let c = side.curvature(p.base.radius) * side.sigma;
+            let k = p.base.conic;
+            c > 0.0 && c.is_finite() && 1.0 + k >= 0.0 && p.terms.is_empty()
+        }
         _ => false,
     };
     centred && rising
+}
+
+/// The centres of the cells a point may lie in, as the array's layout
+/// places them: a rectangular grid's or a linear array's (`grid_cells`, a
+/// linear array's pitch infinite across it), or a hex grid's.
+fn candidate_cells(
+    g: &mut Graph,
+    layout: &Layout,
+    at: (Id, Id),
+    half: (f64, f64),
+    nearest: bool,
+) -> Result<Vec<(Id, Id)>, LowerError> {
+    match *layout {
+        Layout::Grid {
+            pitch_x,
+            pitch_y,
+            count_x,
+            count_y,
+        } => grid_cells(g, (pitch_x, pitch_y, count_x, count_y), at, half, nearest),
+        Layout::Linear {
+            pitch,
+            count,
+            axis: Axis::Y,
+        } => grid_cells(g, (f64::INFINITY, pitch, 1.0, count), at, half, nearest),
+        Layout::Linear {
+            pitch,
+            count,
+            axis: Axis::X,
+        } => grid_cells(g, (pitch, f64::INFINITY, count, 1.0), at, half, nearest),
+        Layout::Hex {
+            pitch,
+            count_x,
+            count_y,
+        } => hex_cells(g, (pitch, count_x, count_y), at, half),
+    }
 }
 
 /// The centres of the cells of a rectangular grid or a linear array a
 /// point may lie in: its own and, where apertures reach past half a
 /// pitch, its neighbours — unless the own cell's lenslet is known to cut
 /// deepest (`nearest`, see `nearest_wins`): then its own alone.
+/// (`px`, `py`: the pitches along x and y; `nx`, `ny`: the counts.)
 fn grid_cells(
     g: &mut Graph,
-    o: &Object,
+    (px, py, nx, ny): (f64, f64, f64, f64),
     (x, y): (Id, Id),
     (hx, hy): (f64, f64),
     nearest: bool,
 ) -> Result<Vec<(Id, Id)>, LowerError> {
-    let f = &o.fields;
-    let num = |name: &str| value::num(f, name).unwrap_or(1.0);
     let mut candidates: Vec<(Id, Id)> = Vec::new();
-    let along_y = value::word(f, "axis") == Some("y");
-    let (px, py, nx, ny) = match o.kind.name {
-        "grid" => (
-            num("pitch_x"),
-            num("pitch_y"),
-            num("count_x"),
-            num("count_y"),
-        ),
-        _ if along_y => (f64::INFINITY, num("pitch"), 1.0, num("count")),
-        _ => (num("pitch"), f64::INFINITY, num("count"), 1.0),
-    };
     let reach = |half: f64, pitch: f64| {
         if half > 1.5 * pitch {
             None
@@ -354,18 +372,16 @@ fn grid_cells(
     Ok(candidates)
 }
 
-/// The centres of the cells of a hexagonal grid a point may lie in: three
-/// rows of three.
+/// The centres of the cells of a hexagonal grid (pitch `p`, `nx` per row,
+/// `ny` rows) a point may lie in: three rows of three.
 fn hex_cells(
     g: &mut Graph,
-    o: &Object,
+    (p, nx, ny): (f64, f64, f64),
     (x, y): (Id, Id),
     (hx, hy): (f64, f64),
 ) -> Result<Vec<(Id, Id)>, LowerError> {
-    let num = |name: &str| value::num(&o.fields, name).unwrap_or(1.0);
     let mut candidates: Vec<(Id, Id)> = Vec::new();
     // Hexagonal: rows of spacing p·√3/2, odd rows shifted by p/2.
-    let (p, nx, ny) = (num("pitch"), num("count_x"), num("count_y"));
     if hx.max(hy) > 1.5 * p {
         return Err(LowerError::Aperture(
             "lenslet apertures reach past their neighbours",

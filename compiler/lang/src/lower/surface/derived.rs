@@ -4,53 +4,41 @@
 use lensc_runtime::surface::ir::{Graph, Id, SurfaceTape, Unary, Var};
 
 use super::{LowerError, height, radius_squared};
-use crate::value::{self, Object};
+use crate::schema::{self, Axis, OffAxis, Revolve, Surface, Wrap};
 
 /// A wrapped design: the flat design's height; the roller only maps y to
 /// the arc around it.
-pub(super) fn wrap_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError> {
-    let f = &o.fields;
-    // The flat design; the roller only maps y to the arc around it.
-    let design =
-        value::object(f, "surface").ok_or(LowerError::Unsupported("wrap without a design"))?;
-    height(g, design, x, y)
+pub(super) fn wrap_height(g: &mut Graph, p: &Wrap, x: Id, y: Id) -> Result<Id, LowerError> {
+    height(g, &p.surface, x, y)
 }
 
 /// A profile revolved about z: its height at u = start + r, v = 0.
-pub(super) fn revolve_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError> {
-    let at = revolved_at(g, o, x, y)?;
+pub(super) fn revolve_height(g: &mut Graph, p: &Revolve, x: Id, y: Id) -> Result<Id, LowerError> {
+    let at = revolved_at(g, p, x, y);
     height(g, at.profile, at.u, at.zero)
 }
 
 /// Where a revolved profile is read at (x, y): the profile, r, u = start +
 /// r and the constant 0 (its v).
-struct RevolvedAt<'o> {
-    profile: &'o Object,
+struct RevolvedAt<'p> {
+    profile: &'p Surface,
     r: Id,
     u: Id,
     zero: Id,
 }
 
-fn revolved_at<'o>(
-    g: &mut Graph,
-    o: &'o Object,
-    x: Id,
-    y: Id,
-) -> Result<RevolvedAt<'o>, LowerError> {
-    let f = &o.fields;
-    let profile =
-        value::object(f, "profile").ok_or(LowerError::Unsupported("revolve without a profile"))?;
-    let start = g.constant_node(value::num(f, "start").unwrap_or(0.0));
+fn revolved_at<'p>(g: &mut Graph, p: &'p Revolve, x: Id, y: Id) -> RevolvedAt<'p> {
+    let start = g.constant_node(p.start);
     let r2 = radius_squared(g, x, y);
     let r = g.sqrt(r2);
     let u = g.add(start, r);
     let zero = g.constant_node(0.0);
-    Ok(RevolvedAt {
-        profile,
+    RevolvedAt {
+        profile: &p.profile,
         r,
         u,
         zero,
-    })
+    }
 }
 
 /// The six outputs of a revolved profile (the order of
@@ -72,7 +60,7 @@ fn revolved_at<'o>(
 /// where it is not, as at a cone's tip.
 pub(super) fn revolved_outputs(
     g: &mut Graph,
-    o: &Object,
+    p: &Revolve,
     x: Id,
     y: Id,
 ) -> Result<[Id; 6], LowerError> {
@@ -81,12 +69,12 @@ pub(super) fn revolved_outputs(
         r,
         u,
         zero,
-    } = revolved_at(g, o, x, y)?;
+    } = revolved_at(g, p, x, y);
     // The profile over (u, v), in a scratch graph, at v = 0.
     let mut h = Graph::new();
     let (hu, hv) = (h.x(), h.constant_node(0.0));
-    let (hz, hzu, hzuu) = if matches!(profile.kind.name, "grid" | "hex_grid" | "linear_array") {
-        let [z, zu, _, zuu, _, _] = super::arrays::array_outputs(&mut h, profile, hu, hv)?;
+    let (hz, hzu, hzuu) = if let Surface::Array(array) = profile {
+        let [z, zu, _, zuu, _, _] = super::arrays::array_outputs(&mut h, array, hu, hv)?;
         (z, zu, zuu)
     } else {
         let z = height(&mut h, profile, hu, hv)?;
@@ -152,14 +140,9 @@ pub(super) fn revolved_outputs(
 
 /// An off-axis section: the parent moved to the section's centre, less
 /// its height there (and its slope, with `tilt: remove`).
-pub(super) fn off_axis_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError> {
-    let f = &o.fields;
-    let parent =
-        value::object(f, "parent").ok_or(LowerError::Unsupported("off_axis without a parent"))?;
-    let (x0, y0) = (
-        value::num(f, "x").unwrap_or(0.0),
-        value::num(f, "y").unwrap_or(0.0),
-    );
+pub(super) fn off_axis_height(g: &mut Graph, p: &OffAxis, x: Id, y: Id) -> Result<Id, LowerError> {
+    let parent = &p.parent;
+    let (x0, y0) = (p.x, p.y);
     let cx = g.constant_node(x0);
     let cy = g.constant_node(y0);
     let px = g.add(x, cx);
@@ -173,7 +156,7 @@ pub(super) fn off_axis_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result
     let o0 = lensc_runtime::surface::ir::SurfaceFn::eval(&at, x0, y0);
     let z0 = g.constant_node(o0[0]);
     let mut z = g.sub(zp, z0);
-    if value::word(f, "tilt") == Some("remove") {
+    if p.remove_tilt {
         let sx = g.constant_node(o0[1]);
         let sy = g.constant_node(o0[2]);
         let tx = g.mul(sx, x);
@@ -193,8 +176,13 @@ pub(super) fn off_axis_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result
 /// (|θ| < 45°), and the derivatives flow through the iterations (used
 /// where the tilt is part of another surface; a tilted surface of its own
 /// has its derivatives in closed form, `tilted_outputs`).
-pub(super) fn tilted_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError> {
-    let t = Tilt::solve(g, o, x, y, Steps::WrittenOut)?;
+pub(super) fn tilted_height(
+    g: &mut Graph,
+    p: &schema::Tilt,
+    x: Id,
+    y: Id,
+) -> Result<Id, LowerError> {
+    let t = Tilt::solve(g, p, x, y, Steps::WrittenOut)?;
     Ok(t.height(g))
 }
 
@@ -220,23 +208,23 @@ pub(super) fn tilted_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<I
 /// graph once: the same values, a sixth of Newton's nodes.
 pub(super) fn tilted_outputs(
     g: &mut Graph,
-    o: &Object,
+    p: &schema::Tilt,
     x: Id,
     y: Id,
 ) -> Result<[Id; 6], LowerError> {
-    tilted_outputs_with(g, o, x, y, Steps::Loop)
+    tilted_outputs_with(g, p, x, y, Steps::Loop)
 }
 
 /// `tilted_outputs` with the Newton steps put in the graph as `steps`
 /// says (the same values either way).
 pub(super) fn tilted_outputs_with(
     g: &mut Graph,
-    o: &Object,
+    p: &schema::Tilt,
     x: Id,
     y: Id,
     steps: Steps,
 ) -> Result<[Id; 6], LowerError> {
-    let mut t = Tilt::solve(g, o, x, y, steps)?;
+    let mut t = Tilt::solve(g, p, x, y, steps)?;
     let z = t.height(g);
     let h = &mut t.parent;
     let hzq = h.derivative(t.hz, Var::Y);
@@ -311,12 +299,16 @@ struct Tilt {
 }
 
 impl Tilt {
-    fn solve(g: &mut Graph, o: &Object, x: Id, y: Id, steps: Steps) -> Result<Tilt, LowerError> {
-        let f = &o.fields;
-        let parent =
-            value::object(f, "parent").ok_or(LowerError::Unsupported("tilt without a parent"))?;
-        let theta = value::num(f, "angle").unwrap_or(0.0);
-        let about_x = value::word(f, "about") == Some("x");
+    fn solve(
+        g: &mut Graph,
+        p: &schema::Tilt,
+        x: Id,
+        y: Id,
+        steps: Steps,
+    ) -> Result<Tilt, LowerError> {
+        let parent = &p.parent;
+        let theta = p.angle;
+        let about_x = p.about == Axis::X;
         // Turning about y moves x; about x moves y, with the sign of the
         // right-hand rule (a positive turn about x lifts +y).
         let (cos, sin) = (

@@ -3,17 +3,14 @@
 use lensc_grammar::ast::{BinaryOp, Expr, ExprKind, UnaryOp};
 use lensc_runtime::surface::ir::{Binary, Graph, Id, Unary};
 
-use super::{LowerError, radius_squared};
+use super::radius_squared;
+use crate::schema::Freeform;
 use crate::units;
-use crate::value::{self, Formula, Object, Value};
+use crate::value::Formula;
 
 /// A freeform surface: its formula `z(x, y) = …`.
-pub(super) fn freeform_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError> {
-    let f = &o.fields;
-    let Some(Value::Formula(formula)) = value::field(f, "z").map(|fl| &fl.value) else {
-        return Err(LowerError::Unsupported("freeform without a formula"));
-    };
-    Ok(lower_formula(g, formula, x, y))
+pub(super) fn freeform_height(g: &mut Graph, p: &Freeform, x: Id, y: Id) -> Id {
+    lower_formula(g, &p.z, x, y)
 }
 
 /// Lowers a checked formula body (in base units: mm and rad) at the

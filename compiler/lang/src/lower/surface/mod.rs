@@ -2,6 +2,9 @@
 //! z(x, y) in mm as a `SurfaceTape` (with its exact derivatives) and the
 //! domain it is defined on.
 //!
+//! A surface is read once into its typed parameters (`schema::Surface`)
+//! and lowered from them: nothing here looks a parameter up by its name.
+//!
 //! This file holds what every family shares (the lowered surface, the
 //! material side, the domain, the conic sag and power series) and the one
 //! dispatch `height`; each family lowers in its own file: `rotational`,
@@ -19,13 +22,15 @@ mod tests;
 pub use arrays::{array_centres, array_lenslet, lower_trajectory};
 pub use formula::lower_formula;
 pub use polynomial::{zernike_ansi, zernike_fringe};
+use rotational::Radial;
 pub use rotational::rotational_sag;
 
 use lensc_runtime::surface::analysis::Domain;
 use lensc_runtime::surface::ir::{Binary, Graph, Id, SurfaceTape};
 
-use crate::domain::surface_domain;
-use crate::value::{self, Object};
+use crate::domain::domain;
+use crate::schema::{Category, Facing, Surface};
+use crate::value::{self, Object, Reader};
 
 /// A surface ready to evaluate.
 pub struct LoweredSurface {
@@ -40,6 +45,9 @@ pub enum LowerError {
     Unsupported(&'static str),
     /// The aperture or domain is of a shape the surface cannot use.
     Aperture(&'static str),
+    /// A parameter the checker requires is missing (a declaration that did
+    /// not check): E0121's words.
+    Missing(String),
 }
 
 /// How the material side enters the height: z = σ · sag(c), with c the
@@ -52,28 +60,34 @@ pub struct Side {
     pub signed: bool,
 }
 
-impl Side {
-    /// Reads `sense` / `convention` of a checked surface. With `sense`,
-    /// radii are magnitudes and σ = +1 concave, −1 convex (Lin's s). With
-    /// `convention: optical` (light along +z into the material), the sag is
-    /// the lens designer's, seen from the other side: σ = −1 and radii keep
-    /// their sign, so R > 0 is convex to the tool.
-    pub fn of(f: &[value::Field]) -> Side {
-        if value::word(f, "convention") == Some("optical") {
-            Side {
+impl From<Facing> for Side {
+    /// With `sense`, radii are magnitudes and σ = +1 concave, −1 convex
+    /// (Lin's s). With `convention: optical` (light along +z into the
+    /// material), the sag is the lens designer's, seen from the other side:
+    /// σ = −1 and radii keep their sign, so R > 0 is convex to the tool.
+    fn from(facing: Facing) -> Side {
+        match facing {
+            Facing::Optical => Side {
                 sigma: -1.0,
                 signed: true,
-            }
-        } else {
-            Side {
-                sigma: if value::word(f, "sense") == Some("convex") {
-                    -1.0
-                } else {
-                    1.0
-                },
+            },
+            Facing::Convex => Side {
+                sigma: -1.0,
                 signed: false,
-            }
+            },
+            Facing::Concave => Side {
+                sigma: 1.0,
+                signed: false,
+            },
         }
+    }
+}
+
+impl Side {
+    /// The side of a checked surface with these fields (`sense` /
+    /// `convention`, read as `Facing`).
+    pub fn of(f: &[value::Field]) -> Side {
+        Side::from(Facing::read(&Reader::new(f)))
     }
     /// σ · sag, as a node: the height on the material's side.
     pub(crate) fn apply(self, g: &mut Graph, sag: Id) -> Id {
@@ -92,59 +106,67 @@ impl Side {
 
 /// Lowers a checked surface object.
 pub fn lower_surface(o: &Object) -> Result<LoweredSurface, LowerError> {
-    let domain = surface_domain(o).ok_or(LowerError::Aperture("no aperture or domain"))?;
-    if let Some(tape) = rotational::radial_tape(o) {
+    lower(&read(o)?)
+}
+
+/// A checked surface's parameters, read once for lowering.
+fn read(o: &Object) -> Result<Surface, LowerError> {
+    if o.kind.category != Category::Surface {
+        return Err(LowerError::Unsupported(o.kind.name));
+    }
+    Surface::read(o).map_err(|d| LowerError::Missing(d.message))
+}
+
+/// Lowers a surface read.
+fn lower(s: &Surface) -> Result<LoweredSurface, LowerError> {
+    let domain = domain(s).ok_or(LowerError::Aperture("no aperture or domain"))?;
+    if let Some(tape) = rotational::radial_tape(s) {
         return Ok(LoweredSurface { tape, domain });
     }
     let mut g = Graph::new();
     let (x, y) = (g.x(), g.y());
-    if matches!(o.kind.name, "grid" | "hex_grid" | "linear_array") {
-        let outputs = arrays::array_outputs(&mut g, o, x, y)?;
-        return Ok(LoweredSurface {
-            tape: SurfaceTape::with_outputs(g, outputs),
-            domain,
-        });
-    }
-    let closed_forms = match o.kind.name {
-        "tilt" => Some(derived::tilted_outputs as fn(&mut Graph, &Object, Id, Id) -> _),
-        "revolve" => Some(derived::revolved_outputs as _),
+    let closed_forms = match s {
+        Surface::Array(a) => Some(arrays::array_outputs(&mut g, a, x, y)?),
+        Surface::Tilt(t) => Some(derived::tilted_outputs(&mut g, t, x, y)?),
+        Surface::Revolve(r) => Some(derived::revolved_outputs(&mut g, r, x, y)?),
         _ => None,
     };
-    if let Some(outputs_of) = closed_forms {
-        let outputs = outputs_of(&mut g, o, x, y)?;
+    if let Some(outputs) = closed_forms {
         return Ok(LoweredSurface {
             tape: SurfaceTape::with_outputs(g, outputs),
             domain,
         });
     }
-    let z = height(&mut g, o, x, y)?;
+    let z = height(&mut g, s, x, y)?;
     Ok(LoweredSurface {
         tape: SurfaceTape::new(g, z),
         domain,
     })
 }
 
-/// The height of surface `o` at the coordinates `x`, `y` (nodes of `g`),
+/// The height of surface `s` at the coordinates `x`, `y` (nodes of `g`),
 /// built into `g`: sections and wrapped designs build their parent's height
 /// at moved coordinates.
-pub fn height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError> {
-    match o.kind.name {
-        "plane" => Ok(g.constant_node(0.0)),
-        "sphere" | "conic" | "asphere" => rotational::conic_height(g, o, x, y),
-        "qbfs" | "qcon" => rotational::forbes_height(g, o, x, y),
-        "cylinder" | "acylinder" => anamorphic::cylinder_height(g, o, x, y),
-        "biconic" => anamorphic::biconic_height(g, o, x, y),
-        "toroid" => anamorphic::toroid_height(g, o, x, y),
-        "ellipsoid" => anamorphic::ellipsoid_height(g, o, x, y),
-        "xy_polynomial" => polynomial::xy_polynomial_height(g, o, x, y),
-        "zernike" => polynomial::zernike_height(g, o, x, y),
-        "freeform" => formula::freeform_height(g, o, x, y),
-        "wrap" => derived::wrap_height(g, o, x, y),
-        "revolve" => derived::revolve_height(g, o, x, y),
-        "off_axis" => derived::off_axis_height(g, o, x, y),
-        "grid" | "hex_grid" | "linear_array" => arrays::array_height(g, o, x, y),
-        "tilt" => derived::tilted_height(g, o, x, y),
-        other => Err(LowerError::Unsupported(other)),
+pub fn height(g: &mut Graph, s: &Surface, x: Id, y: Id) -> Result<Id, LowerError> {
+    match s {
+        Surface::Plane(_) => Ok(g.constant_node(0.0)),
+        Surface::Sphere(p) | Surface::Conic(p) | Surface::Asphere(p) => {
+            Ok(rotational::conic_height(g, p, x, y))
+        }
+        Surface::Qbfs(p) => Ok(rotational::forbes_height(g, Radial::Qbfs(p), x, y)),
+        Surface::Qcon(p) => Ok(rotational::forbes_height(g, Radial::Qcon(p), x, y)),
+        Surface::Cylinder(p) | Surface::Acylinder(p) => Ok(anamorphic::cylinder_height(g, p, x, y)),
+        Surface::Biconic(p) => Ok(anamorphic::biconic_height(g, p, x, y)),
+        Surface::Toroid(p) => Ok(anamorphic::toroid_height(g, p, x, y)),
+        Surface::Ellipsoid(p) => Ok(anamorphic::ellipsoid_height(g, p, x, y)),
+        Surface::XyPolynomial(p) => Ok(polynomial::xy_polynomial_height(g, p, x, y)),
+        Surface::Zernike(p) => polynomial::zernike_height(g, p, x, y),
+        Surface::Freeform(p) => Ok(formula::freeform_height(g, p, x, y)),
+        Surface::Wrap(p) => derived::wrap_height(g, p, x, y),
+        Surface::Revolve(p) => derived::revolve_height(g, p, x, y),
+        Surface::OffAxis(p) => derived::off_axis_height(g, p, x, y),
+        Surface::Array(p) => arrays::array_height(g, p, x, y),
+        Surface::Tilt(p) => derived::tilted_height(g, p, x, y),
     }
 }
 
@@ -167,13 +189,6 @@ fn conic_sag(g: &mut Graph, c: f64, k: f64, s: Id) -> Id {
     let root = g.sqrt(u);
     let den = g.add(one, root);
     g.div(num, den)
-}
-
-/// The `Aj` coefficients of a checked surface, by power.
-fn power_terms(f: &[value::Field]) -> Vec<(u32, f64)> {
-    (1..=20u32)
-        .filter_map(|j| value::num(f, &format!("A{j}")).map(|a| (j, a)))
-        .collect()
 }
 
 /// sag + Σ A_j (s)^(j/2), with s = r². The even terms are one polynomial

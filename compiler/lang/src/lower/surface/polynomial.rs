@@ -3,31 +3,14 @@
 use lensc_runtime::surface::ir::{Graph, Id};
 
 use super::{LowerError, Side, conic_sag, radius_squared};
-use crate::value::{self, Object, Value};
+use crate::schema::{Base, Ordering, XyPolynomial, Zernike};
 
 /// An x-y polynomial: the base conic (if a radius is given) plus
 /// Σ c_ij x^i y^j, in order of the powers.
-pub(super) fn xy_polynomial_height(
-    g: &mut Graph,
-    o: &Object,
-    x: Id,
-    y: Id,
-) -> Result<Id, LowerError> {
-    let f = &o.fields;
-    let side = Side::of(f);
-    let mut sag = base_conic(g, f, side, x, y);
-    let mut terms: Vec<(u32, u32, f64)> = f
-        .iter()
-        .filter_map(|fl| {
-            let (i, j) = crate::schema::xy_powers(&fl.name)?;
-            match fl.value {
-                Value::Num(v, _) => Some((i, j, v)),
-                _ => None,
-            }
-        })
-        .collect();
-    terms.sort_by_key(|t| (t.0, t.1));
-    for (i, j, cij) in terms {
+pub(super) fn xy_polynomial_height(g: &mut Graph, p: &XyPolynomial, x: Id, y: Id) -> Id {
+    let side = Side::from(p.facing);
+    let mut sag = base_conic(g, p.base, side, x, y);
+    for &(i, j, cij) in &p.terms {
         let xi = g.powi(x, i as i32);
         let yj = g.powi(y, j as i32);
         let m = g.mul(xi, yj);
@@ -35,40 +18,27 @@ pub(super) fn xy_polynomial_height(
         let t = g.mul(cc, m);
         sag = g.add(sag, t);
     }
-    Ok(side.apply(g, sag))
+    side.apply(g, sag)
 }
 
 /// The base conic of a polynomial surface in r² = x² + y²: zero when no
 /// `radius` is given.
-fn base_conic(g: &mut Graph, f: &[value::Field], side: Side, x: Id, y: Id) -> Id {
-    let k = value::num(f, "conic").unwrap_or(0.0);
+fn base_conic(g: &mut Graph, base: Option<Base>, side: Side, x: Id, y: Id) -> Id {
     let r2 = radius_squared(g, x, y);
-    match value::num(f, "radius") {
-        Some(radius) => conic_sag(g, side.curvature(radius), k, r2),
+    match base {
+        Some(Base { radius, conic }) => conic_sag(g, side.curvature(radius), conic, r2),
         None => g.constant_node(0.0),
     }
 }
 
 /// A Zernike surface: the base conic (if a radius is given) plus the terms
 /// over ρ = r / `norm_radius`, in the fringe or ANSI numbering.
-pub(super) fn zernike_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError> {
-    let f = &o.fields;
-    let side = Side::of(f);
-    let mut sag = base_conic(g, f, side, x, y);
-    let norm = value::num(f, "norm_radius").ok_or(LowerError::Unsupported("norm_radius"))?;
-    let ansi = value::word(f, "ordering") == Some("ansi");
-    let mut terms: Vec<(u32, f64)> = f
-        .iter()
-        .filter_map(|fl| {
-            let j: u32 = fl.name.strip_prefix('Z')?.parse().ok()?;
-            match fl.value {
-                Value::Num(v, _) => Some((j, v)),
-                _ => None,
-            }
-        })
-        .collect();
-    terms.sort_by_key(|t| t.0);
-    for (j, coef) in terms {
+pub(super) fn zernike_height(g: &mut Graph, p: &Zernike, x: Id, y: Id) -> Result<Id, LowerError> {
+    let side = Side::from(p.facing);
+    let mut sag = base_conic(g, p.base, side, x, y);
+    let norm = p.norm_radius;
+    let ansi = p.ordering == Ordering::Ansi;
+    for &(j, coef) in &p.terms {
         let (n, m) = if ansi {
             zernike_ansi(j)
         } else {

@@ -3,42 +3,61 @@
 
 use lensc_runtime::surface::ir::{Graph, Id, SurfaceTape};
 
-use super::{LowerError, Side, add_power_terms, conic_sag, power_terms, radius_squared};
-use crate::value::{self, Object};
+use super::{Side, add_power_terms, conic_sag, radius_squared};
+use crate::schema::{Conic, FORBES_TOP, Forbes, Surface};
+
+// The Forbes coefficients a surface may state are the ones the runtime's
+// polynomials reach.
+const _: () = assert!(FORBES_TOP == lensc_runtime::surface::forbes::MAX_ORDER);
 
 /// A sphere, conic or asphere: the conic sag in r² plus the power terms.
-pub(super) fn conic_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError> {
-    let f = &o.fields;
-    let side = Side::of(f);
-    let k = value::num(f, "conic").unwrap_or(0.0);
-    let c = side.curvature(value::num(f, "radius").ok_or(LowerError::Unsupported("radius"))?);
+pub(super) fn conic_height(g: &mut Graph, p: &Conic, x: Id, y: Id) -> Id {
+    let side = Side::from(p.facing);
+    let k = p.base.conic;
+    let c = side.curvature(p.base.radius);
     let r2 = radius_squared(g, x, y);
     let sag = conic_sag(g, c, k, r2);
-    let sag = add_power_terms(g, sag, r2, &power_terms(f));
-    Ok(side.apply(g, sag))
+    let sag = add_power_terms(g, sag, r2, &p.terms);
+    side.apply(g, sag)
 }
 
 /// A Forbes Q-bfs or Q-con surface: its radial profile f(s) at s = r².
-pub(super) fn forbes_height(g: &mut Graph, o: &Object, x: Id, y: Id) -> Result<Id, LowerError> {
-    let _f = &o.fields;
-    let (h, [f0, _, _]) = radial_profile(o).ok_or(LowerError::Unsupported(o.kind.name))?;
+pub(super) fn forbes_height(g: &mut Graph, radial: Radial, x: Id, y: Id) -> Id {
+    let (h, [f0, _, _]) = radial_profile(radial);
     let s = radius_squared(g, x, y);
-    Ok(g.import(&h, s, s)[f0.0 as usize])
+    g.import(&h, s, s)[f0.0 as usize]
+}
+
+/// A surface of revolution lowered through its profile in s = x² + y².
+#[derive(Clone, Copy)]
+pub(super) enum Radial<'s> {
+    /// A sphere, conic or asphere.
+    Conic(&'s Conic),
+    Qbfs(&'s Forbes),
+    Qcon(&'s Forbes),
+}
+
+impl<'s> Radial<'s> {
+    fn of(s: &'s Surface) -> Option<Radial<'s>> {
+        match s {
+            Surface::Sphere(p) | Surface::Conic(p) | Surface::Asphere(p) => Some(Radial::Conic(p)),
+            Surface::Qbfs(p) => Some(Radial::Qbfs(p)),
+            Surface::Qcon(p) => Some(Radial::Qcon(p)),
+            _ => None,
+        }
+    }
 }
 
 /// f(s), f'(s) and f''(s) of a surface of revolution, in a scratch graph
 /// whose x stands for s = x² + y².
-fn radial_profile(o: &Object) -> Option<(Graph, [Id; 3])> {
-    if !matches!(
-        o.kind.name,
-        "sphere" | "conic" | "asphere" | "qbfs" | "qcon"
-    ) {
-        return None;
-    }
-    let f = &o.fields;
-    let side = Side::of(f);
-    let c = side.curvature(value::num(f, "radius")?);
-    let k = value::num(f, "conic").unwrap_or(0.0);
+fn radial_profile(radial: Radial) -> (Graph, [Id; 3]) {
+    let (base, facing) = match radial {
+        Radial::Conic(c) => (c.base, c.facing),
+        Radial::Qbfs(f) | Radial::Qcon(f) => (f.base, f.facing),
+    };
+    let side = Side::from(facing);
+    let c = side.curvature(base.radius);
+    let k = base.conic;
     // f(s) in a scratch graph whose x stands for s. The conic's own
     // derivatives in s are written in closed form (g = c s/(1 + q),
     // q = sqrt(1 − κ s), κ = (1+k)c²: g' = c/(2q), g'' = cκ/(4q³)); the
@@ -70,10 +89,10 @@ fn radial_profile(o: &Object) -> Option<(Graph, [Id; 3])> {
         h.div(ck, q3)
     };
     let zero = h.constant_node(0.0);
-    let p0 = match o.kind.name {
-        "qbfs" => qbfs_departure(&mut h, s, c, f)?,
-        "qcon" => qcon_departure(&mut h, s, f)?,
-        _ => add_power_terms(&mut h, zero, s, &power_terms(f)),
+    let p0 = match radial {
+        Radial::Qbfs(f) => qbfs_departure(&mut h, s, c, f),
+        Radial::Qcon(f) => qcon_departure(&mut h, s, f),
+        Radial::Conic(conic) => add_power_terms(&mut h, zero, s, &conic.terms),
     };
     let p1 = h.derivative(p0, lensc_runtime::surface::ir::Var::X);
     let p2 = h.derivative(p1, lensc_runtime::surface::ir::Var::X);
@@ -83,7 +102,7 @@ fn radial_profile(o: &Object) -> Option<(Graph, [Id; 3])> {
         h.mul(sigma, t)
     };
     let (f0, f1, f2) = (sum(g0, p0), sum(g1, p1), sum(g2, p2));
-    Some((h, [f0, f1, f2]))
+    (h, [f0, f1, f2])
 }
 
 /// Rotationally symmetric surfaces z = f(s), s = x² + y², differentiated
@@ -92,8 +111,8 @@ fn radial_profile(o: &Object) -> Option<(Graph, [Id; 3])> {
 ///   z_x = 2x f',  z_xx = 2f' + 4x² f'',  z_xy = 4xy f''  (and in y),
 /// which is the tape a careful hand would write, a third the size of
 /// differentiating in x and y directly.
-pub(super) fn radial_tape(o: &Object) -> Option<SurfaceTape> {
-    let (h, [f0, f1, f2]) = radial_profile(o)?;
+pub(super) fn radial_tape(s: &Surface) -> Option<SurfaceTape> {
+    let (h, [f0, f1, f2]) = radial_profile(Radial::of(s)?);
     // Compose with s = x² + y².
     let mut g = Graph::new();
     let (x, y) = (g.x(), g.y());
@@ -124,8 +143,8 @@ pub(super) fn radial_tape(o: &Object) -> Option<SurfaceTape> {
 /// Forbes's Q-bfs departure in s = ρ²: u²(1 − u²)/sqrt(1 − c² s) · Σ a_m Q_m(u²),
 /// u² = s/ρ_max², the sum evaluated as one Chebyshev series by Clenshaw's
 /// recurrence.
-fn qbfs_departure(h: &mut Graph, s: Id, c: f64, f: &[value::Field]) -> Option<Id> {
-    let (x, series) = forbes_series(h, s, f, lensc_runtime::surface::forbes::qbfs_chebyshev)?;
+fn qbfs_departure(h: &mut Graph, s: Id, c: f64, p: &Forbes) -> Id {
+    let (x, series) = forbes_series(h, s, p, lensc_runtime::surface::forbes::qbfs_chebyshev);
     let one = h.constant_node(1.0);
     // u²(1 − u²) / sqrt(1 − c² s)
     let omx = h.sub(one, x);
@@ -135,35 +154,28 @@ fn qbfs_departure(h: &mut Graph, s: Id, c: f64, f: &[value::Field]) -> Option<Id
     let under = h.sub(one, cs);
     let root = h.sqrt(under);
     let scaled = h.div(pre, root);
-    Some(h.mul(scaled, series))
+    h.mul(scaled, series)
 }
 
 /// Forbes's Q-con departure from the conic in s = ρ²: u⁴ Σ a_m Q_m^con(u²),
 /// u² = s/ρ_max², with Q_m^con(x) = P_m^(0,4)(2x − 1); the sum evaluated
 /// as one Chebyshev series.
-fn qcon_departure(h: &mut Graph, s: Id, f: &[value::Field]) -> Option<Id> {
-    let (x, series) = forbes_series(h, s, f, lensc_runtime::surface::forbes::qcon_chebyshev)?;
+fn qcon_departure(h: &mut Graph, s: Id, p: &Forbes) -> Id {
+    let (x, series) = forbes_series(h, s, p, lensc_runtime::surface::forbes::qcon_chebyshev);
     let x2 = h.powi(x, 2);
-    Some(h.mul(x2, series))
+    h.mul(x2, series)
 }
 
 /// u² = s/ρ_max² and Σ a_m Q_m(u²) for the coefficients `Q0` … `Q20` of a
 /// Forbes surface, `basis(top)` giving each Q_m in the Chebyshev basis:
 /// b_k = Σ_m a_m c_mk, the whole sum one Chebyshev series.
-fn forbes_series(
-    h: &mut Graph,
-    s: Id,
-    f: &[value::Field],
-    basis: fn(usize) -> Vec<Vec<f64>>,
-) -> Option<(Id, Id)> {
-    let norm = value::num(f, "norm_radius")?;
-    let coeffs: Vec<(usize, f64)> = (0..=lensc_runtime::surface::forbes::MAX_ORDER)
-        .filter_map(|m| value::num(f, &format!("Q{m}")).map(|a| (m, a)))
-        .collect();
+fn forbes_series(h: &mut Graph, s: Id, p: &Forbes, basis: fn(usize) -> Vec<Vec<f64>>) -> (Id, Id) {
+    let norm = p.norm_radius;
+    let coeffs = &p.terms;
     let top = coeffs.iter().map(|t| t.0).max().unwrap_or(0);
     let q = basis(top);
     let mut b = vec![0.0; top + 1];
-    for &(m, a) in &coeffs {
+    for &(m, a) in coeffs {
         for (bk, ck) in b.iter_mut().zip(&q[m]) {
             *bk += a * ck;
         }
@@ -171,7 +183,7 @@ fn forbes_series(
     let inv = h.constant_node(1.0 / (norm * norm));
     let x = h.mul(s, inv);
     let series = chebyshev_series(h, x, &b);
-    Some((x, series))
+    (x, series)
 }
 
 /// Σ_k b_k T_k(2x − 1) by Clenshaw's recurrence:

@@ -86,6 +86,12 @@ fn eval_surface(src: &str, name: &str, x: f64, y: f64) -> [f64; 6] {
     Interpreter::new(&l.tape).eval(x, y)
 }
 
+/// The surface `name` of a checked file, read.
+fn read_surface(c: &crate::Checked, name: &str) -> crate::schema::Surface {
+    let o = c.checked.declarations.get(name).expect("surface");
+    crate::schema::Surface::read(o).expect("reads")
+}
+
 fn close(a: f64, b: f64) -> bool {
     (a - b).abs() <= 1e-14 * (1.0 + a.abs().max(b.abs()))
 }
@@ -516,7 +522,9 @@ fn a_grid_of_dimples_cuts_at_its_own_cell_alone() {
 surface microlenses = grid(dimple, pitch_x: 0.1 mm, pitch_y: 0.19634954084936207 mm, count_x: 60, count_y: 96)";
     let c = crate::check_text(&crate::loader::RealFs, "t.lens", src.as_bytes());
     assert!(!c.has_errors(), "{:?}", c.diags());
-    let o = c.checked.declarations.get("microlenses").expect("surface");
+    let crate::schema::Surface::Array(o) = &read_surface(&c, "microlenses") else {
+        panic!("an array")
+    };
     let tapes = |cells: Cells| {
         let mut g = Graph::new();
         let (x, y) = (g.x(), g.y());
@@ -592,7 +600,9 @@ surface microlenses = grid(dimple, pitch_x: 0.1 mm, pitch_y: 0.19634954084936207
     // Convex bumps: the own cell's is the higher one, so all are kept.
     let convex = src.replace("concave", "convex");
     let c = crate::check_text(&crate::loader::RealFs, "t.lens", convex.as_bytes());
-    let o = c.checked.declarations.get("microlenses").expect("surface");
+    let crate::schema::Surface::Array(o) = &read_surface(&c, "microlenses") else {
+        panic!("an array")
+    };
     let nodes = |cells: Cells| {
         let mut g = Graph::new();
         let (x, y) = (g.x(), g.y());
@@ -658,9 +668,12 @@ surface tx = tilt(p, about: x, angle: -8 deg, aperture: circle(radius: 1.5 mm))"
     for name in ["ty", "tx"] {
         let o = c.checked.declarations.get(name).expect("surface");
         let closed = Interpreter::new(&lower_surface(o).expect("lowers").tape);
+        let crate::schema::Surface::Tilt(t) = &read_surface(&c, name) else {
+            panic!("a tilt")
+        };
         let mut g = Graph::new();
         let (x, y) = (g.x(), g.y());
-        let z = derived::tilted_height(&mut g, o, x, y).expect("lowers");
+        let z = derived::tilted_height(&mut g, t, x, y).expect("lowers");
         let through = SurfaceTape::new(g, z);
         let steps = Interpreter::new(&through);
         assert!(
@@ -707,9 +720,12 @@ surface t0 = tilt(p, about: y, angle: 0 deg, aperture: circle(radius: 1.5 mm))";
             })
             .count();
         assert_eq!(repeats, loops, "{name}: loops in the tape");
+        let crate::schema::Surface::Tilt(t) = &read_surface(&c, name) else {
+            panic!("a tilt")
+        };
         let mut g = Graph::new();
         let (x, y) = (g.x(), g.y());
-        let outputs = derived::tilted_outputs_with(&mut g, o, x, y, derived::Steps::WrittenOut)
+        let outputs = derived::tilted_outputs_with(&mut g, t, x, y, derived::Steps::WrittenOut)
             .expect("lowers");
         let written = SurfaceTape::with_outputs(g, outputs);
         if loops == 1 {
@@ -775,9 +791,12 @@ surface tip = revolve(cyl, start: 0.1 mm, aperture: circle(radius: 0.15 mm))";
     let decl = |name: &str| c.checked.declarations.get(name).expect("surface");
     let closed = |name: &str| Interpreter::new(&lower_surface(decl(name)).expect("lowers").tape);
     let through = |name: &str| {
+        let crate::schema::Surface::Revolve(r) = &read_surface(&c, name) else {
+            panic!("a revolved profile")
+        };
         let mut g = Graph::new();
         let (x, y) = (g.x(), g.y());
-        let z = derived::revolve_height(&mut g, decl(name), x, y).expect("lowers");
+        let z = derived::revolve_height(&mut g, r, x, y).expect("lowers");
         SurfaceTape::new(g, z)
     };
     for name in ["rings", "dome", "tip"] {
@@ -813,4 +832,22 @@ surface tip = revolve(cyl, start: 0.1 mm, aperture: circle(radius: 0.15 mm))";
         tip[0].is_finite() && tip[1..].iter().all(|v| v.is_nan()),
         "{tip:?}"
     );
+}
+
+/// A declaration that did not check (its aperture refused) is refused
+/// with what it lacks, as E0121 words it: its parameters are read once,
+/// and nothing unwraps them.
+#[test]
+fn a_surface_that_did_not_check_is_refused_with_what_it_lacks() {
+    let src = "surface s = sphere { radius: 5 mm, sense: convex, aperture: circle(diameter: 2 mm, radius: 1 mm) }";
+    let c = crate::check_text(&crate::loader::RealFs, "t.lens", src.as_bytes());
+    assert!(c.has_errors());
+    let o = c.checked.declarations.get("s").expect("declared");
+    assert_eq!(
+        lower_surface(o).err(),
+        Some(LowerError::Missing(
+            "`sphere` is missing `aperture`".to_string()
+        ))
+    );
+    assert_eq!(crate::domain::surface_domain(o), None);
 }
