@@ -119,6 +119,7 @@ pub fn lowering_words(e: &LowerError) -> String {
         LowerError::Aperture(what) => {
             format!("its aperture or domain is of a shape it cannot use ({what})")
         }
+        LowerError::Missing(why) => why.clone(),
     }
 }
 

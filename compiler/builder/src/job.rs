@@ -31,6 +31,10 @@ use lensc_lang::check::CheckedJob;
 use lensc_lang::check::trim_num;
 use lensc_lang::codes;
 use lensc_lang::lower::surface::LoweredSurface;
+use lensc_lang::schema::machines::MachineParams;
+use lensc_lang::schema::strategies::PathParams;
+use lensc_lang::schema::tools::ToolParams;
+use lensc_lang::schema::{JobParams, Surface};
 use lensc_lang::value::{self, Object};
 
 /// The path tolerance a strategy that states none is held to: 10 nm, the
@@ -109,27 +113,83 @@ pub struct Simulate {
     pub site: (FileId, Span),
 }
 
-/// A checked job's parts, as lowering reads them.
+/// A checked job's parts, as lowering reads them: each part as checked
+/// (the surface is lowered from it, the strategy read by its own folder),
+/// and the job's, the machine's and the tool's parameters read once.
 pub struct Parts<'a> {
     pub job: &'a CheckedJob,
     pub surface: &'a Object,
     pub tool: &'a Object,
     pub machine: &'a Object,
     pub strategy: &'a Object,
+    /// The job's own parameters (tool call, coolant, `simulate`).
+    pub params: JobParams,
+    pub machine_params: MachineParams,
+    pub tool_params: ToolParams,
+    /// The strategy's path tolerance and chord placement, as stated.
+    pub path: PathParams,
+    /// The surface's parameters (the surface itself is lowered from its
+    /// checked object, `lowered`).
+    pub surface_params: Surface,
 }
 
 impl<'a> Parts<'a> {
-    fn of(job: &'a CheckedJob) -> Parts<'a> {
-        let part = |name: &str| -> &'a Object {
-            value::object(&job.fields, name).expect("checked job part")
+    /// The job's parts and parameters, or E0121 for each part (or
+    /// required parameter) missing: the checker refuses those, so only a
+    /// job that did not check gets here.
+    fn of(job: &'a CheckedJob) -> Result<Parts<'a>, Vec<Diagnostic>> {
+        let r = value::Reader::new(&job.fields);
+        let mut errors = Vec::new();
+        let mut part = |name: &str| -> Option<&'a Object> {
+            let o = r.object(name).map(|o| o.as_ref());
+            if o.is_none() {
+                errors.push(site_error(
+                    (job.file, job.name.span),
+                    codes::MISSING_PARAMETER,
+                    format!("this job has no {name} that checked"),
+                ));
+            }
+            o
         };
-        Parts {
+        let (surface, tool, machine, strategy) = (
+            part("surface"),
+            part("tool"),
+            part("machine"),
+            part("strategy"),
+        );
+        let (Some(surface), Some(tool), Some(machine), Some(strategy)) =
+            (surface, tool, machine, strategy)
+        else {
+            return Err(errors);
+        };
+        let machine_params = MachineParams::read(machine).map_err(|d| vec![d]);
+        let tool_params = ToolParams::read(tool).map_err(|d| vec![d]);
+        let surface_params = Surface::read(surface).map_err(|d| vec![d]);
+        let (machine_params, tool_params, surface_params) =
+            match (machine_params, tool_params, surface_params) {
+                (Ok(m), Ok(t), Ok(s)) => (m, t, s),
+                (m, t, s) => {
+                    return Err(m
+                        .err()
+                        .into_iter()
+                        .chain(t.err())
+                        .chain(s.err())
+                        .flatten()
+                        .collect());
+                }
+            };
+        Ok(Parts {
             job,
-            surface: part("surface"),
-            tool: part("tool"),
-            machine: part("machine"),
-            strategy: part("strategy"),
-        }
+            surface,
+            tool,
+            machine,
+            strategy,
+            params: JobParams::read(&job.fields),
+            machine_params,
+            tool_params,
+            path: PathParams::read(strategy),
+            surface_params,
+        })
     }
     pub fn site(&self) -> (FileId, Span) {
         (self.job.file, self.job.name.span)
@@ -209,10 +269,32 @@ impl<'a> Parts<'a> {
         lensc_lang::lower::surface::lower_surface(self.surface)
             .map_err(|e| RuntimeError::Surface(e).at(self.site()))
     }
-    /// The machine's spindle speed limit (rad/s).
+    /// The path tolerance the strategy states, or the default (mm).
+    pub fn chord_tolerance(&self) -> f64 {
+        self.path
+            .chord_tolerance
+            .map_or(DEFAULT_PATH_TOLERANCE, |t| t.value)
+    }
+    /// A tool parameter the strategy needs, or E0121 naming it (the tool
+    /// is of a kind that requires it: only a tool that did not check
+    /// lacks it).
+    pub fn tool_needs(&self, value: Option<f64>, name: &str) -> Result<f64, Vec<Diagnostic>> {
+        value.ok_or_else(|| {
+            vec![self.error(
+                codes::MISSING_PARAMETER,
+                format!(
+                    "this job's tool (`{}`) has no `{name}`",
+                    self.tool_params.kind
+                ),
+            )]
+        })
+    }
+    /// The machine's spindle speed limit (rad/s); none (infinite) for a
+    /// machine that states no spindle.
     pub fn max_spindle_speed(&self) -> f64 {
-        let spindle = value::block(&self.machine.fields, "spindle").expect("required");
-        value::num(spindle, "max_speed").expect("required")
+        self.machine_params
+            .max_spindle_speed
+            .unwrap_or(f64::INFINITY)
     }
     /// E0143 if `speed` (rad/s) is above the machine's spindle limit.
     pub fn spindle_limit(&self, speed: f64) -> Option<Diagnostic> {
@@ -232,7 +314,7 @@ impl<'a> Parts<'a> {
     }
     /// E0142 when the `what` feed (mm/s) is above the machine's maximum.
     pub fn feed_error(&self, what: &str, feed: f64) -> Option<Diagnostic> {
-        let max_feed = value::num(&self.machine.fields, "max_feed").expect("required");
+        let max_feed = self.machine_params.max_feed;
         (feed > max_feed).then(|| {
             self.error(
                 codes::FEED_TOO_HIGH,
@@ -253,8 +335,6 @@ impl<'a> Parts<'a> {
                 .cloned()
                 .unwrap_or_else(|| o.kind.name.to_string())
         };
-        let m = &self.machine.fields;
-        let travel = value::block(m, "travel");
         JobHead {
             name: self.job.name.name.clone(),
             site: self.site(),
@@ -276,11 +356,11 @@ impl<'a> Parts<'a> {
                 lowered,
             },
             dialect,
-            resolution: value::num(m, "resolution").expect("required"),
-            travel: ["x", "y", "z", "c"].map(|a| travel.and_then(|t| value::range(t, a))),
-            simulate: simulate(self.job).ok().flatten(),
+            resolution: self.machine_params.resolution,
+            travel: self.machine_params.travel,
+            simulate: simulate(&self.params).ok().flatten(),
             accept: accept::lower(self.job).unwrap_or_default(),
-            start: program_start(self.job),
+            start: program_start(&self.params),
         }
     }
 }
@@ -306,50 +386,50 @@ pub fn lower_job(
     requested: Option<&str>,
     evaluate: Evaluate,
 ) -> Result<JobSpec, Vec<Diagnostic>> {
-    let p = Parts::of(job);
+    let p = Parts::of(job)?;
     let mut errors = Vec::new();
     let dialect = lensc_lang::lower::dialect(job, requested).map_err(|d| errors.push(d));
     let strategy = p.strategy.kind.name;
     // Until a dialect is known the strategy is lowered in LinuxCNC's: its
     // own errors are reported, the spec is not used.
     let d = dialect.clone().unwrap_or_else(|_| Dialect::linuxcnc());
-    let Some((spec, setup, windowed)) = crate::strategy::lower(strategy, &p, d, evaluate) else {
+    let Some((spec, setup, windowed, axes)) = crate::strategy::lower(strategy, &p, d, evaluate)
+    else {
         errors.push(no_such_strategy(&p));
         return Err(errors);
     };
     // Jobs simulated along their whole profile: a window means nothing
     // to them.
-    if let (false, Some(f)) = (windowed, value::field(&job.fields, "simulate")) {
+    if let (false, Some(f)) = (windowed, p.params.simulate) {
         errors.push(
             Diagnostic::error(
                 codes::UNSUPPORTED_COMBINATION,
                 format!(
                     "`simulate` sets the window of a surface's height map; this `{strategy}` job is simulated along its whole profile"
                 ),
-                f.file,
-                f.span,
+                f.site.0,
+                f.site.1,
             )
             .with_label("not for a profile job")
             .with_help("remove the `simulate` block"),
         );
     }
-    if let Err(d) = simulate(job) {
+    if let Err(d) = simulate(&p.params) {
         errors.push(d);
     }
     if let Err(d) = accept::lower(job) {
         errors.push(d);
     }
-    errors.extend(tolerance::below_resolution(&p, strategy));
-    if let Ok(d) = &dialect
-        && let Some(resolution) = value::num(&p.machine.fields, "resolution")
-    {
+    errors.extend(axes.and_then(|axes| tolerance::below_resolution(&p, axes)));
+    if let Ok(d) = &dialect {
+        let resolution = p.machine_params.resolution;
         if let Err(e) = lensc_runtime::post::check_dialect(d, setup, resolution) {
             errors.push(
                 Diagnostic::error(codes::NOT_PRINTABLE, e.message(), job.file, job.name.span)
                     .with_label("no program was written for this job")
                     .with_help(NOT_PRINTABLE_HELP),
             );
-        } else if let Some(e) = start_error(job, d, setup) {
+        } else if let Some(e) = start_error(job, &p.params, d, setup) {
             errors.push(e);
         }
     }
@@ -389,17 +469,17 @@ fn no_such_strategy(p: &Parts) -> Diagnostic {
 
 /// The job's tool call, spindle direction and coolant (tool 1, its offset
 /// the tool's number, clockwise, no coolant unless it says otherwise).
-fn program_start(job: &CheckedJob) -> Start {
-    let f = &job.fields;
-    let tool = value::num(f, "tool_number").map_or(1, |n| n as u32);
+fn program_start(params: &JobParams) -> Start {
+    let tool = params.tool_number.map_or(1, |n| n.value as u32);
     Start {
         tool,
-        offset: value::num(f, "tool_offset").map_or(tool, |n| n as u32),
-        rotation: match value::word(f, "spindle_direction") {
-            Some("ccw") => Rotation::CounterClockwise,
-            _ => Rotation::Clockwise,
+        offset: params.tool_offset.map_or(tool, |n| n.value as u32),
+        rotation: if params.spindle_ccw {
+            Rotation::CounterClockwise
+        } else {
+            Rotation::Clockwise
         },
-        coolant: match value::word(f, "coolant") {
+        coolant: match params.coolant.map(|c| c.value) {
             Some("flood") => Coolant::Flood,
             Some("mist") => Coolant::Mist,
             _ => Coolant::Off,
@@ -409,20 +489,22 @@ fn program_start(job: &CheckedJob) -> Start {
 
 /// E0173 if the dialect cannot call the job's tool (its number does not
 /// fit the T word) or give its coolant, at the field that asks for it.
-fn start_error(job: &CheckedJob, dialect: &Dialect, setup: Setup) -> Option<Diagnostic> {
+fn start_error(
+    job: &CheckedJob,
+    params: &JobParams,
+    dialect: &Dialect,
+    setup: Setup,
+) -> Option<Diagnostic> {
     use lensc_runtime::post::writer::{coolant_word, tool_call_lines};
-    let start = program_start(job);
-    let (e, field) = match tool_call_lines(dialect, setup, &start) {
-        Err(e) => (
-            e,
-            value::field(&job.fields, "tool_number").or(value::field(&job.fields, "tool_offset")),
-        ),
+    let start = program_start(params);
+    let (e, site) = match tool_call_lines(dialect, setup, &start) {
+        Err(e) => (e, params.tool_number.or(params.tool_offset).map(|s| s.site)),
         Ok(_) => (
             coolant_word(dialect, start.coolant).err()?,
-            value::field(&job.fields, "coolant"),
+            params.coolant.map(|c| c.site),
         ),
     };
-    let (file, span) = field.map_or((job.file, job.name.span), |f| (f.file, f.span));
+    let (file, span) = site.unwrap_or((job.file, job.name.span));
     Some(
         Diagnostic::error(codes::CANNOT_CALL_TOOL, e.message(), file, span)
             .with_label(format!("not in `{}`", dialect.name))
@@ -433,24 +515,24 @@ fn start_error(job: &CheckedJob, dialect: &Dialect, setup: Setup) -> Option<Diag
 }
 
 /// The job's `simulate` block, if any; an error if its window is empty.
-fn simulate(job: &CheckedJob) -> Result<Option<Simulate>, Diagnostic> {
-    let Some(field) = value::field(&job.fields, "simulate") else {
+fn simulate(params: &JobParams) -> Result<Option<Simulate>, Diagnostic> {
+    let Some(stated) = params.simulate else {
         return Ok(None);
     };
-    let b = value::block(&job.fields, "simulate").expect("checked block");
+    let b = stated.value;
     let s = Simulate {
-        x: value::range(b, "x"),
-        y: value::range(b, "y"),
-        spacing: value::num(b, "spacing"),
-        site: (field.file, field.span),
+        x: b.x,
+        y: b.y,
+        spacing: b.spacing,
+        site: stated.site,
     };
     let low_to_high = |r: Option<(f64, f64)>| r.is_none_or(|r| r.1 > r.0);
     if !(low_to_high(s.x) && low_to_high(s.y)) {
         return Err(Diagnostic::error(
             codes::WRONG_VALUE,
             "the simulation window is empty: each range must run from low to high",
-            field.file,
-            field.span,
+            stated.site.0,
+            stated.site.1,
         )
         .with_label("this window"));
     }

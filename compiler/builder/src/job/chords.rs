@@ -8,7 +8,6 @@ use lensc_runtime::plan::chords::{ChordPlacement, FormLimits};
 
 use super::Parts;
 use super::accept::{Accept, Criterion};
-use lensc_lang::value;
 
 /// What the placement is chosen for: the path's tolerance, what its chords
 /// and fits may spend of it, and whether its chords may be sampled longer.
@@ -42,11 +41,11 @@ pub(crate) struct ChordPath {
 /// tighter `form_rms`, `form_pv` or `max_gouge` keeps every point, on the
 /// path, straddling or clear.
 pub(crate) fn placement(p: &Parts, path: ChordPath) -> ChordPlacement {
-    let resolution = value::num(&p.machine.fields, "resolution").expect("required");
+    let resolution = p.machine_params.resolution;
     let margin = 0.5 * resolution;
-    if let Some(stated) = value::word(&p.strategy.fields, "chords") {
+    if let Some(stated) = p.path.chords {
         // The checker has allowed only the four words.
-        return ChordPlacement::from_word(stated, margin).unwrap_or_default();
+        return ChordPlacement::from_word(stated.value, margin).unwrap_or_default();
     }
     let accept = super::accept::lower(p.job).unwrap_or_default();
     let limits = form_limits(&accept, path.tolerance, resolution);

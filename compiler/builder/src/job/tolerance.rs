@@ -29,17 +29,6 @@ use lensc_grammar::Diagnostic;
 
 use super::Parts;
 use lensc_lang::codes;
-use lensc_lang::value;
-
-/// The length axes a strategy's printed path moves in (the n above), or
-/// `None` for a strategy that states no path tolerance.
-fn length_axes(strategy: &str) -> Option<u32> {
-    match strategy {
-        "raster" => Some(3),
-        "profile_turning" | "fts_spiral" | "spiral_turning" => Some(2),
-        _ => None,
-    }
-}
 
 /// The smallest path tolerance (mm) a machine of `resolution` (mm) holds on
 /// a path in `axes` length axes: resolution × √axes (see the module's
@@ -48,15 +37,14 @@ pub fn smallest_tolerance(resolution: f64, axes: u32) -> f64 {
     resolution * f64::from(axes).sqrt()
 }
 
-/// E0180 if the `strategy`'s path tolerance (stated, or the default) is
-/// finer than its machine's resolution can hold; at the tolerance where the
-/// strategy (or the one it copies) states it, else at the job.
-pub(crate) fn below_resolution(p: &Parts, strategy: &str) -> Option<Diagnostic> {
-    let axes = length_axes(strategy)?;
-    let resolution = value::num(&p.machine.fields, "resolution")?;
-    let stated = value::field(&p.strategy.fields, "chord_tolerance");
-    let tolerance =
-        value::num(&p.strategy.fields, "chord_tolerance").unwrap_or(super::DEFAULT_PATH_TOLERANCE);
+/// E0180 if the strategy's path tolerance (stated, or the default) is
+/// finer than its machine's resolution can hold on a path printed in
+/// `axes` length axes (`Strategy::LENGTH_AXES`); at the tolerance where
+/// the strategy (or the one it copies) states it, else at the job.
+pub(crate) fn below_resolution(p: &Parts, axes: u32) -> Option<Diagnostic> {
+    let resolution = p.machine_params.resolution;
+    let stated = p.path.chord_tolerance;
+    let tolerance = stated.map_or(super::DEFAULT_PATH_TOLERANCE, |t| t.value);
     let smallest = smallest_tolerance(resolution, axes);
     if tolerance >= smallest || !tolerance.is_finite() {
         return None;
@@ -96,11 +84,16 @@ pub(crate) fn below_resolution(p: &Parts, strategy: &str) -> Option<Diagnostic> 
         ));
     }
     let d = match stated {
-        Some(f) => Diagnostic::error(codes::TOLERANCE_BELOW_RESOLUTION, message, f.file, f.span)
-            .with_label(format!(
-                "finer than {} nm",
-                lensc_lang::check::trim_num(suggested * 1e6)
-            )),
+        Some(f) => Diagnostic::error(
+            codes::TOLERANCE_BELOW_RESOLUTION,
+            message,
+            f.site.0,
+            f.site.1,
+        )
+        .with_label(format!(
+            "finer than {} nm",
+            lensc_lang::check::trim_num(suggested * 1e6)
+        )),
         None => p
             .error(codes::TOLERANCE_BELOW_RESOLUTION, message)
             .with_label("this job, whose strategy states no tolerance: 10 nm by default"),

@@ -42,6 +42,11 @@ pub trait Strategy: Sized {
     /// Whether its cut is judged on a height map in a window that a
     /// `simulate` block may set (false: along its whole profile).
     const WINDOWED: bool;
+    /// The length axes its printed path moves in, which the path
+    /// tolerance must allow the machine's rounding in
+    /// (`job::tolerance`); `None` for a strategy that states no path
+    /// tolerance.
+    const LENGTH_AXES: Option<u32>;
     /// The checked job lowered to the strategy's typed job, with every
     /// check that needs no planning; every error found.
     fn lower(p: &Parts, dialect: Dialect, evaluate: Evaluate) -> Result<Self, Vec<Diagnostic>>;
@@ -88,20 +93,22 @@ macro_rules! registry {
         pub const NAMES: &[&[&str]] = &[$(<$spec as Strategy>::NAMES,)*];
 
         /// The strategy named `name` lowered from `p` in `dialect`, with
-        /// the set-up its programs are written for; `None` if the
-        /// registry lists no strategy of that name.
+        /// the set-up its programs are written for, whether it is
+        /// simulated in a window and the length axes of its path; `None`
+        /// if the registry lists no strategy of that name.
         pub(crate) fn lower(
             name: &str,
             p: &Parts,
             dialect: Dialect,
             evaluate: Evaluate,
-        ) -> Option<(Result<JobSpec, Vec<Diagnostic>>, Setup, bool)> {
+        ) -> Option<(Result<JobSpec, Vec<Diagnostic>>, Setup, bool, Option<u32>)> {
             $(
                 if <$spec as Strategy>::NAMES.contains(&name) {
                     return Some((
                         <$spec as Strategy>::lower(p, dialect, evaluate).map(JobSpec::$variant),
                         <$spec as Strategy>::SETUP,
                         <$spec as Strategy>::WINDOWED,
+                        <$spec as Strategy>::LENGTH_AXES,
                     ));
                 }
             )*

@@ -8,28 +8,44 @@ use lensc_runtime::post::Dialect;
 use lensc_runtime::reader::MachineLimits;
 
 use crate::check::CheckedJob;
+use crate::schema::machines::MachineParams;
 use crate::schema::{OfferedDialect, offered_dialects};
-use crate::value::{self, Object};
+use crate::value::{Object, Reader};
 
 /// A checked machine's limits as the reader takes them (feeds in mm/min,
-/// spindle speeds in rpm).
+/// spindle speeds in rpm); none but its kind's for a machine that did not
+/// check.
 pub fn machine_limits(machine: &Object) -> MachineLimits {
-    let m = &machine.fields;
-    let travel = value::block(m, "travel");
+    let lathe = !machine.kind.name.starts_with("mill");
     let rpm = |w: f64| w * 60.0 / std::f64::consts::TAU;
-    MachineLimits {
-        lathe: !machine.kind.name.starts_with("mill"),
-        travel: ["x", "y", "z", "c"].map(|a| travel.and_then(|t| value::range(t, a))),
-        max_feed: value::num(m, "max_feed").map(|f| f * 60.0),
-        max_spindle_rpm: value::block(m, "spindle")
-            .and_then(|s| value::num(s, "max_speed"))
-            .map(rpm),
+    match MachineParams::read(machine) {
+        Ok(m) => MachineLimits {
+            lathe,
+            travel: m.travel,
+            max_feed: Some(m.max_feed * 60.0),
+            max_spindle_rpm: m.max_spindle_speed.map(rpm),
+        },
+        Err(_) => MachineLimits {
+            lathe,
+            travel: [None; 4],
+            max_feed: None,
+            max_spindle_rpm: None,
+        },
     }
 }
 
-/// The limits of a job's machine.
+/// The limits of a job's machine (none, on a lathe, if it has none that
+/// checked).
 pub fn job_machine(job: &CheckedJob) -> MachineLimits {
-    machine_limits(value::object(&job.fields, "machine").expect("checked job part"))
+    match Reader::new(&job.fields).object("machine") {
+        Some(m) => machine_limits(m),
+        None => MachineLimits {
+            lathe: true,
+            travel: [None; 4],
+            max_feed: None,
+            max_spindle_rpm: None,
+        },
+    }
 }
 
 /// A declared machine: its limits and the names of the dialects it

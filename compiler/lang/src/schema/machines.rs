@@ -243,8 +243,9 @@ pub struct MachineParams {
     pub resolution: f64,
     /// Fastest cutting feed (mm/s).
     pub max_feed: f64,
-    /// The work spindle's (or a mill's cutter spindle's) limit (rad/s).
-    pub max_spindle_speed: f64,
+    /// The work spindle's limit (rad/s), where the machine has one to
+    /// state (a lathe's; a mill's and a grinder's state none).
+    pub max_spindle_speed: Option<f64>,
     /// X, Y, Z and C travel where the machine states one (mm, rad).
     pub travel: [Option<(f64, f64)>; 4],
     /// A fast-tool-servo lathe's W axis.
@@ -284,7 +285,7 @@ impl MachineParams {
             kind: o.kind.name,
             resolution: r.required_num("resolution"),
             max_feed: r.required_num("max_feed"),
-            max_spindle_speed: r.required_block("spindle", |s| s.required_num("max_speed")),
+            max_spindle_speed: r.block("spindle", |s| s.required_num("max_speed")),
             travel: r
                 .block("travel", |t| ["x", "y", "z", "c"].map(|a| t.range(a)))
                 .unwrap_or([None; 4]),

@@ -146,7 +146,7 @@ impl std::fmt::Debug for Family {
     }
 }
 
-#[derive(Debug)]
+#[derive(Clone, Copy, Debug)]
 pub struct Kind {
     pub name: &'static str,
     pub category: Category,
@@ -230,8 +230,8 @@ fn required_range(r: &Reader, o: &Object, name: &str) -> Result<(f64, f64), Diag
     r.range(name).ok_or_else(|| missing(o, name))
 }
 
-/// Every kind, in the order messages list them.
-pub static KINDS: &[Kind] = &[
+/// Every kind but the strategies, in the order messages list them.
+const PART_KINDS: &[Kind] = &[
     dialects::GCODE,
     surfaces::PLANE,
     surfaces::SPHERE,
@@ -267,13 +267,24 @@ pub static KINDS: &[Kind] = &[
     machines::STS_LATHE,
     machines::MILL_3AXIS,
     machines::GRINDER_2AXIS,
-    strategies::FTS_SPIRAL,
-    strategies::SPIRAL_TURNING,
-    strategies::ROLLER_HELIX,
-    strategies::RASTER,
-    strategies::PROFILE_GRINDING,
-    strategies::PROFILE_TURNING,
 ];
+
+const KIND_COUNT: usize = PART_KINDS.len() + strategies::ALL.len();
+
+/// Every kind, in the order messages list them: the parts', then the
+/// strategies' (`strategies::ALL`, so a strategy is declared in one file).
+pub static KINDS: &[Kind] = &concat::<KIND_COUNT>(PART_KINDS, strategies::ALL);
+
+/// `a` then `b`, as one array of `N` (their lengths' sum) kinds.
+const fn concat<const N: usize>(a: &[Kind], b: &[Kind]) -> [Kind; N] {
+    let mut out = [a[0]; N];
+    let mut i = 0;
+    while i < N {
+        out[i] = if i < a.len() { a[i] } else { b[i - a.len()] };
+        i += 1;
+    }
+    out
+}
 
 /// The parameters of a job block.
 pub static JOB_PARAMS: &[Param] = &[
@@ -357,6 +368,79 @@ pub static JOB_PARAMS: &[Param] = &[
         "the acceptance criteria the simulated part must meet for the program to be written, or `none`; each left out has a default derived from the strategy's tolerance (docs/language/acceptance.md)",
     ),
 ];
+
+/// A job's own checked parameters beyond its four parts, read once.
+#[derive(Clone, Copy, Debug)]
+pub struct JobParams {
+    pub tool_number: Option<crate::value::Stated<f64>>,
+    pub tool_offset: Option<crate::value::Stated<f64>>,
+    /// `spindle_direction: ccw` (else clockwise).
+    pub spindle_ccw: bool,
+    /// `coolant`: `flood`, `mist` or `off`.
+    pub coolant: Option<crate::value::Stated<&'static str>>,
+    /// The `simulate` block, with where it was written.
+    pub simulate: Option<crate::value::Stated<SimulateParams>>,
+    /// Where the job names its surface, tool, machine and strategy.
+    pub part_sites: PartSites,
+}
+
+/// Where a job names each of its four parts (for a message about one).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PartSites {
+    pub surface: Option<(lensc_grammar::FileId, lensc_grammar::ast::Span)>,
+    pub tool: Option<(lensc_grammar::FileId, lensc_grammar::ast::Span)>,
+    pub machine: Option<(lensc_grammar::FileId, lensc_grammar::ast::Span)>,
+    pub strategy: Option<(lensc_grammar::FileId, lensc_grammar::ast::Span)>,
+}
+
+/// A job's `simulate { x: …, y: …, spacing: … }` window.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SimulateParams {
+    pub x: Option<(f64, f64)>,
+    pub y: Option<(f64, f64)>,
+    pub spacing: Option<f64>,
+}
+
+impl JobParams {
+    /// Reads a checked job's own fields.
+    pub fn read(fields: &[crate::value::Field]) -> JobParams {
+        let mut r = Reader::new(fields);
+        let coolant_ty = JOB_PARAMS
+            .iter()
+            .find(|p| p.name == "coolant")
+            .map(|p| p.ty);
+        JobParams {
+            tool_number: r.stated_num("tool_number"),
+            tool_offset: r.stated_num("tool_offset"),
+            spindle_ccw: r.word("spindle_direction") == Some("ccw"),
+            coolant: r.stated_word("coolant").map(|w| crate::value::Stated {
+                value: match coolant_ty {
+                    Some(Ty::Word(words)) => words
+                        .iter()
+                        .find(|x| **x == w.value)
+                        .copied()
+                        .unwrap_or("off"),
+                    _ => "off",
+                },
+                site: w.site,
+            }),
+            simulate: r.site("simulate").and_then(|site| {
+                r.block("simulate", |b| SimulateParams {
+                    x: b.range("x"),
+                    y: b.range("y"),
+                    spacing: b.num("spacing"),
+                })
+                .map(|value| crate::value::Stated { value, site })
+            }),
+            part_sites: PartSites {
+                surface: r.site("surface"),
+                tool: r.site("tool"),
+                machine: r.site("machine"),
+                strategy: r.site("strategy"),
+            },
+        }
+    }
+}
 
 /// The criteria of a job's `accept` block: each a limit on a figure of
 /// the simulated part (docs/language/acceptance.md says how each is

@@ -299,6 +299,17 @@ pub(super) const PROFILE_GRINDING: Kind = Kind {
     doc: "profile grinding with a spherical wheel: position-based interpolation of Kim et al. (seed 001)",
 };
 
+/// Every strategy kind, in the order messages list them (the last of
+/// `KINDS`): a strategy's schema entry is its constant and its line here.
+pub(super) const ALL: &[Kind] = &[
+    FTS_SPIRAL,
+    SPIRAL_TURNING,
+    ROLLER_HELIX,
+    RASTER,
+    PROFILE_GRINDING,
+    PROFILE_TURNING,
+];
+
 pub(super) const PROFILE_TURNING: Kind = Kind {
     name: "profile_turning",
     category: Category::Strategy,
@@ -418,6 +429,13 @@ pub struct PathParams {
     pub chords: Option<Stated<&'static str>>,
 }
 
+impl PathParams {
+    /// Reads the path parameters every strategy that has them shares.
+    pub fn read(o: &Object) -> PathParams {
+        path(&Reader::new(&o.fields))
+    }
+}
+
 fn path(r: &Reader) -> PathParams {
     PathParams {
         chord_tolerance: r.stated_num("chord_tolerance"),
@@ -462,7 +480,6 @@ fn feed(r: &Reader, name: &str) -> Option<StatedFeed> {
 #[derive(Clone, Copy, Debug)]
 pub struct ProfileTurningParams {
     pub feed: Option<StatedFeed>,
-    pub path: PathParams,
     pub spindle_speed: Option<f64>,
     pub surface_speed: Option<f64>,
     pub spindle_cap: Option<f64>,
@@ -487,7 +504,6 @@ impl ProfileTurningParams {
         let search_ty = PROFILE_TURNING.param("search").map(|p| p.ty);
         let v = ProfileTurningParams {
             feed: feed(&r, "feed"),
-            path: path(&r),
             spindle_speed: r.num("spindle_speed"),
             surface_speed: r.num("surface_speed"),
             spindle_cap: r.num("spindle_cap"),
@@ -519,7 +535,6 @@ pub struct SpiralParams {
     pub spindle_speed: Option<f64>,
     pub surface_speed: Option<f64>,
     pub spindle_cap: Option<f64>,
-    pub path: PathParams,
     pub seed_arc: Option<f64>,
     /// `settle` (`fts_spiral` only): `auto` or `none`.
     pub settle: Option<&'static str>,
@@ -537,7 +552,6 @@ impl SpiralParams {
             spindle_speed: r.num("spindle_speed"),
             surface_speed: r.num("surface_speed"),
             spindle_cap: r.num("spindle_cap"),
-            path: path(&r),
             seed_arc: r.num("seed_arc"),
             settle: r
                 .word("settle")
@@ -558,7 +572,6 @@ pub struct RasterParams {
     pub along_y: bool,
     pub zigzag: bool,
     pub stepover: f64,
-    pub path: PathParams,
     pub max_step: Option<f64>,
     pub lin_angle: Option<f64>,
     /// Cutting feed (mm/s).
@@ -574,7 +587,6 @@ impl RasterParams {
             along_y: r.word("along") == Some("y"),
             zigzag: r.word("direction") == Some("zigzag"),
             stepover: r.required_num("stepover"),
-            path: path(&r),
             max_step: r.num("max_step"),
             lin_angle: r.num("lin_angle"),
             feed: r.required_num("feed"),
@@ -627,7 +639,6 @@ pub struct RollerHelixParams {
     /// The rough pass and the radial stock it leaves for the finish.
     pub rough: Option<(HelixPassParams, f64)>,
     pub finish: HelixPassParams,
-    pub path: PathParams,
     /// Axial range of the cut (mm, the design's x).
     pub z: Option<(f64, f64)>,
     pub spindle_speed: f64,
@@ -645,7 +656,6 @@ impl RollerHelixParams {
         let v = RollerHelixParams {
             rough: r.block("rough", |b| (pass(b), b.required_num("finish_allowance"))),
             finish: r.required_block("finish", pass),
-            path: path(&r),
             z: r.range("z"),
             spindle_speed: r.required_num("spindle_speed"),
             blank_radius: r.num("blank_radius"),

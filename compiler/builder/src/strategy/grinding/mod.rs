@@ -16,7 +16,7 @@ use lensc_runtime::surface::SectionAlongX;
 use lensc_runtime::surface::analysis::Domain;
 
 use crate::job::{Evaluate, JobHead, Parts, all_clear};
-use lensc_lang::value;
+use lensc_lang::schema::strategies::ProfileGrindingParams;
 
 /// A `profile_grinding` job on a `grinder_2axis`, typed.
 pub struct GrindingSpec {
@@ -32,6 +32,7 @@ impl crate::strategy::Strategy for GrindingSpec {
     const NAMES: &'static [&'static str] = &["profile_grinding"];
     const SETUP: lensc_runtime::post::Setup = lensc_runtime::post::Setup::Lathe;
     const WINDOWED: bool = false;
+    const LENGTH_AXES: Option<u32> = None;
     fn lower(p: &Parts, dialect: Dialect, evaluate: Evaluate) -> Result<Self, Vec<Diagnostic>> {
         lower(p, dialect, evaluate)
     }
@@ -64,20 +65,21 @@ pub(crate) fn lower(
     evaluate: Evaluate,
 ) -> Result<GrindingSpec, Vec<Diagnostic>> {
     p.needs_kinds("profile grinding", &["grinder_2axis"], &["spherical_wheel"])?;
-    let (st, t) = (&p.strategy.fields, &p.tool.fields);
+    let st = ProfileGrindingParams::read(p.strategy).map_err(|d| vec![d])?;
+    let wheel_diameter = p.tool_needs(p.tool_params.diameter, "diameter")?;
     let lowered = p.lowered().map_err(|d| vec![d])?;
     let edge = match lowered.domain {
         Domain::Circle { radius } | Domain::Annulus { outer: radius, .. } => radius,
         Domain::Rect { x, .. } => x.1,
     };
-    let feed = value::num(st, "feed").expect("required");
+    let feed = st.feed;
     let grinding = ProfileGrinding {
-        wheel_diameter: value::num(t, "diameter").expect("required"),
-        interval: value::num(st, "interval").expect("required"),
+        wheel_diameter,
+        interval: st.interval,
         feed,
-        smoothness: value::num(st, "smoothness").expect("required"),
-        start: value::num(st, "from").unwrap_or(0.0),
-        end: value::num(st, "to").unwrap_or(edge),
+        smoothness: st.smoothness,
+        start: st.from.unwrap_or(0.0),
+        end: st.to.unwrap_or(edge),
     };
     let mut errors: Vec<Diagnostic> = p.feed_error("grinding", feed).into_iter().collect();
     // The checks the planner makes first, on its own contact stations.
@@ -89,7 +91,7 @@ pub(crate) fn lower(
     Ok(GrindingSpec {
         head: p.head(dialect, lowered),
         grinding,
-        retract: value::num(st, "retract").unwrap_or(1.0),
-        spindle_speed: value::num(st, "spindle_speed").expect("required"),
+        retract: st.retract.unwrap_or(1.0),
+        spindle_speed: st.spindle_speed,
     })
 }

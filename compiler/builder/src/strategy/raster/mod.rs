@@ -17,7 +17,8 @@ use lensc_runtime::post::Dialect;
 
 use crate::job::{Evaluate, JobHead, Parts, all_clear};
 use lensc_lang::codes;
-use lensc_lang::value;
+use lensc_lang::schema::strategies::RasterParams;
+use lensc_lang::value::Stated;
 
 /// A `raster` job on a `mill_3axis`, typed.
 pub struct RasterSpec {
@@ -40,6 +41,7 @@ impl crate::strategy::Strategy for RasterSpec {
     const NAMES: &'static [&'static str] = &["raster"];
     const SETUP: lensc_runtime::post::Setup = lensc_runtime::post::Setup::Mill;
     const WINDOWED: bool = true;
+    const LENGTH_AXES: Option<u32> = Some(3);
     fn lower(p: &Parts, dialect: Dialect, evaluate: Evaluate) -> Result<Self, Vec<Diagnostic>> {
         lower(p, dialect, evaluate)
     }
@@ -79,20 +81,16 @@ pub(crate) fn lower(
     evaluate: Evaluate,
 ) -> Result<RasterSpec, Vec<Diagnostic>> {
     p.needs_kinds("raster", &["mill_3axis"], &["microshaper", "ball_end"])?;
-    let (st, t) = (&p.strategy.fields, &p.tool.fields);
+    let st = RasterParams::read(p.strategy).map_err(|d| vec![d])?;
+    let t = p.tool_params;
     let mut raster = Raster {
-        along: if value::word(st, "along") == Some("y") {
-            Axis::Y
-        } else {
-            Axis::X
-        },
-        zigzag: value::word(st, "direction") == Some("zigzag"),
-        stepover: value::num(st, "stepover").expect("required"),
-        chord_tolerance: value::num(st, "chord_tolerance")
-            .unwrap_or(crate::job::DEFAULT_PATH_TOLERANCE),
-        max_step: value::num(st, "max_step"),
-        lin_angle: value::num(st, "lin_angle"),
-        retract: value::num(st, "retract").unwrap_or(1.0),
+        along: if st.along_y { Axis::Y } else { Axis::X },
+        zigzag: st.zigzag,
+        stepover: st.stepover,
+        chord_tolerance: p.chord_tolerance(),
+        max_step: st.max_step,
+        lin_angle: st.lin_angle,
+        retract: st.retract.unwrap_or(1.0),
         chords: ChordPlacement::OnPath,
     };
     // The chords take their share of the tolerance, the fitted lines and
@@ -109,7 +107,7 @@ pub(crate) fn lower(
     );
     let (tool, tool_words) = match p.tool.kind.name {
         "ball_end" => {
-            let d = value::num(t, "diameter").expect("required");
+            let d = p.tool_needs(t.diameter, "diameter")?;
             (
                 RasterTool::Ball { radius: d / 2.0 },
                 format!(
@@ -119,7 +117,7 @@ pub(crate) fn lower(
             )
         }
         _ => {
-            let r = value::num(t, "nose_radius").expect("required");
+            let r = p.tool_needs(t.nose_radius, "nose_radius")?;
             (
                 RasterTool::Knife { nose_radius: r },
                 format!(
@@ -130,11 +128,11 @@ pub(crate) fn lower(
         }
     };
     let lowered = p.lowered().map_err(|d| vec![d])?;
-    let feed = value::num(st, "feed").expect("required");
-    let clearance = value::num(t, "clearance");
+    let feed = st.feed;
+    let clearance = t.clearance;
     let mut errors: Vec<Diagnostic> = p.feed_error("cutting", feed).into_iter().collect();
-    let spindle_speed = value::num(st, "spindle_speed");
-    errors.extend(raster_spindle_error(p, &tool, spindle_speed));
+    let spindle_speed = st.spindle_speed.map(|s| s.value);
+    errors.extend(raster_spindle_error(p, &tool, st.spindle_speed));
     // The checks the planner makes first, on the planes it cuts.
     let kernel = evaluate(&lowered.tape);
     let scanned = check_raster(&raster, &tool, kernel.as_ref(), &lowered.domain)
@@ -156,7 +154,11 @@ pub(crate) fn lower(
 
 /// E0171: a rotating cutter (a ball-end mill) needs its spindle speed; a
 /// knife cuts with the spindle held still and is given none.
-fn raster_spindle_error(p: &Parts, tool: &RasterTool, speed: Option<f64>) -> Option<Diagnostic> {
+fn raster_spindle_error(
+    p: &Parts,
+    tool: &RasterTool,
+    speed: Option<Stated<f64>>,
+) -> Option<Diagnostic> {
     match (tool, speed) {
         (RasterTool::Ball { .. }, None) => Some(
             p.error(
@@ -165,19 +167,16 @@ fn raster_spindle_error(p: &Parts, tool: &RasterTool, speed: Option<f64>) -> Opt
             )
             .with_help("add `spindle_speed: …` (rpm) to the raster strategy"),
         ),
-        (RasterTool::Knife { .. }, Some(_)) => {
-            let f = value::field(&p.strategy.fields, "spindle_speed").expect("given");
-            Some(
+        (RasterTool::Knife { .. }, Some(f)) => Some(
                 Diagnostic::error(
                     codes::RASTER_SPINDLE,
                     "a microshaper knife cuts with the spindle held still (oriented), not turning",
-                    f.file,
-                    f.span,
+                    f.site.0,
+                    f.site.1,
                 )
                 .with_label("a turning spindle would swing the knife through the part")
                 .with_help("remove `spindle_speed`: the program orients and holds the spindle"),
-            )
-        }
+        ),
         _ => None,
     }
 }

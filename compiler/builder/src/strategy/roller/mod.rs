@@ -21,7 +21,8 @@ use lensc_runtime::surface::ir::SurfaceFn;
 use crate::job::{Evaluate, JobHead, Parts, all_clear};
 use lensc_lang::check::trim_num;
 use lensc_lang::codes;
-use lensc_lang::value;
+use lensc_lang::schema::Surface;
+use lensc_lang::schema::strategies::{HelixPassParams, RollerHelixParams};
 
 /// A roller job, typed.
 pub struct RollerSpec {
@@ -45,6 +46,7 @@ impl crate::strategy::Strategy for RollerSpec {
     const NAMES: &'static [&'static str] = &["roller_helix"];
     const SETUP: lensc_runtime::post::Setup = lensc_runtime::post::Setup::Lathe;
     const WINDOWED: bool = true;
+    const LENGTH_AXES: Option<u32> = None;
     fn lower(p: &Parts, dialect: Dialect, evaluate: Evaluate) -> Result<Self, Vec<Diagnostic>> {
         lower(p, dialect, evaluate)
     }
@@ -93,7 +95,8 @@ pub(crate) fn lower(
     evaluate: Evaluate,
 ) -> Result<RollerSpec, Vec<Diagnostic>> {
     let roller_radius = roller_radius(p)?;
-    let (t, st) = (&p.tool.fields, &p.strategy.fields);
+    let st = RollerHelixParams::read(p.strategy).map_err(|d| vec![d])?;
+    let t = p.tool_params;
     let lowered = p.lowered().map_err(|d| vec![d])?;
     let Domain::Rect {
         x: design_x,
@@ -107,9 +110,9 @@ pub(crate) fn lower(
     };
     let kernel = evaluate(&lowered.tape);
     let rt = RollerTool {
-        nose_radius: value::num(t, "nose_radius").expect("required"),
-        clearance_angle: value::num(t, "clearance").expect("required"),
-        opening_angle: value::num(t, "included_angle").unwrap_or(std::f64::consts::PI),
+        nose_radius: p.tool_needs(t.nose_radius, "nose_radius")?,
+        clearance_angle: p.tool_needs(t.clearance, "clearance")?,
+        opening_angle: t.included_angle.unwrap_or(std::f64::consts::PI),
     };
     let region = DesignRegion {
         x: design_x,
@@ -119,22 +122,22 @@ pub(crate) fn lower(
     let check = check_roller_tool(kernel.as_ref(), &region, roller_radius, &rt)
         .map_err(|e| vec![errors::error(e, p.site())])?;
     let mut errors = tool_errors(p, &rt, &check);
-    let spindle_speed = value::num(st, "spindle_speed").expect("required");
+    let spindle_speed = st.spindle_speed;
     errors.extend(p.spindle_limit(spindle_speed));
     all_clear(errors)?;
-    let (z_start, z_end) = value::range(st, "z").unwrap_or(design_x);
+    let (z_start, z_end) = st.z.unwrap_or(design_x);
     let helix = RollerHelix {
         roller_radius,
         // Spindle angle 0 is the design's first row: a design centred on
         // y = 0 wraps from −L/2, not from its middle.
         y_start: design_y.0,
-        passes: passes(st),
+        passes: passes(&st),
         z_start,
         z_end,
         // By default the blank just covers the design: its highest point,
         // found on the tool check's grid and by the refined analysis, or
         // the roller's own radius (an array's land, z = 0, around it).
-        blank_radius: value::num(st, "blank_radius").unwrap_or_else(|| {
+        blank_radius: st.blank_radius.unwrap_or_else(|| {
             let top =
                 lensc_runtime::surface::analysis::analyse(kernel.as_ref(), &lowered.domain, 201)
                     .sag_max
@@ -160,7 +163,7 @@ pub(crate) fn lower(
         ),
         ..helix
     };
-    let retract = value::num(st, "retract").unwrap_or(1.0);
+    let retract = st.retract.unwrap_or(1.0);
     Ok(RollerSpec {
         head: p.head(dialect, lowered),
         safe_x: helix.blank_radius + rt.nose_radius + retract,
@@ -169,7 +172,7 @@ pub(crate) fn lower(
         check,
         design_y,
         spindle_speed,
-        max_feed: value::num(&p.machine.fields, "max_feed").expect("required"),
+        max_feed: p.machine_params.max_feed,
     })
 }
 
@@ -199,10 +202,10 @@ fn chord_sag(design: &dyn SurfaceFn, region: &DesignRegion, arc: f64) -> f64 {
 fn roller_radius(p: &Parts) -> Result<f64, Vec<Diagnostic>> {
     let surface = p.surface;
     let mut errors = p.needs_servo_lathe("roller helix turning", "sts_lathe", " (C, Z, X)");
-    let roller = (surface.kind.name == "wrap")
-        .then(|| value::object(&surface.fields, "onto"))
-        .flatten()
-        .and_then(|r| value::num(&r.fields, "radius"));
+    let roller = match &p.surface_params {
+        Surface::Wrap(w) => Some(w.onto.radius),
+        _ => None,
+    };
     if roller.is_none() {
         errors.push(
             p.error(
@@ -219,20 +222,14 @@ fn roller_radius(p: &Parts) -> Result<f64, Vec<Diagnostic>> {
 }
 
 /// The rough pass, if the strategy has one, then the finish pass.
-fn passes(st: &[value::Field]) -> Vec<HelixPass> {
-    let pass = |block: &[value::Field], finish_allowance: f64| HelixPass {
-        c_step: value::num(block, "c_step").expect("required"),
-        pitch: value::num(block, "pitch").expect("required"),
+fn passes(st: &RollerHelixParams) -> Vec<HelixPass> {
+    let pass = |p: HelixPassParams, finish_allowance: f64| HelixPass {
+        c_step: p.c_step,
+        pitch: p.pitch,
         finish_allowance,
     };
-    let rough = value::block(st, "rough").map(|rough| {
-        pass(
-            rough,
-            value::num(rough, "finish_allowance").expect("required"),
-        )
-    });
-    let finish = pass(value::block(st, "finish").expect("required"), 0.0);
-    rough.into_iter().chain([finish]).collect()
+    let rough = st.rough.map(|(rough, allowance)| pass(rough, allowance));
+    rough.into_iter().chain([pass(st.finish, 0.0)]).collect()
 }
 
 /// What the tool check found wrong: the nose, the clearance, the opening.

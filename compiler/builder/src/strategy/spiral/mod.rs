@@ -25,7 +25,9 @@ use crate::job::{Evaluate, JobHead, Parts, all_clear};
 use lensc_lang::check::trim_num;
 use lensc_lang::codes;
 use lensc_lang::lower::surface::{LowerError, LoweredSurface};
-use lensc_lang::value::{self, Object};
+use lensc_lang::schema::machines::{FastAxisParams, MachineParams, ZAxisParams};
+use lensc_lang::schema::strategies::SpiralParams;
+use lensc_lang::value::Object;
 
 /// A spiral job, typed: what the spiral planner needs.
 pub struct SpiralSpec {
@@ -115,6 +117,7 @@ impl crate::strategy::Strategy for SpiralSpec {
     const NAMES: &'static [&'static str] = &["fts_spiral", "spiral_turning"];
     const SETUP: lensc_runtime::post::Setup = lensc_runtime::post::Setup::Lathe;
     const WINDOWED: bool = true;
+    const LENGTH_AXES: Option<u32> = Some(2);
     fn lower(p: &Parts, dialect: Dialect, evaluate: Evaluate) -> Result<Self, Vec<Diagnostic>> {
         lower(p, dialect, evaluate)
     }
@@ -154,28 +157,28 @@ pub(crate) fn lower(
         ("fts_lathe", "fast-tool-servo turning")
     };
     all_clear(p.needs_servo_lathe(what, lathe, ""))?;
-    let (m, t, st) = (&p.machine.fields, &p.tool.fields, &strategy.fields);
-    let travel = value::block(m, "travel").expect("required");
+    let st = SpiralParams::read(strategy).map_err(|d| vec![d])?;
+    let m = &p.machine_params;
     // The axis that carries the surface: the servo, or Z itself.
-    let fast = value::block(m, if slow { "z_axis" } else { "fast_axis" }).expect("required");
-    let rho = value::num(t, "nose_radius").expect("required");
-    let servo = if slow {
-        None
-    } else {
-        servo_model(fast).map_err(|()| {
+    let fast = carrier(p, slow)?;
+    let rho = p.tool_needs(p.tool_params.nose_radius, "nose_radius")?;
+    let servo = match fast {
+        Carrier::SlowZ { .. } => None,
+        Carrier::Servo(f) => servo_model(&f).map_err(|()| {
             vec![p.error(
                 codes::MISSING_PARAMETER,
                 "the fast axis's servo model needs either `resonance` and `resonant_peak`, or `natural_frequency` and `damping`".into(),
             )]
-        })?
+        })?,
     };
-    let fast_axis = fast_axis(slow, travel, fast);
-    let speed = spindle_speed(st, p.max_spindle_speed());
+    let fast_axis = fast_axis(fast, m);
+    let speed = spindle_speed(p, &st)?;
+    let clearance = p.tool_needs(p.tool_params.clearance, "clearance")?;
 
     let lowered = p.lowered().map_err(|d| vec![d])?;
     // The spiral starts where the surface's farthest point from the axis is.
-    let start = value::num(st, "from").unwrap_or(outer_radius(&lowered.domain));
-    let settling = settling_offset(p, slow, servo, fast, fastest(speed, start))?;
+    let start = st.from.unwrap_or(outer_radius(&lowered.domain));
+    let settling = settling_offset(p, &st, servo, fast, fastest(speed, start))?;
     let design_kernel = evaluate(&lowered.tape);
     let design =
         lensc_runtime::surface::analysis::analyse(design_kernel.as_ref(), &lowered.domain, 201);
@@ -187,15 +190,20 @@ pub(crate) fn lower(
         evaluate,
     )
     .map_err(|e| vec![RuntimeError::Trajectory(e).at(p.site())])?;
-    let mut errors = tool_checks(p, design_kernel.as_ref(), &lowered, &design);
+    let mut errors = tool_checks(
+        p,
+        (rho, clearance),
+        design_kernel.as_ref(),
+        &lowered,
+        &design,
+    );
 
     let mut spiral = FtsSpiral {
-        feed_per_rev: value::num(st, "feed").expect("required") * 2.0 * std::f64::consts::PI,
+        feed_per_rev: st.feed * 2.0 * std::f64::consts::PI,
         speed,
-        chord_tolerance: value::num(st, "chord_tolerance")
-            .unwrap_or(crate::job::DEFAULT_PATH_TOLERANCE),
-        seed_arc: value::num(st, "seed_arc").unwrap_or(0.1),
-        min_interval: 1.0 / value::num(fast, "data_rate").unwrap_or(if slow { 1e3 } else { 20e3 }),
+        chord_tolerance: p.chord_tolerance(),
+        seed_arc: st.seed_arc.unwrap_or(0.1),
+        min_interval: 1.0 / fast.data_rate(),
         start_radius: start,
         end_radius: 0.0,
         chords: ChordPlacement::OnPath,
@@ -210,10 +218,10 @@ pub(crate) fn lower(
             long_chords: true,
         },
     );
-    errors.extend(machine_limits(p, &spiral, travel));
+    errors.extend(machine_limits(p, &spiral));
     all_clear(errors)?;
 
-    let retract = value::num(st, "retract").unwrap_or(1.0);
+    let retract = st.retract.unwrap_or(1.0);
     let safe_w = bounds.z_max + rho + retract;
     Ok(SpiralSpec {
         head: p.head(dialect, lowered),
@@ -270,29 +278,72 @@ fn settled_trajectory(
     Ok((trajectory, bounds))
 }
 
+/// The axis that carries the surface: a fast tool servo, or a slow tool
+/// servo lathe's Z itself.
+#[derive(Clone, Copy)]
+enum Carrier {
+    Servo(FastAxisParams),
+    SlowZ(ZAxisParams),
+}
+
+impl Carrier {
+    /// The rate at which it takes positions (Hz): its own, or 20 kHz for
+    /// a fast tool servo and 1 kHz for a slow one.
+    fn data_rate(self) -> f64 {
+        match self {
+            Carrier::Servo(f) => f.data_rate.unwrap_or(20e3),
+            Carrier::SlowZ(z) => z.data_rate.unwrap_or(1e3),
+        }
+    }
+}
+
+/// The machine's axis that carries the surface, or E0121 if the lathe
+/// (of the kind `needs_servo_lathe` let through) states none.
+fn carrier(p: &Parts, slow: bool) -> Result<Carrier, Vec<Diagnostic>> {
+    let m = &p.machine_params;
+    let (carrier, block) = if slow {
+        (m.z_axis.map(Carrier::SlowZ), "z_axis")
+    } else {
+        (m.fast_axis.map(Carrier::Servo), "fast_axis")
+    };
+    carrier.ok_or_else(|| {
+        vec![p.error(
+            codes::MISSING_PARAMETER,
+            format!("this job's machine (`{}`) has no `{block}`", m.kind),
+        )]
+    })
+}
+
 /// What the axis carrying the surface can do: the fast tool servo's
 /// stroke, or a slow tool servo's Z travel, and its acceleration.
-fn fast_axis(slow: bool, travel: &[value::Field], fast: &[value::Field]) -> FastAxis {
-    FastAxis {
-        stroke: if slow {
-            let (lo, hi) = value::range(travel, "z").expect("required");
-            hi - lo
-        } else {
-            value::num(fast, "stroke").expect("required")
+fn fast_axis(carrier: Carrier, m: &MachineParams) -> FastAxis {
+    match carrier {
+        Carrier::Servo(f) => FastAxis {
+            stroke: f.stroke,
+            max_acceleration: f.max_acceleration,
         },
-        max_acceleration: value::num(fast, "max_acceleration").expect("required"),
+        Carrier::SlowZ(z) => FastAxis {
+            // A lathe's travel states Z (the checker requires it).
+            stroke: m.travel[2].map_or(f64::INFINITY, |(lo, hi)| hi - lo),
+            max_acceleration: z.max_acceleration,
+        },
     }
 }
 
 /// The strategy's spindle speed: a constant surface speed capped (by the
 /// strategy or the machine's limit, rad/s), or a constant spindle speed.
-fn spindle_speed(st: &[value::Field], max_spindle: f64) -> SpindleSpeed {
-    match value::num(st, "surface_speed") {
-        Some(v) => SpindleSpeed::SurfaceSpeed {
+/// E0121 if the strategy states neither (the checker requires one).
+fn spindle_speed(p: &Parts, st: &SpiralParams) -> Result<SpindleSpeed, Vec<Diagnostic>> {
+    match (st.surface_speed, st.spindle_speed) {
+        (Some(v), _) => Ok(SpindleSpeed::SurfaceSpeed {
             speed: v,
-            max: value::num(st, "spindle_cap").unwrap_or(max_spindle),
-        },
-        None => SpindleSpeed::Constant(value::num(st, "spindle_speed").expect("one of them")),
+            max: st.spindle_cap.unwrap_or(p.max_spindle_speed()),
+        }),
+        (None, Some(w)) => Ok(SpindleSpeed::Constant(w)),
+        (None, None) => Err(vec![p.error(
+            codes::MISSING_PARAMETER,
+            "this spiral states neither `spindle_speed` nor `surface_speed`".into(),
+        )]),
     }
 }
 
@@ -321,17 +372,17 @@ fn outer_radius(domain: &Domain) -> f64 {
 /// `settle: auto` finds none.
 fn settling_offset(
     p: &Parts,
-    slow: bool,
+    st: &SpiralParams,
     servo: Option<SecondOrderServo>,
-    fast: &[value::Field],
+    carrier: Carrier,
     fastest: f64,
 ) -> Result<Option<Settling>, Vec<Diagnostic>> {
-    let st = &p.strategy.fields;
-    let settle_word = value::word(st, "settle");
-    let settling = if slow || settle_word == Some("none") {
-        None
-    } else {
-        settling(p.surface, st, servo, fast, fastest)
+    let settle_word = st.settle;
+    let settling = match carrier {
+        Carrier::Servo(fast) if settle_word != Some("none") => {
+            settling(p.surface, st, servo, &fast, fastest)
+        }
+        _ => None,
     };
     if settle_word == Some("auto") && settling.is_none() {
         return Err(vec![
@@ -361,7 +412,7 @@ fn settled_features(surface: &Object, s: &Settling) -> Option<Vec<(f64, f64, f64
 
 /// The spindle's speed and the X travel against the spiral: if it
 /// turns faster than the machine allows (E0143), E0141 if it runs outside X.
-fn machine_limits(p: &Parts, spiral: &FtsSpiral, travel: &[value::Field]) -> Vec<Diagnostic> {
+fn machine_limits(p: &Parts, spiral: &FtsSpiral) -> Vec<Diagnostic> {
     let spin_max = match spiral.speed {
         SpindleSpeed::Constant(w) => w,
         // The spiral runs in to the axis, where the cap is reached.
@@ -369,7 +420,8 @@ fn machine_limits(p: &Parts, spiral: &FtsSpiral, travel: &[value::Field]) -> Vec
     };
     let start = spiral.start_radius;
     let mut errors: Vec<Diagnostic> = p.spindle_limit(spin_max).into_iter().collect();
-    let (tx0, tx1) = value::range(travel, "x").expect("required");
+    // A lathe's travel states X (the checker requires it).
+    let (tx0, tx1) = p.machine_params.travel[0].unwrap_or((f64::NEG_INFINITY, f64::INFINITY));
     if start > tx1 || tx0 > 0.0 {
         errors.push(p.error(
             codes::OUT_OF_TRAVEL,
@@ -387,13 +439,12 @@ fn machine_limits(p: &Parts, spiral: &FtsSpiral, travel: &[value::Field]) -> Vec
 /// The fast axis's second-order servo model, from its resonance and peak
 /// or its natural frequency and damping (`None` if those make no servo);
 /// an error if neither pair is given.
-fn servo_model(fast: &[value::Field]) -> Result<Option<SecondOrderServo>, ()> {
-    let num = |k: &str| value::num(fast, k);
+fn servo_model(fast: &FastAxisParams) -> Result<Option<SecondOrderServo>, ()> {
     match (
-        num("resonance"),
-        num("resonant_peak"),
-        num("natural_frequency"),
-        num("damping"),
+        fast.resonance,
+        fast.resonant_peak,
+        fast.natural_frequency,
+        fast.damping,
     ) {
         (Some(f), Some(peak), None, None) => Ok(SecondOrderServo::from_resonance(f, peak)),
         (None, None, Some(f), Some(zeta)) => Ok(SecondOrderServo::from_natural(f, zeta)),
@@ -401,20 +452,21 @@ fn servo_model(fast: &[value::Field]) -> Result<Option<SecondOrderServo>, ()> {
     }
 }
 
-/// The tool against the design surface: the nose radius against the
+/// The tool (its nose radius and clearance angle) against the design
+/// surface: the nose radius against the
 /// smallest concave radius of curvature; the flank follows the cut around
 /// the spindle, so the clearance angle must exceed the steepest slope
 /// around (circumferential); the edge meets the slope across (radial), so
 /// half its included angle must exceed it.
 fn tool_checks(
     p: &Parts,
+    tool: (f64, f64),
     design_kernel: &dyn SurfaceFn,
     lowered: &LoweredSurface,
     design: &lensc_runtime::surface::analysis::SurfaceAnalysis,
 ) -> Vec<Diagnostic> {
-    let t = &p.tool.fields;
-    let rho = value::num(t, "nose_radius").expect("required");
-    let clearance = value::num(t, "clearance").expect("required");
+    let (rho, clearance) = tool;
+    let t = &p.tool_params;
     let err = |code: &'static str, msg: String| p.error(code, msg);
     let mut errors = Vec::new();
     if let Some(r) = [design.min_radius_concave_x, design.min_radius_concave_y]
@@ -447,7 +499,7 @@ fn tool_checks(
             ),
         ).with_help(format!("use a tool whose `clearance` is above {}°", trim_num(around.0.to_degrees()))));
     }
-    if let Some(included) = value::num(t, "included_angle")
+    if let Some(included) = t.included_angle
         && included / 2.0 <= across.0
     {
         errors.push(err(
@@ -498,14 +550,14 @@ fn polar_slopes(
 /// lenslet's own surface rises over that path past its rim.
 fn settling(
     surface: &Object,
-    st: &[value::Field],
+    st: &SpiralParams,
     servo: Option<SecondOrderServo>,
-    fast: &[value::Field],
+    fast: &FastAxisParams,
     surface_speed: f64,
 ) -> Option<Settling> {
     lensc_lang::lower::surface::array_lenslet(surface)?;
-    let band = value::num(fast, "settling_band").unwrap_or(0.002);
-    let (time, band) = match value::num(st, "settling_time") {
+    let band = fast.settling_band.unwrap_or(0.002);
+    let (time, band) = match st.settling_time {
         Some(t) => (t, None),
         None => (servo?.settling_time(band)?, Some(band)),
     };

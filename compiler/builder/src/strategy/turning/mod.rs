@@ -18,11 +18,13 @@ use lensc_runtime::post::Dialect;
 use lensc_runtime::surface::{SectionAlongX, SurfaceInfo};
 
 use crate::job::{Evaluate, JobHead, Parts};
+use lensc_grammar::{FileId, Span};
 use lensc_lang::check::trim_num;
 use lensc_lang::codes;
-use lensc_lang::domain::{aperture_inner_radius, aperture_radius};
-use lensc_lang::units::Dim;
-use lensc_lang::value::{self, Field, Object, Value};
+use lensc_lang::schema::Surface;
+use lensc_lang::schema::machines::MachineParams;
+use lensc_lang::schema::strategies::{ProfileTurningParams, StatedFeed};
+use lensc_lang::value::{Object, Value};
 
 /// A profile-turning job, typed.
 pub struct TurningSpec {
@@ -35,6 +37,7 @@ impl crate::strategy::Strategy for TurningSpec {
     const NAMES: &'static [&'static str] = &["profile_turning"];
     const SETUP: lensc_runtime::post::Setup = lensc_runtime::post::Setup::Lathe;
     const WINDOWED: bool = false;
+    const LENGTH_AXES: Option<u32> = Some(2);
     fn lower(p: &Parts, dialect: Dialect, evaluate: Evaluate) -> Result<Self, Vec<Diagnostic>> {
         lower(p, dialect, evaluate)
     }
@@ -86,35 +89,32 @@ pub(crate) fn lower(
 fn turning_job(p: &Parts, dialect: Dialect) -> Result<TurningJob, Vec<Diagnostic>> {
     let (surface, tool, machine, strategy) = (p.surface, p.tool, p.machine, p.strategy);
     let mut errors = Vec::new();
-    let at = |name: &str| {
-        let f = value::field(&p.job.fields, name).expect("checked job part");
-        (f.file, f.span)
-    };
-    let unsupported = |what: &str, name: &str, detail: String| {
-        let (file, span) = at(name);
+    let sites = p.params.part_sites;
+    let unsupported = |what: &str, site: Option<(FileId, Span)>, detail: String| {
+        let (file, span) = site.unwrap_or(p.site());
         Diagnostic::error(codes::UNSUPPORTED_COMBINATION, what.to_string(), file, span)
             .with_label(detail)
     };
     if machine.kind.name != "lathe" {
         errors.push(unsupported(
             "profile turning needs a lathe",
-            "machine",
+            sites.machine,
             format!("this is a `{}`", machine.kind.name),
         ));
     }
     if tool.kind.name != "round_nose" {
         errors.push(unsupported(
             "profile turning needs a round-nose tool",
-            "tool",
+            sites.tool,
             format!("this is a `{}`", tool.kind.name),
         ));
     }
-    let surf = surface_info(surface);
+    let surf = surface_info(surface, &p.surface_params);
     if surf.is_none() {
         errors.push(
             unsupported(
                 "profile turning needs a rotationally symmetric surface with a circular aperture",
-                "surface",
+                sites.surface,
                 format!("this is a `{}`", surface.kind.name),
             )
             .with_help("sphere, conic, asphere, qbfs and qcon surfaces with a circle or annulus aperture can be turned, and any profile made a surface of revolution with `revolve`"),
@@ -123,12 +123,11 @@ fn turning_job(p: &Parts, dialect: Dialect) -> Result<TurningJob, Vec<Diagnostic
     let Some(surf) = surf.filter(|_| errors.is_empty()) else {
         return Err(errors);
     };
-    let f = &strategy.fields;
-    let from = value::num(f, "from");
-    if let Some(start) = from
-        && start > surf.aperture_radius
+    let f = ProfileTurningParams::read(strategy).map_err(|d| vec![d])?;
+    if let Some(from) = f.from
+        && from.value > surf.aperture_radius
     {
-        let fld = value::field(f, "from").expect("from");
+        let (start, fld) = (from.value, from.site);
         return Err(vec![
             Diagnostic::error(
                 codes::OUTSIDE_APERTURE,
@@ -137,23 +136,29 @@ fn turning_job(p: &Parts, dialect: Dialect) -> Result<TurningJob, Vec<Diagnostic
                     trim_num(start),
                     trim_num(surf.aperture_radius)
                 ),
-                fld.file,
-                fld.span,
+                fld.0,
+                fld.1,
             )
             .with_label("beyond the aperture")
             .with_help("start at or inside the aperture edge"),
         ]);
     }
+    let feed = f.feed.map(feed_of).ok_or_else(|| {
+        vec![p.error(
+            codes::MISSING_PARAMETER,
+            "this profile turning states no `feed`".into(),
+        )]
+    })?;
     Ok(TurningJob {
         name: p.job.name.name.clone(),
         surface_name: name_of(p, "surface", surface),
         tool_name: name_of(p, "tool", tool),
         machine_name: name_of(p, "machine", machine),
         strategy_name: name_of(p, "strategy", strategy),
-        strategy: profile_turning(p, f, surface, p.max_spindle_speed()),
+        strategy: profile_turning(p, &f, feed)?,
         surface: surf,
-        tool: round_nose(&tool.fields),
-        machine: lathe(&machine.fields, dialect),
+        tool: round_nose(p)?,
+        machine: lathe(&p.machine_params, dialect),
     })
 }
 
@@ -165,19 +170,21 @@ fn name_of(p: &Parts, part: &str, o: &Object) -> String {
         .unwrap_or_else(|| o.kind.name.to_string())
 }
 
-/// A feed field (per revolution or per minute), if given.
-fn feed_of(f: &[Field], name: &str) -> Option<Feed> {
-    match value::field(f, name).map(|x| &x.value) {
-        Some(Value::Num(v, d)) if *d == Dim::FEED_PER_REV => Some(Feed::PerRevolution(*v)),
-        Some(Value::Num(v, _)) => Some(Feed::PerTime(*v)),
-        _ => None,
+/// A feed as the planner takes it.
+fn feed_of(f: StatedFeed) -> Feed {
+    match f {
+        StatedFeed::PerRevolution(v) => Feed::PerRevolution(v),
+        StatedFeed::PerTime(v) => Feed::PerTime(v),
     }
 }
 
-fn profile_turning(p: &Parts, f: &[Field], surface: &Object, max_spindle: f64) -> ProfileTurning {
-    let feed = feed_of(f, "feed").expect("feed is required and checked");
-    let tolerance = value::num(f, "chord_tolerance").unwrap_or(crate::job::DEFAULT_PATH_TOLERANCE);
-    ProfileTurning {
+fn profile_turning(
+    p: &Parts,
+    f: &ProfileTurningParams,
+    feed: Feed,
+) -> Result<ProfileTurning, Vec<Diagnostic>> {
+    let tolerance = p.chord_tolerance();
+    Ok(ProfileTurning {
         // The chords take their share of the tolerance, the fitted lines
         // and arcs theirs (`plan::optimise`).
         chords: crate::job::chords::placement(
@@ -192,74 +199,76 @@ fn profile_turning(p: &Parts, f: &[Field], surface: &Object, max_spindle: f64) -
         ),
         feed,
         // Under constant surface speed the spindle speed is its cap.
-        spindle_speed: value::num(f, "spindle_speed")
-            .or_else(|| value::num(f, "spindle_cap"))
-            .unwrap_or(max_spindle),
-        surface_speed: value::num(f, "surface_speed"),
-        chord_tolerance: value::num(f, "chord_tolerance")
-            .unwrap_or(crate::job::DEFAULT_PATH_TOLERANCE),
-        start_radius: value::num(f, "from"),
+        spindle_speed: f
+            .spindle_speed
+            .or(f.spindle_cap)
+            .unwrap_or(p.max_spindle_speed()),
+        surface_speed: f.surface_speed,
+        chord_tolerance: tolerance,
+        start_radius: f.from.map(|s| s.value),
         // An annular aperture's cut ends at its inner edge.
-        end_radius: value::num(f, "to").unwrap_or_else(|| {
-            value::object(&surface.fields, "aperture").map_or(0.0, |a| aperture_inner_radius(a))
-        }),
-        retract: value::num(f, "retract").unwrap_or(1.0),
+        end_radius: f
+            .to
+            .unwrap_or_else(|| p.surface_params.region().map_or(0.0, |a| a.inner_radius())),
+        retract: f.retract.unwrap_or(1.0),
         location: tool_location(f),
         roughing: roughing(f),
-    }
+    })
 }
 
-fn lathe(m: &[Field], dialect: Dialect) -> Lathe {
-    let travel = value::block(m, "travel").expect("required");
-    let spindle = value::block(m, "spindle").expect("required");
+fn lathe(m: &MachineParams, dialect: Dialect) -> Lathe {
+    // A lathe's travel states X and Z (the checker requires both).
+    let all = (f64::NEG_INFINITY, f64::INFINITY);
     Lathe {
         dialect,
-        resolution: value::num(m, "resolution").expect("required"),
-        travel_x: value::range(travel, "x").expect("required"),
-        travel_z: value::range(travel, "z").expect("required"),
-        max_feed: value::num(m, "max_feed").expect("required"),
-        max_spindle_speed: value::num(spindle, "max_speed").expect("required"),
+        resolution: m.resolution,
+        travel_x: m.travel[0].unwrap_or(all),
+        travel_z: m.travel[2].unwrap_or(all),
+        max_feed: m.max_feed,
+        max_spindle_speed: m.max_spindle_speed.unwrap_or(f64::INFINITY),
     }
 }
 
-fn round_nose(t: &[Field]) -> RoundNoseTool {
-    RoundNoseTool {
-        nose_radius: value::num(t, "nose_radius").expect("required"),
-        clearance_angle: value::num(t, "clearance").expect("required"),
-        centre_height: value::num(t, "centre_height").unwrap_or(0.0),
-        rake_angle: value::num(t, "rake").unwrap_or(0.0),
-    }
+/// The round-nose tool, or E0121 for what it lacks.
+fn round_nose(p: &Parts) -> Result<RoundNoseTool, Vec<Diagnostic>> {
+    let t = &p.tool_params;
+    Ok(RoundNoseTool {
+        nose_radius: p.tool_needs(t.nose_radius, "nose_radius")?,
+        clearance_angle: p.tool_needs(t.clearance, "clearance")?,
+        centre_height: t.centre_height.unwrap_or(0.0),
+        rake_angle: t.rake.unwrap_or(0.0),
+    })
 }
 
 /// Roughing passes, when the strategy states the stock and a depth of cut.
-fn roughing(f: &[Field]) -> Option<Roughing> {
-    let stock = match (value::num(f, "stock_top"), value::num(f, "stock_allowance")) {
+fn roughing(f: &ProfileTurningParams) -> Option<Roughing> {
+    let stock = match (f.stock_top, f.stock_allowance) {
         (Some(top), _) => Stock::Flat { top },
         (None, Some(allowance)) => Stock::Offset { allowance },
         (None, None) => return None,
     };
     Some(Roughing {
         stock,
-        depth_of_cut: value::num(f, "depth_of_cut")?,
-        finish_allowance: value::num(f, "finish_allowance").unwrap_or(0.0),
+        depth_of_cut: f.depth_of_cut?,
+        finish_allowance: f.finish_allowance.unwrap_or(0.0),
         // The checker refuses a stock without it (E0170).
-        feed: feed_of(f, "rough_feed")?,
-        spindle_speed: value::num(f, "rough_spindle_speed"),
+        feed: f.rough_feed.map(feed_of)?,
+        spindle_speed: f.rough_spindle_speed,
     })
 }
 
 /// The `search` of a profile-turning strategy: exact unless the user asks
 /// for one of Lei et al.'s reference searches.
-fn tool_location(f: &[Field]) -> ToolLocation {
-    let spacing = value::num(f, "search_spacing").unwrap_or(1e-3);
-    match value::word(f, "search") {
+fn tool_location(f: &ProfileTurningParams) -> ToolLocation {
+    let spacing = f.search_spacing.unwrap_or(1e-3);
+    match f.search {
         Some("sequential") => ToolLocation::Sequential {
             spacing,
-            step: value::num(f, "search_step").unwrap_or(1e-5),
+            step: f.search_step.unwrap_or(1e-5),
         },
         Some("binary") => ToolLocation::Binary {
             spacing,
-            tolerance: value::num(f, "search_step").unwrap_or(1e-6),
+            tolerance: f.search_step.unwrap_or(1e-6),
         },
         _ => ToolLocation::Exact,
     }
@@ -268,10 +277,9 @@ fn tool_location(f: &[Field]) -> ToolLocation {
 /// What the program header says about a surface of revolution that can be
 /// turned (sphere, conic, asphere, Q-bfs, Q-con with a circular or annular
 /// aperture), or `None` if it is not one.
-fn surface_info(o: &Object) -> Option<SurfaceInfo> {
-    if o.kind.name == "revolve" {
-        let ap = value::object(&o.fields, "aperture")?;
-        let aperture_radius = aperture_radius(ap)?;
+fn surface_info(o: &Object, params: &Surface) -> Option<SurfaceInfo> {
+    if let Surface::Revolve(revolve) = params {
+        let aperture_radius = revolve.aperture.radius()?;
         return Some(SurfaceInfo {
             description: format!(
                 "{}, aperture radius {} mm; +Z out of the material",
@@ -281,16 +289,16 @@ fn surface_info(o: &Object) -> Option<SurfaceInfo> {
             aperture_radius,
         });
     }
-    if !matches!(
-        o.kind.name,
-        "sphere" | "conic" | "asphere" | "qbfs" | "qcon"
-    ) {
-        return None;
-    }
-    let ap = value::object(&o.fields, "aperture")?;
-    let aperture_radius = aperture_radius(ap)?;
-    let side = lensc_lang::lower::surface::Side::of(&o.fields);
-    let radius = value::num(&o.fields, "radius")?;
+    let (base, facing, ap) = match params {
+        Surface::Sphere(c) | Surface::Conic(c) | Surface::Asphere(c) => {
+            (&c.base, c.facing, &c.aperture)
+        }
+        Surface::Qbfs(f) | Surface::Qcon(f) => (&f.base, f.facing, &f.aperture),
+        _ => return None,
+    };
+    let aperture_radius = ap.radius()?;
+    let side = lensc_lang::lower::surface::Side::from(facing);
+    let radius = base.radius;
     let convex = if side.signed {
         radius > 0.0
     } else {
@@ -306,7 +314,7 @@ fn surface_info(o: &Object) -> Option<SurfaceInfo> {
             _ => {}
         }
     }
-    let inner = aperture_inner_radius(ap);
+    let inner = ap.inner_radius();
     let aperture = if inner > 0.0 {
         format!(
             "annular aperture {} .. {} mm",
