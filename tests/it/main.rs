@@ -9,6 +9,7 @@
 
 mod common;
 
+mod architecture;
 mod bad_programs;
 mod build_errors;
 mod chords;
