@@ -34,7 +34,7 @@ use lensc_runtime::surface::ir::{SurfaceFn, SurfaceTape};
 
 use crate::check::CheckedJob;
 use crate::codes;
-use crate::lower::diagnostics::RuntimeError;
+use crate::lower::diagnostics::{NOT_PRINTABLE_HELP, RuntimeError};
 use crate::lower::surface::LoweredSurface;
 use crate::value::{self, Object};
 
@@ -490,9 +490,6 @@ fn simulate(job: &CheckedJob) -> Result<Option<Simulate>, Diagnostic> {
     }
     Ok(Some(s))
 }
-
-/// What to do when a job's dialect cannot write its program (E0150).
-pub const NOT_PRINTABLE_HELP: &str = "write the program in a dialect of the machine that can (`lensc build --dialect NAME`; `lensc list dialects`), or change the machine (its `resolution`, its `dialect`) so this one can";
 
 /// What to write instead of a part of the wrong kind: the standard
 /// library's items of the kinds needed, with their `use`, or how to make
