@@ -90,6 +90,10 @@ impl DeclKind {
     }
 }
 
+/// Deepest expression tree accepted (operators, calls, brackets together):
+/// both parsers give up on, or report, a deeper one.
+pub const MAX_EXPR_DEPTH: u32 = 200;
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Expr {
     pub kind: ExprKind,

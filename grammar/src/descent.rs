@@ -20,7 +20,6 @@
 //! up at once.
 
 use crate::ast::*;
-use crate::parser::MAX_EXPR_DEPTH;
 
 /// Parses `text` (a batch of whole items starting at byte `offset` of its
 /// file) as the grammar's `file` rule, appending its items to `out`.

@@ -14,9 +14,6 @@ use crate::diagnostic::{Diagnostic, FileId, codes};
 #[grammar = "lens.pest"]
 struct LensParser;
 
-/// Deepest expression tree accepted (operators, calls, brackets together).
-pub const MAX_EXPR_DEPTH: u32 = 200;
-
 /// Longest run of operators in a row (`- - - x`) and most `^` in one item:
 /// pest parses prefix operators and right-associative powers recursively.
 pub const MAX_OPERATOR_RUN: usize = 32;
