@@ -17,6 +17,7 @@ pub(crate) mod parts;
 pub mod pipeline;
 pub mod plots;
 pub mod progress;
+pub mod read_along;
 pub mod read_back;
 pub mod report;
 pub(crate) mod spool;
