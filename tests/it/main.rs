@@ -28,7 +28,6 @@ mod fuzz_properties;
 mod headers;
 mod import;
 mod interrupt;
-mod jit_conformance;
 mod limits;
 mod list;
 mod lsp;
