@@ -188,14 +188,7 @@ impl<'a> Descent<'a> {
                 ItemKind::Job { name, body }
             }
             _ => {
-                let kind = match keyword {
-                    "surface" => DeclKind::Surface,
-                    "tool" => DeclKind::Tool,
-                    "machine" => DeclKind::Machine,
-                    "strategy" => DeclKind::Strategy,
-                    "dialect" => DeclKind::Dialect,
-                    _ => return None,
-                };
+                let kind = DeclKind::from_keyword(keyword)?;
                 let (name, value) = self.named_value()?;
                 ItemKind::Decl { kind, name, value }
             }

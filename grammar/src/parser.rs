@@ -369,13 +369,9 @@ impl Builder<'_> {
                 ItemKind::Let { name, value }
             }
             Rule::decl_item => {
-                let kind = match inner.next().expect("decl kind").as_str() {
-                    "surface" => DeclKind::Surface,
-                    "tool" => DeclKind::Tool,
-                    "machine" => DeclKind::Machine,
-                    "dialect" => DeclKind::Dialect,
-                    _ => DeclKind::Strategy,
-                };
+                let keyword = inner.next().expect("decl kind").as_str();
+                let kind = DeclKind::from_keyword(keyword)
+                    .unwrap_or_else(|| unreachable!("`{keyword}` is in lens.pest's decl_kind"));
                 let name = self.ident(inner.next().expect("decl name"));
                 let value = self.expr(inner.next().expect("decl value"));
                 ItemKind::Decl { kind, name, value }
