@@ -280,6 +280,12 @@ fn bit_identical<B: Backend>(t: &SurfaceTape, xs: &[f64], ys: &[f64], what: &str
     }
 }
 
+/// Builds a tape's graph, returning its output.
+type TapeFn = fn(&mut Graph) -> Id;
+
+/// The six outputs in closed form at (x, y).
+type ClosedForm = fn(f64, f64) -> [f64; 6];
+
 /// The suite, one associated function a test (see `surface_fn_tests!`).
 pub struct Conformance<B>(PhantomData<B>);
 
@@ -517,7 +523,7 @@ impl<B: Backend> Conformance<B> {
     /// one product.
     pub fn constant_and_coordinate_outputs() {
         let pts = points(50);
-        let cases: [(&str, fn(&mut Graph) -> Id, fn(f64, f64) -> [f64; 6]); 4] = [
+        let cases: [(&str, TapeFn, ClosedForm); 4] = [
             (
                 "constant",
                 |g| g.constant_node(3.5),
@@ -546,8 +552,7 @@ impl<B: Backend> Conformance<B> {
     /// with the reference: for a sum of every other operation, the conic
     /// asphere and the sinusoidal freeform.
     pub fn batches_of_every_length_agree_with_single_points() {
-        let tapes: [fn(&mut Graph) -> Id; 3] =
-            [every_other_operation, conic_asphere, sinusoidal_freeform];
+        let tapes: [TapeFn; 3] = [every_other_operation, conic_asphere, sinusoidal_freeform];
         for build in tapes {
             let t = tape(build);
             let f = B::build(&t);
