@@ -79,6 +79,20 @@ pub enum DeclKind {
 }
 
 impl DeclKind {
+    /// Every kind of declaration, in the grammar's order.
+    pub const ALL: [DeclKind; 5] = [
+        DeclKind::Surface,
+        DeclKind::Tool,
+        DeclKind::Machine,
+        DeclKind::Strategy,
+        DeclKind::Dialect,
+    ];
+
+    /// The kind `keyword` declares; `None` for any other word.
+    pub fn from_keyword(keyword: &str) -> Option<DeclKind> {
+        DeclKind::ALL.into_iter().find(|k| k.keyword() == keyword)
+    }
+
     pub fn keyword(self) -> &'static str {
         match self {
             DeclKind::Surface => "surface",
@@ -89,6 +103,10 @@ impl DeclKind {
         }
     }
 }
+
+/// Deepest expression tree accepted (operators, calls, brackets together):
+/// both parsers give up on, or report, a deeper one.
+pub const MAX_EXPR_DEPTH: u32 = 200;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Expr {

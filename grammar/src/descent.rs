@@ -20,7 +20,6 @@
 //! up at once.
 
 use crate::ast::*;
-use crate::parser::MAX_EXPR_DEPTH;
 
 /// Parses `text` (a batch of whole items starting at byte `offset` of its
 /// file) as the grammar's `file` rule, appending its items to `out`.
@@ -189,14 +188,7 @@ impl<'a> Descent<'a> {
                 ItemKind::Job { name, body }
             }
             _ => {
-                let kind = match keyword {
-                    "surface" => DeclKind::Surface,
-                    "tool" => DeclKind::Tool,
-                    "machine" => DeclKind::Machine,
-                    "strategy" => DeclKind::Strategy,
-                    "dialect" => DeclKind::Dialect,
-                    _ => return None,
-                };
+                let kind = DeclKind::from_keyword(keyword)?;
                 let (name, value) = self.named_value()?;
                 ItemKind::Decl { kind, name, value }
             }

@@ -14,9 +14,6 @@ use crate::diagnostic::{Diagnostic, FileId, codes};
 #[grammar = "lens.pest"]
 struct LensParser;
 
-/// Deepest expression tree accepted (operators, calls, brackets together).
-pub const MAX_EXPR_DEPTH: u32 = 200;
-
 /// Longest run of operators in a row (`- - - x`) and most `^` in one item:
 /// pest parses prefix operators and right-associative powers recursively.
 pub const MAX_OPERATOR_RUN: usize = 32;
@@ -372,13 +369,9 @@ impl Builder<'_> {
                 ItemKind::Let { name, value }
             }
             Rule::decl_item => {
-                let kind = match inner.next().expect("decl kind").as_str() {
-                    "surface" => DeclKind::Surface,
-                    "tool" => DeclKind::Tool,
-                    "machine" => DeclKind::Machine,
-                    "dialect" => DeclKind::Dialect,
-                    _ => DeclKind::Strategy,
-                };
+                let keyword = inner.next().expect("decl kind").as_str();
+                let kind = DeclKind::from_keyword(keyword)
+                    .unwrap_or_else(|| unreachable!("`{keyword}` is in lens.pest's decl_kind"));
                 let name = self.ident(inner.next().expect("decl name"));
                 let value = self.expr(inner.next().expect("decl value"));
                 ItemKind::Decl { kind, name, value }

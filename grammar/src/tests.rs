@@ -337,3 +337,30 @@ fn fast_path_agrees_with_pest_on_mutated_files() {
         }
     }
 }
+
+/// Every keyword `lens.pest` declares with (`decl_kind`) is a `DeclKind`,
+/// and both parsers read it as that kind: no keyword falls to another.
+#[test]
+fn every_declaration_keyword_is_its_own_kind() {
+    let rule = include_str!("lens.pest")
+        .lines()
+        .find(|l| l.starts_with("decl_kind"))
+        .expect("the decl_kind rule");
+    let keywords: Vec<&str> = rule.split('"').skip(1).step_by(2).collect();
+    assert_eq!(keywords.len(), DeclKind::ALL.len(), "{keywords:?}");
+    for kw in keywords {
+        let kind = DeclKind::from_keyword(kw).unwrap_or_else(|| panic!("`{kw}` is no DeclKind"));
+        assert_eq!(kind.keyword(), kw);
+        let src = format!("{kw} a = b {{ }}\n");
+        for (file, diags) in [
+            parse(&src, FileId(0)),
+            crate::parse_reference(&src, FileId(0)),
+        ] {
+            assert!(diags.is_empty(), "{src}: {diags:?}");
+            match &file.items[0].kind {
+                ItemKind::Decl { kind: k, .. } => assert_eq!(*k, kind, "{src}"),
+                other => panic!("{src}: {other:?}"),
+            }
+        }
+    }
+}

@@ -73,6 +73,15 @@ pub enum Plane {
 }
 
 impl Plane {
+    /// Every plane, G17's, G18's and G19's.
+    pub const ALL: [Plane; 3] = [Plane::Xy, Plane::Zx, Plane::Yz];
+
+    /// The plane named `name` in the language and dialect files; `None`
+    /// for any other word.
+    pub fn from_name(name: &str) -> Option<Plane> {
+        Plane::ALL.into_iter().find(|p| p.name() == name)
+    }
+
     /// Indices into `Position::axes()` of the plane's first and second axis.
     pub fn axes(self) -> (usize, usize) {
         match self {

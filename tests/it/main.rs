@@ -9,6 +9,7 @@
 
 mod common;
 
+mod architecture;
 mod bad_programs;
 mod build_errors;
 mod chords;
@@ -28,7 +29,6 @@ mod fuzz_properties;
 mod headers;
 mod import;
 mod interrupt;
-mod jit_conformance;
 mod limits;
 mod list;
 mod lsp;

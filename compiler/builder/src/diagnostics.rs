@@ -13,6 +13,9 @@ use lensc_lang::lower::surface::LowerError;
 use lensc_runtime::post::ProgramError;
 use lensc_runtime::verify::window::TooManyCells;
 
+/// What to do when a job's dialect cannot write its program (E0150).
+pub const NOT_PRINTABLE_HELP: &str = "write the program in a dialect of the machine that can (`lensc build --dialect NAME`; `lensc list dialects`), or change the machine (its `resolution`, its `dialect`) so this one can";
+
 /// Every error a build can meet after checking, with what its message
 /// needs beyond the error itself.
 #[derive(Debug)]
@@ -86,7 +89,7 @@ impl RuntimeError<'_> {
             RuntimeError::Program(e) => Coded {
                 label: "no program was written for this job",
                 ..coded(codes::NOT_PRINTABLE, e.message())
-                    .help(crate::job::NOT_PRINTABLE_HELP)
+                    .help(NOT_PRINTABLE_HELP)
             },
             RuntimeError::Surface(e) => coded(
                 codes::UNSUPPORTED_COMBINATION,

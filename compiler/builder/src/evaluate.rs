@@ -19,7 +19,7 @@ pub type Sample = [f64; 7];
 
 /// The backend that evaluates surfaces: a JIT kernel, or the reference
 /// interpreter should cranelift refuse the tape (they agree to 1e-13, see
-/// tests/jit_conformance.rs and tests/surface_kinds.rs).
+/// `lensc_runtime::surface::conformance` and tests/it/surface_kinds.rs).
 /// The second value names the backend used (reports carry it).
 pub fn evaluator(
     tape: &lensc_runtime::surface::ir::SurfaceTape,

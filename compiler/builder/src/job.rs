@@ -26,7 +26,7 @@ use lensc_runtime::moves::{Coolant, Rotation, Start};
 use lensc_runtime::post::{Dialect, Setup};
 use lensc_runtime::surface::ir::{SurfaceFn, SurfaceTape};
 
-use crate::diagnostics::RuntimeError;
+use crate::diagnostics::{NOT_PRINTABLE_HELP, RuntimeError};
 use lensc_lang::check::CheckedJob;
 use lensc_lang::check::trim_num;
 use lensc_lang::codes;
@@ -538,9 +538,6 @@ fn simulate(params: &JobParams) -> Result<Option<Simulate>, Diagnostic> {
     }
     Ok(Some(s))
 }
-
-/// What to do when a job's dialect cannot write its program (E0150).
-pub const NOT_PRINTABLE_HELP: &str = "write the program in a dialect of the machine that can (`lensc build --dialect NAME`; `lensc list dialects`), or change the machine (its `resolution`, its `dialect`) so this one can";
 
 /// What to write instead of a part of the wrong kind: the standard
 /// library's items of the kinds needed, with their `use`, or how to make

@@ -20,6 +20,7 @@ pub mod output;
 pub mod pipeline;
 pub mod plots;
 pub mod progress;
+pub mod read_along;
 pub mod read_back;
 pub mod report;
 pub(crate) mod spool;

@@ -54,7 +54,7 @@ pub enum ProgramText {
         bytes: u64,
         /// The reader reading the text as it was spooled, if it was
         /// (its findings are taken by the read-back).
-        read: Option<crate::read_back::ReadAlong>,
+        read: Option<crate::read_along::ReadAlong>,
     },
 }
 

@@ -10,7 +10,8 @@ use lensc_runtime::post::ProgramError;
 
 use crate::output::{Destination, ProgramText};
 use crate::progress::Meter;
-use crate::read_back::{ReadAlong, ReadBack};
+use crate::read_along::ReadAlong;
+use crate::read_back::ReadBack;
 
 /// Where a text goes as it is written: memory, a spool file, or nowhere.
 pub(crate) enum Sink {
@@ -50,7 +51,7 @@ impl Sink {
                     lines: 0,
                     bytes: 0,
                     error: None,
-                    reader: read.map(ReadAlong::start),
+                    reader: read.map(|r| ReadAlong::start(&r.dialect, &r.machine)),
                 })
             }
         })

@@ -32,9 +32,96 @@ impl Word {
 /// A Siemens keyword (`DIAMOF`, `LIMS=3000.`, `T="DIAMOND"`).
 #[derive(Clone, Debug)]
 pub(crate) struct Keyword {
-    pub name: String,
+    pub kind: KeywordKind,
     pub value: Option<f64>,
     pub span: (usize, usize),
+}
+
+/// What a Siemens keyword is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum KeywordKind {
+    /// A word of several letters the reader knows (`DIAMOF`, `LIMS=3000.`).
+    Word(SiemensWord),
+    /// An address letter given a string: `T="DIAMOND"`, a tool by name.
+    Text(char),
+}
+
+/// The Siemens words of several letters the reader knows (840D sl
+/// programming manual): the ones lensc's dialects write and their
+/// opposites. Any other is refused as a word the controller does not read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum SiemensWord {
+    Diamof,
+    Diamon,
+    Diam90,
+    Compcad,
+    Compcurv,
+    Compon,
+    Compof,
+    Spcon,
+    Spcof,
+    Spos,
+    Ctol,
+    Otol,
+    Atol,
+    Lims,
+    Soft,
+    Brisk,
+    Ffwon,
+    Ffwof,
+}
+
+impl SiemensWord {
+    /// Every word, in declaration order.
+    const ALL: [SiemensWord; 18] = [
+        SiemensWord::Diamof,
+        SiemensWord::Diamon,
+        SiemensWord::Diam90,
+        SiemensWord::Compcad,
+        SiemensWord::Compcurv,
+        SiemensWord::Compon,
+        SiemensWord::Compof,
+        SiemensWord::Spcon,
+        SiemensWord::Spcof,
+        SiemensWord::Spos,
+        SiemensWord::Ctol,
+        SiemensWord::Otol,
+        SiemensWord::Atol,
+        SiemensWord::Lims,
+        SiemensWord::Soft,
+        SiemensWord::Brisk,
+        SiemensWord::Ffwon,
+        SiemensWord::Ffwof,
+    ];
+
+    /// The word as a program writes it.
+    fn name(self) -> &'static str {
+        match self {
+            SiemensWord::Diamof => "DIAMOF",
+            SiemensWord::Diamon => "DIAMON",
+            SiemensWord::Diam90 => "DIAM90",
+            SiemensWord::Compcad => "COMPCAD",
+            SiemensWord::Compcurv => "COMPCURV",
+            SiemensWord::Compon => "COMPON",
+            SiemensWord::Compof => "COMPOF",
+            SiemensWord::Spcon => "SPCON",
+            SiemensWord::Spcof => "SPCOF",
+            SiemensWord::Spos => "SPOS",
+            SiemensWord::Ctol => "CTOL",
+            SiemensWord::Otol => "OTOL",
+            SiemensWord::Atol => "ATOL",
+            SiemensWord::Lims => "LIMS",
+            SiemensWord::Soft => "SOFT",
+            SiemensWord::Brisk => "BRISK",
+            SiemensWord::Ffwon => "FFWON",
+            SiemensWord::Ffwof => "FFWOF",
+        }
+    }
+
+    /// The word `name` is; `None` for a word the reader does not know.
+    fn of(name: &str) -> Option<SiemensWord> {
+        SiemensWord::ALL.into_iter().find(|w| w.name() == name)
+    }
 }
 
 /// A line's contents.
@@ -246,7 +333,7 @@ impl Lexer {
                 if bytes.get(i) == Some(&b'"') {
                     let close = code[i + 1..].find('"').map_or(code.len(), |c| i + 2 + c);
                     b.keywords.push(Keyword {
-                        name: name.to_string(),
+                        kind: KeywordKind::Text(letter),
                         value: None,
                         span: (start, close),
                     });
@@ -309,9 +396,11 @@ impl Lexer {
             }
             i = end;
         }
-        if self.controller == Controller::Siemens && SIEMENS_KEYWORDS.contains(&name) {
+        if self.controller == Controller::Siemens
+            && let Some(word) = SiemensWord::of(name)
+        {
             b.keywords.push(Keyword {
-                name: name.to_string(),
+                kind: KeywordKind::Word(word),
                 value,
                 span: (start, i),
             });
@@ -456,13 +545,6 @@ fn significant_digits(t: &[u8]) -> usize {
     t[i..].iter().filter(|b| b.is_ascii_digit()).count()
 }
 
-/// Siemens keywords the reader knows (840D sl programming manual): the
-/// ones lensc's dialects write and their opposites.
-const SIEMENS_KEYWORDS: &[&str] = &[
-    "DIAMOF", "DIAMON", "DIAM90", "COMPCAD", "COMPCURV", "COMPON", "COMPOF", "SPCON", "SPCOF",
-    "SPOS", "CTOL", "OTOL", "ATOL", "LIMS", "SOFT", "BRISK", "FFWON", "FFWOF",
-];
-
 /// Whether a controller reads `letter` as a whole number only (a decimal
 /// point in it is refused): block and program numbers and M codes
 /// everywhere; Fanuc's S, T, D, H, P and L too (its manuals: "a decimal
@@ -544,6 +626,19 @@ const POWERS_OF_TEN: [f64; 23] = [
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every Siemens word is in `ALL`, at its place, and reads back from
+    /// its name (the match in `name` is exhaustive, so a new word needs
+    /// one; the reader's matches over keywords are too).
+    #[test]
+    fn every_siemens_word_reads_back_from_its_name() {
+        assert_eq!(SiemensWord::ALL.len(), SiemensWord::Ffwof as usize + 1);
+        for (i, w) in SiemensWord::ALL.into_iter().enumerate() {
+            assert_eq!(w as usize, i);
+            assert_eq!(SiemensWord::of(w.name()), Some(w));
+        }
+        assert_eq!(SiemensWord::of("DIAMOND"), None);
+    }
 
     /// Every number the fast path reads is the value `parse` gives, bit
     /// for bit (signs, zeros, a point at either end, 15 digits), and the

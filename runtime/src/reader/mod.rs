@@ -18,6 +18,7 @@
 //! Every finding names its line and a byte span in the whole text, with a
 //! [`Rule`] (its diagnostic code lives with the compiler's others).
 
+mod chord;
 mod header;
 mod klartext;
 mod lexer;

@@ -6,7 +6,7 @@
 //! then the program's end). The moves themselves are `motion`'s.
 
 use super::klartext::Klartext;
-use super::lexer::{Block, Found, Lexer, Word};
+use super::lexer::{Block, Found, KeywordKind, Lexer, SiemensWord, Word};
 use super::{Controller, MachineLimits, Rule};
 use crate::dialect::Dialect;
 use crate::moves::Plane;
@@ -487,10 +487,18 @@ impl State {
             }
         }
         for k in &b.keywords {
-            match k.name.as_str() {
-                "DIAMON" | "DIAM90" => self.diameter = self.machine.lathe,
-                "DIAMOF" => self.diameter = false,
-                _ => {}
+            use SiemensWord::*;
+            match k.kind {
+                KeywordKind::Word(Diamon | Diam90) => self.diameter = self.machine.lathe,
+                KeywordKind::Word(Diamof) => self.diameter = false,
+                // SPCON, SPCOF, SPOS and LIMS are `spindle_and_tool`'s, a
+                // tool by name `tool`'s; the rest change nothing the reader
+                // holds a program to.
+                KeywordKind::Word(
+                    Compcad | Compcurv | Compon | Compof | Spcon | Spcof | Spos | Ctol | Otol
+                    | Atol | Lims | Soft | Brisk | Ffwon | Ffwof,
+                )
+                | KeywordKind::Text(_) => {}
             }
         }
         if let Some(f) = b.words.iter().find(|w| w.letter == 'F') {
@@ -524,7 +532,11 @@ impl State {
         if has(GGroup::SpindleCap) {
             self.cap = s.map(|s| s.value);
             speeds.extend(s.map(|s| (s.value, s.span)));
-        } else if let Some(cap) = b.keywords.iter().find(|k| k.name == "LIMS") {
+        } else if let Some(cap) = b
+            .keywords
+            .iter()
+            .find(|k| k.kind == KeywordKind::Word(SiemensWord::Lims))
+        {
             self.cap = cap.value;
             speeds.extend(cap.value.map(|v| (v, cap.span)));
         } else {
@@ -564,15 +576,23 @@ impl State {
         self.speed_limits(&speeds, line, out);
         self.tool(b, ms);
         for k in &b.keywords {
-            match k.name.as_str() {
-                "SPCON" => self.position_mode = true,
-                "SPCOF" => self.position_mode = false,
-                "SPOS" => {
+            use SiemensWord::*;
+            match k.kind {
+                KeywordKind::Word(Spcon) => self.position_mode = true,
+                KeywordKind::Word(Spcof) => self.position_mode = false,
+                KeywordKind::Word(Spos) => {
                     // Stopped and held at an angle: as M19 elsewhere.
                     self.spindle_on = false;
                     self.position_mode = true;
                 }
-                _ => {}
+                // DIAMON, DIAM90 and DIAMOF are `modes`', LIMS is read
+                // above, a tool by name in `tool`; the rest change nothing
+                // the reader holds a program to.
+                KeywordKind::Word(
+                    Diamof | Diamon | Diam90 | Compcad | Compcurv | Compon | Compof | Ctol | Otol
+                    | Atol | Lims | Soft | Brisk | Ffwon | Ffwof,
+                )
+                | KeywordKind::Text(_) => {}
             }
         }
         for &(m, w) in ms {
@@ -590,7 +610,8 @@ impl State {
     }
 
     fn tool(&mut self, b: &Block, ms: &[(MCode, usize)]) {
-        let t = b.words.iter().any(|w| w.letter == 'T') || b.keywords.iter().any(|k| k.name == "T");
+        let t = b.words.iter().any(|w| w.letter == 'T')
+            || b.keywords.iter().any(|k| k.kind == KeywordKind::Text('T'));
         if t {
             self.tool_selected = true;
         }

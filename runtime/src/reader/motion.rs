@@ -27,6 +27,7 @@
 //!
 //! An arc that ends where it starts is a full circle on every one of them.
 
+use super::chord::chord;
 use super::lexer::{Block, Found, Word};
 use super::modal::{FeedMode, Motion, State};
 use super::{Controller, Executed, Path, Rule};
@@ -570,18 +571,6 @@ pub(super) type Over = Option<(f64, f64)>;
 /// The block's axis words (X, Y, Z, C), in order.
 fn axes(b: &Block) -> impl Iterator<Item = &Word> {
     b.words.iter().filter(|w| LETTERS.contains(&w.letter))
-}
-
-pub(super) fn chord(start: &[Option<f64>; 4], end: &[Option<f64>; 4]) -> Option<f64> {
-    let mut sum = 0.0;
-    for i in 0..3 {
-        match (start[i], end[i]) {
-            (Some(p), Some(q)) => sum += (q - p) * (q - p),
-            (None, Some(_)) => return None,
-            _ => {}
-        }
-    }
-    Some(sum.sqrt())
 }
 
 fn plane_name(p: Plane) -> &'static str {

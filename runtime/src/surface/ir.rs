@@ -972,8 +972,12 @@ fn value(op: Op, v: &[f64], k: usize, x: f64, y: f64) -> f64 {
 
 impl SurfaceFn for Interpreter {
     fn eval_batch(&self, xs: &[f64], ys: &[f64], out: &mut [f64]) {
-        assert_eq!(xs.len(), ys.len());
-        assert_eq!(out.len(), 6 * xs.len());
+        assert_eq!(xs.len(), ys.len(), "xs and ys differ in length");
+        assert_eq!(
+            out.len(),
+            6 * xs.len(),
+            "out must hold six values per point"
+        );
         let mut v = vec![0.0f64; self.slots];
         // A tape without loops (nearly all) in a walk that never calls
         // out: the loop-aware walk's call (which may write any slot) makes

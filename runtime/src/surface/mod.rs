@@ -9,8 +9,7 @@
 //! s = −1 convex — the same s as Lin 2022 (seed 000) eq 7.
 
 pub mod analysis;
-#[cfg(test)]
-mod conformance;
+pub mod conformance;
 pub mod fdlibm;
 pub mod forbes;
 pub mod ir;

@@ -2,6 +2,8 @@
 //! function per rule, run once a kind's parameters have checked.
 
 use lensc_grammar::Diagnostic;
+use lensc_grammar::suggest::did_you_mean;
+use lensc_runtime::moves::Plane;
 
 use super::{Checker, trim_num};
 use crate::codes;
@@ -19,6 +21,7 @@ impl<'a> Checker<'a> {
             "zernike" => self.fringe_terms(o),
             "ellipsoid" => self.ellipsoid_rim(o),
             "profile_turning" => self.profile_turning_passes(o),
+            "gcode" => self.arc_planes_named(o),
             _ => true,
         }
     }
@@ -83,6 +86,43 @@ impl<'a> Checker<'a> {
             return false;
         }
         true
+    }
+
+    /// E0126: each of a dialect's `arc_planes` names a plane (`xy`, `zx`,
+    /// `yz`); lowering has no arcs for another word, so it would drop the
+    /// word and the arcs in that plane without a word.
+    fn arc_planes_named(&mut self, o: &Object) -> bool {
+        let Some(f) = value::field(&o.fields, "arc_planes") else {
+            return true;
+        };
+        let Value::List(items) = &f.value else {
+            return true;
+        };
+        let names = Plane::ALL.map(Plane::name);
+        let mut ok = true;
+        for (v, span) in items {
+            let Value::Str(s) = v else { continue };
+            if Plane::from_name(s).is_some() {
+                continue;
+            }
+            ok = false;
+            let quoted: Vec<String> = names.iter().map(|n| format!("\"{n}\"")).collect();
+            let help = match did_you_mean(s, names.iter().copied()) {
+                Some(n) => format!("did you mean \"{n}\"?"),
+                None => "the planes are \"xy\" (G17), \"zx\" (G18) and \"yz\" (G19)".into(),
+            };
+            self.err(
+                Diagnostic::error(
+                    codes::UNKNOWN_WORD,
+                    format!("`arc_planes` cannot hold \"{s}\": it is not a plane"),
+                    f.file,
+                    *span,
+                )
+                .with_label(format!("expected one of {}", quoted.join(", ")))
+                .with_help(help),
+            );
+        }
+        ok
     }
 
     /// E0134: a design wrapped onto a roller is no longer than the roller's

@@ -15,8 +15,8 @@
 //! The tests below read generated lines, valid and subtly not, both ways
 //! and compare the findings and the state after every line.
 
+use super::super::chord::chord;
 use super::super::lexer::{Lexer, WordLimits, number};
-use super::super::motion::chord;
 use super::super::{Controller, Executed, Path};
 use super::{Motion, State, g_tenths};
 
