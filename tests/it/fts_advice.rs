@@ -9,7 +9,7 @@ use std::path::Path;
 
 use crate::common::{examples, root};
 use lensc_build::driver::{Request, check_path, plan_and_emit};
-use lensc_build::job::JobSpec;
+use lensc_build::strategy::JobSpec;
 use lensc_build::strategy::spiral::{Prepared, advice};
 use lensc_lang::check::trim_num;
 use lensc_lang::loader::RealFs;

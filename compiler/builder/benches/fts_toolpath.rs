@@ -23,7 +23,7 @@ fn main() {
     let job = &c.checked.jobs[0];
     let t = Instant::now();
     let limits = lensc_build::job::Limits::default();
-    let Ok((lensc_build::job::JobSpec::Spiral(spec), _)) =
+    let Ok((lensc_build::strategy::JobSpec::Spiral(spec), _)) =
         lensc_build::pipeline::lower(job, None, &limits)
     else {
         panic!("lowers to a spiral")

@@ -28,8 +28,9 @@ mod timing;
 use std::path::Path;
 use std::time::Instant;
 
-use lensc_build::job::{JobSpec, Limits};
+use lensc_build::job::Limits;
 use lensc_build::output::Destination;
+use lensc_build::strategy::JobSpec;
 use lensc_lang::Checked;
 use lensc_runtime::post::Provenance;
 

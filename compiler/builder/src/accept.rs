@@ -11,8 +11,8 @@
 //! place every strategy's simulation lands), so a criterion is measured
 //! the same way for every strategy.
 
-use crate::job::JobSpec;
 use crate::job::accept::{self, Accept, Criterion};
+use crate::strategy::JobSpec;
 use lensc_grammar::{Diagnostic, FileId, Span};
 use lensc_lang::check::trim_num;
 use lensc_lang::codes;

@@ -17,16 +17,14 @@ pub mod estimate;
 pub mod tolerance;
 pub mod window;
 
-pub use crate::strategy::JobSpec;
-pub use crate::strategy::spiral::{AtSpeed, Settling};
-pub use estimate::{DEFAULT_MAX_PROGRAM_SIZE, Estimate, Limits, MAX_POINTS, estimate, refusals};
+pub use estimate::{DEFAULT_MAX_PROGRAM_SIZE, Estimate, Limits, MAX_POINTS, refusals};
 
 use lensc_grammar::{Diagnostic, FileId, Span};
 use lensc_runtime::moves::{Coolant, Rotation, Start};
 use lensc_runtime::post::{Dialect, Setup};
 use lensc_runtime::surface::ir::{SurfaceFn, SurfaceTape};
 
-use crate::diagnostics::{NOT_PRINTABLE_HELP, RuntimeError};
+use crate::diagnostics::RuntimeError;
 use lensc_lang::check::CheckedJob;
 use lensc_lang::check::trim_num;
 use lensc_lang::codes;
@@ -137,7 +135,7 @@ impl<'a> Parts<'a> {
     /// The job's parts and parameters, or E0121 for each part (or
     /// required parameter) missing: the checker refuses those, so only a
     /// job that did not check gets here.
-    fn of(job: &'a CheckedJob) -> Result<Parts<'a>, Vec<Diagnostic>> {
+    pub(crate) fn of(job: &'a CheckedJob) -> Result<Parts<'a>, Vec<Diagnostic>> {
         let r = value::Reader::new(&job.fields);
         let mut errors = Vec::new();
         let mut part = |name: &str| -> Option<&'a Object> {
@@ -374,102 +372,13 @@ pub(crate) fn all_clear(errors: Vec<Diagnostic>) -> Result<(), Vec<Diagnostic>> 
     }
 }
 
-fn site_error(site: (FileId, Span), code: &'static str, msg: String) -> Diagnostic {
+pub(crate) fn site_error(site: (FileId, Span), code: &'static str, msg: String) -> Diagnostic {
     Diagnostic::error(code, msg, site.0, site.1).with_label("this job")
-}
-
-/// Lowers one checked job to its `JobSpec`, in the dialect `requested` (by
-/// `lensc build --dialect`) or the machine's own, or returns every reason
-/// it cannot be built that is known before planning.
-pub fn lower_job(
-    job: &CheckedJob,
-    requested: Option<&str>,
-    evaluate: Evaluate,
-) -> Result<JobSpec, Vec<Diagnostic>> {
-    let p = Parts::of(job)?;
-    let mut errors = Vec::new();
-    let dialect = lensc_lang::lower::dialect(job, requested).map_err(|d| errors.push(d));
-    let strategy = p.strategy.kind.name;
-    // Until a dialect is known the strategy is lowered in LinuxCNC's: its
-    // own errors are reported, the spec is not used.
-    let d = dialect.clone().unwrap_or_else(|_| Dialect::linuxcnc());
-    let Some((spec, setup, windowed, axes)) = crate::strategy::lower(strategy, &p, d, evaluate)
-    else {
-        errors.push(no_such_strategy(&p));
-        return Err(errors);
-    };
-    // Jobs simulated along their whole profile: a window means nothing
-    // to them.
-    if let (false, Some(f)) = (windowed, p.params.simulate) {
-        errors.push(
-            Diagnostic::error(
-                codes::UNSUPPORTED_COMBINATION,
-                format!(
-                    "`simulate` sets the window of a surface's height map; this `{strategy}` job is simulated along its whole profile"
-                ),
-                f.site.0,
-                f.site.1,
-            )
-            .with_label("not for a profile job")
-            .with_help("remove the `simulate` block"),
-        );
-    }
-    if let Err(d) = simulate(&p.params) {
-        errors.push(d);
-    }
-    if let Err(d) = accept::lower(job) {
-        errors.push(d);
-    }
-    errors.extend(axes.and_then(|axes| tolerance::below_resolution(&p, axes)));
-    if let Ok(d) = &dialect {
-        let resolution = p.machine_params.resolution;
-        if let Err(e) = lensc_runtime::post::check_dialect(d, setup, resolution) {
-            errors.push(
-                Diagnostic::error(codes::NOT_PRINTABLE, e.message(), job.file, job.name.span)
-                    .with_label("no program was written for this job")
-                    .with_help(NOT_PRINTABLE_HELP),
-            );
-        } else if let Some(e) = start_error(job, &p.params, d, setup) {
-            errors.push(e);
-        }
-    }
-    match spec {
-        Ok(spec) => {
-            errors.extend(window::check_grid(&spec));
-            if errors.is_empty() {
-                Ok(spec)
-            } else {
-                Err(errors)
-            }
-        }
-        Err(mut more) => {
-            errors.append(&mut more);
-            Err(errors)
-        }
-    }
-}
-
-/// E0135: the registry lists no strategy of the job's strategy's kind
-/// (a kind the schema has and no folder builds).
-fn no_such_strategy(p: &Parts) -> Diagnostic {
-    let names: Vec<String> = crate::strategy::NAMES
-        .iter()
-        .flat_map(|n| n.iter())
-        .map(|n| format!("`{n}`"))
-        .collect();
-    p.error(
-        codes::NO_SUCH_STRATEGY,
-        format!(
-            "lensc has no planner for the strategy `{}`",
-            p.strategy.kind.name
-        ),
-    )
-    .with_help(format!("the strategies lensc builds: {}", names.join(", ")))
 }
 
 /// The job's tool call, spindle direction and coolant (tool 1, its offset
 /// the tool's number, clockwise, no coolant unless it says otherwise).
-fn program_start(params: &JobParams) -> Start {
+pub(crate) fn program_start(params: &JobParams) -> Start {
     let tool = params.tool_number.map_or(1, |n| n.value as u32);
     Start {
         tool,
@@ -489,7 +398,7 @@ fn program_start(params: &JobParams) -> Start {
 
 /// E0173 if the dialect cannot call the job's tool (its number does not
 /// fit the T word) or give its coolant, at the field that asks for it.
-fn start_error(
+pub(crate) fn start_error(
     job: &CheckedJob,
     params: &JobParams,
     dialect: &Dialect,
@@ -515,7 +424,7 @@ fn start_error(
 }
 
 /// The job's `simulate` block, if any; an error if its window is empty.
-fn simulate(params: &JobParams) -> Result<Option<Simulate>, Diagnostic> {
+pub(crate) fn simulate(params: &JobParams) -> Result<Option<Simulate>, Diagnostic> {
     let Some(stated) = params.simulate else {
         return Ok(None);
     };

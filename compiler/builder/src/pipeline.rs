@@ -6,7 +6,8 @@
 use std::path::Path;
 
 use crate::context::BuildContext;
-use crate::job::{Estimate, JobSpec, Limits, lower_job};
+use crate::job::{Estimate, Limits};
+use crate::strategy::{JobSpec, lower_job};
 use lensc_grammar::Diagnostic;
 use lensc_lang::Checked;
 use lensc_lang::check::CheckedJob;
@@ -61,8 +62,8 @@ pub fn lower(
     limits: &Limits,
 ) -> Result<(JobSpec, Estimate), Vec<Diagnostic>> {
     let spec = lower_job(job, dialect, &evaluate)?;
-    let estimate = crate::job::estimate(&spec, &evaluate);
-    let refused = crate::job::refusals(&spec, &estimate, limits);
+    let estimate = spec.estimate(&evaluate);
+    let refused = crate::job::refusals(spec.head(), &estimate, limits);
     if refused.is_empty() {
         Ok((spec, estimate))
     } else {

@@ -178,7 +178,9 @@ impl<'a> ProgramSink<'a> {
     /// met writing it.
     pub(crate) fn written(self, head: &JobHead) -> Result<Sink, Vec<Diagnostic>> {
         match self.error {
-            Some(e) => Err(vec![crate::context::not_printable(head, e)]),
+            Some(e) => Err(vec![
+                crate::diagnostics::RuntimeError::Program(e).at(head.site),
+            ]),
             None => Ok(self.sink),
         }
     }

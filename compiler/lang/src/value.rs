@@ -6,7 +6,7 @@ use std::rc::Rc;
 use lensc_grammar::FileId;
 use lensc_grammar::ast::{Expr, Span};
 
-use crate::schema::Kind;
+use crate::schema::kind::Kind;
 use crate::units::Dim;
 
 #[derive(Clone, Debug)]

@@ -20,8 +20,7 @@
 
 use lensc_grammar::Diagnostic;
 
-use super::Evaluate;
-use crate::strategy::JobSpec;
+use super::JobHead;
 use lensc_lang::codes;
 
 /// The most points lensc plans for one job: 200 million (a spiral's or a
@@ -69,18 +68,8 @@ pub struct Estimate {
     pub servo_samples: f64,
 }
 
-/// The job's estimate, from its typed spec; surfaces are evaluated with
-/// `evaluate` on a coarse grid.
-pub fn estimate(spec: &JobSpec, evaluate: Evaluate) -> Estimate {
-    let header = 900.0 + spec.head().surface.words.len() as f64;
-    let mut e = spec.strategy_estimate(evaluate);
-    e.program_bytes += header;
-    e
-}
-
 /// Every limit the estimate is over, as an error at the job.
-pub fn refusals(spec: &JobSpec, e: &Estimate, limits: &Limits) -> Vec<Diagnostic> {
-    let head = spec.head();
+pub fn refusals(head: &JobHead, e: &Estimate, limits: &Limits) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     // (NaN is over every limit.)
     if over(e.points, limits.max_points) {

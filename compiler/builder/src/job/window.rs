@@ -9,7 +9,7 @@ use lensc_grammar::Diagnostic;
 use lensc_runtime::surface::analysis::Domain;
 use lensc_runtime::verify::window::{Window, check_cells};
 
-use super::{JobHead, JobSpec};
+use super::JobHead;
 use crate::diagnostics::RuntimeError;
 
 /// The extent of a surface's domain (x, y ranges, mm).
@@ -42,12 +42,16 @@ pub fn simulated(head: &JobHead, extent: ((f64, f64), (f64, f64))) -> Option<Win
     ))
 }
 
-/// E0149, at the `simulate` block, when the job's window makes tiles
+/// E0149, at the `simulate` block, when the job's window (its left-out
+/// ranges the part's `extent`) makes tiles (`tiles`, the strategy's)
 /// tiling cannot bound; `None` when they fit, when the job gives no
 /// window, or when its strategy simulates no height map.
-pub(crate) fn check_grid(spec: &JobSpec) -> Option<Diagnostic> {
-    let head = spec.head();
-    let window = simulated(head, spec.part_extent())?;
-    let e = check_cells(&spec.tiles(&window)?).err()?;
+pub(crate) fn check_grid(
+    head: &JobHead,
+    extent: ((f64, f64), (f64, f64)),
+    tiles: impl FnOnce(&Window) -> Option<Vec<lensc_runtime::verify::window::Tile>>,
+) -> Option<Diagnostic> {
+    let window = simulated(head, extent)?;
+    let e = check_cells(&tiles(&window)?).err()?;
     Some(RuntimeError::Simulation(e).at(head.simulate?.site))
 }

@@ -25,6 +25,9 @@ use lensc_grammar::Diagnostic;
 use lensc_runtime::post::{Dialect, Setup};
 use lensc_runtime::verify::window::{Tile, Window};
 
+use lensc_lang::check::CheckedJob;
+use lensc_lang::codes;
+
 use crate::context::BuildContext;
 use crate::job::estimate::Estimate;
 use crate::job::{Evaluate, JobHead, Parts};
@@ -124,9 +127,12 @@ macro_rules! registry {
             pub fn path_tolerance(&self) -> Option<f64> {
                 match self { $(JobSpec::$variant(s) => s.path_tolerance(),)* }
             }
-            /// The strategy's own estimate (`job::estimate` adds the header).
-            pub(crate) fn strategy_estimate(&self, evaluate: Evaluate) -> Estimate {
-                match self { $(JobSpec::$variant(s) => s.estimate(evaluate),)* }
+            /// Points, program size and servo samples, estimated before
+            /// planning: the strategy's own, with the header's bytes.
+            pub fn estimate(&self, evaluate: Evaluate) -> Estimate {
+                let mut e = match self { $(JobSpec::$variant(s) => s.estimate(evaluate),)* };
+                e.program_bytes += 900.0 + self.head().surface.words.len() as f64;
+                e
             }
             /// The extent (x, y ranges, mm) of what the job cuts.
             pub fn part_extent(&self) -> ((f64, f64), (f64, f64)) {
@@ -154,6 +160,98 @@ registry! {
     Raster(raster::RasterSpec),
     Grinding(grinding::GrindingSpec),
     Roller(roller::RollerSpec),
+}
+
+/// Lowers one checked job to its `JobSpec`, in the dialect `requested` (by
+/// `lensc build --dialect`) or the machine's own, or returns every reason
+/// it cannot be built that is known before planning.
+pub fn lower_job(
+    job: &CheckedJob,
+    requested: Option<&str>,
+    evaluate: Evaluate,
+) -> Result<JobSpec, Vec<Diagnostic>> {
+    let p = Parts::of(job)?;
+    let mut errors = Vec::new();
+    let dialect = lensc_lang::lower::dialect(job, requested).map_err(|d| errors.push(d));
+    let strategy = p.strategy.kind.name;
+    // Until a dialect is known the strategy is lowered in LinuxCNC's: its
+    // own errors are reported, the spec is not used.
+    let d = dialect.clone().unwrap_or_else(|_| Dialect::linuxcnc());
+    let Some((spec, setup, windowed, axes)) = lower(strategy, &p, d, evaluate) else {
+        errors.push(no_such_strategy(&p));
+        return Err(errors);
+    };
+    // Jobs simulated along their whole profile: a window means nothing
+    // to them.
+    if let (false, Some(f)) = (windowed, p.params.simulate) {
+        errors.push(
+            Diagnostic::error(
+                codes::UNSUPPORTED_COMBINATION,
+                format!(
+                    "`simulate` sets the window of a surface's height map; this `{strategy}` job is simulated along its whole profile"
+                ),
+                f.site.0,
+                f.site.1,
+            )
+            .with_label("not for a profile job")
+            .with_help("remove the `simulate` block"),
+        );
+    }
+    if let Err(d) = crate::job::simulate(&p.params) {
+        errors.push(d);
+    }
+    if let Err(d) = crate::job::accept::lower(job) {
+        errors.push(d);
+    }
+    errors.extend(axes.and_then(|axes| crate::job::tolerance::below_resolution(&p, axes)));
+    if let Ok(d) = &dialect {
+        let resolution = p.machine_params.resolution;
+        if let Err(e) = lensc_runtime::post::check_dialect(d, setup, resolution) {
+            errors.push(
+                Diagnostic::error(codes::NOT_PRINTABLE, e.message(), job.file, job.name.span)
+                    .with_label("no program was written for this job")
+                    .with_help(crate::diagnostics::NOT_PRINTABLE_HELP),
+            );
+        } else if let Some(e) = crate::job::start_error(job, &p.params, d, setup) {
+            errors.push(e);
+        }
+    }
+    match spec {
+        Ok(spec) => {
+            errors.extend(crate::job::window::check_grid(
+                spec.head(),
+                spec.part_extent(),
+                |w| spec.tiles(w),
+            ));
+            if errors.is_empty() {
+                Ok(spec)
+            } else {
+                Err(errors)
+            }
+        }
+        Err(mut more) => {
+            errors.append(&mut more);
+            Err(errors)
+        }
+    }
+}
+
+/// E0135: the registry lists no strategy of the job's strategy's kind
+/// (a kind the schema has and no folder builds).
+fn no_such_strategy(p: &Parts) -> Diagnostic {
+    let names: Vec<String> = NAMES
+        .iter()
+        .flat_map(|n| n.iter())
+        .map(|n| format!("`{n}`"))
+        .collect();
+    p.error(
+        codes::NO_SUCH_STRATEGY,
+        format!(
+            "lensc has no planner for the strategy `{}`",
+            p.strategy.kind.name
+        ),
+    )
+    .with_help(format!("the strategies lensc builds: {}", names.join(", ")))
 }
 
 #[cfg(test)]

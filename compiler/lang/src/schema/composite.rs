@@ -1,12 +1,16 @@
 //! Surfaces made of other surfaces: a design wrapped onto a roller, an
 //! off-axis section, a profile revolved, arrays of lenslets, a tilted
 //! surface; beside each, the struct its parameters are read into, the
-//! surfaces it is made of read with it.
+//! surfaces it is made of read with it; at the end, `Surface`, any
+//! surface read once, those of one formula (`surfaces`) included.
 
 use lensc_grammar::Diagnostic;
 
 use super::apertures::Aperture;
-use super::surfaces::{APERTURE, Axis, Surface, aperture};
+use super::surfaces::{
+    APERTURE, Axis, Biconic, Conic, Cylinder, Ellipsoid, Forbes, Freeform, Plane, Toroid,
+    XyPolynomial, Zernike, aperture,
+};
 use super::{
     ANGLE, Category, Check, Kind, LENGTH, NUMBER, Param, Ty, finish, not_a, opt, req,
     required_object,
@@ -416,5 +420,88 @@ impl Roller {
         };
         finish(r, o)?;
         Ok(roller)
+    }
+}
+
+/// A checked surface of any kind read once, with every surface it is made
+/// of: what lowering and the domain work from, no parameter looked up by
+/// its name after.
+#[derive(Clone, Debug)]
+pub enum Surface {
+    Plane(Plane),
+    Sphere(Conic),
+    Conic(Conic),
+    Asphere(Conic),
+    Cylinder(Cylinder),
+    Acylinder(Cylinder),
+    Biconic(Biconic),
+    Toroid(Toroid),
+    Ellipsoid(Ellipsoid),
+    XyPolynomial(XyPolynomial),
+    Zernike(Zernike),
+    Qbfs(Forbes),
+    Qcon(Forbes),
+    Freeform(Freeform),
+    Wrap(Wrap),
+    OffAxis(OffAxis),
+    Revolve(Revolve),
+    /// `grid`, `hex_grid` and `linear_array`, told apart by their layout.
+    Array(Array),
+    Tilt(Tilt),
+}
+
+impl Surface {
+    /// Reads a checked surface: E0121 for a parameter it (or a surface or
+    /// aperture in it) lacks, E0124 if `o` is not a surface.
+    pub fn read(o: &Object) -> Result<Surface, Diagnostic> {
+        Ok(match o.kind.name {
+            "plane" => Surface::Plane(Plane::read(o)?),
+            "sphere" => Surface::Sphere(Conic::read(o)?),
+            "conic" => Surface::Conic(Conic::read(o)?),
+            "asphere" => Surface::Asphere(Conic::read(o)?),
+            "cylinder" => Surface::Cylinder(Cylinder::read(o)?),
+            "acylinder" => Surface::Acylinder(Cylinder::read(o)?),
+            "biconic" => Surface::Biconic(Biconic::read(o)?),
+            "toroid" => Surface::Toroid(Toroid::read(o)?),
+            "ellipsoid" => Surface::Ellipsoid(Ellipsoid::read(o)?),
+            "xy_polynomial" => Surface::XyPolynomial(XyPolynomial::read(o)?),
+            "zernike" => Surface::Zernike(Zernike::read(o)?),
+            "qbfs" => Surface::Qbfs(Forbes::read(o)?),
+            "qcon" => Surface::Qcon(Forbes::read(o)?),
+            "freeform" => Surface::Freeform(Freeform::read(o)?),
+            "wrap" => Surface::Wrap(Wrap::read(o)?),
+            "off_axis" => Surface::OffAxis(OffAxis::read(o)?),
+            "revolve" => Surface::Revolve(Revolve::read(o)?),
+            "grid" | "hex_grid" | "linear_array" => Surface::Array(Array::read(o)?),
+            "tilt" => Surface::Tilt(Tilt::read(o)?),
+            _ => return Err(not_a(o, Category::Surface.noun())),
+        })
+    }
+
+    /// The region it is machined on, if it states one: its aperture, or a
+    /// freeform's domain (an array's aperture is optional; a wrapped
+    /// design has none of its own).
+    pub fn region(&self) -> Option<&Aperture> {
+        match self {
+            Surface::Plane(Plane { aperture })
+            | Surface::Sphere(Conic { aperture, .. })
+            | Surface::Conic(Conic { aperture, .. })
+            | Surface::Asphere(Conic { aperture, .. })
+            | Surface::Cylinder(Cylinder { aperture, .. })
+            | Surface::Acylinder(Cylinder { aperture, .. })
+            | Surface::Biconic(Biconic { aperture, .. })
+            | Surface::Toroid(Toroid { aperture, .. })
+            | Surface::Ellipsoid(Ellipsoid { aperture, .. })
+            | Surface::XyPolynomial(XyPolynomial { aperture, .. })
+            | Surface::Zernike(Zernike { aperture, .. })
+            | Surface::Qbfs(Forbes { aperture, .. })
+            | Surface::Qcon(Forbes { aperture, .. })
+            | Surface::OffAxis(OffAxis { aperture, .. })
+            | Surface::Revolve(Revolve { aperture, .. })
+            | Surface::Tilt(Tilt { aperture, .. }) => Some(aperture),
+            Surface::Freeform(Freeform { domain, .. }) => Some(domain),
+            Surface::Array(Array { aperture, .. }) => aperture.as_ref(),
+            Surface::Wrap(_) => None,
+        }
     }
 }

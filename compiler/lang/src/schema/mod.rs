@@ -7,7 +7,8 @@
 //! (`Surface::read`, `Aperture::read`, `Gcode::read`): the only place a
 //! checked parameter is looked up by its name.
 //!
-//! This file holds the types of the tables and the lookups; the kinds live
+//! This file holds the lookups (the types of the tables are in `kind`,
+//! which knows no kind, so a value can name its kind); the kinds live
 //! by category: `surfaces` (one formula each), `composite` (surfaces made
 //! of others), `coefficients` (the `A4`, `X2Y1`, `Z11`, `Q3` families),
 //! `apertures`, `tools`, `machines`, `dialects` and `strategies`.
@@ -17,154 +18,14 @@ use std::rc::Rc;
 use std::sync::OnceLock;
 
 use lensc_grammar::Diagnostic;
-use lensc_grammar::ast::DeclKind;
 
 use crate::units::Dim;
 use crate::value::{Object, Reader};
 
-/// What a kind makes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Category {
-    Surface,
-    Tool,
-    Machine,
-    Strategy,
-    Aperture,
-    Roller,
-    Dialect,
-}
+pub mod kind;
 
-impl Category {
-    pub fn of(kind: DeclKind) -> Category {
-        match kind {
-            DeclKind::Surface => Category::Surface,
-            DeclKind::Tool => Category::Tool,
-            DeclKind::Machine => Category::Machine,
-            DeclKind::Strategy => Category::Strategy,
-            DeclKind::Dialect => Category::Dialect,
-        }
-    }
-    pub fn noun(self) -> &'static str {
-        match self {
-            Category::Surface => "a surface",
-            Category::Tool => "a tool",
-            Category::Machine => "a machine",
-            Category::Strategy => "a strategy",
-            Category::Aperture => "an aperture",
-            Category::Roller => "a roller",
-            Category::Dialect => "a dialect",
-        }
-    }
-}
-
-/// The type a parameter's value must have.
-#[derive(Clone, Copy, Debug)]
-pub enum Ty {
-    /// A quantity of one of these dimensions.
-    Quantity(&'static [Dim]),
-    /// One of these words.
-    Word(&'static [&'static str]),
-    /// A value constructed by a kind of this category.
-    Object(Category),
-    /// A list `[a, b]` of values of this category.
-    Objects(Category),
-    /// A string `"…"`.
-    Text,
-    /// A list of strings `["…", "…"]`.
-    Texts,
-    /// A nested block with its own parameters.
-    Block(&'static [Param]),
-    /// A nested block with its own parameters, or one of these words
-    /// instead (`accept: none`).
-    BlockOr(&'static [Param], &'static [&'static str]),
-    /// `lo .. hi`, both of this dimension.
-    Range(Dim),
-    /// `name(coords) = expr` giving this dimension, over these coordinates.
-    Formula {
-        coords: &'static [&'static str],
-        result: Dim,
-    },
-}
-
-/// Allowed values of a quantity, in base units.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Check {
-    Any,
-    Positive,
-    NonNegative,
-    /// lo ≤ v < hi
-    HalfOpen(f64, f64),
-    /// lo < v < hi
-    Open(f64, f64),
-    /// A whole number from 1 to 100 000.
-    Count,
-}
-
-#[derive(Clone, Copy, Debug)]
-pub struct Param {
-    pub name: &'static str,
-    pub ty: Ty,
-    pub required: bool,
-    pub check: Check,
-    pub doc: &'static str,
-}
-
-const fn req(name: &'static str, ty: Ty, check: Check, doc: &'static str) -> Param {
-    Param {
-        name,
-        ty,
-        required: true,
-        check,
-        doc,
-    }
-}
-const fn opt(name: &'static str, ty: Ty, check: Check, doc: &'static str) -> Param {
-    Param {
-        name,
-        ty,
-        required: false,
-        check,
-        doc,
-    }
-}
-
-pub const LENGTH: Ty = Ty::Quantity(&[Dim::LENGTH]);
-pub const NUMBER: Ty = Ty::Quantity(&[Dim::NONE]);
-pub const ANGLE: Ty = Ty::Quantity(&[Dim::ANGLE]);
-const DEG90: f64 = std::f64::consts::FRAC_PI_2;
-
-/// A family of parameters named by a pattern (`X2Y1`, `Z11`): a
-/// description for messages, and the parameter a name stands for.
-pub struct Family {
-    pub describe: &'static str,
-    pub param: fn(&str) -> Option<Param>,
-}
-
-impl std::fmt::Debug for Family {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.describe)
-    }
-}
-
-#[derive(Clone, Copy, Debug)]
-pub struct Kind {
-    pub name: &'static str,
-    pub category: Category,
-    pub params: &'static [Param],
-    /// Coefficients named by a pattern, beyond `params`.
-    pub family: Option<&'static Family>,
-    /// Parameter names that positional arguments fill, in order.
-    pub positional: &'static [&'static str],
-    /// At most one of each group may be given; `exactly_one` groups need one.
-    pub exclusive: &'static [(&'static [&'static str], bool)],
-    pub doc: &'static str,
-}
-
-impl Kind {
-    pub fn param(&self, name: &str) -> Option<&'static Param> {
-        self.params.iter().find(|p| p.name == name)
-    }
-}
+pub use kind::{ANGLE, Category, Check, Family, Kind, LENGTH, NUMBER, Param, Ty};
+use kind::{DEG90, opt, req};
 
 mod apertures;
 mod coefficients;
@@ -180,11 +41,11 @@ pub use coefficients::{
     FORBES_TOP, POWER_COEFFICIENTS, QBFS_COEFFICIENTS, QCON_COEFFICIENTS, XY_COEFFICIENTS,
     ZERNIKE_COEFFICIENTS, xy_powers,
 };
-pub use composite::{Array, Layout, OffAxis, Revolve, Roller, Tilt, Wrap};
+pub use composite::{Array, Layout, OffAxis, Revolve, Roller, Surface, Tilt, Wrap};
 pub use dialects::{Gcode, Line, OfferedDialect, offered_dialects};
 pub use surfaces::{
     Axis, Base, Biconic, Conic, Cylinder, Ellipsoid, Facing, Forbes, Freeform, Ordering, Plane,
-    Surface, Toroid, XyPolynomial, Zernike,
+    Toroid, XyPolynomial, Zernike,
 };
 
 /// E0121 for a required parameter `name` that `o` lacks (worded as

@@ -48,7 +48,7 @@ impl Spiral {
     pub fn new(
         s: &FtsSummary,
         spiral: &FtsSpiral,
-        settling: Option<&crate::job::Settling>,
+        settling: Option<&super::Settling>,
         servo: Option<&SecondOrderServo>,
         rho: f64,
     ) -> Spiral {
