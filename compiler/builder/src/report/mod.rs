@@ -27,8 +27,9 @@ pub use crate::strategy::turning::report::{
 };
 pub use common::{AtPoint, AtRadius, AtX, DEG, Optimisation, rpm};
 
+// Each section is its strategy's, in `strategy/NAME/report.rs`.
 /// The toolpath as planned; its fields depend on the strategy, named by
-/// `strategy` (each section is its strategy's, in its `report.rs`).
+/// `strategy`.
 #[derive(Clone, Debug, Serialize, JsonSchema)]
 #[serde(tag = "strategy", rename_all = "snake_case")]
 pub enum Toolpath {
