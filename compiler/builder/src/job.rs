@@ -357,7 +357,7 @@ impl<'a> Parts<'a> {
             resolution: self.machine_params.resolution,
             travel: self.machine_params.travel,
             simulate: simulate(&self.params).ok().flatten(),
-            accept: accept::lower(self.job).unwrap_or_default(),
+            accept: accept::lower(&self.params).unwrap_or_default(),
             start: program_start(&self.params),
         }
     }

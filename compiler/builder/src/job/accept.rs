@@ -7,10 +7,9 @@
 
 use lensc_grammar::{Diagnostic, FileId, Span};
 
-use lensc_lang::check::CheckedJob;
 use lensc_lang::codes;
+use lensc_lang::schema::{AcceptParams, JobParams};
 use lensc_lang::units::Dim;
-use lensc_lang::value::{self, Value};
 
 /// A figure of the simulated part an `accept` block can limit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -138,23 +137,18 @@ impl Accept {
 /// The job's `accept` block, typed; E0123 for an uncut fraction above 1
 /// (the checker has refused wrong dimensions, negative limits and unknown
 /// names).
-pub(crate) fn lower(job: &CheckedJob) -> Result<Accept, Diagnostic> {
-    let Some(field) = value::field(&job.fields, "accept") else {
-        return Ok(Accept::Defaults);
-    };
-    let block = match &field.value {
-        Value::Word(w) if w == "none" => return Ok(Accept::Nothing),
-        Value::Block(b) => b,
-        _ => return Ok(Accept::Defaults),
+pub(crate) fn lower(params: &JobParams) -> Result<Accept, Diagnostic> {
+    let (criteria, block_site) = match &params.accept {
+        AcceptParams::Defaults => return Ok(Accept::Defaults),
+        AcceptParams::Nothing => return Ok(Accept::Nothing),
+        AcceptParams::Stated { criteria, site } => (criteria, *site),
     };
     let mut limits = Vec::new();
     for c in Criterion::ALL {
-        let Some(f) = value::field(block, c.name()) else {
+        let Some((_, stated)) = criteria.iter().find(|(name, _)| *name == c.name()) else {
             continue;
         };
-        let Value::Num(v, dim) = f.value else {
-            continue;
-        };
+        let ((v, dim), (file, span)) = (stated.value, stated.site);
         let fraction = c == Criterion::UncutArea && dim == Dim::NONE;
         if fraction && v > 1.0 {
             return Err(Diagnostic::error(
@@ -163,8 +157,8 @@ pub(crate) fn lower(job: &CheckedJob) -> Result<Accept, Diagnostic> {
                     "`uncut_area` as a plain number is a fraction of the area simulated, at most 1, but it is {}",
                     lensc_lang::check::trim_num(v)
                 ),
-                f.file,
-                f.span,
+                file,
+                span,
             )
             .with_label("more than the whole")
             .with_help("give a fraction from 0 to 1, or an area with its unit, as in `0.01 mm^2`"));
@@ -174,12 +168,12 @@ pub(crate) fn lower(job: &CheckedJob) -> Result<Accept, Diagnostic> {
             Limit {
                 value: v,
                 fraction,
-                site: (f.file, f.span),
+                site: (file, span),
             },
         ));
     }
     Ok(Accept::Stated {
         limits,
-        site: (field.file, field.span),
+        site: block_site,
     })
 }

@@ -47,7 +47,7 @@ pub(crate) fn placement(p: &Parts, path: ChordPath) -> ChordPlacement {
         // The checker has allowed only the four words.
         return ChordPlacement::from_word(stated.value, margin).unwrap_or_default();
     }
-    let accept = super::accept::lower(p.job).unwrap_or_default();
+    let accept = super::accept::lower(&p.params).unwrap_or_default();
     let limits = form_limits(&accept, path.tolerance, resolution);
     ChordPlacement::fewest_points_meeting(path.sag, path.fit, &limits, margin, path.long_chords)
 }

@@ -200,7 +200,7 @@ pub fn lower_job(
     if let Err(d) = crate::job::simulate(&p.params) {
         errors.push(d);
     }
-    if let Err(d) = crate::job::accept::lower(job) {
+    if let Err(d) = crate::job::accept::lower(&p.params) {
         errors.push(d);
     }
     errors.extend(axes.and_then(|axes| crate::job::tolerance::below_resolution(&p, axes)));

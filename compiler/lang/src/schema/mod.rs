@@ -231,7 +231,7 @@ pub static JOB_PARAMS: &[Param] = &[
 ];
 
 /// A job's own checked parameters beyond its four parts, read once.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct JobParams {
     pub tool_number: Option<crate::value::Stated<f64>>,
     pub tool_offset: Option<crate::value::Stated<f64>>,
@@ -243,6 +243,22 @@ pub struct JobParams {
     pub simulate: Option<crate::value::Stated<SimulateParams>>,
     /// Where the job names its surface, tool, machine and strategy.
     pub part_sites: PartSites,
+    /// The `accept` block as written.
+    pub accept: AcceptParams,
+}
+
+/// A job's `accept`, as written: none (the defaults), `none`, or a block.
+#[derive(Clone, Debug, Default)]
+pub enum AcceptParams {
+    #[default]
+    Defaults,
+    Nothing,
+    /// Each criterion the block states (its name, its value and dimension,
+    /// where), in the schema's order, and where the block is.
+    Stated {
+        criteria: Vec<(&'static str, crate::value::Stated<(f64, Dim)>)>,
+        site: (lensc_grammar::FileId, lensc_grammar::ast::Span),
+    },
 }
 
 /// Where a job names each of its four parts (for a message about one).
@@ -293,6 +309,22 @@ impl JobParams {
                 })
                 .map(|value| crate::value::Stated { value, site })
             }),
+            accept: match (r.site("accept"), r.word("accept")) {
+                (None, _) => AcceptParams::Defaults,
+                (Some(_), Some("none")) => AcceptParams::Nothing,
+                (Some(site), _) => r
+                    .block("accept", |b| AcceptParams::Stated {
+                        criteria: ACCEPT_PARAMS
+                            .iter()
+                            .filter_map(|c| {
+                                let (value, at) = (b.quantity(c.name)?, b.site(c.name)?);
+                                Some((c.name, crate::value::Stated { value, site: at }))
+                            })
+                            .collect(),
+                        site,
+                    })
+                    .unwrap_or_default(),
+            },
             part_sites: PartSites {
                 surface: r.site("surface"),
                 tool: r.site("tool"),
