@@ -158,15 +158,22 @@ fn build_writes_program_to_out_dir() {
         ["kim_convex.ngc", "kim_convex.report.json"],
         "temporary files left"
     );
-    // Put in place readable by all, not with the temporary file's 0600.
-    #[cfg(unix)]
+    // Put in place with the user's usual mode (0666 less the umask this
+    // process, and so lensc, inherited), not a temporary file's 0600.
+    #[cfg(target_os = "linux")]
     for f in &leftovers {
         use std::os::unix::fs::PermissionsExt;
+        let status = std::fs::read_to_string("/proc/self/status").expect("status");
+        let umask = status
+            .lines()
+            .find_map(|l| l.strip_prefix("Umask:"))
+            .and_then(|u| u32::from_str_radix(u.trim(), 8).ok())
+            .expect("a Umask line");
         let mode = std::fs::metadata(dir.path().join("out").join(f))
             .expect("meta")
             .permissions()
             .mode();
-        assert_eq!(mode & 0o777, 0o644, "{f}");
+        assert_eq!(mode & 0o777, 0o666 & !umask, "{f}");
     }
     // The report: provenance, the program, the toolpath and the surface.
     let report: serde_json::Value = serde_json::from_str(
@@ -493,4 +500,32 @@ fn sample_works_on_every_example_surface() {
         }
     }
     assert!(sampled >= 15, "only {sampled} surfaces");
+}
+
+/// A build's program and report get the mode the user's umask gives a
+/// new file (0666 less the umask), whatever the umask: never a forced
+/// 0644, which would open them wider than a umask of 077 asks.
+#[cfg(unix)]
+#[test]
+fn build_outputs_follow_the_umask() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().expect("tmp");
+    std::fs::copy(root().join(GOOD), dir.path().join("job.lens")).expect("copy");
+    for (umask, mode) in [("077", 0o600), ("002", 0o664)] {
+        let run = std::process::Command::new("sh")
+            .current_dir(dir.path())
+            .arg("-c")
+            .arg(format!(
+                "umask {umask} && exec \"$0\" build job.lens --job kim_convex --out o{umask}"
+            ))
+            .arg(env!("CARGO_BIN_EXE_lensc"))
+            .output()
+            .expect("run");
+        assert!(run.status.success(), "{}", text(&run.stderr));
+        for f in ["kim_convex.ngc", "kim_convex.report.json"] {
+            let p = dir.path().join(format!("o{umask}")).join(f);
+            let got = std::fs::metadata(&p).expect("written").permissions().mode() & 0o777;
+            assert_eq!(got, mode, "umask {umask}, {f}: {got:o}");
+        }
+    }
 }

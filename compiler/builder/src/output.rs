@@ -85,7 +85,6 @@ impl ProgramText {
             ProgramText::Memory(t) => write_atomic(path, &t),
             ProgramText::Spooled { file, .. } => {
                 not_a_link(path)?;
-                readable_by_all(file.as_file())?;
                 file.as_file().sync_all()?;
                 file.persist(path)
             }
@@ -120,24 +119,13 @@ fn not_a_link(path: &Path) -> std::io::Result<()> {
     }
 }
 
-/// Makes a finished output file readable by all and writable by its owner.
-fn readable_by_all(file: &std::fs::File) -> std::io::Result<()> {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        file.set_permissions(std::fs::Permissions::from_mode(0o644))?;
-    }
-    #[cfg(not(unix))]
-    let _ = file;
-    Ok(())
-}
-
 /// Writes `text` to `path` atomically: a temporary file in the same
 /// directory, flushed, then renamed over the target. On failure the
 /// target is untouched and no temporary file is left behind.
-/// Temporary files are created private (0600); a program and its report
-/// are put in place readable by all (0644), as any other written file, so
-/// they can be copied to the controller's share.
+/// Temporary files are created with the mode the user's files get (0666
+/// less the umask: 0644 under the usual 022), so a program and its report
+/// are put in place as any other file the user writes, and can be copied
+/// to the controller's share.
 pub fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {
     use std::io::Write;
     let dir = path
@@ -148,7 +136,6 @@ pub fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {
     not_a_link(path)?;
     let mut tmp = crate::temps::TempFile::create_in(dir)?;
     tmp.write_all(text.as_bytes())?;
-    readable_by_all(tmp.as_file())?;
     tmp.as_file().sync_all()?;
     tmp.persist(path)
 }

@@ -35,13 +35,20 @@ pub struct TempFile {
 }
 
 impl TempFile {
-    /// Creates `.lensc-<pid>-<random>.tmp` in `dir` (private, 0600).
+    /// Creates `.lensc-<pid>-<random>.tmp` in `dir`, with the mode a file
+    /// the user creates gets (0666 less the umask, as the kernel applies
+    /// it when the file is created), since it becomes an output file.
     pub fn create_in(dir: &Path) -> io::Result<TempFile> {
         let mut live = live();
-        let file = tempfile::Builder::new()
-            .prefix(&format!("{PREFIX}{}-", std::process::id()))
-            .suffix(SUFFIX)
-            .tempfile_in(dir)?;
+        let prefix = format!("{PREFIX}{}-", std::process::id());
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(&prefix).suffix(SUFFIX);
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            builder.permissions(std::fs::Permissions::from_mode(0o666));
+        }
+        let file = builder.tempfile_in(dir)?;
         live.push(file.path().to_path_buf());
         Ok(TempFile { file: Some(file) })
     }

@@ -84,6 +84,12 @@ pub const IMPORT_UNREADABLE: &str = "E0350";
 pub const IMPORT_NOTHING: &str = "E0351";
 /// `lensc import`: a non-sequential Zemax design.
 pub const IMPORT_NON_SEQUENTIAL: &str = "E0352";
+/// `lensc import`: a surface with a number that has no finite value in
+/// lensc's terms (a curvature so small its radius overflows, a value that
+/// is infinite).
+pub const IMPORT_NOT_FINITE: &str = "E0353";
+/// `lensc import`: the `.lens` text would be over the 16 MiB lensc reads.
+pub const IMPORT_TOO_LARGE: &str = "E0354";
 
 /// The simulated part misses one of its job's acceptance criteria (the
 /// message names which, by how much and where); no program is written.
@@ -296,6 +302,8 @@ pub const ALL: &[&str] = &[
     IMPORT_UNREADABLE,
     IMPORT_NOTHING,
     IMPORT_NON_SEQUENTIAL,
+    IMPORT_NOT_FINITE,
+    IMPORT_TOO_LARGE,
     IMPORT_UNSUPPORTED_SURFACE,
     IMPORT_PARAMETER_DROPPED,
     IMPORT_NO_SEMI_DIAMETER,
