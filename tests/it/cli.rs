@@ -529,3 +529,81 @@ fn build_outputs_follow_the_umask() {
         }
     }
 }
+
+/// `check` refuses what `build` would refuse at once: an infinite
+/// quantity (a roller's rough `finish_allowance` of 1e308 × 1e308 µm) is
+/// E0186 where it first overflows.
+#[test]
+fn check_refuses_an_infinite_quantity() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let job = std::fs::read_to_string(root().join("examples/liu_roller_pattern.lens"))
+        .expect("example")
+        .replace(
+            "finish_allowance: 10 um",
+            "finish_allowance: 1e308 * 1e308 * 10 um",
+        );
+    assert!(job.contains("1e308 * 1e308"));
+    std::fs::write(dir.path().join("job.lens"), &job).expect("write");
+    let out = lensc(dir.path(), &["check", "job.lens"]);
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("[E0186]"), "{err}");
+    let line = job.lines().position(|l| l.contains("1e308")).expect("line") + 1;
+    assert!(err.contains(&format!("job.lens:{line}:")), "{err}");
+}
+
+const UNDEFINED: &str = "\
+// Defined for r < 1 mm only, over an aperture of radius 1.5 mm.
+surface dome = freeform {
+    z(x, y) = sqrt(1 mm^2 - x^2 - y^2) - 1 mm
+    domain: circle(radius: 1.5 mm)
+}
+
+// Defined exactly to its rim: passes.
+surface rim = freeform {
+    z(x, y) = sqrt(1 mm^2 - x^2 - y^2) - 1 mm
+    domain: circle(radius: 1 mm)
+}
+";
+
+/// A surface with no value over part of its aperture is E0187 in
+/// `check`; `analyse` and `sample` warn (W0022) and go on, its points
+/// shown as NaN; a surface defined exactly to its rim passes.
+#[test]
+fn a_surface_undefined_over_its_aperture() {
+    let dir = tempfile::tempdir().expect("tmp");
+    std::fs::write(dir.path().join("s.lens"), UNDEFINED).expect("write");
+    let out = lensc(dir.path(), &["check", "s.lens"]);
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert_eq!(err.matches("[E0187]").count(), 1, "{err}");
+    assert!(err.contains("`dome`") && err.contains("s.lens:2:"), "{err}");
+
+    let out = lensc(
+        dir.path(),
+        &["sample", "s.lens", "--surface", "dome", "--radial", "3"],
+    );
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(err.contains("[W0022]"), "{err}");
+    assert!(text(&out.stdout).contains("NaN"));
+    let out = lensc(dir.path(), &["analyse", "s.lens", "--surface", "dome"]);
+    assert!(
+        text(&out.stderr).contains("[W0022]"),
+        "{}",
+        text(&out.stderr)
+    );
+    for cmd in ["sample", "analyse"] {
+        let mut args = vec![cmd, "s.lens", "--surface", "rim"];
+        if cmd == "sample" {
+            args.extend(["--radial", "3"]);
+        }
+        let out = lensc(dir.path(), &args);
+        assert_eq!(out.status.code(), Some(0), "{cmd}");
+        assert!(
+            !text(&out.stderr).contains("W0022"),
+            "{cmd}: {}",
+            text(&out.stderr)
+        );
+    }
+}

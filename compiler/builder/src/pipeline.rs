@@ -80,7 +80,9 @@ pub fn findings_before_planning(c: &Checked, limits: &Limits) -> Vec<Diagnostic>
     if c.has_errors() {
         return Vec::new();
     }
-    let mut found = Vec::new();
+    // A surface with no value over part of its aperture: refused here, as
+    // the build would refuse it once planning.
+    let mut found = crate::evaluate::undefined_surfaces(c, lensc_grammar::Severity::Error, None);
     for j in &c.checked.jobs {
         match lower(j, None, limits) {
             Ok((spec, _)) => found.extend(spec.warnings_before_planning()),

@@ -77,6 +77,12 @@ pub const TOLERANCE_BELOW_RESOLUTION: &str = "E0180";
 /// `lensc fmt` refused to write a layout that would not parse back to the
 /// same program (a formatter bug; the file is left as it is).
 pub const FORMAT_WOULD_CHANGE_MEANING: &str = "E0185";
+/// A number with no finite value: an overflow (`1e308 * 1e308`), an
+/// infinity or NaN.
+pub const NOT_FINITE: &str = "E0186";
+/// A surface whose sag has no value (NaN or infinite) somewhere over its
+/// aperture (the square root of a negative number, a conic that closes).
+pub const SURFACE_UNDEFINED: &str = "E0187";
 /// `lensc import`: the file is not a prescription lensc reads (not a
 /// `.zmx` or optiland JSON file, or a value in it that is not a number).
 pub const IMPORT_UNREADABLE: &str = "E0350";
@@ -112,6 +118,9 @@ pub const SEAM_STEP: &str = "W0006";
 pub const ACCEPTANCE_MISSED_WARNING: &str = "W0020";
 /// E0196 under `lensc build --accept=warn`: the program is written.
 pub const ACCEPTANCE_UNMEASURED_WARNING: &str = "W0021";
+/// E0187 as `lensc analyse` and `lensc sample` report it: the points with
+/// no value are shown as NaN, the rest analysed.
+pub const SURFACE_UNDEFINED_WARNING: &str = "W0022";
 /// `lensc import`: a surface of a type (or form) lensc does not import.
 pub const IMPORT_UNSUPPORTED_SURFACE: &str = "W0015";
 /// `lensc import`: a parameter of an imported surface that is not carried over.
@@ -299,6 +308,8 @@ pub const ALL: &[&str] = &[
     CHORDS_OVER_TOLERANCE,
     SEAM_STEP,
     FORMAT_WOULD_CHANGE_MEANING,
+    NOT_FINITE,
+    SURFACE_UNDEFINED,
     IMPORT_UNREADABLE,
     IMPORT_NOTHING,
     IMPORT_NON_SEQUENTIAL,
@@ -343,6 +354,7 @@ pub const ALL: &[&str] = &[
     PROGRAM_FRAME,
     ACCEPTANCE_MISSED_WARNING,
     ACCEPTANCE_UNMEASURED_WARNING,
+    SURFACE_UNDEFINED_WARNING,
 ];
 
 #[cfg(test)]
