@@ -607,3 +607,75 @@ fn a_surface_undefined_over_its_aperture() {
         );
     }
 }
+
+/// A dialect whose extension would give the program its report's name
+/// is refused (E0188) by `check` and by `build`, before anything is
+/// built or written.
+#[test]
+fn a_program_named_as_its_report_is_refused() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let job = "use std::machines::linuxcnc_lathe
+use std::tools::diamond_r500um
+dialect ours = linuxcnc { extension: \"Report.JSON\" }
+machine m = linuxcnc_lathe { dialect: ours }
+surface lens = sphere { radius: 20 mm, sense: convex, aperture: circle(diameter: 4 mm) }
+strategy s = profile_turning { feed: 5 um/rev, spindle_speed: 1000 rpm, chord_tolerance: 200 nm }
+job j { surface: lens, tool: diamond_r500um, machine: m, strategy: s }
+";
+    std::fs::write(dir.path().join("j.lens"), job).expect("write");
+    for cmd in ["check", "build"] {
+        let out = lensc(
+            dir.path(),
+            &[cmd, "j.lens", "--out", "o"][..if cmd == "check" { 2 } else { 4 }],
+        );
+        let err = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{cmd}: {err}");
+        assert!(err.contains("[E0188]"), "{cmd}: {err}");
+    }
+    assert!(!dir.path().join("o").exists(), "something was written");
+}
+
+/// A build whose program cannot be put in place (a symbolic link planted
+/// at its name) leaves the previous report too: a program and its report
+/// are replaced together or not at all.
+#[cfg(unix)]
+#[test]
+fn a_failed_program_write_leaves_the_previous_report() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let job = std::fs::read_to_string(root().join(GOOD)).expect("example");
+    std::fs::write(dir.path().join("job.lens"), &job).expect("write");
+    let build = || {
+        lensc(
+            dir.path(),
+            &["build", "job.lens", "--job", "kim_convex", "--out", "o"],
+        )
+    };
+    let out = build();
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let report = std::fs::read(dir.path().join("o/kim_convex.report.json")).expect("report");
+    let program = dir.path().join("o/kim_convex.ngc");
+    std::fs::rename(&program, dir.path().join("elsewhere.ngc")).expect("move");
+    std::os::unix::fs::symlink(dir.path().join("elsewhere.ngc"), &program).expect("link");
+    // Another build of a changed job: its report would differ.
+    let changed = job.replace("chord_tolerance: 10 nm", "chord_tolerance: 9 nm");
+    assert_ne!(changed, job);
+    std::fs::write(dir.path().join("job.lens"), changed).expect("write");
+    let out = build();
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stderr).contains("symbolic link"),
+        "{}",
+        text(&out.stderr)
+    );
+    assert_eq!(
+        std::fs::read(dir.path().join("o/kim_convex.report.json")).expect("report"),
+        report,
+        "the report was replaced without its program"
+    );
+    let left: Vec<String> = std::fs::read_dir(dir.path().join("o"))
+        .expect("o")
+        .map(|e| e.expect("e").file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(".lensc-"))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+}

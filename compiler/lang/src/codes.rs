@@ -83,6 +83,9 @@ pub const NOT_FINITE: &str = "E0186";
 /// A surface whose sag has no value (NaN or infinite) somewhere over its
 /// aperture (the square root of a negative number, a conic that closes).
 pub const SURFACE_UNDEFINED: &str = "E0187";
+/// A dialect's extension that gives the program the name of another file
+/// the build writes beside it (`JOB.report.json`, a servo table, a plot).
+pub const OUTPUT_NAME_RESERVED: &str = "E0188";
 /// `lensc import`: the file is not a prescription lensc reads (not a
 /// `.zmx` or optiland JSON file, or a value in it that is not a number).
 pub const IMPORT_UNREADABLE: &str = "E0350";
@@ -310,6 +313,7 @@ pub const ALL: &[&str] = &[
     FORMAT_WOULD_CHANGE_MEANING,
     NOT_FINITE,
     SURFACE_UNDEFINED,
+    OUTPUT_NAME_RESERVED,
     IMPORT_UNREADABLE,
     IMPORT_NOTHING,
     IMPORT_NON_SEQUENTIAL,
