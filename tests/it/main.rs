@@ -30,6 +30,7 @@ mod import;
 mod interrupt;
 mod jit_conformance;
 mod limits;
+mod linear;
 mod list;
 mod lsp;
 mod plots;

@@ -356,6 +356,11 @@ impl<'a> Checker<'a> {
         coords: &[String],
     ) -> Vec<Field> {
         let mut fields = Vec::new();
+        // The names given so far: a name given once is pushed at once, and
+        // only a repeated one is looked for among the fields (to report
+        // where it was first given), so a block of n entries checks in
+        // O(n), not O(n²).
+        let mut seen: std::collections::HashSet<String> = std::collections::HashSet::new();
         for entry in &block.entries {
             let f = match entry {
                 Entry::Param { name, value } => {
@@ -408,7 +413,11 @@ impl<'a> Checker<'a> {
                     }
                 }
             };
-            self.push_field(&mut fields, f);
+            if seen.insert(f.name.clone()) {
+                fields.push(f);
+            } else {
+                self.push_field(&mut fields, f);
+            }
         }
         fields
     }
