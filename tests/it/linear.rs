@@ -93,3 +93,63 @@ fn a_diagnostic_on_a_long_line() {
         },
     );
 }
+
+/// A chain of n files, each `use`-ing the next: loaded and checked in
+/// time linear in n (the import-cycle check looked through the files
+/// being loaded at each `use`).
+#[test]
+fn a_chain_of_used_files() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let write_chain = |n: usize| {
+        let sub = dir.path().join(format!("chain{n}"));
+        std::fs::create_dir_all(&sub).expect("mkdir");
+        for i in 0..n {
+            let next = if i + 1 < n {
+                format!("use \"f{}.lens\"\n", i + 1)
+            } else {
+                String::new()
+            };
+            std::fs::write(
+                sub.join(format!("f{i}.lens")),
+                format!("{next}let v{i} = {i} mm\n"),
+            )
+            .expect("write");
+        }
+        sub.join("f0.lens").display().to_string()
+    };
+    // 800 nested loads: a stack as large as the binary's main thread.
+    std::thread::scope(|s| {
+        std::thread::Builder::new()
+            .stack_size(8 << 20)
+            .spawn_scoped(s, || {
+                linear("use chain", 200, write_chain, |path| {
+                    let c = lensc_lang::check_path(&RealFs, std::path::Path::new(path))
+                        .expect("checked");
+                    assert!(!c.has_errors(), "{:?}", c.diags().first());
+                })
+            })
+            .expect("a thread")
+            .join()
+            .expect("linear");
+    });
+}
+
+/// A chain of more files than one check loads (E0189, said once) is
+/// refused, by the binary as a user runs it.
+#[test]
+fn a_chain_past_the_file_limit_is_refused() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let n = lensc_lang::loader::MAX_FILES + 50;
+    for i in 0..n {
+        std::fs::write(
+            dir.path().join(format!("f{i}.lens")),
+            format!("use \"f{}.lens\"\nlet v{i} = {i} mm\n", i + 1),
+        )
+        .expect("write");
+    }
+    let out = crate::common::lensc(dir.path(), &["check", "f0.lens"]);
+    let err = crate::common::text(&out.stderr);
+    let head = &err[..err.len().min(2000)];
+    assert_eq!(out.status.code(), Some(1), "{head}");
+    assert_eq!(err.matches("[E0189]").count(), 1, "{head}");
+}

@@ -86,6 +86,8 @@ pub const SURFACE_UNDEFINED: &str = "E0187";
 /// A dialect's extension that gives the program the name of another file
 /// the build writes beside it (`JOB.report.json`, a servo table, a plot).
 pub const OUTPUT_NAME_RESERVED: &str = "E0188";
+/// A project whose `use`s would load more than `loader::MAX_FILES` files.
+pub const TOO_MANY_FILES: &str = "E0189";
 /// `lensc import`: the file is not a prescription lensc reads (not a
 /// `.zmx` or optiland JSON file, or a value in it that is not a number).
 pub const IMPORT_UNREADABLE: &str = "E0350";
@@ -314,6 +316,7 @@ pub const ALL: &[&str] = &[
     NOT_FINITE,
     SURFACE_UNDEFINED,
     OUTPUT_NAME_RESERVED,
+    TOO_MANY_FILES,
     IMPORT_UNREADABLE,
     IMPORT_NOTHING,
     IMPORT_NON_SEQUENTIAL,
