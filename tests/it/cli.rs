@@ -158,15 +158,22 @@ fn build_writes_program_to_out_dir() {
         ["kim_convex.ngc", "kim_convex.report.json"],
         "temporary files left"
     );
-    // Put in place readable by all, not with the temporary file's 0600.
-    #[cfg(unix)]
+    // Put in place with the user's usual mode (0666 less the umask this
+    // process, and so lensc, inherited), not a temporary file's 0600.
+    #[cfg(target_os = "linux")]
     for f in &leftovers {
         use std::os::unix::fs::PermissionsExt;
+        let status = std::fs::read_to_string("/proc/self/status").expect("status");
+        let umask = status
+            .lines()
+            .find_map(|l| l.strip_prefix("Umask:"))
+            .and_then(|u| u32::from_str_radix(u.trim(), 8).ok())
+            .expect("a Umask line");
         let mode = std::fs::metadata(dir.path().join("out").join(f))
             .expect("meta")
             .permissions()
             .mode();
-        assert_eq!(mode & 0o777, 0o644, "{f}");
+        assert_eq!(mode & 0o777, 0o666 & !umask, "{f}");
     }
     // The report: provenance, the program, the toolpath and the surface.
     let report: serde_json::Value = serde_json::from_str(
@@ -493,4 +500,182 @@ fn sample_works_on_every_example_surface() {
         }
     }
     assert!(sampled >= 15, "only {sampled} surfaces");
+}
+
+/// A build's program and report get the mode the user's umask gives a
+/// new file (0666 less the umask), whatever the umask: never a forced
+/// 0644, which would open them wider than a umask of 077 asks.
+#[cfg(unix)]
+#[test]
+fn build_outputs_follow_the_umask() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().expect("tmp");
+    std::fs::copy(root().join(GOOD), dir.path().join("job.lens")).expect("copy");
+    for (umask, mode) in [("077", 0o600), ("002", 0o664)] {
+        let run = std::process::Command::new("sh")
+            .current_dir(dir.path())
+            .arg("-c")
+            .arg(format!(
+                "umask {umask} && exec \"$0\" build job.lens --job kim_convex --out o{umask}"
+            ))
+            .arg(env!("CARGO_BIN_EXE_lensc"))
+            .output()
+            .expect("run");
+        assert!(run.status.success(), "{}", text(&run.stderr));
+        for f in ["kim_convex.ngc", "kim_convex.report.json"] {
+            let p = dir.path().join(format!("o{umask}")).join(f);
+            let got = std::fs::metadata(&p).expect("written").permissions().mode() & 0o777;
+            assert_eq!(got, mode, "umask {umask}, {f}: {got:o}");
+        }
+    }
+}
+
+/// `check` refuses what `build` would refuse at once: an infinite
+/// quantity (a roller's rough `finish_allowance` of 1e308 × 1e308 µm) is
+/// E0186 where it first overflows.
+#[test]
+fn check_refuses_an_infinite_quantity() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let job = std::fs::read_to_string(root().join("examples/liu_roller_pattern.lens"))
+        .expect("example")
+        .replace(
+            "finish_allowance: 10 um",
+            "finish_allowance: 1e308 * 1e308 * 10 um",
+        );
+    assert!(job.contains("1e308 * 1e308"));
+    std::fs::write(dir.path().join("job.lens"), &job).expect("write");
+    let out = lensc(dir.path(), &["check", "job.lens"]);
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("[E0186]"), "{err}");
+    let line = job.lines().position(|l| l.contains("1e308")).expect("line") + 1;
+    assert!(err.contains(&format!("job.lens:{line}:")), "{err}");
+}
+
+const UNDEFINED: &str = "\
+// Defined for r < 1 mm only, over an aperture of radius 1.5 mm.
+surface dome = freeform {
+    z(x, y) = sqrt(1 mm^2 - x^2 - y^2) - 1 mm
+    domain: circle(radius: 1.5 mm)
+}
+
+// Defined exactly to its rim: passes.
+surface rim = freeform {
+    z(x, y) = sqrt(1 mm^2 - x^2 - y^2) - 1 mm
+    domain: circle(radius: 1 mm)
+}
+";
+
+/// A surface with no value over part of its aperture is E0187 in
+/// `check`; `analyse` and `sample` warn (W0022) and go on, its points
+/// shown as NaN; a surface defined exactly to its rim passes.
+#[test]
+fn a_surface_undefined_over_its_aperture() {
+    let dir = tempfile::tempdir().expect("tmp");
+    std::fs::write(dir.path().join("s.lens"), UNDEFINED).expect("write");
+    let out = lensc(dir.path(), &["check", "s.lens"]);
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert_eq!(err.matches("[E0187]").count(), 1, "{err}");
+    assert!(err.contains("`dome`") && err.contains("s.lens:2:"), "{err}");
+
+    let out = lensc(
+        dir.path(),
+        &["sample", "s.lens", "--surface", "dome", "--radial", "3"],
+    );
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(err.contains("[W0022]"), "{err}");
+    assert!(text(&out.stdout).contains("NaN"));
+    let out = lensc(dir.path(), &["analyse", "s.lens", "--surface", "dome"]);
+    assert!(
+        text(&out.stderr).contains("[W0022]"),
+        "{}",
+        text(&out.stderr)
+    );
+    for cmd in ["sample", "analyse"] {
+        let mut args = vec![cmd, "s.lens", "--surface", "rim"];
+        if cmd == "sample" {
+            args.extend(["--radial", "3"]);
+        }
+        let out = lensc(dir.path(), &args);
+        assert_eq!(out.status.code(), Some(0), "{cmd}");
+        assert!(
+            !text(&out.stderr).contains("W0022"),
+            "{cmd}: {}",
+            text(&out.stderr)
+        );
+    }
+}
+
+/// A dialect whose extension would give the program its report's name
+/// is refused (E0188) by `check` and by `build`, before anything is
+/// built or written.
+#[test]
+fn a_program_named_as_its_report_is_refused() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let job = "use std::machines::linuxcnc_lathe
+use std::tools::diamond_r500um
+dialect ours = linuxcnc { extension: \"Report.JSON\" }
+machine m = linuxcnc_lathe { dialect: ours }
+surface lens = sphere { radius: 20 mm, sense: convex, aperture: circle(diameter: 4 mm) }
+strategy s = profile_turning { feed: 5 um/rev, spindle_speed: 1000 rpm, chord_tolerance: 200 nm }
+job j { surface: lens, tool: diamond_r500um, machine: m, strategy: s }
+";
+    std::fs::write(dir.path().join("j.lens"), job).expect("write");
+    for cmd in ["check", "build"] {
+        let out = lensc(
+            dir.path(),
+            &[cmd, "j.lens", "--out", "o"][..if cmd == "check" { 2 } else { 4 }],
+        );
+        let err = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{cmd}: {err}");
+        assert!(err.contains("[E0188]"), "{cmd}: {err}");
+    }
+    assert!(!dir.path().join("o").exists(), "something was written");
+}
+
+/// A build whose program cannot be put in place (a symbolic link planted
+/// at its name) leaves the previous report too: a program and its report
+/// are replaced together or not at all.
+#[cfg(unix)]
+#[test]
+fn a_failed_program_write_leaves_the_previous_report() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let job = std::fs::read_to_string(root().join(GOOD)).expect("example");
+    std::fs::write(dir.path().join("job.lens"), &job).expect("write");
+    let build = || {
+        lensc(
+            dir.path(),
+            &["build", "job.lens", "--job", "kim_convex", "--out", "o"],
+        )
+    };
+    let out = build();
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let report = std::fs::read(dir.path().join("o/kim_convex.report.json")).expect("report");
+    let program = dir.path().join("o/kim_convex.ngc");
+    std::fs::rename(&program, dir.path().join("elsewhere.ngc")).expect("move");
+    std::os::unix::fs::symlink(dir.path().join("elsewhere.ngc"), &program).expect("link");
+    // Another build of a changed job: its report would differ.
+    let changed = job.replace("chord_tolerance: 10 nm", "chord_tolerance: 9 nm");
+    assert_ne!(changed, job);
+    std::fs::write(dir.path().join("job.lens"), changed).expect("write");
+    let out = build();
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stderr).contains("symbolic link"),
+        "{}",
+        text(&out.stderr)
+    );
+    assert_eq!(
+        std::fs::read(dir.path().join("o/kim_convex.report.json")).expect("report"),
+        report,
+        "the report was replaced without its program"
+    );
+    let left: Vec<String> = std::fs::read_dir(dir.path().join("o"))
+        .expect("o")
+        .map(|e| e.expect("e").file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(".lensc-"))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
 }

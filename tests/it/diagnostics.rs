@@ -164,3 +164,60 @@ fn labels_after_multibyte_characters_point_at_the_right_bytes() {
         .expect("marker");
     assert_eq!(marker_col, char_col, "\n{line}\n{marker}");
 }
+
+/// Nothing from a file reaches the terminal raw: ESC, an OSC sequence
+/// ended by BEL, a C1 control (U+009B, a one-character CSI) and a
+/// right-to-left override in a job file are shown escaped by `check`,
+/// and ESC in a program's line by `verify`, in the source line and in the
+/// messages that quote it.
+#[test]
+fn control_characters_are_escaped_on_the_terminal() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let job = "let a = 1 mm\nlet b = a + \u{1b}]0;pwned\u{7}\u{9b}31m\u{202e}zz\n";
+    std::fs::write(dir.path().join("esc.lens"), job).expect("write");
+    let out = crate::common::lensc(dir.path(), &["check", "esc.lens"]);
+    let err = crate::common::text(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    for raw in ['\u{1b}', '\u{7}', '\u{9b}', '\u{202e}'] {
+        assert!(!err.contains(raw), "{raw:?} raw in:\n{err}");
+    }
+    assert!(err.contains("\\u{1b}"), "{err}");
+    assert!(err.contains("esc.lens:2:"), "{err}");
+
+    let program = std::fs::read_to_string(
+        crate::common::root().join("tests/bad_programs/e0302_unknown_g_code.ngc"),
+    )
+    .expect("program")
+    .replace(
+        "G66 X3. Z1.5",
+        "G66 X3. Z1.5 (\u{1b}[2J\u{1b}]8;;http://x\u{7})",
+    );
+    std::fs::write(dir.path().join("esc.ngc"), program).expect("write");
+    let out = crate::common::lensc(dir.path(), &["verify", "esc.ngc"]);
+    let err = crate::common::text(&out.stderr);
+    assert!(err.contains("E0302"), "{err}");
+    assert!(!err.contains('\u{1b}') && !err.contains('\u{7}'), "{err}");
+    assert!(err.contains("\\u{1b}[2J"), "{err}");
+}
+
+/// A diagnostic on a very long line prints a window around its label and
+/// the rest summarised: the same few hundred bytes for a line of 100 kB
+/// as for one of 4 MB, with the label's line and column those of the
+/// file.
+#[test]
+fn a_long_line_is_shown_in_a_window() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mut sizes = Vec::new();
+    for n in [100_000, 4_000_000] {
+        let job = format!("let a = 1 mm\nlet b = {}zz + a\n", " ".repeat(n));
+        std::fs::write(dir.path().join("long.lens"), job).expect("write");
+        let out = crate::common::lensc(dir.path(), &["check", "long.lens"]);
+        let err = crate::common::text(&out.stderr);
+        assert!(err.contains("E0100"), "{err}");
+        assert!(err.contains(&format!("long.lens:2:{} ]", n + 9)), "{err}");
+        assert!(err.contains(&format!("…({} bytes)…", n + 8 - 80)), "{err}");
+        assert!(err.len() < 2_000, "{} bytes", err.len());
+        sizes.push(err.len());
+    }
+    assert!(sizes[1] - sizes[0] < 10, "{sizes:?}");
+}

@@ -365,8 +365,13 @@ fn unsupported_surfaces_are_named_in_the_output_too() {
 #[test]
 fn a_file_that_cannot_be_imported_writes_nothing() {
     let dir = tempfile::tempdir().expect("tmp");
-    let cases: [(&str, &[u8], &str); 4] = [
+    let cases: [(&str, &[u8], &str); 5] = [
         ("nsc.zmx", b"MODE NSC\nSURF 0\n", "E0352"),
+        (
+            "tiny.zmx",
+            b"SURF 0\nSURF 1\n  CURV 1e-320\n  DIAM 4\nSURF 2\n",
+            "E0353",
+        ),
         ("bad.zmx", b"SURF 0\n  CURV 1/20\n", "E0350"),
         (
             "flat.zmx",
@@ -385,5 +390,39 @@ fn a_file_that_cannot_be_imported_writes_nothing() {
             text(&run.stderr)
         );
         assert!(!dir.path().join("out.lens").exists(), "{name} wrote a file");
+    }
+}
+
+/// The imported file gets the mode any file the user creates gets, 0666
+/// less the umask (not a temporary file's private 0600).
+#[cfg(unix)]
+#[test]
+fn the_written_file_has_the_users_usual_mode() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().expect("tmp");
+    std::fs::copy(
+        root().join("tests/import/cooke_triplet.zmx"),
+        dir.path().join("c.zmx"),
+    )
+    .expect("copy");
+    for (umask, mode) in [("022", 0o644), ("002", 0o664), ("077", 0o600)] {
+        let out = dir.path().join(format!("c{umask}.lens"));
+        let run = std::process::Command::new("sh")
+            .current_dir(dir.path())
+            .arg("-c")
+            .arg(format!(
+                "umask {umask} && exec \"$0\" import c.zmx -o {}",
+                out.display()
+            ))
+            .arg(env!("CARGO_BIN_EXE_lensc"))
+            .output()
+            .expect("run");
+        assert!(run.status.success(), "{}", text(&run.stderr));
+        let got = std::fs::metadata(&out)
+            .expect("written")
+            .permissions()
+            .mode()
+            & 0o777;
+        assert_eq!(got, mode, "umask {umask}: {got:o}");
     }
 }

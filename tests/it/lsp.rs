@@ -102,6 +102,46 @@ impl Client {
         self.stdin.flush().expect("flush");
     }
 
+    /// Writes bytes as they are, framed or not.
+    fn raw(&mut self, bytes: &[u8]) {
+        // The server may have read what it needs and moved on: a write
+        // into a closed pipe is the test's concern only when the server
+        // died, which the answers awaited show.
+        let _ = self.stdin.write_all(bytes);
+        let _ = self.stdin.flush();
+    }
+
+    /// Sends a request and returns the whole answer, result or error.
+    fn answer(&mut self, method: &str, params: Value) -> Value {
+        let id = self.next_id;
+        self.next_id += 1;
+        self.send(json!({"jsonrpc": "2.0", "id": id, "method": method, "params": params}));
+        loop {
+            let msg = self.next();
+            if msg["id"] == json!(id) {
+                return msg;
+            }
+        }
+    }
+
+    /// The next message that is not a notification.
+    fn next_answer(&mut self) -> Value {
+        loop {
+            let msg = self.next();
+            if msg.get("method").is_none() {
+                return msg;
+            }
+        }
+    }
+
+    fn initialize(&mut self, work: &Path) {
+        self.request(
+            "initialize",
+            json!({"processId": null, "rootUri": uri_of(work), "capabilities": {}}),
+        );
+        self.notify("initialized", json!({}));
+    }
+
     fn notify(&mut self, method: &str, params: Value) {
         self.send(json!({"jsonrpc": "2.0", "method": method, "params": params}));
     }
@@ -465,6 +505,158 @@ fn lowering_findings_show_on_open_and_save() {
     );
     assert_eq!(codes(&c.diagnostics(&uri)), Vec::<String>::new());
 
+    let r = c.request("shutdown", Value::Null);
+    assert_eq!(r, Value::Null);
+    c.notify("exit", Value::Null);
+    assert!(c.child.wait().expect("wait").success());
+}
+
+/// A session for the malformed-input tests: its directory kept alive.
+fn session() -> (tempfile::TempDir, std::path::PathBuf, Client) {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let work = dir.path().canonicalize().expect("dir").join("work");
+    let cache = dir.path().join("cache");
+    std::fs::create_dir_all(&work).expect("mkdir");
+    let mut c = Client::start(&work, &cache);
+    c.initialize(&work);
+    (dir, work, c)
+}
+
+/// Every kind of frame that is not a JSON-RPC message, each followed by a
+/// good request: the bad frame is answered with an error (a parse error,
+/// -32700, or an invalid request, -32600, with the id when it has one) and
+/// the request after it is answered as usual. Lengths of a tebibyte and
+/// 2 GiB cost nothing (the server neither allocates nor waits for them),
+/// nor does a header line with no end.
+#[test]
+fn every_malformed_frame_is_answered_and_the_server_stays_up() {
+    let (_dir, _work, mut c) = session();
+    let framed = |body: &str| format!("Content-Length: {}\r\n\r\n{body}", body.len()).into_bytes();
+    let mut endless = vec![b'A'; 1 << 20];
+    endless.extend_from_slice(b"\r\n\r\n");
+    let cases: Vec<(&str, Vec<u8>, Value, i64)> = vec![
+        (
+            "a tebibyte",
+            b"Content-Length: 1099511627776\r\n\r\n".to_vec(),
+            Value::Null,
+            -32600,
+        ),
+        (
+            "2 GiB",
+            b"Content-Length: 2147483648\r\n\r\n{".to_vec(),
+            Value::Null,
+            -32600,
+        ),
+        (
+            "negative",
+            b"Content-Length: -40\r\n\r\n{}".to_vec(),
+            Value::Null,
+            -32700,
+        ),
+        (
+            "missing",
+            b"Content-Type: application/json\r\n\r\n{}".to_vec(),
+            Value::Null,
+            -32700,
+        ),
+        ("endless header line", endless, Value::Null, -32700),
+        (
+            "not JSON",
+            framed("{\"jsonrpc\": 2.0, oops"),
+            Value::Null,
+            -32700,
+        ),
+        ("an array", framed("[1, 2]"), Value::Null, -32600),
+        (
+            "no jsonrpc",
+            framed(r#"{"id": 5, "method": "textDocument/hover"}"#),
+            json!(5),
+            -32600,
+        ),
+        (
+            "no method",
+            framed(r#"{"jsonrpc": "2.0", "id": "six"}"#),
+            json!("six"),
+            -32600,
+        ),
+        (
+            "a method not a string",
+            framed(r#"{"jsonrpc": "2.0", "id": 7, "method": 7}"#),
+            json!(7),
+            -32600,
+        ),
+    ];
+    for (what, bytes, id, code) in cases {
+        c.raw(&bytes);
+        let e = c.next_answer();
+        assert_eq!(e["id"], id, "{what}: {e}");
+        assert_eq!(e["error"]["code"], json!(code), "{what}: {e}");
+        // The server is still there and in step.
+        let a = c.answer("lensc/nothing", json!({}));
+        assert_eq!(a["error"]["code"], json!(-32601), "{what}: {a}");
+    }
+    let r = c.request("shutdown", Value::Null);
+    assert_eq!(r, Value::Null);
+    c.notify("exit", Value::Null);
+    assert!(c.child.wait().expect("wait").success());
+}
+
+/// After `shutdown` every request is an invalid request (-32600) until
+/// `exit`, which then ends the server with 0; `exit` without `shutdown`
+/// ends it with 1, as the protocol says.
+#[test]
+fn shutdown_then_exit() {
+    let (_dir, work, mut c) = session();
+    let uri = uri_of(&work.join("a.lens"));
+    let r = c.request("shutdown", Value::Null);
+    assert_eq!(r, Value::Null);
+    for method in ["textDocument/hover", "shutdown", "initialize"] {
+        let a = c.answer(
+            method,
+            json!({"textDocument": {"uri": uri}, "position": {"line": 0, "character": 0}}),
+        );
+        assert_eq!(a["error"]["code"], json!(-32600), "{method}: {a}");
+    }
+    c.notify("exit", Value::Null);
+    assert_eq!(c.child.wait().expect("wait").code(), Some(0));
+
+    let (_dir, _work, mut c) = session();
+    c.notify("exit", Value::Null);
+    assert_eq!(c.child.wait().expect("wait").code(), Some(1));
+}
+
+/// A document over the 16 MiB a file may have is refused as `lensc check`
+/// refuses the file (E0109) and its text is not kept; a whole new text
+/// within the limit is checked again.
+#[test]
+fn a_document_over_the_file_limit_is_refused() {
+    let (_dir, work, mut c) = session();
+    let uri = uri_of(&work.join("big.lens"));
+    let big = format!(
+        "let a = 1 mm\n{}",
+        "// padding\n".repeat(17 << 20 >> 4 << 1)
+    );
+    assert!(big.len() > 16 << 20 && big.len() < 2 * (16 << 20));
+    c.notify(
+        "textDocument/didOpen",
+        json!({"textDocument": {"uri": uri, "languageId": "lens", "version": 1, "text": big}}),
+    );
+    let d = c.diagnostics(&uri);
+    assert_eq!(d.len(), 1, "{d:?}");
+    assert_eq!(d[0]["code"], "E0109", "{d:?}");
+    // An edit inside it has nothing to edit; a whole small text is checked.
+    c.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": uri, "version": 2}, "contentChanges": [
+            {"range": {"start": {"line": 0, "character": 0}, "end": {"line": 0, "character": 0}}, "text": "x"},
+            {"text": "let a = 1 mm +\n"},
+        ]}),
+    );
+    let d = c.diagnostics(&uri);
+    assert!(
+        !d.is_empty() && d.iter().all(|d| d["code"] != "E0109"),
+        "{d:?}"
+    );
     let r = c.request("shutdown", Value::Null);
     assert_eq!(r, Value::Null);
     c.notify("exit", Value::Null);

@@ -30,6 +30,7 @@ mod headers;
 mod import;
 mod interrupt;
 mod limits;
+mod linear;
 mod list;
 mod lsp;
 mod plots;

@@ -1,6 +1,8 @@
 //! What a built job is before it reaches the disk (`Built`, the program's
 //! text in memory or spooled) and how every output file is put in place:
-//! atomically, readable by all, with no temporary file left on failure,
+//! atomically (a job's program, report and tables as one unit:
+//! `put_in_place`), with the user's usual mode, with no temporary file
+//! left on failure,
 //! and never in place of a symbolic link (`--out` itself may be one: the
 //! user chose it; a link planted at an output's name is refused, not
 //! followed or replaced).
@@ -78,6 +80,18 @@ impl ProgramText {
             ProgramText::Spooled { file, .. } => std::fs::read_to_string(file.path()),
         }
     }
+    /// The text in a temporary file in `dir`, flushed to disk, ready to be
+    /// put in place with the rest of its unit (`put_in_place`): a spooled
+    /// program is already one (it was spooled into `dir`).
+    pub fn into_temp(self, dir: &Path) -> std::io::Result<crate::temps::TempFile> {
+        let file = match self {
+            ProgramText::Memory(t) => text_temp(dir, &t)?,
+            ProgramText::Spooled { file, .. } => file,
+        };
+        file.as_file().sync_all()?;
+        Ok(file)
+    }
+
     /// Puts the program at `path` atomically (a spooled program is renamed
     /// into place: it was written in the same directory).
     pub fn write_to(self, path: &Path) -> std::io::Result<()> {
@@ -85,7 +99,6 @@ impl ProgramText {
             ProgramText::Memory(t) => write_atomic(path, &t),
             ProgramText::Spooled { file, .. } => {
                 not_a_link(path)?;
-                readable_by_all(file.as_file())?;
                 file.as_file().sync_all()?;
                 file.persist(path)
             }
@@ -120,24 +133,34 @@ fn not_a_link(path: &Path) -> std::io::Result<()> {
     }
 }
 
-/// Makes a finished output file readable by all and writable by its owner.
-fn readable_by_all(file: &std::fs::File) -> std::io::Result<()> {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        file.set_permissions(std::fs::Permissions::from_mode(0o644))?;
-    }
-    #[cfg(not(unix))]
-    let _ = file;
-    Ok(())
+/// `text` in a new temporary file in `dir` (created if need be).
+pub fn text_temp(dir: &Path, text: &str) -> std::io::Result<crate::temps::TempFile> {
+    use std::io::Write;
+    std::fs::create_dir_all(dir)?;
+    let mut tmp = crate::temps::TempFile::create_in(dir)?;
+    tmp.write_all(text.as_bytes())?;
+    tmp.as_file().sync_all()?;
+    Ok(tmp)
+}
+
+/// Puts a job's files in place as one unit (`temps::persist_all`): each
+/// is already whole in a temporary file beside its target; nothing is
+/// renamed unless every target can be replaced, and a signal waits for
+/// the whole unit. The order is the order given (the program last, so a
+/// program on disk always has its report and tables beside it).
+pub fn put_in_place(
+    files: Vec<(crate::temps::TempFile, std::path::PathBuf)>,
+) -> std::io::Result<()> {
+    crate::temps::persist_all(files)
 }
 
 /// Writes `text` to `path` atomically: a temporary file in the same
 /// directory, flushed, then renamed over the target. On failure the
 /// target is untouched and no temporary file is left behind.
-/// Temporary files are created private (0600); a program and its report
-/// are put in place readable by all (0644), as any other written file, so
-/// they can be copied to the controller's share.
+/// Temporary files are created with the mode the user's files get (0666
+/// less the umask: 0644 under the usual 022), so a program and its report
+/// are put in place as any other file the user writes, and can be copied
+/// to the controller's share.
 pub fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {
     use std::io::Write;
     let dir = path
@@ -148,7 +171,6 @@ pub fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {
     not_a_link(path)?;
     let mut tmp = crate::temps::TempFile::create_in(dir)?;
     tmp.write_all(text.as_bytes())?;
-    readable_by_all(tmp.as_file())?;
     tmp.as_file().sync_all()?;
     tmp.persist(path)
 }

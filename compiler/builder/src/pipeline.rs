@@ -62,6 +62,9 @@ pub fn lower(
     limits: &Limits,
 ) -> Result<(JobSpec, Estimate), Vec<Diagnostic>> {
     let spec = lower_job(job, dialect, &evaluate)?;
+    if let Some(d) = reserved_name(spec.head()) {
+        return Err(vec![d]);
+    }
     let estimate = spec.estimate(&evaluate);
     let refused = crate::job::refusals(spec.head(), &estimate, limits);
     if refused.is_empty() {
@@ -69,6 +72,55 @@ pub fn lower(
     } else {
         Err(refused)
     }
+}
+
+/// The names, after the job's name and a dot, of the files a build or
+/// `lensc report` writes beside a program (the report, the plots).
+pub const RESERVED_EXTENSIONS: [&str; 4] = [
+    "report.json",
+    "profile.svg",
+    "form_error.svg",
+    "following.svg",
+];
+
+/// E0188 when the program's name (`JOB.EXT`) would be the name of a file
+/// written beside it: the report, a plot, the dialect's servo table.
+/// Compared without case (a share on a case-blind file system), and any
+/// extension ending in one of them (`x.report.json`) too.
+fn reserved_name(head: &crate::job::JobHead) -> Option<Diagnostic> {
+    let ext = head.dialect.extension.to_ascii_lowercase();
+    let table = head
+        .dialect
+        .fts_table
+        .as_deref()
+        .map(str::to_ascii_lowercase);
+    let clash = RESERVED_EXTENSIONS
+        .iter()
+        .map(|r| r.to_string())
+        .chain(table.clone())
+        .find(|r| ext == *r || ext.ends_with(&format!(".{r}")))?;
+    let what = if Some(&clash) == table.as_ref() {
+        "the servo table the dialect writes beside the program"
+    } else if clash == "report.json" {
+        "the build report"
+    } else {
+        "a plot `lensc report` writes"
+    };
+    Some(
+        head.error(
+            lensc_lang::codes::OUTPUT_NAME_RESERVED,
+            format!(
+                "the program `{}` would have the name of {what} (`{}.{clash}`)",
+                head.program_name(),
+                head.name
+            ),
+        )
+        .with_help(format!(
+            "give the dialect `{}` another extension (the names after the job's are reserved: {})",
+            head.dialect.name,
+            RESERVED_EXTENSIONS.join(", ")
+        )),
+    )
 }
 
 /// What `lensc check` reports of a checked file beyond the checker's own
@@ -81,7 +133,9 @@ pub fn findings_before_planning(c: &Checked, limits: &Limits) -> Vec<Diagnostic>
     if c.has_errors() {
         return Vec::new();
     }
-    let mut found = Vec::new();
+    // A surface with no value over part of its aperture: refused here, as
+    // the build would refuse it once planning.
+    let mut found = crate::evaluate::undefined_surfaces(c, lensc_grammar::Severity::Error, None);
     for j in &c.checked.jobs {
         match lower(j, None, limits) {
             Ok((spec, _)) => found.extend(spec.warnings_before_planning()),

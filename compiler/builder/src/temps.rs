@@ -35,13 +35,20 @@ pub struct TempFile {
 }
 
 impl TempFile {
-    /// Creates `.lensc-<pid>-<random>.tmp` in `dir` (private, 0600).
+    /// Creates `.lensc-<pid>-<random>.tmp` in `dir`, with the mode a file
+    /// the user creates gets (0666 less the umask, as the kernel applies
+    /// it when the file is created), since it becomes an output file.
     pub fn create_in(dir: &Path) -> io::Result<TempFile> {
         let mut live = live();
-        let file = tempfile::Builder::new()
-            .prefix(&format!("{PREFIX}{}-", std::process::id()))
-            .suffix(SUFFIX)
-            .tempfile_in(dir)?;
+        let prefix = format!("{PREFIX}{}-", std::process::id());
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(&prefix).suffix(SUFFIX);
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            builder.permissions(std::fs::Permissions::from_mode(0o666));
+        }
+        let file = builder.tempfile_in(dir)?;
         live.push(file.path().to_path_buf());
         Ok(TempFile { file: Some(file) })
     }
@@ -76,6 +83,134 @@ impl TempFile {
             }
         }
     }
+}
+
+/// What a commit's journal is called: `.lensc-<pid>-commit.tmp`.
+fn journal_name(pid: u32) -> String {
+    format!("{PREFIX}{pid}-commit{SUFFIX}")
+}
+
+/// Puts temporary files in place as one unit (a program, its report and
+/// the files beside it, all in one directory): every target is checked
+/// first, then, with the registry locked (so SIGINT or SIGTERM, whose
+/// clean-up takes the lock, waits until the unit is in place), a journal
+/// naming each temporary file and its target is written and flushed, the
+/// files are renamed in order, and the journal removed. A process killed
+/// outright between two renames leaves the journal: the next build's
+/// sweep (`remove_stale`) finishes the renames it names before anything
+/// else, so the directory holds the previous files or the new ones,
+/// never a mix once a build has started there.
+pub fn persist_all(files: Vec<(TempFile, PathBuf)>) -> io::Result<()> {
+    let Some(dir) = files.first().map(|(t, _)| {
+        t.path()
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(Path::new("."))
+            .to_path_buf()
+    }) else {
+        return Ok(());
+    };
+    for (t, target) in &files {
+        let parent = |p: &Path| {
+            let d = p
+                .parent()
+                .filter(|d| !d.as_os_str().is_empty())
+                .unwrap_or(Path::new("."));
+            std::fs::canonicalize(d).unwrap_or_else(|_| d.to_path_buf())
+        };
+        if parent(target) != parent(t.path()) {
+            return Err(io::Error::other("a unit's files must share one directory"));
+        }
+        if let Ok(m) = std::fs::symlink_metadata(target) {
+            if m.file_type().is_symlink() {
+                return Err(io::Error::new(
+                    io::ErrorKind::AlreadyExists,
+                    format!(
+                        "{} is a symbolic link (lensc writes no output through or over one; remove it)",
+                        target.display()
+                    ),
+                ));
+            }
+            if m.is_dir() {
+                return Err(io::Error::new(
+                    io::ErrorKind::AlreadyExists,
+                    format!("{} is a directory", target.display()),
+                ));
+            }
+        }
+    }
+    let mut live = live();
+    let name = |p: &Path| {
+        p.file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default()
+    };
+    let journal = dir.join(journal_name(std::process::id()));
+    let mut text = String::new();
+    for (t, target) in &files {
+        text.push_str(&format!("{}\t{}\n", name(t.path()), name(target)));
+    }
+    {
+        let mut j = std::fs::File::create(&journal)?;
+        j.write_all(text.as_bytes())?;
+        j.sync_all()?;
+    }
+    sync_dir(&dir);
+    let mut result = Ok(());
+    for (mut t, target) in files {
+        let file = t.file.take().expect("a temporary file in use");
+        let path = file.path().to_path_buf();
+        if result.is_err() {
+            drop(file);
+        } else if let Err(e) = file.persist(&target) {
+            drop(e.file);
+            result = Err(e.error);
+        }
+        forget(&mut live, &path);
+    }
+    sync_dir(&dir);
+    let _ = std::fs::remove_file(&journal);
+    result
+}
+
+/// Flushes a directory's entries (the renames in it), where that can be
+/// asked.
+fn sync_dir(dir: &Path) {
+    #[cfg(unix)]
+    if let Ok(d) = std::fs::File::open(dir) {
+        let _ = d.sync_all();
+    }
+    #[cfg(not(unix))]
+    let _ = dir;
+}
+
+/// Finishes the commit a journal left by a process that is no longer
+/// running names: each temporary file still there renamed to its target
+/// (both plain names in `dir`), then the journal removed.
+fn roll_forward(dir: &Path, journal: &Path) {
+    let Ok(text) = std::fs::read_to_string(journal) else {
+        return;
+    };
+    let plain = |n: &str| !n.is_empty() && !n.contains('/') && n != "." && n != "..";
+    let pairs: Vec<(&str, &str)> = text.lines().filter_map(|l| l.split_once('\t')).collect();
+    // A journal cut short (the process killed while writing it) commits
+    // nothing: its temporary files are swept.
+    if !text.ends_with('\n')
+        || pairs
+            .iter()
+            .any(|(t, g)| !plain(t) || !plain(g) || owner(t).is_none())
+    {
+        let _ = std::fs::remove_file(journal);
+        return;
+    }
+    for (tmp, target) in pairs {
+        let from = dir.join(tmp);
+        if std::fs::symlink_metadata(&from).is_ok_and(|m| m.is_file()) {
+            let _ = std::fs::rename(&from, dir.join(target));
+        }
+    }
+    sync_dir(dir);
+    let _ = std::fs::remove_file(journal);
 }
 
 impl Write for TempFile {
@@ -120,6 +255,19 @@ pub fn remove_all_and_hold() -> MutexGuard<'static, Vec<PathBuf>> {
 /// `.lensc-*.tmp` files without a pid (which name no owner), are kept.
 /// A missing or unreadable `dir` has nothing to sweep.
 pub fn remove_stale(dir: &Path) -> usize {
+    // First the commits of lenscs that died mid-way, finished.
+    if let Ok(entries) = std::fs::read_dir(dir) {
+        for entry in entries.flatten() {
+            let name = entry.file_name();
+            let Some(name) = name.to_str() else { continue };
+            if let Some(pid) = owner(name)
+                && name == journal_name(pid)
+                && !is_running(pid)
+            {
+                roll_forward(dir, &entry.path());
+            }
+        }
+    }
     let Ok(entries) = std::fs::read_dir(dir) else {
         return 0;
     };
@@ -183,6 +331,52 @@ mod tests {
         assert_eq!(owner(".lensc-12-.tmp"), None);
         assert_eq!(owner("lensc-12-x.tmp"), None);
         assert_eq!(owner(".lensc-12-x.ngc"), None);
+    }
+
+    /// A unit put in place whole; and a commit a killed process left
+    /// half done (its journal and one temporary file still there) finished
+    /// by the next sweep, not swept away.
+    #[test]
+    fn a_unit_is_put_in_place_and_a_half_done_one_finished() {
+        let dir = tempfile::tempdir().expect("tmp");
+        let d = dir.path();
+        let mut a = TempFile::create_in(d).expect("a");
+        a.write_all(b"new report").expect("write");
+        let mut b = TempFile::create_in(d).expect("b");
+        b.write_all(b"new program").expect("write");
+        std::fs::write(d.join("j.report.json"), "old report").expect("old");
+        persist_all(vec![(a, d.join("j.report.json")), (b, d.join("j.ngc"))]).expect("persist");
+        assert_eq!(
+            std::fs::read_to_string(d.join("j.report.json")).expect("r"),
+            "new report"
+        );
+        assert_eq!(
+            std::fs::read_to_string(d.join("j.ngc")).expect("p"),
+            "new program"
+        );
+
+        // Killed after the report's rename, before the program's.
+        let dead = u32::try_from(i32::MAX).expect("pid");
+        assert!(!is_running(dead));
+        let tmp = format!(".lensc-{dead}-x1.tmp");
+        std::fs::write(d.join(&tmp), "newer program").expect("tmp");
+        std::fs::write(d.join("j.report.json"), "newer report").expect("renamed already");
+        std::fs::write(
+            d.join(journal_name(dead)),
+            format!(".lensc-{dead}-x0.tmp\tj.report.json\n{tmp}\tj.ngc\n"),
+        )
+        .expect("journal");
+        remove_stale(d);
+        assert_eq!(
+            std::fs::read_to_string(d.join("j.ngc")).expect("p"),
+            "newer program"
+        );
+        let left: Vec<_> = std::fs::read_dir(d)
+            .expect("dir")
+            .map(|e| e.expect("e").file_name().to_string_lossy().into_owned())
+            .filter(|n| n.starts_with(PREFIX))
+            .collect();
+        assert!(left.is_empty(), "{left:?}");
     }
 
     #[test]

@@ -77,6 +77,17 @@ pub const TOLERANCE_BELOW_RESOLUTION: &str = "E0180";
 /// `lensc fmt` refused to write a layout that would not parse back to the
 /// same program (a formatter bug; the file is left as it is).
 pub const FORMAT_WOULD_CHANGE_MEANING: &str = "E0185";
+/// A number with no finite value: an overflow (`1e308 * 1e308`), an
+/// infinity or NaN.
+pub const NOT_FINITE: &str = "E0186";
+/// A surface whose sag has no value (NaN or infinite) somewhere over its
+/// aperture (the square root of a negative number, a conic that closes).
+pub const SURFACE_UNDEFINED: &str = "E0187";
+/// A dialect's extension that gives the program the name of another file
+/// the build writes beside it (`JOB.report.json`, a servo table, a plot).
+pub const OUTPUT_NAME_RESERVED: &str = "E0188";
+/// A project whose `use`s would load more than `loader::MAX_FILES` files.
+pub const TOO_MANY_FILES: &str = "E0189";
 /// `lensc import`: the file is not a prescription lensc reads (not a
 /// `.zmx` or optiland JSON file, or a value in it that is not a number).
 pub const IMPORT_UNREADABLE: &str = "E0350";
@@ -84,6 +95,12 @@ pub const IMPORT_UNREADABLE: &str = "E0350";
 pub const IMPORT_NOTHING: &str = "E0351";
 /// `lensc import`: a non-sequential Zemax design.
 pub const IMPORT_NON_SEQUENTIAL: &str = "E0352";
+/// `lensc import`: a surface with a number that has no finite value in
+/// lensc's terms (a curvature so small its radius overflows, a value that
+/// is infinite).
+pub const IMPORT_NOT_FINITE: &str = "E0353";
+/// `lensc import`: the `.lens` text would be over the 16 MiB lensc reads.
+pub const IMPORT_TOO_LARGE: &str = "E0354";
 
 /// The simulated part misses one of its job's acceptance criteria (the
 /// message names which, by how much and where); no program is written.
@@ -106,6 +123,9 @@ pub const SEAM_STEP: &str = "W0006";
 pub const ACCEPTANCE_MISSED_WARNING: &str = "W0020";
 /// E0196 under `lensc build --accept=warn`: the program is written.
 pub const ACCEPTANCE_UNMEASURED_WARNING: &str = "W0021";
+/// E0187 as `lensc analyse` and `lensc sample` report it: the points with
+/// no value are shown as NaN, the rest analysed.
+pub const SURFACE_UNDEFINED_WARNING: &str = "W0022";
 /// `lensc import`: a surface of a type (or form) lensc does not import.
 pub const IMPORT_UNSUPPORTED_SURFACE: &str = "W0015";
 /// `lensc import`: a parameter of an imported surface that is not carried over.
@@ -293,9 +313,15 @@ pub const ALL: &[&str] = &[
     CHORDS_OVER_TOLERANCE,
     SEAM_STEP,
     FORMAT_WOULD_CHANGE_MEANING,
+    NOT_FINITE,
+    SURFACE_UNDEFINED,
+    OUTPUT_NAME_RESERVED,
+    TOO_MANY_FILES,
     IMPORT_UNREADABLE,
     IMPORT_NOTHING,
     IMPORT_NON_SEQUENTIAL,
+    IMPORT_NOT_FINITE,
+    IMPORT_TOO_LARGE,
     IMPORT_UNSUPPORTED_SURFACE,
     IMPORT_PARAMETER_DROPPED,
     IMPORT_NO_SEMI_DIAMETER,
@@ -335,6 +361,7 @@ pub const ALL: &[&str] = &[
     PROGRAM_FRAME,
     ACCEPTANCE_MISSED_WARNING,
     ACCEPTANCE_UNMEASURED_WARNING,
+    SURFACE_UNDEFINED_WARNING,
 ];
 
 #[cfg(test)]

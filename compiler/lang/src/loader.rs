@@ -136,6 +136,8 @@ fn load_bytes(fs: &dyn FileSystem, root: PathBuf, key: Key, path: &Path, bytes: 
         },
         keys: HashMap::new(),
         stack: Vec::new(),
+        on_stack: HashMap::new(),
+        refused_more: false,
     };
     l.add(
         key,
@@ -160,7 +162,17 @@ struct Loader<'f> {
     keys: HashMap<Key, FileId>,
     /// Files being loaded, outermost first, to detect import cycles.
     stack: Vec<(Key, FileId)>,
+    /// Where each file being loaded is on `stack`: a cycle is found in
+    /// constant time, so a chain of n `use`s loads in O(n).
+    on_stack: HashMap<Key, usize>,
+    /// Whether a `use` past `MAX_FILES` was refused (said once).
+    refused_more: bool,
 }
+
+/// The most files one check loads (the standard library's included): a
+/// project of more is refused (E0189) rather than loaded without bound,
+/// and the depth of a chain of `use`s is bounded with it.
+pub const MAX_FILES: usize = 1000;
 
 impl Loader<'_> {
     fn add(&mut self, key: Key, name: String, path: Option<PathBuf>, bytes: Vec<u8>) -> FileId {
@@ -193,6 +205,7 @@ impl Loader<'_> {
         }
         let (ast, mut diags) = lensc_grammar::parse(&self.loaded.sources.get(id).text, id);
         self.loaded.diags.append(&mut diags);
+        self.on_stack.insert(key.clone(), self.stack.len());
         self.stack.push((key.clone(), id));
         let mut imports = Vec::new();
         for item in &ast.items {
@@ -206,7 +219,9 @@ impl Loader<'_> {
                 span: Span::new(0, 0),
             });
         }
-        self.stack.pop();
+        if let Some((k, _)) = self.stack.pop() {
+            self.on_stack.remove(&k);
+        }
         let slot = &mut self.loaded.files[id.0 as usize];
         slot.ast = ast;
         slot.imports = imports;
@@ -323,7 +338,7 @@ impl Loader<'_> {
             return;
         }
         let key = Key::Path(resolved.clone());
-        if let Some(pos) = self.stack.iter().position(|(k, _)| *k == key) {
+        if let Some(&pos) = self.on_stack.get(&key) {
             let mut chain: Vec<String> = self.stack[pos..]
                 .iter()
                 .map(|(_, f)| self.loaded.sources.get(*f).name.clone())
@@ -341,6 +356,21 @@ impl Loader<'_> {
         }
         if let Some(&f) = self.keys.get(&key) {
             imports.push(Import::All { file: f, span });
+            return;
+        }
+        if self.loaded.files.len() >= MAX_FILES {
+            if !std::mem::replace(&mut self.refused_more, true) {
+                self.loaded.diags.push(
+                    Diagnostic::error(
+                        codes::TOO_MANY_FILES,
+                        format!("this `use` would load more than {MAX_FILES} files"),
+                        from,
+                        pspan,
+                    )
+                    .with_label("one file too many")
+                    .with_help("a job and what it uses are at most 1000 files: join small files into larger ones"),
+                );
+            }
             return;
         }
         match self.fs.read(&resolved) {

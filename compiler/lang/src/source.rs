@@ -52,6 +52,20 @@ impl SourceMap {
             .enumerate()
             .map(|(i, f)| (FileId(i as u32), f))
     }
+    /// The 0-based line a byte offset is on.
+    pub fn line_of(&self, id: FileId, offset: usize) -> usize {
+        let f = self.get(id);
+        f.line_starts
+            .partition_point(|&s| s <= offset.min(f.text.len()))
+            - 1
+    }
+    /// The byte range of 0-based line `line`, with its line feed.
+    pub fn line_range(&self, id: FileId, line: usize) -> std::ops::Range<usize> {
+        let f = self.get(id);
+        let start = f.line_starts[line.min(f.line_starts.len() - 1)];
+        let end = f.line_starts.get(line + 1).copied().unwrap_or(f.text.len());
+        start..end
+    }
     /// 1-based line and column (in characters) of a byte offset.
     pub fn line_col(&self, id: FileId, offset: usize) -> (usize, usize) {
         let f = self.get(id);

@@ -16,7 +16,38 @@ use crate::units::{self, Dim};
 use crate::value::{Field, Formula, Value};
 
 impl<'a> Checker<'a> {
+    /// The value of `e`. A number that is not finite (an overflow such as
+    /// `1e308 * 1e308`, `inf - inf`) is an error where it first appears,
+    /// and no value; in a formula a coordinate is NaN, so only an infinity
+    /// is reported there (a formula is sampled over its aperture later).
     pub(super) fn eval(&mut self, file: FileId, e: &Expr, coords: &[String]) -> Value {
+        let v = self.eval_inner(file, e, coords);
+        match v {
+            Value::Num(x, _) if x.is_infinite() || (x.is_nan() && coords.is_empty()) => {
+                self.err(
+                    Diagnostic::error(
+                        codes::NOT_FINITE,
+                        format!(
+                            "this number is {}",
+                            if x.is_nan() {
+                                "not a number (NaN)"
+                            } else {
+                                "infinite: larger than about 1.8e308"
+                            }
+                        ),
+                        file,
+                        e.span,
+                    )
+                    .with_label("no finite value")
+                    .with_help("every quantity must be a finite number: check the exponents and the operations here"),
+                );
+                Value::Error
+            }
+            v => v,
+        }
+    }
+
+    fn eval_inner(&mut self, file: FileId, e: &Expr, coords: &[String]) -> Value {
         match &e.kind {
             ExprKind::Invalid => Value::Error,
             ExprKind::Quantity { value, unit } => {
@@ -325,6 +356,11 @@ impl<'a> Checker<'a> {
         coords: &[String],
     ) -> Vec<Field> {
         let mut fields = Vec::new();
+        // The names given so far: a name given once is pushed at once, and
+        // only a repeated one is looked for among the fields (to report
+        // where it was first given), so a block of n entries checks in
+        // O(n), not O(n²).
+        let mut seen: std::collections::HashSet<String> = std::collections::HashSet::new();
         for entry in &block.entries {
             let f = match entry {
                 Entry::Param { name, value } => {
@@ -377,7 +413,11 @@ impl<'a> Checker<'a> {
                     }
                 }
             };
-            self.push_field(&mut fields, f);
+            if seen.insert(f.name.clone()) {
+                fields.push(f);
+            } else {
+                self.push_field(&mut fields, f);
+            }
         }
         fields
     }

@@ -340,6 +340,11 @@ pub struct Imported {
 /// Reads `bytes` (the file `name`) and writes its surfaces as a `.lens`
 /// file in the canonical layout. `lens` is `None` when an error was found.
 pub fn import(name: &str, bytes: &[u8]) -> Imported {
+    import_within(name, bytes, crate::sandbox::MAX_FILE_BYTES)
+}
+
+/// `import`, refusing (E0354) a `.lens` text over `limit` bytes.
+pub fn import_within(name: &str, bytes: &[u8], limit: u64) -> Imported {
     let text = decode(bytes);
     let mut diags = Vec::new();
     let read = match Format::of(name, &text) {
@@ -347,6 +352,9 @@ pub fn import(name: &str, bytes: &[u8]) -> Imported {
         Format::Optiland => optiland::read(name, &text, &mut diags),
     };
     let lens = read.and_then(|p| {
+        if diags.iter().any(Diagnostic::is_error) {
+            return None;
+        }
         if !p.entries.iter().any(|e| matches!(e.what, What::Surface(_))) {
             diags.push(
                 Diagnostic::error(
@@ -362,6 +370,26 @@ pub fn import(name: &str, bytes: &[u8]) -> Imported {
             return None;
         }
         match crate::format::format_source(&write::lens_text(&p)) {
+            Ok(formatted) if formatted.len() as u64 > limit => {
+                diags.push(
+                    Diagnostic::error(
+                        codes::IMPORT_TOO_LARGE,
+                        format!(
+                            "the .lens text imported from {name} would be {} bytes, over the {} lensc reads; nothing is written",
+                            formatted.len(),
+                            if limit >= 1 << 20 {
+                                format!("{} MiB", limit >> 20)
+                            } else {
+                                format!("{limit} bytes")
+                            }
+                        ),
+                        FileId(0),
+                        Span::new(0, 0),
+                    )
+                    .with_help("import a copy of the design with only the surfaces the part needs"),
+                );
+                None
+            }
             Ok(formatted) => Some(formatted),
             Err(d) => {
                 diags.extend(d);
@@ -486,6 +514,18 @@ pub(crate) fn decide(f: Found, diags: &mut Vec<Diagnostic>) -> Entry {
             "flat, with no optical power and no aspheric terms".into(),
         ));
     }
+    if let Err(why) = finite(&shape) {
+        diags.push(
+            Diagnostic::error(
+                codes::IMPORT_NOT_FINITE,
+                format!("surface {} ({}): {why}", f.number, f.type_name),
+                FileId(0),
+                f.span,
+            )
+            .with_help("a curvature this close to 0 is a flat surface: write 0 in the design, or the radius it means"),
+        );
+        return entry(What::Skipped(why));
+    }
     if let Err(why) = representable(&shape) {
         diags.push(unsupported(f.span, f.number, &f.type_name, &why));
         return entry(What::Skipped(why));
@@ -524,6 +564,71 @@ pub(crate) fn decide(f: Found, diags: &mut Vec<Diagnostic>) -> Entry {
 }
 
 /// Whether a kind of the language says this shape exactly.
+/// Every number the shape is written with is finite: its values, and the
+/// radius 1/c of each curvature that is not 0 (a curvature under about
+/// 5.6e-309 1/mm has none).
+fn finite(shape: &Shape) -> Result<(), String> {
+    let (curvatures, values): (Vec<f64>, Vec<f64>) = match shape {
+        Shape::Rotational {
+            curvature,
+            conic,
+            terms,
+        } => (
+            vec![*curvature],
+            std::iter::once(*conic)
+                .chain(terms.iter().map(|t| t.1))
+                .collect(),
+        ),
+        Shape::Biconic { cx, cy, kx, ky } => (vec![*cx, *cy], vec![*kx, *ky]),
+        Shape::Toroid {
+            cy,
+            conic,
+            rotation_radius,
+            terms,
+        } => (
+            vec![*cy],
+            [*conic]
+                .into_iter()
+                .chain(*rotation_radius)
+                .chain(terms.iter().map(|t| t.1))
+                .collect(),
+        ),
+        Shape::XyPolynomial {
+            curvature,
+            conic,
+            terms,
+        } => (
+            vec![*curvature],
+            std::iter::once(*conic)
+                .chain(terms.iter().map(|t| t.2))
+                .collect(),
+        ),
+        Shape::Zernike {
+            curvature,
+            conic,
+            norm_radius,
+            terms,
+        } => (
+            vec![*curvature],
+            [*conic, *norm_radius]
+                .into_iter()
+                .chain(terms.iter().map(|t| t.1))
+                .collect(),
+        ),
+    };
+    for c in curvatures {
+        if !c.is_finite() || (c != 0.0 && !(1.0 / c).is_finite()) {
+            return Err(format!(
+                "its curvature {c:e} 1/mm has no finite radius (1/c overflows)"
+            ));
+        }
+    }
+    match values.iter().find(|v| !v.is_finite()) {
+        Some(v) => Err(format!("it has a value that is not finite ({v})")),
+        None => Ok(()),
+    }
+}
+
 fn representable(shape: &Shape) -> Result<(), String> {
     match shape {
         Shape::Toroid {

@@ -245,3 +245,42 @@ fn an_optiland_biconic_is_read_by_its_own_keys() {
     let lens = out.lens.expect("written");
     assert!(lens.contains("acylinder"), "{lens}");
 }
+
+/// A `.lens` text over the limit is refused (E0354) and not returned; at
+/// the limit it is written.
+#[test]
+fn a_lens_text_over_the_limit_is_refused() {
+    let zmx = b"SURF 0\nSURF 1\n  CURV 0.05\n  DIAM 4\nSURF 2\n  CURV -0.05\n  DIAM 4\nSURF 3\n";
+    let whole = import("two.zmx", zmx);
+    let lens = whole.lens.expect("imported");
+    let at = import_within("two.zmx", zmx, lens.len() as u64);
+    assert_eq!(at.lens.as_deref(), Some(lens.as_str()));
+    let over = import_within("two.zmx", zmx, lens.len() as u64 - 1);
+    assert!(over.lens.is_none());
+    let codes: Vec<&str> = over.diags.iter().map(|d| d.code).collect();
+    assert_eq!(codes, [codes::IMPORT_TOO_LARGE]);
+}
+
+/// A curvature whose radius overflows (1/1e-320) is refused (E0353), in
+/// either reader, never written as a radius of 0.
+#[test]
+fn a_curvature_with_no_finite_radius_is_refused() {
+    let zmx = b"SURF 0\nSURF 1\n  CURV 1e-320\n  DIAM 4\nSURF 2\n";
+    let json = br#"{"surface_group": {"surfaces": [
+        {"geometry": {"type": "Plane"}},
+        {"geometry": {"type": "StandardGeometry", "radius": 1e308, "conic": 0},
+         "aperture": {"type": "RadialAperture", "r_max": 2}},
+        {"geometry": {"type": "StandardGeometry", "radius": 1e-320, "conic": 0},
+         "aperture": {"type": "RadialAperture", "r_max": 2}},
+        {"geometry": {"type": "Plane"}}
+    ]}}"#;
+    for (name, bytes) in [("tiny.zmx", &zmx[..]), ("tiny.json", &json[..])] {
+        let i = import(name, bytes);
+        assert!(i.lens.is_none(), "{name}: {:?}", i.lens);
+        assert!(
+            i.diags.iter().any(|d| d.code == codes::IMPORT_NOT_FINITE),
+            "{name}: {:?}",
+            i.diags
+        );
+    }
+}

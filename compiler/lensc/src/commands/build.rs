@@ -43,8 +43,8 @@ pub fn jobs_asked(c: &driver::Checked, job: Option<&str>) -> usize {
         .count()
 }
 
-/// Puts one built job's files in `dir` (the report first: a program on
-/// disk always has its report beside it) and says what was written.
+/// Puts one built job's files in `dir` as one unit (all written first,
+/// then renamed together, the program last) and says what was written.
 fn write_job(built: Built, dir: &Path, reporter: &Reporter) -> Result<(), u8> {
     let names = std::iter::once(&built.program_name)
         .chain([&built.report_name])
@@ -74,26 +74,43 @@ fn write_job(built: Built, dir: &Path, reporter: &Reporter) -> Result<(), u8> {
         so_far += bytes;
         reporter.wrote(&job, bytes, so_far);
     };
-    let mut written = driver::write_atomic(&report_path, &report)
-        .map(|()| wrote(report.len() as u64))
-        .map_err(|e| (report_path.clone(), e));
-    // Then what the program reads, then the program.
-    for (name, text) in built.beside {
-        let (path, bytes) = (dir.join(&name), text.bytes());
-        written = written.and_then(|()| {
-            text.write_to(&path)
-                .map(|()| wrote(bytes))
-                .map_err(|e| (path, e))
-        });
+    // Every file whole in a temporary file beside its target first (the
+    // program may already be: it was spooled there), then all put in
+    // place as one unit: a failed write or a signal before that leaves the
+    // previous files, and the unit is renamed whole (program last).
+    let stage = |name: &str, text: driver::ProgramText| {
+        let path = dir.join(name);
+        let bytes = text.bytes();
+        text.into_temp(dir)
+            .map(|t| (t, path.clone(), bytes))
+            .map_err(|e| (path, e))
+    };
+    let mut staged = Vec::new();
+    let mut failed = None;
+    let files = built
+        .beside
+        .into_iter()
+        .chain([(
+            built.report_name.clone(),
+            driver::ProgramText::Memory(report),
+        )])
+        .chain([(built.program_name.clone(), built.program)]);
+    for (name, text) in files {
+        match stage(&name, text) {
+            Ok((t, path, bytes)) => {
+                wrote(bytes);
+                staged.push((t, path));
+            }
+            Err(e) => {
+                failed = Some(e);
+                break;
+            }
+        }
     }
-    let program_bytes = built.program.bytes();
-    let written = written.and_then(|()| {
-        built
-            .program
-            .write_to(&target)
-            .map(|()| wrote(program_bytes))
-            .map_err(|e| (target.clone(), e))
-    });
+    let written = match failed {
+        Some(e) => Err(e),
+        None => driver::put_in_place(staged).map_err(|e| (target.clone(), e)),
+    };
     if let Err((path, e)) = written {
         cannot_write(&path, &e);
         return Err(1);

@@ -18,7 +18,17 @@ pub fn run(
     points: Option<std::path::PathBuf>,
 ) -> u8 {
     let Some(c) = load(out, file) else { return 1 };
-    out.diagnostics(&c, c.diags());
+    // A surface with no value over part of its aperture is a warning
+    // here (W0022; `check` and `build` refuse it): its points are NaN.
+    let mut diags = c.diags().to_vec();
+    if !c.has_errors() {
+        diags.extend(lensc_build::evaluate::undefined_surfaces(
+            &c,
+            lensc_grammar::Severity::Warning,
+            Some(surface),
+        ));
+    }
+    out.diagnostics(&c, &diags);
     if c.has_errors() {
         return 1;
     }

@@ -46,7 +46,8 @@ pub fn run(out: &Output, program: &Path, machine: Option<&str>, dialect: Option<
     let declarations = declarations(&head, program, machine_name, asked_dialect);
     let Some((limits, offered)) = read_back::machine_named(&declarations, machine_name) else {
         eprintln!(
-            "error: no machine `{machine_name}` is declared in the program's source or the standard library"
+            "error: no machine `{}` is declared in the program's source or the standard library",
+            render::escape(machine_name)
         );
         return 1;
     };
@@ -54,7 +55,7 @@ pub fn run(out: &Output, program: &Path, machine: Option<&str>, dialect: Option<
     let Some(d) = dialect_name.and_then(|n| read_back::dialect_named(&declarations, n)) else {
         eprintln!(
             "error: no dialect `{}` is declared in the program's source or the standard library",
-            dialect_name.unwrap_or("")
+            render::escape(dialect_name.unwrap_or(""))
         );
         return 1;
     };
@@ -67,9 +68,10 @@ pub fn run(out: &Output, program: &Path, machine: Option<&str>, dialect: Option<
     if findings.is_empty() {
         if out.format == MessageFormat::Human {
             eprintln!(
-                "{}: read as {} on {machine_name}: nothing found",
-                program.display(),
-                d.name
+                "{}: read as {} on {}: nothing found",
+                render::escape(&program.display().to_string()),
+                render::escape(&d.name),
+                render::escape(machine_name)
             );
         }
         return 0;

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use lensc_grammar::ast::{ItemKind, Span};
 use lensc_grammar::{Diagnostic, FileId, Severity};
 use lensc_lang::loader::{FileSystem, Import, RealFs, STDLIB};
-use lensc_lang::sandbox::ReadError;
+use lensc_lang::sandbox::{MAX_FILE_BYTES, ReadError};
 use lsp_types::{self as lsp, Uri};
 
 use super::text::{LineIndex, path_to_uri, uri_to_path};
@@ -27,6 +27,42 @@ pub struct Document {
     pub text: String,
     /// Its file, resolved, for `file://` documents.
     pub path: Option<PathBuf>,
+    /// The size of a text over the limit of what lensc reads
+    /// (`sandbox::MAX_FILE_BYTES`, as `lensc check` refuses such a file):
+    /// its text is not kept, and it is not checked.
+    pub too_large: Option<u64>,
+}
+
+impl Document {
+    pub fn new(uri: Uri, text: String) -> Document {
+        let path = document_path(&uri);
+        let mut d = Document {
+            uri,
+            text: String::new(),
+            path,
+            too_large: None,
+        };
+        d.set_text(text);
+        d
+    }
+
+    /// Replaces the text, or drops it when it is over the limit.
+    pub fn set_text(&mut self, text: String) {
+        if text.len() as u64 > MAX_FILE_BYTES {
+            self.too_large = Some(text.len() as u64);
+            self.text = String::new();
+        } else {
+            self.too_large = None;
+            self.text = text;
+        }
+    }
+
+    fn refusal(&self) -> Option<ReadError> {
+        self.too_large.map(|bytes| ReadError::TooLarge {
+            bytes,
+            limit: MAX_FILE_BYTES,
+        })
+    }
 }
 
 /// The documents open, read before the disk.
@@ -37,7 +73,10 @@ pub struct Overlay<'d> {
 impl FileSystem for Overlay<'_> {
     fn read(&self, path: &Path) -> Result<Vec<u8>, ReadError> {
         match self.docs.values().find(|d| d.path.as_deref() == Some(path)) {
-            Some(d) => Ok(d.text.clone().into_bytes()),
+            Some(d) => match d.refusal() {
+                Some(e) => Err(e),
+                None => Ok(d.text.clone().into_bytes()),
+            },
             None => RealFs.read(path),
         }
     }
@@ -54,8 +93,9 @@ pub struct Analysis {
     /// worked out when the document is opened or saved (`lower_jobs`);
     /// empty after a change, until the next save.
     pub before_planning: Vec<Diagnostic>,
-    /// Why the document could not be checked at all (outside the root).
-    pub refused: Option<String>,
+    /// Why the document could not be checked at all (outside the root,
+    /// over the size limit): its code and the reason.
+    pub refused: Option<(&'static str, String)>,
 }
 
 /// Checks the document `uri`: with the workspace root as the project root
@@ -63,6 +103,13 @@ pub struct Analysis {
 pub fn analyse(docs: &Docs, root: Option<&Path>, uri: &str) -> Option<Analysis> {
     let doc = docs.get(uri)?;
     let fs = Overlay { docs };
+    if let Some(e) = doc.refusal() {
+        return Some(Analysis {
+            checked: lensc_lang::check_text(&fs, uri, b"let unchecked = 0"),
+            before_planning: Vec::new(),
+            refused: Some((e.code(), e.to_string())),
+        });
+    }
     let Some(path) = &doc.path else {
         let c = lensc_lang::check_text(&fs, uri, doc.text.as_bytes());
         return Some(Analysis {
@@ -83,7 +130,7 @@ pub fn analyse(docs: &Docs, root: Option<&Path>, uri: &str) -> Option<Analysis> 
         Err(e) => Some(Analysis {
             checked: lensc_lang::check_text(&fs, uri, b"let unchecked = 0"),
             before_planning: Vec::new(),
-            refused: Some(e.to_string()),
+            refused: Some((e.code(), e.to_string())),
         }),
     }
 }
@@ -208,10 +255,11 @@ pub fn declared_in(a: &Analysis, file: FileId, name: &str) -> Option<Span> {
 /// with its place as related information.
 pub fn diagnostics(a: &Analysis, doc_uri: &Uri, text: &str) -> Vec<lsp::Diagnostic> {
     let ix = LineIndex::new(text);
-    if let Some(why) = &a.refused {
+    if let Some((code, why)) = &a.refused {
         return vec![lsp::Diagnostic {
             range: ix.range(0, 0),
             severity: Some(lsp::DiagnosticSeverity::ERROR),
+            code: Some(lsp::NumberOrString::String(code.to_string())),
             source: Some("lensc".into()),
             message: format!("lensc cannot check this file: {why}"),
             ..Default::default()

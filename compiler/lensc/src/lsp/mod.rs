@@ -1,5 +1,6 @@
 //! `lensc lsp`: a language server over stdin and stdout (JSON-RPC, the
-//! Language Server Protocol; transport `lsp-server`, types `lsp-types`).
+//! Language Server Protocol; types `lsp-types`, the transport its own in
+//! `transport`: bounded, and answering every malformed frame).
 //! It keeps the documents the editor has open, checks each as it changes
 //! and publishes the checker's diagnostics with their codes (and, when a
 //! document is opened or saved, what lowering its jobs finds, as `lensc
@@ -19,33 +20,35 @@ mod definition;
 mod hover;
 mod lookup;
 mod text;
+mod transport;
 
 use std::collections::HashMap;
 use std::path::PathBuf;
 
-use lsp_server::{Connection, ErrorCode, Message, Notification, Request, Response};
 use lsp_types::notification::{self as note, Notification as _};
 use lsp_types::request::{self as req, Request as _};
 use lsp_types::{self as lsp, Uri};
 use serde::de::DeserializeOwned;
+use serde_json::Value;
 
 use analysis::{Analysis, Docs, Document};
 use text::LineIndex;
+use transport::{Frame, Message};
 
-/// Runs the server until the editor says `exit`; returns the exit code.
+/// Runs the server until the editor says `exit` (or closes its end);
+/// returns the exit code: 0 after `shutdown`, else 1, as the protocol
+/// says.
 pub fn run() -> u8 {
-    let (connection, io_threads) = Connection::stdio();
-    let code = match serve(&connection) {
-        Ok(()) => 0,
+    let stdin = std::io::stdin();
+    let stdout = std::io::stdout();
+    let mut reader = transport::Reader::new(stdin.lock());
+    let mut writer = transport::Writer::new(stdout.lock());
+    match serve(&mut reader, &mut writer) {
+        Ok(code) => code,
         Err(e) => {
             eprintln!("lensc lsp: {e}");
             1
         }
-    };
-    drop(connection);
-    match io_threads.join() {
-        Ok(()) => code,
-        Err(_) => 1,
     }
 }
 
@@ -71,47 +74,108 @@ fn capabilities() -> lsp::ServerCapabilities {
     }
 }
 
-fn serve(connection: &Connection) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
-    let (id, params) = connection.initialize_start()?;
-    let params: lsp::InitializeParams = serde_json::from_value(params)?;
-    let result = lsp::InitializeResult {
+/// Where the session is.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum State {
+    /// Before `initialize`: requests answered "not initialized".
+    Waiting,
+    Running,
+    /// After `shutdown`: requests answered "invalid request" until `exit`.
+    ShutDown,
+}
+
+/// The message loop; the exit code once the editor says `exit` or closes
+/// its end.
+fn serve<R: std::io::BufRead, W: std::io::Write>(
+    reader: &mut transport::Reader<R>,
+    writer: &mut transport::Writer<W>,
+) -> std::io::Result<u8> {
+    let mut state = State::Waiting;
+    let mut server = Server {
+        docs: HashMap::new(),
+        analyses: HashMap::new(),
+        root: None,
+    };
+    loop {
+        let (id, method, params) = match reader.read()? {
+            Frame::Eof => return Ok(if state == State::ShutDown { 0 } else { 1 }),
+            Frame::Malformed { id, code, message } => {
+                writer.error(id, code, &message)?;
+                continue;
+            }
+            Frame::Message(Message::Response) => continue,
+            Frame::Message(Message::Notification { method, params }) => (None, method, params),
+            Frame::Message(Message::Request { id, method, params }) => (Some(id), method, params),
+        };
+        let Some(id) = id else {
+            if method == note::Exit::METHOD {
+                return Ok(if state == State::ShutDown { 0 } else { 1 });
+            }
+            if state == State::Running {
+                for (uri, diags) in
+                    guarded(|| server.notification(&method, params)).unwrap_or_default()
+                {
+                    writer.notify(note::PublishDiagnostics::METHOD, publish(uri, diags))?;
+                }
+            }
+            continue;
+        };
+        match (state, method.as_str()) {
+            (State::Waiting, req::Initialize::METHOD) => {
+                match serde_json::from_value::<lsp::InitializeParams>(params) {
+                    Ok(p) => {
+                        server.root = workspace_root(&p);
+                        state = State::Running;
+                        writer.result(id, initialize_result())?;
+                    }
+                    Err(e) => writer.error(
+                        id,
+                        transport::INVALID_PARAMS,
+                        &format!("bad initialize parameters: {e}"),
+                    )?,
+                }
+            }
+            (State::Waiting, _) => writer.error(
+                id,
+                transport::SERVER_NOT_INITIALIZED,
+                "lensc lsp has not been initialized",
+            )?,
+            (State::ShutDown, _) => writer.error(
+                id,
+                transport::INVALID_REQUEST,
+                "lensc lsp has been shut down: only `exit` is left",
+            )?,
+            (State::Running, req::Shutdown::METHOD) => {
+                state = State::ShutDown;
+                writer.result(id, Value::Null)?;
+            }
+            (State::Running, req::Initialize::METHOD) => writer.error(
+                id,
+                transport::INVALID_REQUEST,
+                "lensc lsp is already initialized",
+            )?,
+            (State::Running, _) => match guarded(|| server.request(&method, params)) {
+                Some(Ok(v)) => writer.result(id, v)?,
+                Some(Err((code, message))) => writer.error(id, code, &message)?,
+                None => writer.error(
+                    id,
+                    transport::INTERNAL_ERROR,
+                    "lensc lsp failed on this request (a bug: please report it)",
+                )?,
+            },
+        }
+    }
+}
+
+fn initialize_result() -> Value {
+    serde_json::to_value(lsp::InitializeResult {
         capabilities: capabilities(),
         server_info: Some(lsp::ServerInfo {
             name: "lensc".into(),
             version: Some(env!("CARGO_PKG_VERSION").into()),
         }),
-    };
-    connection.initialize_finish(id, serde_json::to_value(result)?)?;
-    let mut server = Server {
-        docs: HashMap::new(),
-        analyses: HashMap::new(),
-        root: workspace_root(&params),
-    };
-    for msg in &connection.receiver {
-        match msg {
-            Message::Request(r) => {
-                if connection.handle_shutdown(&r)? {
-                    return Ok(());
-                }
-                let id = r.id.clone();
-                let resp = guarded(|| server.request(r)).unwrap_or_else(|| {
-                    Response::new_err(
-                        id,
-                        ErrorCode::InternalError as i32,
-                        "lensc lsp failed on this request (a bug: please report it)".into(),
-                    )
-                });
-                connection.sender.send(Message::Response(resp))?;
-            }
-            Message::Notification(n) => {
-                for out in guarded(|| server.notification(n)).unwrap_or_default() {
-                    connection.sender.send(Message::Notification(out))?;
-                }
-            }
-            Message::Response(_) => {}
-        }
-    }
-    Ok(())
+    })
+    .unwrap_or_default()
 }
 
 /// A bug that panics on one message costs that answer (an internal
@@ -141,42 +205,39 @@ struct Server {
 }
 
 impl Server {
-    fn notification(&mut self, n: Notification) -> Vec<Notification> {
+    /// What a notification changes: the diagnostics to publish, by
+    /// document.
+    fn notification(&mut self, method: &str, params: Value) -> Vec<(Uri, Vec<lsp::Diagnostic>)> {
         // Opening or saving lowers the jobs too (`Analysis::lower_jobs`).
         let lower = matches!(
-            n.method.as_str(),
+            method,
             note::DidOpenTextDocument::METHOD | note::DidSaveTextDocument::METHOD
         );
-        let changed = match n.method.as_str() {
-            note::DidOpenTextDocument::METHOD => params::<lsp::DidOpenTextDocumentParams>(n.params)
+        let changed = match method {
+            note::DidOpenTextDocument::METHOD => parse::<lsp::DidOpenTextDocumentParams>(params)
                 .map(|p| {
                     let uri = p.text_document.uri;
-                    let path = analysis::document_path(&uri);
                     self.docs.insert(
                         uri.as_str().to_string(),
-                        Document {
-                            uri,
-                            text: p.text_document.text,
-                            path,
-                        },
+                        Document::new(uri, p.text_document.text),
                     );
                 }),
             note::DidChangeTextDocument::METHOD => {
-                params::<lsp::DidChangeTextDocumentParams>(n.params).and_then(|p| {
+                parse::<lsp::DidChangeTextDocumentParams>(params).and_then(|p| {
                     let doc = self.docs.get_mut(p.text_document.uri.as_str())?;
                     for c in p.content_changes {
-                        apply_change(&mut doc.text, c);
+                        apply_change(doc, c);
                     }
                     Some(())
                 })
             }
-            note::DidSaveTextDocument::METHOD => params::<lsp::DidSaveTextDocumentParams>(n.params)
+            note::DidSaveTextDocument::METHOD => parse::<lsp::DidSaveTextDocumentParams>(params)
                 .and_then(|p| self.docs.get(p.text_document.uri.as_str()).map(|_| ())),
             note::DidCloseTextDocument::METHOD => {
-                if let Some(p) = params::<lsp::DidCloseTextDocumentParams>(n.params) {
+                if let Some(p) = parse::<lsp::DidCloseTextDocumentParams>(params) {
                     self.docs.remove(p.text_document.uri.as_str());
                     self.analyses.remove(p.text_document.uri.as_str());
-                    return vec![publish(p.text_document.uri, Vec::new())];
+                    return vec![(p.text_document.uri, Vec::new())];
                 }
                 None
             }
@@ -198,17 +259,17 @@ impl Server {
                 }
                 let doc = &self.docs[&k];
                 let diags = analysis::diagnostics(&a, &doc.uri, &doc.text);
-                out.push(publish(doc.uri.clone(), diags));
+                out.push((doc.uri.clone(), diags));
                 self.analyses.insert(k, a);
             }
         }
         out
     }
 
-    fn request(&mut self, r: Request) -> Response {
-        let id = r.id.clone();
-        let result = match r.method.as_str() {
-            req::HoverRequest::METHOD => self.with_position(r, |a, _, text, at| {
+    /// A request's result, or its error's code and message.
+    fn request(&mut self, method: &str, params: Value) -> Result<Value, (i32, String)> {
+        let result = match method {
+            req::HoverRequest::METHOD => self.with_position(params, |a, _, text, at| {
                 hover::hover(a, text, at).map(|(md, s, e)| lsp::Hover {
                     contents: lsp::HoverContents::Markup(lsp::MarkupContent {
                         kind: lsp::MarkupKind::Markdown,
@@ -217,40 +278,36 @@ impl Server {
                     range: Some(LineIndex::new(text).range(s, e)),
                 })
             }),
-            req::Completion::METHOD => self.with_position(r, |a, _, text, at| {
+            req::Completion::METHOD => self.with_position(params, |a, _, text, at| {
                 Some(lsp::CompletionResponse::Array(completion::complete(
                     a, text, at,
                 )))
             }),
-            req::GotoDefinition::METHOD => self.with_position(r, |a, uri, text, at| {
+            req::GotoDefinition::METHOD => self.with_position(params, |a, uri, text, at| {
                 definition::definition(a?, uri, text, at).map(lsp::GotoDefinitionResponse::Scalar)
             }),
-            req::Formatting::METHOD => match params::<lsp::DocumentFormattingParams>(r.params) {
+            req::Formatting::METHOD => match parse::<lsp::DocumentFormattingParams>(params) {
                 Some(p) => Ok(self.format(&p.text_document.uri)),
                 None => Err("bad formatting parameters".to_string()),
             },
             _ => {
-                return Response::new_err(
-                    id,
-                    ErrorCode::MethodNotFound as i32,
-                    format!("lensc lsp does not answer `{}`", r.method),
-                );
+                return Err((
+                    transport::METHOD_NOT_FOUND,
+                    format!("lensc lsp does not answer `{method}`"),
+                ));
             }
         };
-        match result {
-            Ok(v) => Response::new_ok(id, v),
-            Err(e) => Response::new_err(id, ErrorCode::InvalidParams as i32, e),
-        }
+        result.map_err(|e| (transport::INVALID_PARAMS, e))
     }
 
     /// Answers a request about a position in an open document.
     fn with_position<T: serde::Serialize>(
         &self,
-        r: Request,
+        params: Value,
         answer: impl FnOnce(Option<&Analysis>, &Uri, &str, usize) -> Option<T>,
     ) -> Result<serde_json::Value, String> {
         let p: lsp::TextDocumentPositionParams =
-            serde_json::from_value(r.params.clone()).map_err(|e| format!("bad parameters: {e}"))?;
+            serde_json::from_value(params).map_err(|e| format!("bad parameters: {e}"))?;
         let uri = &p.text_document.uri;
         let Some(doc) = self.docs.get(uri.as_str()) else {
             return Ok(serde_json::Value::Null);
@@ -277,31 +334,34 @@ impl Server {
     }
 }
 
-fn params<T: DeserializeOwned>(v: serde_json::Value) -> Option<T> {
+fn parse<T: DeserializeOwned>(v: serde_json::Value) -> Option<T> {
     serde_json::from_value(v).ok()
 }
 
-fn apply_change(text: &mut String, c: lsp::TextDocumentContentChangeEvent) {
+/// Applies one change. A document over the size limit has no text to
+/// change: only a whole new text (within the limit) brings it back.
+fn apply_change(doc: &mut Document, c: lsp::TextDocumentContentChangeEvent) {
     match c.range {
-        None => *text = c.text,
+        None => doc.set_text(c.text),
+        Some(_) if doc.too_large.is_some() => {}
         Some(r) => {
-            let ix = LineIndex::new(text);
+            let mut text = std::mem::take(&mut doc.text);
+            let ix = LineIndex::new(&text);
             let (s, e) = (ix.offset(r.start), ix.offset(r.end));
             let (s, e) = (s.min(e), s.max(e));
             text.replace_range(s..e, &c.text);
+            doc.set_text(text);
         }
     }
 }
 
-fn publish(uri: Uri, diagnostics: Vec<lsp::Diagnostic>) -> Notification {
-    Notification::new(
-        note::PublishDiagnostics::METHOD.to_string(),
-        lsp::PublishDiagnosticsParams {
-            uri,
-            diagnostics,
-            version: None,
-        },
-    )
+fn publish(uri: Uri, diagnostics: Vec<lsp::Diagnostic>) -> Value {
+    serde_json::to_value(lsp::PublishDiagnosticsParams {
+        uri,
+        diagnostics,
+        version: None,
+    })
+    .unwrap_or_default()
 }
 
 #[cfg(test)]
@@ -336,11 +396,7 @@ mod tests {
             let mut docs = Docs::new();
             docs.insert(
                 uri.as_str().to_string(),
-                Document {
-                    uri: uri.clone(),
-                    path: analysis::document_path(&uri),
-                    text: text.clone(),
-                },
+                Document::new(uri.clone(), text.clone()),
             );
             let a = analysis::analyse(&docs, None, uri.as_str()).expect("analysed");
             let _ = analysis::diagnostics(&a, &uri, &text);
