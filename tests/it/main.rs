@@ -17,6 +17,7 @@ mod complete_programs;
 mod determinism;
 mod diagnostics;
 mod dialects;
+mod differential;
 mod docs;
 mod editors;
 mod examples;

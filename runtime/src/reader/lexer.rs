@@ -294,6 +294,27 @@ impl Lexer {
         out: &mut Vec<Found>,
     ) -> usize {
         let bytes = code.as_bytes();
+        // A Sinumerik cycle call, `CYCLE832(0.001,1,1)`: its name with its
+        // number, and its arguments, numbers separated by commas.
+        if self.controller == Controller::Siemens
+            && &code[start..i] == "CYCLE"
+            && let Some(call) = cycle_call(code, i)
+        {
+            let name = &code[start..call.0];
+            if SIEMENS_CYCLES.contains(&name) {
+                b.keywords.push(Keyword {
+                    name: name.to_string(),
+                    value: None,
+                    span: (start, call.1),
+                });
+            } else {
+                out.push(unknown(
+                    (start, call.1),
+                    &format!("`{name}` is not a cycle lensc reads"),
+                ));
+            }
+            return call.1;
+        }
         let name = &code[start..i];
         let mut value = None;
         if bytes.get(i) == Some(&b'=') {
@@ -456,11 +477,34 @@ fn significant_digits(t: &[u8]) -> usize {
     t[i..].iter().filter(|b| b.is_ascii_digit()).count()
 }
 
+/// The Sinumerik cycles lensc reads: CYCLE832, high-speed settings
+/// (tolerance, smoothing, compressor), which moves nothing.
+const SIEMENS_CYCLES: &[&str] = &["CYCLE832"];
+
+/// `832(…)` after `CYCLE` at `i`: the end of the cycle's number and the
+/// end of the call (after its `)`), if its arguments are numbers
+/// separated by commas.
+fn cycle_call(code: &str, i: usize) -> Option<(usize, usize)> {
+    let bytes = code.as_bytes();
+    let mut j = i;
+    while j < bytes.len() && bytes[j].is_ascii_digit() {
+        j += 1;
+    }
+    if j == i || bytes.get(j) != Some(&b'(') {
+        return None;
+    }
+    let close = j + code[j..].find(')')?;
+    let args = &code[j + 1..close];
+    args.split(',')
+        .all(|a| a.trim().parse::<f64>().is_ok())
+        .then_some((j, close + 1))
+}
+
 /// Siemens keywords the reader knows (840D sl programming manual): the
 /// ones lensc's dialects write and their opposites.
 const SIEMENS_KEYWORDS: &[&str] = &[
     "DIAMOF", "DIAMON", "DIAM90", "COMPCAD", "COMPCURV", "COMPON", "COMPOF", "SPCON", "SPCOF",
-    "SPOS", "CTOL", "OTOL", "ATOL", "LIMS", "SOFT", "BRISK", "FFWON", "FFWOF",
+    "SPOS", "CTOL", "OTOL", "ATOL", "LIMS", "SOFT", "BRISK", "FFWON", "FFWOF", "SUPA",
 ];
 
 /// Whether a controller reads `letter` as a whole number only (a decimal

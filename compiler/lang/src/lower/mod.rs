@@ -69,7 +69,77 @@ pub fn dialect(job: &CheckedJob, requested: Option<&str>) -> Result<Dialect, Dia
         .with_help(dialect_help(requested.unwrap_or(""), &offered, &names)));
     };
     check_word_formats(o)?;
+    controller_can_run(job, o)?;
     Ok(dialect_of(o, dialect_name(o)))
+}
+
+/// E0176 a G-code system on a dialect chosen for a machine that is not a
+/// lathe; E0177 constant surface speed asked of a dialect that has none.
+/// Both name the dialect and the machine.
+fn controller_can_run(job: &CheckedJob, o: &Object) -> Result<(), Diagnostic> {
+    let machine = value::object(&job.fields, "machine").expect("checked job part");
+    let (file, span) = job_site(job);
+    let system = match value::field(&o.fields, "gcode_system").map(|f| &f.value) {
+        Some(Value::Str(s)) => Some(s.as_str()),
+        _ => None,
+    };
+    if let Some(system) = system
+        && !matches!(system, "A" | "B" | "C")
+    {
+        return Err(Diagnostic::error(
+            codes::GCODE_SYSTEM_NOT_OFFERED,
+            format!(
+                "`{}` names G-code system `{system}`; a Fanuc lathe offers systems A, B and C (machine `{}`)",
+                dialect_name(o),
+                dialect_name(machine)
+            ),
+            file,
+            span,
+        )
+        .with_label("this job")
+        .with_help("write `gcode_system: \"A\"` (the 0i-TF's default), `\"B\"` or `\"C\"`, as the control's parameter is set"));
+    }
+    if let Some(system) = system
+        && machine.kind.name == "mill_3axis"
+    {
+        return Err(Diagnostic::error(
+            codes::GCODE_SYSTEM_NOT_OFFERED,
+            format!(
+                "`{}` is set to G-code system {}, a Fanuc lathe's setting; this machine is a `{}`",
+                dialect_name(o),
+                system,
+                machine.kind.name
+            ),
+            file,
+            span,
+        )
+        .with_label("this job")
+        .with_help("a mill's Fanuc control has one G-code system: name a mill dialect (`fanuc_0i_mill`), or leave `gcode_system` out of your copy"));
+    }
+    let strategy = value::object(&job.fields, "strategy").expect("checked job part");
+    let empty = |n: &str| match value::field(&o.fields, n).map(|f| &f.value) {
+        Some(Value::List(items)) => items.is_empty(),
+        _ => true,
+    };
+    if strategy.kind.name == "profile_turning"
+        && value::field(&strategy.fields, "surface_speed").is_some()
+        && empty("surface_speed")
+    {
+        return Err(Diagnostic::error(
+            codes::NO_SURFACE_SPEED,
+            format!(
+                "`{}` has no constant surface speed (no `surface_speed` lines), and strategy `{}` asks for it on machine `{}`",
+                dialect_name(o),
+                dialect_name(strategy),
+                dialect_name(machine)
+            ),
+            file,
+            span,
+        )
+        .with_label("this job")
+        .with_help("give the strategy a `spindle_speed` instead, or give the dialect the blocks that set constant surface speed (`surface_speed: [\"G96 D{cap} S{speed}\"]`)"));
+    }
+    Ok(())
 }
 
 /// E0174 where a machine that is not a mill names a Klartext dialect
@@ -217,7 +287,30 @@ pub(crate) fn dialect_of(o: &Object, name: String) -> Dialect {
         _ => Vec::new(),
     };
     let count = |n: &str| value::num(f, n).map(|v| v as u64);
+    use lensc_runtime::dialect::GcodeSystem;
     use lensc_runtime::moves::Plane;
+    let system = match opt_text("gcode_system").as_deref() {
+        Some("A") => Some(GcodeSystem::A),
+        Some("B") => Some(GcodeSystem::B),
+        Some("C") => Some(GcodeSystem::C),
+        _ => None,
+    };
+    // A Fanuc lathe's code system fills its placeholders and feed words.
+    let system_words = |l: String| match system {
+        None => l,
+        Some(s) => {
+            let a = s == GcodeSystem::A;
+            l.replace("{feeds}", if a { "G98" } else { "G90 G94" })
+                .replace("{clamp}", if a { "G50" } else { "G92" })
+                .replace("{home}", if a { "G28 U0. W0." } else { "G91 G28 X0. Z0." })
+        }
+    };
+    let lines = |n: &str| -> Vec<String> { lines(n).into_iter().map(system_words).collect() };
+    let (minute, revolution) = match system {
+        Some(GcodeSystem::A) => (Some("G98"), Some("G99")),
+        Some(_) => (Some("G94"), Some("G95")),
+        None => (None, None),
+    };
     Dialect {
         name,
         language: match value::word(f, "language") {
@@ -260,8 +353,8 @@ pub(crate) fn dialect_of(o: &Object, name: String) -> Dialect {
             .collect(),
         arc_centre_absolute: value::word(f, "arc_centre") == Some("absolute"),
         arc_radius_tolerance: value::num(f, "arc_radius_tolerance").unwrap_or(0.001),
-        per_minute: opt_text("per_minute"),
-        per_revolution: opt_text("per_revolution"),
+        per_minute: opt_text("per_minute").or(minute.map(String::from)),
+        per_revolution: opt_text("per_revolution").or(revolution.map(String::from)),
         inverse_time: opt_text("inverse_time"),
         spindle_on: text("spindle_on", "M3"),
         spindle_ccw: text("spindle_ccw", "M4"),
@@ -284,6 +377,10 @@ pub(crate) fn dialect_of(o: &Object, name: String) -> Dialect {
         line_numbers: count("line_numbers"),
         max_line_number: count("max_line_number"),
         block_end: text("block_end", ""),
+        gcode_system: system,
+        length_offset: text("length_offset", ""),
+        surface_speed_per_revolution: value::word(f, "surface_speed_feed")
+            == Some("per_revolution"),
     }
 }
 
