@@ -109,6 +109,28 @@ pub struct Dialect {
     pub line_numbers: Option<u64>,
     pub max_line_number: Option<u64>,
     pub block_end: String,
+    /// Fanuc lathes: the G-code system (A, B or C) the control is set to;
+    /// the reader takes its words (system A: G98/G99 feeds, G50 S clamp,
+    /// G90 G92 G94 turning cycles; B and C: G94/G95 feeds, G92 S clamp,
+    /// G90/G91 distance). None: not a Fanuc lathe's setting.
+    pub gcode_system: Option<GcodeSystem>,
+    /// Words that take the tool's length offset, written in the block of
+    /// the first move that states Z after the tool call (`G43 H{offset}`
+    /// on a Fanuc mill); empty: the tool call takes it.
+    pub length_offset: String,
+    /// Whether constant surface speed selects feed per revolution itself
+    /// (Sinumerik: "G95 is activated automatically with G96", and G94 or
+    /// G95 would switch it off): no feed-mode word is written while it is
+    /// on, and a feed per minute under it is refused.
+    pub surface_speed_per_revolution: bool,
+}
+
+/// A Fanuc lathe's G-code system (parameter-selected on the control).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GcodeSystem {
+    A,
+    B,
+    C,
 }
 
 /// How one word's number is written, as a dialect states it (`S5`,
@@ -178,8 +200,8 @@ impl Dialect {
             comment: CommentStyle::Parentheses,
             start: Vec::new(),
             program_number: 1,
-            lathe_setup: lines(&["G18 G21 G90 G8 G40 G49 G80 G94"]),
-            mill_setup: lines(&["G17 G21 G90 G40 G49 G80 G94"]),
+            lathe_setup: lines(&["G18 G21 G90 G8 G40 G49 G80 G94 G54"]),
+            mill_setup: lines(&["G17 G21 G90 G40 G49 G80 G94 G54"]),
             lathe_tool_call: lines(&["T{tool} M6 G43"]),
             mill_tool_call: lines(&["T{tool} M6 G43 H{offset}"]),
             path_tolerance: lines(&["G64 P{tolerance}"]),
@@ -189,7 +211,7 @@ impl Dialect {
             fts_table: None,
             fts_on: Vec::new(),
             fts_off: Vec::new(),
-            end: lines(&["M2"]),
+            end: lines(&["G53 G0 Z0", "M2"]),
             trailer: Vec::new(),
             lathe_x_diameter: false,
             rapid: "G0".into(),
@@ -218,10 +240,13 @@ impl Dialect {
             c_decimals: 5,
             max_decimals: None,
             max_digits: None,
-            max_line_length: Some(255),
+            max_line_length: Some(252),
             line_numbers: None,
             max_line_number: None,
             block_end: String::new(),
+            gcode_system: None,
+            length_offset: String::new(),
+            surface_speed_per_revolution: false,
         }
     }
 }

@@ -18,6 +18,7 @@ mod complete_programs;
 mod determinism;
 mod diagnostics;
 mod dialects;
+mod differential;
 mod docs;
 mod editors;
 mod examples;

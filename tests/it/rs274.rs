@@ -22,7 +22,7 @@ fn rs274() -> Command {
 /// rs274 instances running at the same time crash each other with SIGBUS
 /// (seen with 10 in parallel: they share interpreter state outside the
 /// process), so the tests run it one at a time.
-static RS274: std::sync::Mutex<()> = std::sync::Mutex::new(());
+pub(crate) static RS274: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
 /// Runs rs274 on a program; returns the canonical commands it printed.
 fn interpret(program: &Path) -> String {

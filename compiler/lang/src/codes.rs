@@ -72,6 +72,13 @@ pub const BAD_WORD_FORMAT: &str = "E0172";
 pub const CANNOT_CALL_TOOL: &str = "E0173";
 /// A machine that is not a mill naming a Klartext dialect.
 pub const KLARTEXT_ON_A_LATHE: &str = "E0174";
+/// A G-code system (`gcode_system`, Fanuc lathes' A, B or C) on a
+/// dialect chosen for a machine that is not a lathe: the code systems are
+/// a lathe control's.
+pub const GCODE_SYSTEM_NOT_OFFERED: &str = "E0176";
+/// Constant surface speed asked of a machine whose dialect has none
+/// (no `surface_speed` lines).
+pub const NO_SURFACE_SPEED: &str = "E0177";
 /// A path tolerance finer than the machine's resolution can hold.
 pub const TOLERANCE_BELOW_RESOLUTION: &str = "E0180";
 /// `lensc fmt` refused to write a layout that would not parse back to the
@@ -304,6 +311,8 @@ pub const ALL: &[&str] = &[
     BAD_WORD_FORMAT,
     CANNOT_CALL_TOOL,
     KLARTEXT_ON_A_LATHE,
+    GCODE_SYSTEM_NOT_OFFERED,
+    NO_SURFACE_SPEED,
     TOLERANCE_BELOW_RESOLUTION,
     ACCEPTANCE_MISSED,
     ACCEPTANCE_UNMEASURED,

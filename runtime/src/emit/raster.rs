@@ -18,8 +18,8 @@ pub struct RasterCut {
     pub zigzag: bool,
 }
 
-/// The move stream of a raster: up to the safe height, the spindle
-/// started (or held, for a knife), then each pass reached by rapids at
+/// The move stream of a raster: the spindle started (or held, for a
+/// knife), up to the safe height, then each pass reached by rapids at
 /// the safe height, a plunge at the feed, the cut and a retract. A zigzag
 /// joins each pass to the next with a link (`link`) when one is safe, so
 /// the tool retracts only at the start and the end.
@@ -29,12 +29,13 @@ pub fn raster_moves(path: &crate::plan::raster::RasterPath, cut: RasterCut) -> V
         ..Position::KEEP
     };
     let feed = Some(moves::Feed::PerTime(cut.feed));
+    // The spindle first: no approach before it runs (or is held).
     let mut out = vec![
-        moves::Move::Rapid(safe),
         match cut.spindle_speed {
             Some(w) => moves::Move::SpindleOn(w),
             None => moves::Move::SpindleHeld,
         },
+        moves::Move::Rapid(safe),
     ];
     // The steepest the tool-centre surface rises per mm in any direction.
     let gradient = path

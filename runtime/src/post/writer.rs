@@ -114,6 +114,12 @@ pub struct ProgramWriter {
     start: Option<Start>,
     /// What the spindle is doing.
     spindle: Spindle,
+    /// The length-offset words (`G43 H3 `) still to be written with the
+    /// first move that states Z (`Dialect::length_offset`).
+    pending_length_offset: Option<String>,
+    /// Constant surface speed is on and selects feed per revolution
+    /// itself (`Dialect::surface_speed_per_revolution`).
+    css_per_revolution: bool,
     /// The most digits before the point per word letter A…Z, as a power
     /// of ten (`u64::MAX`: no limit).
     integer_limit: [u64; 26],
@@ -288,6 +294,8 @@ impl ProgramWriter {
             job: job.to_string(),
             start: None,
             spindle: Spindle::Stopped,
+            pending_length_offset: None,
+            css_per_revolution: false,
             integer_limit: limits,
             feed_decimals,
             feed_format: Decimals::new(feed_decimals),
@@ -316,6 +324,16 @@ impl ProgramWriter {
         }
         if let Some(word) = coolant_word(&self.dialect, start.coolant)? {
             self.block_line(&word)?;
+        }
+        if !self.dialect.length_offset.is_empty() {
+            let words = self
+                .dialect
+                .length_offset
+                .replace("{offset}", &start.offset.to_string())
+                .replace("{tool}", &start.tool.to_string());
+            check_numbers(&words, self.dialect.comment)?;
+            check_word_formats(&words, &self.dialect)?;
+            self.pending_length_offset = Some(words);
         }
         self.start = Some(*start);
         Ok(())
@@ -618,6 +636,7 @@ impl ProgramWriter {
         // Some controllers group G96/G97 with the feed modes (Sinumerik's
         // group 15): the next feed states its mode again.
         self.mode = None;
+        self.css_per_revolution = false;
         self.block_line(&block)
     }
 
@@ -640,7 +659,10 @@ impl ProgramWriter {
         }
         let on = self.spindle_on_word();
         self.spindle = Spindle::Turning;
-        self.mode = None;
+        // Where G96 selects feed per revolution itself (Sinumerik), no
+        // feed-mode word follows it: G95 would switch it off.
+        self.css_per_revolution = self.dialect.surface_speed_per_revolution;
+        self.mode = self.css_per_revolution.then_some(FeedMode::PerRevolution);
         self.block_line(&on)
     }
 
@@ -743,6 +765,19 @@ impl ProgramWriter {
             ),
         });
         let mode_changes = mode.is_some_and(|(m, ..)| self.mode != Some(m));
+        if self.css_per_revolution && mode_changes {
+            self.text.truncate(start);
+            return Err(ProgramError::Unsupported(format!(
+                "a feed not per revolution under constant surface speed ({}: G96 selects feed per revolution, and G94 or G93 would switch constant surface speed off)",
+                self.dialect.name
+            )));
+        }
+        if !to.z.is_nan()
+            && let Some(words) = self.pending_length_offset.take()
+        {
+            self.text.extend_from_slice(words.as_bytes());
+            self.text.push(b' ');
+        }
         if let Some((m, ..)) = mode
             && mode_changes
         {

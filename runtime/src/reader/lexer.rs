@@ -44,6 +44,9 @@ pub(crate) enum KeywordKind {
     Word(SiemensWord),
     /// An address letter given a string: `T="DIAMOND"`, a tool by name.
     Text(char),
+    /// `CYCLE832(…)`: the high-speed settings (tolerance, smoothing,
+    /// compressor), which move nothing.
+    Cycle832,
 }
 
 /// The Siemens words of several letters the reader knows (840D sl
@@ -69,11 +72,12 @@ pub(crate) enum SiemensWord {
     Brisk,
     Ffwon,
     Ffwof,
+    Supa,
 }
 
 impl SiemensWord {
     /// Every word, in declaration order.
-    const ALL: [SiemensWord; 18] = [
+    const ALL: [SiemensWord; 19] = [
         SiemensWord::Diamof,
         SiemensWord::Diamon,
         SiemensWord::Diam90,
@@ -92,6 +96,7 @@ impl SiemensWord {
         SiemensWord::Brisk,
         SiemensWord::Ffwon,
         SiemensWord::Ffwof,
+        SiemensWord::Supa,
     ];
 
     /// The word as a program writes it.
@@ -115,6 +120,7 @@ impl SiemensWord {
             SiemensWord::Brisk => "BRISK",
             SiemensWord::Ffwon => "FFWON",
             SiemensWord::Ffwof => "FFWOF",
+            SiemensWord::Supa => "SUPA",
         }
     }
 
@@ -381,6 +387,27 @@ impl Lexer {
         out: &mut Vec<Found>,
     ) -> usize {
         let bytes = code.as_bytes();
+        // A Sinumerik cycle call, `CYCLE832(0.001,1,1)`: its name with its
+        // number, and its arguments, numbers separated by commas.
+        if self.controller == Controller::Siemens
+            && &code[start..i] == "CYCLE"
+            && let Some(call) = cycle_call(code, i)
+        {
+            let name = &code[start..call.0];
+            if SIEMENS_CYCLES.contains(&name) {
+                b.keywords.push(Keyword {
+                    kind: KeywordKind::Cycle832,
+                    value: None,
+                    span: (start, call.1),
+                });
+            } else {
+                out.push(unknown(
+                    (start, call.1),
+                    &format!("`{name}` is not a cycle lensc reads"),
+                ));
+            }
+            return call.1;
+        }
         let name = &code[start..i];
         let mut value = None;
         if bytes.get(i) == Some(&b'=') {
@@ -543,6 +570,29 @@ fn significant_digits(t: &[u8]) -> usize {
         i += 1;
     }
     t[i..].iter().filter(|b| b.is_ascii_digit()).count()
+}
+
+/// The Sinumerik cycles lensc reads: CYCLE832, high-speed settings
+/// (tolerance, smoothing, compressor), which moves nothing.
+const SIEMENS_CYCLES: &[&str] = &["CYCLE832"];
+
+/// `832(…)` after `CYCLE` at `i`: the end of the cycle's number and the
+/// end of the call (after its `)`), if its arguments are numbers
+/// separated by commas.
+fn cycle_call(code: &str, i: usize) -> Option<(usize, usize)> {
+    let bytes = code.as_bytes();
+    let mut j = i;
+    while j < bytes.len() && bytes[j].is_ascii_digit() {
+        j += 1;
+    }
+    if j == i || bytes.get(j) != Some(&b'(') {
+        return None;
+    }
+    let close = j + code[j..].find(')')?;
+    let args = &code[j + 1..close];
+    args.split(',')
+        .all(|a| a.trim().parse::<f64>().is_ok())
+        .then_some((j, close + 1))
 }
 
 /// Whether a controller reads `letter` as a whole number only (a decimal

@@ -49,6 +49,9 @@ enum GGroup {
     NonModal,
     WorkOffset,
     Cycle,
+    /// G28 (reference point), G53 (machine coordinates): the move goes to
+    /// a position of the machine's, not of the program's.
+    MachineMove,
 }
 
 /// What an M code does, for this dialect.
@@ -66,6 +69,8 @@ enum MCode {
     Stop,
     Coolant,
     Other,
+    /// Heidenhain's M91: the block's coordinates are the machine's.
+    MachinePosition,
 }
 
 /// The state of a program being read.
@@ -79,6 +84,9 @@ pub(crate) struct State {
     feed_codes: Vec<(i64, FeedMode)>,
     max_line_number: Option<u64>,
     numbered: bool,
+    /// A Fanuc lathe's G-code system A: G90 and G94 are turning cycles,
+    /// positions absolute by X Z (incremental U W).
+    system_a: bool,
     /// Whether the spindle-speed mode must be stated before a start.
     css_capable: bool,
     // The modal state.
@@ -148,7 +156,13 @@ impl State {
                 .and_then(|n| n.parse::<f64>().ok())
                 .map(|v| (v * 10.0).round() as i64)
         };
-        let mut feed_codes = vec![(940, FeedMode::PerMinute)];
+        let system_a = d.gcode_system == Some(crate::dialect::GcodeSystem::A);
+        // G94 is feed per minute everywhere but in Fanuc's system A.
+        let mut feed_codes = if system_a {
+            Vec::new()
+        } else {
+            vec![(940, FeedMode::PerMinute)]
+        };
         for (w, m) in [
             (&d.per_minute, FeedMode::PerMinute),
             (&d.per_revolution, FeedMode::PerRevolution),
@@ -164,6 +178,7 @@ impl State {
             dialect_m,
             feed_codes,
             max_line_number: d.max_line_number,
+            system_a,
             numbered: matches!(
                 lex.controller,
                 Controller::HeidenhainIso | Controller::HeidenhainKlartext
@@ -171,7 +186,8 @@ impl State {
             css_capable: machine.lathe || d.constant_rpm.is_some() || !d.surface_speed.is_empty(),
             metric: None,
             plane: None,
-            absolute: None,
+            // System A has no G90: X Z are absolute, U W incremental.
+            absolute: system_a.then_some(true),
             feed_mode: None,
             motion: None,
             feed: None,
@@ -252,11 +268,26 @@ impl State {
         }
         self.modes(b, groups, line, out);
         self.spindle_and_tool(b, groups, ms, line, out);
-        // G50 S and G4 take their own words; no move.
-        if !groups
+        // A move to a machine position (G28, G53, Siemens' SUPA,
+        // Heidenhain's M91): where it ends is the machine's, not the
+        // program's; the next move starts from an unknown position.
+        let machine_move = groups.iter().any(|(g, _)| *g == GGroup::MachineMove)
+            || b.keywords
+                .iter()
+                .any(|k| k.kind == KeywordKind::Word(SiemensWord::Supa))
+            || ms.iter().any(|(m, _)| *m == MCode::MachinePosition);
+        if machine_move {
+            if let Some((GGroup::Motion(m), _)) =
+                groups.iter().find(|(g, _)| matches!(g, GGroup::Motion(_)))
+            {
+                self.motion = Some(*m);
+            }
+            self.pos = [None; 4];
+        } else if !groups
             .iter()
             .any(|(g, _)| matches!(g, GGroup::SpindleCap | GGroup::NonModal))
         {
+            // G50 S and G4 take their own words; no move.
             self.move_block(b, line, out);
         }
         if ms.iter().any(|(m, _)| *m == MCode::End) {
@@ -384,6 +415,7 @@ impl State {
 
     fn known_letter(&self, l: char) -> bool {
         let letters = match self.lex.controller {
+            Controller::Fanuc if self.system_a => "XYZCUWIJKRFSTDHPQLNO",
             Controller::Fanuc => "XYZCIJKRFSTDHPQLNO",
             Controller::UltraPrecision => "XYZCWIJKRFSTDHPQLNO",
             Controller::LinuxCnc => "XYZABCUVWIJKRFSTDHPQLN",
@@ -410,8 +442,13 @@ impl State {
             170 => GGroup::Plane(Plane::Xy),
             180 => GGroup::Plane(Plane::Zx),
             190 => GGroup::Plane(Plane::Yz),
+            // In Fanuc's system A, G90 is the outer-diameter turning cycle
+            // and there is no G91: not codes lensc reads.
+            900 | 910 if self.system_a => return None,
             900 => GGroup::Distance(true),
             910 => GGroup::Distance(false),
+            280 if matches!(c, LinuxCnc | Fanuc | UltraPrecision) => GGroup::MachineMove,
+            530 if matches!(c, LinuxCnc | Fanuc | Siemens | UltraPrecision) => GGroup::MachineMove,
             400 | 410 | 420 => GGroup::CutterComp,
             960 if c != HeidenhainIso && c != HeidenhainKlartext => GGroup::SpindleMode(true),
             970 if c != HeidenhainIso && c != HeidenhainKlartext => GGroup::SpindleMode(false),
@@ -428,7 +465,9 @@ impl State {
             80 if c == LinuxCnc => GGroup::Diameter(false),
             610 | 640 if c == LinuxCnc => GGroup::PathControl,
             600 | 640 | 6410 | 6420 if c == Siemens => GGroup::PathControl,
-            500 if c == Fanuc || c == UltraPrecision => GGroup::SpindleCap,
+            // The clamp: G50 S in Fanuc's system A, G92 S in B and C.
+            500 if (c == Fanuc && self.system_a) || c == UltraPrecision => GGroup::SpindleCap,
+            920 if c == Fanuc && !self.system_a => GGroup::SpindleCap,
             51 if c == Fanuc => GGroup::NonModal,
             _ => {
                 return self
@@ -452,6 +491,13 @@ impl State {
             0 | 1 => MCode::Stop,
             7..=9 => MCode::Coolant,
             19 => MCode::Orient,
+            91 if matches!(
+                self.lex.controller,
+                Controller::HeidenhainIso | Controller::HeidenhainKlartext
+            ) =>
+            {
+                MCode::MachinePosition
+            }
             _ => return None,
         })
     }
@@ -496,9 +542,10 @@ impl State {
                 // holds a program to.
                 KeywordKind::Word(
                     Compcad | Compcurv | Compon | Compof | Spcon | Spcof | Spos | Ctol | Otol
-                    | Atol | Lims | Soft | Brisk | Ffwon | Ffwof,
+                    | Atol | Lims | Soft | Brisk | Ffwon | Ffwof | Supa,
                 )
-                | KeywordKind::Text(_) => {}
+                | KeywordKind::Text(_)
+                | KeywordKind::Cycle832 => {}
             }
         }
         if let Some(f) = b.words.iter().find(|w| w.letter == 'F') {
@@ -590,9 +637,10 @@ impl State {
                 // the reader holds a program to.
                 KeywordKind::Word(
                     Diamof | Diamon | Diam90 | Compcad | Compcurv | Compon | Compof | Ctol | Otol
-                    | Atol | Lims | Soft | Brisk | Ffwon | Ffwof,
+                    | Atol | Lims | Soft | Brisk | Ffwon | Ffwof | Supa,
                 )
-                | KeywordKind::Text(_) => {}
+                | KeywordKind::Text(_)
+                | KeywordKind::Cycle832 => {}
             }
         }
         for &(m, w) in ms {
@@ -716,7 +764,7 @@ fn same_m_group(a: MCode, b: MCode) -> bool {
         SpindleOn | SpindleOff | PositionOn | PositionOff | Orient => 1,
         End | Stop => 2,
         ToolChange => 3,
-        Coolant | Other => 0,
+        Coolant | Other | MachinePosition => 0,
     };
     group(a) != 0 && group(a) == group(b)
 }

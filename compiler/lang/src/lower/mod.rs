@@ -69,6 +69,7 @@ pub fn dialect(job: &CheckedJob, requested: Option<&str>) -> Result<Dialect, Dia
     };
     let gcode = Gcode::read(o.dialect);
     check_word_formats(&gcode, &o.name())?;
+    controller_can_run(job, &gcode, &o.name())?;
     Ok(dialect_from(gcode, o.name()))
 }
 
@@ -85,6 +86,68 @@ fn machine_of(job: &CheckedJob) -> Result<&Object, Diagnostic> {
         )
         .with_label("this job")),
     }
+}
+
+/// E0176 a G-code system on a dialect chosen for a machine that is not a
+/// lathe, or one a Fanuc lathe does not offer; E0177 constant surface
+/// speed asked of a dialect that has none. Both name the dialect and the
+/// machine.
+fn controller_can_run(job: &CheckedJob, g: &Gcode, dialect: &str) -> Result<(), Diagnostic> {
+    let parts = Reader::new(&job.fields);
+    let (Some(machine), Some(strategy)) = (parts.object("machine"), parts.object("strategy"))
+    else {
+        return Ok(());
+    };
+    let name = |o: &Object| o.name.clone().unwrap_or_else(|| o.kind.name.to_string());
+    let (file, span) = job_site(job);
+    if let Some(system) = g.gcode_system.as_deref()
+        && !matches!(system, "A" | "B" | "C")
+    {
+        return Err(Diagnostic::error(
+            codes::GCODE_SYSTEM_NOT_OFFERED,
+            format!(
+                "`{dialect}` names G-code system `{system}`; a Fanuc lathe offers systems A, B and C (machine `{}`)",
+                name(machine)
+            ),
+            file,
+            span,
+        )
+        .with_label("this job")
+        .with_help("write `gcode_system: \"A\"` (the 0i-TF's default), `\"B\"` or `\"C\"`, as the control's parameter is set"));
+    }
+    if let Some(system) = g.gcode_system.as_deref()
+        && machine.kind.name == "mill_3axis"
+    {
+        return Err(Diagnostic::error(
+            codes::GCODE_SYSTEM_NOT_OFFERED,
+            format!(
+                "`{dialect}` is set to G-code system {system}, a Fanuc lathe's setting; this machine is a `{}`",
+                machine.kind.name
+            ),
+            file,
+            span,
+        )
+        .with_label("this job")
+        .with_help("a mill's Fanuc control has one G-code system: name a mill dialect (`fanuc_0i_mill`), or leave `gcode_system` out of your copy"));
+    }
+    let asks_surface_speed = strategy.kind.name == "profile_turning"
+        && crate::schema::strategies::ProfileTurningParams::read(strategy)
+            .is_ok_and(|p| p.surface_speed.is_some());
+    if asks_surface_speed && g.surface_speed.is_empty() {
+        return Err(Diagnostic::error(
+            codes::NO_SURFACE_SPEED,
+            format!(
+                "`{dialect}` has no constant surface speed (no `surface_speed` lines), and strategy `{}` asks for it on machine `{}`",
+                name(strategy),
+                name(machine)
+            ),
+            file,
+            span,
+        )
+        .with_label("this job")
+        .with_help("give the strategy a `spindle_speed` instead, or give the dialect the blocks that set constant surface speed (`surface_speed: [\"G96 D{cap} S{speed}\"]`)"));
+    }
+    Ok(())
 }
 
 /// E0174 where a machine that is not a mill names a Klartext dialect
@@ -180,7 +243,49 @@ pub(crate) fn dialect_of(o: &Object, name: String) -> Dialect {
 
 /// A dialect's parameters, read, as the post-processor reads them.
 fn dialect_from(g: Gcode, name: String) -> Dialect {
+    use lensc_runtime::dialect::GcodeSystem;
     use lensc_runtime::moves::Plane;
+    let system = match g.gcode_system.as_deref() {
+        Some("A") => Some(GcodeSystem::A),
+        Some("B") => Some(GcodeSystem::B),
+        Some("C") => Some(GcodeSystem::C),
+        _ => None,
+    };
+    // A Fanuc lathe's code system fills its placeholders and feed words.
+    let system_words = |lines: &mut Vec<String>| {
+        let Some(s) = system else { return };
+        let a = s == GcodeSystem::A;
+        for l in lines.iter_mut() {
+            *l = l
+                .replace("{feeds}", if a { "G98" } else { "G90 G94" })
+                .replace("{clamp}", if a { "G50" } else { "G92" })
+                .replace("{home}", if a { "G28 U0. W0." } else { "G91 G28 X0. Z0." });
+        }
+    };
+    let mut g = g;
+    for lines in [
+        &mut g.start,
+        &mut g.lathe_setup,
+        &mut g.mill_setup,
+        &mut g.lathe_tool_call,
+        &mut g.mill_tool_call,
+        &mut g.path_tolerance,
+        &mut g.c_axis_on,
+        &mut g.c_axis_off,
+        &mut g.surface_speed,
+        &mut g.fts_on,
+        &mut g.fts_off,
+        &mut g.end,
+        &mut g.trailer,
+        &mut g.spindle_orient,
+    ] {
+        system_words(lines);
+    }
+    let (minute, revolution) = match system {
+        Some(GcodeSystem::A) => (Some("G98"), Some("G99")),
+        Some(_) => (Some("G94"), Some("G95")),
+        None => (None, None),
+    };
     Dialect {
         name,
         language: if g.klartext {
@@ -226,8 +331,8 @@ fn dialect_from(g: Gcode, name: String) -> Dialect {
             .collect(),
         arc_centre_absolute: g.arc_centre_absolute,
         arc_radius_tolerance: g.arc_radius_tolerance,
-        per_minute: g.per_minute,
-        per_revolution: g.per_revolution,
+        per_minute: g.per_minute.or(minute.map(String::from)),
+        per_revolution: g.per_revolution.or(revolution.map(String::from)),
         inverse_time: g.inverse_time,
         spindle_on: g.spindle_on,
         spindle_ccw: g.spindle_ccw,
@@ -251,6 +356,9 @@ fn dialect_from(g: Gcode, name: String) -> Dialect {
         line_numbers: g.line_numbers,
         max_line_number: g.max_line_number,
         block_end: g.block_end,
+        gcode_system: system,
+        length_offset: g.length_offset,
+        surface_speed_per_revolution: g.surface_speed_per_revolution,
     }
 }
 

@@ -205,6 +205,20 @@ const GCODE_PARAMS: &[Param] = &[
         "block_end",
         "text closing every block (Heidenhain ISO: ` *`); default none",
     ),
+    text(
+        "gcode_system",
+        "a Fanuc lathe's G-code system, as its parameter sets the control: `\"A\"` (G98/G99 feeds per minute and per revolution, `G50 S` the spindle clamp, G90 G92 G94 turning cycles, no G90/G91 words), `b` or `c` (G94/G95 feeds, `G92 S` the clamp, G90 absolute); lines may hold `{feeds}` (A: `G98`; B, C: `G90 G94`), `{clamp}` (A: `G50`; B, C: `G92`) and `{home}` (A: `G28 U0. W0.`; B, C: `G91 G28 X0. Z0.`), and `per_minute` and `per_revolution` default to the system's words; only for a lathe, and only A, B or C (E0176); absent: not a Fanuc lathe",
+    ),
+    text(
+        "length_offset",
+        "words taking the tool's length offset in the block of the first move that states Z after the tool call (`G43 H{offset}`: Fanuc's G43 H with its Z move); default none (the tool call takes it)",
+    ),
+    opt(
+        "surface_speed_feed",
+        Ty::Word(&["stated", "per_revolution"]),
+        Check::Any,
+        "`per_revolution`: constant surface speed selects feed per revolution itself, and a feed-mode word would switch it off (Sinumerik: G94 G95 G96 G97 are one group), so none is written while it is on; default `stated` (the first feed after the spindle block states its mode)",
+    ),
 ];
 
 pub(super) const GCODE: Kind = Kind {
@@ -284,6 +298,13 @@ pub struct Gcode {
     pub line_numbers: Option<u64>,
     pub max_line_number: Option<u64>,
     pub block_end: String,
+    /// A Fanuc lathe's G-code system as written (`"A"`, `"B"`, `"C"`;
+    /// anything else is E0176).
+    pub gcode_system: Option<String>,
+    /// Words taking the tool's length offset with the first Z move.
+    pub length_offset: String,
+    /// `surface_speed_feed: per_revolution`.
+    pub surface_speed_per_revolution: bool,
 }
 
 impl Gcode {
@@ -362,6 +383,9 @@ impl Gcode {
             line_numbers: count("line_numbers"),
             max_line_number: count("max_line_number"),
             block_end: text("block_end", ""),
+            gcode_system: opt_text("gcode_system"),
+            length_offset: text("length_offset", ""),
+            surface_speed_per_revolution: r.word("surface_speed_feed") == Some("per_revolution"),
         }
     }
 }

@@ -48,7 +48,7 @@ fn unchanged_words_and_feeds_are_left_out() {
     .expect("writes");
     assert_eq!(
         text,
-        "(t)\nG17 G21 G90 G40 G49 G80 G94\nG64 P0.001\nT1 M6 G43 H1\nG97 S1000 M3\nG0 X1. Y2. Z5.\nG94 G1 Z0.5 F60.\nG1 X1.5\nG1 Y2.5 F120.\nM5\nM2\n"
+        "(t)\nG17 G21 G90 G40 G49 G80 G94 G54\nG64 P0.001\nT1 M6 G43 H1\nG97 S1000 M3\nG0 X1. Y2. Z5.\nG94 G1 Z0.5 F60.\nG1 X1.5\nG1 Y2.5 F120.\nM5\nG53 G0 Z0\nM2\n"
     );
 }
 
@@ -74,7 +74,7 @@ fn inverse_time_writes_a_feed_on_every_move_and_c_in_degrees() {
     .expect("writes");
     assert_eq!(
         text,
-        "(t)\nG17 G21 G90 G40 G49 G80 G94\nG64 P0.001\nT1 M6 G43 H1\nG97 S1000 M3\nG93 G1 X1. Z0. C90. F120.\nG1 X0.9 C180. F120.\nG95 G1 X0.8 Z0.1 F0.006283\nM5\nM2\n"
+        "(t)\nG17 G21 G90 G40 G49 G80 G94 G54\nG64 P0.001\nT1 M6 G43 H1\nG97 S1000 M3\nG93 G1 X1. Z0. C90. F120.\nG1 X0.9 C180. F120.\nG95 G1 X0.8 Z0.1 F0.006283\nM5\nG53 G0 Z0\nM2\n"
     );
 }
 
@@ -334,7 +334,7 @@ proptest::proptest! {
         let written: Vec<&str> = text
             .lines()
             .skip_while(|l| !l.starts_with("G93"))
-            .take_while(|l| *l != "M2")
+            .take_while(|l| *l != "G53 G0 Z0")
             .collect();
         proptest::prop_assert_eq!(written, expected);
         proptest::prop_assert!(text.lines().all(|l| l.len() <= 255));
@@ -486,7 +486,7 @@ fn no_move_before_the_tool_call_and_no_feed_with_the_spindle_stopped() {
     w.write(&cut).expect("a cut");
     let text = w.finish().expect("ends");
     assert!(text.contains("M19 R0\nG94 G1 X1. Z0. F60.\n"), "{text}");
-    assert!(text.ends_with("M5\nM2\n"), "{text}");
+    assert!(text.ends_with("M5\nG53 G0 Z0\nM2\n"), "{text}");
 }
 
 #[test]
@@ -502,7 +502,7 @@ fn the_spindle_turns_the_jobs_way_and_coolant_is_on_between_call_and_end() {
     w.write(&M::SpindleOn(RPM_1000)).expect("M4");
     let text = w.finish().expect("ends");
     assert!(
-        text.ends_with("T1 M6 G43 H1\nM7\nG97 S1000 M4\nM5\nM9\nM2\n"),
+        text.ends_with("T1 M6 G43 H1\nM7\nG97 S1000 M4\nM5\nM9\nG53 G0 Z0\nM2\n"),
         "{text}"
     );
     let mut dry = Dialect::linuxcnc();
