@@ -34,8 +34,15 @@ fn every_program_snapshot_reads_back() {
         files.sort();
         for snap in files {
             let all = std::fs::read_to_string(&snap).expect("read");
-            // The snapshot's own header is three lines (`---`, source, `---`).
-            let program: String = all.split_inclusive('\n').skip(3).collect();
+            // The snapshot's own header: insta's metadata between two `---`
+            // lines (source, and sometimes its assertion line).
+            let program: String = all
+                .split_inclusive('\n')
+                .skip_while(|l| l.trim_end() != "---")
+                .skip(1)
+                .skip_while(|l| l.trim_end() != "---")
+                .skip(1)
+                .collect();
             let abridged = program
                 .lines()
                 .any(|l| l.starts_with("… ") && l.contains(" lines, "));

@@ -322,12 +322,8 @@ fn dialect_from(g: Gcode, name: String) -> Dialect {
         arc_planes: g
             .arc_planes
             .iter()
-            .filter_map(|p| match p.as_str() {
-                "xy" => Some(Plane::Xy),
-                "zx" => Some(Plane::Zx),
-                "yz" => Some(Plane::Yz),
-                _ => None,
-            })
+            // The checker refuses a plane that does not name one (E0126).
+            .filter_map(|p| Plane::from_name(p))
             .collect(),
         arc_centre_absolute: g.arc_centre_absolute,
         arc_radius_tolerance: g.arc_radius_tolerance,
