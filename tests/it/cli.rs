@@ -494,3 +494,43 @@ fn sample_works_on_every_example_surface() {
     }
     assert!(sampled >= 15, "only {sampled} surfaces");
 }
+
+#[test]
+fn verify_reads_the_servo_table_a_build_writes_as_a_table() {
+    // Issue #29: `lensc verify` on the `.fts` table beside a program
+    // exited 1 ("names no machine in its header").
+    let dir = tempfile::tempdir().expect("tmp");
+    let out = lensc(
+        &root(),
+        &[
+            "build",
+            "tests/jobs/fts_small_array.lens",
+            "--dialect",
+            "ultra_precision_lathe_gcode",
+            "--out",
+            dir.path().to_str().expect("utf8"),
+        ],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let table = dir.path().join("corner_fts.fts");
+    let out = lensc(&root(), &["verify", table.to_str().expect("utf8")]);
+    let said = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{said}");
+    assert!(
+        said.contains("a fast-tool-servo table for job corner_fts, not a program"),
+        "{said}"
+    );
+    assert!(said.contains("corner_fts.nc`"), "{said}");
+    // A row cut short is refused, by its line.
+    let whole = std::fs::read_to_string(&table).expect("table");
+    let mut lines: Vec<&str> = whole.lines().collect();
+    lines[6] = "1440. 4.749747";
+    std::fs::write(&table, lines.join("\n")).expect("write");
+    let out = lensc(&root(), &["verify", table.to_str().expect("utf8")]);
+    let said = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{said}");
+    assert!(
+        said.contains("error[E0190]") && said.contains("line 7"),
+        "{said}"
+    );
+}
