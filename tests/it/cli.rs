@@ -534,3 +534,25 @@ fn verify_reads_the_servo_table_a_build_writes_as_a_table() {
         "{said}"
     );
 }
+
+#[test]
+fn a_job_with_no_chord_tolerance_builds_on_every_0_1_um_stdlib_machine() {
+    // Issue #29: the default 10 nm was refused (E0180) on
+    // `linuxcnc_lathe` and `generic_3axis_mill`, the first job of every
+    // newcomer on them. The default is now the smallest each holds.
+    let dir = tempfile::tempdir().expect("tmp");
+    let out = lensc(
+        &root(),
+        &[
+            "build",
+            "tests/jobs/newcomer_defaults.lens",
+            "--out",
+            dir.path().to_str().expect("utf8"),
+        ],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    for (program, tolerance) in [("turned.ngc", "142 nm"), ("scraped.ngc", "174 nm")] {
+        let t = std::fs::read_to_string(dir.path().join(program)).expect("program");
+        assert!(t.contains(&format!("path tolerance {tolerance}")), "{t}");
+    }
+}
