@@ -242,14 +242,14 @@ fn any_shape(rng: &mut Rng, out: &mut String, r: f64) {
         ),
         1 => writeln!(
             out,
-            "surface s = xy_polynomial {{ X2Y0: {} mm^-1, X0Y2: {} mm^-1, X1Y1: {} mm^-1, aperture: {aperture} }}",
+            "surface s = xy_polynomial {{ sense: concave, X2Y0: {} mm^-1, X0Y2: {} mm^-1, X1Y1: {} mm^-1, aperture: {aperture} }}",
             free_number(rng, -0.05, 0.05),
             free_number(rng, -0.05, 0.05),
             free_number(rng, -0.05, 0.05)
         ),
         2 => writeln!(
             out,
-            "surface s = zernike {{ ordering: {}, norm_radius: {}, Z4: {} um, Z5: {} um, Z11: {} um, aperture: {aperture} }}",
+            "surface s = zernike {{ sense: concave, ordering: {}, norm_radius: {}, Z4: {} um, Z5: {} um, Z11: {} um, aperture: {aperture} }}",
             ["fringe", "ansi"][rng.below(2)],
             length(rng, r),
             free_number(rng, -2.0, 2.0),

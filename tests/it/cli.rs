@@ -679,3 +679,65 @@ fn a_failed_program_write_leaves_the_previous_report() {
         .collect();
     assert!(left.is_empty(), "{left:?}");
 }
+
+#[test]
+fn verify_reads_the_servo_table_a_build_writes_as_a_table() {
+    // Issue #29: `lensc verify` on the `.fts` table beside a program
+    // exited 1 ("names no machine in its header").
+    let dir = tempfile::tempdir().expect("tmp");
+    let out = lensc(
+        &root(),
+        &[
+            "build",
+            "tests/jobs/fts_small_array.lens",
+            "--dialect",
+            "ultra_precision_lathe_gcode",
+            "--out",
+            dir.path().to_str().expect("utf8"),
+        ],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let table = dir.path().join("corner_fts.fts");
+    let out = lensc(&root(), &["verify", table.to_str().expect("utf8")]);
+    let said = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{said}");
+    assert!(
+        said.contains("a fast-tool-servo table for job corner_fts, not a program"),
+        "{said}"
+    );
+    assert!(said.contains("corner_fts.nc`"), "{said}");
+    // A row cut short is refused, by its line.
+    let whole = std::fs::read_to_string(&table).expect("table");
+    let mut lines: Vec<&str> = whole.lines().collect();
+    lines[6] = "1440. 4.749747";
+    std::fs::write(&table, lines.join("\n")).expect("write");
+    let out = lensc(&root(), &["verify", table.to_str().expect("utf8")]);
+    let said = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{said}");
+    assert!(
+        said.contains("error[E0190]") && said.contains("line 7"),
+        "{said}"
+    );
+}
+
+#[test]
+fn a_job_with_no_chord_tolerance_builds_on_every_0_1_um_stdlib_machine() {
+    // Issue #29: the default 10 nm was refused (E0180) on
+    // `linuxcnc_lathe` and `generic_3axis_mill`, the first job of every
+    // newcomer on them. The default is now the smallest each holds.
+    let dir = tempfile::tempdir().expect("tmp");
+    let out = lensc(
+        &root(),
+        &[
+            "build",
+            "tests/jobs/newcomer_defaults.lens",
+            "--out",
+            dir.path().to_str().expect("utf8"),
+        ],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    for (program, tolerance) in [("turned.ngc", "142 nm"), ("scraped.ngc", "174 nm")] {
+        let t = std::fs::read_to_string(dir.path().join(program)).expect("program");
+        assert!(t.contains(&format!("path tolerance {tolerance}")), "{t}");
+    }
+}

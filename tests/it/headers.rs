@@ -249,3 +249,92 @@ fn a_header_states_small_high_order_terms_exactly() {
     let items = parse(&words);
     assert_eq!(compare(o, &items[1..], "s"), 10, "{words}");
 }
+
+/// Builds `src` (written to a job file in a new directory) and returns the
+/// program `NAME.EXT`'s text and the report's JSON.
+fn build_text(src: &str, program: &str) -> (String, serde_json::Value) {
+    let dir = tempfile::tempdir().expect("tmp");
+    let file = dir.path().join("job.lens");
+    std::fs::write(&file, src).expect("write");
+    let out = crate::common::lensc(
+        dir.path(),
+        &["build", file.to_str().expect("utf8"), "--out", "out"],
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        crate::common::text(&out.stderr)
+    );
+    let text = std::fs::read_to_string(dir.path().join("out").join(program)).expect("program");
+    let stem = program.rsplit_once('.').expect("extension").0;
+    let report =
+        std::fs::read_to_string(dir.path().join("out").join(format!("{stem}.report.json")))
+            .expect("report");
+    (text, serde_json::from_str(&report).expect("json"))
+}
+
+/// The header's `estimated cutting time` in seconds (`1 h 2 min 3 s`).
+fn header_time(program: &str) -> f64 {
+    let line = header_comments(program)
+        .into_iter()
+        .find_map(|c| {
+            c.strip_prefix("estimated cutting time ")
+                .map(str::to_string)
+        })
+        .unwrap_or_else(|| panic!("no estimated cutting time in\n{program}"));
+    let words: Vec<&str> = line.split(' ').collect();
+    words
+        .chunks(2)
+        .map(|w| {
+            let n: f64 = w[0].parse().expect("figure");
+            n * match w[1] {
+                "h" => 3600.0,
+                "min" => 60.0,
+                "s" => 1.0,
+                u => panic!("unit {u}"),
+            }
+        })
+        .sum()
+}
+
+#[test]
+fn servo_and_raster_headers_state_the_cutting_time_of_the_report() {
+    // Issue #29: only turning and grinding headers stated it.
+    let servo =
+        std::fs::read_to_string(root().join("tests/jobs/fts_small_array.lens")).expect("job");
+    let raster = "use std::machines::generic_3axis_mill\nuse std::tools::microshaper_r85um\n\
+        surface s = sphere { radius: 4 mm, sense: convex, aperture: circle(diameter: 0.4 mm) }\n\
+        strategy scrape = raster { along: x, stepover: 20 um, feed: 200 mm/min, chord_tolerance: 400 nm }\n\
+        job scraped { surface: s, tool: microshaper_r85um, machine: generic_3axis_mill, strategy: scrape }\n";
+    for (src, program) in [(servo.as_str(), "corner_fts.ngc"), (raster, "scraped.ngc")] {
+        let (text, report) = build_text(src, program);
+        let stated = header_time(&text);
+        let reported = report["toolpath"]["cutting_time_s"]
+            .as_f64()
+            .expect("cutting_time_s");
+        assert!(
+            (stated - reported).abs() <= 0.5 + 0.01 * reported,
+            "{program}: header {stated} s, report {reported} s"
+        );
+    }
+}
+
+#[test]
+fn a_header_prints_a_spindle_cap_and_a_tolerance_as_stated() {
+    // Issue #29: `spindle_cap: 1000 rpm` printed `capped at 999 rpm`, and
+    // a tolerance written in µm printed `200.00000000000003 nm`.
+    let turning = "use std::machines::ultra_precision_lathe\nuse std::tools::diamond_r500um\n\
+        surface s = sphere { radius: 20 mm, sense: convex, aperture: circle(diameter: 2 mm) }\n\
+        strategy f = profile_turning { feed: 5 um/rev, surface_speed: 3 m/min, spindle_cap: 1000 rpm, chord_tolerance: 0.2 um }\n\
+        job turned { surface: s, tool: diamond_r500um, machine: ultra_precision_lathe, strategy: f }\n";
+    let (text, _) = build_text(turning, "turned.ngc");
+    assert!(text.contains("capped at 1000 rpm"), "{text}");
+    let servo = std::fs::read_to_string(root().join("tests/jobs/fts_small_array.lens"))
+        .expect("job")
+        .replace("chord_tolerance: 50 nm", "chord_tolerance: 0.2 um");
+    let (text, _) = build_text(&servo, "corner_fts.ngc");
+    let head = header_comments(&text).join("\n");
+    assert!(head.contains("path tolerance 200 nm"), "{head}");
+    assert!(!head.contains("00000000"), "{head}");
+}

@@ -41,6 +41,22 @@ use lensc_lang::value::{self, Object};
 /// and the header's `10 nm` reads back to it.
 pub const DEFAULT_PATH_TOLERANCE: f64 = 10.0 * 1e-6;
 
+/// The path tolerance (mm) a strategy that states none is held to on a
+/// machine of `resolution` (mm) printing `axes` length axes: 10 nm, or,
+/// where the machine cannot hold that, the smallest tolerance it holds
+/// (resolution × √axes, `tolerance::smallest_tolerance`) rounded up to a
+/// whole nm, as a file's `N nm` reads (142 nm for a lathe at 0.1 µm, 174
+/// nm for a 3-axis mill at 0.1 µm): every machine holds its default, so
+/// a job that states none is never refused for it (E0180).
+pub fn default_path_tolerance(resolution: f64, axes: u32) -> f64 {
+    let smallest = tolerance::smallest_tolerance(resolution, axes);
+    if smallest <= DEFAULT_PATH_TOLERANCE || !smallest.is_finite() {
+        DEFAULT_PATH_TOLERANCE
+    } else {
+        (smallest * 1e6 - 1e-9).ceil() * 1e-6
+    }
+}
+
 /// How lowering evaluates a surface for the checks that analyse it: the
 /// build passes its JIT (with the interpreter behind it), so the figures
 /// `check` reports are the ones `build` plans with.
@@ -267,11 +283,14 @@ impl<'a> Parts<'a> {
         lensc_lang::lower::surface::lower_surface(self.surface)
             .map_err(|e| RuntimeError::Surface(e).at(self.site()))
     }
-    /// The path tolerance the strategy states, or the default (mm).
-    pub fn chord_tolerance(&self) -> f64 {
-        self.path
-            .chord_tolerance
-            .map_or(DEFAULT_PATH_TOLERANCE, |t| t.value)
+    /// The path tolerance the strategy states, or the default its machine
+    /// holds on a path in `axes` length axes (`default_path_tolerance`,
+    /// mm).
+    pub fn chord_tolerance(&self, axes: u32) -> f64 {
+        self.path.chord_tolerance.map_or_else(
+            || default_path_tolerance(self.machine_params.resolution, axes),
+            |t| t.value,
+        )
     }
     /// A tool parameter the strategy needs, or E0121 naming it (the tool
     /// is of a kind that requires it: only a tool that did not check

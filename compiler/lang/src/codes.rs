@@ -214,6 +214,10 @@ pub const PROGRAM_NO_CIRCLE_CENTRE: &str = "E0331";
 /// Klartext: the program not framed by `BEGIN PGM` and `END PGM` of one name.
 pub const PROGRAM_FRAME: &str = "E0332";
 
+/// A fast-tool-servo table (`lensc verify`) with a row that is not three
+/// numbers C X W, or whose C runs backwards.
+pub const SERVO_TABLE_ROW: &str = "E0190";
+
 /// The code of a rule a program read back breaks.
 pub fn program_rule(rule: lensc_runtime::reader::Rule) -> &'static str {
     use lensc_runtime::reader::Rule::*;
@@ -368,6 +372,7 @@ pub const ALL: &[&str] = &[
     PROGRAM_BLOCK_SEQUENCE,
     PROGRAM_NO_CIRCLE_CENTRE,
     PROGRAM_FRAME,
+    SERVO_TABLE_ROW,
     ACCEPTANCE_MISSED_WARNING,
     ACCEPTANCE_UNMEASURED_WARNING,
     SURFACE_UNDEFINED_WARNING,

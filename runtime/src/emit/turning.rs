@@ -53,7 +53,7 @@ pub fn emit(
                 Some(v) => format!(
                     ", constant surface speed {} m/min capped at {} rpm",
                     exact_in(v, M_PER_MIN),
-                    num((job.strategy.spindle_speed * 60.0 / (2.0 * PI)).floor())
+                    exact_in(job.strategy.spindle_speed, 2.0 * PI / 60.0)
                 ),
                 None => String::new(),
             },

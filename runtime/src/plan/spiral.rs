@@ -90,6 +90,29 @@ pub struct FtsSpiral {
     pub chords: ChordPlacement,
 }
 
+impl FtsSpiral {
+    /// The cutting time (s) of the whole spiral, in closed form: the angle
+    /// turned is 2π/feed per mm of radius, at the speed `speed.at(r)`, so
+    /// t = (2π / feed) ∫ dr / ω(r) from `end_radius` to `start_radius`
+    /// (r / v above the radius where the cap takes over, 1 / ω_max below
+    /// it). What the header states before the points are planned; the
+    /// points' own times add up to it.
+    pub fn cutting_time(&self) -> f64 {
+        let (a, b) = (self.end_radius.max(0.0), self.start_radius);
+        if self.feed_per_rev <= 0.0 || b <= a {
+            return 0.0;
+        }
+        let integral = match self.speed {
+            SpindleSpeed::Constant(w) => (b - a) / w,
+            SpindleSpeed::SurfaceSpeed { speed, max } => {
+                let capped_below = (speed / max).clamp(a, b);
+                (b * b - capped_below * capped_below) / (2.0 * speed) + (capped_below - a) / max
+            }
+        };
+        std::f64::consts::TAU / self.feed_per_rev * integral
+    }
+}
+
 /// The fast axis's limits.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FastAxis {

@@ -37,14 +37,16 @@ pub fn smallest_tolerance(resolution: f64, axes: u32) -> f64 {
     resolution * f64::from(axes).sqrt()
 }
 
-/// E0180 if the strategy's path tolerance (stated, or the default) is
+/// E0180 if the strategy's stated path tolerance is
 /// finer than its machine's resolution can hold on a path printed in
 /// `axes` length axes (`Strategy::LENGTH_AXES`); at the tolerance where
-/// the strategy (or the one it copies) states it, else at the job.
+/// the strategy (or the one it copies) states it. A default is never
+/// refused: it is one the machine holds (`default_path_tolerance`).
 pub(crate) fn below_resolution(p: &Parts, axes: u32) -> Option<Diagnostic> {
     let resolution = p.machine_params.resolution;
-    let stated = p.path.chord_tolerance;
-    let tolerance = stated.map_or(super::DEFAULT_PATH_TOLERANCE, |t| t.value);
+    // The default is one the machine holds (`default_path_tolerance`).
+    let stated = p.path.chord_tolerance?;
+    let tolerance = stated.value;
     let smallest = smallest_tolerance(resolution, axes);
     if tolerance >= smallest || !tolerance.is_finite() {
         return None;
@@ -83,21 +85,16 @@ pub(crate) fn below_resolution(p: &Parts, axes: u32) -> Option<Diagnostic> {
             lensc_lang::check::trim_num(finest)
         ));
     }
-    let d = match stated {
-        Some(f) => Diagnostic::error(
-            codes::TOLERANCE_BELOW_RESOLUTION,
-            message,
-            f.site.0,
-            f.site.1,
-        )
-        .with_label(format!(
-            "finer than {} nm",
-            lensc_lang::check::trim_num(suggested * 1e6)
-        )),
-        None => p
-            .error(codes::TOLERANCE_BELOW_RESOLUTION, message)
-            .with_label("this job, whose strategy states no tolerance: 10 nm by default"),
-    };
+    let d = Diagnostic::error(
+        codes::TOLERANCE_BELOW_RESOLUTION,
+        message,
+        stated.site.0,
+        stated.site.1,
+    )
+    .with_label(format!(
+        "finer than {} nm",
+        lensc_lang::check::trim_num(suggested * 1e6)
+    ));
     Some(d.with_help(help))
 }
 

@@ -337,17 +337,30 @@ impl<'a> Checker<'a> {
             }
             return ok;
         }
-        if value::field(f, "sense").is_none()
-            && (!radii.is_empty()
-                || o.kind
+        // Every kind that reads `sense` needs it stated, a plane base with
+        // coefficients too: there σ flips every coefficient, so a default
+        // would cut the mould of the part as silently as the part.
+        if value::field(f, "sense").is_none() {
+            let plane_base = radii.is_empty()
+                && !o
+                    .kind
                     .params
                     .iter()
-                    .any(|p| p.name == "radius" && p.required))
-        {
+                    .any(|p| p.name == "radius" && p.required);
+            let help = if plane_base {
+                "with no `radius` the base is a plane and `sense` signs the terms: `sense: concave` cuts them as written (+z towards the tool), `sense: convex` cuts them negated; or write them as designed with `convention: optical`"
+            } else {
+                "add `sense: convex` (a dome) or `sense: concave` (a bowl), or give a signed radius with `convention: optical`"
+            };
             self.err(
-                Diagnostic::error(codes::MISSING_PARAMETER, format!("`{}` is missing `sense`", o.kind.name), o.file, o.head)
-                    .with_label("needs `sense`")
-                    .with_help("add `sense: convex` (a dome) or `sense: concave` (a bowl), or give a signed radius with `convention: optical`"),
+                Diagnostic::error(
+                    codes::MISSING_PARAMETER,
+                    format!("`{}` is missing `sense`", o.kind.name),
+                    o.file,
+                    o.head,
+                )
+                .with_label("needs `sense`")
+                .with_help(help),
             );
             ok = false;
         }

@@ -366,8 +366,34 @@ pub fn job_site(job: &CheckedJob) -> (FileId, lensc_grammar::Span) {
 /// A figure `v` (base units) as a header states it in `unit`: the
 /// shortest decimal that reads back, through the unit, to the same f64
 /// (scientific notation past 17 characters, never `-0`).
+///
+/// A figure the file stated in another unit may have no such decimal
+/// (`0.2 um` is 0.2 × 1e-3 mm, and no d × 1e-6 is that f64): then the
+/// shortest decimal whose product with the unit is that f64's neighbour
+/// (one unit in the last place, the rounding of the unit conversion
+/// itself): `200 nm`, not `200.00000000000003 nm`.
 pub fn exact_in(v: f64, unit: &str) -> String {
-    lensc_runtime::post::header::exact_in(v, crate::units::size_of(unit).unwrap_or(1.0))
+    let size = crate::units::size_of(unit).unwrap_or(1.0);
+    let exact = lensc_runtime::post::header::exact_in(v, size);
+    if size == 1.0 || !v.is_finite() {
+        return exact;
+    }
+    // The fewest significant digits that read back to `v` or, failing
+    // that at this many digits, to a neighbour of it.
+    let shown = v / size;
+    let neighbours = [v.next_down(), v.next_up()];
+    for digits in 0..17 {
+        let Ok(d) = format!("{shown:.digits$e}").parse::<f64>() else {
+            continue;
+        };
+        if d * size == v {
+            return lensc_runtime::post::header::exact(d);
+        }
+        if neighbours.contains(&(d * size)) {
+            return lensc_runtime::post::header::exact(d);
+        }
+    }
+    exact
 }
 
 /// A quantity as a header states it: the figure in its dimension's display

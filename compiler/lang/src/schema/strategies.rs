@@ -14,7 +14,7 @@ const CHORD_TOLERANCE: Param = opt(
     "chord_tolerance",
     LENGTH,
     Check::Positive,
-    "largest chord deviation from the exact tool-centre path; default 10 nm",
+    "largest chord deviation from the exact tool-centre path; default 10 nm, or the smallest the machine's resolution holds (resolution × √axes, rounded up to a whole nm) where that is coarser",
 );
 const CHORDS: Param = opt(
     "chords",
@@ -327,7 +327,7 @@ pub(super) const PROFILE_TURNING: Kind = Kind {
             "chord_tolerance",
             LENGTH,
             Check::Positive,
-            "the path's tolerance: the most the program, as the machine runs it, may stray from the exact tool-centre path; default 10 nm",
+            "the path's tolerance: the most the program, as the machine runs it, may stray from the exact tool-centre path; default 10 nm, or the smallest the machine's resolution holds (resolution × √axes, rounded up to a whole nm) where that is coarser",
         ),
         CHORDS,
         opt(

@@ -43,8 +43,9 @@ pub enum Facing {
     Optical,
     /// `sense: convex`.
     Convex,
-    /// `sense: concave`, or no `sense` (what `convention: sense` means
-    /// without one).
+    /// `sense: concave`. A surface that reads `Facing` states its side:
+    /// the checker refuses one with neither `sense` nor `convention:
+    /// optical` (E0121), a plane base with coefficients too.
     Concave,
 }
 

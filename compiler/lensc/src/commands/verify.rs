@@ -33,6 +33,9 @@ pub fn run(out: &Output, program: &Path, machine: Option<&str>, dialect: Option<
         Ok(h) => h,
         Err(e) => return cannot_read(e),
     };
+    if let Some(job) = servo_table_job(&head) {
+        return verify_table(out, program, job);
+    }
     let header = reader::header_names(&head);
     let machine_name = machine.or(header.as_ref().map(|h| h.machine.as_str()));
     let Some(machine_name) = machine_name else {
@@ -100,6 +103,110 @@ pub fn run(out: &Output, program: &Path, machine: Option<&str>, dialect: Option<
         let _ = writeln!(std::io::stderr(), "error: cannot print the diagnostics");
     }
     1
+}
+
+/// The job of a fast-tool-servo table a build writes beside its program
+/// (`# lensc VERSION fast-tool-servo table for job NAME`), if `head` is
+/// one.
+fn servo_table_job(head: &str) -> Option<&str> {
+    let first = head.lines().next()?.strip_prefix("# lensc ")?;
+    let (_, job) = first.split_once(" fast-tool-servo table for job ")?;
+    Some(job.trim())
+}
+
+/// Reads a servo table as a table: every row after the `#` lines three
+/// finite numbers `C X W`, C never running backwards. Exit 0 with what it
+/// holds, 1 at the first row that is not (E0190).
+fn verify_table(out: &Output, table: &Path, job: &str) -> u8 {
+    let text = match std::fs::read_to_string(table) {
+        Ok(t) => t,
+        Err(e) => {
+            eprintln!(
+                "error[{}]: cannot read {}: {e}",
+                lensc_lang::codes::CANNOT_READ,
+                table.display()
+            );
+            return 1;
+        }
+    };
+    let (mut rows, mut last_c) = (0usize, f64::NEG_INFINITY);
+    let (mut x, mut w) = (
+        (f64::INFINITY, f64::NEG_INFINITY),
+        (f64::INFINITY, f64::NEG_INFINITY),
+    );
+    for (i, line) in text.lines().enumerate() {
+        if line.starts_with('#') || line.trim().is_empty() {
+            continue;
+        }
+        let figures: Vec<f64> = line
+            .split_whitespace()
+            .map_while(|f| f.parse::<f64>().ok().filter(|v| v.is_finite()))
+            .collect();
+        let whole = figures.len() == 3 && line.split_whitespace().count() == 3;
+        if !whole || figures[0] < last_c {
+            eprintln!(
+                "error[{}]: {} line {}: a fast-tool-servo table row is three numbers `C X W` with C in order, not `{}`",
+                lensc_lang::codes::SERVO_TABLE_ROW,
+                table.display(),
+                i + 1,
+                line.trim()
+            );
+            return 1;
+        }
+        last_c = figures[0];
+        x = (x.0.min(figures[1]), x.1.max(figures[1]));
+        w = (w.0.min(figures[2]), w.1.max(figures[2]));
+        rows += 1;
+    }
+    if out.format == MessageFormat::Human {
+        let program = sibling_program(table, job);
+        eprintln!(
+            "{}: a fast-tool-servo table for job {job}, not a program: {rows} rows C X W, C 0 .. {} deg, X {} .. {} mm, W {} .. {} mm, every row three numbers in order; {}",
+            table.display(),
+            lensc_runtime::post::header::num(last_c.max(0.0)),
+            lensc_runtime::post::header::num(x.0),
+            lensc_runtime::post::header::num(x.1),
+            lensc_runtime::post::header::num(w.0),
+            lensc_runtime::post::header::num(w.1),
+            match program {
+                Some(p) => format!(
+                    "the program that drives it is read by `lensc verify {}`",
+                    p.display()
+                ),
+                None => format!(
+                    "the program that drives it (job {job}) is read by `lensc verify PROGRAM`"
+                ),
+            }
+        );
+    }
+    0
+}
+
+/// The program beside a servo table: the other file of the job's name that
+/// is neither the table nor its report.
+fn sibling_program(table: &Path, job: &str) -> Option<std::path::PathBuf> {
+    let dir = table.parent()?;
+    let mut found: Vec<_> = std::fs::read_dir(if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    })
+    .ok()?
+    .filter_map(|e| e.ok().map(|e| e.path()))
+    .filter(|p| {
+        p.file_stem().is_some_and(|s| s == job)
+            && p.extension().is_some_and(|e| e != "json")
+            && p.extension() != table.extension()
+    })
+    .collect();
+    found.sort();
+    found.into_iter().next().map(|p| {
+        if dir.as_os_str().is_empty() {
+            std::path::PathBuf::from(p.file_name().unwrap_or_default())
+        } else {
+            p
+        }
+    })
 }
 
 /// The program's first 200 lines, where its header is.

@@ -167,5 +167,10 @@ fn header_lines(
         "machine {}: {} 3-axis mill",
         head.names.machine, head.dialect.name
     ));
+    // As the report's `cutting_time_s`: the cut's length at the feed.
+    header.push(format!(
+        "estimated cutting time {}",
+        lensc_runtime::post::header::duration(path.cut_length / spec.feed)
+    ));
     header
 }

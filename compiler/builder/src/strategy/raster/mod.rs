@@ -87,7 +87,8 @@ pub(crate) fn lower(
         along: if st.along_y { Axis::Y } else { Axis::X },
         zigzag: st.zigzag,
         stepover: st.stepover,
-        chord_tolerance: p.chord_tolerance(),
+        chord_tolerance: p
+            .chord_tolerance(<RasterSpec as crate::strategy::Strategy>::LENGTH_AXES.unwrap_or(2)),
         max_step: st.max_step,
         lin_angle: st.lin_angle,
         retract: st.retract.unwrap_or(1.0),

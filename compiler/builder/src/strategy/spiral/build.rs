@@ -347,5 +347,9 @@ fn header_lines(spec: &SpiralSpec, prov: &Provenance, table: Option<&str>) -> Ve
         )),
         None => lines.push("settling: none, the tool follows the surface".into()),
     }
+    lines.push(format!(
+        "estimated cutting time {}",
+        lensc_runtime::post::header::duration(spiral.cutting_time())
+    ));
     lines
 }

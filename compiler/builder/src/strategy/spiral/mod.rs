@@ -201,7 +201,8 @@ pub(crate) fn lower(
     let mut spiral = FtsSpiral {
         feed_per_rev: st.feed * 2.0 * std::f64::consts::PI,
         speed,
-        chord_tolerance: p.chord_tolerance(),
+        chord_tolerance: p
+            .chord_tolerance(<SpiralSpec as crate::strategy::Strategy>::LENGTH_AXES.unwrap_or(2)),
         seed_arc: st.seed_arc.unwrap_or(0.1),
         min_interval: 1.0 / fast.data_rate(),
         start_radius: start,

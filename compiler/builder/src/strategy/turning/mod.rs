@@ -183,7 +183,8 @@ fn profile_turning(
     f: &ProfileTurningParams,
     feed: Feed,
 ) -> Result<ProfileTurning, Vec<Diagnostic>> {
-    let tolerance = p.chord_tolerance();
+    let tolerance =
+        p.chord_tolerance(<TurningSpec as crate::strategy::Strategy>::LENGTH_AXES.unwrap_or(2));
     Ok(ProfileTurning {
         // The chords take their share of the tolerance, the fitted lines
         // and arcs theirs (`plan::optimise`).

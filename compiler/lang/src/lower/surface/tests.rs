@@ -122,7 +122,7 @@ fn zernike_indices_follow_the_tables() {
 
 #[test]
 fn zernike_terms_match_their_polynomials() {
-    let base = "surface w = zernike { norm_radius: 2 mm, ordering: ORD, aperture: circle(radius: 2 mm), TERM: 1 um }";
+    let base = "surface w = zernike { sense: concave, norm_radius: 2 mm, ordering: ORD, aperture: circle(radius: 2 mm), TERM: 1 um }";
     let at = |ord: &str, term: &str, x: f64, y: f64| {
         eval_surface(&base.replace("ORD", ord).replace("TERM", term), "w", x, y)[0]
     };
@@ -234,7 +234,7 @@ fn cylinder_toroid_biconic_ellipsoid_and_xy_polynomial() {
     ));
     // XY polynomial on a plane: 0.01 x²y − 0.002 y³ (coefficients in mm^-2).
     let p = eval_surface(
-        "surface p = xy_polynomial { aperture: circle(radius: 1 mm), X2Y1: 0.01 mm^-2, X0Y3: -0.002 mm^-2 }",
+        "surface p = xy_polynomial { sense: concave, aperture: circle(radius: 1 mm), X2Y1: 0.01 mm^-2, X0Y3: -0.002 mm^-2 }",
         "p",
         x,
         y,
