@@ -682,7 +682,7 @@ mod tests {
     /// one; the reader's matches over keywords are too).
     #[test]
     fn every_siemens_word_reads_back_from_its_name() {
-        assert_eq!(SiemensWord::ALL.len(), SiemensWord::Ffwof as usize + 1);
+        assert_eq!(SiemensWord::ALL.len(), SiemensWord::Supa as usize + 1);
         for (i, w) in SiemensWord::ALL.into_iter().enumerate() {
             assert_eq!(w as usize, i);
             assert_eq!(SiemensWord::of(w.name()), Some(w));
