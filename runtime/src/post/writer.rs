@@ -120,6 +120,9 @@ pub struct ProgramWriter {
     /// Constant surface speed is on and selects feed per revolution
     /// itself (`Dialect::surface_speed_per_revolution`).
     css_per_revolution: bool,
+    /// `common_blocks` as it was before a pending length offset turned it
+    /// off, restored once the offset is written.
+    common_blocks_after_offset: bool,
     /// The most digits before the point per word letter A…Z, as a power
     /// of ten (`u64::MAX`: no limit).
     integer_limit: [u64; 26],
@@ -296,6 +299,7 @@ impl ProgramWriter {
             spindle: Spindle::Stopped,
             pending_length_offset: None,
             css_per_revolution: false,
+            common_blocks_after_offset: false,
             integer_limit: limits,
             feed_decimals,
             feed_format: Decimals::new(feed_decimals),
@@ -334,6 +338,11 @@ impl ProgramWriter {
             check_numbers(&words, self.dialect.comment)?;
             check_word_formats(&words, &self.dialect)?;
             self.pending_length_offset = Some(words);
+            // Every block takes the general path until the offset is
+            // written (the common path's test stays as it was: its cost
+            // is per line).
+            self.common_blocks_after_offset = self.common_blocks;
+            self.common_blocks = false;
         }
         self.start = Some(*start);
         Ok(())
@@ -777,6 +786,7 @@ impl ProgramWriter {
         {
             self.text.extend_from_slice(words.as_bytes());
             self.text.push(b' ');
+            self.common_blocks = std::mem::take(&mut self.common_blocks_after_offset);
         }
         if let Some((m, ..)) = mode
             && mode_changes

@@ -44,11 +44,9 @@ impl ProgramWriter {
         // The general path's checks before a block: the tool called, the
         // C axis switched on before its first move, no feed move with
         // the spindle stopped (unless the C axis turns the part).
-        if !self.common_blocks
-            || self.start.is_none()
-            || (!to.c.is_nan() && !self.c_axis_on)
-            || (self.pending_length_offset.is_some() && !to.z.is_nan())
-        {
+        // (A length offset waiting for its first Z move turns
+        // `common_blocks` off until the general path has written it.)
+        if !self.common_blocks || self.start.is_none() || (!to.c.is_nan() && !self.c_axis_on) {
             return false;
         }
         if matches!(word, Word::Linear) && self.spindle == Spindle::Stopped && !self.c_axis_on {
