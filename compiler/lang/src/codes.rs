@@ -213,6 +213,10 @@ pub const PROGRAM_BLOCK_SEQUENCE: &str = "E0330";
 pub const PROGRAM_NO_CIRCLE_CENTRE: &str = "E0331";
 /// Klartext: the program not framed by `BEGIN PGM` and `END PGM` of one name.
 pub const PROGRAM_FRAME: &str = "E0332";
+/// A parameter word no code of its block uses (LinuxCNC).
+pub const PROGRAM_UNUSED_WORD: &str = "E0333";
+/// An arc from a point the program never stated.
+pub const PROGRAM_POSITION_UNKNOWN: &str = "E0334";
 
 /// A fast-tool-servo table (`lensc verify`) with a row that is not three
 /// numbers C X W, or whose C runs backwards.
@@ -255,6 +259,8 @@ pub fn program_rule(rule: lensc_runtime::reader::Rule) -> &'static str {
         BlockSequence => PROGRAM_BLOCK_SEQUENCE,
         NoCircleCentre => PROGRAM_NO_CIRCLE_CENTRE,
         ProgramFrame => PROGRAM_FRAME,
+        UnusedWord => PROGRAM_UNUSED_WORD,
+        PositionUnknown => PROGRAM_POSITION_UNKNOWN,
     }
 }
 
@@ -372,6 +378,8 @@ pub const ALL: &[&str] = &[
     PROGRAM_BLOCK_SEQUENCE,
     PROGRAM_NO_CIRCLE_CENTRE,
     PROGRAM_FRAME,
+    PROGRAM_UNUSED_WORD,
+    PROGRAM_POSITION_UNKNOWN,
     SERVO_TABLE_ROW,
     ACCEPTANCE_MISSED_WARNING,
     ACCEPTANCE_UNMEASURED_WARNING,

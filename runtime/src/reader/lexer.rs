@@ -312,6 +312,12 @@ impl Lexer {
                     .unwrap_or(code.len() - i);
                 continue;
             }
+            if c == b'/' && self.controller == Controller::LinuxCnc && code[..i].trim().is_empty() {
+                // Block delete, first on the line: the block is read as
+                // run (the switch off, as `rs274 -g` runs it).
+                i += 1;
+                continue;
+            }
             if !c.is_ascii_alphabetic() {
                 let end = i + code[i..].chars().next().map_or(1, char::len_utf8);
                 out.push(unknown(
@@ -445,7 +451,8 @@ impl Lexer {
         let format = self.formats.iter().find(|f| f.letter == letter);
         let whole = format.is_some_and(|f| f.decimals.is_none());
         WordLimits {
-            point: !(whole || integer_only(self.controller, letter)),
+            point: self.controller == Controller::LinuxCnc
+                || !(whole || integer_only(self.controller, letter)),
             integer_only: integer_only(self.controller, letter),
             max_decimals: format.and_then(|f| f.decimals).or(self.max_decimals),
             // No limit on the digits to hold them against: not counted.
@@ -460,7 +467,25 @@ impl Lexer {
     pub(crate) fn number_format(&self, w: &Word, code: &str, out: &mut Vec<Found>) {
         let text = &code[w.span.0..w.span.1];
         let limits = self.limits(w.letter);
-        if w.point && !limits.point {
+        if self.controller == Controller::LinuxCnc {
+            // LinuxCNC reads any word with a point; M, T and H must be
+            // whole numbers within 0.0001 as its `read_integer_value`
+            // takes them: the fraction above the floor over 0.0001 and
+            // under 0.9999 is "Non integer value for integer" (`M3.00009`
+            // reads, `M3.0001` and `T1.0002` do not).
+            let fraction = w.value - w.value.floor();
+            if matches!(w.letter, 'M' | 'T' | 'H') && fraction > 1e-4 && fraction <= 0.9999 {
+                out.push((
+                    Rule::DecimalPoint,
+                    w.span,
+                    format!(
+                        "`{text}`: LinuxCNC reads {} words as whole numbers (within 0.0001)",
+                        w.letter
+                    ),
+                    Some(format!("write {}{}", w.letter, w.value.round())),
+                ));
+            }
+        } else if w.point && !limits.point {
             let whose = if limits.integer_only {
                 "this controller reads"
             } else {
@@ -601,6 +626,10 @@ fn cycle_call(code: &str, i: usize) -> Option<(usize, usize)> {
 /// point cannot be used" in these addresses).
 fn integer_only(c: Controller, letter: char) -> bool {
     match letter {
+        // LinuxCNC reads a line number with a point (`N56.78`) and an M
+        // code within 0.0001 of a whole number (`M3.`, `M3.00001`; `M3.0001`
+        // is "Non integer value for integer"): `Lexer::number_format`.
+        'N' | 'M' if c == Controller::LinuxCnc => false,
         'N' | 'O' | 'M' => true,
         'T' => c != Controller::LinuxCnc,
         'S' | 'D' | 'H' | 'P' | 'L' => c == Controller::Fanuc,

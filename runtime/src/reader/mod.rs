@@ -114,6 +114,11 @@ pub enum Rule {
     /// Klartext: the program not opened by `BEGIN PGM` or not closed by
     /// `END PGM` of the same name.
     ProgramFrame,
+    /// A parameter word (I J K R P Q L D H) no code of its block uses
+    /// (LinuxCNC).
+    UnusedWord,
+    /// An arc from a point the program never stated (lensc's policy).
+    PositionUnknown,
 }
 
 /// One thing wrong with a program: where (line from 1, byte span in the

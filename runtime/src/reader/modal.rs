@@ -12,6 +12,7 @@ use crate::dialect::Dialect;
 use crate::moves::Plane;
 
 mod fast;
+mod word_use;
 
 /// How F is read.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -266,6 +267,9 @@ impl State {
         if !self.classify(b, line, out, groups, ms) {
             return;
         }
+        if self.lex.controller == Controller::LinuxCnc {
+            self.word_use(b, groups, line, out);
+        }
         self.modes(b, groups, line, out);
         self.spindle_and_tool(b, groups, ms, line, out);
         // A move to a machine position (G28, G53, Siemens' SUPA,
@@ -375,19 +379,27 @@ impl State {
         ms.clear();
         for (i, w) in b.words.iter().enumerate() {
             match w.letter {
-                'G' => match g_tenths(w.value).and_then(|code| self.g_group(code)) {
+                'G' => match self.g_code(w.value).and_then(|code| self.g_group(code)) {
                     Some(g) => {
                         let siemens = self.lex.controller == Controller::Siemens;
-                        if let Some(&(_, o)) =
-                            groups.iter().find(|(o, _)| same_group(*o, g, siemens))
-                        {
+                        let linuxcnc = self.lex.controller == Controller::LinuxCnc;
+                        if let Some(&(_, o)) = groups.iter().find(|(o, _)| {
+                            if linuxcnc {
+                                same_group_linuxcnc(*o, g)
+                            } else {
+                                same_group(*o, g, siemens)
+                            }
+                        }) {
                             out.push(conflict(w, &b.words[o], line));
                         }
                         groups.push((g, i));
                     }
                     None => out.push(unknown_code(w, line)),
                 },
-                'M' => match self.m_code(w.value as i64).filter(|_| !w.point) {
+                'M' => match self
+                    .m_code(w.value.round() as i64)
+                    .filter(|_| !w.point || self.lex.controller == Controller::LinuxCnc)
+                {
                     Some(m) => {
                         if let Some(&(_, o)) = ms.iter().find(|(o, _)| same_m_group(*o, m)) {
                             out.push(conflict(w, &b.words[o], line));
@@ -413,12 +425,24 @@ impl State {
         out.len() == before
     }
 
+    /// A G word's code in tenths: within 1e-9 of a tenth, or on LinuxCNC
+    /// within 0.001 of one, as its interpreter reads it (`G1.0001` is G1,
+    /// `G1.00011` "G-code out of range").
+    pub(super) fn g_code(&self, value: f64) -> Option<i64> {
+        if self.lex.controller != Controller::LinuxCnc {
+            return g_tenths(value);
+        }
+        let scaled = value * 10.0;
+        let code = round_to_integer(scaled);
+        ((scaled - code as f64).abs() <= 0.001 + 1e-9).then_some(code)
+    }
+
     fn known_letter(&self, l: char) -> bool {
         let letters = match self.lex.controller {
             Controller::Fanuc if self.system_a => "XYZCUWIJKRFSTDHPQLNO",
             Controller::Fanuc => "XYZCIJKRFSTDHPQLNO",
             Controller::UltraPrecision => "XYZCWIJKRFSTDHPQLNO",
-            Controller::LinuxCnc => "XYZABCUVWIJKRFSTDHPQLN",
+            Controller::LinuxCnc => "XYZABCIJKRFSTDHPQLN",
             Controller::Siemens => "XYZABCIJKRFSTDHPLN",
             Controller::HeidenhainIso => "XYZABCIJKRFSTLPHN",
             Controller::HeidenhainKlartext => "XYZIJFSTN",
@@ -510,7 +534,10 @@ impl State {
                 GGroup::Plane(p) => self.plane = Some(p),
                 GGroup::Distance(a) => self.absolute = Some(a),
                 GGroup::Feed(m) => {
-                    if self.feed_mode != Some(m) {
+                    // LinuxCNC forgets F at every G93/G94/G95, the mode in
+                    // force restated too ("Cannot do g1 with zero feed
+                    // rate" after `G95` then `G1` with no F).
+                    if self.feed_mode != Some(m) || self.lex.controller == Controller::LinuxCnc {
                         self.feed = None;
                     }
                     self.feed_mode = Some(m);
@@ -527,7 +554,16 @@ impl State {
                     }
                     self.feed_mode = Some(FeedMode::PerRevolution);
                 }
-                GGroup::Diameter(d) => self.diameter = d && self.machine.lathe,
+                // LinuxCNC's interpreter knows no lathe from a mill: G7
+                // reads X as a diameter on either.
+                GGroup::Diameter(d) => {
+                    self.diameter =
+                        d && (self.machine.lathe || self.lex.controller == Controller::LinuxCnc)
+                }
+                // A length offset taken or dropped moves the program's
+                // coordinates by the tool's length, which the reader does
+                // not know: where the tool is becomes unknown.
+                GGroup::ToolLength => self.pos = [None; 4],
                 GGroup::Motion(m) => self.motion = Some(m),
                 _ => {}
             }
@@ -756,6 +792,15 @@ fn same_group(a: GGroup, b: GGroup, siemens: bool) -> bool {
         return true;
     }
     !matches!(a, NonModal | WorkOffset) && std::mem::discriminant(&a) == std::mem::discriminant(&b)
+}
+
+/// Whether two G codes are of one modal group on LinuxCNC, whose group 0
+/// holds the non-modal codes (G4, G28, G53 …) and group 12 the work
+/// offsets: two of either in a block are refused too.
+fn same_group_linuxcnc(a: GGroup, b: GGroup) -> bool {
+    use GGroup::*;
+    let group_0 = |g| matches!(g, NonModal | MachineMove);
+    (group_0(a) && group_0(b)) || std::mem::discriminant(&a) == std::mem::discriminant(&b)
 }
 
 fn same_m_group(a: MCode, b: MCode) -> bool {

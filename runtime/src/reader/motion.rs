@@ -247,7 +247,9 @@ impl State {
         self.may_cut(b, span, out);
         let (length, path) = match motion {
             Motion::Cw | Motion::Ccw => {
-                match self.arc(motion == Motion::Cw, start, end, centre, span, line, out) {
+                let turns = b.words.iter().find(|w| w.letter == 'P');
+                let cw = motion == Motion::Cw;
+                match self.arc(cw, start, end, centre, turns, span, line, out) {
                     Some((length, arc)) => (Some(length), Some(arc)),
                     None => (None, None),
                 }
@@ -414,6 +416,7 @@ impl State {
         start: &[Option<f64>; 4],
         end: &[Option<f64>; 4],
         centre: &[&Word],
+        turns: Option<&Word>,
         span: (usize, usize),
         line: &str,
         out: &mut Vec<Found>,
@@ -440,6 +443,26 @@ impl State {
             );
             return None;
         }
+        // LinuxCNC's radius format (`G2 X… Z… R…`, doc 11.5.5.3): the
+        // centre from the radius; elsewhere R is not a centre word.
+        let linuxcnc = self.lex.controller == Controller::LinuxCnc;
+        let radius = centre.iter().find(|w| w.letter == 'R' && linuxcnc);
+        let centre: Vec<&Word> = centre
+            .iter()
+            .copied()
+            .filter(|w| !(w.letter == 'R' && linuxcnc))
+            .collect();
+        if let (Some(r), Some(w)) = (radius, centre.first()) {
+            arc_words(
+                format!(
+                    "`{}` and `{}`: an arc is given by its centre or by its radius, not both",
+                    w.text(line),
+                    r.text(line)
+                ),
+                r.span,
+            );
+            return None;
+        }
         if let Some(w) = centre.iter().find(|w| !letters.contains(&w.letter)) {
             arc_words(
                 format!(
@@ -453,11 +476,21 @@ impl State {
             );
             return None;
         }
-        if centre.is_empty() {
+        if centre.is_empty() && radius.is_none() {
             arc_words("an arc with no centre (I, J or K)".into(), span);
             return None;
         }
+        let turns = self.turns(turns, line, out)?;
         let (Some(sa), Some(sb), Some(ea), Some(eb)) = (start[a], start[b], end[a], end[b]) else {
+            out.push((
+                Rule::PositionUnknown,
+                span,
+                format!(
+                    "an arc from a point the program never stated (its {} or {} is unknown here): its centre and radius depend on where the tool happens to stand",
+                    AXIS[a], AXIS[b]
+                ),
+                Some("move to a stated position, absolute, before the arc".into()),
+            ));
             return None;
         };
         let unit = self.mm_per_unit();
@@ -467,7 +500,9 @@ impl State {
                 .find(|w| w.letter == l)
                 .map(|w| w.value * unit)
         };
-        let (ca, cb) = if self.arc_centre_absolute {
+        let (ca, cb) = if let Some(r) = radius {
+            self.radius_centre(cw, (sa, sb), (ea, eb), r.value * unit, r.span, out)?
+        } else if self.arc_centre_absolute {
             (
                 word(letters[0]).unwrap_or(sa),
                 word(letters[1]).unwrap_or(sb),
@@ -489,7 +524,7 @@ impl State {
             } else {
                 t.rem_euclid(tau)
             };
-            if t == 0.0 { tau } else { t }
+            (if t == 0.0 { tau } else { t }) + tau * (turns - 1) as f64
         };
         let rise = match (start[third], end[third]) {
             (Some(p), Some(q)) => q - p,
@@ -502,6 +537,75 @@ impl State {
             turn,
         };
         Some(((0.5 * (r1 + r2) * turn).hypot(rise), arc))
+    }
+
+    /// The turns an arc's P word asks (LinuxCNC, doc 11.5.5: a whole
+    /// number, 1 or more; 1 when there is none); `None`, refused, for any
+    /// other P.
+    fn turns(&self, p: Option<&Word>, line: &str, out: &mut Vec<Found>) -> Option<u32> {
+        let Some(p) = p else {
+            return Some(1);
+        };
+        let whole = (p.value - p.value.round()).abs() < 1e-4;
+        if self.lex.controller == Controller::LinuxCnc && whole && p.value >= 1.0 {
+            return Some(p.value.round().min(1e6) as u32);
+        }
+        out.push((
+            Rule::ArcWords,
+            p.span,
+            format!(
+                "`{}`: an arc's P is its number of turns, a whole number from 1",
+                p.text(line)
+            ),
+            None,
+        ));
+        None
+    }
+
+    /// The centre of a radius-format arc from `s` to `e` (in the plane's
+    /// order) of radius `r` (mm): LinuxCNC's `arc_data_r` — on the right
+    /// of the chord for G2 and a positive R (under half a turn), on the
+    /// left for G3, the other side for a negative R. Refused: an end at
+    /// the start, or a radius too small to reach the end (beyond 0.0001).
+    fn radius_centre(
+        &self,
+        cw: bool,
+        s: (f64, f64),
+        e: (f64, f64),
+        r: f64,
+        span: (usize, usize),
+        out: &mut Vec<Found>,
+    ) -> Option<(f64, f64)> {
+        let (dx, dy) = (e.0 - s.0, e.1 - s.1);
+        let half = 0.5 * dx.hypot(dy);
+        if half == 0.0 {
+            out.push((
+                Rule::FullCircle,
+                span,
+                "a radius-format arc that ends where it starts: it has no centre, and the controller refuses it".into(),
+                Some("give a full circle by its centre (I, J, K)".into()),
+            ));
+            return None;
+        }
+        if r.abs() < half - 1e-4 || !r.is_finite() {
+            out.push((
+                Rule::ArcRadiusMismatch,
+                span,
+                format!(
+                    "R {} mm cannot reach the arc's end, {} mm away: the controller refuses it",
+                    num(r),
+                    num(2.0 * half)
+                ),
+                None,
+            ));
+            return None;
+        }
+        let h = (r * r - half * half).max(0.0).sqrt();
+        // The chord's unit vector, turned a quarter to its right.
+        let (ux, uy) = (dx / (2.0 * half), dy / (2.0 * half));
+        let right = if cw == (r > 0.0) { 1.0 } else { -1.0 };
+        let mid = (s.0 + 0.5 * dx, s.1 + 0.5 * dy);
+        Some((mid.0 + right * h * uy, mid.1 - right * h * ux))
     }
 
     fn arc_radii(

@@ -279,3 +279,130 @@ fn a_program_read_from_a_stream_reads_as_line_by_line() {
         }
     }
 }
+
+/// LinuxCNC refuses a parameter word no code of its block uses, and two
+/// codes that both take the axis words; the words its codes do use pass
+/// (each case checked with `rs274 -g`, linuxcnc-uspace 2.9).
+#[test]
+fn linuxcnc_refuses_words_no_code_of_the_block_uses() {
+    let d = Dialect::linuxcnc();
+    let refused: &[(&str, &str, Rule)] = &[
+        ("G0 X3 Z1.5", "G0 X3 Z1.5 R1", Rule::UnusedWord),
+        ("G0 X3 Z1.5", "G0 X3 Z1.5 I1", Rule::UnusedWord),
+        (
+            "G95 G1 Z0.1 F0.002",
+            "G95 G1 Z0.1 F0.002 P1",
+            Rule::UnusedWord,
+        ),
+        (
+            "G95 G1 Z0.1 F0.002",
+            "G95 G1 Z0.1 F0.002 Q1",
+            Rule::UnusedWord,
+        ),
+        (
+            "G95 G1 Z0.1 F0.002",
+            "G95 G1 Z0.1 F0.002 L1",
+            Rule::UnusedWord,
+        ),
+        (
+            "G95 G1 Z0.1 F0.002",
+            "G95 G1 Z0.1 F0.002 D1",
+            Rule::UnusedWord,
+        ),
+        (
+            "G95 G1 Z0.1 F0.002",
+            "G95 G1 Z0.1 F0.002 H1",
+            Rule::UnusedWord,
+        ),
+        ("G97 S500 M3", "G97 S500 M3 P1", Rule::UnusedWord),
+        ("G97 S500 M3", "G97 D100 S500 M3", Rule::UnusedWord),
+        ("M5\n", "M5\nK1\n", Rule::UnusedWord),
+        ("G0 X3 Z1.5", "G0 X3 Z1.5 U1", Rule::UnknownWord),
+        ("G0 X3 Z1.5", "G0 X3 Z1.5 W1", Rule::UnknownWord),
+        ("G0 Z1.5\nM5", "G28 G0 Z1.5\nM5", Rule::SameModalGroup),
+        ("M5\n", "M5\nG3\n", Rule::ArcWords),
+        ("M5\n", "M5\nG53\n", Rule::UnusedWord),
+        ("G0 Z1.5\nM5", "G53 G2 X3 Z1.5 I1\nM5", Rule::UnusedWord),
+    ];
+    for (from, to, rule) in refused {
+        let text = GOOD.replacen(from, to, 1);
+        assert_ne!(text, GOOD, "{from}");
+        let found = rules(&text, &d, &lathe());
+        assert!(found.contains(rule), "{to}: {found:?}");
+    }
+    let read: &[(&str, &str)] = &[
+        ("M5\n", "M5\nM19 R0 Q1 P0\n"),
+        ("T1 M6\n", "T1 M6 G43 H1\nG64 P0.001 Q0.001\nG4 P0.5\n"),
+        ("G97 S500 M3", "G96 D500 S50 M3"),
+        ("G0 Z1.5\nM5", "G0 Z1.5\nG28\nM5"),
+        ("G0 Z1.5\nM5", "G0 Z1.5\nG53 G0 Z2\nM5"),
+    ];
+    for (from, to) in read {
+        let text = GOOD.replacen(from, to, 1);
+        assert_ne!(text, GOOD, "{from}");
+        assert_eq!(rules(&text, &d, &lathe()), vec![], "{to}");
+    }
+}
+
+/// What LinuxCNC reads that the reader refused before (issue #28): a
+/// radius-format arc, an arc with a turn count, block delete, `M3.`,
+/// `S1000.5`, a line number with a point; and the arcs it makes of them.
+#[test]
+fn linuxcnc_reads_radius_arcs_turns_and_block_delete() {
+    let d = Dialect::linuxcnc();
+    // The arc of GOOD from (3, 0.1) to (0, 0.469317) about (Z -11.9, X 0):
+    // radius hypot(3, 12) = 12.369317…
+    let r = 3f64.hypot(12.0);
+    let by_radius = GOOD.replace("I-3 K-12", &format!("R{r:.6}"));
+    assert_eq!(rules(&by_radius, &d, &lathe()), vec![], "{by_radius}");
+    let (_, moves) = read_moves(&by_radius, &d, &lathe());
+    let (_, want) = read_moves(GOOD, &d, &lathe());
+    let arc = |m: &[Executed]| {
+        m.iter()
+            .find_map(|m| match m.path {
+                Path::Arc { centre, turn, .. } => Some((centre, turn)),
+                _ => None,
+            })
+            .expect("an arc")
+    };
+    let ((cz, cx), turn) = arc(&moves);
+    let ((wz, wx), wturn) = arc(&want);
+    assert!(
+        (cz - wz).abs() < 1e-5 && (cx - wx).abs() < 1e-5,
+        "{cz} {cx}"
+    );
+    assert!((turn - wturn).abs() < 1e-6);
+    // Two turns more with P3.
+    let turns = GOOD.replace("I-3 K-12", "I-3 K-12 P3");
+    let (found, moves) = read_moves(&turns, &d, &lathe());
+    assert_eq!(found, vec![]);
+    let (_, turn) = arc(&moves);
+    assert!((turn - wturn - 2.0 * std::f64::consts::TAU).abs() < 1e-9);
+    for (from, to, rule) in [
+        ("I-3 K-12", "I-3 K-12 P1.5", Rule::ArcWords),
+        ("I-3 K-12", "I-3 K-12 P0", Rule::ArcWords),
+        ("I-3 K-12", "R1", Rule::ArcRadiusMismatch),
+        ("I-3 K-12", "I-3 K-12 R12", Rule::ArcWords),
+        ("M5\n", "M5.001\n", Rule::DecimalPoint),
+        ("G0 X3 Z1.5", "G0 Z1.5", Rule::PositionUnknown),
+        (
+            "G95 G1 Z0.1 F0.002",
+            "G95 G1 Z0.1 F0.002\nG95 G1 Z0.1",
+            Rule::NoFeedRate,
+        ),
+        ("G97 S500 M3", "G97 S500 M3 G1", Rule::NoFeedRate),
+    ] {
+        let text = GOOD.replacen(from, to, 1);
+        let found = rules(&text, &d, &lathe());
+        assert!(found.contains(&rule), "{to}: {found:?}");
+    }
+    for (from, to) in [
+        ("M5\n", "/M5\n"),
+        ("M5\n", "  / M5.\n"),
+        ("G97 S500 M3", "G97 S500.5 M3."),
+        ("M5\n", "N10.5 M5.00001\n"),
+    ] {
+        let text = GOOD.replacen(from, to, 1);
+        assert_eq!(rules(&text, &d, &lathe()), vec![], "{to}");
+    }
+}

@@ -1,0 +1,204 @@
+//! The words a LinuxCNC block's codes use: a parameter word (I J K R P Q
+//! L D H) that no code of its block takes is refused, as the RS274NGC
+//! interpreter refuses it (`interp_check.cc`, `check_other_codes`; its
+//! messages, such as "I word with no G2, G3, G5, G5.1, G10, G33.1, G76,
+//! or G87 to use it", are those of `rs274 -g` from linuxcnc-uspace 2.9,
+//! checked block by block in `docs/controllers/linuxcnc.md`), and so are
+//! two codes that both take the axis words (G28 with a motion code).
+//!
+//! The motion a block's words go to is the block's own motion code, or,
+//! when the block has axis words (or, in an arc mode, centre words) and
+//! no code of its own, the motion mode in force: the interpreter's
+//! `motion_to_be`. Codes the reader does not know (G10, canned cycles,
+//! G33, G76, M66 …) are refused as unknown before this rule, so the uses
+//! they would give a word are not listed here.
+
+use super::super::Rule;
+use super::super::lexer::{Block, Found};
+use super::{GGroup, Motion, State};
+
+/// What a block holds that may use a parameter word.
+struct Users {
+    /// The motion the block's words go to (`motion_to_be`).
+    motion: Option<Motion>,
+    /// The block's G codes, in tenths (`G64` is 640).
+    g: Vec<i64>,
+    /// The block's M codes.
+    m: Vec<i64>,
+}
+
+impl Users {
+    fn g(&self, code: i64) -> bool {
+        self.g.contains(&code)
+    }
+
+    fn arc(&self) -> bool {
+        matches!(self.motion, Some(Motion::Cw | Motion::Ccw))
+    }
+
+    /// Whether a code of the block uses `letter`, by LinuxCNC's rules; the
+    /// codes that would, for the message.
+    fn uses(&self, letter: char) -> (bool, &'static str) {
+        let spline = |codes: &[i64]| codes.iter().any(|c| self.g(*c));
+        match letter {
+            'I' | 'J' => (
+                self.arc() || spline(&[50, 51]),
+                "G2, G3, G5 or G5.1 (or G10, G33.1, G76, G87, which lensc does not read)",
+            ),
+            'K' => (
+                self.arc(),
+                "G2 or G3 (or G33, G33.1, G76, G87, which lensc does not read)",
+            ),
+            'R' => (
+                self.arc() || self.m.contains(&19),
+                "G2, G3 or M19 (or G10 and the canned cycles, which lensc does not read)",
+            ),
+            'P' => (
+                self.arc() || spline(&[40, 50, 52, 640]) || self.m.contains(&19),
+                "G2, G3 (turns), G4 (dwell), G5, G5.2, G64 or M19",
+            ),
+            'Q' => (spline(&[50, 640]) || self.m.contains(&19), "G5, G64 or M19"),
+            'L' => (
+                spline(&[52]) || spline(&[410, 420]),
+                "G5.2 or cutter compensation (G41, G42)",
+            ),
+            'D' => (spline(&[410, 420, 960]), "G41, G42 or G96"),
+            'H' => (self.g(430), "G43"),
+            _ => (true, ""),
+        }
+    }
+}
+
+impl State {
+    /// Every parameter word no code of the block uses, and two codes of
+    /// the block that both take its axis words (LinuxCNC only).
+    pub(super) fn word_use(
+        &self,
+        b: &Block,
+        groups: &[(GGroup, usize)],
+        line: &str,
+        out: &mut Vec<Found>,
+    ) {
+        let g: Vec<i64> = b
+            .words
+            .iter()
+            .filter(|w| w.letter == 'G')
+            .filter_map(|w| self.g_code(w.value))
+            .collect();
+        let m: Vec<i64> = b
+            .words
+            .iter()
+            .filter(|w| w.letter == 'M')
+            .map(|w| w.value.round() as i64)
+            .collect();
+        let own = groups.iter().find_map(|(g, i)| match g {
+            GGroup::Motion(m) => Some((*m, *i)),
+            _ => None,
+        });
+        let axis_users = groups
+            .iter()
+            .find(|(g, _)| *g == GGroup::MachineMove)
+            .filter(|(_, i)| self.g_code(b.words[*i].value) == Some(280));
+        if let (Some((_, i)), Some(&(_, j))) = (own, axis_users) {
+            out.push((
+                Rule::SameModalGroup,
+                b.words[i].span,
+                format!(
+                    "`{}` and `{}` both take the block's axis words: the controller refuses the block",
+                    b.words[j].text(line),
+                    b.words[i].text(line)
+                ),
+                Some("put the motion and the G28 in blocks of their own".into()),
+            ));
+        }
+        let has = |letters: &[char]| b.words.iter().any(|w| letters.contains(&w.letter));
+        let modal_arc = matches!(self.motion, Some(Motion::Cw | Motion::Ccw));
+        let motion = match own {
+            Some((m, _)) => Some(m),
+            None if axis_users.is_none()
+                && (has(&['X', 'Y', 'Z', 'A', 'B', 'C'])
+                    || (modal_arc && has(&['I', 'J', 'K', 'R']))) =>
+            {
+                self.motion
+            }
+            None => None,
+        };
+        if let Some((arc @ (Motion::Cw | Motion::Ccw), i)) = own
+            && !has(&['I', 'J', 'K', 'R'])
+        {
+            out.push((
+                Rule::ArcWords,
+                b.words[i].span,
+                format!(
+                    "`{}` with no centre (I, J, K) or radius (R): the controller refuses the block",
+                    b.words[i].text(line)
+                ),
+                Some(format!(
+                    "give the arc its end and centre, or leave the {} out",
+                    if arc == Motion::Cw { "G2" } else { "G3" }
+                )),
+            ));
+        }
+        if let Some(i) = b
+            .words
+            .iter()
+            .position(|w| w.letter == 'G' && self.g_code(w.value) == Some(530))
+            && !matches!(motion, Some(Motion::Rapid | Motion::Linear))
+        {
+            out.push((
+                Rule::UnusedWord,
+                b.words[i].span,
+                "`G53` with no straight move (G0 or G1 with axis words) to go to machine coordinates: the controller refuses it".into(),
+                Some("write G53 in a block with G0 or G1 and the axis words".into()),
+            ));
+        }
+        // A feed motion code with no feed in force, in a block with no
+        // axis words: "Cannot do g1 with zero feed rate" (a block with
+        // axis words is `motion`'s to check).
+        let feed_code = groups.iter().any(|(g, _)| matches!(g, GGroup::Feed(_)));
+        let feed = has(&['F']) || (self.feed.is_some() && !feed_code);
+        if let Some((Motion::Linear | Motion::Cw | Motion::Ccw, i)) = own
+            && !feed
+            && !has(&['X', 'Y', 'Z', 'A', 'B', 'C'])
+        {
+            out.push((
+                Rule::NoFeedRate,
+                b.words[i].span,
+                format!(
+                    "`{}` with no feed (F) in force: the controller refuses it (a G93, G94 or G95 forgets F)",
+                    b.words[i].text(line)
+                ),
+                Some("give F in this block".into()),
+            ));
+        }
+        let users = Users { motion, g, m };
+        for w in &b.words {
+            let (used, by) = users.uses(w.letter);
+            if !used {
+                out.push((
+                    Rule::UnusedWord,
+                    w.span,
+                    format!(
+                        "`{}`: no code of this block uses {} word (the controller refuses it)",
+                        w.text(line),
+                        a_word(w.letter)
+                    ),
+                    Some(format!(
+                        "{} word goes with {by}; take it out or add the code meant",
+                        a_word(w.letter)
+                    )),
+                ));
+            }
+        }
+    }
+}
+
+/// "an R", "a P": the letter with its article, as it is spoken.
+fn a_word(letter: char) -> String {
+    let article = if "AEFHILMNORSX".contains(letter) {
+        "an"
+    } else {
+        "a"
+    };
+    format!("{article} {letter}")
+}
