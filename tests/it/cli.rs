@@ -741,3 +741,97 @@ fn a_job_with_no_chord_tolerance_builds_on_every_0_1_um_stdlib_machine() {
         assert!(t.contains(&format!("path tolerance {tolerance}")), "{t}");
     }
 }
+
+/// `lensc verify` tells lensc's policy from the controller's rules: a
+/// policy finding is named (text and JSON, with its reason), fails by
+/// default and only warns under `--policy warn`; a controller finding
+/// fails either way (issue #28, item 3).
+#[test]
+fn verify_tells_policy_findings_from_the_controllers() {
+    let plunge = "tests/bad_programs/e0315_rapid_plunge.ngc";
+    let out = lensc(&root(), &["--message-format", "json", "verify", plunge]);
+    assert_eq!(out.status.code(), Some(1));
+    let v: serde_json::Value =
+        serde_json::from_str(text(&out.stdout).lines().next().expect("a line")).expect("json");
+    assert_eq!(v["class"], "policy");
+    assert_eq!(v["policy"]["name"], "rapid-into-material");
+    assert!(
+        v["policy"]["reason"]
+            .as_str()
+            .expect("reason")
+            .contains("plunge")
+    );
+    let out = lensc(&root(), &["verify", plunge, "--policy", "warn"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let err = text(&out.stderr);
+    assert!(err.contains("Warning: policy rapid-into-material"), "{err}");
+    assert!(err.contains("1 of lensc's own policy"), "{err}");
+    let stray = "tests/bad_programs/e0333_stray_word_on_a_line.ngc";
+    let out = lensc(
+        &root(),
+        &[
+            "--message-format",
+            "json",
+            "verify",
+            stray,
+            "--policy",
+            "warn",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out.stdout).contains("\"class\":\"controller\""));
+}
+
+/// `lensc verify` checks the header's source hash against the `.lens`
+/// file: silent when it agrees, W0023 when the file changed, W0024 when
+/// it is not at hand; none of them changes the exit code (issue #28,
+/// item 3).
+#[test]
+fn verify_checks_the_header_hash_against_the_source() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out_dir = dir.path().join("out");
+    let example = "examples/kim2008_convex_asphere.lens";
+    let built = lensc(
+        &root(),
+        &["build", example, "--out", out_dir.to_str().expect("utf8")],
+    );
+    assert_eq!(built.status.code(), Some(0), "{}", text(&built.stderr));
+    let program = out_dir.join("kim_convex.ngc");
+    let program = program.to_str().expect("utf8");
+    let same = lensc(&root(), &["verify", program]);
+    assert_eq!(same.status.code(), Some(0), "{}", text(&same.stderr));
+    assert!(
+        !text(&same.stderr).contains("W002"),
+        "{}",
+        text(&same.stderr)
+    );
+    let edited = dir.path().join("edited.lens");
+    let mut source = std::fs::read_to_string(root().join(example)).expect("read");
+    source.push_str("// edited after the build\n");
+    std::fs::write(&edited, source).expect("write");
+    let changed = lensc(
+        &root(),
+        &[
+            "verify",
+            program,
+            "--source",
+            edited.to_str().expect("utf8"),
+        ],
+    );
+    assert_eq!(changed.status.code(), Some(0));
+    assert!(
+        text(&changed.stderr).contains("[W0023]"),
+        "{}",
+        text(&changed.stderr)
+    );
+    let gone = lensc(
+        &root(),
+        &["verify", program, "--source", "no/such/file.lens"],
+    );
+    assert_eq!(gone.status.code(), Some(0));
+    assert!(
+        text(&gone.stderr).contains("[W0024]"),
+        "{}",
+        text(&gone.stderr)
+    );
+}

@@ -181,7 +181,7 @@ fn plan_jobs(
     let mut out = Vec::new();
     let prov = Provenance {
         source: source_name.to_string(),
-        source_hash: source_hash(&c.loaded),
+        source_hash: c.loaded.fnv1a64(),
         lensc_version: env!("CARGO_PKG_VERSION").to_string(),
     };
     let jobs: Vec<&CheckedJob> = c
@@ -318,16 +318,4 @@ fn build_metered(
         meter,
         read,
     })
-}
-
-/// FNV-1a 64 over every loaded source, in load order.
-fn source_hash(l: &lensc_lang::loader::Loaded) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for (_, f) in l.sources.iter() {
-        for b in f.text.bytes().chain(std::iter::once(0u8)) {
-            h ^= u64::from(b);
-            h = h.wrapping_mul(0x0100_0000_01b3);
-        }
-    }
-    h
 }

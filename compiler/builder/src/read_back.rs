@@ -73,10 +73,17 @@ pub(crate) fn findings(
             .map(|f| {
                 let d = head.error(
                     lensc_lang::codes::program_rule(f.rule),
-                    format!(
-                        "{name}, line {}, read back as the controller reads it: {}",
-                        f.line, f.message
-                    ),
+                    match f.rule.policy() {
+                        Some(_) => format!(
+                            "{name}, line {}, read back, breaks lensc's {}",
+                            f.line,
+                            lensc_lang::lower::read_back::policy_message(f)
+                        ),
+                        None => format!(
+                            "{name}, line {}, read back as the controller reads it: {}",
+                            f.line, f.message
+                        ),
+                    },
                 );
                 let help =
                     "no program was written; `lensc verify` reads a program by the same rules";

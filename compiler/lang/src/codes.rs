@@ -133,6 +133,12 @@ pub const ACCEPTANCE_UNMEASURED_WARNING: &str = "W0021";
 /// E0187 as `lensc analyse` and `lensc sample` report it: the points with
 /// no value are shown as NaN, the rest analysed.
 pub const SURFACE_UNDEFINED_WARNING: &str = "W0022";
+/// `lensc verify`: the program's `.lens` file (and the files it uses) no
+/// longer hash to the value its header carries.
+pub const SOURCE_CHANGED_WARNING: &str = "W0023";
+/// `lensc verify`: the program's `.lens` file could not be found or read,
+/// so its header hash was not checked.
+pub const SOURCE_UNCHECKED_WARNING: &str = "W0024";
 /// `lensc import`: a surface of a type (or form) lensc does not import.
 pub const IMPORT_UNSUPPORTED_SURFACE: &str = "W0015";
 /// `lensc import`: a parameter of an imported surface that is not carried over.
@@ -203,7 +209,7 @@ pub const PROGRAM_NO_SPEED_CAP: &str = "E0325";
 pub const PROGRAM_BLOCK_NUMBER: &str = "E0326";
 /// A block without the dialect's block end.
 pub const PROGRAM_BLOCK_END: &str = "E0327";
-/// A program with no end, or a block after it.
+/// A program with no end.
 pub const PROGRAM_END: &str = "E0328";
 /// A comment opened inside a comment.
 pub const PROGRAM_NESTED_COMMENT: &str = "E0329";
@@ -217,6 +223,8 @@ pub const PROGRAM_FRAME: &str = "E0332";
 pub const PROGRAM_UNUSED_WORD: &str = "E0333";
 /// An arc from a point the program never stated.
 pub const PROGRAM_POSITION_UNKNOWN: &str = "E0334";
+/// A block after the program's end (M2, M30), which is never run.
+pub const PROGRAM_BLOCK_AFTER_END: &str = "E0335";
 
 /// A fast-tool-servo table (`lensc verify`) with a row that is not three
 /// numbers C X W, or whose C runs backwards.
@@ -261,6 +269,7 @@ pub fn program_rule(rule: lensc_runtime::reader::Rule) -> &'static str {
         ProgramFrame => PROGRAM_FRAME,
         UnusedWord => PROGRAM_UNUSED_WORD,
         PositionUnknown => PROGRAM_POSITION_UNKNOWN,
+        BlockAfterEnd => PROGRAM_BLOCK_AFTER_END,
     }
 }
 
@@ -380,10 +389,13 @@ pub const ALL: &[&str] = &[
     PROGRAM_FRAME,
     PROGRAM_UNUSED_WORD,
     PROGRAM_POSITION_UNKNOWN,
+    PROGRAM_BLOCK_AFTER_END,
     SERVO_TABLE_ROW,
     ACCEPTANCE_MISSED_WARNING,
     ACCEPTANCE_UNMEASURED_WARNING,
     SURFACE_UNDEFINED_WARNING,
+    SOURCE_CHANGED_WARNING,
+    SOURCE_UNCHECKED_WARNING,
 ];
 
 #[cfg(test)]

@@ -82,6 +82,20 @@ impl Loaded {
     pub fn file(&self, id: FileId) -> &ParsedFile {
         &self.files[id.0 as usize]
     }
+
+    /// FNV-1a 64 over every loaded source, in load order, each followed
+    /// by a zero byte: the hash a program's header carries (`source PATH
+    /// fnv1a64 …`), which `lensc verify` checks against the file.
+    pub fn fnv1a64(&self) -> u64 {
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        for (_, f) in self.sources.iter() {
+            for b in f.text.bytes().chain(std::iter::once(0u8)) {
+                h ^= u64::from(b);
+                h = h.wrapping_mul(0x0100_0000_01b3);
+            }
+        }
+        h
+    }
 }
 
 /// Loads `file` (as the user named it) and the closure of its `use`s,

@@ -91,6 +91,17 @@ pub enum Command {
         /// The dialect to read it in (default: the header's).
         #[arg(long)]
         dialect: Option<String>,
+        /// What a finding of lensc's own policy (a rule the controller
+        /// would run, such as `rapid-into-material`) does: `fail` (exit 1,
+        /// as the controller's rules) or `warn` (printed as a warning;
+        /// exit 0 if nothing else is found).
+        #[arg(long, value_enum, default_value = "fail")]
+        policy: PolicyChoice,
+        /// The `.lens` file the program was built from, to check the hash
+        /// its header carries against (default: the path the header
+        /// names, from the current directory, else beside the program).
+        #[arg(long)]
+        source: Option<PathBuf>,
     },
     /// Plan and simulate a file's jobs as `build` does and write SVG plots
     /// of what each program will cut: `JOB.profile.svg` (profile jobs: the
@@ -217,6 +228,13 @@ pub enum Format {
 pub enum MessageFormat {
     Human,
     Json,
+}
+
+/// What `verify` does with a finding of lensc's own policy.
+#[derive(Clone, Copy, ValueEnum, PartialEq)]
+pub enum PolicyChoice {
+    Fail,
+    Warn,
 }
 
 #[derive(Clone, Copy, ValueEnum)]

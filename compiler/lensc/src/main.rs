@@ -70,7 +70,18 @@ fn run(cli: Cli) -> u8 {
             program,
             machine,
             dialect,
-        } => commands::verify::run(&out, &program, machine.as_deref(), dialect.as_deref()),
+            policy,
+            source,
+        } => commands::verify::run(
+            &out,
+            &program,
+            commands::verify::Asked {
+                machine: machine.as_deref(),
+                dialect: dialect.as_deref(),
+                policy_fails: policy == lensc::cli::PolicyChoice::Fail,
+                source: source.as_deref(),
+            },
+        ),
         Command::Fmt { files, check } => commands::fmt::run(&out, &files, check),
         Command::Import { file, output } => commands::import::run(&out, &file, output.as_deref()),
         Command::Analyse {

@@ -38,6 +38,17 @@ pub fn header_source(text: &str) -> Option<String> {
     })
 }
 
+/// The source file a header names and the hash it carries (`source PATH
+/// fnv1a64 HEX`), with the line it is on (from 1), if any.
+pub fn header_source_hash(text: &str) -> Option<(String, u64, usize)> {
+    text.lines().take(200).enumerate().find_map(|(i, line)| {
+        let rest = comment_text(line)?.trim().strip_prefix("source ")?;
+        let (path, hash) = rest.rsplit_once(" fnv1a64 ")?;
+        let hash = u64::from_str_radix(hash.trim(), 16).ok()?;
+        Some((path.to_string(), hash, i + 1))
+    })
+}
+
 /// The text of a whole-line comment in any dialect: `(…)`, `; …`, a
 /// numbered `N9 ; … *`, or Klartext's `9 ; …`.
 fn comment_text(line: &str) -> Option<&str> {

@@ -24,8 +24,11 @@ mod klartext;
 mod lexer;
 mod modal;
 mod motion;
+mod policy;
+mod spline;
 
-pub use header::{HeaderNames, header_names, header_source};
+pub use header::{HeaderNames, header_names, header_source, header_source_hash};
+pub use policy::{Class, Policy};
 
 use crate::dialect::Dialect;
 
@@ -119,6 +122,8 @@ pub enum Rule {
     UnusedWord,
     /// An arc from a point the program never stated (lensc's policy).
     PositionUnknown,
+    /// A block after the program's end (lensc's policy).
+    BlockAfterEnd,
 }
 
 /// One thing wrong with a program: where (line from 1, byte span in the
@@ -239,6 +244,9 @@ pub struct Reader {
     repeats: std::collections::BTreeMap<Rule, usize>,
     line_no: usize,
     last_span: (usize, usize),
+    /// Rapids down before the first cut: lowest point along the axis out
+    /// of the material, line, span in the whole text.
+    pre_cut: Vec<(f64, usize, (usize, usize))>,
 }
 
 impl Reader {
@@ -249,6 +257,7 @@ impl Reader {
             repeats: Default::default(),
             line_no: 0,
             last_span: (0, 0),
+            pre_cut: Vec::new(),
         }
     }
 
@@ -298,6 +307,16 @@ impl Reader {
         self.last_span = (offset, offset + text.len());
         let mut out = Vec::new();
         self.state.line(text, &mut out);
+        if let Some((low, (s, e))) = self.state.pre_cut_rapid.take() {
+            self.pre_cut
+                .push((low, self.line_no, (offset + s, offset + e)));
+        }
+        self.found(out, offset);
+    }
+
+    /// Keeps the first finding of each rule (counting the others), on the
+    /// line being read, which starts at byte `offset`.
+    fn found(&mut self, out: Vec<lexer::Found>, offset: usize) {
         for (rule, (s, e), message, hint) in out {
             if self.findings.iter().any(|f| f.rule == rule) {
                 *self.repeats.entry(rule).or_default() += 1;
@@ -315,6 +334,46 @@ impl Reader {
 
     /// Every finding, once the whole program is read.
     pub fn finish(mut self) -> Vec<Finding> {
+        // A rapid down before the first cut, below the highest point the
+        // cuts then reach: a plunge into the material (conservative, as
+        // every rapid rule: the reader knows no stock).
+        if let Some(top) = self.state.top
+            && let Some(&(low, line, span)) =
+                self.pre_cut.iter().find(|(low, ..)| *low < top - 1e-7)
+        {
+            let axis = ["X", "Y", "Z", "C"][self.state.away];
+            let n = self
+                .pre_cut
+                .iter()
+                .filter(|(l, ..)| *l < top - 1e-7)
+                .count();
+            let at = self.line_no;
+            self.line_no = line;
+            self.found(
+                vec![(
+                    Rule::RapidIntoPart,
+                    (0, 0),
+                    format!(
+                        "a rapid down to {axis}{} before the first cut, below the highest point the cuts reach ({axis}{}): it would plunge the tool into the part",
+                        motion_num(low),
+                        motion_num(top)
+                    ),
+                    Some(format!("rapid to above {axis}{} and feed down from there", motion_num(top))),
+                )],
+                0,
+            );
+            if let Some(f) = self
+                .findings
+                .iter_mut()
+                .rfind(|f| f.rule == Rule::RapidIntoPart && f.line == line)
+            {
+                f.span = span;
+            }
+            if n > 1 {
+                *self.repeats.entry(Rule::RapidIntoPart).or_default() += n - 1;
+            }
+            self.line_no = at;
+        }
         let mut out = Vec::new();
         self.state.finish(&mut out);
         for (rule, _, message, hint) in out {
@@ -381,6 +440,13 @@ fn line_end(bytes: &[u8]) -> Option<usize> {
         i += 8;
     }
     bytes[i..].iter().position(|&b| b == b'\n').map(|k| i + k)
+}
+
+/// A figure for a message: up to 7 decimals, no trailing zeros.
+fn motion_num(v: f64) -> String {
+    let s = format!("{v:.7}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" { "0".into() } else { s.to_string() }
 }
 
 #[cfg(test)]

@@ -31,6 +31,8 @@ pub(crate) enum Motion {
     Ccw,
     /// G80: canned cycles off, in LinuxCNC the motion mode "none".
     Cancel,
+    /// LinuxCNC's G5 and G5.1 (`spline`).
+    Spline(super::spline::Spline),
 }
 
 /// The modal group of a G code (value × 10, `G05.1` is 51).
@@ -114,6 +116,14 @@ pub(crate) struct State {
     pub away: usize,
     /// The highest point along `away` a feed move has reached.
     pub top: Option<f64>,
+    /// A rapid down (or across) before the first cut, this line: the
+    /// lowest point it reaches along `away` and its span in the line, for
+    /// `Reader` to hold against the highest point the cuts reach.
+    pub pre_cut_rapid: Option<(f64, (usize, usize))>,
+    /// The P Q of the last G5 block, for a G5 that leaves out I J.
+    pub last_spline_pq: Option<(f64, f64)>,
+    /// The points of the last spline read, handed over as straight moves.
+    pub spline_points: Vec<(f64, f64)>,
     /// The moves made so far, when they are asked for.
     pub moves: Option<Vec<super::Executed>>,
     ended: bool,
@@ -204,6 +214,9 @@ impl State {
             pos: [None; 4],
             away: 2,
             top: None,
+            pre_cut_rapid: None,
+            last_spline_pq: None,
+            spline_points: Vec::new(),
             moves: None,
             ended: false,
             klartext: (lex.controller == Controller::HeidenhainKlartext).then(Klartext::default),
@@ -256,7 +269,7 @@ impl State {
         }
         if self.ended && !b.percent {
             out.push((
-                Rule::ProgramEnd,
+                Rule::BlockAfterEnd,
                 (0, line.len()),
                 "a block after the program's end: the controller never runs it".into(),
                 Some("end the program with its last block".into()),
@@ -483,6 +496,8 @@ impl State {
             7000 if c == Siemens => GGroup::Units(false),
             7100 if c == Siemens => GGroup::Units(true),
             800 if c == LinuxCnc => GGroup::Motion(Motion::Cancel),
+            50 if c == LinuxCnc => GGroup::Motion(Motion::Spline(super::spline::Spline::Cubic)),
+            51 if c == LinuxCnc => GGroup::Motion(Motion::Spline(super::spline::Spline::Quadratic)),
             800 if c == Fanuc || c == UltraPrecision => GGroup::Cycle,
             430 | 490 if c == LinuxCnc || c == Fanuc => GGroup::ToolLength,
             70 if c == LinuxCnc => GGroup::Diameter(true),

@@ -75,6 +75,9 @@ impl State {
             self.position_mode = true;
         }
         self.travel(&end, b, out);
+        if !matches!(motion, Motion::Spline(_)) {
+            self.last_spline_pq = None;
+        }
         let path = match motion {
             Motion::Rapid => {
                 self.rapid(&start, &end, span, out);
@@ -83,11 +86,23 @@ impl State {
             _ => self.feed_move(motion, b, &start, &end, &centre, span, line, out),
         };
         if let (Some(moves), Some(path)) = (&mut self.moves, path) {
-            moves.push(Executed {
-                from: start,
-                to: end,
-                path,
-            });
+            if matches!(motion, Motion::Spline(_)) {
+                // A spline's straight moves, X and Y along its points.
+                let points = std::mem::take(&mut self.spline_points);
+                for pair in points.windows(2) {
+                    let mut from = start;
+                    let mut to = end;
+                    (from[0], from[1]) = (Some(pair[0].0), Some(pair[0].1));
+                    (to[0], to[1]) = (Some(pair[1].0), Some(pair[1].1));
+                    moves.push(Executed { from, to, path });
+                }
+            } else {
+                moves.push(Executed {
+                    from: start,
+                    to: end,
+                    path,
+                });
+            }
         }
         self.pos = end;
     }
@@ -195,13 +210,26 @@ impl State {
 
     /// A rapid may not cross or plunge into the material cut so far.
     fn rapid(
-        &self,
+        &mut self,
         start: &[Option<f64>; 4],
         end: &[Option<f64>; 4],
         span: (usize, usize),
         out: &mut Vec<Found>,
     ) {
         let a = self.away;
+        if self.top.is_none()
+            && let Some(q) = end[a]
+        {
+            // Before the first cut the top of the material is not known
+            // yet: the rapid is held against the highest point the cuts
+            // reach, once the program is read (`Reader::finish`).
+            let across = (0..4).any(|i| i != a && end[i].is_some() && end[i] != start[i]);
+            let low = start[a].map_or(q, |p| if across { p.min(q) } else { q });
+            let down = start[a].is_none_or(|p| q < p) || across;
+            if down {
+                self.pre_cut_rapid = Some((low, span));
+            }
+        }
         let (Some(top), Some(p), Some(q)) = (self.top, start[a], end[a]) else {
             return;
         };
@@ -253,6 +281,25 @@ impl State {
                     Some((length, arc)) => (Some(length), Some(arc)),
                     None => (None, None),
                 }
+            }
+            Motion::Spline(kind) => {
+                let (Some(sx), Some(sy), Some(ex), Some(ey)) = (start[0], start[1], end[0], end[1])
+                else {
+                    out.push((
+                        Rule::PositionUnknown,
+                        span,
+                        "a spline from a point the program never stated (its X or Y is unknown here)".into(),
+                        Some("move to a stated position, absolute, before the spline".into()),
+                    ));
+                    return None;
+                };
+                let points = self.spline(kind, b, (sx, sy), (ex, ey), span, out)?;
+                let length: f64 = points
+                    .windows(2)
+                    .map(|p| (p[1].0 - p[0].0).hypot(p[1].1 - p[0].1))
+                    .sum();
+                self.spline_points = points;
+                (Some(length), Some(Path::Line))
             }
             _ => (chord(start, end), Some(Path::Line)),
         };
@@ -580,7 +627,7 @@ impl State {
         let half = 0.5 * dx.hypot(dy);
         if half == 0.0 {
             out.push((
-                Rule::FullCircle,
+                Rule::ArcWords,
                 span,
                 "a radius-format arc that ends where it starts: it has no centre, and the controller refuses it".into(),
                 Some("give a full circle by its centre (I, J, K)".into()),

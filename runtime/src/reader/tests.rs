@@ -47,6 +47,7 @@ fn each_change_breaks_its_rule() {
         ("I-3 K-12", "I-3 J-12", Rule::ArcWords),
         ("G18 G21 G90", "G18 G90", Rule::ModalStateUnstated),
         ("M2\n", "", Rule::ProgramEnd),
+        ("M2\n", "M2\nM5\n", Rule::BlockAfterEnd),
         ("G0 X3 Z1.5", "G0 G1 X3 Z1.5", Rule::SameModalGroup),
         ("G0 X3 Z1.5", "G0 X3 X3 Z1.5", Rule::RepeatedWord),
         ("G97 S500", "G97 S5000", Rule::SpindleTooFast),
@@ -404,5 +405,73 @@ fn linuxcnc_reads_radius_arcs_turns_and_block_delete() {
     ] {
         let text = GOOD.replacen(from, to, 1);
         assert_eq!(rules(&text, &d, &lathe()), vec![], "{to}");
+    }
+}
+
+/// A rapid down before the first cut is held against the highest point
+/// the cuts then reach (issue #28: "a rapid plunge into the part before
+/// the first cut" read clean); one above it reads clean.
+#[test]
+fn a_rapid_plunge_before_the_first_cut_is_refused() {
+    let d = Dialect::linuxcnc();
+    let plunge = GOOD.replacen("G0 X3 Z1.5\n", "G0 X3 Z1.5\nG0 Z0.2\n", 1);
+    let found = read(&plunge, &d, &lathe());
+    let f = found
+        .iter()
+        .find(|f| f.rule == Rule::RapidIntoPart)
+        .expect("the plunge is found");
+    assert_eq!(f.line, 6, "{found:?}");
+    assert_eq!(&plunge[f.span.0..f.span.1], "Z0.2");
+    let above = GOOD.replacen("G0 X3 Z1.5\n", "G0 X3 Z1.5\nG0 Z0.5\n", 1);
+    assert_eq!(rules(&above, &d, &lathe()), vec![]);
+}
+
+/// LinuxCNC's G5 and G5.1 splines read (each case checked with `rs274
+/// -g`), and are handed over as straight moves along the curve; what the
+/// manual refuses is refused.
+#[test]
+fn linuxcnc_reads_splines_as_moves_along_the_curve() {
+    let d = Dialect::linuxcnc();
+    let mill = MachineLimits {
+        lathe: false,
+        travel: [None; 4],
+        max_feed: None,
+        max_spindle_rpm: None,
+    };
+    let program = |moves: &str| {
+        format!(
+            "G17 G21 G90 G94\nT1 M6\nG97 S1000 M3\nG0 X0 Y0 Z1\nG1 Z0 F100\n{moves}\nG0 Z1\nM5\nM2\n"
+        )
+    };
+    let good = program("G5 I0 J3 P0 Q-3 X1 Y1\nG5 P0 Q-3 X2 Y2\nG5.1 X3 I0.5 J-1");
+    let (found, moves) = read_moves(&good, &d, &mill);
+    assert_eq!(found, vec![], "{good}");
+    let lines: Vec<&Executed> = moves.iter().filter(|m| m.path == Path::Line).collect();
+    assert!(lines.len() > 100, "{} lines", lines.len());
+    // Consecutive, from (0, 0) to (3, 2), through the first cubic's middle
+    // (the Bézier (0,0) (0,3) (1,-2) (1,1) at t = 1/2 is (0.5, 0.5)).
+    for w in lines.windows(2) {
+        assert_eq!(w[0].to, w[1].from);
+    }
+    assert_eq!(lines[1].from[..2], [Some(0.0), Some(0.0)]);
+    let last = lines.last().expect("a line").to;
+    assert!((last[0].unwrap() - 3.0).abs() < 1e-12 && (last[1].unwrap() - 2.0).abs() < 1e-12);
+    let near_middle = lines
+        .iter()
+        .map(|m| (m.to[0].unwrap() - 0.5).hypot(m.to[1].unwrap() - 0.5))
+        .fold(f64::INFINITY, f64::min);
+    assert!(near_middle < 0.01, "{near_middle}");
+    for also in ["G5 P0 Q-3 X1 Y1", "G5.1 X3 I0 J0"] {
+        assert_eq!(rules(&program(also), &d, &mill), vec![], "{also}");
+    }
+    for bad in [
+        "G5 I0 P0 Q-3 X1 Y1",
+        "G5 I0 J3 P0 X1 Y1",
+        "G5 I0 J3 P0 Q-3 X1 Y1 Z1",
+        "G18\nG5 I0 J3 P0 Q-3 X1 Y1",
+    ] {
+        let text = program(bad);
+        let found = rules(&text, &d, &mill);
+        assert!(!found.is_empty(), "{bad}");
     }
 }

@@ -95,15 +95,35 @@ pub fn finding_diagnostic(
     f: &lensc_runtime::reader::Finding,
     file: lensc_grammar::FileId,
 ) -> lensc_grammar::Diagnostic {
-    let d = lensc_grammar::Diagnostic::error(
-        crate::codes::program_rule(f.rule),
-        f.message.clone(),
-        file,
-        lensc_grammar::Span::new(f.span.0, f.span.1),
-    )
-    .with_label("this block");
-    match &f.hint {
-        Some(h) => d.with_help(h.clone()),
-        None => d,
+    let span = lensc_grammar::Span::new(f.span.0, f.span.1);
+    let code = crate::codes::program_rule(f.rule);
+    let Some(policy) = f.rule.policy() else {
+        let d = lensc_grammar::Diagnostic::error(code, f.message.clone(), file, span)
+            .with_label("this block");
+        return match &f.hint {
+            Some(h) => d.with_help(h.clone()),
+            None => d,
+        };
+    };
+    let help = format!(
+        "lensc's policy, not the controller's: {}{}",
+        policy.reason,
+        f.hint
+            .as_ref()
+            .map(|h| format!("; {h}"))
+            .unwrap_or_default()
+    );
+    lensc_grammar::Diagnostic::error(code, policy_message(f), file, span)
+        .with_label("this block")
+        .with_help(help)
+}
+
+/// A finding's message, named by its policy where it is one of lensc's
+/// own rules (`policy rapid-into-material: …`), so text and JSON both
+/// say which class it is.
+pub fn policy_message(f: &lensc_runtime::reader::Finding) -> String {
+    match f.rule.policy() {
+        Some(p) => format!("policy {}: {}", p.name, f.message),
+        None => f.message.clone(),
     }
 }

@@ -1,16 +1,22 @@
-//! `lensc verify PROGRAM [--machine NAME] [--dialect NAME]`: reads a
-//! program back from its text as its controller would
-//! (`lensc_runtime::reader`), against the machine and dialect its header
-//! names (`(machine NAME: DIALECT …)`) unless told otherwise. The machine
-//! is looked up in the source file the header names (when it can be read,
-//! from the current directory or beside the program) or else the standard
-//! library. Exit 0: nothing found; 1: findings (rendered over the
+//! `lensc verify PROGRAM [--machine NAME] [--dialect NAME] [--policy
+//! fail|warn] [--source FILE]`: reads a program back from its text as its
+//! controller would (`lensc_runtime::reader`), against the machine and
+//! dialect its header names (`(machine NAME: DIALECT …)`) unless told
+//! otherwise. The machine is looked up in the source file the header names
+//! (when it can be read, from the current directory or beside the program)
+//! or else the standard library. Each finding is of one of two classes:
+//! the controller's rule (it refuses the program too) or lensc's own
+//! policy (it would run it), named and with its reason. The header's
+//! source hash is checked against that file (W0023 when they differ,
+//! W0024 when it could not be checked). Exit 0: nothing found (or only
+//! policy findings under `--policy warn`); 1: findings (rendered over the
 //! program's text) or no machine or dialect to read it by.
 
 use std::io::{BufRead, Write};
 use std::path::Path;
 
 use lensc::render;
+use lensc_grammar::{Diagnostic, Severity};
 use lensc_lang::loader::RealFs;
 use lensc_lang::lower::read_back;
 use lensc_lang::source::SourceMap;
@@ -19,8 +25,24 @@ use lensc_runtime::reader;
 use crate::MessageFormat;
 use crate::output::Output;
 
+/// What the user asked besides the program.
+pub struct Asked<'a> {
+    pub machine: Option<&'a str>,
+    pub dialect: Option<&'a str>,
+    /// Whether a policy finding fails the program (exit 1).
+    pub policy_fails: bool,
+    /// The `.lens` file to check the header's hash against.
+    pub source: Option<&'a Path>,
+}
+
 /// Runs the subcommand; returns the exit code.
-pub fn run(out: &Output, program: &Path, machine: Option<&str>, dialect: Option<&str>) -> u8 {
+pub fn run(out: &Output, program: &Path, asked: Asked) -> u8 {
+    let Asked {
+        machine,
+        dialect,
+        policy_fails,
+        source,
+    } = asked;
     let cannot_read = |e: std::io::Error| {
         eprintln!(
             "error[{}]: cannot read {}: {e}",
@@ -68,18 +90,9 @@ pub fn run(out: &Output, program: &Path, machine: Option<&str>, dialect: Option<
         Ok(f) => f,
         Err(e) => return cannot_read(e),
     };
-    if findings.is_empty() {
-        if out.format == MessageFormat::Human {
-            eprintln!(
-                "{}: read as {} on {}: nothing found",
-                render::escape(&program.display().to_string()),
-                render::escape(&d.name),
-                render::escape(machine_name)
-            );
-        }
-        return 0;
-    }
-    let (text, findings) = match excerpt(program, findings) {
+    let stale = source_check(&head, program, source);
+    let header_line = stale.as_ref().map_or(0, |s| s.line);
+    let (text, findings) = match excerpt(program, findings, header_line) {
         Ok(t) => t,
         Err(e) => return cannot_read(e),
     };
@@ -87,22 +100,158 @@ pub fn run(out: &Output, program: &Path, machine: Option<&str>, dialect: Option<
     let file = sources.add(
         program.display().to_string(),
         Some(program.to_path_buf()),
-        text,
+        text.clone(),
     );
-    let diags: Vec<_> = findings
-        .iter()
-        .map(|f| read_back::finding_diagnostic(f, file))
-        .collect();
+    let mut diags: Vec<_> = stale.iter().map(|s| s.diagnostic(&text, file)).collect();
+    diags.extend(findings.iter().map(|f| {
+        let d = read_back::finding_diagnostic(f, file);
+        if f.rule.policy().is_some() && !policy_fails {
+            Diagnostic {
+                severity: Severity::Warning,
+                ..d
+            }
+        } else {
+            d
+        }
+    }));
     let written = match out.format {
         MessageFormat::Human => {
             render::human(&diags, &sources, out.color, &mut std::io::stderr().lock())
         }
-        MessageFormat::Json => render::json_lines(&diags, &sources, &mut std::io::stdout().lock()),
+        MessageFormat::Json => {
+            let mut w = std::io::stdout().lock();
+            let classes = stale
+                .iter()
+                .map(|_| ("source", None))
+                .chain(findings.iter().map(|f| match f.rule.policy() {
+                    Some(p) => ("policy", Some(p)),
+                    None => ("controller", None),
+                }));
+            diags
+                .iter()
+                .zip(classes)
+                .try_for_each(|(d, (class, policy))| {
+                    let mut v = render::json_value(d, &sources);
+                    v["class"] = class.into();
+                    if let Some(p) = policy {
+                        v["policy"] = serde_json::json!({ "name": p.name, "reason": p.reason });
+                    }
+                    writeln!(w, "{v}")
+                })
+        }
     };
     if written.is_err() {
         let _ = writeln!(std::io::stderr(), "error: cannot print the diagnostics");
     }
-    1
+    let policy = findings
+        .iter()
+        .filter(|f| f.rule.policy().is_some())
+        .count();
+    let controller = findings.len() - policy;
+    if out.format == MessageFormat::Human {
+        let shown = program.display().to_string();
+        let name = render::escape(&shown);
+        let on = format!(
+            "read as {} on {}",
+            render::escape(&d.name),
+            render::escape(machine_name)
+        );
+        if findings.is_empty() {
+            eprintln!("{name}: {on}: nothing found");
+        } else {
+            let would_run = match policy {
+                0 => "",
+                1 => " (the controller would run it)",
+                _ => " (the controller would run them)",
+            };
+            eprintln!(
+                "{name}: {on}: {controller} finding{} of the controller's rules, {policy} of lensc's own policy{would_run}{}",
+                if controller == 1 { "" } else { "s" },
+                if policy > 0 && !policy_fails {
+                    "; policy findings warn only (--policy warn)"
+                } else {
+                    ""
+                }
+            );
+        }
+    }
+    u8::from(controller > 0 || (policy > 0 && policy_fails))
+}
+
+/// What the header's source hash check found: the hash differs (W0023)
+/// or could not be checked (W0024), at the header's `source` line.
+struct SourceCheck {
+    code: &'static str,
+    message: String,
+    help: String,
+    line: usize,
+}
+
+impl SourceCheck {
+    fn diagnostic(&self, text: &str, file: lensc_grammar::FileId) -> Diagnostic {
+        let start: usize = text
+            .split_inclusive('\n')
+            .take(self.line.saturating_sub(1))
+            .map(str::len)
+            .sum();
+        let len = text[start..].find('\n').unwrap_or(text.len() - start);
+        Diagnostic::warning(
+            self.code,
+            self.message.clone(),
+            file,
+            lensc_grammar::Span::new(start, start + len),
+        )
+        .with_label("the hash the program was written with")
+        .with_help(self.help.clone())
+    }
+}
+
+/// Checks the hash the header carries (`source PATH fnv1a64 HEX`) against
+/// the `.lens` file: `source` if given, else the header's path from the
+/// current directory, else beside the program. `None`: the hashes agree,
+/// or the header carries none.
+fn source_check(head: &str, program: &Path, source: Option<&Path>) -> Option<SourceCheck> {
+    let (named, want, line) = reader::header_source_hash(head)?;
+    let beside = program.parent().unwrap_or(Path::new("."));
+    let candidates: Vec<std::path::PathBuf> = match source {
+        Some(s) => vec![s.to_path_buf()],
+        None => vec![Path::new(&named).to_path_buf(), beside.join(&named)],
+    };
+    let Some(path) = candidates.iter().find(|p| p.is_file()) else {
+        return Some(SourceCheck {
+            code: lensc_lang::codes::SOURCE_UNCHECKED_WARNING,
+            message: format!(
+                "the program's source `{}` is not at hand: whether the program is still what it says was not checked",
+                render::escape(&candidates[0].display().to_string())
+            ),
+            help: "give the .lens file with --source FILE".into(),
+            line,
+        });
+    };
+    let path_text = path.display().to_string();
+    let shown = render::escape(&path_text);
+    match lensc_lang::loader::load(&RealFs, path) {
+        Ok(loaded) if loaded.fnv1a64() == want => None,
+        Ok(loaded) => Some(SourceCheck {
+            code: lensc_lang::codes::SOURCE_CHANGED_WARNING,
+            message: format!(
+                "`{shown}` (with the files it uses) hashes to {:016x}, not the {want:016x} the program was written from: the file changed since",
+                loaded.fnv1a64()
+            ),
+            help: format!(
+                "build the program again from `{shown}`, or verify against the file it was built from"
+            ),
+            line,
+        }),
+        Err(e) => Some(SourceCheck {
+            code: lensc_lang::codes::SOURCE_UNCHECKED_WARNING,
+            message: format!(
+                "`{shown}` could not be read ({e:?}): the program's hash was not checked"
+            ),
+            help: "give the .lens file with --source FILE".into(),
+            line,
+        }),
+    }
 }
 
 /// The job of a fast-tool-servo table a build writes beside its program
@@ -228,8 +377,10 @@ fn head(program: &Path) -> std::io::Result<String> {
 fn excerpt(
     program: &Path,
     mut findings: Vec<reader::Finding>,
+    also: usize,
 ) -> std::io::Result<(String, Vec<reader::Finding>)> {
-    let wanted: std::collections::BTreeSet<usize> = findings.iter().map(|f| f.line).collect();
+    let mut wanted: std::collections::BTreeSet<usize> = findings.iter().map(|f| f.line).collect();
+    wanted.insert(also);
     let mut r = std::io::BufReader::new(std::fs::File::open(program)?);
     let (mut text, mut buf) = (String::new(), Vec::new());
     let (mut line, mut offset) = (0, 0);
