@@ -90,7 +90,7 @@ const POLICY: &[(&str, &str)] = &[
 const KNOWN_GAPS: &[(&str, &str)] = &[
     (
         "E0302",
-        "codes and characters rs274 reads that the reader does not yet: G5.2/G5.3 NURBS blocks, `#` parameters and `[ ]` expressions",
+        "codes rs274 reads that the reader does not yet: G5.2/G5.3 NURBS blocks (and the codes of TABLE lensc does not read: G7/G8 on some machines, G43 forms)",
     ),
     ("E0303", "a number form rs274 reads (a sign or point alone)"),
 ];

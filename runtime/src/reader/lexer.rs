@@ -168,6 +168,10 @@ pub(crate) struct Lexer {
     max_digits: Option<u32>,
     /// The dialect's format of each word (`S5`, `X4.4`).
     formats: Vec<WordFormat>,
+    /// LinuxCNC's parameters (`expr`), and those the line being read sets,
+    /// which take effect once it is read.
+    params: std::cell::RefCell<super::expr::Parameters>,
+    pending: std::cell::RefCell<Vec<(super::expr::Name, f64)>>,
 }
 
 impl Lexer {
@@ -179,6 +183,8 @@ impl Lexer {
             max_line_length: d.max_line_length,
             max_decimals: d.max_decimals,
             max_digits: d.max_digits,
+            params: Default::default(),
+            pending: Default::default(),
             formats: d.word_formats.clone(),
         }
     }
@@ -205,6 +211,11 @@ impl Lexer {
         }
         let code = self.strip_comments(code, b, out);
         self.words(&code, b, out);
+        // Parameters set on the line take effect once it is read.
+        let mut params = self.params.borrow_mut();
+        for (n, v) in self.pending.borrow_mut().drain(..) {
+            params.set(n, v);
+        }
     }
 
     /// Whether a block needs nothing closing it (no `*` end to strip).
@@ -318,6 +329,10 @@ impl Lexer {
                 i += 1;
                 continue;
             }
+            if c == b'#' && self.controller == Controller::LinuxCnc {
+                i = self.assignment(code, i, out);
+                continue;
+            }
             if !c.is_ascii_alphabetic() {
                 let end = i + code[i..].chars().next().map_or(1, char::len_utf8);
                 out.push(unknown(
@@ -353,6 +368,41 @@ impl Lexer {
                     continue;
                 }
             }
+            let after = code[i..].trim_start();
+            if self.controller == Controller::LinuxCnc
+                && (after.starts_with('[') || after.starts_with('#'))
+            {
+                let params = self.params.borrow();
+                match super::expr::value(code, i, &params) {
+                    Ok((value, end)) => {
+                        let w = Word {
+                            letter,
+                            value,
+                            span: (start, end),
+                            point: true,
+                            decimals: 0,
+                        };
+                        drop(params);
+                        self.number_format(&w, code, out);
+                        if w.letter == 'N' && b.words.is_empty() && b.number.is_none() {
+                            b.number = Some(w);
+                        } else {
+                            b.words.push(w);
+                        }
+                        i = end;
+                    }
+                    Err(e) => {
+                        out.push((
+                            Rule::MalformedNumber,
+                            (start, code.len()),
+                            format!("`{}`: {e}", &code[start..]),
+                            None,
+                        ));
+                        i = code.len();
+                    }
+                }
+                continue;
+            }
             let (number, end) = number(code, i);
             i = end;
             let Some((value, point, decimals)) = number else {
@@ -379,6 +429,36 @@ impl Lexer {
                 b.number = Some(w);
             } else {
                 b.words.push(w);
+            }
+        }
+    }
+
+    /// A LinuxCNC parameter setting at `code[i..]` (`#1=2`, `#<depth>=[#1*2]`),
+    /// kept until the line is read; returns where it ends.
+    fn assignment(&self, code: &str, i: usize, out: &mut Vec<Found>) -> usize {
+        let params = self.params.borrow();
+        let set = super::expr::name(code, i + 1, &params).and_then(|(n, j)| {
+            let rest = &code[j..];
+            let eq = j + rest.len() - rest.trim_start().len();
+            if code.as_bytes().get(eq) != Some(&b'=') {
+                return Err("a parameter is set with `=`".to_string());
+            }
+            let (v, end) = super::expr::value(code, eq + 1, &params)?;
+            Ok((n, v, end))
+        });
+        match set {
+            Ok((n, v, end)) => {
+                self.pending.borrow_mut().push((n, v));
+                end
+            }
+            Err(e) => {
+                out.push((
+                    Rule::MalformedNumber,
+                    (i, code.len()),
+                    format!("`{}`: {e}", &code[i..]),
+                    None,
+                ));
+                code.len()
             }
         }
     }

@@ -19,6 +19,7 @@
 //! [`Rule`] (its diagnostic code lives with the compiler's others).
 
 mod chord;
+mod expr;
 mod header;
 mod klartext;
 mod lexer;

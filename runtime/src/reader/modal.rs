@@ -543,7 +543,14 @@ impl State {
 
     /// Units, plane, distance, feed mode, diameter mode.
     fn modes(&mut self, b: &Block, groups: &[(GGroup, usize)], line: &str, out: &mut Vec<Found>) {
+        // G80 beside another motion code (LinuxCNC): the other code wins.
+        let moving = groups
+            .iter()
+            .any(|(g, _)| matches!(g, GGroup::Motion(m) if *m != Motion::Cancel));
         for (g, _) in groups {
+            if moving && *g == GGroup::Motion(Motion::Cancel) {
+                continue;
+            }
             match *g {
                 GGroup::Units(m) => self.metric = Some(m),
                 GGroup::Plane(p) => self.plane = Some(p),
@@ -814,6 +821,12 @@ fn same_group(a: GGroup, b: GGroup, siemens: bool) -> bool {
 /// offsets: two of either in a block are refused too.
 fn same_group_linuxcnc(a: GGroup, b: GGroup) -> bool {
     use GGroup::*;
+    // G80 beside another motion code is read, the other code winning
+    // (`rs274 -g` runs `G80 G0` and `G0 G80`).
+    let cancel = Motion(self::Motion::Cancel);
+    if (a == cancel && matches!(b, Motion(_))) || (b == cancel && matches!(a, Motion(_))) {
+        return false;
+    }
     let group_0 = |g| matches!(g, NonModal | MachineMove);
     (group_0(a) && group_0(b)) || std::mem::discriminant(&a) == std::mem::discriminant(&b)
 }

@@ -475,3 +475,31 @@ fn linuxcnc_reads_splines_as_moves_along_the_curve() {
         assert!(!found.is_empty(), "{bad}");
     }
 }
+
+/// LinuxCNC's parameters and expressions are evaluated where a word's
+/// number would be; a setting takes effect after its line (checked with
+/// `rs274 -g`: `#1=1.5 #<r>=[#1*2]` on one line sets #<r> to 0).
+#[test]
+fn linuxcnc_reads_parameters_and_expressions() {
+    let d = Dialect::linuxcnc();
+    let text = GOOD.replacen(
+        "G0 X3 Z1.5\n",
+        "#1=1.5 #<r>=[#1*2]\n#<r>=[#1*2]\nG0 X#<r> Z[#1+[0*#1]]\n",
+        1,
+    );
+    let (found, moves) = read_moves(&text, &d, &lathe());
+    assert_eq!(found, vec![], "{text}");
+    let rapid = moves
+        .iter()
+        .find(|m| m.path == Path::Rapid)
+        .expect("a rapid");
+    assert_eq!(rapid.to[0], Some(3.0));
+    assert_eq!(rapid.to[2], Some(1.5));
+    for bad in ["G0 X#<unset> Z1.5\n", "G0 X[1+ Z1.5\n", "#1=\nG0 X3 Z1.5\n"] {
+        let t = GOOD.replacen("G0 X3 Z1.5\n", bad, 1);
+        assert!(
+            rules(&t, &d, &lathe()).contains(&Rule::MalformedNumber),
+            "{bad}"
+        );
+    }
+}

@@ -91,10 +91,14 @@ impl State {
             .filter(|w| w.letter == 'M')
             .map(|w| w.value.round() as i64)
             .collect();
-        let own = groups.iter().find_map(|(g, i)| match g {
-            GGroup::Motion(m) => Some((*m, *i)),
-            _ => None,
-        });
+        // G80 beside another motion code: the other code wins.
+        let own = groups
+            .iter()
+            .filter_map(|(g, i)| match g {
+                GGroup::Motion(m) => Some((*m, *i)),
+                _ => None,
+            })
+            .min_by_key(|(m, _)| *m == Motion::Cancel);
         let axis_users = groups
             .iter()
             .find(|(g, _)| *g == GGroup::MachineMove)
