@@ -90,7 +90,7 @@ const POLICY: &[(&str, &str)] = &[
 const KNOWN_GAPS: &[(&str, &str)] = &[
     (
         "E0302",
-        "codes rs274 reads that the reader does not yet: G5.2/G5.3 NURBS blocks (and the codes of TABLE lensc does not read: G7/G8 on some machines, G43 forms)",
+        "codes rs274 reads that the reader does not yet: M60 (pallet change pause), M99 (in a main program: start again from the top, which the reader cannot simulate), G5.2/G5.3 NURBS blocks",
     ),
     ("E0303", "a number form rs274 reads (a sign or point alone)"),
 ];
@@ -364,6 +364,8 @@ struct Figures {
     agree_refuse: usize,
     policy: usize,
     known_gaps: BTreeMap<String, usize>,
+    /// The mutants of the known gaps, to print.
+    gap_mutants: Vec<String>,
     unlisted: Vec<String>,
 }
 
@@ -402,6 +404,8 @@ fn round(n: usize, seed: u64) -> Figures {
                 } else if codes.iter().all(|(_, class)| class == "policy") {
                     f.policy += 1;
                 } else {
+                    f.gap_mutants
+                        .push(format!("{name} mutant {k} ({what}): {codes:?}"));
                     for (c, class) in &codes {
                         if class != "policy" {
                             *f.known_gaps.entry(c.clone()).or_default() += 1;
@@ -419,12 +423,17 @@ fn round(n: usize, seed: u64) -> Figures {
 
 fn report(f: &Figures) -> String {
     format!(
-        "{} mutants: {} both run, {} both refuse, {} refused by lensc's policy only, known reader gaps {:?}, {} unlisted disagreements{}",
+        "{} mutants: {} both run, {} both refuse, {} refused by lensc's policy only, known reader gaps {:?}{}\n{} unlisted disagreements{}",
         f.mutants,
         f.agree_run,
         f.agree_refuse,
         f.policy,
         f.known_gaps,
+        f.gap_mutants
+            .iter()
+            .take(20)
+            .map(|u| format!("\n  gap: {u}"))
+            .collect::<String>(),
         f.unlisted.len(),
         f.unlisted
             .iter()
