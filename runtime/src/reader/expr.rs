@@ -155,10 +155,14 @@ impl Reader<'_> {
                 self.primary()
             }
             Some(c) if c.is_ascii_digit() || c == b'.' => {
-                let (n, end) = super::lexer::number(self.code, self.i);
-                self.i = end;
-                n.map(|n| n.0)
-                    .ok_or_else(|| "a malformed number".to_string())
+                let b = self.code.as_bytes();
+                let start = self.i;
+                while self.i < b.len() && (b[self.i].is_ascii_digit() || b[self.i] == b'.') {
+                    self.i += 1;
+                }
+                self.code[start..self.i]
+                    .parse::<f64>()
+                    .map_err(|_| "a malformed number".to_string())
             }
             Some(c) if c.is_ascii_alphabetic() => self.function(),
             _ => Err("a number, parameter or expression was expected".into()),

@@ -738,3 +738,69 @@ fn num(v: f64) -> String {
     let s = s.trim_end_matches('0').trim_end_matches('.');
     if s == "-0" { "0".into() } else { s.to_string() }
 }
+
+impl State {
+    /// The points (X, Y in mm) of the spline of block `b` from `s` to `e`,
+    /// its first point `s` and its last `e`; `None` (with the finding)
+    /// where the controller refuses the block.
+    pub(crate) fn spline(
+        &mut self,
+        kind: super::spline::Spline,
+        b: &Block,
+        s: (f64, f64),
+        e: (f64, f64),
+        span: (usize, usize),
+        out: &mut Vec<Found>,
+    ) -> Option<Vec<(f64, f64)>> {
+        let unit = self.mm_per_unit();
+        let word = |l: char| {
+            b.words
+                .iter()
+                .find(|w| w.letter == l)
+                .map(|w| w.value * unit)
+        };
+        let mut refuse = |msg: &str| {
+            out.push((Rule::ArcWords, span, msg.to_string(), None));
+            None
+        };
+        if self.plane != Some(crate::moves::Plane::Xy) {
+            return refuse("G5 and G5.1 are splines in the XY plane (G17) only");
+        }
+        if b.words.iter().any(|w| {
+            !matches!(
+                w.letter,
+                'G' | 'X' | 'Y' | 'I' | 'J' | 'P' | 'Q' | 'F' | 'S' | 'T' | 'M' | 'N'
+            )
+        }) {
+            return refuse("a spline moves X and Y only: another axis word is refused");
+        }
+        let (i, j) = (word('I'), word('J'));
+        let first = match kind {
+            // The manual refuses I and J both left out or zero; `rs274`
+            // 2.9 runs it, as a straight line.
+            super::spline::Spline::Quadratic => (s.0 + i.unwrap_or(0.0), s.1 + j.unwrap_or(0.0)),
+            super::spline::Spline::Cubic => match (i, j, self.last_spline_pq) {
+                (Some(i), Some(j), _) => (s.0 + i, s.1 + j),
+                (None, None, Some((p, q))) => (s.0 - p, s.1 - q),
+                // The manual refuses I and J left out in the first G5 of a
+                // series; `rs274` 2.9 runs it with I0 J0.
+                (None, None, None) => s,
+                _ => return refuse("G5 with one of I and J: give both or neither"),
+            },
+        };
+        let points = match kind {
+            super::spline::Spline::Quadratic => {
+                self.last_spline_pq = None;
+                super::spline::bezier(&[s, first, e])
+            }
+            super::spline::Spline::Cubic => {
+                let (Some(p), Some(q)) = (word('P'), word('Q')) else {
+                    return refuse("G5 needs both P and Q");
+                };
+                self.last_spline_pq = Some((p, q));
+                super::spline::bezier(&[s, first, (e.0 + p, e.1 + q), e])
+            }
+        };
+        Some(points)
+    }
+}

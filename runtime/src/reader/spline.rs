@@ -6,14 +6,10 @@
 //! mirrored) and its second at P Q from the end; G5.1 a quadratic Bézier
 //! with its control point at I J from the start. Where `rs274` 2.9 runs
 //! what the manual calls an error (a first G5 without I J, a G5.1 with I
-//! and J zero) the reader follows `rs274`. The reader hands a
+//! and J zero) the reader follows `rs274` (`State::spline`, in `motion`). The reader hands a
 //! spline over as straight moves sampled within [`SPLINE_TOLERANCE`] of
 //! the curve, so the read-back simulation cuts what the controller cuts
 //! to well under any machine's resolution.
-
-use super::Rule;
-use super::lexer::{Block, Found};
-use super::modal::State;
 
 /// The largest distance (mm) between a spline and the straight moves it
 /// is handed over as: 1 nm.
@@ -31,78 +27,12 @@ pub(crate) enum Spline {
     Quadratic,
 }
 
-impl State {
-    /// The points (X, Y in mm) of the spline of block `b` from `s` to `e`,
-    /// its first point `s` and its last `e`; `None` (with the finding)
-    /// where the controller refuses the block.
-    pub(crate) fn spline(
-        &mut self,
-        kind: Spline,
-        b: &Block,
-        s: (f64, f64),
-        e: (f64, f64),
-        span: (usize, usize),
-        out: &mut Vec<Found>,
-    ) -> Option<Vec<(f64, f64)>> {
-        let unit = self.mm_per_unit();
-        let word = |l: char| {
-            b.words
-                .iter()
-                .find(|w| w.letter == l)
-                .map(|w| w.value * unit)
-        };
-        let mut refuse = |msg: &str| {
-            out.push((Rule::ArcWords, span, msg.to_string(), None));
-            None
-        };
-        if self.plane != Some(crate::moves::Plane::Xy) {
-            return refuse("G5 and G5.1 are splines in the XY plane (G17) only");
-        }
-        if b.words.iter().any(|w| {
-            !matches!(
-                w.letter,
-                'G' | 'X' | 'Y' | 'I' | 'J' | 'P' | 'Q' | 'F' | 'S' | 'T' | 'M' | 'N'
-            )
-        }) {
-            return refuse("a spline moves X and Y only: another axis word is refused");
-        }
-        let (i, j) = (word('I'), word('J'));
-        let first = match kind {
-            // The manual refuses I and J both left out or zero; `rs274`
-            // 2.9 runs it, as a straight line.
-            Spline::Quadratic => (s.0 + i.unwrap_or(0.0), s.1 + j.unwrap_or(0.0)),
-            Spline::Cubic => match (i, j, self.last_spline_pq) {
-                (Some(i), Some(j), _) => (s.0 + i, s.1 + j),
-                (None, None, Some((p, q))) => (s.0 - p, s.1 - q),
-                // The manual refuses I and J left out in the first G5 of a
-                // series; `rs274` 2.9 runs it with I0 J0.
-                (None, None, None) => s,
-                _ => return refuse("G5 with one of I and J: give both or neither"),
-            },
-        };
-        let points = match kind {
-            Spline::Quadratic => {
-                self.last_spline_pq = None;
-                bezier(&[s, first, e])
-            }
-            Spline::Cubic => {
-                let (Some(p), Some(q)) = (word('P'), word('Q')) else {
-                    return refuse("G5 needs both P and Q");
-                };
-                self.last_spline_pq = Some((p, q));
-                bezier(&[s, first, (e.0 + p, e.1 + q), e])
-            }
-        };
-        Some(points)
-    }
-}
-
 /// A Bézier curve of 3 or 4 control points as points whose chords stay
 /// within [`SPLINE_TOLERANCE`] of it: a chord of a piece of parameter
 /// length h is within h² max|B''| / 8 of the curve, and |B''| is largest at
 /// an end (it is linear in the parameter for a cubic, constant for a
 /// quadratic).
-fn bezier(c: &[(f64, f64)]) -> Vec<(f64, f64)> {
+pub(crate) fn bezier(c: &[(f64, f64)]) -> Vec<(f64, f64)> {
     let n = c.len() - 1;
     let second = |a: (f64, f64), b: (f64, f64), d: (f64, f64)| {
         let k = (n * (n - 1)) as f64;
