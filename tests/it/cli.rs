@@ -741,3 +741,60 @@ fn a_job_with_no_chord_tolerance_builds_on_every_0_1_um_stdlib_machine() {
         assert!(t.contains(&format!("path tolerance {tolerance}")), "{t}");
     }
 }
+
+/// A file of two jobs, one refused by its gate: by default nothing is
+/// written (all or nothing) and the summary says of each job what became
+/// of it; `--keep-going` writes the job that passed, and still exits 1.
+#[test]
+fn a_build_summarises_each_job_and_writes_all_or_nothing_unless_keep_going() {
+    let file = "tests/fixtures/two_jobs_one_refused.lens";
+    let dir = tempfile::tempdir().expect("tmp");
+    let out_dir = dir.path().join("all");
+    let out = lensc(
+        &root(),
+        &["build", file, "--out", out_dir.to_str().expect("utf-8")],
+    );
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(!out_dir.exists() || std::fs::read_dir(&out_dir).expect("dir").count() == 0);
+    assert!(
+        stderr.contains("good: passed, not written: another job failed"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("tight: REFUSED by its acceptance gate (E0195)"),
+        "{stderr}"
+    );
+    // Each figure with its limit, the area judged, the time, the size.
+    for line in [
+        "  PV        1.09 nm    limit 2 nm (stated)\n",
+        "  PV        1.09 nm    limit 0.01 nm (stated)  MISSED\n",
+        "  judged    the profile, radius 0 to 3 mm\n",
+        "  cutting   1 min 31.0 s\n",
+    ] {
+        assert!(stderr.contains(line), "{line:?} not in {stderr}");
+    }
+
+    let kept = dir.path().join("kept");
+    let out = lensc(
+        &root(),
+        &[
+            "build",
+            file,
+            "--keep-going",
+            "--out",
+            kept.to_str().expect("utf-8"),
+        ],
+    );
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let mut names: Vec<String> = std::fs::read_dir(&kept)
+        .expect("kept")
+        .map(|e| e.expect("e").file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["good.ngc", "good.report.json"]);
+    assert!(stderr.contains("good: passed, written\n"), "{stderr}");
+    let wrote = format!("  wrote     {}", kept.join("good.ngc").display());
+    assert!(stderr.contains(&wrote), "{stderr}");
+}

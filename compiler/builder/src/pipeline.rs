@@ -154,8 +154,53 @@ pub fn plan_and_emit(
     source_name: &str,
     spool_dir: Option<&Path>,
 ) -> (Vec<Built>, Vec<Diagnostic>) {
+    let (outcomes, diags) = plan_and_emit_outcomes(c, request, source_name, spool_dir);
+    (built_only(outcomes), diags)
+}
+
+/// `plan_and_emit`, with every job's outcome, built or not, in the order
+/// of the file (`lensc build`'s summary lists each).
+pub fn plan_and_emit_outcomes(
+    c: &Checked,
+    request: Request,
+    source_name: &str,
+    spool_dir: Option<&Path>,
+) -> (Vec<Outcome>, Vec<Diagnostic>) {
     let to = spool_dir.map_or(Destination::Memory, Destination::Spool);
     plan_jobs(c, request, source_name, to)
+}
+
+/// What became of one job of a build.
+pub struct Outcome {
+    /// The job's name.
+    pub job: String,
+    /// Its program and report, if it was built (refused by its acceptance
+    /// gate or not: the report's figures say by how much it missed).
+    pub built: Option<Built>,
+    /// Built and passed its gate: its files may be written.
+    pub accepted: bool,
+    /// The codes of the errors that refused it, in order, each once.
+    pub errors: Vec<&'static str>,
+}
+
+/// The jobs built and passed, in order.
+fn built_only(outcomes: Vec<Outcome>) -> Vec<Built> {
+    outcomes
+        .into_iter()
+        .filter(|o| o.accepted)
+        .filter_map(|o| o.built)
+        .collect()
+}
+
+/// The codes of the errors among `diags`, each once, in order.
+fn error_codes(diags: &[Diagnostic]) -> Vec<&'static str> {
+    let mut codes = Vec::new();
+    for d in diags.iter().filter(|d| d.is_error()) {
+        if !codes.contains(&d.code) {
+            codes.push(d.code);
+        }
+    }
+    codes
 }
 
 /// Plans and simulates the checked jobs as `plan_and_emit` does, with
@@ -168,7 +213,8 @@ pub fn plan_and_simulate(
     request: Request,
     source_name: &str,
 ) -> (Vec<Built>, Vec<Diagnostic>) {
-    plan_jobs(c, request, source_name, Destination::Nowhere)
+    let (outcomes, diags) = plan_jobs(c, request, source_name, Destination::Nowhere);
+    (built_only(outcomes), diags)
 }
 
 fn plan_jobs(
@@ -176,7 +222,7 @@ fn plan_jobs(
     request: Request,
     source_name: &str,
     to: Destination,
-) -> (Vec<Built>, Vec<Diagnostic>) {
+) -> (Vec<Outcome>, Vec<Diagnostic>) {
     let mut diags = Vec::new();
     let mut out = Vec::new();
     let prov = Provenance {
@@ -202,7 +248,6 @@ fn plan_jobs(
             Ok((mut b, mut gate)) => {
                 diags.append(&mut b.warnings);
                 let refused = gate.iter().any(|d| d.is_error());
-                diags.append(&mut gate);
                 observer.event(Event::JobDone {
                     job: name,
                     built: !refused,
@@ -211,11 +256,22 @@ fn plan_jobs(
                 });
                 // A job that fails its gate is not written (its spooled
                 // program is removed as it is dropped).
-                if !refused {
-                    out.push(b);
-                }
+                let errors = error_codes(&gate);
+                diags.append(&mut gate);
+                out.push(Outcome {
+                    job: name.to_string(),
+                    built: Some(b),
+                    accepted: !refused,
+                    errors,
+                });
             }
             Err(mut d) => {
+                out.push(Outcome {
+                    job: name.to_string(),
+                    built: None,
+                    accepted: false,
+                    errors: error_codes(&d),
+                });
                 diags.append(&mut d);
                 observer.event(Event::JobDone {
                     job: name,

@@ -71,6 +71,12 @@ pub enum Command {
         /// exploration).
         #[arg(long, value_enum, default_value_t = AcceptChoice::Error)]
         accept: AcceptChoice,
+        /// Write the jobs that pass even when others fail (the exit code is
+        /// still 1). Without it a build is all or nothing: the files of
+        /// every job are written together, as one unit, only if every job
+        /// passes.
+        #[arg(long)]
+        keep_going: bool,
         /// No progress: neither the bar a terminal shows nor the JSON
         /// progress events of `--message-format json`.
         #[arg(long, short)]

@@ -99,6 +99,7 @@ fn run(cli: Cli) -> u8 {
             out: dir,
             max_program_size,
             accept,
+            keep_going,
             quiet,
         } => commands::build::run(
             &out,
@@ -115,6 +116,7 @@ fn run(cli: Cli) -> u8 {
             },
             &dir,
             quiet,
+            keep_going,
         ),
     }
 }
