@@ -18,6 +18,7 @@ pub mod height_map;
 pub mod job;
 pub mod output;
 pub mod pipeline;
+pub mod plausibility;
 pub mod plots;
 pub mod progress;
 pub mod read_along;

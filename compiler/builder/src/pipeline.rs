@@ -322,6 +322,10 @@ fn build_job(
         read_back(job, &spec, &mut b)?;
     }
     b.report.estimate = (&est).into();
+    b.warnings.extend(crate::plausibility::cutting_time_warning(
+        spec.head(),
+        b.cutting_time,
+    ));
     let gate = crate::accept::gate(&spec, &mut b, request.accept);
     Ok((b, gate))
 }

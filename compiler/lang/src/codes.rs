@@ -126,6 +126,12 @@ pub const CENTRE_LEFT_UNCUT: &str = "W0004";
 pub const CHORDS_OVER_TOLERANCE: &str = "W0005";
 /// A wrapped design whose two ends do not meet where the roller closes.
 pub const SEAM_STEP: &str = "W0006";
+/// A cutting time over a day, the job stating no `max_cutting_time`.
+pub const CUTTING_TIME_IMPLAUSIBLE: &str = "W0030";
+/// An approach at the cutting feed longer than half a minute.
+pub const LONG_APPROACH_AT_FEED: &str = "W0031";
+/// A quarter or more of the time at feed spent approaching the cut.
+pub const AIR_CUTTING: &str = "W0032";
 /// E0195 under `lensc build --accept=warn`: the program is written.
 pub const ACCEPTANCE_MISSED_WARNING: &str = "W0020";
 /// E0196 under `lensc build --accept=warn`: the program is written.
@@ -325,6 +331,9 @@ pub const ALL: &[&str] = &[
     CENTRE_LEFT_UNCUT,
     CHORDS_OVER_TOLERANCE,
     SEAM_STEP,
+    CUTTING_TIME_IMPLAUSIBLE,
+    LONG_APPROACH_AT_FEED,
+    AIR_CUTTING,
     FORMAT_WOULD_CHANGE_MEANING,
     NOT_FINITE,
     SURFACE_UNDEFINED,

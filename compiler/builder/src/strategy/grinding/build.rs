@@ -92,7 +92,7 @@ pub(super) fn build(spec: &GrindingSpec, cx: &BuildContext) -> Result<Built, Vec
         )),
         ..Default::default()
     };
-    Ok(parts::built(
+    let mut built = parts::built(
         head,
         prov,
         ProgramText::Memory(text),
@@ -100,5 +100,7 @@ pub(super) fn build(spec: &GrindingSpec, cx: &BuildContext) -> Result<Built, Vec
         report::Simulation::Profile((&cut).into()),
         plots,
         (path.points.len(), path.total_time),
-    ))
+    );
+    built.warnings = crate::plausibility::air_warnings(head, &stream);
+    Ok(built)
 }

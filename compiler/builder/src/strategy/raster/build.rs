@@ -132,9 +132,9 @@ pub(super) fn build(spec: &RasterSpec, cx: &BuildContext) -> Result<Built, Vec<D
     let simulation = report::Simulation::HeightMap(report::HeightMapOnly { height_map });
     let text = ProgramText::Memory(text);
     let cut = (path.point_count, time);
-    Ok(parts::built(
-        head, prov, text, toolpath, simulation, plots, cut,
-    ))
+    let mut built = parts::built(head, prov, text, toolpath, simulation, plots, cut);
+    built.warnings = crate::plausibility::air_warnings(head, &moves);
+    Ok(built)
 }
 
 /// The program's header: provenance, units, surface, the tool, the raster

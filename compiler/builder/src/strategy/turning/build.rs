@@ -86,6 +86,9 @@ pub(super) fn build(spec: &TurningSpec, cx: &BuildContext) -> Result<Built, Vec<
     // other strategies give its kind), as it always has.
     built.report.surface.surface = head.names.surface_declared.clone();
     built.warnings = warnings;
+    built
+        .warnings
+        .extend(crate::plausibility::air_warnings(head, &stream));
     Ok(built)
 }
 
