@@ -186,7 +186,8 @@ fn tilt_removed(g: &mut Graph, p: &OffAxis, x: Id, y: Id) -> Result<Id, LowerErr
     let at = lensc_runtime::surface::ir::Interpreter::new(&SurfaceTape::new(h, hz));
     let o = lensc_runtime::surface::ir::SurfaceFn::eval(&at, 0.0, 0.0);
     let (sx, sy) = (o[1], o[2]);
-    if !(sx.hypot(sy).atan() < MAX_REMOVED_TILT) {
+    let angle = sx.hypot(sy).atan();
+    if angle.is_nan() || angle >= MAX_REMOVED_TILT {
         return Err(LowerError::Unsupported(
             "`tilt: remove` of a section sloping 45° or more at its centre",
         ));
@@ -197,7 +198,7 @@ fn tilt_removed(g: &mut Graph, p: &OffAxis, x: Id, y: Id) -> Result<Id, LowerErr
             parent: Box::new(surface),
             about: Axis::Y,
             angle: sx.atan(),
-            aperture: p.aperture.clone(),
+            aperture: p.aperture,
         });
     }
     let sy_left = sy / sx.hypot(1.0);
@@ -208,7 +209,7 @@ fn tilt_removed(g: &mut Graph, p: &OffAxis, x: Id, y: Id) -> Result<Id, LowerErr
             parent: Box::new(surface),
             about: Axis::X,
             angle: -sy_left.atan(),
-            aperture: p.aperture.clone(),
+            aperture: p.aperture,
         });
     }
     height(g, &surface, x, y)

@@ -299,7 +299,10 @@ surface t = off_axis(p, x: 3 mm, y: 0 mm, tilt: remove, aperture: circle(radius:
     // With the tilt removed: the section turned rigidly, level at its
     // centre (`tilt_removed_is_the_exact_turned_section` checks the turn).
     let t = eval_surface(src, "t", 0.0, 0.0);
-    assert!(t[0].abs() < 1e-15 && t[1].abs() < 1e-15 && t[2].abs() < 1e-15, "{t:?}");
+    assert!(
+        t[0].abs() < 1e-15 && t[1].abs() < 1e-15 && t[2].abs() < 1e-15,
+        "{t:?}"
+    );
     // A wrapped design evaluates as the flat design.
     let w = eval_surface(
         "surface f = freeform { z(x, y) = 0.02 mm * sin(5 rad/mm * x), domain: rect(x: 0 mm .. 6 mm, y: 0 mm .. 18.84955592153876 mm) }
@@ -882,7 +885,10 @@ surface t = off_axis(p, x: {x0} mm, y: {y0} mm, tilt: remove, aperture: circle(r
             [-cb * sa, sb, cb * ca],
         ];
         let centre = eval_surface(&src, "t", 0.0, 0.0);
-        assert!(centre[1].abs() < 1e-12 && centre[2].abs() < 1e-12, "{centre:?}");
+        assert!(
+            centre[1].abs() < 1e-12 && centre[2].abs() < 1e-12,
+            "{centre:?}"
+        );
         for (x, y) in [(11.0, 0.0), (-11.0, 2.0), (3.0, -8.0), (0.0, 11.5)] {
             let z = eval_surface(&src, "t", x, y)[0];
             let back = |i: usize| m[0][i] * x + m[1][i] * y + m[2][i] * z;
