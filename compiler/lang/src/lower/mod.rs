@@ -7,7 +7,7 @@
 pub mod read_back;
 pub mod surface;
 
-use lensc_grammar::suggest::did_you_mean;
+use lensc_grammar::suggest::{completions, did_you_mean, meant};
 use lensc_grammar::{Diagnostic, FileId};
 use lensc_runtime::post::Dialect;
 
@@ -203,6 +203,18 @@ fn dialect_help(requested: &str, offered: &[OfferedDialect], names: &[String]) -
     if let Some(s) = did_you_mean(requested, offered_names.iter().map(String::as_str)) {
         return format!("did you mean `--dialect {s}`? {}", capitalised(&offers));
     }
+    let cut_short = completions(requested, offered_names.iter().map(String::as_str));
+    if !cut_short.is_empty() {
+        let options: Vec<String> = cut_short
+            .iter()
+            .map(|c| format!("`--dialect {c}`"))
+            .collect();
+        return format!(
+            "did you mean {}? {}",
+            options.join(" or "),
+            capitalised(&offers)
+        );
+    }
     let std_dialects = || {
         crate::stdlib::items()
             .iter()
@@ -214,9 +226,9 @@ fn dialect_help(requested: &str, offered: &[OfferedDialect], names: &[String]) -
             "{offers}; if its controller reads `{requested}`, add it to the machine's `other_dialects: [{requested}]`"
         );
     }
-    match did_you_mean(requested, std_dialects()) {
+    match meant(requested, std_dialects()) {
         Some(s) => format!(
-            "no standard dialect is called `{requested}`: did you mean `{s}`? {offers}; `lensc list dialects` shows them all"
+            "no standard dialect is called `{requested}`: did you mean {s}? {offers}; `lensc list dialects` shows them all"
         ),
         None => format!(
             "no standard dialect is called `{requested}`; {offers}; `lensc list dialects` shows them all"
