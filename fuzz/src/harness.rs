@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use lensc_build::driver;
 use lensc_build::job::Limits;
 use lensc_grammar::Diagnostic;
-use lensc_lang::loader::FileSystem;
+use lensc_lang::loader::{FileSystem, Root};
 use lensc_lang::sandbox::ReadError;
 use lensc_lang::source::SourceMap;
 
@@ -53,7 +53,7 @@ impl MemFs {
 impl FileSystem for MemFs {
     /// Named files are read; a few names stand for what the sandbox
     /// refuses (a directory, a file too large, one outside the root).
-    fn read(&self, path: &Path) -> Result<Vec<u8>, ReadError> {
+    fn read(&self, _root: &Root, path: &Path) -> Result<Vec<u8>, ReadError> {
         let name = path.file_name().map(|n| n.to_string_lossy().into_owned());
         let name = name.unwrap_or_default();
         if let Some(text) = self.files.get(&name) {
