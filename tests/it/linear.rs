@@ -185,6 +185,7 @@ fn program_with_a_bad_last_line(path: &std::path::Path, lines: usize) {
 /// `lensc verify` on `program`: its exit code, stderr and peak resident
 /// set in KiB (`wait4`'s figure for this child alone).
 #[cfg(target_os = "linux")]
+#[allow(clippy::zombie_processes)] // reaped by `wait4`, which also reads its peak memory
 fn verify_peak_kib(program: &std::path::Path, args: &[&str]) -> (i32, String, i64) {
     use std::os::unix::process::ExitStatusExt;
     let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_lensc"))

@@ -215,10 +215,19 @@ pub fn human(
     out: &mut dyn Write,
 ) -> std::io::Result<()> {
     for d in diags {
+        // A span inside its file, on character boundaries (ariadne slices
+        // the text there and panics mid-character).
         let clamp = |id: FileId, span: lensc_grammar::Span| {
-            let len = sources.get(id).text.len();
-            let s = (span.start as usize).min(len);
-            (s, (span.end as usize).clamp(s, len))
+            let text = &sources.get(id).text;
+            let fit = |p: usize| {
+                let mut p = p.min(text.len());
+                while !text.is_char_boundary(p) {
+                    p -= 1;
+                }
+                p
+            };
+            let s = fit(span.start as usize);
+            (s, fit(span.end as usize).max(s))
         };
         // Each file the labels are in, by the name shown (two files with
         // one name share it: the first one's excerpt is shown).

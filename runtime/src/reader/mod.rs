@@ -298,7 +298,20 @@ impl Reader {
         self.last_span = (offset, offset + text.len());
         let mut out = Vec::new();
         self.state.line(text, &mut out);
+        // A finding's span lies in its line, on character boundaries, its
+        // start not after its end (a rule's span that ran backwards, or into
+        // a `�` that stands for a byte that is not UTF-8, cannot reach a
+        // renderer).
+        let fit = |p: usize| {
+            let mut p = p.min(text.len());
+            while !text.is_char_boundary(p) {
+                p -= 1;
+            }
+            p
+        };
         for (rule, (s, e), message, hint) in out {
+            let (s, e) = (fit(s), fit(e));
+            let (s, e) = (s, e.max(s));
             if self.findings.iter().any(|f| f.rule == rule) {
                 *self.repeats.entry(rule).or_default() += 1;
                 continue;
