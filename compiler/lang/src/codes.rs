@@ -95,6 +95,9 @@ pub const SURFACE_UNDEFINED: &str = "E0187";
 pub const OUTPUT_NAME_RESERVED: &str = "E0188";
 /// A project whose `use`s would load more than `loader::MAX_FILES` files.
 pub const TOO_MANY_FILES: &str = "E0189";
+/// A file under the project root with more than one name (a hard link):
+/// another of its names may lie outside the root.
+pub const HARD_LINKED: &str = "E0191";
 /// `lensc import`: the file is not a prescription lensc reads (not a
 /// `.zmx` or optiland JSON file, or a value in it that is not a number).
 pub const IMPORT_UNREADABLE: &str = "E0350";
@@ -339,6 +342,7 @@ pub const ALL: &[&str] = &[
     SURFACE_UNDEFINED,
     OUTPUT_NAME_RESERVED,
     TOO_MANY_FILES,
+    HARD_LINKED,
     IMPORT_UNREADABLE,
     IMPORT_NOTHING,
     IMPORT_NON_SEQUENTIAL,
