@@ -155,7 +155,11 @@ fn build_writes_program_to_out_dir() {
     leftovers.sort();
     assert_eq!(
         leftovers,
-        ["kim_convex.ngc", "kim_convex.report.json"],
+        [
+            "kim_convex.ngc",
+            "kim_convex.report.json",
+            "kim_convex.setup.txt"
+        ],
         "temporary files left"
     );
     // Put in place with the user's usual mode (0666 less the umask this
@@ -220,7 +224,8 @@ fn failed_build_leaves_earlier_output_untouched() {
         .expect("out")
         .map(|e| e.expect("e").file_name())
         .collect();
-    assert_eq!(names.len(), 2, "partial files left: {names:?}");
+    // The program, its report and its set-up sheet of the good build.
+    assert_eq!(names.len(), 3, "partial files left: {names:?}");
 }
 
 #[test]
@@ -433,7 +438,7 @@ use std::strategies::finish_turning
 // A concave sphere R = 10 mm cut only on the ring 1 mm <= r <= 2 mm (at a
 // tolerance the lathe's 0.1 um holds).
 surface ring = sphere { radius: 10 mm, sense: concave, aperture: annulus(inner: 1 mm, outer: 2 mm) }
-tool t = round_nose { nose_radius: 0.5 mm, clearance: 7 deg }
+tool t = round_nose { nose_radius: 0.5 mm, clearance: 7 deg, control_point: tool_centre }
 strategy finish = finish_turning { chord_tolerance: 150 nm }
 job ring_cut { surface: ring, tool: t, machine: linuxcnc_lathe, strategy: finish }
 ";

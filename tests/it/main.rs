@@ -15,6 +15,7 @@ mod build_errors;
 mod chords;
 mod cli;
 mod complete_programs;
+mod control_point;
 mod determinism;
 mod diagnostics;
 mod dialects;

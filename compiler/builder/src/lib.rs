@@ -24,6 +24,7 @@ pub mod progress;
 pub mod read_along;
 pub mod read_back;
 pub mod report;
+pub mod setup_sheet;
 pub(crate) mod spool;
 pub mod strategy;
 pub mod temps;

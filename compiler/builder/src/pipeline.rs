@@ -75,16 +75,19 @@ pub fn lower(
 }
 
 /// The names, after the job's name and a dot, of the files a build or
-/// `lensc report` writes beside a program (the report, the plots).
-pub const RESERVED_EXTENSIONS: [&str; 4] = [
+/// `lensc report` writes beside a program (the report, the set-up sheet,
+/// the plots).
+pub const RESERVED_EXTENSIONS: [&str; 5] = [
     "report.json",
+    crate::setup_sheet::EXTENSION,
     "profile.svg",
     "form_error.svg",
     "following.svg",
 ];
 
 /// E0188 when the program's name (`JOB.EXT`) would be the name of a file
-/// written beside it: the report, a plot, the dialect's servo table.
+/// written beside it: the report, the set-up sheet, a plot, the dialect's
+/// servo table.
 /// Compared without case (a share on a case-blind file system), and any
 /// extension ending in one of them (`x.report.json`) too.
 fn reserved_name(head: &crate::job::JobHead) -> Option<Diagnostic> {
@@ -103,6 +106,8 @@ fn reserved_name(head: &crate::job::JobHead) -> Option<Diagnostic> {
         "the servo table the dialect writes beside the program"
     } else if clash == "report.json" {
         "the build report"
+    } else if clash == crate::setup_sheet::EXTENSION {
+        "the set-up sheet"
     } else {
         "a plot `lensc report` writes"
     };
@@ -327,6 +332,10 @@ fn build_job(
         b.cutting_time,
     ));
     let gate = crate::accept::gate(&spec, &mut b, request.accept);
+    // The set-up sheet, written in one unit with the program it sets up.
+    if !matches!(to, Destination::Nowhere) {
+        crate::setup_sheet::add(spec.head(), &mut b);
+    }
     Ok((b, gate))
 }
 

@@ -79,6 +79,9 @@ pub const GCODE_SYSTEM_NOT_OFFERED: &str = "E0176";
 /// Constant surface speed asked of a machine whose dialect has none
 /// (no `surface_speed` lines).
 pub const NO_SURFACE_SPEED: &str = "E0177";
+/// A tool's control point the job's dialect cannot program (a tip on a
+/// fast-tool-servo lathe whose servo table states the nose centre).
+pub const CONTROL_POINT_NOT_EXPRESSIBLE: &str = "E0178";
 /// A path tolerance finer than the machine's resolution can hold.
 pub const TOLERANCE_BELOW_RESOLUTION: &str = "E0180";
 /// `lensc fmt` refused to write a layout that would not parse back to the
@@ -326,6 +329,7 @@ pub const ALL: &[&str] = &[
     KLARTEXT_ON_A_LATHE,
     GCODE_SYSTEM_NOT_OFFERED,
     NO_SURFACE_SPEED,
+    CONTROL_POINT_NOT_EXPRESSIBLE,
     TOLERANCE_BELOW_RESOLUTION,
     ACCEPTANCE_MISSED,
     ACCEPTANCE_UNMEASURED,

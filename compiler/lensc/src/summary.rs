@@ -8,8 +8,13 @@ use lensc_build::report::{CriterionResult, HeightMap, LimitSource, Report, Simul
 
 /// What became of a job, as its summary says it.
 pub enum Fate<'a> {
-    /// Built, judged and written: the program and report at these paths.
-    Written { program: &'a str, report: &'a str },
+    /// Built, judged and written: the program and report at these paths,
+    /// and the files beside them (set-up sheet, servo table).
+    Written {
+        program: &'a str,
+        report: &'a str,
+        beside: &'a [String],
+    },
     /// Built and passed, but not written: another job failed and the
     /// build writes all or nothing (`--keep-going` writes it).
     Held,
@@ -56,7 +61,14 @@ pub fn job_summary(job: &str, fate: &Fate, built: Option<(&Report, &Program)>) -
         Fate::Written {
             program: path,
             report: report_path,
-        } => line("wrote", format!("{path} ({size}) and {report_path}")),
+            beside,
+        } => {
+            let mut others: Vec<&str> = beside.iter().map(String::as_str).collect();
+            others.push(report_path);
+            let last = others.pop().unwrap_or_default();
+            let rest = others.iter().map(|o| format!(", {o}")).collect::<String>();
+            line("wrote", format!("{path} ({size}){rest} and {last}"))
+        }
         _ => line("program", format!("{size}, not written")),
     }
     out

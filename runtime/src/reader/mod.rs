@@ -25,7 +25,7 @@ mod lexer;
 mod modal;
 mod motion;
 
-pub use header::{HeaderNames, header_names, header_source};
+pub use header::{HeaderNames, header_control_offset, header_names, header_source};
 
 use crate::dialect::Dialect;
 
@@ -155,6 +155,31 @@ pub enum Path {
         cw: bool,
         turn: f64,
     },
+}
+
+/// `moves` (read from a program whose control point lies `offset` mm
+/// from the tool's centre, `header_control_offset`) as the tool centre's
+/// moves: the offset taken off every position and arc centre, so a
+/// program written for the tip simulates as the one written for the
+/// centre.
+pub fn to_tool_centre(moves: &mut [Executed], offset: [f64; 3]) {
+    if offset == [0.0; 3] {
+        return;
+    }
+    for m in moves {
+        for p in [&mut m.from, &mut m.to] {
+            for (v, o) in p.iter_mut().zip(offset) {
+                if let Some(v) = v {
+                    *v -= o;
+                }
+            }
+        }
+        if let Path::Arc { plane, centre, .. } = &mut m.path {
+            let (a, b) = plane.axes();
+            centre.0 -= offset[a];
+            centre.1 -= offset[b];
+        }
+    }
 }
 
 /// Reads `text` (a whole program) in `dialect` on `machine`: every rule

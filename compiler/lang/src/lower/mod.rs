@@ -90,8 +90,9 @@ fn machine_of(job: &CheckedJob) -> Result<&Object, Diagnostic> {
 
 /// E0176 a G-code system on a dialect chosen for a machine that is not a
 /// lathe, or one a Fanuc lathe does not offer; E0177 constant surface
-/// speed asked of a dialect that has none. Both name the dialect and the
-/// machine.
+/// speed asked of a dialect that has none; E0178 a tool set to its tip on
+/// a fast-tool-servo lathe whose dialect drives the servo from a table of
+/// nose-centre heights. Each names the dialect and the machine.
 fn controller_can_run(job: &CheckedJob, g: &Gcode, dialect: &str) -> Result<(), Diagnostic> {
     let parts = Reader::new(&job.fields);
     let (Some(machine), Some(strategy)) = (parts.object("machine"), parts.object("strategy"))
@@ -129,6 +130,27 @@ fn controller_can_run(job: &CheckedJob, g: &Gcode, dialect: &str) -> Result<(), 
         )
         .with_label("this job")
         .with_help("a mill's Fanuc control has one G-code system: name a mill dialect (`fanuc_0i_mill`), or leave `gcode_system` out of your copy"));
+    }
+    let tip_stated = parts.object("tool").and_then(|t| {
+        Reader::new(&t.fields)
+            .stated_word("control_point")
+            .filter(|w| w.value == "tool_tip")
+            .map(|w| (name(t), w.site))
+    });
+    if let (Some((tool, (tip_file, tip_span))), Some(table)) = (tip_stated, g.fts_table.as_deref())
+        && machine.kind.name == "fts_lathe"
+    {
+        return Err(Diagnostic::error(
+            codes::CONTROL_POINT_NOT_EXPRESSIBLE,
+            format!(
+                "tool `{tool}` is set to its tip (`control_point: tool_tip`), and `{dialect}` drives the fast tool servo of machine `{}` from a `.{table}` table whose W is the nose centre's height: the table cannot be written for the tip",
+                name(machine)
+            ),
+            tip_file,
+            tip_span,
+        )
+        .with_label("the tip")
+        .with_help("set the tool to its nose centre (`control_point: tool_centre`, the servo lathes' default), or name a dialect without a servo table"));
     }
     let asks_surface_speed = strategy.kind.name == "profile_turning"
         && crate::schema::strategies::ProfileTurningParams::read(strategy)

@@ -45,7 +45,11 @@ pub fn run(
     reporter.done(code == 0);
     for s in &summaries {
         let fate = match (&s.fate, s.accepted) {
-            (Some((program, report)), _) => Fate::Written { program, report },
+            (Some((program, report, beside)), _) => Fate::Written {
+                program,
+                report,
+                beside,
+            },
             (None, true) if written.is_err() && to_write.contains(&s.index) => Fate::NotWritten,
             (None, true) => Fate::Held,
             (None, false) if s.built.is_some() => Fate::Refused { errors: &s.errors },
@@ -67,8 +71,8 @@ struct Summary {
     built: Option<(lensc_build::report::Report, Program)>,
     /// Its files, until they are written.
     files: Option<Built>,
-    /// Where its program and report were written.
-    fate: Option<(String, String)>,
+    /// Where its program, report and the files beside them were written.
+    fate: Option<(String, String, Vec<String>)>,
 }
 
 impl Summary {
@@ -136,19 +140,19 @@ fn write_unit(
         cannot_write(&first_program, &e);
         return Err(());
     }
-    for (i, total, (program, report, files)) in done {
-        reporter.written(&jobs[i].job, files, total);
-        jobs[i].fate = Some((program, report));
+    for (i, total, (program, report, beside)) in done {
+        reporter.written(&jobs[i].job, 2 + beside.len(), total);
+        jobs[i].fate = Some((program, report, beside));
     }
     Ok(())
 }
 
 /// Staged temporary files of one job with their targets, its total bytes,
-/// and its program's and report's paths with its count of files.
+/// and its program's, report's and other files' paths.
 type Staged = (
     Vec<(lensc_build::temps::TempFile, std::path::PathBuf)>,
     u64,
-    (String, String, usize),
+    (String, String, Vec<String>),
 );
 
 /// One built job's files, each whole in a temporary file in `dir`.
@@ -166,7 +170,11 @@ fn stage_job(built: Built, dir: &Path, reporter: &Reporter) -> Result<Staged, ()
     let target = dir.join(&built.program_name);
     let report_path = dir.join(&built.report_name);
     let report = built.report.to_json_text();
-    let files_count = 2 + built.beside.len();
+    let beside_paths: Vec<String> = built
+        .beside
+        .iter()
+        .map(|(name, _)| dir.join(name).display().to_string())
+        .collect();
     let total = report.len() as u64
         + built.program.bytes()
         + built.beside.iter().map(|(_, t)| t.bytes()).sum::<u64>();
@@ -202,7 +210,7 @@ fn stage_job(built: Built, dir: &Path, reporter: &Reporter) -> Result<Staged, ()
         (
             target.display().to_string(),
             report_path.display().to_string(),
-            files_count,
+            beside_paths,
         ),
     ))
 }

@@ -42,7 +42,7 @@ pub(super) fn build(spec: &GrindingSpec, cx: &BuildContext) -> Result<Built, Vec
     );
     let mut header = parts::header(head, prov, &units);
     header.push(format!(
-        "tool {}: spherical wheel, diameter {} mm; coordinates are the wheel centre",
+        "tool {}: spherical wheel, diameter {} mm",
         head.names.tool,
         exact_in(grinding.wheel_diameter, "mm")
     ));

@@ -112,7 +112,7 @@ pub(crate) fn lower(
             (
                 RasterTool::Ball { radius: d / 2.0 },
                 format!(
-                    "ball-end mill, diameter {} mm, referenced at the ball centre",
+                    "ball-end mill, diameter {} mm",
                     lensc_lang::lower::exact_in(d, "mm")
                 ),
             )
@@ -122,7 +122,7 @@ pub(crate) fn lower(
             (
                 RasterTool::Knife { nose_radius: r },
                 format!(
-                    "microshaper knife, nose radius {} mm, its edge across the cut, referenced at the nose centre",
+                    "microshaper knife, nose radius {} mm, its edge across the cut",
                     lensc_lang::lower::exact_in(r, "mm")
                 ),
             )

@@ -33,7 +33,13 @@ pub(super) fn build(spec: &TurningSpec, cx: &BuildContext) -> Result<Built, Vec<
                 .collect::<Vec<_>>()
         })?;
     let warnings = warnings(spec, &path);
-    let emitted = match lensc_runtime::emit::turning::emit(job, &path, prov, &head.start) {
+    let emitted = match lensc_runtime::emit::turning::emit(
+        job,
+        &path,
+        prov,
+        &head.start,
+        &head.control.header_line(head.start.control),
+    ) {
         Ok(e) => e,
         Err(e) => {
             let mut all = warnings;
