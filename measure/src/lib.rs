@@ -1,0 +1,18 @@
+//! Measured parts: the files interferometers, profilometers and stylus
+//! profilers write, read into one model with their units (millimetres
+//! here, as everywhere in lensc) and their invalid points; the
+//! measurement registered to the job's design surface (piston, tilt,
+//! decentre and clocking); and the figures the error map gives: PV and
+//! RMS along the surface normal, texture after form removal (ISO 25178-2),
+//! and a turned part's set-up errors.
+//!
+//! No language and no file system here: readers take bytes, the caller
+//! (lensc-build) opens the file under lensc's sandbox rules and turns
+//! these errors into coded diagnostics.
+
+pub mod error;
+pub mod map;
+pub mod read;
+
+pub use error::ReadError;
+pub use map::{HeightMap, Measured, Measurement, PointCloud, Profile2d};
