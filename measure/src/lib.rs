@@ -13,6 +13,9 @@
 pub mod error;
 pub mod map;
 pub mod read;
+pub mod register;
+pub mod texture;
+pub mod turned;
 
 pub use error::ReadError;
 pub use map::{HeightMap, Measured, Measurement, PointCloud, Profile2d};
