@@ -16,6 +16,17 @@ pub mod read;
 pub mod register;
 pub mod texture;
 pub mod turned;
+pub mod write;
 
 pub use error::ReadError;
 pub use map::{HeightMap, Measured, Measurement, PointCloud, Profile2d};
+
+/// The MD5 of a file's bytes, as lowercase hex: which measurement a
+/// report (and a later compensation) was made from.
+pub fn md5_hex(bytes: &[u8]) -> String {
+    use md5::{Digest, Md5};
+    Md5::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}

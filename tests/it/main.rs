@@ -34,6 +34,7 @@ mod limits;
 mod linear;
 mod list;
 mod lsp;
+mod measure;
 mod plots;
 mod progress;
 mod read_back;
