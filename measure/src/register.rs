@@ -221,11 +221,11 @@ fn determinable(a: &[[f64; 6]; 6], two_d: bool) -> Freedom {
         on[3] = false;
         why.push((
             "decentre_x",
-            "it cannot be told from tilt on this surface (on a paraboloid a decentre is a tilt)",
+            "the measured points cannot tell it from tilt (on a paraboloid, or over too small a field, a decentre is a tilt)",
         ));
         if two_d {
             on[4] = false;
-            why.push(("decentre_y", "it cannot be told from tilt on this surface (on a paraboloid a decentre is a tilt)"));
+            why.push(("decentre_y", "the measured points cannot tell it from tilt (on a paraboloid, or over too small a field, a decentre is a tilt)"));
         }
     }
     (on, why)
@@ -259,15 +259,15 @@ pub fn register_heights(
     pts: &[[f64; 3]],
     opts: Options,
 ) -> Result<Registration, RegisterError> {
+    let requested = if opts.two_d { 6 } else { 3 };
+    if pts.len() <= requested {
+        return Err(RegisterError::TooFewPoints { points: pts.len() });
+    }
     let mut buf = Vec::new();
     let mut p = [0.0; 6];
     // The piston to start from: the mean height difference.
     let (a0, g0, _) = normal_equations(f, pts, &p, &mut buf)?;
     let (on, left_out) = determinable(&a0, opts.two_d);
-    let fitted_count = on.iter().filter(|b| **b).count();
-    if pts.len() <= fitted_count {
-        return Err(RegisterError::TooFewPoints { points: pts.len() });
-    }
     p[0] = g0[0] / a0[0][0];
     let (mut a, mut g, mut ssr) = normal_equations(f, pts, &p, &mut buf)?;
     let mut lambda = 1e-4;
@@ -372,6 +372,9 @@ pub fn register_cloud(
     let mut r = nalgebra::Matrix3::<f64>::identity();
     let mut t = nalgebra::Vector3::<f64>::zeros();
     let mut on: Option<Freedom> = None;
+    if pts.len() <= if opts.two_d { 6 } else { 3 } {
+        return Err(RegisterError::TooFewPoints { points: pts.len() });
+    }
     for it in 1..=opts.max_iterations {
         let mut a = [[0.0; 6]; 6];
         let mut g = [0.0; 6];

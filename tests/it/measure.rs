@@ -279,3 +279,90 @@ fn zip_entries(bytes: &[u8]) -> Vec<(String, Vec<u8>)> {
         })
         .collect()
 }
+
+/// A point cloud (x y z text in µm) and a stylus profile (x z in mm) of
+/// the placed design are registered back: ICP and the profile's fit.
+#[test]
+fn a_cloud_and_a_profile_are_measured_back() {
+    let (dx, dy, p) = (3e-3, -2e-3, 1e-4);
+    // The cloud: points on a spiral, in µm.
+    let xy: Vec<(f64, f64)> = (0..3000)
+        .map(|k| {
+            let r = 1.5 * ((k as f64 + 0.5) / 3000.0).sqrt();
+            let t = k as f64 * 2.399_963;
+            (r * t.cos(), r * t.sin())
+        })
+        .collect();
+    let moved: Vec<(f64, f64)> = xy.iter().map(|(x, y)| (x - dx, y - dy)).collect();
+    let cloud: String = xy
+        .iter()
+        .zip(design(&moved))
+        .map(|((x, y), h)| format!("{} {} {}\n", x * 1e3, y * 1e3, (h + p) * 1e3))
+        .collect();
+    let dir = project("cloud.xyz", cloud.as_bytes());
+    let out = lensc(
+        dir.path(),
+        &[
+            "measure",
+            "job.lens",
+            "cloud.xyz",
+            "--job",
+            "kim_convex",
+            "--units",
+            "um",
+            "--keep-origin",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let report: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("out/kim_convex.measure.json")).unwrap(),
+    )
+    .unwrap();
+    let r = &report["registration"];
+    assert!(
+        r["method"].as_str().unwrap().contains("closest point"),
+        "{report:#}"
+    );
+    for (key, want) in [
+        ("decentre_x_um", 3.0),
+        ("decentre_y_um", -2.0),
+        ("piston_um", 0.1),
+    ] {
+        let got = r[key].as_f64().unwrap();
+        assert!(
+            (got - want).abs() <= 1e-3f64.max(0.05 * want.abs()),
+            "{key}: {got}: {report:#}"
+        );
+    }
+    assert!(report.get("texture").is_none() && report["texture_skipped"].is_string());
+    // The profile along x.
+    let xs: Vec<(f64, f64)> = (0..=600).map(|i| (-1.5 + 0.005 * i as f64, 0.0)).collect();
+    let moved: Vec<(f64, f64)> = xs.iter().map(|(x, _)| (x - dx, 0.0)).collect();
+    let profile: String = xs
+        .iter()
+        .zip(design(&moved))
+        .map(|((x, _), h)| format!("{x} {}\n", h + p + 20e-6 * x))
+        .collect();
+    let dir = project("profile.txt", profile.as_bytes());
+    let out = lensc(
+        dir.path(),
+        &["measure", "job.lens", "profile.txt", "--job", "kim_convex"],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let report: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("out/kim_convex.measure.json")).unwrap(),
+    )
+    .unwrap();
+    let r = &report["registration"];
+    for (key, want) in [
+        ("decentre_x_um", 3.0),
+        ("tilt_x_urad", 20.0),
+        ("piston_um", 0.1),
+    ] {
+        let got = r[key].as_f64().unwrap();
+        assert!(
+            (got - want).abs() <= 1e-3f64.max(0.05 * want.abs()),
+            "{key}: {got}: {report:#}"
+        );
+    }
+}

@@ -167,3 +167,24 @@ fn a_paraboloid_cannot_tell_decentre_from_tilt_and_says_so() {
     assert!(found.left_out.iter().any(|(p, _)| *p == "decentre_x"));
     assert_recovers(&found, &[1e-4, 20e-6, 0.0, 0.0, 0.0, 0.0]);
 }
+
+#[test]
+fn too_few_iterations_is_not_converged_not_a_guess() {
+    let f = asphere(0.0);
+    let pts = synthetic_map(&f, &[2e-4, 50e-6, -20e-6, 5e-3, -3e-3, 0.0], 41);
+    let e = register_heights(
+        &f,
+        &pts,
+        Options {
+            max_iterations: 1,
+            ..Options::default()
+        },
+    )
+    .unwrap_err();
+    assert!(
+        matches!(e, RegisterError::NotConverged { iterations: 1, .. }),
+        "{e:?}"
+    );
+    let e = register_heights(&f, &pts[..4], Options::default()).unwrap_err();
+    assert_eq!(e, RegisterError::TooFewPoints { points: 4 });
+}
