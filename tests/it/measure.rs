@@ -366,3 +366,21 @@ fn a_cloud_and_a_profile_are_measured_back() {
         );
     }
 }
+
+#[test]
+fn flags_out_of_range_are_usage_errors() {
+    let m = placed_map(21, [0.0; 5], &|_| true, 1.0);
+    let dir = project("part.x3p", &lensc_measure::write::x3p(&m, "test"));
+    for bad in [
+        ["--min-valid", "150"],
+        ["--min-valid", "NaN"],
+        ["--cutoff", "0.08"],
+        ["--cutoff", "-1mm"],
+    ] {
+        let mut args = vec!["measure", "job.lens", "part.x3p", "--job", "kim_convex"];
+        args.extend_from_slice(&bad);
+        let out = lensc(dir.path(), &args);
+        assert_eq!(out.status.code(), Some(2), "{bad:?}: {}", text(&out.stderr));
+        assert!(written(dir.path()).is_empty());
+    }
+}

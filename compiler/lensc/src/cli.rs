@@ -214,7 +214,7 @@ pub enum Command {
         units: TextUnit,
         /// The least share (percent) of the measured aperture whose points
         /// must be valid.
-        #[arg(long, value_name = "PERCENT", default_value_t = 50.0)]
+        #[arg(long, value_name = "PERCENT", default_value = "50", value_parser = parse_percent)]
         min_valid: f64,
         /// The nesting index λc of the texture's Gaussian filter, with its
         /// unit (`0.08mm`, `250um`).
@@ -330,6 +330,14 @@ impl TextUnit {
             TextUnit::Um => 1e-3,
             TextUnit::Nm => 1e-6,
         }
+    }
+}
+
+/// A share in percent, 0 to 100.
+pub fn parse_percent(text: &str) -> Result<f64, String> {
+    match text.trim().trim_end_matches('%').parse::<f64>() {
+        Ok(v) if (0.0..=100.0).contains(&v) => Ok(v),
+        _ => Err(format!("`{text}` is not a percentage from 0 to 100")),
     }
 }
 
