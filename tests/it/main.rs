@@ -35,6 +35,7 @@ mod limits;
 mod linear;
 mod list;
 mod lsp;
+mod measure;
 mod plots;
 mod progress;
 mod read_back;

@@ -16,6 +16,7 @@ pub mod driver;
 pub mod evaluate;
 pub mod height_map;
 pub mod job;
+pub mod measure;
 pub mod output;
 pub mod pipeline;
 pub mod plausibility;

@@ -114,6 +114,24 @@ pub const IMPORT_NON_SEQUENTIAL: &str = "E0352";
 pub const IMPORT_NOT_FINITE: &str = "E0353";
 /// `lensc import`: the `.lens` text would be over the 16 MiB lensc reads.
 pub const IMPORT_TOO_LARGE: &str = "E0354";
+/// `lensc measure`: the measurement file is not one lensc reads (an
+/// unknown format, a malformed header or value, a variant not read).
+pub const MEASURE_UNREADABLE: &str = "E0360";
+/// `lensc measure`: the measurement file ends before the data its header
+/// promises.
+pub const MEASURE_TRUNCATED: &str = "E0361";
+/// `lensc measure`: a checksum the measurement file carries does not
+/// match its data.
+pub const MEASURE_CHECKSUM: &str = "E0362";
+/// `lensc measure`: the invalid-point mask leaves less than the stated
+/// share of the measured aperture.
+pub const MEASURE_TOO_LITTLE: &str = "E0363";
+/// `lensc measure`: the measurement does not fit the job's surface: most
+/// of it lies outside the aperture, or it departs from the design far
+/// more than a part of it could (other units, another surface).
+pub const MEASURE_MISMATCH: &str = "E0364";
+/// `lensc measure`: the registration to the design did not converge.
+pub const MEASURE_NOT_CONVERGED: &str = "E0365";
 
 /// The simulated part misses one of its job's acceptance criteria (the
 /// message names which, by how much and where); no program is written.
@@ -352,6 +370,12 @@ pub const ALL: &[&str] = &[
     IMPORT_NON_SEQUENTIAL,
     IMPORT_NOT_FINITE,
     IMPORT_TOO_LARGE,
+    MEASURE_UNREADABLE,
+    MEASURE_TRUNCATED,
+    MEASURE_CHECKSUM,
+    MEASURE_TOO_LITTLE,
+    MEASURE_MISMATCH,
+    MEASURE_NOT_CONVERGED,
     IMPORT_UNSUPPORTED_SURFACE,
     IMPORT_PARAMETER_DROPPED,
     IMPORT_NO_SEMI_DIAMETER,

@@ -73,6 +73,28 @@ fn run(cli: Cli) -> u8 {
         } => commands::verify::run(&out, &program, machine.as_deref(), dialect.as_deref()),
         Command::Fmt { files, check } => commands::fmt::run(&out, &files, check),
         Command::Import { file, output } => commands::import::run(&out, &file, output.as_deref()),
+        Command::Measure {
+            file,
+            part,
+            job,
+            out: dir,
+            units,
+            min_valid,
+            cutoff,
+            keep_origin,
+        } => commands::measure::run(
+            &out,
+            (&file, &part),
+            job.as_deref(),
+            &dir,
+            lensc_build::measure::Options {
+                units: lensc_measure::read::TextUnits(units.mm()),
+                min_valid: min_valid / 100.0,
+                cutoff,
+                keep_origin,
+            },
+        ),
+
         Command::Analyse {
             file,
             surface,
