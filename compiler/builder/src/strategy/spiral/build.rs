@@ -224,7 +224,13 @@ fn simulated_height_map(
         design.as_ref(),
         window,
         lowered.domain,
-        spec.spiral.start_radius,
+        // The default window is the disc the spiral cuts; one the job
+        // gives counts every cell of it, cut or not.
+        if window.given {
+            f64::INFINITY
+        } else {
+            spec.spiral.start_radius
+        },
         &spec.lenslets,
     );
     // A polar grid's cells lie askew to the raster's blocks: √2 times the
