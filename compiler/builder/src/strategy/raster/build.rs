@@ -13,7 +13,7 @@ use lensc_runtime::verify::heightmap::Cutter;
 
 use crate::context::{self as parts, BuildContext};
 use crate::evaluate::evaluator;
-use crate::height_map::{self, Simulation, domain_centre};
+use crate::height_map::{self, Simulation};
 use crate::output::{Built, ProgramText};
 use crate::report;
 use lensc_runtime::verify::window::split;
@@ -92,10 +92,16 @@ pub(super) fn build(spec: &RasterSpec, cx: &BuildContext) -> Result<Built, Vec<D
         ),
     };
     let along_x = raster.along == Axis::X;
+    // The whole part by default, as fine as its cutter's budget allows.
+    let budget = match cutter {
+        Cutter::Nose { .. } => height_map::WHOLE_CELLS_NOSE,
+        Cutter::Ball { .. } => height_map::WHOLE_CELLS_BALL,
+    };
     let window = height_map::window(
         head,
-        domain_centre(&lowered.domain),
         height_map::domain_extent(&lowered.domain),
+        budget,
+        |w| split(&w.cartesian(along_x), None),
     );
     let grid = window.cartesian(along_x);
     let mut sweep = Simulation::of(grid, split(&grid, None), cutter);

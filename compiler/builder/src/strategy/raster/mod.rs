@@ -58,14 +58,10 @@ impl crate::strategy::Strategy for RasterSpec {
         &self,
         window: &lensc_runtime::verify::window::Window,
     ) -> Option<Vec<lensc_runtime::verify::window::Tile>> {
-        match self.tool {
-            // A ball-end mill is not simulated in tiles.
-            RasterTool::Knife { .. } => Some(lensc_runtime::verify::window::split(
-                &window.cartesian(self.raster.along == Axis::X),
-                None,
-            )),
-            RasterTool::Ball { .. } => None,
-        }
+        Some(lensc_runtime::verify::window::split(
+            &window.cartesian(self.raster.along == Axis::X),
+            None,
+        ))
     }
     fn build(
         &self,

@@ -57,8 +57,9 @@ pub(super) fn build(spec: &RollerSpec, cx: &BuildContext) -> Result<Built, Vec<D
     let (design_y, z) = (spec.design_y, (helix.z_start, helix.z_end));
     let window = height_map::window(
         head,
-        ((z.0 + z.1) / 2.0, (design_y.0 + design_y.1) / 2.0),
         height_map::roller_extent(&lowered.domain, z, design_y),
+        height_map::WHOLE_CELLS_NOSE,
+        |w| split(&w.roller(helix.roller_radius, helix.y_start), None),
     );
     let grid = window.roller(helix.roller_radius, helix.y_start);
     let mut sweep = Simulation::new(grid, split(&grid, None), rho);
