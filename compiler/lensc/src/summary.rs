@@ -157,7 +157,8 @@ fn height_map(sim: &Simulation) -> Option<&HeightMap> {
 }
 
 /// The area the figures come from: a profile's radii, or a height map's
-/// window (stated by the job's `simulate` block or the default).
+/// extent (the whole part, or a window stated by the job's `simulate`
+/// block).
 fn judged(sim: &Simulation) -> String {
     if let Simulation::Profile(p) = sim {
         return match (p.from_radius_mm, p.to_radius_mm) {
@@ -172,7 +173,9 @@ fn judged(sim: &Simulation) -> String {
         };
     };
     let w = &h.window;
-    let whose = if w.given {
+    let whose = if w.whole_part {
+        "the whole part"
+    } else if w.given {
         "the job's `simulate` window"
     } else {
         "the default window"
