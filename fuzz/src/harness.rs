@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use lensc_build::driver;
 use lensc_build::job::Limits;
 use lensc_grammar::Diagnostic;
-use lensc_lang::loader::FileSystem;
+use lensc_lang::loader::{FileSystem, Root};
 use lensc_lang::sandbox::ReadError;
 use lensc_lang::source::SourceMap;
 
@@ -53,7 +53,7 @@ impl MemFs {
 impl FileSystem for MemFs {
     /// Named files are read; a few names stand for what the sandbox
     /// refuses (a directory, a file too large, one outside the root).
-    fn read(&self, path: &Path) -> Result<Vec<u8>, ReadError> {
+    fn read(&self, _root: &Root, path: &Path) -> Result<Vec<u8>, ReadError> {
         let name = path.file_name().map(|n| n.to_string_lossy().into_owned());
         let name = name.unwrap_or_default();
         if let Some(text) = self.files.get(&name) {
@@ -86,12 +86,34 @@ pub enum Depth {
     Check,
     /// Also lower every job of a clean file.
     Lower,
+    /// Also lower every job of a clean file, held to these size limits.
+    LowerWithin(Limits),
     /// Also build every job of a clean file and write its files.
     Build,
+    /// Build as `Build`, in this dialect instead of each machine's own
+    /// (`--dialect`) and to this largest program (`--max-program-size`).
+    BuildAs {
+        dialect: Option<&'static str>,
+        max_program_size: Option<u64>,
+    },
+    /// Not a `.lens` file: a program for `lensc verify` (the number picks
+    /// the machine and dialect it is read by if its header names none).
+    Verify(usize),
+    /// Not a `.lens` file: a prescription for `lensc import` (`.json` if
+    /// true, else `.zmx`).
+    Import { json: bool },
+    /// Not a `.lens` file: a session of messages for `lensc lsp`.
+    Lsp,
 }
 
 /// Runs `bytes` as far as `depth` asks (and the checker lets it).
 pub fn run(fs: &MemFs, bytes: &[u8], depth: Depth, out_dir: &Path) -> Result<Reached, Fault> {
+    match depth {
+        Depth::Verify(pair) => return crate::targets::verify(fs, bytes, pair),
+        Depth::Import { json } => return crate::targets::import(fs, bytes, json),
+        Depth::Lsp => return crate::targets::lsp(bytes),
+        _ => {}
+    }
     let c = driver::check_text(fs, "fuzz.lens", bytes);
     let sources = &c.loaded.sources;
     well_formed(c.diags(), sources)?;
@@ -106,19 +128,33 @@ pub fn run(fs: &MemFs, bytes: &[u8], depth: Depth, out_dir: &Path) -> Result<Rea
         return Ok(reached);
     }
     match depth {
-        Depth::Check => {}
-        Depth::Lower => {
+        Depth::Check | Depth::Verify(_) | Depth::Import { .. } | Depth::Lsp => {}
+        Depth::Lower | Depth::LowerWithin(_) => {
+            let limits = match depth {
+                Depth::LowerWithin(l) => l,
+                _ => Limits::default(),
+            };
             for job in &c.checked.jobs {
-                if let Err(diags) = lensc_build::pipeline::lower(job, None, &Limits::default()) {
+                if let Err(diags) = lensc_build::pipeline::lower(job, None, &limits) {
                     well_formed(&diags, sources)?;
                     render(&diags, sources)?;
                 }
                 reached.lowered += 1;
             }
         }
-        Depth::Build => {
-            let (built, diags) =
-                driver::plan_and_emit(&c, driver::Request::default(), "fuzz.lens", Some(out_dir));
+        Depth::Build | Depth::BuildAs { .. } => {
+            let request = match depth {
+                Depth::BuildAs {
+                    dialect,
+                    max_program_size,
+                } => driver::Request {
+                    dialect,
+                    max_program_size,
+                    ..driver::Request::default()
+                },
+                _ => driver::Request::default(),
+            };
+            let (built, diags) = driver::plan_and_emit(&c, request, "fuzz.lens", Some(out_dir));
             well_formed(&diags, sources)?;
             render(&diags, sources)?;
             reached.lowered = c.checked.jobs.len();
@@ -176,7 +212,7 @@ fn parses_alike(bytes: &[u8]) -> Result<(), Fault> {
 
 /// The invariant: every diagnostic has a code and a primary span lying in
 /// its file, on character boundaries.
-fn well_formed(diags: &[Diagnostic], sources: &SourceMap) -> Result<(), Fault> {
+pub fn well_formed(diags: &[Diagnostic], sources: &SourceMap) -> Result<(), Fault> {
     let files = sources.iter().count();
     for d in diags {
         let what = || format!("{} {:?}: {}", d.code, d.severity, d.message);
@@ -208,7 +244,7 @@ fn well_formed(diags: &[Diagnostic], sources: &SourceMap) -> Result<(), Fault> {
 }
 
 /// Both renderers take every diagnostic.
-fn render(diags: &[Diagnostic], sources: &SourceMap) -> Result<(), Fault> {
+pub fn render(diags: &[Diagnostic], sources: &SourceMap) -> Result<(), Fault> {
     if diags.is_empty() {
         return Ok(());
     }

@@ -1,12 +1,17 @@
-//! `cargo run --release -p fuzz -- --seconds N [--seed S] [--build-every K]`:
-//! fuzzes lensc for N seconds. Each input is a file from the
+//! `cargo run --release -p fuzz -- --seconds N [--seed S] [--build-every K]
+//! [--target T]`: fuzzes lensc for N seconds. With the default target
+//! (`mixed`, CI's fixed-seed minute) each input is a file from the
 //! structure-aware generator (`generate`), a mutation of a real file
 //! (`mutate`) or, every K-th, a small whole job (`small_jobs`) that is
 //! built and written. Every input runs under the supervisor (`supervise`:
 //! panics caught, hangs timed out) through the harness (`harness`: every
 //! diagnostic coded and spanned). Failing inputs are saved in
 //! fuzz/crashes/; the run ends with throughput and counts, and exits 1 if
-//! anything failed.
+//! anything failed. The other targets (`targets`, and `fuzz/campaign.sh`
+//! that runs them all for an hour) take one path each: `check` (with size
+//! limits drawn per input), `build` (small jobs in a dialect and to a
+//! program size drawn per input), `verify` (mutated programs), `import`
+//! (mutated prescriptions) and `lsp` (message sequences).
 
 mod generate;
 mod harness;
@@ -14,6 +19,7 @@ mod mutate;
 mod rng;
 mod small_jobs;
 mod supervise;
+mod targets;
 
 use std::collections::HashMap;
 use std::io::Write;
@@ -25,6 +31,7 @@ use std::time::{Duration, Instant};
 use clap::Parser;
 
 use harness::{Depth, MemFs};
+use lensc_build::job::Limits;
 use mutate::Corpus;
 use rng::Rng;
 use supervise::{Outcome, Supervisor};
@@ -60,6 +67,103 @@ struct Cli {
     /// Print input I of the seed to stdout and stop.
     #[arg(long, value_name = "I")]
     print: Option<u64>,
+    /// What the inputs go through.
+    #[arg(long, value_enum, default_value_t = Target::Mixed)]
+    target: Target,
+    /// The `lensc` binary the `lsp` target starts.
+    #[arg(long, value_name = "PATH")]
+    lensc: Option<PathBuf>,
+}
+
+/// What the inputs go through.
+#[derive(Clone, Copy, PartialEq, Eq, Debug, clap::ValueEnum)]
+enum Target {
+    /// Check, one in eight lowered, one in `--build-every` a small job
+    /// built and written (CI's minute).
+    Mixed,
+    /// Check, one in eight lowered under size limits drawn per input.
+    Check,
+    /// Small jobs only, built in a dialect and to a program size drawn
+    /// per input, and written.
+    Build,
+    /// `lensc verify` on mutated programs.
+    Verify,
+    /// `lensc import` on mutated `.zmx` and `.json` prescriptions.
+    Import,
+    /// `lensc lsp` on random message sequences (`--lensc` names the binary).
+    Lsp,
+}
+
+/// The mutation corpora: `.lens` files, programs and prescriptions.
+struct Corpora {
+    lens: Corpus,
+    programs: Corpus,
+    prescriptions: Corpus,
+}
+
+/// Dialects a build may be asked for (a machine that does not offer one
+/// refuses it with a coded error, which is also an input worth making).
+const DIALECTS: &[&str] = &[
+    "linuxcnc",
+    "fanuc_0i_lathe",
+    "fanuc_0i_mill",
+    "siemens_840d_lathe",
+    "siemens_840d_mill",
+    "heidenhain_iso",
+    "heidenhain_tnc_klartext",
+    "ultra_precision_lathe_gcode",
+];
+
+/// Makes input `index` of `target` in the run seeded `seed`.
+fn input_for(
+    target: Target,
+    seed: u64,
+    index: u64,
+    build_every: u64,
+    corpora: &Corpora,
+) -> (Source, Vec<u8>, Depth) {
+    let mut rng = Rng::for_input(seed, index);
+    match target {
+        Target::Mixed => input(seed, index, build_every, &corpora.lens),
+        Target::Check => {
+            let (source, bytes, depth) = input(seed, index, 0, &corpora.lens);
+            let depth = match depth {
+                Depth::Lower => Depth::LowerWithin(Limits {
+                    max_program_size: rng.log_uniform(1e3, 1e10) as u64,
+                    max_points: rng.log_uniform(10.0, 1e9) as u64,
+                }),
+                d => d,
+            };
+            (source, bytes, depth)
+        }
+        Target::Build => {
+            let dialect = rng.chance(0.3).then(|| *rng.pick(DIALECTS));
+            let max_program_size = rng.chance(0.15).then(|| rng.log_uniform(1e3, 1e8) as u64);
+            (
+                Source::SmallJob,
+                small_jobs::file(&mut rng).into_bytes(),
+                Depth::BuildAs {
+                    dialect,
+                    max_program_size,
+                },
+            )
+        }
+        Target::Verify => (
+            Source::Program,
+            mutate::mutant(&corpora.programs, &mut rng),
+            Depth::Verify(rng.below(64)),
+        ),
+        Target::Import => {
+            let bytes = mutate::mutant(&corpora.prescriptions, &mut rng);
+            let json = bytes.iter().find(|b| !b.is_ascii_whitespace()) == Some(&b'{');
+            (Source::Prescription, bytes, Depth::Import { json })
+        }
+        Target::Lsp => (
+            Source::Session,
+            targets::session(&corpora.lens, &mut rng),
+            Depth::Lsp,
+        ),
+    }
 }
 
 /// Where an input came from.
@@ -68,6 +172,9 @@ enum Source {
     Generated,
     Mutated,
     SmallJob,
+    Program,
+    Prescription,
+    Session,
 }
 
 /// Makes input `index` of the run seeded `seed`.
@@ -126,15 +233,35 @@ fn main() -> ExitCode {
             .unwrap_or(1)
     });
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let corpus = match Corpus::load(&root) {
+    let corpora = Corpus::load(&root).and_then(|lens| {
+        Ok(Corpora {
+            lens,
+            programs: targets::programs(&root)?,
+            prescriptions: targets::prescriptions(&root)?,
+        })
+    });
+    let corpora = match corpora {
         Ok(c) => c,
         Err(e) => {
             eprintln!("fuzz: cannot read the corpus under {}: {e}", root.display());
             return ExitCode::from(2);
         }
     };
+    if cli.target == Target::Lsp {
+        match &cli.lensc {
+            Some(p) => {
+                let _ = targets::LENSC.set(p.clone());
+            }
+            None => {
+                eprintln!(
+                    "fuzz: the lsp target needs --lensc PATH (cargo build --release -p lensc)"
+                );
+                return ExitCode::from(2);
+            }
+        }
+    }
     if let Some(i) = cli.print {
-        let (_, bytes, _) = input(seed, i, cli.build_every, &corpus);
+        let (_, bytes, _) = input_for(cli.target, seed, i, cli.build_every, &corpora);
         let _ = std::io::stdout().write_all(&bytes);
         return ExitCode::SUCCESS;
     }
@@ -163,14 +290,14 @@ fn main() -> ExitCode {
         cli.jobs.max(1)
     };
     eprintln!(
-        "fuzz: seed {seed}, build every {}th input, {} s, {jobs} worker(s)",
-        cli.build_every, cli.seconds
+        "fuzz: target {:?}, seed {seed}, build every {}th input, {} s, {jobs} worker(s)",
+        cli.target, cli.build_every, cli.seconds
     );
     let run = Run {
         cli: &cli,
         seed,
-        corpus: &corpus,
-        fs: std::sync::Arc::new(MemFs::new(&corpus.files)),
+        corpora: &corpora,
+        fs: std::sync::Arc::new(MemFs::new(&corpora.lens.files)),
         out: out.path(),
         crashes: Path::new(env!("CARGO_MANIFEST_DIR")).join("crashes"),
         seen: Mutex::new(HashMap::new()),
@@ -207,7 +334,7 @@ fn main() -> ExitCode {
 struct Run<'a> {
     cli: &'a Cli,
     seed: u64,
-    corpus: &'a Corpus,
+    corpora: &'a Corpora,
     fs: std::sync::Arc<MemFs>,
     out: &'a Path,
     crashes: PathBuf,
@@ -241,7 +368,8 @@ impl Run<'_> {
                     Duration::from_secs(cli.timeout),
                 )
             });
-            let (source, bytes, depth) = input(self.seed, index, cli.build_every, self.corpus);
+            let (source, bytes, depth) =
+                input_for(cli.target, self.seed, index, cli.build_every, self.corpora);
             *counts.inputs.entry(source).or_default() += 1;
             let began = Instant::now();
             let outcome = sup.run(index, bytes.clone(), depth);
@@ -265,7 +393,14 @@ impl Run<'_> {
             *n
         };
         if n <= 3 {
-            let saved = save(&self.crashes, what, self.seed, index, bytes, message);
+            let saved = save(
+                &self.crashes,
+                (what, self.cli.target, source),
+                self.seed,
+                index,
+                bytes,
+                message,
+            );
             // Not `eprintln!`, which panics if stderr cannot be written.
             let _ = writeln!(
                 std::io::stderr(),
@@ -292,7 +427,7 @@ impl Counts {
                 self.built += r.built as u64;
                 self.written += r.written as u64;
                 self.unwritten += r.unwritten as u64;
-                if matches!(depth, Depth::Build) {
+                if matches!(depth, Depth::Build | Depth::BuildAs { .. }) {
                     self.build_inputs += 1;
                     self.build_time += took;
                     self.slowest_build = self.slowest_build.max(took);
@@ -346,11 +481,26 @@ fn parse_range(s: &str) -> Option<std::ops::Range<u64>> {
     }
 }
 
-/// Saves a failing input (as bytes) and what went wrong beside it.
-fn save(dir: &Path, what: &str, seed: u64, index: u64, bytes: &[u8], message: &str) -> String {
-    let path: PathBuf = dir.join(format!("{what}-{seed}-{index}.lens"));
+/// Saves a failing input (as bytes, named for what it is) and what went
+/// wrong beside it, with the command that replays it.
+fn save(
+    dir: &Path,
+    (what, target, source): (&str, Target, Source),
+    seed: u64,
+    index: u64,
+    bytes: &[u8],
+    message: &str,
+) -> String {
+    let ext = match source {
+        Source::Program => "ngc",
+        Source::Prescription => "zmx",
+        Source::Session => "lsp",
+        _ => "lens",
+    };
+    let target_name = format!("{target:?}").to_lowercase();
+    let path: PathBuf = dir.join(format!("{what}-{target_name}-{seed}-{index}.{ext}"));
     let note = format!(
-        "{what}: {message}\nreplay: cargo run --release -p fuzz -- --seed {seed} --replay {index}\n"
+        "{what}: {message}\nreplay: cargo run --release -p fuzz -- --target {target_name} --seed {seed} --replay {index}\n"
     );
     let written = std::fs::create_dir_all(dir)
         .and_then(|()| std::fs::write(&path, bytes))
@@ -375,11 +525,14 @@ fn summary(c: &Counts, elapsed: Duration, distinct: usize, lanes: u64) {
     let _ = writeln!(out, "fuzz: {secs:.1} s, {lanes} lane(s)");
     let _ = writeln!(
         out,
-        "  inputs            {} ({} generated, {} mutated, {} small jobs), {:.0}/s",
-        get(Source::Generated) + get(Source::Mutated) + get(Source::SmallJob),
+        "  inputs            {} ({} generated, {} mutated, {} small jobs, {} programs, {} prescriptions, {} sessions), {:.0}/s",
+        c.inputs.values().sum::<u64>(),
         get(Source::Generated),
         get(Source::Mutated),
         get(Source::SmallJob),
+        get(Source::Program),
+        get(Source::Prescription),
+        get(Source::Session),
         c.checked as f64 / secs
     );
     let _ = writeln!(
@@ -401,6 +554,13 @@ fn summary(c: &Counts, elapsed: Duration, distinct: usize, lanes: u64) {
         c.built as f64 * lanes as f64 / c.build_time.as_secs_f64().max(1e-9),
         c.slowest_build.as_secs_f64(),
         c.slow_builds
+    );
+    let rate = c.checked as f64 / secs;
+    let _ = writeln!(
+        out,
+        "  an hour at this rate: {:.2e} inputs, {:.2e} builds",
+        rate * 3600.0,
+        c.built as f64 / secs * 3600.0
     );
     let _ = writeln!(
         out,

@@ -185,6 +185,12 @@ enum TooDeep {
     Powers,
 }
 
+/// Whether byte `i` of `b` is one of the three of a byte-order mark.
+fn in_bom(b: &[u8], i: usize) -> bool {
+    const BOM: &[u8] = "\u{FEFF}".as_bytes();
+    (0..3).any(|k| i >= k && b[i - k..].starts_with(BOM))
+}
+
 /// One pass over the bytes: bracket depth (outside comments and strings) and
 /// the byte offsets where top-level items start.
 fn scan(src: &str) -> Scan {
@@ -216,6 +222,11 @@ fn scan(src: &str) -> Scan {
                 }
             }
             b' ' | b'\t' | b'\r' | b'\n' => {}
+            // A byte-order mark is blank to the parser: it does not end a
+            // run of operators either (a run split by one counted as two
+            // runs, and `lensc fmt`, which drops the mark, refused the file
+            // with E0185).
+            0xEF | 0xBB | 0xBF if in_bom(b, i) => {}
             _ => op_run = 0,
         }
         match c {

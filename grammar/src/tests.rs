@@ -364,3 +364,24 @@ fn every_declaration_keyword_is_its_own_kind() {
         }
     }
 }
+
+/// A byte-order mark inside a run of operators does not split the run:
+/// 40 `-` with a mark after the 14th are one run of 40, refused (E0002),
+/// as the same run without the mark is (the fuzzer's `check` target found
+/// the file checked with the mark and `lensc fmt`, which drops it,
+/// refused it with E0185).
+#[test]
+fn a_byte_order_mark_does_not_split_a_run_of_operators() {
+    let run = |mark: &str| {
+        let ops: Vec<&str> = (0..40)
+            .map(|i| if i == 14 { "-\u{feff}" } else { "-" })
+            .collect();
+        let text = format!("let a = {} 1", ops.join(" ").replace('\u{feff}', mark));
+        crate::parse(&text, crate::FileId(0))
+            .1
+            .iter()
+            .any(|d| d.code == crate::diagnostic::codes::TOO_DEEP)
+    };
+    assert!(run(""), "40 operators are over the limit");
+    assert!(run("\u{feff}"), "a mark in the run leaves it one run");
+}

@@ -177,23 +177,103 @@ pub enum Coolant {
 
 /// What a program states before its first move, whatever its strategy:
 /// the tool it calls (its number and offset register), which way the
-/// spindle turns when it turns, and the coolant.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// spindle turns when it turns, the coolant, and the point of the tool
+/// its coordinates are.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Start {
     pub tool: u32,
     pub offset: u32,
     pub rotation: Rotation,
     pub coolant: Coolant,
+    pub control: ControlOffset,
+    /// The workpiece blank, where the program states one (Klartext's
+    /// `BLK FORM`, for the control's graphic test run).
+    pub blank: Option<Blank>,
+}
+
+/// A workpiece blank as a box in work coordinates (mm): its least and
+/// greatest X, Y and Z.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Blank {
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+}
+
+/// Where the tool's control point (the point its length and X offsets
+/// are measured to, which the controller moves to the programmed
+/// coordinates) lies from the tool's centre (the ball's, the nose's, the
+/// wheel's: the point every planner's move stream gives), in mm along X,
+/// Y and Z: zero for a tool set to its centre; `Z = -r` for a ball-end
+/// mill measured to its tip; `X = -r, Z = -r` for a lathe tool's
+/// imaginary tip. The writer adds it to every position it prints and the
+/// read-back subtracts it again.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ControlOffset {
+    pub x: f64,
+    pub y: f64,
+    pub z: f64,
+}
+
+impl ControlOffset {
+    /// The tool's centre: no offset.
+    pub const CENTRE: ControlOffset = ControlOffset {
+        x: 0.0,
+        y: 0.0,
+        z: 0.0,
+    };
+
+    /// Whether it moves anything.
+    pub fn is_zero(&self) -> bool {
+        self.x == 0.0 && self.y == 0.0 && self.z == 0.0
+    }
+
+    /// `p` moved by the offset (an axis left where it is stays so).
+    pub fn apply(&self, p: Position) -> Position {
+        Position {
+            x: p.x + self.x,
+            y: p.y + self.y,
+            z: p.z + self.z,
+            c: p.c,
+        }
+    }
+
+    /// `m` with its positions and arc centre moved by the offset.
+    pub fn apply_to(&self, m: &Move) -> Move {
+        match *m {
+            Move::Rapid(to) => Move::Rapid(self.apply(to)),
+            Move::Linear { to, feed } => Move::Linear {
+                to: self.apply(to),
+                feed,
+            },
+            Move::Arc {
+                to,
+                centre,
+                plane,
+                ccw,
+                feed,
+            } => Move::Arc {
+                to: self.apply(to),
+                centre: self.apply(centre),
+                plane,
+                ccw,
+                feed,
+            },
+            other => other,
+        }
+    }
 }
 
 impl Default for Start {
-    /// Tool 1 with offset 1, clockwise, no coolant.
+    /// Tool 1 with offset 1, clockwise, no coolant, programmed at the
+    /// tool's centre.
     fn default() -> Start {
         Start {
             tool: 1,
             offset: 1,
             rotation: Rotation::Clockwise,
             coolant: Coolant::Off,
+            control: ControlOffset::CENTRE,
+            blank: None,
         }
     }
 }

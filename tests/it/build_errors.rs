@@ -85,6 +85,15 @@ const PLANNING_ONLY: &[(&str, &str)] = &[
         "W0005",
         "the chords over tolerance are found on the planned spiral",
     ),
+    ("W0030", "the cutting time is the planned path's"),
+    (
+        "W0031",
+        "the approach is the planned program's first feed move",
+    ),
+    (
+        "W0032",
+        "the time in the air is summed over the planned moves",
+    ),
 ];
 
 #[test]

@@ -155,7 +155,11 @@ fn build_writes_program_to_out_dir() {
     leftovers.sort();
     assert_eq!(
         leftovers,
-        ["kim_convex.ngc", "kim_convex.report.json"],
+        [
+            "kim_convex.ngc",
+            "kim_convex.report.json",
+            "kim_convex.setup.txt"
+        ],
         "temporary files left"
     );
     // Put in place with the user's usual mode (0666 less the umask this
@@ -220,7 +224,8 @@ fn failed_build_leaves_earlier_output_untouched() {
         .expect("out")
         .map(|e| e.expect("e").file_name())
         .collect();
-    assert_eq!(names.len(), 2, "partial files left: {names:?}");
+    // The program, its report and its set-up sheet of the good build.
+    assert_eq!(names.len(), 3, "partial files left: {names:?}");
 }
 
 #[test]
@@ -433,7 +438,7 @@ use std::strategies::finish_turning
 // A concave sphere R = 10 mm cut only on the ring 1 mm <= r <= 2 mm (at a
 // tolerance the lathe's 0.1 um holds).
 surface ring = sphere { radius: 10 mm, sense: concave, aperture: annulus(inner: 1 mm, outer: 2 mm) }
-tool t = round_nose { nose_radius: 0.5 mm, clearance: 7 deg }
+tool t = round_nose { nose_radius: 0.5 mm, clearance: 7 deg, control_point: tool_centre }
 strategy finish = finish_turning { chord_tolerance: 150 nm }
 job ring_cut { surface: ring, tool: t, machine: linuxcnc_lathe, strategy: finish }
 ";
@@ -834,4 +839,61 @@ fn verify_checks_the_header_hash_against_the_source() {
         "{}",
         text(&gone.stderr)
     );
+}
+
+/// A file of two jobs, one refused by its gate: by default nothing is
+/// written (all or nothing) and the summary says of each job what became
+/// of it; `--keep-going` writes the job that passed, and still exits 1.
+#[test]
+fn a_build_summarises_each_job_and_writes_all_or_nothing_unless_keep_going() {
+    let file = "tests/fixtures/two_jobs_one_refused.lens";
+    let dir = tempfile::tempdir().expect("tmp");
+    let out_dir = dir.path().join("all");
+    let out = lensc(
+        &root(),
+        &["build", file, "--out", out_dir.to_str().expect("utf-8")],
+    );
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(!out_dir.exists() || std::fs::read_dir(&out_dir).expect("dir").count() == 0);
+    assert!(
+        stderr.contains("good: passed, not written: another job failed"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("tight: REFUSED by its acceptance gate (E0195)"),
+        "{stderr}"
+    );
+    // Each figure with its limit, the area judged, the time, the size.
+    for line in [
+        "  PV        1.09 nm    limit 2 nm (stated)\n",
+        "  PV        1.09 nm    limit 0.01 nm (stated)  MISSED\n",
+        "  judged    the profile, radius 0 to 3 mm\n",
+        "  cutting   1 min 31.0 s\n",
+    ] {
+        assert!(stderr.contains(line), "{line:?} not in {stderr}");
+    }
+
+    let kept = dir.path().join("kept");
+    let out = lensc(
+        &root(),
+        &[
+            "build",
+            file,
+            "--keep-going",
+            "--out",
+            kept.to_str().expect("utf-8"),
+        ],
+    );
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let mut names: Vec<String> = std::fs::read_dir(&kept)
+        .expect("kept")
+        .map(|e| e.expect("e").file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["good.ngc", "good.report.json", "good.setup.txt"]);
+    assert!(stderr.contains("good: passed, written\n"), "{stderr}");
+    let wrote = format!("  wrote     {}", kept.join("good.ngc").display());
+    assert!(stderr.contains(&wrote), "{stderr}");
 }

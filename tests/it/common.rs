@@ -24,6 +24,12 @@ pub fn lensc(cwd: &Path, args: &[&str]) -> Output {
         .expect("run lensc")
 }
 
+/// Whether a file a build wrote is a program: not its report, its
+/// set-up sheet or a servo table.
+pub fn is_program(name: &str) -> bool {
+    !(name.ends_with(".json") || name.ends_with(".fts") || name.ends_with(".setup.txt"))
+}
+
 /// Every `.lens` file in examples/.
 pub fn examples() -> Vec<PathBuf> {
     let mut v: Vec<PathBuf> = std::fs::read_dir(root().join("examples"))
@@ -189,7 +195,7 @@ pub fn built_examples() -> &'static [Built] {
                 let abridged_findings = files
                     .iter()
                     .filter(|(_, f)| matches!(f, Written::Abridged(_)))
-                    .filter(|(name, _)| !name.ends_with(".json") && !name.ends_with(".fts"))
+                    .filter(|(name, _)| is_program(name))
                     .map(|(name, _)| (name.clone(), verify_codes(&dir.path().join(name))))
                     .collect();
                 Built {

@@ -67,7 +67,8 @@ fn number(w: &str) -> Option<&str> {
 /// A Klartext block as the G-code words of the same meaning, for the
 /// rules above (TNC conversational programming): `TOOL CALL 1 Z S1000` →
 /// `T1 S1000`, `L … FMAX` → `G0 …`, `L … F…` → `G1 …`, `C … DR-` →
-/// `G2 …`, `DR+` → `G3`; the block number and `BEGIN`/`END PGM` left out.
+/// `G2 …`, `DR+` → `G3`, `CYCL DEF 13.0 ORIENTATION` → `M19`; the block
+/// number, `BEGIN`/`END PGM`, `BLK FORM` and other cycles left out.
 fn klartext_as_words(line: &str) -> String {
     let rest = line
         .trim_start_matches(|c: char| c.is_ascii_digit())
@@ -75,6 +76,8 @@ fn klartext_as_words(line: &str) -> String {
     let rest = rest.split(';').next().unwrap_or("").trim();
     let words: Vec<&str> = rest.split_whitespace().collect();
     match words.first().copied() {
+        // Cycle 13 orients the spindle and holds it, as M19 does.
+        Some("CYCL") if words.get(2) == Some(&"13.0") => "M19".to_string(),
         Some("BEGIN" | "END" | "CYCL" | "BLK") | None => String::new(),
         Some("TOOL") => words[2..]
             .iter()
@@ -193,7 +196,7 @@ fn every_example_program_is_complete_in_its_own_dialect() {
     let mut read = 0;
     for built in built_examples() {
         for (name, file) in &built.files {
-            if name.ends_with(".json") || name.ends_with(".fts") {
+            if !crate::common::is_program(name) {
                 continue;
             }
             let text = match file {

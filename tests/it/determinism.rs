@@ -72,20 +72,16 @@ fn a_whole_part_in_tiles_reports_the_same_on_any_number_of_threads() {
     // Both coarse copies miss their criteria away from their default
     // windows (the corner 175 nm PV, the roller 153): they are built here
     // for their figures, not to pass.
-    let roller_accept =
-        "accept: { form_pv: 100 nm, form_rms: 30 nm, max_gouge: 100 nm, uncut_area: 0 } }";
-    for (job, end, extra) in [
-        ("fts_small_array", "strategy: coarse }", ", accept: none"),
-        ("roller_small", roller_accept, ""),
+    let roller_accept = "accept: { form_pv: 200 nm, form_rms: 50 nm, max_gouge: 100 nm, max_residual: 100 nm, uncut_area: 0 } }";
+    let corner_accept = "accept: { form_pv: 200 nm, max_residual: 200 nm } }";
+    for (job, stated) in [
+        ("fts_small_array", corner_accept),
+        ("roller_small", roller_accept),
     ] {
         let src = std::fs::read_to_string(root().join(format!("tests/jobs/{job}.lens")))
             .expect("the small job")
-            .replace(roller_accept, "accept: none }");
-        let end = if end == roller_accept {
-            "accept: none }"
-        } else {
-            end
-        };
+            .replace(stated, "accept: none }");
+        let (end, extra) = ("accept: none }", "");
         assert!(src.contains(end), "{job}'s job line");
         let whole = src.replace(
             end,

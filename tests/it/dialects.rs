@@ -181,7 +181,8 @@ fn a_fanuc_lathe_program_is_in_diameter_with_radius_arc_centres() {
          use std::tools::diamond_r496um\n\
          surface insert = conic { radius: 12 mm, conic: -0.6, sense: concave, aperture: circle(radius: 3 mm) }\n\
          strategy finish = profile_turning { feed: 2 um/rev, spindle_speed: 1000 rpm, chord_tolerance: 150 nm }\n\
-         job fanuc_insert { surface: insert, tool: diamond_r496um, machine: linuxcnc_lathe, strategy: finish }\n",
+         tool nose = diamond_r496um { control_point: tool_centre }\n\
+         job fanuc_insert { surface: insert, tool: nose, machine: linuxcnc_lathe, strategy: finish }\n",
     )
     .expect("write");
     let checked = check_path(&RealFs, &file).expect("readable");
@@ -200,7 +201,7 @@ fn a_fanuc_lathe_program_is_in_diameter_with_radius_arc_centres() {
     let text = programs[0].program.text().expect("text");
     obeys("fanuc_0i_lathe", &text).expect("Fanuc rules");
     // X is the diameter: the first position is twice the nose centre's
-    // radius at the rim; the arcs' I stays a radius (the centre of the
+    // radius at the rim (the tool is set to its centre here); the arcs' I stays a radius (the centre of the
     // last arc, which ends on the axis, is within its radius of it).
     let first_x: f64 = text
         .lines()
@@ -267,8 +268,16 @@ fn a_fast_tool_servo_table_holds_the_same_points_as_the_linuxcnc_program() {
     };
     let linuxcnc = build("linuxcnc");
     let table_built = build("ultra_precision_lathe_gcode");
-    assert!(linuxcnc.beside.is_empty());
-    assert_eq!(table_built.beside.len(), 1);
+    // Beside each program its set-up sheet; beside the table dialect's,
+    // the table first.
+    let names = |b: &lensc_build::output::Built| {
+        b.beside.iter().map(|(n, _)| n.clone()).collect::<Vec<_>>()
+    };
+    assert_eq!(names(&linuxcnc), ["corner_fts.setup.txt"]);
+    assert_eq!(
+        names(&table_built),
+        ["corner_fts.fts", "corner_fts.setup.txt"]
+    );
     let (name, table) = &table_built.beside[0];
     assert_eq!(name, "corner_fts.fts");
     let table = table.text().expect("table");

@@ -126,3 +126,39 @@ fn every_surface_of_every_example_samples() {
         }
     }
 }
+
+/// Every program has its set-up sheet beside it, stating the control
+/// point; one sheet per strategy family (the first example job of each,
+/// by the report's `strategy` tag) is a reviewed snapshot.
+#[test]
+fn every_program_has_a_set_up_sheet_and_one_per_strategy_is_snapshot() {
+    let mut first = std::collections::BTreeMap::new();
+    let mut sheets = 0;
+    for b in built_examples() {
+        for name in b.files.keys().filter(|n| crate::common::is_program(n)) {
+            let job = name.rsplit_once('.').map_or(name.as_str(), |(j, _)| j);
+            let sheet = match b.files.get(&format!("{job}.setup.txt")) {
+                Some(Written::Whole(bytes)) => text(bytes),
+                _ => panic!("{}: {name} has no set-up sheet beside it", b.example),
+            };
+            assert!(
+                sheet.contains("\ncontrol point  ") && sheet.contains("\nwork offset    "),
+                "{}: {job}'s sheet states no control point or work offset:\n{sheet}",
+                b.example
+            );
+            sheets += 1;
+            let strategy = b.report(job)["toolpath"]["strategy"]
+                .as_str()
+                .expect("strategy tag")
+                .to_string();
+            first.entry(strategy).or_insert(sheet);
+        }
+    }
+    assert!(sheets >= 20, "{sheets} sheets");
+    assert!(first.len() >= 5, "strategies: {:?}", first.keys());
+    for (strategy, sheet) in first {
+        insta::with_settings!({ snapshot_path => "../snapshots/setup_sheets", prepend_module_to_snapshot => false, omit_expression => true }, {
+            insta::assert_snapshot!(strategy, sheet);
+        });
+    }
+}

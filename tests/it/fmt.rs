@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use lensc_lang::Checked;
 use lensc_lang::format::format_source;
-use lensc_lang::loader::{FileSystem, RealFs};
+use lensc_lang::loader::{FileSystem, RealFs, Root};
 use lensc_lang::sandbox::ReadError;
 use lensc_lang::value::{Field, Value};
 use proptest::prelude::*;
@@ -36,11 +36,11 @@ struct Overlay {
 }
 
 impl FileSystem for Overlay {
-    fn read(&self, path: &Path) -> Result<Vec<u8>, ReadError> {
+    fn read(&self, root: &Root, path: &Path) -> Result<Vec<u8>, ReadError> {
         if RealFs.canonical(path) == self.path {
             Ok(self.text.clone().into_bytes())
         } else {
-            RealFs.read(path)
+            RealFs.read(root, path)
         }
     }
     fn canonical(&self, path: &Path) -> PathBuf {

@@ -235,3 +235,48 @@ fn empty_and_whitespace_files_are_errors() {
         assert!(check(src.as_bytes()).has_errors(), "{src:?}");
     }
 }
+
+/// The inputs the fuzzer's `verify` target found (`tests/fuzz_crashes/`):
+/// a byte that is not UTF-8 where a finding's span ends (read as `�`, the
+/// span ended inside it and the renderer panicked: exit 101), and spans
+/// that ran backwards (end before start). `lensc verify` reports each with
+/// exit 1, in both formats, every span forwards.
+#[test]
+fn verify_survives_the_programs_the_fuzzer_found() {
+    let dir = common::root().join("tests/fuzz_crashes");
+    let mut programs: Vec<_> = std::fs::read_dir(&dir)
+        .expect("tests/fuzz_crashes")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| {
+            p.file_name()
+                .is_some_and(|n| n.to_string_lossy().starts_with("verify_"))
+        })
+        .collect();
+    programs.sort();
+    assert!(programs.len() >= 3, "{programs:?}");
+    for p in &programs {
+        let path = p.display().to_string();
+        let human = common::lensc(&common::root(), &["verify", &path]);
+        let err = common::text(&human.stderr);
+        assert_eq!(human.status.code(), Some(1), "{path}: {err}");
+        assert!(!err.contains("panicked"), "{path}: {err}");
+        let json = common::lensc(
+            &common::root(),
+            &["verify", "--message-format", "json", &path],
+        );
+        assert_eq!(json.status.code(), Some(1), "{path}");
+        for line in common::text(&json.stdout).lines() {
+            let v: serde_json::Value = serde_json::from_str(line).expect("a JSON line");
+            let spans = std::iter::once(&v["span"]).chain(
+                v["labels"]
+                    .as_array()
+                    .into_iter()
+                    .flatten()
+                    .map(|l| &l["span"]),
+            );
+            for s in spans {
+                assert!(s["start"].as_u64() <= s["end"].as_u64(), "{path}: {line}");
+            }
+        }
+    }
+}

@@ -283,7 +283,9 @@ fn header_time(program: &str) -> f64 {
                 .map(str::to_string)
         })
         .unwrap_or_else(|| panic!("no estimated cutting time in\n{program}"));
-    let words: Vec<&str> = line.split(' ').collect();
+    // The figure alone (a roller's goes on: "at the spindle's pace …").
+    let figure = line.split(" at ").next().unwrap_or(&line);
+    let words: Vec<&str> = figure.split(' ').collect();
     words
         .chunks(2)
         .map(|w| {
@@ -318,6 +320,22 @@ fn servo_and_raster_headers_state_the_cutting_time_of_the_report() {
             "{program}: header {stated} s, report {reported} s"
         );
     }
+}
+
+#[test]
+fn a_roller_header_states_the_cutting_time_of_the_report() {
+    // Issue #29: roller headers had none (the cycles of each pass come
+    // from the design's survey, which now runs before the header).
+    let roller = std::fs::read_to_string(root().join("tests/jobs/roller_small.lens")).expect("job");
+    let (text, report) = build_text(&roller, "roller_small.ngc");
+    let stated = header_time(&text);
+    let reported = report["toolpath"]["cutting_time_s"]
+        .as_f64()
+        .expect("cutting_time_s");
+    assert!(
+        (stated - reported).abs() <= 0.5 + 0.01 * reported,
+        "header {stated} s, report {reported} s"
+    );
 }
 
 #[test]

@@ -238,3 +238,153 @@ fn eight_builds_into_one_directory_leave_one_builds_files() {
         assert!(got[name] == *bytes, "{name} differs from a single build's");
     }
 }
+
+/// The files of a job's unit in `dir`, without lensc's temporary files.
+fn unit(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
+    files(dir)
+        .into_iter()
+        .filter(|(name, _)| !name.starts_with(".lensc-"))
+        .collect()
+}
+
+/// A build of the small servo job whose outputs differ from SMALL's
+/// (another feed): the same names, other bytes.
+fn other_feed(dir: &Path) -> std::path::PathBuf {
+    let text = std::fs::read_to_string(root().join(SMALL)).expect("job");
+    assert!(text.contains("feed: 50 um/rev"), "the job states its feed");
+    let path = dir.join("corner_other_feed.lens");
+    std::fs::write(&path, text.replace("feed: 50 um/rev", "feed: 40 um/rev")).expect("write");
+    path
+}
+
+/// The dialect in which SMALL's build writes a servo table too.
+const SERVO_DIALECT: &str = "ultra_precision_lathe_gcode";
+
+/// A build that replaces a previous unit (servo table, report, program),
+/// stopped by SIGTERM or SIGKILL at every step of its commit (before each
+/// rename and after the last), leaves the previous unit or the new one,
+/// never a mix: SIGTERM waits for the unit, which is then in place (the
+/// exit is 143, or 0 when the build ends before the handler); SIGKILL leaves each file whole (the previous or the new) and
+/// a journal, which the next lensc run in the directory rolls forward to
+/// the new unit before anything else.
+#[test]
+fn a_commit_stopped_at_every_step_leaves_one_whole_unit() {
+    let jobs = tempfile::tempdir().expect("tmp");
+    let newer_job = other_feed(jobs.path()).display().to_string();
+    // The servo dialect: the build writes a table beside the program.
+    let build = |job: &str, out: &Path| {
+        let built = crate::common::lensc(
+            &root(),
+            &[
+                "build",
+                job,
+                "--dialect",
+                SERVO_DIALECT,
+                "--out",
+                &out.display().to_string(),
+            ],
+        );
+        assert_eq!(built.status.code(), Some(0), "{}", text(&built.stderr));
+    };
+    let previous_dir = tempfile::tempdir().expect("tmp");
+    build(SMALL, previous_dir.path());
+    let previous = unit(previous_dir.path());
+    let newer_dir = tempfile::tempdir().expect("tmp");
+    build(&newer_job, newer_dir.path());
+    let newer = unit(newer_dir.path());
+    assert_eq!(
+        newer.keys().collect::<Vec<_>>(),
+        previous.keys().collect::<Vec<_>>()
+    );
+    assert!(
+        newer.len() >= 3,
+        "a servo table, a report and a program: {:?}",
+        newer.keys()
+    );
+    for (name, bytes) in &newer {
+        assert!(
+            previous[name] != *bytes,
+            "{name}: the two builds must differ to tell them apart"
+        );
+    }
+    let steps: Vec<String> = (0..newer.len())
+        .map(|s| s.to_string())
+        .chain(["end".to_string()])
+        .collect();
+    for signal in ["TERM", "KILL"] {
+        for step in &steps {
+            let out = tempfile::tempdir().expect("tmp");
+            for (name, bytes) in &previous {
+                std::fs::write(out.path().join(name), bytes).expect("previous unit");
+            }
+            let run = Command::new(env!("CARGO_BIN_EXE_lensc"))
+                .current_dir(root())
+                .args(["build", &newer_job, "--dialect", SERVO_DIALECT, "--out"])
+                .arg(out.path())
+                .env("NO_COLOR", "1")
+                .env("LENSC_TEST_STOP_COMMIT", format!("{step}:{signal}"))
+                .stdout(Stdio::null())
+                .stderr(Stdio::piped())
+                .output()
+                .expect("run lensc");
+            let what = format!("SIG{signal} before step {step}");
+            let left = unit(out.path());
+            if signal == "TERM" {
+                // The handler waits for the unit; the build may then end
+                // first (0: its work was done) or the handler (143).
+                assert!(
+                    matches!(run.status.code(), Some(0 | 143)),
+                    "{what}: {:?} {}",
+                    run.status.code(),
+                    text(&run.stderr)
+                );
+                assert!(
+                    temporaries(out.path()).is_empty(),
+                    "{what}: {:?}",
+                    temporaries(out.path())
+                );
+                assert!(left == newer, "{what}: not the new unit: {:?}", left.keys());
+                continue;
+            }
+            assert_eq!(
+                run.status.code(),
+                None,
+                "{what}: killed, {}",
+                text(&run.stderr)
+            );
+            assert_eq!(
+                left.keys().collect::<Vec<_>>(),
+                newer.keys().collect::<Vec<_>>(),
+                "{what}"
+            );
+            for (name, bytes) in &left {
+                assert!(
+                    *bytes == previous[name] || *bytes == newer[name],
+                    "{what}: {name} is neither the previous nor the new file"
+                );
+            }
+            // The next run in the directory finishes the commit first.
+            let next = Command::new(env!("CARGO_BIN_EXE_lensc"))
+                .args(["build", "no_such_job.lens", "--out"])
+                .arg(out.path())
+                .env("NO_COLOR", "1")
+                .output()
+                .expect("run lensc");
+            assert_eq!(
+                next.status.code(),
+                Some(1),
+                "{what}: {}",
+                text(&next.stderr)
+            );
+            assert!(
+                temporaries(out.path()).is_empty(),
+                "{what}: {:?}",
+                temporaries(out.path())
+            );
+            assert!(
+                unit(out.path()) == newer,
+                "{what}: not the new unit after the next run"
+            );
+        }
+    }
+}

@@ -153,3 +153,135 @@ fn a_chain_past_the_file_limit_is_refused() {
     assert_eq!(out.status.code(), Some(1), "{head}");
     assert_eq!(err.matches("[E0189]").count(), 1, "{head}");
 }
+
+/// A program of `lines` moves on the clean LinuxCNC lathe fixture, with a
+/// line no controller reads (`G999`) at its end: one finding, on the last
+/// line.
+#[cfg(target_os = "linux")]
+fn program_with_a_bad_last_line(path: &std::path::Path, lines: usize) {
+    use std::io::Write;
+    let base = std::fs::read_to_string(
+        crate::common::root().join("tests/bad_programs/clean/linuxcnc_base.ngc"),
+    )
+    .expect("fixture");
+    let head = base
+        .split_inclusive('\n')
+        .take_while(|l| !l.starts_with("G2 "))
+        .collect::<String>();
+    let mut f = std::io::BufWriter::new(std::fs::File::create(path).expect("create"));
+    f.write_all(head.as_bytes()).expect("write");
+    for i in 0..lines {
+        writeln!(
+            f,
+            "G1 X{:.6} Z{:.6}",
+            3.0 - 3.0 * i as f64 / lines as f64,
+            0.1 - 1e-4 * (i % 100) as f64
+        )
+        .expect("write");
+    }
+    f.write_all(b"G999 X0.\nG0 Z1.5\nM5\nM2\n").expect("write");
+}
+
+/// `lensc verify` on `program`: its exit code, stderr and peak resident
+/// set in KiB (`wait4`'s figure for this child alone).
+#[cfg(target_os = "linux")]
+#[allow(clippy::zombie_processes)] // reaped by `wait4`, which also reads its peak memory
+fn verify_peak_kib(program: &std::path::Path, args: &[&str]) -> (i32, String, i64) {
+    use std::os::unix::process::ExitStatusExt;
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_lensc"))
+        .arg("verify")
+        .args(args)
+        .arg(program)
+        .env("NO_COLOR", "1")
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("run lensc");
+    let mut err = String::new();
+    std::io::Read::read_to_string(&mut child.stderr.take().expect("stderr"), &mut err)
+        .expect("stderr");
+    let (mut status, mut usage) = (0, std::mem::MaybeUninit::<libc::rusage>::zeroed());
+    // SAFETY: the child is ours and not yet waited for; `usage` is written
+    // whole by a successful wait4.
+    let r = unsafe { libc::wait4(child.id() as i32, &mut status, 0, usage.as_mut_ptr()) };
+    assert_eq!(r, child.id() as i32, "wait4");
+    // SAFETY: wait4 succeeded.
+    let usage = unsafe { usage.assume_init() };
+    let code = std::process::ExitStatus::from_raw(status)
+        .code()
+        .unwrap_or(-1);
+    (code, err, usage.ru_maxrss)
+}
+
+/// `lensc verify` with a finding keeps only the lines it shows, not the
+/// program: its peak memory on a program of 2,000,000 lines is within a
+/// few MiB of its peak on 200,000 lines (holding an empty line per program
+/// line, as it did, grew by 9 bytes a line: 16 MiB more here).
+#[cfg(target_os = "linux")]
+#[test]
+fn verify_with_a_finding_does_not_hold_the_program() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let (small, large) = (dir.path().join("small.ngc"), dir.path().join("large.ngc"));
+    program_with_a_bad_last_line(&small, 200_000);
+    program_with_a_bad_last_line(&large, 2_000_000);
+    for args in [&[][..], &["--message-format", "json"][..]] {
+        let (code_s, err_s, kib_s) = verify_peak_kib(&small, args);
+        let (code_l, err_l, kib_l) = verify_peak_kib(&large, args);
+        eprintln!("verify {args:?}: 200,000 lines {kib_s} KiB, 2,000,000 lines {kib_l} KiB");
+        assert_eq!((code_s, code_l), (1, 1), "{err_s}\n{err_l}");
+        if args.is_empty() {
+            assert!(
+                err_l.contains("2000009") && err_l.contains("G999"),
+                "{err_l}"
+            );
+        }
+        assert!(
+            kib_l - kib_s < 6 * 1024,
+            "verify grew by {} KiB from 200,000 to 2,000,000 lines",
+            kib_l - kib_s
+        );
+    }
+}
+
+/// `lensc verify`'s human diagnostics on a program line of n bytes: a
+/// window on the line, in time linear in n (over 120 s for 10 MB once).
+#[test]
+fn verify_on_a_long_line() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let base = std::fs::read_to_string(
+        crate::common::root().join("tests/bad_programs/clean/linuxcnc_base.ngc"),
+    )
+    .expect("fixture");
+    let counter = std::cell::Cell::new(0);
+    linear(
+        "verify long line",
+        1_000_000,
+        |n| {
+            counter.set(counter.get() + 1);
+            let path = dir.path().join(format!("long{}.ngc", counter.get()));
+            let (head, tail) = base.split_at(base.find("G0 Z1.5").expect("a retract"));
+            std::fs::write(
+                &path,
+                format!("{head}(note {})\n{tail}", "x\u{1b}".repeat(n / 2)),
+            )
+            .expect("write");
+            path.display().to_string()
+        },
+        |path| {
+            let out = crate::common::lensc(dir.path(), &["verify", path]);
+            let err = crate::common::text(&out.stderr);
+            assert_eq!(
+                out.status.code(),
+                Some(1),
+                "{}",
+                &err[..err.len().min(2000)]
+            );
+            assert!(err.len() < 4_000, "{}", err.len());
+            assert!(
+                err.contains("bytes)…"),
+                "the long line is shown in windows: {err}"
+            );
+        },
+    );
+}

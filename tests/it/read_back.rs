@@ -76,7 +76,7 @@ fn every_example_program_reads_back_whole() {
             let Written::Whole(bytes) = file else {
                 continue;
             };
-            if name.ends_with(".json") || name.ends_with(".fts") {
+            if !crate::common::is_program(name) {
                 continue;
             }
             let found = unexpected(codes(name, &text(bytes)));
@@ -212,8 +212,7 @@ fn every_program_reads_the_same_on_the_fast_path() {
     for b in built_examples() {
         for (name, file) in &b.files {
             if let Written::Whole(bytes) = file
-                && !name.ends_with(".json")
-                && !name.ends_with(".fts")
+                && crate::common::is_program(name)
             {
                 programs.push((format!("{} {name}", b.example), text(bytes)));
             }

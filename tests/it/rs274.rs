@@ -133,6 +133,15 @@ fn kim_convex_program() -> String {
     }
 }
 
+/// Where the program's control point lies from the nose centre (X, Z),
+/// as its header states it: the program moves the imaginary tip, the
+/// curve below is the centre's.
+fn kim_control_offset() -> (f64, f64) {
+    let o = lensc_runtime::reader::header_control_offset(&kim_convex_program())
+        .expect("the header states the control point");
+    (o[0], o[2])
+}
+
 #[test]
 fn every_example_program_passes_rs274() {
     let dir = tempfile::tempdir().expect("tmp");
@@ -181,7 +190,12 @@ fn canonical_moves_lie_on_the_offset_curve() {
     std::fs::write(&program, kim_convex_program()).expect("write program");
     let canon = interpret(&program);
     assert!(canon.contains("ARC_FEED("), "no arcs");
-    let moves = cut_points_xz(&canon);
+    // As the nose centre's: the control point's offset taken off.
+    let (ox, oz) = kim_control_offset();
+    let moves: Vec<(f64, f64)> = cut_points_xz(&canon)
+        .into_iter()
+        .map(|(x, z)| (x - ox, z - oz))
+        .collect();
     // The first feed is the plunge from the retract height to the start.
     let cut = &moves[1..];
     assert!(cut.len() >= 10, "{} cutting moves", cut.len());
@@ -211,6 +225,7 @@ fn program_path_stays_within_the_path_tolerance() {
     // the strategy's 10 nm path tolerance of the exact wheel-centre curve,
     // plus rounding.
     let program = kim_convex_program();
+    let (ox, oz) = kim_control_offset();
     let (mut x, mut z) = (f64::NAN, f64::NAN);
     let mut motion = "";
     // (start, end, arc centre and direction if an arc) of each cutting move.
@@ -242,7 +257,10 @@ fn program_path_stays_within_the_path_tolerance() {
             "G3" => Some(((x0 + i, z0 + k), true)),
             _ => None,
         };
-        cuts.push(((x0, z0), (x, z), arc));
+        // As the nose centre's: the control point's offset taken off
+        // (arc centres too; I and K are from the start, so unchanged).
+        let c = |(px, pz): (f64, f64)| (px - ox, pz - oz);
+        cuts.push((c((x0, z0)), c((x, z)), arc.map(|(p, ccw)| (c(p), ccw))));
     }
     let arcs = cuts.iter().filter(|c| c.2.is_some()).count();
     assert!(arcs > 0, "no arcs fitted");

@@ -144,6 +144,24 @@ fn a_file_over_16_mib_is_refused() {
 }
 
 #[test]
+fn a_hard_link_to_a_file_outside_the_root_is_refused_unread() {
+    let dir = project(&[("job.lens", "use \"common.lens\"\n")]);
+    std::fs::write(
+        dir.path().join("other.lens"),
+        "let secret_of_another_job = 1\n",
+    )
+    .expect("outside");
+    std::fs::hard_link(
+        dir.path().join("other.lens"),
+        dir.path().join("proj/common.lens"),
+    )
+    .expect("hard link");
+    let all = refused(dir.path(), &[], "E0191");
+    assert!(!all.contains("secret_of_another_job"), "{all}");
+    assert!(all.contains("hard link"), "{all}");
+}
+
+#[test]
 fn a_directory_is_refused() {
     let dir = project(&[("job.lens", "use \"sub\"\n")]);
     std::fs::create_dir(dir.path().join("proj/sub")).expect("dir");

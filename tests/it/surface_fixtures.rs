@@ -949,7 +949,7 @@ surface a = linear_array(c, pitch: 1 mm, count: 5, axis: x)";
 #[test]
 fn off_axis_sections_keep_or_remove_the_tilt() {
     // A convex asphere, sectioned about (3, −1.5): z(x, y) = z_p(x + 3, y − 1.5)
-    // − z_p(3, −1.5), less the tangent plane there with `tilt: remove`.
+    // − z_p(3, −1.5); with `tilt: remove`, turned level at its centre.
     let src = "surface p = asphere { radius: 15 mm, conic: -1.3, sense: convex, aperture: circle(radius: 5 mm), A4: 2e-5 mm^-3 }
 surface k = off_axis(p, x: 3 mm, y: -1.5 mm, aperture: circle(radius: 1 mm))
 surface flat = off_axis(p, x: 3 mm, y: -1.5 mm, tilt: remove, aperture: circle(radius: 1 mm))";
@@ -964,18 +964,13 @@ surface flat = off_axis(p, x: 3 mm, y: -1.5 mm, tilt: remove, aperture: circle(r
         },
         "parent about (3, −1.5)",
     );
-    let (sx, sy) = (o.zx.expect("zx"), o.zy.expect("zy"));
+    // With `tilt: remove` the section is turned rigidly, not sheared: level
+    // at its centre (the turn itself is checked point by point in
+    // lensc-lang's lower::surface::tests::tilt_removed_is_the_exact_turned_section).
     surface(src, "flat").expect(
-        &pts,
-        |x, y| {
-            let w = parent(x + 3.0, y - 1.5);
-            z_slopes(
-                w.z - o.z - sx * x - sy * y,
-                w.zx.expect("zx") - sx,
-                w.zy.expect("zy") - sy,
-            )
-        },
-        "parent about (3, −1.5) less its tangent plane",
+        &[(0.0, 0.0)],
+        |_, _| z_slopes(0.0, 0.0, 0.0),
+        "the section turned level at its centre",
     );
 }
 

@@ -231,16 +231,24 @@ fn a_tool_set_off_centre_is_corrected_in_x() {
             "use std::machines::linuxcnc_lathe",
             "use std::machines::linuxcnc_lathe\ndialect straight = linuxcnc { arc_planes: [] }",
             1,
+        )
+        // The programs of the nose centre, whose radius the correction is
+        // of (the imaginary tip's X would be a nose radius less).
+        .replacen(
+            "tool wheel = round_nose { nose_radius: 2 mm, clearance: 10° }",
+            "tool wheel = round_nose { nose_radius: 2 mm, clearance: 10°, control_point: tool_centre }",
+            1,
         );
     assert!(src.contains("dialect: straight"));
+    assert!(src.contains("control_point: tool_centre"));
     assert!(src.contains("accept: none"));
     let dir = tempfile::tempdir().expect("tmp");
     let on = dir.path().join("on.lens");
     let off = dir.path().join("off.lens");
     std::fs::write(&on, &src).expect("write");
     let shifted = src.replace(
-        "tool wheel = round_nose { nose_radius: 2 mm, clearance: 10° }",
-        "tool wheel = round_nose { nose_radius: 2 mm, clearance: 10°, centre_height: 20 um }",
+        "control_point: tool_centre }",
+        "control_point: tool_centre, centre_height: 20 um }",
     );
     assert_ne!(shifted, src);
     std::fs::write(&off, shifted).expect("write");

@@ -180,8 +180,14 @@ fn simulate_roller(spec: &JobSpec, passes: &[Vec<[f64; 3]>]) -> usize {
     let (design_y, z) = (s.design_y, (helix.z_start, helix.z_end));
     let window = height_map::window(
         head,
-        ((z.0 + z.1) / 2.0, (design_y.0 + design_y.1) / 2.0),
         height_map::roller_extent(&lowered.domain, z, design_y),
+        height_map::WHOLE_CELLS_NOSE,
+        |w| {
+            lensc_runtime::verify::window::split(
+                &w.roller(helix.roller_radius, helix.y_start),
+                None,
+            )
+        },
     );
     let grid = window.roller(helix.roller_radius, helix.y_start);
     let tiles = lensc_runtime::verify::window::split(&grid, None);

@@ -19,7 +19,8 @@ use lensc_lang::codes;
 
 use crate::output::Built;
 use crate::report::{
-    AcceptanceMode, CriterionResult, HeightMap, LimitSource, Place, ProfileCut, Simulation,
+    AcceptanceMode, CriterionResult, HeightMap, Judged, JudgedArea, LimitSource, Place, ProfileCut,
+    Simulation,
 };
 
 /// How a build treats criteria missed.
@@ -39,8 +40,12 @@ use crate::job::accept::DEFAULT_TOLERANCE;
 /// measurable (errors under `Mode::Gate`, warnings under `Mode::Warn`).
 pub fn gate(spec: &JobSpec, built: &mut Built, mode: Mode) -> Vec<Diagnostic> {
     let head = spec.head();
+    let judged = judged(&built.report.simulation);
     if head.accept == Accept::Nothing {
-        built.report.acceptance = crate::report::Acceptance::pending();
+        built.report.acceptance = crate::report::Acceptance {
+            judged,
+            ..crate::report::Acceptance::pending()
+        };
         return Vec::new();
     }
     let tolerance = spec.path_tolerance();
@@ -89,8 +94,61 @@ pub fn gate(spec: &JobSpec, built: &mut Built, mode: Mode) -> Vec<Diagnostic> {
         },
         passed: results.iter().all(|r| r.passed),
         criteria: results,
+        judged,
     };
     diags
+}
+
+/// The area of the part `sim`'s figures come from, in words: the whole
+/// part or the window of a height map (with its place, size and spacing),
+/// or the radii a profile samples.
+fn judged(sim: &Simulation) -> Judged {
+    let um = |mm: f64| trim_num((mm * 1e4).round() / 10.0);
+    let mm = |v: f64| trim_num((v * 1e4).round() / 1e4);
+    match form(sim) {
+        Ok(Form::Map(h)) => {
+            let w = &h.window;
+            let place = format!(
+                "x {} .. {} mm, y {} .. {} mm at {} um",
+                mm(w.x_mm[0]),
+                mm(w.x_mm[1]),
+                mm(w.y_mm[0]),
+                mm(w.y_mm[1]),
+                um(w.spacing_mm)
+            );
+            if w.whole_part {
+                Judged {
+                    area: JudgedArea::WholePart,
+                    words: format!("whole part ({place})"),
+                }
+            } else {
+                Judged {
+                    area: JudgedArea::Window,
+                    words: format!(
+                        "window {} x {} mm of the part ({place}, the job's `simulate` block)",
+                        mm(w.x_mm[1] - w.x_mm[0]),
+                        mm(w.y_mm[1] - w.y_mm[0])
+                    ),
+                }
+            }
+        }
+        Ok(Form::Profile(p)) => Judged {
+            area: JudgedArea::WholePart,
+            words: match (p.from_radius_mm, p.to_radius_mm) {
+                (Some(a), Some(b)) => format!(
+                    "whole profile ({} samples, r {} .. {} mm)",
+                    p.samples,
+                    mm(a),
+                    mm(b)
+                ),
+                _ => "whole profile".into(),
+            },
+        },
+        Err(why) => Judged {
+            area: JudgedArea::None,
+            words: why.into(),
+        },
+    }
 }
 
 /// Why criteria cannot be measured, their names, and where the first of

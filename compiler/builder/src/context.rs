@@ -52,19 +52,20 @@ pub(crate) fn inverse_time_words(head: &JobHead) -> String {
     )
 }
 
-/// The lines every header starts with.
+/// The lines every header starts with: provenance, units, the control
+/// point, the surface.
 pub(crate) fn header(head: &JobHead, prov: &Provenance, units: &str) -> Vec<String> {
     vec![
         format!("lensc {}: job {}", prov.lensc_version, head.name),
         format!("source {} fnv1a64 {:016x}", prov.source, prov.source_hash),
         units.to_string(),
+        head.control.header_line(head.start.control),
         format!("surface {}: {}", head.names.surface, head.surface.words),
     ]
 }
 
-/// The lines of a header whose coordinates are the tool nose's centre (the
-/// servo lathes'): provenance, units, coordinates and feed, surface, and
-/// the round-nose tool.
+/// The lines of a servo lathe's header: provenance, units, the control
+/// point, the feed, surface, and the round-nose tool.
 pub(crate) fn nose_centre_header(
     head: &JobHead,
     prov: &Provenance,
@@ -72,14 +73,8 @@ pub(crate) fn nose_centre_header(
     nose_radius: f64,
 ) -> Vec<String> {
     let mut lines = header(head, prov, units);
-    // The coordinates' words stand between the units and the surface.
-    lines.insert(
-        3,
-        format!(
-            "coordinates are the centre of the tool nose; {}",
-            inverse_time_words(head)
-        ),
-    );
+    // The feed's words stand between the control point and the surface.
+    lines.insert(4, inverse_time_words(head));
     lines.push(format!(
         "tool {}: round nose, nose radius {} mm",
         head.names.tool,
@@ -195,7 +190,13 @@ pub(crate) fn executed_moves(
         max_feed: None,
         max_spindle_rpm: None,
     };
-    lensc_runtime::reader::read_moves(text, &head.dialect, &machine).1
+    let mut moves = lensc_runtime::reader::read_moves(text, &head.dialect, &machine).1;
+    // As `lensc verify` would: the control point the program's header
+    // states, taken off again, so the cut is the tool centre's.
+    if let Some(offset) = lensc_runtime::reader::header_control_offset(text) {
+        lensc_runtime::reader::to_tool_centre(&mut moves, offset);
+    }
+    moves
 }
 
 /// What a lathe or grinder program cuts, read from its text as the

@@ -5,5 +5,7 @@
 
 pub use crate::evaluate::{SamplePoints, declared_surface, evaluator, sample, surface_analysis};
 pub use crate::output::{Built, ProgramText, output_path, put_in_place, write_atomic};
-pub use crate::pipeline::{Request, plan_and_emit, plan_and_simulate};
+pub use crate::pipeline::{
+    Outcome, Request, plan_and_emit, plan_and_emit_outcomes, plan_and_simulate,
+};
 pub use lensc_lang::{Checked, check_path, check_path_in, check_text};

@@ -20,7 +20,7 @@ pub mod window;
 pub use estimate::{DEFAULT_MAX_PROGRAM_SIZE, Estimate, Limits, MAX_POINTS, refusals};
 
 use lensc_grammar::{Diagnostic, FileId, Span};
-use lensc_runtime::moves::{Coolant, Rotation, Start};
+use lensc_runtime::moves::{ControlOffset, Coolant, Rotation, Start};
 use lensc_runtime::post::{Dialect, Setup};
 use lensc_runtime::surface::ir::{SurfaceFn, SurfaceTape};
 
@@ -81,8 +81,108 @@ pub struct JobHead {
     pub simulate: Option<Simulate>,
     /// What the simulated part must meet for the program to be written.
     pub accept: accept::Accept,
-    /// The tool call, spindle direction and coolant every program states.
+    /// The tool call, spindle direction, coolant and control point every
+    /// program states.
     pub start: Start,
+    /// What the tool's offsets are measured to, in words and as stated.
+    pub control: ControlPoint,
+}
+
+/// The tool's control point: what its length (and on a lathe its X)
+/// offset is measured to, so the point the program's coordinates move.
+/// The planners plan the tool's centre; the writer adds `Start::control`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ControlPoint {
+    /// `tip` (true) or `centre`.
+    pub tip: bool,
+    /// Whether the tool states it (else the machine kind's default).
+    pub stated: bool,
+    /// The machine's kind, whose default it is.
+    pub machine_kind: &'static str,
+    /// What each offset is measured to, in words (for the header and the
+    /// set-up sheet).
+    pub measured_to: String,
+}
+
+impl ControlPoint {
+    /// The tool's control point, as `tool` states it or as the machine's
+    /// kind defaults it: a mill's and a lathe's tools are set to their tip
+    /// (a mill's tool length measured to the ball's or nose's lowest
+    /// point; a lathe's X and Z to the imaginary tip, the nose's -X and -Z
+    /// sides, as a diameter and a face are touched off), the servo lathes'
+    /// and the grinder's to the centre of the nose or wheel (the diamond
+    /// turning shop's tool set on centre; an assumption, stated in
+    /// docs/language/machines-and-tools.md); and its offset from the
+    /// tool's centre (mm).
+    pub fn of(machine: &MachineParams, tool: &ToolParams) -> (ControlPoint, ControlOffset) {
+        let lathe_like = machine.kind != "mill_3axis";
+        let default_tip = matches!(machine.kind, "mill_3axis" | "lathe");
+        let tip = tool.control_point.map_or(default_tip, |s| s.value);
+        let radius = tool
+            .nose_radius
+            .or(tool.diameter.map(|d| d / 2.0))
+            .filter(|r| r.is_finite())
+            .unwrap_or(0.0);
+        let (offset, measured_to) = match (tip, lathe_like) {
+            (false, _) => (
+                ControlOffset::CENTRE,
+                "the centre of the ball, nose or wheel, the program moves it".to_string(),
+            ),
+            (true, false) => (
+                ControlOffset {
+                    x: 0.0,
+                    y: 0.0,
+                    z: -radius,
+                },
+                "the tip, the tool length to the lowest point of the ball or nose, the radius not applied (G40)".to_string(),
+            ),
+            (true, true) => (
+                ControlOffset {
+                    x: -radius,
+                    y: 0.0,
+                    z: -radius,
+                },
+                "the imaginary tip, tip direction 3, X to the nose -X side (a diameter touched off), Z to the nose -Z side (the face touched off), the nose radius not applied (G40)".to_string(),
+            ),
+        };
+        let point = ControlPoint {
+            tip,
+            stated: tool.control_point.is_some(),
+            machine_kind: machine.kind,
+            measured_to,
+        };
+        (point, offset)
+    }
+
+    /// The header's line: the control point, whether stated or the
+    /// default, what it is measured to, and its offset from the tool's
+    /// centre in the words `reader::header_control_offset` reads back.
+    pub fn header_line(&self, offset: ControlOffset) -> String {
+        format!(
+            "control point {} at X{:+} Y{:+} Z{:+} mm from the tool centre ({}): {}",
+            self.name(),
+            offset.x,
+            offset.y,
+            offset.z,
+            self.whose(),
+            self.measured_to
+        )
+    }
+
+    /// `tip` or `centre`: the header's and the sheet's word for it (the
+    /// tool's `control_point: tool_tip` or `tool_centre`).
+    pub fn name(&self) -> &'static str {
+        if self.tip { "tip" } else { "centre" }
+    }
+
+    /// "stated" or "the default on a `KIND`".
+    pub fn whose(&self) -> String {
+        if self.stated {
+            "stated".to_string()
+        } else {
+            format!("the default on a {}", self.machine_kind)
+        }
+    }
 }
 
 impl JobHead {
@@ -377,7 +477,11 @@ impl<'a> Parts<'a> {
             travel: self.machine_params.travel,
             simulate: simulate(&self.params).ok().flatten(),
             accept: accept::lower(&self.params).unwrap_or_default(),
-            start: program_start(&self.params),
+            start: Start {
+                control: ControlPoint::of(&self.machine_params, &self.tool_params).1,
+                ..program_start(&self.params)
+            },
+            control: ControlPoint::of(&self.machine_params, &self.tool_params).0,
         }
     }
 }
@@ -412,6 +516,8 @@ pub(crate) fn program_start(params: &JobParams) -> Start {
             Some("mist") => Coolant::Mist,
             _ => Coolant::Off,
         },
+        control: ControlOffset::CENTRE,
+        blank: None,
     }
 }
 

@@ -75,16 +75,19 @@ pub fn lower(
 }
 
 /// The names, after the job's name and a dot, of the files a build or
-/// `lensc report` writes beside a program (the report, the plots).
-pub const RESERVED_EXTENSIONS: [&str; 4] = [
+/// `lensc report` writes beside a program (the report, the set-up sheet,
+/// the plots).
+pub const RESERVED_EXTENSIONS: [&str; 5] = [
     "report.json",
+    crate::setup_sheet::EXTENSION,
     "profile.svg",
     "form_error.svg",
     "following.svg",
 ];
 
 /// E0188 when the program's name (`JOB.EXT`) would be the name of a file
-/// written beside it: the report, a plot, the dialect's servo table.
+/// written beside it: the report, the set-up sheet, a plot, the dialect's
+/// servo table.
 /// Compared without case (a share on a case-blind file system), and any
 /// extension ending in one of them (`x.report.json`) too.
 fn reserved_name(head: &crate::job::JobHead) -> Option<Diagnostic> {
@@ -103,6 +106,8 @@ fn reserved_name(head: &crate::job::JobHead) -> Option<Diagnostic> {
         "the servo table the dialect writes beside the program"
     } else if clash == "report.json" {
         "the build report"
+    } else if clash == crate::setup_sheet::EXTENSION {
+        "the set-up sheet"
     } else {
         "a plot `lensc report` writes"
     };
@@ -154,8 +159,53 @@ pub fn plan_and_emit(
     source_name: &str,
     spool_dir: Option<&Path>,
 ) -> (Vec<Built>, Vec<Diagnostic>) {
+    let (outcomes, diags) = plan_and_emit_outcomes(c, request, source_name, spool_dir);
+    (built_only(outcomes), diags)
+}
+
+/// `plan_and_emit`, with every job's outcome, built or not, in the order
+/// of the file (`lensc build`'s summary lists each).
+pub fn plan_and_emit_outcomes(
+    c: &Checked,
+    request: Request,
+    source_name: &str,
+    spool_dir: Option<&Path>,
+) -> (Vec<Outcome>, Vec<Diagnostic>) {
     let to = spool_dir.map_or(Destination::Memory, Destination::Spool);
     plan_jobs(c, request, source_name, to)
+}
+
+/// What became of one job of a build.
+pub struct Outcome {
+    /// The job's name.
+    pub job: String,
+    /// Its program and report, if it was built (refused by its acceptance
+    /// gate or not: the report's figures say by how much it missed).
+    pub built: Option<Built>,
+    /// Built and passed its gate: its files may be written.
+    pub accepted: bool,
+    /// The codes of the errors that refused it, in order, each once.
+    pub errors: Vec<&'static str>,
+}
+
+/// The jobs built and passed, in order.
+fn built_only(outcomes: Vec<Outcome>) -> Vec<Built> {
+    outcomes
+        .into_iter()
+        .filter(|o| o.accepted)
+        .filter_map(|o| o.built)
+        .collect()
+}
+
+/// The codes of the errors among `diags`, each once, in order.
+fn error_codes(diags: &[Diagnostic]) -> Vec<&'static str> {
+    let mut codes = Vec::new();
+    for d in diags.iter().filter(|d| d.is_error()) {
+        if !codes.contains(&d.code) {
+            codes.push(d.code);
+        }
+    }
+    codes
 }
 
 /// Plans and simulates the checked jobs as `plan_and_emit` does, with
@@ -168,7 +218,8 @@ pub fn plan_and_simulate(
     request: Request,
     source_name: &str,
 ) -> (Vec<Built>, Vec<Diagnostic>) {
-    plan_jobs(c, request, source_name, Destination::Nowhere)
+    let (outcomes, diags) = plan_jobs(c, request, source_name, Destination::Nowhere);
+    (built_only(outcomes), diags)
 }
 
 fn plan_jobs(
@@ -176,7 +227,7 @@ fn plan_jobs(
     request: Request,
     source_name: &str,
     to: Destination,
-) -> (Vec<Built>, Vec<Diagnostic>) {
+) -> (Vec<Outcome>, Vec<Diagnostic>) {
     let mut diags = Vec::new();
     let mut out = Vec::new();
     let prov = Provenance {
@@ -202,7 +253,6 @@ fn plan_jobs(
             Ok((mut b, mut gate)) => {
                 diags.append(&mut b.warnings);
                 let refused = gate.iter().any(|d| d.is_error());
-                diags.append(&mut gate);
                 observer.event(Event::JobDone {
                     job: name,
                     built: !refused,
@@ -211,11 +261,22 @@ fn plan_jobs(
                 });
                 // A job that fails its gate is not written (its spooled
                 // program is removed as it is dropped).
-                if !refused {
-                    out.push(b);
-                }
+                let errors = error_codes(&gate);
+                diags.append(&mut gate);
+                out.push(Outcome {
+                    job: name.to_string(),
+                    built: Some(b),
+                    accepted: !refused,
+                    errors,
+                });
             }
             Err(mut d) => {
+                out.push(Outcome {
+                    job: name.to_string(),
+                    built: None,
+                    accepted: false,
+                    errors: error_codes(&d),
+                });
                 diags.append(&mut d);
                 observer.event(Event::JobDone {
                     job: name,
@@ -266,7 +327,15 @@ fn build_job(
         read_back(job, &spec, &mut b)?;
     }
     b.report.estimate = (&est).into();
+    b.warnings.extend(crate::plausibility::cutting_time_warning(
+        spec.head(),
+        b.cutting_time,
+    ));
     let gate = crate::accept::gate(&spec, &mut b, request.accept);
+    // The set-up sheet, written in one unit with the program it sets up.
+    if !matches!(to, Destination::Nowhere) {
+        crate::setup_sheet::add(spec.head(), &mut b);
+    }
     Ok((b, gate))
 }
 

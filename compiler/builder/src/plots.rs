@@ -590,9 +590,9 @@ fn level_runs(r: &ErrorRaster, lo_nm: f64, hi_nm: f64) -> Vec<Rectangle<(f64, f6
 /// The colour scale beside a form-error map: every level, in nm.
 fn draw_colour_scale(
     area: &Area,
-    lo_nm: f64,
-    hi_nm: f64,
+    (lo_nm, hi_nm): (f64, f64),
     (margin, bottom): (u32, u32),
+    desc: &str,
 ) -> Result<(), String> {
     let mut bar = ChartBuilder::on(area)
         .margin(margin)
@@ -604,7 +604,7 @@ fn draw_colour_scale(
     bar.configure_mesh()
         .disable_mesh()
         .disable_x_axis()
-        .y_desc("form error, cut − design (nm)")
+        .y_desc(desc)
         .y_label_formatter(&ticks(lo_nm, hi_nm))
         .axis_desc_style((FONT, 16))
         .label_style((FONT, 13))
@@ -630,6 +630,39 @@ fn form_error_svg(job: &str, f: &FormErrorSeries) -> Result<String, String> {
     let Some((lo, hi)) = r.range() else {
         return Err("the height map has no cut cell in its window".into());
     };
+    let text = form_error_caption(f, lo, hi);
+    error_map_svg(
+        &format!("{job}: form error over the simulation window"),
+        &text,
+        r,
+        (f.x_axis, f.y_axis),
+        "form error, cut − design (nm)",
+    )
+}
+
+/// A measured part's error map (`lensc measure`): the blocks of the
+/// raster in colour, with `caption` under it.
+pub fn measured_error_svg(title: &str, caption: &str, r: &ErrorRaster) -> Result<String, String> {
+    error_map_svg(
+        title,
+        caption,
+        r,
+        ("x (mm)", "y (mm)"),
+        "error along the normal, measured − design (nm)",
+    )
+}
+
+/// An error raster drawn to scale with its colour scale and caption.
+fn error_map_svg(
+    title: &str,
+    text: &str,
+    r: &ErrorRaster,
+    (x_axis, y_axis): (&str, &str),
+    scale: &str,
+) -> Result<String, String> {
+    let Some((lo, hi)) = r.range() else {
+        return Err("the map has no cell to draw".into());
+    };
     let (lo_nm, hi_nm) = if hi > lo {
         (lo * 1e6, hi * 1e6)
     } else {
@@ -637,8 +670,7 @@ fn form_error_svg(job: &str, f: &FormErrorSeries) -> Result<String, String> {
     };
     let (w, h) = (r.nx as f64 * r.block, r.ny as f64 * r.block);
     let (x0, y0) = (r.x.0, r.y.0);
-    let text = form_error_caption(f, lo, hi);
-    let lines = wrap(&text, f64::from(WIDTH) - 40.0);
+    let lines = wrap(text, f64::from(WIDTH) - 40.0);
     // The map's plotting area keeps the window's aspect (axes to scale).
     let side = 600.0;
     let (pw, ph) = if w >= h {
@@ -653,11 +685,7 @@ fn form_error_svg(job: &str, f: &FormErrorSeries) -> Result<String, String> {
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (WIDTH, height)).into_drawing_area();
-        let (plot, below) = page(
-            &root,
-            &format!("{job}: form error over the simulation window"),
-            lines.len(),
-        )?;
+        let (plot, below) = page(&root, title, lines.len())?;
         let map_area = plot.clone().shrink((0, 0), (map_w, map_h));
         let mut chart = ChartBuilder::on(&map_area)
             .margin(margin)
@@ -668,8 +696,8 @@ fn form_error_svg(job: &str, f: &FormErrorSeries) -> Result<String, String> {
         chart
             .configure_mesh()
             .disable_mesh()
-            .x_desc(f.x_axis)
-            .y_desc(f.y_axis)
+            .x_desc(x_axis)
+            .y_desc(y_axis)
             .x_label_formatter(&ticks(x0, x0 + w))
             .y_label_formatter(&ticks(y0, y0 + h))
             .axis_desc_style((FONT, 16))
@@ -683,7 +711,7 @@ fn form_error_svg(job: &str, f: &FormErrorSeries) -> Result<String, String> {
             .map_err(err)?;
         // The scale: every level, labelled in nm.
         let bar_area = plot.clone().shrink((map_w + 10, 0), (170u32, map_h));
-        draw_colour_scale(&bar_area, lo_nm, hi_nm, (margin, bottom))?;
+        draw_colour_scale(&bar_area, (lo_nm, hi_nm), (margin, bottom), scale)?;
         caption(&below, &lines)?;
         root.present().map_err(err)?;
     }

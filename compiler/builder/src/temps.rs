@@ -157,7 +157,8 @@ pub fn persist_all(files: Vec<(TempFile, PathBuf)>) -> io::Result<()> {
     }
     sync_dir(&dir);
     let mut result = Ok(());
-    for (mut t, target) in files {
+    for (step, (mut t, target)) in files.into_iter().enumerate() {
+        stop_for_a_test(step);
         let file = t.file.take().expect("a temporary file in use");
         let path = file.path().to_path_buf();
         if result.is_err() {
@@ -168,9 +169,54 @@ pub fn persist_all(files: Vec<(TempFile, PathBuf)>) -> io::Result<()> {
         }
         forget(&mut live, &path);
     }
+    stop_for_a_test(usize::MAX);
     sync_dir(&dir);
     let _ = std::fs::remove_file(&journal);
     result
+}
+
+/// The tests' way to stop a commit part-way: with
+/// `LENSC_TEST_STOP_COMMIT=STEP:SIGNAL` (`SIGNAL` being `TERM`, `INT` or
+/// `KILL`), the process sends itself that signal just before its commit's
+/// rename number `STEP` (from 0), or with `STEP` `end` after the last
+/// rename, before the journal is removed. Unset, as in every real build,
+/// it does nothing. (A signal from outside cannot be aimed between two
+/// renames a few microseconds apart; `tests/it/interrupt.rs` aims this
+/// one at every step.)
+fn stop_for_a_test(step: usize) {
+    let Some(spec) = std::env::var_os("LENSC_TEST_STOP_COMMIT") else {
+        return;
+    };
+    let spec = spec.to_string_lossy();
+    let Some((at, signal)) = spec.split_once(':') else {
+        return;
+    };
+    let at = if at == "end" {
+        usize::MAX
+    } else {
+        match at.parse() {
+            Ok(n) => n,
+            Err(_) => return,
+        }
+    };
+    if at != step {
+        return;
+    }
+    #[cfg(unix)]
+    {
+        let signal = match signal {
+            "TERM" => libc::SIGTERM,
+            "INT" => libc::SIGINT,
+            "KILL" => libc::SIGKILL,
+            _ => return,
+        };
+        // SAFETY: kill(2) on this process's own pid; no memory is touched.
+        unsafe {
+            libc::kill(libc::getpid(), signal);
+        }
+    }
+    #[cfg(not(unix))]
+    let _ = signal;
 }
 
 /// Flushes a directory's entries (the renames in it), where that can be

@@ -79,6 +79,9 @@ pub const GCODE_SYSTEM_NOT_OFFERED: &str = "E0176";
 /// Constant surface speed asked of a machine whose dialect has none
 /// (no `surface_speed` lines).
 pub const NO_SURFACE_SPEED: &str = "E0177";
+/// A tool's control point the job's dialect cannot program (a tip on a
+/// fast-tool-servo lathe whose servo table states the nose centre).
+pub const CONTROL_POINT_NOT_EXPRESSIBLE: &str = "E0178";
 /// A path tolerance finer than the machine's resolution can hold.
 pub const TOLERANCE_BELOW_RESOLUTION: &str = "E0180";
 /// `lensc fmt` refused to write a layout that would not parse back to the
@@ -95,6 +98,9 @@ pub const SURFACE_UNDEFINED: &str = "E0187";
 pub const OUTPUT_NAME_RESERVED: &str = "E0188";
 /// A project whose `use`s would load more than `loader::MAX_FILES` files.
 pub const TOO_MANY_FILES: &str = "E0189";
+/// A file under the project root with more than one name (a hard link):
+/// another of its names may lie outside the root.
+pub const HARD_LINKED: &str = "E0191";
 /// `lensc import`: the file is not a prescription lensc reads (not a
 /// `.zmx` or optiland JSON file, or a value in it that is not a number).
 pub const IMPORT_UNREADABLE: &str = "E0350";
@@ -108,6 +114,24 @@ pub const IMPORT_NON_SEQUENTIAL: &str = "E0352";
 pub const IMPORT_NOT_FINITE: &str = "E0353";
 /// `lensc import`: the `.lens` text would be over the 16 MiB lensc reads.
 pub const IMPORT_TOO_LARGE: &str = "E0354";
+/// `lensc measure`: the measurement file is not one lensc reads (an
+/// unknown format, a malformed header or value, a variant not read).
+pub const MEASURE_UNREADABLE: &str = "E0360";
+/// `lensc measure`: the measurement file ends before the data its header
+/// promises.
+pub const MEASURE_TRUNCATED: &str = "E0361";
+/// `lensc measure`: a checksum the measurement file carries does not
+/// match its data.
+pub const MEASURE_CHECKSUM: &str = "E0362";
+/// `lensc measure`: the invalid-point mask leaves less than the stated
+/// share of the measured aperture.
+pub const MEASURE_TOO_LITTLE: &str = "E0363";
+/// `lensc measure`: the measurement does not fit the job's surface: most
+/// of it lies outside the aperture, or it departs from the design far
+/// more than a part of it could (other units, another surface).
+pub const MEASURE_MISMATCH: &str = "E0364";
+/// `lensc measure`: the registration to the design did not converge.
+pub const MEASURE_NOT_CONVERGED: &str = "E0365";
 
 /// The simulated part misses one of its job's acceptance criteria (the
 /// message names which, by how much and where); no program is written.
@@ -126,6 +150,12 @@ pub const CENTRE_LEFT_UNCUT: &str = "W0004";
 pub const CHORDS_OVER_TOLERANCE: &str = "W0005";
 /// A wrapped design whose two ends do not meet where the roller closes.
 pub const SEAM_STEP: &str = "W0006";
+/// A cutting time over a day, the job stating no `max_cutting_time`.
+pub const CUTTING_TIME_IMPLAUSIBLE: &str = "W0030";
+/// An approach at the cutting feed longer than half a minute.
+pub const LONG_APPROACH_AT_FEED: &str = "W0031";
+/// A quarter or more of the time at feed spent approaching the cut.
+pub const AIR_CUTTING: &str = "W0032";
 /// E0195 under `lensc build --accept=warn`: the program is written.
 pub const ACCEPTANCE_MISSED_WARNING: &str = "W0020";
 /// E0196 under `lensc build --accept=warn`: the program is written.
@@ -332,6 +362,7 @@ pub const ALL: &[&str] = &[
     KLARTEXT_ON_A_LATHE,
     GCODE_SYSTEM_NOT_OFFERED,
     NO_SURFACE_SPEED,
+    CONTROL_POINT_NOT_EXPRESSIBLE,
     TOLERANCE_BELOW_RESOLUTION,
     ACCEPTANCE_MISSED,
     ACCEPTANCE_UNMEASURED,
@@ -340,16 +371,26 @@ pub const ALL: &[&str] = &[
     CENTRE_LEFT_UNCUT,
     CHORDS_OVER_TOLERANCE,
     SEAM_STEP,
+    CUTTING_TIME_IMPLAUSIBLE,
+    LONG_APPROACH_AT_FEED,
+    AIR_CUTTING,
     FORMAT_WOULD_CHANGE_MEANING,
     NOT_FINITE,
     SURFACE_UNDEFINED,
     OUTPUT_NAME_RESERVED,
     TOO_MANY_FILES,
+    HARD_LINKED,
     IMPORT_UNREADABLE,
     IMPORT_NOTHING,
     IMPORT_NON_SEQUENTIAL,
     IMPORT_NOT_FINITE,
     IMPORT_TOO_LARGE,
+    MEASURE_UNREADABLE,
+    MEASURE_TRUNCATED,
+    MEASURE_CHECKSUM,
+    MEASURE_TOO_LITTLE,
+    MEASURE_MISMATCH,
+    MEASURE_NOT_CONVERGED,
     IMPORT_UNSUPPORTED_SURFACE,
     IMPORT_PARAMETER_DROPPED,
     IMPORT_NO_SEMI_DIAMETER,

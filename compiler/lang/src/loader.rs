@@ -13,6 +13,7 @@ use lensc_grammar::diagnostic::codes as syntax_codes;
 use lensc_grammar::{Diagnostic, FileId};
 
 use crate::codes;
+pub use crate::sandbox::Root;
 pub use crate::sandbox::plain_io_error;
 use crate::sandbox::{self, ReadError};
 use crate::source::SourceMap;
@@ -36,20 +37,22 @@ pub const STDLIB: &[(&str, &str)] = &[
 pub const PRELUDE: &str = "dialects";
 
 pub trait FileSystem {
-    /// The text of a regular file, bounded in size.
-    fn read(&self, path: &Path) -> Result<Vec<u8>, ReadError>;
+    /// The text of the regular file `path` (resolved, as `canonical` gives
+    /// it) beneath the project root `root`, bounded in size: opened
+    /// through the root's directory handle, never by its full name.
+    fn read(&self, root: &Root, path: &Path) -> Result<Vec<u8>, ReadError>;
     /// The path made absolute with its symlinks resolved: equal for two
     /// paths naming the same file, and what the project root is checked on.
     fn canonical(&self, path: &Path) -> PathBuf;
 }
 
-/// The real file system: regular files of at most
-/// `sandbox::MAX_FILE_BYTES`, read without blocking.
+/// The real file system: regular files of one name and at most
+/// `sandbox::MAX_FILE_BYTES`, read without blocking, beneath the root.
 pub struct RealFs;
 
 impl FileSystem for RealFs {
-    fn read(&self, path: &Path) -> Result<Vec<u8>, ReadError> {
-        sandbox::read_regular(path, sandbox::MAX_FILE_BYTES)
+    fn read(&self, root: &Root, path: &Path) -> Result<Vec<u8>, ReadError> {
+        root.read(path, sandbox::MAX_FILE_BYTES)
     }
     fn canonical(&self, path: &Path) -> PathBuf {
         sandbox::resolve(path)
@@ -116,7 +119,8 @@ pub fn load_in(fs: &dyn FileSystem, file: &Path, root: Option<&Path>) -> Result<
     if !sandbox::inside(&resolved, &root) {
         return Err(ReadError::OutsideRoot { resolved, root });
     }
-    let bytes = fs.read(&resolved)?;
+    let root = Root::open(root);
+    let bytes = fs.read(&root, &resolved)?;
     Ok(load_bytes(fs, root, Key::Path(resolved), file, bytes))
 }
 
@@ -125,7 +129,7 @@ pub fn load_in(fs: &dyn FileSystem, file: &Path, root: Option<&Path>) -> Result<
 pub fn load_text(fs: &dyn FileSystem, name: &str, text: &[u8]) -> Loaded {
     load_bytes(
         fs,
-        fs.canonical(Path::new(".")),
+        Root::open(fs.canonical(Path::new("."))),
         Key::Path(PathBuf::from(name)),
         Path::new(name),
         text.to_vec(),
@@ -139,7 +143,7 @@ fn directory_of(file: &Path) -> &Path {
         .unwrap_or(Path::new("."))
 }
 
-fn load_bytes(fs: &dyn FileSystem, root: PathBuf, key: Key, path: &Path, bytes: Vec<u8>) -> Loaded {
+fn load_bytes(fs: &dyn FileSystem, root: Root, key: Key, path: &Path, bytes: Vec<u8>) -> Loaded {
     let mut l = Loader {
         fs,
         root,
@@ -170,8 +174,9 @@ enum Key {
 
 struct Loader<'f> {
     fs: &'f dyn FileSystem,
-    /// The project root, resolved: no file outside it is read.
-    root: PathBuf,
+    /// The project root, opened once: no file outside it is read, and each
+    /// file is opened through its handle.
+    root: Root,
     loaded: Loaded,
     keys: HashMap<Key, FileId>,
     /// Files being loaded, outermost first, to detect import cycles.
@@ -345,10 +350,14 @@ impl Loader<'_> {
         let base = from_path.and_then(Path::parent).unwrap_or(Path::new(""));
         let full = base.join(path);
         let resolved = self.fs.canonical(&full);
-        if !sandbox::inside(&resolved, &self.root) {
-            self.loaded
-                .diags
-                .push(outside_root(from, pspan, &full, &resolved, &self.root));
+        if !sandbox::inside(&resolved, self.root.path()) {
+            self.loaded.diags.push(outside_root(
+                from,
+                pspan,
+                &full,
+                &resolved,
+                self.root.path(),
+            ));
             return;
         }
         let key = Key::Path(resolved.clone());
@@ -387,7 +396,7 @@ impl Loader<'_> {
             }
             return;
         }
-        match self.fs.read(&resolved) {
+        match self.fs.read(&self.root, &resolved) {
             Ok(bytes) => {
                 let f = self.add(key, full.display().to_string(), Some(full), bytes);
                 imports.push(Import::All { file: f, span });
@@ -409,12 +418,18 @@ impl Loader<'_> {
                         "files of at most {} MiB are read; split it into files joined by `use`",
                         limit >> 20
                     ),
+                    ReadError::HardLinked { .. } => {
+                        "copy the file into the project instead of linking it".to_string()
+                    }
                     _ => "paths are relative to the file that uses them".to_string(),
                 }),
             ),
         }
     }
 }
+
+#[cfg(all(test, target_os = "linux"))]
+mod race;
 
 /// E0107: a `use` of a file outside the project root. The file is not
 /// read, so nothing of it can show in a diagnostic.

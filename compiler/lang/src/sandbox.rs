@@ -1,9 +1,12 @@
 //! Which files a job may read, and reading them safely: only regular files
 //! (never a FIFO, device, socket or directory, so nothing can block or
 //! stream forever), at most `MAX_FILE_BYTES` each (read with a bounded
-//! reader), and only under the project root after symlinks are resolved.
-//! The errors are data (`ReadError`); the loader turns them into coded
-//! diagnostics.
+//! reader), only one name each (no hard link), and only beneath the
+//! project root: every file under the root is opened relative to the
+//! root's directory handle (`Root`), component by component, so no
+//! directory swapped for a symlink between the check and the open can
+//! lead outside it. The errors are data (`ReadError`); the loader turns
+//! them into coded diagnostics.
 
 use std::io::Read;
 use std::path::{Component, Path, PathBuf};
@@ -25,6 +28,9 @@ pub enum ReadError {
     TooLarge { bytes: u64, limit: u64 },
     /// The file resolves (after symlinks) to `resolved`, outside `root`.
     OutsideRoot { resolved: PathBuf, root: PathBuf },
+    /// A regular file under the root with `links` names (hard links): one
+    /// of them may lie outside the root.
+    HardLinked { links: u64 },
 }
 
 impl ReadError {
@@ -35,6 +41,7 @@ impl ReadError {
             ReadError::NotAFile { .. } => codes::NOT_A_FILE,
             ReadError::TooLarge { .. } => codes::FILE_TOO_LARGE,
             ReadError::OutsideRoot { .. } => codes::OUTSIDE_ROOT,
+            ReadError::HardLinked { .. } => codes::HARD_LINKED,
         }
     }
 }
@@ -57,13 +64,19 @@ impl std::fmt::Display for ReadError {
             ReadError::OutsideRoot { root, .. } => {
                 write!(f, "it lies outside the project root `{}`", root.display())
             }
+            ReadError::HardLinked { links } => write!(
+                f,
+                "it has {links} names (hard links), and one may lie outside the project root"
+            ),
         }
     }
 }
 
 impl std::error::Error for ReadError {}
 
-/// Reads the regular file at `path`, at most `limit` bytes. What the path
+/// Reads the regular file at `path`, at most `limit` bytes: a file the
+/// user named (on the command line), not one beneath a project root
+/// (`Root::read` reads those). What the path
 /// names is checked before it is opened (a FIFO is never opened, a device
 /// never read) and again on the opened file, which is opened non-blocking
 /// and without following a final symlink, so a file swapped in between
@@ -72,6 +85,126 @@ pub fn read_regular(path: &Path, limit: u64) -> Result<Vec<u8>, ReadError> {
     regular(&std::fs::metadata(path)?, limit)?;
     let file = open_no_block(path)?;
     let size = regular(&file.metadata()?, limit)?;
+    read_bounded(file, size, limit)
+}
+
+/// The project root, opened once: the files beneath it are opened through
+/// its directory handle, never by their full name, so what the root's path
+/// names later (a directory in it renamed, swapped for a symlink) cannot
+/// change what is read. Where the kernel has it (Linux 5.6 on), `cap-std`
+/// opens with `openat2(RESOLVE_BENEATH)`; elsewhere it walks the path one
+/// component at a time from the handle, never above it.
+pub struct Root {
+    /// The root, resolved (what `inside` is checked against).
+    path: PathBuf,
+    /// Its directory handle, or why it could not be opened.
+    dir: std::io::Result<cap_std::fs::Dir>,
+}
+
+impl Root {
+    /// Opens the directory `path` (resolved, as `resolve` gives it). A
+    /// root that cannot be opened is kept with its error: every read
+    /// beneath it fails with that error.
+    pub fn open(path: PathBuf) -> Root {
+        let dir = cap_std::fs::Dir::open_ambient_dir(&path, cap_std::ambient_authority());
+        Root { path, dir }
+    }
+
+    /// The root, resolved.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Reads the regular file `file` (resolved: absolute, no `..`) beneath
+    /// the root, at most `limit` bytes, opened through the root's handle;
+    /// a file with more than one name (hard link) is refused. A path that
+    /// leads outside the root, now or by a swap while it is opened, is
+    /// `OutsideRoot` and nothing of it is read.
+    pub fn read(&self, file: &Path, limit: u64) -> Result<Vec<u8>, ReadError> {
+        let outside = || ReadError::OutsideRoot {
+            resolved: file.to_path_buf(),
+            root: self.path.clone(),
+        };
+        let rel = file.strip_prefix(&self.path).map_err(|_| outside())?;
+        if !rel.components().all(|c| matches!(c, Component::Normal(_))) {
+            return Err(outside());
+        }
+        if rel.as_os_str().is_empty() {
+            return Err(ReadError::NotAFile {
+                what: "a directory",
+            });
+        }
+        let dir = match &self.dir {
+            Ok(d) => d,
+            Err(e) => return Err(ReadError::Io(std::io::Error::new(e.kind(), e.to_string()))),
+        };
+        let refusal = |e: std::io::Error| {
+            if escaped(&e) {
+                outside()
+            } else {
+                ReadError::Io(e)
+            }
+        };
+        // What the path names is checked before it is opened (a device is
+        // never opened), and again on the opened file.
+        let before = dir.metadata(rel).map_err(refusal)?;
+        if !before.is_file() {
+            return Err(ReadError::NotAFile {
+                what: describe_beneath(&before.file_type()),
+            });
+        }
+        let file = dir
+            .open_with(rel, &beneath_options())
+            .map_err(refusal)?
+            .into_std();
+        let meta = file.metadata()?;
+        let size = regular(&meta, limit)?;
+        let links = link_count(&meta);
+        if links > 1 {
+            return Err(ReadError::HardLinked { links });
+        }
+        read_bounded(file, size, limit)
+    }
+}
+
+/// How a file beneath the root is opened: for reading, and on Unix
+/// without blocking (a FIFO swapped in after the check cannot hang the
+/// open; `regular_type` then refuses it).
+fn beneath_options() -> cap_std::fs::OpenOptions {
+    let mut o = cap_std::fs::OpenOptions::new();
+    o.read(true);
+    #[cfg(unix)]
+    {
+        use cap_std::fs::OpenOptionsExt;
+        o.custom_flags(libc::O_NONBLOCK);
+    }
+    o
+}
+
+/// Whether an open failed because the path led outside the root: `cap-std`
+/// says so in words; `openat2` says EXDEV.
+fn escaped(e: &std::io::Error) -> bool {
+    #[cfg(unix)]
+    if e.raw_os_error() == Some(libc::EXDEV) {
+        return true;
+    }
+    e.kind() == std::io::ErrorKind::PermissionDenied && e.to_string().contains("outside")
+}
+
+/// The number of names the opened file has.
+#[cfg(unix)]
+fn link_count(meta: &std::fs::Metadata) -> u64 {
+    use std::os::unix::fs::MetadataExt;
+    meta.nlink()
+}
+
+#[cfg(not(unix))]
+fn link_count(_meta: &std::fs::Metadata) -> u64 {
+    1
+}
+
+/// Reads an opened file of `size` bytes (as stated), at most `limit`.
+fn read_bounded(file: impl Read, size: u64, limit: u64) -> Result<Vec<u8>, ReadError> {
     let mut bytes = Vec::with_capacity(size as usize);
     file.take(limit + 1).read_to_end(&mut bytes)?;
     if bytes.len() as u64 > limit {
@@ -96,6 +229,29 @@ fn regular(meta: &std::fs::Metadata, limit: u64) -> Result<u64, ReadError> {
         });
     }
     Ok(meta.len())
+}
+
+/// What a file beneath the root that is not a regular file is, in words
+/// (as `describe` says it).
+fn describe_beneath(t: &cap_std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use cap_std::fs::FileTypeExt;
+        if t.is_fifo() {
+            return "a FIFO";
+        }
+        if t.is_char_device() || t.is_block_device() {
+            return "a device";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+    }
+    if t.is_dir() {
+        "a directory"
+    } else {
+        "not a regular file"
+    }
 }
 
 /// What a file that is not a regular file is, in words.
@@ -203,6 +359,38 @@ mod tests {
                 what: "a directory"
             }
         ));
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_file_with_a_second_name_is_not_read_beneath_the_root() {
+        let base = std::env::temp_dir().join(format!("lensc-link-{}", std::process::id()));
+        let proj = base.join("proj");
+        std::fs::create_dir_all(&proj).expect("proj");
+        std::fs::write(base.join("outside.lens"), "let secret = 1\n").expect("outside");
+        std::fs::hard_link(base.join("outside.lens"), proj.join("linked.lens")).expect("link");
+        std::fs::write(proj.join("one.lens"), "let mine = 1\n").expect("one");
+        let root = Root::open(resolve(&proj));
+        let linked = root.read(&resolve(&proj.join("linked.lens")), MAX_FILE_BYTES);
+        let one = root.read(&resolve(&proj.join("one.lens")), MAX_FILE_BYTES);
+        let _ = std::fs::remove_dir_all(&base);
+        assert!(
+            matches!(linked, Err(ReadError::HardLinked { links: 2 })),
+            "{linked:?}"
+        );
+        assert_eq!(one.expect("one name: read"), b"let mine = 1\n");
+    }
+
+    #[test]
+    fn a_path_beneath_the_root_is_opened_from_its_handle_only() {
+        let root = Root::open(resolve(&std::env::temp_dir()));
+        let e = root
+            .read(Path::new("/etc/passwd"), MAX_FILE_BYTES)
+            .unwrap_err();
+        assert!(matches!(e, ReadError::OutsideRoot { .. }), "{e:?}");
+        let dotdot = root.path().join("x/../../etc/passwd");
+        let e = root.read(&dotdot, MAX_FILE_BYTES).unwrap_err();
+        assert!(matches!(e, ReadError::OutsideRoot { .. }), "{e:?}");
     }
 
     #[cfg(unix)]

@@ -1,5 +1,8 @@
 //! Loaded source texts, with the names diagnostics show for them and the
-//! mapping from byte offsets to lines and columns.
+//! mapping from byte offsets to lines and columns. A text may be a part
+//! of a larger file (a line of a program `lensc verify` reads, which it
+//! never holds whole): its lines and offsets then count from where the
+//! part starts in that file.
 
 use std::path::PathBuf;
 
@@ -12,6 +15,10 @@ pub struct SourceFile {
     pub path: Option<PathBuf>,
     pub text: String,
     line_starts: Vec<usize>,
+    /// The lines of the file before `text` (0 for a whole file).
+    pub first_line: usize,
+    /// The bytes of the file before `text` (0 for a whole file).
+    pub first_byte: usize,
 }
 
 /// The byte offset where each line of `text` starts: 0, then one past
@@ -34,12 +41,27 @@ pub struct SourceMap {
 
 impl SourceMap {
     pub fn add(&mut self, name: String, path: Option<PathBuf>, text: String) -> FileId {
+        self.add_part(name, path, text, 0, 0)
+    }
+    /// Adds `text`, the part of a file that starts on its 0-based line
+    /// `first_line`, at its byte `first_byte`: lines are shown as the
+    /// file's (`line_col`), spans stay offsets into `text`.
+    pub fn add_part(
+        &mut self,
+        name: String,
+        path: Option<PathBuf>,
+        text: String,
+        first_line: usize,
+        first_byte: usize,
+    ) -> FileId {
         let line_starts = line_starts(&text);
         self.files.push(SourceFile {
             name,
             path,
             text,
             line_starts,
+            first_line,
+            first_byte,
         });
         FileId(self.files.len() as u32 - 1)
     }
@@ -66,7 +88,8 @@ impl SourceMap {
         let end = f.line_starts.get(line + 1).copied().unwrap_or(f.text.len());
         start..end
     }
-    /// 1-based line and column (in characters) of a byte offset.
+    /// 1-based line (the file's, for a part) and column (in characters)
+    /// of a byte offset into the text.
     pub fn line_col(&self, id: FileId, offset: usize) -> (usize, usize) {
         let f = self.get(id);
         let offset = offset.min(f.text.len());
@@ -76,6 +99,6 @@ impl SourceMap {
             .text
             .get(start..offset)
             .map_or(offset - start, |s| s.chars().count());
-        (line + 1, col + 1)
+        (f.first_line + line + 1, col + 1)
     }
 }

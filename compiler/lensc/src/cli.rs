@@ -71,6 +71,12 @@ pub enum Command {
         /// exploration).
         #[arg(long, value_enum, default_value_t = AcceptChoice::Error)]
         accept: AcceptChoice,
+        /// Write the jobs that pass even when others fail (the exit code is
+        /// still 1). Without it a build is all or nothing: the files of
+        /// every job are written together, as one unit, only if every job
+        /// passes.
+        #[arg(long)]
+        keep_going: bool,
         /// No progress: neither the bar a terminal shows nor the JSON
         /// progress events of `--message-format json`.
         #[arg(long, short)]
@@ -199,6 +205,43 @@ pub enum Command {
         #[arg(short = 'o', long = "output", value_name = "OUT.lens")]
         output: Option<PathBuf>,
     },
+    /// Hold a measured part to its job's design: read the measurement (an
+    /// X3P, SDF or MetroPro file, its ASCII export, x y z points or an x z
+    /// profile), register it to the job's surface (piston, tilt, decentre
+    /// and, off a surface of revolution, clocking), and write
+    /// `JOB.measure.json` (the error along the normal with its PV and RMS,
+    /// the registration, the texture after form removal, a turned part's
+    /// centre-height error and X offset with their corrections) and
+    /// `JOB.error_map.svg`. Nothing is written if the file cannot be read
+    /// or does not fit the surface.
+    Measure {
+        /// The .lens file with the job.
+        file: PathBuf,
+        /// The measurement file (under the project root, as job files).
+        part: PathBuf,
+        /// The job the part was cut by (needed when the file has several).
+        #[arg(long)]
+        job: Option<String>,
+        /// Directory for the report and the picture.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+        /// What a plain-text file's numbers are (X3P, SDF and MetroPro
+        /// files state their own units).
+        #[arg(long, value_enum, default_value_t = TextUnit::Mm)]
+        units: TextUnit,
+        /// The least share (percent) of the measured aperture whose points
+        /// must be valid.
+        #[arg(long, value_name = "PERCENT", default_value = "50", value_parser = parse_percent)]
+        min_valid: f64,
+        /// The nesting index λc of the texture's Gaussian filter, with its
+        /// unit (`0.08mm`, `250um`).
+        #[arg(long, value_name = "LENGTH", default_value = "0.08mm", value_parser = parse_length)]
+        cutoff: f64,
+        /// Use the file's own x and y instead of centring the measurement
+        /// on its middle.
+        #[arg(long)]
+        keep_origin: bool,
+    },
     /// Explain a diagnostic code (`E0147`), with an example that causes it
     /// and its fix.
     Explain {
@@ -293,6 +336,65 @@ impl Listed {
 
 /// A size in bytes: a whole number, optionally with a decimal (`kB`, `MB`,
 /// `GB`, `TB`) or binary (`KiB`, `MiB`, `GiB`, `TiB`) unit.
+/// The units of a plain-text measurement's numbers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum TextUnit {
+    M,
+    Mm,
+    Um,
+    Nm,
+}
+
+impl TextUnit {
+    /// Millimetres per unit.
+    pub fn mm(self) -> f64 {
+        match self {
+            TextUnit::M => 1000.0,
+            TextUnit::Mm => 1.0,
+            TextUnit::Um => 1e-3,
+            TextUnit::Nm => 1e-6,
+        }
+    }
+}
+
+/// A share in percent, 0 to 100.
+pub fn parse_percent(text: &str) -> Result<f64, String> {
+    match text.trim().trim_end_matches('%').parse::<f64>() {
+        Ok(v) if (0.0..=100.0).contains(&v) => Ok(v),
+        _ => Err(format!("`{text}` is not a percentage from 0 to 100")),
+    }
+}
+
+/// A length with its unit (`0.08mm`, `80um`, `80 µm`), in mm.
+pub fn parse_length(text: &str) -> Result<f64, String> {
+    let t = text.trim();
+    let split = t
+        .find(|c: char| !(c.is_ascii_digit() || c == '.' || c == 'e' || c == '-'))
+        .unwrap_or(t.len());
+    let (number, unit) = t.split_at(split);
+    let v: f64 = number
+        .parse()
+        .map_err(|_| format!("`{text}` is not a length (write `0.08mm` or `80um`)"))?;
+    let scale = match unit.trim() {
+        "mm" => 1.0,
+        "um" | "µm" => 1e-3,
+        "nm" => 1e-6,
+        "m" => 1000.0,
+        "" => {
+            return Err(format!(
+                "`{text}` has no unit: write `{text}mm` or `{text}um`"
+            ));
+        }
+        u => return Err(format!("`{u}` is not a unit of length (mm, um, nm, m)")),
+    };
+    let mm = v * scale;
+    if mm.is_finite() && mm > 0.0 {
+        Ok(mm)
+    } else {
+        Err(format!("`{text}` is not a positive length"))
+    }
+}
+
 pub fn parse_size(text: &str) -> Result<u64, String> {
     let t = text.trim();
     let split = t

@@ -10,3 +10,4 @@
 pub mod cli;
 pub mod cli_page;
 pub mod render;
+pub mod summary;

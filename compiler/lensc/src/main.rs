@@ -84,6 +84,28 @@ fn run(cli: Cli) -> u8 {
         ),
         Command::Fmt { files, check } => commands::fmt::run(&out, &files, check),
         Command::Import { file, output } => commands::import::run(&out, &file, output.as_deref()),
+        Command::Measure {
+            file,
+            part,
+            job,
+            out: dir,
+            units,
+            min_valid,
+            cutoff,
+            keep_origin,
+        } => commands::measure::run(
+            &out,
+            (&file, &part),
+            job.as_deref(),
+            &dir,
+            lensc_build::measure::Options {
+                units: lensc_measure::read::TextUnits(units.mm()),
+                min_valid: min_valid / 100.0,
+                cutoff,
+                keep_origin,
+            },
+        ),
+
         Command::Analyse {
             file,
             surface,
@@ -110,6 +132,7 @@ fn run(cli: Cli) -> u8 {
             out: dir,
             max_program_size,
             accept,
+            keep_going,
             quiet,
         } => commands::build::run(
             &out,
@@ -126,6 +149,7 @@ fn run(cli: Cli) -> u8 {
             },
             &dir,
             quiet,
+            keep_going,
         ),
     }
 }

@@ -56,7 +56,8 @@ pub fn escape(s: &str) -> Cow<'_, str> {
 struct Excerpt {
     text: String,
     file: FileId,
-    /// The file's lines shown, 0-based.
+    /// The file's lines shown, 0-based (as the whole file counts them, for
+    /// a part of one).
     first_line: usize,
     last_line: usize,
     /// Whether anything was escaped or left out.
@@ -71,11 +72,13 @@ impl Excerpt {
         let text = &sources.get(file).text;
         let lo = line_of(sources, file, points.iter().copied().min().unwrap_or(0));
         let hi = line_of(sources, file, points.iter().copied().max().unwrap_or(0));
+        // Numbered as the file's lines (a part of a file starts later).
+        let shown = sources.get(file).first_line;
         let mut e = Excerpt {
             text: String::new(),
             file,
-            first_line: lo,
-            last_line: hi,
+            first_line: shown + lo,
+            last_line: shown + hi,
             altered: false,
             map: Vec::new(),
         };
@@ -212,10 +215,19 @@ pub fn human(
     out: &mut dyn Write,
 ) -> std::io::Result<()> {
     for d in diags {
+        // A span inside its file, on character boundaries (ariadne slices
+        // the text there and panics mid-character).
         let clamp = |id: FileId, span: lensc_grammar::Span| {
-            let len = sources.get(id).text.len();
-            let s = (span.start as usize).min(len);
-            (s, (span.end as usize).clamp(s, len))
+            let text = &sources.get(id).text;
+            let fit = |p: usize| {
+                let mut p = p.min(text.len());
+                while !text.is_char_boundary(p) {
+                    p -= 1;
+                }
+                p
+            };
+            let s = fit(span.start as usize);
+            (s, fit(span.end as usize).max(s))
         };
         // Each file the labels are in, by the name shown (two files with
         // one name share it: the first one's excerpt is shown).
@@ -434,6 +446,11 @@ pub fn json_value(d: &Diagnostic, sources: &SourceMap) -> serde_json::Value {
         let (line, column) = sources.line_col(file, span.start as usize);
         (sources.get(file).name.clone(), line, column)
     };
+    // Spans as offsets into the whole file (a part starts further in).
+    let at = |file: FileId, span: lensc_grammar::Span| {
+        let base = sources.get(file).first_byte;
+        json!({ "start": base + span.start as usize, "end": base + span.end as usize })
+    };
     let p = d.primary();
     let (file, line, column) = place(p.file, p.span);
     let labels: Vec<serde_json::Value> = d
@@ -443,7 +460,7 @@ pub fn json_value(d: &Diagnostic, sources: &SourceMap) -> serde_json::Value {
             let (file, line, column) = place(l.file, l.span);
             json!({
                 "file": file, "line": line, "column": column,
-                "span": { "start": l.span.start, "end": l.span.end },
+                "span": at(l.file, l.span),
                 "message": l.message,
             })
         })
@@ -455,7 +472,7 @@ pub fn json_value(d: &Diagnostic, sources: &SourceMap) -> serde_json::Value {
         "file": file,
         "line": line,
         "column": column,
-        "span": { "start": p.span.start, "end": p.span.end },
+        "span": at(p.file, p.span),
         "labels": labels,
         "help": d.help,
     })

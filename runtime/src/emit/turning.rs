@@ -14,13 +14,15 @@ use std::f64::consts::PI;
 const M_PER_MIN: f64 = 1000.0 / 60.0;
 
 /// Writes a lathe program for a profile-turning path in the machine's
-/// dialect, optimised (lines merged, arcs fitted) within the fitting share
+/// dialect for the tool's control point (`start.control`, stated in
+/// words in the header's `control_point` line), optimised (lines merged, arcs fitted) within the fitting share
 /// of the strategy's tolerance.
 pub fn emit(
     job: &TurningJob,
     path: &Toolpath,
     prov: &Provenance,
     start: &Start,
+    control_point: &str,
 ) -> Result<Emitted, ProgramError> {
     let centre_height = if job.tool.centre_height == 0.0 {
         String::new()
@@ -37,7 +39,7 @@ pub fn emit(
             "units mm; X is {}, Z along the spindle axis, +Z out of the material",
             x_word(&job.machine.dialect)
         ),
-        "coordinates are the centre of the tool nose; no cutter compensation".into(),
+        format!("{control_point}; no cutter compensation"),
         format!("surface {}: {}", job.surface_name, job.surface.description),
         format!(
             "tool {}: round nose, nose radius {} mm{centre_height}",

@@ -800,6 +800,32 @@ fn cycles(stock: f64, allowance: f64, depth: Option<f64>) -> (Vec<f64>, f64) {
     }
 }
 
+/// The helix's cutting time at the spindle's pace (s), before any point is
+/// planned: each pass's cycles (from the design's survey, as
+/// `plan_roller_helix_sectioned` takes them) times its turns over the
+/// spindle speed; `None` without a spindle speed. What a header states;
+/// moves the feed limit slows (known once planned) add to it.
+pub fn spindle_time(
+    h: &RollerHelix,
+    nose_radius: f64,
+    design: &(dyn SurfaceFn + Sync),
+) -> Result<Option<f64>, RollerError> {
+    validate(h, nose_radius)?;
+    let Some(w) = h.spindle_speed else {
+        return Ok(None);
+    };
+    let s = survey_reach(h, nose_radius, design)?;
+    let mut stock = h.blank_radius - (h.roller_radius + s.z_min);
+    let mut time = 0.0;
+    for pass in &h.passes {
+        let (_, total) = pass_steps(h, pass)?;
+        let (offsets, _) = cycles(stock, pass.finish_allowance, h.depth_of_cut);
+        stock = pass.finish_allowance;
+        time += offsets.len() as f64 * total / w;
+    }
+    Ok(Some(time))
+}
+
 /// Plans every pass and returns their points, one `Vec` per pass (see
 /// `plan_roller_helix_into` for the figures and the streaming form).
 pub fn plan_roller_helix(

@@ -569,9 +569,15 @@ impl Planner<'_> {
             }
             // Half-width in angle at the radius nearest the disc centre.
             let r = d.clamp(r_in, r_out);
-            let half = if d <= rr || r <= rr {
-                std::f64::consts::PI
-            } else {
+            if d <= rr || r <= rr {
+                // The disc is all round the axis at these radii: the whole
+                // revolution is over it. (As centre ± π its two pieces in
+                // [c0, c1) need not meet to the bit, and a level point
+                // between them was a step in W.)
+                spans.push((c0, c1));
+                continue;
+            }
+            let half = {
                 let cos = ((r * r + d * d - rr * rr) / (2.0 * r * d)).clamp(-1.0, 1.0);
                 cos.acos()
             };

@@ -7,7 +7,7 @@ use super::format::{
 };
 use super::header::{num, write_comment};
 use crate::dialect::{CommentStyle, Dialect, Language, WordFormat};
-use crate::moves::{Coolant, Plane, Position, Rotation, Start};
+use crate::moves::{ControlOffset, Coolant, Plane, Position, Rotation, Start};
 use std::f64::consts::PI;
 
 /// Which safe-start lines a program uses, and the arc plane they select.
@@ -114,6 +114,15 @@ pub struct ProgramWriter {
     start: Option<Start>,
     /// What the spindle is doing.
     spindle: Spindle,
+    /// The tool's control point from its centre, added to every position
+    /// (`Start::control`); none: the program is the centre's.
+    control: Option<ControlOffset>,
+    /// Klartext: the path-tolerance blocks (cycle 32), written after the
+    /// blank by `call_tool`.
+    tolerance_lines: Vec<String>,
+    /// Klartext: the tool-call blocks and coolant word not yet written,
+    /// waiting for the spindle's speed (`TOOL CALL 3 Z S12000`).
+    pending_tool_call: Option<(Vec<String>, Option<String>)>,
     /// The length-offset words (`G43 H3 `) still to be written with the
     /// first move that states Z (`Dialect::length_offset`).
     pending_length_offset: Option<String>,
@@ -136,7 +145,7 @@ pub struct ProgramWriter {
     feed_unit_limits: [u64; 2],
     /// Klartext: the circle centre `CC` last written, in units of the
     /// axes' last decimal.
-    circle_centre: Option<(i64, i64)>,
+    circle_centre: Option<(Plane, i64, i64)>,
     pub moves: usize,
     /// How far the text's spare capacity is zeroed: see `block_room`.
     zeroed: Zeroed,
@@ -223,9 +232,18 @@ impl ProgramWriter {
         for line in header {
             w.comment(line);
         }
-        for line in setup_lines.iter().chain(&dialect.path_tolerance) {
+        for line in setup_lines {
             let l = w.fill(line, path_tolerance);
             w.block_line(&l)?;
+        }
+        for line in &dialect.path_tolerance {
+            let l = w.fill(line, path_tolerance);
+            if dialect.language == Language::Klartext {
+                // After the blank, which follows `BEGIN PGM` (`call_tool`).
+                w.tolerance_lines.push(l);
+            } else {
+                w.block_line(&l)?;
+            }
         }
         Ok(w)
     }
@@ -297,6 +315,9 @@ impl ProgramWriter {
             job: job.to_string(),
             start: None,
             spindle: Spindle::Stopped,
+            control: None,
+            pending_tool_call: None,
+            tolerance_lines: Vec::new(),
             pending_length_offset: None,
             css_per_revolution: false,
             common_blocks_after_offset: false,
@@ -323,11 +344,26 @@ impl ProgramWriter {
     /// calls it once, after `new` and before its first move (a move
     /// before it is refused).
     pub fn call_tool(&mut self, start: &Start) -> Result<(), ProgramError> {
-        for line in tool_call_lines(&self.dialect, self.setup_kind(), start)? {
-            self.block_line(&line)?;
-        }
-        if let Some(word) = coolant_word(&self.dialect, start.coolant)? {
-            self.block_line(&word)?;
+        self.control = (!start.control.is_zero()).then_some(start.control);
+        let lines = tool_call_lines(&self.dialect, self.setup_kind(), start)?;
+        let coolant = coolant_word(&self.dialect, start.coolant)?;
+        if self.dialect.language == Language::Klartext {
+            // The blank first; the tool is called with its speed, in one
+            // `TOOL CALL` block, once the spindle's first move says it.
+            if let Some(blank) = start.blank {
+                self.blank_form(&blank)?;
+            }
+            for line in std::mem::take(&mut self.tolerance_lines) {
+                self.block_line(&line)?;
+            }
+            self.pending_tool_call = Some((lines, coolant));
+        } else {
+            for line in lines {
+                self.block_line(&line)?;
+            }
+            if let Some(word) = coolant {
+                self.block_line(&word)?;
+            }
         }
         if !self.dialect.length_offset.is_empty() {
             let words = self
@@ -345,6 +381,27 @@ impl ProgramWriter {
             self.common_blocks = false;
         }
         self.start = Some(*start);
+        Ok(())
+    }
+
+    /// Klartext: the tool call held back by `call_tool`, with the
+    /// spindle speed `s` in its `TOOL CALL` block where one is given,
+    /// then the coolant word.
+    fn write_tool_call(&mut self, s: Option<&str>) -> Result<(), ProgramError> {
+        let Some((lines, coolant)) = self.pending_tool_call.take() else {
+            return Ok(());
+        };
+        for line in lines {
+            match s {
+                Some(s) if line.starts_with("TOOL CALL") => {
+                    self.block_line(&format!("{line} S{s}"))?
+                }
+                _ => self.block_line(&line)?,
+            }
+        }
+        if let Some(word) = coolant {
+            self.block_line(&word)?;
+        }
         Ok(())
     }
 
@@ -538,6 +595,15 @@ impl ProgramWriter {
     #[inline(always)]
     fn write_move(&mut self, m: &crate::moves::Move) -> Result<(), ProgramError> {
         use crate::moves::Move as M;
+        // The stream is the tool centre's; the program the control point's.
+        let moved;
+        let m = match self.control {
+            Some(c) => {
+                moved = c.apply_to(m);
+                &moved
+            }
+            None => m,
+        };
         let common = match *m {
             M::Linear { to, feed } => self.common_block(Word::Linear, to, feed),
             M::Rapid(to) => self.common_block(Word::Rapid, to, None),
@@ -550,6 +616,9 @@ impl ProgramWriter {
             return Err(ProgramError::Unsupported(
                 "a move before the tool is called (the writer's `call_tool`)".into(),
             ));
+        }
+        if self.pending_tool_call.is_some() && !matches!(*m, M::SpindleOn(_)) {
+            self.write_tool_call(None)?;
         }
         let (word, to, feed, arc) = match *m {
             M::Rapid(to) => (Word::Rapid, to, None, None),
@@ -625,10 +694,15 @@ impl ProgramWriter {
         let rpm = speed * 60.0 / (2.0 * PI);
         let s = self.s_value(rpm, false)?;
         if self.dialect.language == Language::Klartext {
-            // The speed is the tool call's: `TOOL CALL Z S…` changes it
-            // for the tool in the spindle; M3 starts it in its own block.
+            // The speed is the tool call's: the first in the tool's own
+            // call, `TOOL CALL 3 Z S…`; a later one `TOOL CALL Z S…`, for
+            // the tool in the spindle. M3 starts it in its own block.
             self.spindle = Spindle::Turning;
-            self.block_line(&format!("TOOL CALL Z S{s}"))?;
+            if self.pending_tool_call.is_some() {
+                self.write_tool_call(Some(&s))?;
+            } else {
+                self.block_line(&format!("TOOL CALL Z S{s}"))?;
+            }
             let on = self.spindle_on_word();
             return self.block_line(&on);
         }
@@ -1114,6 +1188,9 @@ impl ProgramWriter {
                 "a program that calls no tool (the writer's `call_tool`)".into(),
             ));
         };
+        if self.pending_tool_call.is_some() {
+            self.write_tool_call(None)?;
+        }
         if self.spindle != Spindle::Stopped {
             self.spindle = Spindle::Stopped;
             let off = self.dialect.spindle_off.clone();

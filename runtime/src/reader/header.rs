@@ -49,6 +49,27 @@ pub fn header_source_hash(text: &str) -> Option<(String, u64, usize)> {
     })
 }
 
+/// Where the program's control point lies from the tool's centre (mm
+/// along X, Y, Z), as its header states it
+/// (`control point tip at Y+0 Z-0.5 mm from the tool centre …`,
+/// on its comment's first line: nothing before the offset folds); none if
+/// the header states none (a program written before the control point
+/// was stated is the tool centre's).
+pub fn header_control_offset(text: &str) -> Option<[f64; 3]> {
+    text.lines().take(200).find_map(|line| {
+        let comment = comment_text(line)?.trim();
+        let rest = comment.strip_prefix("control point ")?;
+        let (_, rest) = rest.split_once(" at ")?;
+        let (rest, _) = rest.split_once(" mm from the tool centre")?;
+        let mut offset = [0.0; 3];
+        for word in rest.split_whitespace() {
+            let axis = "XYZ".find(word.get(..1)?)?;
+            offset[axis] = word.get(1..)?.parse().ok()?;
+        }
+        Some(offset)
+    })
+}
+
 /// The text of a whole-line comment in any dialect: `(…)`, `; …`, a
 /// numbered `N9 ; … *`, or Klartext's `9 ; …`.
 fn comment_text(line: &str) -> Option<&str> {

@@ -15,14 +15,16 @@
 
 use super::Rule;
 use super::lexer::{Block, Found, Lexer, Word, number};
+use crate::moves::Plane;
 
 /// What the Klartext reader keeps from block to block.
 #[derive(Default)]
 pub(crate) struct Klartext {
     /// The block number the next block must carry.
     next: u64,
-    /// The circle centre `CC` in force (X, Y as written).
-    centre: Option<(f64, f64)>,
+    /// The circle centre `CC` in force: the plane its two axes name, and
+    /// its two coordinates as written (in X, Y, Z order).
+    centre: Option<CircleCentre>,
     /// The name of `BEGIN PGM`, once read.
     name: Option<String>,
     /// Blocks read so far (a `BEGIN PGM` must be the first).
@@ -32,6 +34,10 @@ pub(crate) struct Klartext {
     /// The frame rule already reported for a missing `BEGIN PGM`.
     no_begin_told: bool,
 }
+
+/// A circle centre: the plane its two axes name, and each axis's letter
+/// and coordinate as written (in X, Y, Z order).
+type CircleCentre = (Plane, (char, f64), (char, f64));
 
 /// A word the modal reader takes, standing for Klartext text at `span`.
 fn word(letter: char, value: f64, span: (usize, usize)) -> Word {
@@ -102,7 +108,7 @@ impl Klartext {
         match head {
             "BEGIN" | "END" => {}
             "BLK" if tokens.get(1).is_some_and(|t| t.0 == "FORM") => {}
-            "CYCL" => cycle(&tokens, out),
+            "CYCL" => cycle(&tokens, &mut b, out),
             "TOOL" => tool(&tokens, lex, line, &mut b, out),
             "L" => self.path(&tokens, false, lex, line, &mut b, out),
             "CC" => self.circle_centre(&tokens, lex, line, out),
@@ -253,9 +259,22 @@ impl Klartext {
         b.words.insert(0, word('G', g, head));
         if arc {
             match self.centre {
-                Some((x, y)) => {
-                    b.words.push(word('I', x, head));
-                    b.words.push(word('J', y, head));
+                Some((plane, (l1, v1), (l2, v2))) => {
+                    // The arc's plane is its centre's: as G17/G18/G19
+                    // with the centre as absolute I, J, K.
+                    let g = match plane {
+                        Plane::Xy => 17.0,
+                        Plane::Zx => 18.0,
+                        Plane::Yz => 19.0,
+                    };
+                    let ijk = |l: char| match l {
+                        'X' => 'I',
+                        'Y' => 'J',
+                        _ => 'K',
+                    };
+                    b.words.insert(0, word('G', g, head));
+                    b.words.push(word(ijk(l1), v1, head));
+                    b.words.push(word(ijk(l2), v2, head));
                 }
                 None => {
                     out.push((
@@ -271,38 +290,55 @@ impl Klartext {
         }
     }
 
-    /// `CC X… Y…`: the centre of the arcs that follow.
+    /// `CC X… Y…`, `CC X… Z…` or `CC Y… Z…`: the centre of the arcs that
+    /// follow, in the plane its two axes name (TNC 620 conversational
+    /// manual: a circle may lie in a plane other than the working plane;
+    /// see docs/controllers/heidenhain.md).
     fn circle_centre(&mut self, tokens: &[Token], lex: &Lexer, line: &str, out: &mut Vec<Found>) {
         let mut b = Block::default();
         for &t in &tokens[1..] {
-            address(t, lex, line, &mut b, out, "XY");
+            address(t, lex, line, &mut b, out, "XYZ");
         }
-        let at = |l: char| b.words.iter().find(|w| w.letter == l).map(|w| w.value);
-        match (at('X'), at('Y')) {
-            (Some(x), Some(y)) => self.centre = Some((x, y)),
-            _ => out.push((
+        let at = |l: char| b.words.iter().find(|w| w.letter == l).map(|w| (l, w.value));
+        let plane = match (at('X'), at('Y'), at('Z')) {
+            (Some(x), Some(y), None) => Some((Plane::Xy, x, y)),
+            (Some(x), None, Some(z)) => Some((Plane::Zx, x, z)),
+            (None, Some(y), Some(z)) => Some((Plane::Yz, y, z)),
+            _ => None,
+        };
+        match plane {
+            Some(c) => self.centre = Some(c),
+            None => out.push((
                 Rule::ArcWords,
                 tokens[0].1,
-                "a circle centre needs X and Y (arcs are read in the XY plane)".into(),
+                "a circle centre needs two axes of one plane: X and Y, X and Z, or Y and Z".into(),
                 None,
             )),
         }
     }
 }
 
-/// `CYCL DEF 32.0 TOLERANCE`, `32.1 T…`, `32.2 …`: the only cycle lensc
+/// `CYCL DEF 32.0 TOLERANCE`, `32.1 T…`, `32.2 …` (the path tolerance)
+/// and `CYCL DEF 13.0 ORIENTATION`, `13.1 ANGLE …` (the spindle stopped
+/// and held at an angle, read as M19 is elsewhere): the cycles lensc
 /// writes; others are not read.
-fn cycle(tokens: &[Token], out: &mut Vec<Found>) {
-    let ok = tokens.get(1).is_some_and(|t| t.0 == "DEF")
-        && tokens.get(2).is_some_and(|t| t.0.starts_with("32."));
-    if !ok {
-        let span = (tokens[0].1.0, tokens[tokens.len() - 1].1.1);
-        out.push((
-            Rule::UnknownWord,
-            span,
-            "a cycle other than 32 (TOLERANCE), which this reader does not follow".into(),
-            None,
-        ));
+fn cycle(tokens: &[Token], b: &mut Block, out: &mut Vec<Found>) {
+    let number = tokens
+        .get(2)
+        .filter(|_| tokens.get(1).is_some_and(|t| t.0 == "DEF"));
+    match number.map(|t| t.0) {
+        Some(n) if n.starts_with("32.") => {}
+        Some("13.0") => b.words.push(word('M', 19.0, tokens[0].1)),
+        Some(n) if n.starts_with("13.") => {}
+        _ => {
+            let span = (tokens[0].1.0, tokens[tokens.len() - 1].1.1);
+            out.push((
+                Rule::UnknownWord,
+                span,
+                "a cycle other than 32 (TOLERANCE) and 13 (ORIENTATION), which this reader does not follow".into(),
+                None,
+            ));
+        }
     }
 }
 

@@ -28,7 +28,9 @@ mod motion;
 mod policy;
 mod spline;
 
-pub use header::{HeaderNames, header_names, header_source, header_source_hash};
+pub use header::{
+    HeaderNames, header_control_offset, header_names, header_source, header_source_hash,
+};
 pub use policy::{Class, Policy};
 
 use crate::dialect::Dialect;
@@ -168,6 +170,31 @@ pub enum Path {
     },
 }
 
+/// `moves` (read from a program whose control point lies `offset` mm
+/// from the tool's centre, `header_control_offset`) as the tool centre's
+/// moves: the offset taken off every position and arc centre, so a
+/// program written for the tip simulates as the one written for the
+/// centre.
+pub fn to_tool_centre(moves: &mut [Executed], offset: [f64; 3]) {
+    if offset == [0.0; 3] {
+        return;
+    }
+    for m in moves {
+        for p in [&mut m.from, &mut m.to] {
+            for (v, o) in p.iter_mut().zip(offset) {
+                if let Some(v) = v {
+                    *v -= o;
+                }
+            }
+        }
+        if let Path::Arc { plane, centre, .. } = &mut m.path {
+            let (a, b) = plane.axes();
+            centre.0 -= offset[a];
+            centre.1 -= offset[b];
+        }
+    }
+}
+
 /// Reads `text` (a whole program) in `dialect` on `machine`: every rule
 /// broken, the first line breaking each, in order of their lines.
 pub fn read(text: &str, dialect: &Dialect, machine: &MachineLimits) -> Vec<Finding> {
@@ -224,10 +251,15 @@ pub fn read_from(
         if chunk.is_empty() {
             break;
         }
+        // The last line break is looked for in the new bytes only: a line
+        // of megabytes arriving in chunks is scanned once, not once per
+        // chunk (which made a 4 MB line take 12 s to read).
+        let before = pending.len();
+        let last_break = chunk.iter().rposition(|&b| b == b'\n');
         pending.extend_from_slice(chunk);
         let n = chunk.len();
         input.consume(n);
-        if let Some(last) = pending.iter().rposition(|&b| b == b'\n') {
+        if let Some(last) = last_break.map(|i| before + i) {
             offset = r.bytes(&pending[..=last], offset);
             pending.drain(..=last);
         }
@@ -308,7 +340,27 @@ impl Reader {
         self.last_span = (offset, offset + text.len());
         let mut out = Vec::new();
         self.state.line(text, &mut out);
-        if let Some((low, (s, e))) = self.state.pre_cut_rapid.take() {
+        // A finding's span lies in its line, on character boundaries, its
+        // start not after its end (a rule's span that ran backwards, or into
+        // a `�` that stands for a byte that is not UTF-8, cannot reach a
+        // renderer).
+        let fit = |p: usize| {
+            let mut p = p.min(text.len());
+            while !text.is_char_boundary(p) {
+                p -= 1;
+            }
+            p
+        };
+        let fit_span = |(s, e): (usize, usize)| {
+            let (s, e) = (fit(s), fit(e));
+            (s, e.max(s))
+        };
+        let out = out
+            .into_iter()
+            .map(|(rule, span, message, hint)| (rule, fit_span(span), message, hint))
+            .collect();
+        if let Some((low, span)) = self.state.pre_cut_rapid.take() {
+            let (s, e) = fit_span(span);
             self.pre_cut
                 .push((low, self.line_no, (offset + s, offset + e)));
         }

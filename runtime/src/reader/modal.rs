@@ -458,7 +458,7 @@ impl State {
             Controller::LinuxCnc => "XYZABCIJKRFSTDHPQLN",
             Controller::Siemens => "XYZABCIJKRFSTDHPLN",
             Controller::HeidenhainIso => "XYZABCIJKRFSTLPHN",
-            Controller::HeidenhainKlartext => "XYZIJFSTN",
+            Controller::HeidenhainKlartext => "XYZIJKFSTN",
         };
         // Every letter listed is ASCII: a byte compare, not a char search.
         l.is_ascii() && letters.as_bytes().contains(&(l as u8))

@@ -53,9 +53,15 @@ pub fn split_columns(grid: &Grid, feature: Option<usize>, most: usize) -> Vec<Ti
         .collect()
 }
 
-/// The default window: this wide (mm) and this fine (mm).
-pub const DEFAULT_SIZE: f64 = 0.2;
+/// The spacing of a window the job gives without one (mm).
 pub const DEFAULT_SPACING: f64 = 1e-3;
+
+/// The spacings a whole part is simulated at by default, finest first
+/// (mm): the finest whose tiles hold at most the strategy's budget of
+/// cells is taken ([`Window::whole`]).
+pub const WHOLE_SPACINGS: [f64; 12] = [
+    1e-3, 2e-3, 5e-3, 1e-2, 2e-2, 5e-2, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0,
+];
 
 /// The part of the surface (x, y in the design's coordinates, mm) that is
 /// simulated, and the grid spacing (mm).
@@ -66,6 +72,9 @@ pub struct Window {
     pub spacing: f64,
     /// Given by the job, not a default.
     pub given: bool,
+    /// It covers the whole of what the job cuts (its extent), not a part
+    /// of it.
+    pub whole: bool,
 }
 
 /// A simulation tiles cannot bound: more cells than lensc takes (its
@@ -119,27 +128,49 @@ pub fn check_cells(tiles: &[Tile]) -> Result<(), TooManyCells> {
 
 impl Window {
     /// The window a job gives (x and y ranges, mm; its spacing, or the
-    /// default one).
-    pub fn given(x: (f64, f64), y: (f64, f64), spacing: Option<f64>) -> Window {
+    /// default one), within the `extent` of what the job cuts: whole when
+    /// its ranges hold that extent.
+    pub fn given(
+        x: (f64, f64),
+        y: (f64, f64),
+        spacing: Option<f64>,
+        extent: ((f64, f64), (f64, f64)),
+    ) -> Window {
+        let holds = |r: (f64, f64), e: (f64, f64)| r.0 <= e.0 && r.1 >= e.1;
         Window {
             x,
             y,
             spacing: spacing.unwrap_or(DEFAULT_SPACING),
             given: true,
+            whole: holds(x, extent.0) && holds(y, extent.1),
         }
     }
 
-    /// The default window about `centre`: `DEFAULT_SIZE` wide at
-    /// `DEFAULT_SPACING`, small enough for every grid (a few hundred
-    /// thousand cells at most).
-    pub fn about(centre: (f64, f64)) -> Window {
-        let h = DEFAULT_SIZE / 2.0;
-        Window {
-            x: (centre.0 - h, centre.0 + h),
-            y: (centre.1 - h, centre.1 + h),
-            spacing: DEFAULT_SPACING,
+    /// The default window: the whole `extent` of what the job cuts, at the
+    /// finest of [`WHOLE_SPACINGS`] whose `tiles` hold at most `budget`
+    /// cells between them (the coarsest if none does).
+    pub fn whole(
+        extent: ((f64, f64), (f64, f64)),
+        budget: usize,
+        tiles: impl Fn(&Window) -> Vec<Tile>,
+    ) -> Window {
+        let at = |spacing: f64| Window {
+            x: extent.0,
+            y: extent.1,
+            spacing,
             given: false,
-        }
+            whole: true,
+        };
+        let cells = |w: &Window| {
+            tiles(w).iter().fold(0usize, |n, t| {
+                n.saturating_add(t.grid.ns.saturating_mul(t.grid.nu))
+            })
+        };
+        WHOLE_SPACINGS
+            .iter()
+            .map(|&s| at(s))
+            .find(|w| cells(w) <= budget)
+            .unwrap_or_else(|| at(WHOLE_SPACINGS[WHOLE_SPACINGS.len() - 1]))
     }
 
     /// The tiles of a lathe's polar grid: lenslet by lenslet when the
@@ -270,35 +301,35 @@ impl Window {
 mod tests {
     use super::*;
 
-    /// A default window fits every grid wherever it lies, so only a window
-    /// the job gives needs checking (before planning).
+    /// The default window is the whole extent, at the finest spacing
+    /// whose tiles stay within the budget: a 4 mm square at 2 µm is 4
+    /// million cells, at 5 µm 641 601; a budget no spacing meets takes the
+    /// coarsest.
     #[test]
-    fn default_windows_fit_every_grid() {
-        for centre in [
-            (0.0, 0.0),
-            (0.05, 0.0),
-            (0.101, 0.0),
-            (0.3, 0.2),
-            (40.0, 0.0),
-        ] {
-            let w = Window::about(centre);
-            for grid in [
-                w.cartesian(true),
-                w.cartesian(false),
-                w.polar(),
-                w.roller(0.05, 0.0),
-                w.roller(100.0, 0.0),
-            ] {
-                let tiles = split(&grid, None);
-                assert_eq!(tiles.len(), 1, "{centre:?}: {grid:?}");
-                assert!(check_cells(&tiles).is_ok(), "{centre:?}: {grid:?}");
-            }
-        }
+    fn the_default_window_is_the_whole_part_within_its_budget() {
+        let extent = ((-2.0, 2.0), (-2.0, 2.0));
+        let tiles = |w: &Window| split(&w.cartesian(true), None);
+        let w = Window::whole(extent, 1_000_000, tiles);
+        assert_eq!((w.x, w.y, w.spacing), (extent.0, extent.1, 5e-3));
+        assert!(w.whole && !w.given);
+        let cells: usize = tiles(&w).iter().map(|t| t.grid.ns * t.grid.nu).sum();
+        assert_eq!(cells, 801 * 801);
+        assert!(check_cells(&tiles(&w)).is_ok());
+        assert_eq!(Window::whole(extent, 5_000_000, tiles).spacing, 2e-3);
+        assert_eq!(Window::whole(extent, 1, tiles).spacing, 5.0);
+        // A job's window is whole only when it holds the extent.
+        assert!(Window::given((-3.0, 3.0), (-2.0, 2.0), None, extent).whole);
+        assert!(!Window::given((-1.0, 3.0), (-2.0, 2.0), None, extent).whole);
     }
 
     #[test]
     fn a_fine_window_is_too_large() {
-        let w = Window::given((-1.0, 1.0), (-1.0, 1.0), Some(20e-6));
+        let w = Window::given(
+            (-1.0, 1.0),
+            (-1.0, 1.0),
+            Some(20e-6),
+            ((-1.0, 1.0), (-1.0, 1.0)),
+        );
         let tiles = split(&w.cartesian(true), None);
         let e = check_cells(&tiles).unwrap_err();
         assert_eq!((e.cells, e.tiles), (100_001 * 100_001, 10_001));
@@ -307,7 +338,7 @@ mod tests {
     /// Tiles cover their grid's cells once each, at the grid's own places.
     #[test]
     fn tiles_cover_the_grid_once() {
-        let w = Window::given((0.0, 5.0), (0.0, 3.0), Some(1e-3));
+        let w = Window::given((0.0, 5.0), (0.0, 3.0), Some(1e-3), ((0.0, 5.0), (0.0, 3.0)));
         let g = w.cartesian(true);
         let tiles = split(&g, None);
         // 5001 columns of 3001 rows, 349 to a tile.
@@ -326,12 +357,22 @@ mod tests {
     #[test]
     fn a_lathe_goes_lenslet_by_lenslet() {
         let features = [(0.0, 2.0, 0.5), (2.0, 0.0, 0.5), (-2.0, 0.0, 0.5)];
-        let w = Window::given((-3.0, 3.0), (-1.0, 1.0), Some(5e-3));
+        let w = Window::given(
+            (-3.0, 3.0),
+            (-1.0, 1.0),
+            Some(5e-3),
+            ((-3.0, 3.0), (-3.0, 3.0)),
+        );
         let tiles = w.polar_tiles(&features);
         let owners: Vec<Option<usize>> = tiles.iter().map(|t| t.feature).collect();
         assert_eq!(owners, [Some(0), Some(1)]);
         // One lenslet in the window: the window's own grid.
-        let one = Window::given((1.0, 3.0), (-1.0, 1.0), Some(5e-3));
+        let one = Window::given(
+            (1.0, 3.0),
+            (-1.0, 1.0),
+            Some(5e-3),
+            ((-3.0, 3.0), (-3.0, 3.0)),
+        );
         assert_eq!(one.polar_tiles(&features), split(&one.polar(), None));
         // Each covers its lenslet's square: radii 1.5 .. 2.55 mm.
         let g = tiles[0].grid;

@@ -3,7 +3,8 @@
 //! area's extent), and the tiles the window's grid is simulated in (the
 //! ones the job's builder sweeps) must not hold more cells, or longer
 //! columns, than the simulation takes (E0149): tiles bound its memory,
-//! not its time. A default window is always small enough.
+//! not its time. A default window (the whole part, at a spacing chosen
+//! for it: `height_map::window`) is always small enough.
 
 use lensc_grammar::Diagnostic;
 use lensc_runtime::surface::analysis::Domain;
@@ -39,6 +40,7 @@ pub fn simulated(head: &JobHead, extent: ((f64, f64), (f64, f64))) -> Option<Win
         s.x.unwrap_or(extent.0),
         s.y.unwrap_or(extent.1),
         s.spacing,
+        extent,
     ))
 }
 

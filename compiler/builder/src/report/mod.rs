@@ -397,6 +397,7 @@ impl HeightMap {
                 y_mm: [window.y.0, window.y.1],
                 spacing_mm: window.spacing,
                 given: window.given,
+                whole_part: window.whole,
             },
             grid: Grid {
                 coordinates,
@@ -441,8 +442,12 @@ pub struct Window {
     pub y_mm: [f64; 2],
     /// The grid spacing asked for (mm).
     pub spacing_mm: f64,
-    /// Set by the job's `simulate` block (false: the default window).
+    /// Set by the job's `simulate` block (false: the default window,
+    /// which is the whole part).
     pub given: bool,
+    /// It covers the whole of what the job cuts (the part's extent, or
+    /// the disc a spiral's `from` bounds), not a part of it.
+    pub whole_part: bool,
 }
 
 /// The grid of a height map.
@@ -593,6 +598,9 @@ pub struct Acceptance {
     pub passed: bool,
     /// Each criterion the job is held to, in a fixed order.
     pub criteria: Vec<CriterionResult>,
+    /// The area of the part the simulated figures come from: the whole
+    /// part, or the window a job's `simulate` block narrows it to.
+    pub judged: Judged,
 }
 
 impl Acceptance {
@@ -602,8 +610,37 @@ impl Acceptance {
             mode: AcceptanceMode::None,
             passed: true,
             criteria: Vec::new(),
+            judged: Judged {
+                area: JudgedArea::None,
+                words: "nothing simulated".into(),
+            },
         }
     }
+}
+
+/// The area of the part a job's figures (and so its verdict) come from.
+#[derive(Clone, Debug, PartialEq, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct Judged {
+    /// `whole_part`, `window` or `none`.
+    pub area: JudgedArea,
+    /// The same in words, with the window's place and size and the grid's
+    /// spacing (a profile job: the radii sampled), as the build's summary
+    /// prints it.
+    pub words: String,
+}
+
+/// Which area of the part a job is judged on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum JudgedArea {
+    /// Everything the job cuts: a height map over the part's extent, or
+    /// a profile over every radius it cuts.
+    WholePart,
+    /// Only the window a job's `simulate` block gives.
+    Window,
+    /// Nothing was simulated.
+    None,
 }
 
 /// How a build treats its acceptance criteria.

@@ -123,6 +123,10 @@ macro_rules! registry {
             pub fn head(&self) -> &JobHead {
                 match self { $(JobSpec::$variant(s) => s.head(),)* }
             }
+            /// The set-up its programs are written for: a lathe or a mill.
+            pub fn setup(&self) -> Setup {
+                match self { $(JobSpec::$variant(_) => <$spec as Strategy>::SETUP,)* }
+            }
             /// The tolerance the strategy plans its path to (mm), if any.
             pub fn path_tolerance(&self) -> Option<f64> {
                 match self { $(JobSpec::$variant(s) => s.path_tolerance(),)* }

@@ -249,18 +249,25 @@ fn ty_words(ty: &Ty) -> String {
     }
 }
 
-fn example_unit(d: Dim) -> &'static str {
+fn example_unit(d: Dim) -> String {
     match d {
-        Dim::LENGTH => "`85 um` or `1.5 mm`",
-        Dim::ANGLE => "`7 deg`",
-        Dim::SPEED => "`100 mm/min`",
-        Dim::FEED_PER_REV => "`2 um/rev`",
-        Dim::ROTATIONAL_SPEED => "`1000 rpm`",
-        Dim::TIME => "`1 ms`",
-        Dim::FREQUENCY => "`20 kHz`",
-        Dim::ACCELERATION => "`25 g`",
-        Dim::AREA => "`0.01 mm^2`",
-        _ => "`1 mm^-3`",
+        Dim::LENGTH => "`85 um` or `1.5 mm`".into(),
+        Dim::ANGLE => "`7 deg`".into(),
+        Dim::SPEED => "`100 mm/min`".into(),
+        Dim::FEED_PER_REV => "`2 um/rev`".into(),
+        Dim::ROTATIONAL_SPEED => "`1000 rpm`".into(),
+        Dim::TIME => "`1 ms`".into(),
+        Dim::FREQUENCY => "`20 kHz`".into(),
+        Dim::ACCELERATION => "`25 g`".into(),
+        Dim::AREA => "`0.01 mm^2`".into(),
+        // A power of a length (an asphere's A6 is mm^-5): that power.
+        Dim {
+            length,
+            angle: 0,
+            time: 0,
+        } => format!("`1 mm^{length}`"),
+        // Anything else: the unit in the dimension's own words.
+        other => format!("a number with a unit in {other}"),
     }
 }
 

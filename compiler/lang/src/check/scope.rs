@@ -5,7 +5,7 @@
 use std::collections::HashMap;
 
 use lensc_grammar::ast::{DeclKind, Ident, ItemKind, Span};
-use lensc_grammar::suggest::did_you_mean;
+use lensc_grammar::suggest::{completions, did_you_mean, meant};
 use lensc_grammar::{Diagnostic, FileId};
 
 use super::{COORDINATES, Checker, Decl, FUNCTIONS, State};
@@ -187,8 +187,8 @@ impl<'a> Checker<'a> {
                 let names: Vec<&str> = source.keys().copied().collect();
                 let mut sorted = names.clone();
                 sorted.sort_unstable();
-                d = d.with_help(match did_you_mean(&name.name, names) {
-                    Some(s) => format!("did you mean `{s}`?"),
+                d = d.with_help(match meant(&name.name, names.iter().copied()) {
+                    Some(s) => format!("did you mean {s}?"),
                     None => format!("it has: {}", sorted.join(", ")),
                 });
                 self.err(d);
@@ -338,7 +338,13 @@ impl<'a> Checker<'a> {
             // Its declaration was refused, with its own error.
             return;
         }
-        if COORDINATES.contains(&name) {
+        if let Some(line) = unread_declaration(&self.loaded.sources.get(file).text, name) {
+            // Declared, but the parser could not read the declaration (its
+            // syntax error is reported): not a unit, not a misspelling.
+            d = d.with_help(format!(
+                "`{name}` is declared on line {line}, but that declaration could not be read: mend the syntax error there first"
+            ));
+        } else if COORDINATES.contains(&name) {
             d = d.with_help(
                 "coordinates can only be used inside a surface formula such as `z(x, y) = …`",
             );
@@ -380,6 +386,29 @@ impl<'a> Checker<'a> {
     }
 }
 
+/// The line (from 1) of a declaration of `name` in `text` that the parser
+/// did not read (`surface s = …`, `let s = …`, a job): a line that starts
+/// with the keyword and the name, then `=` or `{`.
+fn unread_declaration(text: &str, name: &str) -> Option<usize> {
+    const KEYWORDS: [&str; 7] = [
+        "surface", "tool", "machine", "strategy", "dialect", "let", "job",
+    ];
+    text.lines()
+        .position(|line| {
+            let mut words = line.trim_start().splitn(2, char::is_whitespace);
+            let (Some(keyword), Some(rest)) = (words.next(), words.next()) else {
+                return false;
+            };
+            let rest = rest.trim_start();
+            KEYWORDS.contains(&keyword)
+                && rest.strip_prefix(name).is_some_and(|after| {
+                    let after = after.trim_start();
+                    after.starts_with('=') || after.starts_with('{')
+                })
+        })
+        .map(|i| i + 1)
+}
+
 /// Help for a name not in `scope`: the `use` that brings it in when the
 /// standard library declares it, else the nearest of `candidates` or of the
 /// standard library's names ("did you mean `s`?", with its `use` when the
@@ -400,7 +429,27 @@ pub(super) fn known_elsewhere<'c>(
         return Some(format!("`{name}` is {}", use_it(item)));
     }
     let stdlib_names = stdlib::items().iter().map(|i| i.name.as_str());
-    let s = did_you_mean(name, candidates.into_iter().chain(stdlib_names))?;
+    let candidates: Vec<&str> = candidates.into_iter().chain(stdlib_names).collect();
+    let Some(s) = did_you_mean(name, candidates.iter().copied()) else {
+        // A name cut short: every name it begins, with the `use` of each
+        // the file lacks.
+        let all = completions(name, candidates.iter().copied());
+        let meant = meant(name, all.iter().copied())?;
+        let uses: Vec<String> = all
+            .iter()
+            .filter(|c| !scope.contains_key(*c))
+            .filter_map(|c| stdlib::find(c))
+            .map(|item| format!("`{}`", item.use_line()))
+            .collect();
+        return Some(if uses.is_empty() {
+            format!("did you mean {meant}?")
+        } else {
+            format!(
+                "did you mean {meant}? From the standard library: {}",
+                uses.join(", ")
+            )
+        });
+    };
     Some(match stdlib::find(s) {
         Some(item) if !scope.contains_key(s) => {
             format!("did you mean `{s}`? It is {}", use_it(item))

@@ -7,7 +7,7 @@
 pub mod read_back;
 pub mod surface;
 
-use lensc_grammar::suggest::did_you_mean;
+use lensc_grammar::suggest::{completions, did_you_mean, meant};
 use lensc_grammar::{Diagnostic, FileId};
 use lensc_runtime::post::Dialect;
 
@@ -90,8 +90,9 @@ fn machine_of(job: &CheckedJob) -> Result<&Object, Diagnostic> {
 
 /// E0176 a G-code system on a dialect chosen for a machine that is not a
 /// lathe, or one a Fanuc lathe does not offer; E0177 constant surface
-/// speed asked of a dialect that has none. Both name the dialect and the
-/// machine.
+/// speed asked of a dialect that has none; E0178 a tool set to its tip on
+/// a fast-tool-servo lathe whose dialect drives the servo from a table of
+/// nose-centre heights. Each names the dialect and the machine.
 fn controller_can_run(job: &CheckedJob, g: &Gcode, dialect: &str) -> Result<(), Diagnostic> {
     let parts = Reader::new(&job.fields);
     let (Some(machine), Some(strategy)) = (parts.object("machine"), parts.object("strategy"))
@@ -129,6 +130,27 @@ fn controller_can_run(job: &CheckedJob, g: &Gcode, dialect: &str) -> Result<(), 
         )
         .with_label("this job")
         .with_help("a mill's Fanuc control has one G-code system: name a mill dialect (`fanuc_0i_mill`), or leave `gcode_system` out of your copy"));
+    }
+    let tip_stated = parts.object("tool").and_then(|t| {
+        Reader::new(&t.fields)
+            .stated_word("control_point")
+            .filter(|w| w.value == "tool_tip")
+            .map(|w| (name(t), w.site))
+    });
+    if let (Some((tool, (tip_file, tip_span))), Some(table)) = (tip_stated, g.fts_table.as_deref())
+        && machine.kind.name == "fts_lathe"
+    {
+        return Err(Diagnostic::error(
+            codes::CONTROL_POINT_NOT_EXPRESSIBLE,
+            format!(
+                "tool `{tool}` is set to its tip (`control_point: tool_tip`), and `{dialect}` drives the fast tool servo of machine `{}` from a `.{table}` table whose W is the nose centre's height: the table cannot be written for the tip",
+                name(machine)
+            ),
+            tip_file,
+            tip_span,
+        )
+        .with_label("the tip")
+        .with_help("set the tool to its nose centre (`control_point: tool_centre`, the servo lathes' default), or name a dialect without a servo table"));
     }
     let asks_surface_speed = strategy.kind.name == "profile_turning"
         && crate::schema::strategies::ProfileTurningParams::read(strategy)
@@ -203,6 +225,18 @@ fn dialect_help(requested: &str, offered: &[OfferedDialect], names: &[String]) -
     if let Some(s) = did_you_mean(requested, offered_names.iter().map(String::as_str)) {
         return format!("did you mean `--dialect {s}`? {}", capitalised(&offers));
     }
+    let cut_short = completions(requested, offered_names.iter().map(String::as_str));
+    if !cut_short.is_empty() {
+        let options: Vec<String> = cut_short
+            .iter()
+            .map(|c| format!("`--dialect {c}`"))
+            .collect();
+        return format!(
+            "did you mean {}? {}",
+            options.join(" or "),
+            capitalised(&offers)
+        );
+    }
     let std_dialects = || {
         crate::stdlib::items()
             .iter()
@@ -214,9 +248,9 @@ fn dialect_help(requested: &str, offered: &[OfferedDialect], names: &[String]) -
             "{offers}; if its controller reads `{requested}`, add it to the machine's `other_dialects: [{requested}]`"
         );
     }
-    match did_you_mean(requested, std_dialects()) {
+    match meant(requested, std_dialects()) {
         Some(s) => format!(
-            "no standard dialect is called `{requested}`: did you mean `{s}`? {offers}; `lensc list dialects` shows them all"
+            "no standard dialect is called `{requested}`: did you mean {s}? {offers}; `lensc list dialects` shows them all"
         ),
         None => format!(
             "no standard dialect is called `{requested}`; {offers}; `lensc list dialects` shows them all"

@@ -104,7 +104,7 @@ pub(super) const OFF_AXIS: Kind = Kind {
             "tilt",
             Ty::Word(&["keep", "remove"]),
             Check::Any,
-            "`keep` (default) the parent's slope at the centre, or `remove` it (the section mounted square to the spindle, small-angle)",
+            "`keep` (default) the parent's slope at the centre, or `remove` it (the section turned rigidly, about y then x, until it is level at its centre: mounted square to the spindle; under 45°)",
         ),
         APERTURE,
     ],
@@ -121,7 +121,7 @@ pub struct OffAxis {
     /// The section's centre on the parent.
     pub x: f64,
     pub y: f64,
-    /// `tilt: remove`: the parent's slope at the centre taken off.
+    /// `tilt: remove`: the section turned rigidly until level at its centre.
     pub remove_tilt: bool,
     pub aperture: Aperture,
 }

@@ -196,7 +196,7 @@ pub static JOB_PARAMS: &[Param] = &[
             ),
         ]),
         Check::Any,
-        "the window of a surface job's height-map simulation (design x, y); `simulate: { spacing: 2 um }` simulates the whole part, in tiles; default a 0.2 mm square where the surface is representative",
+        "the window of a surface job's height-map simulation (design x, y); `simulate: { spacing: 2 um }` sets the whole part's spacing; default the whole part, at the finest spacing within its budget of cells",
     ),
     opt(
         "tool_number",

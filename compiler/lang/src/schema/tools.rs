@@ -1,7 +1,19 @@
 //! The tools: turning inserts, the fast-tool-servo microshaper, ball-end
 //! cutters and grinding wheels.
 
-use super::{ANGLE, Category, Check, DEG90, Kind, LENGTH, opt, req};
+use super::{ANGLE, Category, Check, DEG90, Kind, LENGTH, Param, Ty, opt, req};
+
+/// The words `control_point` takes.
+pub const CONTROL_POINTS: &[&str] = &["tool_tip", "tool_centre"];
+
+/// What the tool's length offset (and on a lathe its X offset) is
+/// measured to, so the point the program's coordinates are.
+const CONTROL_POINT: Param = opt(
+    "control_point",
+    Ty::Word(CONTROL_POINTS),
+    Check::Any,
+    "what the tool's offsets are measured to, the point the program's coordinates move: `tool_tip` (a mill's length to the lowest point of the ball or nose; a lathe's imaginary tip, the nose's -X and -Z sides touched off) or `tool_centre` (the ball's, nose's or wheel's centre); default `tool_tip` on a `mill_3axis` and a `lathe`, `tool_centre` on the servo lathes and the grinder (docs/language/machines-and-tools.md)",
+);
 
 pub(super) const ROUND_NOSE: Kind = Kind {
     name: "round_nose",
@@ -37,11 +49,12 @@ pub(super) const ROUND_NOSE: Kind = Kind {
             Check::Any,
             "height of the edge above the spindle axis as set (below: negative); profile turning corrects X for it; default 0",
         ),
+        CONTROL_POINT,
     ],
     family: None,
     positional: &[],
     exclusive: &[],
-    doc: "a round-nose diamond turning tool, referenced at its nose centre",
+    doc: "a round-nose diamond turning tool; its path is planned for its nose centre and programmed for its `control_point`",
 };
 
 pub(super) const MICROSHAPER: Kind = Kind {
@@ -60,6 +73,7 @@ pub(super) const MICROSHAPER: Kind = Kind {
             Check::HalfOpen(0.0, DEG90),
             "clearance angle of the flank; when given, checked against the steepest slope along the cut",
         ),
+        CONTROL_POINT,
     ],
     family: None,
     positional: &[],
@@ -70,31 +84,32 @@ pub(super) const MICROSHAPER: Kind = Kind {
 pub(super) const BALL_END: Kind = Kind {
     name: "ball_end",
     category: Category::Tool,
-    params: &[req(
-        "diameter",
-        LENGTH,
-        Check::Positive,
-        "diameter of the ball",
-    )],
+    params: &[
+        req("diameter", LENGTH, Check::Positive, "diameter of the ball"),
+        CONTROL_POINT,
+    ],
     family: None,
     positional: &[],
     exclusive: &[],
-    doc: "a ball-end mill, referenced at the ball's centre",
+    doc: "a ball-end mill; its path is planned for the ball's centre and programmed for its `control_point`",
 };
 
 pub(super) const SPHERICAL_WHEEL: Kind = Kind {
     name: "spherical_wheel",
     category: Category::Tool,
-    params: &[req(
-        "diameter",
-        LENGTH,
-        Check::Positive,
-        "diameter D_t of the wheel's spherical tip",
-    )],
+    params: &[
+        req(
+            "diameter",
+            LENGTH,
+            Check::Positive,
+            "diameter D_t of the wheel's spherical tip",
+        ),
+        CONTROL_POINT,
+    ],
     family: None,
     positional: &[],
     exclusive: &[],
-    doc: "a spherical grinding wheel, referenced at its centre (seed 001)",
+    doc: "a spherical grinding wheel (seed 001); its path is planned for its centre and programmed for its `control_point`",
 };
 
 /// A tool's checked parameters, read once (every tool kind; what a kind
@@ -115,6 +130,8 @@ pub struct ToolParams {
     pub included_angle: Option<f64>,
     /// Height of the edge above the spindle axis as set (mm).
     pub centre_height: Option<f64>,
+    /// `control_point: tool_tip` (true) or `tool_centre` (false), where stated.
+    pub control_point: Option<crate::value::Stated<bool>>,
 }
 
 impl ToolParams {
@@ -138,6 +155,12 @@ impl ToolParams {
             rake: need("rake"),
             included_angle: need("included_angle"),
             centre_height: need("centre_height"),
+            control_point: r
+                .stated_word("control_point")
+                .map(|w| crate::value::Stated {
+                    value: w.value == "tool_tip",
+                    site: w.site,
+                }),
         };
         r.finish(o.kind.name, (o.file, o.head))?;
         Ok(t)

@@ -9,7 +9,7 @@ use std::path::Path;
 
 use lensc::render;
 use lensc_build::temps::TempFile;
-use lensc_lang::loader::{FileSystem, RealFs};
+use lensc_lang::sandbox;
 use lensc_lang::source::SourceMap;
 
 use crate::MessageFormat;
@@ -51,7 +51,7 @@ pub fn run(out: &Output, files: &[std::path::PathBuf], check: bool) -> u8 {
 
 /// The file's text, or `None` once its refusal is reported.
 fn read(out: &Output, path: &Path) -> Option<String> {
-    let (code, why) = match RealFs.read(path) {
+    let (code, why) = match sandbox::read_regular(path, sandbox::MAX_FILE_BYTES) {
         Ok(bytes) => match String::from_utf8(bytes) {
             Ok(text) => return Some(text),
             Err(_) => (

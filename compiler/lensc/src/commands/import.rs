@@ -11,7 +11,8 @@ use std::path::Path;
 use lensc::render;
 use lensc_build::temps::TempFile;
 use lensc_grammar::Diagnostic;
-use lensc_lang::loader::{FileSystem, RealFs};
+use lensc_lang::loader::RealFs;
+use lensc_lang::sandbox;
 use lensc_lang::source::SourceMap;
 
 use crate::MessageFormat;
@@ -21,7 +22,7 @@ use crate::output::{Output, cannot_write};
 /// read or imported, or the output written.
 pub fn run(out: &Output, file: &Path, output: Option<&Path>) -> u8 {
     let name = file.display().to_string();
-    let bytes = match RealFs.read(file) {
+    let bytes = match sandbox::read_regular(file, sandbox::MAX_FILE_BYTES) {
         Ok(b) => b,
         Err(e) => {
             eprintln!("error[{}]: cannot read {name}: {e}", e.code());

@@ -8,6 +8,7 @@ pub mod explain;
 pub mod fmt;
 pub mod import;
 pub mod list;
+pub mod measure;
 pub mod report;
 pub mod sample;
 pub mod verify;

@@ -91,20 +91,16 @@ pub fn run(out: &Output, program: &Path, asked: Asked) -> u8 {
         Err(e) => return cannot_read(e),
     };
     let stale = source_check(&head, program, source);
-    let header_line = stale.as_ref().map_or(0, |s| s.line);
-    let (text, findings) = match excerpt(program, findings, header_line) {
-        Ok(t) => t,
+    let mut sources = SourceMap::default();
+    let mut diags: Vec<_> = stale
+        .iter()
+        .map(|s| s.diagnostic(&head, program, &mut sources))
+        .collect();
+    let found = match lines_of_findings(program, &findings, &mut sources) {
+        Ok(d) => d,
         Err(e) => return cannot_read(e),
     };
-    let mut sources = SourceMap::default();
-    let file = sources.add(
-        program.display().to_string(),
-        Some(program.to_path_buf()),
-        text.clone(),
-    );
-    let mut diags: Vec<_> = stale.iter().map(|s| s.diagnostic(&text, file)).collect();
-    diags.extend(findings.iter().map(|f| {
-        let d = read_back::finding_diagnostic(f, file);
+    diags.extend(findings.iter().zip(found).map(|(f, d)| {
         if f.rule.policy().is_some() && !policy_fails {
             Diagnostic {
                 severity: Severity::Warning,
@@ -188,18 +184,34 @@ struct SourceCheck {
 }
 
 impl SourceCheck {
-    fn diagnostic(&self, text: &str, file: lensc_grammar::FileId) -> Diagnostic {
-        let start: usize = text
+    /// The warning over the header's `source` line, a part of the program
+    /// taken from its head (numbered as the program's line).
+    fn diagnostic(&self, head: &str, program: &Path, sources: &mut SourceMap) -> Diagnostic {
+        let start: usize = head
             .split_inclusive('\n')
             .take(self.line.saturating_sub(1))
             .map(str::len)
             .sum();
-        let len = text[start..].find('\n').unwrap_or(text.len() - start);
+        let start = start.min(head.len());
+        let text = head[start..]
+            .split('\n')
+            .next()
+            .unwrap_or("")
+            .trim_end_matches('\r')
+            .to_string();
+        let len = text.len();
+        let file = sources.add_part(
+            program.display().to_string(),
+            Some(program.to_path_buf()),
+            text,
+            self.line.saturating_sub(1),
+            start,
+        );
         Diagnostic::warning(
             self.code,
             self.message.clone(),
             file,
-            lensc_grammar::Span::new(start, start + len),
+            lensc_grammar::Span::new(0, len),
         )
         .with_label("the hash the program was written with")
         .with_help(self.help.clone())
@@ -370,21 +382,23 @@ fn head(program: &Path) -> std::io::Result<String> {
     Ok(String::from_utf8_lossy(&head).into_owned())
 }
 
-/// The program as the diagnostics show it: every line a finding is on,
-/// the others left empty (a program of millions of lines keeps its line
-/// numbers without being held whole), with the findings' spans moved to
-/// match.
-fn excerpt(
+/// The findings as diagnostics, each over the one line of the program it
+/// is on, added to `sources` as a part of the program (numbered as the
+/// program's line): the program is read once more, a line at a time, and
+/// only the lines with findings are kept (a handful: the reader reports
+/// each rule once), so memory does not grow with the program.
+fn lines_of_findings(
     program: &Path,
-    mut findings: Vec<reader::Finding>,
-    also: usize,
-) -> std::io::Result<(String, Vec<reader::Finding>)> {
-    let mut wanted: std::collections::BTreeSet<usize> = findings.iter().map(|f| f.line).collect();
-    wanted.insert(also);
+    findings: &[reader::Finding],
+    sources: &mut SourceMap,
+) -> std::io::Result<Vec<lensc_grammar::Diagnostic>> {
+    let wanted: std::collections::BTreeSet<usize> = findings.iter().map(|f| f.line).collect();
+    let last = wanted.last().copied().unwrap_or(0);
+    let mut parts = std::collections::HashMap::new();
     let mut r = std::io::BufReader::new(std::fs::File::open(program)?);
-    let (mut text, mut buf) = (String::new(), Vec::new());
+    let mut buf = Vec::new();
     let (mut line, mut offset) = (0, 0);
-    loop {
+    while line < last {
         buf.clear();
         let n = r.read_until(b'\n', &mut buf)?;
         if n == 0 {
@@ -392,16 +406,40 @@ fn excerpt(
         }
         line += 1;
         if wanted.contains(&line) {
-            for f in findings.iter_mut().filter(|f| f.line == line) {
-                let shift = |p: usize| p.saturating_sub(offset) + text.len();
-                f.span = (shift(f.span.0), shift(f.span.1));
-            }
-            text.push_str(String::from_utf8_lossy(&buf).trim_end_matches(['\n', '\r']));
+            let text = String::from_utf8_lossy(&buf);
+            let file = sources.add_part(
+                program.display().to_string(),
+                Some(program.to_path_buf()),
+                text.trim_end_matches(['\n', '\r']).to_string(),
+                line - 1,
+                offset,
+            );
+            parts.insert(line, (file, offset));
         }
-        text.push('\n');
         offset += n;
     }
-    Ok((text, findings))
+    let mut diags = Vec::with_capacity(findings.len());
+    for f in findings {
+        // A finding past the last line read (the file shrank): shown on
+        // an empty part at its line.
+        let (file, start) = *parts.entry(f.line).or_insert_with(|| {
+            let file = sources.add_part(
+                program.display().to_string(),
+                Some(program.to_path_buf()),
+                String::new(),
+                f.line.saturating_sub(1),
+                f.span.0,
+            );
+            (file, f.span.0)
+        });
+        let mut f = f.clone();
+        f.span = (
+            f.span.0.saturating_sub(start),
+            f.span.1.saturating_sub(start),
+        );
+        diags.push(read_back::finding_diagnostic(&f, file));
+    }
+    Ok(diags)
 }
 
 /// The declarations of the source file the header names, if it can be

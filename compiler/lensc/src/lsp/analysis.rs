@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use lensc_grammar::ast::{ItemKind, Span};
 use lensc_grammar::{Diagnostic, FileId, Severity};
-use lensc_lang::loader::{FileSystem, Import, RealFs, STDLIB};
+use lensc_lang::loader::{FileSystem, Import, RealFs, Root, STDLIB};
 use lensc_lang::sandbox::{MAX_FILE_BYTES, ReadError};
 use lsp_types::{self as lsp, Uri};
 
@@ -71,13 +71,13 @@ pub struct Overlay<'d> {
 }
 
 impl FileSystem for Overlay<'_> {
-    fn read(&self, path: &Path) -> Result<Vec<u8>, ReadError> {
+    fn read(&self, root: &Root, path: &Path) -> Result<Vec<u8>, ReadError> {
         match self.docs.values().find(|d| d.path.as_deref() == Some(path)) {
             Some(d) => match d.refusal() {
                 Some(e) => Err(e),
                 None => Ok(d.text.clone().into_bytes()),
             },
-            None => RealFs.read(path),
+            None => RealFs.read(root, path),
         }
     }
     fn canonical(&self, path: &Path) -> PathBuf {

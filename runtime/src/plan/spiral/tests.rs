@@ -414,3 +414,50 @@ proptest::proptest! {
         proptest::prop_assert_eq!(ours.to_bits(), fold.to_bits(), "{} against {}", ours, fold);
     }
 }
+
+/// A lenslet centred on the spindle, its feature disc around the axis
+/// (`settle: auto` on an array with a lenslet at the centre): every
+/// revolution inside it is over the lenslet all the way round. The disc's
+/// angular span is then the whole turn, whose two pieces in a revolution
+/// need not meet to the bit (centre ± π + 2πn): on main a level point (the
+/// land's height plus the nose) stood between them, a step in W at any
+/// speed (E0147 at 10^15 m/s² and "no speed down to 0.006 rpm").
+#[test]
+fn a_feature_around_the_spindle_spans_every_revolution_whole() {
+    let d = Dimple {
+        r: 20.0,
+        h: 0.02,
+        cx: 0.0,
+    };
+    let s = FtsSpiral {
+        start_radius: 0.4,
+        feed_per_rev: 0.002,
+        ..spiral()
+    };
+    let mut p = planner(&s, &d, 0.496);
+    p.bounds.features = Some(vec![(0.0, 0.0, 0.95)]);
+    let fa = FastAxis {
+        stroke: 5.0,
+        max_acceleration: 1e6,
+    };
+    let two_pi = 2.0 * std::f64::consts::PI;
+    for k in 0..p.revolutions() {
+        let (c0, c1) = (
+            two_pi * k as f64,
+            (two_pi * (k + 1) as f64).min(p.total_angle()),
+        );
+        if c1 > c0 {
+            assert_eq!(
+                p.feature_spans(c0, c1),
+                Some(vec![(c0, c1)]),
+                "revolution {k}"
+            );
+        }
+    }
+    let summary = p.plan(&fa, |_| {}).expect("plans within 1000 m/s²");
+    assert!(
+        summary.max_acceleration < 1.0,
+        "{}",
+        summary.max_acceleration
+    );
+}

@@ -5,7 +5,7 @@
 //! TNC itself writes them).
 
 use super::{FeedMode, ProgramWriter, Spindle, Word};
-use crate::moves::{Feed, Plane, Position};
+use crate::moves::{Blank, Feed, Plane, Position};
 use crate::post::ProgramError;
 use crate::post::format::fixed_units;
 
@@ -71,14 +71,14 @@ impl ProgramWriter {
         arc: Option<(Plane, Position)>,
     ) -> Result<bool, ProgramError> {
         if let Some((plane, centre)) = arc {
-            if plane != Plane::Xy || !self.dialect.arc_planes.contains(&plane) {
+            if !self.dialect.arc_planes.contains(&plane) {
                 return Err(ProgramError::Unsupported(format!(
                     "arcs in the {} plane",
                     plane.name()
                 )));
             }
             self.check_arc_radii(plane, to, centre)?;
-            self.circle_centre_block(centre)?;
+            self.circle_centre_block(plane, centre)?;
         }
         let start = self.text.len();
         self.begin_block();
@@ -131,27 +131,54 @@ impl ProgramWriter {
         Ok(true)
     }
 
-    /// `CC X… Y…`, the circle centre of the arcs that follow, when it
-    /// differs from the one in force (CC is modal on the TNC).
-    fn circle_centre_block(&mut self, centre: Position) -> Result<(), ProgramError> {
+    /// `CC X… Y…` (or `CC X… Z…`, `CC Y… Z…`), the circle centre of the
+    /// arcs that follow, in the two axes of their plane (the TNC takes the
+    /// arc's plane from the axes of its centre), when it differs from the
+    /// one in force (CC is modal on the TNC).
+    fn circle_centre_block(&mut self, plane: Plane, centre: Position) -> Result<(), ProgramError> {
         let d = self.decimals;
-        let (Some(x), Some(y)) = (fixed_units(centre.x, d), fixed_units(centre.y, d)) else {
-            return Err(ProgramError::NotPrintable {
-                word: 'X',
-                value: centre.x,
-            });
+        let axes = centre.axes();
+        let (a, b) = plane.axes();
+        // Written in X, Y, Z order: `CC X… Z…` for the ZX plane.
+        let (first, second) = (a.min(b), a.max(b));
+        let (Some(u), Some(v)) = (fixed_units(axes[first], d), fixed_units(axes[second], d)) else {
+            return Err(self.not_printable(first, axes[first]));
         };
-        if self.circle_centre == Some((x, y)) {
+        if self.circle_centre == Some((plane, u, v)) {
             return Ok(());
         }
+        let letter = |i: usize| ['X', 'Y', 'Z'][i];
         let start = self.text.len();
         self.begin_block();
-        self.text.extend_from_slice(b"CC X");
-        self.signed_number('X', centre.x, x, d)?;
-        self.text.extend_from_slice(b" Y");
-        self.signed_number('Y', centre.y, y, d)?;
+        self.text.extend_from_slice(b"CC ");
+        self.text.push(letter(first) as u8);
+        self.signed_number(letter(first), axes[first], u, d)?;
+        self.text.push(b' ');
+        self.text.push(letter(second) as u8);
+        self.signed_number(letter(second), axes[second], v, d)?;
         self.end_block(start)?;
-        self.circle_centre = Some((x, y));
+        self.circle_centre = Some((plane, u, v));
+        Ok(())
+    }
+
+    /// The workpiece blank for the TNC's graphic test run:
+    /// `BLK FORM 0.1 Z X… Y… Z…` (the tool axis Z and the least corner),
+    /// `BLK FORM 0.2 X… Y… Z…` (the greatest).
+    pub(super) fn blank_form(&mut self, blank: &Blank) -> Result<(), ProgramError> {
+        let d = self.decimals;
+        for (head, corner) in [("BLK FORM 0.1 Z", blank.min), ("BLK FORM 0.2", blank.max)] {
+            let start = self.text.len();
+            self.begin_block();
+            self.text.extend_from_slice(head.as_bytes());
+            for (i, letter) in ['X', 'Y', 'Z'].into_iter().enumerate() {
+                let Some(n) = fixed_units(corner[i], d) else {
+                    return Err(self.not_printable(i, corner[i]));
+                };
+                self.text.extend_from_slice(&[b' ', letter as u8]);
+                self.signed_number(letter, corner[i], n, d)?;
+            }
+            self.end_block(start)?;
+        }
         Ok(())
     }
 
@@ -295,21 +322,20 @@ mod tests {
              1 ; units mm; X Y Z of the tool centre, +Z out of the material\n\
              2 CYCL DEF 32.0 TOLERANCE\n\
              3 CYCL DEF 32.1 T0.001\n\
-             4 TOOL CALL 1 Z\n\
-             5 TOOL CALL Z S12000\n\
-             6 M3\n\
-             7 L X+1 Y+0 Z+5 R0 FMAX\n\
-             8 L Z-0.25 R0 F120\n\
-             9 CC X+0 Y+0\n\
-             10 C X+0 Y+1 DR+ F300\n\
-             11 C X-1 Y+0 DR+\n\
-             12 CC X-1.5 Y+0\n\
-             13 C X-2 DR-\n\
-             14 L Z+5 R0 FMAX\n\
-             15 L Z+4 R0 F300\n\
-             16 M5\n\
-             17 M30\n\
-             18 END PGM DOME MM\n"
+             4 TOOL CALL 1 Z S12000\n\
+             5 M3\n\
+             6 L X+1 Y+0 Z+5 R0 FMAX\n\
+             7 L Z-0.25 R0 F120\n\
+             8 CC X+0 Y+0\n\
+             9 C X+0 Y+1 DR+ F300\n\
+             10 C X-1 Y+0 DR+\n\
+             11 CC X-1.5 Y+0\n\
+             12 C X-2 DR-\n\
+             13 L Z+5 R0 FMAX\n\
+             14 L Z+4 R0 F300\n\
+             15 M5\n\
+             16 M30\n\
+             17 END PGM DOME MM\n"
         );
         let (findings, moves) = reader::read_moves(&text, &klartext(), &mill());
         assert!(findings.is_empty(), "{findings:?}");
@@ -329,6 +355,107 @@ mod tests {
             ]
         );
         assert_eq!(moves.len(), 7);
+    }
+
+    /// One `TOOL CALL` with the speed, the blank as `BLK FORM`, arcs in
+    /// the ZX and YZ planes as `CC` of the plane's axes and `C`, a knife's
+    /// spindle held by cycle 13; the reader reads each back as written.
+    #[test]
+    fn klartext_states_the_blank_calls_the_tool_once_and_cuts_arcs_in_every_plane() {
+        let d = Dialect {
+            arc_planes: Plane::ALL.to_vec(),
+            spindle_orient: vec![
+                "CYCL DEF 13.0 ORIENTATION".into(),
+                "CYCL DEF 13.1 ANGLE 0".into(),
+            ],
+            ..klartext()
+        };
+        let start = Start {
+            tool: 3,
+            blank: Some(crate::moves::Blank {
+                min: [-2.0, -2.0, -1.5],
+                max: [2.0, 2.0, 0.0],
+            }),
+            ..Start::default()
+        };
+        let cut = |plane, to, centre, ccw| M::Arc {
+            to,
+            centre,
+            plane,
+            ccw,
+            feed: Some(F::PerTime(5.0)),
+        };
+        let mut w =
+            ProgramWriter::new(&d, Setup::Mill, "arcs", &[], "XYZ", 1e-3, 1e-3).expect("writer");
+        w.call_tool(&start).expect("tool");
+        w.write_all(&[
+            M::SpindleOn(12000.0 * 2.0 * PI / 60.0),
+            M::Rapid(P::xyz(-1.0, 0.0, 0.0)),
+            // A quarter turn in ZX about (X0, Z0): from X-1 Z0 to X0 Z-1,
+            // clockwise seen in Z then X.
+            cut(
+                Plane::Zx,
+                P::xyz(0.0, 0.0, -1.0),
+                P::xyz(0.0, f64::NAN, 0.0),
+                false,
+            ),
+            // And in YZ about (Y0, Z0): from Y0 Z-1 to Y1 Z0.
+            cut(
+                Plane::Yz,
+                P::xyz(0.0, 1.0, 0.0),
+                P::xyz(f64::NAN, 0.0, 0.0),
+                true,
+            ),
+            M::SpindleOff,
+            M::SpindleHeld,
+            M::Linear {
+                to: P::xyz(0.0, 1.0, 1.0),
+                feed: Some(F::PerTime(5.0)),
+            },
+        ])
+        .expect("moves");
+        let text = w.finish().expect("program");
+        for block in [
+            "1 BLK FORM 0.1 Z X-2 Y-2 Z-1.5\n",
+            "2 BLK FORM 0.2 X+2 Y+2 Z+0\n",
+            "5 TOOL CALL 3 Z S12000\n6 M3\n",
+            "CC X+0 Z+0\n",
+            "C X+0 Z-1 DR- F300\n",
+            "CC Y+0 Z+0\n",
+            "C Y+1 Z+0 DR+\n",
+            "CYCL DEF 13.0 ORIENTATION\n",
+        ] {
+            assert!(text.contains(block), "no `{block}` in\n{text}");
+        }
+        assert_eq!(text.matches("TOOL CALL").count(), 1, "{text}");
+        let (findings, moves) = reader::read_moves(&text, &d, &mill());
+        assert!(findings.is_empty(), "{findings:?}\n{text}");
+        let arcs: Vec<_> = moves
+            .iter()
+            .filter_map(|m| match m.path {
+                Path::Arc {
+                    plane, centre, cw, ..
+                } => Some((plane, centre, cw, m.to)),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(
+            arcs,
+            [
+                (
+                    Plane::Zx,
+                    (0.0, 0.0),
+                    true,
+                    [Some(0.0), Some(0.0), Some(-1.0), None]
+                ),
+                (
+                    Plane::Yz,
+                    (0.0, 0.0),
+                    false,
+                    [Some(0.0), Some(1.0), Some(0.0), None]
+                ),
+            ]
+        );
     }
 
     #[test]
@@ -371,8 +498,8 @@ mod tests {
         };
         assert!(rules(&good).is_empty());
         let cases = [
-            ("8 L Z-0.25", "9 L Z-0.25", reader::Rule::BlockSequence),
-            ("9 CC X+0 Y+0\n", "", reader::Rule::NoCircleCentre),
+            ("7 L Z-0.25", "8 L Z-0.25", reader::Rule::BlockSequence),
+            ("8 CC X+0 Y+0\n", "", reader::Rule::NoCircleCentre),
             (
                 "END PGM DOME MM",
                 "END PGM OTHER MM",
@@ -385,7 +512,7 @@ mod tests {
             ),
             ("R0 F120", "RL F120", reader::Rule::UnknownWord),
             ("DR+", "", reader::Rule::ArcWords),
-            ("6 M3", "6 M5", reader::Rule::SpindleStopped),
+            ("5 M3", "5 M5", reader::Rule::SpindleStopped),
         ];
         for (from, to, rule) in cases {
             let bad = good.replacen(from, to, 1);

@@ -42,7 +42,7 @@ pub(super) fn build(spec: &GrindingSpec, cx: &BuildContext) -> Result<Built, Vec
     );
     let mut header = parts::header(head, prov, &units);
     header.push(format!(
-        "tool {}: spherical wheel, diameter {} mm; coordinates are the wheel centre",
+        "tool {}: spherical wheel, diameter {} mm",
         head.names.tool,
         exact_in(grinding.wheel_diameter, "mm")
     ));
@@ -92,7 +92,7 @@ pub(super) fn build(spec: &GrindingSpec, cx: &BuildContext) -> Result<Built, Vec
         )),
         ..Default::default()
     };
-    Ok(parts::built(
+    let mut built = parts::built(
         head,
         prov,
         ProgramText::Memory(text),
@@ -100,5 +100,7 @@ pub(super) fn build(spec: &GrindingSpec, cx: &BuildContext) -> Result<Built, Vec
         report::Simulation::Profile((&cut).into()),
         plots,
         (path.points.len(), path.total_time),
-    ))
+    );
+    built.warnings = crate::plausibility::air_warnings(head, &stream);
+    Ok(built)
 }

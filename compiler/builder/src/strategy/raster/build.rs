@@ -13,7 +13,7 @@ use lensc_runtime::verify::heightmap::Cutter;
 
 use crate::context::{self as parts, BuildContext};
 use crate::evaluate::evaluator;
-use crate::height_map::{self, Simulation, domain_centre};
+use crate::height_map::{self, Simulation};
 use crate::output::{Built, ProgramText};
 use crate::report;
 use lensc_runtime::verify::window::split;
@@ -60,13 +60,17 @@ pub(super) fn build(spec: &RasterSpec, cx: &BuildContext) -> Result<Built, Vec<D
         ),
     );
     let resolution = head.resolution;
+    let start = lensc_runtime::moves::Start {
+        blank: blank(&moves, tool),
+        ..head.start
+    };
     let text = lensc_runtime::emit::raster::emit_mill(
         dialect,
         &head.name,
         &header_lines(spec, prov, &path, &optimised),
         &moves,
         (resolution, raster.chord_tolerance),
-        &head.start,
+        &start,
     )
     .map_err(|e| vec![parts::not_printable(head, e)])?;
     let section = report::Raster::new(&path, raster, feed, &optimised);
@@ -88,10 +92,16 @@ pub(super) fn build(spec: &RasterSpec, cx: &BuildContext) -> Result<Built, Vec<D
         ),
     };
     let along_x = raster.along == Axis::X;
+    // The whole part by default, as fine as its cutter's budget allows.
+    let budget = match cutter {
+        Cutter::Nose { .. } => height_map::WHOLE_CELLS_NOSE,
+        Cutter::Ball { .. } => height_map::WHOLE_CELLS_BALL,
+    };
     let window = height_map::window(
         head,
-        domain_centre(&lowered.domain),
         height_map::domain_extent(&lowered.domain),
+        budget,
+        |w| split(&w.cartesian(along_x), None),
     );
     let grid = window.cartesian(along_x);
     let mut sweep = Simulation::of(grid, split(&grid, None), cutter);
@@ -132,9 +142,74 @@ pub(super) fn build(spec: &RasterSpec, cx: &BuildContext) -> Result<Built, Vec<D
     let simulation = report::Simulation::HeightMap(report::HeightMapOnly { height_map });
     let text = ProgramText::Memory(text);
     let cut = (path.point_count, time);
-    Ok(parts::built(
-        head, prov, text, toolpath, simulation, plots, cut,
-    ))
+    let mut built = parts::built(head, prov, text, toolpath, simulation, plots, cut);
+    built.warnings = crate::plausibility::air_warnings(head, &moves);
+    Ok(built)
+}
+
+/// The blank the program states for the control's graphic test run
+/// (Klartext's `BLK FORM`): a box holding every cutting move's contact
+/// (the tool centre less the ball's or nose's radius in Z) where it ends,
+/// where it starts in X and Y, and the top of every arc in the ZX or YZ
+/// plane as if it passed over its centre; 1 mm deeper than the lowest
+/// contact. None without a cut.
+fn blank(
+    moves: &[lensc_runtime::moves::Move],
+    tool: RasterTool,
+) -> Option<lensc_runtime::moves::Blank> {
+    use lensc_runtime::moves::{Move, Plane, Position};
+    let r = match tool {
+        RasterTool::Knife { nose_radius } => nose_radius,
+        RasterTool::Ball { radius } => radius,
+    };
+    let (mut min, mut max) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    let mut take = |p: [f64; 3]| {
+        for i in 0..3 {
+            if p[i].is_finite() {
+                min[i] = min[i].min(p[i]);
+                max[i] = max[i].max(p[i]);
+            }
+        }
+    };
+    let mut at = [f64::NAN; 3];
+    let moved = |to: &Position, at: &mut [f64; 3]| {
+        for (a, v) in at.iter_mut().zip([to.x, to.y, to.z]) {
+            if !v.is_nan() {
+                *a = v;
+            }
+        }
+    };
+    for m in moves {
+        match m {
+            Move::Rapid(to) => moved(to, &mut at),
+            Move::Linear { to, .. } | Move::Arc { to, .. } => {
+                // Where it starts in X and Y (in Z it may start in the
+                // air: a plunge's start is the safe height).
+                take([at[0], at[1], f64::NAN]);
+                moved(to, &mut at);
+                take([at[0], at[1], at[2] - r]);
+                if let Move::Arc {
+                    centre,
+                    plane: Plane::Zx | Plane::Yz,
+                    ..
+                } = m
+                {
+                    let across = if centre.x.is_nan() {
+                        at[1] - centre.y
+                    } else {
+                        at[0] - centre.x
+                    };
+                    let radius = across.hypot(at[2] - centre.z);
+                    take([f64::NAN, f64::NAN, centre.z + radius - r]);
+                }
+            }
+            _ => {}
+        }
+    }
+    min[2] -= 1.0;
+    (0..3)
+        .all(|i| min[i] <= max[i])
+        .then_some(lensc_runtime::moves::Blank { min, max })
 }
 
 /// The program's header: provenance, units, surface, the tool, the raster
@@ -149,7 +224,7 @@ fn header_lines(
     let mut header = parts::header(
         head,
         prov,
-        "units mm; X Y Z of the tool centre, +Z out of the material; no cutter compensation",
+        "units mm; X Y Z of the control point, +Z out of the material; no cutter compensation",
     );
     header.push(format!("tool {}: {}", head.names.tool, spec.tool_words));
     header.push(format!(

@@ -58,14 +58,10 @@ impl crate::strategy::Strategy for RasterSpec {
         &self,
         window: &lensc_runtime::verify::window::Window,
     ) -> Option<Vec<lensc_runtime::verify::window::Tile>> {
-        match self.tool {
-            // A ball-end mill is not simulated in tiles.
-            RasterTool::Knife { .. } => Some(lensc_runtime::verify::window::split(
-                &window.cartesian(self.raster.along == Axis::X),
-                None,
-            )),
-            RasterTool::Ball { .. } => None,
-        }
+        Some(lensc_runtime::verify::window::split(
+            &window.cartesian(self.raster.along == Axis::X),
+            None,
+        ))
     }
     fn build(
         &self,
@@ -112,7 +108,7 @@ pub(crate) fn lower(
             (
                 RasterTool::Ball { radius: d / 2.0 },
                 format!(
-                    "ball-end mill, diameter {} mm, referenced at the ball centre",
+                    "ball-end mill, diameter {} mm",
                     lensc_lang::lower::exact_in(d, "mm")
                 ),
             )
@@ -122,7 +118,7 @@ pub(crate) fn lower(
             (
                 RasterTool::Knife { nose_radius: r },
                 format!(
-                    "microshaper knife, nose radius {} mm, its edge across the cut, referenced at the nose centre",
+                    "microshaper knife, nose radius {} mm, its edge across the cut",
                     lensc_lang::lower::exact_in(r, "mm")
                 ),
             )

@@ -33,10 +33,13 @@ pub(super) fn build(spec: &RollerSpec, cx: &BuildContext) -> Result<Built, Vec<D
     let (section, _) = evaluator(&lowered.tape.axial_section());
     let resolution = head.resolution;
     let printed_at = lensc_runtime::verify::simulate::Printed::new(resolution);
+    // The header's time, at the spindle's pace, from the design's survey.
+    let pace = lensc_runtime::plan::roller::spindle_time(helix, rho, kernel.as_ref())
+        .map_err(|e| vec![super::errors::error(e, site)])?;
     let mut program = RollerProgram::new(
         &head.dialect,
         &head.name,
-        &header_lines(spec, prov),
+        &header_lines(spec, prov, pace),
         RollerLimits {
             resolution,
             max_feed: spec.max_feed,
@@ -54,8 +57,9 @@ pub(super) fn build(spec: &RollerSpec, cx: &BuildContext) -> Result<Built, Vec<D
     let (design_y, z) = (spec.design_y, (helix.z_start, helix.z_end));
     let window = height_map::window(
         head,
-        ((z.0 + z.1) / 2.0, (design_y.0 + design_y.1) / 2.0),
         height_map::roller_extent(&lowered.domain, z, design_y),
+        height_map::WHOLE_CELLS_NOSE,
+        |w| split(&w.roller(helix.roller_radius, helix.y_start), None),
     );
     let grid = window.roller(helix.roller_radius, helix.y_start);
     let mut sweep = Simulation::new(grid, split(&grid, None), rho);
@@ -177,7 +181,7 @@ pub fn seam_warning(
 
 /// The program's header: provenance, units, the surface and tool, the
 /// helix and its passes, and the machine in words.
-fn header_lines(spec: &RollerSpec, prov: &Provenance) -> Vec<String> {
+fn header_lines(spec: &RollerSpec, prov: &Provenance, pace: Option<f64>) -> Vec<String> {
     let (head, helix) = (&spec.head, &spec.helix);
     let deg = |a: f64| exact_in(a, "°");
     let pass_words: Vec<String> = helix
@@ -210,5 +214,11 @@ fn header_lines(spec: &RollerSpec, prov: &Provenance) -> Vec<String> {
         "machine {}: {} slow-tool-servo lathe",
         head.names.machine, head.dialect.name
     ));
+    if let Some(t) = pace {
+        lines.push(format!(
+            "estimated cutting time {} at the spindle's pace (a move slowed to the feed limit adds to it)",
+            lensc_runtime::post::header::duration(t)
+        ));
+    }
     lines
 }

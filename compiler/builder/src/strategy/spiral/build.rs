@@ -79,12 +79,13 @@ pub(super) fn build(spec: &SpiralSpec, cx: &BuildContext) -> Result<Built, Vec<D
     // planned (a slow tool servo's Z has no servo model here).
     let data_rate = 1.0 / p.spiral.min_interval;
     let mut following = following(spec, data_rate);
-    // The height map over the window, from the same printed points.
-    let domain = &head.surface.lowered.domain;
+    // The height map over the window (by default the whole of what the
+    // spiral cuts), from the same printed points.
     let window = height_map::window(
         head,
-        height_map::lathe_centre(domain, &p.lenslets),
-        height_map::domain_extent(domain),
+        crate::strategy::Strategy::part_extent(spec),
+        height_map::WHOLE_CELLS_NOSE,
+        |w| w.polar_tiles(&p.lenslets),
     );
     let mut sweep = Simulation::new(
         window.polar(),
@@ -219,7 +220,19 @@ fn simulated_height_map(
 ) -> report::HeightMap {
     let lowered = &spec.head.surface.lowered;
     let design = evaluator(&lowered.tape).0;
-    let frame = LatheFrame::new(design.as_ref(), window, lowered.domain, &spec.lenslets);
+    let frame = LatheFrame::new(
+        design.as_ref(),
+        window,
+        lowered.domain,
+        // The default window is the disc the spiral cuts; one the job
+        // gives counts every cell of it, cut or not.
+        if window.given {
+            f64::INFINITY
+        } else {
+            spec.spiral.start_radius
+        },
+        &spec.lenslets,
+    );
     // A polar grid's cells lie askew to the raster's blocks: √2 times the
     // spacing puts a cell in every block (1.5 for margin).
     let (map, raster) = sweep.finish(&frame, &window, 1.5 * window.spacing);

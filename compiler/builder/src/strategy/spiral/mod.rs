@@ -130,6 +130,14 @@ impl crate::strategy::Strategy for SpiralSpec {
     fn estimate(&self, evaluate: Evaluate) -> crate::job::Estimate {
         estimate::estimate(self, evaluate)
     }
+    /// The disc the spiral sweeps from its start radius (`from:`, or
+    /// the surface's farthest point from the axis) in to the axis, within
+    /// the surface's domain.
+    fn part_extent(&self) -> ((f64, f64), (f64, f64)) {
+        let (x, y) = crate::job::window::domain_extent(&self.head.surface.lowered.domain);
+        let r = self.spiral.start_radius;
+        ((x.0.max(-r), x.1.min(r)), (y.0.max(-r), y.1.min(r)))
+    }
     fn tiles(
         &self,
         window: &lensc_runtime::verify::window::Window,

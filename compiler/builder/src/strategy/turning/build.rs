@@ -33,7 +33,13 @@ pub(super) fn build(spec: &TurningSpec, cx: &BuildContext) -> Result<Built, Vec<
                 .collect::<Vec<_>>()
         })?;
     let warnings = warnings(spec, &path);
-    let emitted = match lensc_runtime::emit::turning::emit(job, &path, prov, &head.start) {
+    let emitted = match lensc_runtime::emit::turning::emit(
+        job,
+        &path,
+        prov,
+        &head.start,
+        &head.control.header_line(head.start.control),
+    ) {
         Ok(e) => e,
         Err(e) => {
             let mut all = warnings;
@@ -86,6 +92,9 @@ pub(super) fn build(spec: &TurningSpec, cx: &BuildContext) -> Result<Built, Vec<
     // other strategies give its kind), as it always has.
     built.report.surface.surface = head.names.surface_declared.clone();
     built.warnings = warnings;
+    built
+        .warnings
+        .extend(crate::plausibility::air_warnings(head, &stream));
     Ok(built)
 }
 

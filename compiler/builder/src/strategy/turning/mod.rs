@@ -79,6 +79,9 @@ pub(crate) fn lower(
             .map(|e| errors::error(e, p.site()))
             .collect());
     }
+    if let Some(e) = nose_out_of_reach(p, &job, &SectionAlongX(kernel.as_ref())) {
+        return Err(vec![e]);
+    }
     Ok(TurningSpec {
         head: p.head(dialect, lowered),
         job,
@@ -117,7 +120,7 @@ fn turning_job(p: &Parts, dialect: Dialect) -> Result<TurningJob, Vec<Diagnostic
                 sites.surface,
                 format!("this is a `{}`", surface.kind.name),
             )
-            .with_help("sphere, conic, asphere, qbfs and qcon surfaces with a circle or annulus aperture can be turned, and any profile made a surface of revolution with `revolve`"),
+            .with_help(not_turnable_help(surface.kind.name)),
         );
     }
     let Some(surf) = surf.filter(|_| errors.is_empty()) else {
@@ -341,4 +344,58 @@ fn surface_info(o: &Object, params: &Surface) -> Option<SurfaceInfo> {
         ),
         aperture_radius,
     })
+}
+
+/// What to do with a surface profile turning cannot cut: a rotationally
+/// symmetric kind needs a circular aperture; any other is cut on a spiral
+/// that follows its height around each turn (`revolve` would sweep one
+/// profile round: another part).
+fn not_turnable_help(kind: &str) -> String {
+    const SYMMETRIC: [&str; 7] = [
+        "sphere", "conic", "asphere", "qbfs", "qcon", "plane", "revolve",
+    ];
+    if SYMMETRIC.contains(&kind) {
+        "sphere, conic, asphere, qbfs, qcon and revolve surfaces are turned with a circle or annulus aperture: give it one".to_string()
+    } else {
+        format!(
+            "a `{kind}` is not rotationally symmetric: cut it with `spiral_turning` on a slow-tool-servo lathe (or `fts_spiral` with a fast tool servo), whose spiral follows its height around each turn; `revolve` would sweep one profile round, another part"
+        )
+    }
+}
+
+/// E0141, before planning, at the tool's nose radius: a nose so large that
+/// its centre, touching the surface where the cut ends, is above the
+/// machine's Z travel (a 0.5 m nose for 0.5 mm): the nose cannot reach
+/// the part, whatever the path. The centre there is z + ρ / sqrt(1 + z′²).
+fn nose_out_of_reach(
+    p: &Parts,
+    job: &TurningJob,
+    profile: &dyn lensc_runtime::surface::Profile,
+) -> Option<Diagnostic> {
+    let (_, z_max) = p.machine_params.travel[2]?;
+    let rho = job.tool.nose_radius;
+    let end = profile.point(job.strategy.end_radius);
+    let centre = end.z + rho / end.dz.hypot(1.0);
+    if centre.is_nan() || centre <= z_max {
+        return None;
+    }
+    let (file, span) = lensc_lang::value::Reader::new(&p.tool.fields)
+        .field("nose_radius")
+        .map_or(p.site(), |f| (f.file, f.span));
+    Some(
+        Diagnostic::error(
+            codes::OUT_OF_TRAVEL,
+            format!(
+                "a nose of radius {} mm cannot reach the part: touching it at r = {} mm its centre is at Z {} mm, above the machine's Z travel (up to {} mm)",
+                trim_num(rho),
+                trim_num(job.strategy.end_radius),
+                trim_num(centre),
+                trim_num(z_max)
+            ),
+            file,
+            span,
+        )
+        .with_label("this nose radius")
+        .with_help("check the nose radius's unit (`0.5 mm`, not `0.5 m`); a nose this size needs a machine with that much Z travel"),
+    )
 }

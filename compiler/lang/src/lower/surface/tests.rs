@@ -296,8 +296,13 @@ surface t = off_axis(p, x: 3 mm, y: 0 mm, tilt: remove, aperture: circle(radius:
     assert!(
         close(s[0], ((x + 3.0) * (x + 3.0) + y * y - 9.0) / 20.0) && close(s[1], (x + 3.0) / 10.0)
     );
-    let t = eval_surface(src, "t", x, y);
-    assert!(close(t[0], (x * x + y * y) / 20.0) && close(t[1], x / 10.0));
+    // With the tilt removed: the section turned rigidly, level at its
+    // centre (`tilt_removed_is_the_exact_turned_section` checks the turn).
+    let t = eval_surface(src, "t", 0.0, 0.0);
+    assert!(
+        t[0].abs() < 1e-15 && t[1].abs() < 1e-15 && t[2].abs() < 1e-15,
+        "{t:?}"
+    );
     // A wrapped design evaluates as the flat design.
     let w = eval_surface(
         "surface f = freeform { z(x, y) = 0.02 mm * sin(5 rad/mm * x), domain: rect(x: 0 mm .. 6 mm, y: 0 mm .. 18.84955592153876 mm) }
@@ -850,4 +855,53 @@ fn a_surface_that_did_not_check_is_refused_with_what_it_lacks() {
         ))
     );
     assert_eq!(crate::domain::surface_domain(o), None);
+}
+
+/// `off_axis(…, tilt: remove)` is the level section turned rigidly (about
+/// y by atan(s_x), then about x by −atan(s_y / sqrt(1 + s_x²))): every
+/// point of it, turned back by the transposed rotation, lies on the level
+/// section, and its slope at the centre is zero. At 14° (a paraboloid of
+/// R = 48.13 mm sectioned 12 mm off axis) the small-angle shear it
+/// replaces, z − s_x x, is tens of µm off it at the section's edge: on
+/// main this test fails there.
+#[test]
+fn tilt_removed_is_the_exact_turned_section() {
+    let r = 12.0 / 14f64.to_radians().tan();
+    for (x0, y0) in [(12.0, 0.0), (5.0, -7.0)] {
+        let src = format!(
+            "surface p = conic {{ radius: {r} mm, conic: -1, sense: concave, aperture: circle(radius: 30 mm) }}
+surface t = off_axis(p, x: {x0} mm, y: {y0} mm, tilt: remove, aperture: circle(radius: 12 mm))"
+        );
+        let parent = |x: f64, y: f64| (x * x + y * y) / (2.0 * r);
+        let level = |u: f64, v: f64| parent(u + x0, v + y0) - parent(x0, y0);
+        let (sx, sy) = (x0 / r, y0 / r);
+        let a = sx.atan();
+        let b = -(sy / sx.hypot(1.0)).atan();
+        // M = Rx(b) · Ry(a), rows; its transpose turns a point back.
+        let (ca, sa, cb, sb) = (a.cos(), a.sin(), b.cos(), b.sin());
+        let m = [
+            [ca, 0.0, sa],
+            [-sb * -sa, cb, -sb * ca],
+            [-cb * sa, sb, cb * ca],
+        ];
+        let centre = eval_surface(&src, "t", 0.0, 0.0);
+        assert!(
+            centre[1].abs() < 1e-12 && centre[2].abs() < 1e-12,
+            "{centre:?}"
+        );
+        for (x, y) in [(11.0, 0.0), (-11.0, 2.0), (3.0, -8.0), (0.0, 11.5)] {
+            let z = eval_surface(&src, "t", x, y)[0];
+            let back = |i: usize| m[0][i] * x + m[1][i] * y + m[2][i] * z;
+            let (u, v, w) = (back(0), back(1), back(2));
+            assert!(
+                (w - level(u, v)).abs() < 1e-11,
+                "({x0}, {y0}) at ({x}, {y}): {w} vs {}",
+                level(u, v)
+            );
+            if y0 == 0.0 && x == 11.0 {
+                let shear = level(x, y) - sx * x;
+                assert!((z - shear).abs() > 10e-3, "{z} vs the shear {shear}");
+            }
+        }
+    }
 }

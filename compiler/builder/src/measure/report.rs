@@ -1,0 +1,195 @@
+//! The measurement report (`JOB.measure.json`) as typed data: what was
+//! measured, how it was registered to the design, the error along the
+//! surface normal, the texture after form removal and, for a turned
+//! part, the set-up errors. `docs/measure.schema.json` is generated from
+//! these types and checked for staleness (the test below).
+
+use schemars::JsonSchema;
+use serde::Serialize;
+
+/// The report of one `lensc measure`.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct MeasureReport {
+    /// The job whose design the part is held to.
+    pub job: String,
+    /// The job's surface (its declared name, or its kind written in place).
+    pub surface: String,
+    pub measurement: Measurement,
+    pub coverage: Coverage,
+    pub registration: Registration,
+    pub form_error: FormError,
+    /// Texture after form removal (maps only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub texture: Option<Texture>,
+    /// Why there is no texture, when there is none.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub texture_skipped: Option<String>,
+    /// A turned part's set-up errors (lathe jobs with a map or a cloud).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub setup: Option<SetUp>,
+}
+
+/// The file read.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct Measurement {
+    /// As given on the command line.
+    pub file: String,
+    /// `x3p`, `sdf`, `metropro_dat`, `metropro_ascii`, `xyz`, `profile`.
+    pub format: String,
+    /// `map`, `point_cloud` or `profile`.
+    pub kind: String,
+    /// The MD5 of the file's bytes (hex): which measurement this is.
+    pub md5: String,
+    /// The instrument or software the file names, if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub instrument: Option<String>,
+    /// Points in the file, and how many are valid.
+    pub points: usize,
+    pub valid_points: usize,
+    /// The pixel spacing along x and y (µm), for a map.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pixel_um: Option<[f64; 2]>,
+    /// Where the points lie, after centring (mm): [[x min, x max], [y min, y max]].
+    pub extent_mm: [[f64; 2]; 2],
+    /// Whether the map was centred on its middle pixel (false: the file's
+    /// own coordinates, `--keep-origin`).
+    pub centred: bool,
+}
+
+/// How much of the measured aperture is valid.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct Coverage {
+    /// Measured points inside the surface's aperture (valid or not).
+    pub points_in_aperture: usize,
+    /// The share of those that are valid, and the least share required.
+    pub valid_share: f64,
+    pub min_valid_share: f64,
+}
+
+/// The placement found.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct Registration {
+    pub method: String,
+    pub piston_um: f64,
+    /// Slopes of the fitted plane (µrad): +x and +y rise.
+    pub tilt_x_urad: f64,
+    pub tilt_y_urad: f64,
+    /// Where the design's vertex sits in the measurement's frame (µm).
+    pub decentre_x_um: f64,
+    pub decentre_y_um: f64,
+    /// The part turned about z against the design (µrad); absent for a
+    /// surface of revolution.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub clocking_urad: Option<f64>,
+    /// Parameters not fitted, each with the reason.
+    pub left_out: Vec<LeftOut>,
+    pub iterations: usize,
+}
+
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct LeftOut {
+    pub parameter: String,
+    pub reason: String,
+}
+
+/// The error map's figures, as the acceptance section defines them:
+/// measured − design along the surface normal, positive where material
+/// is left; PV the largest less the least, RMS about the mean.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct FormError {
+    pub along: String,
+    pub points: usize,
+    pub pv_nm: f64,
+    pub rms_nm: f64,
+    pub mean_nm: f64,
+    /// The largest and least error (nm) and where (x, y, mm).
+    pub max: Extreme,
+    pub min: Extreme,
+}
+
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct Extreme {
+    pub nm: f64,
+    pub at_mm: [f64; 2],
+}
+
+/// ISO 25178-2 parameters of the S-L surface.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct Texture {
+    /// What was removed as form: the registered design surface.
+    pub form_removed: String,
+    /// The L-filter, named, and its nesting index λc (mm).
+    pub filter: String,
+    pub cutoff_mm: f64,
+    pub sa_nm: f64,
+    pub sq_nm: f64,
+    pub sz_nm: f64,
+    /// Root mean square gradient (dimensionless).
+    pub sdq: f64,
+    pub points: usize,
+}
+
+/// A turned part's set-up errors and the corrections to apply.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct SetUp {
+    /// δx (µm): the tool stood this much further from the spindle axis
+    /// than programmed (negative: it passed the centre).
+    pub x_offset_um: f64,
+    pub x_correction: String,
+    /// |h| (µm): the tool tip's distance from the centre height (a map
+    /// does not tell above from below), resolved to `ring_um`.
+    pub centre_height_um: f64,
+    pub centre_height_correction: String,
+    /// The radius of the uncut stub at the centre (µm; 0: none seen).
+    pub stub_radius_um: f64,
+    pub ring_um: f64,
+    /// RMS of the ring-averaged error about the fitted cone (nm).
+    pub cone_fit_rms_nm: f64,
+    pub rings: usize,
+    /// The model, in words.
+    pub model: String,
+}
+
+/// The JSON Schema of [`MeasureReport`] as written (draft 2020-12).
+pub fn schema() -> schemars::Schema {
+    schemars::generate::SchemaSettings::draft2020_12()
+        .for_serialize()
+        .into_generator()
+        .into_root_schema_for::<MeasureReport>()
+}
+
+/// The schema as committed at `docs/measure.schema.json`.
+pub fn schema_text() -> String {
+    serde_json::to_string_pretty(&schema()).expect("a schema prints") + "\n"
+}
+
+#[cfg(test)]
+mod tests {
+    /// The committed schema is the one the structs generate.
+    #[test]
+    fn committed_schema_is_current() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../docs/measure.schema.json"
+        );
+        let generated = super::schema_text();
+        if std::env::var_os("LENSC_BLESS").is_some() {
+            std::fs::write(path, &generated).expect("write docs/measure.schema.json");
+            return;
+        }
+        let committed = std::fs::read_to_string(path).unwrap_or_default();
+        assert!(
+            committed == generated,
+            "docs/measure.schema.json is stale: regenerate it with\n    LENSC_BLESS=1 cargo test -p lensc-build --lib measure"
+        );
+    }
+}

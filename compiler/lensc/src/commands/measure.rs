@@ -1,0 +1,124 @@
+//! `lensc measure FILE PART [--job NAME]`: a measured part held to its
+//! job's design (`lensc_build::measure`): the job lowered as `build`
+//! lowers it, the measurement read under the project's file rules,
+//! registered and figured; `JOB.measure.json` and `JOB.error_map.svg`
+//! written as one unit, or nothing and a coded error naming the file.
+
+use std::path::Path;
+
+use lensc::render;
+use lensc_build::measure::{self, Failure, Options};
+use lensc_grammar::{Diagnostic, Span};
+use lensc_lang::source::SourceMap;
+
+use crate::MessageFormat;
+use crate::output::{Output, cannot_write, load_jobs};
+
+/// Runs the subcommand; returns the exit code.
+pub fn run(
+    out: &Output,
+    (file, part): (&Path, &Path),
+    job: Option<&str>,
+    dir: &Path,
+    opts: Options,
+) -> u8 {
+    let c = match load_jobs(out, file, job) {
+        Ok(c) => c,
+        Err(code) => return code,
+    };
+    let jobs: Vec<_> = c
+        .checked
+        .jobs
+        .iter()
+        .filter(|j| job.is_none_or(|n| j.name.name == n))
+        .collect();
+    let [checked_job] = jobs[..] else {
+        let names: Vec<&str> = jobs.iter().map(|j| j.name.name.as_str()).collect();
+        eprintln!(
+            "error: {} has {} jobs ({}): name the one the part was cut by with --job",
+            file.display(),
+            names.len(),
+            names.join(", ")
+        );
+        return 2;
+    };
+    let spec = match lensc_build::pipeline::lower(checked_job, None, &Default::default()) {
+        Ok((spec, _)) => spec,
+        Err(diags) => {
+            out.diagnostics(&c, &diags);
+            return 1;
+        }
+    };
+    let root = out.root.clone().unwrap_or_else(|| {
+        file.parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."))
+            .to_path_buf()
+    });
+    let name = part.display().to_string();
+    let bytes = match measure::read_file(part, &root) {
+        Ok(b) => b,
+        Err(f) => return refuse(out, part, &[], &f),
+    };
+    let outcome = match measure::measure(&spec, &name, &bytes, &opts) {
+        Ok(o) => o,
+        Err(f) => return refuse(out, part, &bytes, &f),
+    };
+    let job_name = &outcome.report.job;
+    let json = lensc_build::report::json_text(&outcome.report);
+    let files = [
+        (format!("{job_name}.measure.json"), json),
+        (format!("{job_name}.error_map.svg"), outcome.svg),
+    ];
+    let mut temps = Vec::new();
+    for (n, text) in &files {
+        let target = dir.join(n);
+        match lensc_build::driver::output_path(dir, n)
+            .and_then(|p| lensc_build::output::text_temp(dir, text).map(|t| (t, p)))
+        {
+            Ok(t) => temps.push(t),
+            Err(e) => {
+                cannot_write(&target, &e);
+                return 1;
+            }
+        }
+    }
+    if let Err(e) = lensc_build::driver::put_in_place(temps) {
+        cannot_write(dir, &e);
+        return 1;
+    }
+    let f = &outcome.report.form_error;
+    let r = &outcome.report.registration;
+    if out.format == MessageFormat::Human {
+        eprintln!(
+            "{name}: error along the normal PV {:.2} nm, RMS {:.2} nm; decentre {:.3}, {:.3} µm, tilt {:.1}, {:.1} µrad",
+            f.pv_nm, f.rms_nm, r.decentre_x_um, r.decentre_y_um, r.tilt_x_urad, r.tilt_y_urad
+        );
+    }
+    for (n, text) in &files {
+        eprintln!("wrote {} ({} bytes)", dir.join(n).display(), text.len());
+    }
+    0
+}
+
+/// Prints a refusal over the measurement file (its text, when it is
+/// text) and returns exit code 1.
+fn refuse(out: &Output, part: &Path, bytes: &[u8], f: &Failure) -> u8 {
+    let text = std::str::from_utf8(bytes)
+        .map(str::to_owned)
+        .unwrap_or_default();
+    let at = f.at.filter(|a| *a <= text.len()).unwrap_or(0);
+    let mut sources = SourceMap::default();
+    let id = sources.add(part.display().to_string(), Some(part.to_path_buf()), text);
+    let mut d = Diagnostic::error(f.code, f.message.clone(), id, Span::new(at, at));
+    if let Some(h) = &f.help {
+        d = d.with_help(h.clone());
+    }
+    let _ = match out.format {
+        MessageFormat::Human => {
+            render::human(&[d], &sources, out.color, &mut std::io::stderr().lock())
+        }
+        MessageFormat::Json => render::json_lines(&[d], &sources, &mut std::io::stdout().lock()),
+    };
+    1
+}
