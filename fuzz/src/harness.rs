@@ -108,12 +108,6 @@ pub enum Depth {
 
 /// Runs `bytes` as far as `depth` asks (and the checker lets it).
 pub fn run(fs: &MemFs, bytes: &[u8], depth: Depth, out_dir: &Path) -> Result<Reached, Fault> {
-    match depth {
-        Depth::Verify(pair) => return crate::targets::verify(fs, bytes, pair),
-        Depth::Import { json } => return crate::targets::import(fs, bytes, json),
-        Depth::Lsp => return crate::targets::lsp(bytes),
-        _ => {}
-    }
     let c = driver::check_text(fs, "fuzz.lens", bytes);
     let sources = &c.loaded.sources;
     well_formed(c.diags(), sources)?;
@@ -128,6 +122,7 @@ pub fn run(fs: &MemFs, bytes: &[u8], depth: Depth, out_dir: &Path) -> Result<Rea
         return Ok(reached);
     }
     match depth {
+        // Not `.lens` inputs: `targets::run` takes them before they come here.
         Depth::Check | Depth::Verify(_) | Depth::Import { .. } | Depth::Lsp => {}
         Depth::Lower | Depth::LowerWithin(_) => {
             let limits = match depth {

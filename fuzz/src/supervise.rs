@@ -15,7 +15,7 @@ use std::sync::Arc;
 use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender, channel};
 use std::time::Duration;
 
-use crate::harness::{self, Depth, Fault, MemFs, Reached};
+use crate::harness::{Depth, Fault, MemFs, Reached};
 
 /// Inputs one worker thread runs before the next takes over.
 const BATCH: u64 = 1000;
@@ -28,7 +28,7 @@ pub enum Outcome {
     Hung,
 }
 
-/// What a worker does with an input: `harness::run`, or a stand-in in
+/// What a worker does with an input: `targets::run`, or a stand-in in
 /// the tests.
 pub type Runner = fn(&MemFs, &[u8], Depth, &std::path::Path) -> Result<Reached, Fault>;
 
@@ -90,7 +90,7 @@ impl Supervisor {
             out_dir,
             timeout,
             worker: None,
-            runner: harness::run,
+            runner: crate::targets::run,
         }
     }
 

@@ -19,9 +19,20 @@ use lensc_lang::lower::read_back;
 use lensc_lang::source::SourceMap;
 use lensc_runtime::reader;
 
-use crate::harness::{Fault, MemFs, Reached, render, well_formed};
+use crate::harness::{Depth, Fault, MemFs, Reached, render, well_formed};
 use crate::mutate::Corpus;
 use crate::rng::Rng;
+
+/// Runs one input of any target: a program, a prescription or a session
+/// here, a `.lens` file through `harness::run`.
+pub fn run(fs: &MemFs, bytes: &[u8], depth: Depth, out_dir: &Path) -> Result<Reached, Fault> {
+    match depth {
+        Depth::Verify(pair) => verify(fs, bytes, pair),
+        Depth::Import { json } => import(fs, bytes, json),
+        Depth::Lsp => lsp(bytes),
+        _ => crate::harness::run(fs, bytes, depth, out_dir),
+    }
+}
 
 /// The stdlib machines and the dialects they are read by, for programs
 /// whose (mutated) header names none that can be found.
