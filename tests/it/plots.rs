@@ -163,12 +163,16 @@ fn a_roller_job_maps_its_form_error_with_a_scale() {
             "form error, cut − design (nm)",
         ],
     );
-    // The default window, 0.2 mm square at 1 µm: 201 × 201 cells, one
-    // per block.
+    // The whole part by default (issue #29): every cell of the raster,
+    // one per block.
     let all = series("tests/jobs/roller_small.lens");
     let f = all[0].1.form_error.as_ref().expect("height map series");
-    assert_eq!((f.raster.nx, f.raster.ny), (201, 201));
-    assert!(svg.contains("Shown on 201 × 201 blocks 1.00 µm square"));
+    let (nx, ny) = (f.raster.nx, f.raster.ny);
+    assert!(nx * ny > 201 * 201 / 10, "{nx} × {ny}");
+    assert!(
+        svg.contains(&format!("Shown on {nx} × {ny} blocks")),
+        "{nx} × {ny}"
+    );
     // The scale: one rectangle per colour level, and the map's colours are
     // the scale's.
     let fills = |s: &str| -> Vec<String> {
@@ -184,12 +188,18 @@ fn a_roller_job_maps_its_form_error_with_a_scale() {
     for f in &all_fills[..all_fills.len() - plots::COLOUR_LEVELS] {
         assert!(distinct.contains(f), "map colour {f} is not on the scale");
     }
-    // The least and largest block values are the report's extremes.
+    // The largest block value is the report's highest residual; the least
+    // lies within the report's PV of it (a block keeps its cells' error of
+    // largest magnitude, so a shallow low beside a high peak may not show
+    // once blocks hold many cells, as they do over the whole part).
     let (lo, hi) = f.raster.range().expect("cut blocks");
     let hm = &all[0].2["simulation"]["height_map"]["surface"];
     let max = hm["max_residual_nm"]["value"].as_f64().expect("nm");
     let pv = hm["pv_nm"].as_f64().expect("nm");
-    assert!((hi * 1e6 - max).abs() < 1e-9 && ((hi - lo) * 1e6 - pv).abs() < 1e-9);
+    assert!(
+        (hi * 1e6 - max).abs() < 1e-9 && (hi - lo) * 1e6 <= pv + 1e-9,
+        "blocks {lo} .. {hi} mm, report max {max} nm, pv {pv} nm"
+    );
 }
 
 #[test]
