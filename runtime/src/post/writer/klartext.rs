@@ -390,7 +390,13 @@ mod tests {
         w.call_tool(&start).expect("tool");
         w.write_all(&[
             M::SpindleOn(12000.0 * 2.0 * PI / 60.0),
-            M::Rapid(P::xyz(-1.0, 0.0, 0.0)),
+            // Above everything the program feeds through, then down at
+            // feed (a rapid below it would be a plunge, lensc's policy).
+            M::Rapid(P::xyz(-1.0, 0.0, 2.0)),
+            M::Linear {
+                to: P::xyz(-1.0, 0.0, 0.0),
+                feed: Some(F::PerTime(5.0)),
+            },
             // A quarter turn in ZX about (X0, Z0): from X-1 Z0 to X0 Z-1,
             // clockwise seen in Z then X.
             cut(
@@ -420,7 +426,7 @@ mod tests {
             "2 BLK FORM 0.2 X+2 Y+2 Z+0\n",
             "5 TOOL CALL 3 Z S12000\n6 M3\n",
             "CC X+0 Z+0\n",
-            "C X+0 Z-1 DR- F300\n",
+            "C X+0 Z-1 DR-\n",
             "CC Y+0 Z+0\n",
             "C Y+1 Z+0 DR+\n",
             "CYCL DEF 13.0 ORIENTATION\n",
