@@ -277,3 +277,26 @@ impl Default for Start {
         }
     }
 }
+
+/// A curve the controller interpolates itself: a clamped, non-rational
+/// B-spline of `order` (degree + 1) through X, Y and Z, as Fanuc's G06.2
+/// takes one. It starts at its first control point, which must be where
+/// the axes are, and ends at its last; `knots` holds as many values as
+/// control points plus the order, its first `order` equal and its last
+/// `order` equal. Positions are the tool centre's, like every move's.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Spline {
+    pub order: usize,
+    pub points: Vec<[f64; 3]>,
+    pub knots: Vec<f64>,
+    /// The feed along it; `None` keeps the feed in force.
+    pub feed: Option<Feed>,
+}
+
+/// One step of a program written with splines: a move of the stream, or
+/// a spline that stands for a run of its straight moves.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Step {
+    Move(Move),
+    Spline(Spline),
+}

@@ -9,5 +9,6 @@ pub mod optimise;
 pub mod raster;
 pub mod roller;
 pub mod spiral;
+pub mod spline;
 pub mod stream;
 pub mod turning;

@@ -1,0 +1,583 @@
+//! Splines in the move stream: runs of straight cutting moves refitted as
+//! clamped cubic B-splines (order 4, unit weights) of the form Fanuc's
+//! G06.2 takes (docs/controllers/fanuc.md): the first control point is
+//! where the run starts, the last where it ends, the first four knots
+//! equal and the last four equal. Each run is fitted by least squares
+//! with its two ends held (Piegl and Tiller, *The NURBS Book*, 2nd ed.,
+//! 1997, §9.4.1, eqs. 9.63–9.69: chord-length parameters, knots by
+//! averaging so every span holds points), with as few control points as
+//! hold the fit within its share of the tolerance, found by doubling and
+//! then halving the interval. Knots and control points are rounded as the
+//! program prints them (the dialect's decimals, the control point's
+//! offset added first) and the fit is checked again after rounding: every
+//! planned point, and the middle of each chord's arc (the circle through
+//! the chord's ends and a neighbour, standing for the exact path between
+//! planned points), must lie within the share plus the rounding the same
+//! points get when printed as lines. A run that cannot be held, or whose
+//! spline would take as many blocks as its lines, stays lines. The
+//! controller's evaluation of the curve is not this file's: the reader
+//! evaluates it from the program's text (`reader/nurbs.rs`).
+
+use crate::moves::{ControlOffset, Feed, Move, Position, Spline, Step};
+
+/// Order (degree + 1) of the splines written.
+pub const ORDER: usize = 4;
+const DEGREE: usize = ORDER - 1;
+
+/// The fewest straight moves a run needs to be fitted: below it a spline
+/// (at least four control points and four knot blocks) saves nothing.
+pub const FEWEST_LINES: usize = 16;
+
+/// Consecutive moves turning more than this (cosine of the angle, 25°)
+/// break a run: a corner (a plunge, a lift) is kept sharp.
+const CORNER_COS: f64 = 0.906;
+
+/// What a fit is held to.
+#[derive(Clone, Copy, Debug)]
+pub struct SplineFit {
+    /// The fit's share of the path tolerance (mm).
+    pub tolerance: f64,
+    /// Decimals of the printed axes and knots.
+    pub decimals: u32,
+    /// The control point's offset from the tool centre, added before
+    /// rounding as the writer adds it.
+    pub control: ControlOffset,
+}
+
+impl SplineFit {
+    /// The rounding a printed point gets: half a unit of the last decimal
+    /// on each of three axes.
+    pub fn rounding(&self) -> f64 {
+        0.5 * 10f64.powi(-(self.decimals as i32)) * 3f64.sqrt()
+    }
+}
+
+/// What the fitting did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Summary {
+    /// Program blocks of the moves before (one each) and after (a spline
+    /// takes one block per control point and one per end knot).
+    pub blocks_before: usize,
+    pub blocks_after: usize,
+    pub splines: usize,
+    /// Straight moves the splines replaced.
+    pub lines_replaced: usize,
+    /// The largest distance (mm) of a planned point or chord's arc middle
+    /// from its spline as printed (rounded).
+    pub max_deviation: f64,
+    /// What that distance was held to (mm): the share plus the rounding.
+    pub limit: f64,
+}
+
+/// Fits every run of straight cutting moves of `moves` it can.
+pub fn fit_splines(moves: &[Move], fit: &SplineFit) -> (Vec<Step>, Summary) {
+    let mut out = Vec::with_capacity(moves.len() / 4);
+    let mut summary = Summary {
+        blocks_before: moves.len(),
+        limit: fit.tolerance + fit.rounding(),
+        ..Summary::default()
+    };
+    let mut at = [f64::NAN; 3];
+    let mut i = 0;
+    while i < moves.len() {
+        let (run_end, feed) = run(moves, i, at);
+        if run_end - i >= FEWEST_LINES {
+            let mut points = Vec::with_capacity(run_end - i + 1);
+            points.push(at);
+            let mut p = at;
+            for m in &moves[i..run_end] {
+                if let Move::Linear { to, .. } = m {
+                    p = merged(p, to);
+                    points.push(p);
+                }
+            }
+            if let Some((spline, deviation)) = fit_run(&points, fit) {
+                summary.splines += 1;
+                summary.lines_replaced += run_end - i;
+                summary.max_deviation = summary.max_deviation.max(deviation);
+                out.push(Step::Spline(Spline { feed, ..spline }));
+                at = p;
+                i = run_end;
+                continue;
+            }
+        }
+        // Not fitted: the run (or the one move) as it is.
+        for &m in &moves[i..run_end.max(i + 1)] {
+            if let Move::Rapid(to) | Move::Linear { to, .. } | Move::Arc { to, .. } = m {
+                at = merged(at, &to);
+            }
+            out.push(Step::Move(m));
+        }
+        i = run_end.max(i + 1);
+    }
+    summary.blocks_after = out
+        .iter()
+        .map(|s| match s {
+            Step::Move(_) => 1,
+            Step::Spline(s) => s.points.len() + s.order,
+        })
+        .sum();
+    (out, summary)
+}
+
+/// `at` moved to `to` (an axis `to` leaves alone stays).
+fn merged(at: [f64; 3], to: &Position) -> [f64; 3] {
+    let mut p = at;
+    for (v, t) in p.iter_mut().zip([to.x, to.y, to.z]) {
+        if !t.is_nan() {
+            *v = t;
+        }
+    }
+    p
+}
+
+/// Where the run of straight cutting moves starting at `moves[i]` (from
+/// `at`) ends (exclusive), and its feed: one feed per minute, no C, a
+/// known start, no corner.
+fn run(moves: &[Move], i: usize, at: [f64; 3]) -> (usize, Option<Feed>) {
+    if at.iter().any(|v| v.is_nan()) {
+        return (i, None);
+    }
+    let mut feed = None;
+    let mut prev = at;
+    let mut dir: Option<[f64; 3]> = None;
+    let mut j = i;
+    while let Some(Move::Linear { to, feed: f }) = moves.get(j) {
+        if !to.c.is_nan() {
+            break;
+        }
+        match (f, feed) {
+            (Some(Feed::PerTime(v)), _) if j == i => feed = Some(Feed::PerTime(*v)),
+            (None, _) => {}
+            (Some(f), Some(g)) if *f == g => {}
+            _ => break,
+        }
+        let p = merged(prev, to);
+        let d = [p[0] - prev[0], p[1] - prev[1], p[2] - prev[2]];
+        let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        if len == 0.0 {
+            break;
+        }
+        let d = [d[0] / len, d[1] / len, d[2] / len];
+        if let Some(e) = dir
+            && d[0] * e[0] + d[1] * e[1] + d[2] * e[2] < CORNER_COS
+        {
+            break;
+        }
+        dir = Some(d);
+        prev = p;
+        j += 1;
+    }
+    (j, feed)
+}
+
+/// The spline with the fewest control points that holds `points` within
+/// the fit's limits, and its largest deviation; none if it would not save
+/// blocks.
+fn fit_run(points: &[[f64; 3]], fit: &SplineFit) -> Option<(Spline, f64)> {
+    let lines = points.len() - 1;
+    // A spline of n control points takes n + 4 blocks: it must take fewer
+    // than half the lines' blocks to be worth writing.
+    let most = (lines / 2).checked_sub(ORDER)?;
+    if most < ORDER {
+        return None;
+    }
+    let params = chord_params(points);
+    let arcs = arc_middles(points);
+    let try_n = |n: usize| fitted(points, &params, &arcs, n, fit);
+    // Doubling, then halving the interval between a failure and a success.
+    let mut fail = ORDER - 1;
+    let mut n = ORDER;
+    let mut best = loop {
+        if let Some(b) = try_n(n) {
+            break b;
+        }
+        fail = n;
+        if n == most {
+            return None;
+        }
+        n = (n * 2).min(most);
+    };
+    let mut ok = n;
+    while ok - fail > 1 {
+        let mid = (ok + fail) / 2;
+        match try_n(mid) {
+            Some(b) => {
+                best = b;
+                ok = mid;
+            }
+            None => fail = mid,
+        }
+    }
+    Some(best)
+}
+
+/// Chord-length parameters of the points (mm from the first, along the
+/// polyline).
+fn chord_params(points: &[[f64; 3]]) -> Vec<f64> {
+    let mut u = Vec::with_capacity(points.len());
+    let mut s = 0.0;
+    u.push(0.0);
+    for w in points.windows(2) {
+        s += dist(w[0], w[1]);
+        u.push(s);
+    }
+    u
+}
+
+/// For each chord, the middle of the circle's arc through its ends and a
+/// neighbouring point (the next, or for the last chord the one before):
+/// where the exact path between two planned points is taken to run.
+fn arc_middles(points: &[[f64; 3]]) -> Vec<[f64; 3]> {
+    (0..points.len() - 1)
+        .map(|k| {
+            let (a, b) = (points[k], points[k + 1]);
+            let c = if k + 2 < points.len() {
+                points[k + 2]
+            } else if k > 0 {
+                points[k - 1]
+            } else {
+                return mid(a, b);
+            };
+            circle_arc_middle(a, b, c).unwrap_or_else(|| mid(a, b))
+        })
+        .collect()
+}
+
+fn mid(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        (a[0] + b[0]) / 2.0,
+        (a[1] + b[1]) / 2.0,
+        (a[2] + b[2]) / 2.0,
+    ]
+}
+
+/// The middle of the arc from `a` to `b` of the circle through `a`, `b`
+/// and `c`, on the side away from `c`'s arc; none for three points in a
+/// line.
+fn circle_arc_middle(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> Option<[f64; 3]> {
+    let ab = sub(b, a);
+    let ac = sub(c, a);
+    let n = cross(ab, ac);
+    let nn = dot(n, n);
+    if nn <= 1e-30 * dot(ab, ab) * dot(ac, ac) {
+        return None;
+    }
+    // Circumcentre of a, b, c.
+    let t = add(
+        scale(cross(n, ab), dot(ac, ac)),
+        scale(cross(ac, n), dot(ab, ab)),
+    );
+    let centre = add(a, scale(t, 0.5 / nn));
+    let r = dist(centre, a);
+    let m = mid(a, b);
+    let d = sub(m, centre);
+    let dl = dot(d, d).sqrt();
+    if dl == 0.0 {
+        return None;
+    }
+    // The minor arc from a to b (c lies beyond b, on the same circle).
+    Some(add(centre, scale(d, r / dl)))
+}
+
+/// The fit with `n` control points, rounded, if it holds.
+fn fitted(
+    points: &[[f64; 3]],
+    params: &[f64],
+    arcs: &[[f64; 3]],
+    n: usize,
+    fit: &SplineFit,
+) -> Option<(Spline, f64)> {
+    let m = points.len() - 1;
+    let unit = 10f64.powi(-(fit.decimals as i32));
+    let round = |v: f64| (v / unit).round() * unit;
+    let length = params[m];
+    let end = round(length);
+    if end <= 0.0 {
+        return None;
+    }
+    // Parameters scaled onto the printed knots' range.
+    let u: Vec<f64> = params.iter().map(|p| p * end / length).collect();
+    let knots = knots(&u, n, round)?;
+    let ctrl = least_squares(points, &u, &knots, n)?;
+    let o = [fit.control.x, fit.control.y, fit.control.z];
+    let check = |ctrl: &[[f64; 3]]| deviation(ctrl, &knots, points, &u, arcs);
+    if check(&ctrl) > fit.tolerance {
+        return None;
+    }
+    let printed: Vec<[f64; 3]> = ctrl
+        .iter()
+        .map(|p| std::array::from_fn(|i| round(p[i] + o[i]) - o[i]))
+        .collect();
+    let worst = check(&printed);
+    (worst <= fit.tolerance + fit.rounding()).then(|| {
+        (
+            Spline {
+                order: ORDER,
+                points: printed,
+                knots,
+                feed: None,
+            },
+            worst,
+        )
+    })
+}
+
+/// The clamped knot vector of `n` control points over parameters `u`,
+/// interior knots by averaging (Piegl and Tiller eq. 9.69), each rounded
+/// to the printed decimals; none if two interior knots round together or
+/// onto an end (a span with no length).
+fn knots(u: &[f64], n: usize, round: impl Fn(f64) -> f64) -> Option<Vec<f64>> {
+    let m = u.len() - 1;
+    let end = u[m];
+    let mut k = vec![0.0; ORDER];
+    let d = (m + 1) as f64 / (n - DEGREE) as f64;
+    for j in 1..n - DEGREE {
+        let jd = j as f64 * d;
+        let i = jd.floor() as usize;
+        let a = jd - i as f64;
+        let v = round((1.0 - a) * u[i.saturating_sub(1)] + a * u[i.min(m)]);
+        if v <= *k.last().expect("a knot") || v >= end {
+            return None;
+        }
+        k.push(v);
+    }
+    k.extend([end; ORDER]);
+    Some(k)
+}
+
+/// The span holding `t` (index of the knot at or before it, at most the
+/// last non-empty span's).
+fn span(knots: &[f64], n: usize, t: f64) -> usize {
+    if t >= knots[n] {
+        return n - 1;
+    }
+    // Largest s in DEGREE..n with knots[s] <= t.
+    let mut lo = DEGREE;
+    let mut hi = n;
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        if knots[mid] <= t {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
+/// The four non-zero cubic basis functions at `t` in span `s` (Piegl and
+/// Tiller algorithm A2.2): values for control points s−3 … s.
+fn basis(knots: &[f64], s: usize, t: f64) -> [f64; ORDER] {
+    let mut n = [0.0; ORDER];
+    let mut left = [0.0; ORDER];
+    let mut right = [0.0; ORDER];
+    n[0] = 1.0;
+    for j in 1..ORDER {
+        left[j] = t - knots[s + 1 - j];
+        right[j] = knots[s + j] - t;
+        let mut saved = 0.0;
+        for r in 0..j {
+            let tmp = n[r] / (right[r + 1] + left[j - r]);
+            n[r] = saved + right[r + 1] * tmp;
+            saved = left[j - r] * tmp;
+        }
+        n[j] = saved;
+    }
+    n
+}
+
+/// The curve's point at `t`.
+fn point(ctrl: &[[f64; 3]], knots: &[f64], t: f64) -> [f64; 3] {
+    let s = span(knots, ctrl.len(), t);
+    let b = basis(knots, s, t);
+    let mut p = [0.0; 3];
+    for (r, w) in b.iter().enumerate() {
+        let c = ctrl[s - DEGREE + r];
+        for i in 0..3 {
+            p[i] += w * c[i];
+        }
+    }
+    p
+}
+
+/// Interior control points by least squares, the ends held at the run's
+/// ends (Piegl and Tiller eqs. 9.63–9.67); none if the normal equations
+/// are singular.
+fn least_squares(points: &[[f64; 3]], u: &[f64], knots: &[f64], n: usize) -> Option<Vec<[f64; 3]>> {
+    let m = points.len() - 1;
+    let (q0, qm) = (points[0], points[m]);
+    let inner = n - 2;
+    // Banded normal matrix: a[i][d] = entry (i, i + d), d = 0..=DEGREE.
+    let mut a = vec![[0.0f64; ORDER]; inner];
+    let mut rhs = vec![[0.0f64; 3]; inner];
+    for k in 1..m {
+        let s = span(knots, n, u[k]);
+        let b = basis(knots, s, u[k]);
+        let first = s - DEGREE;
+        let mut r = points[k];
+        for (j, w) in b.iter().enumerate() {
+            let idx = first + j;
+            if idx == 0 {
+                r = sub(r, scale(q0, *w));
+            } else if idx == n - 1 {
+                r = sub(r, scale(qm, *w));
+            }
+        }
+        for (j, wj) in b.iter().enumerate() {
+            let ij = first + j;
+            if ij == 0 || ij == n - 1 {
+                continue;
+            }
+            let row = ij - 1;
+            for c in 0..3 {
+                rhs[row][c] += wj * r[c];
+            }
+            for (l, wl) in b.iter().enumerate().skip(j) {
+                let il = first + l;
+                if il == 0 || il == n - 1 {
+                    continue;
+                }
+                a[row][il - ij] += wj * wl;
+            }
+        }
+    }
+    // Banded Cholesky: a = L Lᵀ, L stored in place as l[i][d] = L(i + d, i).
+    for i in 0..inner {
+        for d in 0..ORDER {
+            let j = i + d;
+            if j >= inner {
+                break;
+            }
+            let mut v = a[i][d];
+            for k in 1..ORDER - d {
+                if k > i {
+                    break;
+                }
+                v -= a[i - k][k] * a[i - k][k + d];
+            }
+            if d == 0 {
+                if v <= 1e-300 {
+                    return None;
+                }
+                a[i][0] = v.sqrt();
+            } else {
+                a[i][d] = v / a[i][0];
+            }
+        }
+    }
+    // L y = rhs, then Lᵀ x = y.
+    let mut x = rhs;
+    for i in 0..inner {
+        for k in 1..ORDER {
+            if k > i {
+                break;
+            }
+            let l = a[i - k][k];
+            for c in 0..3 {
+                x[i][c] -= l * x[i - k][c];
+            }
+        }
+        for c in 0..3 {
+            x[i][c] /= a[i][0];
+        }
+    }
+    for i in (0..inner).rev() {
+        for d in 1..ORDER {
+            if i + d >= inner {
+                break;
+            }
+            let l = a[i][d];
+            for c in 0..3 {
+                x[i][c] -= l * x[i + d][c];
+            }
+        }
+        for c in 0..3 {
+            x[i][c] /= a[i][0];
+        }
+    }
+    let mut ctrl = Vec::with_capacity(n);
+    ctrl.push(q0);
+    ctrl.extend(x);
+    ctrl.push(qm);
+    ctrl.iter().flatten().all(|v| v.is_finite()).then_some(ctrl)
+}
+
+/// The largest distance from the curve of the planned points and of the
+/// chords' arc middles, each found by a few Newton steps on the distance
+/// from its parameter (the curve's derivatives by central differences).
+fn deviation(
+    ctrl: &[[f64; 3]],
+    knots: &[f64],
+    points: &[[f64; 3]],
+    u: &[f64],
+    arcs: &[[f64; 3]],
+) -> f64 {
+    let end = u[u.len() - 1];
+    let h = end * 1e-5;
+    let nearest = |q: [f64; 3], t0: f64, lo: f64, hi: f64| {
+        let mut t = t0;
+        let mut best = dist(point(ctrl, knots, t), q);
+        for _ in 0..4 {
+            let (a, b) = ((t - h).max(0.0), (t + h).min(end));
+            let (pa, pb, p) = (
+                point(ctrl, knots, a),
+                point(ctrl, knots, b),
+                point(ctrl, knots, t),
+            );
+            let d1 = scale(sub(pb, pa), 1.0 / (b - a));
+            let d2 = scale(add(sub(pb, scale(p, 2.0)), pa), 4.0 / ((b - a) * (b - a)));
+            let e = sub(p, q);
+            let g = dot(e, d1);
+            let gp = dot(d1, d1) + dot(e, d2);
+            if gp <= 0.0 {
+                break;
+            }
+            t = (t - g / gp).clamp(lo, hi);
+            let d = dist(point(ctrl, knots, t), q);
+            if d >= best {
+                break;
+            }
+            best = d;
+        }
+        best
+    };
+    let last = u.len() - 1;
+    let mut worst: f64 = 0.0;
+    for (k, &q) in points.iter().enumerate() {
+        let lo = u[k.saturating_sub(1)];
+        let hi = u[(k + 1).min(last)];
+        worst = worst.max(nearest(q, u[k], lo, hi));
+    }
+    for (k, &q) in arcs.iter().enumerate() {
+        worst = worst.max(nearest(q, (u[k] + u[k + 1]) / 2.0, u[k], u[k + 1]));
+    }
+    worst
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
+    [a[0] * s, a[1] * s, a[2] * s]
+}
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    let d = sub(a, b);
+    dot(d, d).sqrt()
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,170 @@
+use super::*;
+use crate::moves::{Feed, Move, Position};
+
+const FIT: SplineFit = SplineFit {
+    tolerance: 30e-6,
+    decimals: 4,
+    control: ControlOffset::CENTRE,
+};
+
+/// A raster-like pass: lines along X over a circle of radius `r` in XZ,
+/// `n` chords from x = −w to w, from a start at the pass's first point.
+fn pass(r: f64, w: f64, n: usize) -> Vec<Move> {
+    let z = |x: f64| (r * r - x * x).sqrt() - r;
+    let mut moves = vec![Move::Rapid(Position::xyz(-w, 0.5, z(-w)))];
+    for k in 1..=n {
+        let x = -w + 2.0 * w * k as f64 / n as f64;
+        moves.push(Move::Linear {
+            to: Position::xyz(x, 0.5, z(x)),
+            feed: (k == 1).then_some(Feed::PerTime(100.0 / 60.0)),
+        });
+    }
+    moves
+}
+
+/// The exact circle's distance from the spline, sampled densely along it
+/// (the curve evaluated here by de Boor's algorithm, not the fitter's
+/// basis functions).
+fn worst_from_circle(s: &Spline, r: f64) -> f64 {
+    let k = &s.knots;
+    let end = k[k.len() - 1];
+    let mut worst: f64 = 0.0;
+    for i in 0..=4000 {
+        let t = end * i as f64 / 4000.0;
+        let p = de_boor(s, t);
+        let d = (p[0].hypot(p[2] + r) - r).abs();
+        worst = worst.max(d);
+    }
+    worst
+}
+
+fn de_boor(s: &Spline, t: f64) -> [f64; 3] {
+    let (k, p, deg) = (&s.knots, &s.points, s.order - 1);
+    let n = p.len();
+    let mut j = deg;
+    while j + 1 < n && k[j + 1] <= t {
+        j += 1;
+    }
+    let mut d: Vec<[f64; 3]> = (0..=deg).map(|r| p[j - deg + r]).collect();
+    for r in 1..=deg {
+        for q in (r..=deg).rev() {
+            let i = j - deg + q;
+            let a = (t - k[i]) / (k[i + deg + 1 - r] - k[i]);
+            for c in 0..3 {
+                d[q][c] = (1.0 - a) * d[q - 1][c] + a * d[q][c];
+            }
+        }
+    }
+    d[deg]
+}
+
+#[test]
+fn a_smooth_pass_becomes_one_spline_within_its_limit() {
+    let moves = pass(1.0, 0.7, 400);
+    let (steps, summary) = fit_splines(&moves, &FIT);
+    let splines: Vec<&Spline> = steps
+        .iter()
+        .filter_map(|s| match s {
+            Step::Spline(s) => Some(s),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(splines.len(), 1, "{summary:?}");
+    let s = splines[0];
+    assert_eq!(s.knots.len(), s.points.len() + ORDER);
+    assert_eq!(s.feed, Some(Feed::PerTime(100.0 / 60.0)));
+    // Starts where the pass starts, ends where it ends.
+    assert!((s.points[0][0] + 0.7).abs() < 1e-12);
+    assert!((s.points[s.points.len() - 1][0] - 0.7).abs() < 1e-4);
+    assert!(summary.max_deviation <= summary.limit, "{summary:?}");
+    // The exact circle, not only the planned points, within the limit.
+    let worst = worst_from_circle(s, 1.0);
+    assert!(worst <= summary.limit, "{worst:e} over {:e}", summary.limit);
+    // A fraction of the blocks.
+    assert!(
+        summary.blocks_after * 5 <= summary.blocks_before,
+        "{summary:?}"
+    );
+}
+
+#[test]
+fn control_points_and_knots_are_printed_values() {
+    let fit = SplineFit {
+        control: ControlOffset {
+            x: 0.0,
+            y: 0.0,
+            z: -0.085_03,
+        },
+        ..FIT
+    };
+    let (steps, _) = fit_splines(&pass(1.0, 0.7, 400), &fit);
+    let Some(Step::Spline(s)) = steps.iter().find(|s| matches!(s, Step::Spline(_))) else {
+        panic!("no spline");
+    };
+    let on_grid = |v: f64| ((v * 1e4) - (v * 1e4).round()).abs() < 1e-6;
+    assert!(s.knots.iter().all(|&k| on_grid(k)));
+    assert!(
+        s.points[1..]
+            .iter()
+            .all(|p| on_grid(p[0]) && on_grid(p[1]) && on_grid(p[2] - 0.085_03))
+    );
+}
+
+/// Down `n` steps of 0.05 mm to Z0, then along X `n` steps.
+fn corner(n: usize) -> Vec<Move> {
+    let mut moves = vec![Move::Rapid(Position::xyz(0.0, 0.0, n as f64 * 0.05))];
+    for k in 1..=n {
+        moves.push(Move::Linear {
+            to: Position::xyz(0.0, 0.0, (n - k) as f64 * 0.05),
+            feed: (k == 1).then_some(Feed::PerTime(1.0)),
+        });
+    }
+    for k in 1..=n {
+        moves.push(Move::Linear {
+            to: Position::xyz(k as f64 * 0.05, 0.0, 0.0),
+            feed: None,
+        });
+    }
+    moves
+}
+
+#[test]
+fn short_runs_stay_lines() {
+    let moves = corner(10);
+    let (steps, summary) = fit_splines(&moves, &FIT);
+    assert_eq!(summary.splines, 0);
+    assert_eq!(steps.len(), moves.len());
+}
+
+#[test]
+fn a_corner_is_kept() {
+    let (steps, summary) = fit_splines(&corner(30), &FIT);
+    assert_eq!(summary.splines, 2, "{summary:?}");
+    let ends: Vec<([f64; 3], [f64; 3])> = steps
+        .iter()
+        .filter_map(|s| match s {
+            Step::Spline(s) => Some((s.points[0], s.points[s.points.len() - 1])),
+            _ => None,
+        })
+        .collect();
+    // The first ends at the corner, the second starts there.
+    assert!(ends[0].1.iter().all(|v| v.abs() < 1e-12), "{ends:?}");
+    assert!(ends[1].0.iter().all(|v| v.abs() < 1e-12), "{ends:?}");
+}
+
+#[test]
+fn a_pass_too_coarse_to_hold_stays_lines() {
+    // Chords 0.1 mm long over a 0.2 mm radius: no cubic through few
+    // enough points to save blocks holds 30 nm of every chord's arc.
+    let mut moves = vec![Move::Rapid(Position::xyz(0.2, 0.0, 0.0))];
+    for k in 1..=40 {
+        let a = k as f64 * 0.35;
+        moves.push(Move::Linear {
+            to: Position::xyz(0.2 * a.cos(), 0.0, 0.2 * a.sin()),
+            feed: (k == 1).then_some(Feed::PerTime(1.0)),
+        });
+    }
+    let (steps, summary) = fit_splines(&moves, &FIT);
+    assert_eq!(summary.splines, 0, "{summary:?}");
+    assert_eq!(steps.len(), moves.len());
+}
