@@ -123,6 +123,23 @@ pub struct Dialect {
     /// G95 would switch it off): no feed-mode word is written while it is
     /// on, and a feed per minute under it is refused.
     pub surface_speed_per_revolution: bool,
+    /// The spline the controller interpolates and lensc writes (none:
+    /// lines and arcs only).
+    pub spline: Option<SplineForm>,
+    /// The control option the spline needs, for the header and the
+    /// set-up sheet (empty: none named).
+    pub spline_option: String,
+    /// Whether a job that does not say writes splines (`interpolation:
+    /// spline` as the dialect's default).
+    pub spline_by_default: bool,
+}
+
+/// A controller's spline, as lensc writes and reads it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SplineForm {
+    /// Fanuc's NURBS interpolation, G06.2: rank P, knots K, weights R,
+    /// control points in any of X, Y, Z (docs/controllers/fanuc.md).
+    Nurbs,
 }
 
 /// A Fanuc lathe's G-code system (parameter-selected on the control).
@@ -247,6 +264,9 @@ impl Dialect {
             gcode_system: None,
             length_offset: String::new(),
             surface_speed_per_revolution: false,
+            spline: None,
+            spline_option: String::new(),
+            spline_by_default: false,
         }
     }
 }

@@ -1130,6 +1130,156 @@ impl ProgramWriter {
         Ok(())
     }
 
+    /// Writes one step of a program written with splines.
+    pub fn write_step(&mut self, s: &crate::moves::Step) -> Result<(), ProgramError> {
+        match s {
+            crate::moves::Step::Move(m) => self.write_move(m),
+            crate::moves::Step::Spline(sp) => self.write_spline(sp),
+        }
+    }
+
+    /// Writes a spline in the dialect's form: Fanuc's NURBS interpolation,
+    /// `G06.2 P<order> K<knot> X Y Z [F]` with the first control point
+    /// (where the axes are), one `K X Y Z` block per further control
+    /// point, then one `K` block per end knot (docs/controllers/fanuc.md).
+    /// Every control point states X, Y and Z (the control interpolates
+    /// only the axes its second block names); knots are printed to the
+    /// axes' decimals, weights left out (1). The blocks are written whole
+    /// or not at all.
+    pub fn write_spline(&mut self, s: &crate::moves::Spline) -> Result<(), ProgramError> {
+        if self.dialect.spline != Some(crate::dialect::SplineForm::Nurbs)
+            || self.dialect.language != Language::GCode
+        {
+            return Err(ProgramError::Unsupported(format!(
+                "splines ({} has no spline lensc writes)",
+                self.dialect.name
+            )));
+        }
+        if self.start.is_none() {
+            return Err(ProgramError::Unsupported(
+                "a move before the tool is called (the writer's `call_tool`)".into(),
+            ));
+        }
+        if self.pending_tool_call.is_some() {
+            self.write_tool_call(None)?;
+        }
+        if self.spindle == Spindle::Stopped && !self.c_axis_on {
+            return Err(ProgramError::Unsupported(
+                "a feed move with the spindle stopped".into(),
+            ));
+        }
+        if self.pending_length_offset.is_some() {
+            return Err(ProgramError::Unsupported(
+                "a spline before the first move that takes the length offset".into(),
+            ));
+        }
+        let n = s.points.len();
+        if s.knots.len() != n + s.order || n < s.order || !(2..=4).contains(&s.order) {
+            return Err(ProgramError::Unsupported(format!(
+                "a spline of order {} with {n} control points and {} knots",
+                s.order,
+                s.knots.len()
+            )));
+        }
+        if self.letters[..3].iter().any(|l| l.is_none()) {
+            return Err(ProgramError::Unsupported(
+                "a spline on a machine without X, Y and Z".into(),
+            ));
+        }
+        let o = self.control.map_or([0.0; 3], |c| [c.x, c.y, c.z]);
+        let start = self.text.len();
+        let r = self.spline_blocks(s, o);
+        if r.is_err() {
+            self.text.truncate(start);
+        }
+        r
+    }
+
+    fn spline_blocks(&mut self, s: &crate::moves::Spline, o: [f64; 3]) -> Result<(), ProgramError> {
+        use crate::moves::Feed as F;
+        let d = self.decimals;
+        let knot_format = Decimals::new(d);
+        let mut printed = [0i64; 3];
+        let mut new_mode = None;
+        let mut new_feed = None;
+        for (i, p) in s.points.iter().enumerate() {
+            let start = self.text.len();
+            self.begin_block();
+            if i == 0 {
+                if matches!(s.feed, Some(F::PerTime(_))) && self.mode != Some(FeedMode::PerMinute) {
+                    let w = self.feed_mode_word(FeedMode::PerMinute)?.to_string();
+                    self.text.extend_from_slice(w.as_bytes());
+                    self.text.push(b' ');
+                    new_mode = Some(FeedMode::PerMinute);
+                } else if s.feed.is_some_and(|f| !matches!(f, F::PerTime(_))) {
+                    return Err(ProgramError::Unsupported(
+                        "a spline fed other than per minute".into(),
+                    ));
+                }
+                self.text
+                    .extend_from_slice(format!("G06.2 P{} ", s.order).as_bytes());
+            }
+            self.knot_word(s.knots[i], &knot_format)?;
+            for (a, letter) in ['X', 'Y', 'Z'].into_iter().enumerate() {
+                let value = (p[a] + o[a]) * self.axis_scale[a];
+                let Some(units) = self.axis_formats[a].units(value) else {
+                    return Err(self.not_printable(a, p[a]));
+                };
+                self.text.push(b' ');
+                self.text.push(letter as u8);
+                self.number(letter, value, units, self.axis_decimals[a])?;
+                printed[a] = units;
+            }
+            if i == 0
+                && let Some(F::PerTime(v)) = s.feed
+            {
+                let f = v * 60.0;
+                let Some(units) = self.feed_format.units(f) else {
+                    return Err(ProgramError::NotPrintable {
+                        word: 'F',
+                        value: f,
+                    });
+                };
+                self.text.extend_from_slice(b" F");
+                self.number('F', f, units, self.feed_decimals)?;
+                new_feed = Some(units);
+            }
+            self.end_block(start)?;
+        }
+        for &k in &s.knots[s.points.len()..] {
+            let start = self.text.len();
+            self.begin_block();
+            self.knot_word(k, &knot_format)?;
+            self.end_block(start)?;
+        }
+        // The axes are at the last control point, as printed.
+        if let Some(mode) = new_mode {
+            self.mode = Some(mode);
+        }
+        if new_feed.is_some() {
+            self.last_feed = new_feed;
+        }
+        let last = s.points[s.points.len() - 1];
+        for a in 0..3 {
+            self.last[a] = printed[a];
+            self.at[a] = last[a];
+        }
+        self.moves += 1;
+        Ok(())
+    }
+
+    /// A knot word `K…`, printed to `format`'s decimals.
+    fn knot_word(&mut self, k: f64, format: &Decimals) -> Result<(), ProgramError> {
+        let Some(units) = format.units(k) else {
+            return Err(ProgramError::NotPrintable {
+                word: 'K',
+                value: k,
+            });
+        };
+        self.text.push(b'K');
+        self.number('K', k, units, format.places())
+    }
+
     /// Writes every move of a stream.
     pub fn write_all<'a>(
         &mut self,

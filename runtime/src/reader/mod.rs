@@ -25,6 +25,7 @@ mod klartext;
 mod lexer;
 mod modal;
 mod motion;
+mod nurbs;
 mod policy;
 mod spline;
 
@@ -127,6 +128,10 @@ pub enum Rule {
     PositionUnknown,
     /// A block after the program's end (lensc's policy).
     BlockAfterEnd,
+    /// A spline block the controller refuses: its rank, knots, weights,
+    /// a block without its knot, a curve cut short or not starting where
+    /// the tool is (Fanuc G06.2, `nurbs`).
+    SplineRefused,
 }
 
 /// One thing wrong with a program: where (line from 1, byte span in the

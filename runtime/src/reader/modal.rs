@@ -33,6 +33,8 @@ pub(crate) enum Motion {
     Cancel,
     /// LinuxCNC's G5 and G5.1 (`spline`).
     Spline(super::spline::Spline),
+    /// Fanuc's G06.2 (`nurbs`), where the dialect has it.
+    Nurbs,
 }
 
 /// The modal group of a G code (value × 10, `G05.1` is 51).
@@ -126,6 +128,10 @@ pub(crate) struct State {
     pub spline_points: Vec<(f64, f64)>,
     /// The moves made so far, when they are asked for.
     pub moves: Option<Vec<super::Executed>>,
+    /// Whether the dialect has NURBS interpolation (G06.2).
+    nurbs_mode: bool,
+    /// The NURBS curve being read, until its last knot.
+    pub nurbs: Option<super::nurbs::Nurbs>,
     ended: bool,
     /// A Klartext program's own reader, whose blocks become words.
     klartext: Option<Klartext>,
@@ -217,6 +223,8 @@ impl State {
             pre_cut_rapid: None,
             last_spline_pq: None,
             spline_points: Vec::new(),
+            nurbs_mode: d.spline == Some(crate::dialect::SplineForm::Nurbs),
+            nurbs: None,
             moves: None,
             ended: false,
             klartext: (lex.controller == Controller::HeidenhainKlartext).then(Klartext::default),
@@ -305,7 +313,15 @@ impl State {
             .any(|(g, _)| matches!(g, GGroup::SpindleCap | GGroup::NonModal))
         {
             // G50 S and G4 take their own words; no move.
-            self.move_block(b, line, out);
+            if self.motion == Some(Motion::Nurbs) {
+                let starts = groups
+                    .iter()
+                    .any(|(g, _)| *g == GGroup::Motion(Motion::Nurbs));
+                self.nurbs_block(b, starts, line, out);
+            } else {
+                self.nurbs_cut_short(line, out);
+                self.move_block(b, line, out);
+            }
         }
         if ms.iter().any(|(m, _)| *m == MCode::End) {
             self.ended = true;
@@ -313,8 +329,26 @@ impl State {
         }
     }
 
+    /// A NURBS curve left before its last knot: the control refuses it.
+    fn nurbs_cut_short(&mut self, line: &str, out: &mut Vec<Found>) {
+        if let Some(n) = self.nurbs.take() {
+            out.push((
+                Rule::SplineRefused,
+                (0, line.len()),
+                format!(
+                    "the NURBS curve ends before its last knot: {} control points need {} knot blocks after them, {} given",
+                    n.points.len(),
+                    n.order,
+                    n.end_knots
+                ),
+                None,
+            ));
+        }
+    }
+
     /// What is wrong once the whole program is read.
     pub fn finish(&mut self, out: &mut Vec<Found>) {
+        self.nurbs_cut_short("", out);
         if let Some(k) = &self.klartext {
             k.finish(out);
         }
@@ -498,6 +532,7 @@ impl State {
             800 if c == LinuxCnc => GGroup::Motion(Motion::Cancel),
             50 if c == LinuxCnc => GGroup::Motion(Motion::Spline(super::spline::Spline::Cubic)),
             51 if c == LinuxCnc => GGroup::Motion(Motion::Spline(super::spline::Spline::Quadratic)),
+            62 if self.nurbs_mode => GGroup::Motion(Motion::Nurbs),
             800 if c == Fanuc || c == UltraPrecision => GGroup::Cycle,
             430 | 490 if c == LinuxCnc || c == Fanuc => GGroup::ToolLength,
             70 if c == LinuxCnc => GGroup::Diameter(true),

@@ -313,7 +313,7 @@ impl State {
     }
 
     /// Tool, spindle, feed mode and feed, before any cut.
-    fn may_cut(&self, b: &Block, span: (usize, usize), out: &mut Vec<Found>) {
+    pub(super) fn may_cut(&self, b: &Block, span: (usize, usize), out: &mut Vec<Found>) {
         if !self.tool_loaded {
             out.push((
                 Rule::NoTool,
@@ -360,7 +360,7 @@ impl State {
 
     /// The feed of the move (mm/min) against the machine's, and in inverse
     /// time C's speed against the spindle's.
-    fn feed_limit(
+    pub(super) fn feed_limit(
         &self,
         b: &Block,
         start: &[Option<f64>; 4],

@@ -503,3 +503,99 @@ fn linuxcnc_reads_parameters_and_expressions() {
         );
     }
 }
+
+/// A Fanuc mill that interpolates NURBS (G06.2).
+fn fanuc_nurbs() -> Dialect {
+    let mut d = Dialect::linuxcnc();
+    d.start = vec!["%".into(), "O{number} ({JOB})".into()];
+    d.mill_setup = vec!["G17 G21 G40 G49 G80 G90 G94".into()];
+    d.max_digits = Some(8);
+    d.max_decimals = Some(4);
+    d.spline = Some(crate::dialect::SplineForm::Nurbs);
+    d
+}
+
+fn mill() -> MachineLimits {
+    MachineLimits {
+        lathe: false,
+        travel: [
+            Some((-100.0, 100.0)),
+            Some((-100.0, 100.0)),
+            Some((-50.0, 50.0)),
+            None,
+        ],
+        max_feed: Some(5000.0),
+        max_spindle_rpm: Some(20000.0),
+    }
+}
+
+/// A rank-3 NURBS over three control points in X and Z, a quarter of the
+/// unit circle about (0, 0, -1) with the middle weight √2/2: the tool ends
+/// at X1 Z-1 and every move read lies on the circle.
+const NURBS: &str = "%\nO1 (J)\n(+Z out of the material)\nG17 G21 G40 G49 G80 G90 G94\nT1 M6\nG97 S1000 M3\nG0 X0. Y0. Z1.\nG1 Z0. F100.\nG06.2 P3 K0. X0. Y0. Z0. F100.\nK0. X1. Y0. Z0. R0.7071\nK0. X1. Y0. Z-1.\nK1.\nK1.\nK1.\nG1 X2.\nG0 Z1.\nM5\nM30\n%\n";
+
+#[test]
+fn a_nurbs_curve_is_read_as_the_control_moves_it() {
+    let d = fanuc_nurbs();
+    assert_eq!(Controller::of(&d), Controller::Fanuc);
+    let (found, moves) = read_moves(NURBS, &d, &mill());
+    assert_eq!(found, vec![]);
+    let on_curve: Vec<&Executed> = moves
+        .iter()
+        .filter(|m| m.from[2].is_some_and(|z| z <= 0.0) && m.to[0].is_some_and(|x| x <= 1.0))
+        .collect();
+    assert!(on_curve.len() > 50, "{}", on_curve.len());
+    let last = on_curve[on_curve.len() - 1].to;
+    assert_eq!((last[0], last[2]), (Some(1.0), Some(-1.0)));
+    // R0.7071 is √2/2 to 4 decimals: on the circle to well under 1e-4.
+    for m in &on_curve {
+        let (x, z) = (m.to[0].unwrap(), m.to[2].unwrap());
+        assert!((x.hypot(z + 1.0) - 1.0).abs() < 2e-5, "{x} {z}");
+    }
+    // The next G1 starts where the curve ends.
+    let after = moves.iter().find(|m| m.to[0] == Some(2.0)).expect("G1 X2.");
+    assert_eq!((after.from[0], after.from[2]), (Some(1.0), Some(-1.0)));
+}
+
+#[test]
+fn a_nurbs_curve_the_control_refuses_is_found_with_its_span() {
+    let d = fanuc_nurbs();
+    let cases: &[(&str, &str, &str)] = &[
+        ("G06.2 P3", "G06.2 P5", "P5"),
+        ("K0. X1. Y0. Z-1.", "X1. Y0. Z-1.", "1002"),
+        ("K1.\nK1.\nK1.\n", "K1.\nK1.\n", "before its last knot"),
+        (
+            "K0. X1. Y0. Z-1.",
+            "K0.5 X1. Y0. Z-1.",
+            "must each be equal",
+        ),
+        ("R0.7071", "R-1.", "above zero"),
+        (
+            "G06.2 P3 K0. X0. Y0. Z0.",
+            "G06.2 P3 K0. X0.1 Y0. Z0.",
+            "where the tool is",
+        ),
+        (
+            "K0. X1. Y0. Z0. R0.7071",
+            "K0. X1. Y0. Z0. R0.7071 P3",
+            "only in the G06.2 block",
+        ),
+    ];
+    for (from, to, what) in cases {
+        let text = NURBS.replacen(from, to, 1);
+        assert_ne!(text, NURBS, "{from}");
+        let found = read(&text, &d, &mill());
+        let f = found
+            .iter()
+            .find(|f| f.rule == Rule::SplineRefused)
+            .unwrap_or_else(|| panic!("{to}: {found:?}"));
+        assert!(f.message.contains(what), "{to}: {}", f.message);
+        assert!(
+            f.span.1 > f.span.0 || what.contains("last knot"),
+            "{to}: {f:?}"
+        );
+    }
+    // Without the dialect's spline, G06.2 is a code the control lacks.
+    let found = rules(NURBS, &Dialect { spline: None, ..d }, &mill());
+    assert!(found.contains(&Rule::UnknownWord), "{found:?}");
+}

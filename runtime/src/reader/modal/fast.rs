@@ -67,7 +67,10 @@ impl State {
         let Some(rules) = self.fast.as_ref().filter(|_| self.fast_on) else {
             return false;
         };
-        if self.ended || rules.max_line_length.is_some_and(|max| line.len() > max) {
+        if self.ended
+            || self.nurbs.is_some()
+            || rules.max_line_length.is_some_and(|max| line.len() > max)
+        {
             return false;
         }
         // The words: each letter once, each number as the lexer reads it

@@ -1,0 +1,505 @@
+//! Fanuc's NURBS interpolation (G06.2) as the control reads and moves it,
+//! from *FANUC Series 15i/150i-MA Operator's Manual (Programming)*, §4.17,
+//! pp. 143–144 and 158 (docs/controllers/fanuc.md): `G06.2 [P] K X Y Z
+//! [R] [F]` starts the mode, one block per control point `K X Y Z [R]`
+//! follows, then as many blocks holding only a knot as the rank P (2 to
+//! 4, default 4). The rules checked: P in 2..4 and only in the first block;
+//! a knot in every block (alarm 1002); as many knots as control points
+//! plus the rank, the first rank knots equal and the last rank equal
+//! (alarm 1007); no knot value more than rank times (alarm 1008); knots
+//! never decreasing and weights above zero (Mitsubishi's rules for the
+//! same format, an assumption for Fanuc); the first control point where
+//! the tool is; absolute coordinates (lensc's policy: the reader does not
+//! read incremental control points). The curve is evaluated by the
+//! manual's definition: P(t) = Σ N_i,k(t) w_i P_i / Σ N_i,k(t) w_i, the
+//! basis by de Boor–Cox's recursion, and handed over as straight moves
+//! within [`super::spline::SPLINE_TOLERANCE`] of it. This shares no code
+//! with the fitter (`plan/spline.rs`).
+
+use super::lexer::{Block, Found};
+use super::modal::State;
+use super::{Executed, Path, Rule};
+
+/// The most straight moves one span of a curve is sampled into.
+const MOST_PIECES_PER_SPAN: usize = 4096;
+
+/// A NURBS curve being read, block by block.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Nurbs {
+    /// The rank (order): degree + 1.
+    pub order: usize,
+    pub points: Vec<[f64; 3]>,
+    pub weights: Vec<f64>,
+    pub knots: Vec<f64>,
+    /// Blocks holding only a knot, read so far.
+    pub end_knots: usize,
+    /// Where the tool was when the curve began.
+    pub start: [Option<f64>; 4],
+    /// The span of the `G06.2` block's words, in its line.
+    pub span: (usize, usize),
+}
+
+impl Nurbs {
+    /// What the control refuses in the whole curve, if anything.
+    fn refusal(&self) -> Option<String> {
+        let k = self.order;
+        let n = self.points.len();
+        if n < k {
+            return Some(format!(
+                "a NURBS curve of rank {k} needs at least {k} control points; this one has {n}"
+            ));
+        }
+        if self.knots.windows(2).any(|w| w[1] < w[0]) {
+            return Some("the knots of a NURBS curve may not decrease".into());
+        }
+        let (first, last) = (self.knots[0], self.knots[self.knots.len() - 1]);
+        if self.knots[..k].iter().any(|&v| v != first)
+            || self.knots[self.knots.len() - k..]
+                .iter()
+                .any(|&v| v != last)
+        {
+            return Some(format!(
+                "the first {k} knots and the last {k} knots of a NURBS curve of rank {k} must each be equal (the curve runs from its first control point to its last; Fanuc alarm 1007)"
+            ));
+        }
+        if last <= first {
+            return Some("a NURBS curve's last knot must be above its first".into());
+        }
+        let mut run = 1;
+        for w in self.knots.windows(2) {
+            run = if w[1] == w[0] { run + 1 } else { 1 };
+            if run > k {
+                return Some(format!(
+                    "a knot value repeated more than the rank ({k}) times (Fanuc alarm 1008)"
+                ));
+            }
+        }
+        if let Some(w) = self.weights.iter().find(|w| **w <= 0.0) {
+            return Some(format!("a NURBS weight R{w}: weights must be above zero"));
+        }
+        None
+    }
+
+    /// The curve at `t`, by the manual's rational form with the basis by
+    /// de Boor–Cox's recursion over the span holding `t`.
+    pub(crate) fn at(&self, t: f64) -> [f64; 3] {
+        let k = self.order;
+        let n = self.points.len();
+        let x = &self.knots;
+        // The span i with x[i] <= t < x[i+1], among the curve's (k-1 .. n-1).
+        let mut s = k - 1;
+        while s + 1 < n && x[s + 1] <= t {
+            s += 1;
+        }
+        // N[j] for the basis functions i = s-k+1+j of rank r, built up
+        // from rank 1 (1 on span s only).
+        let mut basis = vec![0.0; k];
+        basis[k - 1] = 1.0;
+        for r in 2..=k {
+            let mut next = vec![0.0; k];
+            for (j, slot) in next.iter_mut().enumerate() {
+                let i = s + 1 + j - k;
+                let a = ratio(t - x[i], x[i + r - 1] - x[i]) * basis[j];
+                let right = if j + 1 < k { basis[j + 1] } else { 0.0 };
+                let b = ratio(x[i + r] - t, x[i + r] - x[i + 1]) * right;
+                *slot = a + b;
+            }
+            basis = next;
+        }
+        let (mut num, mut den) = ([0.0; 3], 0.0);
+        for (j, nb) in basis.iter().enumerate() {
+            let i = s + 1 + j - k;
+            let w = nb * self.weights[i];
+            den += w;
+            for c in 0..3 {
+                num[c] += w * self.points[i][c];
+            }
+        }
+        [num[0] / den, num[1] / den, num[2] / den]
+    }
+
+    /// The curve as points whose chords stay within the reader's spline
+    /// tolerance of it: each knot span halved until the chord's middle
+    /// and quarters lie that close to the curve.
+    pub(crate) fn sampled(&self) -> Vec<[f64; 3]> {
+        let x = &self.knots;
+        let (first, last) = (x[0], x[x.len() - 1]);
+        let mut out = vec![self.at(first)];
+        let mut breaks: Vec<f64> = x.iter().copied().filter(|v| *v > first).collect();
+        breaks.dedup();
+        let mut from = first;
+        for to in breaks {
+            let mut pieces = 1;
+            while pieces < MOST_PIECES_PER_SPAN && !self.within(from, to, pieces) {
+                pieces *= 2;
+            }
+            for p in 1..=pieces {
+                let t = if p == pieces {
+                    to
+                } else {
+                    from + (to - from) * p as f64 / pieces as f64
+                };
+                out.push(if t == last {
+                    self.end_point()
+                } else {
+                    self.at(t)
+                });
+            }
+            from = to;
+        }
+        out
+    }
+
+    /// The last control point: where a clamped curve ends (the basis at
+    /// the last knot, whose half-open span is empty, taken as its limit).
+    fn end_point(&self) -> [f64; 3] {
+        self.points[self.points.len() - 1]
+    }
+
+    /// Whether `pieces` equal chords of [a, b] lie within the tolerance.
+    fn within(&self, a: f64, b: f64, pieces: usize) -> bool {
+        let h = (b - a) / pieces as f64;
+        (0..pieces).all(|p| {
+            let (t0, t1) = (a + h * p as f64, a + h * (p + 1) as f64);
+            let (p0, p1) = (self.at(t0), self.at(t1));
+            [0.25, 0.5, 0.75].iter().all(|f| {
+                let c = self.at(t0 + (t1 - t0) * f);
+                let chord = [
+                    p0[0] + f * (p1[0] - p0[0]),
+                    p0[1] + f * (p1[1] - p0[1]),
+                    p0[2] + f * (p1[2] - p0[2]),
+                ];
+                let d = ((c[0] - chord[0]).powi(2)
+                    + (c[1] - chord[1]).powi(2)
+                    + (c[2] - chord[2]).powi(2))
+                .sqrt();
+                d <= super::spline::SPLINE_TOLERANCE / 2.0
+            })
+        })
+    }
+}
+
+/// a / b, and 0 for 0 / 0 (the recursion's convention for repeated knots).
+fn ratio(a: f64, b: f64) -> f64 {
+    if b == 0.0 { 0.0 } else { a / b }
+}
+
+impl State {
+    /// A block in NURBS mode (`starts`: it holds G06.2).
+    pub(crate) fn nurbs_block(
+        &mut self,
+        b: &Block,
+        starts: bool,
+        line: &str,
+        out: &mut Vec<Found>,
+    ) {
+        let Some(first) = b.words.iter().find(|w| w.letter != 'N') else {
+            return;
+        };
+        let span = (first.span.0, b.words.last().expect("a word").span.1);
+        let refuse = |msg: String, out: &mut Vec<Found>| {
+            out.push((Rule::SplineRefused, span, msg, None));
+        };
+        let word = |l: char| b.words.iter().find(|w| w.letter == l);
+        if starts {
+            if self.nurbs.is_some() {
+                refuse(
+                    "G06.2 before the NURBS curve in force has its last knot".into(),
+                    out,
+                );
+            }
+            let order = word('P').map_or(4.0, |w| w.value);
+            if !(2.0..=4.0).contains(&order) || order.fract() != 0.0 {
+                refuse(
+                    format!("NURBS rank P{order}: the control takes P2, P3 or P4"),
+                    out,
+                );
+                self.nurbs = None;
+                self.motion = None;
+                return;
+            }
+            if self.absolute != Some(true) {
+                refuse(
+                    "a NURBS curve in incremental coordinates: lensc reads NURBS control points in G90 only".into(),
+                    out,
+                );
+            }
+            self.nurbs = Some(Nurbs {
+                order: order as usize,
+                start: self.pos,
+                span,
+                ..Nurbs::default()
+            });
+        } else if word('P').is_some() {
+            refuse(
+                "P (the NURBS rank) is given only in the G06.2 block".into(),
+                out,
+            );
+        }
+        let Some(nurbs) = self.nurbs.as_mut() else {
+            return;
+        };
+        let Some(k) = word('K') else {
+            refuse(
+                "a block of a NURBS curve without its knot K (Fanuc alarm 1002)".into(),
+                out,
+            );
+            self.nurbs = None;
+            return;
+        };
+        let unit = if self.metric == Some(false) {
+            25.4
+        } else {
+            1.0
+        };
+        let axes: Vec<_> = b
+            .words
+            .iter()
+            .filter(|w| matches!(w.letter, 'X' | 'Y' | 'Z'))
+            .collect();
+        if axes.is_empty() && !(starts && nurbs.points.is_empty()) {
+            nurbs.knots.push(k.value);
+            nurbs.end_knots += 1;
+        } else {
+            if nurbs.end_knots > 0 {
+                refuse(
+                    "a control point after the NURBS curve's end knots".into(),
+                    out,
+                );
+                self.nurbs = None;
+                return;
+            }
+            // Axes left out keep the previous control point's (the first
+            // one's: where the tool is).
+            let mut p = match nurbs.points.last() {
+                Some(p) => *p,
+                None => [
+                    nurbs.start[0].unwrap_or(f64::NAN),
+                    nurbs.start[1].unwrap_or(f64::NAN),
+                    nurbs.start[2].unwrap_or(f64::NAN),
+                ],
+            };
+            for w in &axes {
+                let i = match w.letter {
+                    'X' => 0,
+                    'Y' => 1,
+                    _ => 2,
+                };
+                p[i] = w.value * unit;
+            }
+            nurbs.points.push(p);
+            nurbs.weights.push(word('R').map_or(1.0, |w| w.value));
+            nurbs.knots.push(k.value);
+        }
+        if nurbs.end_knots < nurbs.order {
+            return;
+        }
+        let nurbs = self.nurbs.take().expect("a curve");
+        self.nurbs_done(nurbs, b, span, line, out);
+    }
+
+    /// A curve read to its last knot: checked, then moved along.
+    fn nurbs_done(
+        &mut self,
+        nurbs: Nurbs,
+        b: &Block,
+        span: (usize, usize),
+        _line: &str,
+        out: &mut Vec<Found>,
+    ) {
+        if let Some(msg) = nurbs.refusal() {
+            out.push((Rule::SplineRefused, nurbs.span, msg, None));
+            return;
+        }
+        let start = nurbs.start;
+        let p0 = nurbs.points[0];
+        let known = (0..3).all(|i| start[i].is_some() || p0[i].is_nan());
+        let off = (0..3).any(|i| match start[i] {
+            Some(s) => (s - p0[i]).abs() > 1e-9,
+            None => !p0[i].is_nan(),
+        });
+        if !known || off || p0.iter().any(|v| v.is_nan()) {
+            out.push((
+                Rule::SplineRefused,
+                nurbs.span,
+                "the NURBS curve's first control point is not where the tool is: the curve must start from the current position".into(),
+                Some("give the current position as the first control point, in the G06.2 block".into()),
+            ));
+            return;
+        }
+        self.may_cut(b, nurbs.span, out);
+        let points = nurbs.sampled();
+        let length: f64 = points
+            .windows(2)
+            .map(|w| {
+                ((w[1][0] - w[0][0]).powi(2)
+                    + (w[1][1] - w[0][1]).powi(2)
+                    + (w[1][2] - w[0][2]).powi(2))
+                .sqrt()
+            })
+            .sum();
+        let last = points[points.len() - 1];
+        let mut end = self.pos;
+        for i in 0..3 {
+            end[i] = Some(last[i]);
+        }
+        self.feed_limit(b, &start, &end, length, span, out);
+        for (i, lim) in self.machine.travel.iter().enumerate().take(3) {
+            if let Some((lo, hi)) = lim
+                && let Some(p) = points.iter().find(|p| p[i] < lo - 1e-9 || p[i] > hi + 1e-9)
+            {
+                out.push((
+                    Rule::OutsideTravel,
+                    nurbs.span,
+                    format!(
+                        "this NURBS curve takes {} to {} mm, outside the machine's travel {} .. {} mm",
+                        ["X", "Y", "Z"][i],
+                        p[i],
+                        lo,
+                        hi
+                    ),
+                    None,
+                ));
+                break;
+            }
+        }
+        if self.away < 3 {
+            let a = self.away;
+            let high = points
+                .iter()
+                .map(|p| p[a])
+                .fold(f64::NEG_INFINITY, f64::max);
+            self.top = Some(self.top.map_or(high, |t| t.max(high)));
+        }
+        if let Some(moves) = &mut self.moves {
+            for w in points.windows(2) {
+                let mut from = start;
+                let mut to = start;
+                for i in 0..3 {
+                    from[i] = Some(w[0][i]);
+                    to[i] = Some(w[1][i]);
+                }
+                moves.push(Executed {
+                    from,
+                    to,
+                    path: Path::Line,
+                });
+            }
+        }
+        self.pos = end;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn curve(order: usize, points: &[[f64; 3]], weights: &[f64], knots: &[f64]) -> Nurbs {
+        Nurbs {
+            order,
+            points: points.to_vec(),
+            weights: weights.to_vec(),
+            knots: knots.to_vec(),
+            ..Nurbs::default()
+        }
+    }
+
+    /// A quarter circle as a rational quadratic (rank 3) with weights 1,
+    /// √2/2, 1: every sampled point on the unit circle, within the
+    /// sampling's own rounding.
+    #[test]
+    fn a_rational_quadratic_quarter_circle_lies_on_the_circle() {
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let c = curve(
+            3,
+            &[[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+            &[1.0, h, 1.0],
+            &[0.0, 0.0, 0.0, 1.0, 1.0, 1.0],
+        );
+        assert_eq!(c.refusal(), None);
+        let pts = c.sampled();
+        assert_eq!(pts[0], [1.0, 0.0, 0.0]);
+        assert_eq!(pts[pts.len() - 1], [0.0, 1.0, 0.0]);
+        for p in &pts {
+            assert!((p[0].hypot(p[1]) - 1.0).abs() < 1e-12, "{p:?}");
+        }
+        // Sampled finely enough for 1 nm chords, not needlessly finer.
+        assert!(pts.len() > 100 && pts.len() < 5000, "{}", pts.len());
+    }
+
+    /// A clamped cubic with one interior knot against its Bézier pieces,
+    /// worked by hand: knots 0 0 0 0 1 2 2 2 2 and control points on a
+    /// line x = 0, 1, 2, 3, 4 make x(t) = 2t (a linear function is
+    /// reproduced by the Greville abscissae 0, 1/3, 1, 5/3, 2 … here the
+    /// points are chosen at them).
+    #[test]
+    fn a_cubic_reproduces_a_straight_line_at_its_greville_points() {
+        let g = [0.0, 1.0 / 3.0, 1.0, 5.0 / 3.0, 2.0];
+        let pts: Vec<[f64; 3]> = g.iter().map(|x| [*x, 0.0, 2.0 * x]).collect();
+        let c = curve(
+            4,
+            &pts,
+            &[1.0; 5],
+            &[0.0, 0.0, 0.0, 0.0, 1.0, 2.0, 2.0, 2.0, 2.0],
+        );
+        assert_eq!(c.refusal(), None);
+        for i in 0..=20 {
+            let t = i as f64 / 10.0;
+            let p = c.at(t.min(2.0 - 1e-15));
+            assert!((p[0] - t).abs() < 1e-12 && (p[2] - 2.0 * t).abs() < 1e-12);
+        }
+        // A straight line needs one chord per span.
+        assert_eq!(c.sampled().len(), 3);
+    }
+
+    #[test]
+    fn curves_the_control_refuses_are_refused() {
+        let pts = [[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [3.0, 0.0, 0.0]];
+        let ok = [0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
+        assert_eq!(curve(4, &pts, &[1.0; 4], &ok).refusal(), None);
+        for (knots, weights, what) in [
+            (
+                vec![0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0, 1.0],
+                [1.0; 4],
+                "equal",
+            ),
+            (
+                vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 0.5],
+                [1.0; 4],
+                "decrease",
+            ),
+            (ok.to_vec(), [1.0, 0.0, 1.0, 1.0], "above zero"),
+            (vec![0.0; 8], [1.0; 4], "above its first"),
+        ] {
+            let r = curve(4, &pts, &weights, &knots).refusal();
+            assert!(r.as_deref().is_some_and(|m| m.contains(what)), "{r:?}");
+        }
+        let five = [
+            [0.0; 3],
+            [1.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [3.0, 0.0, 0.0],
+            [4.0, 0.0, 0.0],
+            [5.0, 0.0, 0.0],
+        ];
+        let r = curve(
+            2,
+            &five,
+            &[1.0; 6],
+            &[0.0, 0.0, 0.5, 0.5, 0.5, 1.0, 1.0, 1.0],
+        )
+        .refusal();
+        assert!(r.as_deref().is_some_and(|m| m.contains("1008")), "{r:?}");
+        let r = curve(
+            4,
+            &pts[..3],
+            &[1.0; 3],
+            &[0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0],
+        )
+        .refusal();
+        assert!(
+            r.as_deref().is_some_and(|m| m.contains("at least")),
+            "{r:?}"
+        );
+    }
+}
