@@ -14,6 +14,7 @@
 pub mod accept;
 pub mod chords;
 pub mod estimate;
+pub mod interpolation;
 pub mod tolerance;
 pub mod window;
 
@@ -86,6 +87,9 @@ pub struct JobHead {
     pub start: Start,
     /// What the tool's offsets are measured to, in words and as stated.
     pub control: ControlPoint,
+    /// The program moves between planned points by the controller's
+    /// spline (`interpolation: spline`), not lines and arcs.
+    pub spline: bool,
 }
 
 /// The tool's control point: what its length (and on a lathe its X)
@@ -452,7 +456,9 @@ impl<'a> Parts<'a> {
                 .cloned()
                 .unwrap_or_else(|| o.kind.name.to_string())
         };
+        let spline = interpolation::spline(self, &dialect);
         JobHead {
+            spline,
             name: self.job.name.name.clone(),
             site: self.site(),
             names: PartNames {

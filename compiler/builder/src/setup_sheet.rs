@@ -194,6 +194,9 @@ pub fn sheet(head: &JobHead, built: &Built) -> String {
             }
         ),
     );
+    if let Some(i) = after("interpolation: ") {
+        line("interpolation", &i);
+    }
     line(
         "program ends",
         &format!("{} (the dialect's end blocks)", head.dialect.end.join(", ")),

@@ -84,6 +84,9 @@ pub const NO_SURFACE_SPEED: &str = "E0177";
 pub const CONTROL_POINT_NOT_EXPRESSIBLE: &str = "E0178";
 /// A path tolerance finer than the machine's resolution can hold.
 pub const TOLERANCE_BELOW_RESOLUTION: &str = "E0180";
+/// `interpolation: spline` where lensc writes no spline: the dialect has
+/// none (in the path's plane), or the strategy is not fitted yet.
+pub const SPLINE_NOT_OFFERED: &str = "E0182";
 /// `lensc fmt` refused to write a layout that would not parse back to the
 /// same program (a formatter bug; the file is left as it is).
 pub const FORMAT_WOULD_CHANGE_MEANING: &str = "E0185";
@@ -255,6 +258,10 @@ pub const PROGRAM_UNUSED_WORD: &str = "E0333";
 pub const PROGRAM_POSITION_UNKNOWN: &str = "E0334";
 /// A block after the program's end (M2, M30), which is never run.
 pub const PROGRAM_BLOCK_AFTER_END: &str = "E0335";
+/// A spline block the controller refuses (Fanuc G06.2: its rank, knots,
+/// weights, a block without its knot, a curve cut short or not starting
+/// where the tool is).
+pub const PROGRAM_SPLINE_REFUSED: &str = "E0340";
 
 /// A fast-tool-servo table (`lensc verify`) with a row that is not three
 /// numbers C X W, or whose C runs backwards.
@@ -300,6 +307,7 @@ pub fn program_rule(rule: lensc_runtime::reader::Rule) -> &'static str {
         UnusedWord => PROGRAM_UNUSED_WORD,
         PositionUnknown => PROGRAM_POSITION_UNKNOWN,
         BlockAfterEnd => PROGRAM_BLOCK_AFTER_END,
+        SplineRefused => PROGRAM_SPLINE_REFUSED,
     }
 }
 
@@ -364,6 +372,7 @@ pub const ALL: &[&str] = &[
     NO_SURFACE_SPEED,
     CONTROL_POINT_NOT_EXPRESSIBLE,
     TOLERANCE_BELOW_RESOLUTION,
+    SPLINE_NOT_OFFERED,
     ACCEPTANCE_MISSED,
     ACCEPTANCE_UNMEASURED,
     UNUSED,
@@ -431,6 +440,7 @@ pub const ALL: &[&str] = &[
     PROGRAM_UNUSED_WORD,
     PROGRAM_POSITION_UNKNOWN,
     PROGRAM_BLOCK_AFTER_END,
+    PROGRAM_SPLINE_REFUSED,
     SERVO_TABLE_ROW,
     ACCEPTANCE_MISSED_WARNING,
     ACCEPTANCE_UNMEASURED_WARNING,

@@ -129,6 +129,31 @@ pub fn emit_mill(
     w.finish()
 }
 
+/// `emit_mill` for a program written with splines (`plan::spline`).
+pub fn emit_mill_steps(
+    dialect: &Dialect,
+    job: &str,
+    header: &[String],
+    steps: &[moves::Step],
+    (resolution, tolerance): (f64, f64),
+    start: &Start,
+) -> Result<String, ProgramError> {
+    let mut w = ProgramWriter::new(
+        dialect,
+        Setup::Mill,
+        job,
+        header,
+        "XYZ",
+        resolution,
+        tolerance * optimise::BLEND_SHARE,
+    )?;
+    w.call_tool(start)?;
+    for s in steps {
+        w.write_step(s)?;
+    }
+    w.finish()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -219,6 +219,7 @@ pub fn lower_job(
         } else if let Some(e) = crate::job::start_error(job, &p.params, d, setup) {
             errors.push(e);
         }
+        errors.extend(crate::job::interpolation::error(&p, d));
     }
     match spec {
         Ok(spec) => {

@@ -209,6 +209,22 @@ const GCODE_PARAMS: &[Param] = &[
         "gcode_system",
         "a Fanuc lathe's G-code system, as its parameter sets the control: `\"A\"` (G98/G99 feeds per minute and per revolution, `G50 S` the spindle clamp, G90 G92 G94 turning cycles, no G90/G91 words), `b` or `c` (G94/G95 feeds, `G92 S` the clamp, G90 absolute); lines may hold `{feeds}` (A: `G98`; B, C: `G90 G94`), `{clamp}` (A: `G50`; B, C: `G92`) and `{home}` (A: `G28 U0. W0.`; B, C: `G91 G28 X0. Z0.`), and `per_minute` and `per_revolution` default to the system's words; only for a lathe, and only A, B or C (E0176); absent: not a Fanuc lathe",
     ),
+    opt(
+        "spline",
+        Ty::Word(&["none", "nurbs"]),
+        Check::Any,
+        "the spline the controller interpolates that lensc writes: `nurbs` (Fanuc's G06.2: rank P, knots K, weights R, control points in X, Y and Z, docs/controllers/fanuc.md) or `none` (the default: a job asking `interpolation: spline` is E0182)",
+    ),
+    text(
+        "spline_option",
+        "the control option the spline needs, named in the program's header and the set-up sheet; default none named",
+    ),
+    opt(
+        "interpolation",
+        Ty::Word(&["lines_arcs", "spline"]),
+        Check::Any,
+        "how a job that does not say is written: `lines_arcs` (the default) or `spline` (only where `spline` names one)",
+    ),
     text(
         "length_offset",
         "words taking the tool's length offset in the block of the first move that states Z after the tool call (`G43 H{offset}`: Fanuc's G43 H with its Z move); default none (the tool call takes it)",
@@ -305,6 +321,11 @@ pub struct Gcode {
     pub length_offset: String,
     /// `surface_speed_feed: per_revolution`.
     pub surface_speed_per_revolution: bool,
+    /// `spline: nurbs`.
+    pub nurbs: bool,
+    pub spline_option: String,
+    /// `interpolation: spline`.
+    pub spline_by_default: bool,
 }
 
 impl Gcode {
@@ -386,6 +407,9 @@ impl Gcode {
             gcode_system: opt_text("gcode_system"),
             length_offset: text("length_offset", ""),
             surface_speed_per_revolution: r.word("surface_speed_feed") == Some("per_revolution"),
+            nurbs: r.word("spline") == Some("nurbs"),
+            spline_option: text("spline_option", ""),
+            spline_by_default: r.word("interpolation") == Some("spline"),
         }
     }
 }

@@ -223,6 +223,12 @@ pub static JOB_PARAMS: &[Param] = &[
         "coolant through the whole program: `flood` (M8), `mist` (M7) or `off` (default)",
     ),
     opt(
+        "interpolation",
+        Ty::Word(&["lines_arcs", "spline"]),
+        Check::Any,
+        "how the program moves the tool between planned points: `lines_arcs` (straight moves and arcs) or `spline` (the controller's own spline, fitted within the path tolerance's share, where its dialect has one: E0182 where not); default the dialect's (`lines_arcs` in every standard dialect)",
+    ),
+    opt(
         "accept",
         Ty::BlockOr(ACCEPT_PARAMS, &["none"]),
         Check::Any,
@@ -245,6 +251,9 @@ pub struct JobParams {
     pub part_sites: PartSites,
     /// The `accept` block as written.
     pub accept: AcceptParams,
+    /// `interpolation: spline` (true) or `lines_arcs` (false), with where;
+    /// none: the dialect's default.
+    pub interpolation: Option<crate::value::Stated<bool>>,
 }
 
 /// A job's `accept`, as written: none (the defaults), `none`, or a block.
@@ -325,6 +334,12 @@ impl JobParams {
                     })
                     .unwrap_or_default(),
             },
+            interpolation: r
+                .stated_word("interpolation")
+                .map(|w| crate::value::Stated {
+                    value: w.value == "spline",
+                    site: w.site,
+                }),
             part_sites: PartSites {
                 surface: r.site("surface"),
                 tool: r.site("tool"),

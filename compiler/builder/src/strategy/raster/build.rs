@@ -49,30 +49,78 @@ pub(super) fn build(spec: &RasterSpec, cx: &BuildContext) -> Result<Built, Vec<D
     if !errors.is_empty() {
         return Err(errors);
     }
-    // Points placed clear of the material are not fitted back into it.
-    let (moves, optimised) = lensc_runtime::plan::optimise::optimise_within(
-        &moves,
-        raster.chord_tolerance * lensc_runtime::plan::optimise::FIT_SHARE,
-        &dialect.arc_planes,
-        matches!(
-            raster.chords,
-            lensc_runtime::plan::chords::ChordPlacement::Clear { .. }
-        ),
-    );
     let resolution = head.resolution;
-    let start = lensc_runtime::moves::Start {
-        blank: blank(&moves, tool),
-        ..head.start
+    let fit_share = raster.chord_tolerance * lensc_runtime::plan::optimise::FIT_SHARE;
+    let (moves, optimised, text) = if head.spline {
+        // The planned moves fitted with the controller's splines; the
+        // moves themselves stay the path the fit is measured against.
+        let decimals = lensc_runtime::post::check_dialect(
+            dialect,
+            lensc_runtime::post::Setup::Mill,
+            resolution,
+        )
+        .map_err(|e| vec![parts::not_printable(head, e)])?;
+        let fit = lensc_runtime::plan::spline::SplineFit {
+            tolerance: fit_share,
+            decimals,
+            control: head.start.control,
+        };
+        let (steps, fitted) = lensc_runtime::plan::spline::fit_splines(&moves, &fit);
+        let optimised = Summary {
+            moves_before: fitted.blocks_before,
+            moves_after: fitted.blocks_after,
+            arcs: 0,
+            merged_lines: 0,
+            max_deviation: fitted.max_deviation,
+            tolerance: fitted.limit,
+        };
+        let start = lensc_runtime::moves::Start {
+            blank: blank(&moves, tool),
+            ..head.start
+        };
+        let mut header = header_lines(spec, prov, &path, &optimised);
+        header.retain(|l| !l.starts_with("optimised "));
+        let at = header
+            .iter()
+            .position(|l| l.starts_with("machine "))
+            .unwrap_or(header.len());
+        header.insert(at, spline_words(dialect, &fitted));
+        let text = lensc_runtime::emit::raster::emit_mill_steps(
+            dialect,
+            &head.name,
+            &header,
+            &steps,
+            (resolution, raster.chord_tolerance),
+            &start,
+        )
+        .map_err(|e| vec![parts::not_printable(head, e)])?;
+        (moves, optimised, text)
+    } else {
+        // Points placed clear of the material are not fitted back into it.
+        let (moves, optimised) = lensc_runtime::plan::optimise::optimise_within(
+            &moves,
+            fit_share,
+            &dialect.arc_planes,
+            matches!(
+                raster.chords,
+                lensc_runtime::plan::chords::ChordPlacement::Clear { .. }
+            ),
+        );
+        let start = lensc_runtime::moves::Start {
+            blank: blank(&moves, tool),
+            ..head.start
+        };
+        let text = lensc_runtime::emit::raster::emit_mill(
+            dialect,
+            &head.name,
+            &header_lines(spec, prov, &path, &optimised),
+            &moves,
+            (resolution, raster.chord_tolerance),
+            &start,
+        )
+        .map_err(|e| vec![parts::not_printable(head, e)])?;
+        (moves, optimised, text)
     };
-    let text = lensc_runtime::emit::raster::emit_mill(
-        dialect,
-        &head.name,
-        &header_lines(spec, prov, &path, &optimised),
-        &moves,
-        (resolution, raster.chord_tolerance),
-        &start,
-    )
-    .map_err(|e| vec![parts::not_printable(head, e)])?;
     let section = report::Raster::new(&path, raster, feed, &optimised);
     let time = section.cutting_time_s;
     let toolpath = report::Toolpath::Raster(section);
@@ -210,6 +258,29 @@ fn blank(
     (0..3)
         .all(|i| min[i] <= max[i])
         .then_some(lensc_runtime::moves::Blank { min, max })
+}
+
+/// The header line of a program written with splines: which, how many,
+/// how close, and the control option they need.
+fn spline_words(
+    dialect: &lensc_runtime::dialect::Dialect,
+    s: &lensc_runtime::plan::spline::Summary,
+) -> String {
+    format!(
+        "interpolation: NURBS (G06.2, order {}): {} splines for {} straight moves, {} blocks of moves instead of {}, largest deviation {} nm (limit {} nm); needs the control's {}",
+        lensc_runtime::plan::spline::ORDER,
+        s.splines,
+        s.lines_replaced,
+        s.blocks_after,
+        s.blocks_before,
+        lensc_runtime::post::header::num((s.max_deviation * 1e7).round() / 10.0),
+        lensc_runtime::post::header::num((s.limit * 1e7).round() / 10.0),
+        if dialect.spline_option.is_empty() {
+            "spline interpolation"
+        } else {
+            &dialect.spline_option
+        }
+    )
 }
 
 /// The program's header: provenance, units, surface, the tool, the raster

@@ -1,0 +1,63 @@
+//! How a job's program moves the tool between planned points: straight
+//! moves and arcs, or the controller's own spline (`interpolation`, the
+//! job's or its dialect's default), and E0182 where the spline asked for
+//! is one lensc cannot write: the dialect has none (LinuxCNC's G5–G5.2 are
+//! in the XY plane only, and no lensc path lies in it; Siemens, Heidenhain
+//! and the ultra-precision lathes are not written yet:
+//! docs/controllers/), or the strategy's programs are not fitted yet
+//! (raster jobs only, so far).
+
+use lensc_grammar::Diagnostic;
+use lensc_lang::codes;
+use lensc_runtime::dialect::Dialect;
+
+use super::Parts;
+
+/// The strategies whose programs are fitted with splines.
+pub const SPLINE_STRATEGIES: &[&str] = &["raster"];
+
+/// Whether the job's program is written with splines: as the job says,
+/// else as its dialect's default.
+pub fn spline(p: &Parts, dialect: &Dialect) -> bool {
+    p.params
+        .interpolation
+        .as_ref()
+        .map_or(dialect.spline_by_default, |s| s.value)
+}
+
+/// E0182 if the job is to be written with splines that lensc cannot
+/// write for its dialect or strategy.
+pub fn error(p: &Parts, dialect: &Dialect) -> Option<Diagnostic> {
+    if !spline(p, dialect) {
+        return None;
+    }
+    let strategy = p.strategy.kind.name;
+    let (message, help) = if dialect.spline.is_none() {
+        (
+            format!(
+                "`interpolation: spline`, but the `{}` dialect has no spline lensc writes",
+                dialect.name
+            ),
+            "write `interpolation: lines_arcs`, or build in a dialect with `spline: nurbs` (`fanuc_0i_mill`); LinuxCNC's G5, G5.1 and G5.2 interpolate in the XY plane only, and Siemens' BSPLINE is not written yet (docs/controllers/)".to_string(),
+        )
+    } else if !SPLINE_STRATEGIES.contains(&strategy) {
+        (
+            format!(
+                "`interpolation: spline` for a `{strategy}` job: lensc fits splines to raster jobs only so far"
+            ),
+            "write `interpolation: lines_arcs` for this job".to_string(),
+        )
+    } else {
+        return None;
+    };
+    let (file, span) = p
+        .params
+        .interpolation
+        .as_ref()
+        .map_or((p.job.file, p.job.name.span), |s| s.site);
+    Some(
+        Diagnostic::error(codes::SPLINE_NOT_OFFERED, message, file, span)
+            .with_label("no spline here")
+            .with_help(help),
+    )
+}
