@@ -35,8 +35,6 @@ pub(crate) struct Nurbs {
     pub end_knots: usize,
     /// Where the tool was when the curve began.
     pub start: [Option<f64>; 4],
-    /// The span of the `G06.2` block's words, in its line.
-    pub span: (usize, usize),
 }
 
 impl Nurbs {
@@ -227,7 +225,6 @@ impl State {
             self.nurbs = Some(Nurbs {
                 order: order as usize,
                 start: self.pos,
-                span,
                 ..Nurbs::default()
             });
         } else if word('P').is_some() {
@@ -235,6 +232,12 @@ impl State {
                 "P (the NURBS rank) is given only in the G06.2 block".into(),
                 out,
             );
+        }
+        let has_axes = b.words.iter().any(|w| matches!(w.letter, 'X' | 'Y' | 'Z'));
+        if word('K').is_none() && !has_axes && !starts && self.nurbs.is_none() {
+            // No curve being read and nothing of one here (`M5` after a
+            // curve, G06.2 still modal): not a NURBS block.
+            return;
         }
         let Some(nurbs) = self.nurbs.as_mut() else {
             return;
@@ -308,7 +311,8 @@ impl State {
         out: &mut Vec<Found>,
     ) {
         if let Some(msg) = nurbs.refusal() {
-            out.push((Rule::SplineRefused, nurbs.span, msg, None));
+            // Found when its last knot is read: the span is that block's.
+            out.push((Rule::SplineRefused, span, msg, None));
             return;
         }
         let start = nurbs.start;
@@ -321,13 +325,13 @@ impl State {
         if !known || off || p0.iter().any(|v| v.is_nan()) {
             out.push((
                 Rule::SplineRefused,
-                nurbs.span,
+                span,
                 "the NURBS curve's first control point is not where the tool is: the curve must start from the current position".into(),
                 Some("give the current position as the first control point, in the G06.2 block".into()),
             ));
             return;
         }
-        self.may_cut(b, nurbs.span, out);
+        self.may_cut(b, span, out);
         let points = nurbs.sampled();
         let length: f64 = points
             .windows(2)
@@ -350,7 +354,7 @@ impl State {
             {
                 out.push((
                     Rule::OutsideTravel,
-                    nurbs.span,
+                    span,
                     format!(
                         "this NURBS curve takes {} to {} mm, outside the machine's travel {} .. {} mm",
                         ["X", "Y", "Z"][i],
