@@ -42,6 +42,7 @@ mod read_back;
 mod rs274;
 mod sandbox;
 mod seed_sketches;
+mod splines;
 mod surface_fixtures;
 mod surface_kinds;
 mod toolpaths;

@@ -1,0 +1,103 @@
+//! Programs written with the controller's splines (`interpolation:
+//! spline`, issue #31): one raster job built with Fanuc's NURBS (G06.2)
+//! and with lines and arcs cuts the same form, as each program's text is
+//! read back and simulated; the spline program is read clean by `lensc
+//! verify`, says what it needs in its header and set-up sheet, and takes a
+//! fraction of the planned moves' blocks; a dialect without a spline
+//! refuses the job (E0182) and writes nothing.
+
+use crate::common::{lensc, text};
+
+/// Seed 000's hyperboloid (Lin 2022) scraped on the generic mill, at a
+/// 20 µm stepover to keep the test short: once with splines, once not.
+const JOBS: &str = "use std::machines::generic_3axis_mill
+use std::tools::microshaper_r85um
+surface hyperboloid = conic { radius: 1 mm, conic: -20, sense: convex, aperture: circle(diameter: 1.6 mm) }
+strategy scrape = raster { along: x, direction: one_way, stepover: 20 um, chord_tolerance: 200 nm, lin_angle: 5 deg, feed: 100 mm/min, retract: 0.05 mm }
+job with_splines { surface: hyperboloid, tool: microshaper_r85um, machine: generic_3axis_mill, strategy: scrape, interpolation: spline, accept: { form_pv: 300 nm, form_rms: 50 nm, max_gouge: 150 nm, uncut_area: 0 } }
+job with_lines { surface: hyperboloid, tool: microshaper_r85um, machine: generic_3axis_mill, strategy: scrape, accept: { form_pv: 300 nm, form_rms: 50 nm, max_gouge: 150 nm, uncut_area: 0 } }
+";
+
+fn measured(dir: &std::path::Path, job: &str, criterion: &str) -> f64 {
+    let report =
+        std::fs::read_to_string(dir.join(format!("out/{job}.report.json"))).expect("report");
+    let r: serde_json::Value = serde_json::from_str(&report).expect("json");
+    r["acceptance"]["criteria"]
+        .as_array()
+        .expect("criteria")
+        .iter()
+        .find(|c| c["criterion"] == criterion)
+        .and_then(|c| c["measured"].as_f64())
+        .expect("measured")
+}
+
+#[test]
+fn a_spline_program_cuts_the_form_its_lines_program_cuts() {
+    let dir = tempfile::tempdir().expect("tmp");
+    std::fs::write(dir.path().join("jobs.lens"), JOBS).expect("write");
+    let out = lensc(
+        dir.path(),
+        &["build", "jobs.lens", "--dialect", "fanuc_0i_mill"],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let program = std::fs::read_to_string(dir.path().join("out/with_splines.nc")).expect("nc");
+    let lines = std::fs::read_to_string(dir.path().join("out/with_lines.nc")).expect("nc");
+    assert!(program.contains("\nG06.2 P4 K0. "), "no NURBS block");
+    assert!(!lines.contains("G06.2"));
+    // The header's line, folded over comment lines (`(  ` continues one).
+    let all: Vec<&str> = program.lines().collect();
+    let i = all
+        .iter()
+        .position(|l| l.starts_with("(interpolation: NURBS"))
+        .expect("the header names the interpolation");
+    let header: String = std::iter::once(all[i])
+        .chain(
+            all[i + 1..]
+                .iter()
+                .copied()
+                .take_while(|l| l.starts_with("(  ")),
+        )
+        .map(|l| l.trim_start_matches('(').trim_end_matches(')').trim())
+        .collect::<Vec<_>>()
+        .join(" ");
+    assert!(header.contains("needs the control"), "{header}");
+    let sheet =
+        std::fs::read_to_string(dir.path().join("out/with_splines.setup.txt")).expect("sheet");
+    assert!(sheet.contains("interpolation  NURBS"), "{sheet}");
+    // The spline program as the control reads it: clean.
+    let verify = lensc(dir.path(), &["verify", "out/with_splines.nc"]);
+    assert_eq!(verify.status.code(), Some(0), "{}", text(&verify.stderr));
+    // The same form within what the fit may move the path: its share of
+    // the tolerance (30 nm) and the rounding of three axes to 0.1 um.
+    let limit = 30.0 + 0.05 * 3f64.sqrt() * 1e3;
+    for c in ["form_pv", "form_rms", "max_gouge"] {
+        let (s, l) = (
+            measured(dir.path(), "with_splines", c),
+            measured(dir.path(), "with_lines", c),
+        );
+        assert!(
+            (s - l).abs() <= limit,
+            "{c}: {s} nm with splines, {l} with lines"
+        );
+    }
+    // A fraction of the planned moves' blocks: the header counts them.
+    let counts: Vec<usize> = header
+        .split(|c: char| !c.is_ascii_digit())
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    // "order 4): S splines for L straight moves, A blocks of moves instead of B"
+    let (after, before) = (counts[3], counts[4]);
+    assert!(after * 4 <= before, "{after} blocks of {before}: {header}");
+}
+
+#[test]
+fn a_dialect_without_a_spline_refuses_it_and_writes_nothing() {
+    let dir = tempfile::tempdir().expect("tmp");
+    std::fs::write(dir.path().join("jobs.lens"), JOBS).expect("write");
+    // The generic mill's own dialect, LinuxCNC: G5.2 is in XY only.
+    let out = lensc(dir.path(), &["build", "jobs.lens"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = text(&out.stderr);
+    assert!(err.contains("[E0182]"), "{err}");
+    assert!(!dir.path().join("out/with_splines.ngc").exists());
+}
