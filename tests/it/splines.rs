@@ -80,14 +80,33 @@ fn a_spline_program_cuts_the_form_its_lines_program_cuts() {
             "{c}: {s} nm with splines, {l} with lines"
         );
     }
-    // A fraction of the planned moves' blocks: the header counts them.
-    let counts: Vec<usize> = header
-        .split(|c: char| !c.is_ascii_digit())
-        .filter_map(|w| w.parse().ok())
-        .collect();
-    // "order 4): S splines for L straight moves, A blocks of moves instead of B"
-    let (after, before) = (counts[3], counts[4]);
+    // Fewer blocks than the planned moves': the header counts both.
+    let number_before = |words: &str| -> usize {
+        let head = &header[..header.find(words).expect(words)];
+        let digits: String = head
+            .chars()
+            .rev()
+            .skip_while(|c| *c == ' ')
+            .take_while(|c| c.is_ascii_digit())
+            .collect();
+        digits
+            .chars()
+            .rev()
+            .collect::<String>()
+            .parse()
+            .expect("a count")
+    };
+    let (after, before) = (number_before(" blocks of moves"), number_before(" planned"));
     assert!(after * 4 <= before, "{after} blocks of {before}: {header}");
+    // Never more blocks than lines and arcs: a run is a spline only where
+    // that is shorter.
+    let blocks = |p: &str| p.lines().filter(|l| !l.starts_with('(')).count();
+    assert!(
+        blocks(&program) <= blocks(&lines),
+        "{} > {}",
+        blocks(&program),
+        blocks(&lines)
+    );
 }
 
 #[test]

@@ -69,8 +69,24 @@ pub struct Summary {
     pub limit: f64,
 }
 
-/// Fits every run of straight cutting moves of `moves` it can.
-pub fn fit_splines(moves: &[Move], fit: &SplineFit) -> (Vec<Step>, Summary) {
+/// The lines and arcs a run would be written as otherwise: the
+/// optimiser's fit (`plan::optimise`) of the run, its arcs only in
+/// `arc_planes`, held above the polyline with `above`. A spline is written
+/// only where it takes fewer blocks than these.
+#[derive(Clone, Copy, Debug)]
+pub struct Otherwise<'a> {
+    pub arc_planes: &'a [crate::moves::Plane],
+    pub above: bool,
+}
+
+/// Fits every run of straight cutting moves of `moves` it can; with
+/// `otherwise`, every run is written as the optimiser's lines and arcs
+/// where those take no more blocks than its spline (or it has none).
+pub fn fit_splines(
+    moves: &[Move],
+    fit: &SplineFit,
+    otherwise: Option<Otherwise<'_>>,
+) -> (Vec<Step>, Summary) {
     let mut out = Vec::with_capacity(moves.len() / 4);
     let mut summary = Summary {
         blocks_before: moves.len(),
@@ -81,6 +97,31 @@ pub fn fit_splines(moves: &[Move], fit: &SplineFit) -> (Vec<Step>, Summary) {
     let mut i = 0;
     while i < moves.len() {
         let (run_end, feed) = run(moves, i, at);
+        // The run as lines and arcs, where those are the other way.
+        let lines_arcs = otherwise.filter(|_| run_end > i).map(|o| {
+            let mut stream = Vec::with_capacity(run_end - i + 1);
+            stream.push(Move::Rapid(Position::xyz(at[0], at[1], at[2])));
+            stream.extend_from_slice(&moves[i..run_end]);
+            // The optimiser starts a run at a stated feed: a run that
+            // keeps the feed in force is given one for the fit (any: one
+            // feed for the whole run), and keeps the one in force again.
+            let first_feed = match moves[i] {
+                Move::Linear { feed, .. } => feed,
+                _ => None,
+            };
+            if let Some(Move::Linear { feed, .. }) = stream.get_mut(1)
+                && feed.is_none()
+            {
+                *feed = Some(Feed::PerTime(1.0));
+            }
+            let (mut opt, _) =
+                super::optimise::optimise_within(&stream, fit.tolerance, o.arc_planes, o.above);
+            opt.remove(0);
+            if let Some(Move::Linear { feed, .. } | Move::Arc { feed, .. }) = opt.first_mut() {
+                *feed = first_feed;
+            }
+            opt
+        });
         if run_end - i >= FEWEST_LINES {
             let mut points = Vec::with_capacity(run_end - i + 1);
             points.push(at);
@@ -91,7 +132,11 @@ pub fn fit_splines(moves: &[Move], fit: &SplineFit) -> (Vec<Step>, Summary) {
                     points.push(p);
                 }
             }
-            if let Some((spline, deviation)) = fit_run(&points, fit) {
+            if let Some((spline, deviation)) = fit_run(&points, fit)
+                && lines_arcs
+                    .as_ref()
+                    .is_none_or(|l| spline.points.len() + spline.order < l.len())
+            {
                 summary.splines += 1;
                 summary.lines_replaced += run_end - i;
                 summary.max_deviation = summary.max_deviation.max(deviation);
@@ -101,8 +146,12 @@ pub fn fit_splines(moves: &[Move], fit: &SplineFit) -> (Vec<Step>, Summary) {
                 continue;
             }
         }
-        // Not fitted: the run (or the one move) as it is.
-        for &m in &moves[i..run_end.max(i + 1)] {
+        // Not fitted: the run as lines and arcs, or as it is (or the one
+        // move that is no run).
+        let kept = lines_arcs
+            .as_deref()
+            .unwrap_or(&moves[i..run_end.max(i + 1)]);
+        for &m in kept {
             if let Move::Rapid(to) | Move::Linear { to, .. } | Move::Arc { to, .. } = m {
                 at = merged(at, &to);
             }

@@ -61,7 +61,7 @@ fn de_boor(s: &Spline, t: f64) -> [f64; 3] {
 #[test]
 fn a_smooth_pass_becomes_one_spline_within_its_limit() {
     let moves = pass(1.0, 0.7, 400);
-    let (steps, summary) = fit_splines(&moves, &FIT);
+    let (steps, summary) = fit_splines(&moves, &FIT, None);
     let splines: Vec<&Spline> = steps
         .iter()
         .filter_map(|s| match s {
@@ -97,7 +97,7 @@ fn control_points_and_knots_are_printed_values() {
         },
         ..FIT
     };
-    let (steps, _) = fit_splines(&pass(1.0, 0.7, 400), &fit);
+    let (steps, _) = fit_splines(&pass(1.0, 0.7, 400), &fit, None);
     let Some(Step::Spline(s)) = steps.iter().find(|s| matches!(s, Step::Spline(_))) else {
         panic!("no spline");
     };
@@ -131,14 +131,14 @@ fn corner(n: usize) -> Vec<Move> {
 #[test]
 fn short_runs_stay_lines() {
     let moves = corner(10);
-    let (steps, summary) = fit_splines(&moves, &FIT);
+    let (steps, summary) = fit_splines(&moves, &FIT, None);
     assert_eq!(summary.splines, 0);
     assert_eq!(steps.len(), moves.len());
 }
 
 #[test]
 fn a_corner_is_kept() {
-    let (steps, summary) = fit_splines(&corner(30), &FIT);
+    let (steps, summary) = fit_splines(&corner(30), &FIT, None);
     assert_eq!(summary.splines, 2, "{summary:?}");
     let ends: Vec<([f64; 3], [f64; 3])> = steps
         .iter()
@@ -164,7 +164,75 @@ fn a_pass_too_coarse_to_hold_stays_lines() {
             feed: (k == 1).then_some(Feed::PerTime(1.0)),
         });
     }
-    let (steps, summary) = fit_splines(&moves, &FIT);
+    let (steps, summary) = fit_splines(&moves, &FIT, None);
     assert_eq!(summary.splines, 0, "{summary:?}");
     assert_eq!(steps.len(), moves.len());
+}
+
+/// Where the optimiser writes a run in fewer blocks (a circle: one arc),
+/// the run is written as its lines and arcs, not as a spline.
+#[test]
+fn a_run_the_optimiser_writes_shorter_stays_lines_and_arcs() {
+    use crate::moves::Plane;
+    let moves = pass(1.0, 0.7, 400);
+    let planes = [Plane::Zx];
+    let o = Otherwise {
+        arc_planes: &planes,
+        above: false,
+    };
+    let (steps, summary) = fit_splines(&moves, &FIT, Some(o));
+    assert_eq!(summary.splines, 0, "{summary:?}");
+    assert!(
+        steps
+            .iter()
+            .any(|s| matches!(s, Step::Move(Move::Arc { .. })))
+    );
+    assert!(steps.len() < 8, "{}", steps.len());
+    // Without arcs the spline is the shorter.
+    let o = Otherwise {
+        arc_planes: &[],
+        above: false,
+    };
+    let (_, summary) = fit_splines(&moves, &FIT, Some(o));
+    assert_eq!(summary.splines, 1, "{summary:?}");
+}
+
+/// A pass after a plunge keeps the plunge's feed (its first move states
+/// none): it is weighed against its lines and arcs all the same, and the
+/// whole stream comes out as the optimiser writes it (one arc).
+#[test]
+fn a_run_keeping_the_feed_in_force_is_weighed_too() {
+    use crate::moves::Plane;
+    let mut moves = pass(4.0, 0.7, 400);
+    let Move::Rapid(p) = moves[0] else {
+        panic!("a rapid first")
+    };
+    moves[0] = Move::Rapid(Position::xyz(p.x, p.y, 0.5));
+    moves.insert(
+        1,
+        Move::Linear {
+            to: Position::xyz(p.x, p.y, p.z),
+            feed: Some(Feed::PerTime(1.0)),
+        },
+    );
+    if let Move::Linear { feed, .. } = &mut moves[2] {
+        *feed = None;
+    }
+    let planes = [Plane::Xy, Plane::Zx, Plane::Yz];
+    let o = Otherwise {
+        arc_planes: &planes,
+        above: false,
+    };
+    let (steps, summary) = fit_splines(&moves, &FIT, Some(o));
+    let (opt, _) = crate::plan::optimise::optimise_within(&moves, FIT.tolerance, &planes, false);
+    assert_eq!(summary.splines, 0, "{summary:?}");
+    let written: Vec<Move> = steps
+        .iter()
+        .map(|s| match s {
+            Step::Move(m) => *m,
+            Step::Spline(_) => unreachable!(),
+        })
+        .collect();
+    // NaN (an axis left alone) is never equal to itself: compare as text.
+    assert_eq!(format!("{written:?}"), format!("{opt:?}"));
 }

@@ -65,7 +65,18 @@ pub(super) fn build(spec: &RasterSpec, cx: &BuildContext) -> Result<Built, Vec<D
             decimals,
             control: head.start.control,
         };
-        let (steps, fitted) = lensc_runtime::plan::spline::fit_splines(&moves, &fit);
+        // Each run as a spline, or as the optimiser's lines and arcs where
+        // those take fewer blocks (points placed clear of the material are
+        // not fitted back into it).
+        let otherwise = lensc_runtime::plan::spline::Otherwise {
+            arc_planes: &dialect.arc_planes,
+            above: matches!(
+                raster.chords,
+                lensc_runtime::plan::chords::ChordPlacement::Clear { .. }
+            ),
+        };
+        let (steps, fitted) =
+            lensc_runtime::plan::spline::fit_splines(&moves, &fit, Some(otherwise));
         let optimised = Summary {
             moves_before: fitted.blocks_before,
             moves_after: fitted.blocks_after,
@@ -267,7 +278,7 @@ fn spline_words(
     s: &lensc_runtime::plan::spline::Summary,
 ) -> String {
     format!(
-        "interpolation: NURBS (G06.2, order {}): {} splines for {} straight moves, {} blocks of moves instead of {}, largest deviation {} nm (limit {} nm); needs the control's {}",
+        "interpolation: NURBS (G06.2, order {}) where shorter than lines and arcs: {} splines for {} straight moves, {} blocks of moves from {} planned, largest deviation {} nm (limit {} nm); needs the control's {}",
         lensc_runtime::plan::spline::ORDER,
         s.splines,
         s.lines_replaced,
