@@ -6,8 +6,10 @@
 //! fitted or optimised, written, read back, simulated, judged). Per job:
 //! the program's lines and bytes both ways and their ratios, the planned
 //! moves' blocks (what the fit started from, from the spline program's
-//! header), the simulated form PV both ways, and the build's wall time
-//! both ways (the fitting's cost; goal: at most 1.3×).
+//! header), and the build's wall time both ways (the fitting's cost; goal:
+//! at most 1.3×). Then the same in a copy of the dialect without arcs
+//! (splines against straight lines alone). The simulated form of the two
+//! programs is compared by `tests/it/splines.rs`.
 //!
 //! Seed 004's profile (`examples/lei2021_cylinder_array.lens`) is a
 //! profile-turning job: lensc fits no turning program yet (E0182), so it is
@@ -26,19 +28,19 @@ use lensc_runtime::post::Provenance;
 
 const EXAMPLE: &str = "examples/lin2022_scraping.lens";
 const DIALECT: &str = "fanuc_0i_mill";
+const DIALECT_LINES: &str = "fanuc_lines";
 
 struct Figures {
     lines: usize,
     bytes: u64,
     seconds: f64,
-    pv_nm: f64,
     header: String,
 }
 
-fn build(checked: &lensc_lang::Checked, job: usize, dir: &Path) -> Figures {
+fn build(checked: &lensc_lang::Checked, job: usize, dir: &Path, dialect: &str) -> Figures {
     let job = &checked.checked.jobs[job];
     let t = Instant::now();
-    let (spec, _) = lensc_build::pipeline::lower(job, Some(DIALECT), &Limits::default())
+    let (spec, _) = lensc_build::pipeline::lower(job, Some(dialect), &Limits::default())
         .unwrap_or_else(|_| panic!("{} lowers", job.name.name));
     let prov = Provenance {
         source: "bench.lens".into(),
@@ -54,13 +56,6 @@ fn build(checked: &lensc_lang::Checked, job: usize, dir: &Path) -> Figures {
     built.program.write_to(&path).expect("program written");
     let text = std::fs::read_to_string(&path).expect("program read");
     std::fs::remove_file(&path).expect("program removed");
-    let report = serde_json::to_value(&built.report).expect("report");
-    let _ = &built.program_name;
-    let pv_nm = report["acceptance"]["criteria"]
-        .as_array()
-        .and_then(|c| c.iter().find(|c| c["criterion"] == "form_pv"))
-        .and_then(|c| c["measured"].as_f64())
-        .unwrap_or(f64::NAN);
     // The interpolation's header line, unfolded.
     let all: Vec<&str> = text.lines().collect();
     let header = all
@@ -82,7 +77,6 @@ fn build(checked: &lensc_lang::Checked, job: usize, dir: &Path) -> Figures {
         lines,
         bytes,
         seconds,
-        pv_nm,
         header,
     }
 }
@@ -98,55 +92,67 @@ fn main() {
     );
     assert_ne!(splined_source, source);
     let splined = lensc_lang::check_text(&fs, "lin2022.lens", splined_source.as_bytes());
+    // The same in a copy of the dialect without arcs: splines against
+    // straight lines alone.
+    let no_arcs = |s: &str| {
+        format!(
+            "dialect fanuc_lines = fanuc_0i_mill {{ arc_planes: [] }}\nmachine mill = generic_3axis_mill {{ dialect: fanuc_lines }}\n{}",
+            s.replace("machine: generic_3axis_mill", "machine: mill")
+        )
+    };
+    let plain_lines = lensc_lang::check_text(&fs, "lin2022.lens", no_arcs(&source).as_bytes());
+    let splined_lines =
+        lensc_lang::check_text(&fs, "lin2022.lens", no_arcs(&splined_source).as_bytes());
     assert!(
-        !plain.has_errors() && !splined.has_errors(),
+        [&plain, &splined, &plain_lines, &splined_lines]
+            .iter()
+            .all(|c| !c.has_errors()),
         "the example checks"
     );
     let dir = tempfile::tempdir_in(root.join("target")).expect("temporary directory");
-    println!(
-        "{:<24} {:>9} {:>9} {:>6} {:>10} {:>10} {:>6} {:>8} {:>8} {:>8} {:>6}",
-        "job",
-        "lines",
-        "spline",
-        "ratio",
-        "bytes",
-        "spline",
-        "ratio",
-        "PV nm",
-        "spline",
-        "build s",
-        "ratio"
-    );
-    let (mut total_lines, mut total_bytes) = ((0, 0), (0, 0));
-    for i in 0..plain.checked.jobs.len() {
-        let name = &plain.checked.jobs[i].name.name;
-        let a = build(&plain, i, dir.path());
-        let s = build(&splined, i, dir.path());
-        total_lines = (total_lines.0 + a.lines, total_lines.1 + s.lines);
-        total_bytes = (total_bytes.0 + a.bytes, total_bytes.1 + s.bytes);
+    for (label, dialect, plain, splined) in [
+        ("lines and arcs", DIALECT, &plain, &splined),
+        (
+            "lines only (no arcs)",
+            DIALECT_LINES,
+            &plain_lines,
+            &splined_lines,
+        ),
+    ] {
+        println!("{DIALECT}, {label}:");
         println!(
-            "{:<24} {:>9} {:>9} {:>6.2} {:>10} {:>10} {:>6.2} {:>8.1} {:>8.1} {:>8.2} {:>6.2}",
-            name,
-            a.lines,
-            s.lines,
-            a.lines as f64 / s.lines as f64,
-            a.bytes,
-            s.bytes,
-            a.bytes as f64 / s.bytes as f64,
-            a.pv_nm,
-            s.pv_nm,
-            a.seconds,
-            s.seconds / a.seconds,
+            "{:<24} {:>9} {:>9} {:>6} {:>10} {:>10} {:>6} {:>8} {:>6}",
+            "job", "lines", "spline", "ratio", "bytes", "spline", "ratio", "build s", "ratio"
         );
-        println!("    {}", s.header);
+        let (mut total_lines, mut total_bytes) = ((0, 0), (0, 0));
+        for i in 0..plain.checked.jobs.len() {
+            let name = &plain.checked.jobs[i].name.name;
+            let a = build(plain, i, dir.path(), dialect);
+            let s = build(splined, i, dir.path(), dialect);
+            total_lines = (total_lines.0 + a.lines, total_lines.1 + s.lines);
+            total_bytes = (total_bytes.0 + a.bytes, total_bytes.1 + s.bytes);
+            println!(
+                "{:<24} {:>9} {:>9} {:>6.2} {:>10} {:>10} {:>6.2} {:>8.2} {:>6.2}",
+                name,
+                a.lines,
+                s.lines,
+                a.lines as f64 / s.lines as f64,
+                a.bytes,
+                s.bytes,
+                a.bytes as f64 / s.bytes as f64,
+                a.seconds,
+                s.seconds / a.seconds,
+            );
+            println!("    {}", s.header);
+        }
+        println!(
+            "all six: lines {} / {} = {:.2}x, bytes {} / {} = {:.2}x ({label} / splines)",
+            total_lines.0,
+            total_lines.1,
+            total_lines.0 as f64 / total_lines.1 as f64,
+            total_bytes.0,
+            total_bytes.1,
+            total_bytes.0 as f64 / total_bytes.1 as f64
+        );
     }
-    println!(
-        "all six: lines {} / {} = {:.2}x, bytes {} / {} = {:.2}x (lines and arcs / splines)",
-        total_lines.0,
-        total_lines.1,
-        total_lines.0 as f64 / total_lines.1 as f64,
-        total_bytes.0,
-        total_bytes.1,
-        total_bytes.0 as f64 / total_bytes.1 as f64
-    );
 }
