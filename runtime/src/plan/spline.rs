@@ -359,17 +359,15 @@ fn fitted(
         .map(|p| std::array::from_fn(|i| round(p[i] + o[i]) - o[i]))
         .collect();
     let worst = check(&printed);
-    (worst <= fit.tolerance + fit.rounding()).then(|| {
-        (
-            Spline {
-                order: ORDER,
-                points: printed,
-                knots,
-                feed: None,
-            },
-            worst,
-        )
-    })
+    (worst <= fit.tolerance + fit.rounding()).then_some((
+        Spline {
+            order: ORDER,
+            points: printed,
+            knots,
+            feed: None,
+        },
+        worst,
+    ))
 }
 
 /// The clamped knot vector of `n` control points over parameters `u`,
@@ -523,13 +521,10 @@ fn least_squares(points: &[[f64; 3]], u: &[f64], knots: &[f64], n: usize) -> Opt
                 break;
             }
             let l = a[i - k][k];
-            for c in 0..3 {
-                x[i][c] -= l * x[i - k][c];
-            }
+            let before = x[i - k];
+            x[i] = sub(x[i], scale(before, l));
         }
-        for c in 0..3 {
-            x[i][c] /= a[i][0];
-        }
+        x[i] = scale(x[i], 1.0 / a[i][0]);
     }
     for i in (0..inner).rev() {
         for d in 1..ORDER {
@@ -537,13 +532,10 @@ fn least_squares(points: &[[f64; 3]], u: &[f64], knots: &[f64], n: usize) -> Opt
                 break;
             }
             let l = a[i][d];
-            for c in 0..3 {
-                x[i][c] -= l * x[i + d][c];
-            }
+            let after = x[i + d];
+            x[i] = sub(x[i], scale(after, l));
         }
-        for c in 0..3 {
-            x[i][c] /= a[i][0];
-        }
+        x[i] = scale(x[i], 1.0 / a[i][0]);
     }
     let mut ctrl = Vec::with_capacity(n);
     ctrl.push(q0);

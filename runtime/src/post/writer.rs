@@ -1260,10 +1260,8 @@ impl ProgramWriter {
             self.last_feed = new_feed;
         }
         let last = s.points[s.points.len() - 1];
-        for a in 0..3 {
-            self.last[a] = printed[a];
-            self.at[a] = last[a];
-        }
+        self.last[..3].copy_from_slice(&printed);
+        self.at[..3].copy_from_slice(&last);
         self.moves += 1;
         Ok(())
     }

@@ -109,8 +109,8 @@ impl Nurbs {
             let i = s + 1 + j - k;
             let w = nb * self.weights[i];
             den += w;
-            for c in 0..3 {
-                num[c] += w * self.points[i][c];
+            for (v, p) in num.iter_mut().zip(self.points[i]) {
+                *v += w * p;
             }
         }
         [num[0] / den, num[1] / den, num[2] / den]
