@@ -50,9 +50,8 @@ fn de_boor(s: &Spline, t: f64) -> [f64; 3] {
         for q in (r..=deg).rev() {
             let i = j - deg + q;
             let a = (t - k[i]) / (k[i + deg + 1 - r] - k[i]);
-            for c in 0..3 {
-                d[q][c] = (1.0 - a) * d[q - 1][c] + a * d[q][c];
-            }
+            let (before, here) = (d[q - 1], d[q]);
+            d[q] = std::array::from_fn(|c| (1.0 - a) * before[c] + a * here[c]);
         }
     }
     d[deg]
