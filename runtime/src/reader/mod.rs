@@ -26,6 +26,7 @@ mod lexer;
 mod modal;
 mod motion;
 mod nurbs;
+mod nurbs_moves;
 mod policy;
 mod spline;
 
