@@ -29,6 +29,9 @@ pub(crate) struct ChordPath {
     /// 4,010 straddling long chords); nor on a roller helix, whose points
     /// are a fixed C step apart.
     pub long_chords: bool,
+    /// The tolerance the machine's class holds (`Parts::holds`): the
+    /// default limits never loosen beyond it.
+    pub holds: f64,
 }
 
 /// The placement the strategy states, or the default: the fewest points
@@ -48,16 +51,16 @@ pub(crate) fn placement(p: &Parts, path: ChordPath) -> ChordPlacement {
         return ChordPlacement::from_word(stated.value, margin).unwrap_or_default();
     }
     let accept = super::accept::lower(&p.params).unwrap_or_default();
-    let limits = form_limits(&accept, path.tolerance, resolution);
+    let limits = form_limits(&accept, path.tolerance, resolution, path.holds);
     ChordPlacement::fewest_points_meeting(path.sag, path.fit, &limits, margin, path.long_chords)
 }
 
 /// The job's limits on the form, stated or default; none under `accept:
 /// none`.
-fn form_limits(accept: &Accept, tolerance: Option<f64>, resolution: f64) -> FormLimits {
+fn form_limits(accept: &Accept, tolerance: Option<f64>, resolution: f64, holds: f64) -> FormLimits {
     let limit = |c| {
         accept
-            .limit(c, tolerance, resolution)
+            .limit(c, tolerance, resolution, holds)
             .unwrap_or(f64::INFINITY)
     };
     FormLimits {
