@@ -258,14 +258,7 @@ fn build_text(src: &str, program: &str) -> (String, serde_json::Value) {
     std::fs::write(&file, src).expect("write");
     let out = crate::common::lensc(
         dir.path(),
-        // The headers are the point here, not the part: the criteria warn.
-        &[
-            "build",
-            file.to_str().expect("utf8"),
-            "--accept=warn",
-            "--out",
-            "out",
-        ],
+        &["build", file.to_str().expect("utf8"), "--out", "out"],
     );
     assert_eq!(
         out.status.code(),

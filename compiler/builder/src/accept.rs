@@ -1,6 +1,7 @@
 //! The acceptance gate: a built job's simulated part against the criteria
 //! its `accept` block states, the rest at defaults derived from the
-//! strategy's path tolerance and the machine's resolution. Each criterion
+//! machine: the path tolerance its class holds (or the strategy's, if
+//! tighter) and its resolution (`job::accept::default_limit`). Each criterion
 //! missed (or that the simulation cannot measure) is a coded diagnostic
 //! naming the criterion, by how much and where on the part — an error
 //! that stops the program being written, or under `--accept=warn` a

@@ -393,9 +393,6 @@ impl<'a> Parts<'a> {
         lensc_lang::lower::surface::lower_surface(self.surface)
             .map_err(|e| RuntimeError::Surface(e).at(self.site()))
     }
-    /// The path tolerance the strategy states, or the default its machine
-    /// holds on a path in `axes` length axes (`default_path_tolerance`,
-    /// mm).
     /// The path tolerance (mm) the machine's class holds for a strategy
     /// printing `axes` length axes (`Strategy::LENGTH_AXES`; `None`: one
     /// that plans to no tolerance of its own): the default one
@@ -405,6 +402,9 @@ impl<'a> Parts<'a> {
     pub fn holds(&self, axes: Option<u32>) -> f64 {
         holds(self.machine_params.resolution, axes)
     }
+    /// The path tolerance the strategy states, or the default its machine
+    /// holds on a path in `axes` length axes (`default_path_tolerance`,
+    /// mm).
     pub fn chord_tolerance(&self, axes: u32) -> f64 {
         self.path.chord_tolerance.map_or_else(
             || default_path_tolerance(self.machine_params.resolution, axes),
