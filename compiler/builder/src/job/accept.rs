@@ -193,3 +193,40 @@ pub(crate) fn lower(params: &JobParams) -> Result<Accept, Diagnostic> {
         site: block_site,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const NM: f64 = 1e-6;
+
+    #[test]
+    fn a_looser_tolerance_does_not_widen_the_defaults() {
+        // A lathe at 1 nm holds 10 nm: a 10 mm tolerance (the sphere
+        // turned as a cone of issue #29) is held to 2 × (10 + 1) nm PV,
+        // as a job that states none; a tighter 4 nm tightens them.
+        let pv = |t: Option<f64>| default_limit(Criterion::FormPv, t, NM, 10.0 * NM).unwrap();
+        assert!((pv(Some(10.0)) - 22.0 * NM).abs() < 1e-12);
+        assert!((pv(Some(200.0 * NM)) - 22.0 * NM).abs() < 1e-12);
+        assert_eq!(pv(None), pv(Some(10.0)));
+        assert!((pv(Some(4.0 * NM)) - 10.0 * NM).abs() < 1e-12);
+        // A machine that holds only 142 nm (0.1 µm, two axes): that band.
+        let coarse = default_limit(Criterion::MaxGouge, Some(1.0), 100.0 * NM, 142.0 * NM);
+        assert!((coarse.unwrap() - 242.0 * NM).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_following_error_has_a_default_and_the_cutting_time_none() {
+        let fe = default_limit(Criterion::MaxFollowingError, Some(50.0 * NM), NM, 10.0 * NM);
+        assert!((fe.unwrap() - 11.0 * NM).abs() < 1e-12);
+        assert_eq!(
+            default_limit(Criterion::MaxCuttingTime, None, NM, 10.0 * NM),
+            None
+        );
+        // `accept: none` holds nothing, a stated limit wins.
+        assert_eq!(
+            Accept::Nothing.limit(Criterion::FormPv, None, NM, 10.0 * NM),
+            None
+        );
+    }
+}

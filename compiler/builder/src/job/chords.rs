@@ -38,9 +38,10 @@ pub(crate) struct ChordPath {
 /// whose promise (`ChordPlacement::promise`: the band its chords and fits
 /// keep to about the exact path, so its largest gouge and residual, its PV
 /// and a bound on its RMS) meets every form criterion the gate will judge
-/// (`ChordPlacement::fewest_points_meeting`). With no criteria stated
-/// the defaults (± the tolerance and the resolution) are met by long
-/// straddled chords wherever they write fewer blocks; a job that states a
+/// (`ChordPlacement::fewest_points_meeting`). The defaults are ± the
+/// tolerance the machine holds (or a tighter path tolerance) and the
+/// resolution: at a path tolerance no looser than that, long straddled
+/// chords meet them wherever they write fewer blocks; a job that states a
 /// tighter `form_rms`, `form_pv` or `max_gouge` keeps every point, on the
 /// path, straddling or clear.
 pub(crate) fn placement(p: &Parts, path: ChordPath) -> ChordPlacement {
