@@ -30,6 +30,7 @@ pub fn run(fs: &MemFs, bytes: &[u8], depth: Depth, out_dir: &Path) -> Result<Rea
         Depth::Verify(pair) => verify(fs, bytes, pair),
         Depth::Import { json } => import(fs, bytes, json),
         Depth::Lsp => lsp(bytes),
+        Depth::Measure { ext } => crate::measure::run(&format!("fuzz.{ext}"), bytes),
         _ => crate::harness::run(fs, bytes, depth, out_dir),
     }
 }
