@@ -22,24 +22,8 @@ use crate::rng::Rng;
 /// The measurement files mutations start from: every peer file a reader
 /// takes, and two maps lensc writes (one with invalid points).
 pub fn corpus(root: &Path) -> std::io::Result<Corpus> {
-    let dir = root.join("tests/measure/peer");
-    let mut paths: Vec<_> = std::fs::read_dir(&dir)?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.is_file())
-        .collect();
-    paths.sort();
-    let mut files = Vec::new();
-    for p in paths {
-        let name = p
-            .file_name()
-            .unwrap_or_default()
-            .to_string_lossy()
-            .into_owned();
-        let bytes = std::fs::read(&p)?;
-        if lensc_measure::read::detect(&name, &bytes).is_some() {
-            files.push((name, bytes));
-        }
-    }
+    let mut files = crate::targets::files_under(root, &["tests/measure/peer"], |_| true)?.files;
+    files.retain(|(name, bytes)| lensc_measure::read::detect(name, bytes).is_some());
     let mut map = HeightMap::from_heights(
         24,
         16,

@@ -65,7 +65,11 @@ pub fn prescriptions(root: &Path) -> std::io::Result<Corpus> {
     })
 }
 
-fn files_under(root: &Path, dirs: &[&str], keep: impl Fn(&str) -> bool) -> std::io::Result<Corpus> {
+pub fn files_under(
+    root: &Path,
+    dirs: &[&str],
+    keep: impl Fn(&str) -> bool,
+) -> std::io::Result<Corpus> {
     let mut files = Vec::new();
     for dir in dirs {
         let mut paths: Vec<PathBuf> = std::fs::read_dir(root.join(dir))?
