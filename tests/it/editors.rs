@@ -87,3 +87,82 @@ fn the_vscode_extension_ties_the_grammar_and_server_to_lens_files() {
         "the extension runs `lensc lsp`"
     );
 }
+
+/// `editors/nvim/lensc.lua` as the README tells a Neovim user to load it,
+/// in a real Neovim (Debian 12's 0.7.2 in CI, which `.ci/run` installs),
+/// headless: a `.lens` buffer gets the filetype, `//` comments, `K` and
+/// `gd`, and the server's diagnostics with their codes. Without `nvim`
+/// the test says so and passes, except under CI, where it fails.
+#[test]
+fn neovim_gets_the_servers_diagnostics_from_the_shipped_setup() {
+    let has_nvim = std::process::Command::new("nvim")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !has_nvim {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "CI must install neovim for this test"
+        );
+        eprintln!("skipped: no nvim on PATH");
+        return;
+    }
+    let dir = tempfile::tempdir().expect("tmp");
+    let job = dir.path().join("bad.lens");
+    std::fs::write(
+        &job,
+        "surface s = sphere { radius: 10 mm, aperture: 5 mmm }\n",
+    )
+    .expect("job");
+    let out = dir.path().join("seen.txt");
+    let probe = dir.path().join("probe.lua");
+    std::fs::write(
+        &probe,
+        r#"vim.wait(20000, function() return #vim.diagnostic.get(0) > 1 end, 100)
+local out = { 'filetype=' .. vim.bo.filetype, 'commentstring=' .. vim.bo.commentstring,
+  'K=' .. vim.fn.maparg('K', 'n'), 'gd=' .. vim.fn.maparg('gd', 'n') }
+for _, d in ipairs(vim.diagnostic.get(0)) do
+  table.insert(out, string.format('%d:%d %s', d.lnum, d.col, tostring(d.code)))
+end
+vim.fn.writefile(out, vim.env.LENSC_NVIM_OUT)
+vim.cmd('qa!')
+"#,
+    )
+    .expect("probe");
+    let bin = std::path::Path::new(env!("CARGO_BIN_EXE_lensc"))
+        .parent()
+        .expect("bin dir")
+        .to_path_buf();
+    let path = std::env::join_paths(std::iter::once(bin).chain(std::env::split_paths(
+        &std::env::var_os("PATH").unwrap_or_default(),
+    )))
+    .expect("PATH");
+    let run = std::process::Command::new("nvim")
+        .args(["--headless", "-u"])
+        .arg(root().join("editors/nvim/lensc.lua"))
+        .arg(&job)
+        .arg("-c")
+        .arg(format!("luafile {}", probe.display()))
+        .env("PATH", path)
+        .env("LENSC_NVIM_OUT", &out)
+        .env("XDG_CONFIG_HOME", dir.path())
+        .env("XDG_DATA_HOME", dir.path())
+        .env("XDG_STATE_HOME", dir.path())
+        .current_dir(dir.path())
+        .stdin(std::process::Stdio::null())
+        .output()
+        .expect("nvim runs");
+    let seen = std::fs::read_to_string(&out).unwrap_or_default();
+    assert!(
+        run.status.success(),
+        "nvim: {}\n{seen}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let lines: Vec<&str> = seen.lines().collect();
+    assert_eq!(lines.first(), Some(&"filetype=lens"), "{seen}");
+    assert!(seen.contains("commentstring=// %s"), "{seen}");
+    assert!(!seen.contains("K=\n") && !seen.contains("gd=\n"), "{seen}");
+    // Both of the checker's findings, with their codes and places.
+    assert!(seen.contains("0:48 E0110"), "{seen}");
+    assert!(seen.contains("0:12 E0121"), "{seen}");
+}
