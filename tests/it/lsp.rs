@@ -358,8 +358,12 @@ fn an_editor_session() {
         "textDocument/completion",
         at(&uri, pos(&typed, "conic {", 0, 0)),
     ));
+    // A surface's value: the surface kinds, not the `let`s or functions
+    // (a slot of one category offers that category only).
     assert!(
-        l.contains(&"asphere".to_string()) && l.contains(&"depth".to_string()),
+        l.contains(&"asphere".to_string())
+            && !l.contains(&"depth".to_string())
+            && !l.contains(&"sin".to_string()),
         "{l:?}"
     );
     c.notify(
@@ -517,6 +521,63 @@ fn lowering_findings_are_kept_while_typing_and_renewed_after_a_pause() {
     assert_eq!(r, Value::Null);
     c.notify("exit", Value::Null);
     assert!(c.child.wait().expect("wait").success());
+}
+
+/// Completion in a slot that takes a machine (issue #32: it offered 79
+/// items, surfaces and functions among them) offers only machines: the
+/// document's own, the machine kinds and the standard library's; picking
+/// a standard-library machine not yet in scope adds its `use` line.
+#[test]
+fn completion_in_a_machine_slot_offers_machines_and_adds_the_use() {
+    let (_dir, work, mut c) = session();
+    let text = "// a job in the making\nuse std::tools::diamond_r500um\nsurface lens = sphere { radius: 20 mm, sense: convex, aperture: 5 mm }\nmachine mine = lathe { resolution: 1 nm }\nmachine m2 = \njob j { surface: lens, tool: diamond_r500um, machine: m }\n";
+    std::fs::write(work.join("c.lens"), text).expect("write");
+    let uri = uri_of(&work.join("c.lens"));
+    c.notify(
+        "textDocument/didOpen",
+        json!({"textDocument": {"uri": uri, "languageId": "lens", "version": 1, "text": text}}),
+    );
+    c.diagnostics(&uri);
+    let machines: Vec<String> = lensc_lang::stdlib::items()
+        .iter()
+        .filter(|i| i.module == "machines")
+        .map(|i| i.name.clone())
+        .collect();
+    assert!(machines.len() >= 3, "{machines:?}");
+    for (what, p) in [
+        ("after `machine m2 =`", pos(text, "m2 = ", 0, 5)),
+        ("in `machine:`", pos(text, "machine: m", 0, 10)),
+    ] {
+        let items = c.request("textDocument/completion", at(&uri, p));
+        let got = labels(&items);
+        for m in &machines {
+            assert!(got.contains(m), "{what}: no {m} in {got:?}");
+        }
+        assert!(got.contains(&"mine".to_string()), "{what}: {got:?}");
+        for not in ["sphere", "lens", "sin", "diamond_r500um", "raster"] {
+            assert!(!got.contains(&not.to_string()), "{what}: {not} in {got:?}");
+        }
+        assert!(got.len() < 30, "{what}: {} items", got.len());
+        // The standard library's machine brings its `use` line, after the
+        // file's own `use`.
+        let lathe = items
+            .as_array()
+            .expect("items")
+            .iter()
+            .find(|i| i["label"] == machines[0].as_str())
+            .expect("a stdlib machine");
+        let edit = &lathe["additionalTextEdits"][0];
+        assert_eq!(
+            edit["newText"],
+            format!("use std::machines::{}\n", machines[0]),
+            "{what}: {lathe}"
+        );
+        assert_eq!(
+            edit["range"]["start"],
+            json!({"line": 2, "character": 0}),
+            "{what}"
+        );
+    }
 }
 
 /// A session for the malformed-input tests: its directory kept alive.
