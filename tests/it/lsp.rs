@@ -580,6 +580,144 @@ fn completion_in_a_machine_slot_offers_machines_and_adds_the_use() {
     }
 }
 
+/// The outline, references and rename across a `use`d file, and the
+/// quick fixes lensc's diagnostics carry (issue #32: each answered
+/// -32601, method not found).
+#[test]
+fn outline_references_rename_and_quick_fixes() {
+    let (_dir, work, mut c) = session();
+    std::fs::write(work.join("job.lens"), JOB).expect("write");
+    std::fs::write(work.join("common.lens"), COMMON).expect("write");
+    let uri = uri_of(&work.join("job.lens"));
+    let common = uri_of(&work.join("common.lens"));
+    c.notify(
+        "textDocument/didOpen",
+        json!({"textDocument": {"uri": uri, "languageId": "lens", "version": 1, "text": JOB}}),
+    );
+    c.diagnostics(&uri);
+
+    // The outline: each item by name, the job with its entries.
+    let outline = c.request(
+        "textDocument/documentSymbol",
+        json!({"textDocument": {"uri": uri}}),
+    );
+    let names: Vec<&str> = outline
+        .as_array()
+        .expect("symbols")
+        .iter()
+        .map(|s| s["name"].as_str().expect("a name"))
+        .collect();
+    assert_eq!(
+        names,
+        ["depth", "lens", "knife", "lathe1", "pass", "j"],
+        "{outline}"
+    );
+    let job = &outline[5];
+    assert_eq!(
+        job["children"].as_array().expect("entries").len(),
+        4,
+        "{job}"
+    );
+    assert_eq!(job["selectionRange"]["start"], pos(JOB, "j {", 0, 0));
+
+    // References to `margin`, declared in common.lens: its declaration
+    // there and its use here.
+    let refs = c.request(
+        "textDocument/references",
+        json!({"textDocument": {"uri": uri}, "position": pos(JOB, "margin", 0, 1),
+               "context": {"includeDeclaration": true}}),
+    );
+    let mut got: Vec<(String, Value)> = refs
+        .as_array()
+        .expect("locations")
+        .iter()
+        .map(|l| {
+            (
+                l["uri"].as_str().expect("uri").to_string(),
+                l["range"]["start"].clone(),
+            )
+        })
+        .collect();
+    got.sort_by(|a, b| a.0.cmp(&b.0));
+    assert_eq!(
+        got,
+        [
+            (common.clone(), pos(COMMON, "margin", 0, 0)),
+            (uri.clone(), pos(JOB, "margin", 0, 0)),
+        ],
+        "{refs}"
+    );
+
+    // Rename `depth` (declared and used here): both places.
+    let edit = c.request(
+        "textDocument/rename",
+        json!({"textDocument": {"uri": uri}, "position": pos(JOB, "depth", 1, 0), "newName": "cut_depth"}),
+    );
+    let edits = edit["changes"][uri.as_str()]
+        .as_array()
+        .expect("edits")
+        .clone();
+    let starts: Vec<Value> = edits.iter().map(|e| e["range"]["start"].clone()).collect();
+    assert_eq!(
+        starts,
+        [pos(JOB, "depth", 0, 0), pos(JOB, "depth", 1, 0)],
+        "{edit}"
+    );
+    assert!(edits.iter().all(|e| e["newText"] == "cut_depth"));
+    // A taken name, a word that is not a name, a standard-library item.
+    for (at, new, why) in [
+        (pos(JOB, "depth", 1, 0), "knife", "already a name"),
+        (pos(JOB, "depth", 1, 0), "2cut", "not a name"),
+        (
+            pos(JOB, "linuxcnc_lathe", 0, 2),
+            "my_lathe",
+            "standard library",
+        ),
+    ] {
+        let answer = c.answer(
+            "textDocument/rename",
+            json!({"textDocument": {"uri": uri}, "position": at, "newName": new}),
+        );
+        let message = answer["error"]["message"]
+            .as_str()
+            .unwrap_or_default()
+            .to_string();
+        assert!(message.contains(why), "{new}: {answer}");
+    }
+
+    // Quick fixes: a unit mistyped, a standard-library machine not used.
+    let typed = JOB
+        .replace("85 µm", "85 umm")
+        .replace("use std::machines::linuxcnc_lathe\n", "");
+    assert_ne!(typed, JOB);
+    c.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": uri, "version": 2}, "contentChanges": [{"text": typed}]}),
+    );
+    let diags = c.diagnostics(&uri);
+    let actions = c.request(
+        "textDocument/codeAction",
+        json!({"textDocument": {"uri": uri}, "range": {"start": {"line": 0, "character": 0}, "end": {"line": 0, "character": 0}},
+               "context": {"diagnostics": diags}}),
+    );
+    let titles: Vec<&str> = actions
+        .as_array()
+        .expect("actions")
+        .iter()
+        .map(|a| a["title"].as_str().expect("a title"))
+        .collect();
+    assert!(
+        titles.iter().any(|t| t.contains("write `mm`")),
+        "{titles:?} {diags:?}"
+    );
+    assert!(
+        titles
+            .iter()
+            .any(|t| t.contains("add `use std::machines::linuxcnc_lathe`")),
+        "{titles:?} {diags:?}"
+    );
+}
+
 /// A session for the malformed-input tests: its directory kept alive.
 fn session() -> (tempfile::TempDir, std::path::PathBuf, Client) {
     let dir = tempfile::tempdir().expect("tempdir");

@@ -309,7 +309,7 @@ fn category_items(a: Option<&Analysis>, text: &str, c: Category) -> Vec<Completi
 
 /// Where a new `use` line goes: after the last `use` line at the top of
 /// the file (after its leading comments if it has none).
-fn use_line_offset(text: &str) -> usize {
+pub fn use_line_offset(text: &str) -> usize {
     let mut offset = 0;
     let mut after = None;
     for line in text.split_inclusive('\n') {

@@ -7,20 +7,23 @@
 //! is opened or saved, and after a pause in typing (`PAUSE`; the last
 //! lowering's findings are kept meanwhile, moved with the edits, and a
 //! message from the editor cancels a lowering not yet started). It answers
-//! hover, completion, go to definition and formatting (`lensc fmt`'s
-//! layout). Positions are the protocol's UTF-16 columns (`text`); what the
+//! hover, completion, go to definition, formatting (`lensc fmt`'s
+//! layout), the outline, references and rename (`symbols`) and the quick
+//! fixes the diagnostics carry (`actions`). Positions are the protocol's UTF-16 columns (`text`); what the
 //! cursor is on is read from the text (`context`) and the checker's own
 //! tables (`lookup`); the standard library's files are written to a cache
 //! directory for an editor to open (`analysis::stdlib_dir`).
 //!
 //! This file holds the message loop and the dispatch; one file per answer.
 
+mod actions;
 mod analysis;
 mod completion;
 mod context;
 mod definition;
 mod hover;
 mod lookup;
+mod symbols;
 mod text;
 mod transport;
 
@@ -77,6 +80,10 @@ fn capabilities() -> lsp::ServerCapabilities {
         }),
         definition_provider: Some(lsp::OneOf::Left(true)),
         document_formatting_provider: Some(lsp::OneOf::Left(true)),
+        document_symbol_provider: Some(lsp::OneOf::Left(true)),
+        references_provider: Some(lsp::OneOf::Left(true)),
+        rename_provider: Some(lsp::OneOf::Left(true)),
+        code_action_provider: Some(lsp::CodeActionProviderCapability::Simple(true)),
         ..Default::default()
     }
 }
@@ -410,6 +417,62 @@ impl Server {
             req::GotoDefinition::METHOD => self.with_position(params, |a, uri, text, at| {
                 definition::definition(a?, uri, text, at).map(lsp::GotoDefinitionResponse::Scalar)
             }),
+            req::DocumentSymbolRequest::METHOD => {
+                match parse::<lsp::DocumentSymbolParams>(params) {
+                    Some(p) => {
+                        let key = p.text_document.uri.as_str();
+                        let symbols = match (self.analyses.get(key), self.docs.get(key)) {
+                            (Some(a), Some(doc)) => symbols::outline(a, &doc.text),
+                            _ => Vec::new(),
+                        };
+                        serde_json::to_value(lsp::DocumentSymbolResponse::Nested(symbols))
+                            .map_err(|e| e.to_string())
+                    }
+                    None => Err("bad document symbol parameters".to_string()),
+                }
+            }
+            req::References::METHOD => match parse::<lsp::ReferenceParams>(params) {
+                Some(p) => {
+                    let with = p.context.include_declaration;
+                    self.with_position(
+                        serde_json::to_value(p.text_document_position).unwrap_or_default(),
+                        |a, uri, text, at| Some(symbols::references(a?, uri, text, at, with)),
+                    )
+                }
+                None => Err("bad reference parameters".to_string()),
+            },
+            req::Rename::METHOD => match parse::<lsp::RenameParams>(params) {
+                Some(p) => {
+                    let mut refused = None;
+                    let new_name = p.new_name;
+                    let edit = self.with_position(
+                        serde_json::to_value(p.text_document_position).unwrap_or_default(),
+                        |a, uri, text, at| match symbols::rename(a?, uri, text, at, &new_name) {
+                            Ok(e) => Some(e),
+                            Err(why) => {
+                                refused = Some(why);
+                                None
+                            }
+                        },
+                    );
+                    match refused {
+                        Some(why) => return Err((transport::INVALID_PARAMS, why)),
+                        None => edit,
+                    }
+                }
+                None => Err("bad rename parameters".to_string()),
+            },
+            req::CodeActionRequest::METHOD => match parse::<lsp::CodeActionParams>(params) {
+                Some(p) => {
+                    let uri = &p.text_document.uri;
+                    let actions = match self.docs.get(uri.as_str()) {
+                        Some(doc) => actions::quick_fixes(uri, &doc.text, &p.context.diagnostics),
+                        None => Vec::new(),
+                    };
+                    serde_json::to_value(actions).map_err(|e| e.to_string())
+                }
+                None => Err("bad code action parameters".to_string()),
+            },
             req::Formatting::METHOD => match parse::<lsp::DocumentFormattingParams>(params) {
                 Some(p) => Ok(self.format(&p.text_document.uri)),
                 None => Err("bad formatting parameters".to_string()),
