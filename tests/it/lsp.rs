@@ -718,6 +718,36 @@ fn outline_references_rename_and_quick_fixes() {
     );
 }
 
+/// Hover on an acceptance criterion inside `accept { }` (issue #32: it
+/// said nothing) and on a standard-library machine (its travel and
+/// limits were left out).
+#[test]
+fn hover_on_criteria_and_a_machines_limits() {
+    let (_dir, work, mut c) = session();
+    let text = JOB.replace(
+        "job j { surface: lens, tool: knife, machine: lathe1, strategy: pass }",
+        "job j {\n    surface: lens\n    tool: knife\n    machine: lathe1\n    strategy: pass\n    accept: { form_pv: 50 nm, max_gouge: 20 nm }\n}",
+    );
+    assert_ne!(text, JOB);
+    std::fs::write(work.join("a.lens"), &text).expect("write");
+    std::fs::write(work.join("common.lens"), COMMON).expect("write");
+    let uri = uri_of(&work.join("a.lens"));
+    c.notify(
+        "textDocument/didOpen",
+        json!({"textDocument": {"uri": uri, "languageId": "lens", "version": 1, "text": text}}),
+    );
+    c.diagnostics(&uri);
+    let h = hover_text(&mut c, &uri, pos(&text, "form_pv", 0, 2));
+    assert!(
+        h.contains("**form_pv**") && h.contains("peak-to-valley"),
+        "{h}"
+    );
+    let h = hover_text(&mut c, &uri, pos(&text, "max_gouge", 0, 1));
+    assert!(h.contains("deepest cut below the design"), "{h}");
+    let h = hover_text(&mut c, &uri, pos(&text, "linuxcnc_lathe {", 0, 3));
+    assert!(h.contains("travel:") && h.contains("max_feed:"), "{h}");
+}
+
 /// A session for the malformed-input tests: its directory kept alive.
 fn session() -> (tempfile::TempDir, std::path::PathBuf, Client) {
     let dir = tempfile::tempdir().expect("tempdir");
