@@ -166,3 +166,85 @@ vim.cmd('qa!')
     assert!(seen.contains("0:48 E0110"), "{seen}");
     assert!(seen.contains("0:12 E0121"), "{seen}");
 }
+
+/// `editors/emacs/lensc.el` as the README tells an Emacs user to load it,
+/// in Debian 12's Emacs 28.2 with its elpa-eglot (which `.ci/run`
+/// installs), headless: a `.lens` buffer is in `lens-mode` with `//`
+/// comments, eglot connects to `lensc lsp`, and flymake shows the server's
+/// diagnostics. Without `emacs` the test says so and passes, except under
+/// CI, where it fails.
+#[test]
+fn emacs_eglot_gets_the_servers_diagnostics_from_the_shipped_setup() {
+    let has_emacs = std::process::Command::new("emacs")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !has_emacs {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "CI must install emacs-nox and elpa-eglot for this test"
+        );
+        eprintln!("skipped: no emacs on PATH");
+        return;
+    }
+    let dir = tempfile::tempdir().expect("tmp");
+    let job = dir.path().join("bad.lens");
+    std::fs::write(
+        &job,
+        "surface s = sphere { radius: 10 mm, aperture: 5 mmm }\n",
+    )
+    .expect("job");
+    let out = dir.path().join("seen.txt");
+    let probe = dir.path().join("probe.el");
+    std::fs::write(
+        &probe,
+        r#"(find-file (getenv "LENSC_JOB"))
+;; eglot-ensure connects after the next command, which batch never runs.
+(run-hooks 'post-command-hook)
+(let ((deadline (+ (float-time) 20)))
+  (while (and (< (length (flymake-diagnostics)) 2) (< (float-time) deadline))
+    (accept-process-output nil 0.2))
+  (let ((lines (list (format "mode=%s" major-mode)
+                     (format "comment=%s" comment-start)
+                     (format "eglot=%s" (if (eglot-current-server) "yes" "no")))))
+    (dolist (d (flymake-diagnostics))
+      (push (car (split-string (flymake-diagnostic-text d) "\n")) lines))
+    (with-temp-file (getenv "LENSC_EMACS_OUT")
+      (insert (mapconcat #'identity lines "\n") "\n"))))
+(kill-emacs 0)
+"#,
+    )
+    .expect("probe");
+    let bin = std::path::Path::new(env!("CARGO_BIN_EXE_lensc"))
+        .parent()
+        .expect("bin dir")
+        .to_path_buf();
+    let path = std::env::join_paths(std::iter::once(bin).chain(std::env::split_paths(
+        &std::env::var_os("PATH").unwrap_or_default(),
+    )))
+    .expect("PATH");
+    let run = std::process::Command::new("emacs")
+        .args(["--batch", "-l"])
+        .arg(root().join("editors/emacs/lensc.el"))
+        .arg("-l")
+        .arg(&probe)
+        .env("PATH", path)
+        .env("HOME", dir.path())
+        .env("LENSC_JOB", &job)
+        .env("LENSC_EMACS_OUT", &out)
+        .current_dir(dir.path())
+        .stdin(std::process::Stdio::null())
+        .output()
+        .expect("emacs runs");
+    let seen = std::fs::read_to_string(&out).unwrap_or_default();
+    assert!(
+        run.status.success(),
+        "emacs: {}\n{seen}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(seen.contains("mode=lens-mode"), "{seen}");
+    assert!(seen.contains("comment=// "), "{seen}");
+    assert!(seen.contains("eglot=yes"), "{seen}");
+    assert!(seen.contains("[E0110]: unknown unit `mmm`"), "{seen}");
+    assert!(seen.contains("[E0121]"), "{seen}");
+}
