@@ -30,6 +30,7 @@ pub fn run(fs: &MemFs, bytes: &[u8], depth: Depth, out_dir: &Path) -> Result<Rea
         Depth::Verify(pair) => verify(fs, bytes, pair),
         Depth::Import { json } => import(fs, bytes, json),
         Depth::Lsp => lsp(bytes),
+        Depth::Measure { ext } => crate::measure::run(&format!("fuzz.{ext}"), bytes),
         _ => crate::harness::run(fs, bytes, depth, out_dir),
     }
 }
@@ -64,7 +65,11 @@ pub fn prescriptions(root: &Path) -> std::io::Result<Corpus> {
     })
 }
 
-fn files_under(root: &Path, dirs: &[&str], keep: impl Fn(&str) -> bool) -> std::io::Result<Corpus> {
+pub fn files_under(
+    root: &Path,
+    dirs: &[&str],
+    keep: impl Fn(&str) -> bool,
+) -> std::io::Result<Corpus> {
     let mut files = Vec::new();
     for dir in dirs {
         let mut paths: Vec<PathBuf> = std::fs::read_dir(root.join(dir))?

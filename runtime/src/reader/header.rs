@@ -72,7 +72,7 @@ pub fn header_control_offset(text: &str) -> Option<[f64; 3]> {
 
 /// The text of a whole-line comment in any dialect: `(…)`, `; …`, a
 /// numbered `N9 ; … *`, or Klartext's `9 ; …`.
-fn comment_text(line: &str) -> Option<&str> {
+pub fn comment_text(line: &str) -> Option<&str> {
     let t = line.trim();
     if let Some(inner) = t.strip_prefix('(') {
         return inner.strip_suffix(')');

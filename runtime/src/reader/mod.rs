@@ -29,7 +29,8 @@ mod policy;
 mod spline;
 
 pub use header::{
-    HeaderNames, header_control_offset, header_names, header_source, header_source_hash,
+    HeaderNames, comment_text, header_control_offset, header_names, header_source,
+    header_source_hash,
 };
 pub use policy::{Class, Policy};
 
