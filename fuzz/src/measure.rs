@@ -22,7 +22,7 @@ use crate::rng::Rng;
 /// The measurement files mutations start from: every peer file a reader
 /// takes, and two maps lensc writes (one with invalid points).
 pub fn corpus(root: &Path) -> std::io::Result<Corpus> {
-    let mut files = crate::targets::files_under(root, &["tests/measure/peer"], |_| true)?.files;
+    let mut files = Corpus::under(root, &["tests/measure/peer"], |_| true)?.files;
     files.retain(|(name, bytes)| lensc_measure::read::detect(name, bytes).is_some());
     let mut map = HeightMap::from_heights(
         24,
