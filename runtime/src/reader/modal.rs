@@ -55,6 +55,13 @@ enum GGroup {
     /// G28 (reference point), G53 (machine coordinates): the move goes to
     /// a position of the machine's, not of the program's.
     MachineMove,
+    /// Heidenhain ISO's G36 (cycle 13 ORIENTATION): the spindle stopped and
+    /// held at the angle its S word gives (degrees, not a speed).
+    Orient,
+    /// Heidenhain ISO's G30 and G31: the workpiece blank's least and
+    /// greatest corner (BLK FORM) for the graphic test run; their X Y Z
+    /// are the blank's, not a move.
+    BlankForm,
 }
 
 /// What an M code does, for this dialect.
@@ -300,11 +307,14 @@ impl State {
                 self.motion = Some(*m);
             }
             self.pos = [None; 4];
-        } else if !groups
-            .iter()
-            .any(|(g, _)| matches!(g, GGroup::SpindleCap | GGroup::NonModal))
-        {
-            // G50 S and G4 take their own words; no move.
+        } else if !groups.iter().any(|(g, _)| {
+            matches!(
+                g,
+                GGroup::SpindleCap | GGroup::NonModal | GGroup::Orient | GGroup::BlankForm
+            )
+        }) {
+            // G50 S, G4, G36 S and the blank's G30 G31 take their own
+            // words; no move.
             self.move_block(b, line, out);
         }
         if ms.iter().any(|(m, _)| *m == MCode::End) {
@@ -508,6 +518,8 @@ impl State {
             500 if (c == Fanuc && self.system_a) || c == UltraPrecision => GGroup::SpindleCap,
             920 if c == Fanuc && !self.system_a => GGroup::SpindleCap,
             51 if c == Fanuc => GGroup::NonModal,
+            360 if c == HeidenhainIso => GGroup::Orient,
+            300 | 310 if c == HeidenhainIso => GGroup::BlankForm,
             _ => {
                 return self
                     .feed_codes
@@ -634,7 +646,9 @@ impl State {
         let s = b.words.iter().find(|w| w.letter == 'S');
         // The rpm and caps this block sets, to hold against the maximum.
         let mut speeds = Vec::new();
-        if has(GGroup::SpindleCap) {
+        if has(GGroup::Orient) {
+            self.orient();
+        } else if has(GGroup::SpindleCap) {
             self.cap = s.map(|s| s.value);
             speeds.extend(s.map(|s| (s.value, s.span)));
         } else if let Some(cap) = b
@@ -733,6 +747,13 @@ impl State {
         {
             self.tool_loaded = true;
         }
+    }
+
+    /// Heidenhain ISO's G36: the spindle stopped and held at the angle
+    /// its S word gives (degrees: not a speed), as M19 holds it elsewhere.
+    fn orient(&mut self) {
+        self.spindle_on = false;
+        self.position_mode = true;
     }
 
     /// The speeds this block sets (an rpm, or a cap) against the

@@ -503,3 +503,44 @@ fn linuxcnc_reads_parameters_and_expressions() {
         );
     }
 }
+
+/// Heidenhain ISO orients the spindle by G36 (cycle 13 in ISO, S the
+/// angle, not a speed) and states the blank by G30 and G31 (BLK FORM):
+/// the reader takes G36 as the spindle held, so a knife may cut after it,
+/// and the blank's corners as no move.
+#[test]
+fn heidenhain_iso_reads_g36_and_the_blank() {
+    let mut d = Dialect::linuxcnc();
+    d.comment = crate::dialect::CommentStyle::Semicolon;
+    d.block_end = " *".into();
+    d.line_numbers = Some(1);
+    d.max_line_number = Some(99999);
+    d.arc_centre_absolute = true;
+    d.surface_speed = Vec::new();
+    d.constant_rpm = None;
+    d.spindle_orient = vec!["G36 S0".into()];
+    assert_eq!(Controller::of(&d), Controller::HeidenhainIso);
+    let mill = MachineLimits {
+        lathe: false,
+        travel: [
+            Some((-250.0, 250.0)),
+            Some((-200.0, 200.0)),
+            Some((-150.0, 150.0)),
+            None,
+        ],
+        max_feed: Some(5000.0),
+        max_spindle_rpm: Some(12000.0),
+    };
+    let good = "%J G71 *\nN1 ; +Z out of the material *\nN2 G17 G90 G40 G94 *\nN3 G30 G17 X-1 Y-1 Z-2 *\nN4 G31 G90 X1 Y1 Z0.5 *\nN5 T1 G17 *\nN6 G36 S0 *\nN7 G00 Z1. *\nN8 G00 X-1. Y0. *\nN9 G01 Z-0.1 F100. *\nN10 G01 X1. *\nN11 G00 Z1. *\nN12 M5 *\nN13 G00 Z0 M91 *\nN14 M30 *\nN99999999 %J G71 *\n";
+    assert_eq!(rules(good, &d, &mill), vec![]);
+    let (_, moves) = read_moves(good, &d, &mill);
+    // The first move is the rapid to Z1: G30 G31 moved nothing.
+    assert_eq!(moves[0].to[2], Some(1.0));
+    assert_eq!(moves[0].from, [None; 4]);
+    // Without G36 the knife cuts with the spindle stopped.
+    let unoriented = good.replace("N6 G36 S0 *\n", "");
+    assert!(rules(&unoriented, &d, &mill).contains(&Rule::SpindleStopped));
+    // G36 S is an angle: no speed is set, and the spindle stays still.
+    let started = good.replace("N6 G36 S0 *\n", "N6 G36 S0 *\nN6 M3 *\n");
+    assert!(rules(&started, &d, &mill).contains(&Rule::NoSpindleSpeed));
+}
