@@ -249,7 +249,7 @@ pub const PROGRAM_BLOCK_SEQUENCE: &str = "E0330";
 pub const PROGRAM_NO_CIRCLE_CENTRE: &str = "E0331";
 /// Klartext: the program not framed by `BEGIN PGM` and `END PGM` of one name.
 pub const PROGRAM_FRAME: &str = "E0332";
-/// A parameter word no code of its block uses (LinuxCNC).
+/// A parameter word no code of its block uses (LinuxCNC, Fanuc, Sinumerik, Heidenhain ISO).
 pub const PROGRAM_UNUSED_WORD: &str = "E0333";
 /// An arc from a point the program never stated.
 pub const PROGRAM_POSITION_UNKNOWN: &str = "E0334";

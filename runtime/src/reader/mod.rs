@@ -121,7 +121,8 @@ pub enum Rule {
     /// `END PGM` of the same name.
     ProgramFrame,
     /// A parameter word (I J K R P Q L D H) no code of its block uses
-    /// (LinuxCNC).
+    /// (LinuxCNC; Fanuc, Sinumerik and Heidenhain ISO for the words whose
+    /// use lensc reads).
     UnusedWord,
     /// An arc from a point the program never stated (lensc's policy).
     PositionUnknown,

@@ -289,6 +289,8 @@ impl State {
         }
         if self.lex.controller == Controller::LinuxCnc {
             self.word_use(b, groups, line, out);
+        } else {
+            self.parameter_words(b, groups, line, out);
         }
         self.modes(b, groups, line, out);
         self.spindle_and_tool(b, groups, ms, line, out);

@@ -544,3 +544,116 @@ fn heidenhain_iso_reads_g36_and_the_blank() {
     let started = good.replace("N6 G36 S0 *\n", "N6 G36 S0 *\nN6 M3 *\n");
     assert!(rules(&started, &d, &mill).contains(&Rule::NoSpindleSpeed));
 }
+
+/// A mill's limits for the parameter-word tests.
+fn mill() -> MachineLimits {
+    MachineLimits {
+        lathe: false,
+        travel: [
+            Some((-250.0, 250.0)),
+            Some((-200.0, 200.0)),
+            Some((-150.0, 150.0)),
+            None,
+        ],
+        max_feed: Some(5000.0),
+        max_spindle_rpm: Some(12000.0),
+    }
+}
+
+/// Each `(from, to)` change of `good` breaks `rule`; each of `clean` reads
+/// clean; `good` itself reads clean.
+fn holds(d: &Dialect, good: &str, broken: &[(&str, &str)], clean: &[(&str, &str)]) {
+    assert_eq!(rules(good, d, &mill()), vec![], "{good}");
+    for (from, to) in broken {
+        let text = good.replacen(from, to, 1);
+        assert_ne!(text, good, "{from}");
+        let found = rules(&text, d, &mill());
+        assert!(found.contains(&Rule::UnusedWord), "{to}: {found:?}");
+    }
+    for (from, to) in clean {
+        let text = good.replacen(from, to, 1);
+        assert_ne!(text, good, "{from}");
+        assert_eq!(rules(&text, d, &mill()), vec![], "{to}");
+    }
+}
+
+/// Fanuc refuses a parameter word no code of its block uses: I J K R
+/// away from an arc, P without G4, Q without G05.1, H without G43, D
+/// without G41/G42, L (M98, G10, not read) (docs/controllers/fanuc.md:
+/// assumptions, no Fanuc manual found).
+#[test]
+fn fanuc_refuses_words_no_code_of_the_block_uses() {
+    let mut d = Dialect::linuxcnc();
+    d.start = vec!["%".into(), "O{number} ({JOB})".into()];
+    d.constant_rpm = None;
+    d.surface_speed = Vec::new();
+    assert_eq!(Controller::of(&d), Controller::Fanuc);
+    let good = "%\nO1 (J)\n(+Z out of the material)\nG17 G21 G40 G49 G80 G90 G94 G54\nT1 M6\nS1000 M3\nG43 H1 G0 Z1.\nG0 X-1. Y0.\nG1 Z-0.1 F100.\nG2 X1. I1. J0.\nG0 Z1.\nM5\nM30\n%\n";
+    holds(
+        &d,
+        good,
+        &[
+            ("G1 Z-0.1 F100.", "G1 Z-0.1 I1. F100."),
+            ("G0 X-1. Y0.", "G0 X-1. Y0. R1."),
+            ("G0 X-1. Y0.", "G0 X-1. Y0. K0."),
+            ("S1000 M3", "S1000 M3 P5"),
+            ("G0 Z1.\nM5", "G0 Z1. Q1\nM5"),
+            ("T1 M6", "T1 M6 H1"),
+            ("G1 Z-0.1 F100.", "G1 Z-0.1 D1 F100."),
+            ("M5\n", "M5 L2\n"),
+        ],
+        &[
+            ("M5\n", "M5\nG4 P500\n"),
+            ("T1 M6\n", "T1 M6\nG05.1 Q1\n"),
+            // An arc's words in the arc mode in force.
+            ("G0 Z1.\nM5", "X-1. I-1. J0.\nG0 Z1.\nM5"),
+        ],
+    );
+}
+
+/// A Sinumerik refuses I J K away from an arc and P away from a
+/// subprogram call's passes (an arc's turns are `TURN=`)
+/// (docs/controllers/siemens.md).
+#[test]
+fn sinumerik_refuses_words_no_code_of_the_block_uses() {
+    let mut d = Dialect::linuxcnc();
+    d.comment = crate::dialect::CommentStyle::Semicolon;
+    assert_eq!(Controller::of(&d), Controller::Siemens);
+    let good = "; +Z out of the material\nG17 G71 G90 G40 G94 G54\nT1 D1\nM6\nG97 S1000 M3\nG0 Z1\nG0 X-1 Y0\nG94 G1 Z-0.1 F100\nG2 X1 I1 J0\nG0 Z1\nM5\nM30\n";
+    holds(
+        &d,
+        good,
+        &[
+            ("G94 G1 Z-0.1 F100", "G94 G1 Z-0.1 K1 F100"),
+            ("G0 X-1 Y0", "G0 X-1 Y0 J2"),
+            ("G94 G1 Z-0.1 F100", "G94 G1 Z-0.1 F100 P2"),
+            ("G2 X1 I1 J0", "G2 X1 I1 J0 P1"),
+        ],
+        &[("G0 Z1\nM5", "X-1 I-1 J0\nG0 Z1\nM5")],
+    );
+}
+
+/// Heidenhain ISO refuses I J K on a straight move; alone in a block they
+/// set the circle centre (docs/controllers/heidenhain.md).
+#[test]
+fn heidenhain_iso_refuses_centre_words_on_a_straight_move() {
+    let mut d = Dialect::linuxcnc();
+    d.comment = crate::dialect::CommentStyle::Semicolon;
+    d.block_end = " *".into();
+    d.line_numbers = Some(1);
+    d.max_line_number = Some(99999);
+    d.arc_centre_absolute = true;
+    d.surface_speed = Vec::new();
+    d.constant_rpm = None;
+    assert_eq!(Controller::of(&d), Controller::HeidenhainIso);
+    let good = "%J G71 *\nN1 ; +Z out of the material *\nN2 G17 G90 G40 G94 *\nN3 T1 G17 *\nN4 S1000 M3 *\nN5 G00 Z1. *\nN6 G00 X-1. Y0. *\nN7 G01 Z-0.1 F100. *\nN8 G02 X1. I0. J0. *\nN9 G00 Z1. *\nN10 M5 *\nN11 M30 *\nN99999999 %J G71 *\n";
+    holds(
+        &d,
+        good,
+        &[
+            ("N7 G01 Z-0.1 F100.", "N7 G01 Z-0.1 I1. F100."),
+            ("N6 G00 X-1. Y0.", "N6 G00 X-1. Y0. J0."),
+        ],
+        &[("N5 G00 Z1. *\n", "N5 G00 Z1. *\nN5 I0. J0. *\n")],
+    );
+}
