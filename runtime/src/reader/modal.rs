@@ -121,6 +121,11 @@ pub(crate) struct State {
     pub pos: [Option<f64>; 4],
     /// The axis whose + leads out of the material (header).
     pub away: usize,
+    /// Where the program's control point lies from the tool's centre (mm
+    /// along X, Y, Z; header): taken off every position held against the
+    /// machine's travel, which bounds the tool centre as the build's
+    /// planner and simulation take it.
+    pub control: [f64; 3],
     /// The highest point along `away` a feed move has reached.
     pub top: Option<f64>,
     /// A rapid down (or across) before the first cut, this line: the
@@ -220,6 +225,7 @@ impl State {
             diameter: machine.lathe && d.lathe_x_diameter,
             pos: [None; 4],
             away: 2,
+            control: [0.0; 3],
             top: None,
             pre_cut_rapid: None,
             last_spline_pq: None,
@@ -268,6 +274,9 @@ impl State {
         for c in &b.comments {
             if let Some(a) = super::header::away_axis(c) {
                 self.away = a;
+            }
+            if let Some(o) = super::header::control_offset(c) {
+                self.control = o;
             }
         }
         self.block_number(b, line, out);

@@ -657,3 +657,36 @@ fn heidenhain_iso_refuses_centre_words_on_a_straight_move() {
         &[("N5 G00 Z1. *\n", "N5 G00 Z1. *\nN5 I0. J0. *\n")],
     );
 }
+
+/// A program written for the tool's tip (its header states the control
+/// point's offset from the centre) is held to the machine's travel as the
+/// tool centre, as the centre's program is: both read to the same
+/// findings, in or out of the travel (`lensc verify` reads by `read_from`).
+#[test]
+fn a_tip_program_is_held_to_the_travel_as_its_centre_program() {
+    let d = Dialect::linuxcnc();
+    let mut m = mill();
+    m.travel[2] = Some((-1.0, 150.0));
+    let program = |control: &str, depth: f64| {
+        format!(
+            "(+Z out of the material)\n{control}G17 G21 G90 G40 G49 G80 G94 G54\nT1 M6 G43 H1\nG97 S1000 M3\nG0 Z1\nG0 X-1 Y0\nG94 G1 Z{depth} F100\nG1 X1\nG0 Z1\nM5\nM2\n"
+        )
+    };
+    let tip = "(control point tip at X+0 Y+0 Z-0.085 mm from the tool centre: the tip)\n";
+    let findings = |text: &str| {
+        read_from(text.as_bytes(), &d, &m)
+            .expect("read")
+            .into_iter()
+            .map(|f| (f.rule, f.message.replace("the tool centre's ", "")))
+            .collect::<Vec<_>>()
+    };
+    // The centre at -0.95 mm is inside the travel; its tip at -1.035 mm.
+    assert_eq!(findings(&program("", -0.95)), vec![]);
+    assert_eq!(findings(&program(tip, -0.95 - 0.085)), vec![]);
+    // The centre at -1.05 mm is outside, by the same figure either way.
+    let centre = findings(&program("", -1.05));
+    assert_eq!(centre.len(), 1, "{centre:?}");
+    assert_eq!(centre[0].0, Rule::OutsideTravel);
+    assert!(centre[0].1.contains("-1.05 mm"), "{centre:?}");
+    assert_eq!(findings(&program(tip, -1.05 - 0.085)), centre);
+}
