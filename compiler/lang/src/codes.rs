@@ -255,6 +255,8 @@ pub const PROGRAM_UNUSED_WORD: &str = "E0333";
 pub const PROGRAM_POSITION_UNKNOWN: &str = "E0334";
 /// A block after the program's end (M2, M30), which is never run.
 pub const PROGRAM_BLOCK_AFTER_END: &str = "E0335";
+/// M99 in a LinuxCNC main program: the program again from the top, for ever.
+pub const PROGRAM_MAIN_LOOP: &str = "E0336";
 
 /// A fast-tool-servo table (`lensc verify`) with a row that is not three
 /// numbers C X W, or whose C runs backwards.
@@ -300,6 +302,7 @@ pub fn program_rule(rule: lensc_runtime::reader::Rule) -> &'static str {
         UnusedWord => PROGRAM_UNUSED_WORD,
         PositionUnknown => PROGRAM_POSITION_UNKNOWN,
         BlockAfterEnd => PROGRAM_BLOCK_AFTER_END,
+        MainProgramLoop => PROGRAM_MAIN_LOOP,
     }
 }
 
@@ -431,6 +434,7 @@ pub const ALL: &[&str] = &[
     PROGRAM_UNUSED_WORD,
     PROGRAM_POSITION_UNKNOWN,
     PROGRAM_BLOCK_AFTER_END,
+    PROGRAM_MAIN_LOOP,
     SERVO_TABLE_ROW,
     ACCEPTANCE_MISSED_WARNING,
     ACCEPTANCE_UNMEASURED_WARNING,

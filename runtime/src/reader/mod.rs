@@ -128,6 +128,9 @@ pub enum Rule {
     PositionUnknown,
     /// A block after the program's end (lensc's policy).
     BlockAfterEnd,
+    /// M99 in a main program (LinuxCNC): the program starts again from
+    /// its first block, for ever (lensc's policy).
+    MainProgramLoop,
 }
 
 /// One thing wrong with a program: where (line from 1, byte span in the

@@ -81,6 +81,9 @@ enum MCode {
     Other,
     /// Heidenhain's M91: the block's coordinates are the machine's.
     MachinePosition,
+    /// LinuxCNC's M99 in a main program: back to the first block, for
+    /// ever; the reader reads no further (as at an end).
+    Loop,
 }
 
 /// The state of a program being read.
@@ -332,6 +335,17 @@ impl State {
             self.ended = true;
             self.spindle_on = false;
         }
+        if let Some(&(_, w)) = ms.iter().find(|(m, _)| *m == MCode::Loop) {
+            out.push((
+                Rule::MainProgramLoop,
+                b.words[w].span,
+                "M99 in a main program: the controller starts the program again from its first block, for ever".into(),
+                Some("end the program with M2 or M30".into()),
+            ));
+            // No block after it runs in this pass; the end is not missing.
+            self.ended = true;
+            self.spindle_on = false;
+        }
     }
 
     /// What is wrong once the whole program is read.
@@ -551,6 +565,11 @@ impl State {
             6 => MCode::ToolChange,
             2 | 30 => MCode::End,
             0 | 1 => MCode::Stop,
+            // M60: the pallet change pause, a stop as M0 is; M99 in a main
+            // program: the program again from the top (LinuxCNC's M-code
+            // reference, docs/controllers/linuxcnc.md).
+            60 if self.lex.controller == Controller::LinuxCnc => MCode::Stop,
+            99 if self.lex.controller == Controller::LinuxCnc => MCode::Loop,
             7..=9 => MCode::Coolant,
             19 => MCode::Orient,
             91 if matches!(
@@ -867,7 +886,7 @@ fn same_m_group(a: MCode, b: MCode) -> bool {
     use MCode::*;
     let group = |m| match m {
         SpindleOn | SpindleOff | PositionOn | PositionOff | Orient => 1,
-        End | Stop => 2,
+        End | Stop | Loop => 2,
         ToolChange => 3,
         Coolant | Other | MachinePosition => 0,
     };

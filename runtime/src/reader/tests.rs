@@ -690,3 +690,27 @@ fn a_tip_program_is_held_to_the_travel_as_its_centre_program() {
     assert!(centre[0].1.contains("-1.05 mm"), "{centre:?}");
     assert_eq!(findings(&program(tip, -1.05 - 0.085)), centre);
 }
+
+/// LinuxCNC's M60 is the pallet change pause, a stop as M0 is (rs274
+/// runs it); M99 in a main program starts it again from the top, which
+/// lensc refuses as its policy (`main-program-loop`) and reads no
+/// further, so blocks after it are not counted again.
+#[test]
+fn linuxcnc_reads_m60_as_a_pause_and_m99_as_an_endless_loop() {
+    let d = Dialect::linuxcnc();
+    let paused = GOOD.replacen("M5\n", "M5\nM60\n", 1);
+    assert_eq!(rules(&paused, &d, &lathe()), vec![]);
+    let paused_with_m0 = GOOD.replacen("M5\n", "M5\nM60 M0\n", 1);
+    assert_eq!(
+        rules(&paused_with_m0, &d, &lathe()),
+        vec![Rule::SameModalGroup]
+    );
+    let looped = GOOD.replacen("M2\n", "M99\n", 1);
+    assert_eq!(rules(&looped, &d, &lathe()), vec![Rule::MainProgramLoop]);
+    assert!(Rule::MainProgramLoop.policy().is_some());
+    let looped_early = GOOD.replacen("G0 Z1.5\nM5", "M99\nG0 Z1.5\nM5", 1);
+    assert_eq!(
+        rules(&looped_early, &d, &lathe()),
+        vec![Rule::MainProgramLoop, Rule::BlockAfterEnd]
+    );
+}
