@@ -252,12 +252,14 @@ pub const PROGRAM_BLOCK_SEQUENCE: &str = "E0330";
 pub const PROGRAM_NO_CIRCLE_CENTRE: &str = "E0331";
 /// Klartext: the program not framed by `BEGIN PGM` and `END PGM` of one name.
 pub const PROGRAM_FRAME: &str = "E0332";
-/// A parameter word no code of its block uses (LinuxCNC).
+/// A parameter word no code of its block uses (LinuxCNC, Fanuc, Sinumerik, Heidenhain ISO).
 pub const PROGRAM_UNUSED_WORD: &str = "E0333";
 /// An arc from a point the program never stated.
 pub const PROGRAM_POSITION_UNKNOWN: &str = "E0334";
 /// A block after the program's end (M2, M30), which is never run.
 pub const PROGRAM_BLOCK_AFTER_END: &str = "E0335";
+/// M99 in a LinuxCNC main program: the program again from the top, for ever.
+pub const PROGRAM_MAIN_LOOP: &str = "E0336";
 
 /// A fast-tool-servo table (`lensc verify`) with a row that is not three
 /// numbers C X W, or whose C runs backwards.
@@ -303,6 +305,7 @@ pub fn program_rule(rule: lensc_runtime::reader::Rule) -> &'static str {
         UnusedWord => PROGRAM_UNUSED_WORD,
         PositionUnknown => PROGRAM_POSITION_UNKNOWN,
         BlockAfterEnd => PROGRAM_BLOCK_AFTER_END,
+        MainProgramLoop => PROGRAM_MAIN_LOOP,
     }
 }
 
@@ -435,6 +438,7 @@ pub const ALL: &[&str] = &[
     PROGRAM_UNUSED_WORD,
     PROGRAM_POSITION_UNKNOWN,
     PROGRAM_BLOCK_AFTER_END,
+    PROGRAM_MAIN_LOOP,
     SERVO_TABLE_ROW,
     ACCEPTANCE_MISSED_WARNING,
     ACCEPTANCE_UNMEASURED_WARNING,
