@@ -145,6 +145,7 @@ fn report(
             &head.surface.lowered,
             201,
         ),
+        compensation: head.surface.compensation.clone(),
     }
 }
 

@@ -213,7 +213,21 @@ pub struct PartNames {
 pub struct SurfaceSpec {
     pub kind: &'static str,
     pub words: String,
+    /// The surface the program cuts: the design, or with a `compensate`
+    /// block the corrected surface.
     pub lowered: LoweredSurface,
+    /// With a `compensate` block: the design itself (what a part is
+    /// measured against) and the iteration for the report.
+    pub design: Option<LoweredSurface>,
+    pub compensation: Option<crate::report::Compensation>,
+}
+
+impl SurfaceSpec {
+    /// The design surface: what the part is to be, whatever is cut to
+    /// make it.
+    pub fn design(&self) -> &LoweredSurface {
+        self.design.as_ref().unwrap_or(&self.lowered)
+    }
 }
 
 /// A `simulate { x: …, y: …, spacing: … }` block: the window of the
@@ -245,6 +259,9 @@ pub struct Parts<'a> {
     /// The surface's parameters (the surface itself is lowered from its
     /// checked object, `lowered`).
     pub surface_params: Surface,
+    /// With a `compensate` block, once `lowered` has made the correction:
+    /// the design and the iteration, for the head.
+    compensated: std::cell::RefCell<Option<(LoweredSurface, crate::report::Compensation)>>,
 }
 
 impl<'a> Parts<'a> {
@@ -303,6 +320,7 @@ impl<'a> Parts<'a> {
             tool_params,
             path: PathParams::read(strategy),
             surface_params,
+            compensated: std::cell::RefCell::new(None),
         })
     }
     pub fn site(&self) -> (FileId, Span) {
@@ -378,10 +396,18 @@ impl<'a> Parts<'a> {
         }
         errors
     }
-    /// The surface lowered to IR, or E0131.
+    /// The surface the program is to cut, lowered to IR: the design, or
+    /// with a `compensate` block the design corrected from its measurement
+    /// (`crate::compensate`); E0131, or the correction's refusal.
     pub fn lowered(&self) -> Result<LoweredSurface, Diagnostic> {
-        lensc_lang::lower::surface::lower_surface(self.surface)
-            .map_err(|e| RuntimeError::Surface(e).at(self.site()))
+        let design = lensc_lang::lower::surface::lower_surface(self.surface)
+            .map_err(|e| RuntimeError::Surface(e).at(self.site()))?;
+        let Some(c) = &self.params.compensate else {
+            return Ok(design);
+        };
+        let (corrected, report) = crate::compensate::corrected(self, &design, c)?;
+        *self.compensated.borrow_mut() = Some((design, report));
+        Ok(corrected)
     }
     /// The path tolerance the strategy states, or the default its machine
     /// holds on a path in `axes` length axes (`default_path_tolerance`,
@@ -467,10 +493,15 @@ impl<'a> Parts<'a> {
                 machine: name("machine", self.machine),
                 strategy: name("strategy", self.strategy),
             },
-            surface: SurfaceSpec {
-                kind: self.surface.kind.name,
-                words: lensc_lang::lower::describe(self.surface),
-                lowered,
+            surface: {
+                let (design, compensation) = self.compensated.borrow_mut().take().unzip();
+                SurfaceSpec {
+                    kind: self.surface.kind.name,
+                    words: lensc_lang::lower::describe(self.surface),
+                    lowered,
+                    design,
+                    compensation,
+                }
             },
             dialect,
             resolution: self.machine_params.resolution,

@@ -39,6 +39,9 @@ pub struct Options {
     pub cutoff: f64,
     /// Use the file's own coordinates instead of centring the map.
     pub keep_origin: bool,
+    /// Whether a job's `compensate` block names the file (its messages
+    /// then name the block's parameters instead of the command's flags).
+    pub from_job: bool,
 }
 
 impl Default for Options {
@@ -48,6 +51,7 @@ impl Default for Options {
             min_valid: 0.5,
             cutoff: 0.08,
             keep_origin: false,
+            from_job: false,
         }
     }
 }
@@ -253,105 +257,31 @@ pub fn measure(
         lensc_measure::read::read(file, bytes, opts.units).map_err(|e| read_failure(file, &e))?;
     let head = spec.head();
     let surface_name = head.names.surface.clone();
-    let lowered = &head.surface.lowered;
+    let lowered = head.surface.design();
     let (f, _) = crate::evaluate::evaluator(&lowered.tape);
-    let domain = lowered.domain;
     let format = m.format;
     let kind = match &m.data {
         Measured::Map(_) => "map",
         Measured::Cloud(_) => "point_cloud",
         Measured::Profile(_) => "profile",
     };
-    let p = points(m.data, opts, &|x, y| domain.contains(x, y));
-    let aperture = aperture_words(&domain);
-    // Does it lie on the part at all? Then is enough of it valid?
-    let on_part = p.in_aperture as f64 / p.total.max(1) as f64;
-    if on_part < 0.5 {
-        return Err(fail(
-            codes::MEASURE_MISMATCH,
-            format!(
-                "{file}: {:.1} % of the measured points lie inside the aperture of `{surface_name}` ({aperture}): a measurement in other units, or of another part",
-                100.0 * on_part
-            ),
-            Some(if matches!(format, Format::Xyz | Format::Profile) {
-                "a text file's numbers carry no unit: say which with --units (mm unless given)"
-            } else {
-                "check that the file measures this job's part; --keep-origin uses the file's own coordinates instead of centring the map"
-            }),
-        ));
-    }
-    let share = p.inside.len() as f64 / p.in_aperture.max(1) as f64;
-    if share < opts.min_valid {
-        return Err(fail(
-            codes::MEASURE_TOO_LITTLE,
-            format!(
-                "{file}: {:.1} % of the {} measured points inside the aperture of `{surface_name}` are valid; at least {:.1} % are needed (--min-valid)",
-                100.0 * share,
-                p.in_aperture,
-                100.0 * opts.min_valid
-            ),
-            Some(
-                "measure the part again, or lower --min-valid knowing what the figures then cover",
-            ),
-        ));
-    }
-    let fit = Fit {
-        two_d: p.two_d,
-        ..Fit::default()
-    };
-    let reg = if p.cloud {
-        register::register_cloud(f.as_ref(), &p.inside, fit)
-    } else {
-        register::register_heights(f.as_ref(), &p.inside, fit)
-    };
-    let reg = reg.map_err(|e| match e {
-        RegisterError::TooFewPoints { points } => fail(
-            codes::MEASURE_TOO_LITTLE,
-            format!("{file}: {points} valid points inside the aperture of `{surface_name}`: too few to register"),
-            None,
-        ),
-        RegisterError::NotConverged { iterations, rms } => fail(
-            codes::MEASURE_NOT_CONVERGED,
-            format!(
-                "{file}: the registration to `{surface_name}` did not converge in {iterations} iterations{}",
-                if rms.is_finite() { format!(" (residual RMS {:.1} nm)", rms * 1e6) } else { String::new() }
-            ),
-            Some("centre the map in the instrument's software, or check that it measures this surface"),
-        ),
-        RegisterError::Undefined { points } => fail(
-            codes::MEASURE_NOT_CONVERGED,
-            format!("{file}: the registration to `{surface_name}` moved {points} measured points where the design has no value"),
-            Some("centre the map in the instrument's software, or check that it measures this surface"),
-        ),
-    })?;
-    // The error along the normal, at each registered point.
-    let pred = register::predict(f.as_ref(), &p.inside, &reg.values);
-    let errors: Vec<f64> = p
-        .inside
-        .iter()
-        .zip(&pred)
-        .map(|(q, h)| (q[2] - h[0]) / (1.0 + h[1] * h[1] + h[2] * h[2]).sqrt())
-        .collect();
-    let form = form_error(&p.inside, &errors);
-    let (lo, hi) = pred
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), h| {
-            (lo.min(h[0]), hi.max(h[0]))
-        });
-    let sag_range = hi - lo;
-    if form.rms_nm * 1e-6 > 0.25 * sag_range && form.rms_nm > 1000.0 {
-        return Err(fail(
-            codes::MEASURE_MISMATCH,
-            format!(
-                "{file}: after registration the measurement departs from `{surface_name}` by {:.3} µm RMS, more than a quarter of the design's {:.3} µm sag range over the measured points: heights in other units, or another surface",
-                form.rms_nm / 1000.0,
-                sag_range * 1000.0
-            ),
-            Some(
-                "check the file's units (--units for a text file) and that it measures this job's surface",
-            ),
-        ));
-    }
+    let placed = register_measurement(
+        f.as_ref(),
+        &lowered.domain,
+        &surface_name,
+        file,
+        m.data,
+        format,
+        opts,
+    )?;
+    let Registered {
+        points: p,
+        registration: reg,
+        errors,
+        form,
+        share,
+        ..
+    } = placed;
     let (texture, texture_skipped) = texture_of(&p, &errors, opts.cutoff);
     let setup = (spec.setup() == Setup::Lathe)
         .then(|| setup_of(f.as_ref(), &p, &errors, &reg))
@@ -398,6 +328,165 @@ pub fn measure(
         setup,
     };
     Ok(Outcome { report, svg })
+}
+
+/// A measurement registered to a design: its points, the placement found,
+/// and the error at each point, along the normal (`errors`) and along z
+/// (`vertical`: measured − design height, mm).
+pub struct Registered {
+    points: Points,
+    pub registration: register::Registration,
+    pub errors: Vec<f64>,
+    pub vertical: Vec<f64>,
+    pub form: report::FormError,
+    /// The share of the measured aperture that is valid.
+    pub share: f64,
+}
+
+impl Registered {
+    /// The valid points inside the aperture, as measured (mm).
+    pub fn inside(&self) -> &[[f64; 3]] {
+        &self.points.inside
+    }
+    /// Whether the measurement is a profile (one line, no y).
+    pub fn is_profile(&self) -> bool {
+        !self.points.two_d
+    }
+    /// The report's words for the placement found.
+    pub fn registration_report(&self) -> report::Registration {
+        registration_report(&self.registration)
+    }
+}
+
+/// Registers the measurement `data` (of the file `file`) to the design
+/// `f` over `domain` (the surface `surface_name`): refused, with its code,
+/// when too little of it lies on the aperture or is valid, when the
+/// registration does not converge, or when what is left departs from the
+/// design more than a part could (other units, another surface).
+pub fn register_measurement(
+    f: &dyn SurfaceFn,
+    domain: &lensc_runtime::surface::analysis::Domain,
+    surface_name: &str,
+    file: &str,
+    data: Measured,
+    format: Format,
+    opts: &Options,
+) -> Result<Registered, Failure> {
+    use lensc_lang::codes;
+    let domain = *domain;
+    let p = points(data, opts, &|x, y| domain.contains(x, y));
+    let aperture = aperture_words(&domain);
+    // Does it lie on the part at all? Then is enough of it valid?
+    let on_part = p.in_aperture as f64 / p.total.max(1) as f64;
+    if on_part < 0.5 {
+        return Err(fail(
+            codes::MEASURE_MISMATCH,
+            format!(
+                "{file}: {:.1} % of the measured points lie inside the aperture of `{surface_name}` ({aperture}): a measurement in other units, or of another part",
+                100.0 * on_part
+            ),
+            Some(if matches!(format, Format::Xyz | Format::Profile) {
+                if opts.from_job {
+                    "a text file's numbers carry no unit: say which with `units:` in the `compensate` block (mm unless given)"
+                } else {
+                    "a text file's numbers carry no unit: say which with --units (mm unless given)"
+                }
+            } else if opts.from_job {
+                "check that the file measures this job's part, centred on it"
+            } else {
+                "check that the file measures this job's part; --keep-origin uses the file's own coordinates instead of centring the map"
+            }),
+        ));
+    }
+    let share = p.inside.len() as f64 / p.in_aperture.max(1) as f64;
+    if share < opts.min_valid {
+        return Err(fail(
+            codes::MEASURE_TOO_LITTLE,
+            format!(
+                "{file}: {:.1} % of the {} measured points inside the aperture of `{surface_name}` are valid; at least {:.1} % are needed{}",
+                100.0 * share,
+                p.in_aperture,
+                100.0 * opts.min_valid,
+                if opts.from_job { "" } else { " (--min-valid)" }
+            ),
+            Some(if opts.from_job {
+                "measure the part again: a correction is made only where the part was measured"
+            } else {
+                "measure the part again, or lower --min-valid knowing what the figures then cover"
+            }),
+        ));
+    }
+    let fit = Fit {
+        two_d: p.two_d,
+        ..Fit::default()
+    };
+    let reg = if p.cloud {
+        register::register_cloud(f, &p.inside, fit)
+    } else {
+        register::register_heights(f, &p.inside, fit)
+    };
+    let reg = reg.map_err(|e| match e {
+        RegisterError::TooFewPoints { points } => fail(
+            codes::MEASURE_TOO_LITTLE,
+            format!("{file}: {points} valid points inside the aperture of `{surface_name}`: too few to register"),
+            None,
+        ),
+        RegisterError::NotConverged { iterations, rms } => fail(
+            codes::MEASURE_NOT_CONVERGED,
+            format!(
+                "{file}: the registration to `{surface_name}` did not converge in {iterations} iterations{}",
+                if rms.is_finite() { format!(" (residual RMS {:.1} nm)", rms * 1e6) } else { String::new() }
+            ),
+            Some("centre the map in the instrument's software, or check that it measures this surface"),
+        ),
+        RegisterError::Undefined { points } => fail(
+            codes::MEASURE_NOT_CONVERGED,
+            format!("{file}: the registration to `{surface_name}` moved {points} measured points where the design has no value"),
+            Some("centre the map in the instrument's software, or check that it measures this surface"),
+        ),
+    })?;
+    // The error along the normal, at each registered point.
+    let pred = register::predict(f, &p.inside, &reg.values);
+    let errors: Vec<f64> = p
+        .inside
+        .iter()
+        .zip(&pred)
+        .map(|(q, h)| (q[2] - h[0]) / (1.0 + h[1] * h[1] + h[2] * h[2]).sqrt())
+        .collect();
+    let vertical: Vec<f64> = p
+        .inside
+        .iter()
+        .zip(&pred)
+        .map(|(q, h)| q[2] - h[0])
+        .collect();
+    let form = form_error(&p.inside, &errors);
+    let (lo, hi) = pred
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), h| {
+            (lo.min(h[0]), hi.max(h[0]))
+        });
+    let sag_range = hi - lo;
+    if form.rms_nm * 1e-6 > 0.25 * sag_range && form.rms_nm > 1000.0 {
+        return Err(fail(
+            codes::MEASURE_MISMATCH,
+            format!(
+                "{file}: after registration the measurement departs from `{surface_name}` by {:.3} µm RMS, more than a quarter of the design's {:.3} µm sag range over the measured points: heights in other units, or another surface",
+                form.rms_nm / 1000.0,
+                sag_range * 1000.0
+            ),
+            Some(
+                "check the file's units (--units for a text file) and that it measures this job's surface",
+            ),
+        ));
+    }
+    Ok(Registered {
+        points: p,
+        registration: reg,
+        errors,
+        vertical,
+        form,
+        share,
+    })
 }
 
 fn aperture_words(d: &lensc_runtime::surface::analysis::Domain) -> String {

@@ -1,0 +1,359 @@
+//! A job's `compensate` block: the surface the next cut aims at, made
+//! from a measurement of the part the last cut made. The measurement file
+//! is read as a `use`d file is (beside the job's file, beneath the project
+//! root, a regular file, bounded in size), registered to the design as
+//! `lensc measure` registers it, and its error along z fitted by smooth
+//! polynomials over the whole aperture (`lensc_measure::correct`, which
+//! states the method); the surface cut is the design less `gain` times
+//! that fit, one IR tape, so every strategy plans it with exact
+//! derivatives as it plans the design. Every refusal is a coded
+//! diagnostic at the block's `measurement`, naming the file.
+
+use std::path::Path;
+
+use lensc_grammar::Diagnostic;
+use lensc_lang::codes;
+use lensc_lang::lower::surface::LoweredSurface;
+use lensc_lang::sandbox;
+use lensc_lang::schema::CompensateParams;
+use lensc_lang::value::Stated;
+use lensc_measure::correct::{self, Basis, Correction};
+use lensc_measure::read::TextUnits;
+use lensc_runtime::surface::analysis::{self, Domain};
+use lensc_runtime::surface::ir::{SurfaceTape, Var};
+
+use crate::job::Parts;
+use crate::measure::{self, Failure, MAX_MEASUREMENT_BYTES};
+use crate::report::Compensation;
+
+/// The strategies whose cut is a surface of revolution (a lathe without a
+/// servo, a profile grinder): their correction is radial, the mean of
+/// each ring being all such a cut can follow.
+const TURNED: [&str; 3] = ["profile_turning", "profile_grinding", "spiral_turning"];
+
+/// The surface to cut instead of `design`, and the iteration for the
+/// report; or why no correction is made.
+pub(crate) fn corrected(
+    p: &Parts,
+    design: &LoweredSurface,
+    block: &Stated<CompensateParams>,
+) -> Result<(LoweredSurface, Compensation), Diagnostic> {
+    let c = &block.value;
+    let file = c.measurement.value.as_str();
+    let at = |f: Failure| {
+        let mut d = Diagnostic::error(
+            f.code,
+            f.message,
+            c.measurement.site.0,
+            c.measurement.site.1,
+        )
+        .with_label("the measurement this job is compensated from");
+        if let Some(h) = f.help {
+            d = d.with_help(h);
+        }
+        d
+    };
+    let bytes = read(p, &c.measurement)?;
+    let m = lensc_measure::read::read(file, &bytes, TextUnits(c.units))
+        .map_err(|e| at(measure::read_failure(file, &e)))?;
+    let format = m.format;
+    let surface_name = p
+        .job
+        .part_names
+        .get("surface")
+        .cloned()
+        .unwrap_or_else(|| p.surface.kind.name.to_string());
+    let (f, _) = crate::evaluate::evaluator(&design.tape);
+    let opts = measure::Options {
+        units: TextUnits(c.units),
+        from_job: true,
+        ..measure::Options::default()
+    };
+    let placed = measure::register_measurement(
+        f.as_ref(),
+        &design.domain,
+        &surface_name,
+        file,
+        m.data,
+        format,
+        &opts,
+    )
+    .map_err(at)?;
+    // Each measured point in the design's frame, with its error along z.
+    let (us, vs) = lensc_measure::register::moved(placed.inside(), &placed.registration.values);
+    let xy: Vec<(f64, f64)> = us.into_iter().zip(vs).collect();
+    let radial = placed.is_profile() || TURNED.contains(&p.strategy.kind.name);
+    let (basis, cell) = basis(&design.domain, radial, c.smoothing);
+    let cells = correct::bin(&basis, &xy, &placed.vertical, cell);
+    let fitted = correct::fit(basis, &cells)
+        .filter(|k| k.coefficients.iter().all(|v| v.is_finite()))
+        .ok_or_else(|| {
+            at(Failure {
+                code: codes::COMPENSATE_UNFITTED,
+                message: format!(
+                    "{file}: the measured points fill {} {} of the aperture of `{surface_name}`: too few to fit the {} terms a smoothing length of {} mm asks",
+                    cells.len(),
+                    if radial { "rings" } else { "cells" },
+                    basis.terms().len(),
+                    lensc_lang::check::trim_num(c.smoothing)
+                ),
+                at: None,
+                help: Some(
+                    "give a longer `smoothing` (a lower order), or measure more of the part"
+                        .into(),
+                ),
+            })
+        })?;
+    // A polynomial carried beyond its points can swing: one that swings
+    // far beyond the error it was fitted to follows no measurement.
+    let (measured_pv, measured_rms) = pv_rms(&placed.vertical);
+    let swing = correction_pv(&fitted, &design.domain);
+    if swing > 2.0 * measured_pv + 1e-6 {
+        return Err(at(Failure {
+            code: codes::COMPENSATE_UNFITTED,
+            message: format!(
+                "{file}: the correction fitted to the measured error ({:.1} nm PV) swings {:.1} nm over the aperture of `{surface_name}`: it follows no measurement where it is carried beyond the measured points",
+                measured_pv * 1e6,
+                swing * 1e6
+            ),
+            at: None,
+            help: Some(
+                "give a longer `smoothing` (a lower order), or measure the whole aperture".into(),
+            ),
+        }));
+    }
+    let tape = corrected_tape(&design.tape, &fitted, c.gain);
+    let corrected = LoweredSurface {
+        tape,
+        domain: design.domain,
+    };
+    curvature_check(p, design, &corrected, file, &surface_name).map_err(at)?;
+    // What the next part is predicted to be, should the machine repeat
+    // the measured error.
+    let predicted: Vec<f64> = xy
+        .iter()
+        .zip(&placed.vertical)
+        .map(|(&(x, y), e)| e - c.gain * fitted.at(x, y))
+        .collect();
+    let (predicted_pv, predicted_rms) = pv_rms(&predicted);
+    let report = Compensation {
+        measurement: file.to_owned(),
+        format: format.name().to_owned(),
+        md5: lensc_measure::md5_hex(&bytes),
+        points: placed.inside().len(),
+        valid_share: placed.share,
+        registration: placed.registration_report(),
+        measured_pv_nm: measured_pv * 1e6,
+        measured_rms_nm: measured_rms * 1e6,
+        gain: c.gain,
+        smoothing_mm: c.smoothing,
+        method: format!(
+            "the registered error along z averaged in {} {} mm wide, fitted by least squares weighted by each cell's points; piston{} left out; the polynomial carries the correction over the whole aperture, holes and rim included; the surface cut is the design less the gain times it",
+            if radial {
+                "rings about the axis (a turned cut follows each ring's mean)"
+            } else {
+                "squares"
+            },
+            lensc_lang::check::trim_num(cell),
+            if radial { "" } else { " and tilts" }
+        ),
+        basis: basis.words(),
+        order: basis.order(),
+        terms: basis.terms().len(),
+        cells: fitted.cells,
+        fit_residual_rms_nm: fitted.fit_residual_rms * 1e6,
+        correction_pv_nm: c.gain * swing * 1e6,
+        predicted_pv_nm: predicted_pv * 1e6,
+        predicted_rms_nm: predicted_rms * 1e6,
+    };
+    Ok((corrected, report))
+}
+
+/// The measurement's bytes, read as the loader reads a `use`d file:
+/// relative to the job's file, beneath the project root, a regular file,
+/// at most `MAX_MEASUREMENT_BYTES`.
+fn read(p: &Parts, m: &Stated<String>) -> Result<Vec<u8>, Diagnostic> {
+    let job = p.job;
+    let base = job
+        .path
+        .as_deref()
+        .and_then(Path::parent)
+        .unwrap_or(Path::new(""));
+    let full = base.join(&m.value);
+    let resolved = sandbox::resolve(&full);
+    let root = job
+        .root
+        .as_ref()
+        .map(|r| r.path().to_path_buf())
+        .unwrap_or_else(|| sandbox::resolve(Path::new(".")));
+    let e = if !sandbox::inside(&resolved, &root) {
+        sandbox::ReadError::OutsideRoot {
+            resolved: resolved.clone(),
+            root,
+        }
+    } else {
+        let read = match &job.root {
+            Some(r) => r.read(&resolved, MAX_MEASUREMENT_BYTES),
+            None => sandbox::read_regular(&resolved, MAX_MEASUREMENT_BYTES),
+        };
+        match read {
+            Ok(b) => return Ok(b),
+            Err(e) => e,
+        }
+    };
+    Err(Diagnostic::error(
+        e.code(),
+        format!("cannot read the measurement `{}`: {e}", full.display()),
+        m.site.0,
+        m.site.1,
+    )
+    .with_label("named here")
+    .with_help(match e {
+        sandbox::ReadError::OutsideRoot { .. } => {
+            "a job reads only files under its project root (the directory of the file given on the command line unless `--root DIR`)"
+        }
+        sandbox::ReadError::TooLarge { .. } => "measurements of at most 256 MiB are read",
+        _ => "the path is relative to the job's file",
+    }))
+}
+
+/// The basis over the aperture and the width of the cells the error is
+/// averaged in: rings a tenth of the smoothing length wide (five rings or
+/// more to each term), squares a quarter of it, and no finer than a
+/// 2000th of the radius (rings) or a 200th of the width (squares), which
+/// bounds the fit's work.
+fn basis(domain: &Domain, radial: bool, smoothing: f64) -> (Basis, f64) {
+    let (x, y) = match *domain {
+        Domain::Circle { radius } => ((-radius, radius), (-radius, radius)),
+        Domain::Annulus { outer, .. } => ((-outer, outer), (-outer, outer)),
+        Domain::Rect { x, y } => (x, y),
+    };
+    if radial {
+        // The farthest corner from the axis: every point of the aperture
+        // lies within it (for a disc or ring, its outer radius).
+        let radius = match *domain {
+            Domain::Circle { radius } => radius,
+            Domain::Annulus { outer, .. } => outer,
+            Domain::Rect { .. } => x.0.abs().max(x.1.abs()).hypot(y.0.abs().max(y.1.abs())),
+        };
+        (
+            Basis::radial(radius, smoothing),
+            (smoothing / 10.0).max(radius / 2000.0),
+        )
+    } else {
+        let width = (x.1 - x.0).max(y.1 - y.0);
+        (
+            Basis::map(x, y, smoothing),
+            (smoothing / 4.0).max(width / 200.0),
+        )
+    }
+}
+
+/// The design's tape less `gain` × the correction, value and derivatives
+/// (the correction's derivatives taken by the graph, exactly).
+pub fn corrected_tape(design: &SurfaceTape, fitted: &Correction, gain: f64) -> SurfaceTape {
+    let mut g = design.graph.clone();
+    let (x, y) = (g.x(), g.y());
+    let c = fitted.node(&mut g, x, y, gain);
+    let cx = g.derivative(c, Var::X);
+    let cy = g.derivative(c, Var::Y);
+    let cxx = g.derivative(cx, Var::X);
+    let cxy = g.derivative(cx, Var::Y);
+    let cyy = g.derivative(cy, Var::Y);
+    let o = design.outputs;
+    let outputs = [
+        g.sub(o[0], c),
+        g.sub(o[1], cx),
+        g.sub(o[2], cy),
+        g.sub(o[3], cxx),
+        g.sub(o[4], cxy),
+        g.sub(o[5], cyy),
+    ];
+    SurfaceTape::with_outputs(g, outputs)
+}
+
+/// E0366 when the corrected surface curves (concave, towards the tool)
+/// more tightly than the tool's nose or ball, where the design did not:
+/// the tool cannot follow the correction.
+fn curvature_check(
+    p: &Parts,
+    design: &LoweredSurface,
+    corrected: &LoweredSurface,
+    file: &str,
+    surface_name: &str,
+) -> Result<(), Failure> {
+    let Some(tool) = p
+        .tool_params
+        .nose_radius
+        .or(p.tool_params.diameter.map(|d| d / 2.0))
+        .filter(|r| r.is_finite() && *r > 0.0)
+    else {
+        return Ok(());
+    };
+    let tightest = |l: &LoweredSurface| {
+        let (f, _) = crate::evaluate::evaluator(&l.tape);
+        let a = analysis::analyse(f.as_ref(), &l.domain, 201);
+        [a.min_radius_concave_x, a.min_radius_concave_y]
+            .into_iter()
+            .flatten()
+            .min_by(|a, b| a.value.total_cmp(&b.value))
+    };
+    let Some(after) = tightest(corrected).filter(|e| e.value < tool) else {
+        return Ok(());
+    };
+    if tightest(design).is_some_and(|e| e.value < tool) {
+        // The design itself is too tight: the strategy's own check says so.
+        return Ok(());
+    }
+    Err(Failure {
+        code: codes::COMPENSATE_CURVATURE,
+        message: format!(
+            "{file}: the corrected `{surface_name}` curves concave to a radius of {:.4} mm at ({:.3}, {:.3}) mm, tighter than the tool's {} mm: the tool cannot follow the correction",
+            after.value,
+            after.x,
+            after.y,
+            lensc_lang::check::trim_num(tool)
+        ),
+        at: None,
+        help: Some(
+            "give a longer `smoothing` (the correction then follows no ripple shorter than it), or a lower `gain`"
+                .into(),
+        ),
+    })
+}
+
+/// Peak to valley and RMS about the mean.
+fn pv_rms(e: &[f64]) -> (f64, f64) {
+    let n = e.len().max(1) as f64;
+    let mean = e.iter().sum::<f64>() / n;
+    let rms = (e.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n).sqrt();
+    let (lo, hi) = e
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(*v), hi.max(*v))
+        });
+    (hi - lo, rms)
+}
+
+/// The correction's peak to valley over the aperture (mm), on a 201 × 201
+/// grid over its bounding box.
+fn correction_pv(fitted: &Correction, domain: &Domain) -> f64 {
+    let (x, y) = match *domain {
+        Domain::Circle { radius } => ((-radius, radius), (-radius, radius)),
+        Domain::Annulus { outer, .. } => ((-outer, outer), (-outer, outer)),
+        Domain::Rect { x, y } => (x, y),
+    };
+    let mut v = Vec::new();
+    for j in 0..201 {
+        for i in 0..201 {
+            let (px, py) = (
+                x.0 + (x.1 - x.0) * i as f64 / 200.0,
+                y.0 + (y.1 - y.0) * j as f64 / 200.0,
+            );
+            if domain.contains(px, py) {
+                v.push(fitted.at(px, py));
+            }
+        }
+    }
+    pv_rms(&v).0
+}
