@@ -148,13 +148,14 @@ pub(crate) fn corrected(
         gain: c.gain,
         smoothing_mm: c.smoothing,
         method: format!(
-            "the registered error along z averaged in {} {} mm wide, fitted by least squares weighted by each cell's points; piston{} left out; the polynomial carries the correction over the whole aperture, holes and rim included; the surface cut is the design less the gain times it",
-            if radial {
-                "rings about the axis (a turned cut follows each ring's mean)"
-            } else {
-                "squares"
-            },
+            "the registered error along z averaged in {} {} mm wide{}, fitted by least squares weighted by each cell's points; piston{} left out; the polynomial carries the correction over the whole aperture, holes and rim included; the surface cut is the design less the gain times it",
+            if radial { "rings" } else { "squares" },
             lensc_lang::check::trim_num(cell),
+            if radial {
+                " about the axis (a turned cut follows each ring's mean)"
+            } else {
+                ""
+            },
             if radial { "" } else { " and tilts" }
         ),
         basis: basis.words(),
