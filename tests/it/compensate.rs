@@ -490,3 +490,115 @@ fn bad_measurements_are_coded_errors_at_the_compensate_block() {
         .collect();
     refused("short.txt", Some(profile.as_bytes()), "0.3 mm", "E0367");
 }
+
+/// The measurement the tutorial (docs/usage/compensate.md) starts from:
+/// FRONT's program, read back and cut by the mis-set machine of
+/// `one_compensation_leaves_a_fifth_of_the_form_error`, mapped at 50 µm
+/// pixels with 1 nm of noise. Committed so a user can run the tutorial;
+/// `LENSC_BLESS=1` writes it again when the program changes.
+#[test]
+fn the_tutorial_measurement_is_current() {
+    let path = crate::common::root().join("examples/measured/front_first_part.x3p");
+    let dir = project("", &[]);
+    let program = build(dir.path());
+    let wrong = SetUp {
+        x_offset: -1e-3,
+        centre_height: 0.0,
+        nose_radius: 0.502,
+    };
+    let inst = Instrument {
+        tilt_x: 20e-6,
+        centre: (3e-3, -2e-3),
+        noise: 1e-6,
+    };
+    let part = map(&cut(dir.path(), &program, wrong), 121, 0.05, 2.95, inst);
+    let bytes = lensc_measure::write::x3p(&part, "simulated (tests/it/compensate.rs)");
+    if std::env::var_os("LENSC_BLESS").is_some() {
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(&path, &bytes).unwrap();
+    }
+    assert!(
+        std::fs::read(&path).ok() == Some(bytes),
+        "{} is stale: write it again with\n    LENSC_BLESS=1 cargo test --test it -- compensate::the_tutorial",
+        path.display()
+    );
+}
+
+/// The tutorial's commands, run as written: each ```lens block is the
+/// job file `front.lens` from there on; each `$ lensc …` line of a
+/// ```text block is run in a project folder holding the tutorial's
+/// measurement as `first_part.x3p` (the `cp` the page shows), and every
+/// line shown after it (but `…`) must be a line of what it printed; its
+/// exit code is 1 where the page shows an error, else 0.
+#[test]
+fn the_tutorial_runs_as_written() {
+    let root = crate::common::root();
+    let page = std::fs::read_to_string(root.join("docs/usage/compensate.md")).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(
+        root.join("examples/measured/front_first_part.x3p"),
+        dir.path().join("first_part.x3p"),
+    )
+    .unwrap();
+    let (mut fence, mut block): (Option<String>, Vec<String>) = (None, Vec::new());
+    let mut ran = 0;
+    for line in page.lines() {
+        match (&fence, line.strip_prefix("```")) {
+            (None, Some(lang)) => {
+                fence = Some(lang.to_string());
+                block.clear();
+            }
+            (Some(lang), Some(_)) => {
+                if lang == "lens" {
+                    std::fs::write(dir.path().join("front.lens"), block.join("\n") + "\n").unwrap();
+                } else if lang == "text" {
+                    ran += run_block(dir.path(), &block);
+                }
+                fence = None;
+            }
+            (Some(_), None) => block.push(line.to_string()),
+            (None, None) => {}
+        }
+    }
+    assert!(ran >= 3, "the tutorial runs {ran} lensc commands");
+}
+
+/// Runs the `$ lensc …` commands of one block; how many.
+fn run_block(dir: &Path, block: &[String]) -> usize {
+    let mut ran = 0;
+    let mut i = 0;
+    while i < block.len() {
+        let Some(cmd) = block[i].strip_prefix("$ ") else {
+            i += 1;
+            continue;
+        };
+        let shown: Vec<&str> = block[i + 1..]
+            .iter()
+            .take_while(|l| !l.starts_with("$ "))
+            .map(|l| l.trim())
+            .filter(|l| !l.is_empty() && *l != "…")
+            .collect();
+        i += 1 + shown.len();
+        let Some(args) = cmd.strip_prefix("lensc ") else {
+            continue;
+        };
+        let args: Vec<&str> = args.split_whitespace().collect();
+        let out = lensc(dir, &args);
+        let printed = format!("{}{}", text(&out.stdout), text(&out.stderr));
+        let lines: Vec<&str> = printed.lines().map(str::trim).collect();
+        let error = shown.iter().any(|l| l.contains("Error:"));
+        assert_eq!(
+            out.status.code(),
+            Some(if error { 1 } else { 0 }),
+            "`{cmd}` printed:\n{printed}"
+        );
+        for s in &shown {
+            assert!(
+                lines.contains(s),
+                "`{cmd}`: the tutorial shows `{s}`, which it did not print:\n{printed}"
+            );
+        }
+        ran += 1;
+    }
+    ran
+}

@@ -28,8 +28,10 @@ use crate::report::Compensation;
 
 /// The strategies whose cut is a surface of revolution (a lathe without a
 /// servo, a profile grinder): their correction is radial, the mean of
-/// each ring being all such a cut can follow.
-const TURNED: [&str; 3] = ["profile_turning", "profile_grinding", "spiral_turning"];
+/// each ring being all such a cut can follow. Every other strategy (a
+/// spiral whose Z or servo follows the surface, a mill's raster) is given
+/// the map's correction.
+const TURNED: [&str; 2] = ["profile_turning", "profile_grinding"];
 
 /// The surface to cut instead of `design`, and the iteration for the
 /// report; or why no correction is made.
@@ -57,6 +59,7 @@ pub(crate) fn corrected(
     let m = lensc_measure::read::read(file, &bytes, TextUnits(c.units))
         .map_err(|e| at(measure::read_failure(file, &e)))?;
     let format = m.format;
+    let (data, stride) = thinned(m.data);
     let surface_name = p
         .job
         .part_names
@@ -74,7 +77,7 @@ pub(crate) fn corrected(
         &design.domain,
         &surface_name,
         file,
-        m.data,
+        data,
         format,
         &opts,
     )
@@ -157,7 +160,13 @@ pub(crate) fn corrected(
                 ""
             },
             if radial { "" } else { " and tilts" }
-        ),
+        ) + &if stride > 1 {
+            format!(
+                "; a map of more than {MAX_POINTS} points taken at every {stride}th pixel along each axis"
+            )
+        } else {
+            String::new()
+        },
         basis: basis.words(),
         order: basis.order(),
         terms: basis.terms().len(),
@@ -168,6 +177,61 @@ pub(crate) fn corrected(
         predicted_rms_nm: predicted_rms * 1e6,
     };
     Ok((corrected, report))
+}
+
+/// The program header's line for a compensated job: what is cut instead
+/// of the design, from which measurement.
+pub(crate) fn header_words(c: &Compensation) -> String {
+    format!(
+        "compensated: the surface cut is the design less {} times the error measured in {} md5 {}, fitted to order {} over smoothing {} mm; next part predicted {:.2} nm PV, {:.2} nm RMS",
+        c.gain,
+        c.measurement,
+        c.md5,
+        c.order,
+        lensc_lang::check::trim_num(c.smoothing_mm),
+        c.predicted_pv_nm,
+        c.predicted_rms_nm
+    )
+}
+
+/// The most points of a map a correction registers and fits: a larger
+/// map is taken at every k-th pixel along each axis, k the least that
+/// brings it under. A correction of order at most 12 needs no more, and
+/// the noise of a quarter of a million points averages to far under a
+/// nanometre; registering a 1000 × 1000 map whole would cost the build
+/// several times its own planning.
+pub const MAX_POINTS: usize = 250_000;
+
+/// The measurement with a map thinned to at most `MAX_POINTS` points, and
+/// the stride taken (1: whole).
+fn thinned(data: lensc_measure::Measured) -> (lensc_measure::Measured, usize) {
+    let lensc_measure::Measured::Map(m) = data else {
+        return (data, 1);
+    };
+    let n = m.nx * m.ny;
+    if n <= MAX_POINTS {
+        return (lensc_measure::Measured::Map(m), 1);
+    }
+    let k = ((n as f64 / MAX_POINTS as f64).sqrt().ceil() as usize).max(2);
+    let (nx, ny) = (m.nx.div_ceil(k), m.ny.div_ceil(k));
+    let (mut z, mut valid) = (Vec::with_capacity(nx * ny), Vec::with_capacity(nx * ny));
+    for j in (0..m.ny).step_by(k) {
+        for i in (0..m.nx).step_by(k) {
+            z.push(m.z[j * m.nx + i]);
+            valid.push(m.valid[j * m.nx + i]);
+        }
+    }
+    let thin = lensc_measure::HeightMap {
+        nx,
+        ny,
+        dx: m.dx * k as f64,
+        dy: m.dy * k as f64,
+        x0: m.x0,
+        y0: m.y0,
+        z,
+        valid,
+    };
+    (lensc_measure::Measured::Map(thin), k)
 }
 
 /// The measurement's bytes, read as the loader reads a `use`d file:
