@@ -215,19 +215,40 @@ impl Correction {
             }
         };
         let pu = legendre_nodes(g, u, n);
-        let pv = v.map(|v| legendre_nodes(g, v, n));
         let mut sum = g.constant_node(0.0);
-        for ((i, j), c) in self.basis.terms().into_iter().zip(&self.coefficients) {
-            if *c == 0.0 {
-                continue;
+        let Some(v) = v else {
+            for (k, c) in self.coefficients.iter().enumerate() {
+                if *c != 0.0 {
+                    let c = g.constant_node(c * scale);
+                    let t = g.mul(c, pu[k]);
+                    sum = g.add(sum, t);
+                }
             }
-            let term = match &pv {
-                None => pu[i],
-                Some(pv) => g.mul(pu[i], pv[j]),
-            };
-            let c = g.constant_node(c * scale);
-            let t = g.mul(c, term);
-            sum = g.add(sum, t);
+            return sum;
+        };
+        // Across a map, Σ_i P_i(u) · Σ_j c_ij P_j(v): a product per i, not
+        // per term, so the graph's derivatives (product rule per product)
+        // stay a few times smaller.
+        let pv = legendre_nodes(g, v, n);
+        for i in 0..=n {
+            let mut q: Option<Id> = None;
+            for j in 0..=n - i {
+                let d = i + j;
+                let c = self.coefficients[d * (d + 1) / 2 + (d - i)];
+                if c == 0.0 {
+                    continue;
+                }
+                let c = g.constant_node(c * scale);
+                let t = g.mul(c, pv[j]);
+                q = Some(match q {
+                    None => t,
+                    Some(q) => g.add(q, t),
+                });
+            }
+            if let Some(q) = q {
+                let t = g.mul(pu[i], q);
+                sum = g.add(sum, t);
+            }
         }
         sum
     }
