@@ -230,23 +230,23 @@ impl Correction {
         // per term, so the graph's derivatives (product rule per product)
         // stay a few times smaller.
         let pv = legendre_nodes(g, v, n);
-        for i in 0..=n {
+        for (i, &p_i) in pu.iter().enumerate() {
             let mut q: Option<Id> = None;
-            for j in 0..=n - i {
+            for (j, &p_j) in pv.iter().enumerate().take(n - i + 1) {
                 let d = i + j;
                 let c = self.coefficients[d * (d + 1) / 2 + (d - i)];
                 if c == 0.0 {
                     continue;
                 }
                 let c = g.constant_node(c * scale);
-                let t = g.mul(c, pv[j]);
+                let t = g.mul(c, p_j);
                 q = Some(match q {
                     None => t,
                     Some(q) => g.add(q, t),
                 });
             }
             if let Some(q) = q {
-                let t = g.mul(pu[i], q);
+                let t = g.mul(p_i, q);
                 sum = g.add(sum, t);
             }
         }
