@@ -22,9 +22,78 @@ use lensc_measure::read::TextUnits;
 use lensc_runtime::surface::analysis::{self, Domain};
 use lensc_runtime::surface::ir::{SurfaceTape, Var};
 
-use crate::job::Parts;
-use crate::measure::{self, Failure, MAX_MEASUREMENT_BYTES};
-use crate::report::Compensation;
+use crate::measure::placed::{self as measure, Failure, MAX_MEASUREMENT_BYTES};
+use lensc_lang::check::CheckedJob;
+use lensc_runtime::surface::ir::SurfaceFn;
+use schemars::JsonSchema;
+use serde::Serialize;
+
+/// One iteration of the measure-and-correct loop: the measurement the
+/// correction was made from, how it was placed on the design, and the
+/// correction cut (the design less `gain` times the fitted error).
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct Compensation {
+    /// The measurement file, as the job names it.
+    pub measurement: String,
+    /// The file's format (`x3p`, `sdf`, …).
+    pub format: String,
+    /// MD5 of the file's bytes, lowercase hex: which measurement this is.
+    pub md5: String,
+    /// Valid measured points inside the aperture, and their share of the
+    /// measured aperture.
+    pub points: usize,
+    pub valid_share: f64,
+    /// The placement of the measurement on the design.
+    pub registration: crate::measure::report::Registration,
+    /// The measured part's form error along z after registration (nm).
+    pub measured_pv_nm: f64,
+    pub measured_rms_nm: f64,
+    /// The share of the fitted error taken out.
+    pub gain: f64,
+    /// The smoothing length (mm): no ripple shorter is followed.
+    pub smoothing_mm: f64,
+    /// How the error was smoothed and carried over the aperture, in words.
+    pub method: String,
+    /// The polynomials fitted, with their frame.
+    pub basis: String,
+    pub order: usize,
+    /// Terms fitted (piston and tilts among them, left out of the
+    /// correction), and the cells (rings or squares) fitted to.
+    pub terms: usize,
+    pub cells: usize,
+    /// RMS of the cells' mean errors about the fit (nm): what the
+    /// correction does not follow.
+    pub fit_residual_rms_nm: f64,
+    /// The correction's peak to valley over the aperture (nm): how far the
+    /// surface cut departs from the design.
+    pub correction_pv_nm: f64,
+    /// The form error the next part is predicted to have, should the
+    /// machine repeat the measured error: the measured error less `gain`
+    /// times the correction, at the measured points, PV and RMS about its
+    /// mean (nm).
+    pub predicted_pv_nm: f64,
+    pub predicted_rms_nm: f64,
+}
+
+/// What a correction needs of its job: the job itself (where its file is,
+/// its root), its surface's name, its strategy's kind and its tool's
+/// radius (nose or ball), if it has one.
+pub(crate) struct Of<'a> {
+    pub job: &'a CheckedJob,
+    pub surface_name: String,
+    pub strategy_kind: &'static str,
+    pub tool_radius: Option<f64>,
+}
+
+/// The kernel a correction is made with: the JIT, or the interpreter
+/// should cranelift refuse the tape (as the build evaluates surfaces).
+fn kernel(tape: &SurfaceTape) -> Box<dyn SurfaceFn + Sync> {
+    match lensc_runtime::surface::jit::JitSurface::compile(tape) {
+        Ok(j) => Box::new(j),
+        Err(_) => Box::new(lensc_runtime::surface::ir::Interpreter::new(tape)),
+    }
+}
 
 /// The strategies whose cut is a surface of revolution (a lathe without a
 /// servo, a profile grinder): their correction is radial, the mean of
@@ -36,7 +105,7 @@ const TURNED: [&str; 2] = ["profile_turning", "profile_grinding"];
 /// The surface to cut instead of `design`, and the iteration for the
 /// report; or why no correction is made.
 pub(crate) fn corrected(
-    p: &Parts,
+    p: &Of,
     design: &LoweredSurface,
     block: &Stated<CompensateParams>,
 ) -> Result<(LoweredSurface, Compensation), Diagnostic> {
@@ -60,13 +129,8 @@ pub(crate) fn corrected(
         .map_err(|e| at(measure::read_failure(file, &e)))?;
     let format = m.format;
     let (data, stride) = thinned(m.data);
-    let surface_name = p
-        .job
-        .part_names
-        .get("surface")
-        .cloned()
-        .unwrap_or_else(|| p.surface.kind.name.to_string());
-    let (f, _) = crate::evaluate::evaluator(&design.tape);
+    let surface_name = p.surface_name.clone();
+    let f = kernel(&design.tape);
     let opts = measure::Options {
         units: TextUnits(c.units),
         from_job: true,
@@ -85,7 +149,7 @@ pub(crate) fn corrected(
     // Each measured point in the design's frame, with its error along z.
     let (us, vs) = lensc_measure::register::moved(placed.inside(), &placed.registration.values);
     let xy: Vec<(f64, f64)> = us.into_iter().zip(vs).collect();
-    let radial = placed.is_profile() || TURNED.contains(&p.strategy.kind.name);
+    let radial = placed.is_profile() || TURNED.contains(&p.strategy_kind);
     let (basis, cell) = basis(&design.domain, radial, c.smoothing);
     let cells = correct::bin(&basis, &xy, &placed.vertical, cell);
     let fitted = correct::fit(basis, &cells)
@@ -237,7 +301,7 @@ fn thinned(data: lensc_measure::Measured) -> (lensc_measure::Measured, usize) {
 /// The measurement's bytes, read as the loader reads a `use`d file:
 /// relative to the job's file, beneath the project root, a regular file,
 /// at most `MAX_MEASUREMENT_BYTES`.
-fn read(p: &Parts, m: &Stated<String>) -> Result<Vec<u8>, Diagnostic> {
+fn read(p: &Of, m: &Stated<String>) -> Result<Vec<u8>, Diagnostic> {
     let job = p.job;
     let base = job
         .path
@@ -341,22 +405,17 @@ pub fn corrected_tape(design: &SurfaceTape, fitted: &Correction, gain: f64) -> S
 /// more tightly than the tool's nose or ball, where the design did not:
 /// the tool cannot follow the correction.
 fn curvature_check(
-    p: &Parts,
+    p: &Of,
     design: &LoweredSurface,
     corrected: &LoweredSurface,
     file: &str,
     surface_name: &str,
 ) -> Result<(), Failure> {
-    let Some(tool) = p
-        .tool_params
-        .nose_radius
-        .or(p.tool_params.diameter.map(|d| d / 2.0))
-        .filter(|r| r.is_finite() && *r > 0.0)
-    else {
+    let Some(tool) = p.tool_radius.filter(|r| r.is_finite() && *r > 0.0) else {
         return Ok(());
     };
     let tightest = |l: &LoweredSurface| {
-        let (f, _) = crate::evaluate::evaluator(&l.tape);
+        let f = kernel(&l.tape);
         // 101 × 101 points: the correction's shortest ripple, the aperture
         // over 12, spans eight of them.
         let a = analysis::analyse(f.as_ref(), &l.domain, 101);

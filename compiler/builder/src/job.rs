@@ -219,7 +219,7 @@ pub struct SurfaceSpec {
     /// With a `compensate` block: the design itself (what a part is
     /// measured against) and the iteration for the report.
     pub design: Option<LoweredSurface>,
-    pub compensation: Option<crate::report::Compensation>,
+    pub compensation: Option<crate::compensate::Compensation>,
 }
 
 impl SurfaceSpec {
@@ -261,7 +261,7 @@ pub struct Parts<'a> {
     pub surface_params: Surface,
     /// With a `compensate` block, once `lowered` has made the correction:
     /// the design and the iteration, for the head.
-    compensated: std::cell::RefCell<Option<(LoweredSurface, crate::report::Compensation)>>,
+    compensated: std::cell::RefCell<Option<(LoweredSurface, crate::compensate::Compensation)>>,
 }
 
 impl<'a> Parts<'a> {
@@ -405,7 +405,21 @@ impl<'a> Parts<'a> {
         let Some(c) = &self.params.compensate else {
             return Ok(design);
         };
-        let (corrected, report) = crate::compensate::corrected(self, &design, c)?;
+        let of = crate::compensate::Of {
+            job: self.job,
+            surface_name: self
+                .job
+                .part_names
+                .get("surface")
+                .cloned()
+                .unwrap_or_else(|| self.surface.kind.name.to_string()),
+            strategy_kind: self.strategy.kind.name,
+            tool_radius: self
+                .tool_params
+                .nose_radius
+                .or(self.tool_params.diameter.map(|d| d / 2.0)),
+        };
+        let (corrected, report) = crate::compensate::corrected(&of, &design, c)?;
         *self.compensated.borrow_mut() = Some((design, report));
         Ok(corrected)
     }

@@ -16,6 +16,7 @@ use serde::Serialize;
 
 pub(crate) mod common;
 
+pub use crate::compensate::Compensation;
 pub use crate::strategy::grinding::report::{Intervals, ProfileGrinding};
 pub use crate::strategy::raster::report::Raster;
 pub use crate::strategy::roller::report::{HelixPass, RollerHelix, RollerToolCheck};
@@ -81,54 +82,6 @@ pub struct Report {
     /// `compensate` block: the iteration of the measure-and-correct loop.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub compensation: Option<Compensation>,
-}
-
-/// One iteration of the measure-and-correct loop: the measurement the
-/// correction was made from, how it was placed on the design, and the
-/// correction cut (the design less `gain` times the fitted error).
-#[derive(Clone, Debug, Serialize, JsonSchema)]
-#[schemars(deny_unknown_fields)]
-pub struct Compensation {
-    /// The measurement file, as the job names it.
-    pub measurement: String,
-    /// The file's format (`x3p`, `sdf`, …).
-    pub format: String,
-    /// MD5 of the file's bytes, lowercase hex: which measurement this is.
-    pub md5: String,
-    /// Valid measured points inside the aperture, and their share of the
-    /// measured aperture.
-    pub points: usize,
-    pub valid_share: f64,
-    /// The placement of the measurement on the design.
-    pub registration: crate::measure::report::Registration,
-    /// The measured part's form error along z after registration (nm).
-    pub measured_pv_nm: f64,
-    pub measured_rms_nm: f64,
-    /// The share of the fitted error taken out.
-    pub gain: f64,
-    /// The smoothing length (mm): no ripple shorter is followed.
-    pub smoothing_mm: f64,
-    /// How the error was smoothed and carried over the aperture, in words.
-    pub method: String,
-    /// The polynomials fitted, with their frame.
-    pub basis: String,
-    pub order: usize,
-    /// Terms fitted (piston and tilts among them, left out of the
-    /// correction), and the cells (rings or squares) fitted to.
-    pub terms: usize,
-    pub cells: usize,
-    /// RMS of the cells' mean errors about the fit (nm): what the
-    /// correction does not follow.
-    pub fit_residual_rms_nm: f64,
-    /// The correction's peak to valley over the aperture (nm): how far the
-    /// surface cut departs from the design.
-    pub correction_pv_nm: f64,
-    /// The form error the next part is predicted to have, should the
-    /// machine repeat the measured error: the measured error less `gain`
-    /// times the correction, at the measured points, PV and RMS about its
-    /// mean (nm).
-    pub predicted_pv_nm: f64,
-    pub predicted_rms_nm: f64,
 }
 
 impl Report {
