@@ -10,6 +10,7 @@
 //! draw that report.
 
 pub mod accept;
+pub mod compensate;
 pub mod context;
 pub mod diagnostics;
 pub mod driver;

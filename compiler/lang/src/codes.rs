@@ -132,6 +132,12 @@ pub const MEASURE_TOO_LITTLE: &str = "E0363";
 pub const MEASURE_MISMATCH: &str = "E0364";
 /// `lensc measure`: the registration to the design did not converge.
 pub const MEASURE_NOT_CONVERGED: &str = "E0365";
+/// A job's `compensate` block: the corrected surface curves more tightly
+/// (concave) than the tool's nose or ball can follow.
+pub const COMPENSATE_CURVATURE: &str = "E0366";
+/// A job's `compensate` block: the measurement does not cover enough of
+/// the aperture for a correction of the order its smoothing length asks.
+pub const COMPENSATE_UNFITTED: &str = "E0367";
 
 /// The simulated part misses one of its job's acceptance criteria (the
 /// message names which, by how much and where); no program is written.
@@ -397,6 +403,8 @@ pub const ALL: &[&str] = &[
     MEASURE_TOO_LITTLE,
     MEASURE_MISMATCH,
     MEASURE_NOT_CONVERGED,
+    COMPENSATE_CURVATURE,
+    COMPENSATE_UNFITTED,
     IMPORT_UNSUPPORTED_SURFACE,
     IMPORT_PARAMETER_DROPPED,
     IMPORT_NO_SEMI_DIAMETER,

@@ -101,6 +101,12 @@ pub struct Root {
     dir: std::io::Result<cap_std::fs::Dir>,
 }
 
+impl std::fmt::Debug for Root {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Root({})", self.path.display())
+    }
+}
+
 impl Root {
     /// Opens the directory `path` (resolved, as `resolve` gives it). A
     /// root that cannot be opened is kept with its error: every read

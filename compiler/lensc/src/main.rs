@@ -103,6 +103,7 @@ fn run(cli: Cli) -> u8 {
                 min_valid: min_valid / 100.0,
                 cutoff,
                 keep_origin,
+                from_job: false,
             },
         ),
 

@@ -55,6 +55,21 @@ pub fn job_summary(job: &str, fate: &Fate, built: Option<(&Report, &Program)>) -
         }
     }
     line("judged", judged(&report.simulation));
+    if let Some(c) = &report.compensation {
+        line(
+            "corrected",
+            format!(
+                "from {} (measured {:.2} nm PV, {:.2} nm RMS), gain {}, smoothing {} mm: next part predicted {:.2} nm PV, {:.2} nm RMS",
+                c.measurement,
+                c.measured_pv_nm,
+                c.measured_rms_nm,
+                c.gain,
+                c.smoothing_mm,
+                c.predicted_pv_nm,
+                c.predicted_rms_nm
+            ),
+        );
+    }
     line("cutting", duration(program.cutting_time));
     let size = format!("{} lines, {}", program.lines, bytes(program.bytes));
     match fate {

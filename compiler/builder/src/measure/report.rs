@@ -146,7 +146,8 @@ pub struct SetUp {
     pub x_offset_um: f64,
     pub x_correction: String,
     /// |h| (µm): the tool tip's distance from the centre height (a map
-    /// does not tell above from below), resolved to `ring_um`.
+    /// does not tell above from below): the stub found in rings `ring_um`
+    /// wide, its edge placed between the points on either side of it.
     pub centre_height_um: f64,
     pub centre_height_correction: String,
     /// The radius of the uncut stub at the centre (µm; 0: none seen).

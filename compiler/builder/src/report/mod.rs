@@ -16,6 +16,7 @@ use serde::Serialize;
 
 pub(crate) mod common;
 
+pub use crate::compensate::Compensation;
 pub use crate::strategy::grinding::report::{Intervals, ProfileGrinding};
 pub use crate::strategy::raster::report::Raster;
 pub use crate::strategy::roller::report::{HelixPass, RollerHelix, RollerToolCheck};
@@ -77,6 +78,10 @@ pub struct Report {
     /// The surface's analysis over its whole domain (what `lensc analyse`
     /// prints).
     pub surface: SurfaceAnalysis,
+    /// The correction cut instead of the design, when the job has a
+    /// `compensate` block: the iteration of the measure-and-correct loop.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub compensation: Option<Compensation>,
 }
 
 impl Report {

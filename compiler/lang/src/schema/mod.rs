@@ -223,12 +223,58 @@ pub static JOB_PARAMS: &[Param] = &[
         "coolant through the whole program: `flood` (M8), `mist` (M7) or `off` (default)",
     ),
     opt(
+        "compensate",
+        Ty::Block(COMPENSATE_PARAMS),
+        Check::Any,
+        "cut a corrected surface from a measurement of the part this job cut: the design less `gain` times the measured error, registered to the design and smoothed over `smoothing` (docs/usage/compensate.md); default none, the design as it is",
+    ),
+    opt(
         "accept",
         Ty::BlockOr(ACCEPT_PARAMS, &["none"]),
         Check::Any,
         "the acceptance criteria the simulated part must meet for the program to be written, or `none`; each left out has a default from the machine: its held tolerance (10 nm, or the smallest the machine holds where coarser; the strategy's `chord_tolerance` where tighter) and its resolution, which no looser tolerance or feed widens (docs/language/acceptance.md)",
     ),
 ];
+
+/// The parameters of a job's `compensate` block.
+pub static COMPENSATE_PARAMS: &[Param] = &[
+    req(
+        "measurement",
+        Ty::Text,
+        Check::Any,
+        "the measured part's file (X3P, SDF, MetroPro, x y z points, an x z profile), relative to the job's file and read under the project root like a `use`d file",
+    ),
+    req(
+        "gain",
+        NUMBER,
+        Check::Open(0.0, 2.0),
+        "the share of the measured error taken out of the next cut (1: all of it; below 1 approaches in steps, above 1 over-corrects)",
+    ),
+    req(
+        "smoothing",
+        LENGTH,
+        Check::Positive,
+        "the shortest period of error the correction follows: the fitted polynomials' order is the aperture's width over it (at most 12)",
+    ),
+    opt(
+        "units",
+        Ty::Word(&["mm", "um", "nm"]),
+        Check::Any,
+        "what a plain-text measurement's numbers are (a text file carries no unit); default mm",
+    ),
+];
+
+/// A job's `compensate` block, read once.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CompensateParams {
+    /// The measurement file as written, relative to the job's file.
+    pub measurement: crate::value::Stated<String>,
+    pub gain: f64,
+    /// The smoothing length (mm).
+    pub smoothing: f64,
+    /// mm per unit of a plain-text file's numbers.
+    pub units: f64,
+}
 
 /// A job's own checked parameters beyond its four parts, read once.
 #[derive(Clone, Debug)]
@@ -245,6 +291,8 @@ pub struct JobParams {
     pub part_sites: PartSites,
     /// The `accept` block as written.
     pub accept: AcceptParams,
+    /// The `compensate` block, with where it was written.
+    pub compensate: Option<crate::value::Stated<CompensateParams>>,
 }
 
 /// A job's `accept`, as written: none (the defaults), `none`, or a block.
@@ -325,6 +373,31 @@ impl JobParams {
                     })
                     .unwrap_or_default(),
             },
+            compensate: r.site("compensate").and_then(|site| {
+                let stated = r.block("compensate", |b| {
+                    let measurement = b.field("measurement").and_then(|f| match &f.value {
+                        crate::value::Value::Str(s) => Some(crate::value::Stated {
+                            value: s.clone(),
+                            site: (f.file, f.span),
+                        }),
+                        _ => None,
+                    })?;
+                    Some(CompensateParams {
+                        measurement,
+                        gain: b.num("gain")?,
+                        smoothing: b.num("smoothing")?,
+                        units: match b.word("units") {
+                            Some("um") => 1e-3,
+                            Some("nm") => 1e-6,
+                            _ => 1.0,
+                        },
+                    })
+                })??;
+                Some(crate::value::Stated {
+                    value: stated,
+                    site,
+                })
+            }),
             part_sites: PartSites {
                 surface: r.site("surface"),
                 tool: r.site("tool"),
