@@ -598,6 +598,8 @@ pub struct Scallops {
 /// The figures of one lenslet (a feature disc) in the window.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FeatureFigures {
+    /// Its index among the frame's features.
+    pub index: usize,
     pub centre: (f64, f64),
     /// Over every cell of the aperture (scallops included).
     pub surface: Option<ErrorFigures>,
@@ -1006,6 +1008,7 @@ impl HeightMap {
                 .iter()
                 .filter(|(_, f)| f.surface.count > 0)
                 .map(|(&k, f)| FeatureFigures {
+                    index: k,
                     centre: (features[k].0, features[k].1),
                     surface: f.surface.figures(),
                     contact: f.contact.figures(),
