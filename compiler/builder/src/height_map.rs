@@ -219,7 +219,10 @@ impl Frame for LatheFrame<'_> {
         (u * g.du * g.ds.sin()).abs()
     }
     fn inside(&self, x: f64, y: f64) -> bool {
-        self.window.contains(x, y) && self.domain.contains(x, y) && x.hypot(y) <= self.reach
+        // By squares, not `hypot`: every cell is asked.
+        self.window.contains(x, y)
+            && self.domain.contains(x, y)
+            && x * x + y * y <= self.reach * self.reach
     }
     fn features(&self) -> &[(f64, f64, f64)] {
         &self.features
