@@ -96,7 +96,13 @@ pub fn gate(spec: &JobSpec, built: &mut Built, mode: Mode) -> Vec<Diagnostic> {
         Ok(Form::Map(h)) => lenslets::judge(h, &form_limits),
         _ => Vec::new(),
     };
-    for l in lenslets.iter().filter(|l| !l.passed) {
+    // A lenslet is named where the whole part passes: where it misses,
+    // its diagnostic says so already (the summary names the worst).
+    let whole_passed = |name: &str| results.iter().any(|r| r.criterion == name && r.passed);
+    for l in lenslets
+        .iter()
+        .filter(|l| !l.passed && whole_passed(l.criterion))
+    {
         diags.push(lenslets::missed(l, &form_limits, head.site, mode));
     }
     built.report.acceptance = crate::report::Acceptance {

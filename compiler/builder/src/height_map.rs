@@ -219,10 +219,9 @@ impl Frame for LatheFrame<'_> {
         (u * g.du * g.ds.sin()).abs()
     }
     fn inside(&self, x: f64, y: f64) -> bool {
-        // By squares, not `hypot`: every cell is asked.
-        self.window.contains(x, y)
-            && self.domain.contains(x, y)
-            && x * x + y * y <= self.reach * self.reach
+        // `hypot`, not squares: a polar grid's row lies on the reach's
+        // circle, and squares would drop some of its cells.
+        self.window.contains(x, y) && self.domain.contains(x, y) && x.hypot(y) <= self.reach
     }
     fn features(&self) -> &[(f64, f64, f64)] {
         &self.features
