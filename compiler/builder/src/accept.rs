@@ -1,6 +1,7 @@
 //! The acceptance gate: a built job's simulated part against the criteria
 //! its `accept` block states, the rest at defaults derived from the
-//! strategy's path tolerance and the machine's resolution. Each criterion
+//! machine: the path tolerance its class holds (or the strategy's, if
+//! tighter) and its resolution (`job::accept::default_limit`). Each criterion
 //! missed (or that the simulation cannot measure) is a coded diagnostic
 //! naming the criterion, by how much and where on the part — an error
 //! that stops the program being written, or under `--accept=warn` a
@@ -51,6 +52,7 @@ pub fn gate(spec: &JobSpec, built: &mut Built, mode: Mode) -> Vec<Diagnostic> {
         return Vec::new();
     }
     let tolerance = spec.path_tolerance();
+    let holds = crate::job::holds(head.resolution, spec.length_axes());
     let mut results = Vec::new();
     let mut diags = Vec::new();
     // Criteria the simulation cannot measure, by the reason: one
@@ -66,12 +68,17 @@ pub fn gate(spec: &JobSpec, built: &mut Built, mode: Mode) -> Vec<Diagnostic> {
                 fraction: l.fraction,
                 rule: None,
             },
-            None => match default_limit(c, tolerance, head.resolution) {
+            None => match default_limit(c, tolerance, head.resolution, holds) {
                 Some(l) => l,
                 None => continue,
             },
         };
         let r = judge(c, &limit, built);
+        // A following error is held to its default only where the job
+        // simulates one (a fast tool servo with a servo model).
+        if stated.is_none() && c == Criterion::MaxFollowingError && r.unmeasured.is_some() {
+            continue;
+        }
         form_limits.push((c, r.limit, stated.map(|l| l.site)));
         match r.unmeasured {
             Some(why) => match unmeasured.iter_mut().find(|u| u.0 == why) {
@@ -186,9 +193,20 @@ struct Limit {
 /// `None`: it has none of its own) on a machine of `resolution` (mm)
 /// (`accept::default_limit`: the form error lies within ±(tolerance +
 /// resolution)), with the rule that derives it in words.
-fn default_limit(c: Criterion, tolerance: Option<f64>, resolution: f64) -> Option<Limit> {
-    let value = accept::default_limit(c, tolerance, resolution)?;
+fn default_limit(
+    c: Criterion,
+    tolerance: Option<f64>,
+    resolution: f64,
+    holds: f64,
+) -> Option<Limit> {
+    let value = accept::default_limit(c, tolerance, resolution, holds)?;
     let t_words = match tolerance {
+        Some(t) if t > holds => format!(
+            "{} nm (the least of the path tolerance {} nm and the {} nm the machine holds: a looser path does not loosen the part)",
+            trim_num(holds * 1e6),
+            trim_num(t * 1e6),
+            trim_num(holds * 1e6)
+        ),
         Some(t) => format!("the path tolerance {} nm", trim_num(t * 1e6)),
         None => format!(
             "{} nm (the strategy has no path tolerance: the default chord_tolerance)",
@@ -203,8 +221,11 @@ fn default_limit(c: Criterion, tolerance: Option<f64>, resolution: f64) -> Optio
         Criterion::FormPv => format!("2 × ({sum})"),
         Criterion::FormRms => format!("({sum}) / 2"),
         Criterion::MaxGouge | Criterion::MaxResidual => sum,
+        Criterion::MaxFollowingError => format!(
+            "{sum}: the servo's lag moves the cut by as much, beyond the form the commands simulate"
+        ),
         Criterion::UncutArea => "none of the area simulated left uncut".into(),
-        Criterion::MaxFollowingError | Criterion::MaxCuttingTime => return None,
+        Criterion::MaxCuttingTime => return None,
     };
     Some(Limit {
         value,

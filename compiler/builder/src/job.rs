@@ -57,6 +57,16 @@ pub fn default_path_tolerance(resolution: f64, axes: u32) -> f64 {
     }
 }
 
+/// The path tolerance (mm) a machine of `resolution` (mm) holds for a
+/// strategy printing `axes` length axes (`None`: one that plans to no
+/// tolerance of its own, held to `DEFAULT_PATH_TOLERANCE`): its default
+/// one.
+pub fn holds(resolution: f64, axes: Option<u32>) -> f64 {
+    axes.map_or(DEFAULT_PATH_TOLERANCE, |n| {
+        default_path_tolerance(resolution, n)
+    })
+}
+
 /// How lowering evaluates a surface for the checks that analyse it: the
 /// build passes its JIT (with the interpreter behind it), so the figures
 /// `check` reports are the ones `build` plans with.
@@ -382,6 +392,15 @@ impl<'a> Parts<'a> {
     pub fn lowered(&self) -> Result<LoweredSurface, Diagnostic> {
         lensc_lang::lower::surface::lower_surface(self.surface)
             .map_err(|e| RuntimeError::Surface(e).at(self.site()))
+    }
+    /// The path tolerance (mm) the machine's class holds for a strategy
+    /// printing `axes` length axes (`Strategy::LENGTH_AXES`; `None`: one
+    /// that plans to no tolerance of its own): the default one
+    /// (`default_path_tolerance`), 10 nm where the machine holds that. The
+    /// default acceptance limits are never looser than it allows
+    /// (`accept::default_limit`).
+    pub fn holds(&self, axes: Option<u32>) -> f64 {
+        holds(self.machine_params.resolution, axes)
     }
     /// The path tolerance the strategy states, or the default its machine
     /// holds on a path in `axes` length axes (`default_path_tolerance`,

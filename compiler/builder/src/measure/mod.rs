@@ -149,25 +149,51 @@ struct Points {
     cloud: bool,
 }
 
-fn points(data: Measured, opts: &Options, within: &dyn Fn(f64, f64) -> bool) -> Points {
-    let extent_of = |pts: &[[f64; 3]]| {
-        let mut e = [[f64::INFINITY, f64::NEG_INFINITY]; 2];
-        for p in pts {
-            for k in 0..2 {
-                e[k][0] = e[k][0].min(p[k]);
-                e[k][1] = e[k][1].max(p[k]);
-            }
+/// The x and y ranges of points: [[x min, x max], [y min, y max]].
+fn extent_of(pts: &[[f64; 3]]) -> [[f64; 2]; 2] {
+    let mut e = [[f64::INFINITY, f64::NEG_INFINITY]; 2];
+    for p in pts {
+        for k in 0..2 {
+            e[k][0] = e[k][0].min(p[k]);
+            e[k][1] = e[k][1].max(p[k]);
         }
-        e
-    };
-    let centre = |pts: &mut Vec<[f64; 3]>| {
-        let e = extent_of(pts);
+    }
+    e
+}
+
+/// Points measured anywhere (a cloud, or a profile along x when `cloud`
+/// is false), centred on their extent unless `keep_origin`, with those
+/// within the aperture kept.
+fn scattered(
+    mut pts: Vec<[f64; 3]>,
+    keep_origin: bool,
+    within: &dyn Fn(f64, f64) -> bool,
+    cloud: bool,
+) -> Points {
+    if !keep_origin {
+        let e = extent_of(&pts);
         let (cx, cy) = ((e[0][0] + e[0][1]) / 2.0, (e[1][0] + e[1][1]) / 2.0);
         for p in pts.iter_mut() {
             p[0] -= cx;
             p[1] -= cy;
         }
-    };
+    }
+    let total = pts.len();
+    let extent = extent_of(&pts);
+    let inside: Vec<[f64; 3]> = pts.into_iter().filter(|p| within(p[0], p[1])).collect();
+    Points {
+        in_aperture: inside.len(),
+        total,
+        valid: total,
+        inside,
+        extent,
+        map: None,
+        two_d: cloud,
+        cloud,
+    }
+}
+
+fn points(data: Measured, opts: &Options, within: &dyn Fn(f64, f64) -> bool) -> Points {
     match data {
         Measured::Map(m) => {
             let m = if opts.keep_origin { m } else { m.centred() };
@@ -199,43 +225,10 @@ fn points(data: Measured, opts: &Options, within: &dyn Fn(f64, f64) -> bool) -> 
                 cloud: false,
             }
         }
-        Measured::Cloud(c) => {
-            let mut pts = c.points;
-            if !opts.keep_origin {
-                centre(&mut pts);
-            }
-            let total = pts.len();
-            let extent = extent_of(&pts);
-            let inside: Vec<[f64; 3]> = pts.into_iter().filter(|p| within(p[0], p[1])).collect();
-            Points {
-                in_aperture: inside.len(),
-                total,
-                valid: total,
-                inside,
-                extent,
-                map: None,
-                two_d: true,
-                cloud: true,
-            }
-        }
+        Measured::Cloud(c) => scattered(c.points, opts.keep_origin, within, true),
         Measured::Profile(p) => {
-            let mut pts: Vec<[f64; 3]> = p.x.iter().zip(&p.z).map(|(x, z)| [*x, 0.0, *z]).collect();
-            if !opts.keep_origin {
-                centre(&mut pts);
-            }
-            let total = pts.len();
-            let extent = extent_of(&pts);
-            let inside: Vec<[f64; 3]> = pts.into_iter().filter(|p| within(p[0], p[1])).collect();
-            Points {
-                in_aperture: inside.len(),
-                total,
-                valid: total,
-                inside,
-                extent,
-                map: None,
-                two_d: false,
-                cloud: false,
-            }
+            let pts = p.x.iter().zip(&p.z).map(|(x, z)| [*x, 0.0, *z]).collect();
+            scattered(pts, opts.keep_origin, within, false)
         }
     }
 }

@@ -161,15 +161,12 @@ pub struct SetUp {
 
 /// The JSON Schema of [`MeasureReport`] as written (draft 2020-12).
 pub fn schema() -> schemars::Schema {
-    schemars::generate::SchemaSettings::draft2020_12()
-        .for_serialize()
-        .into_generator()
-        .into_root_schema_for::<MeasureReport>()
+    crate::report::schema_of::<MeasureReport>()
 }
 
 /// The schema as committed at `docs/measure.schema.json`.
 pub fn schema_text() -> String {
-    serde_json::to_string_pretty(&schema()).expect("a schema prints") + "\n"
+    crate::report::schema_text_of::<MeasureReport>()
 }
 
 #[cfg(test)]
@@ -177,19 +174,10 @@ mod tests {
     /// The committed schema is the one the structs generate.
     #[test]
     fn committed_schema_is_current() {
-        let path = concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../docs/measure.schema.json"
-        );
-        let generated = super::schema_text();
-        if std::env::var_os("LENSC_BLESS").is_some() {
-            std::fs::write(path, &generated).expect("write docs/measure.schema.json");
-            return;
-        }
-        let committed = std::fs::read_to_string(path).unwrap_or_default();
-        assert!(
-            committed == generated,
-            "docs/measure.schema.json is stale: regenerate it with\n    LENSC_BLESS=1 cargo test -p lensc-build --lib measure"
+        crate::report::assert_schema_committed(
+            "measure.schema.json",
+            &super::schema_text(),
+            "measure",
         );
     }
 }

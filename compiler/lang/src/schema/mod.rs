@@ -226,7 +226,7 @@ pub static JOB_PARAMS: &[Param] = &[
         "accept",
         Ty::BlockOr(ACCEPT_PARAMS, &["none"]),
         Check::Any,
-        "the acceptance criteria the simulated part must meet for the program to be written, or `none`; each left out has a default derived from the strategy's tolerance (docs/language/acceptance.md)",
+        "the acceptance criteria the simulated part must meet for the program to be written, or `none`; each left out has a default from the machine: its held tolerance (10 nm, or the smallest the machine holds where coarser; the strategy's `chord_tolerance` where tighter) and its resolution, which no looser tolerance or feed widens (docs/language/acceptance.md)",
     ),
 ];
 
@@ -343,25 +343,25 @@ pub static ACCEPT_PARAMS: &[Param] = &[
         "form_pv",
         LENGTH,
         Check::NonNegative,
-        "the largest peak-to-valley form error (largest minus least of cut − design at the contacts); default 2 × (path tolerance + resolution)",
+        "the largest peak-to-valley form error (largest minus least of cut − design at the contacts); default 2 × (held tolerance + resolution)",
     ),
     opt(
         "form_rms",
         LENGTH,
         Check::NonNegative,
-        "the largest RMS form error, about its mean, at the contacts; default (path tolerance + resolution) / 2",
+        "the largest RMS form error, about its mean, at the contacts; default (held tolerance + resolution) / 2",
     ),
     opt(
         "max_gouge",
         LENGTH,
         Check::NonNegative,
-        "the deepest cut below the design allowed anywhere; default path tolerance + resolution",
+        "the deepest cut below the design allowed anywhere; default held tolerance + resolution",
     ),
     opt(
         "max_residual",
         LENGTH,
         Check::NonNegative,
-        "the most material allowed above the design at the contacts (scallops apart); default path tolerance + resolution",
+        "the most material allowed above the design at the contacts (scallops apart); default held tolerance + resolution",
     ),
     opt(
         "uncut_area",
@@ -373,7 +373,7 @@ pub static ACCEPT_PARAMS: &[Param] = &[
         "max_following_error",
         LENGTH,
         Check::NonNegative,
-        "the largest following error of the fast tool servo's model (jobs with a servo model)",
+        "the largest following error of the fast tool servo's model (jobs with a servo model; its lag cuts the part where the commands do not show it); default held tolerance + resolution",
     ),
     opt(
         "max_cutting_time",

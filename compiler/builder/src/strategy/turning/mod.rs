@@ -199,6 +199,7 @@ fn profile_turning(
                 fit: tolerance * optimise::FIT_SHARE,
                 // Fitted lines and arcs: fewest through points on the path.
                 long_chords: false,
+                holds: p.holds(<TurningSpec as crate::strategy::Strategy>::LENGTH_AXES),
             },
         ),
         feed,
