@@ -12,6 +12,8 @@
 //! place every strategy's simulation lands), so a criterion is measured
 //! the same way for every strategy.
 
+mod lenslets;
+
 use crate::job::accept::{self, Accept, Criterion};
 use crate::strategy::JobSpec;
 use lensc_grammar::{Diagnostic, FileId, Span};
@@ -56,6 +58,8 @@ pub fn gate(spec: &JobSpec, built: &mut Built, mode: Mode) -> Vec<Diagnostic> {
     // Criteria the simulation cannot measure, by the reason: one
     // diagnostic a reason.
     let mut unmeasured: Vec<Unmeasured> = Vec::new();
+    // The form criteria's limits, for the lenslets.
+    let mut form_limits = Vec::new();
     for c in Criterion::ALL {
         let stated = head.accept.stated(c);
         let limit = match stated {
@@ -75,6 +79,7 @@ pub fn gate(spec: &JobSpec, built: &mut Built, mode: Mode) -> Vec<Diagnostic> {
         if stated.is_none() && c == Criterion::MaxFollowingError && r.unmeasured.is_some() {
             continue;
         }
+        form_limits.push((c, r.limit, stated.map(|l| l.site)));
         match r.unmeasured {
             Some(why) => match unmeasured.iter_mut().find(|u| u.0 == why) {
                 Some(u) => {
@@ -94,14 +99,28 @@ pub fn gate(spec: &JobSpec, built: &mut Built, mode: Mode) -> Vec<Diagnostic> {
     for (why, names, site) in unmeasured {
         diags.push(cannot_measure(why, &names, site, head.site, mode));
     }
+    let lenslets = match form(&built.report.simulation) {
+        Ok(Form::Map(h)) => lenslets::judge(h, &form_limits),
+        _ => Vec::new(),
+    };
+    // A lenslet is named where the whole part passes: where it misses,
+    // its diagnostic says so already (the summary names the worst).
+    let whole_passed = |name: &str| results.iter().any(|r| r.criterion == name && r.passed);
+    for l in lenslets
+        .iter()
+        .filter(|l| !l.passed && whole_passed(l.criterion))
+    {
+        diags.push(lenslets::missed(l, &form_limits, head.site, mode));
+    }
     built.report.acceptance = crate::report::Acceptance {
         mode: match mode {
             Mode::Gate => AcceptanceMode::Gate,
             Mode::Warn => AcceptanceMode::Warn,
         },
-        passed: results.iter().all(|r| r.passed),
+        passed: results.iter().all(|r| r.passed) && lenslets.iter().all(|l| l.passed),
         criteria: results,
         judged,
+        lenslets,
     };
     diags
 }

@@ -107,14 +107,20 @@ pub fn lower_trajectory(o: &Object, settle: f64) -> Result<LoweredSurface, Lower
     })
 }
 
-/// The centres of an array's lenslets (mm): a rectangular grid's, a
-/// linear array's or a hexagonal grid's (rows p·√3/2 apart, row j shifted
-/// along x by p/2 · parity(j) − p/4, as `hex_cells` places them); `None`
-/// for other surfaces.
+/// The centres of an array's lenslets (mm), row by row from the least y,
+/// as the lowering places them; `None` for other surfaces.
 pub fn array_centres(o: &Object) -> Option<Vec<(f64, f64)>> {
     let Ok(Surface::Array(a)) = super::read(o) else {
         return None;
     };
+    if let Layout::Hex {
+        pitch,
+        count_x,
+        count_y,
+    } = a.layout
+    {
+        return Some(hex_centres(pitch, count_x, count_y));
+    }
     let (px, py, nx, ny) = match a.layout {
         Layout::Grid {
             pitch_x,
@@ -132,11 +138,7 @@ pub fn array_centres(o: &Object) -> Option<Vec<(f64, f64)>> {
             count,
             axis: Axis::X,
         } => (pitch, 0.0, count, 1.0),
-        Layout::Hex {
-            pitch,
-            count_x,
-            count_y,
-        } => return Some(hex_centres(pitch, count_x as usize, count_y as usize)),
+        Layout::Hex { .. } => return None,
     };
     let (nx, ny) = (nx as usize, ny as usize);
     let mut centres = Vec::with_capacity(nx * ny);
@@ -151,18 +153,27 @@ pub fn array_centres(o: &Object) -> Option<Vec<(f64, f64)>> {
     Some(centres)
 }
 
-/// The centres of a hexagonal grid of `nx` by `ny` lenslets at `pitch`
-/// (mm), row by row.
-fn hex_centres(pitch: f64, nx: usize, ny: usize) -> Vec<(f64, f64)> {
-    let row = pitch * 3f64.sqrt() / 2.0;
-    let mut centres = Vec::with_capacity(nx * ny);
-    for j in 0..ny {
-        let shift = pitch / 2.0 * (j % 2) as f64 - pitch / 4.0;
-        let cy = (j as f64 - (ny as f64 - 1.0) / 2.0) * row;
-        for i in 0..nx {
-            centres.push(((i as f64 - (nx as f64 - 1.0) / 2.0) * pitch + shift, cy));
+/// The centres of a hexagonal grid's lenslets, as `hex_cells` places
+/// them: rows p·√3/2 apart, row j shifted by (parity(j) − 1/2)·p/2, row
+/// and column indices clamped to n − 1 as `cell_index` clamps them (a
+/// hex grid's row count need not be whole).
+fn hex_centres(p: f64, nx: f64, ny: f64) -> Vec<(f64, f64)> {
+    let row = p * 3f64.sqrt() / 2.0;
+    let indices = |n: f64| -> Vec<f64> {
+        (0..n.ceil().max(1.0) as usize)
+            .map(|k| (k as f64).min(n - 1.0).max(0.0))
+            .collect()
+    };
+    let mut centres = Vec::new();
+    for j in indices(ny) {
+        let parity = j - 2.0 * (j * 0.5).floor();
+        let shift = parity * (p / 2.0) - p / 4.0;
+        let cy = (j - (ny - 1.0) / 2.0) * row;
+        for i in indices(nx) {
+            centres.push(((i - (nx - 1.0) / 2.0) * p + shift, cy));
         }
     }
+    centres.dedup();
     centres
 }
 
