@@ -17,6 +17,7 @@ pub mod driver;
 pub mod evaluate;
 pub mod height_map;
 pub mod job;
+pub mod json_schema;
 pub mod measure;
 pub mod output;
 pub mod pipeline;

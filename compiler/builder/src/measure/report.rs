@@ -162,12 +162,12 @@ pub struct SetUp {
 
 /// The JSON Schema of [`MeasureReport`] as written (draft 2020-12).
 pub fn schema() -> schemars::Schema {
-    crate::report::schema_of::<MeasureReport>()
+    crate::json_schema::schema_of::<MeasureReport>()
 }
 
 /// The schema as committed at `docs/measure.schema.json`.
 pub fn schema_text() -> String {
-    crate::report::schema_text_of::<MeasureReport>()
+    crate::json_schema::schema_text_of::<MeasureReport>()
 }
 
 #[cfg(test)]
@@ -175,7 +175,7 @@ mod tests {
     /// The committed schema is the one the structs generate.
     #[test]
     fn committed_schema_is_current() {
-        crate::report::assert_schema_committed(
+        crate::json_schema::assert_schema_committed(
             "measure.schema.json",
             &super::schema_text(),
             "measure",

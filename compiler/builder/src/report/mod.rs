@@ -1004,42 +1004,12 @@ pub struct MinRadii {
 /// The JSON Schema of [`Report`] as written (draft 2020-12): a field is
 /// required unless it is left out when empty.
 pub fn schema() -> schemars::Schema {
-    schema_of::<Report>()
+    crate::json_schema::schema_of::<Report>()
 }
 
 /// The schema as committed at `docs/report.schema.json`.
 pub fn schema_text() -> String {
-    schema_text_of::<Report>()
-}
-
-/// The JSON Schema (draft 2020-12) of a report lensc writes, as written.
-pub(crate) fn schema_of<T: schemars::JsonSchema>() -> schemars::Schema {
-    schemars::generate::SchemaSettings::draft2020_12()
-        .for_serialize()
-        .into_generator()
-        .into_root_schema_for::<T>()
-}
-
-/// That schema as the text committed under `docs/`.
-pub(crate) fn schema_text_of<T: schemars::JsonSchema>() -> String {
-    serde_json::to_string_pretty(&schema_of::<T>()).expect("a schema prints") + "\n"
-}
-
-/// Holds the schema committed at `docs/NAME` to `generated`, or with
-/// `LENSC_BLESS` set writes it; `module` names the tests that regenerate
-/// it.
-#[cfg(test)]
-pub(crate) fn assert_schema_committed(name: &str, generated: &str, module: &str) {
-    let path = format!("{}/../../docs/{name}", env!("CARGO_MANIFEST_DIR"));
-    if std::env::var_os("LENSC_BLESS").is_some() {
-        std::fs::write(&path, generated).unwrap_or_else(|e| panic!("write docs/{name}: {e}"));
-        return;
-    }
-    let committed = std::fs::read_to_string(&path).unwrap_or_default();
-    assert!(
-        committed == generated,
-        "docs/{name} is stale: regenerate it with\n    LENSC_BLESS=1 cargo test -p lensc-build --lib {module}"
-    );
+    crate::json_schema::schema_text_of::<Report>()
 }
 
 #[cfg(test)]
@@ -1047,6 +1017,10 @@ mod tests {
     /// The committed schema is the one the structs generate.
     #[test]
     fn committed_schema_is_current() {
-        super::assert_schema_committed("report.schema.json", &super::schema_text(), "report");
+        crate::json_schema::assert_schema_committed(
+            "report.schema.json",
+            &super::schema_text(),
+            "report",
+        );
     }
 }
