@@ -499,9 +499,14 @@ impl State {
             );
             return None;
         }
-        // LinuxCNC's radius format (`G2 X… Z… R…`, doc 11.5.5.3): the
-        // centre from the radius; elsewhere R is not a centre word.
-        let linuxcnc = self.lex.controller == Controller::LinuxCnc;
+        // The radius format (`G2 X… Z… R…`): LinuxCNC's (doc 11.5.5.3) and
+        // Fanuc's (an assumption, docs/controllers/fanuc.md: the same
+        // convention, R < 0 for more than half a turn); elsewhere R is not
+        // a centre word (Sinumerik writes `CR=`).
+        let linuxcnc = matches!(
+            self.lex.controller,
+            Controller::LinuxCnc | Controller::Fanuc
+        );
         let radius = centre.iter().find(|w| w.letter == 'R' && linuxcnc);
         let centre: Vec<&Word> = centre
             .iter()

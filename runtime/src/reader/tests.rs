@@ -611,6 +611,49 @@ fn fanuc_refuses_words_no_code_of_the_block_uses() {
     );
 }
 
+/// A Fanuc reads a radius-format arc (`G2 X1. R1.`) as LinuxCNC does: it
+/// runs them (the reader refused it, E0319), the centre on the chord's
+/// right for G2 and a positive R; R and I J together, or an R too short
+/// for the chord, are refused.
+#[test]
+fn fanuc_reads_radius_format_arcs() {
+    let mut d = Dialect::linuxcnc();
+    d.start = vec!["%".into(), "O{number} ({JOB})".into()];
+    d.constant_rpm = None;
+    d.surface_speed = Vec::new();
+    assert_eq!(Controller::of(&d), Controller::Fanuc);
+    let by_centre = "%\nO1 (J)\n(+Z out of the material)\nG17 G21 G40 G49 G80 G90 G94 G54\nT1 M6\nS1000 M3\nG43 H1 G0 Z1.\nG0 X-1. Y0.\nG1 Z-0.1 F100.\nG2 X1. I1. J0.\nG0 Z1.\nM5\nM30\n%\n";
+    let by_radius = by_centre.replace("G2 X1. I1. J0.", "G2 X1. R1.");
+    let mill = mill();
+    assert_eq!(rules(&by_radius, &d, &mill), vec![], "{by_radius}");
+    let centre_of = |text: &str| {
+        read_moves(text, &d, &mill)
+            .1
+            .iter()
+            .find_map(|m| match m.path {
+                Path::Arc { centre, .. } => Some(centre),
+                _ => None,
+            })
+            .expect("an arc")
+    };
+    let (a, b) = (centre_of(&by_radius), centre_of(by_centre));
+    assert!(
+        (a.0 - b.0).abs() < 1e-9 && (a.1 - b.1).abs() < 1e-9,
+        "{a:?} {b:?}"
+    );
+    for (to, rule) in [
+        ("G2 X1. I1. J0. R1.", Rule::ArcWords),
+        ("G2 X1. R0.5", Rule::ArcRadiusMismatch),
+    ] {
+        let bad = by_centre.replace("G2 X1. I1. J0.", to);
+        assert!(
+            rules(&bad, &d, &mill).contains(&rule),
+            "{to}: {:?}",
+            rules(&bad, &d, &mill)
+        );
+    }
+}
+
 /// A Sinumerik refuses I J K away from an arc and P away from a
 /// subprogram call's passes (an arc's turns are `TURN=`)
 /// (docs/controllers/siemens.md).
