@@ -248,12 +248,14 @@ fn unit(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
 }
 
 /// A build of the small servo job whose outputs differ from SMALL's
-/// (another feed): the same names, other bytes.
+/// (another feed, 45 um/rev: 144 nm PV, within the job's 200 nm; at 40
+/// um/rev one lenslet's rim reaches 418.5 nm, a planner finding left for
+/// issue #29): the same names, other bytes.
 fn other_feed(dir: &Path) -> std::path::PathBuf {
     let text = std::fs::read_to_string(root().join(SMALL)).expect("job");
     assert!(text.contains("feed: 50 um/rev"), "the job states its feed");
     let path = dir.join("corner_other_feed.lens");
-    std::fs::write(&path, text.replace("feed: 50 um/rev", "feed: 40 um/rev")).expect("write");
+    std::fs::write(&path, text.replace("feed: 50 um/rev", "feed: 45 um/rev")).expect("write");
     path
 }
 
@@ -269,7 +271,6 @@ const SERVO_DIALECT: &str = "ultra_precision_lathe_gcode";
 /// a journal, which the next lensc run in the directory rolls forward to
 /// the new unit before anything else.
 #[test]
-#[ignore = "finding: at 40 um/rev the small array's whole part is 418.5 nm PV and 412.0 nm high (x = 2.4456, y = -2.2385 mm), over the 200 nm its job states (175 nm at 50 um/rev): the 2x2 array at 40 um/rev (planners branch)"]
 fn a_commit_stopped_at_every_step_leaves_one_whole_unit() {
     let jobs = tempfile::tempdir().expect("tmp");
     let newer_job = other_feed(jobs.path()).display().to_string();
