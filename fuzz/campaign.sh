@@ -16,7 +16,7 @@ cargo build --release -p fuzz -p lensc || exit 2
 lensc=target/release/lensc
 fuzz=target/release/fuzz
 # target:percent of the time
-plan="check:45 build:35 verify:8 import:6 lsp:6"
+plan="check:45 build:33 verify:7 import:5 lsp:5 measure:5"
 status=0
 summary=""
 for entry in $plan; do

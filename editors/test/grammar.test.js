@@ -1,4 +1,4 @@
-// The TextMate grammar (editors/lens.tmLanguage.json) as VS Code runs it:
+// The TextMate grammar (editors/vscode/syntaxes/lens.tmLanguage.json) as VS Code runs it:
 // vscode-textmate with the Oniguruma regex engine compiled to WebAssembly.
 // Every example and standard-library file is tokenised line by line, and
 // no token with text other than whitespace may be left with only the
@@ -13,7 +13,7 @@ const vsctm = require('vscode-textmate');
 const oniguruma = require('vscode-oniguruma');
 
 const repo = path.resolve(__dirname, '..', '..');
-const grammarPath = path.join(repo, 'editors', 'lens.tmLanguage.json');
+const grammarPath = path.join(repo, 'editors', 'vscode', 'syntaxes', 'lens.tmLanguage.json');
 
 async function loadGrammar() {
   const wasm = fs.readFileSync(path.join(path.dirname(require.resolve('vscode-oniguruma')), 'onig.wasm'));

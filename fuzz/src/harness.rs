@@ -104,6 +104,9 @@ pub enum Depth {
     Import { json: bool },
     /// Not a `.lens` file: a session of messages for `lensc lsp`.
     Lsp,
+    /// Not a `.lens` file: a measurement file named `fuzz.EXT`, read as
+    /// `lensc measure` reads it.
+    Measure { ext: &'static str },
 }
 
 /// Runs `bytes` as far as `depth` asks (and the checker lets it).
@@ -123,7 +126,11 @@ pub fn run(fs: &MemFs, bytes: &[u8], depth: Depth, out_dir: &Path) -> Result<Rea
     }
     match depth {
         // Not `.lens` inputs: `targets::run` takes them before they come here.
-        Depth::Check | Depth::Verify(_) | Depth::Import { .. } | Depth::Lsp => {}
+        Depth::Check
+        | Depth::Verify(_)
+        | Depth::Import { .. }
+        | Depth::Lsp
+        | Depth::Measure { .. } => {}
         Depth::Lower | Depth::LowerWithin(_) => {
             let limits = match depth {
                 Depth::LowerWithin(l) => l,

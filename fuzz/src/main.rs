@@ -15,6 +15,7 @@
 
 mod generate;
 mod harness;
+mod measure;
 mod mutate;
 mod rng;
 mod small_jobs;
@@ -92,6 +93,9 @@ enum Target {
     Import,
     /// `lensc lsp` on random message sequences (`--lensc` names the binary).
     Lsp,
+    /// The measurement readers on mutated peer files (X3P mutated inside
+    /// its archive too).
+    Measure,
 }
 
 /// The mutation corpora: `.lens` files, programs and prescriptions.
@@ -99,6 +103,7 @@ struct Corpora {
     lens: Corpus,
     programs: Corpus,
     prescriptions: Corpus,
+    measurements: Corpus,
 }
 
 /// Dialects a build may be asked for (a machine that does not offer one
@@ -158,6 +163,16 @@ fn input_for(
             let json = bytes.iter().find(|b| !b.is_ascii_whitespace()) == Some(&b'{');
             (Source::Prescription, bytes, Depth::Import { json })
         }
+        Target::Measure => {
+            let (name, bytes) = measure::input(&corpora.measurements, &mut rng);
+            (
+                Source::Measurement,
+                bytes,
+                Depth::Measure {
+                    ext: measure_ext(&name),
+                },
+            )
+        }
         Target::Lsp => (
             Source::Session,
             targets::session(&corpora.lens, &mut rng),
@@ -175,6 +190,17 @@ enum Source {
     Program,
     Prescription,
     Session,
+    Measurement,
+}
+
+/// The extension a measurement input is read with (the text readers are
+/// chosen by it).
+fn measure_ext(name: &str) -> &'static str {
+    let ext = name.rsplit_once('.').map(|(_, e)| e.to_ascii_lowercase());
+    ["x3p", "sdf", "dat", "asc", "xyz", "csv", "txt", "prf"]
+        .into_iter()
+        .find(|e| ext.as_deref() == Some(*e))
+        .unwrap_or("bin")
 }
 
 /// Makes input `index` of the run seeded `seed`.
@@ -238,6 +264,7 @@ fn main() -> ExitCode {
             lens,
             programs: targets::programs(&root)?,
             prescriptions: targets::prescriptions(&root)?,
+            measurements: measure::corpus(&root)?,
         })
     });
     let corpora = match corpora {
@@ -495,6 +522,7 @@ fn save(
         Source::Program => "ngc",
         Source::Prescription => "zmx",
         Source::Session => "lsp",
+        Source::Measurement => "measurement",
         _ => "lens",
     };
     let target_name = format!("{target:?}").to_lowercase();
@@ -525,7 +553,7 @@ fn summary(c: &Counts, elapsed: Duration, distinct: usize, lanes: u64) {
     let _ = writeln!(out, "fuzz: {secs:.1} s, {lanes} lane(s)");
     let _ = writeln!(
         out,
-        "  inputs            {} ({} generated, {} mutated, {} small jobs, {} programs, {} prescriptions, {} sessions), {:.0}/s",
+        "  inputs            {} ({} generated, {} mutated, {} small jobs, {} programs, {} prescriptions, {} sessions, {} measurements), {:.0}/s",
         c.inputs.values().sum::<u64>(),
         get(Source::Generated),
         get(Source::Mutated),
@@ -533,6 +561,7 @@ fn summary(c: &Counts, elapsed: Duration, distinct: usize, lanes: u64) {
         get(Source::Program),
         get(Source::Prescription),
         get(Source::Session),
+        get(Source::Measurement),
         c.checked as f64 / secs
     );
     let _ = writeln!(

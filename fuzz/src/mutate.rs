@@ -2,7 +2,7 @@
 //! bad-input corpora, with bytes flipped, tokens swapped, lines deleted or
 //! duplicated, numbers replaced by extremes and files spliced together.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::rng::Rng;
 
@@ -12,26 +12,42 @@ pub struct Corpus {
 }
 
 impl Corpus {
-    /// Every `.lens` file of examples/, stdlib/, tests/bad/ and
-    /// tests/bad_builds/ under the repository at `root`.
-    pub fn load(root: &Path) -> std::io::Result<Corpus> {
+    /// Every file directly in `dirs` under `root` whose name `keep` takes,
+    /// in name order.
+    pub fn under(
+        root: &Path,
+        dirs: &[&str],
+        keep: impl Fn(&str) -> bool,
+    ) -> std::io::Result<Corpus> {
         let mut files = Vec::new();
-        for dir in ["examples", "stdlib", "tests/bad", "tests/bad_builds"] {
-            let mut names: Vec<_> = std::fs::read_dir(root.join(dir))?
+        for dir in dirs {
+            let mut paths: Vec<PathBuf> = std::fs::read_dir(root.join(dir))?
                 .filter_map(|e| e.ok().map(|e| e.path()))
                 .filter(|p| p.is_file())
                 .collect();
-            names.sort();
-            for path in names {
-                let name = path
+            paths.sort();
+            for p in paths {
+                let name = p
                     .file_name()
                     .unwrap_or_default()
                     .to_string_lossy()
                     .into_owned();
-                files.push((name, std::fs::read(&path)?));
+                if keep(&name) {
+                    files.push((name, std::fs::read(&p)?));
+                }
             }
         }
         Ok(Corpus { files })
+    }
+
+    /// Every `.lens` file of examples/, stdlib/, tests/bad/ and
+    /// tests/bad_builds/ under the repository at `root`.
+    pub fn load(root: &Path) -> std::io::Result<Corpus> {
+        Corpus::under(
+            root,
+            &["examples", "stdlib", "tests/bad", "tests/bad_builds"],
+            |_| true,
+        )
     }
 }
 

@@ -30,6 +30,7 @@ pub fn run(fs: &MemFs, bytes: &[u8], depth: Depth, out_dir: &Path) -> Result<Rea
         Depth::Verify(pair) => verify(fs, bytes, pair),
         Depth::Import { json } => import(fs, bytes, json),
         Depth::Lsp => lsp(bytes),
+        Depth::Measure { ext } => crate::measure::run(&format!("fuzz.{ext}"), bytes),
         _ => crate::harness::run(fs, bytes, depth, out_dir),
     }
 }
@@ -50,7 +51,7 @@ const MACHINES: &[(&str, &str)] = &[
 
 /// Every program of the bad-program corpus (clean ones included).
 pub fn programs(root: &Path) -> std::io::Result<Corpus> {
-    files_under(
+    Corpus::under(
         root,
         &["tests/bad_programs", "tests/bad_programs/clean"],
         |_| true,
@@ -59,31 +60,9 @@ pub fn programs(root: &Path) -> std::io::Result<Corpus> {
 
 /// Every prescription `lensc import` reads in the import corpus.
 pub fn prescriptions(root: &Path) -> std::io::Result<Corpus> {
-    files_under(root, &["tests/import"], |name| {
+    Corpus::under(root, &["tests/import"], |name| {
         name.ends_with(".zmx") || name.ends_with(".json")
     })
-}
-
-fn files_under(root: &Path, dirs: &[&str], keep: impl Fn(&str) -> bool) -> std::io::Result<Corpus> {
-    let mut files = Vec::new();
-    for dir in dirs {
-        let mut paths: Vec<PathBuf> = std::fs::read_dir(root.join(dir))?
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.is_file())
-            .collect();
-        paths.sort();
-        for p in paths {
-            let name = p
-                .file_name()
-                .unwrap_or_default()
-                .to_string_lossy()
-                .into_owned();
-            if keep(&name) {
-                files.push((name, std::fs::read(&p)?));
-            }
-        }
-    }
-    Ok(Corpus { files })
 }
 
 /// A machine's limits and a dialect, as `lensc verify` finds them.

@@ -145,6 +145,19 @@ fn parse_with(source: &str, file: FileId, fast: bool) -> (File, Vec<Diagnostic>)
             match LensParser::parse(Rule::file, text) {
                 Ok(pairs) => b.items(pairs, &mut items),
                 Err(e) => {
+                    // An entry half typed (`chords:` with no value yet, or
+                    // `chor`) costs only that entry, not the whole item:
+                    // blanked out, the rest parses and is kept.
+                    if let Some((fixed, half_typed)) = without_half_typed_entries(text)
+                        && let Ok(pairs) = LensParser::parse(Rule::file, &fixed)
+                    {
+                        for (span, name, colon) in half_typed {
+                            b.diags
+                                .push(half_typed_entry(file, start, span, &name, colon));
+                        }
+                        b.items(pairs, &mut items);
+                        continue;
+                    }
                     let d = b.syntax_error(source, text, e);
                     diags.push(d);
                 }
@@ -152,6 +165,77 @@ fn parse_with(source: &str, file: FileId, fast: bool) -> (File, Vec<Diagnostic>)
         }
     }
     (File { items }, diags)
+}
+
+/// An entry half typed: its span in the item, its name, and whether it
+/// had its `:`.
+type HalfTyped = ((usize, usize), String, bool);
+
+/// The item's text with every line that holds only a name, or a name and
+/// a `:` (an entry half typed inside a block), blanked with spaces (so
+/// every other span stays where it is); each such line's span in the item,
+/// its name and whether it had the `:`. `None` if there is no such line.
+/// The item's first line (its keyword and name) is never blanked.
+fn without_half_typed_entries(text: &str) -> Option<(String, Vec<HalfTyped>)> {
+    let mut fixed = text.as_bytes().to_vec();
+    let mut found = Vec::new();
+    let mut offset = 0;
+    for (n, line) in text.split_inclusive('\n').enumerate() {
+        let start = offset;
+        offset += line.len();
+        if n == 0 {
+            continue;
+        }
+        let body = line.trim_end_matches(['\n', '\r']);
+        let trimmed = body.trim();
+        let (name, colon) = match trimmed.strip_suffix(':') {
+            Some(n) => (n.trim_end(), true),
+            None => (trimmed, false),
+        };
+        let is_name = name
+            .chars()
+            .next()
+            .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+            && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+        if !is_name {
+            continue;
+        }
+        let lead = body.len() - body.trim_start().len();
+        let (s, e) = (start + lead, start + lead + trimmed.len());
+        fixed[s..e].fill(b' ');
+        found.push(((s, e), name.to_string(), colon));
+    }
+    if found.is_empty() {
+        return None;
+    }
+    String::from_utf8(fixed).ok().map(|f| (f, found))
+}
+
+/// The error for an entry half typed at `span` of the item at `offset`.
+fn half_typed_entry(
+    file: FileId,
+    offset: usize,
+    (s, e): (usize, usize),
+    name: &str,
+    colon: bool,
+) -> Diagnostic {
+    let span = Span::new(offset + s, offset + e);
+    if colon {
+        Diagnostic::error(codes::SYNTAX, format!("`{name}` has no value"), file, span)
+            .with_label("a value goes after the `:`")
+            .with_help(format!("write its value (`{name}: …`) or remove the line; the rest of the block is read without it"))
+    } else {
+        Diagnostic::error(
+            codes::SYNTAX,
+            format!("`{name}` is not an entry"),
+            file,
+            span,
+        )
+        .with_label("an entry is `name: value`")
+        .with_help(format!(
+            "write `{name}: value`, or remove the line; the rest of the block is read without it"
+        ))
+    }
 }
 
 /// Bytes of source parsed in one pest call, at most (one item may be longer).

@@ -10,6 +10,7 @@
 //! (lensc-build) opens the file under lensc's sandbox rules and turns
 //! these errors into coded diagnostics.
 
+pub mod correct;
 pub mod error;
 pub mod map;
 pub mod read;

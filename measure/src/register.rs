@@ -111,7 +111,9 @@ pub fn predict(f: &dyn SurfaceFn, pts: &[[f64; 3]], p: &[f64; 6]) -> Vec<[f64; 3
         .collect()
 }
 
-fn moved(pts: &[[f64; 3]], p: &[f64; 6]) -> (Vec<f64>, Vec<f64>) {
+/// The design-frame (x, y) of each measured point under the placement
+/// `p`: the point moved by the decentre, then turned by the clocking.
+pub fn moved(pts: &[[f64; 3]], p: &[f64; 6]) -> (Vec<f64>, Vec<f64>) {
     let (s, c) = p[5].sin_cos();
     pts.iter()
         .map(|q| {

@@ -18,8 +18,10 @@
 //! f(r − δx) − f(r) (f and f′ from the surface's kernel along +x); the
 //! stub is the run of rings from the centre whose error stands above that
 //! fit by more than five times its RMS (and 1 nm); h follows from its
-//! radius. h is a magnitude (a map does not tell above from below
-//! centre) and is resolved to the ring width.
+//! radius, its edge placed between the points on either side of it (a
+//! map's points lie at many radii about a centre that is not a pixel's,
+//! so far finer than a ring). h is a magnitude (a map does not tell above
+//! from below centre).
 
 use lensc_runtime::surface::ir::SurfaceFn;
 
@@ -33,7 +35,7 @@ pub struct SetUp {
     pub centre_height: f64,
     /// The stub's radius ρ (0: none seen).
     pub stub_radius: f64,
-    /// The ring width: the resolution of ρ and h.
+    /// The ring width (the stub's edge is then found between points).
     pub ring: f64,
     /// RMS of the rings outside the stub about the fitted cone (mm).
     pub residual_rms: f64,
@@ -105,7 +107,13 @@ pub fn fit(f: &dyn SurfaceFn, r: &[f64], e: &[f64], ring: f64) -> Option<SetUp> 
             .take_while(|q| q.1 - model(&p, q.0) > threshold)
             .last()
             .map_or(0.0, |q| q.0);
-        let stub = if stub > 0.0 { stub + ring / 2.0 } else { 0.0 };
+        let stub = if stub > 0.0 {
+            edge(r, e, stub + ring / 2.0, ring, &|rr| {
+                model(&p, rr) + threshold
+            })
+        } else {
+            0.0
+        };
         inner = (2.0 * stub).max(2.0 * ring);
         if _pass == 1 || stub == 0.0 {
             let h2 = stub * stub - p[1].max(0.0).powi(2);
@@ -120,6 +128,43 @@ pub fn fit(f: &dyn SurfaceFn, r: &[f64], e: &[f64], ring: f64) -> Option<SetUp> 
         }
     }
     None
+}
+
+/// The stub's edge to the point, not the ring: among the points within two
+/// rings of `rough`, the radius that best splits those standing above
+/// `level(r)` (inside) from those that do not (outside), the fewest
+/// points on the wrong side, halfway between the two points it falls
+/// between. A map's points lie at many radii about a centre that is not
+/// a pixel's, so the edge is found far finer than a ring (a pixel).
+fn edge(r: &[f64], e: &[f64], rough: f64, ring: f64, level: &dyn Fn(f64) -> f64) -> f64 {
+    let (lo, hi) = (rough - 2.0 * ring, rough + 2.0 * ring);
+    let mut near: Vec<(f64, bool)> = r
+        .iter()
+        .zip(e)
+        .filter(|(rr, _)| **rr > lo && **rr < hi)
+        .map(|(rr, ee)| (*rr, *ee > level(*rr)))
+        .collect();
+    near.sort_by(|a, b| a.0.total_cmp(&b.0));
+    // wrong(b): points outside the split that stand above, plus points
+    // inside it that do not; the split b = 0 puts every point outside.
+    let above_total = near.iter().filter(|q| q.1).count();
+    let (mut best, mut best_wrong) = (0, above_total);
+    let (mut inside_low, mut inside_high) = (0, 0);
+    for (b, q) in near.iter().enumerate() {
+        if q.1 {
+            inside_high += 1;
+        } else {
+            inside_low += 1;
+        }
+        let wrong = inside_low + (above_total - inside_high);
+        if wrong < best_wrong {
+            (best, best_wrong) = (b + 1, wrong);
+        }
+    }
+    if best == 0 || best == near.len() {
+        return rough;
+    }
+    (near[best - 1].0 + near[best].0) / 2.0
 }
 
 #[cfg(test)]
@@ -150,6 +195,29 @@ mod tests {
         let s = fit(&f, &r, &e, ring).expect("fits");
         assert!((s.x_offset - dx).abs() <= 0.05 * dx, "{s:?}");
         assert!((s.centre_height - h).abs() <= 2.0 * ring, "{s:?}");
+    }
+
+    /// A part passed by 1 µm in rings 0.5 µm wide (a coarse pixel): the stub's edge is found from the points, so h is
+    /// still within 5 %, where the ring alone resolves it to a ring.
+    #[test]
+    fn centre_height_is_resolved_finer_than_a_ring() {
+        let f = crate::register::tests::asphere(0.0);
+        // h = 2.2 µm: its edge in the middle of a 0.5 µm ring.
+        let (dx, h): (f64, f64) = (-1e-3, 2.2e-3);
+        let (mut r, mut e) = (Vec::new(), Vec::new());
+        for k in 1..=20000 {
+            let rr = 0.8 * (k as f64 / 20000.0).powi(2);
+            let cut = if rr > h {
+                f.eval((rr * rr - h * h).sqrt() - dx, 0.0)[0]
+            } else {
+                f.eval(0.0, 0.0)[0] + 5e-4
+            };
+            r.push(rr);
+            e.push(cut - f.eval(rr, 0.0)[0]);
+        }
+        let s = fit(&f, &r, &e, 5e-4).expect("fits");
+        assert!((s.centre_height - h).abs() <= 0.05 * h, "{s:?}");
+        assert!((s.x_offset - dx).abs() <= 0.05 * dx.abs(), "{s:?}");
     }
 
     /// A part with no set-up error shows neither.

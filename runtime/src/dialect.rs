@@ -91,6 +91,11 @@ pub struct Dialect {
     /// Blocks that stop the spindle at a fixed angle and hold it there,
     /// for a tool that cuts with the spindle still (a shaping knife).
     pub spindle_orient: Vec<String>,
+    /// Blocks stating the workpiece blank for the control's graphic test
+    /// run (`{x0}` `{y0}` `{z0}` its least corner, `{x1}` `{y1}` `{z1}` its
+    /// greatest, mm), written after the setup where the program states a
+    /// blank (`Start::blank`); Klartext writes `BLK FORM` itself.
+    pub blank_form: Vec<String>,
     /// Coolant words: flood, mist and off; none: the controller has none.
     pub coolant_flood: Option<String>,
     pub coolant_mist: Option<String>,
@@ -246,6 +251,7 @@ impl Dialect {
             spindle_off: "M5".into(),
             constant_rpm: Some("G97".into()),
             spindle_orient: lines(&["M19 R0"]),
+            blank_form: Vec::new(),
             coolant_flood: Some("M8".into()),
             coolant_mist: Some("M7".into()),
             coolant_off: Some("M9".into()),

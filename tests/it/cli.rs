@@ -869,7 +869,7 @@ fn a_build_summarises_each_job_and_writes_all_or_nothing_unless_keep_going() {
         "  PV        1.09 nm    limit 2 nm (stated)\n",
         "  PV        1.09 nm    limit 0.01 nm (stated)  MISSED\n",
         "  judged    the profile, radius 0 to 3 mm\n",
-        "  cutting   1 min 31.0 s\n",
+        "  cutting   1 min 5.3 s\n",
     ] {
         assert!(stderr.contains(line), "{line:?} not in {stderr}");
     }

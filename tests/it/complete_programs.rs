@@ -2,7 +2,8 @@
 //! from the controllers' manuals (not from the writer): a tool call before
 //! the first move; the spindle started (at a stated S, its mode G96/G97
 //! stated where the controller has constant surface speed), held still
-//! for a knife, or turned as a C axis before any feed move; S, T, M, H
+//! for a knife (M19; Heidenhain ISO's G36, cycle 13), or turned as a C
+//! axis before any feed move; S, T, M, H
 //! and D written as integers, without a decimal point; and at the program
 //! end the spindle stopped. Run over every example's program in its
 //! machine's own dialect here, and in every other dialect it offers by
@@ -149,6 +150,8 @@ pub fn complete(dialect: &str, program: &str) -> Result<(), String> {
                 ('G', "96" | "97") => mode_given = true,
                 ('C', _) if spindle != Spindle::Turning => spindle = Spindle::CAxis,
                 ('M', "19") => spindle = Spindle::Held,
+                // Heidenhain ISO: G36 is cycle 13 ORIENTATION (S the angle).
+                ('G', "36") if dialect == "heidenhain_iso" => spindle = Spindle::Held,
                 ('M', "5") => spindle = Spindle::Stopped,
                 ('M', "2" | "30") => ended = true,
                 _ => {}

@@ -64,6 +64,10 @@ fn obeys(dialect: &str, program: &str) -> Result<(), String> {
                     return Err(format!("a block without its end: {l}"));
                 }
             }
+            heidenhain_start_and_end(body, "T", "G30 G17 ", "G31 G90 ", "G00 Z0 M91 *")?;
+            if body.iter().any(|l| l.contains(" M19 ")) {
+                return Err("M19 is the machine builder's: the TNC orients by G36".into());
+            }
         }
         "heidenhain_tnc_klartext" => {
             let name = lines[0]
@@ -86,6 +90,13 @@ fn obeys(dialect: &str, program: &str) -> Result<(), String> {
                     return Err(format!("an L block without R0: {l}"));
                 }
             }
+            heidenhain_start_and_end(
+                &lines,
+                "TOOL CALL",
+                "BLK FORM 0.1 Z ",
+                "BLK FORM 0.2 ",
+                "L Z+0 R0 FMAX M91",
+            )?;
         }
         "ultra_precision_lathe_gcode" => {
             if lines.iter().any(|l| l.contains("G8") || l.contains("G64")) {
@@ -93,6 +104,49 @@ fn obeys(dialect: &str, program: &str) -> Result<(), String> {
             }
         }
         other => return Err(format!("no rules for {other}")),
+    }
+    Ok(())
+}
+
+/// A TNC program's start and end (both languages): one tool call (its
+/// block's first word `call`), the blank's least (`min`) and greatest
+/// (`max`) corner before it, and the retract to the top of Z in machine
+/// coordinates (`home`) before the program's end.
+fn heidenhain_start_and_end(
+    lines: &[&str],
+    call: &str,
+    min: &str,
+    max: &str,
+    home: &str,
+) -> Result<(), String> {
+    // A block's words after its number.
+    let words = |l: &str| l.split_once(' ').map_or("", |(_, r)| r).to_string();
+    let at = |head: &str| lines.iter().position(|l| words(l).starts_with(head));
+    // Only one call names a tool (Klartext may restate the speed as
+    // `TOOL CALL Z S…`).
+    let naming = |l: &&&str| {
+        words(l)
+            .strip_prefix(call)
+            .is_some_and(|r| r.trim_start().starts_with(|c: char| c.is_ascii_digit()))
+    };
+    let named = lines.iter().filter(naming).count();
+    if named != 1 {
+        return Err(format!("{named} tool calls naming a tool"));
+    }
+    let tool = lines
+        .iter()
+        .position(|l| naming(&l))
+        .ok_or("no tool call")?;
+    match (at(min), at(max)) {
+        (Some(a), Some(b)) if a < b && b < tool => {}
+        _ => return Err(format!("no blank ({min}then {max}) before the tool call")),
+    }
+    let end = lines
+        .iter()
+        .rposition(|l| words(l).starts_with("M30"))
+        .ok_or("no M30")?;
+    if !lines[..end].iter().any(|l| l.ends_with(home)) {
+        return Err(format!("no `{home}` before the program's end"));
     }
     Ok(())
 }

@@ -258,14 +258,7 @@ fn build_text(src: &str, program: &str) -> (String, serde_json::Value) {
     std::fs::write(&file, src).expect("write");
     let out = crate::common::lensc(
         dir.path(),
-        // The headers are the point here, not the part: the criteria warn.
-        &[
-            "build",
-            file.to_str().expect("utf8"),
-            "--accept=warn",
-            "--out",
-            "out",
-        ],
+        &["build", file.to_str().expect("utf8"), "--out", "out"],
     );
     assert_eq!(
         out.status.code(),
@@ -355,9 +348,19 @@ fn a_header_prints_a_spindle_cap_and_a_tolerance_as_stated() {
         job turned { surface: s, tool: diamond_r500um, machine: ultra_precision_lathe, strategy: f }\n";
     let (text, _) = build_text(turning, "turned.ngc");
     assert!(text.contains("capped at 1000 rpm"), "{text}");
-    let servo = std::fs::read_to_string(root().join("tests/jobs/fts_small_array.lens"))
-        .expect("job")
-        .replace("chord_tolerance: 50 nm", "chord_tolerance: 0.2 um");
+    // The small array at a 0.2 µm tolerance states what that tolerance
+    // allows (its own limits are for 50 nm: at 0.2 µm it measures 205 nm
+    // PV, 13.6 nm RMS, 205 nm high and lags by 513 nm).
+    let stated = "accept: { form_pv: 200 nm, form_rms: 10 nm, max_residual: 200 nm, max_following_error: 500 nm }";
+    let servo =
+        std::fs::read_to_string(root().join("tests/jobs/fts_small_array.lens")).expect("job");
+    assert!(servo.contains(stated), "the small array states its limits");
+    let servo = servo
+        .replace("chord_tolerance: 50 nm", "chord_tolerance: 0.2 um")
+        .replace(
+            stated,
+            "accept: { form_pv: 402 nm, form_rms: 100.5 nm, max_gouge: 201 nm, max_residual: 201 nm, max_following_error: 600 nm }",
+        );
     let (text, _) = build_text(&servo, "corner_fts.ngc");
     let head = header_comments(&text).join("\n");
     assert!(head.contains("path tolerance 200 nm"), "{head}");

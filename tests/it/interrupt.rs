@@ -248,19 +248,14 @@ fn unit(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
 }
 
 /// A build of the small servo job whose outputs differ from SMALL's
-/// (another feed): the same names, other bytes.
+/// (another feed, 45 um/rev: 144 nm PV, within the job's 200 nm; at 40
+/// um/rev one lenslet's rim reaches 418.5 nm, a planner finding left for
+/// issue #29): the same names, other bytes.
 fn other_feed(dir: &Path) -> std::path::PathBuf {
     let text = std::fs::read_to_string(root().join(SMALL)).expect("job");
     assert!(text.contains("feed: 50 um/rev"), "the job states its feed");
     let path = dir.join("corner_other_feed.lens");
-    // Not judged: at 40 µm/rev the whole part misses the limits stated for
-    // 50 µm/rev (423 nm PV), and this build is about its files.
-    let accept = "accept: { form_pv: 200 nm, max_residual: 200 nm }";
-    assert!(text.contains(accept), "the job states its limits");
-    let text = text
-        .replace("feed: 50 um/rev", "feed: 40 um/rev")
-        .replace(accept, "accept: none");
-    std::fs::write(&path, text).expect("write");
+    std::fs::write(&path, text.replace("feed: 50 um/rev", "feed: 45 um/rev")).expect("write");
     path
 }
 
@@ -271,7 +266,8 @@ const SERVO_DIALECT: &str = "ultra_precision_lathe_gcode";
 /// stopped by SIGTERM or SIGKILL at every step of its commit (before each
 /// rename and after the last), leaves the previous unit or the new one,
 /// never a mix: SIGTERM waits for the unit, which is then in place (the
-/// exit is 143, or 0 when the build ends before the handler); SIGKILL leaves each file whole (the previous or the new) and
+/// exit is 143, even when the build ends before the handler); SIGKILL
+/// leaves each file whole (the previous or the new) and
 /// a journal, which the next lensc run in the directory rolls forward to
 /// the new unit before anything else.
 #[test]
@@ -337,12 +333,13 @@ fn a_commit_stopped_at_every_step_leaves_one_whole_unit() {
             let what = format!("SIG{signal} before step {step}");
             let left = unit(out.path());
             if signal == "TERM" {
-                // The handler waits for the unit; the build may then end
-                // first (0: its work was done) or the handler (143).
-                assert!(
-                    matches!(run.status.code(), Some(0 | 143)),
-                    "{what}: {:?} {}",
+                // The handler waits for the unit, which is then in place;
+                // the run exits as stopped (143), whether the build or the
+                // handler ends first: never 0 to a caller that stopped it.
+                assert_eq!(
                     run.status.code(),
+                    Some(143),
+                    "{what}: {}",
                     text(&run.stderr)
                 );
                 assert!(

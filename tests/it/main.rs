@@ -14,6 +14,7 @@ mod bad_programs;
 mod build_errors;
 mod chords;
 mod cli;
+mod compensate;
 mod complete_programs;
 mod control_point;
 mod determinism;

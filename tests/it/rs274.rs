@@ -264,10 +264,15 @@ fn program_path_stays_within_the_path_tolerance() {
     }
     let arcs = cuts.iter().filter(|c| c.2.is_some()).count();
     assert!(arcs > 0, "no arcs fitted");
-    // The first cut is the plunge from the retract height to the start.
+    // The first cuts are the approach straight down to the start (through
+    // the air, then the last clearance at the feed): X does not move.
+    let start = cuts
+        .iter()
+        .position(|c| c.0.0 != c.1.0)
+        .unwrap_or(cuts.len());
     let rounding = 0.5e-5 * 2.0;
     let mut worst: f64 = 0.0;
-    for &((x0, z0), (x1, z1), arc) in &cuts[1..] {
+    for &((x0, z0), (x1, z1), arc) in &cuts[start..] {
         for step in 0..=32 {
             let t = step as f64 / 32.0;
             let (px, pz) = match arc {

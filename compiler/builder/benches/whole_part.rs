@@ -91,6 +91,17 @@ fn compare(title: &str, source: &str, window: &str, spacing: f64) {
         s["max_gouge_nm"]["value"],
         report["acceptance"]["judged"]["words"]
     );
+    if let Some(w) = h["worst_lenslet"].as_object() {
+        println!(
+            "  worst lenslet {} at {}: PV {} nm, RMS {} nm, residual {} nm; accepted: {}",
+            w["index"],
+            w["centre_mm"],
+            w["pv_nm"],
+            w["rms_nm"],
+            w["max_residual_nm"],
+            report["acceptance"]["passed"]
+        );
+    }
 }
 
 fn main() {

@@ -1,6 +1,7 @@
 //! The acceptance gate: a built job's simulated part against the criteria
 //! its `accept` block states, the rest at defaults derived from the
-//! strategy's path tolerance and the machine's resolution. Each criterion
+//! machine: the path tolerance its class holds (or the strategy's, if
+//! tighter) and its resolution (`job::accept::default_limit`). Each criterion
 //! missed (or that the simulation cannot measure) is a coded diagnostic
 //! naming the criterion, by how much and where on the part — an error
 //! that stops the program being written, or under `--accept=warn` a
@@ -10,6 +11,8 @@
 //! The figures are read from the report the builder filled (the one
 //! place every strategy's simulation lands), so a criterion is measured
 //! the same way for every strategy.
+
+mod lenslets;
 
 use crate::job::accept::{self, Accept, Criterion};
 use crate::strategy::JobSpec;
@@ -49,11 +52,14 @@ pub fn gate(spec: &JobSpec, built: &mut Built, mode: Mode) -> Vec<Diagnostic> {
         return Vec::new();
     }
     let tolerance = spec.path_tolerance();
+    let holds = crate::job::holds(head.resolution, spec.length_axes());
     let mut results = Vec::new();
     let mut diags = Vec::new();
     // Criteria the simulation cannot measure, by the reason: one
     // diagnostic a reason.
     let mut unmeasured: Vec<Unmeasured> = Vec::new();
+    // The form criteria's limits, for the lenslets.
+    let mut form_limits = Vec::new();
     for c in Criterion::ALL {
         let stated = head.accept.stated(c);
         let limit = match stated {
@@ -62,12 +68,18 @@ pub fn gate(spec: &JobSpec, built: &mut Built, mode: Mode) -> Vec<Diagnostic> {
                 fraction: l.fraction,
                 rule: None,
             },
-            None => match default_limit(c, tolerance, head.resolution) {
+            None => match default_limit(c, tolerance, head.resolution, holds) {
                 Some(l) => l,
                 None => continue,
             },
         };
         let r = judge(c, &limit, built);
+        // A following error is held to its default only where the job
+        // simulates one (a fast tool servo with a servo model).
+        if stated.is_none() && c == Criterion::MaxFollowingError && r.unmeasured.is_some() {
+            continue;
+        }
+        form_limits.push((c, r.limit, stated.map(|l| l.site)));
         match r.unmeasured {
             Some(why) => match unmeasured.iter_mut().find(|u| u.0 == why) {
                 Some(u) => {
@@ -87,14 +99,28 @@ pub fn gate(spec: &JobSpec, built: &mut Built, mode: Mode) -> Vec<Diagnostic> {
     for (why, names, site) in unmeasured {
         diags.push(cannot_measure(why, &names, site, head.site, mode));
     }
+    let lenslets = match form(&built.report.simulation) {
+        Ok(Form::Map(h)) => lenslets::judge(h, &form_limits),
+        _ => Vec::new(),
+    };
+    // A lenslet is named where the whole part passes: where it misses,
+    // its diagnostic says so already (the summary names the worst).
+    let whole_passed = |name: &str| results.iter().any(|r| r.criterion == name && r.passed);
+    for l in lenslets
+        .iter()
+        .filter(|l| !l.passed && whole_passed(l.criterion))
+    {
+        diags.push(lenslets::missed(l, &form_limits, head.site, mode));
+    }
     built.report.acceptance = crate::report::Acceptance {
         mode: match mode {
             Mode::Gate => AcceptanceMode::Gate,
             Mode::Warn => AcceptanceMode::Warn,
         },
-        passed: results.iter().all(|r| r.passed),
+        passed: results.iter().all(|r| r.passed) && lenslets.iter().all(|l| l.passed),
         criteria: results,
         judged,
+        lenslets,
     };
     diags
 }
@@ -167,9 +193,20 @@ struct Limit {
 /// `None`: it has none of its own) on a machine of `resolution` (mm)
 /// (`accept::default_limit`: the form error lies within ±(tolerance +
 /// resolution)), with the rule that derives it in words.
-fn default_limit(c: Criterion, tolerance: Option<f64>, resolution: f64) -> Option<Limit> {
-    let value = accept::default_limit(c, tolerance, resolution)?;
+fn default_limit(
+    c: Criterion,
+    tolerance: Option<f64>,
+    resolution: f64,
+    holds: f64,
+) -> Option<Limit> {
+    let value = accept::default_limit(c, tolerance, resolution, holds)?;
     let t_words = match tolerance {
+        Some(t) if t > holds => format!(
+            "{} nm (the least of the path tolerance {} nm and the {} nm the machine holds: a looser path does not loosen the part)",
+            trim_num(holds * 1e6),
+            trim_num(t * 1e6),
+            trim_num(holds * 1e6)
+        ),
         Some(t) => format!("the path tolerance {} nm", trim_num(t * 1e6)),
         None => format!(
             "{} nm (the strategy has no path tolerance: the default chord_tolerance)",
@@ -184,8 +221,11 @@ fn default_limit(c: Criterion, tolerance: Option<f64>, resolution: f64) -> Optio
         Criterion::FormPv => format!("2 × ({sum})"),
         Criterion::FormRms => format!("({sum}) / 2"),
         Criterion::MaxGouge | Criterion::MaxResidual => sum,
+        Criterion::MaxFollowingError => format!(
+            "{sum}: the servo's lag moves the cut by as much, beyond the form the commands simulate"
+        ),
         Criterion::UncutArea => "none of the area simulated left uncut".into(),
-        Criterion::MaxFollowingError | Criterion::MaxCuttingTime => return None,
+        Criterion::MaxCuttingTime => return None,
     };
     Some(Limit {
         value,

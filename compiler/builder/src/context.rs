@@ -55,13 +55,17 @@ pub(crate) fn inverse_time_words(head: &JobHead) -> String {
 /// The lines every header starts with: provenance, units, the control
 /// point, the surface.
 pub(crate) fn header(head: &JobHead, prov: &Provenance, units: &str) -> Vec<String> {
-    vec![
+    let mut lines = vec![
         format!("lensc {}: job {}", prov.lensc_version, head.name),
         format!("source {} fnv1a64 {:016x}", prov.source, prov.source_hash),
         units.to_string(),
         head.control.header_line(head.start.control),
         format!("surface {}: {}", head.names.surface, head.surface.words),
-    ]
+    ];
+    if let Some(c) = &head.surface.compensation {
+        lines.push(crate::compensate::header_words(c));
+    }
+    lines
 }
 
 /// The lines of a servo lathe's header: provenance, units, the control
@@ -145,6 +149,7 @@ fn report(
             &head.surface.lowered,
             201,
         ),
+        compensation: head.surface.compensation.clone(),
     }
 }
 

@@ -182,7 +182,8 @@ pub struct LatheFrame<'a> {
     pub domain: Domain,
     /// The radius the spiral starts at (mm): the job cuts nothing beyond.
     pub reach: f64,
-    /// The lenslets (centre x, y, radius) that reach into the window.
+    /// The array's lenslets (centre x, y, radius), in the array's order
+    /// (their indices are the lenslets' in the report).
     pub features: Vec<(f64, f64, f64)>,
 }
 
@@ -194,18 +195,12 @@ impl<'a> LatheFrame<'a> {
         reach: f64,
         features: &[(f64, f64, f64)],
     ) -> LatheFrame<'a> {
-        let reaches = |&&(cx, cy, r): &&(f64, f64, f64)| {
-            cx + r >= window.x.0
-                && cx - r <= window.x.1
-                && cy + r >= window.y.0
-                && cy - r <= window.y.1
-        };
         LatheFrame {
             kernel,
             window,
             domain,
             reach,
-            features: features.iter().filter(reaches).copied().collect(),
+            features: features.to_vec(),
         }
     }
 }
@@ -224,6 +219,8 @@ impl Frame for LatheFrame<'_> {
         (u * g.du * g.ds.sin()).abs()
     }
     fn inside(&self, x: f64, y: f64) -> bool {
+        // `hypot`, not squares: a polar grid's row lies on the reach's
+        // circle, and squares would drop some of its cells.
         self.window.contains(x, y) && self.domain.contains(x, y) && x.hypot(y) <= self.reach
     }
     fn features(&self) -> &[(f64, f64, f64)] {

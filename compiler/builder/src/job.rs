@@ -58,6 +58,16 @@ pub fn default_path_tolerance(resolution: f64, axes: u32) -> f64 {
     }
 }
 
+/// The path tolerance (mm) a machine of `resolution` (mm) holds for a
+/// strategy printing `axes` length axes (`None`: one that plans to no
+/// tolerance of its own, held to `DEFAULT_PATH_TOLERANCE`): its default
+/// one.
+pub fn holds(resolution: f64, axes: Option<u32>) -> f64 {
+    axes.map_or(DEFAULT_PATH_TOLERANCE, |n| {
+        default_path_tolerance(resolution, n)
+    })
+}
+
 /// How lowering evaluates a surface for the checks that analyse it: the
 /// build passes its JIT (with the interpreter behind it), so the figures
 /// `check` reports are the ones `build` plans with.
@@ -217,7 +227,21 @@ pub struct PartNames {
 pub struct SurfaceSpec {
     pub kind: &'static str,
     pub words: String,
+    /// The surface the program cuts: the design, or with a `compensate`
+    /// block the corrected surface.
     pub lowered: LoweredSurface,
+    /// With a `compensate` block: the design itself (what a part is
+    /// measured against) and the iteration for the report.
+    pub design: Option<LoweredSurface>,
+    pub compensation: Option<crate::compensate::Compensation>,
+}
+
+impl SurfaceSpec {
+    /// The design surface: what the part is to be, whatever is cut to
+    /// make it.
+    pub fn design(&self) -> &LoweredSurface {
+        self.design.as_ref().unwrap_or(&self.lowered)
+    }
 }
 
 /// A `simulate { x: …, y: …, spacing: … }` block: the window of the
@@ -249,6 +273,9 @@ pub struct Parts<'a> {
     /// The surface's parameters (the surface itself is lowered from its
     /// checked object, `lowered`).
     pub surface_params: Surface,
+    /// With a `compensate` block, once `lowered` has made the correction:
+    /// the design and the iteration, for the head.
+    compensated: std::cell::RefCell<Option<(LoweredSurface, crate::compensate::Compensation)>>,
 }
 
 impl<'a> Parts<'a> {
@@ -307,6 +334,7 @@ impl<'a> Parts<'a> {
             tool_params,
             path: PathParams::read(strategy),
             surface_params,
+            compensated: std::cell::RefCell::new(None),
         })
     }
     pub fn site(&self) -> (FileId, Span) {
@@ -382,10 +410,41 @@ impl<'a> Parts<'a> {
         }
         errors
     }
-    /// The surface lowered to IR, or E0131.
+    /// The surface the program is to cut, lowered to IR: the design, or
+    /// with a `compensate` block the design corrected from its measurement
+    /// (`crate::compensate`); E0131, or the correction's refusal.
     pub fn lowered(&self) -> Result<LoweredSurface, Diagnostic> {
-        lensc_lang::lower::surface::lower_surface(self.surface)
-            .map_err(|e| RuntimeError::Surface(e).at(self.site()))
+        let design = lensc_lang::lower::surface::lower_surface(self.surface)
+            .map_err(|e| RuntimeError::Surface(e).at(self.site()))?;
+        let Some(c) = &self.params.compensate else {
+            return Ok(design);
+        };
+        let of = crate::compensate::Of {
+            job: self.job,
+            surface_name: self
+                .job
+                .part_names
+                .get("surface")
+                .cloned()
+                .unwrap_or_else(|| self.surface.kind.name.to_string()),
+            strategy_kind: self.strategy.kind.name,
+            tool_radius: self
+                .tool_params
+                .nose_radius
+                .or(self.tool_params.diameter.map(|d| d / 2.0)),
+        };
+        let (corrected, report) = crate::compensate::corrected(&of, &design, c)?;
+        *self.compensated.borrow_mut() = Some((design, report));
+        Ok(corrected)
+    }
+    /// The path tolerance (mm) the machine's class holds for a strategy
+    /// printing `axes` length axes (`Strategy::LENGTH_AXES`; `None`: one
+    /// that plans to no tolerance of its own): the default one
+    /// (`default_path_tolerance`), 10 nm where the machine holds that. The
+    /// default acceptance limits are never looser than it allows
+    /// (`accept::default_limit`).
+    pub fn holds(&self, axes: Option<u32>) -> f64 {
+        holds(self.machine_params.resolution, axes)
     }
     /// The path tolerance the strategy states, or the default its machine
     /// holds on a path in `axes` length axes (`default_path_tolerance`,
@@ -473,10 +532,15 @@ impl<'a> Parts<'a> {
                 machine: name("machine", self.machine),
                 strategy: name("strategy", self.strategy),
             },
-            surface: SurfaceSpec {
-                kind: self.surface.kind.name,
-                words: lensc_lang::lower::describe(self.surface),
-                lowered,
+            surface: {
+                let (design, compensation) = self.compensated.borrow_mut().take().unzip();
+                SurfaceSpec {
+                    kind: self.surface.kind.name,
+                    words: lensc_lang::lower::describe(self.surface),
+                    lowered,
+                    design,
+                    compensation,
+                }
             },
             dialect,
             resolution: self.machine_params.resolution,

@@ -10,12 +10,14 @@
 //! draw that report.
 
 pub mod accept;
+pub mod compensate;
 pub mod context;
 pub mod diagnostics;
 pub mod driver;
 pub mod evaluate;
 pub mod height_map;
 pub mod job;
+pub mod json_schema;
 pub mod measure;
 pub mod output;
 pub mod pipeline;

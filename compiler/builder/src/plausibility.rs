@@ -51,33 +51,42 @@ pub fn cutting_time_warning(head: &JobHead, cutting_time: f64) -> Option<Diagnos
     )
 }
 
-/// One approach: the feed move from where a rapid left the tool to where
-/// the cut begins, all of it in the air.
+/// One approach: the feed moves from where a rapid left the tool to where
+/// the cut begins, all of them in the air, along one line. A lathe's
+/// approach may feed through the air fast and slow to the cutting feed
+/// for its last part (`plan::approach`): the figures are those of its
+/// last move, at the feed the cut begins with, and `air_time` the whole
+/// approach's.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Approach {
-    /// Its length (mm).
+    /// The last move's length (mm).
     pub length: f64,
     /// Its path speed (mm/s).
     pub speed: f64,
     /// Its time (s).
     pub time: f64,
+    /// The time (s) of every move of the approach.
+    pub air_time: f64,
 }
 
 /// What a move stream spends at a cutting feed without cutting: every
-/// approach (a feed move straight after a rapid), and the feed time of
-/// the whole stream (s).
+/// approach (the feed moves straight after a rapid that carry on along
+/// the first one's line), and the feed time of the whole stream (s).
 pub fn feed_in_air(stream: &[Move]) -> (Vec<Approach>, f64) {
     let mut at = [f64::NAN; 4];
     let mut spindle = Spindle::Stopped;
     let mut feed: Option<Feed> = None;
     let mut after_rapid = false;
-    let mut approaches = Vec::new();
+    // The open approach's direction, while its moves carry on along it.
+    let mut heading: Option<[f64; 3]> = None;
+    let mut approaches: Vec<Approach> = Vec::new();
     let mut feed_time = 0.0;
     for m in stream {
         match *m {
             Move::Rapid(to) => {
                 at = merged(at, to);
                 after_rapid = true;
+                heading = None;
             }
             Move::Linear { to, feed: f } | Move::Arc { to, feed: f, .. } => {
                 if f.is_some() {
@@ -87,14 +96,31 @@ pub fn feed_in_air(stream: &[Move]) -> (Vec<Approach>, f64) {
                 let length = distance(at, next);
                 let speed = feed.map_or(f64::NAN, |f| speed(f, spindle, at[0], length));
                 let time = if speed > 0.0 { length / speed } else { 0.0 };
+                let line = matches!(m, Move::Linear { .. });
                 if time.is_finite() {
                     feed_time += time;
+                    let d = direction(at, next);
+                    let along = line && heading.is_some_and(|h| same_line(h, d));
                     if after_rapid && length > 0.0 {
                         approaches.push(Approach {
                             length,
                             speed,
                             time,
+                            air_time: time,
                         });
+                        heading = line.then_some(d);
+                    } else if along
+                        && length > 0.0
+                        && let Some(a) = approaches.last_mut()
+                    {
+                        *a = Approach {
+                            length,
+                            speed,
+                            time,
+                            air_time: a.air_time + time,
+                        };
+                    } else {
+                        heading = None;
                     }
                 }
                 after_rapid = false;
@@ -110,6 +136,23 @@ pub fn feed_in_air(stream: &[Move]) -> (Vec<Approach>, f64) {
     (approaches, feed_time)
 }
 
+/// The unit vector from `a` to `b` over X, Y and Z (axes not yet known
+/// counted as not moving).
+fn direction(a: [f64; 4], b: [f64; 4]) -> [f64; 3] {
+    let l = distance(a, b);
+    let mut d = [0.0; 3];
+    for (i, v) in d.iter_mut().enumerate() {
+        let s = b[i] - a[i];
+        *v = if s.is_finite() && l > 0.0 { s / l } else { 0.0 };
+    }
+    d
+}
+
+/// Whether two unit vectors point the same way.
+fn same_line(a: [f64; 3], b: [f64; 3]) -> bool {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2] > 1.0 - 1e-9
+}
+
 /// W0031 for the longest approach over `LONG_APPROACH`, W0032 when the
 /// approaches together are over `AIR_SHARE` of the feed time and
 /// `AIR_AT_LEAST` (and not the one approach W0031 names).
@@ -122,7 +165,7 @@ pub fn air_warnings(head: &JobHead, stream: &[Move]) -> Vec<Diagnostic> {
         .max_by(|a, b| a.time.total_cmp(&b.time));
     let mut warned = 0.0;
     if let Some(a) = longest.filter(|a| a.time > LONG_APPROACH) {
-        warned = a.time;
+        warned = a.air_time;
         out.push(
             warning(
                 head,
@@ -137,7 +180,7 @@ pub fn air_warnings(head: &JobHead, stream: &[Move]) -> Vec<Diagnostic> {
             .with_help("lower the strategy's retract (or safe) height, or start the cut nearer the part: the approach runs from where the rapid stops"),
         );
     }
-    let air: f64 = approaches.iter().map(|a| a.time).sum();
+    let air: f64 = approaches.iter().map(|a| a.air_time).sum();
     if air > AIR_AT_LEAST && air > AIR_SHARE * feed_time && air - warned > AIR_AT_LEAST {
         out.push(
             warning(
@@ -271,6 +314,35 @@ mod tests {
         assert!((a.time - 88.0).abs() < 1e-9, "{a:?}");
         let cut = (9.0f64 + 0.36).sqrt() / (3.0 / 60.0);
         assert!((feed_time - 88.0 - cut).abs() < 1e-9, "{feed_time}");
+    }
+
+    #[test]
+    fn an_approach_through_air_then_at_feed_is_timed_by_its_last_move() {
+        // A lathe's approach as `plan::approach` writes it: a rapid to
+        // 0.1 mm over the top, 1.5 mm down at 100 mm/min, the last 0.1 mm
+        // at 0.05 mm/min (two minutes), then the cut across.
+        let stream = [
+            Move::SpindleOn(100.0),
+            Move::Rapid(Position::xz(3.0, 0.1)),
+            Move::Linear {
+                to: Position::xz(3.0, -1.4),
+                feed: Some(Feed::PerTime(100.0 / 60.0)),
+            },
+            Move::Linear {
+                to: Position::xz(3.0, -1.5),
+                feed: Some(Feed::PerTime(0.05 / 60.0)),
+            },
+            Move::Linear {
+                to: Position::xz(0.0, 0.0),
+                feed: None,
+            },
+        ];
+        let (approaches, _) = feed_in_air(&stream);
+        assert_eq!(approaches.len(), 1);
+        let a = approaches[0];
+        assert!((a.length - 0.1).abs() < 1e-12, "{a:?}");
+        assert!((a.time - 120.0).abs() < 1e-9, "{a:?}");
+        assert!((a.air_time - 120.9).abs() < 1e-9, "{a:?}");
     }
 
     #[test]

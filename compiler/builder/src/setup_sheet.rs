@@ -39,7 +39,7 @@ fn header_comments(program: &ProgramText) -> Vec<String> {
     };
     let mut out: Vec<String> = Vec::new();
     for line in &lines {
-        let Some(text) = comment(line) else {
+        let Some(text) = lensc_runtime::reader::comment_text(line) else {
             continue;
         };
         match (out.last_mut(), text.strip_prefix("  ")) {
@@ -47,22 +47,10 @@ fn header_comments(program: &ProgramText) -> Vec<String> {
                 last.push(' ');
                 last.push_str(rest.trim_start());
             }
-            _ => out.push(text.to_string()),
+            _ => out.push(text.trim().to_string()),
         }
     }
     out
-}
-
-/// The text of a whole-line comment: `(…)`, `; …`, `N9 ; … *`, `9 ; …`.
-fn comment(line: &str) -> Option<&str> {
-    let t = line.trim();
-    if let Some(inner) = t.strip_prefix('(') {
-        return inner.strip_suffix(')');
-    }
-    let t = t.strip_prefix('N').unwrap_or(t);
-    let t = t.trim_start_matches(|c: char| c.is_ascii_digit()).trim();
-    let inner = t.strip_prefix(';')?;
-    Some(inner.trim().trim_end_matches('*').trim_end())
 }
 
 /// The work offset the dialect's setup selects (`G54`…`G59`, `G500`…,

@@ -79,6 +79,10 @@ pub struct Loaded {
     /// Indexed by `FileId`; the first is the root file.
     pub files: Vec<ParsedFile>,
     pub diags: Vec<Diagnostic>,
+    /// The project root every file was read beneath, kept open for the
+    /// files a job names beside its `use`s (a `compensate` block's
+    /// measurement), which are read under the same rules.
+    pub root: Option<std::sync::Arc<Root>>,
 }
 
 impl Loaded {
@@ -151,6 +155,7 @@ fn load_bytes(fs: &dyn FileSystem, root: Root, key: Key, path: &Path, bytes: Vec
             sources: SourceMap::default(),
             files: Vec::new(),
             diags: Vec::new(),
+            root: None,
         },
         keys: HashMap::new(),
         stack: Vec::new(),
@@ -163,7 +168,9 @@ fn load_bytes(fs: &dyn FileSystem, root: Root, key: Key, path: &Path, bytes: Vec
         Some(path.to_path_buf()),
         bytes,
     );
-    l.loaded
+    let mut loaded = l.loaded;
+    loaded.root = Some(std::sync::Arc::new(l.root));
+    loaded
 }
 
 #[derive(Clone, PartialEq, Eq, Hash)]

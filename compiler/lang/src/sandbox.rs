@@ -101,6 +101,12 @@ pub struct Root {
     dir: std::io::Result<cap_std::fs::Dir>,
 }
 
+impl std::fmt::Debug for Root {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Root({})", self.path.display())
+    }
+}
+
 impl Root {
     /// Opens the directory `path` (resolved, as `resolve` gives it). A
     /// root that cannot be opened is kept with its error: every read
@@ -235,41 +241,45 @@ fn regular(meta: &std::fs::Metadata, limit: u64) -> Result<u64, ReadError> {
 /// (as `describe` says it).
 fn describe_beneath(t: &cap_std::fs::FileType) -> &'static str {
     #[cfg(unix)]
-    {
+    let special = {
         use cap_std::fs::FileTypeExt;
-        if t.is_fifo() {
-            return "a FIFO";
-        }
-        if t.is_char_device() || t.is_block_device() {
-            return "a device";
-        }
-        if t.is_socket() {
-            return "a socket";
-        }
-    }
-    if t.is_dir() {
-        "a directory"
-    } else {
-        "not a regular file"
-    }
+        [
+            t.is_fifo(),
+            t.is_char_device() || t.is_block_device(),
+            t.is_socket(),
+        ]
+    };
+    #[cfg(not(unix))]
+    let special = [false; 3];
+    kind_in_words(special, t.is_dir())
 }
 
 /// What a file that is not a regular file is, in words.
 fn describe(t: &std::fs::FileType) -> &'static str {
     #[cfg(unix)]
-    {
+    let special = {
         use std::os::unix::fs::FileTypeExt;
-        if t.is_fifo() {
-            return "a FIFO";
-        }
-        if t.is_char_device() || t.is_block_device() {
-            return "a device";
-        }
-        if t.is_socket() {
-            return "a socket";
-        }
-    }
-    if t.is_dir() {
+        [
+            t.is_fifo(),
+            t.is_char_device() || t.is_block_device(),
+            t.is_socket(),
+        ]
+    };
+    #[cfg(not(unix))]
+    let special = [false; 3];
+    kind_in_words(special, t.is_dir())
+}
+
+/// A kind of file in words, from whether it is a FIFO, a device or a
+/// socket (`special`), or a directory.
+fn kind_in_words([fifo, device, socket]: [bool; 3], dir: bool) -> &'static str {
+    if fifo {
+        "a FIFO"
+    } else if device {
+        "a device"
+    } else if socket {
+        "a socket"
+    } else if dir {
         "a directory"
     } else {
         "not a regular file"

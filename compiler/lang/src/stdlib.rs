@@ -24,6 +24,8 @@ pub struct StdItem {
     /// The name its value is made from: a kind (`lathe { … }`) or another
     /// item it copies (`linuxcnc_lathe { … }`).
     pub made_from: Option<String>,
+    /// The declaration as written (its travel, limits and settings).
+    pub source: String,
 }
 
 impl StdItem {
@@ -60,6 +62,10 @@ fn module_items(module: &'static str, text: &str) -> Vec<StdItem> {
                 kind: *kind,
                 doc: doc_above(text, item.span.start as usize),
                 made_from: head_name(value),
+                source: text
+                    .get(item.span.start as usize..item.span.end as usize)
+                    .unwrap_or_default()
+                    .to_string(),
             }),
             _ => None,
         })

@@ -255,8 +255,10 @@ pub enum Command {
         format: Format,
     },
     /// Run a language server on stdin and stdout for an editor: diagnostics
-    /// as you type, hover, completion, go to definition and formatting
-    /// (editors/README.md says how to set one up).
+    /// as you type (and what lowering the jobs finds, after a pause),
+    /// hover, completion, go to definition, references, rename, the
+    /// outline, quick fixes and formatting (editors/README.md says how to
+    /// set one up).
     Lsp,
 }
 

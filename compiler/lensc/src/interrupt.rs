@@ -30,6 +30,11 @@ fn on_signal_remove_temporaries() {
         .collect();
     // Without the handler the signal still stops the build, only leaving
     // its temporary files for the next build's sweep.
+    // Noted in the signal handler itself, so a run whose work ends before
+    // the handler's thread is scheduled still exits as stopped.
+    for &signal in &caught {
+        let _ = signal_hook::flag::register_usize(signal, caught_flag(), signal as usize);
+    }
     let Ok(mut signals) = signal_hook::iterator::Signals::new(caught) else {
         return;
     };
@@ -42,6 +47,32 @@ fn on_signal_remove_temporaries() {
                 std::process::exit(128 + signal);
             }
         });
+}
+
+/// The signal caught so far (0: none), set in the signal handler.
+#[cfg(unix)]
+fn caught_flag() -> std::sync::Arc<std::sync::atomic::AtomicUsize> {
+    static CAUGHT: std::sync::OnceLock<std::sync::Arc<std::sync::atomic::AtomicUsize>> =
+        std::sync::OnceLock::new();
+    CAUGHT.get_or_init(Default::default).clone()
+}
+
+/// The exit status of a run that SIGINT or SIGTERM asked to stop (128 +
+/// the signal's number), whether or not its work had ended: a caller that
+/// sent the signal is told the run was stopped, never 0. `None` if no
+/// signal came.
+pub fn stopped_status() -> Option<u8> {
+    #[cfg(unix)]
+    {
+        let signal = caught_flag().load(std::sync::atomic::Ordering::SeqCst);
+        if signal != 0 {
+            // Once the temporaries are gone (the handler holds the
+            // registry until it exits, so none is made meanwhile).
+            let _held = lensc_build::temps::remove_all_and_hold();
+            return Some((128 + signal).min(255) as u8);
+        }
+    }
+    None
 }
 
 /// Whether `signal` is ignored (its disposition inherited from the parent).

@@ -27,7 +27,7 @@ fn main() -> ExitCode {
         .stack_size(256 << 20)
         .spawn(move || run(cli));
     match worker.map(|h| h.join()) {
-        Ok(Ok(code)) => ExitCode::from(code),
+        Ok(Ok(code)) => ExitCode::from(interrupt::stopped_status().unwrap_or(code)),
         _ => ExitCode::from(101),
     }
 }
@@ -103,6 +103,7 @@ fn run(cli: Cli) -> u8 {
                 min_valid: min_valid / 100.0,
                 cutoff,
                 keep_origin,
+                from_job: false,
             },
         ),
 

@@ -54,7 +54,25 @@ pub fn job_summary(job: &str, fate: &Fate, built: Option<(&Report, &Program)>) -
             line(label, text);
         }
     }
+    if let Some(text) = lenslets(report) {
+        line("lenslets", text);
+    }
     line("judged", judged(&report.simulation));
+    if let Some(c) = &report.compensation {
+        line(
+            "corrected",
+            format!(
+                "from {} (measured {:.2} nm PV, {:.2} nm RMS), gain {}, smoothing {} mm: next part predicted {:.2} nm PV, {:.2} nm RMS",
+                c.measurement,
+                c.measured_pv_nm,
+                c.measured_rms_nm,
+                c.gain,
+                c.smoothing_mm,
+                c.predicted_pv_nm,
+                c.predicted_rms_nm
+            ),
+        );
+    }
     line("cutting", duration(program.cutting_time));
     let size = format!("{} lines, {}", program.lines, bytes(program.bytes));
     match fate {
@@ -154,6 +172,37 @@ fn height_map(sim: &Simulation) -> Option<&HeightMap> {
         Simulation::HeightMap(h) => Some(&h.height_map),
         Simulation::Skipped(s) => s.height_map.as_ref(),
     }
+}
+
+/// An array's lenslets: how many, the worst named (its index and centre)
+/// with its figures, and how many miss their limits; `None` without
+/// lenslets.
+fn lenslets(report: &Report) -> Option<String> {
+    let h = height_map(&report.simulation)?;
+    let w = h.worst_lenslet.as_ref()?;
+    let mut missed: Vec<usize> = report
+        .acceptance
+        .lenslets
+        .iter()
+        .flat_map(|c| c.missed.iter().copied())
+        .collect();
+    missed.sort_unstable();
+    missed.dedup();
+    let verdict = match missed.len() {
+        0 if report.acceptance.lenslets.is_empty() => String::new(),
+        0 => ", every one within its limits".to_string(),
+        1 => ", 1 misses its limits".to_string(),
+        n => format!(", {n} miss their limits"),
+    };
+    Some(format!(
+        "{}, the worst {} at x {}, y {} mm: PV {} nm, residual {} nm{verdict}",
+        h.lenslets.len(),
+        w.index,
+        mm(w.centre_mm[0]),
+        mm(w.centre_mm[1]),
+        nm(w.pv_nm),
+        nm(w.max_residual_nm)
+    ))
 }
 
 /// The area the figures come from: a profile's radii, or a height map's

@@ -346,3 +346,30 @@ fn build_x3p_with(
     zip.finish().unwrap();
     out.into_inner()
 }
+
+/// Found by the fuzzer's measure target: an SDF height of 1e308 µm
+/// (1e305 mm) was read, and its Sq came out infinite. Heights beyond
+/// `REACH_MM` are refused as a damaged file, naming the number.
+#[test]
+fn a_height_beyond_any_instrument_is_refused() {
+    let sdf = "aISO-1.0\nManufacID = ISOTC213\nNumPoints = 3\nNumProfiles = 2\nXscale = 1.0E-6\nYscale = 1.0E-6\nZscale = 1.0E-6\nCompression = 0\nDataType = 7\nCheckType = 0\n*\n1.0 0.99 0.98\n0.97 1e308 0.95\n*\n";
+    let err = read("part.sdf", sdf.as_bytes(), TextUnits::MM).unwrap_err();
+    let text = err.to_string();
+    assert!(
+        text.contains("1e305 mm") && text.contains("point 4"),
+        "{text}"
+    );
+    // Below the reach it reads (the same file with a plausible height).
+    let fine = sdf.replace("1e308", "0.96");
+    assert!(read("part.sdf", fine.as_bytes(), TextUnits::MM).is_ok());
+    // A scale that underflows to a zero pixel spacing (found by the
+    // fuzzer too: `Yscale = 1.0E-100000`).
+    let zero = sdf.replace("Yscale = 1.0E-6", "Yscale = 1.0E-100000");
+    let err = read("part.sdf", zero.as_bytes(), TextUnits::MM).unwrap_err();
+    assert!(err.to_string().contains("along y is 0e0 mm"), "{err}");
+    // A cloud and a profile are held to the same reach.
+    let err = read("p.xyz", b"0 0 0\n1 1 2e4\n", TextUnits::MM).unwrap_err();
+    assert!(err.to_string().contains("20000 mm"), "{err}");
+    let err = read("p.txt", b"0 0\n-3e4 1\n", TextUnits::MM).unwrap_err();
+    assert!(err.to_string().contains("-30000 mm"), "{err}");
+}

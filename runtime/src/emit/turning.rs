@@ -97,7 +97,8 @@ pub fn emit(
 
 /// The move stream of a profile-turning path: the spindle started, a
 /// rapid up to the safe height before any other move, the planner's moves
-/// (X corrected for an edge set off centre) at each pass's feed, the
+/// (X corrected for an edge set off centre) at each pass's feed (an
+/// approach's feed through air at its own), the
 /// spindle switched to the finish's speed before the finish pass where
 /// roughing runs at its own, and the spindle stopped.
 pub fn turning_moves(job: &TurningJob, path: &Toolpath) -> Vec<moves::Move> {
@@ -144,9 +145,10 @@ pub fn turning_moves(job: &TurningJob, path: &Toolpath) -> Vec<moves::Move> {
         let rates = if i < finish_from { &rough } else { &finish };
         out.push(match *m {
             Move::Rapid(to) => Move::Rapid(Position::xz(corrected(to.x), to.z)),
-            Move::Linear { to, .. } => Move::Linear {
+            // The planner's own feed (an approach through air) kept.
+            Move::Linear { to, feed: f } => Move::Linear {
                 to: Position::xz(corrected(to.x), to.z),
-                feed: Some(feed(rates)),
+                feed: Some(f.unwrap_or_else(|| feed(rates))),
             },
             other => other,
         });

@@ -2,6 +2,7 @@
 //! limits into neutral tool-centre points and moves. No program text here:
 //! `emit/` turns their output into the move stream.
 
+pub mod approach;
 pub mod chords;
 pub mod envelope;
 pub mod grinding;

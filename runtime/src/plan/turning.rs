@@ -7,6 +7,7 @@ use nalgebra::Vector2;
 use crate::machine::Lathe;
 use crate::machine::tool::RoundNoseTool;
 use crate::moves::{Move, Position};
+use crate::plan::approach;
 use crate::plan::chords::{self, Band, ChordPlacement};
 use crate::plan::envelope::{self, Pieces};
 use crate::surface::Profile;
@@ -263,9 +264,10 @@ pub fn plan_profile_turning(
     };
     let cut = cut_path(&section, rho, strat);
     let mut passes = roughing_passes(&section, rho, strat, &cut);
+    let stock = stock_outline(&section, rho, strat, &cut);
     let roughing_count = passes.len();
     passes.push(cut);
-    let linked = link_passes(&passes, roughing_count, strat);
+    let linked = link_passes(&passes, roughing_count, strat, &stock, job.machine.max_feed);
     let cut = passes.pop().expect("the finish pass");
     let cutting_time = linked.pass_times.iter().sum();
 
@@ -360,22 +362,70 @@ struct LinkedPasses {
     pass_starts: Vec<usize>,
 }
 
+/// What lies over a pass before it cuts, as the nose centre meets it: the
+/// path the pass before ran (its material is that pass's cut), the
+/// stock's, or a flat face.
+#[derive(Clone, Debug, PartialEq)]
+enum Outline {
+    /// Nose-centre points (along the path, X either way).
+    Path(Vec<Vector2<f64>>),
+    /// A flat face: the nose centre meets it at this height everywhere.
+    Level(f64),
+}
+
+impl Outline {
+    /// The nose-centre height (mm) at which the nose meets this material
+    /// at X `x`, or `None` where the outline does not reach `x`. A path is
+    /// interpolated between the two points about `x`: the nose centre at
+    /// or above the exact offset of a surface is clear of that surface,
+    /// and the chords stray from it by the chord tolerance, which the
+    /// approach's clearance covers.
+    fn height_at(&self, x: f64) -> Option<f64> {
+        match self {
+            Outline::Level(z) => Some(*z),
+            Outline::Path(points) => points.windows(2).find_map(|w| {
+                let (a, b) = (w[0], w[1]);
+                let (lo, hi) = (a.x.min(b.x), a.x.max(b.x));
+                if x < lo || x > hi {
+                    return None;
+                }
+                if hi - lo <= 0.0 {
+                    return Some(a.y.max(b.y));
+                }
+                let t = (x - a.x) / (b.x - a.x);
+                Some(a.y + t * (b.y - a.y))
+            }),
+        }
+    }
+}
+
 /// Each pass in turn: a rapid above its first point at the safe height
-/// (the retract above the highest point of any pass), a feed down to it,
-/// the pass, and a rapid back up. The first `roughing` passes are timed
-/// at the roughing feed and spindle speed.
+/// (the retract above the highest point of any pass), the approach down
+/// to it (`plan::approach`: a rapid to a clearance over the part's top, a
+/// feed through the air, the last clearance and any material at the
+/// pass's feed), the pass, and a rapid back up. The first `roughing`
+/// passes are timed at the roughing feed and spindle speed. `stock` is
+/// what lies over the first pass; over each later pass lies the pass
+/// before it.
 fn link_passes(
     passes: &[Vec<Vector2<f64>>],
     roughing: usize,
     strat: &ProfileTurning,
+    stock: &Outline,
+    max_feed: f64,
 ) -> LinkedPasses {
-    let top = passes
+    let cuts_top = passes
         .iter()
         .flatten()
         .map(|c| c.y)
         .fold(f64::NEG_INFINITY, f64::max);
-    let safe_z = top + strat.retract;
-    let mut moves = Vec::with_capacity(passes.iter().map(|p| p.len() + 3).sum());
+    let safe_z = cuts_top + strat.retract;
+    // Rapids stay above the stock as well as above the cuts.
+    let top = match stock {
+        Outline::Level(z) => cuts_top.max(*z),
+        Outline::Path(_) => cuts_top,
+    };
+    let mut moves = Vec::with_capacity(passes.iter().map(|p| p.len() + 5).sum());
     let mut cut_length = 0.0;
     let mut pass_times = Vec::with_capacity(passes.len());
     let mut pass_starts = Vec::with_capacity(passes.len());
@@ -385,11 +435,39 @@ fn link_passes(
         } else {
             PassRates::finish(strat)
         };
+        let over = if i == 0 {
+            stock.clone()
+        } else {
+            Outline::Path(passes[i - 1].clone())
+        };
+        // Where the outline does not reach the first point, nothing is
+        // known of the material there: the whole approach below the
+        // rapid is at the pass's feed.
+        let material = over.height_at(cut[0].x).unwrap_or(f64::INFINITY);
+        let approach = approach::Approach {
+            x: cut[0].x,
+            safe_z,
+            top,
+            material,
+            start_z: cut[0].y,
+            cutting_speed: rates.speed_at(cut[0].x),
+            max_feed,
+            retract: strat.retract,
+        };
         pass_starts.push(moves.len());
         moves.push(Move::Rapid(Position::xz(cut[0].x, safe_z)));
-        moves.push(cutting(cut[0].x, cut[0].y));
-        cut_length += (safe_z - cut[0].y).abs();
-        let mut time = (safe_z - cut[0].y).abs() / rates.speed_at(cut[0].x);
+        // The air feed in the pass's kind of feed: per revolution at the
+        // spindle's speed over the first point (X does not change).
+        let per_rev = match rates.feed {
+            Feed::PerRevolution(f) => Some(f / approach.cutting_speed),
+            Feed::PerTime(_) => None,
+        };
+        moves.extend(approach.moves(None, |v| match per_rev {
+            Some(k) => crate::moves::Feed::PerRevolution(k * v),
+            None => crate::moves::Feed::PerTime(v),
+        }));
+        let (mut time, length) = approach.feed_time_and_length();
+        cut_length += length;
         for w in cut.windows(2) {
             let len = (w[1] - w[0]).norm();
             cut_length += len;
@@ -488,6 +566,30 @@ fn travel_error(machine: &Lathe, moves: &[Move]) -> Option<PlanError> {
                 })
             })
     })
+}
+
+/// What lies over the first pass, as the nose centre meets it: the
+/// stock's face, the stock's offset surface, or, with no stock given,
+/// the design itself (a finishing job's blank is taken to be the part
+/// within what the finish pass removes).
+fn stock_outline(
+    section: &Section,
+    rho: f64,
+    strat: &ProfileTurning,
+    finish: &[Vector2<f64>],
+) -> Outline {
+    match strat.roughing.map(|r| r.stock) {
+        None => Outline::Path(finish.to_vec()),
+        Some(Stock::Flat { top }) => Outline::Level(top + rho),
+        Some(Stock::Offset { allowance }) => {
+            let exact = ProfileTurning {
+                location: ToolLocation::Exact,
+                chords: ChordPlacement::OnPath,
+                ..strat.clone()
+            };
+            Outline::Path(cut_path(section, rho + allowance, &exact))
+        }
+    }
 }
 
 /// The roughing passes, outermost first: each the exact nose-centre path

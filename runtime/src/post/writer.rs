@@ -358,6 +358,9 @@ impl ProgramWriter {
             }
             self.pending_tool_call = Some((lines, coolant));
         } else {
+            if let Some(blank) = start.blank {
+                self.blank_blocks(&blank)?;
+            }
             for line in lines {
                 self.block_line(&line)?;
             }
@@ -381,6 +384,28 @@ impl ProgramWriter {
             self.common_blocks = false;
         }
         self.start = Some(*start);
+        Ok(())
+    }
+
+    /// The dialect's `blank_form` blocks with the blank's corners filled
+    /// in, to the machine's decimals (Heidenhain ISO's G30 and G31).
+    fn blank_blocks(&mut self, blank: &crate::moves::Blank) -> Result<(), ProgramError> {
+        for line in self.dialect.blank_form.clone() {
+            let mut l = line;
+            for (i, axis) in ['x', 'y', 'z'].into_iter().enumerate() {
+                for (corner, value) in [('0', blank.min[i]), ('1', blank.max[i])] {
+                    let mut n = String::new();
+                    if !push_fixed(&mut n, value, self.decimals) {
+                        return Err(ProgramError::NotPrintable {
+                            word: axis.to_ascii_uppercase(),
+                            value,
+                        });
+                    }
+                    l = l.replace(&format!("{{{axis}{corner}}}"), &n);
+                }
+            }
+            self.block_line(&l)?;
+        }
         Ok(())
     }
 

@@ -56,23 +56,29 @@ pub fn header_source_hash(text: &str) -> Option<(String, u64, usize)> {
 /// the header states none (a program written before the control point
 /// was stated is the tool centre's).
 pub fn header_control_offset(text: &str) -> Option<[f64; 3]> {
-    text.lines().take(200).find_map(|line| {
-        let comment = comment_text(line)?.trim();
-        let rest = comment.strip_prefix("control point ")?;
-        let (_, rest) = rest.split_once(" at ")?;
-        let (rest, _) = rest.split_once(" mm from the tool centre")?;
-        let mut offset = [0.0; 3];
-        for word in rest.split_whitespace() {
-            let axis = "XYZ".find(word.get(..1)?)?;
-            offset[axis] = word.get(1..)?.parse().ok()?;
-        }
-        Some(offset)
-    })
+    text.lines()
+        .take(200)
+        .find_map(|line| control_offset(comment_text(line)?))
+}
+
+/// The control point's offset from the tool's centre, if this header
+/// comment states it (`control point tip at X+0 Y+0 Z-0.085 mm from the
+/// tool centre …`).
+pub(crate) fn control_offset(comment: &str) -> Option<[f64; 3]> {
+    let rest = comment.trim().strip_prefix("control point ")?;
+    let (_, rest) = rest.split_once(" at ")?;
+    let (rest, _) = rest.split_once(" mm from the tool centre")?;
+    let mut offset = [0.0f64; 3];
+    for word in rest.split_whitespace() {
+        let axis = "XYZ".find(word.get(..1)?)?;
+        offset[axis] = word.get(1..)?.parse().ok()?;
+    }
+    offset.iter().all(|v| v.is_finite()).then_some(offset)
 }
 
 /// The text of a whole-line comment in any dialect: `(…)`, `; …`, a
 /// numbered `N9 ; … *`, or Klartext's `9 ; …`.
-fn comment_text(line: &str) -> Option<&str> {
+pub fn comment_text(line: &str) -> Option<&str> {
     let t = line.trim();
     if let Some(inner) = t.strip_prefix('(') {
         return inner.strip_suffix(')');

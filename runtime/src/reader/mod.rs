@@ -31,7 +31,8 @@ mod policy;
 mod spline;
 
 pub use header::{
-    HeaderNames, header_control_offset, header_names, header_source, header_source_hash,
+    HeaderNames, comment_text, header_control_offset, header_names, header_source,
+    header_source_hash,
 };
 pub use policy::{Class, Policy};
 
@@ -123,7 +124,8 @@ pub enum Rule {
     /// `END PGM` of the same name.
     ProgramFrame,
     /// A parameter word (I J K R P Q L D H) no code of its block uses
-    /// (LinuxCNC).
+    /// (LinuxCNC; Fanuc, Sinumerik and Heidenhain ISO for the words whose
+    /// use lensc reads).
     UnusedWord,
     /// An arc from a point the program never stated (lensc's policy).
     PositionUnknown,
@@ -133,6 +135,9 @@ pub enum Rule {
     /// a block without its knot, a curve cut short or not starting where
     /// the tool is (Fanuc G06.2, `nurbs`).
     SplineRefused,
+    /// M99 in a main program (LinuxCNC): the program starts again from
+    /// its first block, for ever (lensc's policy).
+    MainProgramLoop,
 }
 
 /// One thing wrong with a program: where (line from 1, byte span in the

@@ -57,6 +57,13 @@ enum GGroup {
     /// G28 (reference point), G53 (machine coordinates): the move goes to
     /// a position of the machine's, not of the program's.
     MachineMove,
+    /// Heidenhain ISO's G36 (cycle 13 ORIENTATION): the spindle stopped and
+    /// held at the angle its S word gives (degrees, not a speed).
+    Orient,
+    /// Heidenhain ISO's G30 and G31: the workpiece blank's least and
+    /// greatest corner (BLK FORM) for the graphic test run; their X Y Z
+    /// are the blank's, not a move.
+    BlankForm,
 }
 
 /// What an M code does, for this dialect.
@@ -76,6 +83,9 @@ enum MCode {
     Other,
     /// Heidenhain's M91: the block's coordinates are the machine's.
     MachinePosition,
+    /// LinuxCNC's M99 in a main program: back to the first block, for
+    /// ever; the reader reads no further (as at an end).
+    Loop,
 }
 
 /// The state of a program being read.
@@ -116,6 +126,11 @@ pub(crate) struct State {
     pub pos: [Option<f64>; 4],
     /// The axis whose + leads out of the material (header).
     pub away: usize,
+    /// Where the program's control point lies from the tool's centre (mm
+    /// along X, Y, Z; header): taken off every position held against the
+    /// machine's travel, which bounds the tool centre as the build's
+    /// planner and simulation take it.
+    pub control: [f64; 3],
     /// The highest point along `away` a feed move has reached.
     pub top: Option<f64>,
     /// A rapid down (or across) before the first cut, this line: the
@@ -219,6 +234,7 @@ impl State {
             diameter: machine.lathe && d.lathe_x_diameter,
             pos: [None; 4],
             away: 2,
+            control: [0.0; 3],
             top: None,
             pre_cut_rapid: None,
             last_spline_pq: None,
@@ -270,6 +286,9 @@ impl State {
             if let Some(a) = super::header::away_axis(c) {
                 self.away = a;
             }
+            if let Some(o) = super::header::control_offset(c) {
+                self.control = o;
+            }
         }
         self.block_number(b, line, out);
         if b.is_empty() {
@@ -290,6 +309,8 @@ impl State {
         }
         if self.lex.controller == Controller::LinuxCnc {
             self.word_use(b, groups, line, out);
+        } else {
+            self.parameter_words(b, groups, line, out);
         }
         self.modes(b, groups, line, out);
         self.spindle_and_tool(b, groups, ms, line, out);
@@ -308,11 +329,14 @@ impl State {
                 self.motion = Some(*m);
             }
             self.pos = [None; 4];
-        } else if !groups
-            .iter()
-            .any(|(g, _)| matches!(g, GGroup::SpindleCap | GGroup::NonModal))
-        {
-            // G50 S and G4 take their own words; no move.
+        } else if !groups.iter().any(|(g, _)| {
+            matches!(
+                g,
+                GGroup::SpindleCap | GGroup::NonModal | GGroup::Orient | GGroup::BlankForm
+            )
+        }) {
+            // G50 S, G4, G36 S and the blank's G30 G31 take their own
+            // words; no move.
             if self.motion == Some(Motion::Nurbs) {
                 let starts = groups
                     .iter()
@@ -324,6 +348,17 @@ impl State {
             }
         }
         if ms.iter().any(|(m, _)| *m == MCode::End) {
+            self.ended = true;
+            self.spindle_on = false;
+        }
+        if let Some(&(_, w)) = ms.iter().find(|(m, _)| *m == MCode::Loop) {
+            out.push((
+                Rule::MainProgramLoop,
+                b.words[w].span,
+                "M99 in a main program: the controller starts the program again from its first block, for ever".into(),
+                Some("end the program with M2 or M30".into()),
+            ));
+            // No block after it runs in this pass; the end is not missing.
             self.ended = true;
             self.spindle_on = false;
         }
@@ -543,6 +578,8 @@ impl State {
             500 if (c == Fanuc && self.system_a) || c == UltraPrecision => GGroup::SpindleCap,
             920 if c == Fanuc && !self.system_a => GGroup::SpindleCap,
             51 if c == Fanuc => GGroup::NonModal,
+            360 if c == HeidenhainIso => GGroup::Orient,
+            300 | 310 if c == HeidenhainIso => GGroup::BlankForm,
             _ => {
                 return self
                     .feed_codes
@@ -563,6 +600,11 @@ impl State {
             6 => MCode::ToolChange,
             2 | 30 => MCode::End,
             0 | 1 => MCode::Stop,
+            // M60: the pallet change pause, a stop as M0 is; M99 in a main
+            // program: the program again from the top (LinuxCNC's M-code
+            // reference, docs/controllers/linuxcnc.md).
+            60 if self.lex.controller == Controller::LinuxCnc => MCode::Stop,
+            99 if self.lex.controller == Controller::LinuxCnc => MCode::Loop,
             7..=9 => MCode::Coolant,
             19 => MCode::Orient,
             91 if matches!(
@@ -669,7 +711,9 @@ impl State {
         let s = b.words.iter().find(|w| w.letter == 'S');
         // The rpm and caps this block sets, to hold against the maximum.
         let mut speeds = Vec::new();
-        if has(GGroup::SpindleCap) {
+        if has(GGroup::Orient) {
+            self.orient();
+        } else if has(GGroup::SpindleCap) {
             self.cap = s.map(|s| s.value);
             speeds.extend(s.map(|s| (s.value, s.span)));
         } else if let Some(cap) = b
@@ -768,6 +812,13 @@ impl State {
         {
             self.tool_loaded = true;
         }
+    }
+
+    /// Heidenhain ISO's G36: the spindle stopped and held at the angle
+    /// its S word gives (degrees: not a speed), as M19 holds it elsewhere.
+    fn orient(&mut self) {
+        self.spindle_on = false;
+        self.position_mode = true;
     }
 
     /// The speeds this block sets (an rpm, or a cap) against the
@@ -870,7 +921,7 @@ fn same_m_group(a: MCode, b: MCode) -> bool {
     use MCode::*;
     let group = |m| match m {
         SpindleOn | SpindleOff | PositionOn | PositionOff | Orient => 1,
-        End | Stop => 2,
+        End | Stop | Loop => 2,
         ToolChange => 3,
         Coolant | Other | MachinePosition => 0,
     };

@@ -177,7 +177,12 @@ impl State {
                     Rule::OutsideTravel,
                     w.span,
                     format!(
-                        "this move takes {} to {}{unit}, outside the machine's travel {} .. {}{unit}",
+                        "this move takes {}{} to {}{unit}, outside the machine's travel {} .. {}{unit}",
+                        if i < 3 && self.control[i] != 0.0 {
+                            "the tool centre's "
+                        } else {
+                            ""
+                        },
                         AXIS[i],
                         num(v),
                         num(lo),
@@ -189,7 +194,9 @@ impl State {
         }
     }
 
-    /// Where axis `i` ends (`v`) if that is outside the machine's travel:
+    /// Where axis `i`'s tool centre ends (`v`, the control point's
+    /// position, less the header's control offset) if that is outside the
+    /// machine's travel:
     /// the end and the travel as a message gives them (C in degrees), and
     /// their unit.
     pub(super) fn outside_travel(
@@ -200,6 +207,8 @@ impl State {
         let (Some(v), Some((lo, hi))) = (v, self.machine.travel[i]) else {
             return None;
         };
+        // The tool centre's position: the control point less its offset.
+        let v = v - self.control.get(i).copied().unwrap_or(0.0);
         let (v, lo, hi, unit) = if i == 3 {
             (v, lo.to_degrees(), hi.to_degrees(), "°")
         } else {
@@ -490,9 +499,14 @@ impl State {
             );
             return None;
         }
-        // LinuxCNC's radius format (`G2 X… Z… R…`, doc 11.5.5.3): the
-        // centre from the radius; elsewhere R is not a centre word.
-        let linuxcnc = self.lex.controller == Controller::LinuxCnc;
+        // The radius format (`G2 X… Z… R…`): LinuxCNC's (doc 11.5.5.3) and
+        // Fanuc's (an assumption, docs/controllers/fanuc.md: the same
+        // convention, R < 0 for more than half a turn); elsewhere R is not
+        // a centre word (Sinumerik writes `CR=`).
+        let linuxcnc = matches!(
+            self.lex.controller,
+            Controller::LinuxCnc | Controller::Fanuc
+        );
         let radius = centre.iter().find(|w| w.letter == 'R' && linuxcnc);
         let centre: Vec<&Word> = centre
             .iter()

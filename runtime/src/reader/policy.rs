@@ -96,6 +96,10 @@ impl Rule {
                 "arc-from-unstated-point",
                 "an arc from a point the program never stated: its centre and radius depend on where the tool stands",
             ),
+            Rule::MainProgramLoop => (
+                "main-program-loop",
+                "M99 in a main program starts it again from its first block, for ever: the part is cut again and again until the operator stops the machine",
+            ),
             Rule::BlockAfterEnd => (
                 "blocks-after-end",
                 "blocks after M2 or M30 are never run (the controller does not even read them): a stray end code loses the rest of the cut silently",

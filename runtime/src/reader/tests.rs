@@ -504,6 +504,260 @@ fn linuxcnc_reads_parameters_and_expressions() {
     }
 }
 
+/// Heidenhain ISO orients the spindle by G36 (cycle 13 in ISO, S the
+/// angle, not a speed) and states the blank by G30 and G31 (BLK FORM):
+/// the reader takes G36 as the spindle held, so a knife may cut after it,
+/// and the blank's corners as no move.
+#[test]
+fn heidenhain_iso_reads_g36_and_the_blank() {
+    let mut d = Dialect::linuxcnc();
+    d.comment = crate::dialect::CommentStyle::Semicolon;
+    d.block_end = " *".into();
+    d.line_numbers = Some(1);
+    d.max_line_number = Some(99999);
+    d.arc_centre_absolute = true;
+    d.surface_speed = Vec::new();
+    d.constant_rpm = None;
+    d.spindle_orient = vec!["G36 S0".into()];
+    assert_eq!(Controller::of(&d), Controller::HeidenhainIso);
+    let mill = MachineLimits {
+        lathe: false,
+        travel: [
+            Some((-250.0, 250.0)),
+            Some((-200.0, 200.0)),
+            Some((-150.0, 150.0)),
+            None,
+        ],
+        max_feed: Some(5000.0),
+        max_spindle_rpm: Some(12000.0),
+    };
+    let good = "%J G71 *\nN1 ; +Z out of the material *\nN2 G17 G90 G40 G94 *\nN3 G30 G17 X-1 Y-1 Z-2 *\nN4 G31 G90 X1 Y1 Z0.5 *\nN5 T1 G17 *\nN6 G36 S0 *\nN7 G00 Z1. *\nN8 G00 X-1. Y0. *\nN9 G01 Z-0.1 F100. *\nN10 G01 X1. *\nN11 G00 Z1. *\nN12 M5 *\nN13 G00 Z0 M91 *\nN14 M30 *\nN99999999 %J G71 *\n";
+    assert_eq!(rules(good, &d, &mill), vec![]);
+    let (_, moves) = read_moves(good, &d, &mill);
+    // The first move is the rapid to Z1: G30 G31 moved nothing.
+    assert_eq!(moves[0].to[2], Some(1.0));
+    assert_eq!(moves[0].from, [None; 4]);
+    // Without G36 the knife cuts with the spindle stopped.
+    let unoriented = good.replace("N6 G36 S0 *\n", "");
+    assert!(rules(&unoriented, &d, &mill).contains(&Rule::SpindleStopped));
+    // G36 S is an angle: no speed is set, and the spindle stays still.
+    let started = good.replace("N6 G36 S0 *\n", "N6 G36 S0 *\nN6 M3 *\n");
+    assert!(rules(&started, &d, &mill).contains(&Rule::NoSpindleSpeed));
+}
+
+/// A mill's limits for the parameter-word tests.
+fn mill() -> MachineLimits {
+    MachineLimits {
+        lathe: false,
+        travel: [
+            Some((-250.0, 250.0)),
+            Some((-200.0, 200.0)),
+            Some((-150.0, 150.0)),
+            None,
+        ],
+        max_feed: Some(5000.0),
+        max_spindle_rpm: Some(12000.0),
+    }
+}
+
+/// Each `(from, to)` change of `good` breaks `rule`; each of `clean` reads
+/// clean; `good` itself reads clean.
+fn holds(d: &Dialect, good: &str, broken: &[(&str, &str)], clean: &[(&str, &str)]) {
+    assert_eq!(rules(good, d, &mill()), vec![], "{good}");
+    for (from, to) in broken {
+        let text = good.replacen(from, to, 1);
+        assert_ne!(text, good, "{from}");
+        let found = rules(&text, d, &mill());
+        assert!(found.contains(&Rule::UnusedWord), "{to}: {found:?}");
+    }
+    for (from, to) in clean {
+        let text = good.replacen(from, to, 1);
+        assert_ne!(text, good, "{from}");
+        assert_eq!(rules(&text, d, &mill()), vec![], "{to}");
+    }
+}
+
+/// Fanuc refuses a parameter word no code of its block uses: I J K R
+/// away from an arc, P without G4, Q without G05.1, H without G43, D
+/// without G41/G42, L (M98, G10, not read) (docs/controllers/fanuc.md:
+/// assumptions, no Fanuc manual found).
+#[test]
+fn fanuc_refuses_words_no_code_of_the_block_uses() {
+    let mut d = Dialect::linuxcnc();
+    d.start = vec!["%".into(), "O{number} ({JOB})".into()];
+    d.constant_rpm = None;
+    d.surface_speed = Vec::new();
+    assert_eq!(Controller::of(&d), Controller::Fanuc);
+    let good = "%\nO1 (J)\n(+Z out of the material)\nG17 G21 G40 G49 G80 G90 G94 G54\nT1 M6\nS1000 M3\nG43 H1 G0 Z1.\nG0 X-1. Y0.\nG1 Z-0.1 F100.\nG2 X1. I1. J0.\nG0 Z1.\nM5\nM30\n%\n";
+    holds(
+        &d,
+        good,
+        &[
+            ("G1 Z-0.1 F100.", "G1 Z-0.1 I1. F100."),
+            ("G0 X-1. Y0.", "G0 X-1. Y0. R1."),
+            ("G0 X-1. Y0.", "G0 X-1. Y0. K0."),
+            ("S1000 M3", "S1000 M3 P5"),
+            ("G0 Z1.\nM5", "G0 Z1. Q1\nM5"),
+            ("T1 M6", "T1 M6 H1"),
+            ("G1 Z-0.1 F100.", "G1 Z-0.1 D1 F100."),
+            ("M5\n", "M5 L2\n"),
+        ],
+        &[
+            ("M5\n", "M5\nG4 P500\n"),
+            ("T1 M6\n", "T1 M6\nG05.1 Q1\n"),
+            // An arc's words in the arc mode in force.
+            ("G0 Z1.\nM5", "X-1. I-1. J0.\nG0 Z1.\nM5"),
+        ],
+    );
+}
+
+/// A Fanuc reads a radius-format arc (`G2 X1. R1.`) as LinuxCNC does: it
+/// runs them (the reader refused it, E0319), the centre on the chord's
+/// right for G2 and a positive R; R and I J together, or an R too short
+/// for the chord, are refused.
+#[test]
+fn fanuc_reads_radius_format_arcs() {
+    let mut d = Dialect::linuxcnc();
+    d.start = vec!["%".into(), "O{number} ({JOB})".into()];
+    d.constant_rpm = None;
+    d.surface_speed = Vec::new();
+    assert_eq!(Controller::of(&d), Controller::Fanuc);
+    let by_centre = "%\nO1 (J)\n(+Z out of the material)\nG17 G21 G40 G49 G80 G90 G94 G54\nT1 M6\nS1000 M3\nG43 H1 G0 Z1.\nG0 X-1. Y0.\nG1 Z-0.1 F100.\nG2 X1. I1. J0.\nG0 Z1.\nM5\nM30\n%\n";
+    let by_radius = by_centre.replace("G2 X1. I1. J0.", "G2 X1. R1.");
+    let mill = mill();
+    assert_eq!(rules(&by_radius, &d, &mill), vec![], "{by_radius}");
+    let centre_of = |text: &str| {
+        read_moves(text, &d, &mill)
+            .1
+            .iter()
+            .find_map(|m| match m.path {
+                Path::Arc { centre, .. } => Some(centre),
+                _ => None,
+            })
+            .expect("an arc")
+    };
+    let (a, b) = (centre_of(&by_radius), centre_of(by_centre));
+    assert!(
+        (a.0 - b.0).abs() < 1e-9 && (a.1 - b.1).abs() < 1e-9,
+        "{a:?} {b:?}"
+    );
+    for (to, rule) in [
+        ("G2 X1. I1. J0. R1.", Rule::ArcWords),
+        ("G2 X1. R0.5", Rule::ArcRadiusMismatch),
+    ] {
+        let bad = by_centre.replace("G2 X1. I1. J0.", to);
+        assert!(
+            rules(&bad, &d, &mill).contains(&rule),
+            "{to}: {:?}",
+            rules(&bad, &d, &mill)
+        );
+    }
+}
+
+/// A Sinumerik refuses I J K away from an arc and P away from a
+/// subprogram call's passes (an arc's turns are `TURN=`)
+/// (docs/controllers/siemens.md).
+#[test]
+fn sinumerik_refuses_words_no_code_of_the_block_uses() {
+    let mut d = Dialect::linuxcnc();
+    d.comment = crate::dialect::CommentStyle::Semicolon;
+    assert_eq!(Controller::of(&d), Controller::Siemens);
+    let good = "; +Z out of the material\nG17 G71 G90 G40 G94 G54\nT1 D1\nM6\nG97 S1000 M3\nG0 Z1\nG0 X-1 Y0\nG94 G1 Z-0.1 F100\nG2 X1 I1 J0\nG0 Z1\nM5\nM30\n";
+    holds(
+        &d,
+        good,
+        &[
+            ("G94 G1 Z-0.1 F100", "G94 G1 Z-0.1 K1 F100"),
+            ("G0 X-1 Y0", "G0 X-1 Y0 J2"),
+            ("G94 G1 Z-0.1 F100", "G94 G1 Z-0.1 F100 P2"),
+            ("G2 X1 I1 J0", "G2 X1 I1 J0 P1"),
+        ],
+        &[("G0 Z1\nM5", "X-1 I-1 J0\nG0 Z1\nM5")],
+    );
+}
+
+/// Heidenhain ISO refuses I J K on a straight move; alone in a block they
+/// set the circle centre (docs/controllers/heidenhain.md).
+#[test]
+fn heidenhain_iso_refuses_centre_words_on_a_straight_move() {
+    let mut d = Dialect::linuxcnc();
+    d.comment = crate::dialect::CommentStyle::Semicolon;
+    d.block_end = " *".into();
+    d.line_numbers = Some(1);
+    d.max_line_number = Some(99999);
+    d.arc_centre_absolute = true;
+    d.surface_speed = Vec::new();
+    d.constant_rpm = None;
+    assert_eq!(Controller::of(&d), Controller::HeidenhainIso);
+    let good = "%J G71 *\nN1 ; +Z out of the material *\nN2 G17 G90 G40 G94 *\nN3 T1 G17 *\nN4 S1000 M3 *\nN5 G00 Z1. *\nN6 G00 X-1. Y0. *\nN7 G01 Z-0.1 F100. *\nN8 G02 X1. I0. J0. *\nN9 G00 Z1. *\nN10 M5 *\nN11 M30 *\nN99999999 %J G71 *\n";
+    holds(
+        &d,
+        good,
+        &[
+            ("N7 G01 Z-0.1 F100.", "N7 G01 Z-0.1 I1. F100."),
+            ("N6 G00 X-1. Y0.", "N6 G00 X-1. Y0. J0."),
+        ],
+        &[("N5 G00 Z1. *\n", "N5 G00 Z1. *\nN5 I0. J0. *\n")],
+    );
+}
+
+/// A program written for the tool's tip (its header states the control
+/// point's offset from the centre) is held to the machine's travel as the
+/// tool centre, as the centre's program is: both read to the same
+/// findings, in or out of the travel (`lensc verify` reads by `read_from`).
+#[test]
+fn a_tip_program_is_held_to_the_travel_as_its_centre_program() {
+    let d = Dialect::linuxcnc();
+    let mut m = mill();
+    m.travel[2] = Some((-1.0, 150.0));
+    let program = |control: &str, depth: f64| {
+        format!(
+            "(+Z out of the material)\n{control}G17 G21 G90 G40 G49 G80 G94 G54\nT1 M6 G43 H1\nG97 S1000 M3\nG0 Z1\nG0 X-1 Y0\nG94 G1 Z{depth} F100\nG1 X1\nG0 Z1\nM5\nM2\n"
+        )
+    };
+    let tip = "(control point tip at X+0 Y+0 Z-0.085 mm from the tool centre: the tip)\n";
+    let findings = |text: &str| {
+        read_from(text.as_bytes(), &d, &m)
+            .expect("read")
+            .into_iter()
+            .map(|f| (f.rule, f.message.replace("the tool centre's ", "")))
+            .collect::<Vec<_>>()
+    };
+    // The centre at -0.95 mm is inside the travel; its tip at -1.035 mm.
+    assert_eq!(findings(&program("", -0.95)), vec![]);
+    assert_eq!(findings(&program(tip, -0.95 - 0.085)), vec![]);
+    // The centre at -1.05 mm is outside, by the same figure either way.
+    let centre = findings(&program("", -1.05));
+    assert_eq!(centre.len(), 1, "{centre:?}");
+    assert_eq!(centre[0].0, Rule::OutsideTravel);
+    assert!(centre[0].1.contains("-1.05 mm"), "{centre:?}");
+    assert_eq!(findings(&program(tip, -1.05 - 0.085)), centre);
+}
+
+/// LinuxCNC's M60 is the pallet change pause, a stop as M0 is (rs274
+/// runs it); M99 in a main program starts it again from the top, which
+/// lensc refuses as its policy (`main-program-loop`) and reads no
+/// further, so blocks after it are not counted again.
+#[test]
+fn linuxcnc_reads_m60_as_a_pause_and_m99_as_an_endless_loop() {
+    let d = Dialect::linuxcnc();
+    let paused = GOOD.replacen("M5\n", "M5\nM60\n", 1);
+    assert_eq!(rules(&paused, &d, &lathe()), vec![]);
+    let paused_with_m0 = GOOD.replacen("M5\n", "M5\nM60 M0\n", 1);
+    assert_eq!(
+        rules(&paused_with_m0, &d, &lathe()),
+        vec![Rule::SameModalGroup]
+    );
+    let looped = GOOD.replacen("M2\n", "M99\n", 1);
+    assert_eq!(rules(&looped, &d, &lathe()), vec![Rule::MainProgramLoop]);
+    assert!(Rule::MainProgramLoop.policy().is_some());
+    let looped_early = GOOD.replacen("G0 Z1.5\nM5", "M99\nG0 Z1.5\nM5", 1);
+    assert_eq!(
+        rules(&looped_early, &d, &lathe()),
+        vec![Rule::MainProgramLoop, Rule::BlockAfterEnd]
+    );
+}
+
 /// A Fanuc mill that interpolates NURBS (G06.2).
 fn fanuc_nurbs() -> Dialect {
     let mut d = Dialect::linuxcnc();
@@ -515,7 +769,7 @@ fn fanuc_nurbs() -> Dialect {
     d
 }
 
-fn mill() -> MachineLimits {
+fn nurbs_mill() -> MachineLimits {
     MachineLimits {
         lathe: false,
         travel: [
@@ -538,7 +792,7 @@ const NURBS: &str = "%\nO1 (J)\n(+Z out of the material)\nG17 G21 G40 G49 G80 G9
 fn a_nurbs_curve_is_read_as_the_control_moves_it() {
     let d = fanuc_nurbs();
     assert_eq!(Controller::of(&d), Controller::Fanuc);
-    let (found, moves) = read_moves(NURBS, &d, &mill());
+    let (found, moves) = read_moves(NURBS, &d, &nurbs_mill());
     assert_eq!(found, vec![]);
     let on_curve: Vec<&Executed> = moves
         .iter()
@@ -584,7 +838,7 @@ fn a_nurbs_curve_the_control_refuses_is_found_with_its_span() {
     for (from, to, what) in cases {
         let text = NURBS.replacen(from, to, 1);
         assert_ne!(text, NURBS, "{from}");
-        let found = read(&text, &d, &mill());
+        let found = read(&text, &d, &nurbs_mill());
         let f = found
             .iter()
             .find(|f| f.rule == Rule::SplineRefused)
@@ -596,6 +850,6 @@ fn a_nurbs_curve_the_control_refuses_is_found_with_its_span() {
         );
     }
     // Without the dialect's spline, G06.2 is a code the control lacks.
-    let found = rules(NURBS, &Dialect { spline: None, ..d }, &mill());
+    let found = rules(NURBS, &Dialect { spline: None, ..d }, &nurbs_mill());
     assert!(found.contains(&Rule::UnknownWord), "{found:?}");
 }

@@ -14,8 +14,11 @@ use super::heightmap::{
 };
 use super::window::Tile;
 
-/// Steps a block holds: its extent lets a tile skip it whole.
-const BLOCK: usize = 4096;
+/// Steps a block holds: its extent lets a tile skip it whole. Short
+/// enough that a spiral's block is a fraction of a turn (seed 003 has
+/// about 1,300 points a turn), so a lenslet's tile skips the blocks whose
+/// angles miss it (32 bytes of extent a block).
+const BLOCK: usize = 128;
 
 /// The nose path (s, u, h, as a [`Sweep`] takes it), kept for tiles: the
 /// segments that reach the band of u the tiles need, a lift (NaN) where
@@ -111,11 +114,19 @@ impl Recorder {
         reaches
     }
 
-    /// Sweeps the blocks that reach `grid`'s band (and, on a grid that does
-    /// not repeat, its columns) into `sweep`.
-    fn replay(&self, sweep: &mut dyn NosePath, band: (f64, f64), s_range: Option<(f64, f64)>) {
+    /// Sweeps the blocks that reach `grid`'s band and its columns into
+    /// `sweep`: `s_range` the columns' range of s, repeating every
+    /// `period` on a lathe's or roller's grid (a block of a spiral, an
+    /// unwrapped angle, is swept only if some turn of it crosses them).
+    fn replay(
+        &self,
+        sweep: &mut dyn NosePath,
+        band: (f64, f64),
+        s_range: Option<(f64, f64)>,
+        period: Option<f64>,
+    ) {
         for (b, e) in self.extents.iter().enumerate() {
-            let misses_s = s_range.is_some_and(|(lo, hi)| e[1] < lo || e[0] > hi);
+            let misses_s = s_range.is_some_and(|r| misses(r, period, (e[0], e[1])));
             if e[3] < band.0 || e[2] > band.1 || misses_s {
                 continue;
             }
@@ -141,6 +152,17 @@ impl Recorder {
                 }
             }
         }
+    }
+}
+
+/// Whether the range `(lo, hi)` of s misses the columns' range
+/// `(from, to)`, or every copy of it shifted by a whole number of
+/// `period`s: no turn m with from + m·period ≤ hi and to + m·period ≥ lo
+/// (the turns `Sweep::segment` would visit).
+fn misses((from, to): (f64, f64), period: Option<f64>, (lo, hi): (f64, f64)) -> bool {
+    match period {
+        None => hi < from || lo > to,
+        Some(p) => ((lo - to) / p).ceil() > ((hi - from) / p).floor(),
     }
 }
 
@@ -208,7 +230,7 @@ impl Frame for TileFrame<'_> {
             && self.own.as_ref().is_none_or(|own| {
                 !own.earlier
                     .iter()
-                    .any(|&(cx, cy, r)| (x - cx).hypot(y - cy) <= r)
+                    .any(|&disc| super::heightmap::in_disc(disc, x, y))
             })
     }
     fn features(&self) -> &[(f64, f64, f64)] {
@@ -248,12 +270,9 @@ pub fn simulate(
             match cutter {
                 Cutter::Nose { radius } => {
                     let mut sweep = Sweep::new(g, radius);
-                    let s_range = g
-                        .period
-                        .is_none()
-                        .then(|| (g.s0, g.s(g.ns.saturating_sub(1))));
+                    let s_range = (g.s(0), g.s(g.ns.saturating_sub(1)));
                     let band = sweep.band();
-                    recorder.replay(&mut sweep, band, s_range);
+                    recorder.replay(&mut sweep, band, Some(s_range), g.period);
                     sweep.finish_tile(&tile_frame, &global, &layout, parallel)
                 }
                 // A ball reaches columns its radius from its centre.
@@ -261,7 +280,7 @@ pub fn simulate(
                     let mut sweep = BallSweep::new(g, radius);
                     let s_range = (g.s0 - radius, g.s(g.ns.saturating_sub(1)) + radius);
                     let band = sweep.band();
-                    recorder.replay(&mut sweep, band, Some(s_range));
+                    recorder.replay(&mut sweep, band, Some(s_range), None);
                     sweep.finish_tile(&tile_frame, &global, &layout, parallel)
                 }
             }

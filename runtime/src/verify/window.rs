@@ -175,26 +175,25 @@ impl Window {
 
     /// The tiles of a lathe's polar grid: lenslet by lenslet when the
     /// window reaches more than one of the `features` (discs: centre x, y,
-    /// radius), each over the part of the window its square covers, its
-    /// index counted among the lenslets that reach into the window; else
-    /// the window's whole grid.
+    /// radius), each over the part of the window its square covers, with
+    /// its index among `features`; else the window's whole grid.
     pub fn polar_tiles(&self, features: &[(f64, f64, f64)]) -> Vec<Tile> {
-        let squares: Vec<Window> = features
+        let squares: Vec<(usize, Window)> = features
             .iter()
             .map(|&(cx, cy, r)| Window {
                 x: (self.x.0.max(cx - r), self.x.1.min(cx + r)),
                 y: (self.y.0.max(cy - r), self.y.1.min(cy + r)),
                 ..*self
             })
-            .filter(|w| w.x.1 >= w.x.0 && w.y.1 >= w.y.0)
+            .enumerate()
+            .filter(|(_, w)| w.x.1 >= w.x.0 && w.y.1 >= w.y.0)
             .collect();
         if squares.len() < 2 {
             return split(&self.polar(), None);
         }
         squares
             .iter()
-            .enumerate()
-            .flat_map(|(k, square)| split(&square.polar(), Some(k)))
+            .flat_map(|&(k, square)| split(&square.polar(), Some(k)))
             .collect()
     }
 
@@ -365,7 +364,8 @@ mod tests {
         );
         let tiles = w.polar_tiles(&features);
         let owners: Vec<Option<usize>> = tiles.iter().map(|t| t.feature).collect();
-        assert_eq!(owners, [Some(0), Some(1)]);
+        // Each by its index among the lenslets, the one outside skipped.
+        assert_eq!(owners, [Some(1), Some(2)]);
         // One lenslet in the window: the window's own grid.
         let one = Window::given(
             (1.0, 3.0),

@@ -101,21 +101,31 @@ pub const DEFAULT_TOLERANCE: f64 = super::DEFAULT_PATH_TOLERANCE;
 
 /// The default limit of `c` (in its base unit) for a strategy planned to
 /// `tolerance` (mm; `None`: it has none of its own, and
-/// `DEFAULT_TOLERANCE` stands in) on a machine of `resolution` (mm): the
-/// path's chords stray up to the tolerance from the exact path, and the
-/// printed coordinates up to half the resolution on each axis, so the form
-/// error lies within ±(tolerance + resolution): PV twice that, RMS a
-/// quarter of the PV, a gouge or a residual at most that. Nothing is left
-/// uncut. The following error and the cutting time have no default (a job
-/// states them).
-pub fn default_limit(c: Criterion, tolerance: Option<f64>, resolution: f64) -> Option<f64> {
-    let band = tolerance.unwrap_or(DEFAULT_TOLERANCE) + resolution;
+/// `DEFAULT_TOLERANCE` stands in) on a machine of `resolution` (mm) whose
+/// class holds `holds` (mm: the tolerance a job that states none is
+/// planned to, `job::default_path_tolerance`, 10 nm or the least its
+/// resolution holds): the path's chords stray up to the tolerance from
+/// the exact path, and the printed coordinates up to half the resolution
+/// on each axis, so the form error lies within ±(T + resolution), T the
+/// path's tolerance but never more than the machine holds (a looser
+/// `chord_tolerance` plans a looser path; it does not loosen what the part
+/// is held to): PV twice that, RMS a quarter of the PV, a gouge, a
+/// residual or a fast tool servo's following error (which the form
+/// figures, simulated from the commands, leave out) at most that. Nothing
+/// is left uncut. The cutting time has no default (a job states it).
+pub fn default_limit(
+    c: Criterion,
+    tolerance: Option<f64>,
+    resolution: f64,
+    holds: f64,
+) -> Option<f64> {
+    let band = tolerance.unwrap_or(DEFAULT_TOLERANCE).min(holds) + resolution;
     match c {
         Criterion::FormPv => Some(2.0 * band),
         Criterion::FormRms => Some(band / 2.0),
-        Criterion::MaxGouge | Criterion::MaxResidual => Some(band),
+        Criterion::MaxGouge | Criterion::MaxResidual | Criterion::MaxFollowingError => Some(band),
         Criterion::UncutArea => Some(0.0),
-        Criterion::MaxFollowingError | Criterion::MaxCuttingTime => None,
+        Criterion::MaxCuttingTime => None,
     }
 }
 
@@ -123,12 +133,18 @@ impl Accept {
     /// The limit the gate holds `c` to (base unit): the one stated, else
     /// its default (`default_limit`); none under `accept: none`. An uncut
     /// area stated as a fraction is returned as that fraction.
-    pub fn limit(&self, c: Criterion, tolerance: Option<f64>, resolution: f64) -> Option<f64> {
+    pub fn limit(
+        &self,
+        c: Criterion,
+        tolerance: Option<f64>,
+        resolution: f64,
+        holds: f64,
+    ) -> Option<f64> {
         match self {
             Accept::Nothing => None,
             _ => match self.stated(c) {
                 Some(l) => Some(l.value),
-                None => default_limit(c, tolerance, resolution),
+                None => default_limit(c, tolerance, resolution, holds),
             },
         }
     }
@@ -176,4 +192,41 @@ pub(crate) fn lower(params: &JobParams) -> Result<Accept, Diagnostic> {
         limits,
         site: block_site,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const NM: f64 = 1e-6;
+
+    #[test]
+    fn a_looser_tolerance_does_not_widen_the_defaults() {
+        // A lathe at 1 nm holds 10 nm: a 10 mm tolerance (the sphere
+        // turned as a cone of issue #29) is held to 2 × (10 + 1) nm PV,
+        // as a job that states none; a tighter 4 nm tightens them.
+        let pv = |t: Option<f64>| default_limit(Criterion::FormPv, t, NM, 10.0 * NM).unwrap();
+        assert!((pv(Some(10.0)) - 22.0 * NM).abs() < 1e-12);
+        assert!((pv(Some(200.0 * NM)) - 22.0 * NM).abs() < 1e-12);
+        assert_eq!(pv(None), pv(Some(10.0)));
+        assert!((pv(Some(4.0 * NM)) - 10.0 * NM).abs() < 1e-12);
+        // A machine that holds only 142 nm (0.1 µm, two axes): that band.
+        let coarse = default_limit(Criterion::MaxGouge, Some(1.0), 100.0 * NM, 142.0 * NM);
+        assert!((coarse.unwrap() - 242.0 * NM).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_following_error_has_a_default_and_the_cutting_time_none() {
+        let fe = default_limit(Criterion::MaxFollowingError, Some(50.0 * NM), NM, 10.0 * NM);
+        assert!((fe.unwrap() - 11.0 * NM).abs() < 1e-12);
+        assert_eq!(
+            default_limit(Criterion::MaxCuttingTime, None, NM, 10.0 * NM),
+            None
+        );
+        // `accept: none` holds nothing, a stated limit wins.
+        assert_eq!(
+            Accept::Nothing.limit(Criterion::FormPv, None, NM, 10.0 * NM),
+            None
+        );
+    }
 }

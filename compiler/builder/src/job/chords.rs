@@ -29,15 +29,19 @@ pub(crate) struct ChordPath {
     /// 4,010 straddling long chords); nor on a roller helix, whose points
     /// are a fixed C step apart.
     pub long_chords: bool,
+    /// The tolerance the machine's class holds (`Parts::holds`): the
+    /// default limits never loosen beyond it.
+    pub holds: f64,
 }
 
 /// The placement the strategy states, or the default: the fewest points
 /// whose promise (`ChordPlacement::promise`: the band its chords and fits
 /// keep to about the exact path, so its largest gouge and residual, its PV
 /// and a bound on its RMS) meets every form criterion the gate will judge
-/// (`ChordPlacement::fewest_points_meeting`). With no criteria stated
-/// the defaults (± the tolerance and the resolution) are met by long
-/// straddled chords wherever they write fewer blocks; a job that states a
+/// (`ChordPlacement::fewest_points_meeting`). The defaults are ± the
+/// tolerance the machine holds (or a tighter path tolerance) and the
+/// resolution: at a path tolerance no looser than that, long straddled
+/// chords meet them wherever they write fewer blocks; a job that states a
 /// tighter `form_rms`, `form_pv` or `max_gouge` keeps every point, on the
 /// path, straddling or clear.
 pub(crate) fn placement(p: &Parts, path: ChordPath) -> ChordPlacement {
@@ -48,16 +52,16 @@ pub(crate) fn placement(p: &Parts, path: ChordPath) -> ChordPlacement {
         return ChordPlacement::from_word(stated.value, margin).unwrap_or_default();
     }
     let accept = super::accept::lower(&p.params).unwrap_or_default();
-    let limits = form_limits(&accept, path.tolerance, resolution);
+    let limits = form_limits(&accept, path.tolerance, resolution, path.holds);
     ChordPlacement::fewest_points_meeting(path.sag, path.fit, &limits, margin, path.long_chords)
 }
 
 /// The job's limits on the form, stated or default; none under `accept:
 /// none`.
-fn form_limits(accept: &Accept, tolerance: Option<f64>, resolution: f64) -> FormLimits {
+fn form_limits(accept: &Accept, tolerance: Option<f64>, resolution: f64, holds: f64) -> FormLimits {
     let limit = |c| {
         accept
-            .limit(c, tolerance, resolution)
+            .limit(c, tolerance, resolution, holds)
             .unwrap_or(f64::INFINITY)
     };
     FormLimits {

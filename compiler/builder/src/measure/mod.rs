@@ -8,236 +8,27 @@
 //! error map as an SVG picture. Every refusal is a `Failure`, a coded
 //! error in words that names the file; nothing is written then.
 
+pub mod placed;
 pub mod report;
 
-use std::path::Path;
-
-use lensc_measure::map::{Format, Measured};
-use lensc_measure::read::TextUnits;
-use lensc_measure::register::{self, Options as Fit, RegisterError};
+use lensc_measure::map::Measured;
+use lensc_measure::register;
 use lensc_measure::texture;
-use lensc_measure::{HeightMap, ReadError};
 use lensc_runtime::post::Setup;
 use lensc_runtime::surface::ir::SurfaceFn;
 use lensc_runtime::verify::heightmap::ErrorRaster;
 
 use crate::strategy::JobSpec;
+pub use placed::{
+    Failure, MAX_MEASUREMENT_BYTES, Options, read_failure, read_file, register_measurement,
+};
+use placed::{Points, Registered, fail, registration_report};
 use report::MeasureReport;
-
-/// The largest measurement file read: 256 MiB (a 4096 × 4096 map of
-/// float64 with room to spare). Job files have their own, smaller, limit.
-pub const MAX_MEASUREMENT_BYTES: u64 = 256 << 20;
-
-/// What `lensc measure` was asked for beyond the files.
-#[derive(Clone, Copy, Debug)]
-pub struct Options {
-    /// What a plain-text file's numbers are (mm per unit).
-    pub units: TextUnits,
-    /// The least share of the measured aperture that must be valid.
-    pub min_valid: f64,
-    /// The texture's nesting index λc (mm).
-    pub cutoff: f64,
-    /// Use the file's own coordinates instead of centring the map.
-    pub keep_origin: bool,
-}
-
-impl Default for Options {
-    fn default() -> Self {
-        Options {
-            units: TextUnits::MM,
-            min_valid: 0.5,
-            cutoff: 0.08,
-            keep_origin: false,
-        }
-    }
-}
-
-/// A refusal: its code, its words (naming the file), the byte of the
-/// file it points at when there is one, and help.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Failure {
-    pub code: &'static str,
-    pub message: String,
-    pub at: Option<usize>,
-    pub help: Option<String>,
-}
-
-fn fail(code: &'static str, message: String, help: Option<&str>) -> Failure {
-    Failure {
-        code,
-        message,
-        at: None,
-        help: help.map(str::to_owned),
-    }
-}
 
 /// What was made: the report and the picture.
 pub struct Outcome {
     pub report: MeasureReport,
     pub svg: String,
-}
-
-/// Reads the measurement file at `path` as lensc reads a job's files:
-/// inside `root` once symlinks are resolved, a regular file, at most
-/// `MAX_MEASUREMENT_BYTES`.
-pub fn read_file(path: &Path, root: &Path) -> Result<Vec<u8>, Failure> {
-    use lensc_lang::sandbox;
-    let resolved = sandbox::resolve(path);
-    let root = sandbox::resolve(root);
-    let e = if !sandbox::inside(&resolved, &root) {
-        sandbox::ReadError::OutsideRoot { resolved, root }
-    } else {
-        match sandbox::read_regular(&resolved, MAX_MEASUREMENT_BYTES) {
-            Ok(b) => return Ok(b),
-            Err(e) => e,
-        }
-    };
-    Err(fail(
-        e.code(),
-        format!("cannot read {}: {e}", path.display()),
-        None,
-    ))
-}
-
-/// The coded failure for a reader's error on `file`.
-pub fn read_failure(file: &str, e: &ReadError) -> Failure {
-    use lensc_lang::codes;
-    let (code, at, help) = match e {
-        ReadError::Malformed { at, .. } => (codes::MEASURE_UNREADABLE, *at, None),
-        ReadError::UnknownFormat => (
-            codes::MEASURE_UNREADABLE,
-            None,
-            Some(
-                "export the measurement as X3P, or name a text file .xyz/.csv (points) or .txt (an x z profile)",
-            ),
-        ),
-        ReadError::Unsupported { .. } => (codes::MEASURE_UNREADABLE, None, None),
-        ReadError::Truncated { .. } => (
-            codes::MEASURE_TRUNCATED,
-            None,
-            Some("copy the file again from the instrument"),
-        ),
-        ReadError::Checksum { .. } => (
-            codes::MEASURE_CHECKSUM,
-            None,
-            Some(
-                "export the measurement again; a file edited by hand needs its checksums written again",
-            ),
-        ),
-    };
-    Failure {
-        code,
-        message: format!("{file}: {e}"),
-        at,
-        help: help.map(str::to_owned),
-    }
-}
-
-/// The points to register, in mm, in the design's frame before
-/// registration, with the kind of data and what the report says of it.
-struct Points {
-    /// Valid points inside the aperture.
-    inside: Vec<[f64; 3]>,
-    /// All measured points inside the aperture, valid or not, and all points.
-    in_aperture: usize,
-    total: usize,
-    valid: usize,
-    extent: [[f64; 2]; 2],
-    /// The map (centred or not), for texture and the picture's spacing.
-    map: Option<HeightMap>,
-    two_d: bool,
-    cloud: bool,
-}
-
-fn points(data: Measured, opts: &Options, within: &dyn Fn(f64, f64) -> bool) -> Points {
-    let extent_of = |pts: &[[f64; 3]]| {
-        let mut e = [[f64::INFINITY, f64::NEG_INFINITY]; 2];
-        for p in pts {
-            for k in 0..2 {
-                e[k][0] = e[k][0].min(p[k]);
-                e[k][1] = e[k][1].max(p[k]);
-            }
-        }
-        e
-    };
-    let centre = |pts: &mut Vec<[f64; 3]>| {
-        let e = extent_of(pts);
-        let (cx, cy) = ((e[0][0] + e[0][1]) / 2.0, (e[1][0] + e[1][1]) / 2.0);
-        for p in pts.iter_mut() {
-            p[0] -= cx;
-            p[1] -= cy;
-        }
-    };
-    match data {
-        Measured::Map(m) => {
-            let m = if opts.keep_origin { m } else { m.centred() };
-            let (mut inside, mut in_aperture) = (Vec::new(), 0);
-            for j in 0..m.ny {
-                for i in 0..m.nx {
-                    let (x, y) = (m.x(i), m.y(j));
-                    if within(x, y) {
-                        in_aperture += 1;
-                        let k = j * m.nx + i;
-                        if m.valid[k] {
-                            inside.push([x, y, m.z[k]]);
-                        }
-                    }
-                }
-            }
-            let extent = [
-                [m.x(0).min(m.x(m.nx - 1)), m.x(0).max(m.x(m.nx - 1))],
-                [m.y(0).min(m.y(m.ny - 1)), m.y(0).max(m.y(m.ny - 1))],
-            ];
-            Points {
-                in_aperture,
-                total: m.nx * m.ny,
-                valid: m.valid_count(),
-                inside,
-                extent,
-                map: Some(m),
-                two_d: true,
-                cloud: false,
-            }
-        }
-        Measured::Cloud(c) => {
-            let mut pts = c.points;
-            if !opts.keep_origin {
-                centre(&mut pts);
-            }
-            let total = pts.len();
-            let extent = extent_of(&pts);
-            let inside: Vec<[f64; 3]> = pts.into_iter().filter(|p| within(p[0], p[1])).collect();
-            Points {
-                in_aperture: inside.len(),
-                total,
-                valid: total,
-                inside,
-                extent,
-                map: None,
-                two_d: true,
-                cloud: true,
-            }
-        }
-        Measured::Profile(p) => {
-            let mut pts: Vec<[f64; 3]> = p.x.iter().zip(&p.z).map(|(x, z)| [*x, 0.0, *z]).collect();
-            if !opts.keep_origin {
-                centre(&mut pts);
-            }
-            let total = pts.len();
-            let extent = extent_of(&pts);
-            let inside: Vec<[f64; 3]> = pts.into_iter().filter(|p| within(p[0], p[1])).collect();
-            Points {
-                in_aperture: inside.len(),
-                total,
-                valid: total,
-                inside,
-                extent,
-                map: None,
-                two_d: false,
-                cloud: false,
-            }
-        }
-    }
 }
 
 /// Holds the measurement `bytes` (of the file named `file`) to the job's
@@ -253,105 +44,31 @@ pub fn measure(
         lensc_measure::read::read(file, bytes, opts.units).map_err(|e| read_failure(file, &e))?;
     let head = spec.head();
     let surface_name = head.names.surface.clone();
-    let lowered = &head.surface.lowered;
+    let lowered = head.surface.design();
     let (f, _) = crate::evaluate::evaluator(&lowered.tape);
-    let domain = lowered.domain;
     let format = m.format;
     let kind = match &m.data {
         Measured::Map(_) => "map",
         Measured::Cloud(_) => "point_cloud",
         Measured::Profile(_) => "profile",
     };
-    let p = points(m.data, opts, &|x, y| domain.contains(x, y));
-    let aperture = aperture_words(&domain);
-    // Does it lie on the part at all? Then is enough of it valid?
-    let on_part = p.in_aperture as f64 / p.total.max(1) as f64;
-    if on_part < 0.5 {
-        return Err(fail(
-            codes::MEASURE_MISMATCH,
-            format!(
-                "{file}: {:.1} % of the measured points lie inside the aperture of `{surface_name}` ({aperture}): a measurement in other units, or of another part",
-                100.0 * on_part
-            ),
-            Some(if matches!(format, Format::Xyz | Format::Profile) {
-                "a text file's numbers carry no unit: say which with --units (mm unless given)"
-            } else {
-                "check that the file measures this job's part; --keep-origin uses the file's own coordinates instead of centring the map"
-            }),
-        ));
-    }
-    let share = p.inside.len() as f64 / p.in_aperture.max(1) as f64;
-    if share < opts.min_valid {
-        return Err(fail(
-            codes::MEASURE_TOO_LITTLE,
-            format!(
-                "{file}: {:.1} % of the {} measured points inside the aperture of `{surface_name}` are valid; at least {:.1} % are needed (--min-valid)",
-                100.0 * share,
-                p.in_aperture,
-                100.0 * opts.min_valid
-            ),
-            Some(
-                "measure the part again, or lower --min-valid knowing what the figures then cover",
-            ),
-        ));
-    }
-    let fit = Fit {
-        two_d: p.two_d,
-        ..Fit::default()
-    };
-    let reg = if p.cloud {
-        register::register_cloud(f.as_ref(), &p.inside, fit)
-    } else {
-        register::register_heights(f.as_ref(), &p.inside, fit)
-    };
-    let reg = reg.map_err(|e| match e {
-        RegisterError::TooFewPoints { points } => fail(
-            codes::MEASURE_TOO_LITTLE,
-            format!("{file}: {points} valid points inside the aperture of `{surface_name}`: too few to register"),
-            None,
-        ),
-        RegisterError::NotConverged { iterations, rms } => fail(
-            codes::MEASURE_NOT_CONVERGED,
-            format!(
-                "{file}: the registration to `{surface_name}` did not converge in {iterations} iterations{}",
-                if rms.is_finite() { format!(" (residual RMS {:.1} nm)", rms * 1e6) } else { String::new() }
-            ),
-            Some("centre the map in the instrument's software, or check that it measures this surface"),
-        ),
-        RegisterError::Undefined { points } => fail(
-            codes::MEASURE_NOT_CONVERGED,
-            format!("{file}: the registration to `{surface_name}` moved {points} measured points where the design has no value"),
-            Some("centre the map in the instrument's software, or check that it measures this surface"),
-        ),
-    })?;
-    // The error along the normal, at each registered point.
-    let pred = register::predict(f.as_ref(), &p.inside, &reg.values);
-    let errors: Vec<f64> = p
-        .inside
-        .iter()
-        .zip(&pred)
-        .map(|(q, h)| (q[2] - h[0]) / (1.0 + h[1] * h[1] + h[2] * h[2]).sqrt())
-        .collect();
-    let form = form_error(&p.inside, &errors);
-    let (lo, hi) = pred
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), h| {
-            (lo.min(h[0]), hi.max(h[0]))
-        });
-    let sag_range = hi - lo;
-    if form.rms_nm * 1e-6 > 0.25 * sag_range && form.rms_nm > 1000.0 {
-        return Err(fail(
-            codes::MEASURE_MISMATCH,
-            format!(
-                "{file}: after registration the measurement departs from `{surface_name}` by {:.3} µm RMS, more than a quarter of the design's {:.3} µm sag range over the measured points: heights in other units, or another surface",
-                form.rms_nm / 1000.0,
-                sag_range * 1000.0
-            ),
-            Some(
-                "check the file's units (--units for a text file) and that it measures this job's surface",
-            ),
-        ));
-    }
+    let placed = register_measurement(
+        f.as_ref(),
+        &lowered.domain,
+        &surface_name,
+        file,
+        m.data,
+        format,
+        opts,
+    )?;
+    let Registered {
+        points: p,
+        registration: reg,
+        errors,
+        form,
+        share,
+        ..
+    } = placed;
     let (texture, texture_skipped) = texture_of(&p, &errors, opts.cutoff);
     let setup = (spec.setup() == Setup::Lathe)
         .then(|| setup_of(f.as_ref(), &p, &errors, &reg))
@@ -398,45 +115,6 @@ pub fn measure(
         setup,
     };
     Ok(Outcome { report, svg })
-}
-
-fn aperture_words(d: &lensc_runtime::surface::analysis::Domain) -> String {
-    use lensc_runtime::surface::analysis::Domain;
-    match *d {
-        Domain::Circle { radius } => format!("a disc {} mm across", 2.0 * radius),
-        Domain::Annulus { inner, outer } => {
-            format!("a ring {} to {} mm across", 2.0 * inner, 2.0 * outer)
-        }
-        Domain::Rect { x, y } => format!("x {} .. {} mm, y {} .. {} mm", x.0, x.1, y.0, y.1),
-    }
-}
-
-fn form_error(pts: &[[f64; 3]], e: &[f64]) -> report::FormError {
-    let n = e.len() as f64;
-    let mean = e.iter().sum::<f64>() / n;
-    let rms = (e.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n).sqrt();
-    let (mut imax, mut imin) = (0, 0);
-    for k in 0..e.len() {
-        if e[k] > e[imax] {
-            imax = k;
-        }
-        if e[k] < e[imin] {
-            imin = k;
-        }
-    }
-    let at = |k: usize| report::Extreme {
-        nm: e[k] * 1e6,
-        at_mm: [pts[k][0], pts[k][1]],
-    };
-    report::FormError {
-        along: "the surface normal, measured − design (positive: material left)".into(),
-        points: e.len(),
-        pv_nm: (e[imax] - e[imin]) * 1e6,
-        rms_nm: rms * 1e6,
-        mean_nm: mean * 1e6,
-        max: at(imax),
-        min: at(imin),
-    }
 }
 
 fn texture_of(
@@ -535,29 +213,6 @@ fn setup_of(
         rings: s.rings,
         model: "z(r) = f(sqrt(r² − h²) − δx): δx from the cone outside the stub, |h| from the stub's radius ρ = sqrt(δx² + h²)".into(),
     })
-}
-
-fn registration_report(r: &register::Registration) -> report::Registration {
-    let (tx, ty) = r.tilt();
-    let (dx, dy) = r.decentre();
-    report::Registration {
-        method: r.method.to_owned(),
-        piston_um: r.piston() * 1000.0,
-        tilt_x_urad: tx * 1e6,
-        tilt_y_urad: ty * 1e6,
-        decentre_x_um: dx * 1000.0,
-        decentre_y_um: dy * 1000.0,
-        clocking_urad: r.clocking().map(|c| c * 1e6),
-        left_out: r
-            .left_out
-            .iter()
-            .map(|(p, why)| report::LeftOut {
-                parameter: (*p).to_owned(),
-                reason: (*why).to_owned(),
-            })
-            .collect(),
-        iterations: r.iterations,
-    }
 }
 
 /// The error in blocks at most 200 a side (no smaller than the pixel),

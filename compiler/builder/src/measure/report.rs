@@ -146,7 +146,8 @@ pub struct SetUp {
     pub x_offset_um: f64,
     pub x_correction: String,
     /// |h| (µm): the tool tip's distance from the centre height (a map
-    /// does not tell above from below), resolved to `ring_um`.
+    /// does not tell above from below): the stub found in rings `ring_um`
+    /// wide, its edge placed between the points on either side of it.
     pub centre_height_um: f64,
     pub centre_height_correction: String,
     /// The radius of the uncut stub at the centre (µm; 0: none seen).
@@ -161,15 +162,12 @@ pub struct SetUp {
 
 /// The JSON Schema of [`MeasureReport`] as written (draft 2020-12).
 pub fn schema() -> schemars::Schema {
-    schemars::generate::SchemaSettings::draft2020_12()
-        .for_serialize()
-        .into_generator()
-        .into_root_schema_for::<MeasureReport>()
+    crate::json_schema::schema_of::<MeasureReport>()
 }
 
 /// The schema as committed at `docs/measure.schema.json`.
 pub fn schema_text() -> String {
-    serde_json::to_string_pretty(&schema()).expect("a schema prints") + "\n"
+    crate::json_schema::schema_text_of::<MeasureReport>()
 }
 
 #[cfg(test)]
@@ -177,19 +175,10 @@ mod tests {
     /// The committed schema is the one the structs generate.
     #[test]
     fn committed_schema_is_current() {
-        let path = concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../docs/measure.schema.json"
-        );
-        let generated = super::schema_text();
-        if std::env::var_os("LENSC_BLESS").is_some() {
-            std::fs::write(path, &generated).expect("write docs/measure.schema.json");
-            return;
-        }
-        let committed = std::fs::read_to_string(path).unwrap_or_default();
-        assert!(
-            committed == generated,
-            "docs/measure.schema.json is stale: regenerate it with\n    LENSC_BLESS=1 cargo test -p lensc-build --lib measure"
+        crate::json_schema::assert_schema_committed(
+            "measure.schema.json",
+            &super::schema_text(),
+            "measure",
         );
     }
 }

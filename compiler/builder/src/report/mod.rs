@@ -16,6 +16,7 @@ use serde::Serialize;
 
 pub(crate) mod common;
 
+pub use crate::compensate::Compensation;
 pub use crate::strategy::grinding::report::{Intervals, ProfileGrinding};
 pub use crate::strategy::raster::report::Raster;
 pub use crate::strategy::roller::report::{HelixPass, RollerHelix, RollerToolCheck};
@@ -77,6 +78,10 @@ pub struct Report {
     /// The surface's analysis over its whole domain (what `lensc analyse`
     /// prints).
     pub surface: SurfaceAnalysis,
+    /// The correction cut instead of the design, when the job has a
+    /// `compensate` block: the iteration of the measure-and-correct loop.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub compensation: Option<Compensation>,
 }
 
 impl Report {
@@ -360,8 +365,12 @@ pub struct HeightMap {
     pub rq_cutting_direction_nm: Option<f64>,
     /// RMS roughness across the cut (nm), null if not measured.
     pub rq_stepover_direction_nm: Option<f64>,
-    /// The same figures per lenslet in the window.
+    /// The same figures per lenslet in the window (an array's lenslets,
+    /// each with a cut cell), in the array's order.
     pub lenslets: Vec<LensletHeightMap>,
+    /// The lenslet with the largest PV at its contacts, null if none has
+    /// contacts: the one to look at first.
+    pub worst_lenslet: Option<WorstLenslet>,
     /// Raster jobs: the knife's edge and the path's own error.
     #[serde(flatten)]
     pub raster: Option<RasterEdge>,
@@ -390,6 +399,8 @@ impl HeightMap {
         stepover: f64,
     ) -> HeightMap {
         let g = &map.grid;
+        let lenslets: Vec<LensletHeightMap> =
+            map.features.iter().map(LensletHeightMap::from).collect();
         HeightMap {
             kind: "height map of the nose swept along the program's moves, as printed, against the design",
             window: Window {
@@ -421,7 +432,8 @@ impl HeightMap {
             },
             rq_cutting_direction_nm: finite(map.rq_cutting * 1e6),
             rq_stepover_direction_nm: finite(map.rq_stepover * 1e6),
-            lenslets: map.features.iter().map(LensletHeightMap::from).collect(),
+            worst_lenslet: worst_lenslet(&lenslets),
+            lenslets,
             raster: None,
         }
     }
@@ -560,6 +572,9 @@ impl From<&lensc_runtime::verify::heightmap::Scallops> for Scallops {
 #[derive(Clone, Copy, Debug, Serialize, JsonSchema)]
 #[schemars(deny_unknown_fields)]
 pub struct LensletHeightMap {
+    /// The lenslet's index in its array, from 0: row by row from the
+    /// least y, along each row from the least x.
+    pub index: usize,
     /// The lenslet's centre, x and y (mm).
     pub centre_mm: [f64; 2],
     /// Form error over the cut surface there, null if none.
@@ -568,17 +583,106 @@ pub struct LensletHeightMap {
     pub contact: Option<Figures>,
     /// Scallops there, null if none.
     pub scallops: Option<Scallops>,
+    /// The most material left above the design at any of its cells less
+    /// its highest scallop (nm, ≥ 0; 0 without scallops: the whole
+    /// residual), and where: material no pass's contact reached and no
+    /// scallop explains, such as the nub a spiral leaves on the spindle
+    /// axis when the lenslet is not centred there. Null if no cell was
+    /// cut.
+    pub residual_beyond_scallops_nm: Option<AtPoint>,
 }
 
 impl From<&FeatureFigures> for LensletHeightMap {
     fn from(f: &FeatureFigures) -> LensletHeightMap {
+        let scallop = f.scallops.as_ref().map_or(0.0, |s| s.max.max(0.0));
         LensletHeightMap {
+            index: f.index,
             centre_mm: [f.centre.0, f.centre.1],
             surface: f.surface.as_ref().map(Figures::from),
             contact: f.contact.as_ref().map(Figures::from),
             scallops: f.scallops.as_ref().map(Scallops::from),
+            residual_beyond_scallops_nm: f.surface.as_ref().map(|s| {
+                let (v, (x, y)) = s.max_residual;
+                AtPoint {
+                    value: (v - scallop).max(0.0) * 1e6,
+                    x_mm: x,
+                    y_mm: y,
+                }
+            }),
         }
     }
+}
+
+/// The worst lenslet of a height map: the one with the largest form
+/// error, its contacts' PV or the material beyond its scallops (the
+/// larger of the two).
+#[derive(Clone, Copy, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct WorstLenslet {
+    /// Its index in its array (as in `lenslets`).
+    pub index: usize,
+    /// Its centre, x and y (mm).
+    pub centre_mm: [f64; 2],
+    /// Its contacts' PV (nm).
+    pub pv_nm: f64,
+    /// Its contacts' RMS (nm).
+    pub rms_nm: f64,
+    /// The most material left above the design (nm): at its contacts, or
+    /// at any cell beyond its highest scallop, the larger.
+    pub max_residual_nm: f64,
+    /// The deepest cut below the design there, at a contact or any cell
+    /// (nm).
+    pub max_gouge_nm: f64,
+}
+
+impl LensletHeightMap {
+    /// The most material left above the design (nm): at its contacts, or
+    /// at any cell beyond its highest scallop, the larger; `None` without
+    /// contacts.
+    pub fn max_residual_nm(&self) -> Option<f64> {
+        let beyond = self.residual_beyond_scallops_nm.map_or(0.0, |a| a.value);
+        self.contact
+            .as_ref()
+            .map(|c| c.max_residual_nm.value.max(beyond))
+    }
+
+    /// The deepest cut below the design (nm), at its contacts or any of
+    /// its cells; `None` without contacts.
+    pub fn max_gouge_nm(&self) -> Option<f64> {
+        let cells = self.surface.as_ref().map_or(0.0, |s| s.max_gouge_nm.value);
+        self.contact
+            .as_ref()
+            .map(|c| c.max_gouge_nm.value.max(cells))
+    }
+}
+
+/// Of `lenslets`, the one whose contacts' PV or residual beyond its
+/// scallops is the largest (the first of equals); `None` if none has
+/// contacts.
+fn worst_lenslet(lenslets: &[LensletHeightMap]) -> Option<WorstLenslet> {
+    let mut worst: Option<(f64, WorstLenslet)> = None;
+    for l in lenslets {
+        let (Some(c), Some(residual), Some(gouge)) =
+            (&l.contact, l.max_residual_nm(), l.max_gouge_nm())
+        else {
+            continue;
+        };
+        let key = c.pv_nm.max(residual);
+        if worst.is_none_or(|(k, _)| key > k) {
+            worst = Some((
+                key,
+                WorstLenslet {
+                    index: l.index,
+                    centre_mm: l.centre_mm,
+                    pv_nm: c.pv_nm,
+                    rms_nm: c.rms_nm,
+                    max_residual_nm: residual,
+                    max_gouge_nm: gouge,
+                },
+            ));
+        }
+    }
+    worst.map(|(_, w)| w)
 }
 
 /// The acceptance gate of a job (README, "Acceptance"): the criteria
@@ -601,6 +705,11 @@ pub struct Acceptance {
     /// The area of the part the simulated figures come from: the whole
     /// part, or the window a job's `simulate` block narrows it to.
     pub judged: Judged,
+    /// An array's form criteria judged lenslet by lenslet, each lenslet
+    /// against the same limit as the whole part (empty without
+    /// lenslets); a lenslet that misses fails the job as the whole part
+    /// would.
+    pub lenslets: Vec<LensletCriterion>,
 }
 
 impl Acceptance {
@@ -610,6 +719,7 @@ impl Acceptance {
             mode: AcceptanceMode::None,
             passed: true,
             criteria: Vec::new(),
+            lenslets: Vec::new(),
             judged: Judged {
                 area: JudgedArea::None,
                 words: "nothing simulated".into(),
@@ -683,6 +793,39 @@ pub struct CriterionResult {
     pub passed: bool,
     /// Why the figure could not be measured; null if it was.
     pub unmeasured: Option<&'static str>,
+}
+
+/// A form criterion judged lenslet by lenslet: each lenslet's figure, at
+/// its own contacts (its gouge at any of its cells too), against the
+/// criterion's limit.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct LensletCriterion {
+    /// Its name in an `accept` block: `form_pv`, `form_rms`, `max_gouge`
+    /// or `max_residual`.
+    pub criterion: &'static str,
+    /// The limit (nm), the whole part's.
+    pub limit: f64,
+    /// Lenslets judged: those with contacts.
+    pub judged: usize,
+    /// The lenslet whose figure is the largest (the first of equals).
+    pub worst: LensletFigure,
+    /// The indices of the lenslets over the limit, in the array's order.
+    pub missed: Vec<usize>,
+    /// Every lenslet judged is within the limit.
+    pub passed: bool,
+}
+
+/// One lenslet's figure for a criterion.
+#[derive(Clone, Copy, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct LensletFigure {
+    /// Its index in its array (as in the height map's `lenslets`).
+    pub index: usize,
+    /// Its centre, x and y (mm).
+    pub centre_mm: [f64; 2],
+    /// The figure (nm).
+    pub measured: f64,
 }
 
 /// Where a limit came from.
@@ -861,15 +1004,12 @@ pub struct MinRadii {
 /// The JSON Schema of [`Report`] as written (draft 2020-12): a field is
 /// required unless it is left out when empty.
 pub fn schema() -> schemars::Schema {
-    schemars::generate::SchemaSettings::draft2020_12()
-        .for_serialize()
-        .into_generator()
-        .into_root_schema_for::<Report>()
+    crate::json_schema::schema_of::<Report>()
 }
 
 /// The schema as committed at `docs/report.schema.json`.
 pub fn schema_text() -> String {
-    serde_json::to_string_pretty(&schema()).expect("a schema prints") + "\n"
+    crate::json_schema::schema_text_of::<Report>()
 }
 
 #[cfg(test)]
@@ -877,16 +1017,10 @@ mod tests {
     /// The committed schema is the one the structs generate.
     #[test]
     fn committed_schema_is_current() {
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/report.schema.json");
-        let generated = super::schema_text();
-        if std::env::var_os("LENSC_BLESS").is_some() {
-            std::fs::write(path, &generated).expect("write docs/report.schema.json");
-            return;
-        }
-        let committed = std::fs::read_to_string(path).unwrap_or_default();
-        assert!(
-            committed == generated,
-            "docs/report.schema.json is stale: regenerate it with\n    LENSC_BLESS=1 cargo test -p lensc-build --lib report"
+        crate::json_schema::assert_schema_committed(
+            "report.schema.json",
+            &super::schema_text(),
+            "report",
         );
     }
 }

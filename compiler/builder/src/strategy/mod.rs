@@ -131,6 +131,11 @@ macro_rules! registry {
             pub fn path_tolerance(&self) -> Option<f64> {
                 match self { $(JobSpec::$variant(s) => s.path_tolerance(),)* }
             }
+            /// The length axes its path is printed in, if it states a
+            /// path tolerance (`Strategy::LENGTH_AXES`).
+            pub fn length_axes(&self) -> Option<u32> {
+                match self { $(JobSpec::$variant(_) => <$spec as Strategy>::LENGTH_AXES,)* }
+            }
             /// Points, program size and servo samples, estimated before
             /// planning: the strategy's own, with the header's bytes.
             pub fn estimate(&self, evaluate: Evaluate) -> Estimate {

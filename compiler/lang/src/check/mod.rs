@@ -44,6 +44,12 @@ pub struct CheckedJob {
     pub fields: Vec<Field>,
     /// The declared names of the job's parts, for the program header.
     pub part_names: HashMap<String, String>,
+    /// The file the job is written in (`None` for text given directly)
+    /// and the project root it was read beneath: a file the job names
+    /// (`compensate { measurement: … }`) is found beside the one and
+    /// read beneath the other.
+    pub path: Option<std::path::PathBuf>,
+    pub root: Option<std::sync::Arc<crate::sandbox::Root>>,
 }
 
 pub struct Checked {
@@ -204,6 +210,8 @@ impl<'a> Checker<'a> {
                     file: root.id,
                     fields,
                     part_names,
+                    path: self.loaded.sources.get(root.id).path.clone(),
+                    root: self.loaded.root.clone(),
                 });
             }
         }

@@ -363,9 +363,17 @@ pub fn import_within(name: &str, bytes: &[u8], limit: u64) -> Imported {
                     FileId(0),
                     Span::new(0, 0),
                 )
-                .with_help(
-                    "every surface is flat, unsupported or without a semi-diameter; the warnings above say which",
-                ),
+                .with_help(format!(
+                    "every surface is skipped: {}",
+                    p.entries
+                        .iter()
+                        .map(|e| match &e.what {
+                            What::Skipped(why) => format!("surface {} ({why})", e.number),
+                            _ => format!("surface {}", e.number),
+                        })
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )),
             );
             return None;
         }
@@ -496,7 +504,26 @@ pub(crate) fn decide(f: Found, diags: &mut Vec<Diagnostic>) -> Entry {
     };
     match f.role {
         Role::Object => return entry(What::Skipped("the object surface".into())),
-        Role::Image => return entry(What::Skipped("the image surface".into())),
+        Role::Image => {
+            // The last surface is the image plane by the format's rule; a
+            // curved one may be a lens surface of a file cut short.
+            if f.shape.as_ref().is_ok_and(|s| !s.is_flat()) {
+                diags.push(
+                    Diagnostic::warning(
+                        codes::IMPORT_IMAGE_CURVED,
+                        format!(
+                            "surface {}, the last, is taken as the image surface and not imported, but it is curved",
+                            f.number
+                        ),
+                        FileId(0),
+                        f.span,
+                    )
+                    .with_label("the last surface of a design is its image surface")
+                    .with_help("if this is a lens surface (a file cut short after it), add the image surface after it, as OpticStudio writes one, and import again"),
+                );
+            }
+            return entry(What::Skipped("the image surface".into()));
+        }
         Role::Optical => {}
     }
     for (span, what) in &f.dropped {

@@ -284,3 +284,58 @@ fn a_curvature_with_no_finite_radius_is_refused() {
         );
     }
 }
+
+/// A file cut short after its last lens surface (issue #32): the last
+/// surface is the image by the format's rule, so the lens surface is
+/// dropped, but no longer silently: a curved last surface is warned about
+/// (W0040), and the error that nothing is left names every surface
+/// skipped and why, not "the warnings above" when there are none.
+#[test]
+fn a_file_cut_short_after_its_lens_surface_says_what_was_dropped() {
+    let cut = "MODE SEQ\nUNIT MM\nSURF 0\n  CURV 0\n  DISZ INFINITY\nSURF 1\n  CURV 0.02\n  CONI -1\n  DIAM 5\n";
+    let out = import("cut.zmx", cut.as_bytes());
+    assert!(out.lens.is_none());
+    let codes: Vec<&str> = out.diags.iter().map(|d| d.code).collect();
+    assert_eq!(codes, [codes::IMPORT_IMAGE_CURVED, codes::IMPORT_NOTHING]);
+    assert!(out.diags[0].message.contains("surface 1, the last"));
+    let help = out.diags[1].help.clone().unwrap_or_default();
+    assert!(
+        help.contains("surface 0 (the object surface)")
+            && help.contains("surface 1 (the image surface)")
+            && !help.contains("warnings above"),
+        "{help}"
+    );
+    // The whole singlet, with its flat image surface last: no warning.
+    let whole = import("singlet.zmx", SINGLET.as_bytes());
+    assert!(whole.lens.is_some());
+    assert!(
+        !whole
+            .diags
+            .iter()
+            .any(|d| d.code == codes::IMPORT_IMAGE_CURVED),
+        "{:?}",
+        whole.diags
+    );
+}
+
+/// A number past f64's range (`1e400`) is named as what it is (E0353,
+/// beyond the largest number), not "needs a number here"; a word that is
+/// not a number still gets E0350.
+#[test]
+fn a_number_past_the_largest_is_named_as_such() {
+    let big = SINGLET.replace("CURV 0.02", "CURV 1e400");
+    let out = import("big.zmx", big.as_bytes());
+    assert!(out.lens.is_none());
+    let d = out.diags.iter().find(|d| d.is_error()).expect("an error");
+    assert_eq!(d.code, codes::IMPORT_NOT_FINITE, "{d:?}");
+    assert!(
+        d.message.contains("1e400 is beyond the largest number"),
+        "{}",
+        d.message
+    );
+    let word = SINGLET.replace("CURV 0.02", "CURV 1/50");
+    let out = import("word.zmx", word.as_bytes());
+    let d = out.diags.iter().find(|d| d.is_error()).expect("an error");
+    assert_eq!(d.code, codes::IMPORT_UNREADABLE);
+    assert!(d.message.contains("needs a number here"), "{}", d.message);
+}

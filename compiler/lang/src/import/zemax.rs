@@ -58,6 +58,21 @@ pub fn read(name: &str, text: &str, diags: &mut Vec<Diagnostic>) -> Option<Presc
             let w = rest.get(i).copied().unwrap_or("");
             match w.parse::<f64>() {
                 Ok(v) if v.is_finite() => Some(v),
+                Ok(_)
+                    if !w.to_ascii_lowercase().contains("inf")
+                        && !w.to_ascii_lowercase().contains("nan") =>
+                {
+                    diags.push(
+                        Diagnostic::error(
+                            codes::IMPORT_NOT_FINITE,
+                            format!("`{key}` {w} is beyond the largest number lensc reads (about 1.8e308)"),
+                            FileId(0),
+                            span,
+                        )
+                        .with_help("a number this large is a damaged file or a value no design holds: write the value the design means"),
+                    );
+                    None
+                }
                 _ => {
                     diags.push(unreadable(
                         span,

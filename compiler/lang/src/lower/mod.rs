@@ -369,6 +369,7 @@ fn dialect_from(g: Gcode, name: String) -> Dialect {
         spindle_off: g.spindle_off,
         constant_rpm: g.constant_rpm,
         spindle_orient: g.spindle_orient,
+        blank_form: g.blank_form,
         coolant_flood: g.coolant_flood,
         coolant_mist: g.coolant_mist,
         coolant_off: g.coolant_off,

@@ -150,6 +150,10 @@ const GCODE_PARAMS: &[Param] = &[
         "spindle_orient",
         "the blocks that stop the spindle at a fixed angle and hold it, for a knife that cuts with the spindle still (`M19`)",
     ),
+    texts(
+        "blank_form",
+        "blocks that state the workpiece blank for the control's graphic test run, where the strategy states one: `{x0}` `{y0}` `{z0}` its least corner and `{x1}` `{y1}` `{z1}` its greatest (mm), written after the setup (Heidenhain ISO's `G30 G17 X{x0} Y{y0} Z{z0}`, `G31 G90 X{x1} Y{y1} Z{z1}`; Klartext writes its `BLK FORM` itself); absent: no blank is stated",
+    ),
     text(
         "coolant_flood",
         "the flood-coolant word (`M8`); absent: none",
@@ -300,6 +304,7 @@ pub struct Gcode {
     pub spindle_ccw: String,
     pub constant_rpm: Option<String>,
     pub spindle_orient: Vec<String>,
+    pub blank_form: Vec<String>,
     pub coolant_flood: Option<String>,
     pub coolant_mist: Option<String>,
     pub coolant_off: Option<String>,
@@ -391,6 +396,7 @@ impl Gcode {
             spindle_ccw: text("spindle_ccw", "M4"),
             constant_rpm: opt_text("constant_rpm"),
             spindle_orient: lines("spindle_orient"),
+            blank_form: lines("blank_form"),
             coolant_flood: opt_text("coolant_flood"),
             coolant_mist: opt_text("coolant_mist"),
             coolant_off: opt_text("coolant_off"),

@@ -229,12 +229,58 @@ pub static JOB_PARAMS: &[Param] = &[
         "how the program moves the tool between planned points: `lines_arcs` (straight moves and arcs) or `spline` (the controller's own spline, fitted within the path tolerance's share, where its dialect has one: E0182 where not); default the dialect's (`lines_arcs` in every standard dialect)",
     ),
     opt(
+        "compensate",
+        Ty::Block(COMPENSATE_PARAMS),
+        Check::Any,
+        "cut a corrected surface from a measurement of the part this job cut: the design less `gain` times the measured error, registered to the design and smoothed over `smoothing` (docs/usage/compensate.md); default none, the design as it is",
+    ),
+    opt(
         "accept",
         Ty::BlockOr(ACCEPT_PARAMS, &["none"]),
         Check::Any,
-        "the acceptance criteria the simulated part must meet for the program to be written, or `none`; each left out has a default derived from the strategy's tolerance (docs/language/acceptance.md)",
+        "the acceptance criteria the simulated part must meet for the program to be written, or `none`; each left out has a default from the machine: its held tolerance (10 nm, or the smallest the machine holds where coarser; the strategy's `chord_tolerance` where tighter) and its resolution, which no looser tolerance or feed widens (docs/language/acceptance.md)",
     ),
 ];
+
+/// The parameters of a job's `compensate` block.
+pub static COMPENSATE_PARAMS: &[Param] = &[
+    req(
+        "measurement",
+        Ty::Text,
+        Check::Any,
+        "the measured part's file (X3P, SDF, MetroPro, x y z points, an x z profile), relative to the job's file and read under the project root like a `use`d file",
+    ),
+    req(
+        "gain",
+        NUMBER,
+        Check::Open(0.0, 2.0),
+        "the share of the measured error taken out of the next cut (1: all of it; below 1 approaches in steps, above 1 over-corrects)",
+    ),
+    req(
+        "smoothing",
+        LENGTH,
+        Check::Positive,
+        "the shortest period of error the correction follows: the fitted polynomials' order is the aperture's width over it (at most 12)",
+    ),
+    opt(
+        "units",
+        Ty::Word(&["mm", "um", "nm"]),
+        Check::Any,
+        "what a plain-text measurement's numbers are (a text file carries no unit); default mm",
+    ),
+];
+
+/// A job's `compensate` block, read once.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CompensateParams {
+    /// The measurement file as written, relative to the job's file.
+    pub measurement: crate::value::Stated<String>,
+    pub gain: f64,
+    /// The smoothing length (mm).
+    pub smoothing: f64,
+    /// mm per unit of a plain-text file's numbers.
+    pub units: f64,
+}
 
 /// A job's own checked parameters beyond its four parts, read once.
 #[derive(Clone, Debug)]
@@ -254,6 +300,8 @@ pub struct JobParams {
     /// `interpolation: spline` (true) or `lines_arcs` (false), with where;
     /// none: the dialect's default.
     pub interpolation: Option<crate::value::Stated<bool>>,
+    /// The `compensate` block, with where it was written.
+    pub compensate: Option<crate::value::Stated<CompensateParams>>,
 }
 
 /// A job's `accept`, as written: none (the defaults), `none`, or a block.
@@ -340,6 +388,31 @@ impl JobParams {
                     value: w.value == "spline",
                     site: w.site,
                 }),
+            compensate: r.site("compensate").and_then(|site| {
+                let stated = r.block("compensate", |b| {
+                    let measurement = b.field("measurement").and_then(|f| match &f.value {
+                        crate::value::Value::Str(s) => Some(crate::value::Stated {
+                            value: s.clone(),
+                            site: (f.file, f.span),
+                        }),
+                        _ => None,
+                    })?;
+                    Some(CompensateParams {
+                        measurement,
+                        gain: b.num("gain")?,
+                        smoothing: b.num("smoothing")?,
+                        units: match b.word("units") {
+                            Some("um") => 1e-3,
+                            Some("nm") => 1e-6,
+                            _ => 1.0,
+                        },
+                    })
+                })??;
+                Some(crate::value::Stated {
+                    value: stated,
+                    site,
+                })
+            }),
             part_sites: PartSites {
                 surface: r.site("surface"),
                 tool: r.site("tool"),
@@ -358,25 +431,25 @@ pub static ACCEPT_PARAMS: &[Param] = &[
         "form_pv",
         LENGTH,
         Check::NonNegative,
-        "the largest peak-to-valley form error (largest minus least of cut − design at the contacts); default 2 × (path tolerance + resolution)",
+        "the largest peak-to-valley form error (largest minus least of cut − design at the contacts); default 2 × (held tolerance + resolution)",
     ),
     opt(
         "form_rms",
         LENGTH,
         Check::NonNegative,
-        "the largest RMS form error, about its mean, at the contacts; default (path tolerance + resolution) / 2",
+        "the largest RMS form error, about its mean, at the contacts; default (held tolerance + resolution) / 2",
     ),
     opt(
         "max_gouge",
         LENGTH,
         Check::NonNegative,
-        "the deepest cut below the design allowed anywhere; default path tolerance + resolution",
+        "the deepest cut below the design allowed anywhere; default held tolerance + resolution",
     ),
     opt(
         "max_residual",
         LENGTH,
         Check::NonNegative,
-        "the most material allowed above the design at the contacts (scallops apart); default path tolerance + resolution",
+        "the most material allowed above the design at the contacts (scallops apart); default held tolerance + resolution",
     ),
     opt(
         "uncut_area",
@@ -388,7 +461,7 @@ pub static ACCEPT_PARAMS: &[Param] = &[
         "max_following_error",
         LENGTH,
         Check::NonNegative,
-        "the largest following error of the fast tool servo's model (jobs with a servo model)",
+        "the largest following error of the fast tool servo's model (jobs with a servo model; its lag cuts the part where the commands do not show it); default held tolerance + resolution",
     ),
     opt(
         "max_cutting_time",

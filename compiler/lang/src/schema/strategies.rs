@@ -346,7 +346,7 @@ pub(super) const PROFILE_TURNING: Kind = Kind {
             "retract",
             LENGTH,
             Check::Positive,
-            "clearance above the part for rapid moves; default 1 mm",
+            "clearance above the part for rapid moves between passes; each pass's approach rapids on down to 0.1 mm (or the retract, if less) over the part's top and feeds through the air to 0.1 mm over the material at its first point; default 1 mm",
         ),
         opt(
             "search",

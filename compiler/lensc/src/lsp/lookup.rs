@@ -37,7 +37,8 @@ pub fn params_at(
         Owner::Param(p) => {
             let (params, kind) = params_at(a, outer)?;
             match param_in(params, kind, p)?.ty {
-                Ty::Block(sub) => Some((sub, None)),
+                // `accept { … }` takes a block or a word (`accept: none`).
+                Ty::Block(sub) | Ty::BlockOr(sub, _) => Some((sub, None)),
                 _ => None,
             }
         }
@@ -111,6 +112,11 @@ pub fn stdlib_markdown(item: &stdlib::StdItem) -> String {
     );
     if item.module != lensc_lang::loader::PRELUDE {
         s.push_str(&format!("\n\n`{}`", item.use_line()));
+    }
+    // The declaration itself: a machine's travel, limits and resolution,
+    // a tool's geometry, as the standard library states them.
+    if !item.source.is_empty() {
+        s.push_str(&format!("\n\n```lens\n{}\n```", item.source));
     }
     s
 }

@@ -54,13 +54,16 @@ fn job(roughing: Roughing) -> (TurningJob, RotationalSurface) {
     (job, s)
 }
 
-/// The cutting passes of a plan, split at its rapids.
+/// The cutting passes of a plan, split at its rapids: the moves at the
+/// pass's feed (an approach's feed through air carries its own).
 fn passes(path: &Toolpath) -> Vec<Vec<(f64, f64)>> {
     let mut out: Vec<Vec<(f64, f64)>> = Vec::new();
     for m in &path.moves {
         match *m {
             Move::Rapid(_) if out.last().is_none_or(|p| !p.is_empty()) => out.push(Vec::new()),
-            Move::Linear { to, .. } => out.last_mut().expect("a rapid first").push((to.x, to.z)),
+            Move::Linear { to, feed: None } => {
+                out.last_mut().expect("a rapid first").push((to.x, to.z))
+            }
             _ => {}
         }
     }
@@ -248,5 +251,101 @@ fn flat_stock_passes_remove_at_most_the_depth_of_cut() {
             assert!(before - now <= 0.1 + 1e-9, "x {x}: {before} to {now}");
         }
         previous = Some(pass);
+    }
+}
+
+/// Each pass's approach, the moves from its rapid above the first point
+/// to the first point: (length at the pass's feed, lowest rapid's Z).
+fn approaches(path: &Toolpath) -> Vec<(f64, f64)> {
+    let mut out = Vec::new();
+    for &start in &path.pass_starts {
+        let (mut z, mut at_feed, mut lowest_rapid) = (f64::NAN, 0.0, f64::INFINITY);
+        for m in &path.moves[start..] {
+            match *m {
+                Move::Rapid(to) => {
+                    lowest_rapid = lowest_rapid.min(to.z);
+                    z = to.z;
+                }
+                Move::Linear { to, feed } if to.z < z => {
+                    if feed.is_none() {
+                        at_feed += z - to.z;
+                    }
+                    z = to.z;
+                }
+                _ => break,
+            }
+        }
+        out.push((at_feed, lowest_rapid));
+    }
+    out
+}
+
+#[test]
+fn a_convex_rim_is_approached_at_feed_over_the_clearance_only() {
+    // Issue #29: the 1 mm retract was fed down at the finishing feed, the
+    // whole sag of a convex part below the top with it: every turning
+    // example warned W0031 (50 s to 1 min 56 s of cutting air).
+    let (mut j, s) = job(Roughing {
+        stock: Stock::Flat { top: 0.05 },
+        depth_of_cut: 0.1,
+        finish_allowance: 0.01,
+        feed: Feed::PerRevolution(0.01),
+        spindle_speed: None,
+    });
+    j.strategy.roughing = None;
+    let path = plan_profile_turning(&j, &s).unwrap();
+    let cut_top = passes(&path)
+        .iter()
+        .flatten()
+        .map(|p| p.1)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let [(at_feed, lowest_rapid)] = approaches(&path)[..] else {
+        panic!("one pass")
+    };
+    // The sphere's rim is 0.456 mm below its top; only the clearance is
+    // at the finishing feed, and no rapid ends below the top.
+    assert!(
+        (at_feed - approach::APPROACH_CLEARANCE).abs() < 1e-9,
+        "{at_feed} mm at the finishing feed"
+    );
+    assert!(lowest_rapid >= cut_top, "{lowest_rapid} below {cut_top}");
+}
+
+#[test]
+fn roughing_passes_slow_over_what_the_pass_before_left() {
+    // Flat stock at 0.05 over the top: each pass feeds the clearance and
+    // the material over its first point at its feed, no more; rapids stay
+    // over the stock.
+    let (j, s) = job(Roughing {
+        stock: Stock::Flat { top: 0.05 },
+        depth_of_cut: 0.1,
+        finish_allowance: 0.01,
+        feed: Feed::PerRevolution(0.01),
+        spindle_speed: None,
+    });
+    let path = plan_profile_turning(&j, &s).unwrap();
+    let cuts = passes(&path);
+    let rho = j.tool.nose_radius;
+    for (i, (at_feed, lowest_rapid)) in approaches(&path).into_iter().enumerate() {
+        assert!(
+            lowest_rapid >= 0.05 + rho - 1e-12,
+            "pass {i}: rapid to {lowest_rapid}"
+        );
+        let first = cuts[i][0];
+        let over = if i == 0 {
+            0.05 + rho
+        } else {
+            // The pass before, at the same X, between its points there.
+            let prev = &cuts[i - 1];
+            prev.windows(2)
+                .find(|w| (w[0].0 - first.0) * (w[1].0 - first.0) <= 0.0)
+                .map(|w| w[0].1 + (first.0 - w[0].0) / (w[1].0 - w[0].0) * (w[1].1 - w[0].1))
+                .expect("the pass before reaches this X")
+        };
+        let expected = (over - first.1).max(0.0) + approach::APPROACH_CLEARANCE;
+        assert!(
+            (at_feed - expected).abs() < 1e-6,
+            "pass {i}: {at_feed} mm at feed, {expected} expected"
+        );
     }
 }

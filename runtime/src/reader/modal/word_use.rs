@@ -12,9 +12,14 @@
 //! `motion_to_be`. Codes the reader does not know (G10, canned cycles,
 //! G33, G76, M66 …) are refused as unknown before this rule, so the uses
 //! they would give a word are not listed here.
+//!
+//! Fanuc, Sinumerik and Heidenhain ISO blocks are held to the same rule
+//! for the parameter words whose use lensc reads (`parameter_words`):
+//! their tables are in `docs/controllers/<family>.md`, each row with its
+//! source or marked an assumption.
 
-use super::super::Rule;
 use super::super::lexer::{Block, Found};
+use super::super::{Controller, Rule};
 use super::{GGroup, Motion, State};
 
 /// What a block holds that may use a parameter word.
@@ -178,6 +183,86 @@ impl State {
         let users = Users { motion, g, m };
         for w in &b.words {
             let (used, by) = users.uses(w.letter);
+            if !used {
+                out.push((
+                    Rule::UnusedWord,
+                    w.span,
+                    format!(
+                        "`{}`: no code of this block uses {} word (the controller refuses it)",
+                        w.text(line),
+                        a_word(w.letter)
+                    ),
+                    Some(format!(
+                        "{} word goes with {by}; take it out or add the code meant",
+                        a_word(w.letter)
+                    )),
+                ));
+            }
+        }
+    }
+}
+
+impl State {
+    /// Fanuc, Sinumerik and Heidenhain ISO: a parameter word that no code
+    /// of its block uses (the uses lensc reads; a word of a code it does
+    /// not read is refused with its code, as unknown). I, J and K are an
+    /// arc's centre (G2, G3: the block's own code, or the mode in force
+    /// for a block with axis words); on a Heidenhain ISO block with no
+    /// motion and no axis words they set the circle centre. Fanuc: R is an
+    /// arc's radius, P the dwell of G4, Q the mode of G05.1, H the length
+    /// offset of G43, D the radius offset of G41 and G42; L goes with M98
+    /// and G10, which lensc does not read. Sinumerik: P is a subprogram's
+    /// passes, with L (an arc's turns are `TURN=`).
+    pub(super) fn parameter_words(
+        &self,
+        b: &Block,
+        groups: &[(GGroup, usize)],
+        line: &str,
+        out: &mut Vec<Found>,
+    ) {
+        let c = self.lex.controller;
+        if !matches!(
+            c,
+            Controller::Fanuc | Controller::Siemens | Controller::HeidenhainIso
+        ) {
+            return;
+        }
+        let has = |letters: &[char]| b.words.iter().any(|w| letters.contains(&w.letter));
+        let g = |code: i64| {
+            b.words
+                .iter()
+                .any(|w| w.letter == 'G' && self.g_code(w.value) == Some(code))
+        };
+        let own = groups.iter().find_map(|(g, _)| match g {
+            GGroup::Motion(m) => Some(*m),
+            _ => None,
+        });
+        // A NURBS block (G06.2 and the blocks of its curve) carries its
+        // own P (rank), K (knots) and R (weights): the NURBS reader holds
+        // them to the control's rules (E0340).
+        if own == Some(Motion::Nurbs) || self.motion == Some(Motion::Nurbs) {
+            return;
+        }
+        let axes = has(&['X', 'Y', 'Z', 'A', 'B', 'C', 'U', 'W']);
+        let motion = own.or(if axes { self.motion } else { None });
+        let arc = matches!(motion, Some(Motion::Cw | Motion::Ccw));
+        // A Heidenhain ISO block of I J K alone sets the circle centre.
+        let centre_alone = c == Controller::HeidenhainIso && motion.is_none() && !axes;
+        for w in &b.words {
+            let (used, by) = match (c, w.letter) {
+                (_, 'I' | 'J' | 'K') => (arc || centre_alone, "G2 or G3 (an arc's centre)"),
+                (Controller::Fanuc, 'R') => (arc, "G2 or G3 (an arc's radius)"),
+                (Controller::Fanuc, 'P') => (g(40), "G4 (the dwell)"),
+                (Controller::Fanuc, 'Q') => (g(51), "G05.1 (AI contour control)"),
+                (Controller::Fanuc, 'H') => (g(430) || g(440), "G43 or G44 (the length offset)"),
+                (Controller::Fanuc, 'D') => (g(410) || g(420), "G41 or G42 (the radius offset)"),
+                (Controller::Fanuc, 'L') => (false, "M98 or G10, which lensc does not read"),
+                (Controller::Siemens, 'P') => (
+                    has(&['L']),
+                    "L (a subprogram's passes; an arc's turns are TURN=)",
+                ),
+                _ => (true, ""),
+            };
             if !used {
                 out.push((
                     Rule::UnusedWord,

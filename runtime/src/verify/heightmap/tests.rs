@@ -356,3 +356,88 @@ fn cells_no_pass_reaches_are_uncut_area() {
     let (x, _) = map.uncut_at.unwrap();
     assert!(x > 0.060, "{x}");
 }
+
+/// The contacts as they were found before the design was evaluated for a
+/// whole column at once: one piece at a time, five samples and the
+/// parabola's vertex each (the brute force the batched search must
+/// equal bit for bit).
+fn valleys_one_piece_at_a_time(cut: &ColumnCut, g: &Grid) -> Vec<(f64, f64)> {
+    let (s, r) = (cut.s, cut.r);
+    let (u_lo, u_hi) = (g.u0, g.u_end());
+    let mut valleys = vec![(f64::NAN, f64::NAN); cut.pieces.len()];
+    for (q, v) in valleys.iter_mut().enumerate() {
+        let (cu, _) = cut.centres[cut.pieces[q].0];
+        let a = cut.pieces[q].1.max(cu - r).max(u_lo);
+        let b = cut.end(q).min(cu + r).min(u_hi);
+        if b.partial_cmp(&a) != Some(std::cmp::Ordering::Greater) {
+            continue;
+        }
+        let probe: Vec<(f64, f64)> = (0..5).map(|k| (s, a + (b - a) * k as f64 / 4.0)).collect();
+        let mut d = [0.0; 5];
+        cut.frame.design(&probe, &mut d);
+        let e: Vec<f64> = (0..5).map(|k| cut.height(q, probe[k].1) - d[k]).collect();
+        let m = (1..4).min_by(|&x, &y| e[x].total_cmp(&e[y])).unwrap_or(2);
+        let (mut best_u, mut best) = (probe[m].1, e[m]);
+        for k in [0, 4] {
+            if e[k] < best {
+                (best_u, best) = (probe[k].1, e[k]);
+            }
+        }
+        let curv = e[m - 1] - 2.0 * e[m] + e[m + 1];
+        if curv > 0.0 {
+            let t = 0.5 * (e[m - 1] - e[m + 1]) / curv;
+            if t.abs() <= 1.0 {
+                let u = probe[m].1 + t * (b - a) / 4.0;
+                let eu = cut.height(q, u) - cut.design_at(u);
+                if eu < best {
+                    (best_u, best) = (u, eu);
+                }
+            }
+        }
+        let clipped = (best_u == a && a > cut.pieces[q].1.max(cu - r))
+            || (best_u == b && b < cut.end(q).min(cu + r));
+        if !clipped && cut.in_window(best_u) {
+            *v = (best_u, best);
+        }
+    }
+    valleys
+}
+
+/// Over a sphere, passes 7 µm apart with a ripple, some pieces cut short
+/// by the window's edges: the column's contacts found for all its pieces
+/// at once are those found one piece at a time, bit for bit.
+#[test]
+fn contacts_found_for_a_whole_column_at_once_are_those_found_piece_by_piece() {
+    let (r, g) = (0.05, grid(81, 0.001));
+    let frame = Flat {
+        z: |s: f64, u: f64| 2.0 - (4.0 - s * s - u * u).sqrt(),
+        window: (0.0, 0.08, 0.003, 0.07),
+    };
+    let mut contacts = 0;
+    for j in [0, 17, 40, 80] {
+        let s = g.s(j);
+        let mut centres: Vec<(f64, f64)> = (-10..=20)
+            .map(|k| {
+                let u = k as f64 * 0.007;
+                let ripple = 4e-6 * (k as f64 * 1.3 + s * 50.0).sin();
+                (u, r + (frame.z)(s, u) + ripple)
+            })
+            .collect();
+        centres.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let pieces = envelope(&centres, r);
+        let cut = ColumnCut {
+            s,
+            r,
+            centres,
+            pieces,
+            frame: &frame,
+        };
+        let (batched, brute) = (cut.valleys(&g), valleys_one_piece_at_a_time(&cut, &g));
+        let bits = |v: &[(f64, f64)]| -> Vec<(u64, u64)> {
+            v.iter().map(|p| (p.0.to_bits(), p.1.to_bits())).collect()
+        };
+        assert_eq!(bits(&batched), bits(&brute), "column {j}");
+        contacts += batched.iter().filter(|v| !v.1.is_nan()).count();
+    }
+    assert!(contacts > 20, "{contacts}");
+}

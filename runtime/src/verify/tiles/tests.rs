@@ -179,3 +179,92 @@ fn the_recorder_keeps_the_band_only() {
     assert_eq!(r.arcs, [(2, (2.5, 1.0))]);
     assert!(r.steps[3].0.is_nan());
 }
+
+/// A spiral's design on a polar grid (s the spindle angle, u the radius).
+struct Turned;
+fn turned_design(x: f64, y: f64) -> f64 {
+    1e-4 * (3.0 * x).sin() * (2.0 * y).cos()
+}
+impl Frame for Turned {
+    fn design(&self, points: &[(f64, f64)], out: &mut [f64]) {
+        for (o, &(s, u)) in out.iter_mut().zip(points) {
+            let (x, y) = self.xy(s, u);
+            *o = turned_design(x, y);
+        }
+    }
+    fn xy(&self, s: f64, u: f64) -> (f64, f64) {
+        (u * s.cos(), u * s.sin())
+    }
+    fn inside(&self, x: f64, y: f64) -> bool {
+        (1.0..=1.05).contains(&x.hypot(y))
+    }
+}
+
+/// Five turns of a spiral, 10 000 points a turn (each of the recorder's
+/// blocks under half a turn), 12 µm a turn inward, with a ripple.
+fn spiral(path: &mut dyn NosePath, nose: f64) {
+    for k in 0..50_000 {
+        let s = k as f64 * std::f64::consts::TAU / 10_000.0;
+        let u = 1.062 - 0.012 * s / std::f64::consts::TAU;
+        let ripple = 2e-6 * (k as f64 * 0.37).sin();
+        path.point(
+            s,
+            u,
+            nose + turned_design(u * s.cos(), u * s.sin()) + ripple,
+        );
+    }
+}
+
+/// A lathe's tiles sweep only the recorder's blocks some turn of which
+/// crosses their columns; the figures are those of one grid swept with
+/// every point of the path (the brute force): counts, extremes and their
+/// places exactly, means and RMS to rounding.
+#[test]
+fn a_lathe_s_tiles_skip_the_turns_that_miss_them_and_keep_the_figures() {
+    let nose = 0.02;
+    let grid = Grid {
+        s0: 0.2,
+        ds: 0.001,
+        ns: 300,
+        u0: 1.0,
+        du: 0.001,
+        nu: 51,
+        period: Some(std::f64::consts::TAU),
+        j0: 0,
+        i0: 0,
+    };
+    let mut sweep = Sweep::new(grid, nose);
+    spiral(&mut sweep, nose);
+    let whole = sweep.finish(&Turned);
+    let tiles = split_columns(&grid, None, 60);
+    let mut recorder = Recorder::new(Recorder::band_of(&tiles, nose));
+    spiral(&mut recorder, nose);
+    let layout = RasterLayout::new((-1.1, 1.1), (-1.1, 1.1), 0.01, 16);
+    let m = simulate(
+        &recorder,
+        &tiles,
+        grid,
+        Cutter::Nose { radius: nose },
+        &Turned,
+        layout,
+    )
+    .map;
+    assert_eq!((m.cells, m.uncut), (whole.cells, whole.uncut));
+    assert!(whole.cells > 10_000 && whole.uncut == 0, "{}", whole.uncut);
+    for (a, b) in [(m.surface, whole.surface), (m.contact, whole.contact)] {
+        let (a, b) = (a.expect("figures"), b.expect("figures"));
+        assert_eq!(
+            (a.count, a.pv, a.max_gouge, a.max_residual),
+            (b.count, b.pv, b.max_gouge, b.max_residual)
+        );
+        assert!(close(a.mean, b.mean) && close(a.rms, b.rms), "{a:?} {b:?}");
+    }
+    // Blocks of a turn's part: the first misses the columns (0.2 .. 0.5
+    // rad) in every turn, one a turn later crosses them.
+    let p = Some(std::f64::consts::TAU);
+    assert!(misses((0.2, 0.5), p, (1.0, 3.0)));
+    assert!(misses((0.2, 0.5), p, (1.0 + 6.3, 3.0 + 6.3)));
+    assert!(!misses((0.2, 0.5), p, (6.3, 6.7)));
+    assert!(!misses((0.2, 0.5), p, (1.0, 9.0)));
+    assert!(misses((0.2, 0.5), None, (6.3, 6.7)));
+}

@@ -6,6 +6,7 @@
 use super::GrindingSpec;
 use lensc_grammar::Diagnostic;
 use lensc_lang::lower::exact_in;
+use lensc_runtime::plan::approach::Approach;
 use lensc_runtime::surface::SectionAlongX;
 
 use crate::context::{self as parts, BuildContext};
@@ -31,8 +32,20 @@ pub(super) fn build(spec: &GrindingSpec, cx: &BuildContext) -> Result<Built, Vec
         .map(|q| q.z)
         .fold(f64::NEG_INFINITY, f64::max);
     let safe_z = top + retract;
+    // The wheel comes down at the cut's first point over the design
+    // itself: a grinding pass takes µm from a pre-formed blank.
+    let approach = path.points.first().map(|first| Approach {
+        x: first.x,
+        safe_z,
+        top,
+        material: first.z,
+        start_z: first.z,
+        cutting_speed: feed,
+        max_feed: spec.max_feed,
+        retract,
+    });
     let stream =
-        lensc_runtime::emit::grinding::grinding_moves(&path, feed, safe_z, spec.spindle_speed);
+        lensc_runtime::emit::grinding::grinding_moves(&path, feed, approach, spec.spindle_speed);
     if let Some(e) = parts::travel_error(head, &stream) {
         return Err(vec![e]);
     }

@@ -26,6 +26,8 @@ pub struct GrindingSpec {
     pub retract: f64,
     /// The work spindle's speed (rad/s).
     pub spindle_speed: f64,
+    /// The grinder's maximum feed (mm/s), for the approach through air.
+    pub max_feed: f64,
 }
 
 impl crate::strategy::Strategy for GrindingSpec {
@@ -93,5 +95,6 @@ pub(crate) fn lower(
         grinding,
         retract: st.retract.unwrap_or(1.0),
         spindle_speed: st.spindle_speed,
+        max_feed: p.machine_params.max_feed,
     })
 }

@@ -100,6 +100,7 @@ pub(crate) fn lower(
             fit: raster.chord_tolerance * optimise::FIT_SHARE,
             // Fitted lines and arcs: fewest through points on the path.
             long_chords: false,
+            holds: p.holds(<RasterSpec as crate::strategy::Strategy>::LENGTH_AXES),
         },
     );
     let (tool, tool_words) = match p.tool.kind.name {

@@ -159,6 +159,7 @@ pub(crate) fn lower(
                 sag,
                 fit: 0.0,
                 long_chords: false,
+                holds: p.holds(<RollerSpec as crate::strategy::Strategy>::LENGTH_AXES),
             },
         ),
         ..helix

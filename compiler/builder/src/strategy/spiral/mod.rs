@@ -225,6 +225,7 @@ pub(crate) fn lower(
             sag: spiral.chord_tolerance * lensc_runtime::plan::optimise::UNOPTIMISED_CHORD_SHARE,
             fit: 0.0,
             long_chords: true,
+            holds: p.holds(<SpiralSpec as crate::strategy::Strategy>::LENGTH_AXES),
         },
     );
     errors.extend(machine_limits(p, &spiral));

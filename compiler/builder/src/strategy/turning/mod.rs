@@ -82,10 +82,17 @@ pub(crate) fn lower(
     if let Some(e) = nose_out_of_reach(p, &job, &SectionAlongX(kernel.as_ref())) {
         return Err(vec![e]);
     }
-    Ok(TurningSpec {
-        head: p.head(dialect, lowered),
-        job,
-    })
+    let head = p.head(dialect, lowered);
+    let mut job = job;
+    if let Some(c) = &head.surface.compensation {
+        // The runtime writes the header: the surface's line says it.
+        job.surface.description = format!(
+            "{}; {}",
+            job.surface.description,
+            crate::compensate::header_words(c)
+        );
+    }
+    Ok(TurningSpec { head, job })
 }
 
 /// The runtime's description of the job, or why it cannot be turned.
@@ -199,6 +206,7 @@ fn profile_turning(
                 fit: tolerance * optimise::FIT_SHARE,
                 // Fitted lines and arcs: fewest through points on the path.
                 long_chords: false,
+                holds: p.holds(<TurningSpec as crate::strategy::Strategy>::LENGTH_AXES),
             },
         ),
         feed,

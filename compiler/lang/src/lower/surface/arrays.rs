@@ -107,12 +107,20 @@ pub fn lower_trajectory(o: &Object, settle: f64) -> Result<LoweredSurface, Lower
     })
 }
 
-/// The centres of a rectangular grid's or a linear array's lenslets (mm);
-/// `None` for other surfaces.
+/// The centres of an array's lenslets (mm), row by row from the least y,
+/// as the lowering places them; `None` for other surfaces.
 pub fn array_centres(o: &Object) -> Option<Vec<(f64, f64)>> {
     let Ok(Surface::Array(a)) = super::read(o) else {
         return None;
     };
+    if let Layout::Hex {
+        pitch,
+        count_x,
+        count_y,
+    } = a.layout
+    {
+        return Some(hex_centres(pitch, count_x, count_y));
+    }
     let (px, py, nx, ny) = match a.layout {
         Layout::Grid {
             pitch_x,
@@ -143,6 +151,30 @@ pub fn array_centres(o: &Object) -> Option<Vec<(f64, f64)>> {
         }
     }
     Some(centres)
+}
+
+/// The centres of a hexagonal grid's lenslets, as `hex_cells` places
+/// them: rows p·√3/2 apart, row j shifted by (parity(j) − 1/2)·p/2, row
+/// and column indices clamped to n − 1 as `cell_index` clamps them (a
+/// hex grid's row count need not be whole).
+fn hex_centres(p: f64, nx: f64, ny: f64) -> Vec<(f64, f64)> {
+    let row = p * 3f64.sqrt() / 2.0;
+    let indices = |n: f64| -> Vec<f64> {
+        (0..n.ceil().max(1.0) as usize)
+            .map(|k| (k as f64).min(n - 1.0).max(0.0))
+            .collect()
+    };
+    let mut centres = Vec::new();
+    for j in indices(ny) {
+        let parity = j - 2.0 * (j * 0.5).floor();
+        let shift = parity * (p / 2.0) - p / 4.0;
+        let cy = (j - (ny - 1.0) / 2.0) * row;
+        for i in indices(nx) {
+            centres.push(((i - (nx - 1.0) / 2.0) * p + shift, cy));
+        }
+    }
+    centres.dedup();
+    centres
 }
 
 /// The lenslet of an array as its own surface, with the radius of its

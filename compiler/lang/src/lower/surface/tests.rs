@@ -392,6 +392,57 @@ surface h = hex_grid(l, pitch: 1 mm, count_x: 3, count_y: 2)";
 }
 
 #[test]
+fn a_hex_grid_s_centres_are_its_lenslets_deepest_points() {
+    // The per-lenslet figures of a simulation go by these centres: before
+    // issue #29 a hex grid had none (`None`), so its lenslets went
+    // unreported and ungated.
+    let src =
+        "surface l = sphere { radius: 2 mm, sense: concave, aperture: circle(radius: 0.2 mm) }
+surface h = hex_grid(l, pitch: 1 mm, count_x: 3, count_y: 3)";
+    let c = crate::check_text(&crate::loader::RealFs, "t.lens", src.as_bytes());
+    assert!(!c.has_errors(), "{:?}", c.diags());
+    let o = c.checked.declarations.get("h").expect("surface");
+    let centres = array_centres(o).expect("a hex grid's centres");
+    assert_eq!(centres.len(), 9);
+    let rim = sphere_sag(2.0, 0.2);
+    let row = 3f64.sqrt() / 2.0;
+    // The middle row (odd) is shifted by +1/4 pitch: no lenslet on the axis.
+    assert!(centres.contains(&(0.25, 0.0)) && centres.contains(&(-1.25, -row)));
+    for &(x, y) in &centres {
+        assert!(
+            close(eval_surface(src, "h", x, y)[0], -rim),
+            "no lenslet centre at ({x}, {y})"
+        );
+    }
+}
+
+#[test]
+fn a_hex_grid_names_its_lenslet_centres() {
+    // The simulation judges an array lenslet by lenslet, and the planner
+    // samples only over them: a hex grid without its centres was judged
+    // over its land, where a settled spiral holds the tool above it
+    // (issue #29: 10.9 um "residual" over the land of a 5 x 5 hex array).
+    let src =
+        "surface l = sphere { radius: 2 mm, sense: concave, aperture: circle(radius: 0.2 mm) }
+surface h = hex_grid(l, pitch: 1 mm, count_x: 3, count_y: 2)";
+    let c = crate::check_text(&crate::loader::RealFs, "t.lens", src.as_bytes());
+    assert!(!c.has_errors(), "{:?}", c.diags());
+    let o = c.checked.declarations.get("h").expect("surface");
+    let centres = array_centres(o).expect("a hex grid has centres");
+    assert_eq!(centres.len(), 6);
+    let rim = sphere_sag(2.0, 0.2);
+    for &(x, y) in &centres {
+        assert!(
+            close(eval_surface(src, "h", x, y)[0], -rim),
+            "no lenslet centre at ({x}, {y})"
+        );
+    }
+    let row = 3f64.sqrt() / 2.0;
+    assert!(close(centres[0].0, -1.25) && close(centres[0].1, -row / 2.0));
+    assert!(close(centres[5].0, 1.25) && close(centres[5].1, row / 2.0));
+}
+
+#[test]
 fn a_settled_trajectory_has_finite_slopes_wherever_a_spiral_goes() {
     // Issue 15's 5 × 5 hex array (R 3 mm): at its edges the cell indices
     // clamp, and a neighbour 3.02 mm off was continued past its sphere's

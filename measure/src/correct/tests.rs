@@ -1,0 +1,176 @@
+use super::*;
+use lensc_runtime::surface::ir::{Interpreter, SurfaceFn, SurfaceTape};
+
+/// A radial error made of known terms is fitted back to them, its piston
+/// left out of the correction.
+#[test]
+fn a_radial_error_is_fitted_to_its_terms() {
+    let basis = Basis::radial(2.0, 0.5); // order 8
+    assert_eq!(basis.order(), 8);
+    let truth = |x: f64, y: f64| {
+        let t = 2.0 * (x * x + y * y) / 4.0 - 1.0;
+        let p = legendre(t, 8);
+        4e-6 + 3e-5 * p[2] - 1e-5 * p[5] + 2e-6 * p[8]
+    };
+    let mut xy = Vec::new();
+    let mut e = Vec::new();
+    for j in 0..101 {
+        for i in 0..101 {
+            let (x, y) = (-2.0 + 0.04 * i as f64, -2.0 + 0.04 * j as f64);
+            if x * x + y * y <= 4.0 {
+                xy.push((x, y));
+                e.push(truth(x, y));
+            }
+        }
+    }
+    let cells = bin(&basis, &xy, &e, 0.002);
+    let c = fit(basis, &cells).expect("fits");
+    let want = [0.0, 0.0, 3e-5, 0.0, 0.0, -1e-5, 0.0, 0.0, 2e-6];
+    // Within 2e-9 mm (0.002 nm): a ring's mean error is not the error at
+    // its mean radius, to second order in the ring's 2 µm width.
+    for (k, (got, want)) in c.coefficients.iter().zip(want).enumerate() {
+        assert!((got - want).abs() < 2e-9, "term {k}: {got} vs {want}");
+    }
+    assert!(c.fit_residual_rms < 1e-9, "{}", c.fit_residual_rms);
+    // The correction is the error less its piston, everywhere.
+    assert!((c.at(0.7, -1.1) - (truth(0.7, -1.1) - 4e-6)).abs() < 1e-8);
+}
+
+/// A map's error is fitted with its piston and tilts left out; ripple
+/// shorter than the smoothing length is not followed.
+#[test]
+fn a_map_error_is_fitted_without_placement_and_without_short_ripple() {
+    let basis = Basis::map((-1.0, 1.0), (-1.0, 1.0), 0.5); // order 4
+    assert_eq!(basis.order(), 4);
+    let form = |x: f64, y: f64| 2e-5 * (x * x - y * y) + 1e-5 * x * y * y;
+    let ripple = |x: f64, _y: f64| 1e-6 * (2.0 * std::f64::consts::PI * x / 0.05).sin();
+    let mut xy = Vec::new();
+    let mut e = Vec::new();
+    for j in 0..201 {
+        for i in 0..201 {
+            let (x, y) = (-1.0 + 0.01 * i as f64, -1.0 + 0.01 * j as f64);
+            xy.push((x, y));
+            e.push(3e-6 + 1e-5 * x - 2e-5 * y + form(x, y) + ripple(x, y));
+        }
+    }
+    let cells = bin(&basis, &xy, &e, 0.01);
+    let c = fit(basis, &cells).expect("fits");
+    for (x, y) in [(0.3, -0.4), (-0.9, 0.8), (0.0, 0.0)] {
+        // x·y² = x·(2 P2(y) + 1)/3 holds a tilt x/3, left out with the
+        // others; differences from the centre leave out the piston.
+        let kept = |x: f64, y: f64| form(x, y) - 1e-5 / 3.0 * x;
+        let want = kept(x, y) - kept(0.0, 0.0);
+        let got = c.at(x, y) - c.at(0.0, 0.0);
+        assert!((got - want).abs() < 3e-8, "({x}, {y}): {got} vs {want}");
+    }
+    // The ripple (50 µm period, a tenth of the smoothing length) is left.
+    assert!(
+        (c.fit_residual_rms - 1e-6 / 2f64.sqrt()).abs() < 5e-8,
+        "{}",
+        c.fit_residual_rms
+    );
+}
+
+/// Too few cells for the terms: no fit rather than a made-up one.
+#[test]
+fn too_few_cells_is_no_fit() {
+    let basis = Basis::radial(1.0, 0.1); // order 20: 21 terms
+    let cells: Vec<_> = (0..10).map(|k| (0.1 * k as f64, 0.0, 0.0, 1.0)).collect();
+    assert!(fit(basis, &cells).is_none());
+}
+
+fn tapes(c: &Correction) -> SurfaceTape {
+    let mut g = Graph::new();
+    let (x, y) = (g.x(), g.y());
+    let z = c.node(&mut g, x, y, 0.7);
+    SurfaceTape::new(g, z)
+}
+
+fn sample_correction(basis: Basis) -> Correction {
+    let n = basis.terms().len();
+    let coefficients = (0..n)
+        .map(|k| {
+            if basis.is_placement(basis.terms()[k]) {
+                0.0
+            } else {
+                1e-5 / (1.0 + k as f64)
+            }
+        })
+        .collect();
+    Correction {
+        basis,
+        coefficients,
+        fit_residual_rms: 0.0,
+        cells: 0,
+    }
+}
+
+/// The IR of a correction computes what `at` computes, and its
+/// derivatives agree with finite differences of it.
+#[test]
+fn the_ir_is_the_polynomial_with_its_derivatives() {
+    for basis in [
+        Basis::radial(1.5, 0.1),
+        Basis::map((-1.0, 2.0), (-0.5, 1.5), 0.3),
+    ] {
+        let c = sample_correction(basis);
+        let f = Interpreter::new(&tapes(&c));
+        for (x, y) in [(0.3, -0.2), (-0.9, 0.4), (1.1, 0.9), (0.0, 0.0)] {
+            let o = f.eval(x, y);
+            let want = 0.7 * c.at(x, y);
+            assert!(
+                (o[0] - want).abs() <= 1e-13 * want.abs().max(1e-6),
+                "{basis:?} z at ({x}, {y}): {} vs {want}",
+                o[0]
+            );
+            let h = 1e-5;
+            let at = |x: f64, y: f64| 0.7 * c.at(x, y);
+            let fd = [
+                (at(x + h, y) - at(x - h, y)) / (2.0 * h),
+                (at(x, y + h) - at(x, y - h)) / (2.0 * h),
+                (at(x + h, y) - 2.0 * at(x, y) + at(x - h, y)) / (h * h),
+                (at(x + h, y + h) - at(x + h, y - h) - at(x - h, y + h) + at(x - h, y - h))
+                    / (4.0 * h * h),
+                (at(x, y + h) - 2.0 * at(x, y) + at(x, y - h)) / (h * h),
+            ];
+            for k in 0..5 {
+                let tol = if k < 2 { 1e-9 } else { 1e-4 };
+                assert!(
+                    (o[k + 1] - fd[k]).abs() <= tol * (1.0 + fd[k].abs()),
+                    "{basis:?} output {} at ({x}, {y}): {} vs {}",
+                    k + 1,
+                    o[k + 1],
+                    fd[k]
+                );
+            }
+        }
+    }
+}
+
+/// The JIT and the interpreter agree on a correction's tape (the
+/// conformance rule every surface is held to: 1e-13 relative).
+#[test]
+fn jit_and_interpreter_agree() {
+    use lensc_runtime::surface::jit::JitSurface;
+    for basis in [
+        Basis::radial(1.5, 0.08),
+        Basis::map((-1.0, 2.0), (-0.5, 1.5), 0.3),
+    ] {
+        let c = sample_correction(basis);
+        let tape = tapes(&c);
+        let i = Interpreter::new(&tape);
+        let j = JitSurface::compile(&tape).expect("compiles");
+        let xs: Vec<f64> = (0..97).map(|k| -1.0 + 0.021 * k as f64).collect();
+        let ys: Vec<f64> = (0..97).map(|k| 1.4 - 0.019 * k as f64).collect();
+        let (mut a, mut b) = (vec![0.0; 6 * 97], vec![0.0; 6 * 97]);
+        i.eval_batch(&xs, &ys, &mut a);
+        j.eval_batch(&xs, &ys, &mut b);
+        for (k, (a, b)) in a.iter().zip(&b).enumerate() {
+            let scale = a.abs().max(b.abs()).max(1e-300);
+            assert!(
+                (a - b).abs() <= 1e-13 * scale.max(1e-6),
+                "{basis:?} value {k}: {a} vs {b}"
+            );
+        }
+    }
+}
