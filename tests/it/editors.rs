@@ -95,16 +95,7 @@ fn the_vscode_extension_ties_the_grammar_and_server_to_lens_files() {
 /// the test says so and passes, except under CI, where it fails.
 #[test]
 fn neovim_gets_the_servers_diagnostics_from_the_shipped_setup() {
-    let has_nvim = std::process::Command::new("nvim")
-        .arg("--version")
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !has_nvim {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "CI must install neovim for this test"
-        );
-        eprintln!("skipped: no nvim on PATH");
+    if !editor_on_path("nvim", "neovim") {
         return;
     }
     let dir = tempfile::tempdir().expect("tmp");
@@ -129,14 +120,7 @@ vim.cmd('qa!')
 "#,
     )
     .expect("probe");
-    let bin = std::path::Path::new(env!("CARGO_BIN_EXE_lensc"))
-        .parent()
-        .expect("bin dir")
-        .to_path_buf();
-    let path = std::env::join_paths(std::iter::once(bin).chain(std::env::split_paths(
-        &std::env::var_os("PATH").unwrap_or_default(),
-    )))
-    .expect("PATH");
+    let path = path_with_lensc();
     let run = std::process::Command::new("nvim")
         .args(["--headless", "-u"])
         .arg(root().join("editors/nvim/lensc.lua"))
@@ -175,16 +159,7 @@ vim.cmd('qa!')
 /// CI, where it fails.
 #[test]
 fn emacs_eglot_gets_the_servers_diagnostics_from_the_shipped_setup() {
-    let has_emacs = std::process::Command::new("emacs")
-        .arg("--version")
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !has_emacs {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "CI must install emacs-nox and elpa-eglot for this test"
-        );
-        eprintln!("skipped: no emacs on PATH");
+    if !editor_on_path("emacs", "emacs-nox and elpa-eglot") {
         return;
     }
     let dir = tempfile::tempdir().expect("tmp");
@@ -215,14 +190,7 @@ fn emacs_eglot_gets_the_servers_diagnostics_from_the_shipped_setup() {
 "#,
     )
     .expect("probe");
-    let bin = std::path::Path::new(env!("CARGO_BIN_EXE_lensc"))
-        .parent()
-        .expect("bin dir")
-        .to_path_buf();
-    let path = std::env::join_paths(std::iter::once(bin).chain(std::env::split_paths(
-        &std::env::var_os("PATH").unwrap_or_default(),
-    )))
-    .expect("PATH");
+    let path = path_with_lensc();
     let run = std::process::Command::new("emacs")
         .args(["--batch", "-l"])
         .arg(root().join("editors/emacs/lensc.el"))
@@ -247,4 +215,33 @@ fn emacs_eglot_gets_the_servers_diagnostics_from_the_shipped_setup() {
     assert!(seen.contains("eglot=yes"), "{seen}");
     assert!(seen.contains("[E0110]: unknown unit `mmm`"), "{seen}");
     assert!(seen.contains("[E0121]"), "{seen}");
+}
+
+/// Whether the editor `program` runs here. Without it an editor test says
+/// so and passes, except under CI, which must install `package`.
+fn editor_on_path(program: &str, package: &str) -> bool {
+    let found = std::process::Command::new(program)
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !found {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "CI must install {package} for this test"
+        );
+        eprintln!("skipped: no {program} on PATH");
+    }
+    found
+}
+
+/// PATH with the `lensc` under test first, as an editor finds the server.
+fn path_with_lensc() -> std::ffi::OsString {
+    let bin = std::path::Path::new(env!("CARGO_BIN_EXE_lensc"))
+        .parent()
+        .expect("bin dir")
+        .to_path_buf();
+    std::env::join_paths(std::iter::once(bin).chain(std::env::split_paths(
+        &std::env::var_os("PATH").unwrap_or_default(),
+    )))
+    .expect("PATH")
 }
