@@ -312,18 +312,29 @@ impl<'a> Checker<'a> {
         )
         .with_label("not a kind or declaration");
         let scope = &self.scopes[file.0 as usize];
-        let mut cands: Vec<&str> = schema::KINDS.iter().map(|k| k.name).collect();
+        // As the value of a declaration (`surface s = …`), only the kinds
+        // of that category are meant; elsewhere any kind may be.
+        let category = self
+            .declaring
+            .filter(|&(_, start)| start == span.start)
+            .map(|(c, _)| c);
+        let kinds: Vec<&str> = schema::KINDS
+            .iter()
+            .filter(|k| category.is_none_or(|c| k.category == c))
+            .map(|k| k.name)
+            .collect();
+        let mut cands = kinds.clone();
         cands.extend(scope.keys().copied());
+        let listed = match category {
+            Some(c) => format!("{} is made by one of: {}", c.noun(), kinds.join(", ")),
+            None => format!("the kinds are: {}", kinds.join(", ")),
+        };
         d = d.with_help(match super::scope::known_elsewhere(scope, w, cands) {
             Some(help) => help,
-            None => format!(
-                "the kinds are: {}",
-                schema::KINDS
-                    .iter()
-                    .map(|k| k.name)
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
+            None => match kind_within(w, &kinds) {
+                Some(k) => format!("did you mean `{k}`? {listed}"),
+                None => listed,
+            },
         });
         self.err(d);
         self.block_fields(file, block, coords);
@@ -887,4 +898,18 @@ fn merge(base: &[Field], over: Vec<Field>) -> Vec<Field> {
         }
     }
     out
+}
+
+/// The longest kind name that a misspelt kind contains, or that contains
+/// it (`even_asphere` → `asphere`): names a user qualified or cut short,
+/// beyond the reach of an edit distance.
+fn kind_within<'k>(word: &str, kinds: &[&'k str]) -> Option<&'k str> {
+    let word = word.to_ascii_lowercase();
+    kinds
+        .iter()
+        .copied()
+        .filter(|k| {
+            k.len() >= 4 && word.len() >= 4 && (word.contains(k) || k.contains(word.as_str()))
+        })
+        .max_by_key(|k| k.len())
 }

@@ -94,6 +94,10 @@ struct Checker<'a> {
     /// While a formula body is evaluated: the constants it names, so that
     /// lowering can build its IR without the scopes.
     formula_constants: Option<HashMap<String, f64>>,
+    /// While a declaration's value is evaluated: the category it declares
+    /// and where its value starts, so that an unknown kind there is matched
+    /// against that category's kinds (`surface s = even_asphere { … }`).
+    declaring: Option<(schema::Category, u32)>,
 }
 
 /// Checks a loaded file set. Diagnostics from loading come first.
@@ -106,6 +110,7 @@ pub fn check(loaded: &Loaded) -> Checked {
         state: Vec::new(),
         used: Vec::new(),
         formula_constants: None,
+        declaring: None,
     };
     c.build_scopes();
     for i in 0..c.decls.len() {

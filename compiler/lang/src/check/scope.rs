@@ -224,7 +224,10 @@ impl<'a> Checker<'a> {
             self.decls[i].kind,
             self.decls[i].name,
         );
+        let outer = self.declaring.take();
+        self.declaring = kind.map(|k| (Category::of(k), expr.span.start));
         let mut v = self.eval(file, expr, &[]);
+        self.declaring = outer;
         if let Some(kind) = kind {
             v = self.expect_category(file, expr.span, v, Category::of(kind), Some((kind, name)));
             // A declared object is known by its name (a dialect is chosen by it).
@@ -351,9 +354,16 @@ impl<'a> Checker<'a> {
         } else if let Some(help) = known_elsewhere(scope, name, candidates) {
             d = d.with_help(help);
         } else if units::lookup(name).is_some() {
-            d = d.with_help(format!(
-                "`{name}` is a unit: write it right after a number, as in `1 {name}`"
-            ));
+            let text = &self.loaded.sources.get(file).text;
+            let before = text[..span.start as usize].trim_end();
+            d = d.with_help(if before.ends_with('/') {
+                // `1e-5 /mm^3`: a reciprocal unit written as a division.
+                format!(
+                    "`{name}` is a unit: write it right after the number, a unit per length with a negative power, as in `1e-5 {name}^-3`"
+                )
+            } else {
+                format!("`{name}` is a unit: write it right after a number, as in `1 {name}`")
+            });
         }
         self.err(d);
     }
