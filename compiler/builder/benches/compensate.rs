@@ -9,7 +9,8 @@
 //! registered, fitted and the corrected surface analysed), plan, write
 //! the program into a temporary directory beside the target directory
 //! (spooled and read back), then remove it. The two alternate, best of
-//! `RUNS` each, wall and CPU time.
+//! `RUNS` each, wall and CPU time. First, each job's surface kernel (the
+//! corrected one for the compensated job) is timed alone, a point.
 //!
 //! Run: cargo bench -p lensc-build --bench compensate (`COMPENSATE_RUNS=N`,
 //! default 3).
