@@ -602,3 +602,69 @@ fn run_block(dir: &Path, block: &[String]) -> usize {
     }
     ran
 }
+
+/// A slow-tool-servo spiral on a conic, 6 mm across.
+const STS: &str = "use std::machines::moore_nanotech_450fg
+use std::tools::diamond_r500um
+surface dome = conic { radius: 20 mm, conic: -1, sense: convex, aperture: circle(diameter: 6 mm) }
+strategy sts = spiral_turning { feed: 20 um/rev, spindle_speed: 50 rpm, chord_tolerance: 10 nm }
+job dome_sts { surface: dome, tool: diamond_r500um, machine: moore_nanotech_450fg, strategy: sts COMPENSATE}
+";
+
+/// The trajectory a spiral job's nose centre follows, as lowered.
+fn spiral_trajectory(dir: &Path) -> Box<dyn lensc_runtime::surface::ir::SurfaceFn + Sync> {
+    let c = driver::check_path(&RealFs, &dir.join("job.lens")).expect("checks");
+    let (spec, _) = lensc_build::pipeline::lower(&c.checked.jobs[0], None, &Default::default())
+        .unwrap_or_else(|d| panic!("lowers: {d:?}"));
+    let lensc_build::strategy::JobSpec::Spiral(s) = spec else {
+        panic!("a spiral job")
+    };
+    lensc_build::evaluate::evaluator(&s.trajectory.tape).0
+}
+
+/// A compensated spiral follows the corrected surface: its nose centre's
+/// trajectory is the design's less the measured error (here 40 nm of
+/// astigmatism, which a map correction of order 6 follows exactly), not
+/// the design's with only the program's header saying it is corrected
+/// (as it was: the trajectory was lowered again from the surface as
+/// declared, and the program cut the design).
+#[test]
+fn a_compensated_spiral_follows_the_corrected_surface() {
+    let plain = project_of(&STS.replace("COMPENSATE", ""), &[]);
+    let design = spiral_trajectory(plain.path());
+    let error = |x: f64, y: f64| 40e-6 * (x * x - y * y) / 9.0;
+    let n = 301;
+    let dx = 6.0 / (n - 1) as f64;
+    let mut z = Vec::with_capacity(n * n);
+    for j in 0..n {
+        for i in 0..n {
+            let (x, y) = (-3.0 + i as f64 * dx, -3.0 + j as f64 * dx);
+            z.push(if x.hypot(y) <= 2.98 {
+                design.eval(x, y)[0] + error(x, y)
+            } else {
+                f64::NAN
+            });
+        }
+    }
+    let part = lensc_measure::write::x3p(&HeightMap::from_heights(n, n, (dx, dx), z), "dome");
+    let block = ", compensate: { measurement: \"part.x3p\", gain: 1, smoothing: 1 mm }";
+    let compensated = project_of(&STS.replace("COMPENSATE", block), &[("part.x3p", &part)]);
+    let corrected = spiral_trajectory(compensated.path());
+    let mut worst: f64 = 0.0;
+    for (x, y) in [
+        (0.0, 0.0),
+        (2.5, 0.0),
+        (0.0, 2.5),
+        (1.5, 1.5),
+        (-2.0, 1.0),
+        (0.7, -2.6),
+    ] {
+        let taken = design.eval(x, y)[0] - corrected.eval(x, y)[0];
+        worst = worst.max((taken - error(x, y)).abs());
+    }
+    assert!(
+        worst <= 1e-6,
+        "the trajectory departs from the design less the error by up to {:.2} nm",
+        worst * 1e6
+    );
+}

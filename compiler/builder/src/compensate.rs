@@ -102,13 +102,29 @@ fn kernel(tape: &SurfaceTape) -> Box<dyn SurfaceFn + Sync> {
 /// the map's correction.
 const TURNED: [&str; 2] = ["profile_turning", "profile_grinding"];
 
-/// The surface to cut instead of `design`, and the iteration for the
-/// report; or why no correction is made.
+/// The correction a job cuts with: the fitted polynomial and the share
+/// of it taken out. Whatever else a strategy plans from the design (a
+/// spiral's settled trajectory) takes it out too (`Applied::tape`).
+#[derive(Clone, Debug)]
+pub struct Applied {
+    pub fitted: Correction,
+    pub gain: f64,
+}
+
+impl Applied {
+    /// `tape` less the correction (`corrected_tape`).
+    pub fn tape(&self, tape: &SurfaceTape) -> SurfaceTape {
+        corrected_tape(tape, &self.fitted, self.gain)
+    }
+}
+
+/// The surface to cut instead of `design`, the iteration for the report
+/// and the correction applied; or why no correction is made.
 pub(crate) fn corrected(
     p: &Of,
     design: &LoweredSurface,
     block: &Stated<CompensateParams>,
-) -> Result<(LoweredSurface, Compensation), Diagnostic> {
+) -> Result<(LoweredSurface, Compensation, Applied), Diagnostic> {
     let c = &block.value;
     let file = c.measurement.value.as_str();
     let at = |f: Failure| {
@@ -240,7 +256,11 @@ pub(crate) fn corrected(
         predicted_pv_nm: predicted_pv * 1e6,
         predicted_rms_nm: predicted_rms * 1e6,
     };
-    Ok((corrected, report))
+    let applied = Applied {
+        fitted,
+        gain: c.gain,
+    };
+    Ok((corrected, report, applied))
 }
 
 /// The program header's line for a compensated job: what is cut instead

@@ -276,6 +276,9 @@ pub struct Parts<'a> {
     /// With a `compensate` block, once `lowered` has made the correction:
     /// the design and the iteration, for the head.
     compensated: std::cell::RefCell<Option<(LoweredSurface, crate::compensate::Compensation)>>,
+    /// With a `compensate` block, once `lowered` has made it: the
+    /// correction, for whatever else a strategy plans from the design.
+    correction: std::cell::RefCell<Option<crate::compensate::Applied>>,
 }
 
 impl<'a> Parts<'a> {
@@ -335,6 +338,7 @@ impl<'a> Parts<'a> {
             path: PathParams::read(strategy),
             surface_params,
             compensated: std::cell::RefCell::new(None),
+            correction: std::cell::RefCell::new(None),
         })
     }
     pub fn site(&self) -> (FileId, Span) {
@@ -433,9 +437,15 @@ impl<'a> Parts<'a> {
                 .nose_radius
                 .or(self.tool_params.diameter.map(|d| d / 2.0)),
         };
-        let (corrected, report) = crate::compensate::corrected(&of, &design, c)?;
+        let (corrected, report, applied) = crate::compensate::corrected(&of, &design, c)?;
         *self.compensated.borrow_mut() = Some((design, report));
+        *self.correction.borrow_mut() = Some(applied);
         Ok(corrected)
+    }
+    /// The correction `lowered` made (none without a `compensate` block,
+    /// or before `lowered`).
+    pub fn correction(&self) -> Option<crate::compensate::Applied> {
+        self.correction.borrow().clone()
     }
     /// The path tolerance (mm) the machine's class holds for a strategy
     /// printing `axes` length axes (`Strategy::LENGTH_AXES`; `None`: one

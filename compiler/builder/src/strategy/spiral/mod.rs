@@ -39,8 +39,12 @@ pub struct SpiralSpec {
     pub nose_radius: f64,
     pub fast_axis: FastAxis,
     /// The surface the nose centre follows: the design, or with a
-    /// settling offset its lenslets continued and lifted over the land.
+    /// settling offset its lenslets continued and lifted over the land;
+    /// with a `compensate` block, less the correction.
     pub trajectory: LoweredSurface,
+    /// The correction of a `compensate` block, taken out of every
+    /// trajectory made from `surface_object`.
+    pub correction: Option<crate::compensate::Applied>,
     /// The fast axis's servo model (none for a slow tool servo).
     pub servo: Option<SecondOrderServo>,
     pub settling: Option<Settling>,
@@ -87,6 +91,7 @@ impl SpiralSpec {
         let (trajectory, bounds) = settled_trajectory(
             &self.surface_object,
             Some(&settling),
+            self.correction.as_ref(),
             &self.head.surface.lowered.domain,
             self.bounds.part_top,
             evaluate,
@@ -190,9 +195,11 @@ pub(crate) fn lower(
     let design_kernel = evaluate(&lowered.tape);
     let design =
         lensc_runtime::surface::analysis::analyse(design_kernel.as_ref(), &lowered.domain, 201);
+    let correction = p.correction();
     let (trajectory, bounds) = settled_trajectory(
         surface,
         settling.as_ref(),
+        correction.as_ref(),
         &lowered.domain,
         design.sag_max.value,
         evaluate,
@@ -241,6 +248,7 @@ pub(crate) fn lower(
         nose_radius: rho,
         fast_axis,
         trajectory,
+        correction,
         servo,
         settling,
         safe_w,
@@ -260,19 +268,27 @@ fn fastest(speed: SpindleSpeed, start: f64) -> f64 {
 }
 
 /// The surface the nose centre follows (the design, or with a settling
-/// offset its lenslets continued and lifted over the land) and what the
-/// planner knows of it beforehand; `part_top` is the design's highest.
+/// offset its lenslets continued and lifted over the land; less a
+/// `compensate` block's correction) and what the planner knows of it
+/// beforehand; `part_top` is the design's highest.
 fn settled_trajectory(
     surface: &Object,
     settling: Option<&Settling>,
+    correction: Option<&crate::compensate::Applied>,
     domain: &Domain,
     part_top: f64,
     evaluate: Evaluate,
 ) -> Result<(LoweredSurface, TrajectoryBounds), LowerError> {
-    let trajectory = match settling {
+    let mut trajectory = match settling {
         Some(s) => lensc_lang::lower::surface::lower_trajectory(surface, s.offset)?,
         None => lensc_lang::lower::surface::lower_surface(surface)?,
     };
+    // The trajectory is made from the surface as declared: a correction
+    // is taken out of it as out of the design (without, a compensated
+    // spiral cut the design and only its header said otherwise).
+    if let Some(c) = correction {
+        trajectory.tape = c.tape(&trajectory.tape);
+    }
     let analysis = {
         let k = evaluate(&trajectory.tape);
         lensc_runtime::surface::analysis::analyse(k.as_ref(), domain, 201)
