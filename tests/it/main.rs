@@ -47,3 +47,4 @@ mod surface_fixtures;
 mod surface_kinds;
 mod toolpaths;
 mod verification;
+mod view;

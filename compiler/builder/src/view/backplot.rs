@@ -2,8 +2,11 @@
 //! the program's text by the same reader as `lensc verify` and the build's
 //! read-back, thinned for drawing to a bounded number of segments — every
 //! rapid kept, every pass's first and last point kept, the cutting moves
-//! between them taken one in `stride` — with the counts that say how much
-//! was drawn of how much.
+//! between them kept where they lie at least `step` from the point kept
+//! before (the step doubled whenever the budget is reached, so a program
+//! of any length ends with at most `SEGMENT_BUDGET` cutting segments,
+//! spread evenly along the path) — with the counts that say how much was
+//! drawn of how much.
 
 use std::io::BufRead;
 
@@ -15,9 +18,13 @@ use crate::read_back::ReadBack;
 
 /// The most cutting segments drawn (rapids and pass ends come on top).
 pub const SEGMENT_BUDGET: usize = 200_000;
-/// The most points of a backplot whatever the program: past this the rest
-/// of the program is not drawn (and the page says so).
-pub const POINT_CAP: usize = 2 * SEGMENT_BUDGET;
+/// The most rapids drawn: past this the rest of the program is not drawn
+/// (and the page says so).
+pub const RAPID_CAP: usize = SEGMENT_BUDGET;
+/// The most revolutions of a spindle's C axis drawn: past this, one
+/// revolution in so many is drawn whole and the others left out (a
+/// spiral's revolutions lie microns apart: no screen shows them all).
+pub const REVOLUTION_CAP: usize = 400;
 /// Pieces an arc is drawn in per quarter turn.
 const ARC_PIECES_PER_QUARTER: f64 = 8.0;
 
@@ -47,9 +54,12 @@ pub struct Backplot {
     /// Moves the controller makes, as read: rapids and cutting moves.
     pub rapids: u64,
     pub feeds: u64,
-    /// Cutting moves drawn as one segment (1: every one drawn).
-    pub stride: usize,
-    /// The program was longer than `POINT_CAP` points: its rest is not
+    /// The least distance (mm) between two points kept inside a pass (0:
+    /// every point kept).
+    pub step: f64,
+    /// One revolution of the C axis drawn in this many (1: all).
+    pub revolution_stride: usize,
+    /// The program had more than `RAPID_CAP` rapids: its rest is not
     /// drawn.
     pub truncated: bool,
 }
@@ -65,11 +75,17 @@ impl Backplot {
 }
 
 /// The backplot of `program` read by `read`'s dialect and machine;
-/// `lines` (the program's, or an upper bound) sets the stride.
-pub fn read(program: &ProgramText, read: &ReadBack, lines: usize) -> std::io::Result<Backplot> {
+/// `revolutions`, the spindle revolutions its cut turns (a spiral's, from
+/// its report), if known.
+pub fn read(
+    program: &ProgramText,
+    read: &ReadBack,
+    revolutions: Option<usize>,
+) -> std::io::Result<Backplot> {
     let mut reader = Reader::new(&read.dialect, &read.machine);
     reader.keep_moves();
-    let mut thin = Thinning::new(read.machine.lathe, stride(lines));
+    let mut thin = Thinning::new(read.machine.lathe, SEGMENT_BUDGET);
+    thin.out.revolution_stride = revolutions.map_or(1, |n| n.div_ceil(REVOLUTION_CAP).max(1));
     match program {
         ProgramText::Memory(text) => {
             let mut offset = 0;
@@ -98,33 +114,37 @@ pub fn read(program: &ProgramText, read: &ReadBack, lines: usize) -> std::io::Re
     Ok(thin.finish())
 }
 
-/// Cutting moves per drawn segment for a program of `lines` lines.
-pub fn stride(lines: usize) -> usize {
-    lines.div_ceil(SEGMENT_BUDGET).max(1)
+fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
 }
 
 /// The backplot as it is gathered, move by move.
 struct Thinning {
     lathe: bool,
+    budget: usize,
     out: Backplot,
-    /// Cutting moves since the last point kept in this pass.
-    since_kept: usize,
+    /// Cutting points kept.
+    kept: usize,
     /// The last cutting move's end, if not kept (kept at the pass's end).
     pending: Option<[f64; 3]>,
     in_pass: bool,
+    /// Degrees the C axis has turned in cutting moves.
+    turned: f64,
+    /// Moves left out since the last point drawn (a revolution not drawn).
+    gap: bool,
 }
 
 impl Thinning {
-    fn new(lathe: bool, stride: usize) -> Thinning {
+    fn new(lathe: bool, budget: usize) -> Thinning {
         Thinning {
             lathe,
-            out: Backplot {
-                stride,
-                ..Backplot::default()
-            },
-            since_kept: 0,
+            budget,
+            out: Backplot::default(),
+            kept: 0,
             pending: None,
             in_pass: false,
+            turned: 0.0,
+            gap: false,
         }
     }
 
@@ -141,9 +161,8 @@ impl Thinning {
     }
 
     fn push(&mut self, p: [f64; 3], r: Reached) {
-        if self.out.points.len() >= POINT_CAP {
-            self.out.truncated = true;
-            return;
+        if r == Reached::Feed {
+            self.kept += 1;
         }
         self.out.points.push(p);
         self.out.reached.push(r);
@@ -151,6 +170,9 @@ impl Thinning {
 
     fn all(&mut self, moves: Vec<Executed>) {
         for m in moves {
+            if self.out.truncated {
+                return;
+            }
             self.one(&m);
         }
     }
@@ -160,7 +182,6 @@ impl Thinning {
             self.push(p, Reached::Feed);
         }
         self.in_pass = false;
-        self.since_kept = 0;
     }
 
     fn one(&mut self, m: &Executed) {
@@ -179,49 +200,152 @@ impl Thinning {
         match m.path {
             Path::Rapid => {
                 self.out.rapids += 1;
+                if self.out.rapids as usize > RAPID_CAP {
+                    self.out.truncated = true;
+                    return;
+                }
                 self.end_pass();
+                if std::mem::take(&mut self.gap) {
+                    self.push(from, Reached::Start);
+                }
                 self.push(to, Reached::Rapid);
             }
-            Path::Line => {
+            _ if self.left_out(m) => {
                 self.out.feeds += 1;
-                self.feed(vec![to]);
+                if !self.in_pass {
+                    self.in_pass = true;
+                    self.out
+                        .passes
+                        .push(self.out.points.len().saturating_sub(1));
+                }
+                if let Some(p) = self.pending.take() {
+                    self.push(p, Reached::Feed);
+                }
+                self.gap = true;
             }
-            Path::Arc { .. } => {
+            _ => {
                 self.out.feeds += 1;
-                let pieces = arc_points(m)
-                    .into_iter()
-                    .filter_map(|q| self.place(q.map(Some)))
-                    .collect();
-                self.feed(pieces);
+                if std::mem::take(&mut self.gap) {
+                    // The path resumes after the revolutions left out: no
+                    // line across them.
+                    self.push(from, Reached::Start);
+                }
+                let pieces: Vec<[f64; 3]> = match m.path {
+                    Path::Arc { .. } => arc_points(m),
+                    _ => turning_points(m),
+                }
+                .into_iter()
+                .filter_map(|q| self.place(q.map(Some)))
+                .collect();
+                self.feed(&pieces);
             }
         }
     }
 
+    /// Whether cutting move `m` lies in a revolution not drawn (counting
+    /// the C axis's turn).
+    fn left_out(&mut self, m: &Executed) -> bool {
+        if !self.lathe {
+            return false;
+        }
+        if let (Some(a), Some(b)) = (m.from[3], m.to[3]) {
+            self.turned += (b - a).abs();
+        }
+        let revolution = (self.turned / 360.0).floor() as usize;
+        self.out.revolution_stride > 1 && revolution % self.out.revolution_stride != 0
+    }
+
     /// One cutting move through `points` (its end last).
-    fn feed(&mut self, points: Vec<[f64; 3]>) {
+    fn feed(&mut self, points: &[[f64; 3]]) {
         if !self.in_pass {
             self.in_pass = true;
             self.out
                 .passes
                 .push(self.out.points.len().saturating_sub(1));
         }
-        self.since_kept += 1;
-        if self.since_kept >= self.out.stride {
-            self.since_kept = 0;
-            self.pending = None;
-            // A thinned run ends on an arc: its pieces, the run's last.
-            for p in points {
+        for &p in points {
+            let last = *self.out.points.last().expect("a pass starts at a point");
+            if distance(p, last) >= self.out.step {
+                self.pending = None;
                 self.push(p, Reached::Feed);
+            } else {
+                self.pending = Some(p);
             }
-        } else {
-            self.pending = points.last().copied();
         }
+        if self.kept > self.budget {
+            self.coarser();
+        }
+    }
+
+    /// Doubles the step (or sets it, the first time, so that the path
+    /// kept so far would fill half the budget) and thins the points kept
+    /// so far by it.
+    fn coarser(&mut self) {
+        let o = &mut self.out;
+        let length: f64 = (1..o.points.len())
+            .filter(|&i| o.reached[i] == Reached::Feed)
+            .map(|i| distance(o.points[i - 1], o.points[i]))
+            .sum();
+        o.step = (2.0 * o.step).max(2.0 * length / self.budget as f64);
+        let n = o.points.len();
+        let mut index = vec![usize::MAX; n];
+        let (mut points, mut reached) = (Vec::new(), Vec::new());
+        let mut kept = 0;
+        for i in 0..n {
+            let r = o.reached[i];
+            // A pass's last point is kept; so is the last point while the
+            // pass goes on (the next point is measured from it).
+            let pass_end = i + 1 == n || o.reached[i + 1] != Reached::Feed;
+            let keep = r != Reached::Feed
+                || pass_end
+                || distance(o.points[i], *points.last().expect("a start")) >= o.step;
+            if keep {
+                index[i] = points.len();
+                points.push(o.points[i]);
+                reached.push(r);
+                kept += usize::from(r == Reached::Feed);
+            }
+        }
+        for p in &mut o.passes {
+            *p = index[*p];
+        }
+        (o.points, o.reached) = (points, reached);
+        self.kept = kept;
     }
 
     fn finish(mut self) -> Backplot {
         self.end_pass();
+        if self.out.revolution_stride == 0 {
+            self.out.revolution_stride = 1;
+        }
         self.out
     }
+}
+
+/// The most degrees of C one drawn piece of a straight move turns: the
+/// controller moves every axis linearly, so a move that turns C draws a
+/// spiral arc on the part, not a chord.
+const C_PIECE_DEG: f64 = 10.0;
+
+/// Points along a straight move (machine X, Y, Z, C), its end last: one,
+/// or pieces of at most `C_PIECE_DEG` where it turns C.
+fn turning_points(m: &Executed) -> Vec<[f64; 4]> {
+    let from = m.from.map(|v| v.unwrap_or(0.0));
+    let to = m.to.map(|v| v.unwrap_or(0.0));
+    let turn = match (m.from[3], m.to[3]) {
+        (Some(a), Some(b)) => (b - a).abs(),
+        _ => 0.0,
+    };
+    let n = (turn / C_PIECE_DEG).ceil().clamp(1.0, 3600.0) as usize;
+    (1..=n)
+        .map(|k| {
+            if k == n {
+                return to;
+            }
+            let f = k as f64 / n as f64;
+            std::array::from_fn(|i| from[i] + f * (to[i] - from[i]))
+        })
+        .collect()
 }
 
 /// Points along an arc move (machine X, Y, Z, C), its end last: the
@@ -279,22 +403,22 @@ mod tests {
 
     #[test]
     fn thinning_keeps_rapids_and_pass_ends_and_bounds_the_rest() {
-        let mut t = Thinning::new(false, 10);
-        // Two passes of 95 cutting moves, each after a rapid.
+        let mut t = Thinning::new(false, 100);
+        // Two passes of 950 cutting moves 0.01 mm long, each after a rapid.
         for pass in 0..2 {
             let y = pass as f64;
             t.one(&mv([0.0, y - 1.0, 1.0], [0.0, y, 1.0], Path::Rapid));
-            for k in 0..95 {
-                let x = k as f64;
-                t.one(&mv([x, y, 0.0], [x + 1.0, y, 0.0], Path::Line));
+            for k in 0..950 {
+                let x = k as f64 * 0.01;
+                t.one(&mv([x, y, 0.0], [x + 0.01, y, 0.0], Path::Line));
             }
         }
         let b = t.finish();
-        assert_eq!((b.rapids, b.feeds), (2, 190));
+        assert_eq!((b.rapids, b.feeds), (2, 1900));
         assert_eq!(b.passes.len(), 2);
-        // Per pass: 9 points every 10 moves and the pass's last (95).
         let feeds = b.reached.iter().filter(|r| **r == Reached::Feed).count();
-        assert_eq!(feeds, 2 * 10);
+        assert!((50..=100).contains(&feeds), "{feeds} cutting points kept");
+        assert!(b.step > 0.01, "{}", b.step);
         let rapids = b.reached.iter().filter(|r| **r == Reached::Rapid).count();
         assert_eq!(rapids, 2);
         // Each pass ends where its last move ends.
@@ -303,11 +427,86 @@ mod tests {
             .iter()
             .rposition(|r| *r == Reached::Rapid)
             .unwrap();
-        assert_eq!(b.points[rapid_at - 1], [95.0, 0.0, 0.0]);
-        assert_eq!(*b.points.last().unwrap(), [95.0, 1.0, 0.0]);
+        assert!((b.points[rapid_at - 1][0] - 9.5).abs() < 1e-9);
+        assert!((b.points.last().unwrap()[0] - 9.5).abs() < 1e-9);
         // A pass starts at the rapid's end.
         assert_eq!(b.points[b.passes[1]], [0.0, 1.0, 1.0]);
+        assert_eq!(b.points[b.passes[0]], [0.0, 0.0, 1.0]);
+        // Evenly: no two cutting points in a pass closer than the step,
+        // but for a pass's last.
+        for i in 1..b.points.len() - 1 {
+            if b.reached[i] == Reached::Feed && b.reached[i + 1] == Reached::Feed {
+                assert!(distance(b.points[i - 1], b.points[i]) >= b.step - 1e-12);
+            }
+        }
         assert!(!b.truncated);
+    }
+
+    #[test]
+    fn a_spiral_is_drawn_one_revolution_in_so_many_with_no_line_across_the_rest() {
+        let mut t = Thinning::new(true, 1000);
+        t.out.revolution_stride = 3;
+        // Ten revolutions of 36 moves of 10°, the radius falling 0.01 mm
+        // a revolution.
+        let at = |k: usize| {
+            let c = 10.0 * k as f64;
+            [Some(1.0 - c / 36_000.0), Some(0.0), Some(0.0), Some(c)]
+        };
+        for k in 0..360 {
+            t.one(&Executed {
+                from: at(k),
+                to: at(k + 1),
+                path: Path::Line,
+            });
+        }
+        let b = t.finish();
+        assert_eq!(b.feeds, 360);
+        // Revolutions 0, 3, 6 and 9 drawn (the first move of each starts
+        // it after a gap, but the very first).
+        let starts = b.reached.iter().filter(|r| **r == Reached::Start).count();
+        assert_eq!(starts, 4);
+        // Revolution 0 ends a move early (its 36th move completes the
+        // turn), 3, 6 and 9 have 36 moves each.
+        assert_eq!(b.segments(), 4 * 36 - 1);
+        // No segment longer than a 10° chord of the unit circle.
+        for i in 1..b.points.len() {
+            if b.reached[i] == Reached::Feed {
+                assert!(distance(b.points[i - 1], b.points[i]) < 0.18, "{i}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_move_that_turns_c_is_drawn_round_the_spindle() {
+        // One revolution at X 2 in one straight move, as a spiral's first
+        // moves are written (`G1 X.. C360.`).
+        let mut t = Thinning::new(true, 1000);
+        t.one(&Executed {
+            from: [Some(2.0), None, Some(0.0), Some(0.0)],
+            to: [Some(2.0), None, Some(0.0), Some(360.0)],
+            path: Path::Line,
+        });
+        let b = t.finish();
+        assert_eq!(b.segments(), 36);
+        for p in &b.points {
+            assert!((p[0].hypot(p[1]) - 2.0).abs() < 1e-12, "{p:?}");
+        }
+        let far = b.points.iter().map(|p| p[0]).fold(f64::INFINITY, f64::min);
+        assert!((far + 2.0).abs() < 1e-12, "reaches the far side: {far}");
+    }
+
+    #[test]
+    fn a_short_program_is_drawn_whole() {
+        let mut t = Thinning::new(false, 100);
+        t.one(&mv([0.0, 0.0, 1.0], [0.0, 0.0, 0.0], Path::Rapid));
+        for k in 0..10 {
+            let x = k as f64;
+            t.one(&mv([x, 0.0, 0.0], [x + 1.0, 0.0, 0.0], Path::Line));
+        }
+        let b = t.finish();
+        assert_eq!(b.step, 0.0);
+        assert_eq!(b.points.len(), 12);
+        assert_eq!(b.segments(), 11);
     }
 
     #[test]
@@ -329,12 +528,5 @@ mod tests {
             assert!((p[0].hypot(p[2]) - 1.0).abs() < 1e-12, "{p:?}");
         }
         assert_eq!(*pts.last().unwrap(), [0.0, 0.0, 1.0, 0.0]);
-    }
-
-    #[test]
-    fn the_stride_holds_the_budget() {
-        assert_eq!(stride(10), 1);
-        assert_eq!(stride(SEGMENT_BUDGET), 1);
-        assert_eq!(stride(11_000_000), 55);
     }
 }

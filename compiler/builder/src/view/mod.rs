@@ -190,7 +190,8 @@ fn path_data(p: &Backplot, lathe: bool) -> Value {
         "passes": p.passes,
         "rapids": p.rapids,
         "feeds": p.feeds,
-        "stride": p.stride,
+        "step_mm": p.step,
+        "revolution_stride": p.revolution_stride,
         "truncated": p.truncated,
         "segments": p.segments(),
     })

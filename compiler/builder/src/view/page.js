@@ -50,6 +50,10 @@ function duration(s) {
   return parts.join(" ");
 }
 
+function plural(n, word) {
+  return n.toLocaleString("en") + " " + word + (n === 1 ? "" : "s");
+}
+
 function unitText(u) {
   return { nm: "nm", mm2: "mm²", fraction: "of the area", s: "s" }[u] || u;
 }
@@ -430,13 +434,17 @@ function setup() {
   const drawn = P.segments, made = P.rapids + P.feeds;
   $("thinning").textContent =
     "The program as the controller reads it (the reader of lensc verify): " + made.toLocaleString("en") + " moves (" +
-    P.rapids.toLocaleString("en") + " rapids, " + P.feeds.toLocaleString("en") + " cutting moves), " +
-    (P.stride > 1
-      ? "drawn as " + drawn.toLocaleString("en") + " segments: every rapid and every pass's first and last point kept, the cutting moves between them one in " + P.stride + "."
+    plural(P.rapids, "rapid") + ", " + plural(P.feeds, "cutting move") + "), " +
+    (P.revolution_stride > 1
+      ? "one spindle revolution in " + P.revolution_stride + " drawn (the others lie between them, microns apart), "
+      : "") +
+    (P.step_mm > 0
+      ? "drawn as " + drawn.toLocaleString("en") + " segments: every rapid and every pass's first and last point kept, the cutting moves between them thinned to points at least " +
+        sig(1000 * P.step_mm, 3) + " µm apart along the path."
       : "every one drawn (" + drawn.toLocaleString("en") + " segments, arcs in short pieces).") +
     (P.truncated ? " The program is longer than the page draws: its end is not shown." : "") +
     " Coordinates as programmed" + (P.lathe ? " (X a radius, turned by C)." : ".");
-  status.moves = { rapids: P.rapids, feeds: P.feeds, stride: P.stride, truncated: P.truncated, points: npoints, passes: passes.length };
+  status.moves = { rapids: P.rapids, feeds: P.feeds, step_mm: P.step_mm, revolution_stride: P.revolution_stride, truncated: P.truncated, points: npoints, passes: passes.length };
   labels();
   drawScale();
 }

@@ -60,7 +60,7 @@ pub fn run(
             reporter.done(false);
             return 1;
         };
-        let path = match view::backplot::read(&b.program, read, b.program.lines()) {
+        let path = match view::backplot::read(&b.program, read, revolutions(&b.report)) {
             Ok(p) => p,
             Err(e) => {
                 eprintln!("error: job `{name}`: cannot read its program back: {e}");
@@ -87,8 +87,8 @@ pub fn run(
         }
         reporter.wrote(&job, page.len() as u64, page.len() as u64);
         reporter.written(&job, 1, page.len() as u64);
-        let thinned = if path.stride > 1 {
-            format!(", one cutting move in {}", path.stride)
+        let thinned = if path.step > 0.0 {
+            format!(", thinned to points {:.3} mm apart", path.step)
         } else {
             String::new()
         };
@@ -102,4 +102,12 @@ pub fn run(
     }
     reporter.done(code == 0);
     code
+}
+
+/// The spindle revolutions a job's cut turns, where its report gives them
+/// (a spiral's).
+fn revolutions(report: &lensc_build::report::Report) -> Option<usize> {
+    report.to_json()["toolpath"]["revolutions"]
+        .as_u64()
+        .map(|n| n as usize)
 }
