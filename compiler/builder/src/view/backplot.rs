@@ -252,7 +252,7 @@ impl Thinning {
             self.turned += (b - a).abs();
         }
         let revolution = (self.turned / 360.0).floor() as usize;
-        self.out.revolution_stride > 1 && revolution % self.out.revolution_stride != 0
+        self.out.revolution_stride > 1 && !revolution.is_multiple_of(self.out.revolution_stride)
     }
 
     /// One cutting move through `points` (its end last).
@@ -291,7 +291,7 @@ impl Thinning {
         let mut index = vec![usize::MAX; n];
         let (mut points, mut reached) = (Vec::new(), Vec::new());
         let mut kept = 0;
-        for i in 0..n {
+        for (i, slot) in index.iter_mut().enumerate() {
             let r = o.reached[i];
             // A pass's last point is kept; so is the last point while the
             // pass goes on (the next point is measured from it).
@@ -300,7 +300,7 @@ impl Thinning {
                 || pass_end
                 || distance(o.points[i], *points.last().expect("a start")) >= o.step;
             if keep {
-                index[i] = points.len();
+                *slot = points.len();
                 points.push(o.points[i]);
                 reached.push(r);
                 kept += usize::from(r == Reached::Feed);
@@ -325,7 +325,7 @@ impl Thinning {
 /// The most degrees of C one drawn piece of a straight move turns: the
 /// controller moves every axis linearly, so a move that turns C draws a
 /// spiral arc on the part, not a chord.
-const C_PIECE_DEG: f64 = 10.0;
+const C_PIECE_DEG: f64 = 3.0;
 
 /// Points along a straight move (machine X, Y, Z, C), its end last: one,
 /// or pieces of at most `C_PIECE_DEG` where it turns C.
@@ -487,7 +487,7 @@ mod tests {
             path: Path::Line,
         });
         let b = t.finish();
-        assert_eq!(b.segments(), 36);
+        assert_eq!(b.segments(), 120);
         for p in &b.points {
             assert!((p[0].hypot(p[1]) - 2.0).abs() < 1e-12, "{p:?}");
         }

@@ -221,6 +221,10 @@ enum Map {
         /// Base64 of little-endian f32s, NaN where there is none.
         error_nm: String,
         design: String,
+        /// Base64 of one byte per block: 1 where it holds a cell of the
+        /// part the program leaves uncut (drawn as uncut).
+        uncut: String,
+        uncut_blocks: usize,
         x_axis: &'static str,
         y_axis: &'static str,
         flat: bool,
@@ -298,7 +302,7 @@ fn blocks(f: &FormErrorSeries, design: Option<&dyn SurfaceFn>) -> Map {
             (0..xs.len())
                 .map(|i| {
                     let z = out[6 * i];
-                    if z.is_finite() && !r.cells[i].is_nan() {
+                    if z.is_finite() && (!r.cells[i].is_nan() || r.uncut[i]) {
                         z as f32
                     } else {
                         f32::NAN
@@ -317,6 +321,8 @@ fn blocks(f: &FormErrorSeries, design: Option<&dyn SurfaceFn>) -> Map {
         ny: r.ny,
         error_nm: f32s(&errors),
         design: f32s(&heights),
+        uncut: base64(&r.uncut.iter().map(|&u| u8::from(u)).collect::<Vec<u8>>()),
+        uncut_blocks: r.uncut.iter().filter(|u| **u).count(),
         x_axis: f.x_axis,
         y_axis: f.y_axis,
         flat: design.is_none(),

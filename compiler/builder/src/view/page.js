@@ -157,6 +157,8 @@ function colour(t) {
   return "rgb(" + [0, 1, 2].map((k) => Math.round(a[k] + f * (b[k] - a[k]))).join(",") + ")";
 }
 
+const UNCUT = "rgb(150,150,150)";
+
 // The error map as quads: four corners (x, y, z) and the error (nm).
 const quads = [];
 let mapRange = null;
@@ -191,8 +193,16 @@ function buildMap() {
   } else {
     const b = M.block;
     const err = new Float32Array(decode(M.error_nm).buffer), design = new Float32Array(decode(M.design).buffer);
+    const uncut = decode(M.uncut);
     const z = (k) => (M.flat ? 0 : design[k]);
-    const ok = (k) => !isNaN(err[k]) && !isNaN(z(k));
+    const ok = (k) => !isNaN(err[k]) && !isNaN(z(k)) && !uncut[k];
+    // A block holding an uncut cell of the part is drawn grey, whatever
+    // else it holds.
+    for (let k = 0; k < uncut.length; k++) {
+      if (!uncut[k] || isNaN(z(k))) continue;
+      const x0 = M.x0 + (k % M.nx) * b, y0 = M.y0 + Math.floor(k / M.nx) * b;
+      quads.push({ c: [x0, y0, z(k), x0 + b, y0, z(k), x0 + b, y0 + b, z(k), x0, y0 + b, z(k)], e: null });
+    }
     let cells = 0;
     for (let k = 0; k < err.length; k++) {
       if (!ok(k)) continue;
@@ -222,7 +232,8 @@ function buildMap() {
       M.nx + " × " + M.ny + " blocks " + sig(1000 * b, 3) + " µm square (" + cells.toLocaleString("en") +
       " hold cut cells), each the error of largest magnitude among the grid cells in it" +
       (M.flat ? "; drawn flat at z = 0 in " + M.x_axis + " and " + M.y_axis + " (the part unrolled)." : ", drawn at the design's height at its centre.") +
-      " Blocks with no cut cell are not drawn.";
+      " Blocks with no cell of the part are not drawn" +
+      (M.uncut_blocks > 0 ? "; grey: the " + M.uncut_blocks + " blocks holding a cell of the part the program leaves uncut." : "; nothing of the part is left uncut.");
   }
   if (lo > hi) return;
   if (lo === hi) {
@@ -317,7 +328,7 @@ function draw() {
         if (k === 0) ctx.moveTo(p[0], p[1]); else ctx.lineTo(p[0], p[1]);
       }
       ctx.closePath();
-      const c = colour((q.e - lo) / (hi - lo));
+      const c = q.e === null ? UNCUT : colour((q.e - lo) / (hi - lo));
       ctx.fillStyle = c;
       ctx.strokeStyle = c;
       ctx.lineWidth = 0.6;
@@ -348,9 +359,9 @@ function draw() {
     }
     // Many passes are drawn thin and see-through, so the map shows
     // between them.
-    const dense = passes.length > 50;
-    ctx.lineWidth = dense ? 0.7 : 1.5;
-    ctx.strokeStyle = "rgba(214,39,40," + (pass > 0 ? 0.2 : dense ? 0.45 : 1) + ")";
+    const dense = passes.length > 50 || P.revolution_stride > 1 || npoints > 20000;
+    ctx.lineWidth = dense ? 0.6 : 1.5;
+    ctx.strokeStyle = "rgba(214,39,40," + (pass > 0 ? 0.2 : dense ? 0.3 : 1) + ")";
     ctx.stroke(feed);
     ctx.setLineDash([5, 4]);
     ctx.lineWidth = dense ? 0.6 : 1;
