@@ -466,8 +466,9 @@ mod tests {
         let starts = b.reached.iter().filter(|r| **r == Reached::Start).count();
         assert_eq!(starts, 4);
         // Revolution 0 ends a move early (its 36th move completes the
-        // turn), 3, 6 and 9 have 36 moves each.
-        assert_eq!(b.segments(), 4 * 36 - 1);
+        // turn), 3, 6 and 9 have 36 moves each; each 10° move is drawn
+        // in four pieces of at most `C_PIECE_DEG`.
+        assert_eq!(b.segments(), 4 * (4 * 36 - 1));
         // No segment longer than a 10° chord of the unit circle.
         for i in 1..b.points.len() {
             if b.reached[i] == Reached::Feed {
