@@ -48,3 +48,4 @@ mod surface_fixtures;
 mod surface_kinds;
 mod toolpaths;
 mod verification;
+mod view;

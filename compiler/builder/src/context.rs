@@ -112,6 +112,7 @@ pub(crate) fn built(
         cutting_time,
         plots,
         warnings: Vec::new(),
+        read_back: None,
     }
 }
 

@@ -31,3 +31,4 @@ pub mod setup_sheet;
 pub(crate) mod spool;
 pub mod strategy;
 pub mod temps;
+pub mod view;

@@ -43,6 +43,9 @@ pub struct Built {
     pub plots: crate::plots::PlotSeries,
     /// Warnings the build found (the job still built).
     pub warnings: Vec<Diagnostic>,
+    /// The dialect and machine its program was read back by, when it was
+    /// (`lensc view` reads its moves by the same).
+    pub read_back: Option<crate::read_back::ReadBack>,
 }
 
 /// A program's text: in memory, or spooled as it was written to a

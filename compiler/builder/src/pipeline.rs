@@ -326,6 +326,7 @@ fn build_job(
         phase(Phase::ReadingBack, Some(&est));
         read_back(job, &spec, &mut b)?;
     }
+    b.read_back = read;
     b.report.estimate = (&est).into();
     b.warnings.extend(crate::plausibility::cutting_time_warning(
         spec.head(),

@@ -536,10 +536,19 @@ fn level(e: f64, lo: f64, hi: f64) -> usize {
 fn form_error_caption(f: &FormErrorSeries, lo: f64, hi: f64) -> String {
     let r = &f.raster;
     let cut_blocks = r.cells.iter().filter(|e| !e.is_nan()).count();
+    let uncut_blocks = r.uncut.iter().filter(|u| **u).count();
+    let uncut = if uncut_blocks == 0 {
+        "Nothing of the part is left uncut.".to_string()
+    } else {
+        format!(
+            "Grey: the {uncut_blocks} block{} holding a cell of the part the program leaves uncut (drawn as uncut whatever else they hold).",
+            if uncut_blocks == 1 { "" } else { "s" }
+        )
+    };
     format!(
         "The form error of the simulated cut, cut − design, in nm (positive where material is left, negative a gouge) over the simulation window x {wx0} .. {wx1} mm, y {wy0} .. {wy1} mm (grid spacing {sp} µm). \
          Shown on {nx} × {ny} blocks {b} µm square; each block holds the error of largest magnitude (sign kept) among the grid cells in it, so every peak is kept. \
-         White: no cut cell (outside the window, the surface or its lenslets); {cut_blocks} blocks hold cut cells. Colours in {levels} steps from {lo} to {hi} nm, the least and largest block values.",
+         White: no cell of the part (outside the window, the surface or its lenslets); {cut_blocks} blocks hold cut cells. {uncut} Colours in {levels} steps from {lo} to {hi} nm, the least and largest block values.",
         wx0 = num(f.window.0.0, 4),
         wx1 = num(f.window.0.1, 4),
         wy0 = num(f.window.1.0, 4),
@@ -563,14 +572,21 @@ fn level_runs(r: &ErrorRaster, lo_nm: f64, hi_nm: f64) -> Vec<Rectangle<(f64, f6
         let row = &r.cells[by * r.nx..(by + 1) * r.nx];
         let mut bx = 0;
         while bx < r.nx {
+            let uncut = &r.uncut[by * r.nx..(by + 1) * r.nx];
             let e = row[bx];
-            if e.is_nan() {
+            // An uncut block is drawn as uncut (`uncut_runs`), whatever
+            // else it holds.
+            if e.is_nan() || uncut[bx] {
                 bx += 1;
                 continue;
             }
             let k = level(e * 1e6, lo_nm, hi_nm);
             let mut end = bx + 1;
-            while end < r.nx && !row[end].is_nan() && level(row[end] * 1e6, lo_nm, hi_nm) == k {
+            while end < r.nx
+                && !row[end].is_nan()
+                && !uncut[end]
+                && level(row[end] * 1e6, lo_nm, hi_nm) == k
+            {
                 end += 1;
             }
             let yb = y0 + by as f64 * r.block;
@@ -580,6 +596,40 @@ fn level_runs(r: &ErrorRaster, lo_nm: f64, hi_nm: f64) -> Vec<Rectangle<(f64, f6
                     (x0 + end as f64 * r.block, yb + r.block),
                 ],
                 level_colour(k).filled(),
+            ));
+            bx = end;
+        }
+    }
+    rects
+}
+
+/// The colour of a block the program leaves uncut: a grey no level of
+/// the viridis scale comes near.
+const UNCUT: RGBColor = RGBColor(150, 150, 150);
+
+/// The blocks holding an uncut cell of the part as rectangles, runs along
+/// each row of blocks.
+fn uncut_runs(r: &ErrorRaster) -> Vec<Rectangle<(f64, f64)>> {
+    let mut rects = Vec::new();
+    for by in 0..r.ny {
+        let row = &r.uncut[by * r.nx..(by + 1) * r.nx];
+        let mut bx = 0;
+        while bx < r.nx {
+            if !row[bx] {
+                bx += 1;
+                continue;
+            }
+            let mut end = bx + 1;
+            while end < r.nx && row[end] {
+                end += 1;
+            }
+            let yb = r.y.0 + by as f64 * r.block;
+            rects.push(Rectangle::new(
+                [
+                    (r.x.0 + bx as f64 * r.block, yb),
+                    (r.x.0 + end as f64 * r.block, yb + r.block),
+                ],
+                UNCUT.filled(),
             ));
             bx = end;
         }
@@ -709,6 +759,15 @@ fn error_map_svg(
         chart
             .draw_series(level_runs(r, lo_nm, hi_nm))
             .map_err(err)?;
+        let uncut = uncut_runs(r);
+        if !uncut.is_empty() {
+            chart
+                .draw_series(uncut)
+                .map_err(err)?
+                .label("uncut: a cell of the part the program does not cut")
+                .legend(|(x, y)| Rectangle::new([(x, y - 6), (x + 24, y + 6)], UNCUT.filled()));
+            legend(&mut chart)?;
+        }
         // The scale: every level, labelled in nm.
         let bar_area = plot.clone().shrink((map_w + 10, 0), (170u32, map_h));
         draw_colour_scale(&bar_area, (lo_nm, hi_nm), (margin, bottom), scale)?;
@@ -804,6 +863,41 @@ mod tests {
         let flat: Vec<(f64, f64)> = (0..10).map(|i| (i as f64, 1.0)).collect();
         assert_eq!(decimate(&flat, 2).0, vec![(0.0, 1.0), (9.0, 1.0)]);
         assert_eq!(decimate(&flat, 10), (flat.clone(), 1));
+    }
+
+    /// A 4 × 4 map with every block cut, the one at (1, 1) holding an
+    /// uncut cell as well when `uncut`.
+    fn small_map(uncut: bool) -> FormErrorSeries {
+        let mut r = ErrorRaster {
+            x: (0.0, 0.4),
+            y: (0.0, 0.4),
+            block: 0.1,
+            nx: 4,
+            ny: 4,
+            cells: (0..16).map(|k| 1e-6 * k as f64).collect(),
+            uncut: vec![false; 16],
+        };
+        r.uncut[5] = uncut;
+        FormErrorSeries {
+            raster: r,
+            window: ((0.0, 0.4), (0.0, 0.4)),
+            spacing: 0.01,
+            x_axis: "x (mm)",
+            y_axis: "y (mm)",
+        }
+    }
+
+    #[test]
+    fn uncut_area_is_drawn_as_uncut_with_its_legend() {
+        let grey = "#969696";
+        let with = form_error_svg("j", &small_map(true)).expect("svg");
+        assert!(with.contains("uncut: a cell of the part"), "no legend");
+        assert!(with.contains(&format!("fill=\"{grey}\"")), "no grey block");
+        assert!(with.contains("Grey: the 1 block holding"), "caption");
+        let without = form_error_svg("j", &small_map(false)).expect("svg");
+        assert!(!without.contains("uncut: a cell"));
+        assert!(!without.contains(&format!("fill=\"{grey}\"")));
+        assert!(without.contains("Nothing of the part is left uncut."));
     }
 
     #[test]

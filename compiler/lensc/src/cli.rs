@@ -136,6 +136,34 @@ pub enum Command {
         #[arg(long, short)]
         quiet: bool,
     },
+    /// Build a file's jobs as `build` does and write one self-contained
+    /// HTML page per job (`JOB.view.html`, opens offline): the program's
+    /// backplot in 3-D as the controller reads it (rapids and cutting
+    /// moves apart, passes selectable; a long program thinned for drawing,
+    /// and the page says how), the simulated form error over the whole
+    /// part on the design surface, the acceptance figures and the set-up,
+    /// from the build's report. Writes no program (use `build`); a part
+    /// that misses its criteria is viewed all the same, with its verdict;
+    /// nothing is written if any job fails to build.
+    View {
+        /// The .lens file to view.
+        file: PathBuf,
+        /// View only this job.
+        #[arg(long)]
+        job: Option<String>,
+        /// Directory for the pages.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+        /// The largest program to write, in bytes or with a unit (`500MB`,
+        /// `4GB`, `2GiB`): a job whose program is estimated larger is
+        /// refused before it is planned.
+        #[arg(long, value_name = "SIZE", default_value = "4GB", value_parser = parse_size)]
+        max_program_size: u64,
+        /// No progress: neither the bar a terminal shows nor the JSON
+        /// progress events of `--message-format json`.
+        #[arg(long, short)]
+        quiet: bool,
+    },
     /// Analyse a surface over its aperture: sag range, slopes and radii of
     /// curvature with where they occur, as JSON on stdout.
     Analyse {

@@ -126,6 +126,13 @@ fn run(cli: Cli) -> u8 {
             max_program_size,
             quiet,
         } => commands::report::run(&out, &file, job.as_deref(), &dir, max_program_size, quiet),
+        Command::View {
+            file,
+            job,
+            out: dir,
+            max_program_size,
+            quiet,
+        } => commands::view::run(&out, &file, job.as_deref(), &dir, max_program_size, quiet),
         Command::Build {
             file,
             job,

@@ -313,6 +313,22 @@ impl Reader {
         self.state.fast_on = on;
     }
 
+    /// Keeps the moves the controller makes from here on, to be taken by
+    /// [`Reader::take_moves`] as the program is read (a program of
+    /// millions of lines is never held whole, nor its moves).
+    pub fn keep_moves(&mut self) {
+        self.state.moves.get_or_insert_with(Vec::new);
+    }
+
+    /// The moves made since the last call (none unless `keep_moves`).
+    pub fn take_moves(&mut self) -> Vec<Executed> {
+        self.state
+            .moves
+            .as_mut()
+            .map(std::mem::take)
+            .unwrap_or_default()
+    }
+
     /// Reads every line of `text`, which starts at byte `offset` of the
     /// program, as `line` would be given each (the pieces
     /// `split_inclusive('\n')` makes: a last line without its break is

@@ -263,7 +263,7 @@ impl Sweep {
         feature: &dyn Fn(usize) -> usize,
         layout: &RasterLayout,
         parallel: bool,
-    ) -> (Totals, Vec<(usize, f64)>) {
+    ) -> TileBlocks {
         let g = self.grid;
         let columns = if parallel {
             self.columns(frame)
@@ -296,10 +296,11 @@ fn finish_columns(
     frame: &dyn Frame,
     feature: &dyn Fn(usize) -> usize,
     layout: &RasterLayout,
-) -> (Totals, Vec<(usize, f64)>) {
+) -> TileBlocks {
     let totals = Totals::gather(g, columns, frame, feature);
     // Each block's worst, the first of equals in column order.
     let mut worst: std::collections::BTreeMap<usize, f64> = Default::default();
+    let mut uncut = std::collections::BTreeSet::new();
     for (j, c) in columns.iter().enumerate() {
         for (i, &e) in c.errors.iter().enumerate() {
             if let Some(b) = layout.block(frame, g.s(j), g.u(i), e) {
@@ -307,10 +308,30 @@ fn finish_columns(
                 if e.abs() > w.abs() {
                     *w = e;
                 }
+            } else if e.is_nan()
+                && uncut_part_cell(frame, g.s(j), g.u(i))
+                && let Some(b) = layout.block_of(frame, g.s(j), g.u(i))
+            {
+                uncut.insert(b);
             }
         }
     }
-    (totals, worst.into_iter().collect())
+    (
+        totals,
+        worst.into_iter().collect(),
+        uncut.into_iter().collect(),
+    )
+}
+
+/// A tile's totals, its blocks' worst errors and its blocks that hold an
+/// uncut cell of the part.
+pub(crate) type TileBlocks = (Totals, Vec<(usize, f64)>, Vec<usize>);
+
+/// Whether the cell at (s, u), which no pass cut, is part of the part:
+/// in the window and its features (what the totals count as uncut).
+fn uncut_part_cell(frame: &dyn Frame, s: f64, u: f64) -> bool {
+    let (x, y) = frame.xy(s, u);
+    frame.inside(x, y) && in_features(frame.features(), x, y)
 }
 
 /// The height on the minor arc from `a` to `b` about `o` at `s` (between
@@ -647,6 +668,10 @@ pub struct ErrorRaster {
     /// Row by row from `y.0`: the error (mm) of the largest magnitude in
     /// each block; NaN where no cut cell falls.
     pub cells: Vec<f64>,
+    /// Row by row as `cells`: the blocks holding a cell of the part (in
+    /// the window and its features) that the program leaves uncut — a
+    /// plot draws them as uncut, whatever else they hold.
+    pub uncut: Vec<bool>,
 }
 
 /// The blocks of an [`ErrorRaster`], before any cell is placed in them
@@ -709,6 +734,11 @@ impl RasterLayout {
         Some(by * self.nx + bx)
     }
 
+    /// The block (row by row) any cell at (s, u) falls in, cut or not.
+    fn block_of(&self, frame: &dyn Frame, s: f64, u: f64) -> Option<usize> {
+        self.block(frame, s, u, 0.0)
+    }
+
     /// The raster of these blocks holding `cells` (row by row).
     pub fn raster(&self, cells: Vec<f64>) -> ErrorRaster {
         ErrorRaster {
@@ -717,6 +747,7 @@ impl RasterLayout {
             block: self.block,
             nx: self.nx,
             ny: self.ny,
+            uncut: vec![false; cells.len()],
             cells,
         }
     }
@@ -1064,6 +1095,7 @@ impl HeightMap {
     ) -> ErrorRaster {
         let layout = RasterLayout::new(x, y, min_block, max_side);
         let mut cells = vec![f64::NAN; layout.nx * layout.ny];
+        let mut uncut = vec![false; cells.len()];
         let g = &self.grid;
         for j in 0..g.ns {
             let s = g.s(j);
@@ -1074,10 +1106,18 @@ impl HeightMap {
                     if c.is_nan() || e.abs() > c.abs() {
                         *c = e;
                     }
+                } else if e.is_nan()
+                    && uncut_part_cell(frame, s, g.u(i))
+                    && let Some(b) = layout.block_of(frame, s, g.u(i))
+                {
+                    uncut[b] = true;
                 }
             }
         }
-        layout.raster(cells)
+        ErrorRaster {
+            uncut,
+            ..layout.raster(cells)
+        }
     }
 
     /// The scallop a round nose of radius `r` leaves between passes `step`

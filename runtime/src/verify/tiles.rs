@@ -260,7 +260,7 @@ pub fn simulate(
     layout: RasterLayout,
 ) -> TiledMap {
     let nose_radius = cutter.radius();
-    let results: Vec<(Totals, Vec<(usize, f64)>)> = tiles
+    let results: Vec<super::heightmap::TileBlocks> = tiles
         .par_iter()
         .map(|tile| {
             let g = tile.grid;
@@ -288,7 +288,8 @@ pub fn simulate(
         .collect();
     let mut totals = Totals::default();
     let mut cells = vec![f64::NAN; layout.len()];
-    for (t, blocks) in &results {
+    let mut uncut = vec![false; layout.len()];
+    for (t, blocks, uncut_blocks) in &results {
         totals.merge(t);
         for &(b, e) in blocks {
             let c = &mut cells[b];
@@ -296,12 +297,18 @@ pub fn simulate(
                 *c = e;
             }
         }
+        for &b in uncut_blocks {
+            uncut[b] = true;
+        }
     }
     let mut map = HeightMap::of(grid, nose_radius, totals, frame.features(), Vec::new());
     map.tiles = tiles.len();
     TiledMap {
         map,
-        raster: layout.raster(cells),
+        raster: ErrorRaster {
+            uncut,
+            ..layout.raster(cells)
+        },
     }
 }
 

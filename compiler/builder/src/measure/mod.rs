@@ -249,6 +249,8 @@ fn raster(pts: &[[f64; 3]], e: &[f64], pixel: Option<f64>) -> ErrorRaster {
         block,
         nx,
         ny,
+        // A measurement has no uncut area: only points or none.
+        uncut: vec![false; cells.len()],
         cells,
     }
 }

@@ -12,3 +12,4 @@ pub mod measure;
 pub mod report;
 pub mod sample;
 pub mod verify;
+pub mod view;

@@ -16,7 +16,7 @@
 
 use rayon::prelude::*;
 
-use super::{Column, Frame, Grid, NosePath, RasterLayout, Totals, band, in_features};
+use super::{Column, Frame, Grid, NosePath, RasterLayout, band, in_features};
 
 /// One straight or circular piece of the path: its ends (s, u, h), the
 /// arc's centre (s, h) if it is one, and its pass (the step-over
@@ -299,7 +299,7 @@ impl BallSweep {
         feature: &dyn Fn(usize) -> usize,
         layout: &RasterLayout,
         parallel: bool,
-    ) -> (Totals, Vec<(usize, f64)>) {
+    ) -> super::TileBlocks {
         let g = self.grid;
         let one = |(j, list): (usize, &Vec<u32>)| self.column(j, list, frame);
         let columns: Vec<Column> = if parallel {
@@ -842,7 +842,7 @@ mod tests {
                 sweep = sweep.brute();
             }
             swept(&mut sweep, r);
-            let (totals, blocks) = sweep.finish_tile(&Cubic, &|f| f, &layout, false);
+            let (totals, blocks, _) = sweep.finish_tile(&Cubic, &|f| f, &layout, false);
             (
                 super::super::HeightMap::of(g, r, totals, &[], Vec::new()),
                 blocks,

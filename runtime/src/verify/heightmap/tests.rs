@@ -136,6 +136,11 @@ fn a_raster_keeps_each_blocks_worst_error_and_its_sign() {
         }
     }
     assert_eq!(r.range().map(|r| r.0), Some(-5e-3));
+    // The uncut cell of the part marks its block as uncut (issue #32: a
+    // plot draws it so), and only that block.
+    assert_eq!(r.uncut.len(), 100);
+    assert!(r.uncut[0]);
+    assert_eq!(r.uncut.iter().filter(|u| **u).count(), 1);
     // Cells on the far edge of the raster fall in its last blocks.
     let edge = map.raster(&frame, (0.0, 0.0995), (0.0, 0.0995), 0.0, 10);
     assert_eq!((edge.nx, edge.ny), (10, 10));

@@ -150,6 +150,7 @@ fn tiles_give_the_one_grids_figures() {
     );
     let bits = |c: &[f64]| c.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
     assert_eq!(bits(&t.raster.cells), bits(&r.cells));
+    assert_eq!(t.raster.uncut, r.uncut);
 }
 
 type ErrorFiguresXY = crate::verify::heightmap::ErrorFigures;
