@@ -4,6 +4,8 @@
 # another, each on both cores (`--jobs 2`) for its share of the time, with
 # a fresh seed each, printing each target's inputs, inputs/s and totals and
 # the seeds to replay from. Failing inputs are saved in fuzz/crashes/.
+# With --lensc, one in 50 `.lens` inputs of check and build also runs
+# through the release `lensc` binary end to end (exit codes, output files).
 #
 #   fuzz/campaign.sh [SECONDS]     # default 3600: an hour in all
 #
@@ -31,7 +33,7 @@ for entry in $plan; do
         --lensc "$lensc" 2>&1 | tee "$log"
     rc=${PIPESTATUS[0]}
     [ "$rc" -ne 0 ] && status=1
-    summary+="$target (seed $seed, exit $rc):"$'\n'"$(grep -E '^  (inputs|through|an hour|panics)' "$log")"$'\n'
+    summary+="$target (seed $seed, exit $rc):"$'\n'"$(grep -E '^  (inputs|through|end to end|an hour|panics)' "$log")"$'\n'
     rm -f "$log"
 done
 echo
