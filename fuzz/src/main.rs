@@ -28,6 +28,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use clap::Parser;
@@ -236,6 +237,12 @@ fn input(seed: u64, index: u64, build_every: u64, corpus: &Corpus) -> (Source, V
     }
 }
 
+/// Seconds between lines of progress, and what they count: inputs run
+/// and jobs built, over every lane.
+const PROGRESS_EVERY: u64 = 30;
+static PROGRESS_INPUTS: AtomicU64 = AtomicU64::new(0);
+static PROGRESS_BUILT: AtomicU64 = AtomicU64::new(0);
+
 /// Mixed into the seed for the draw of the inputs that also run end to
 /// end (a stream of its own: the inputs stay those of the seed).
 const END_TO_END: u64 = 0xE2E0_0E2E;
@@ -341,7 +348,28 @@ fn main() -> ExitCode {
         start: Instant::now(),
         deadline,
     };
+    let done = AtomicBool::new(false);
     let totals = std::thread::scope(|scope| {
+        // A line of progress now and then: what a run that aborts (an
+        // allocation that fails, a stack overflow) had reached, for
+        // `fuzz/campaign.sh`, which starts it again with a new seed.
+        scope.spawn(|| {
+            let every = Duration::from_secs(PROGRESS_EVERY);
+            let mut next = every;
+            while !done.load(Ordering::Relaxed) {
+                std::thread::sleep(Duration::from_millis(200));
+                if run.start.elapsed() >= next {
+                    next += every;
+                    let _ = writeln!(
+                        std::io::stderr(),
+                        "fuzz: progress {:.0} s: {} inputs, {} built",
+                        run.start.elapsed().as_secs_f64(),
+                        PROGRESS_INPUTS.load(Ordering::Relaxed),
+                        PROGRESS_BUILT.load(Ordering::Relaxed)
+                    );
+                }
+            }
+        });
         let lanes: Vec<_> = (0..jobs)
             .map(|lane| {
                 let run = &run;
@@ -356,6 +384,7 @@ fn main() -> ExitCode {
                 Err(_) => totals.panics += 1,
             }
         }
+        done.store(true, Ordering::Relaxed);
         totals
     });
     let distinct = run.seen.lock().map(|s| s.len()).unwrap_or(0);
@@ -416,6 +445,10 @@ impl Run<'_> {
                 let e = counts.by_strategy.entry(strategy_of(&bytes)).or_default();
                 e.0 += 1;
                 e.1 += took;
+            }
+            PROGRESS_INPUTS.fetch_add(1, Ordering::Relaxed);
+            if let Outcome::Done(Ok(r)) = &outcome {
+                PROGRESS_BUILT.fetch_add(r.built as u64, Ordering::Relaxed);
             }
             if let Some((what, message)) = counts.record(outcome, depth, took, cli.timeout) {
                 self.failed(what, &message, index, source, &bytes);
