@@ -13,6 +13,16 @@ use lensc_lang::loader::{FileSystem, Root};
 use lensc_lang::sandbox::ReadError;
 use lensc_lang::source::SourceMap;
 
+/// One in this many inputs is formatted twice (`formats`) and one in
+/// this many parsed by pest alone too (`parses_alike`), counted per worker.
+const FORMAT_EVERY: u64 = 4;
+const PEST_EVERY: u64 = 8;
+
+thread_local! {
+    /// Inputs this worker has run.
+    static CROSS_CHECKS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
 /// How far an input went.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Reached {
@@ -47,6 +57,11 @@ impl MemFs {
         );
         files.insert("self.lens".into(), b"use \"self.lens\"\n".to_vec());
         MemFs { files }
+    }
+
+    /// Every named file, as the end-to-end share writes them to disk.
+    pub fn files(&self) -> impl Iterator<Item = (&String, &Vec<u8>)> {
+        self.files.iter()
     }
 }
 
@@ -84,9 +99,10 @@ impl FileSystem for MemFs {
 pub enum Depth {
     /// Check and render.
     Check,
-    /// Also lower every job of a clean file.
+    /// Also, as `lensc check` does for a clean file, look for surfaces
+    /// undefined over their aperture and lower every job.
     Lower,
-    /// Also lower every job of a clean file, held to these size limits.
+    /// `Lower`, every job held to these size limits.
     LowerWithin(Limits),
     /// Also build every job of a clean file and write its files.
     Build,
@@ -109,14 +125,36 @@ pub enum Depth {
     Measure { ext: &'static str },
 }
 
+impl Depth {
+    /// The input is a `.lens` file (checked, and lowered or built).
+    pub fn is_lens(self) -> bool {
+        matches!(
+            self,
+            Depth::Check
+                | Depth::Lower
+                | Depth::LowerWithin(_)
+                | Depth::Build
+                | Depth::BuildAs { .. }
+        )
+    }
+}
+
 /// Runs `bytes` as far as `depth` asks (and the checker lets it).
 pub fn run(fs: &MemFs, bytes: &[u8], depth: Depth, out_dir: &Path) -> Result<Reached, Fault> {
     let c = driver::check_text(fs, "fuzz.lens", bytes);
     let sources = &c.loaded.sources;
     well_formed(c.diags(), sources)?;
     render(c.diags(), sources)?;
-    formats(bytes)?;
-    parses_alike(bytes)?;
+    // The fuzzer's own cross-checks beyond what `lensc check` runs (pest
+    // alone costs about as much as the checker): on a share of the inputs,
+    // and always on a worker's first (so a replayed input has them all).
+    let n = CROSS_CHECKS.with(|c| c.replace(c.get() + 1));
+    if n.is_multiple_of(FORMAT_EVERY) {
+        formats(bytes)?;
+    }
+    if n.is_multiple_of(PEST_EVERY) {
+        parses_alike(bytes)?;
+    }
     let mut reached = Reached {
         clean: !c.has_errors(),
         ..Reached::default()
@@ -136,13 +174,12 @@ pub fn run(fs: &MemFs, bytes: &[u8], depth: Depth, out_dir: &Path) -> Result<Rea
                 Depth::LowerWithin(l) => l,
                 _ => Limits::default(),
             };
-            for job in &c.checked.jobs {
-                if let Err(diags) = lensc_build::pipeline::lower(job, None, &limits) {
-                    well_formed(&diags, sources)?;
-                    render(&diags, sources)?;
-                }
-                reached.lowered += 1;
-            }
+            // What `lensc check` runs once a file checks: surfaces
+            // undefined over their aperture, every job lowered.
+            let found = lensc_build::pipeline::findings_before_planning(&c, &limits);
+            well_formed(&found, sources)?;
+            render(&found, sources)?;
+            reached.lowered += c.checked.jobs.len();
         }
         Depth::Build | Depth::BuildAs { .. } => {
             let request = match depth {

@@ -13,6 +13,7 @@
 //! program size drawn per input), `verify` (mutated programs), `import`
 //! (mutated prescriptions) and `lsp` (message sequences).
 
+mod end_to_end;
 mod generate;
 mod harness;
 mod measure;
@@ -27,6 +28,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use clap::Parser;
@@ -71,7 +73,9 @@ struct Cli {
     /// What the inputs go through.
     #[arg(long, value_enum, default_value_t = Target::Mixed)]
     target: Target,
-    /// The `lensc` binary the `lsp` target starts.
+    /// The `lensc` binary the `lsp` target starts; with it, one in 50
+    /// `.lens` inputs of the other targets also runs through it end to end
+    /// (`end_to_end`).
     #[arg(long, value_name = "PATH")]
     lensc: Option<PathBuf>,
 }
@@ -82,7 +86,9 @@ enum Target {
     /// Check, one in eight lowered, one in `--build-every` a small job
     /// built and written (CI's minute).
     Mixed,
-    /// Check, one in eight lowered under size limits drawn per input.
+    /// Check as `lensc check` does (a clean file's jobs lowered), under
+    /// size limits drawn per input; one in 50 also through the binary
+    /// with `--lensc`.
     Check,
     /// Small jobs only, built in a dialect and to a program size drawn
     /// per input, and written.
@@ -131,14 +137,13 @@ fn input_for(
     match target {
         Target::Mixed => input(seed, index, build_every, &corpora.lens),
         Target::Check => {
-            let (source, bytes, depth) = input(seed, index, 0, &corpora.lens);
-            let depth = match depth {
-                Depth::Lower => Depth::LowerWithin(Limits {
-                    max_program_size: rng.log_uniform(1e3, 1e10) as u64,
-                    max_points: rng.log_uniform(10.0, 1e9) as u64,
-                }),
-                d => d,
-            };
+            // Every input as `lensc check` takes it: a clean file's jobs
+            // lowered, under size limits drawn per input.
+            let (source, bytes, _) = input(seed, index, 0, &corpora.lens);
+            let depth = Depth::LowerWithin(Limits {
+                max_program_size: rng.log_uniform(1e3, 1e10) as u64,
+                max_points: rng.log_uniform(10.0, 1e9) as u64,
+            });
             (source, bytes, depth)
         }
         Target::Build => {
@@ -232,8 +237,21 @@ fn input(seed: u64, index: u64, build_every: u64, corpus: &Corpus) -> (Source, V
     }
 }
 
+/// Seconds between lines of progress, and what they count: inputs run
+/// and jobs built, over every lane.
+const PROGRESS_EVERY: u64 = 30;
+static PROGRESS_INPUTS: AtomicU64 = AtomicU64::new(0);
+static PROGRESS_BUILT: AtomicU64 = AtomicU64::new(0);
+
+/// Mixed into the seed for the draw of the inputs that also run end to
+/// end (a stream of its own: the inputs stay those of the seed).
+const END_TO_END: u64 = 0xE2E0_0E2E;
+
 #[derive(Default)]
 struct Counts {
+    /// Inputs also run through the `lensc` binary, and those that failed.
+    end_to_end: u64,
+    end_to_end_failed: u64,
     inputs: HashMap<Source, u64>,
     checked: u64,
     clean: u64,
@@ -246,6 +264,8 @@ struct Counts {
     hangs: u64,
     uncoded: u64,
     build_time: Duration,
+    /// Builds and their time by strategy (as the job's file names it).
+    by_strategy: HashMap<&'static str, (u64, Duration)>,
     slowest_build: Duration,
     slow_builds: u64,
 }
@@ -274,18 +294,15 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    if cli.target == Target::Lsp {
-        match &cli.lensc {
-            Some(p) => {
-                let _ = targets::LENSC.set(p.clone());
-            }
-            None => {
-                eprintln!(
-                    "fuzz: the lsp target needs --lensc PATH (cargo build --release -p lensc)"
-                );
-                return ExitCode::from(2);
-            }
+    match &cli.lensc {
+        Some(p) => {
+            let _ = targets::LENSC.set(p.clone());
         }
+        None if cli.target == Target::Lsp => {
+            eprintln!("fuzz: the lsp target needs --lensc PATH (cargo build --release -p lensc)");
+            return ExitCode::from(2);
+        }
+        None => {}
     }
     if let Some(i) = cli.print {
         let (_, bytes, _) = input_for(cli.target, seed, i, cli.build_every, &corpora);
@@ -331,7 +348,28 @@ fn main() -> ExitCode {
         start: Instant::now(),
         deadline,
     };
+    let done = AtomicBool::new(false);
     let totals = std::thread::scope(|scope| {
+        // A line of progress now and then: what a run that aborts (an
+        // allocation that fails, a stack overflow) had reached, for
+        // `fuzz/campaign.sh`, which starts it again with a new seed.
+        scope.spawn(|| {
+            let every = Duration::from_secs(PROGRESS_EVERY);
+            let mut next = every;
+            while !done.load(Ordering::Relaxed) {
+                std::thread::sleep(Duration::from_millis(200));
+                if run.start.elapsed() >= next {
+                    next += every;
+                    let _ = writeln!(
+                        std::io::stderr(),
+                        "fuzz: progress {:.0} s: {} inputs, {} built",
+                        run.start.elapsed().as_secs_f64(),
+                        PROGRESS_INPUTS.load(Ordering::Relaxed),
+                        PROGRESS_BUILT.load(Ordering::Relaxed)
+                    );
+                }
+            }
+        });
         let lanes: Vec<_> = (0..jobs)
             .map(|lane| {
                 let run = &run;
@@ -346,11 +384,12 @@ fn main() -> ExitCode {
                 Err(_) => totals.panics += 1,
             }
         }
+        done.store(true, Ordering::Relaxed);
         totals
     });
     let distinct = run.seen.lock().map(|s| s.len()).unwrap_or(0);
     summary(&totals, run.start.elapsed(), distinct, jobs);
-    if totals.panics + totals.hangs + totals.uncoded > 0 {
+    if totals.panics + totals.hangs + totals.uncoded + totals.end_to_end_failed > 0 {
         ExitCode::FAILURE
     } else {
         ExitCode::SUCCESS
@@ -377,6 +416,7 @@ impl Run<'_> {
         let cli = self.cli;
         let mut counts = Counts::default();
         let mut sup = None;
+        let mut project = None;
         for index in indices {
             if self.deadline.is_some_and(|d| self.start.elapsed() >= d) {
                 break;
@@ -401,8 +441,31 @@ impl Run<'_> {
             let began = Instant::now();
             let outcome = sup.run(index, bytes.clone(), depth);
             let took = began.elapsed();
+            if matches!(depth, Depth::Build | Depth::BuildAs { .. }) {
+                let e = counts.by_strategy.entry(strategy_of(&bytes)).or_default();
+                e.0 += 1;
+                e.1 += took;
+            }
+            PROGRESS_INPUTS.fetch_add(1, Ordering::Relaxed);
+            if let Outcome::Done(Ok(r)) = &outcome {
+                PROGRESS_BUILT.fetch_add(r.built as u64, Ordering::Relaxed);
+            }
             if let Some((what, message)) = counts.record(outcome, depth, took, cli.timeout) {
                 self.failed(what, &message, index, source, &bytes);
+            }
+            if let Some(lensc) = &cli.lensc
+                && depth.is_lens()
+                && Rng::for_input(self.seed ^ END_TO_END, index).below(end_to_end::SHARE) == 0
+            {
+                let project = project.get_or_insert_with(|| {
+                    let dir = self.out.join(format!("project-{index}"));
+                    end_to_end::Project::new(lensc, dir, self.fs.files())
+                });
+                counts.end_to_end += 1;
+                if let Err(message) = project.run(&bytes, depth) {
+                    counts.end_to_end_failed += 1;
+                    self.failed("end-to-end", &message, index, source, &bytes);
+                }
             }
         }
         counts
@@ -490,12 +553,35 @@ impl Counts {
         self.written += o.written;
         self.unwritten += o.unwritten;
         self.panics += o.panics;
+        self.end_to_end += o.end_to_end;
+        self.end_to_end_failed += o.end_to_end_failed;
         self.hangs += o.hangs;
         self.uncoded += o.uncoded;
         self.build_time += o.build_time;
+        for (k, (n, t)) in o.by_strategy {
+            let e = self.by_strategy.entry(k).or_default();
+            e.0 += n;
+            e.1 += t;
+        }
         self.slowest_build = self.slowest_build.max(o.slowest_build);
         self.slow_builds += o.slow_builds;
     }
+}
+
+/// The strategy a small job's file uses.
+fn strategy_of(bytes: &[u8]) -> &'static str {
+    let text = String::from_utf8_lossy(bytes);
+    [
+        "profile_turning",
+        "profile_grinding",
+        "raster",
+        "spiral_turning",
+        "fts_spiral",
+        "roller_helix",
+    ]
+    .into_iter()
+    .find(|s| text.contains(&format!("= {s} {{")))
+    .unwrap_or("other")
 }
 
 fn parse_range(s: &str) -> Option<std::ops::Range<u64>> {
@@ -584,6 +670,20 @@ fn summary(c: &Counts, elapsed: Duration, distinct: usize, lanes: u64) {
         c.slowest_build.as_secs_f64(),
         c.slow_builds
     );
+    let _ = writeln!(
+        out,
+        "  end to end        {} through the lensc binary, {} failed",
+        c.end_to_end, c.end_to_end_failed
+    );
+    let mut kinds: Vec<_> = c.by_strategy.iter().collect();
+    kinds.sort();
+    for (kind, (n, t)) in kinds {
+        let _ = writeln!(
+            out,
+            "    {kind:<18} {n} jobs, {:.1} ms each on average",
+            t.as_secs_f64() * 1e3 / (*n).max(1) as f64
+        );
+    }
     let rate = c.checked as f64 / secs;
     let _ = writeln!(
         out,

@@ -1,8 +1,12 @@
 //! Small whole jobs for the build tier: one job per file, each strategy
 //! with the machine and tool it needs, a random surface of the kinds it
 //! cuts, and random values kept where a build stays small (apertures of
-//! at most a millimetre, coarse feeds and tolerances) so that one build
-//! takes well under a second. Values that do not change the size of the
+//! at most half a millimetre, rollers of at most 1.5 mm, coarse feeds,
+//! steps and tolerances) so that one build takes well under a second: the
+//! build's time goes to simulating the cut over the part, which grows with
+//! its area over the feed. The size limits themselves are exercised by
+//! the numbers made extreme (`extreme_somewhere`) and by the program sizes
+//! the build target draws. Values that do not change the size of the
 //! cut (conic constants, coefficients, senses, angles) range freely,
 //! extremes included.
 
@@ -149,7 +153,7 @@ fn rotational(rng: &mut Rng, out: &mut String, r: f64) {
 }
 
 fn turning(rng: &mut Rng, out: &mut String) {
-    let r = rng.log_uniform(0.05, 1.0);
+    let r = rng.log_uniform(0.03, 0.5);
     rotational(rng, out, r);
     let machine = rng.pick(&["linuxcnc_lathe", "ultra_precision_lathe"]);
     let _ = writeln!(out, "use std::machines::{machine}");
@@ -170,7 +174,7 @@ fn turning(rng: &mut Rng, out: &mut String) {
     let _ = writeln!(
         out,
         "strategy st = profile_turning {{ feed: {} um/rev, {speed}, chord_tolerance: {} }}",
-        rng.log_uniform(0.5, 50.0),
+        rng.log_uniform(2.0, 60.0),
         random_length(rng, 5e-6, 1e-3)
     );
     let _ = writeln!(
@@ -180,7 +184,7 @@ fn turning(rng: &mut Rng, out: &mut String) {
 }
 
 fn grinding(rng: &mut Rng, out: &mut String) {
-    let r = rng.log_uniform(0.05, 1.0);
+    let r = rng.log_uniform(0.03, 0.5);
     rotational(rng, out, r);
     let _ = writeln!(out, "use std::machines::nano_grinder");
     let _ = writeln!(
@@ -191,7 +195,7 @@ fn grinding(rng: &mut Rng, out: &mut String) {
     let _ = writeln!(
         out,
         "strategy st = profile_grinding {{ interval: {} um, feed: {} um/s, smoothness: {}, spindle_speed: 1000 rpm }}",
-        rng.log_uniform(0.5, 20.0),
+        rng.log_uniform(2.0, 40.0),
         rng.log_uniform(1.0, 100.0),
         free_number(rng, 0.01, 0.99)
     );
@@ -202,7 +206,7 @@ fn grinding(rng: &mut Rng, out: &mut String) {
 }
 
 fn raster(rng: &mut Rng, out: &mut String) {
-    let r = rng.log_uniform(0.03, 0.4);
+    let r = rng.log_uniform(0.02, 0.25);
     if rng.chance(0.5) {
         rotational(rng, out, r);
     } else {
@@ -219,7 +223,7 @@ fn raster(rng: &mut Rng, out: &mut String) {
         "strategy st = raster {{ along: {}, direction: {}, stepover: {} um, feed: {} mm/min, chord_tolerance: {} }}",
         rng.pick(&["x", "y"]),
         rng.pick(&["one_way", "zigzag"]),
-        rng.log_uniform(5.0, 100.0),
+        rng.log_uniform(10.0, 120.0),
         rng.log_uniform(1.0, 1000.0),
         random_length(rng, 2e-5, 1e-3)
     );
@@ -288,7 +292,7 @@ fn any_shape(rng: &mut Rng, out: &mut String, r: f64) {
 }
 
 fn spiral(rng: &mut Rng, out: &mut String) {
-    let r = rng.log_uniform(0.05, 0.6);
+    let r = rng.log_uniform(0.03, 0.3);
     if rng.chance(0.4) {
         rotational(rng, out, r);
     } else if rng.chance(0.6) {
@@ -308,7 +312,7 @@ fn spiral(rng: &mut Rng, out: &mut String) {
     let _ = writeln!(
         out,
         "strategy st = spiral_turning {{ feed: {} um/rev, spindle_speed: {} rpm, chord_tolerance: {} }}",
-        rng.log_uniform(5.0, 50.0),
+        rng.log_uniform(10.0, 60.0),
         10 + rng.below(200),
         random_length(rng, 5e-5, 2e-3)
     );
@@ -319,7 +323,7 @@ fn spiral(rng: &mut Rng, out: &mut String) {
 }
 
 fn fts(rng: &mut Rng, out: &mut String) {
-    let lenslet_r = rng.log_uniform(0.02, 0.15);
+    let lenslet_r = rng.log_uniform(0.02, 0.1);
     let _ = writeln!(
         out,
         "surface lenslet = sphere {{ radius: {}, sense: {}, aperture: circle(radius: {}) }}",
@@ -348,7 +352,7 @@ fn fts(rng: &mut Rng, out: &mut String) {
     let _ = writeln!(
         out,
         "strategy st = fts_spiral {{ feed: {} um/rev, spindle_speed: {} rpm, chord_tolerance: {}, settle: {} }}",
-        rng.log_uniform(5.0, 40.0),
+        rng.log_uniform(10.0, 50.0),
         20 + rng.below(200),
         random_length(rng, 1e-4, 2e-3),
         rng.pick(&["auto", "none"])
@@ -360,8 +364,8 @@ fn fts(rng: &mut Rng, out: &mut String) {
 }
 
 fn roller(rng: &mut Rng, out: &mut String) {
-    let radius = rng.log_uniform(1.0, 10.0);
-    let width = rng.log_uniform(0.3, 2.0);
+    let radius = rng.log_uniform(0.3, 1.5);
+    let width = rng.log_uniform(0.1, 0.4);
     let _ = writeln!(
         out,
         "surface pattern = freeform {{ z(x, y) = {} * sin(5 rad/mm * x) - 0.04 mm, domain: rect(x: 0 mm .. {}, y: 0 mm .. {}) }}",
@@ -394,8 +398,8 @@ fn roller(rng: &mut Rng, out: &mut String) {
     let _ = writeln!(
         out,
         "strategy st = roller_helix {{ {rough}finish: {{ c_step: {} deg, pitch: {} }}, spindle_speed: 60 rpm }}",
-        rng.log_uniform(0.5, 5.0),
-        random_length(rng, 0.05, 0.3)
+        rng.log_uniform(3.0, 12.0),
+        random_length(rng, 0.08, 0.3)
     );
     let _ = writeln!(
         out,

@@ -215,12 +215,14 @@ pub fn read_ascii(bytes: &[u8]) -> Result<Measurement, ReadError> {
     let data_sign = numbers(10, 8).map(|v| v[7] != 0.0).unwrap_or(false);
     let (w, h) = (phase[2] as usize, phase[3] as usize);
     let intens_count = (intens[2] * intens[3] * intens[4]) as usize;
+    let phase_count = w.saturating_mul(h);
     // The data blocks: after the first `#` line, intensity then phase.
     let first = lines
         .iter()
         .position(|(_, l)| l.trim() == "#")
         .ok_or_else(|| malformed("no `#` line ends the header", None))?;
-    let mut values = Vec::with_capacity(intens_count + w * h);
+    let mut values =
+        Vec::with_capacity(intens_count.saturating_add(phase_count).min(super::RESERVE));
     let mut hashes = 0;
     for &(at, line) in &lines[first + 1..] {
         if line.trim() == "#" {
@@ -237,9 +239,9 @@ pub fn read_ascii(bytes: &[u8]) -> Result<Measurement, ReadError> {
             values.push(v);
         }
     }
-    if values.len() != intens_count + w * h {
+    if values.len() != intens_count.saturating_add(phase_count) {
         return Err(ReadError::Truncated {
-            expected: intens_count + w * h,
+            expected: intens_count.saturating_add(phase_count),
             found: values.len(),
             what: format!("values for {intens_count} intensity and {w} × {h} phase points"),
         });

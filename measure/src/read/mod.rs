@@ -46,6 +46,12 @@ pub fn detect(name: &str, bytes: &[u8]) -> Option<Format> {
 }
 
 /// Reads a measurement file given its name (for its extension) and bytes.
+/// The most values a reader reserves room for before it has read them: a
+/// header's counts are not trusted with an allocation (a count of 2^64
+/// overflowed, one of 2^34 asked for 137 GB and aborted; issue #33's
+/// fuzzing), the list grows past this as values are read.
+pub(crate) const RESERVE: usize = 1 << 20;
+
 pub fn read(name: &str, bytes: &[u8], units: TextUnits) -> Result<Measurement, ReadError> {
     let m = read_format(name, bytes, units)?;
     within_reach(&m)?;

@@ -59,14 +59,14 @@ pub fn read(bytes: &[u8]) -> Result<Measurement, ReadError> {
             None,
         ));
     }
-    let n = nx * ny;
+    let n = nx.saturating_mul(ny);
     if n == 0 || xs.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || zs == 0.0 {
         return Err(malformed(
             format!("{nx} × {ny} points, x scale {xs} m, z scale {zs} m"),
             None,
         ));
     }
-    let mut z = Vec::with_capacity(n);
+    let mut z = Vec::with_capacity(n.min(super::RESERVE));
     let mut pos = body_start;
     for line in text[body_start..].split_inclusive('\n') {
         if line.trim() == "*" {

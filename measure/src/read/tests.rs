@@ -373,3 +373,19 @@ fn a_height_beyond_any_instrument_is_refused() {
     let err = read("p.txt", b"0 0\n-3e4 1\n", TextUnits::MM).unwrap_err();
     assert!(err.to_string().contains("-30000 mm"), "{err}");
 }
+
+/// The fuzzer's measure target (issue #33, item 7): header counts that no
+/// file could hold are refused, not trusted with an allocation. A MetroPro
+/// ASCII phase width of 2^64 overflowed `intens + w·h` (a panic, "capacity
+/// overflow"); an SDF of 2^34 points asked for 137 GB and aborted.
+#[test]
+fn counts_no_file_could_hold_are_refused_not_allocated() {
+    let asc = String::from_utf8(peer("metropro-1-window.asc")).expect("text");
+    let huge = asc.replacen("100 200 64 48", "100 200 18446744073709551616 48", 1);
+    assert_ne!(asc, huge);
+    assert!(read("huge.asc", huge.as_bytes(), TextUnits::MM).is_err());
+    let sdf = String::from_utf8(peer("sdf-1.sdf")).expect("text");
+    let huge = sdf.replacen("NumPoints = 7", "NumPoints = 17179869184", 1);
+    assert_ne!(sdf, huge);
+    assert!(read("huge.sdf", huge.as_bytes(), TextUnits::MM).is_err());
+}

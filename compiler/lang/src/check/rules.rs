@@ -10,6 +10,10 @@ use crate::codes;
 use crate::domain::aperture_radius;
 use crate::value::{self, Field, Object, Value};
 
+/// The most lenslets an array may have in all (a thousand by a
+/// thousand): the lowering lists every lenslet's centre.
+pub const MAX_LENSLETS: f64 = 1e6;
+
 impl<'a> Checker<'a> {
     /// Rules that tie several parameters of one kind together.
     pub(super) fn kind_rules(&mut self, o: &Object) -> bool {
@@ -18,6 +22,7 @@ impl<'a> Checker<'a> {
             | "qcon" => self.conic_limit(o),
             "annulus" => self.annulus_order(o),
             "wrap" => self.wrap_fits_roller(o),
+            "grid" | "hex_grid" => self.lenslets_bounded(o),
             "zernike" => self.fringe_terms(o),
             "ellipsoid" => self.ellipsoid_rim(o),
             "profile_turning" => self.profile_turning_passes(o),
@@ -123,6 +128,44 @@ impl<'a> Checker<'a> {
             );
         }
         ok
+    }
+
+    /// E0123: an array has at most `MAX_LENSLETS` lenslets in all (each
+    /// count is bounded alone, but their product, and a hex grid's rows,
+    /// were not: `count_y: 4294967297` rows made `lensc check` ask for
+    /// 34 GB for the lenslets' centres and abort).
+    fn lenslets_bounded(&mut self, o: &Object) -> bool {
+        let (Some(nx), Some(ny)) = (
+            value::num(&o.fields, "count_x"),
+            value::num(&o.fields, "count_y"),
+        ) else {
+            return true;
+        };
+        // A hex grid's rows may be fractional: the lowering places
+        // ceil(count_y) rows.
+        let lenslets = nx.ceil().max(1.0) * ny.ceil().max(1.0);
+        if lenslets <= MAX_LENSLETS {
+            return true;
+        }
+        let at = value::field(&o.fields, "count_y").expect("count_y");
+        self.err(
+            Diagnostic::error(
+                codes::OUT_OF_RANGE,
+                format!(
+                    "this array has {} lenslets ({} by {}), more than the {} an array may have",
+                    trim_num(lenslets),
+                    trim_num(nx.ceil()),
+                    trim_num(ny.ceil()),
+                    trim_num(MAX_LENSLETS)
+                ),
+                at.file,
+                at.span,
+            )
+            .with_label("too many lenslets")
+            .with_note(o.file, o.head, "count_x times count_y lenslets")
+            .with_help("make several jobs of smaller arrays, or check the counts"),
+        );
+        false
     }
 
     /// E0134: a design wrapped onto a roller is no longer than the roller's

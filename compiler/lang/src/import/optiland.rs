@@ -254,7 +254,14 @@ fn line_offset(text: &str, line: usize, column: usize) -> usize {
         .take(line.saturating_sub(1))
         .map(str::len)
         .sum();
-    (start + column.saturating_sub(1)).min(text.len())
+    let mut at = (start + column.saturating_sub(1)).min(text.len());
+    // A column that falls inside a character (serde counts bytes of the
+    // text it was given, which `finite_json` and a `�` read in place of
+    // a byte that is not UTF-8 lengthen) is moved back to its start.
+    while !text.is_char_boundary(at) {
+        at -= 1;
+    }
+    at
 }
 
 fn unreadable(span: Span, msg: String) -> Diagnostic {

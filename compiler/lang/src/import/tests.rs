@@ -339,3 +339,16 @@ fn a_number_past_the_largest_is_named_as_such() {
     assert_eq!(d.code, codes::IMPORT_UNREADABLE);
     assert!(d.message.contains("needs a number here"), "{}", d.message);
 }
+
+#[test]
+fn a_json_error_inside_a_character_is_spanned_at_its_start() {
+    // The fuzzer's import target (issue #33, item 7): a string cut off in
+    // the middle of a character, read as `�`; serde's column fell inside
+    // the `�`, a span off a character boundary.
+    let out = import("f.json", b"{\n    \"_source\": \"\xef");
+    let d = &out.diags[0];
+    assert_eq!(d.code, codes::IMPORT_UNREADABLE);
+    let span = d.labels[0].span;
+    assert!(out.source_text.is_char_boundary(span.start as usize));
+    assert!(out.source_text.is_char_boundary(span.end as usize));
+}
