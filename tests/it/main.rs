@@ -46,4 +46,5 @@ mod seed_sketches;
 mod surface_fixtures;
 mod surface_kinds;
 mod toolpaths;
+mod tutorial;
 mod verification;
