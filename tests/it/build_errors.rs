@@ -4,7 +4,7 @@
 //! findings are warnings builds (exit 0); any error means exit 1 and no
 //! program.
 
-use crate::common::{lensc, root, text};
+use crate::common::{judged_whole_and_passed, lensc, root, text};
 
 #[test]
 fn every_bad_build_is_reported_and_snapshotted() {
@@ -43,6 +43,15 @@ fn every_bad_build_is_reported_and_snapshotted() {
         let written = std::fs::read_dir(dir.path()).map_or(0, |d| d.count());
         if has_error {
             assert_eq!(written, 0, "{rel}: output left behind");
+        } else {
+            // Issue #29: a job that builds is judged on its whole part
+            // and passes, or says it is not judged (`accept: none`).
+            for report in reports_in(dir.path()) {
+                if report["acceptance"]["mode"] != "none" {
+                    judged_whole_and_passed(&report)
+                        .unwrap_or_else(|why| panic!("{rel}: {}: {why}", report["job"]));
+                }
+            }
         }
         let name = path
             .file_stem()
@@ -207,4 +216,18 @@ fn a_dialect_the_machine_does_not_offer_is_explained() {
     insta::with_settings!({ snapshot_path => "../snapshots/bad_builds", prepend_module_to_snapshot => false, omit_expression => true }, {
         insta::assert_snapshot!("dialect_not_offered", seen);
     });
+}
+
+/// The reports a build wrote into `dir`.
+fn reports_in(dir: &std::path::Path) -> Vec<serde_json::Value> {
+    let mut reports = Vec::new();
+    for entry in std::fs::read_dir(dir).expect("out dir") {
+        let path = entry.expect("entry").path();
+        if path.to_string_lossy().ends_with(".report.json") {
+            let text = std::fs::read_to_string(&path).expect("report");
+            reports.push(serde_json::from_str(&text).expect("json"));
+        }
+    }
+    assert!(!reports.is_empty(), "{}: no report", dir.display());
+    reports
 }

@@ -270,3 +270,29 @@ pub fn read_written(dir: &Path) -> BTreeMap<String, Written> {
         })
         .collect()
 }
+
+/// `Ok` where a report's acceptance was the gate's, over the whole part,
+/// with every criterion and every lenslet met; else what is not.
+pub fn judged_whole_and_passed(report: &serde_json::Value) -> Result<(), String> {
+    let a = &report["acceptance"];
+    if a["mode"] != "gate" {
+        return Err(format!("accepted in mode {}, not by the gate", a["mode"]));
+    }
+    if a["judged"]["area"] != "whole_part" {
+        return Err(format!("judged on {}, not the whole part", a["judged"]));
+    }
+    let criteria = a["criteria"].as_array().ok_or("no criteria")?;
+    if criteria.is_empty() {
+        return Err("no criterion judged".into());
+    }
+    let missed: Vec<String> = criteria
+        .iter()
+        .chain(a["lenslets"].as_array().into_iter().flatten())
+        .filter(|c| c["passed"] != true)
+        .map(|c| c.to_string())
+        .collect();
+    if !missed.is_empty() || a["passed"] != true {
+        return Err(format!("missed: {missed:?}"));
+    }
+    Ok(())
+}

@@ -1,6 +1,8 @@
 //! Every example checks clean (no errors, no warnings) and builds.
 
-use crate::common::{Written, built_examples, examples, lensc, root, surface_names, text};
+use crate::common::{
+    Written, built_examples, examples, judged_whole_and_passed, lensc, root, surface_names, text,
+};
 
 #[test]
 fn every_example_checks_clean() {
@@ -160,5 +162,64 @@ fn every_program_has_a_set_up_sheet_and_one_per_strategy_is_snapshot() {
         insta::with_settings!({ snapshot_path => "../snapshots/setup_sheets", prepend_module_to_snapshot => false, omit_expression => true }, {
             insta::assert_snapshot!(strategy, sheet);
         });
+    }
+}
+
+/// Issue #29's promise, audited: a green build means a good part. Every
+/// example job is judged by the gate over its whole part (no window, no
+/// `accept: none`, no criterion or lenslet missed, nothing left
+/// unmeasured), so none passes while its whole part misses its limits.
+#[test]
+fn every_example_passes_on_its_whole_part() {
+    let mut judged = 0;
+    for b in built_examples() {
+        for report in b.reports() {
+            if let Err(why) = judged_whole_and_passed(&report) {
+                panic!("{}: {}: {why}", b.example, report["job"]);
+            }
+            judged += 1;
+        }
+    }
+    assert!(judged >= 20, "only {judged} jobs");
+}
+
+/// The audit bites: a report judged on a window, or with a criterion or a
+/// lenslet missed, or not by the gate, is named.
+#[test]
+fn the_whole_part_audit_names_what_it_finds() {
+    let good = serde_json::json!({
+        "job": "j",
+        "acceptance": {
+            "mode": "gate",
+            "passed": true,
+            "judged": { "area": "whole_part", "words": "the whole part" },
+            "criteria": [{ "criterion": "form_pv", "passed": true }],
+            "lenslets": [{ "criterion": "form_pv", "passed": true }],
+        }
+    });
+    assert_eq!(judged_whole_and_passed(&good), Ok(()));
+    let with = |path: &[&str], v: serde_json::Value| {
+        let mut r = good.clone();
+        let mut at = &mut r["acceptance"];
+        for p in path {
+            at = if let Ok(i) = p.parse::<usize>() {
+                &mut at[i]
+            } else {
+                &mut at[*p]
+            };
+        }
+        *at = v;
+        r
+    };
+    for bad in [
+        with(&["mode"], "warn".into()),
+        with(&["mode"], "none".into()),
+        with(&["judged", "area"], "window".into()),
+        with(&["criteria"], serde_json::json!([])),
+        with(&["criteria", "0", "passed"], false.into()),
+        with(&["lenslets", "0", "passed"], false.into()),
+        with(&["passed"], false.into()),
+    ] {
+        assert!(judged_whole_and_passed(&bad).is_err(), "{bad}");
     }
 }

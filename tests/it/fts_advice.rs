@@ -1,7 +1,9 @@
 //! E0147's advice is a true bound: for every fast-tool-servo example (its
 //! servo weakened until the job is refused), the small array of
 //! tests/jobs/ and the refused jobs of tests/bad_builds/, the job built at
-//! the advised speed passes, and the speed the advice names as refused,
+//! the advised speed passes (its servo's lag within the job's limit, or,
+//! where the advice says it lags more, within the limit the advice says
+//! to state), and the speed the advice names as refused,
 //! within 5 % above it, is refused by the planner itself: the advice is
 //! neither optimistic nor absurdly conservative.
 
@@ -80,7 +82,7 @@ fn advice_holds(name: &str, text: &str, judged: bool) -> (String, String) {
     std::fs::write(&file, text).expect("write");
     let acceleration =
         refused_at(&file).unwrap_or_else(|| panic!("{name} is not refused as written"));
-    let SpeedAdvice::Found { passes, fails } = advice::search(&spiral_of(&file), acceleration)
+    let SpeedAdvice::Found { passes, fails, lag } = advice::search(&spiral_of(&file), acceleration)
     else {
         panic!("{name}: no speed found")
     };
@@ -94,28 +96,82 @@ fn advice_holds(name: &str, text: &str, judged: bool) -> (String, String) {
     std::fs::write(&file, with_speed(text, &fails)).expect("write");
     assert!(refused_at(&file).is_some(), "{name}: {fails} passes");
     // Built at the advised speed: the servo follows, with no error at
-    // all. The part's form is not what the advice is about: unless
-    // `judged`, its criteria only warn (a coarse feed's rim misses the
-    // default limits a 50 nm tolerance gives), so only the planner's own
-    // errors count.
-    std::fs::write(&file, with_speed(text, &passes)).expect("write");
-    let checked = check_path(&RealFs, &file).expect("readable");
-    let spool = tempfile::tempdir().expect("tmp");
-    let request = Request {
-        accept: if judged {
-            lensc_build::accept::Mode::Gate
-        } else {
-            lensc_build::accept::Mode::Warn
-        },
-        ..Request::default()
+    // all, its lag within the job's limit, or (the advice says so) within
+    // the limit the advice names. The part's form is not what the advice
+    // is about: unless `judged`, its criteria only warn (a coarse feed's
+    // rim misses the default limits a 50 nm tolerance gives), so only the
+    // planner's own errors and the servo's count.
+    let mut text = with_speed(text, &passes);
+    if let Some(l) = lag {
+        let accepted = trim_num(advice::accepted_lag_nm(l.lag));
+        eprintln!("{name}: the servo lags {} nm at {passes}", l.lag * 1e6);
+        text = with_accepted_lag(&text, &accepted);
+    }
+    std::fs::write(&file, &text).expect("write");
+    let mode = if judged {
+        lensc_build::accept::Mode::Gate
+    } else {
+        lensc_build::accept::Mode::Warn
     };
-    let (built, diags) = plan_and_emit(&checked, request, name, Some(spool.path()));
+    let (built, diags) = build(name, &file, mode);
     assert!(
         !diags.iter().any(|d| d.is_error()),
         "{name} at {passes}: {diags:?}"
     );
     assert_eq!(built.len(), 1);
+    let following = following_error(&built[0].report);
+    assert!(following.passed, "{name} at {passes}: {following:?}");
     (passes, fails)
+}
+
+/// `text` with its job accepting a following error of `nm` nm, as E0147's
+/// help says to write it.
+fn with_accepted_lag(text: &str, nm: &str) -> String {
+    let job = text
+        .lines()
+        .find(|l| l.starts_with("job "))
+        .expect("a job line");
+    let stated = format!("max_following_error: {nm} nm");
+    let new_job = if let Some(at) = job.find("max_following_error: ") {
+        let end = at + job[at..].find(" nm").expect("a limit in nm") + " nm".len();
+        format!("{}{stated}{}", &job[..at], &job[end..])
+    } else if job.contains("accept: { ") {
+        job.replacen("accept: { ", &format!("accept: {{ {stated}, "), 1)
+    } else {
+        let block = job.trim_end().strip_suffix('}').expect("a job block");
+        format!("{block}, accept: {{ {stated} }} }}")
+    };
+    text.replace(job, &new_job)
+}
+
+/// Builds `file` (its one job `name`) with the gate in `mode`.
+fn build(
+    name: &str,
+    file: &Path,
+    mode: lensc_build::accept::Mode,
+) -> (
+    Vec<lensc_build::output::Built>,
+    Vec<lensc_grammar::Diagnostic>,
+) {
+    let checked = check_path(&RealFs, file).expect("readable");
+    let spool = tempfile::tempdir().expect("tmp");
+    let request = Request {
+        accept: mode,
+        ..Request::default()
+    };
+    plan_and_emit(&checked, request, name, Some(spool.path()))
+}
+
+/// The report's following-error criterion (every fast-tool-servo job
+/// here has a servo model, so it is gated).
+fn following_error(report: &lensc_build::report::Report) -> lensc_build::report::CriterionResult {
+    report
+        .acceptance
+        .criteria
+        .iter()
+        .find(|c| c.criterion == "max_following_error")
+        .cloned()
+        .expect("the following error is judged")
 }
 
 #[test]
@@ -153,7 +209,7 @@ fn the_small_array_builds_at_its_advised_speed() {
 }
 
 #[test]
-#[ignore = "finding: at its advised 185.1 rpm the hex array's form passes lenslet by lenslet (13.2 nm PV), but its servo lags 1.243 um at r = 2.4845 mm, over the default following-error limit of 11 nm: E0147's advice weighs acceleration only, not the lag (next session)"]
+#[ignore = "finding: with the lag accepted as E0147's advice says (the hex array lags 1242.7 nm at its advised 185.1 rpm; 1300 nm stated), lenslet 12 (centre x = -0.25, y = 0 mm) misses max_residual: 2.6 um, the nub the spiral leaves at the spindle axis (planner)"]
 fn refused_bad_builds_build_at_their_advised_speed() {
     // The hex array's whole part passes its default limits at its advised
     // speed: judged lenslet by lenslet, as every array is (issue #29: with

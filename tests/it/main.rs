@@ -47,5 +47,6 @@ mod splines;
 mod surface_fixtures;
 mod surface_kinds;
 mod toolpaths;
+mod tutorial;
 mod verification;
 mod view;

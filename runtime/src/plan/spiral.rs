@@ -157,10 +157,24 @@ pub struct SpiralPoint {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum SpeedAdvice {
     /// `passes` was planned and keeps within the axis's limits; `fails`,
-    /// the lowest speed tried above it, does not.
-    Found { passes: f64, fails: f64 },
+    /// the lowest speed tried above it, does not. `lag`: at `passes` the
+    /// servo (where it has a model and is gated) lags beyond the job's
+    /// following-error limit.
+    Found {
+        passes: f64,
+        fails: f64,
+        lag: Option<LagMissed>,
+    },
     /// No speed tried passes; `lowest_tried` was the slowest.
     NotFound { lowest_tried: f64 },
+}
+
+/// The servo's lag at the advised speed, beyond what the job accepts.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LagMissed {
+    /// The largest following error there (mm) and the limit (mm).
+    pub lag: f64,
+    pub limit: f64,
 }
 
 /// Why a spiral cannot be planned.
@@ -623,6 +637,16 @@ impl Planner<'_> {
     /// the limit (a refusal costs only the revolutions up to it).
     pub fn check(&self, fast_axis: &FastAxis) -> Result<FtsSummary, FtsError> {
         self.run(fast_axis, true, |_| {})
+    }
+
+    /// `check`, handing each revolution's points in order to `sink` as
+    /// `plan` does (up to the batch where a refusal stops it).
+    pub fn check_with(
+        &self,
+        fast_axis: &FastAxis,
+        sink: impl FnMut(&[SpiralPoint]) + Send,
+    ) -> Result<FtsSummary, FtsError> {
+        self.run(fast_axis, true, sink)
     }
 
     fn run(

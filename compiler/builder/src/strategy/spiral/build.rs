@@ -78,7 +78,7 @@ pub(super) fn build(spec: &SpiralSpec, cx: &BuildContext) -> Result<Built, Vec<D
     // The fast axis's servo, run on the commands as printed as they are
     // planned (a slow tool servo's Z has no servo model here).
     let data_rate = 1.0 / p.spiral.min_interval;
-    let mut following = following(spec, data_rate);
+    let mut following = following(spec, &p.spiral, &p.bounds, data_rate);
     // The height map over the window (by default the whole of what the
     // spiral cuts), from the same printed points.
     let window = height_map::window(
@@ -94,17 +94,7 @@ pub(super) fn build(spec: &SpiralSpec, cx: &BuildContext) -> Result<Built, Vec<D
     );
     let mut printed = Vec::new();
     let planned = Prepared::of(spec).planner().plan(&p.fast_axis, |pts| {
-        let printed_at = lensc_runtime::verify::simulate::Printed::new(head.resolution);
-        let as_printed = |v: f64| printed_at.round(v);
-        printed.clear();
-        printed.extend(
-            pts.iter()
-                .map(|q| lensc_runtime::plan::spiral::SpiralPoint {
-                    x: as_printed(q.x),
-                    w: as_printed(q.w),
-                    ..*q
-                }),
-        );
+        as_printed(pts, head.resolution, &mut printed);
         for q in &printed {
             sweep.path().point(q.c, q.x, q.w);
         }
@@ -177,19 +167,43 @@ fn axis_words(spec: &SpiralSpec) -> &'static str {
     if spec.slow { "Z" } else { "the fast axis" }
 }
 
-/// The fast axis's servo following, simulated over radial bins of the
-/// spiral, where it has a servo model.
-fn following(
+/// `points` as the program prints them (X and W rounded to the machine's
+/// `resolution`, mm), into `printed`: what the servo is driven by.
+pub(super) fn as_printed(
+    points: &[lensc_runtime::plan::spiral::SpiralPoint],
+    resolution: f64,
+    printed: &mut Vec<lensc_runtime::plan::spiral::SpiralPoint>,
+) {
+    let printed_at = lensc_runtime::verify::simulate::Printed::new(resolution);
+    let round = |v: f64| printed_at.round(v);
+    printed.clear();
+    printed.extend(
+        points
+            .iter()
+            .map(|q| lensc_runtime::plan::spiral::SpiralPoint {
+                x: round(q.x),
+                w: round(q.w),
+                ..*q
+            }),
+    );
+}
+
+/// The fast axis's servo following along `spiral` (the job's, or at a
+/// trial speed, with the `bounds` its trajectory has there), simulated
+/// over radial bins, where it has a servo model.
+pub(super) fn following(
     spec: &SpiralSpec,
+    spiral: &lensc_runtime::plan::spiral::FtsSpiral,
+    bounds: &lensc_runtime::plan::spiral::TrajectoryBounds,
     data_rate: f64,
 ) -> Option<lensc_runtime::verify::follow::FollowingSimulation> {
     use lensc_runtime::verify::follow::{FollowingSimulation, RadialBins};
     let servo = spec.servo.as_ref().filter(|_| !spec.slow)?;
-    let (r0, r1) = (spec.spiral.start_radius.abs(), spec.spiral.end_radius.abs());
+    let (r0, r1) = (spiral.start_radius.abs(), spiral.end_radius.abs());
     FollowingSimulation::new(
         servo,
         data_rate,
-        spec.bounds.features.as_deref().unwrap_or_default(),
+        bounds.features.as_deref().unwrap_or_default(),
         RadialBins::new(r0.min(r1), r0.max(r1), crate::plots::FOLLOWING_BINS),
     )
 }

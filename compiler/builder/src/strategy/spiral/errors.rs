@@ -59,10 +59,26 @@ fn coded_error(
                 SpindleSpeed::SurfaceSpeed { .. } => "surface speed",
             };
             let help = match advice {
-                Some(SpeedAdvice::Found { passes, fails }) => format!(
+                Some(SpeedAdvice::Found {
+                    passes,
+                    fails,
+                    lag: None,
+                }) => format!(
                     "the highest speed found that respects it is a {kind} of {} (planned and checked; {} is refused)",
                     words(passes),
                     words(fails)
+                ),
+                Some(SpeedAdvice::Found {
+                    passes,
+                    fails,
+                    lag: Some(l),
+                }) => format!(
+                    "the highest speed found that respects it is a {kind} of {} (planned and checked; {} is refused); there the servo lags {} nm, over the job's {} nm `max_following_error`: state `max_following_error: {} nm` to accept the lag, or lower the speed further (the lag falls about in proportion)",
+                    words(passes),
+                    words(fails),
+                    trim_num((l.lag * 1e7).round() / 10.0),
+                    trim_num(l.limit * 1e6),
+                    trim_num(super::advice::accepted_lag_nm(l.lag))
                 ),
                 Some(SpeedAdvice::NotFound { lowest_tried }) => format!(
                     "no {kind} tried respects it, down to {}: the acceleration does not fall with the speed there (a spindle cap, or the path itself)",
