@@ -35,8 +35,17 @@ pub fn split(grid: &Grid, feature: Option<usize>) -> Vec<Tile> {
     split_columns(grid, feature, (TILE_CELLS / grid.nu.max(1)).max(1))
 }
 
-/// `grid` cut into runs of at most `most` columns.
+/// `grid` cut into runs of at most `most` columns. A grid of more than
+/// `MAX_CELLS` cells stays one tile: no simulation takes it
+/// ([`check_cells`] refuses it), and its tiles are not worth counting out
+/// (a window of kilometres at a micron would be billions of them).
 pub fn split_columns(grid: &Grid, feature: Option<usize>, most: usize) -> Vec<Tile> {
+    if grid.ns.saturating_mul(grid.nu) > MAX_CELLS {
+        return vec![Tile {
+            grid: *grid,
+            feature,
+        }];
+    }
     let runs = grid.ns.div_ceil(most.max(1)).max(1);
     (0..runs)
         .map(|c| {
@@ -97,7 +106,7 @@ impl std::fmt::Display for TooManyCells {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "{} cells in {} tiles, columns of {} rows: more than {} cells or {} rows a column",
+            "{} cells (tiles: {}), columns of {} rows: more than {} cells or {} rows a column",
             self.cells,
             self.tiles,
             self.rows,
@@ -300,6 +309,22 @@ impl Window {
 mod tests {
     use super::*;
 
+    /// A window of 100 km at the default micron (a fuzzed job's) is one
+    /// tile that `check_cells` refuses at once: counted out, its columns
+    /// were tiles enough to hang `lensc check` (26 s, 2.7 GB) or abort it
+    /// on a petabyte's allocation.
+    #[test]
+    fn a_window_beyond_any_simulation_is_refused_without_counting_its_tiles() {
+        let w = Window::given((0.35, 1e5), (-0.05, 0.05), None, ((-1.0, 1.0), (-1.0, 1.0)));
+        let tiles = w.polar_tiles(&[]);
+        assert_eq!(tiles.len(), 1);
+        let e = check_cells(&tiles).unwrap_err();
+        assert!(e.cells > MAX_CELLS, "{e}");
+        let tiles = split(&w.cartesian(true), None);
+        assert_eq!(tiles.len(), 1);
+        assert!(check_cells(&tiles).is_err());
+    }
+
     /// The default window is the whole extent, at the finest spacing
     /// whose tiles stay within the budget: a 4 mm square at 2 µm is 4
     /// million cells, at 5 µm 641 601; a budget no spacing meets takes the
@@ -331,7 +356,8 @@ mod tests {
         );
         let tiles = split(&w.cartesian(true), None);
         let e = check_cells(&tiles).unwrap_err();
-        assert_eq!((e.cells, e.tiles), (100_001 * 100_001, 10_001));
+        // Beyond the most cells, the grid stays one tile.
+        assert_eq!((e.cells, e.tiles), (100_001 * 100_001, 1));
     }
 
     /// Tiles cover their grid's cells once each, at the grid's own places.
