@@ -41,6 +41,11 @@ impl Users {
         matches!(self.motion, Some(Motion::Cw | Motion::Ccw))
     }
 
+    /// A block of a NURBS block (G5.2, or its control points in the mode).
+    fn nurbs(&self) -> bool {
+        self.motion == Some(Motion::NurbsBlock)
+    }
+
     /// Whether a code of the block uses `letter`, by LinuxCNC's rules; the
     /// codes that would, for the message.
     fn uses(&self, letter: char) -> (bool, &'static str) {
@@ -59,12 +64,12 @@ impl Users {
                 "G2, G3 or M19 (or G10 and the canned cycles, which lensc does not read)",
             ),
             'P' => (
-                self.arc() || spline(&[40, 50, 52, 640]) || self.m.contains(&19),
+                self.arc() || self.nurbs() || spline(&[40, 50, 640]) || self.m.contains(&19),
                 "G2, G3 (turns), G4 (dwell), G5, G5.2, G64 or M19",
             ),
             'Q' => (spline(&[50, 640]) || self.m.contains(&19), "G5, G64 or M19"),
             'L' => (
-                spline(&[52]) || spline(&[410, 420]),
+                self.nurbs() || spline(&[410, 420]),
                 "G5.2 or cutter compensation (G41, G42)",
             ),
             'D' => (spline(&[410, 420, 960]), "G41, G42 or G96"),
