@@ -48,8 +48,8 @@ pub(crate) struct NurbsBlock {
     pub weights: Vec<f64>,
     /// Where the tool was when the curve began.
     pub start: [Option<f64>; 4],
-    /// A weight not above zero in the first block: its span.
-    pub bad_weight: Option<(usize, usize)>,
+    /// A weight not above zero in the first block (found there).
+    pub bad_weight: bool,
 }
 
 /// LinuxCNC's knot vector for `count` control points of order `k`
@@ -151,7 +151,7 @@ impl State {
             points: Vec::new(),
             weights: Vec::new(),
             start: self.pos,
-            bad_weight: None,
+            bad_weight: false,
         });
         if curve.points.is_empty() {
             // The current point: the first control point, its weight a P
@@ -190,8 +190,14 @@ impl State {
             let curve = self.nurbs_block.as_mut().expect("a curve");
             // The interpreter's P when none is given is −1.
             let w = p.map_or(-1.0, |p| p.value);
-            if w <= 0.0 && curve.bad_weight.is_none() {
-                curve.bad_weight = Some(p.map_or(span, |p| p.span));
+            if w <= 0.0 {
+                curve.bad_weight = true;
+                out.push((
+                    Rule::NurbsWeight,
+                    p.map_or(span, |p| p.span),
+                    "a control point of the first G5.2 block with no weight P, or one not above zero: the controller takes it as written (no P is −1) and the curve turns away from its points".into(),
+                    Some("give every control point a weight P above zero (P1 for a plain B-spline)".into()),
+                ));
             }
             curve
                 .points
@@ -241,14 +247,6 @@ impl State {
             ));
             return;
         }
-        if let Some(wspan) = curve.bad_weight {
-            out.push((
-                Rule::NurbsWeight,
-                wspan,
-                "a control point of the first G5.2 block with no weight P, or one not above zero: the controller takes it as written (no P is −1) and the curve turns away from its points".into(),
-                Some("give every control point a weight P above zero (P1 for a plain B-spline)".into()),
-            ));
-        }
         let (sx, sy) = curve.points[0];
         if sx.is_nan() || sy.is_nan() || curve.points.iter().any(|p| p.0.is_nan() || p.1.is_nan()) {
             out.push((
@@ -270,7 +268,7 @@ impl State {
             start: curve.start,
         };
         self.may_cut(b, span, out);
-        let points = if curve.bad_weight.is_some() {
+        let points = if curve.bad_weight {
             // Not sampled: a weight not above zero may divide by zero.
             vec![nurbs.points[0], nurbs.points[nurbs.points.len() - 1]]
         } else {

@@ -474,6 +474,15 @@ fn linuxcnc_reads_splines_as_moves_along_the_curve() {
         let found = rules(&text, &d, &mill);
         assert!(!found.is_empty(), "{bad}");
     }
+    // A spline code with no axis word: "All axes missing with motion
+    // code" (rs274 2.9; the differential round's `G5` block found it).
+    for bad in ["G5", "G5.1", "G5 P1 Q1"] {
+        assert_eq!(
+            rules(&program(bad), &d, &mill),
+            vec![Rule::ArcWords],
+            "{bad}"
+        );
+    }
 }
 
 /// LinuxCNC's parameters and expressions are evaluated where a word's
@@ -852,4 +861,65 @@ fn a_nurbs_curve_the_control_refuses_is_found_with_its_span() {
     // Without the dialect's spline, G06.2 is a code the control lacks.
     let found = rules(NURBS, &Dialect { spline: None, ..d }, &nurbs_mill());
     assert!(found.contains(&Rule::UnknownWord), "{found:?}");
+}
+
+/// LinuxCNC's NURBS block (G5.2 … G5.3) read as `rs274` 2.9 runs it: the
+/// manual's example (11.5.9) passes through the points LinuxCNC's own
+/// evaluation gives (its Python module `gcode`: (1, 1.5) and (2, 1) at
+/// u = 1 and 2 of 3), and ends at its last control point; what rs274
+/// refuses is E0340 (`tests/it/nurbs_linuxcnc.rs` holds every case
+/// against rs274 itself).
+#[test]
+fn linuxcnc_reads_a_nurbs_block_as_the_interpreter_evaluates_it() {
+    let d = Dialect::linuxcnc();
+    let mill = MachineLimits {
+        lathe: false,
+        travel: [None; 4],
+        max_feed: None,
+        max_spindle_rpm: None,
+    };
+    let program = |moves: &str| {
+        format!(
+            "G17 G21 G90 G94\nT1 M6\nG97 S1000 M3\nG0 X0 Y0 Z1\nG1 Z0 F100\n{moves}\nG0 Z1\nM5\nM2\n"
+        )
+    };
+    let good = program("G5.2 P1 L3\nX0 Y1 P1\nX2 Y2 P1\nX2 Y0 P1\nX0 Y0 P2\nG5.3");
+    let (found, moves) = read_moves(&good, &d, &mill);
+    assert_eq!(found, vec![], "{good}");
+    let lines: Vec<&Executed> = moves
+        .iter()
+        .filter(|m| m.path == Path::Line && m.from[2] == Some(0.0))
+        .collect();
+    assert!(lines.len() > 100, "{} lines", lines.len());
+    for w in lines.windows(2) {
+        assert_eq!(w[0].to, w[1].from);
+    }
+    let last = lines.last().expect("a line").to;
+    assert_eq!(last[..3], [Some(0.0), Some(0.0), Some(0.0)]);
+    for (x, y) in [(1.0, 1.5), (2.0, 1.0)] {
+        let near = lines
+            .iter()
+            .map(|m| (m.to[0].unwrap() - x).hypot(m.to[1].unwrap() - y))
+            .fold(f64::INFINITY, f64::min);
+        assert!(near < 1e-9, "({x}, {y}): {near:e}");
+    }
+    for bad in [
+        "G5.2 X0 Y1 P1 L5\nX2 Y2 P1\nX2 Y0 P1\nG5.3",
+        "G5.2 X0 Y1 P1\nG5.3",
+        "G5.2 X0 Y1 P1\nX2 Y2\nX2 Y0 P1\nG5.3",
+        "G5.2 X0 Y1 P1\nX2 P1\nX2 Y0 P1\nG5.3",
+        "G5.3",
+    ] {
+        assert_eq!(
+            rules(&program(bad), &d, &mill),
+            vec![Rule::SplineRefused],
+            "{bad}"
+        );
+    }
+    let open = program("G5.2 X0 Y1 P1\nX2 Y2 P1\nG1 X0 Y0");
+    assert_eq!(rules(&open, &d, &mill), vec![Rule::NurbsNotCut]);
+    let weightless = program("G5.2 X0 Y1\nX2 Y2 P1\nX2 Y0 P1\nG5.3");
+    let found = read(&weightless, &d, &mill);
+    assert_eq!(found.len(), 1);
+    assert_eq!((found[0].rule, found[0].line), (Rule::NurbsWeight, 6));
 }

@@ -153,6 +153,21 @@ impl State {
                 )),
             ));
         }
+        // G5 and G5.1 with no axis word: "All axes missing with motion
+        // code" (`rs274` 2.9; G0, G1 and G5.2 alone are run).
+        if let Some((Motion::Spline(_), i)) = own
+            && !has(&['X', 'Y', 'Z', 'A', 'B', 'C'])
+        {
+            out.push((
+                Rule::ArcWords,
+                b.words[i].span,
+                format!(
+                    "`{}` with no axis word: the controller refuses a spline with no end",
+                    b.words[i].text(line)
+                ),
+                Some("give the spline its end point X Y, or leave the code out".into()),
+            ));
+        }
         if let Some(i) = b
             .words
             .iter()
