@@ -144,6 +144,9 @@ pub(crate) struct State {
     pub pre_cut_rapid: Option<(f64, (usize, usize))>,
     /// The P Q of the last G5 block, for a G5 that leaves out I J.
     pub last_spline_pq: Option<(f64, f64)>,
+    /// Heidenhain ISO's circle centre (X Y Z from I J K, absolute), as the
+    /// last block with I, J or K defined it.
+    pub circle_centre: [Option<f64>; 3],
     /// The points of the last spline read, handed over as straight moves.
     pub spline_points: Vec<(f64, f64)>,
     /// The moves made so far, when they are asked for.
@@ -245,6 +248,7 @@ impl State {
             top: None,
             pre_cut_rapid: None,
             last_spline_pq: None,
+            circle_centre: [None; 3],
             spline_points: Vec::new(),
             nurbs_mode: d.spline == Some(crate::dialect::SplineForm::Nurbs),
             nurbs: None,

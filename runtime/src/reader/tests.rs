@@ -923,3 +923,56 @@ fn linuxcnc_reads_a_nurbs_block_as_the_interpreter_evaluates_it() {
     assert_eq!(found.len(), 1);
     assert_eq!((found[0].rule, found[0].line), (Rule::NurbsWeight, 6));
 }
+
+/// Heidenhain ISO: a block of I J alone defines the circle centre and
+/// moves nothing, in an arc mode too (it was read as a full circle); an
+/// arc after it without I J goes about that centre (TNC 426/425/415
+/// B/407 ISO Programming User's Manual, "Circle center I, J, K", pp.
+/// 5-16 to 5-18).
+#[test]
+fn heidenhain_iso_reads_i_j_alone_as_the_circle_centre() {
+    let mut d = Dialect::linuxcnc();
+    d.comment = crate::dialect::CommentStyle::Semicolon;
+    d.block_end = " *".into();
+    d.line_numbers = Some(1);
+    d.max_line_number = Some(99999);
+    d.arc_centre_absolute = true;
+    d.surface_speed = Vec::new();
+    d.constant_rpm = None;
+    assert_eq!(Controller::of(&d), Controller::HeidenhainIso);
+    let program = |arcs: &str| {
+        format!(
+            "%J G71 *\nN1 ; +Z out of the material *\nN2 G17 G90 G40 G94 *\nN3 T1 G17 *\nN4 S1000 M3 *\nN5 G00 Z1. *\nN6 G00 X-1. Y0. *\nN7 G01 Z-0.1 F100. *\n{arcs}N20 G00 Z1. *\nN21 M5 *\nN22 M30 *\nN99999999 %J G71 *\n"
+        )
+    };
+    let alone = program("N8 G02 X1. I0. J0. *\nN9 I0. J0. *\n");
+    let (found, moves) = read_moves(&alone, &d, &mill());
+    assert_eq!(found, vec![], "{alone}");
+    let arcs = moves
+        .iter()
+        .filter(|m| matches!(m.path, Path::Arc { .. }))
+        .count();
+    assert_eq!(arcs, 1, "the I J block moves nothing");
+    let about = program("N8 I0. J0. *\nN9 G02 X1. *\nN10 G02 X-1. *\n");
+    let (found, moves) = read_moves(&about, &d, &mill());
+    assert_eq!(found, vec![], "{about}");
+    let turns: Vec<f64> = moves
+        .iter()
+        .filter_map(|m| match m.path {
+            Path::Arc { centre, turn, .. } => {
+                assert_eq!(centre, (0.0, 0.0));
+                Some(turn)
+            }
+            _ => None,
+        })
+        .collect();
+    assert_eq!(turns.len(), 2);
+    assert!(
+        turns
+            .iter()
+            .all(|t| (t - std::f64::consts::PI).abs() < 1e-12)
+    );
+    // No centre defined at all: still refused.
+    let none = program("N8 G02 X1. *\n");
+    assert_eq!(rules(&none, &d, &mill()), vec![Rule::ArcWords]);
+}
