@@ -223,3 +223,45 @@ fn the_whole_part_audit_names_what_it_finds() {
         assert!(judged_whole_and_passed(&bad).is_err(), "{bad}");
     }
 }
+
+/// A program that states its blank (Heidenhain ISO's G30/G31) has it on
+/// its set-up sheet as the stock, not "the job states none" (issue #28).
+#[test]
+fn a_set_up_sheet_states_the_blank_its_program_states() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let src = crate::common::root().join("examples/lin2022_scraping.lens");
+    let out = crate::common::lensc(
+        dir.path(),
+        &[
+            "build",
+            src.to_str().expect("utf8"),
+            "--job",
+            "lin_imaging_sphere",
+            "--dialect",
+            "heidenhain_iso",
+            "--out",
+            "out",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let program =
+        std::fs::read_to_string(dir.path().join("out/lin_imaging_sphere.I")).expect("program");
+    let sheet = std::fs::read_to_string(dir.path().join("out/lin_imaging_sphere.setup.txt"))
+        .expect("sheet");
+    let g30 = program
+        .lines()
+        .find(|l| l.contains(" G30 "))
+        .expect("the program states its blank");
+    let stock = sheet
+        .lines()
+        .find(|l| l.starts_with("stock "))
+        .expect("a stock line");
+    assert!(stock.contains("blank form (G30/G31)"), "{stock}");
+    // The least corner's Z, as the program prints it.
+    let z = g30
+        .split_whitespace()
+        .find_map(|w| w.strip_prefix('Z'))
+        .expect("Z")
+        .trim_end_matches('.');
+    assert!(stock.contains(&format!("Z {z} .. ")), "{g30} / {stock}");
+}

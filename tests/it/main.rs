@@ -37,6 +37,7 @@ mod linear;
 mod list;
 mod lsp;
 mod measure;
+mod nurbs_linuxcnc;
 mod plots;
 mod progress;
 mod read_back;

@@ -22,10 +22,9 @@ pub fn name(job: &str) -> String {
     format!("{job}.{EXTENSION}")
 }
 
-/// The comments of the program's header (its first lines), folded lines
-/// joined, in their order.
-fn header_comments(program: &ProgramText) -> Vec<String> {
-    let lines: Vec<String> = match program {
+/// The program's first lines (its header and set-up blocks).
+fn first_lines(program: &ProgramText) -> Vec<String> {
+    match program {
         ProgramText::Memory(t) => t.lines().take(80).map(str::to_string).collect(),
         ProgramText::Spooled { file, .. } => std::fs::File::open(file.path())
             .map(|f| {
@@ -36,9 +35,54 @@ fn header_comments(program: &ProgramText) -> Vec<String> {
                     .collect()
             })
             .unwrap_or_default(),
+    }
+}
+
+/// The workpiece blank the program states for the control's graphic
+/// test run, in words: Heidenhain ISO's `G30` (least corner) and `G31`
+/// (greatest), Klartext's `BLK FORM 0.1` and `BLK FORM 0.2`, each with
+/// X Y Z; `None` where the program states none.
+fn stated_blank(lines: &[String]) -> Option<String> {
+    let corner = |starts: &dyn Fn(&[&str]) -> bool| -> Option<[f64; 3]> {
+        lines.iter().find_map(|l| {
+            let words: Vec<&str> = l.split_whitespace().collect();
+            if !starts(&words) {
+                return None;
+            }
+            let mut c = [None; 3];
+            for w in &words {
+                let (letter, number) = w.split_at_checked(1)?;
+                let i = ["X", "Y", "Z"].iter().position(|a| *a == letter);
+                if let (Some(i), Ok(v)) = (i, number.parse::<f64>()) {
+                    c[i] = Some(v);
+                }
+            }
+            Some([c[0]?, c[1]?, c[2]?])
+        })
     };
+    let has = |code: &'static str| move |w: &[&str]| w.contains(&code);
+    let blk = |n: &'static str| move |w: &[&str]| w.windows(3).any(|t| t == ["BLK", "FORM", n]);
+    let (low, high, how) = match (corner(&has("G30")), corner(&has("G31"))) {
+        (Some(l), Some(h)) => (l, h, "G30/G31"),
+        _ => (corner(&blk("0.1"))?, corner(&blk("0.2"))?, "BLK FORM"),
+    };
+    let n = lensc_runtime::post::header::num;
+    Some(format!(
+        "X {} .. {}, Y {} .. {}, Z {} .. {} mm, as the program's blank form ({how}) states it for the control's graphic test run: a box holding every cut, 1 mm below the deepest; this is a finishing program, the blank must be roughed to within the strategy's cut of the surface",
+        n(low[0]),
+        n(high[0]),
+        n(low[1]),
+        n(high[1]),
+        n(low[2]),
+        n(high[2])
+    ))
+}
+
+/// The comments of the program's header (its first lines), folded lines
+/// joined, in their order.
+fn header_comments(lines: &[String]) -> Vec<String> {
     let mut out: Vec<String> = Vec::new();
-    for line in &lines {
+    for line in lines {
         let Some(text) = lensc_runtime::reader::comment_text(line) else {
             continue;
         };
@@ -73,7 +117,8 @@ fn work_offset(head: &JobHead, lathe: bool) -> Option<String> {
 /// The set-up sheet of the job `head` built as `built` (its report
 /// complete: estimate and acceptance filled in).
 pub fn sheet(head: &JobHead, built: &Built) -> String {
-    let comments = header_comments(&built.program);
+    let first = first_lines(&built.program);
+    let comments = header_comments(&first);
     let starting = |p: &str| comments.iter().find(|c| c.starts_with(p)).cloned();
     let after = |p: &str| starting(p).map(|c| c[p.len()..].trim().to_string());
     let lathe = comments
@@ -126,9 +171,13 @@ pub fn sheet(head: &JobHead, built: &Built) -> String {
     );
     line(
         "stock",
-        &match comments.iter().find(|c| c.contains("stock")) {
-            Some(c) => format!("as the program's strategy states it: {c}"),
-            None => "the job states none: this is a finishing program; the blank must be roughed to within the strategy's cut of the surface".to_string(),
+        &match (
+            comments.iter().find(|c| c.contains("stock")),
+            stated_blank(&first),
+        ) {
+            (Some(c), _) => format!("as the program's strategy states it: {c}"),
+            (None, Some(blank)) => blank,
+            (None, None) => "the job states none: this is a finishing program; the blank must be roughed to within the strategy's cut of the surface".to_string(),
         },
     );
     line("", "");
@@ -243,4 +292,39 @@ pub(crate) fn add(head: &JobHead, built: &mut Built) {
     built
         .beside
         .push((name(&head.name), ProgramText::Memory(text)));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::stated_blank;
+
+    fn lines(text: &str) -> Vec<String> {
+        text.lines().map(str::to_string).collect()
+    }
+
+    /// The blank as Heidenhain ISO (`G30`/`G31`) and Klartext (`BLK
+    /// FORM`) programs state it; none where a program states none.
+    #[test]
+    fn the_blank_the_program_states_is_read() {
+        let iso = lines(
+            "N13 G17 G90 G40 G94 *\nN14 G30 G17 X-1. Y-1.02 Z-1.1286 *\nN15 G31 G90 X1. Y1.02 Z0.0009 *\nN16 T1 G17 *",
+        );
+        let s = stated_blank(&iso).expect("a blank");
+        assert!(
+            s.starts_with("X -1 .. 1, Y -1.02 .. 1.02, Z -1.1286 .. 0.0009 mm, as the program's blank form (G30/G31)"),
+            "{s}"
+        );
+        let klartext = lines(
+            "13 BLK FORM 0.1 Z X-0.8 Y-0.84 Z-1.1566\n14 BLK FORM 0.2 X+0.8 Y+0.84 Z+0\n15 TOOL CALL 1 Z S12000",
+        );
+        let s = stated_blank(&klartext).expect("a blank");
+        assert!(
+            s.starts_with("X -0.8 .. 0.8, Y -0.84 .. 0.84, Z -1.1566 .. 0 mm, as the program's blank form (BLK FORM)"),
+            "{s}"
+        );
+        let linuxcnc = lines("G17 G21 G90 G40 G49 G80 G94 G54\nT1 M6 G43 H1\nG0 Z0.5");
+        assert_eq!(stated_blank(&linuxcnc), None);
+        // One corner alone is no blank.
+        assert_eq!(stated_blank(&iso[..2]), None);
+    }
 }

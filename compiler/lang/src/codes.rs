@@ -273,6 +273,10 @@ pub const PROGRAM_BLOCK_AFTER_END: &str = "E0335";
 pub const PROGRAM_SPLINE_REFUSED: &str = "E0340";
 /// M99 in a LinuxCNC main program: the program again from the top, for ever.
 pub const PROGRAM_MAIN_LOOP: &str = "E0336";
+/// A LinuxCNC NURBS block (G5.2) left without its G5.3: never cut.
+pub const PROGRAM_NURBS_NOT_CUT: &str = "E0337";
+/// A weight not above zero in the first block of a LinuxCNC NURBS block.
+pub const PROGRAM_NURBS_WEIGHT: &str = "E0338";
 
 /// A fast-tool-servo table (`lensc verify`) with a row that is not three
 /// numbers C X W, or whose C runs backwards.
@@ -320,6 +324,8 @@ pub fn program_rule(rule: lensc_runtime::reader::Rule) -> &'static str {
         BlockAfterEnd => PROGRAM_BLOCK_AFTER_END,
         SplineRefused => PROGRAM_SPLINE_REFUSED,
         MainProgramLoop => PROGRAM_MAIN_LOOP,
+        NurbsNotCut => PROGRAM_NURBS_NOT_CUT,
+        NurbsWeight => PROGRAM_NURBS_WEIGHT,
     }
 }
 
@@ -457,6 +463,8 @@ pub const ALL: &[&str] = &[
     PROGRAM_BLOCK_AFTER_END,
     PROGRAM_SPLINE_REFUSED,
     PROGRAM_MAIN_LOOP,
+    PROGRAM_NURBS_NOT_CUT,
+    PROGRAM_NURBS_WEIGHT,
     SERVO_TABLE_ROW,
     ACCEPTANCE_MISSED_WARNING,
     ACCEPTANCE_UNMEASURED_WARNING,

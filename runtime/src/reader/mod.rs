@@ -26,6 +26,7 @@ mod lexer;
 mod modal;
 mod motion;
 mod nurbs;
+mod nurbs_block;
 mod nurbs_moves;
 mod policy;
 mod spline;
@@ -138,6 +139,12 @@ pub enum Rule {
     /// M99 in a main program (LinuxCNC): the program starts again from
     /// its first block, for ever (lensc's policy).
     MainProgramLoop,
+    /// A LinuxCNC NURBS block (G5.2) left without its G5.3: the control
+    /// never cuts the curve (lensc's policy).
+    NurbsNotCut,
+    /// A weight not above zero in the first block of a LinuxCNC NURBS
+    /// block, an absent P there read as −1 (lensc's policy).
+    NurbsWeight,
 }
 
 /// One thing wrong with a program: where (line from 1, byte span in the

@@ -35,6 +35,11 @@ pub(crate) enum Motion {
     Spline(super::spline::Spline),
     /// Fanuc's G06.2 (`nurbs`), where the dialect has it.
     Nurbs,
+    /// LinuxCNC's G5.2, its NURBS block open (`nurbs_block`).
+    NurbsBlock,
+    /// LinuxCNC's G5.3, which closes the NURBS block and leaves no motion
+    /// mode in force.
+    NurbsBlockEnd,
 }
 
 /// The modal group of a G code (value × 10, `G05.1` is 51).
@@ -139,6 +144,9 @@ pub(crate) struct State {
     pub pre_cut_rapid: Option<(f64, (usize, usize))>,
     /// The P Q of the last G5 block, for a G5 that leaves out I J.
     pub last_spline_pq: Option<(f64, f64)>,
+    /// Heidenhain ISO's circle centre (X Y Z from I J K, absolute), as the
+    /// last block with I, J or K defined it.
+    pub circle_centre: [Option<f64>; 3],
     /// The points of the last spline read, handed over as straight moves.
     pub spline_points: Vec<(f64, f64)>,
     /// The moves made so far, when they are asked for.
@@ -147,6 +155,8 @@ pub(crate) struct State {
     nurbs_mode: bool,
     /// The NURBS curve being read, until its last knot.
     pub nurbs: Option<super::nurbs::Nurbs>,
+    /// LinuxCNC's G5.2 curve being read (`nurbs_block`).
+    pub nurbs_block: Option<super::nurbs_block::NurbsBlock>,
     ended: bool,
     /// A Klartext program's own reader, whose blocks become words.
     klartext: Option<Klartext>,
@@ -238,9 +248,11 @@ impl State {
             top: None,
             pre_cut_rapid: None,
             last_spline_pq: None,
+            circle_centre: [None; 3],
             spline_points: Vec::new(),
             nurbs_mode: d.spline == Some(crate::dialect::SplineForm::Nurbs),
             nurbs: None,
+            nurbs_block: None,
             moves: None,
             ended: false,
             klartext: (lex.controller == Controller::HeidenhainKlartext).then(Klartext::default),
@@ -337,7 +349,16 @@ impl State {
         }) {
             // G50 S, G4, G36 S and the blank's G30 G31 take their own
             // words; no move.
-            if self.motion == Some(Motion::Nurbs) {
+            let nurbs_code = |m: Motion| groups.iter().any(|(g, _)| *g == GGroup::Motion(m));
+            let (opens, closes) = (
+                nurbs_code(Motion::NurbsBlock),
+                nurbs_code(Motion::NurbsBlockEnd),
+            );
+            if (opens || closes || self.nurbs_block.is_some())
+                && self.nurbs_block_line(b, opens, closes, out)
+            {
+                // A block of LinuxCNC's G5.2 curve, or its G5.3.
+            } else if self.motion == Some(Motion::Nurbs) {
                 let starts = groups
                     .iter()
                     .any(|(g, _)| *g == GGroup::Motion(Motion::Nurbs));
@@ -384,6 +405,7 @@ impl State {
     /// What is wrong once the whole program is read.
     pub fn finish(&mut self, out: &mut Vec<Found>) {
         self.nurbs_cut_short("", out);
+        self.nurbs_block_left((0, 0), out);
         if let Some(k) = &self.klartext {
             k.finish(out);
         }
@@ -567,6 +589,8 @@ impl State {
             800 if c == LinuxCnc => GGroup::Motion(Motion::Cancel),
             50 if c == LinuxCnc => GGroup::Motion(Motion::Spline(super::spline::Spline::Cubic)),
             51 if c == LinuxCnc => GGroup::Motion(Motion::Spline(super::spline::Spline::Quadratic)),
+            52 if c == LinuxCnc => GGroup::Motion(Motion::NurbsBlock),
+            53 if c == LinuxCnc => GGroup::Motion(Motion::NurbsBlockEnd),
             62 if self.nurbs_mode => GGroup::Motion(Motion::Nurbs),
             800 if c == Fanuc || c == UltraPrecision => GGroup::Cycle,
             430 | 490 if c == LinuxCnc || c == Fanuc => GGroup::ToolLength,

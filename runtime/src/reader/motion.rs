@@ -44,9 +44,27 @@ impl State {
             .iter()
             .filter(|w| matches!(w.letter, 'I' | 'J' | 'K' | 'R'))
             .collect();
+        // Heidenhain ISO: I, J, K define the circle centre, wherever they
+        // are; a block of them alone moves nothing, in an arc mode too
+        // ("The only effect of I, J, K is to define a position as a circle
+        // center — the tool does not move to the position": TNC
+        // 426/425/415 B/407 ISO Programming User's Manual, "Circle center
+        // I, J, K", pp. 5-16 to 5-17; docs/controllers/heidenhain.md).
+        let iso = self.lex.controller == Controller::HeidenhainIso;
+        if iso {
+            let unit = self.mm_per_unit();
+            for w in b
+                .words
+                .iter()
+                .filter(|w| matches!(w.letter, 'I' | 'J' | 'K'))
+            {
+                let i = (w.letter as u8 - b'I') as usize;
+                self.circle_centre[i] = Some(w.value * unit);
+            }
+        }
         // Centre words alone make a move only in an arc mode (a full
         // circle); elsewhere they belong to their block (`M19 R0`).
-        let arc_mode = matches!(self.motion, Some(Motion::Cw | Motion::Ccw));
+        let arc_mode = matches!(self.motion, Some(Motion::Cw | Motion::Ccw)) && !iso;
         let Some(first) = axes(b)
             .next()
             .or(centre.first().copied().filter(|_| arc_mode))
@@ -537,7 +555,19 @@ impl State {
             );
             return None;
         }
-        if centre.is_empty() && radius.is_none() {
+        // Heidenhain ISO: an arc without I J K goes about the circle centre
+        // an earlier block defined (p. 5-18: "The circle center I, J, K
+        // must have been previously defined in the program").
+        let defined = (self.lex.controller == Controller::HeidenhainIso
+            && self.arc_centre_absolute
+            && centre.is_empty()
+            && radius.is_none())
+        .then(|| (self.circle_centre[a], self.circle_centre[b]));
+        let defined = match defined {
+            Some((Some(ca), Some(cb))) => Some((ca, cb)),
+            _ => None,
+        };
+        if centre.is_empty() && radius.is_none() && defined.is_none() {
             arc_words("an arc with no centre (I, J or K)".into(), span);
             return None;
         }
@@ -563,6 +593,8 @@ impl State {
         };
         let (ca, cb) = if let Some(r) = radius {
             self.radius_centre(cw, (sa, sb), (ea, eb), r.value * unit, r.span, out)?
+        } else if let Some((ca, cb)) = defined {
+            (ca, cb)
         } else if self.arc_centre_absolute {
             (
                 word(letters[0]).unwrap_or(sa),

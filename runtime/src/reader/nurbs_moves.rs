@@ -158,23 +158,33 @@ impl State {
             return;
         }
         self.may_cut(b, span, out);
-        let points = nurbs.sampled();
-        let length: f64 = points
-            .windows(2)
-            .map(|w| {
-                ((w[1][0] - w[0][0]).powi(2)
-                    + (w[1][1] - w[0][1]).powi(2)
-                    + (w[1][2] - w[0][2]).powi(2))
-                .sqrt()
-            })
-            .sum();
+        self.curve_moves(nurbs.sampled(), 3, start, b, span, out);
+    }
+
+    /// The tool moved along `points` (a curve sampled within the spline
+    /// tolerance) from `start`: its first `axes` coordinates (X Y, or X Y
+    /// Z) set, the others kept; the feed, the travel, the highest point
+    /// cut and the straight moves for the simulation.
+    pub(crate) fn curve_moves(
+        &mut self,
+        points: Vec<[f64; 3]>,
+        axes: usize,
+        start: [Option<f64>; 4],
+        b: &Block,
+        span: (usize, usize),
+        out: &mut Vec<Found>,
+    ) {
+        let d = |a: &[f64; 3], b: &[f64; 3]| {
+            (0..axes).map(|i| (b[i] - a[i]).powi(2)).sum::<f64>().sqrt()
+        };
+        let length: f64 = points.windows(2).map(|w| d(&w[0], &w[1])).sum();
         let last = points[points.len() - 1];
-        let mut end = self.pos;
-        for i in 0..3 {
+        let mut end = start;
+        for i in 0..axes {
             end[i] = Some(last[i]);
         }
         self.feed_limit(b, &start, &end, length, span, out);
-        for (i, lim) in self.machine.travel.iter().enumerate().take(3) {
+        for (i, lim) in self.machine.travel.iter().enumerate().take(axes) {
             if let Some((lo, hi)) = lim
                 && let Some(p) = points.iter().find(|p| p[i] < lo - 1e-9 || p[i] > hi + 1e-9)
             {
@@ -193,19 +203,23 @@ impl State {
                 break;
             }
         }
-        if self.away < 3 {
+        if self.away < axes {
             let a = self.away;
             let high = points
                 .iter()
                 .map(|p| p[a])
                 .fold(f64::NEG_INFINITY, f64::max);
             self.top = Some(self.top.map_or(high, |t| t.max(high)));
+        } else if self.away < 3
+            && let Some(h) = start[self.away]
+        {
+            self.top = Some(self.top.map_or(h, |t| t.max(h)));
         }
         if let Some(moves) = &mut self.moves {
             for w in points.windows(2) {
                 let mut from = start;
                 let mut to = start;
-                for i in 0..3 {
+                for i in 0..axes {
                     from[i] = Some(w[0][i]);
                     to[i] = Some(w[1][i]);
                 }

@@ -104,6 +104,14 @@ impl Rule {
                 "blocks-after-end",
                 "blocks after M2 or M30 are never run (the controller does not even read them): a stray end code loses the rest of the cut silently",
             ),
+            Rule::NurbsNotCut => (
+                "nurbs-not-cut",
+                "a LinuxCNC NURBS block (G5.2) left without its G5.3 is never cut: the controller drops the curve at the next motion code and runs on, so a part of the cut is missing silently",
+            ),
+            Rule::NurbsWeight => (
+                "nurbs-weight",
+                "a control point of the first G5.2 block with no weight P (which LinuxCNC reads as −1) or one not above zero: the controller runs it, and the curve turns away from its points or divides by zero",
+            ),
             _ => return None,
         };
         Some(Policy { name, reason })

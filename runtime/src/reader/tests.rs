@@ -474,6 +474,15 @@ fn linuxcnc_reads_splines_as_moves_along_the_curve() {
         let found = rules(&text, &d, &mill);
         assert!(!found.is_empty(), "{bad}");
     }
+    // A spline code with no axis word: "All axes missing with motion
+    // code" (rs274 2.9; the differential round's `G5` block found it).
+    for bad in ["G5", "G5.1", "G5 P1 Q1"] {
+        assert_eq!(
+            rules(&program(bad), &d, &mill),
+            vec![Rule::ArcWords],
+            "{bad}"
+        );
+    }
 }
 
 /// LinuxCNC's parameters and expressions are evaluated where a word's
@@ -852,4 +861,118 @@ fn a_nurbs_curve_the_control_refuses_is_found_with_its_span() {
     // Without the dialect's spline, G06.2 is a code the control lacks.
     let found = rules(NURBS, &Dialect { spline: None, ..d }, &nurbs_mill());
     assert!(found.contains(&Rule::UnknownWord), "{found:?}");
+}
+
+/// LinuxCNC's NURBS block (G5.2 … G5.3) read as `rs274` 2.9 runs it: the
+/// manual's example (11.5.9) passes through the points LinuxCNC's own
+/// evaluation gives (its Python module `gcode`: (1, 1.5) and (2, 1) at
+/// u = 1 and 2 of 3), and ends at its last control point; what rs274
+/// refuses is E0340 (`tests/it/nurbs_linuxcnc.rs` holds every case
+/// against rs274 itself).
+#[test]
+fn linuxcnc_reads_a_nurbs_block_as_the_interpreter_evaluates_it() {
+    let d = Dialect::linuxcnc();
+    let mill = MachineLimits {
+        lathe: false,
+        travel: [None; 4],
+        max_feed: None,
+        max_spindle_rpm: None,
+    };
+    let program = |moves: &str| {
+        format!(
+            "G17 G21 G90 G94\nT1 M6\nG97 S1000 M3\nG0 X0 Y0 Z1\nG1 Z0 F100\n{moves}\nG0 Z1\nM5\nM2\n"
+        )
+    };
+    let good = program("G5.2 P1 L3\nX0 Y1 P1\nX2 Y2 P1\nX2 Y0 P1\nX0 Y0 P2\nG5.3");
+    let (found, moves) = read_moves(&good, &d, &mill);
+    assert_eq!(found, vec![], "{good}");
+    let lines: Vec<&Executed> = moves
+        .iter()
+        .filter(|m| m.path == Path::Line && m.from[2] == Some(0.0))
+        .collect();
+    assert!(lines.len() > 100, "{} lines", lines.len());
+    for w in lines.windows(2) {
+        assert_eq!(w[0].to, w[1].from);
+    }
+    let last = lines.last().expect("a line").to;
+    assert_eq!(last[..3], [Some(0.0), Some(0.0), Some(0.0)]);
+    for (x, y) in [(1.0, 1.5), (2.0, 1.0)] {
+        let near = lines
+            .iter()
+            .map(|m| (m.to[0].unwrap() - x).hypot(m.to[1].unwrap() - y))
+            .fold(f64::INFINITY, f64::min);
+        assert!(near < 1e-9, "({x}, {y}): {near:e}");
+    }
+    for bad in [
+        "G5.2 X0 Y1 P1 L5\nX2 Y2 P1\nX2 Y0 P1\nG5.3",
+        "G5.2 X0 Y1 P1\nG5.3",
+        "G5.2 X0 Y1 P1\nX2 Y2\nX2 Y0 P1\nG5.3",
+        "G5.2 X0 Y1 P1\nX2 P1\nX2 Y0 P1\nG5.3",
+        "G5.3",
+    ] {
+        assert_eq!(
+            rules(&program(bad), &d, &mill),
+            vec![Rule::SplineRefused],
+            "{bad}"
+        );
+    }
+    let open = program("G5.2 X0 Y1 P1\nX2 Y2 P1\nG1 X0 Y0");
+    assert_eq!(rules(&open, &d, &mill), vec![Rule::NurbsNotCut]);
+    let weightless = program("G5.2 X0 Y1\nX2 Y2 P1\nX2 Y0 P1\nG5.3");
+    let found = read(&weightless, &d, &mill);
+    assert_eq!(found.len(), 1);
+    assert_eq!((found[0].rule, found[0].line), (Rule::NurbsWeight, 6));
+}
+
+/// Heidenhain ISO: a block of I J alone defines the circle centre and
+/// moves nothing, in an arc mode too (it was read as a full circle); an
+/// arc after it without I J goes about that centre (TNC 426/425/415
+/// B/407 ISO Programming User's Manual, "Circle center I, J, K", pp.
+/// 5-16 to 5-18).
+#[test]
+fn heidenhain_iso_reads_i_j_alone_as_the_circle_centre() {
+    let mut d = Dialect::linuxcnc();
+    d.comment = crate::dialect::CommentStyle::Semicolon;
+    d.block_end = " *".into();
+    d.line_numbers = Some(1);
+    d.max_line_number = Some(99999);
+    d.arc_centre_absolute = true;
+    d.surface_speed = Vec::new();
+    d.constant_rpm = None;
+    assert_eq!(Controller::of(&d), Controller::HeidenhainIso);
+    let program = |arcs: &str| {
+        format!(
+            "%J G71 *\nN1 ; +Z out of the material *\nN2 G17 G90 G40 G94 *\nN3 T1 G17 *\nN4 S1000 M3 *\nN5 G00 Z1. *\nN6 G00 X-1. Y0. *\nN7 G01 Z-0.1 F100. *\n{arcs}N20 G00 Z1. *\nN21 M5 *\nN22 M30 *\nN99999999 %J G71 *\n"
+        )
+    };
+    let alone = program("N8 G02 X1. I0. J0. *\nN9 I0. J0. *\n");
+    let (found, moves) = read_moves(&alone, &d, &mill());
+    assert_eq!(found, vec![], "{alone}");
+    let arcs = moves
+        .iter()
+        .filter(|m| matches!(m.path, Path::Arc { .. }))
+        .count();
+    assert_eq!(arcs, 1, "the I J block moves nothing");
+    let about = program("N8 I0. J0. *\nN9 G02 X1. *\nN10 G02 X-1. *\n");
+    let (found, moves) = read_moves(&about, &d, &mill());
+    assert_eq!(found, vec![], "{about}");
+    let turns: Vec<f64> = moves
+        .iter()
+        .filter_map(|m| match m.path {
+            Path::Arc { centre, turn, .. } => {
+                assert_eq!(centre, (0.0, 0.0));
+                Some(turn)
+            }
+            _ => None,
+        })
+        .collect();
+    assert_eq!(turns.len(), 2);
+    assert!(
+        turns
+            .iter()
+            .all(|t| (t - std::f64::consts::PI).abs() < 1e-12)
+    );
+    // No centre defined at all: still refused.
+    let none = program("N8 G02 X1. *\n");
+    assert_eq!(rules(&none, &d, &mill()), vec![Rule::ArcWords]);
 }

@@ -41,6 +41,11 @@ impl Users {
         matches!(self.motion, Some(Motion::Cw | Motion::Ccw))
     }
 
+    /// A block of a NURBS block (G5.2, or its control points in the mode).
+    fn nurbs(&self) -> bool {
+        self.motion == Some(Motion::NurbsBlock)
+    }
+
     /// Whether a code of the block uses `letter`, by LinuxCNC's rules; the
     /// codes that would, for the message.
     fn uses(&self, letter: char) -> (bool, &'static str) {
@@ -59,12 +64,12 @@ impl Users {
                 "G2, G3 or M19 (or G10 and the canned cycles, which lensc does not read)",
             ),
             'P' => (
-                self.arc() || spline(&[40, 50, 52, 640]) || self.m.contains(&19),
+                self.arc() || self.nurbs() || spline(&[40, 50, 640]) || self.m.contains(&19),
                 "G2, G3 (turns), G4 (dwell), G5, G5.2, G64 or M19",
             ),
             'Q' => (spline(&[50, 640]) || self.m.contains(&19), "G5, G64 or M19"),
             'L' => (
-                spline(&[52]) || spline(&[410, 420]),
+                self.nurbs() || spline(&[410, 420]),
                 "G5.2 or cutter compensation (G41, G42)",
             ),
             'D' => (spline(&[410, 420, 960]), "G41, G42 or G96"),
@@ -146,6 +151,21 @@ impl State {
                     "give the arc its end and centre, or leave the {} out",
                     if arc == Motion::Cw { "G2" } else { "G3" }
                 )),
+            ));
+        }
+        // G5 and G5.1 with no axis word: "All axes missing with motion
+        // code" (`rs274` 2.9; G0, G1 and G5.2 alone are run).
+        if let Some((Motion::Spline(_), i)) = own
+            && !has(&['X', 'Y', 'Z', 'A', 'B', 'C'])
+        {
+            out.push((
+                Rule::ArcWords,
+                b.words[i].span,
+                format!(
+                    "`{}` with no axis word: the controller refuses a spline with no end",
+                    b.words[i].text(line)
+                ),
+                Some("give the spline its end point X Y, or leave the code out".into()),
             ));
         }
         if let Some(i) = b
