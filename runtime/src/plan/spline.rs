@@ -42,6 +42,22 @@ pub struct SplineFit {
     /// The control point's offset from the tool centre, added before
     /// rounding as the writer adds it.
     pub control: ControlOffset,
+    /// How the interior knots are placed.
+    pub knots: KnotSpacing,
+}
+
+/// Where a fit's interior knots go.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum KnotSpacing {
+    /// By averaging the points' parameters (Piegl and Tiller eq. 9.69),
+    /// each knot printed (Fanuc's G06.2 states every knot, K).
+    Averaged,
+    /// Equally spaced, the spacing rounded to the printed decimals:
+    /// Siemens' BSPLINE states a knot spacing PL per block, and which
+    /// knot interval a block's PL sets is not stated in the manual; with
+    /// every spacing equal the curve is the same whichever it is
+    /// (docs/controllers/siemens.md).
+    Uniform,
 }
 
 impl SplineFit {
@@ -347,7 +363,18 @@ fn fitted(
     }
     // Parameters scaled onto the printed knots' range.
     let u: Vec<f64> = params.iter().map(|p| p * end / length).collect();
-    let knots = knots(&u, n, round)?;
+    let knots = match fit.knots {
+        KnotSpacing::Averaged => knots(&u, n, round)?,
+        KnotSpacing::Uniform => uniform_knots(end, n, round)?,
+    };
+    // The curve's parameter range as its knots end (a uniform spacing,
+    // rounded, times the spans, need not be the path's length).
+    let last = knots[knots.len() - 1];
+    let u: Vec<f64> = if last == end {
+        u
+    } else {
+        u.iter().map(|v| v * last / end).collect()
+    };
     let ctrl = least_squares(points, &u, &knots, n)?;
     let o = [fit.control.x, fit.control.y, fit.control.z];
     let check = |ctrl: &[[f64; 3]]| deviation(ctrl, &knots, points, &u, arcs);
@@ -390,6 +417,21 @@ fn knots(u: &[f64], n: usize, round: impl Fn(f64) -> f64) -> Option<Vec<f64>> {
         k.push(v);
     }
     k.extend([end; ORDER]);
+    Some(k)
+}
+
+/// The clamped knot vector of `n` control points with equally spaced
+/// interior knots: the spacing `end / spans` rounded to the printed
+/// decimals, the end at `spans` times it; none if it rounds to zero.
+fn uniform_knots(end: f64, n: usize, round: impl Fn(f64) -> f64) -> Option<Vec<f64>> {
+    let spans = n - DEGREE;
+    let spacing = round(end / spans as f64);
+    if spacing <= 0.0 {
+        return None;
+    }
+    let mut k = vec![0.0; ORDER];
+    k.extend((1..spans).map(|j| j as f64 * spacing));
+    k.extend([spans as f64 * spacing; ORDER]);
     Some(k)
 }
 

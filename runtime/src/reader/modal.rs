@@ -35,6 +35,8 @@ pub(crate) enum Motion {
     Spline(super::spline::Spline),
     /// Fanuc's G06.2 (`nurbs`), where the dialect has it.
     Nurbs,
+    /// Siemens' BSPLINE (`bspline.rs`).
+    Bspline,
 }
 
 /// The modal group of a G code (value × 10, `G05.1` is 51).
@@ -147,6 +149,9 @@ pub(crate) struct State {
     nurbs_mode: bool,
     /// The NURBS curve being read, until its last knot.
     pub nurbs: Option<super::nurbs::Nurbs>,
+    /// The B spline being read (Siemens' BSPLINE), until a block leaves
+    /// the mode.
+    pub bspline: Option<super::bspline::Bspline>,
     ended: bool,
     /// A Klartext program's own reader, whose blocks become words.
     klartext: Option<Klartext>,
@@ -241,6 +246,7 @@ impl State {
             spline_points: Vec::new(),
             nurbs_mode: d.spline == Some(crate::dialect::SplineForm::Nurbs),
             nurbs: None,
+            bspline: None,
             moves: None,
             ended: false,
             klartext: (lex.controller == Controller::HeidenhainKlartext).then(Klartext::default),
@@ -312,6 +318,16 @@ impl State {
         } else {
             self.parameter_words(b, groups, line, out);
         }
+        // A block leaving B spline mode ends the curve: it is moved along
+        // before this block's own modes (its feed) take effect.
+        if self.bspline.is_some()
+            && (groups
+                .iter()
+                .any(|(g, _)| matches!(g, GGroup::Motion(_) | GGroup::MachineMove))
+                || ms.iter().any(|(m, _)| *m == MCode::End))
+        {
+            self.bspline_end(line, out);
+        }
         self.modes(b, groups, line, out);
         self.spindle_and_tool(b, groups, ms, line, out);
         // A move to a machine position (G28, G53, Siemens' SUPA,
@@ -337,7 +353,9 @@ impl State {
         }) {
             // G50 S, G4, G36 S and the blank's G30 G31 take their own
             // words; no move.
-            if self.motion == Some(Motion::Nurbs) {
+            if self.motion == Some(Motion::Bspline) {
+                self.bspline_block(b, line, out);
+            } else if self.motion == Some(Motion::Nurbs) {
                 let starts = groups
                     .iter()
                     .any(|(g, _)| *g == GGroup::Motion(Motion::Nurbs));
@@ -384,6 +402,7 @@ impl State {
     /// What is wrong once the whole program is read.
     pub fn finish(&mut self, out: &mut Vec<Found>) {
         self.nurbs_cut_short("", out);
+        self.bspline_end("", out);
         if let Some(k) = &self.klartext {
             k.finish(out);
         }
@@ -672,6 +691,9 @@ impl State {
             match k.kind {
                 KeywordKind::Word(Diamon | Diam90) => self.diameter = self.machine.lathe,
                 KeywordKind::Word(Diamof) => self.diameter = false,
+                KeywordKind::Word(Bspline) => self.motion = Some(Motion::Bspline),
+                // A B spline's SD, PL and PW are `bspline_moves.rs`'.
+                KeywordKind::Word(Sd | Pl | Pw) => {}
                 // SPCON, SPCOF, SPOS and LIMS are `spindle_and_tool`'s, a
                 // tool by name `tool`'s; the rest change nothing the reader
                 // holds a program to.
@@ -774,7 +796,7 @@ impl State {
                 // the reader holds a program to.
                 KeywordKind::Word(
                     Diamof | Diamon | Diam90 | Compcad | Compcurv | Compon | Compof | Ctol | Otol
-                    | Atol | Lims | Soft | Brisk | Ffwon | Ffwof | Supa,
+                    | Atol | Lims | Soft | Brisk | Ffwon | Ffwof | Supa | Bspline | Sd | Pl | Pw,
                 )
                 | KeywordKind::Text(_)
                 | KeywordKind::Cycle832 => {}

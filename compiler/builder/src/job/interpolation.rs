@@ -2,9 +2,8 @@
 //! moves and arcs, or the controller's own spline (`interpolation`, the
 //! job's or its dialect's default), and E0182 where the spline asked for
 //! is one lensc cannot write: the dialect has none (LinuxCNC's G5–G5.2 are
-//! in the XY plane only, and no lensc path lies in it; Siemens, Heidenhain
-//! and the ultra-precision lathes are not written yet:
-//! docs/controllers/), or the strategy's programs are not fitted yet
+//! in the XY plane only, and no lensc path lies in it; Heidenhain and the
+//! ultra-precision lathes are not written yet: docs/controllers/), or the strategy's programs are not fitted yet
 //! (raster jobs only, so far).
 
 use lensc_grammar::Diagnostic;
@@ -38,7 +37,7 @@ pub fn error(p: &Parts, dialect: &Dialect) -> Option<Diagnostic> {
                 "`interpolation: spline`, but the `{}` dialect has no spline lensc writes",
                 dialect.name
             ),
-            "write `interpolation: lines_arcs`, or build in a dialect with `spline: nurbs` (`fanuc_0i_mill`); LinuxCNC's G5, G5.1 and G5.2 interpolate in the XY plane only, and Siemens' BSPLINE is not written yet (docs/controllers/)".to_string(),
+            "write `interpolation: lines_arcs`, or build in a dialect with a spline (`fanuc_0i_mill`: NURBS, G06.2; `siemens_840d_mill`: BSPLINE); LinuxCNC's G5, G5.1 and G5.2 interpolate in the XY plane only, and Heidenhain's SPL is not written yet (docs/controllers/)".to_string(),
         )
     } else if !SPLINE_STRATEGIES.contains(&strategy) {
         (
