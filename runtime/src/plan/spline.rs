@@ -60,6 +60,17 @@ pub enum KnotSpacing {
     Uniform,
 }
 
+impl KnotSpacing {
+    /// How `dialect`'s spline places its knots: Fanuc's G06.2 states each
+    /// knot, Siemens' BSPLINE one spacing (PL) that lensc keeps equal.
+    pub fn of(dialect: &crate::dialect::Dialect) -> KnotSpacing {
+        match dialect.spline {
+            Some(crate::dialect::SplineForm::Bspline) => KnotSpacing::Uniform,
+            _ => KnotSpacing::Averaged,
+        }
+    }
+}
+
 impl SplineFit {
     /// The rounding a printed point gets: half a unit of the last decimal
     /// on each of three axes.
@@ -110,13 +121,25 @@ pub fn fit_splines(
         ..Summary::default()
     };
     let mut at = [f64::NAN; 3];
+    // A lathe's moves never state Y: the curve lies in Y = 0.
+    let no_y = moves.iter().all(|m| match m {
+        Move::Rapid(to) | Move::Linear { to, .. } | Move::Arc { to, .. } => to.y.is_nan(),
+        _ => true,
+    });
+    if no_y {
+        at[1] = 0.0;
+    }
     let mut i = 0;
     while i < moves.len() {
         let (run_end, feed) = run(moves, i, at);
         // The run as lines and arcs, where those are the other way.
         let lines_arcs = otherwise.filter(|_| run_end > i).map(|o| {
             let mut stream = Vec::with_capacity(run_end - i + 1);
-            stream.push(Move::Rapid(Position::xyz(at[0], at[1], at[2])));
+            stream.push(Move::Rapid(if no_y {
+                Position::xz(at[0], at[2])
+            } else {
+                Position::xyz(at[0], at[1], at[2])
+            }));
             stream.extend_from_slice(&moves[i..run_end]);
             // The optimiser starts a run at a stated feed: a run that
             // keeps the feed in force is given one for the fit (any: one

@@ -4,7 +4,7 @@
 //! is one lensc cannot write: the dialect has none (LinuxCNC's G5–G5.2 are
 //! in the XY plane only, and no lensc path lies in it; Heidenhain and the
 //! ultra-precision lathes are not written yet: docs/controllers/), or the strategy's programs are not fitted yet
-//! (raster jobs only, so far).
+//! (raster and profile-turning jobs only, so far).
 
 use lensc_grammar::Diagnostic;
 use lensc_lang::codes;
@@ -13,7 +13,7 @@ use lensc_runtime::dialect::Dialect;
 use super::Parts;
 
 /// The strategies whose programs are fitted with splines.
-pub const SPLINE_STRATEGIES: &[&str] = &["raster"];
+pub const SPLINE_STRATEGIES: &[&str] = &["raster", "profile_turning"];
 
 /// Whether the job's program is written with splines: as the job says,
 /// else as its dialect's default.
@@ -42,7 +42,7 @@ pub fn error(p: &Parts, dialect: &Dialect) -> Option<Diagnostic> {
     } else if !SPLINE_STRATEGIES.contains(&strategy) {
         (
             format!(
-                "`interpolation: spline` for a `{strategy}` job: lensc fits splines to raster jobs only so far"
+                "`interpolation: spline` for a `{strategy}` job: lensc fits splines to raster and profile-turning jobs only so far"
             ),
             "write `interpolation: lines_arcs` for this job".to_string(),
         )

@@ -267,3 +267,31 @@ fn uniform_knots_are_equally_spaced_and_hold_the_circle() {
         "{summary:?}"
     );
 }
+
+/// A lathe's profile states X and Z only (Y never): it is fitted all the
+/// same, in Y = 0 (before, every run needed a known Y and none was found).
+#[test]
+fn a_lathe_profile_without_y_is_fitted_in_y_zero() {
+    let moves: Vec<Move> = pass(1.0, 0.7, 400)
+        .into_iter()
+        .map(|m| match m {
+            Move::Rapid(to) => Move::Rapid(Position::xz(to.x, to.z)),
+            Move::Linear { to, feed } => Move::Linear {
+                to: Position::xz(to.x, to.z),
+                feed,
+            },
+            other => other,
+        })
+        .collect();
+    let fit = SplineFit {
+        knots: KnotSpacing::Uniform,
+        ..FIT
+    };
+    let (steps, summary) = fit_splines(&moves, &fit, None);
+    let [Step::Move(_), Step::Spline(s)] = &steps[..] else {
+        panic!("one spline: {summary:?}");
+    };
+    assert!(s.points.iter().all(|p| p[1] == 0.0));
+    let worst = worst_from_circle(s, 1.0);
+    assert!(worst <= summary.limit, "{worst:e} over {:e}", summary.limit);
+}

@@ -64,7 +64,7 @@ pub(super) fn build(spec: &RasterSpec, cx: &BuildContext) -> Result<Built, Vec<D
             tolerance: fit_share,
             decimals,
             control: head.start.control,
-            knots: knot_spacing(dialect),
+            knots: lensc_runtime::plan::spline::KnotSpacing::of(dialect),
         };
         // Each run as a spline, or as the optimiser's lines and arcs where
         // those take fewer blocks (points placed clear of the material are
@@ -96,7 +96,7 @@ pub(super) fn build(spec: &RasterSpec, cx: &BuildContext) -> Result<Built, Vec<D
             .iter()
             .position(|l| l.starts_with("machine "))
             .unwrap_or(header.len());
-        header.insert(at, spline_words(dialect, &fitted));
+        header.insert(at, lensc_runtime::emit::spline_words(dialect, &fitted));
         let text = lensc_runtime::emit::raster::emit_mill_steps(
             dialect,
             &head.name,
@@ -270,51 +270,6 @@ fn blank(
     (0..3)
         .all(|i| min[i] <= max[i])
         .then_some(lensc_runtime::moves::Blank { min, max })
-}
-
-/// How the dialect's spline places its knots: Fanuc's G06.2 states each
-/// knot, Siemens' BSPLINE one spacing (PL) that lensc keeps equal.
-pub(crate) fn knot_spacing(
-    dialect: &lensc_runtime::dialect::Dialect,
-) -> lensc_runtime::plan::spline::KnotSpacing {
-    match dialect.spline {
-        Some(lensc_runtime::dialect::SplineForm::Bspline) => {
-            lensc_runtime::plan::spline::KnotSpacing::Uniform
-        }
-        _ => lensc_runtime::plan::spline::KnotSpacing::Averaged,
-    }
-}
-
-/// The header line of a program written with splines: which, how many,
-/// how close, and the control option they need.
-pub(crate) fn spline_words(
-    dialect: &lensc_runtime::dialect::Dialect,
-    s: &lensc_runtime::plan::spline::Summary,
-) -> String {
-    let form = match dialect.spline {
-        Some(lensc_runtime::dialect::SplineForm::Bspline) => format!(
-            "B spline (BSPLINE SD={}, knots PL apart)",
-            lensc_runtime::plan::spline::ORDER - 1
-        ),
-        _ => format!(
-            "NURBS (G06.2, order {})",
-            lensc_runtime::plan::spline::ORDER
-        ),
-    };
-    format!(
-        "interpolation: {form} where shorter than lines and arcs: {} splines for {} straight moves, {} blocks of moves from {} planned, largest deviation {} nm (limit {} nm); needs the control's {}",
-        s.splines,
-        s.lines_replaced,
-        s.blocks_after,
-        s.blocks_before,
-        lensc_runtime::post::header::num((s.max_deviation * 1e7).round() / 10.0),
-        lensc_runtime::post::header::num((s.limit * 1e7).round() / 10.0),
-        if dialect.spline_option.is_empty() {
-            "spline interpolation"
-        } else {
-            &dialect.spline_option
-        }
-    )
 }
 
 /// The program's header: provenance, units, surface, the tool, the raster
