@@ -145,6 +145,10 @@ pub enum SplineForm {
     /// Fanuc's NURBS interpolation, G06.2: rank P, knots K, weights R,
     /// control points in any of X, Y, Z (docs/controllers/fanuc.md).
     Nurbs,
+    /// Siemens' B spline, BSPLINE: degree SD, knot spacing PL, weights
+    /// PW, the tool's position the first control point
+    /// (docs/controllers/siemens.md).
+    Bspline,
 }
 
 /// A Fanuc lathe's G-code system (parameter-selected on the control).

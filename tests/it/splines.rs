@@ -122,3 +122,58 @@ fn a_dialect_without_a_spline_refuses_it_and_writes_nothing() {
     assert!(err.contains("[E0182]"), "{err}");
     assert!(!dir.path().join("out/with_splines.ngc").exists());
 }
+
+/// The same hyperboloid in Siemens' dialect without arcs: BSPLINE blocks
+/// with one knot spacing PL in every block, read clean by `lensc
+/// verify`, the same form as the lines program within what the fit may
+/// move the path, and under a third of its blocks. A PL changed in one
+/// block is refused by the reader (E0340) at that word.
+#[test]
+fn a_siemens_b_spline_program_reads_clean_and_cuts_the_lines_form() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let jobs = JOBS
+        .replace(
+            "dialect fanuc_lines = fanuc_0i_mill",
+            "dialect sie_lines = siemens_840d_mill",
+        )
+        .replace("{ dialect: fanuc_lines }", "{ dialect: sie_lines }");
+    std::fs::write(dir.path().join("jobs.lens"), jobs).expect("write");
+    let out = lensc(dir.path(), &["build", "jobs.lens"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let program = std::fs::read_to_string(dir.path().join("out/with_splines.MPF")).expect("MPF");
+    let lines = std::fs::read_to_string(dir.path().join("out/with_lines.MPF")).expect("MPF");
+    assert!(program.contains("\nBSPLINE SD=3 PL="), "no B spline block");
+    assert!(!lines.contains("BSPLINE"));
+    assert!(program.contains("; interpolation: B spline"), "header");
+    let verify = lensc(dir.path(), &["verify", "out/with_splines.MPF"]);
+    assert_eq!(verify.status.code(), Some(0), "{}", text(&verify.stderr));
+    let limit = 30.0 + 0.05 * 3f64.sqrt() * 1e3;
+    for c in ["form_pv", "form_rms", "max_gouge"] {
+        let (s, l) = (
+            measured(dir.path(), "with_splines", c),
+            measured(dir.path(), "with_lines", c),
+        );
+        assert!(
+            (s - l).abs() <= limit,
+            "{c}: {s} nm with splines, {l} with lines"
+        );
+    }
+    let blocks = |p: &str| p.lines().filter(|l| !l.starts_with(';')).count();
+    assert!(
+        blocks(&program) * 3 <= blocks(&lines),
+        "{} vs {}",
+        blocks(&program),
+        blocks(&lines)
+    );
+    // One block's PL changed: the curve's spacing is no longer one.
+    let i = program.find("\nPL=").expect("a second block") + 4;
+    let bad = format!("{}9{}", &program[..i], &program[i..]);
+    std::fs::write(dir.path().join("bad.MPF"), bad).expect("write");
+    let verify = lensc(dir.path(), &["verify", "bad.MPF"]);
+    assert_eq!(verify.status.code(), Some(1));
+    let err = text(&verify.stderr);
+    assert!(
+        err.contains("[E0340]") && err.contains("one spacing"),
+        "{err}"
+    );
+}

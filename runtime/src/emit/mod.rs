@@ -22,6 +22,32 @@ pub struct Emitted {
     pub optimised: optimise::Summary,
 }
 
+/// The header line of a program written with splines: which, how many,
+/// how close, and the control option they need.
+pub fn spline_words(dialect: &crate::dialect::Dialect, s: &crate::plan::spline::Summary) -> String {
+    use crate::plan::spline::ORDER;
+    let form = match dialect.spline {
+        Some(crate::dialect::SplineForm::Bspline) => {
+            format!("B spline (BSPLINE SD={}, knots PL apart)", ORDER - 1)
+        }
+        _ => format!("NURBS (G06.2, order {ORDER})"),
+    };
+    format!(
+        "interpolation: {form} where shorter than lines and arcs: {} splines for {} straight moves, {} blocks of moves from {} planned, largest deviation {} nm (limit {} nm); needs the control's {}",
+        s.splines,
+        s.lines_replaced,
+        s.blocks_after,
+        s.blocks_before,
+        crate::post::header::num((s.max_deviation * 1e7).round() / 10.0),
+        crate::post::header::num((s.limit * 1e7).round() / 10.0),
+        if dialect.spline_option.is_empty() {
+            "spline interpolation"
+        } else {
+            &dialect.spline_option
+        }
+    )
+}
+
 /// How a path's tolerance T is stated in a header (exactly, in nm as a
 /// `.lens` file reads nm), with its shares (figures for people).
 pub fn tolerance_words(t: f64) -> String {

@@ -17,12 +17,18 @@ const M_PER_MIN: f64 = 1000.0 / 60.0;
 /// dialect for the tool's control point (`start.control`, stated in
 /// words in the header's `control_point` line), optimised (lines merged, arcs fitted) within the fitting share
 /// of the strategy's tolerance.
+///
+/// With `spline`, each run of straight cutting moves is written as the
+/// dialect's spline where that takes fewer blocks than its lines and
+/// arcs (`plan::spline`), and the header says so; the stream handed back
+/// stays the planned moves, the path the fit is held to.
 pub fn emit(
     job: &TurningJob,
     path: &Toolpath,
     prov: &Provenance,
     start: &Start,
     control_point: &str,
+    spline: bool,
 ) -> Result<Emitted, ProgramError> {
     let centre_height = if job.tool.centre_height == 0.0 {
         String::new()
@@ -68,12 +74,17 @@ pub fn emit(
         format!("estimated cutting time {}", duration(path.cutting_time())),
     ];
     let tolerance = job.strategy.chord_tolerance;
+    let dialect = &job.machine.dialect;
+    let above = matches!(job.strategy.chords, ChordPlacement::Clear { .. });
+    if spline {
+        return emit_splines(job, path, start, &header, above);
+    }
     // Points placed clear of the material are not fitted back into it.
     let (stream, summary) = optimise::optimise_within(
         &turning_moves(job, path),
         tolerance * optimise::FIT_SHARE,
-        &job.machine.dialect.arc_planes,
-        matches!(job.strategy.chords, ChordPlacement::Clear { .. }),
+        &dialect.arc_planes,
+        above,
     );
     let mut header = header.to_vec();
     header.push(optimisation_words(&summary));
@@ -88,6 +99,64 @@ pub fn emit(
     )?;
     w.call_tool(start)?;
     w.write_all(&stream)?;
+    Ok(Emitted {
+        text: w.finish()?,
+        stream,
+        optimised: summary,
+    })
+}
+
+/// The program written with the dialect's splines (`emit`'s `spline`).
+fn emit_splines(
+    job: &TurningJob,
+    path: &Toolpath,
+    start: &Start,
+    header: &[String],
+    above: bool,
+) -> Result<Emitted, ProgramError> {
+    use crate::plan::spline;
+    let dialect = &job.machine.dialect;
+    let tolerance = job.strategy.chord_tolerance;
+    let decimals = crate::post::check_dialect(dialect, Setup::Lathe, job.machine.resolution)?;
+    let fit = spline::SplineFit {
+        tolerance: tolerance * optimise::FIT_SHARE,
+        decimals,
+        control: start.control,
+        knots: spline::KnotSpacing::of(dialect),
+    };
+    let otherwise = spline::Otherwise {
+        arc_planes: &dialect.arc_planes,
+        above,
+    };
+    let stream = turning_moves(job, path);
+    let (steps, fitted) = spline::fit_splines(&stream, &fit, Some(otherwise));
+    let summary = optimise::Summary {
+        moves_before: fitted.blocks_before,
+        moves_after: fitted.blocks_after,
+        arcs: 0,
+        merged_lines: 0,
+        max_deviation: fitted.max_deviation,
+        tolerance: fitted.limit,
+    };
+    let mut header = header.to_vec();
+    let at = header
+        .iter()
+        .position(|l| l.starts_with("machine "))
+        .unwrap_or(header.len());
+    header.insert(at, super::spline_words(dialect, &fitted));
+    let mut w = ProgramWriter::new(
+        dialect,
+        Setup::Lathe,
+        &job.name,
+        &header,
+        "XZ",
+        job.machine.resolution,
+        tolerance * optimise::BLEND_SHARE,
+    )?;
+    w.call_tool(start)?;
+    for s in &steps {
+        w.write_step(s)?;
+    }
     Ok(Emitted {
         text: w.finish()?,
         stream,

@@ -42,6 +42,33 @@ pub struct SplineFit {
     /// The control point's offset from the tool centre, added before
     /// rounding as the writer adds it.
     pub control: ControlOffset,
+    /// How the interior knots are placed.
+    pub knots: KnotSpacing,
+}
+
+/// Where a fit's interior knots go.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum KnotSpacing {
+    /// By averaging the points' parameters (Piegl and Tiller eq. 9.69),
+    /// each knot printed (Fanuc's G06.2 states every knot, K).
+    Averaged,
+    /// Equally spaced, the spacing rounded to the printed decimals:
+    /// Siemens' BSPLINE states a knot spacing PL per block, and which
+    /// knot interval a block's PL sets is not stated in the manual; with
+    /// every spacing equal the curve is the same whichever it is
+    /// (docs/controllers/siemens.md).
+    Uniform,
+}
+
+impl KnotSpacing {
+    /// How `dialect`'s spline places its knots: Fanuc's G06.2 states each
+    /// knot, Siemens' BSPLINE one spacing (PL) that lensc keeps equal.
+    pub fn of(dialect: &crate::dialect::Dialect) -> KnotSpacing {
+        match dialect.spline {
+            Some(crate::dialect::SplineForm::Bspline) => KnotSpacing::Uniform,
+            _ => KnotSpacing::Averaged,
+        }
+    }
 }
 
 impl SplineFit {
@@ -94,13 +121,25 @@ pub fn fit_splines(
         ..Summary::default()
     };
     let mut at = [f64::NAN; 3];
+    // A lathe's moves never state Y: the curve lies in Y = 0.
+    let no_y = moves.iter().all(|m| match m {
+        Move::Rapid(to) | Move::Linear { to, .. } | Move::Arc { to, .. } => to.y.is_nan(),
+        _ => true,
+    });
+    if no_y {
+        at[1] = 0.0;
+    }
     let mut i = 0;
     while i < moves.len() {
         let (run_end, feed) = run(moves, i, at);
         // The run as lines and arcs, where those are the other way.
         let lines_arcs = otherwise.filter(|_| run_end > i).map(|o| {
             let mut stream = Vec::with_capacity(run_end - i + 1);
-            stream.push(Move::Rapid(Position::xyz(at[0], at[1], at[2])));
+            stream.push(Move::Rapid(if no_y {
+                Position::xz(at[0], at[2])
+            } else {
+                Position::xyz(at[0], at[1], at[2])
+            }));
             stream.extend_from_slice(&moves[i..run_end]);
             // The optimiser starts a run at a stated feed: a run that
             // keeps the feed in force is given one for the fit (any: one
@@ -347,7 +386,18 @@ fn fitted(
     }
     // Parameters scaled onto the printed knots' range.
     let u: Vec<f64> = params.iter().map(|p| p * end / length).collect();
-    let knots = knots(&u, n, round)?;
+    let knots = match fit.knots {
+        KnotSpacing::Averaged => knots(&u, n, round)?,
+        KnotSpacing::Uniform => uniform_knots(end, n, round)?,
+    };
+    // The curve's parameter range as its knots end (a uniform spacing,
+    // rounded, times the spans, need not be the path's length).
+    let last = knots[knots.len() - 1];
+    let u: Vec<f64> = if last == end {
+        u
+    } else {
+        u.iter().map(|v| v * last / end).collect()
+    };
     let ctrl = least_squares(points, &u, &knots, n)?;
     let o = [fit.control.x, fit.control.y, fit.control.z];
     let check = |ctrl: &[[f64; 3]]| deviation(ctrl, &knots, points, &u, arcs);
@@ -390,6 +440,21 @@ fn knots(u: &[f64], n: usize, round: impl Fn(f64) -> f64) -> Option<Vec<f64>> {
         k.push(v);
     }
     k.extend([end; ORDER]);
+    Some(k)
+}
+
+/// The clamped knot vector of `n` control points with equally spaced
+/// interior knots: the spacing `end / spans` rounded to the printed
+/// decimals, the end at `spans` times it; none if it rounds to zero.
+fn uniform_knots(end: f64, n: usize, round: impl Fn(f64) -> f64) -> Option<Vec<f64>> {
+    let spans = n - DEGREE;
+    let spacing = round(end / spans as f64);
+    if spacing <= 0.0 {
+        return None;
+    }
+    let mut k = vec![0.0; ORDER];
+    k.extend((1..spans).map(|j| j as f64 * spacing));
+    k.extend([spans as f64 * spacing; ORDER]);
     Some(k)
 }
 

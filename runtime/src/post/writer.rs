@@ -1172,9 +1172,8 @@ impl ProgramWriter {
     /// axes' decimals, weights left out (1). The blocks are written whole
     /// or not at all.
     pub fn write_spline(&mut self, s: &crate::moves::Spline) -> Result<(), ProgramError> {
-        if self.dialect.spline != Some(crate::dialect::SplineForm::Nurbs)
-            || self.dialect.language != Language::GCode
-        {
+        use crate::dialect::SplineForm;
+        if self.dialect.spline.is_none() || self.dialect.language != Language::GCode {
             return Err(ProgramError::Unsupported(format!(
                 "splines ({} has no spline lensc writes)",
                 self.dialect.name
@@ -1197,6 +1196,9 @@ impl ProgramWriter {
             return Err(ProgramError::Unsupported(
                 "a spline before the first move that takes the length offset".into(),
             ));
+        }
+        if self.dialect.spline == Some(SplineForm::Bspline) {
+            return self.write_bspline(s);
         }
         let n = s.points.len();
         if s.knots.len() != n + s.order || n < s.order || !(2..=4).contains(&s.order) {
@@ -1287,6 +1289,139 @@ impl ProgramWriter {
         let last = s.points[s.points.len() - 1];
         self.last[..3].copy_from_slice(&printed);
         self.at[..3].copy_from_slice(&last);
+        self.moves += 1;
+        Ok(())
+    }
+
+    /// Writes a spline as Siemens' B spline (docs/controllers/siemens.md):
+    /// the first control point is where the tool is (not written), then
+    /// `BSPLINE SD=<degree> PL=<spacing> X Y Z [F]` with the second, and
+    /// one `PL=<spacing> X Y Z` block per further control point. The knot
+    /// spacing is stated in every block, and must be the same throughout
+    /// (the fit's `KnotSpacing::Uniform`): which knot interval a block's
+    /// PL sets is not stated in the manual, and with one spacing it does
+    /// not matter. Weights are left out (PW=1). Every axis the machine
+    /// has among X, Y, Z is stated in every block; the axes it has not
+    /// must not move. The blocks are written whole or not at all.
+    fn write_bspline(&mut self, s: &crate::moves::Spline) -> Result<(), ProgramError> {
+        let n = s.points.len();
+        let degree = s.order.wrapping_sub(1);
+        if s.knots.len() != n + s.order || n < s.order || !(2..=3).contains(&degree) {
+            return Err(ProgramError::Unsupported(format!(
+                "a B spline of order {} with {n} control points and {} knots (BSPLINE takes degree SD=2 or 3)",
+                s.order,
+                s.knots.len()
+            )));
+        }
+        let k = &s.knots;
+        let clamped = k[..s.order].iter().all(|v| *v == k[0])
+            && k[n..].iter().all(|v| *v == k[n + s.order - 1]);
+        let spacing = k[s.order] - k[s.order - 1];
+        let uniform = k[degree..=n]
+            .windows(2)
+            .all(|w| ((w[1] - w[0]) - spacing).abs() <= 1e-9 * spacing.abs().max(1.0));
+        if !clamped || !uniform || spacing.is_nan() || spacing <= 0.0 {
+            return Err(ProgramError::Unsupported(
+                "a B spline whose knots are not clamped and equally spaced (BSPLINE's PL)".into(),
+            ));
+        }
+        let axes: Vec<usize> = (0..3).filter(|a| self.letters[*a].is_some()).collect();
+        if !axes.contains(&0) || !axes.contains(&2) {
+            return Err(ProgramError::Unsupported(
+                "a spline on a machine without X and Z".into(),
+            ));
+        }
+        let p0 = s.points[0];
+        if (0..3).any(|a| !axes.contains(&a) && s.points.iter().any(|p| p[a] != p0[a])) {
+            return Err(ProgramError::Unsupported(
+                "a spline moving an axis the machine does not have".into(),
+            ));
+        }
+        let o = self.control.map_or([0.0; 3], |c| [c.x, c.y, c.z]);
+        let start = self.text.len();
+        let r = self.bspline_blocks(s, &axes, spacing, o);
+        if r.is_err() {
+            self.text.truncate(start);
+        }
+        r
+    }
+
+    fn bspline_blocks(
+        &mut self,
+        s: &crate::moves::Spline,
+        axes: &[usize],
+        spacing: f64,
+        o: [f64; 3],
+    ) -> Result<(), ProgramError> {
+        use crate::moves::Feed as F;
+        let format = Decimals::new(self.decimals);
+        let Some(pl_units) = format.units(spacing) else {
+            return Err(ProgramError::NotPrintable {
+                word: 'L',
+                value: spacing,
+            });
+        };
+        let mut printed = self.last;
+        let mut new_mode = None;
+        let mut new_feed = None;
+        for (i, p) in s.points.iter().enumerate().skip(1) {
+            let start = self.text.len();
+            self.begin_block();
+            if i == 1 {
+                if matches!(s.feed, Some(F::PerTime(_))) && self.mode != Some(FeedMode::PerMinute) {
+                    let w = self.feed_mode_word(FeedMode::PerMinute)?.to_string();
+                    self.text.extend_from_slice(w.as_bytes());
+                    self.text.push(b' ');
+                    new_mode = Some(FeedMode::PerMinute);
+                } else if s.feed.is_some_and(|f| !matches!(f, F::PerTime(_))) {
+                    return Err(ProgramError::Unsupported(
+                        "a spline fed other than per minute".into(),
+                    ));
+                }
+                self.text
+                    .extend_from_slice(format!("BSPLINE SD={} ", s.order - 1).as_bytes());
+            }
+            self.text.extend_from_slice(b"PL=");
+            self.number('L', spacing, pl_units, format.places())?;
+            for &a in axes {
+                let letter = self.letters[a].expect("an axis the machine has");
+                let value = (p[a] + o[a]) * self.axis_scale[a];
+                let Some(units) = self.axis_formats[a].units(value) else {
+                    return Err(self.not_printable(a, p[a]));
+                };
+                self.text.push(b' ');
+                self.text.push(letter as u8);
+                self.number(letter, value, units, self.axis_decimals[a])?;
+                printed[a] = units;
+            }
+            if i == 1
+                && let Some(F::PerTime(v)) = s.feed
+            {
+                let f = v * 60.0;
+                let Some(units) = self.feed_format.units(f) else {
+                    return Err(ProgramError::NotPrintable {
+                        word: 'F',
+                        value: f,
+                    });
+                };
+                self.text.extend_from_slice(b" F");
+                self.number('F', f, units, self.feed_decimals)?;
+                new_feed = Some(units);
+            }
+            self.end_block(start)?;
+        }
+        // The axes are at the last control point, as printed.
+        if let Some(mode) = new_mode {
+            self.mode = Some(mode);
+        }
+        if new_feed.is_some() {
+            self.last_feed = new_feed;
+        }
+        let last = s.points[s.points.len() - 1];
+        for &a in axes {
+            self.last[a] = printed[a];
+            self.at[a] = last[a];
+        }
         self.moves += 1;
         Ok(())
     }

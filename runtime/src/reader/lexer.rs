@@ -73,11 +73,17 @@ pub(crate) enum SiemensWord {
     Ffwon,
     Ffwof,
     Supa,
+    /// B spline interpolation (a motion mode) and its block words: the
+    /// degree SD, the knot spacing PL, a control point's weight PW.
+    Bspline,
+    Sd,
+    Pl,
+    Pw,
 }
 
 impl SiemensWord {
     /// Every word, in declaration order.
-    const ALL: [SiemensWord; 19] = [
+    const ALL: [SiemensWord; 23] = [
         SiemensWord::Diamof,
         SiemensWord::Diamon,
         SiemensWord::Diam90,
@@ -97,6 +103,10 @@ impl SiemensWord {
         SiemensWord::Ffwon,
         SiemensWord::Ffwof,
         SiemensWord::Supa,
+        SiemensWord::Bspline,
+        SiemensWord::Sd,
+        SiemensWord::Pl,
+        SiemensWord::Pw,
     ];
 
     /// The word as a program writes it.
@@ -121,6 +131,10 @@ impl SiemensWord {
             SiemensWord::Ffwon => "FFWON",
             SiemensWord::Ffwof => "FFWOF",
             SiemensWord::Supa => "SUPA",
+            SiemensWord::Bspline => "BSPLINE",
+            SiemensWord::Sd => "SD",
+            SiemensWord::Pl => "PL",
+            SiemensWord::Pw => "PW",
         }
     }
 
@@ -791,7 +805,7 @@ mod tests {
     /// one; the reader's matches over keywords are too).
     #[test]
     fn every_siemens_word_reads_back_from_its_name() {
-        assert_eq!(SiemensWord::ALL.len(), SiemensWord::Supa as usize + 1);
+        assert_eq!(SiemensWord::ALL.len(), SiemensWord::Pw as usize + 1);
         for (i, w) in SiemensWord::ALL.into_iter().enumerate() {
             assert_eq!(w as usize, i);
             assert_eq!(SiemensWord::of(w.name()), Some(w));

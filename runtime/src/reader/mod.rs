@@ -18,6 +18,10 @@
 //! Every finding names its line and a byte span in the whole text, with a
 //! [`Rule`] (its diagnostic code lives with the compiler's others).
 
+mod bspline;
+mod bspline_moves;
+#[cfg(test)]
+mod bspline_tests;
 mod chord;
 mod expr;
 mod header;

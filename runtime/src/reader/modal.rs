@@ -40,6 +40,8 @@ pub(crate) enum Motion {
     /// LinuxCNC's G5.3, which closes the NURBS block and leaves no motion
     /// mode in force.
     NurbsBlockEnd,
+    /// Siemens' BSPLINE (`bspline.rs`).
+    Bspline,
 }
 
 /// The modal group of a G code (value × 10, `G05.1` is 51).
@@ -157,6 +159,9 @@ pub(crate) struct State {
     pub nurbs: Option<super::nurbs::Nurbs>,
     /// LinuxCNC's G5.2 curve being read (`nurbs_block`).
     pub nurbs_block: Option<super::nurbs_block::NurbsBlock>,
+    /// The B spline being read (Siemens' BSPLINE), until a block leaves
+    /// the mode.
+    pub bspline: Option<super::bspline::Bspline>,
     ended: bool,
     /// A Klartext program's own reader, whose blocks become words.
     klartext: Option<Klartext>,
@@ -253,6 +258,7 @@ impl State {
             nurbs_mode: d.spline == Some(crate::dialect::SplineForm::Nurbs),
             nurbs: None,
             nurbs_block: None,
+            bspline: None,
             moves: None,
             ended: false,
             klartext: (lex.controller == Controller::HeidenhainKlartext).then(Klartext::default),
@@ -324,6 +330,16 @@ impl State {
         } else {
             self.parameter_words(b, groups, line, out);
         }
+        // A block leaving B spline mode ends the curve: it is moved along
+        // before this block's own modes (its feed) take effect.
+        if self.bspline.is_some()
+            && (groups
+                .iter()
+                .any(|(g, _)| matches!(g, GGroup::Motion(_) | GGroup::MachineMove))
+                || ms.iter().any(|(m, _)| *m == MCode::End))
+        {
+            self.bspline_end(line, out);
+        }
         self.modes(b, groups, line, out);
         self.spindle_and_tool(b, groups, ms, line, out);
         // A move to a machine position (G28, G53, Siemens' SUPA,
@@ -354,7 +370,9 @@ impl State {
                 nurbs_code(Motion::NurbsBlock),
                 nurbs_code(Motion::NurbsBlockEnd),
             );
-            if (opens || closes || self.nurbs_block.is_some())
+            if self.motion == Some(Motion::Bspline) {
+                self.bspline_block(b, line, out);
+            } else if (opens || closes || self.nurbs_block.is_some())
                 && self.nurbs_block_line(b, opens, closes, out)
             {
                 // A block of LinuxCNC's G5.2 curve, or its G5.3.
@@ -406,6 +424,7 @@ impl State {
     pub fn finish(&mut self, out: &mut Vec<Found>) {
         self.nurbs_cut_short("", out);
         self.nurbs_block_left((0, 0), out);
+        self.bspline_end("", out);
         if let Some(k) = &self.klartext {
             k.finish(out);
         }
@@ -696,6 +715,9 @@ impl State {
             match k.kind {
                 KeywordKind::Word(Diamon | Diam90) => self.diameter = self.machine.lathe,
                 KeywordKind::Word(Diamof) => self.diameter = false,
+                KeywordKind::Word(Bspline) => self.motion = Some(Motion::Bspline),
+                // A B spline's SD, PL and PW are `bspline_moves.rs`'.
+                KeywordKind::Word(Sd | Pl | Pw) => {}
                 // SPCON, SPCOF, SPOS and LIMS are `spindle_and_tool`'s, a
                 // tool by name `tool`'s; the rest change nothing the reader
                 // holds a program to.
@@ -798,7 +820,7 @@ impl State {
                 // the reader holds a program to.
                 KeywordKind::Word(
                     Diamof | Diamon | Diam90 | Compcad | Compcurv | Compon | Compof | Ctol | Otol
-                    | Atol | Lims | Soft | Brisk | Ffwon | Ffwof | Supa,
+                    | Atol | Lims | Soft | Brisk | Ffwon | Ffwof | Supa | Bspline | Sd | Pl | Pw,
                 )
                 | KeywordKind::Text(_)
                 | KeywordKind::Cycle832 => {}

@@ -147,7 +147,7 @@ impl State {
         }
     }
 
-    fn end_point(&self, b: &Block) -> [Option<f64>; 4] {
+    pub(super) fn end_point(&self, b: &Block) -> [Option<f64>; 4] {
         let mut end = self.pos;
         for w in axes(b) {
             let i = LETTERS

@@ -2,10 +2,9 @@
 //! moves and arcs, or the controller's own spline (`interpolation`, the
 //! job's or its dialect's default), and E0182 where the spline asked for
 //! is one lensc cannot write: the dialect has none (LinuxCNC's G5–G5.2 are
-//! in the XY plane only, and no lensc path lies in it; Siemens, Heidenhain
-//! and the ultra-precision lathes are not written yet:
-//! docs/controllers/), or the strategy's programs are not fitted yet
-//! (raster jobs only, so far).
+//! in the XY plane only, and no lensc path lies in it; Heidenhain and the
+//! ultra-precision lathes are not written yet: docs/controllers/), or the strategy's programs are not fitted yet
+//! (raster and profile-turning jobs only, so far).
 
 use lensc_grammar::Diagnostic;
 use lensc_lang::codes;
@@ -14,7 +13,7 @@ use lensc_runtime::dialect::Dialect;
 use super::Parts;
 
 /// The strategies whose programs are fitted with splines.
-pub const SPLINE_STRATEGIES: &[&str] = &["raster"];
+pub const SPLINE_STRATEGIES: &[&str] = &["raster", "profile_turning"];
 
 /// Whether the job's program is written with splines: as the job says,
 /// else as its dialect's default.
@@ -38,12 +37,12 @@ pub fn error(p: &Parts, dialect: &Dialect) -> Option<Diagnostic> {
                 "`interpolation: spline`, but the `{}` dialect has no spline lensc writes",
                 dialect.name
             ),
-            "write `interpolation: lines_arcs`, or build in a dialect with `spline: nurbs` (`fanuc_0i_mill`); LinuxCNC's G5, G5.1 and G5.2 interpolate in the XY plane only, and Siemens' BSPLINE is not written yet (docs/controllers/)".to_string(),
+            "write `interpolation: lines_arcs`, or build in a dialect with a spline (`fanuc_0i_mill`: NURBS, G06.2; `siemens_840d_mill`: BSPLINE); LinuxCNC's G5, G5.1 and G5.2 interpolate in the XY plane only, and Heidenhain's SPL is not written yet (docs/controllers/)".to_string(),
         )
     } else if !SPLINE_STRATEGIES.contains(&strategy) {
         (
             format!(
-                "`interpolation: spline` for a `{strategy}` job: lensc fits splines to raster jobs only so far"
+                "`interpolation: spline` for a `{strategy}` job: lensc fits splines to raster and profile-turning jobs only so far"
             ),
             "write `interpolation: lines_arcs` for this job".to_string(),
         )

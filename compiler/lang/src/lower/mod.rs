@@ -390,7 +390,13 @@ fn dialect_from(g: Gcode, name: String) -> Dialect {
         gcode_system: system,
         length_offset: g.length_offset,
         surface_speed_per_revolution: g.surface_speed_per_revolution,
-        spline: g.nurbs.then_some(lensc_runtime::dialect::SplineForm::Nurbs),
+        spline: if g.nurbs {
+            Some(lensc_runtime::dialect::SplineForm::Nurbs)
+        } else if g.bspline {
+            Some(lensc_runtime::dialect::SplineForm::Bspline)
+        } else {
+            None
+        },
         spline_option: g.spline_option,
         spline_by_default: g.spline_by_default,
     }

@@ -215,9 +215,9 @@ const GCODE_PARAMS: &[Param] = &[
     ),
     opt(
         "spline",
-        Ty::Word(&["none", "nurbs"]),
+        Ty::Word(&["none", "nurbs", "bspline"]),
         Check::Any,
-        "the spline the controller interpolates that lensc writes: `nurbs` (Fanuc's G06.2: rank P, knots K, weights R, control points in X, Y and Z, docs/controllers/fanuc.md) or `none` (the default: a job asking `interpolation: spline` is E0182)",
+        "the spline the controller interpolates that lensc writes: `nurbs` (Fanuc's G06.2: rank P, knots K, weights R, control points in X, Y and Z, docs/controllers/fanuc.md), `bspline` (Siemens' BSPLINE: degree SD, knot spacing PL, weights PW, docs/controllers/siemens.md) or `none` (the default: a job asking `interpolation: spline` is E0182)",
     ),
     text(
         "spline_option",
@@ -328,6 +328,8 @@ pub struct Gcode {
     pub surface_speed_per_revolution: bool,
     /// `spline: nurbs`.
     pub nurbs: bool,
+    /// `spline: bspline`.
+    pub bspline: bool,
     pub spline_option: String,
     /// `interpolation: spline`.
     pub spline_by_default: bool,
@@ -414,6 +416,7 @@ impl Gcode {
             length_offset: text("length_offset", ""),
             surface_speed_per_revolution: r.word("surface_speed_feed") == Some("per_revolution"),
             nurbs: r.word("spline") == Some("nurbs"),
+            bspline: r.word("spline") == Some("bspline"),
             spline_option: text("spline_option", ""),
             spline_by_default: r.word("interpolation") == Some("spline"),
         }

@@ -5,6 +5,7 @@ const FIT: SplineFit = SplineFit {
     tolerance: 30e-6,
     decimals: 4,
     control: ControlOffset::CENTRE,
+    knots: KnotSpacing::Averaged,
 };
 
 /// A raster-like pass: lines along X over a circle of radius `r` in XZ,
@@ -234,4 +235,63 @@ fn a_run_keeping_the_feed_in_force_is_weighed_too() {
         .collect();
     // NaN (an axis left alone) is never equal to itself: compare as text.
     assert_eq!(format!("{written:?}"), format!("{opt:?}"));
+}
+
+/// Siemens' knot spacing: every interior span the same printed length,
+/// the curve still within the limit of the exact circle, a fraction of
+/// the blocks.
+#[test]
+fn uniform_knots_are_equally_spaced_and_hold_the_circle() {
+    let fit = SplineFit {
+        knots: KnotSpacing::Uniform,
+        ..FIT
+    };
+    let (steps, summary) = fit_splines(&pass(1.0, 0.7, 400), &fit, None);
+    let [Step::Move(_), Step::Spline(s)] = &steps[..] else {
+        panic!("one spline: {summary:?}");
+    };
+    let k = &s.knots;
+    assert!(k[..ORDER].iter().all(|v| *v == 0.0));
+    let spacing = k[ORDER] - k[ORDER - 1];
+    assert!(spacing > 0.0);
+    // Printed to four decimals.
+    assert!((spacing * 1e4 - (spacing * 1e4).round()).abs() < 1e-6);
+    for w in k[ORDER - 1..k.len() - ORDER + 1].windows(2) {
+        assert!((w[1] - w[0] - spacing).abs() < 1e-12, "{k:?}");
+    }
+    assert!(k[k.len() - ORDER..].iter().all(|v| *v == k[k.len() - 1]));
+    let worst = worst_from_circle(s, 1.0);
+    assert!(worst <= summary.limit, "{worst:e} over {:e}", summary.limit);
+    assert!(
+        summary.blocks_after * 5 <= summary.blocks_before,
+        "{summary:?}"
+    );
+}
+
+/// A lathe's profile states X and Z only (Y never): it is fitted all the
+/// same, in Y = 0 (before, every run needed a known Y and none was found).
+#[test]
+fn a_lathe_profile_without_y_is_fitted_in_y_zero() {
+    let moves: Vec<Move> = pass(1.0, 0.7, 400)
+        .into_iter()
+        .map(|m| match m {
+            Move::Rapid(to) => Move::Rapid(Position::xz(to.x, to.z)),
+            Move::Linear { to, feed } => Move::Linear {
+                to: Position::xz(to.x, to.z),
+                feed,
+            },
+            other => other,
+        })
+        .collect();
+    let fit = SplineFit {
+        knots: KnotSpacing::Uniform,
+        ..FIT
+    };
+    let (steps, summary) = fit_splines(&moves, &fit, None);
+    let [Step::Move(_), Step::Spline(s)] = &steps[..] else {
+        panic!("one spline: {summary:?}");
+    };
+    assert!(s.points.iter().all(|p| p[1] == 0.0));
+    let worst = worst_from_circle(s, 1.0);
+    assert!(worst <= summary.limit, "{worst:e} over {:e}", summary.limit);
 }

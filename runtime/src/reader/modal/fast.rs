@@ -70,6 +70,7 @@ impl State {
         if self.ended
             || self.nurbs.is_some()
             || self.nurbs_block.is_some()
+            || self.bspline.is_some()
             || rules.max_line_length.is_some_and(|max| line.len() > max)
         {
             return false;

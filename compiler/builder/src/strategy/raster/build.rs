@@ -64,6 +64,7 @@ pub(super) fn build(spec: &RasterSpec, cx: &BuildContext) -> Result<Built, Vec<D
             tolerance: fit_share,
             decimals,
             control: head.start.control,
+            knots: lensc_runtime::plan::spline::KnotSpacing::of(dialect),
         };
         // Each run as a spline, or as the optimiser's lines and arcs where
         // those take fewer blocks (points placed clear of the material are
@@ -95,7 +96,7 @@ pub(super) fn build(spec: &RasterSpec, cx: &BuildContext) -> Result<Built, Vec<D
             .iter()
             .position(|l| l.starts_with("machine "))
             .unwrap_or(header.len());
-        header.insert(at, spline_words(dialect, &fitted));
+        header.insert(at, lensc_runtime::emit::spline_words(dialect, &fitted));
         let text = lensc_runtime::emit::raster::emit_mill_steps(
             dialect,
             &head.name,
@@ -269,29 +270,6 @@ fn blank(
     (0..3)
         .all(|i| min[i] <= max[i])
         .then_some(lensc_runtime::moves::Blank { min, max })
-}
-
-/// The header line of a program written with splines: which, how many,
-/// how close, and the control option they need.
-fn spline_words(
-    dialect: &lensc_runtime::dialect::Dialect,
-    s: &lensc_runtime::plan::spline::Summary,
-) -> String {
-    format!(
-        "interpolation: NURBS (G06.2, order {}) where shorter than lines and arcs: {} splines for {} straight moves, {} blocks of moves from {} planned, largest deviation {} nm (limit {} nm); needs the control's {}",
-        lensc_runtime::plan::spline::ORDER,
-        s.splines,
-        s.lines_replaced,
-        s.blocks_after,
-        s.blocks_before,
-        lensc_runtime::post::header::num((s.max_deviation * 1e7).round() / 10.0),
-        lensc_runtime::post::header::num((s.limit * 1e7).round() / 10.0),
-        if dialect.spline_option.is_empty() {
-            "spline interpolation"
-        } else {
-            &dialect.spline_option
-        }
-    )
 }
 
 /// The program's header: provenance, units, surface, the tool, the raster

@@ -39,6 +39,7 @@ pub(super) fn build(spec: &TurningSpec, cx: &BuildContext) -> Result<Built, Vec<
         prov,
         &head.start,
         &head.control.header_line(head.start.control),
+        head.spline,
     ) {
         Ok(e) => e,
         Err(e) => {
