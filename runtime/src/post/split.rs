@@ -92,7 +92,11 @@ pub fn split(
     let mut modal = Modal::default();
     // Each part: (first body line, restatement).
     let mut starts: Vec<(usize, String)> = vec![(0, String::new())];
+    // The last join in the current part after a retract, and the last of
+    // any kind: a part ends after a retract where one fits, mid-cut only
+    // where none does.
     let mut best: Option<(usize, String)> = None;
+    let mut best_retract: Option<(usize, String)> = None;
     let mut in_preamble = true;
     let mut previous_rapid = false;
     let mut previous_move = false;
@@ -103,7 +107,11 @@ pub fn split(
         let join_here = !in_preamble
             && ((previous_rapid && is_move) || (calls.continuous && previous_move && is_move));
         if join_here {
-            best = Some((i, modal.restate(dialect.comment)));
+            let join = (i, modal.restate(dialect.comment));
+            if previous_rapid {
+                best_retract = Some(join.clone());
+            }
+            best = Some(join);
         }
         modal.take(&words, line);
         if is_move {
@@ -123,7 +131,16 @@ pub fn split(
             if i == s || one_line > limit {
                 return Err(SplitError::HeaderOverLimit { needed: one_line });
             }
-            match best.take() {
+            let any = best.take();
+            let chosen = match best_retract.take().filter(|(j, _)| *j > s) {
+                Some(r) => {
+                    // A later join of any kind may end the next part.
+                    best = any.filter(|(b, _)| *b > r.0);
+                    Some(r)
+                }
+                None => any,
+            };
+            match chosen {
                 Some((j, r)) if j > s => starts.push((j, r)),
                 _ => {
                     return Err(SplitError::NoJoin {

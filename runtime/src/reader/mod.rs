@@ -27,6 +27,7 @@ mod modal;
 mod motion;
 mod nurbs;
 mod nurbs_moves;
+pub mod parts;
 mod policy;
 mod spline;
 
