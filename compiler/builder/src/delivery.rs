@@ -18,7 +18,9 @@ use crate::report;
 
 /// The bytes each program file may hold under `d`: its `file_limit`, and
 /// with `link: memory` its `memory` too (the smaller); `None`: no limit.
-pub fn file_limit(d: &DeliveryParams) -> Option<(u64, (lensc_grammar::FileId, lensc_grammar::Span))> {
+pub fn file_limit(
+    d: &DeliveryParams,
+) -> Option<(u64, (lensc_grammar::FileId, lensc_grammar::Span))> {
     let memory = d.memory.filter(|_| d.link.value == "memory");
     [d.file_limit, memory]
         .into_iter()
@@ -33,10 +35,7 @@ pub fn file_limit(d: &DeliveryParams) -> Option<(u64, (lensc_grammar::FileId, le
 /// a data server that states no rate.
 pub fn link_rate(d: &DeliveryParams) -> Option<f64> {
     match d.link.value {
-        "dnc" => d
-            .rate
-            .map(|r| r.value)
-            .or(d.baud.map(|b| b.value / 10.0)),
+        "dnc" => d.rate.map(|r| r.value).or(d.baud.map(|b| b.value / 10.0)),
         "data_server" => d.rate.map(|r| r.value),
         _ => None,
     }
@@ -94,12 +93,13 @@ pub fn deliver(head: &JobHead, b: &mut Built, lathe: bool) -> Result<(), Vec<Dia
             .with_label("this limit")
             .with_help(format!("a file limit of at least {needed} bytes (a control's real limit is megabytes)"))]);
         }
-        Err(SplitError::NoJoin { from, to, bytes }) => {
-            let stops = !head
-                .dialect
-                .parts
-                .as_ref()
-                .is_some_and(|p| p.continuous);
+        Err(SplitError::NoJoin {
+            from,
+            to,
+            bytes,
+            needed,
+        }) => {
+            let stops = !head.dialect.parts.as_ref().is_some_and(|p| p.continuous);
             return Err(vec![at(
                 codes::NO_SAFE_JOIN,
                 format!(
@@ -113,7 +113,7 @@ pub fn deliver(head: &JobHead, b: &mut Built, lathe: bool) -> Result<(), Vec<Dia
             )
             .with_label("this limit")
             .with_help(format!(
-                "raise the file limit above {bytes} bytes, stream the program (`link: data_server` with a larger `file_limit`), or shorten the cut"
+                "raise the file limit to at least {needed} bytes (this cut with a part's own lines), stream the program (`link: data_server` with a larger `file_limit`), or shorten the cut"
             ))]);
         }
     };
@@ -190,8 +190,7 @@ pub fn deliver(head: &JobHead, b: &mut Built, lathe: bool) -> Result<(), Vec<Dia
 pub fn rate_warning(head: &JobHead, b: &Built) -> Option<Diagnostic> {
     let d = head.delivery.as_ref()?;
     let rate = link_rate(d)?;
-    let bytes = b.program.bytes()
-        + b.beside.iter().map(|(_, t)| t.bytes()).sum::<u64>();
+    let bytes = b.program.bytes() + b.beside.iter().map(|(_, t)| t.bytes()).sum::<u64>();
     let time = b.cutting_time;
     if !(time > 0.0) || bytes == 0 {
         return None;

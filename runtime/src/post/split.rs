@@ -35,8 +35,13 @@ pub enum SplitError {
     HeaderOverLimit { needed: u64 },
     /// No join the dialect can make lies within the limit: the program's
     /// lines `from` to `to` (1-based) run `bytes` bytes with nowhere to end
-    /// a part between them.
-    NoJoin { from: usize, to: usize, bytes: u64 },
+    /// a part between them; a part holding them takes `needed` bytes.
+    NoJoin {
+        from: usize,
+        to: usize,
+        bytes: u64,
+        needed: u64,
+    },
 }
 
 /// Renders a part line: `{part}`, `{PART}`, `{number}`, `{k}`, `{job}`,
@@ -143,10 +148,20 @@ pub fn split(
             match chosen {
                 Some((j, r)) if j > s => starts.push((j, r)),
                 _ => {
+                    // With a limit this small, the part's own lines are
+                    // what leave no room.
+                    let longest = body[s..=i].iter().map(|l| l.len()).max().unwrap_or(0);
+                    let needed = frame_bytes(k + 1)
+                        + modal.restate(dialect.comment).len() as u64
+                        + longest as u64;
+                    if needed > limit {
+                        return Err(SplitError::HeaderOverLimit { needed });
+                    }
                     return Err(SplitError::NoJoin {
                         from: head + s + 1,
                         to: head + i + 1,
                         bytes: cum[i + 1] - cum[s],
+                        needed: size,
                     });
                 }
             }
@@ -471,7 +486,9 @@ mod tests {
             .collect();
         let text = PROGRAM.replacen("G1 X1 Z-0.1\n", &long, 1);
         match split(&text, &linuxcnc(false), "j", 400) {
-            Err(SplitError::NoJoin { from, to, bytes }) => {
+            Err(SplitError::NoJoin {
+                from, to, bytes, ..
+            }) => {
                 assert!(from < to && bytes > 200, "{from} {to} {bytes}")
             }
             other => panic!("{other:?}"),

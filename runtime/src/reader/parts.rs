@@ -118,7 +118,10 @@ pub fn assemble(
         let lines: Vec<&str> = text.split_inclusive('\n').collect();
         let (s, e) = (next.start.len(), next.end.len());
         let framed = lines.len() >= s + e
-            && lines[..s].iter().zip(&next.start).all(|(a, b)| a.trim() == b)
+            && lines[..s]
+                .iter()
+                .zip(&next.start)
+                .all(|(a, b)| a.trim() == b)
             && lines[lines.len() - e..]
                 .iter()
                 .zip(&next.end)
@@ -170,7 +173,12 @@ mod tests {
         let mut files = std::collections::HashMap::new();
         files.insert("O4712.nc", "%\nO4712 (O4712)\nG1 X2\nM99\n%\n");
         files.insert("O4713.nc", "%\nO4713 (O4713)\nG1 X3\nM99\n%\n");
-        let mut load = |n: &str| files.get(n).map(|t| t.to_string()).ok_or("absent".to_string());
+        let mut load = |n: &str| {
+            files
+                .get(n)
+                .map(|t| t.to_string())
+                .ok_or("absent".to_string())
+        };
         let d = fanuc();
         assert!(calls_parts(main, &d, "j"));
         assert_eq!(part_files(main, &d, "j"), ["O4712.nc", "O4713.nc"]);

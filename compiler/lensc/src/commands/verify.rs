@@ -405,7 +405,8 @@ fn split_set(
     }
     let main = std::fs::read_to_string(program).map_err(|e| e.to_string())?;
     let beside = program.parent().unwrap_or(Path::new("."));
-    let mut load = |name: &str| std::fs::read_to_string(beside.join(name)).map_err(|e| e.to_string());
+    let mut load =
+        |name: &str| std::fs::read_to_string(beside.join(name)).map_err(|e| e.to_string());
     reader::parts::assemble(&main, d, &job, &mut load)
         .map(Some)
         .map_err(|e| e.message())
