@@ -118,7 +118,7 @@ const GCODE_PARAMS: &[Param] = &[
     ),
     text(
         "part_call",
-        "the block a main program calls a part of a split program with and returns (`{part}` its name, `{PART}` upper case, `{number}` its program number, `{k}` the part from 1); absent: the controller calls no parts, and a program larger than the machine's `delivery` allows is refused (docs/language/delivery.md)",
+        "the block a main program calls a part of a split program with and returns (`{part}` its name, `{PART}` upper case, `{number}` its program number, `{k}` the part from 1); absent: the controller calls no parts, and a program larger than the machine's `delivery` allows is refused (see the delivery page of the language guide)",
     ),
     text(
         "part_name",

@@ -79,7 +79,7 @@ const DELIVERY: Param = opt(
         ),
     ]),
     Check::Any,
-    "how programs reach the control: memory, file-size limit, link and its byte rate (docs/language/delivery.md); default none stated: programs are held to `--max-program-size` only",
+    "how programs reach the control: memory, file-size limit, link and its byte rate (see the language guide's Delivery page); default none stated: programs are held to `--max-program-size` only",
 );
 const LATHE_TRAVEL: Param = req(
     "travel",
