@@ -192,7 +192,7 @@ pub fn rate_warning(head: &JobHead, b: &Built) -> Option<Diagnostic> {
     let rate = link_rate(d)?;
     let bytes = b.program.bytes() + b.beside.iter().map(|(_, t)| t.bytes()).sum::<u64>();
     let time = b.cutting_time;
-    if !(time > 0.0) || bytes == 0 {
+    if time.is_nan() || time <= 0.0 || bytes == 0 {
         return None;
     }
     let needs = bytes as f64 / time;

@@ -286,10 +286,10 @@ fn g_number(w: &str) -> Option<f64> {
 /// The motion word of a move block: 0 a rapid, 1 a line, 2 and 3 arcs.
 fn motion_of(words: &[String]) -> Option<u8> {
     words.iter().find_map(|w| match g_number(w) {
-        Some(g) if g == 0.0 => Some(0),
-        Some(g) if g == 1.0 => Some(1),
-        Some(g) if g == 2.0 => Some(2),
-        Some(g) if g == 3.0 => Some(3),
+        Some(0.0) => Some(0),
+        Some(1.0) => Some(1),
+        Some(2.0) => Some(2),
+        Some(3.0) => Some(3),
         _ => None,
     })
 }
