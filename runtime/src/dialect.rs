@@ -137,6 +137,34 @@ pub struct Dialect {
     /// Whether a job that does not say writes splines (`interpolation:
     /// spline` as the dialect's default).
     pub spline_by_default: bool,
+    /// How a program too large for the control is delivered as parts a
+    /// main program calls (none: the controller calls no parts, and a
+    /// program that does not fit is refused).
+    pub parts: Option<PartCalls>,
+}
+
+/// How a dialect's main program calls the parts of a split program, and
+/// how each part file opens and closes. Lines may hold `{part}` (the
+/// part's name), `{PART}` (upper case), `{number}` (its program number:
+/// the program's number plus the part's) and `{k}` (the part, from 1).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PartCalls {
+    /// The block of the main program that runs a part and returns
+    /// (`M198 P{number}`, `EXTCALL "{PART}"`, `O<{part}> call`).
+    pub call: String,
+    /// A part's name (`{job}_{k}`; `{job}`, `{JOB}`, `{k}`, `{number}`).
+    pub name: String,
+    /// A part file's extension, without the dot.
+    pub extension: String,
+    /// The lines that open a part file.
+    pub start: Vec<String>,
+    /// The lines that close it (its return to the main program).
+    pub end: Vec<String>,
+    /// Whether the control passes from one part to the next without
+    /// stopping the path (its look-ahead reads through the call and the
+    /// return): then a part may end anywhere between two moves; if not,
+    /// only where the tool is clear of the part, after a rapid.
+    pub continuous: bool,
 }
 
 /// A controller's spline, as lensc writes and reads it.
@@ -277,6 +305,7 @@ impl Dialect {
             spline: None,
             spline_option: String::new(),
             spline_by_default: false,
+            parts: None,
         }
     }
 }

@@ -103,6 +103,16 @@ const PLANNING_ONLY: &[(&str, &str)] = &[
         "W0032",
         "the time in the air is summed over the planned moves",
     ),
+    (
+        "E0380",
+        "a part's own lines are known once the program is written",
+    ),
+    ("E0381", "the joins are the written program's retracts"),
+    ("E0382", "the program's size is known once it is written"),
+    (
+        "W0050",
+        "the bytes and the cutting time are the written program's",
+    ),
 ];
 
 #[test]

@@ -17,6 +17,7 @@ mod cli;
 mod compensate;
 mod complete_programs;
 mod control_point;
+mod delivery;
 mod determinism;
 mod diagnostics;
 mod dialects;

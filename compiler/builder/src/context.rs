@@ -137,6 +137,7 @@ fn report(
             lines: program.lines(),
             bytes: program.bytes(),
             fts_table: None,
+            delivery: None,
         },
         toolpath,
         // Filled in by the pipeline, which made the estimate.

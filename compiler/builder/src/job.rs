@@ -100,6 +100,9 @@ pub struct JobHead {
     /// The program moves between planned points by the controller's
     /// spline (`interpolation: spline`), not lines and arcs.
     pub spline: bool,
+    /// How programs reach the control, if the machine states it
+    /// (`crate::delivery`).
+    pub delivery: Option<lensc_lang::schema::machines::DeliveryParams>,
 }
 
 /// The tool's control point: what its length (and on a lathe its X)
@@ -562,6 +565,7 @@ impl<'a> Parts<'a> {
                 ..program_start(&self.params)
             },
             control: ControlPoint::of(&self.machine_params, &self.tool_params).0,
+            delivery: self.machine_params.delivery,
         }
     }
 }

@@ -12,6 +12,7 @@
 pub mod accept;
 pub mod compensate;
 pub mod context;
+pub mod delivery;
 pub mod diagnostics;
 pub mod driver;
 pub mod evaluate;

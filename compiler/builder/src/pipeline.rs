@@ -333,6 +333,13 @@ fn build_job(
         b.cutting_time,
     ));
     let gate = crate::accept::gate(&spec, &mut b, request.accept);
+    // A program larger than the control takes, split into parts a main
+    // program calls (read back as one), and its link's rate checked.
+    if !matches!(to, Destination::Nowhere) {
+        let head = spec.head();
+        crate::delivery::deliver(head, &mut b, head.control.machine_kind != "mill_3axis")?;
+        b.warnings.extend(crate::delivery::rate_warning(head, &b));
+    }
     // The set-up sheet, written in one unit with the program it sets up.
     if !matches!(to, Destination::Nowhere) {
         crate::setup_sheet::add(spec.head(), &mut b);

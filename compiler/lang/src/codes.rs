@@ -165,6 +165,23 @@ pub const CUTTING_TIME_IMPLAUSIBLE: &str = "W0030";
 pub const LONG_APPROACH_AT_FEED: &str = "W0031";
 /// A quarter or more of the time at feed spent approaching the cut.
 pub const AIR_CUTTING: &str = "W0032";
+/// A program larger than the machine's `delivery` allows whose file limit
+/// is smaller than one part's own lines (its opening and closing lines,
+/// the modal words it restates) and one block.
+pub const FILE_LIMIT_BELOW_PART: &str = "E0380";
+/// A program larger than the machine's `delivery` allows with no join the
+/// dialect can make within the file limit: a cut longer than the limit
+/// where the control stops between parts.
+pub const NO_SAFE_JOIN: &str = "E0381";
+/// A program larger than the machine's `delivery` allows in a dialect that
+/// calls no parts (no `part_call`, or numbered blocks).
+pub const CANNOT_SPLIT: &str = "E0382";
+/// A split program whose set of parts does not read back as the whole
+/// program did (a fault of lensc's splitter: nothing is written).
+pub const SPLIT_READS_DIFFERENTLY: &str = "E0383";
+/// A program consuming more bytes per second while it cuts than the
+/// machine's link delivers: the control would starve and stop on the part.
+pub const LINK_TOO_SLOW: &str = "W0050";
 /// E0195 under `lensc build --accept=warn`: the program is written.
 pub const ACCEPTANCE_MISSED_WARNING: &str = "W0020";
 /// E0196 under `lensc build --accept=warn`: the program is written.
@@ -393,6 +410,11 @@ pub const ALL: &[&str] = &[
     SPLINE_NOT_OFFERED,
     ACCEPTANCE_MISSED,
     ACCEPTANCE_UNMEASURED,
+    FILE_LIMIT_BELOW_PART,
+    NO_SAFE_JOIN,
+    CANNOT_SPLIT,
+    SPLIT_READS_DIFFERENTLY,
+    LINK_TOO_SLOW,
     UNUSED,
     SEAM_LEFT_UNCUT,
     CENTRE_LEFT_UNCUT,

@@ -6,6 +6,7 @@
 
 pub mod format;
 pub mod header;
+pub mod split;
 pub mod writer;
 
 pub use crate::dialect::{CommentStyle, Dialect};

@@ -32,6 +32,7 @@ mod motion;
 mod nurbs;
 mod nurbs_block;
 mod nurbs_moves;
+pub mod parts;
 mod policy;
 mod spline;
 

@@ -119,6 +119,32 @@ pub struct Program {
     /// the servo from a table (absent otherwise).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fts_table: Option<FtsTable>,
+    /// Where the program was split because it is larger than the machine's
+    /// `delivery` allows: `file`, `lines` and `bytes` are then the main
+    /// program's, which calls these parts in order (absent when whole).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub delivery: Option<Delivery>,
+}
+
+/// A program split into parts for its control (`crate::delivery`).
+#[derive(Clone, Debug, PartialEq, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct Delivery {
+    /// The limit each part file keeps (bytes): the machine's
+    /// `file_limit`, or its `memory` with `link: memory`.
+    pub limit: u64,
+    /// The whole program's size before it was split (bytes).
+    pub whole_bytes: u64,
+    /// Each part's file name and size (bytes), in the order they are called.
+    pub parts: Vec<Part>,
+}
+
+/// One part of a split program.
+#[derive(Clone, Debug, PartialEq, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct Part {
+    pub file: String,
+    pub bytes: u64,
 }
 
 /// What a job was estimated to write before it was planned: within 2× of

@@ -327,7 +327,7 @@ fn dialect_from(g: Gcode, name: String) -> Dialect {
         } else {
             lensc_runtime::dialect::Language::GCode
         },
-        extension: g.extension,
+        extension: g.extension.clone(),
         comment: if g.semicolon_comments {
             lensc_runtime::post::CommentStyle::Semicolon
         } else {
@@ -399,6 +399,14 @@ fn dialect_from(g: Gcode, name: String) -> Dialect {
         },
         spline_option: g.spline_option,
         spline_by_default: g.spline_by_default,
+        parts: g.part_call.map(|call| lensc_runtime::dialect::PartCalls {
+            call,
+            name: g.part_name,
+            extension: g.part_extension.unwrap_or_else(|| g.extension.clone()),
+            start: g.part_start,
+            end: g.part_end,
+            continuous: g.part_joins_continuous,
+        }),
     }
 }
 

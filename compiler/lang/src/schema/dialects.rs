@@ -116,6 +116,32 @@ const GCODE_PARAMS: &[Param] = &[
         "fts_off",
         "blocks that release the servo after the last revolution",
     ),
+    text(
+        "part_call",
+        "the block a main program calls a part of a split program with and returns (`{part}` its name, `{PART}` upper case, `{number}` its program number, `{k}` the part from 1); absent: the controller calls no parts, and a program larger than the machine's `delivery` allows is refused (see the delivery page of the language guide)",
+    ),
+    text(
+        "part_name",
+        "a part's name (`{job}`, `{JOB}`, `{k}`, `{number}`); default `{job}_{k}`",
+    ),
+    text(
+        "part_extension",
+        "a part file's extension; default the program's",
+    ),
+    texts(
+        "part_start",
+        "the lines that open a part file (`{part}`, `{PART}`, `{number}`, `{k}`)",
+    ),
+    texts(
+        "part_end",
+        "the lines that close a part file: its return to the main program",
+    ),
+    opt(
+        "part_joins",
+        Ty::Word(&["retract", "continuous"]),
+        Check::Any,
+        "where a part may end: `retract` (only where the tool is clear of the part, after a rapid: the control stops between parts) or `continuous` (between any two moves: the control reads through the call and the return without stopping the path); default retract",
+    ),
     opt(
         "arc_radius_tolerance",
         LENGTH,
@@ -333,6 +359,14 @@ pub struct Gcode {
     pub spline_option: String,
     /// `interpolation: spline`.
     pub spline_by_default: bool,
+    /// How a split program's parts are called (`part_call`; none: not).
+    pub part_call: Option<String>,
+    pub part_name: String,
+    pub part_extension: Option<String>,
+    pub part_start: Vec<String>,
+    pub part_end: Vec<String>,
+    /// `part_joins: continuous`.
+    pub part_joins_continuous: bool,
 }
 
 impl Gcode {
@@ -419,6 +453,12 @@ impl Gcode {
             bspline: r.word("spline") == Some("bspline"),
             spline_option: text("spline_option", ""),
             spline_by_default: r.word("interpolation") == Some("spline"),
+            part_call: opt_text("part_call"),
+            part_name: text("part_name", "{job}_{k}"),
+            part_extension: opt_text("part_extension"),
+            part_start: lines("part_start"),
+            part_end: lines("part_end"),
+            part_joins_continuous: r.word("part_joins") == Some("continuous"),
         }
     }
 }

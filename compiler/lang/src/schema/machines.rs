@@ -39,6 +39,48 @@ const SPINDLE: Param = req(
     Check::Any,
     "the work spindle",
 );
+/// How programs reach the control (`delivery { … }`): what it holds, the
+/// largest file it runs, and the link that brings the program and how
+/// fast. A machine that states none is held only to the build's
+/// `--max-program-size` (4 GB by default) and its programs are never
+/// split (`compiler/builder/src/delivery.rs`).
+const DELIVERY: Param = opt(
+    "delivery",
+    Ty::Block(&[
+        opt(
+            "link",
+            Ty::Word(&["memory", "disk", "dnc", "data_server"]),
+            Check::Any,
+            "how the program reaches the control: `memory` (loaded whole into the control's memory before it runs: it must fit `memory`), `disk` (read from the control's own disk as it runs, as LinuxCNC and PC-based controls do: no memory or rate limit), `dnc` (streamed over a serial link at `baud`), `data_server` (streamed from an Ethernet data server, e.g. Fanuc's Fast Data Server in buffer mode or Sinumerik EXTCALL, at `rate`); default memory",
+        ),
+        opt(
+            "memory",
+            NUMBER,
+            Check::Positive,
+            "bytes of program the control holds (with `link: memory`, the largest program it can run whole); default no limit",
+        ),
+        opt(
+            "file_limit",
+            NUMBER,
+            Check::Positive,
+            "bytes of the largest program file the control runs (a data server's buffer-mode file, a file system's limit); a larger program is split into parts a main program calls; default no limit",
+        ),
+        opt(
+            "baud",
+            NUMBER,
+            Check::Positive,
+            "a serial DNC link's baud rate (bits per second; 10 bits a byte: start, 8 data, stop); the link's byte rate is baud / 10 unless `rate` states it",
+        ),
+        opt(
+            "rate",
+            NUMBER,
+            Check::Positive,
+            "bytes per second the link delivers to the control (`dnc`, `data_server`); a program consuming more while it cuts is warned of (W0050); default baud / 10 for `dnc`, none (unchecked) otherwise",
+        ),
+    ]),
+    Check::Any,
+    "how programs reach the control: memory, file-size limit, link and its byte rate (see the language guide's Delivery page); default none stated: programs are held to `--max-program-size` only",
+);
 const LATHE_TRAVEL: Param = req(
     "travel",
     Ty::Block(&[
@@ -55,6 +97,7 @@ pub(super) const LATHE: Kind = Kind {
     params: &[
         DIALECT,
         OTHER_DIALECTS,
+        DELIVERY,
         req(
             "resolution",
             LENGTH,
@@ -100,6 +143,7 @@ pub(super) const FTS_LATHE: Kind = Kind {
     params: &[
         DIALECT,
         OTHER_DIALECTS,
+        DELIVERY,
         RESOLUTION,
         LATHE_TRAVEL,
         MAX_FEED,
@@ -167,6 +211,7 @@ pub(super) const STS_LATHE: Kind = Kind {
     params: &[
         DIALECT,
         OTHER_DIALECTS,
+        DELIVERY,
         RESOLUTION,
         LATHE_TRAVEL,
         MAX_FEED,
@@ -203,6 +248,7 @@ pub(super) const MILL_3AXIS: Kind = Kind {
     params: &[
         DIALECT,
         OTHER_DIALECTS,
+        DELIVERY,
         RESOLUTION,
         req(
             "travel",
@@ -225,7 +271,14 @@ pub(super) const MILL_3AXIS: Kind = Kind {
 pub(super) const GRINDER_2AXIS: Kind = Kind {
     name: "grinder_2axis",
     category: Category::Machine,
-    params: &[DIALECT, OTHER_DIALECTS, RESOLUTION, LATHE_TRAVEL, MAX_FEED],
+    params: &[
+        DIALECT,
+        OTHER_DIALECTS,
+        DELIVERY,
+        RESOLUTION,
+        LATHE_TRAVEL,
+        MAX_FEED,
+    ],
     family: None,
     positional: &[],
     exclusive: &[],
@@ -252,6 +305,24 @@ pub struct MachineParams {
     pub fast_axis: Option<FastAxisParams>,
     /// A slow-tool-servo lathe's Z, which follows the surface.
     pub z_axis: Option<ZAxisParams>,
+    /// How programs reach the control, if the machine states it.
+    pub delivery: Option<DeliveryParams>,
+}
+
+/// How programs reach the control (`delivery { … }`), as stated, each
+/// with where the file states it (for the messages about it).
+#[derive(Clone, Copy, Debug)]
+pub struct DeliveryParams {
+    /// `memory`, `disk`, `dnc` or `data_server` (default `memory`).
+    pub link: crate::value::Stated<&'static str>,
+    /// Bytes the control holds.
+    pub memory: Option<crate::value::Stated<f64>>,
+    /// Bytes of the largest file the control runs.
+    pub file_limit: Option<crate::value::Stated<f64>>,
+    /// A serial link's baud rate (bits per second).
+    pub baud: Option<crate::value::Stated<f64>>,
+    /// Bytes per second the link delivers, as stated.
+    pub rate: Option<crate::value::Stated<f64>>,
 }
 
 /// A fast tool servo (`fast_axis { … }`) and its second-order model.
@@ -303,8 +374,36 @@ impl MachineParams {
                 max_acceleration: z.required_num("max_acceleration"),
                 data_rate: z.num("data_rate"),
             }),
+            delivery: {
+                let site = r.site("delivery").unwrap_or((o.file, o.head));
+                r.block("delivery", |d| DeliveryParams {
+                    link: d
+                        .stated_word("link")
+                        .map(|w| crate::value::Stated {
+                            value: link_word(w.value),
+                            site: w.site,
+                        })
+                        .unwrap_or(crate::value::Stated {
+                            value: "memory",
+                            site,
+                        }),
+                    memory: d.stated_num("memory"),
+                    file_limit: d.stated_num("file_limit"),
+                    baud: d.stated_num("baud"),
+                    rate: d.stated_num("rate"),
+                })
+            },
         };
         r.finish(o.kind.name, (o.file, o.head))?;
         Ok(m)
     }
+}
+
+/// The link word as the schema's own `'static` word (the checker allows
+/// no other; anything else reads as `memory`, the default).
+fn link_word(w: &str) -> &'static str {
+    ["memory", "disk", "dnc", "data_server"]
+        .into_iter()
+        .find(|l| *l == w)
+        .unwrap_or("memory")
 }

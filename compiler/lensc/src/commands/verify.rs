@@ -84,9 +84,26 @@ pub fn run(out: &Output, program: &Path, asked: Asked) -> u8 {
         );
         return 1;
     };
-    let findings = match std::fs::File::open(program)
-        .and_then(|f| reader::read_from(std::io::BufReader::new(f), &d, &limits))
-    {
+    // A main program that calls its parts (a program split for its
+    // control's delivery) is read with each part in place of its call, as
+    // the control runs it.
+    let assembled = match split_set(program, &head, &d) {
+        Ok(a) => a,
+        Err(message) => {
+            eprintln!(
+                "error[{}]: {}: {message}",
+                lensc_lang::codes::CANNOT_READ,
+                program.display()
+            );
+            return 1;
+        }
+    };
+    let findings = match &assembled {
+        Some(text) => Ok(reader::read(text, &d, &limits)),
+        None => std::fs::File::open(program)
+            .and_then(|f| reader::read_from(std::io::BufReader::new(f), &d, &limits)),
+    };
+    let findings = match findings {
         Ok(f) => f,
         Err(e) => return cannot_read(e),
     };
@@ -96,7 +113,7 @@ pub fn run(out: &Output, program: &Path, asked: Asked) -> u8 {
         .iter()
         .map(|s| s.diagnostic(&head, program, &mut sources))
         .collect();
-    let found = match lines_of_findings(program, &findings, &mut sources) {
+    let found = match lines_of_findings(program, assembled.as_deref(), &findings, &mut sources) {
         Ok(d) => d,
         Err(e) => return cannot_read(e),
     };
@@ -371,6 +388,30 @@ fn sibling_program(table: &Path, job: &str) -> Option<std::path::PathBuf> {
 }
 
 /// The program's first 200 lines, where its header is.
+/// The text of the split set `program` heads, its parts (beside it) in
+/// place of their calls; `None` if it calls no parts (the program's name
+/// without its extension names them, as the build named them).
+fn split_set(
+    program: &Path,
+    head: &str,
+    d: &lensc_runtime::dialect::Dialect,
+) -> Result<Option<String>, String> {
+    let job = program
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    if !reader::parts::calls_parts(head, d, &job) {
+        return Ok(None);
+    }
+    let main = std::fs::read_to_string(program).map_err(|e| e.to_string())?;
+    let beside = program.parent().unwrap_or(Path::new("."));
+    let mut load =
+        |name: &str| std::fs::read_to_string(beside.join(name)).map_err(|e| e.to_string());
+    reader::parts::assemble(&main, d, &job, &mut load)
+        .map(Some)
+        .map_err(|e| e.message())
+}
+
 fn head(program: &Path) -> std::io::Result<String> {
     let mut r = std::io::BufReader::new(std::fs::File::open(program)?);
     let mut head = Vec::new();
@@ -389,13 +430,19 @@ fn head(program: &Path) -> std::io::Result<String> {
 /// each rule once), so memory does not grow with the program.
 fn lines_of_findings(
     program: &Path,
+    assembled: Option<&str>,
     findings: &[reader::Finding],
     sources: &mut SourceMap,
 ) -> std::io::Result<Vec<lensc_grammar::Diagnostic>> {
     let wanted: std::collections::BTreeSet<usize> = findings.iter().map(|f| f.line).collect();
     let last = wanted.last().copied().unwrap_or(0);
     let mut parts = std::collections::HashMap::new();
-    let mut r = std::io::BufReader::new(std::fs::File::open(program)?);
+    // A split set's lines are numbered as it is read: its parts in place
+    // of their calls.
+    let mut r: Box<dyn BufRead> = match assembled {
+        Some(text) => Box::new(std::io::Cursor::new(text.as_bytes())),
+        None => Box::new(std::io::BufReader::new(std::fs::File::open(program)?)),
+    };
     let mut buf = Vec::new();
     let (mut line, mut offset) = (0, 0);
     while line < last {
