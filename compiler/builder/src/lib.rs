@@ -27,6 +27,7 @@ pub mod plots;
 pub mod progress;
 pub mod read_along;
 pub mod read_back;
+pub mod reading;
 pub mod report;
 pub mod setup_sheet;
 pub(crate) mod spool;

@@ -45,7 +45,7 @@ pub struct Built {
     pub warnings: Vec<Diagnostic>,
     /// The dialect and machine its program was read back by, when it was
     /// (`lensc view` reads its moves by the same).
-    pub read_back: Option<crate::read_back::ReadBack>,
+    pub read_back: Option<crate::reading::ReadBack>,
 }
 
 /// A program's text: in memory, or spooled as it was written to a

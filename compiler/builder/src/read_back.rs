@@ -14,8 +14,7 @@ use crate::job::JobHead;
 use lensc_grammar::Diagnostic;
 use lensc_lang::check::CheckedJob;
 use lensc_lang::lower::read_back::job_machine;
-use lensc_runtime::dialect::Dialect;
-use lensc_runtime::reader::{self, MachineLimits};
+use lensc_runtime::reader;
 
 use crate::output::ProgramText;
 use crate::read_along::ReadAlong;
@@ -30,23 +29,7 @@ pub fn enabled() -> bool {
     READ_BACK_BY_DEFAULT || std::env::var_os("LENSC_READ_BACK").is_some_and(|v| v == "1")
 }
 
-/// What reading a job's program back takes beside its text: the dialect
-/// it is written in and the job's machine, as data.
-#[derive(Clone, Debug)]
-pub struct ReadBack {
-    pub dialect: Dialect,
-    pub machine: MachineLimits,
-}
-
-impl ReadBack {
-    /// The read-back of `job`'s program (lowered with `head`).
-    pub fn of(job: &CheckedJob, head: &JobHead) -> ReadBack {
-        ReadBack {
-            dialect: head.dialect.clone(),
-            machine: job_machine(job),
-        }
-    }
-}
+pub use crate::reading::ReadBack;
 
 /// The reader's findings in `program` as errors at the job; none if it
 /// reads clean. A program read as it was spooled is not read again: its

@@ -30,7 +30,6 @@ mod lexer;
 mod modal;
 mod motion;
 mod nurbs;
-mod nurbs_block;
 mod nurbs_moves;
 pub mod parts;
 mod policy;

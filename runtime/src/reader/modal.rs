@@ -12,6 +12,7 @@ use crate::dialect::Dialect;
 use crate::moves::Plane;
 
 mod fast;
+mod nurbs_block;
 mod word_use;
 
 /// How F is read.
@@ -158,7 +159,7 @@ pub(crate) struct State {
     /// The NURBS curve being read, until its last knot.
     pub nurbs: Option<super::nurbs::Nurbs>,
     /// LinuxCNC's G5.2 curve being read (`nurbs_block`).
-    pub nurbs_block: Option<super::nurbs_block::NurbsBlock>,
+    pub nurbs_block: Option<nurbs_block::NurbsBlock>,
     /// The B spline being read (Siemens' BSPLINE), until a block leaves
     /// the mode.
     pub bspline: Option<super::bspline::Bspline>,

@@ -151,7 +151,7 @@ fn check(spec: &SpiralSpec, unit: Unit, speed: f64, lag_limit: Option<f64>) -> V
     let kernel = evaluator(&trajectory.tape).0;
     let data_rate = 1.0 / at.spiral.min_interval;
     let mut following =
-        lag_limit.and_then(|_| super::build::following(spec, &at.spiral, &bounds, data_rate));
+        lag_limit.and_then(|_| super::servo::following(spec, &at.spiral, &bounds, data_rate));
     let planner = Planner {
         spiral: &at.spiral,
         surface: kernel.as_ref(),
@@ -161,7 +161,7 @@ fn check(spec: &SpiralSpec, unit: Unit, speed: f64, lag_limit: Option<f64>) -> V
     let (mut printed, resolution) = (Vec::new(), spec.head.resolution);
     let planned = match following.as_mut() {
         Some(sim) => planner.check_with(&spec.fast_axis, |pts| {
-            super::build::as_printed(pts, resolution, &mut printed);
+            super::servo::as_printed(pts, resolution, &mut printed);
             sim.extend(&printed);
         }),
         None => planner.check(&spec.fast_axis),

@@ -6,6 +6,7 @@
 //! written, and the report of what it makes.
 
 use super::SpiralSpec;
+use super::servo::{as_printed, following};
 use lensc_grammar::Diagnostic;
 use lensc_lang::check::trim_num;
 use lensc_lang::codes;
@@ -165,47 +166,6 @@ fn table_name(spec: &SpiralSpec) -> Option<String> {
 /// The axis that carries the surface, in words.
 fn axis_words(spec: &SpiralSpec) -> &'static str {
     if spec.slow { "Z" } else { "the fast axis" }
-}
-
-/// `points` as the program prints them (X and W rounded to the machine's
-/// `resolution`, mm), into `printed`: what the servo is driven by.
-pub(super) fn as_printed(
-    points: &[lensc_runtime::plan::spiral::SpiralPoint],
-    resolution: f64,
-    printed: &mut Vec<lensc_runtime::plan::spiral::SpiralPoint>,
-) {
-    let printed_at = lensc_runtime::verify::simulate::Printed::new(resolution);
-    let round = |v: f64| printed_at.round(v);
-    printed.clear();
-    printed.extend(
-        points
-            .iter()
-            .map(|q| lensc_runtime::plan::spiral::SpiralPoint {
-                x: round(q.x),
-                w: round(q.w),
-                ..*q
-            }),
-    );
-}
-
-/// The fast axis's servo following along `spiral` (the job's, or at a
-/// trial speed, with the `bounds` its trajectory has there), simulated
-/// over radial bins, where it has a servo model.
-pub(super) fn following(
-    spec: &SpiralSpec,
-    spiral: &lensc_runtime::plan::spiral::FtsSpiral,
-    bounds: &lensc_runtime::plan::spiral::TrajectoryBounds,
-    data_rate: f64,
-) -> Option<lensc_runtime::verify::follow::FollowingSimulation> {
-    use lensc_runtime::verify::follow::{FollowingSimulation, RadialBins};
-    let servo = spec.servo.as_ref().filter(|_| !spec.slow)?;
-    let (r0, r1) = (spiral.start_radius.abs(), spiral.end_radius.abs());
-    FollowingSimulation::new(
-        servo,
-        data_rate,
-        bounds.features.as_deref().unwrap_or_default(),
-        RadialBins::new(r0.min(r1), r0.max(r1), crate::plots::FOLLOWING_BINS),
-    )
 }
 
 /// The spiral's section of the report: a fast or a slow tool servo's.

@@ -11,6 +11,7 @@ pub(crate) mod errors;
 pub mod report;
 pub use build::Prepared;
 mod estimate;
+mod servo;
 
 use lensc_grammar::Diagnostic;
 use lensc_runtime::machine::servo::SecondOrderServo;

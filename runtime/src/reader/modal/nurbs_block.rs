@@ -27,16 +27,16 @@
 //! rational, its basis by the de Boor–Cox recursion over the clamped
 //! integer knot vector `knot_vector_creator` builds (0 repeated L times,
 //! 1 … n−L+1, then n−L+2 repeated L times, for n+1 control points), which
-//! is [`super::nurbs::Nurbs`]'s evaluation with those knots. It is handed
-//! over as straight moves within [`super::spline::SPLINE_TOLERANCE`] of
+//! is [`crate::reader::nurbs::Nurbs`]'s evaluation with those knots. It is handed
+//! over as straight moves within [`crate::reader::spline::SPLINE_TOLERANCE`] of
 //! the curve. LinuxCNC's motion controller cuts biarcs through 4(n+1)
 //! points of it (`emccanon.cc`, `NURBS_FEED`); the biarcs' own departure
 //! from the curve is not modelled (an assumption, in the controller page).
 
-use super::Rule;
-use super::lexer::{Block, Found};
-use super::modal::{FeedMode, Motion, State};
-use super::nurbs::Nurbs;
+use super::{FeedMode, Motion, State};
+use crate::reader::Rule;
+use crate::reader::lexer::{Block, Found};
+use crate::reader::nurbs::Nurbs;
 
 /// A G5.2 curve being read.
 #[derive(Clone, Debug)]
