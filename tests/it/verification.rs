@@ -403,7 +403,7 @@ fn a_simulation_window_too_fine_is_refused_with_its_size() {
     assert_eq!(out.status.code(), Some(1));
     let err = text(&out.stderr);
     assert!(
-        err.contains("E0149") && err.contains("10000200001 cells in 10001 tiles"),
+        err.contains("E0149") && err.contains("10000200001 cells, its columns 100001 rows long"),
         "{err}"
     );
     assert!(!dir.path().join("j.ngc").exists());
