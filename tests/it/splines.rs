@@ -120,6 +120,12 @@ fn a_dialect_without_a_spline_refuses_it_and_writes_nothing() {
     assert_eq!(out.status.code(), Some(1));
     let err = text(&out.stderr);
     assert!(err.contains("[E0182]"), "{err}");
+    // The help names the machine's own dialects that have one, as flags.
+    assert!(
+        err.contains("`lensc build --dialect fanuc_0i_mill`")
+            && err.contains("`lensc build --dialect siemens_840d_mill`"),
+        "{err}"
+    );
     assert!(!dir.path().join("out/with_splines.ngc").exists());
 }
 

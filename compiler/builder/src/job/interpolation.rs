@@ -32,12 +32,27 @@ pub fn error(p: &Parts, dialect: &Dialect) -> Option<Diagnostic> {
     }
     let strategy = p.strategy.kind.name;
     let (message, help) = if dialect.spline.is_none() {
+        let with_spline = machine_spline_dialects(p);
+        let choose = if with_spline.is_empty() {
+            "or give the machine a dialect whose control has a spline lensc writes (`fanuc_0i_mill`: NURBS, G06.2; `siemens_840d_mill` or `_lathe`: BSPLINE) in its `other_dialects`".to_string()
+        } else {
+            let flags: Vec<String> = with_spline
+                .iter()
+                .map(|d| format!("`lensc build --dialect {d}`"))
+                .collect();
+            format!(
+                "or build in a dialect of this machine whose control has one: {}",
+                flags.join(" or ")
+            )
+        };
         (
             format!(
                 "`interpolation: spline`, but the `{}` dialect has no spline lensc writes",
                 dialect.name
             ),
-            "write `interpolation: lines_arcs`, or build in a dialect with a spline (`fanuc_0i_mill`: NURBS, G06.2; `siemens_840d_mill`: BSPLINE); LinuxCNC's G5, G5.1 and G5.2 interpolate in the XY plane only, and Heidenhain's SPL is not written yet (docs/controllers/)".to_string(),
+            format!(
+                "write `interpolation: lines_arcs`, {choose}; LinuxCNC's G5, G5.1 and G5.2 interpolate in the XY plane only, and Heidenhain's SPL is not written yet (docs/controllers/)"
+            ),
         )
     } else if !SPLINE_STRATEGIES.contains(&strategy) {
         (
@@ -59,4 +74,16 @@ pub fn error(p: &Parts, dialect: &Dialect) -> Option<Diagnostic> {
             .with_label("no spline here")
             .with_help(help),
     )
+}
+
+/// The dialects the job's machine offers (its `dialect` and
+/// `other_dialects`) in which lensc writes a spline.
+fn machine_spline_dialects(p: &Parts) -> Vec<String> {
+    lensc_lang::schema::offered_dialects(p.machine)
+        .iter()
+        .map(|o| o.name().to_string())
+        .filter(|name| {
+            lensc_lang::lower::dialect(p.job, Some(name)).is_ok_and(|d| d.spline.is_some())
+        })
+        .collect()
 }
