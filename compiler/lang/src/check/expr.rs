@@ -329,13 +329,15 @@ impl<'a> Checker<'a> {
             Some(c) => format!("{} is made by one of: {}", c.noun(), kinds.join(", ")),
             None => format!("the kinds are: {}", kinds.join(", ")),
         };
-        d = d.with_help(match super::scope::known_elsewhere(scope, w, cands) {
-            Some(help) => help,
-            None => match kind_within(w, &kinds) {
-                Some(k) => format!("did you mean `{k}`? {listed}"),
-                None => listed,
+        d = d.with_help(
+            match super::scope::known_elsewhere(scope, w, cands, category) {
+                Some(help) => help,
+                None => match kind_within(w, &kinds) {
+                    Some(k) => format!("did you mean `{k}`? {listed}"),
+                    None => listed,
+                },
             },
-        });
+        );
         self.err(d);
         self.block_fields(file, block, coords);
         Value::Error
@@ -439,7 +441,7 @@ impl<'a> Checker<'a> {
             Value::Error => {}
             Value::Word(w) => {
                 let w = w.clone();
-                self.unknown_name(file, span, &w);
+                self.unknown_name(file, span, &w, None);
             }
             other => self.err(
                 Diagnostic::error(

@@ -392,7 +392,7 @@ impl<'a> Checker<'a> {
         if let Value::Word(w) = &v
             && matches!(p.ty, Ty::Quantity(_) | Ty::Range(_))
         {
-            self.unknown_name(file, span, w);
+            self.unknown_name(file, span, w, None);
             return;
         }
         self.err(

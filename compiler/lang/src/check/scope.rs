@@ -273,7 +273,7 @@ impl<'a> Checker<'a> {
                 Value::Error
             }
             Value::Word(w) => {
-                self.unknown_name(file, span, w);
+                self.unknown_name(file, span, w, Some(cat));
                 Value::Error
             }
             other => {
@@ -325,11 +325,31 @@ impl<'a> Checker<'a> {
             })
     }
 
-    pub(super) fn unknown_name(&mut self, file: FileId, span: Span, name: &str) {
+    /// E0100 for `name`, with a hint; `category`, where the slot takes
+    /// one, narrows the names suggested to that category's.
+    pub(super) fn unknown_name(
+        &mut self,
+        file: FileId,
+        span: Span,
+        name: &str,
+        category: Option<Category>,
+    ) {
         let scope = &self.scopes[file.0 as usize];
-        let mut candidates: Vec<&str> = scope.keys().copied().collect();
-        candidates.extend(FUNCTIONS);
-        candidates.extend(schema::KINDS.iter().map(|k| k.name));
+        let decls = &self.decls;
+        let mut candidates: Vec<&str> = scope
+            .iter()
+            .filter(|&(_, &i)| category.is_none_or(|c| decls[i].kind.map(Category::of) == Some(c)))
+            .map(|(&n, _)| n)
+            .collect();
+        if category.is_none() {
+            candidates.extend(FUNCTIONS);
+        }
+        candidates.extend(
+            schema::KINDS
+                .iter()
+                .filter(|k| category.is_none_or(|c| k.category == c))
+                .map(|k| k.name),
+        );
         let mut d = Diagnostic::error(
             codes::UNKNOWN_NAME,
             format!("unknown name `{name}`"),
@@ -351,7 +371,7 @@ impl<'a> Checker<'a> {
             d = d.with_help(
                 "coordinates can only be used inside a surface formula such as `z(x, y) = …`",
             );
-        } else if let Some(help) = known_elsewhere(scope, name, candidates) {
+        } else if let Some(help) = known_elsewhere(scope, name, candidates, category) {
             d = d.with_help(help);
         } else if units::lookup(name).is_some() {
             let text = &self.loaded.sources.get(file).text;
@@ -427,6 +447,7 @@ pub(super) fn known_elsewhere<'c>(
     scope: &HashMap<&str, usize>,
     name: &str,
     candidates: impl IntoIterator<Item = &'c str>,
+    category: Option<Category>,
 ) -> Option<String> {
     let use_it = |item: &stdlib::StdItem| {
         format!(
@@ -438,7 +459,12 @@ pub(super) fn known_elsewhere<'c>(
     if let Some(item) = stdlib::find(name) {
         return Some(format!("`{name}` is {}", use_it(item)));
     }
-    let stdlib_names = stdlib::items().iter().map(|i| i.name.as_str());
+    // Where the slot takes one category, only the standard library's items
+    // of that category are meant.
+    let stdlib_names = stdlib::items()
+        .iter()
+        .filter(|i| category.is_none_or(|c| Category::of(i.kind) == c))
+        .map(|i| i.name.as_str());
     let candidates: Vec<&str> = candidates.into_iter().chain(stdlib_names).collect();
     let Some(s) = did_you_mean(name, candidates.iter().copied()) else {
         // A name cut short: every name it begins, with the `use` of each
