@@ -1046,6 +1046,21 @@ impl ProgramWriter {
 
     /// The word that switches the controller to feed mode `m`.
     #[cold]
+    /// ` F…` for a spline's feed `v` (mm/s), in mm/min, on the block that
+    /// starts the curve (Fanuc's G06.2, Siemens' BSPLINE); its printed units.
+    fn curve_feed_word(&mut self, v: f64) -> Result<i64, ProgramError> {
+        let f = v * 60.0;
+        let Some(units) = self.feed_format.units(f) else {
+            return Err(ProgramError::NotPrintable {
+                word: 'F',
+                value: f,
+            });
+        };
+        self.text.extend_from_slice(b" F");
+        self.number('F', f, units, self.feed_decimals)?;
+        Ok(units)
+    }
+
     fn feed_mode_word(&self, m: FeedMode) -> Result<&str, ProgramError> {
         let w = match m {
             FeedMode::PerMinute => &self.dialect.per_minute,
@@ -1260,16 +1275,7 @@ impl ProgramWriter {
             if i == 0
                 && let Some(F::PerTime(v)) = s.feed
             {
-                let f = v * 60.0;
-                let Some(units) = self.feed_format.units(f) else {
-                    return Err(ProgramError::NotPrintable {
-                        word: 'F',
-                        value: f,
-                    });
-                };
-                self.text.extend_from_slice(b" F");
-                self.number('F', f, units, self.feed_decimals)?;
-                new_feed = Some(units);
+                new_feed = Some(self.curve_feed_word(v)?);
             }
             self.end_block(start)?;
         }
@@ -1397,16 +1403,7 @@ impl ProgramWriter {
             if i == 1
                 && let Some(F::PerTime(v)) = s.feed
             {
-                let f = v * 60.0;
-                let Some(units) = self.feed_format.units(f) else {
-                    return Err(ProgramError::NotPrintable {
-                        word: 'F',
-                        value: f,
-                    });
-                };
-                self.text.extend_from_slice(b" F");
-                self.number('F', f, units, self.feed_decimals)?;
-                new_feed = Some(units);
+                new_feed = Some(self.curve_feed_word(v)?);
             }
             self.end_block(start)?;
         }
