@@ -48,9 +48,16 @@ pub fn emit(
         format!("{control_point}; no cutter compensation"),
         format!("surface {}: {}", job.surface_name, job.surface.description),
         format!(
-            "tool {}: round nose, nose radius {} mm{centre_height}",
+            "tool {}: round nose, nose radius {} mm{centre_height}{}",
             job.tool_name,
-            exact(job.tool.nose_radius)
+            exact(job.tool.nose_radius),
+            match &job.tool.edge {
+                Some(e) => format!(
+                    ", edge profile {}: path offset by R + its deviation at each angle of contact",
+                    e.source
+                ),
+                None => String::new(),
+            }
         ),
         format!(
             "strategy {}: profile turning, {} points, {}{}{}",

@@ -1,5 +1,6 @@
 //! Machines: their kinematics, limits and the dialect they speak.
 
+pub mod edge;
 pub mod servo;
 pub mod tool;
 

@@ -5,6 +5,7 @@
 use nalgebra::Vector2;
 
 use crate::machine::Lathe;
+use crate::machine::edge::Nose;
 use crate::machine::tool::RoundNoseTool;
 use crate::moves::{Move, Position};
 use crate::plan::approach;
@@ -182,6 +183,18 @@ pub enum PlanError {
     SpindleTooFast { speed: f64, max: f64 },
     /// The surface is undefined (or the offset not finite) at this radius.
     Undefined { at_radius: f64 },
+    /// The tool's measured edge does not cover the angles (rad, from the
+    /// tool's axis towards +X) at which the cut meets it: `needed` the
+    /// least and greatest contact angle, `measured` the profile's.
+    EdgeNotCovering {
+        needed: (f64, f64),
+        measured: (f64, f64),
+        at_radius: f64,
+    },
+    /// A measured edge is compensated only on the exact offset of a
+    /// smooth profile: not on a profile with corners (at this radius) nor
+    /// with Lei's searches (`at_radius` None).
+    EdgeNotCompensated { corner_at: Option<f64> },
 }
 
 /// Number of radii at which the profile is scanned for curvature and slope.
@@ -229,6 +242,12 @@ pub fn check_profile_turning(
         });
     }
     errors.extend(rate_errors(&job.machine, strat, feed_speed));
+    if let Some(e) = &job.tool.edge {
+        errors.extend(edge_coverage(profile, &e.profile, start, strat.end_radius));
+        if strat.location != ToolLocation::Exact {
+            errors.push(PlanError::EdgeNotCompensated { corner_at: None });
+        }
+    }
     if errors.is_empty() {
         Ok(scan)
     } else {
@@ -255,6 +274,13 @@ pub fn plan_profile_turning(
         (if a <= 0.0 { a - rho } else { a }, b)
     };
     let pieces = envelope::split_at_corners(profile, lo, hi);
+    if job.tool.edge.is_some()
+        && let Some(c) = pieces.corners.first()
+    {
+        return Err(vec![PlanError::EdgeNotCompensated {
+            corner_at: Some(c.at),
+        }]);
+    }
     let seams = seams(profile, &pieces, rho, start.min(end), hi);
     let section = Section {
         profile,
@@ -262,7 +288,7 @@ pub fn plan_profile_turning(
         start,
         end,
     };
-    let cut = cut_path(&section, rho, strat);
+    let cut = cut_path(&section, &job.tool.nose(), strat);
     let mut passes = roughing_passes(&section, rho, strat, &cut);
     let stock = stock_outline(&section, rho, strat, &cut);
     let roughing_count = passes.len();
@@ -286,6 +312,40 @@ pub fn plan_profile_turning(
         seams,
         roughing_passes: roughing_count,
         pass_starts: linked.pass_starts,
+    })
+}
+
+/// The contact angles of the cut from `start` to `end` (rad, atan of the
+/// slope: where the surface meets the nose) that `edge` does not cover.
+fn edge_coverage(
+    profile: &dyn Profile,
+    edge: &crate::machine::edge::EdgeProfile,
+    start: f64,
+    end: f64,
+) -> Option<PlanError> {
+    let (mut lo, mut hi) = ((f64::INFINITY, 0.0), (f64::NEG_INFINITY, 0.0));
+    for i in 0..=SCAN_POINTS {
+        let r = end + (start - end) * i as f64 / SCAN_POINTS as f64;
+        let a = profile.point(r).dz.atan();
+        if a < lo.0 {
+            lo = (a, r);
+        }
+        if a > hi.0 {
+            hi = (a, r);
+        }
+    }
+    let (m0, m1) = edge.range();
+    let outside = if lo.0 < m0 {
+        Some(lo.1)
+    } else if hi.0 > m1 {
+        Some(hi.1)
+    } else {
+        None
+    };
+    outside.map(|at_radius| PlanError::EdgeNotCovering {
+        needed: (lo.0, hi.0),
+        measured: (m0, m1),
+        at_radius,
     })
 }
 
@@ -587,7 +647,7 @@ fn stock_outline(
                 chords: ChordPlacement::OnPath,
                 ..strat.clone()
             };
-            Outline::Path(cut_path(section, rho + allowance, &exact))
+            Outline::Path(cut_path(section, &Nose::circle(rho + allowance), &exact))
         }
     }
 }
@@ -616,7 +676,7 @@ fn roughing_passes(
             chords: ChordPlacement::OnPath,
             ..strat.clone()
         };
-        cut_path(section, rho + allowance, &exact)
+        cut_path(section, &Nose::circle(rho + allowance), &exact)
     };
     let mut passes = Vec::new();
     match r.stock {
@@ -666,8 +726,10 @@ struct Section<'a> {
 
 /// The nose-centre points of the cut, within the chord tolerance of the
 /// curve the chosen tool location gives, placed across it as the
-/// strategy's `chords` says.
-fn cut_path(section: &Section, rho: f64, strat: &ProfileTurning) -> Vec<Vector2<f64>> {
+/// strategy's `chords` says. A measured edge is compensated on the exact
+/// offset (`tool_centre_by`); the planner refuses it elsewhere.
+fn cut_path(section: &Section, nose: &Nose, strat: &ProfileTurning) -> Vec<Vector2<f64>> {
+    let rho = nose.radius;
     let placement = strat.chords;
     let sample = |c: &dyn Fn(f64) -> Vector2<f64>, a: f64, b: f64, tol: f64| {
         if placement == ChordPlacement::OnPath {
@@ -685,8 +747,8 @@ fn cut_path(section: &Section, rho: f64, strat: &ProfileTurning) -> Vec<Vector2<
     let tol = strat.chord_tolerance * crate::plan::optimise::CHORD_SHARE * placement.sag_factor();
     // The ends of the cut in the tool's x: the normal offsets of its ends.
     let (x0, x1) = (
-        tool_centre(profile, rho, start).x,
-        tool_centre(profile, rho, end).x,
+        tool_centre_by(profile, nose, start).x,
+        tool_centre_by(profile, nose, end).x,
     );
     let discretised = |spacing: f64| -> Vec<(f64, f64)> {
         let (a, b) = (pieces.bounds[0], pieces.bounds[pieces.bounds.len() - 1]);
@@ -700,7 +762,7 @@ fn cut_path(section: &Section, rho: f64, strat: &ProfileTurning) -> Vec<Vector2<
     };
     match strat.location {
         ToolLocation::Exact if pieces.corners.is_empty() => {
-            let centre = |r: f64| tool_centre(profile, rho, r);
+            let centre = |r: f64| tool_centre_by(profile, nose, r);
             sample(&centre, start, end, tol)
         }
         ToolLocation::Exact => {
@@ -747,9 +809,21 @@ fn seams(profile: &dyn Profile, pieces: &Pieces, rho: f64, a: f64, b: f64) -> Ve
 /// The nose centre when the nose touches the profile at radius `r`: the
 /// profile point moved by ρ along the unit normal that points to the tool.
 pub fn tool_centre(profile: &dyn Profile, nose_radius: f64, r: f64) -> Vector2<f64> {
+    tool_centre_by(profile, &Nose::circle(nose_radius), r)
+}
+
+/// The nose centre when a nose whose edge may be measured touches the
+/// profile at radius `r`: the profile point moved along the normal by the
+/// edge's support h(φ) at the contact angle φ = atan(dz/dr)
+/// (`Nose::support`, R + δ(φ) to first order).
+pub fn tool_centre_by(profile: &dyn Profile, nose: &Nose, r: f64) -> Vector2<f64> {
     let p = profile.point(r);
     let normal = Vector2::new(-p.dz, 1.0).normalize();
-    Vector2::new(r, p.z) + nose_radius * normal
+    let h = match nose.edge {
+        None => nose.radius,
+        Some(_) => nose.support(p.dz.atan()).1,
+    };
+    Vector2::new(r, p.z) + h * normal
 }
 
 /// Samples the curve `c(t)` for t from `a` to `b` so that no chord strays
@@ -856,3 +930,6 @@ mod tests;
 
 #[cfg(test)]
 mod roughing_tests;
+
+#[cfg(test)]
+mod edge_tests;

@@ -8,7 +8,10 @@
 //! surface is the lower envelope of the disc swept along every cutting
 //! move. The envelope is exact: a disc swept along a straight move is
 //! bounded below by its end discs and the move offset by ρ; along an arc,
-//! by its end discs and the arc offset by ±ρ along its normal.
+//! by its end discs and the arc offset by ±ρ along its normal. A nose
+//! whose edge was measured (`machine::edge`, ρ(θ) = R + δ(θ)) is swept
+//! the same way, each offset by the edge point that touches the move's
+//! tangent instead of ρ along its normal (`program_cut_by`).
 //!
 //! Arcs as the controller cuts them. A printed arc's end is rarely at
 //! exactly its start radius from the printed centre (every coordinate is
@@ -24,6 +27,7 @@
 //! read_moves`); `profile_cut` from the planned move stream, as printed.
 
 use super::figures::ErrorStats;
+use crate::machine::edge::Nose;
 use crate::moves::{Move, Plane};
 use crate::post::format::decimals_for;
 use crate::reader::{Executed, Path};
@@ -201,15 +205,9 @@ pub fn centre_path(stream: &[Move], resolution: f64) -> Vec<Vec<(f64, f64)>> {
     runs
 }
 
-/// The lowest point at abscissa `x` of a disc of radius `rho` centred at
-/// `c`, if the disc reaches `x`.
-fn disc_bottom(c: (f64, f64), rho: f64, x: f64) -> Option<f64> {
-    let dx = x - c.0;
-    (dx.abs() <= rho).then(|| c.1 - (rho * rho - dx * dx).sqrt())
-}
-
 impl Piece {
-    /// The radii the disc swept along the piece reaches.
+    /// The radii the nose swept along the piece reaches (`rho` its
+    /// farthest reach from its centre).
     fn reach(&self, rho: f64) -> (f64, f64) {
         match *self {
             Piece::Line { a, b } => (a.0.min(b.0) - rho, a.0.max(b.0) + rho),
@@ -220,19 +218,22 @@ impl Piece {
         }
     }
 
-    /// The lowest point at `x` of the disc of radius `rho` swept along the
-    /// piece, if the swept region reaches `x`.
-    fn bottom(&self, rho: f64, x: f64) -> Option<f64> {
+    /// The lowest point at `x` of the nose swept along the piece, if the
+    /// swept region reaches `x`. A measured edge is convex (its deviation
+    /// is a small share of R), so the region's lower boundary is the
+    /// nose at both ends and the piece moved by the edge point that
+    /// touches a line along the piece (`Nose::support_point`).
+    fn bottom(&self, nose: &Nose, x: f64) -> Option<f64> {
         let (a, b) = match *self {
             Piece::Line { a, b } | Piece::Arc { a, b, .. } => (a, b),
         };
-        let mut low = disc_bottom(a, rho, x);
+        let mut low = nose.bottom(a, x);
         let mut see = |z: Option<f64>| {
             if let Some(z) = z {
                 low = Some(low.map_or(z, |l: f64| l.min(z)));
             }
         };
-        see(disc_bottom(b, rho, x));
+        see(nose.bottom(b, x));
         match *self {
             Piece::Line { a, b } => {
                 let (dx, dz) = (b.0 - a.0, b.1 - a.1);
@@ -244,10 +245,8 @@ impl Piece {
                     } else {
                         (-dz / len, dx / len)
                     };
-                    let (a2, b2) = (
-                        (a.0 + rho * nx, a.1 + rho * nz),
-                        (b.0 + rho * nx, b.1 + rho * nz),
-                    );
+                    let (sx, sz) = nose.support_point((nx, nz));
+                    let (a2, b2) = ((a.0 + sx, a.1 + sz), (b.0 + sx, b.1 + sz));
                     let t = (x - a2.0) / (b2.0 - a2.0);
                     if (0.0..=1.0).contains(&t) {
                         see(Some(a2.1 + t * (b2.1 - a2.1)));
@@ -263,13 +262,16 @@ impl Piece {
                 ..
             } => {
                 for side in [1.0, -1.0] {
-                    see(spiral_offset_at(
-                        o,
-                        (r, r_end),
-                        (start, sweep),
-                        side * rho,
-                        x,
-                    ));
+                    see(match nose.edge {
+                        None => spiral_offset_at(
+                            o,
+                            (r, r_end),
+                            (start, sweep),
+                            side * nose.radius,
+                            x,
+                        ),
+                        Some(_) => edge_offset_at(o, (r, r_end), (start, sweep), side, nose, x),
+                    });
                 }
             }
         }
@@ -349,6 +351,73 @@ fn spiral_offset_at(
     low
 }
 
+/// The envelope of a measured nose swept along the arc of
+/// `spiral_offset_at` on its outer (`side` +1) or inner (−1) side: the
+/// arc's point moved by the edge point that touches the arc's tangent,
+/// e(θ) = c(θ) + s(±n(θ)), at abscissa `x`; the lowest of its crossings
+/// within the sweep. Newton on θ (its slope by central differences) from
+/// the crossings of the offset circle at the mean radius.
+fn edge_offset_at(
+    o: (f64, f64),
+    (r0, r1): (f64, f64),
+    (start, sweep): (f64, f64),
+    side: f64,
+    nose: &Nose,
+    x: f64,
+) -> Option<f64> {
+    let k = if sweep != 0.0 { (r1 - r0) / sweep } else { 0.0 };
+    let rr = 0.5 * (r0 + r1) + side * nose.radius;
+    if rr <= 0.0 {
+        return None;
+    }
+    let s = (x - o.0) / rr;
+    if s.abs() > 1.0 + 1e-3 {
+        return None;
+    }
+    let travelled = |ang: f64| {
+        if sweep >= 0.0 {
+            (ang - start).rem_euclid(2.0 * PI)
+        } else {
+            (start - ang).rem_euclid(2.0 * PI)
+        }
+    };
+    let point = |theta: f64| {
+        let r = r0 + k * (theta - start);
+        let h = r.hypot(k);
+        let (sn, cs) = theta.sin_cos();
+        let n = (side * (r * sn - k * cs) / h, side * (r * cs + k * sn) / h);
+        let (ex, ez) = nose.support_point(n);
+        (o.0 + r * sn + ex, o.1 + r * cs + ez)
+    };
+    let mut low: Option<f64> = None;
+    let base = s.clamp(-1.0, 1.0).asin();
+    for guess in [base, PI - base] {
+        let mut theta = start + travelled(guess) * sweep.signum();
+        for _ in 0..20 {
+            let d = 1e-7;
+            let slope = (point(theta + d).0 - point(theta - d).0) / (2.0 * d);
+            let step = (point(theta).0 - x) / slope;
+            if !step.is_finite() || step.abs() > 0.1 {
+                break;
+            }
+            theta -= step;
+            if step.abs() < 1e-14 {
+                break;
+            }
+        }
+        let t = (theta - start) * sweep.signum();
+        if !(-1e-12..=sweep.abs() + 1e-12).contains(&t) {
+            continue;
+        }
+        let (px, pz) = point(theta);
+        if (px - x).abs() > 1e-9 {
+            continue;
+        }
+        low = Some(low.map_or(pz, |l| l.min(pz)));
+    }
+    low
+}
+
 /// Simulates the cut of a lathe `stream` (nose radius `rho`, coordinates
 /// rounded to `resolution`) on `samples` radii evenly over `from..=to`
 /// and compares it with `design` (the profile's height at a radius).
@@ -361,7 +430,13 @@ pub fn profile_cut(
     range: (f64, f64),
     samples: usize,
 ) -> ProfileCut {
-    cut_of(&pieces(stream, resolution), rho, design, range, samples)
+    cut_of(
+        &pieces(stream, resolution),
+        &Nose::circle(rho),
+        design,
+        range,
+        samples,
+    )
 }
 
 /// Simulates the cut of a lathe program from the moves its controller
@@ -375,7 +450,31 @@ pub fn program_cut(
     range: (f64, f64),
     samples: usize,
 ) -> ProfileCut {
-    cut_of(&executed_pieces(moves), rho, design, range, samples)
+    program_cut_by(moves, &Nose::circle(rho), design, range, samples)
+}
+
+/// `program_cut` by a `nose` whose edge may be measured (the real tool's
+/// edge, swept as it is).
+pub fn program_cut_by(
+    moves: &[Executed],
+    nose: &Nose,
+    design: &dyn Fn(f64) -> f64,
+    range: (f64, f64),
+    samples: usize,
+) -> ProfileCut {
+    cut_of(&executed_pieces(moves), nose, design, range, samples)
+}
+
+/// `profile_cut` by a `nose` whose edge may be measured.
+pub fn profile_cut_by(
+    stream: &[Move],
+    nose: &Nose,
+    resolution: f64,
+    design: &dyn Fn(f64) -> f64,
+    range: (f64, f64),
+    samples: usize,
+) -> ProfileCut {
+    cut_of(&pieces(stream, resolution), nose, design, range, samples)
 }
 
 /// The cutting moves among the executed `moves`: feed moves with X and Z
@@ -417,7 +516,7 @@ fn executed_pieces(moves: &[Executed]) -> Vec<Piece> {
 /// The cut of `pieces` (see `profile_cut`).
 fn cut_of(
     pieces: &[Piece],
-    rho: f64,
+    nose: &Nose,
     design: &dyn Fn(f64) -> f64,
     (from, to): (f64, f64),
     samples: usize,
@@ -429,7 +528,7 @@ fn cut_of(
     let bin = |x: f64| (((x - from) / width).floor().max(0.0) as usize).min(bins - 1);
     let mut in_bin: Vec<Vec<usize>> = vec![Vec::new(); bins];
     for (i, p) in pieces.iter().enumerate() {
-        let (lo, hi) = p.reach(rho);
+        let (lo, hi) = p.reach(nose.reach());
         if hi < from || lo > to || !(lo.is_finite() && hi.is_finite()) {
             continue;
         }
@@ -444,7 +543,7 @@ fn cut_of(
         let x = from + (to - from) * k as f64 / (n - 1) as f64;
         let cut = in_bin[bin(x)]
             .iter()
-            .filter_map(|&i| pieces[i].bottom(rho, x))
+            .filter_map(|&i| pieces[i].bottom(nose, x))
             .fold(f64::INFINITY, f64::min);
         let ring = 2.0 * PI * x.abs() * step;
         area += ring;

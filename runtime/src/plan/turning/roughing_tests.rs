@@ -29,6 +29,7 @@ fn job(roughing: Roughing) -> (TurningJob, RotationalSurface) {
             clearance_angle: 0.1,
             centre_height: 0.0,
             rake_angle: 0.0,
+            edge: None,
         },
         machine: Lathe {
             dialect: Dialect::linuxcnc(),

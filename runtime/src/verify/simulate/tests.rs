@@ -187,7 +187,7 @@ fn an_arc_whose_end_radius_differs_is_cut_as_the_controller_blends_it() {
     let delta = 1e-4;
     let pieces = executed_pieces(&blended_arc(delta));
     assert_eq!(pieces.len(), 1);
-    let bottom = |x: f64| pieces[0].bottom(RHO, x).expect("reached");
+    let bottom = |x: f64| pieces[0].bottom(&Nose::circle(RHO), x).expect("reached");
     // Halfway round, the radius is halfway from start to end (LinuxCNC's
     // pmCirclePoint); a sweep at the start radius would cut -0.5.
     let mid = bottom(0.0);
@@ -205,7 +205,7 @@ fn an_arc_whose_end_radius_differs_is_cut_as_the_controller_blends_it() {
     }
     // With no difference, the circle of the start radius.
     let circle = executed_pieces(&blended_arc(0.0));
-    assert!((circle[0].bottom(RHO, 0.0).expect("reached") + 0.5).abs() < 1e-12);
+    assert!((circle[0].bottom(&Nose::circle(RHO), 0.0).expect("reached") + 0.5).abs() < 1e-12);
 }
 
 #[test]
@@ -225,7 +225,7 @@ fn the_program_cut_of_a_blended_arc_follows_the_spiral_not_the_start_circle() {
     let envelope = |x: f64| {
         centres
             .iter()
-            .filter_map(|&c| disc_bottom(c, RHO, x))
+            .filter_map(|&c| Nose::circle(RHO).bottom(c, x))
             .fold(f64::INFINITY, f64::min)
     };
     let cut = program_cut(&moves, RHO, &envelope, (-1.5, 1.5), 61);
@@ -241,7 +241,7 @@ fn the_program_cut_of_a_blended_arc_follows_the_spiral_not_the_start_circle() {
     if let Piece::Arc { r, r_end, .. } = &mut circle[0] {
         *r_end = *r;
     }
-    let circle_cut = cut_of(&circle, RHO, &envelope, (-1.5, 1.5), 61);
+    let circle_cut = cut_of(&circle, &Nose::circle(RHO), &envelope, (-1.5, 1.5), 61);
     assert!(circle_cut.pv > 0.5 * delta, "{}", circle_cut.pv);
 }
 
@@ -284,6 +284,70 @@ fn printed_rounds_as_the_writer_prints() {
                 "{v:e} at {resolution:e}: {got:e} vs {expected:e}"
             );
             assert!(got.to_bits() == as_printed(v, resolution).to_bits() || got.is_nan());
+        }
+    }
+}
+
+/// A measured edge: 50 nm, 5 periods over ±40°, sampled each 0.25°.
+fn wavy_edge() -> crate::machine::edge::EdgeProfile {
+    use crate::machine::edge::{EdgeProfile, Sample};
+    let samples: Vec<Sample> = (0..=320)
+        .map(|i| {
+            let a = -40.0 + 0.25 * i as f64;
+            Sample {
+                angle_deg: a,
+                deviation_um: 0.05 * (5.0 * PI * a / 40.0).sin(),
+                line: i + 1,
+                at: 0,
+            }
+        })
+        .collect();
+    EdgeProfile::from_samples(&samples).unwrap()
+}
+
+#[test]
+fn a_measured_edge_swept_along_an_arc_and_a_line_is_its_brute_force_envelope() {
+    // The lowest point of the wavy nose swept along each piece, against
+    // the lowest of the nose placed at 200,001 points along it.
+    let edge = wavy_edge();
+    let nose = Nose {
+        radius: RHO,
+        edge: Some(&edge),
+    };
+    // An arc about (0, −10), radius 10.5, from −8° to +8° (G18 angles
+    // from +Z towards +X), blended to radius 10.5003; and a sloped line.
+    let (o, r0, r1, start, sweep) = ((0.0, -10.0), 10.5, 10.5003, -0.14, 0.28);
+    let at = |t: f64| {
+        let (ang, r) = (start + sweep * t, r0 + (r1 - r0) * t);
+        (o.0 + r * ang.sin(), o.1 + r * ang.cos())
+    };
+    let arc = Piece::Arc {
+        o,
+        r: r0,
+        r_end: r1,
+        start,
+        sweep,
+        a: at(0.0),
+        b: at(1.0),
+    };
+    let line = Piece::Line {
+        a: (-1.0, 0.3),
+        b: (1.0, -0.2),
+    };
+    let line_at = |t: f64| (-1.0 + 2.0 * t, 0.3 - 0.5 * t);
+    for (piece, path) in [
+        (arc, &at as &dyn Fn(f64) -> (f64, f64)),
+        (line, &line_at as &dyn Fn(f64) -> (f64, f64)),
+    ] {
+        for x in [-1.2, -0.7, -0.2, 0.0, 0.35, 0.9] {
+            let swept = piece.bottom(&nose, x).expect("reached");
+            let brute = (0..=200_000)
+                .filter_map(|i| nose.bottom(path(i as f64 / 200_000.0), x))
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                (swept - brute).abs() < 2e-9,
+                "{piece:?} at {x}: {swept} vs {brute}"
+            );
         }
     }
 }
