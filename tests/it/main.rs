@@ -23,6 +23,7 @@ mod diagnostics;
 mod dialects;
 mod differential;
 mod docs;
+mod edge_profile;
 mod editors;
 mod examples;
 mod explain;

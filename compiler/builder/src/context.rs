@@ -218,9 +218,26 @@ pub(crate) fn program_cut(
     design: &dyn Fn(f64) -> f64,
     range: (f64, f64),
 ) -> lensc_runtime::verify::simulate::ProfileCut {
-    lensc_runtime::verify::simulate::program_cut(
+    program_cut_by(
+        head,
+        text,
+        &lensc_runtime::machine::edge::Nose::circle(rho),
+        design,
+        range,
+    )
+}
+
+/// `program_cut` by a round nose whose edge may be measured.
+pub(crate) fn program_cut_by(
+    head: &JobHead,
+    text: &str,
+    nose: &lensc_runtime::machine::edge::Nose,
+    design: &dyn Fn(f64) -> f64,
+    range: (f64, f64),
+) -> lensc_runtime::verify::simulate::ProfileCut {
+    lensc_runtime::verify::simulate::program_cut_by(
         &executed_moves(head, text, true),
-        rho,
+        nose,
         design,
         range,
         crate::plots::PROFILE_SAMPLES,

@@ -15,6 +15,7 @@ pub mod context;
 pub mod delivery;
 pub mod diagnostics;
 pub mod driver;
+pub mod edge;
 pub mod evaluate;
 pub mod height_map;
 pub mod job;

@@ -141,6 +141,17 @@ pub const COMPENSATE_CURVATURE: &str = "E0366";
 /// A job's `compensate` block: the measurement does not cover enough of
 /// the aperture for a correction of the order its smoothing length asks.
 pub const COMPENSATE_UNFITTED: &str = "E0367";
+/// A round nose's `edge_profile`: the file is not a list of angle and
+/// deviation pairs (a line of something else, too few samples, angles
+/// that do not increase).
+pub const EDGE_UNREADABLE: &str = "E0374";
+/// A round nose's `edge_profile`: its angles reach beyond the nose's arc,
+/// or do not cover the angles at which the cut meets the nose, or the
+/// cut cannot be compensated for it (a profile with corners, a `search`).
+pub const EDGE_ANGLES: &str = "E0375";
+/// A round nose's `edge_profile`: a deviation at or beyond the stated
+/// share of the nose radius (the edge is then no round nose).
+pub const EDGE_DEVIATION: &str = "E0376";
 
 /// The simulated part misses one of its job's acceptance criteria (the
 /// message names which, by how much and where); no program is written.
@@ -442,6 +453,9 @@ pub const ALL: &[&str] = &[
     MEASURE_NOT_CONVERGED,
     COMPENSATE_CURVATURE,
     COMPENSATE_UNFITTED,
+    EDGE_UNREADABLE,
+    EDGE_ANGLES,
+    EDGE_DEVIATION,
     IMPORT_UNSUPPORTED_SURFACE,
     IMPORT_PARAMETER_DROPPED,
     IMPORT_NO_SEMI_DIAMETER,

@@ -263,13 +263,9 @@ impl Piece {
             } => {
                 for side in [1.0, -1.0] {
                     see(match nose.edge {
-                        None => spiral_offset_at(
-                            o,
-                            (r, r_end),
-                            (start, sweep),
-                            side * nose.radius,
-                            x,
-                        ),
+                        None => {
+                            spiral_offset_at(o, (r, r_end), (start, sweep), side * nose.radius, x)
+                        }
                         Some(_) => edge_offset_at(o, (r, r_end), (start, sweep), side, nose, x),
                     });
                 }

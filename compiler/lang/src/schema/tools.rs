@@ -49,6 +49,12 @@ pub(super) const ROUND_NOSE: Kind = Kind {
             Check::Any,
             "height of the edge above the spindle axis as set (below: negative); profile turning corrects X for it; default 0",
         ),
+        opt(
+            "edge_profile",
+            Ty::Text,
+            Check::Any,
+            "the edge as measured: a text file of angle (deg, from the tool's axis, + towards +X) and deviation from the nose circle (um, + proud) a line, relative to the job's file; profile turning offsets the path by R + δ at the angle of contact and the simulation cuts with this edge (docs/language/edge-profile.md); default none, a perfect circle",
+        ),
         CONTROL_POINT,
     ],
     family: None,
@@ -114,7 +120,7 @@ pub(super) const SPHERICAL_WHEEL: Kind = Kind {
 
 /// A tool's checked parameters, read once (every tool kind; what a kind
 /// lacks is `None`).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct ToolParams {
     /// The tool's kind (`round_nose`, `microshaper`, `ball_end`, …).
     pub kind: &'static str,
@@ -132,6 +138,9 @@ pub struct ToolParams {
     pub centre_height: Option<f64>,
     /// `control_point: tool_tip` (true) or `tool_centre` (false), where stated.
     pub control_point: Option<crate::value::Stated<bool>>,
+    /// A round nose's measured edge: the file as written, relative to the
+    /// job's file.
+    pub edge_profile: Option<crate::value::Stated<String>>,
 }
 
 impl ToolParams {
@@ -161,6 +170,13 @@ impl ToolParams {
                     value: w.value == "tool_tip",
                     site: w.site,
                 }),
+            edge_profile: r.field("edge_profile").and_then(|f| match &f.value {
+                crate::value::Value::Str(s) => Some(crate::value::Stated {
+                    value: s.clone(),
+                    site: (f.file, f.span),
+                }),
+                _ => None,
+            }),
         };
         r.finish(o.kind.name, (o.file, o.head))?;
         Ok(t)

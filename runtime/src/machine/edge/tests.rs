@@ -97,22 +97,32 @@ fn the_lowest_point_is_on_the_edge() {
 
 #[test]
 fn the_text_format_reads_a_certificate() {
-    let text = "# edge of insert 4711\nangle_deg, deviation_um\n-60, 0.01\n0;0.02\n60\t-0.03 # end\n\n";
+    let text =
+        "# edge of insert 4711\nangle_deg, deviation_um\n-60, 0.01\n0;0.02\n60\t-0.03 # end\n\n";
     let s = parse(text).unwrap();
     assert_eq!(s.len(), 3);
-    assert_eq!((s[1].angle_deg, s[1].deviation_um, s[1].line), (0.0, 0.02, 4));
+    assert_eq!(
+        (s[1].angle_deg, s[1].deviation_um, s[1].line),
+        (0.0, 0.02, 4)
+    );
     assert_eq!(s[2].deviation_um, -0.03);
 }
 
 #[test]
 fn bad_text_is_refused_with_its_line() {
     let e = parse("-60 0.01\n0 x\n").unwrap_err();
-    assert!(matches!(e, EdgeError::Malformed { line: 2, at: 9, .. }), "{e:?}");
+    assert!(
+        matches!(e, EdgeError::Malformed { line: 2, at: 9, .. }),
+        "{e:?}"
+    );
     let e = parse("-60 0.01 3\n").unwrap_err();
     assert!(matches!(e, EdgeError::Malformed { line: 1, .. }));
     let s = parse("-60 0\n10 0\n5 0\n").unwrap();
     let e = EdgeProfile::from_samples(&s).unwrap_err();
-    assert!(matches!(e, EdgeError::NotIncreasing { line: 3, .. }), "{e:?}");
+    assert!(
+        matches!(e, EdgeError::NotIncreasing { line: 3, .. }),
+        "{e:?}"
+    );
     let s = parse("-60 0\n10 0\n").unwrap();
     assert_eq!(
         EdgeProfile::from_samples(&s).unwrap_err(),

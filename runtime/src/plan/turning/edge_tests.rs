@@ -107,7 +107,9 @@ fn a_wavy_edge_misses_the_form_unless_compensated() {
     let uncompensated = cut_pv(&job(None), Some(&edge));
     // The path offset by R + δ at each angle of contact.
     let compensated = cut_pv(&job(Some(edge.clone())), Some(&edge));
-    eprintln!("PV nm: circle {circle:.2}, uncompensated {uncompensated:.2}, compensated {compensated:.2}");
+    eprintln!(
+        "PV nm: circle {circle:.2}, uncompensated {uncompensated:.2}, compensated {compensated:.2}"
+    );
     assert!(circle < 3.0, "{circle}");
     assert!(uncompensated > 80.0, "{uncompensated}");
     assert!(compensated < 5.0, "{compensated}");

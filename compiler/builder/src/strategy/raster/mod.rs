@@ -78,7 +78,7 @@ pub(crate) fn lower(
 ) -> Result<RasterSpec, Vec<Diagnostic>> {
     p.needs_kinds("raster", &["mill_3axis"], &["microshaper", "ball_end"])?;
     let st = RasterParams::read(p.strategy).map_err(|d| vec![d])?;
-    let t = p.tool_params;
+    let t = &p.tool_params;
     let mut raster = Raster {
         along: if st.along_y { Axis::Y } else { Axis::X },
         zigzag: st.zigzag,

@@ -96,7 +96,7 @@ pub(crate) fn lower(
 ) -> Result<RollerSpec, Vec<Diagnostic>> {
     let roller_radius = roller_radius(p)?;
     let st = RollerHelixParams::read(p.strategy).map_err(|d| vec![d])?;
-    let t = p.tool_params;
+    let t = &p.tool_params;
     let lowered = p.lowered().map_err(|d| vec![d])?;
     let Domain::Rect {
         x: design_x,

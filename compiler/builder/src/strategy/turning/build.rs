@@ -63,7 +63,8 @@ pub(super) fn build(spec: &TurningSpec, cx: &BuildContext) -> Result<Built, Vec<
                 .start_radius
                 .unwrap_or(job.surface.aperture_radius),
         );
-        let cut = crate::context::program_cut(head, &text, job.tool.nose_radius, &design, range);
+        // The real tool: its measured edge when it names one.
+        let cut = crate::context::program_cut_by(head, &text, &job.tool.nose(), &design, range);
         plots.profile = Some(profile_series(
             &cut,
             &design,
@@ -79,7 +80,8 @@ pub(super) fn build(spec: &TurningSpec, cx: &BuildContext) -> Result<Built, Vec<
             height_map: None,
         })
     };
-    let toolpath = report::ProfileTurning::new(job, &path, &optimised);
+    let mut toolpath = report::ProfileTurning::new(job, &path, &optimised);
+    toolpath.edge_profile = spec.edge.clone();
     let mut built = crate::context::built(
         head,
         prov,

@@ -11,6 +11,11 @@ pub(crate) fn error(e: PlanError, site: (FileId, Span)) -> Diagnostic {
     coded_error(e).at(site)
 }
 
+/// An angle (rad) in degrees as written.
+fn deg(a: f64) -> String {
+    trim_num((a.to_degrees() * 1e3).round() / 1e3)
+}
+
 fn coded_error(e: PlanError) -> Coded {
     match e {
         PlanError::NoseTooLarge { nose_radius, min_radius, at_radius } => coded(
@@ -51,6 +56,29 @@ fn coded_error(e: PlanError) -> Coded {
             ),
         )
         .help(format!("lower `spindle_speed` to at most {} rpm (with `surface_speed`, cap it with `spindle_cap`)", rpm(max))),
+        PlanError::EdgeNotCovering { needed, measured, at_radius } => coded(
+            codes::EDGE_ANGLES,
+            format!(
+                "the cut meets the nose at {}° .. {}° from its axis (the far end at r = {} mm), but the tool's edge profile covers only {}° .. {}°: the path cannot be compensated beyond the measured edge",
+                deg(needed.0),
+                deg(needed.1),
+                trim_num(at_radius),
+                deg(measured.0),
+                deg(measured.1)
+            ),
+        )
+        .help("measure the edge over the angles the cut uses (the surface's slope at each radius is the angle of contact), or cut a smaller `from`"),
+        PlanError::EdgeNotCompensated { corner_at } => coded(
+            codes::EDGE_ANGLES,
+            match corner_at {
+                Some(r) => format!(
+                    "the profile has a corner at r = {} mm: a measured edge is compensated only along a smooth profile, where one angle of the edge touches it",
+                    trim_num(r)
+                ),
+                None => "a measured edge is compensated only with the exact tool location, not with Lei's `search`".to_string(),
+            },
+        )
+        .help("leave the tool's `edge_profile` out for this job (the nose is then a circle), or cut with `search` left out"),
         PlanError::Undefined { at_radius } => coded(
             codes::UNDEFINED_ON_PATH,
             format!(

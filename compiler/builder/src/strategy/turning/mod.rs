@@ -31,6 +31,8 @@ pub struct TurningSpec {
     pub head: JobHead,
     /// What the planner and the post-processor read.
     pub job: TurningJob,
+    /// The tool's measured edge, when it names one, for the report.
+    pub edge: Option<crate::edge::EdgeReport>,
 }
 
 impl crate::strategy::Strategy for TurningSpec {
@@ -69,7 +71,14 @@ pub(crate) fn lower(
     dialect: Dialect,
     evaluate: Evaluate,
 ) -> Result<TurningSpec, Vec<Diagnostic>> {
-    let job = turning_job(p, dialect.clone())?;
+    let mut job = turning_job(p, dialect.clone())?;
+    let edge = match crate::edge::measured_edge(p).map_err(|d| vec![d])? {
+        Some((measured, report)) => {
+            job.tool.edge = Some(measured);
+            Some(report)
+        }
+        None => None,
+    };
     let lowered = p.lowered().map_err(|d| vec![d])?;
     // The checks the planner would make first, on the section it follows.
     let kernel = evaluate(&lowered.tape);
@@ -83,7 +92,6 @@ pub(crate) fn lower(
         return Err(vec![e]);
     }
     let head = p.head(dialect, lowered);
-    let mut job = job;
     if let Some(c) = &head.surface.compensation {
         // The runtime writes the header: the surface's line says it.
         job.surface.description = format!(
@@ -92,7 +100,7 @@ pub(crate) fn lower(
             crate::compensate::header_words(c)
         );
     }
-    Ok(TurningSpec { head, job })
+    Ok(TurningSpec { head, job, edge })
 }
 
 /// The runtime's description of the job, or why it cannot be turned.
@@ -249,6 +257,8 @@ fn round_nose(p: &Parts) -> Result<RoundNoseTool, Vec<Diagnostic>> {
         clearance_angle: p.tool_needs(t.clearance, "clearance")?,
         centre_height: t.centre_height.unwrap_or(0.0),
         rake_angle: t.rake.unwrap_or(0.0),
+        // Read, with its checks, by `lower` (`crate::edge`).
+        edge: None,
     })
 }
 

@@ -48,6 +48,10 @@ pub struct ProfileTurning {
     /// `on_path`, `straddle` or `clear` (the strategy's `chords`, or the
     /// default the job's `max_gouge` chose).
     pub chords: String,
+    /// The tool's measured edge the path was offset for (R + δ at each
+    /// angle of contact), absent for a circular nose.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub edge_profile: Option<crate::edge::EdgeReport>,
 }
 
 impl ProfileTurning {
@@ -98,6 +102,7 @@ impl ProfileTurning {
                 .collect(),
             optimisation: optimised.into(),
             chords: job.strategy.chords.word().to_string(),
+            edge_profile: None,
         }
     }
 }

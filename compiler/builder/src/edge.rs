@@ -1,0 +1,204 @@
+//! A round nose's `edge_profile`: the measured edge read as a job's files
+//! are read (relative to the job's file, beneath the project root, a
+//! regular file of at most `sandbox::MAX_FILE_BYTES`), parsed
+//! (`lensc_runtime::machine::edge`), checked against the nose (its samples
+//! within the nose's arc, no deviation at or beyond
+//! `MAX_DEVIATION_SHARE` of the radius), and named by its MD5 for the
+//! program header and the report. Every refusal is a coded diagnostic at
+//! the tool's `edge_profile`, naming the file.
+
+use std::path::Path;
+
+use lensc_grammar::Diagnostic;
+use lensc_lang::check::trim_num;
+use lensc_lang::codes;
+use lensc_lang::sandbox;
+use lensc_lang::value::Stated;
+use lensc_runtime::machine::edge::{EdgeError, EdgeProfile};
+use lensc_runtime::machine::tool::MeasuredEdge;
+use schemars::JsonSchema;
+use serde::Serialize;
+
+use crate::job::Parts;
+
+/// The largest deviation from the nose circle, as a share of its radius,
+/// an edge profile may state: beyond it the edge is no round nose (a
+/// chip, a file in the wrong unit), and its offset no longer the circle's
+/// plus a small correction.
+pub const MAX_DEVIATION_SHARE: f64 = 0.01;
+
+/// The edge profile a job's tool was compensated for, in the report.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct EdgeReport {
+    /// The file, as the tool names it.
+    pub file: String,
+    /// MD5 of the file's bytes, lowercase hex: which measurement this is.
+    pub md5: String,
+    /// Samples, and the angles (deg) they cover.
+    pub samples: usize,
+    pub from_deg: f64,
+    pub to_deg: f64,
+    /// The largest |deviation| from the nose circle (nm) and its angle (deg).
+    pub largest_deviation_nm: f64,
+    pub largest_at_deg: f64,
+}
+
+/// The tool's measured edge, if it names one, with its report; or the
+/// coded refusal.
+pub(crate) fn measured_edge(p: &Parts) -> Result<Option<(MeasuredEdge, EdgeReport)>, Diagnostic> {
+    let Some(named) = &p.tool_params.edge_profile else {
+        return Ok(None);
+    };
+    let radius = p.tool_params.nose_radius.unwrap_or(f64::NAN);
+    let file = named.value.as_str();
+    let at = |code: &'static str, message: String, help: &str| {
+        Diagnostic::error(code, message, named.site.0, named.site.1)
+            .with_label("the edge profile this tool names")
+            .with_help(help.to_string())
+    };
+    let bytes = read(p, named)?;
+    let text = std::str::from_utf8(&bytes).map_err(|e| {
+        at(
+            codes::EDGE_UNREADABLE,
+            format!("{file}: not text (byte {} is not UTF-8)", e.valid_up_to()),
+            FORMAT_HELP,
+        )
+    })?;
+    let profile = lensc_runtime::machine::edge::parse(text)
+        .and_then(|s| EdgeProfile::from_samples(&s))
+        .map_err(|e| {
+            let help = match e {
+                EdgeError::NotIncreasing { .. } => {
+                    "sort the samples by angle, each angle once (the tool's axis is 0°, + towards +X)"
+                }
+                _ => FORMAT_HELP,
+            };
+            at(codes::EDGE_UNREADABLE, format!("{file}: {e}"), help)
+        })?;
+    // The nose's arc: ± half its included angle about the tool's axis,
+    // ±90° (a half circle) when the tool states none.
+    let half = p
+        .tool_params
+        .included_angle
+        .map_or(std::f64::consts::FRAC_PI_2, |a| 0.5 * a);
+    let (lo, hi) = profile.range();
+    if lo < -half - 1e-12 || hi > half + 1e-12 {
+        return Err(at(
+            codes::EDGE_ANGLES,
+            format!(
+                "{file}: the samples run from {}° to {}°, beyond the nose's arc of ±{}° about its axis",
+                deg(lo),
+                deg(hi),
+                deg(half)
+            ),
+            "angles are measured from the tool's axis (0° at the nose's lowest point, + towards +X); the nose's arc is ± half the tool's `included_angle` (±90° when it states none)",
+        ));
+    }
+    let (largest, largest_at) = profile.largest();
+    if largest >= MAX_DEVIATION_SHARE * radius {
+        return Err(at(
+            codes::EDGE_DEVIATION,
+            format!(
+                "{file}: the edge departs {} um from the nose circle at {}°, {}% of the {} mm nose radius: at most {}% is a round nose's waviness",
+                trim_num((largest * 1e3 * 1e4).round() / 1e4),
+                deg(largest_at),
+                trim_num((largest / radius * 1e4).round() / 1e2),
+                trim_num(radius),
+                trim_num(MAX_DEVIATION_SHARE * 100.0)
+            ),
+            "the deviations are in micrometres (a file in nanometres reads 1000 times too large); an edge chipped this much needs relapping, not compensation",
+        ));
+    }
+    let md5 = lensc_measure::md5_hex(&bytes);
+    let report = EdgeReport {
+        file: file.to_owned(),
+        md5: md5.clone(),
+        samples: profile.len(),
+        from_deg: lo.to_degrees(),
+        to_deg: hi.to_degrees(),
+        largest_deviation_nm: largest * 1e6,
+        largest_at_deg: largest_at.to_degrees(),
+    };
+    Ok(Some((
+        MeasuredEdge {
+            profile,
+            source: format!("{file} md5 {md5}"),
+        },
+        report,
+    )))
+}
+
+/// E0375 for a job whose strategy does not compensate a measured edge
+/// but whose tool names one: refused rather than cut as if the edge were
+/// a circle.
+pub(crate) fn not_compensated(p: &Parts, strategy: &str) -> Option<Diagnostic> {
+    let named = p.tool_params.edge_profile.as_ref()?;
+    Some(
+        Diagnostic::error(
+            codes::EDGE_ANGLES,
+            format!("`{strategy}` does not compensate a measured edge, and this tool names one"),
+            named.site.0,
+            named.site.1,
+        )
+        .with_label("the edge profile this tool names")
+        .with_help(
+            "only `profile_turning` offsets its path by the edge's deviation at the angle of contact; leave `edge_profile` out of a tool for other strategies (the nose is then taken as a circle)",
+        ),
+    )
+}
+
+const FORMAT_HELP: &str = "an edge profile is text, one sample a line: the angle in degrees, then the deviation from the nose circle in micrometres (`-30.0, 0.012`); `#` starts a comment; a first line of column names is skipped";
+
+/// An angle (rad) in degrees, to a thousandth.
+fn deg(a: f64) -> String {
+    trim_num((a.to_degrees() * 1e3).round() / 1e3)
+}
+
+/// The file's bytes, read as the loader reads a `use`d file: relative to
+/// the job's file, beneath the project root, a regular file, at most
+/// `sandbox::MAX_FILE_BYTES`.
+fn read(p: &Parts, m: &Stated<String>) -> Result<Vec<u8>, Diagnostic> {
+    let job = p.job;
+    let base = job
+        .path
+        .as_deref()
+        .and_then(Path::parent)
+        .unwrap_or(Path::new(""));
+    let full = base.join(&m.value);
+    let resolved = sandbox::resolve(&full);
+    let root = job
+        .root
+        .as_ref()
+        .map(|r| r.path().to_path_buf())
+        .unwrap_or_else(|| sandbox::resolve(Path::new(".")));
+    let e = if !sandbox::inside(&resolved, &root) {
+        sandbox::ReadError::OutsideRoot {
+            resolved: resolved.clone(),
+            root,
+        }
+    } else {
+        let read = match &job.root {
+            Some(r) => r.read(&resolved, sandbox::MAX_FILE_BYTES),
+            None => sandbox::read_regular(&resolved, sandbox::MAX_FILE_BYTES),
+        };
+        match read {
+            Ok(b) => return Ok(b),
+            Err(e) => e,
+        }
+    };
+    Err(Diagnostic::error(
+        e.code(),
+        format!("cannot read the edge profile `{}`: {e}", full.display()),
+        m.site.0,
+        m.site.1,
+    )
+    .with_label("named here")
+    .with_help(match e {
+        sandbox::ReadError::OutsideRoot { .. } => {
+            "a job reads only files under its project root (the directory of the file given on the command line unless `--root DIR`)"
+        }
+        sandbox::ReadError::TooLarge { .. } => "files of at most 16 MiB are read",
+        _ => "the path is relative to the job's file",
+    }))
+}

@@ -1,0 +1,207 @@
+//! A round nose's measured edge (`edge_profile`), through the `lensc`
+//! binary: a turned conic cut by a tool whose edge carries a 50 nm
+//! waviness. Each program is read back from its text by the controller
+//! reader and swept with the real, wavy edge (`program_cut_by`): the
+//! program planned for a circle prints the waviness into the part, the
+//! program planned for the measured edge does not. The header and the
+//! report name the profile by its MD5; every bad profile is a coded
+//! error at the tool's `edge_profile`, exit 1, nothing written.
+
+use std::f64::consts::PI;
+use std::path::Path;
+
+use lensc_build::driver;
+use lensc_lang::loader::RealFs;
+use lensc_runtime::machine::edge::{EdgeProfile, Nose};
+use lensc_runtime::reader::{self, MachineLimits};
+
+use crate::common::{lensc, text};
+
+/// The README's condenser front (slopes to 14.5° at its 3 mm rim),
+/// turned with a 0.5 mm nose whose tool line is `TOOL`.
+const FRONT: &str = "use std::machines::ultra_precision_lathe
+
+surface front = conic {
+    radius: 12 mm
+    conic: -0.6
+    sense: convex
+    aperture: circle(diameter: 6 mm)
+}
+
+tool diamond = round_nose { nose_radius: 0.5 mm, clearance: 10°TOOL }
+
+strategy finish = profile_turning { feed: 2 um/rev, spindle_speed: 1500 rpm, chord_tolerance: 4 nm }
+
+job front_surface {
+    surface: front
+    tool: diamond
+    machine: ultra_precision_lathe
+    strategy: finish
+    accept: none
+}
+";
+
+/// A certificate's edge: 50 nm, 4 periods over ±45°, every 0.5°.
+fn wavy_text() -> String {
+    let mut t = String::from("# 0.5 mm nose, waviness\nangle_deg, deviation_um\n");
+    for i in 0..=180 {
+        let a = -45.0 + 0.5 * i as f64;
+        t.push_str(&format!(
+            "{a:.1}, {:.6}\n",
+            0.05 * (4.0 * PI * a / 45.0).sin()
+        ));
+    }
+    t
+}
+
+/// A project with FRONT, its tool given `tool` and the files given.
+fn project(tool: &str, files: &[(&str, &str)]) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().expect("tmp");
+    std::fs::write(dir.path().join("job.lens"), FRONT.replace("TOOL", tool)).expect("write");
+    for (name, body) in files {
+        std::fs::write(dir.path().join(name), body).expect("write");
+    }
+    dir
+}
+
+/// Builds the project; its program's text and its report.
+fn build(dir: &Path) -> (String, serde_json::Value) {
+    let out = lensc(dir, &["build", "job.lens"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let program = std::fs::read_to_string(dir.join("out/front_surface.ngc")).expect("program");
+    let report = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("out/front_surface.report.json")).expect("report"),
+    )
+    .expect("json");
+    (program, report)
+}
+
+/// PV (nm) of the part `program` cuts, read back from its text and swept
+/// with `nose`, against the conic.
+fn cut_pv(dir: &Path, program: &str, nose: &Nose) -> f64 {
+    let c = driver::check_path(&RealFs, &dir.join("job.lens")).expect("checks");
+    let (spec, _) = lensc_build::pipeline::lower(&c.checked.jobs[0], None, &Default::default())
+        .expect("lowers");
+    let machine = MachineLimits {
+        lathe: true,
+        travel: [None; 4],
+        max_feed: None,
+        max_spindle_rpm: None,
+    };
+    let mut moves = reader::read_moves(program, &spec.head().dialect, &machine).1;
+    let offset = reader::header_control_offset(program).expect("control point");
+    reader::to_tool_centre(&mut moves, offset);
+    // The conic: c = 1/12, k = −0.6, convex (material below).
+    let design = |r: f64| {
+        let c = 1.0 / 12.0;
+        -c * r * r / (1.0 + (1.0 - 0.4 * c * c * r * r).sqrt())
+    };
+    let cut =
+        lensc_runtime::verify::simulate::program_cut_by(&moves, nose, &design, (0.0, 2.99), 2000);
+    assert_eq!(cut.uncut_area, 0.0);
+    cut.pv * 1e6
+}
+
+#[test]
+fn a_measured_edge_is_compensated_through_the_written_program() {
+    let edge_text = wavy_text();
+    let samples = lensc_runtime::machine::edge::parse(&edge_text).unwrap();
+    let edge = EdgeProfile::from_samples(&samples).unwrap();
+    let wavy = Nose {
+        radius: 0.5,
+        edge: Some(&edge),
+    };
+    // The tool as a circle: the program prints the edge into the part.
+    let plain = project("", &[]);
+    let (program, _) = build(plain.path());
+    let circle = cut_pv(plain.path(), &program, &Nose::circle(0.5));
+    let uncompensated = cut_pv(plain.path(), &program, &wavy);
+    // The tool naming its measured edge.
+    let named = project(
+        ", edge_profile: \"edge.txt\"",
+        &[("edge.txt", edge_text.as_str())],
+    );
+    let (program, report) = build(named.path());
+    let compensated = cut_pv(named.path(), &program, &wavy);
+    eprintln!(
+        "PV nm: circle {circle:.2}, wavy edge uncompensated {uncompensated:.2}, compensated {compensated:.2}"
+    );
+    assert!(circle < 5.0, "{circle}");
+    assert!(uncompensated > 60.0, "{uncompensated}");
+    assert!(compensated < 5.0, "{compensated}");
+    // The build's own simulation sweeps the measured edge.
+    let simulated = report["simulation"]["form_error_pv_nm"].as_f64().unwrap();
+    assert!(
+        (simulated - compensated).abs() < 1.0,
+        "{simulated} vs {compensated}"
+    );
+    // Which profile: its MD5 in the header's tool line and the report.
+    let md5 = lensc_measure::md5_hex(edge_text.as_bytes());
+    let tool_line = program
+        .lines()
+        .find(|l| l.contains("tool diamond:"))
+        .expect("tool line");
+    assert!(
+        tool_line.contains(&format!("edge profile edge.txt md5 {md5}")),
+        "{tool_line}"
+    );
+    let e = &report["toolpath"]["edge_profile"];
+    assert_eq!(e["md5"], md5.as_str());
+    assert_eq!(e["samples"], 181);
+    assert_eq!(
+        (e["from_deg"].as_f64(), e["to_deg"].as_f64()),
+        (Some(-45.0), Some(45.0))
+    );
+    assert!((e["largest_deviation_nm"].as_f64().unwrap() - 50.0).abs() < 1e-6);
+}
+
+/// Builds FRONT with `tool` and the files; asserts exit 1, `code`, the
+/// tool's `edge_profile` shown, nothing written; returns stderr.
+fn refused(tool: &str, files: &[(&str, &str)], code: &str) -> String {
+    let dir = project(tool, files);
+    let out = lensc(dir.path(), &["build", "job.lens"]);
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains(&format!("[{code}]")), "{code}: {err}");
+    assert!(
+        err.contains("edge_profile: \""),
+        "the field is shown: {err}"
+    );
+    let written = std::fs::read_dir(dir.path().join("out")).map_or(0, |d| d.count());
+    assert_eq!(written, 0, "nothing is written: {err}");
+    err
+}
+
+#[test]
+fn bad_edge_profiles_are_coded_errors_at_the_tool() {
+    let named = ", edge_profile: \"edge.txt\"";
+    // No such file; a file outside the project.
+    refused(named, &[], "E0103");
+    refused(", edge_profile: \"../edge.txt\"", &[], "E0107");
+    // A third column; a word; too few samples; angles going back.
+    let err = refused(
+        named,
+        &[("edge.txt", "-20 0.01\n0 0.02 7\n20 0\n")],
+        "E0374",
+    );
+    assert!(err.contains("edge.txt: line 2"), "{err}");
+    refused(named, &[("edge.txt", "-20 0.01\n0 zero\n20 0\n")], "E0374");
+    refused(named, &[("edge.txt", "-20 0.01\n20 0\n")], "E0374");
+    let err = refused(named, &[("edge.txt", "-20 0\n10 0\n5 0\n20 0\n")], "E0374");
+    assert!(err.contains("line 3"), "{err}");
+    // Beyond the nose's arc: ±45° on a tool of 60° included angle.
+    let wavy = wavy_text();
+    let err = refused(
+        ", included_angle: 60°, edge_profile: \"edge.txt\"",
+        &[("edge.txt", wavy.as_str())],
+        "E0375",
+    );
+    assert!(err.contains("±30°"), "{err}");
+    // Measured over ±5°: the rim meets the nose at −14.5°.
+    let err = refused(named, &[("edge.txt", "-5 0\n0 0.01\n5 0\n")], "E0375");
+    assert!(err.contains("covers only -5° .. 5°"), "{err}");
+    // Nanometres written where micrometres are read: 50 µm on a 0.5 mm
+    // nose is 10 % of it.
+    let err = refused(named, &[("edge.txt", "-45 0\n0 50\n45 0\n")], "E0376");
+    assert!(err.contains("50 um"), "{err}");
+}
