@@ -193,7 +193,7 @@ pub enum PlanError {
     },
     /// A measured edge is compensated only on the exact offset of a
     /// smooth profile: not on a profile with corners (at this radius) nor
-    /// with Lei's searches (`at_radius` None).
+    /// with Lei's searches (`corner_at` None).
     EdgeNotCompensated { corner_at: Option<f64> },
 }
 

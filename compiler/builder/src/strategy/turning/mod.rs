@@ -83,9 +83,21 @@ pub(crate) fn lower(
     // The checks the planner would make first, on the section it follows.
     let kernel = evaluate(&lowered.tape);
     if let Err(errs) = check_profile_turning(&job, &SectionAlongX(kernel.as_ref())) {
+        // The edge's errors at the tool's `edge_profile`, the rest at the job.
+        let edge_site = p.tool_params.edge_profile.as_ref().map(|e| e.site);
         return Err(errs
             .into_iter()
-            .map(|e| errors::error(e, p.site()))
+            .map(|e| {
+                let site = match (&e, edge_site) {
+                    (
+                        lensc_runtime::plan::turning::PlanError::EdgeNotCovering { .. }
+                        | lensc_runtime::plan::turning::PlanError::EdgeNotCompensated { .. },
+                        Some(s),
+                    ) => s,
+                    _ => p.site(),
+                };
+                errors::error(e, site)
+            })
             .collect());
     }
     if let Some(e) = nose_out_of_reach(p, &job, &SectionAlongX(kernel.as_ref())) {
