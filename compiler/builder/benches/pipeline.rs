@@ -204,6 +204,7 @@ fn simulate_roller(spec: &JobSpec, passes: &[Vec<[f64; 3]>]) -> usize {
         roller_radius: helix.roller_radius,
         y_start: helix.y_start,
         domain: lowered.domain,
+        lenslets: None,
     };
     let map = sweep.finish(&frame, &window, window.spacing);
     std::hint::black_box(&map);

@@ -14,6 +14,7 @@ use lensc_runtime::surface::ir::SurfaceFn;
 use lensc_runtime::verify::heightmap::{
     Cutter, ErrorRaster, Frame, Grid, HeightMap, NosePath, RasterLayout,
 };
+use lensc_runtime::verify::lenslets::Lenslets;
 use lensc_runtime::verify::tiles::{Recorder, simulate};
 use lensc_runtime::verify::window::Tile;
 use std::f64::consts::TAU;
@@ -141,6 +142,8 @@ pub struct RasterFrame<'a> {
     pub along_x: bool,
     pub window: Window,
     pub domain: Domain,
+    /// An array's lenslets, each reported on its own.
+    pub lenslets: Option<&'a Lenslets>,
 }
 
 impl Frame for RasterFrame<'_> {
@@ -152,6 +155,9 @@ impl Frame for RasterFrame<'_> {
     }
     fn inside(&self, x: f64, y: f64) -> bool {
         self.window.contains(x, y) && self.domain.contains(x, y)
+    }
+    fn lenslets(&self) -> Option<&Lenslets> {
+        self.lenslets
     }
 }
 
@@ -185,6 +191,9 @@ pub struct LatheFrame<'a> {
     /// The array's lenslets (centre x, y, radius), in the array's order
     /// (their indices are the lenslets' in the report).
     pub features: Vec<(f64, f64, f64)>,
+    /// An array's lenslets, each reported on its own, where they are not
+    /// discs (`features`): rectangular lenslets, rings.
+    pub lenslets: Option<&'a Lenslets>,
 }
 
 impl<'a> LatheFrame<'a> {
@@ -194,6 +203,7 @@ impl<'a> LatheFrame<'a> {
         domain: Domain,
         reach: f64,
         features: &[(f64, f64, f64)],
+        lenslets: Option<&'a Lenslets>,
     ) -> LatheFrame<'a> {
         LatheFrame {
             kernel,
@@ -201,6 +211,7 @@ impl<'a> LatheFrame<'a> {
             domain,
             reach,
             features: features.to_vec(),
+            lenslets,
         }
     }
 }
@@ -226,6 +237,9 @@ impl Frame for LatheFrame<'_> {
     fn features(&self) -> &[(f64, f64, f64)] {
         &self.features
     }
+    fn lenslets(&self) -> Option<&Lenslets> {
+        self.lenslets
+    }
 }
 
 /// A helix on a roller: s the spindle angle, u the axial position (design
@@ -237,6 +251,8 @@ pub struct RollerFrame<'a> {
     /// Design y under spindle angle 0 (`RollerHelix::y_start`).
     pub y_start: f64,
     pub domain: Domain,
+    /// A wrapped array's lenslets (design x, y), each reported on its own.
+    pub lenslets: Option<&'a Lenslets>,
 }
 
 impl Frame for RollerFrame<'_> {
@@ -251,6 +267,9 @@ impl Frame for RollerFrame<'_> {
     }
     fn inside(&self, x: f64, y: f64) -> bool {
         self.window.contains(x, y) && self.domain.contains(x, y)
+    }
+    fn lenslets(&self) -> Option<&Lenslets> {
+        self.lenslets
     }
 }
 

@@ -237,6 +237,10 @@ pub struct SurfaceSpec {
     /// measured against) and the iteration for the report.
     pub design: Option<LoweredSurface>,
     pub compensation: Option<crate::compensate::Compensation>,
+    /// An array's lenslets (also an array wrapped on a roller, in the
+    /// design's coordinates), each judged on its own; none for other
+    /// surfaces.
+    pub lenslets: Option<lensc_runtime::verify::lenslets::Lenslets>,
 }
 
 impl SurfaceSpec {
@@ -553,6 +557,11 @@ impl<'a> Parts<'a> {
                     lowered,
                     design,
                     compensation,
+                    lenslets: lensc_lang::lower::surface::array_cells(self.surface).and_then(
+                        |(centres, aperture)| {
+                            lensc_runtime::verify::lenslets::Lenslets::new(centres, aperture)
+                        },
+                    ),
                 }
             },
             dialect,

@@ -152,6 +152,9 @@ pub const EDGE_ANGLES: &str = "E0375";
 /// A round nose's `edge_profile`: a deviation at or beyond the stated
 /// share of the nose radius (the edge is then no round nose).
 pub const EDGE_DEVIATION: &str = "E0376";
+/// `lensc measure --per-lenslet`: the job's surface is not an array of
+/// lenslets, or the measurement is not a map.
+pub const PER_LENSLET_UNAVAILABLE: &str = "E0368";
 
 /// The simulated part misses one of its job's acceptance criteria (the
 /// message names which, by how much and where); no program is written.
@@ -193,6 +196,10 @@ pub const SPLIT_READS_DIFFERENTLY: &str = "E0383";
 /// A program consuming more bytes per second while it cuts than the
 /// machine's link delivers: the control would starve and stop on the part.
 pub const LINK_TOO_SLOW: &str = "W0050";
+/// `lensc measure --per-lenslet`: a lenslet the map reaches but that
+/// cannot be registered (too few valid points under the mask, or a
+/// registration that does not settle); the others are measured.
+pub const LENSLET_NOT_REGISTERED: &str = "W0036";
 /// E0195 under `lensc build --accept=warn`: the program is written.
 pub const ACCEPTANCE_MISSED_WARNING: &str = "W0020";
 /// E0196 under `lensc build --accept=warn`: the program is written.
@@ -456,6 +463,8 @@ pub const ALL: &[&str] = &[
     EDGE_UNREADABLE,
     EDGE_ANGLES,
     EDGE_DEVIATION,
+    PER_LENSLET_UNAVAILABLE,
+    LENSLET_NOT_REGISTERED,
     IMPORT_UNSUPPORTED_SURFACE,
     IMPORT_PARAMETER_DROPPED,
     IMPORT_NO_SEMI_DIAMETER,

@@ -269,6 +269,13 @@ pub enum Command {
         /// on its middle.
         #[arg(long)]
         keep_origin: bool,
+        /// Also register each lenslet of the job's array on its own (a
+        /// map of an array): each lenslet's piston, tilt and decentre,
+        /// its error PV and RMS and its texture, in the report's
+        /// `lenslets`; a lenslet the mask leaves too little of is a
+        /// finding (W0036), not an error.
+        #[arg(long)]
+        per_lenslet: bool,
     },
     /// Explain a diagnostic code (`E0147`), with an example that causes it
     /// and its fix.

@@ -93,6 +93,7 @@ fn run(cli: Cli) -> u8 {
             min_valid,
             cutoff,
             keep_origin,
+            per_lenslet,
         } => commands::measure::run(
             &out,
             (&file, &part),
@@ -104,6 +105,7 @@ fn run(cli: Cli) -> u8 {
                 cutoff,
                 keep_origin,
                 from_job: false,
+                per_lenslet,
             },
         ),
 

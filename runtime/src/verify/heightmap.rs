@@ -90,6 +90,13 @@ pub trait Frame: Sync {
     fn features(&self) -> &[(f64, f64, f64)] {
         &[]
     }
+    /// An array's lenslets, each reported on its own, where there are no
+    /// `features`: the totals count every cell of the window as before,
+    /// and each cell in a lenslet's aperture (the nearest such lenslet,
+    /// see [`super::lenslets`]) counts for that lenslet too.
+    fn lenslets(&self) -> Option<&super::lenslets::Lenslets> {
+        None
+    }
     /// The part's area (mm²) of the grid cell at (s, u): the parallelogram
     /// its two steps span on the part.
     fn cell_area(&self, g: &Grid, s: f64, u: f64) -> f64 {
@@ -248,7 +255,7 @@ impl Sweep {
         for c in &columns {
             errors.extend_from_slice(&c.errors);
         }
-        HeightMap::of(g, r, totals, frame.features(), errors)
+        HeightMap::of(g, r, totals, frame, errors)
     }
 
     /// The envelope in every column against the design, as one tile of a
@@ -944,11 +951,13 @@ impl Totals {
         feature: &dyn Fn(usize) -> usize,
     ) -> Totals {
         let features = frame.features();
-        let which = |x: f64, y: f64| {
-            features
+        let lenslets = frame.lenslets().filter(|_| features.is_empty());
+        let which = |x: f64, y: f64| match lenslets {
+            Some(l) => l.which(x, y),
+            None => features
                 .iter()
                 .position(|&disc| in_disc(disc, x, y))
-                .map(feature)
+                .map(feature),
         };
         let mut t = Totals::default();
         for (j, c) in columns.iter().enumerate() {
@@ -1031,14 +1040,14 @@ impl Totals {
 }
 
 impl HeightMap {
-    /// The map of `totals` on `g` (its `features` the whole map's).
-    pub(crate) fn of(
-        g: Grid,
-        r: f64,
-        t: Totals,
-        features: &[(f64, f64, f64)],
-        errors: Vec<f64>,
-    ) -> HeightMap {
+    /// The map of `totals` on `g` (its features, or its lenslets, those
+    /// of the whole map's `frame`).
+    pub(crate) fn of(g: Grid, r: f64, t: Totals, frame: &dyn Frame, errors: Vec<f64>) -> HeightMap {
+        let centre = |k: usize| match (frame.features().get(k), frame.lenslets()) {
+            (Some(&(x, y, _)), _) => (x, y),
+            (None, Some(l)) if k < l.len() => l.centre(k),
+            _ => (f64::NAN, f64::NAN),
+        };
         let per_line = |rq: (f64, usize)| {
             if rq.1 == 0 {
                 f64::NAN
@@ -1064,7 +1073,7 @@ impl HeightMap {
                 .filter(|(_, f)| f.surface.count > 0)
                 .map(|(&k, f)| FeatureFigures {
                     index: k,
-                    centre: (features[k].0, features[k].1),
+                    centre: centre(k),
                     surface: f.surface.figures(),
                     contact: f.contact.figures(),
                     scallops: f.cusps.scallops(),

@@ -4,6 +4,7 @@
 pub mod figures;
 pub mod follow;
 pub mod heightmap;
+pub mod lenslets;
 pub mod simulate;
 pub mod tiles;
 pub mod window;

@@ -239,6 +239,9 @@ impl Frame for TileFrame<'_> {
             None => self.base.features(),
         }
     }
+    fn lenslets(&self) -> Option<&super::lenslets::Lenslets> {
+        self.base.lenslets()
+    }
 }
 
 /// What a simulation in tiles leaves: the figures of the whole, and its
@@ -301,7 +304,7 @@ pub fn simulate(
             uncut[b] = true;
         }
     }
-    let mut map = HeightMap::of(grid, nose_radius, totals, frame.features(), Vec::new());
+    let mut map = HeightMap::of(grid, nose_radius, totals, frame, Vec::new());
     map.tiles = tiles.len();
     TiledMap {
         map,

@@ -8,6 +8,7 @@
 //! error map as an SVG picture. Every refusal is a `Failure`, a coded
 //! error in words that names the file; nothing is written then.
 
+mod lenslets;
 pub mod placed;
 pub mod report;
 
@@ -47,6 +48,30 @@ pub fn measure(
     let lowered = head.surface.design();
     let (f, _) = crate::evaluate::evaluator(&lowered.tape);
     let format = m.format;
+    // Lenslet by lenslet: only a map of an array.
+    let array = if opts.per_lenslet {
+        let Some(l) = head.surface.lenslets.as_ref() else {
+            return Err(fail(
+                codes::PER_LENSLET_UNAVAILABLE,
+                format!(
+                    "{file}: --per-lenslet registers each lenslet of an array, and `{surface_name}` is not an array of lenslets (grid, hex_grid or linear_array, or one wrapped on a roller)"
+                ),
+                Some("leave out --per-lenslet to register the whole surface"),
+            ));
+        };
+        if !matches!(m.data, Measured::Map(_)) {
+            return Err(fail(
+                codes::PER_LENSLET_UNAVAILABLE,
+                format!(
+                    "{file}: --per-lenslet registers each lenslet on a map's pixels, and this measurement is a point cloud or a profile"
+                ),
+                Some("measure the array as a map (X3P, SDF, MetroPro), or leave out --per-lenslet"),
+            ));
+        }
+        Some(l)
+    } else {
+        None
+    };
     let kind = match &m.data {
         Measured::Map(_) => "map",
         Measured::Cloud(_) => "point_cloud",
@@ -70,12 +95,18 @@ pub fn measure(
         ..
     } = placed;
     let (texture, texture_skipped) = texture_of(&p, &errors, opts.cutoff);
+    let lenslets = array
+        .zip(p.map.as_ref())
+        .map(|(l, map)| lenslets::measure(f.as_ref(), l, map, &reg, opts));
     let setup = (spec.setup() == Setup::Lathe)
         .then(|| setup_of(f.as_ref(), &p, &errors, &reg))
         .flatten();
     let raster = raster(&p.inside, &errors, p.map.as_ref().map(|m| m.dx.max(m.dy)));
     let registration = registration_report(&reg);
-    let caption = caption(&form, &registration, &raster);
+    let mut caption = caption(&form, &registration, &raster);
+    if let Some(l) = &lenslets {
+        caption.push_str(&lenslets_caption(l));
+    }
     let svg = crate::plots::measured_error_svg(
         &format!("{}: measured error of `{surface_name}` ({file})", head.name),
         &caption,
@@ -113,6 +144,7 @@ pub fn measure(
         texture,
         texture_skipped,
         setup,
+        lenslets,
     };
     Ok(Outcome { report, svg })
 }
@@ -150,20 +182,26 @@ fn texture_of(
         }
     }
     match texture::texture(&res, cutoff) {
-        Some(t) => (
-            Some(report::Texture {
-                form_removed: "the registered design surface (least squares: piston, tilt, decentre, clocking)".into(),
-                filter: "Gaussian L-filter (ISO 16610-61 weighting), first-order regression at edges and holes".into(),
-                cutoff_mm: cutoff,
-                sa_nm: t.sa * 1e6,
-                sq_nm: t.sq * 1e6,
-                sz_nm: t.sz * 1e6,
-                sdq: t.sdq,
-                points: t.points,
-            }),
-            None,
-        ),
+        Some(t) => (Some(texture_report(&t, cutoff)), None),
         None => (None, Some("fewer than two valid points".into())),
+    }
+}
+
+/// The report's words for texture `t` after the filter of nesting index
+/// `cutoff` (mm).
+fn texture_report(t: &texture::Texture, cutoff: f64) -> report::Texture {
+    report::Texture {
+        form_removed:
+            "the registered design surface (least squares: piston, tilt, decentre, clocking)".into(),
+        filter:
+            "Gaussian L-filter (ISO 16610-61 weighting), first-order regression at edges and holes"
+                .into(),
+        cutoff_mm: cutoff,
+        sa_nm: t.sa * 1e6,
+        sq_nm: t.sq * 1e6,
+        sz_nm: t.sz * 1e6,
+        sdq: t.sdq,
+        points: t.points,
     }
 }
 
@@ -274,4 +312,25 @@ fn caption(f: &report::FormError, r: &report::Registration, raster: &ErrorRaster
         raster.ny,
         raster.block * 1000.0
     )
+}
+
+/// What the picture adds with `--per-lenslet`: the lenslets registered,
+/// the worst, and those not registered.
+fn lenslets_caption(l: &report::Lenslets) -> String {
+    let worst = l
+        .worst_pv
+        .and_then(|k| l.each.iter().find(|e| e.index == k))
+        .and_then(|e| e.form_error.as_ref().map(|f| (e.index, e.centre_mm, f)));
+    let mut s = format!(
+        " Lenslet by lenslet (each registered on its own): {} of the array's {} reached, {} not registered",
+        l.reached, l.in_array, l.not_registered
+    );
+    if let Some((k, c, f)) = worst {
+        s.push_str(&format!(
+            "; the worst, lenslet {k} at x {:.4}, y {:.4} mm: PV {:.2} nm, RMS {:.2} nm",
+            c[0], c[1], f.pv_nm, f.rms_nm
+        ));
+    }
+    s.push('.');
+    s
 }

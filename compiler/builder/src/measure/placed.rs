@@ -32,6 +32,9 @@ pub struct Options {
     /// Whether a job's `compensate` block names the file (its messages
     /// then name the block's parameters instead of the command's flags).
     pub from_job: bool,
+    /// Register each lenslet of the job's array on its own too
+    /// (`--per-lenslet`).
+    pub per_lenslet: bool,
 }
 
 impl Default for Options {
@@ -42,6 +45,7 @@ impl Default for Options {
             cutoff: 0.08,
             keep_origin: false,
             from_job: false,
+            per_lenslet: false,
         }
     }
 }

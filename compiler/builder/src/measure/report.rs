@@ -28,6 +28,94 @@ pub struct MeasureReport {
     /// A turned part's set-up errors (lathe jobs with a map or a cloud).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub setup: Option<SetUp>,
+    /// Each lenslet of the job's array registered on its own
+    /// (`--per-lenslet`), in the array's order: those the map reaches.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lenslets: Option<Lenslets>,
+}
+
+/// `--per-lenslet`: each lenslet of the array the map reaches, registered
+/// on its own and figured on its own.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct Lenslets {
+    /// How a point is given to a lenslet and how each is registered.
+    pub method: String,
+    /// Lenslets in the array, and how many the map reaches (a point of
+    /// it inside the lenslet's aperture).
+    pub in_array: usize,
+    pub reached: usize,
+    /// Lenslets reached but not registered (a finding each, below).
+    pub not_registered: usize,
+    /// The registered lenslet with the largest error PV, if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub worst_pv: Option<usize>,
+    pub each: Vec<LensletMeasured>,
+}
+
+/// One lenslet, measured.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct LensletMeasured {
+    /// Its index in its array, from 0: row by row from the least y, along
+    /// each row from the least x (as the build report's lenslets).
+    pub index: usize,
+    /// Its centre in the design (mm).
+    pub centre_mm: [f64; 2],
+    /// Map points inside its aperture widened by a fifth (valid or not),
+    /// and the valid share.
+    pub points_in_aperture: usize,
+    pub valid_share: f64,
+    /// Its registration: piston at its centre (µm), tilt (µrad), and its
+    /// decentre (µm) in the measurement's frame against its place in the
+    /// design; `from_array` the same less what the whole array's
+    /// registration puts there (this lenslet's own error of place).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub registration: Option<LensletRegistration>,
+    /// The error along the normal after its own registration.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub form_error: Option<FormError>,
+    /// Texture after its own form removal.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub texture: Option<Texture>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub texture_skipped: Option<String>,
+    /// Why it was not registered: a coded finding (W0036), not an error.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub finding: Option<Finding>,
+}
+
+/// A lenslet's own placement.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct LensletRegistration {
+    pub piston_um: f64,
+    pub tilt_x_urad: f64,
+    pub tilt_y_urad: f64,
+    pub decentre_x_um: f64,
+    pub decentre_y_um: f64,
+    /// The same, less what the whole array's registration gives there.
+    pub from_array: FromArray,
+    pub iterations: usize,
+}
+
+/// A lenslet's placement less the whole array's there.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct FromArray {
+    pub piston_um: f64,
+    pub tilt_x_urad: f64,
+    pub tilt_y_urad: f64,
+    pub decentre_x_um: f64,
+    pub decentre_y_um: f64,
+}
+
+/// A coded finding about one lenslet.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct Finding {
+    pub code: String,
+    pub message: String,
 }
 
 /// The file read.

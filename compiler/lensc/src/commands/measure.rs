@@ -95,10 +95,47 @@ pub fn run(
             f.pv_nm, f.rms_nm, r.decentre_x_um, r.decentre_y_um, r.tilt_x_urad, r.tilt_y_urad
         );
     }
+    if let Some(l) = &outcome.report.lenslets {
+        let findings: Vec<_> = l.each.iter().filter_map(|e| e.finding.as_ref()).collect();
+        if !findings.is_empty() {
+            warn(out, part, &bytes, &findings);
+        }
+        if out.format == MessageFormat::Human {
+            eprintln!(
+                "{name}: lenslet by lenslet: {} of the array's {} reached, {} registered",
+                l.reached,
+                l.in_array,
+                l.reached - l.not_registered
+            );
+        }
+    }
     for (n, text) in &files {
         eprintln!("wrote {} ({} bytes)", dir.join(n).display(), text.len());
     }
     0
+}
+
+/// Prints each lenslet's finding (W0036) as a warning over the
+/// measurement file.
+fn warn(out: &Output, part: &Path, bytes: &[u8], findings: &[&measure::report::Finding]) {
+    let text = std::str::from_utf8(bytes)
+        .map(str::to_owned)
+        .unwrap_or_default();
+    let mut sources = SourceMap::default();
+    let id = sources.add(part.display().to_string(), Some(part.to_path_buf()), text);
+    let diags: Vec<Diagnostic> = findings
+        .iter()
+        .map(|f| {
+            Diagnostic::warning(lensc_lang::codes::LENSLET_NOT_REGISTERED, f.message.clone(), id, Span::new(0, 0))
+                .with_help("measure that lenslet again, or lower --min-valid knowing what its figures then cover")
+        })
+        .collect();
+    let _ = match out.format {
+        MessageFormat::Human => {
+            render::human(&diags, &sources, out.color, &mut std::io::stderr().lock())
+        }
+        MessageFormat::Json => render::json_lines(&diags, &sources, &mut std::io::stdout().lock()),
+    };
 }
 
 /// Prints a refusal over the measurement file (its text, when it is

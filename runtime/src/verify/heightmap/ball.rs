@@ -844,7 +844,7 @@ mod tests {
             swept(&mut sweep, r);
             let (totals, blocks, _) = sweep.finish_tile(&Cubic, &|f| f, &layout, false);
             (
-                super::super::HeightMap::of(g, r, totals, &[], Vec::new()),
+                super::super::HeightMap::of(g, r, totals, &Cubic, Vec::new()),
                 blocks,
             )
         };

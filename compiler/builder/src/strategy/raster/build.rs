@@ -173,6 +173,7 @@ pub(super) fn build(spec: &RasterSpec, cx: &BuildContext) -> Result<Built, Vec<D
         along_x,
         window,
         domain: lowered.domain,
+        lenslets: head.surface.lenslets.as_ref(),
     };
     let (map, errors) = sweep.finish(&frame, &window, window.spacing);
     plots.form_error = Some(height_map::form_error_series(

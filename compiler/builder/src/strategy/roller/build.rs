@@ -106,6 +106,7 @@ pub(super) fn build(spec: &RollerSpec, cx: &BuildContext) -> Result<Built, Vec<D
         roller_radius: helix.roller_radius,
         y_start: helix.y_start,
         domain: lowered.domain,
+        lenslets: head.surface.lenslets.as_ref(),
     };
     let (map, raster) = sweep.finish(&frame, &window, window.spacing);
     let plots = crate::plots::PlotSeries {

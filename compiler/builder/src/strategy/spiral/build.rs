@@ -206,6 +206,7 @@ fn simulated_height_map(
             spec.spiral.start_radius
         },
         &spec.lenslets,
+        spec.head.surface.lenslets.as_ref(),
     );
     // A polar grid's cells lie askew to the raster's blocks: √2 times the
     // spacing puts a cell in every block (1.5 for margin).

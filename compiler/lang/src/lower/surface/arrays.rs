@@ -113,15 +113,37 @@ pub fn array_centres(o: &Object) -> Option<Vec<(f64, f64)>> {
     let Ok(Surface::Array(a)) = super::read(o) else {
         return None;
     };
-    if let Layout::Hex {
-        pitch,
-        count_x,
-        count_y,
-    } = a.layout
-    {
-        return Some(hex_centres(pitch, count_x, count_y));
-    }
+    Some(centres(&a))
+}
+
+/// The lenslets of an array, or of an array wrapped on a roller (in the
+/// design's coordinates, as the roller's height map reads them): their
+/// centres, row by row from the least y, and the aperture each holds
+/// about its centre. `None` for other surfaces. Every layout (`grid`,
+/// `hex_grid`, `linear_array`) and every aperture (circles, rectangles,
+/// rings) has them: what the height map reports lenslet by lenslet.
+pub fn array_cells(o: &Object) -> Option<(Vec<(f64, f64)>, Domain)> {
+    let a = match super::read(o).ok()? {
+        Surface::Array(a) => a,
+        Surface::Wrap(w) => match *w.surface {
+            Surface::Array(a) => a,
+            _ => return None,
+        },
+        _ => return None,
+    };
+    let aperture = lenslet_domain(&a.lenslet).ok()?;
+    Some((centres(&a), aperture))
+}
+
+/// The centres of `a`'s lenslets (mm), row by row from the least y, as
+/// the lowering places them.
+fn centres(a: &Array) -> Vec<(f64, f64)> {
     let (px, py, nx, ny) = match a.layout {
+        Layout::Hex {
+            pitch,
+            count_x,
+            count_y,
+        } => return hex_centres(pitch, count_x, count_y),
         Layout::Grid {
             pitch_x,
             pitch_y,
@@ -138,7 +160,6 @@ pub fn array_centres(o: &Object) -> Option<Vec<(f64, f64)>> {
             count,
             axis: Axis::X,
         } => (pitch, 0.0, count, 1.0),
-        Layout::Hex { .. } => return None,
     };
     let (nx, ny) = (nx as usize, ny as usize);
     let mut centres = Vec::with_capacity(nx * ny);
@@ -150,7 +171,7 @@ pub fn array_centres(o: &Object) -> Option<Vec<(f64, f64)>> {
             ));
         }
     }
-    Some(centres)
+    centres
 }
 
 /// The centres of a hexagonal grid's lenslets, as `hex_cells` places

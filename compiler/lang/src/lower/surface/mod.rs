@@ -19,7 +19,7 @@ mod rotational;
 #[cfg(test)]
 mod tests;
 
-pub use arrays::{array_centres, array_lenslet, lower_trajectory};
+pub use arrays::{array_cells, array_centres, array_lenslet, lower_trajectory};
 pub use formula::lower_formula;
 pub use polynomial::{zernike_ansi, zernike_fringe};
 use rotational::Radial;
