@@ -133,16 +133,7 @@ fn compare(
     println!("{title}:");
     println!(
         "{:<24} {:>8} {:>8} {:>6} {:>9} {:>9} {:>6} {:>7} {:>7} {:>6}",
-        "job",
-        "lines",
-        "spline",
-        "ratio",
-        "bytes",
-        "spline",
-        "ratio",
-        "build s",
-        "spline",
-        "ratio"
+        "job", "lines", "spline", "ratio", "bytes", "spline", "ratio", "build s", "spline", "ratio"
     );
     let (mut lines, mut bytes, mut time) = ((0, 0), (0, 0), (0.0, 0.0));
     for i in 0..plain.checked.jobs.len() {
