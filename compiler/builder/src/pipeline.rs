@@ -337,8 +337,11 @@ fn build_job(
     // program calls (read back as one), and its link's rate checked.
     if !matches!(to, Destination::Nowhere) {
         let head = spec.head();
-        crate::delivery::deliver(head, &mut b, head.control.machine_kind != "mill_3axis")?;
-        b.warnings.extend(crate::delivery::rate_warning(head, &b));
+        let lathe = head.control.machine_kind != "mill_3axis";
+        let peak = crate::delivery::peak_warning(head, &b, lathe);
+        crate::delivery::deliver(head, &mut b, lathe)?;
+        b.warnings
+            .extend(crate::delivery::rate_warning(head, &b).or(peak));
     }
     // The set-up sheet, written in one unit with the program it sets up.
     if !matches!(to, Destination::Nowhere) {

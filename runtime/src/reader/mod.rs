@@ -34,6 +34,7 @@ mod nurbs_moves;
 pub mod parts;
 mod policy;
 mod spline;
+pub mod timing;
 
 pub use header::{
     HeaderNames, comment_text, header_control_offset, header_names, header_source,

@@ -77,6 +77,12 @@ const DELIVERY: Param = opt(
             Check::Positive,
             "bytes per second the link delivers to the control (`dnc`, `data_server`); a program consuming more while it cuts is warned of (W0050); default baud / 10 for `dnc`, none (unchecked) otherwise",
         ),
+        opt(
+            "buffer",
+            NUMBER,
+            Check::Positive,
+            "bytes of program the control holds ahead of the block it runs, filled by a streaming link: a stretch of short blocks that asks more bytes a second than the link delivers runs on this buffer, and one that would empty it is warned of (W0050); default 4096 (an assumption: see the Delivery page)",
+        ),
     ]),
     Check::Any,
     "how programs reach the control: memory, file-size limit, link and its byte rate (see the language guide's Delivery page); default none stated: programs are held to `--max-program-size` only",
@@ -323,6 +329,8 @@ pub struct DeliveryParams {
     pub baud: Option<crate::value::Stated<f64>>,
     /// Bytes per second the link delivers, as stated.
     pub rate: Option<crate::value::Stated<f64>>,
+    /// Bytes the control holds ahead of the block it runs, as stated.
+    pub buffer: Option<crate::value::Stated<f64>>,
 }
 
 /// A fast tool servo (`fast_axis { … }`) and its second-order model.
@@ -391,6 +399,7 @@ impl MachineParams {
                     file_limit: d.stated_num("file_limit"),
                     baud: d.stated_num("baud"),
                     rate: d.stated_num("rate"),
+                    buffer: d.stated_num("buffer"),
                 })
             },
         };
