@@ -36,6 +36,25 @@ pub struct Reached {
     /// Jobs whose files could not be written: the machine's fault (a full
     /// disk), not the compiler's; counted, not failed.
     pub unwritten: usize,
+    /// Where the input's time went, by phase (`PHASES`).
+    pub times: Phases,
+}
+
+/// The phases of one `.lens` input whose time is counted: `check_text`;
+/// the invariant and both renderers over its diagnostics; the fuzzer's own
+/// cross-checks (fmt, pest); lowering as `lensc check` does; planning and
+/// emitting; writing the files.
+pub const PHASES: [&str; 6] = ["check", "render", "cross-check", "lower", "build", "write"];
+
+/// Time spent in each of `PHASES`.
+pub type Phases = [std::time::Duration; PHASES.len()];
+
+/// Runs `f`, adding its time to phase `i` of `times`.
+fn timed<T>(times: &mut Phases, i: usize, f: impl FnOnce() -> T) -> T {
+    let t = std::time::Instant::now();
+    let out = f();
+    times[i] += t.elapsed();
+    out
 }
 
 /// What is wrong with an input's handling, beyond a panic.
@@ -141,25 +160,32 @@ impl Depth {
 
 /// Runs `bytes` as far as `depth` asks (and the checker lets it).
 pub fn run(fs: &MemFs, bytes: &[u8], depth: Depth, out_dir: &Path) -> Result<Reached, Fault> {
-    let c = driver::check_text(fs, "fuzz.lens", bytes);
+    let mut times = Phases::default();
+    let c = timed(&mut times, 0, || driver::check_text(fs, "fuzz.lens", bytes));
     let sources = &c.loaded.sources;
-    well_formed(c.diags(), sources)?;
-    render(c.diags(), sources)?;
+    timed(&mut times, 1, || {
+        well_formed(c.diags(), sources)?;
+        render(c.diags(), sources)
+    })?;
     // The fuzzer's own cross-checks beyond what `lensc check` runs (pest
     // alone costs about as much as the checker): on a share of the inputs,
     // and always on a worker's first (so a replayed input has them all).
     let n = CROSS_CHECKS.with(|c| c.replace(c.get() + 1));
-    if n.is_multiple_of(FORMAT_EVERY) {
-        formats(bytes)?;
-    }
-    if n.is_multiple_of(PEST_EVERY) {
-        parses_alike(bytes)?;
-    }
+    timed(&mut times, 2, || {
+        if n.is_multiple_of(FORMAT_EVERY) {
+            formats(bytes)?;
+        }
+        if n.is_multiple_of(PEST_EVERY) {
+            parses_alike(bytes)?;
+        }
+        Ok::<(), Fault>(())
+    })?;
     let mut reached = Reached {
         clean: !c.has_errors(),
         ..Reached::default()
     };
     if !reached.clean {
+        reached.times = times;
         return Ok(reached);
     }
     match depth {
@@ -176,9 +202,13 @@ pub fn run(fs: &MemFs, bytes: &[u8], depth: Depth, out_dir: &Path) -> Result<Rea
             };
             // What `lensc check` runs once a file checks: surfaces
             // undefined over their aperture, every job lowered.
-            let found = lensc_build::pipeline::findings_before_planning(&c, &limits);
-            well_formed(&found, sources)?;
-            render(&found, sources)?;
+            let found = timed(&mut times, 3, || {
+                lensc_build::pipeline::findings_before_planning(&c, &limits)
+            });
+            timed(&mut times, 1, || {
+                well_formed(&found, sources)?;
+                render(&found, sources)
+            })?;
             reached.lowered += c.checked.jobs.len();
         }
         Depth::Build | Depth::BuildAs { .. } => {
@@ -193,20 +223,27 @@ pub fn run(fs: &MemFs, bytes: &[u8], depth: Depth, out_dir: &Path) -> Result<Rea
                 },
                 _ => driver::Request::default(),
             };
-            let (built, diags) = driver::plan_and_emit(&c, request, "fuzz.lens", Some(out_dir));
-            well_formed(&diags, sources)?;
-            render(&diags, sources)?;
+            let (built, diags) = timed(&mut times, 4, || {
+                driver::plan_and_emit(&c, request, "fuzz.lens", Some(out_dir))
+            });
+            timed(&mut times, 1, || {
+                well_formed(&diags, sources)?;
+                render(&diags, sources)
+            })?;
             reached.lowered = c.checked.jobs.len();
             reached.built = built.len();
-            for b in built {
-                match write(b, out_dir) {
-                    Ok(()) => reached.written += 1,
-                    Err(_) => reached.unwritten += 1,
+            timed(&mut times, 5, || {
+                for b in built {
+                    match write(b, out_dir) {
+                        Ok(()) => reached.written += 1,
+                        Err(_) => reached.unwritten += 1,
+                    }
                 }
-            }
-            clear(out_dir);
+                clear(out_dir);
+            });
         }
     }
+    reached.times = times;
     Ok(reached)
 }
 

@@ -1,23 +1,29 @@
 //! `cargo run --release -p fuzz -- --seconds N [--seed S] [--build-every K]
-//! [--target T]`: fuzzes lensc for N seconds. With the default target
-//! (`mixed`, CI's fixed-seed minute) each input is a file from the
+//! [--target T] [--jobs J]`: fuzzes lensc for N seconds. With the default
+//! target (`mixed`, CI's fixed-seed minute) each input is a file from the
 //! structure-aware generator (`generate`), a mutation of a real file
 //! (`mutate`) or, every K-th, a small whole job (`small_jobs`) that is
 //! built and written. Every input runs under the supervisor (`supervise`:
 //! panics caught, hangs timed out) through the harness (`harness`: every
-//! diagnostic coded and spanned). Failing inputs are saved in
-//! fuzz/crashes/; the run ends with throughput and counts, and exits 1 if
-//! anything failed. The other targets (`targets`, and `fuzz/campaign.sh`
-//! that runs them all for an hour) take one path each: `check` (with size
-//! limits drawn per input), `build` (small jobs in a dialect and to a
-//! program size drawn per input), `verify` (mutated programs), `import`
-//! (mutated prescriptions) and `lsp` (message sequences).
+//! diagnostic coded and spanned). Each of the J lanes is a child process
+//! (`lanes`: this binary again with `--worker`), so an abort (a failed
+//! allocation, a stack overflow) loses one input, which is saved and
+//! reported, not the run. Failing inputs are saved in fuzz/crashes/; the
+//! run ends with throughput, where the time went by phase, counts and a
+//! projection of the campaign's goals, and exits 1 if anything failed.
+//! The other targets (`targets`, and `fuzz/campaign.sh` that runs them
+//! all) take one path each: `check` (with size limits drawn per input),
+//! `build` (small jobs in a dialect and to a program size drawn per
+//! input), `verify` (mutated programs), `import` (mutated prescriptions),
+//! `lsp` (message sequences) and `measure` (the measurement readers).
 
 mod end_to_end;
 mod generate;
 mod harness;
+mod lanes;
 mod measure;
 mod mutate;
+mod record;
 mod rng;
 mod small_jobs;
 mod supervise;
@@ -27,15 +33,14 @@ use std::collections::HashMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use clap::Parser;
 
-use harness::{Depth, MemFs};
+use harness::{Depth, MemFs, PHASES, Phases};
 use lensc_build::job::Limits;
 use mutate::Corpus;
+use record::{Kind, Record, STRATEGIES, Source};
 use rng::Rng;
 use supervise::{Outcome, Supervisor};
 
@@ -57,14 +62,17 @@ struct Cli {
     /// range of a fixed seed that a longer run has shown clean).
     #[arg(long, value_name = "N")]
     inputs: Option<u64>,
-    /// Worker threads, each with its own share of the inputs.
+    /// Stop once N jobs have been built (the campaign's build goal).
+    #[arg(long, value_name = "N")]
+    until_built: Option<u64>,
+    /// Lanes: worker processes, each with its own share of the inputs.
     #[arg(long, default_value_t = 1)]
     jobs: u64,
     /// Seconds an input may take before it counts as a hang.
     #[arg(long, default_value_t = 10)]
     timeout: u64,
-    /// Run only inputs A..B of the seed (or input A), naming each first:
-    /// for an input that aborted the process.
+    /// Run only inputs A..B of the seed (or input A), naming each first,
+    /// in this process: for an input that aborted a worker.
     #[arg(long, value_name = "A[..B]")]
     replay: Option<String>,
     /// Print input I of the seed to stdout and stop.
@@ -78,6 +86,19 @@ struct Cli {
     /// (`end_to_end`).
     #[arg(long, value_name = "PATH")]
     lensc: Option<PathBuf>,
+    /// Cores the summary's projection of the campaign assumes (default:
+    /// the lanes).
+    #[arg(long, value_name = "N")]
+    cores: Option<u64>,
+    /// (Internal) run as lane L's worker process: inputs from
+    /// `--worker-from` in steps of `--jobs`, a record line for each on
+    /// stdout.
+    #[arg(long, hide = true, value_name = "L")]
+    worker: Option<u64>,
+    #[arg(long, hide = true, value_name = "I")]
+    worker_from: Option<u64>,
+    #[arg(long, hide = true, value_name = "DIR")]
+    worker_dir: Option<PathBuf>,
 }
 
 /// What the inputs go through.
@@ -104,6 +125,12 @@ enum Target {
     Measure,
 }
 
+impl Target {
+    fn name(self) -> String {
+        format!("{self:?}").to_lowercase()
+    }
+}
+
 /// The mutation corpora: `.lens` files, programs and prescriptions.
 struct Corpora {
     lens: Corpus,
@@ -124,6 +151,307 @@ const DIALECTS: &[&str] = &[
     "heidenhain_tnc_klartext",
     "ultra_precision_lathe_gcode",
 ];
+
+/// The campaign's goals (issue #33, item 7).
+const GOAL_CHECKS: f64 = 10e6;
+const GOAL_BUILDS: f64 = 100e3;
+
+/// Seconds between lines of progress.
+const PROGRESS_EVERY: u64 = 30;
+
+/// Mixed into the seed for the draw of the inputs that also run end to
+/// end (a stream of its own: the inputs stay those of the seed).
+const END_TO_END: u64 = 0xE2E0_0E2E;
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let seed = cli.seed.unwrap_or_else(|| {
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map(|d| d.as_nanos() as u64)
+            .unwrap_or(1)
+    });
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let corpora = Corpus::load(&root).and_then(|lens| {
+        Ok(Corpora {
+            lens,
+            programs: targets::programs(&root)?,
+            prescriptions: targets::prescriptions(&root)?,
+            measurements: measure::corpus(&root)?,
+        })
+    });
+    let corpora = match corpora {
+        Ok(c) => c,
+        Err(e) => {
+            eprintln!("fuzz: cannot read the corpus under {}: {e}", root.display());
+            return ExitCode::from(lanes::EXIT_SETUP as u8);
+        }
+    };
+    match &cli.lensc {
+        Some(p) => {
+            let _ = targets::LENSC.set(p.clone());
+        }
+        None if cli.target == Target::Lsp => {
+            eprintln!("fuzz: the lsp target needs --lensc PATH (cargo build --release -p lensc)");
+            return ExitCode::from(lanes::EXIT_SETUP as u8);
+        }
+        None => {}
+    }
+    if let Some(i) = cli.print {
+        let (_, bytes, _) = input_for(cli.target, seed, i, cli.build_every, &corpora);
+        let _ = std::io::stdout().write_all(&bytes);
+        return ExitCode::SUCCESS;
+    }
+    let jobs = cli.jobs.max(1);
+    let end = cli.inputs.unwrap_or(u64::MAX);
+    let deadline = Instant::now() + Duration::from_secs(cli.seconds);
+    let crashes = Path::new(env!("CARGO_MANIFEST_DIR")).join("crashes");
+    if let Some(lane) = cli.worker {
+        supervise::install_panic_hook();
+        let Some(dir) = cli.worker_dir.clone() else {
+            eprintln!("fuzz: a worker needs --worker-dir");
+            return ExitCode::from(lanes::EXIT_SETUP as u8);
+        };
+        let from = cli.worker_from.unwrap_or(lane);
+        let worker = Worker::new(&cli, seed, &corpora, dir);
+        let out = std::io::stdout();
+        let mut hung = false;
+        worker.lane((from..end).step_by(jobs as usize), deadline, |r| {
+            hung = r.kind == Kind::Hung;
+            let mut out = out.lock();
+            // A parent that is gone: nothing left to report to.
+            writeln!(out, "{}", r.line())
+                .and_then(|()| out.flush())
+                .is_ok()
+                && !hung
+        });
+        let _ = std::fs::remove_dir_all(&worker.out);
+        return if hung {
+            // Its stuck thread still runs: a fresh worker takes over.
+            ExitCode::from(lanes::EXIT_AFTER_HANG as u8)
+        } else {
+            ExitCode::SUCCESS
+        };
+    }
+    let scratch = match tempfile::tempdir() {
+        Ok(d) => d,
+        Err(e) => {
+            eprintln!("fuzz: cannot make a temporary output directory: {e}");
+            return ExitCode::from(lanes::EXIT_SETUP as u8);
+        }
+    };
+    let mut tally = Tally {
+        counts: Counts::default(),
+        seen: HashMap::new(),
+        crashes,
+        seed,
+        target: cli.target,
+        build_every: cli.build_every,
+        corpora: &corpora,
+    };
+    let start = Instant::now();
+    let lanes_run;
+    if let Some(range) = cli.replay.as_deref() {
+        let Some(range) = parse_range(range) else {
+            eprintln!("fuzz: --replay takes A or A..B");
+            return ExitCode::from(lanes::EXIT_SETUP as u8);
+        };
+        lanes_run = 1;
+        eprintln!(
+            "fuzz: target {:?}, seed {seed}, replaying {range:?}",
+            cli.target
+        );
+        supervise::install_panic_hook();
+        let worker = Worker::new(&cli, seed, &corpora, scratch.path().join("replay"));
+        worker.lane(
+            range,
+            Instant::now() + Duration::from_secs(365 * 86_400),
+            |r| {
+                tally.take(r);
+                true
+            },
+        );
+    } else {
+        lanes_run = jobs;
+        eprintln!(
+            "fuzz: target {:?}, seed {seed}, build every {}th input, {} s, {jobs} lane(s) in worker processes",
+            cli.target, cli.build_every, cli.seconds
+        );
+        let plan = lanes::Plan {
+            command: worker_command(&cli, seed),
+            lanes: jobs,
+            end,
+            deadline,
+            silence: Duration::from_secs(2 * cli.timeout + 60),
+            scratch: scratch.path().to_path_buf(),
+        };
+        let mut next = Duration::from_secs(PROGRESS_EVERY);
+        // The tally is shared by the three callbacks, one at a time.
+        let tally = std::cell::RefCell::new(&mut tally);
+        let restarts = lanes::run(
+            &plan,
+            |r| tally.borrow_mut().take(&r),
+            |lost| tally.borrow_mut().lost(lost),
+            || {
+                let t = tally.borrow();
+                if start.elapsed() >= next {
+                    next += Duration::from_secs(PROGRESS_EVERY);
+                    // A line the campaign reads if this process dies.
+                    let _ = writeln!(
+                        std::io::stderr(),
+                        "fuzz: progress {:.0} s: {} inputs, {} built",
+                        start.elapsed().as_secs_f64(),
+                        t.counts.inputs.values().sum::<u64>() + t.counts.lost,
+                        t.counts.built
+                    );
+                }
+                cli.until_built.is_some_and(|n| t.counts.built >= n)
+            },
+        );
+        tally.borrow_mut().counts.restarts = restarts;
+    }
+    let distinct = tally.seen.len();
+    let c = &tally.counts;
+    summary(
+        c,
+        start.elapsed(),
+        distinct,
+        lanes_run,
+        cli.cores.unwrap_or(lanes_run),
+        cli.target,
+    );
+    if c.panics + c.hangs + c.uncoded + c.aborts + c.end_to_end_failed > 0 {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+/// This binary with the run's flags, as a worker is started (the lane's
+/// own flags and its time left are added by `lanes`).
+fn worker_command(cli: &Cli, seed: u64) -> Vec<String> {
+    let exe = std::env::current_exe()
+        .map(|p| p.display().to_string())
+        .unwrap_or_else(|_| "fuzz".into());
+    let mut c = vec![
+        exe,
+        "--target".into(),
+        cli.target.name(),
+        "--seed".into(),
+        seed.to_string(),
+        "--build-every".into(),
+        cli.build_every.to_string(),
+        "--jobs".into(),
+        cli.jobs.max(1).to_string(),
+        "--timeout".into(),
+        cli.timeout.to_string(),
+    ];
+    if let Some(n) = cli.inputs {
+        c.extend(["--inputs".into(), n.to_string()]);
+    }
+    if let Some(p) = &cli.lensc {
+        c.extend(["--lensc".into(), p.display().to_string()]);
+    }
+    c
+}
+
+/// What a lane runs its inputs with.
+struct Worker<'a> {
+    cli: &'a Cli,
+    seed: u64,
+    corpora: &'a Corpora,
+    fs: std::sync::Arc<MemFs>,
+    /// The lane's own directory (builds, the end-to-end project).
+    out: PathBuf,
+}
+
+impl<'a> Worker<'a> {
+    fn new(cli: &'a Cli, seed: u64, corpora: &'a Corpora, out: PathBuf) -> Worker<'a> {
+        let _ = std::fs::create_dir_all(&out);
+        Worker {
+            cli,
+            seed,
+            corpora,
+            fs: std::sync::Arc::new(MemFs::new(&corpora.lens.files)),
+            out,
+        }
+    }
+
+    /// Runs these inputs until the deadline, handing each one's record to
+    /// `report`, which says whether to go on.
+    fn lane(
+        &self,
+        indices: impl Iterator<Item = u64>,
+        deadline: Instant,
+        mut report: impl FnMut(&Record) -> bool,
+    ) {
+        let cli = self.cli;
+        let build_dir = self.out.join("build");
+        let _ = std::fs::create_dir_all(&build_dir);
+        let mut sup = Supervisor::new(
+            self.seed,
+            std::sync::Arc::clone(&self.fs),
+            build_dir,
+            Duration::from_secs(cli.timeout),
+        );
+        let mut project = None;
+        for index in indices {
+            if Instant::now() >= deadline {
+                break;
+            }
+            if cli.replay.is_some() {
+                eprintln!("fuzz: input {index}");
+            }
+            let made = Instant::now();
+            let (source, bytes, depth) =
+                input_for(cli.target, self.seed, index, cli.build_every, self.corpora);
+            let building = matches!(depth, Depth::Build | Depth::BuildAs { .. });
+            let strategy = if building {
+                strategy_of(&bytes)
+            } else {
+                "other"
+            };
+            let mut r = Record::new(index, source, building, strategy);
+            r.made = made.elapsed();
+            let began = Instant::now();
+            let outcome = sup.run(index, bytes.clone(), depth);
+            r.took = began.elapsed();
+            match outcome {
+                Outcome::Done(Ok(reached)) => r.reached(&reached),
+                Outcome::Done(Err(fault)) => {
+                    r.kind = Kind::Uncoded;
+                    r.failures.push(("uncoded".into(), fault));
+                }
+                Outcome::Panicked(m) => {
+                    r.kind = Kind::Panicked;
+                    r.failures.push(("panic".into(), m));
+                }
+                Outcome::Hung => {
+                    r.kind = Kind::Hung;
+                    let m = format!("no answer in {} s", cli.timeout);
+                    r.failures.push(("hang".into(), m));
+                }
+            }
+            if let Some(lensc) = &cli.lensc
+                && r.kind != Kind::Hung
+                && depth.is_lens()
+                && Rng::for_input(self.seed ^ END_TO_END, index).below(end_to_end::SHARE) == 0
+            {
+                let project = project.get_or_insert_with(|| {
+                    end_to_end::Project::new(lensc, self.out.join("project"), self.fs.files())
+                });
+                let ran = project.run(&bytes, depth);
+                r.end_to_end = Some(ran.is_ok());
+                if let Err(message) = ran {
+                    r.failures.push(("end-to-end".into(), message));
+                }
+            }
+            if !report(&r) {
+                break;
+            }
+        }
+    }
+}
 
 /// Makes input `index` of `target` in the run seeded `seed`.
 fn input_for(
@@ -186,18 +514,6 @@ fn input_for(
     }
 }
 
-/// Where an input came from.
-#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
-enum Source {
-    Generated,
-    Mutated,
-    SmallJob,
-    Program,
-    Prescription,
-    Session,
-    Measurement,
-}
-
 /// The extension a measurement input is read with (the text readers are
 /// chosen by it).
 fn measure_ext(name: &str) -> &'static str {
@@ -235,353 +551,6 @@ fn input(seed: u64, index: u64, build_every: u64, corpus: &Corpus) -> (Source, V
     } else {
         (Source::Mutated, mutate::mutant(corpus, &mut rng), depth)
     }
-}
-
-/// Seconds between lines of progress, and what they count: inputs run
-/// and jobs built, over every lane.
-const PROGRESS_EVERY: u64 = 30;
-static PROGRESS_INPUTS: AtomicU64 = AtomicU64::new(0);
-static PROGRESS_BUILT: AtomicU64 = AtomicU64::new(0);
-
-/// Mixed into the seed for the draw of the inputs that also run end to
-/// end (a stream of its own: the inputs stay those of the seed).
-const END_TO_END: u64 = 0xE2E0_0E2E;
-
-#[derive(Default)]
-struct Counts {
-    /// Inputs also run through the `lensc` binary, and those that failed.
-    end_to_end: u64,
-    end_to_end_failed: u64,
-    inputs: HashMap<Source, u64>,
-    checked: u64,
-    clean: u64,
-    lowered: u64,
-    build_inputs: u64,
-    built: u64,
-    written: u64,
-    unwritten: u64,
-    panics: u64,
-    hangs: u64,
-    uncoded: u64,
-    build_time: Duration,
-    /// Builds and their time by strategy (as the job's file names it).
-    by_strategy: HashMap<&'static str, (u64, Duration)>,
-    slowest_build: Duration,
-    slow_builds: u64,
-}
-
-fn main() -> ExitCode {
-    let cli = Cli::parse();
-    let seed = cli.seed.unwrap_or_else(|| {
-        std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map(|d| d.as_nanos() as u64)
-            .unwrap_or(1)
-    });
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let corpora = Corpus::load(&root).and_then(|lens| {
-        Ok(Corpora {
-            lens,
-            programs: targets::programs(&root)?,
-            prescriptions: targets::prescriptions(&root)?,
-            measurements: measure::corpus(&root)?,
-        })
-    });
-    let corpora = match corpora {
-        Ok(c) => c,
-        Err(e) => {
-            eprintln!("fuzz: cannot read the corpus under {}: {e}", root.display());
-            return ExitCode::from(2);
-        }
-    };
-    match &cli.lensc {
-        Some(p) => {
-            let _ = targets::LENSC.set(p.clone());
-        }
-        None if cli.target == Target::Lsp => {
-            eprintln!("fuzz: the lsp target needs --lensc PATH (cargo build --release -p lensc)");
-            return ExitCode::from(2);
-        }
-        None => {}
-    }
-    if let Some(i) = cli.print {
-        let (_, bytes, _) = input_for(cli.target, seed, i, cli.build_every, &corpora);
-        let _ = std::io::stdout().write_all(&bytes);
-        return ExitCode::SUCCESS;
-    }
-    let out = match tempfile::tempdir() {
-        Ok(d) => d,
-        Err(e) => {
-            eprintln!("fuzz: cannot make a temporary output directory: {e}");
-            return ExitCode::from(2);
-        }
-    };
-    supervise::install_panic_hook();
-    let (range, deadline) = match cli.replay.as_deref().map(parse_range) {
-        Some(Some(r)) => (r, None),
-        Some(None) => {
-            eprintln!("fuzz: --replay takes A or A..B");
-            return ExitCode::from(2);
-        }
-        None => (
-            0..cli.inputs.unwrap_or(u64::MAX),
-            Some(Duration::from_secs(cli.seconds)),
-        ),
-    };
-    let jobs = if cli.replay.is_some() {
-        1
-    } else {
-        cli.jobs.max(1)
-    };
-    eprintln!(
-        "fuzz: target {:?}, seed {seed}, build every {}th input, {} s, {jobs} worker(s)",
-        cli.target, cli.build_every, cli.seconds
-    );
-    let run = Run {
-        cli: &cli,
-        seed,
-        corpora: &corpora,
-        fs: std::sync::Arc::new(MemFs::new(&corpora.lens.files)),
-        out: out.path(),
-        crashes: Path::new(env!("CARGO_MANIFEST_DIR")).join("crashes"),
-        seen: Mutex::new(HashMap::new()),
-        start: Instant::now(),
-        deadline,
-    };
-    let done = AtomicBool::new(false);
-    let totals = std::thread::scope(|scope| {
-        // A line of progress now and then: what a run that aborts (an
-        // allocation that fails, a stack overflow) had reached, for
-        // `fuzz/campaign.sh`, which starts it again with a new seed.
-        scope.spawn(|| {
-            let every = Duration::from_secs(PROGRESS_EVERY);
-            let mut next = every;
-            while !done.load(Ordering::Relaxed) {
-                std::thread::sleep(Duration::from_millis(200));
-                if run.start.elapsed() >= next {
-                    next += every;
-                    let _ = writeln!(
-                        std::io::stderr(),
-                        "fuzz: progress {:.0} s: {} inputs, {} built",
-                        run.start.elapsed().as_secs_f64(),
-                        PROGRESS_INPUTS.load(Ordering::Relaxed),
-                        PROGRESS_BUILT.load(Ordering::Relaxed)
-                    );
-                }
-            }
-        });
-        let lanes: Vec<_> = (0..jobs)
-            .map(|lane| {
-                let run = &run;
-                let range = range.clone();
-                scope.spawn(move || run.lane(range.skip(lane as usize).step_by(jobs as usize)))
-            })
-            .collect();
-        let mut totals = Counts::default();
-        for lane in lanes {
-            match lane.join() {
-                Ok(c) => totals.add(c),
-                Err(_) => totals.panics += 1,
-            }
-        }
-        done.store(true, Ordering::Relaxed);
-        totals
-    });
-    let distinct = run.seen.lock().map(|s| s.len()).unwrap_or(0);
-    summary(&totals, run.start.elapsed(), distinct, jobs);
-    if totals.panics + totals.hangs + totals.uncoded + totals.end_to_end_failed > 0 {
-        ExitCode::FAILURE
-    } else {
-        ExitCode::SUCCESS
-    }
-}
-
-/// What every lane of a run shares.
-struct Run<'a> {
-    cli: &'a Cli,
-    seed: u64,
-    corpora: &'a Corpora,
-    fs: std::sync::Arc<MemFs>,
-    out: &'a Path,
-    crashes: PathBuf,
-    /// Failure messages seen so far and how often.
-    seen: Mutex<HashMap<String, u32>>,
-    start: Instant,
-    deadline: Option<Duration>,
-}
-
-impl Run<'_> {
-    /// Runs these inputs (one lane's share) until the deadline.
-    fn lane(&self, indices: impl Iterator<Item = u64>) -> Counts {
-        let cli = self.cli;
-        let mut counts = Counts::default();
-        let mut sup = None;
-        let mut project = None;
-        for index in indices {
-            if self.deadline.is_some_and(|d| self.start.elapsed() >= d) {
-                break;
-            }
-            if cli.replay.is_some() {
-                eprintln!("fuzz: input {index}");
-            }
-            // Each lane builds into a directory of its own.
-            let sup = sup.get_or_insert_with(|| {
-                let dir = self.out.join(format!("lane-{index}"));
-                let _ = std::fs::create_dir_all(&dir);
-                Supervisor::new(
-                    self.seed,
-                    std::sync::Arc::clone(&self.fs),
-                    dir,
-                    Duration::from_secs(cli.timeout),
-                )
-            });
-            let (source, bytes, depth) =
-                input_for(cli.target, self.seed, index, cli.build_every, self.corpora);
-            *counts.inputs.entry(source).or_default() += 1;
-            let began = Instant::now();
-            let outcome = sup.run(index, bytes.clone(), depth);
-            let took = began.elapsed();
-            if matches!(depth, Depth::Build | Depth::BuildAs { .. }) {
-                let e = counts.by_strategy.entry(strategy_of(&bytes)).or_default();
-                e.0 += 1;
-                e.1 += took;
-            }
-            PROGRESS_INPUTS.fetch_add(1, Ordering::Relaxed);
-            if let Outcome::Done(Ok(r)) = &outcome {
-                PROGRESS_BUILT.fetch_add(r.built as u64, Ordering::Relaxed);
-            }
-            if let Some((what, message)) = counts.record(outcome, depth, took, cli.timeout) {
-                self.failed(what, &message, index, source, &bytes);
-            }
-            if let Some(lensc) = &cli.lensc
-                && depth.is_lens()
-                && Rng::for_input(self.seed ^ END_TO_END, index).below(end_to_end::SHARE) == 0
-            {
-                let project = project.get_or_insert_with(|| {
-                    let dir = self.out.join(format!("project-{index}"));
-                    end_to_end::Project::new(lensc, dir, self.fs.files())
-                });
-                counts.end_to_end += 1;
-                if let Err(message) = project.run(&bytes, depth) {
-                    counts.end_to_end_failed += 1;
-                    self.failed("end-to-end", &message, index, source, &bytes);
-                }
-            }
-        }
-        counts
-    }
-
-    /// Reports a failure and saves its input (the first three of each
-    /// message).
-    fn failed(&self, what: &str, message: &str, index: u64, source: Source, bytes: &[u8]) {
-        let n = {
-            let Ok(mut seen) = self.seen.lock() else {
-                return;
-            };
-            let n = seen.entry(message.to_string()).or_default();
-            *n += 1;
-            *n
-        };
-        if n <= 3 {
-            let saved = save(
-                &self.crashes,
-                (what, self.cli.target, source),
-                self.seed,
-                index,
-                bytes,
-                message,
-            );
-            // Not `eprintln!`, which panics if stderr cannot be written.
-            let _ = writeln!(
-                std::io::stderr(),
-                "fuzz: {what} on input {index} ({source:?}): {message}\n      saved as {saved}"
-            );
-        }
-    }
-}
-
-impl Counts {
-    /// Counts one input's outcome; returns what failed, if anything.
-    fn record(
-        &mut self,
-        outcome: Outcome,
-        depth: Depth,
-        took: Duration,
-        timeout: u64,
-    ) -> Option<(&'static str, String)> {
-        match outcome {
-            Outcome::Done(Ok(r)) => {
-                self.checked += 1;
-                self.clean += u64::from(r.clean);
-                self.lowered += r.lowered as u64;
-                self.built += r.built as u64;
-                self.written += r.written as u64;
-                self.unwritten += r.unwritten as u64;
-                if matches!(depth, Depth::Build | Depth::BuildAs { .. }) {
-                    self.build_inputs += 1;
-                    self.build_time += took;
-                    self.slowest_build = self.slowest_build.max(took);
-                    self.slow_builds += u64::from(took > Duration::from_secs(1));
-                }
-                None
-            }
-            Outcome::Done(Err(fault)) => {
-                self.checked += 1;
-                self.uncoded += 1;
-                Some(("uncoded", fault))
-            }
-            Outcome::Panicked(m) => {
-                self.panics += 1;
-                Some(("panic", m))
-            }
-            Outcome::Hung => {
-                self.hangs += 1;
-                Some(("hang", format!("no answer in {timeout} s")))
-            }
-        }
-    }
-
-    fn add(&mut self, o: Counts) {
-        for (k, v) in o.inputs {
-            *self.inputs.entry(k).or_default() += v;
-        }
-        self.checked += o.checked;
-        self.clean += o.clean;
-        self.lowered += o.lowered;
-        self.build_inputs += o.build_inputs;
-        self.built += o.built;
-        self.written += o.written;
-        self.unwritten += o.unwritten;
-        self.panics += o.panics;
-        self.end_to_end += o.end_to_end;
-        self.end_to_end_failed += o.end_to_end_failed;
-        self.hangs += o.hangs;
-        self.uncoded += o.uncoded;
-        self.build_time += o.build_time;
-        for (k, (n, t)) in o.by_strategy {
-            let e = self.by_strategy.entry(k).or_default();
-            e.0 += n;
-            e.1 += t;
-        }
-        self.slowest_build = self.slowest_build.max(o.slowest_build);
-        self.slow_builds += o.slow_builds;
-    }
-}
-
-/// The strategy a small job's file uses.
-fn strategy_of(bytes: &[u8]) -> &'static str {
-    let text = String::from_utf8_lossy(bytes);
-    [
-        "profile_turning",
-        "profile_grinding",
-        "raster",
-        "spiral_turning",
-        "fts_spiral",
-        "roller_helix",
-    ]
-    .into_iter()
-    .find(|s| text.contains(&format!("= {s} {{")))
-    .unwrap_or("other")
 }
 
 fn parse_range(s: &str) -> Option<std::ops::Range<u64>> {
@@ -625,22 +594,177 @@ fn save(
     }
 }
 
+/// The parent's figures and the failures it has saved.
+struct Tally<'a> {
+    counts: Counts,
+    /// Failure messages seen so far and how often.
+    seen: HashMap<String, u32>,
+    crashes: PathBuf,
+    seed: u64,
+    target: Target,
+    build_every: u64,
+    corpora: &'a Corpora,
+}
+
+impl Tally<'_> {
+    /// Counts one input's record and saves what failed in it.
+    fn take(&mut self, r: &Record) {
+        self.counts.take(r);
+        for (what, message) in &r.failures {
+            self.failed(what, message, r.index);
+        }
+    }
+
+    /// Counts and saves an input lost with its worker.
+    fn lost(&mut self, lost: lanes::Lost) {
+        self.counts.lost += 1;
+        match lost.what {
+            "hang" => self.counts.hangs += 1,
+            _ => self.counts.aborts += 1,
+        }
+        let message = format!("lane {}: {}", lost.lane, lost.message);
+        self.failed(lost.what, &message, lost.index);
+    }
+
+    /// Reports a failure and saves its input, made again from the seed
+    /// (the first three of each message).
+    fn failed(&mut self, what: &str, message: &str, index: u64) {
+        let n = self.seen.entry(message.to_string()).or_default();
+        *n += 1;
+        if *n > 3 {
+            return;
+        }
+        let (source, bytes, _) = input_for(
+            self.target,
+            self.seed,
+            index,
+            self.build_every,
+            self.corpora,
+        );
+        let saved = save(
+            &self.crashes,
+            (what, self.target, source),
+            self.seed,
+            index,
+            &bytes,
+            message,
+        );
+        // Not `eprintln!`, which panics if stderr cannot be written.
+        let _ = writeln!(
+            std::io::stderr(),
+            "fuzz: {what} on input {index} ({source:?}): {message}\n      saved as {saved}"
+        );
+    }
+}
+
+#[derive(Default)]
+struct Counts {
+    /// Inputs also run through the `lensc` binary, and those that failed.
+    end_to_end: u64,
+    end_to_end_failed: u64,
+    inputs: HashMap<Source, u64>,
+    checked: u64,
+    clean: u64,
+    lowered: u64,
+    build_inputs: u64,
+    built: u64,
+    written: u64,
+    unwritten: u64,
+    panics: u64,
+    hangs: u64,
+    uncoded: u64,
+    /// Inputs whose worker died on them, and workers started again.
+    aborts: u64,
+    /// Inputs lost with their worker (aborts, and hangs it went silent on).
+    lost: u64,
+    restarts: u64,
+    /// Time in the workers: making inputs, running them (builds apart).
+    made: Duration,
+    check_time: Duration,
+    build_time: Duration,
+    /// Time by phase (`harness::PHASES`), over every input.
+    phases: Phases,
+    /// Builds and their time by strategy (as the job's file names it).
+    by_strategy: HashMap<&'static str, (u64, Duration)>,
+    slowest_build: Duration,
+    slow_builds: u64,
+    slowest_check: Duration,
+}
+
+impl Counts {
+    /// Counts one input's record.
+    fn take(&mut self, r: &Record) {
+        *self.inputs.entry(r.source).or_default() += 1;
+        self.made += r.made;
+        for (sum, t) in self.phases.iter_mut().zip(r.times) {
+            *sum += t;
+        }
+        if r.build {
+            let e = self.by_strategy.entry(r.strategy).or_default();
+            e.0 += 1;
+            e.1 += r.took;
+        }
+        if let Some(passed) = r.end_to_end {
+            self.end_to_end += 1;
+            self.end_to_end_failed += u64::from(!passed);
+        }
+        match r.kind {
+            Kind::Done | Kind::Uncoded => {
+                self.checked += 1;
+                self.uncoded += u64::from(r.kind == Kind::Uncoded);
+                self.clean += u64::from(r.clean);
+                self.lowered += r.lowered;
+                self.built += r.built;
+                self.written += r.written;
+                self.unwritten += r.unwritten;
+                if r.build {
+                    self.build_inputs += 1;
+                    self.build_time += r.took;
+                    self.slowest_build = self.slowest_build.max(r.took);
+                    self.slow_builds += u64::from(r.took > Duration::from_secs(1));
+                } else {
+                    self.check_time += r.took;
+                    self.slowest_check = self.slowest_check.max(r.took);
+                }
+            }
+            Kind::Panicked => self.panics += 1,
+            Kind::Hung => self.hangs += 1,
+        }
+    }
+}
+
+/// The strategy a small job's file uses.
+fn strategy_of(bytes: &[u8]) -> &'static str {
+    let text = String::from_utf8_lossy(bytes);
+    STRATEGIES
+        .into_iter()
+        .find(|s| text.contains(&format!("= {s} {{")))
+        .unwrap_or("other")
+}
+
+/// Hours, or minutes under an hour, for a person.
+fn span(seconds: f64) -> String {
+    if !seconds.is_finite() {
+        "never at this rate".into()
+    } else if seconds >= 3600.0 {
+        format!("{:.1} h", seconds / 3600.0)
+    } else {
+        format!("{:.0} min", (seconds / 60.0).ceil())
+    }
+}
+
 /// The run's figures, on stdout (a full disk or a closed pipe loses them
 /// quietly rather than panicking).
-fn summary(c: &Counts, elapsed: Duration, distinct: usize, lanes: u64) {
+fn summary(c: &Counts, elapsed: Duration, distinct: usize, lanes: u64, cores: u64, target: Target) {
     let secs = elapsed.as_secs_f64().max(1e-9);
-    // Lanes run side by side: their build time is shared out among them.
-    let check_secs = (elapsed.saturating_sub(c.build_time / lanes as u32))
-        .as_secs_f64()
-        .max(1e-9);
     let check_only = c.checked.saturating_sub(c.build_inputs);
     let get = |s| c.inputs.get(&s).copied().unwrap_or(0);
+    let total: u64 = c.inputs.values().sum();
     let mut out = std::io::stdout().lock();
     let _ = writeln!(out, "fuzz: {secs:.1} s, {lanes} lane(s)");
     let _ = writeln!(
         out,
-        "  inputs            {} ({} generated, {} mutated, {} small jobs, {} programs, {} prescriptions, {} sessions, {} measurements), {:.0}/s",
-        c.inputs.values().sum::<u64>(),
+        "  inputs            {total} ({} generated, {} mutated, {} small jobs, {} programs, {} prescriptions, {} sessions, {} measurements), {:.0}/s",
         get(Source::Generated),
         get(Source::Mutated),
         get(Source::SmallJob),
@@ -650,12 +774,15 @@ fn summary(c: &Counts, elapsed: Duration, distinct: usize, lanes: u64) {
         get(Source::Measurement),
         c.checked as f64 / secs
     );
+    // Per lane: each lane's time in inputs that are not builds.
+    let per_check_ms = c.check_time.as_secs_f64() * 1e3 / check_only.max(1) as f64;
     let _ = writeln!(
         out,
-        "  through check     {} ({} clean), {:.0} inputs/s outside builds",
+        "  through check     {} ({} clean), {:.0} inputs/s over the run, {per_check_ms:.2} ms each in a lane (outside builds), slowest {:.2} s",
         c.checked,
         c.clean,
-        check_only as f64 / check_secs
+        c.checked as f64 / secs,
+        c.slowest_check.as_secs_f64()
     );
     let _ = writeln!(out, "  jobs lowered      {}", c.lowered);
     let _ = writeln!(
@@ -666,7 +793,7 @@ fn summary(c: &Counts, elapsed: Duration, distinct: usize, lanes: u64) {
         c.unwritten,
         c.build_inputs,
         c.built as f64 / secs,
-        c.built as f64 * lanes as f64 / c.build_time.as_secs_f64().max(1e-9),
+        c.built as f64 / c.build_time.as_secs_f64().max(1e-9),
         c.slowest_build.as_secs_f64(),
         c.slow_builds
     );
@@ -684,6 +811,27 @@ fn summary(c: &Counts, elapsed: Duration, distinct: usize, lanes: u64) {
             t.as_secs_f64() * 1e3 / (*n).max(1) as f64
         );
     }
+    // Where a lane's time went: making inputs, each phase, the rest
+    // (the supervisor, the readers of other targets, the end-to-end runs).
+    let lane_secs = secs * lanes as f64;
+    let mut phases = vec![("make input", c.made)];
+    phases.extend(PHASES.iter().copied().zip(c.phases));
+    let accounted: f64 = phases.iter().map(|(_, t)| t.as_secs_f64()).sum();
+    let mut line = String::from("  time by phase    ");
+    for (name, t) in &phases {
+        if !t.is_zero() {
+            line.push_str(&format!(
+                " {name} {:.3} ms/input ({:.0}%),",
+                t.as_secs_f64() * 1e3 / total.max(1) as f64,
+                100.0 * t.as_secs_f64() / lane_secs
+            ));
+        }
+    }
+    line.push_str(&format!(
+        " other {:.0}% of the lanes' time",
+        100.0 * (lane_secs - accounted).max(0.0) / lane_secs
+    ));
+    let _ = writeln!(out, "{line}");
     let rate = c.checked as f64 / secs;
     let _ = writeln!(
         out,
@@ -691,9 +839,32 @@ fn summary(c: &Counts, elapsed: Duration, distinct: usize, lanes: u64) {
         rate * 3600.0,
         c.built as f64 / secs * 3600.0
     );
+    // The campaign's goals at this run's rate per lane, on `cores` cores
+    // (a lane to a core). A target that builds nothing (or checks
+    // nothing) says nothing of that goal.
+    let scale = cores as f64 / lanes as f64;
+    let check_rate = check_only as f64 / secs * scale;
+    let build_rate = c.built as f64 / secs * scale;
+    let mut goals = Vec::new();
+    if matches!(target, Target::Mixed | Target::Check) && check_rate > 0.0 {
+        goals.push(format!("10 M checks in {}", span(GOAL_CHECKS / check_rate)));
+    }
+    if matches!(target, Target::Mixed | Target::Build) && build_rate > 0.0 {
+        goals.push(format!(
+            "100 k builds in {}",
+            span(GOAL_BUILDS / build_rate)
+        ));
+    }
+    if !goals.is_empty() {
+        let _ = writeln!(
+            out,
+            "  projection        on {cores} core(s) at this run's rate per lane: {}",
+            goals.join(", ")
+        );
+    }
     let _ = writeln!(
         out,
-        "  panics {}, hangs {}, uncoded rejections {} ({} distinct)",
-        c.panics, c.hangs, c.uncoded, distinct
+        "  panics {}, hangs {}, aborts {} (workers started again: {}), uncoded rejections {} ({} distinct)",
+        c.panics, c.hangs, c.aborts, c.restarts, c.uncoded, distinct
     );
 }

@@ -719,3 +719,80 @@ fn a_hex_array_is_judged_lenslet_by_lenslet_and_its_axis_nub_named() {
     assert_eq!(residual["worst"]["index"], 12);
     assert_eq!(residual["passed"], true, "{residual}");
 }
+
+/// The job `job` of `text` as `lensc check` takes it (checked, lowered):
+/// the codes of what it finds, and how long that took.
+fn lowered_codes(text: &str) -> (Vec<&'static str>, std::time::Duration) {
+    let began = std::time::Instant::now();
+    let c = lensc_build::driver::check_text(
+        &lensc_lang::loader::RealFs,
+        "window.lens",
+        text.as_bytes(),
+    );
+    assert!(!c.has_errors(), "{:?}", c.diags().first());
+    let found = lensc_build::pipeline::findings_before_planning(&c, &Default::default());
+    (found.iter().map(|d| d.code).collect(), began.elapsed())
+}
+
+/// A simulation window of 100 km at a nanometre (10^28 cells; the tiles
+/// of a lathe's polar grid over it would be petabytes) is refused at once
+/// with E0149 on a raster, a spiral and a lenslet array cut with a fast
+/// tool servo, by `check` and by `lensc build` (exit 1, never an abort):
+/// in about the time the same job takes with a window of a fifth of a
+/// millimetre (a ratio under 4, so nothing grows with the window).
+#[test]
+fn a_simulation_window_of_a_hundred_kilometres_is_refused_at_once() {
+    let jobs = [
+        "surface s = sphere { radius: 4 mm, sense: convex, aperture: circle(diameter: 2 mm) }\n\
+         use std::machines::generic_3axis_mill\n\
+         use std::tools::microshaper_r85um\n\
+         strategy st = raster { along: x, stepover: 50 um, chord_tolerance: 1 um, feed: 100 mm/min }\n\
+         job j { surface: s, tool: microshaper_r85um, machine: generic_3axis_mill, strategy: st, WINDOW }\n",
+        "surface s = sphere { radius: 4 mm, sense: convex, aperture: circle(diameter: 2 mm) }\n\
+         use std::machines::moore_nanotech_450fg\n\
+         use std::tools::diamond_r500um\n\
+         strategy st = spiral_turning { feed: 20 um/rev, spindle_speed: 100 rpm, chord_tolerance: 1 um }\n\
+         job j { surface: s, tool: diamond_r500um, machine: moore_nanotech_450fg, strategy: st, WINDOW }\n",
+        "surface lenslet = sphere { radius: 20 mm, sense: concave, aperture: circle(diameter: 0.2 mm) }\n\
+         surface s = grid(lenslet, pitch_x: 0.3 mm, pitch_y: 0.3 mm, count_x: 3, count_y: 3)\n\
+         use std::machines::nanoform_x_fts5000\n\
+         use std::tools::diamond_r496um\n\
+         strategy st = fts_spiral { feed: 20 um/rev, spindle_speed: 100 rpm, chord_tolerance: 1 um }\n\
+         job j { surface: s, tool: diamond_r496um, machine: nanoform_x_fts5000, strategy: st, WINDOW }\n",
+    ];
+    let huge = "simulate: { x: -50000 m .. 50000 m, y: -50000 m .. 50000 m, spacing: 1 nm }";
+    let small = "simulate: { x: -0.1 mm .. 0.1 mm, y: -0.1 mm .. 0.1 mm, spacing: 1 um }";
+    for job in jobs {
+        let (refused, _) = lowered_codes(&job.replace("WINDOW", huge));
+        assert_eq!(refused, ["E0149"], "{job}");
+        let (fits, _) = lowered_codes(&job.replace("WINDOW", small));
+        assert!(fits.is_empty(), "{fits:?}: {job}");
+        let refusing = (0..3)
+            .map(|_| lowered_codes(&job.replace("WINDOW", huge)).1)
+            .min()
+            .expect("three");
+        let fitting = (0..3)
+            .map(|_| lowered_codes(&job.replace("WINDOW", small)).1)
+            .min()
+            .expect("three");
+        let ratio = refusing.as_secs_f64() / fitting.as_secs_f64().max(1e-6);
+        assert!(
+            ratio < 4.0,
+            "refusing the 100 km window took {refusing:?}, a small one {fitting:?}: {job}"
+        );
+        let dir = tempfile::tempdir().expect("tmp");
+        std::fs::write(dir.path().join("job.lens"), job.replace("WINDOW", huge)).expect("write");
+        let out = lensc(
+            dir.path(),
+            &[
+                "build",
+                "job.lens",
+                "--out",
+                dir.path().to_str().expect("utf8"),
+            ],
+        );
+        assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
+        assert!(text(&out.stderr).contains("E0149"), "{}", text(&out.stderr));
+        assert!(!dir.path().join("j.ngc").exists());
+    }
+}

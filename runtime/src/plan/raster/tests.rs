@@ -1118,3 +1118,16 @@ fn halves_reusing_their_parents_probes_sample_what_solving_every_probe_samples()
         "{with} evaluations reusing probes, {without} solving every one"
     );
 }
+
+/// The pre-plan check's planes on a fine raster: as many as it scans at
+/// most, evenly spread, in order, with the range's ends and the plane at
+/// the aperture's far edge among them; a coarse raster's every plane.
+#[test]
+fn the_check_scans_a_fine_raster_on_planes_spread_over_it() {
+    assert_eq!(sampled(-3, 10, 9, 1024), (-3..=10).collect::<Vec<_>>());
+    let ks = sampled(-250, 125_250, 125_000, CHECK_PLANES);
+    assert!(ks.len() <= CHECK_PLANES + 1, "{}", ks.len());
+    assert_eq!((ks[0], ks[ks.len() - 1]), (-250, 125_250));
+    assert!(ks.contains(&125_000));
+    assert!(ks.windows(2).all(|w| w[0] < w[1] && w[1] - w[0] <= 123));
+}
