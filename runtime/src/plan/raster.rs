@@ -373,14 +373,21 @@ fn scan_planes(
         });
     }
     let (last, extra) = (last as i64, extra as i64);
-    let mut summary = Summary::new(r.along);
+    // Contacts are taken a stepover beyond the aperture's edge, on the
+    // surface's own continuation where it has one: the planes whose
+    // contacts fall just outside cut the rim's last strip with their
+    // flank, which the plane inside leaves up to a stepover's scallop
+    // proud (more where the contact runs off its plane on a slope). The
+    // figures (slopes, curvatures) stay the aperture's own.
+    let reach = aperture.grown(r.stepover);
+    let mut summary = Summary::within(r.along, *aperture);
     let mut lines = Vec::new();
     for k in -extra..=last + extra {
         let mut v = v0 + k as f64 * r.stepover;
         if k == last {
             v = v.min(v1);
         }
-        let spans = cutter.spans(aperture, v, (u0, u1), &mut summary)?;
+        let spans = cutter.spans(aperture, &reach, v, (u0, u1), &mut summary)?;
         if !spans.is_empty() {
             lines.push((v, spans));
         }
@@ -1013,18 +1020,25 @@ impl<'a> Cutter<'a> {
     fn spans(
         &self,
         aperture: &Domain,
+        reach: &Domain,
         v: f64,
         (u0, u1): (f64, f64),
         summary: &mut Summary,
     ) -> Result<Vec<(Contact, Contact)>, RasterError> {
         // The ball's centre is up to a radius along the cut from its
-        // contact; the knife's is at the contact's u.
+        // contact; the knife's is at the contact's u. Contacts are taken
+        // as far as `reach`, the aperture grown to cut its rim.
         let margin = if self.ball { self.radius } else { 0.0 };
-        let (a, b) = (u0 - margin, u1 + margin);
+        let ((rx0, rx1), (ry0, ry1)) = reach.bounds();
+        let (ru0, ru1) = match self.along {
+            Axis::X => (rx0, rx1),
+            Axis::Y => (ry0, ry1),
+        };
+        let (a, b) = (u0.min(ru0) - margin, u1.max(ru1) + margin);
         let at = |i: usize| a + (b - a) * i as f64 / SCAN as f64;
         let inside = |c: &Contact| {
             let (x, y) = xy(self.along, c.u, c.v);
-            aperture.contains(x, y)
+            reach.contains(x, y)
         };
         let scan = self.probe_plane(aperture, v, &at, &inside)?;
         let scan: Vec<Option<Contact>> = scan
@@ -1459,6 +1473,9 @@ struct Summary {
     /// steeper cannot have a larger slope (atan is monotonic), so its
     /// arctangent is never taken (most contacts' are not).
     steepest: [f64; 2],
+    /// The aperture whose figures these are: contacts the planes take
+    /// beyond it (to cut its rim) are not counted.
+    aperture: Option<Domain>,
 }
 
 impl Summary {
@@ -1475,11 +1492,23 @@ impl Summary {
             concave_along: None,
             tool_limit: None,
             steepest: [f64::NEG_INFINITY; 2],
+            aperture: None,
+        }
+    }
+
+    /// A summary of the contacts inside `aperture` only.
+    fn within(along: Axis, aperture: Domain) -> Summary {
+        Summary {
+            aperture: Some(aperture),
+            ..Summary::new(along)
         }
     }
 
     fn see(&mut self, c: &Contact, cutter: &Cutter) {
         let (x, y) = xy(self.along, c.u, c.v);
+        if self.aperture.is_some_and(|a| !a.contains(x, y)) {
+            return;
+        }
         let at = |value: f64| Extremum { value, x, y };
         for (k, (slope, extremum)) in [
             (c.l.zu.abs(), &mut self.slope_along),
