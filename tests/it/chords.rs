@@ -438,7 +438,6 @@ fn in_a_raster_each_placement_meets_its_promise() {
 const DOME_BAND: &str = "max_residual: 401 nm, form_pv: 802 nm, form_rms: 200.5 nm";
 
 #[test]
-#[ignore = "finding: the raster's rim is left 1.80 um proud (x = -0.04, y = -0.495 mm, the last line at the edge; PV 1.80 um over the whole dome at each of the three limits), beyond the 401 nm stated; likely lin_paraboloid's rim (planners branch)"]
 fn an_optimised_strategy_by_default_meets_max_gouge() {
     // On the path the chords and fits may gouge T/10 + 3T/20 = 100 nm:
     // a 150 nm limit keeps the points there, 80 nm straddles them (20 + 60
