@@ -747,6 +747,34 @@ fn a_job_with_no_chord_tolerance_builds_on_every_0_1_um_stdlib_machine() {
     }
 }
 
+#[test]
+fn a_newcomers_milled_bowl_is_cut_to_its_rim() {
+    // Issue #29: the raster's last plane took its contact a stepover
+    // inside the rim and its flank left the rim proud: 382.66 nm at
+    // (0, -5 mm) over the default 274 nm residual, judged on the whole
+    // part. The passes now take their contacts beyond the rim.
+    let dir = tempfile::tempdir().expect("tmp");
+    let out = lensc(
+        &root(),
+        &[
+            "build",
+            "tests/jobs/newcomer_paraboloid.lens",
+            "--out",
+            dir.path().to_str().expect("utf8"),
+        ],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let report: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("bowl.report.json")).expect("report"),
+    )
+    .expect("json");
+    assert_eq!(report["acceptance"]["judged"]["area"], "whole_part");
+    let residual = report["simulation"]["height_map"]["contact"]["max_residual_nm"]["value"]
+        .as_f64()
+        .expect("residual");
+    assert!(residual < 274.0, "{residual}");
+}
+
 /// `lensc verify` tells lensc's policy from the controller's rules: a
 /// policy finding is named (text and JSON, with its reason), fails by
 /// default and only warns under `--policy warn`; a controller finding

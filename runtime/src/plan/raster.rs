@@ -21,9 +21,15 @@
 //! Points are spaced so that no chord between consecutive centres strays
 //! more than the chord tolerance from the exact centre curve, optionally
 //! also capped by a fixed step and by Lin's step rule (eqs 2–3). Each path
-//! ends where the contact point reaches the aperture edge. Lin's
-//! approximate compensations (eq 4, eqs 5–6) are provided as functions to
-//! compare against; the planner itself does not use them.
+//! ends where the contact point reaches the edge of the aperture grown by
+//! the rim's reach (`rim_reach`: a stepover, or the largest distance
+//! between neighbouring planes' contacts where that is more), so that
+//! every point of the rim lies between two planes' contacts and is cut to
+//! a scallop, not left to the flank of the last plane inside; where the
+//! surface is undefined beyond the aperture, the path ends where it stops
+//! being defined. Lin's approximate compensations (eq 4, eqs 5–6) are
+//! provided as functions to compare against; the planner itself does not
+//! use them.
 //!
 //! Units: mm and rad. +z points out of the material, towards the tool.
 
@@ -201,6 +207,23 @@ impl std::fmt::Display for RasterError {
 
 impl std::error::Error for RasterError {}
 
+impl RasterError {
+    /// The point (x, y) on the part the error names, if it names one.
+    fn place(&self) -> Option<(f64, f64)> {
+        match *self {
+            RasterError::ToolTooLarge { x, y, .. }
+            | RasterError::ClearanceTooSmall { x, y, .. }
+            | RasterError::Undefined { x, y }
+            | RasterError::NoContact { x, y }
+            | RasterError::ToleranceUnreachable { x, y, .. } => Some((x, y)),
+            RasterError::InvalidParameter { .. }
+            | RasterError::TooManyPaths { .. }
+            | RasterError::TooManyPoints { .. }
+            | RasterError::NothingToCut => None,
+        }
+    }
+}
+
 /// A contact point on the surface and the tool centre that touches it there.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ToolContact {
@@ -363,15 +386,54 @@ fn scan_planes(
     most: usize,
 ) -> Result<(Vec<Line>, Summary), RasterError> {
     validate(r, tool, aperture)?;
+    // Contacts are taken beyond the aperture's edge (`rim_reach`), on the
+    // surface's own continuation where it has one: a point of the rim
+    // lies between the contacts of two planes only if the outer plane's
+    // contact reaches past it. A first reach of a stepover covers the rim
+    // wherever the contacts of neighbouring planes lie no further apart
+    // than their planes (a flat or convex section across the cut); where
+    // they spread further (a concave one: a ball in a bowl), the planes
+    // are scanned again with the reach their spread asks for.
+    let (lines, summary) = scan_reach(r, cutter, aperture, r.stepover)?;
+    let reach = rim_reach(r.stepover, cutter.radius, summary.spread);
+    if reach <= r.stepover {
+        return Ok((lines, summary));
+    }
+    scan_reach(r, cutter, aperture, reach)
+}
+
+/// How far (mm) beyond the aperture the contacts are taken: the largest
+/// distance between the contacts of neighbouring planes, `stepover`
+/// times `spread` (the largest ratio of that distance to the stepover at
+/// the aperture's contacts, 1/(1 − ρ ∂(z_v/W)/∂v), `Cutter::spread`), at
+/// least a stepover and at most the tool's radius (a spread that large is
+/// a tool that barely fits its hollow).
+fn rim_reach(stepover: f64, tool_radius: f64, spread: f64) -> f64 {
+    let spacing = stepover * spread;
+    if spacing.is_nan() || spacing <= stepover {
+        return stepover;
+    }
+    spacing.min(tool_radius.max(stepover))
+}
+
+/// The planes' scan (`scan_planes`) with contacts taken up to `margin`
+/// (mm) beyond the aperture.
+fn scan_reach(
+    r: &Raster,
+    cutter: &Cutter,
+    aperture: &Domain,
+    margin: f64,
+) -> Result<(Vec<Line>, Summary), RasterError> {
     let ((x0, x1), (y0, y1)) = aperture.bounds();
     let ((u0, u1), (v0, v1)) = match r.along {
         Axis::X => ((x0, x1), (y0, y1)),
         Axis::Y => ((y0, y1), (x0, x1)),
     };
-    // The contact lies off its plane by up to the tool's radius, so the
-    // planes reach a radius beyond the aperture on either side.
+    // The contact lies off its plane by up to the tool's radius, and is
+    // taken up to `margin` beyond the aperture, so the planes reach that
+    // far beyond it on either side.
     let last = ((v1 - v0) / r.stepover + 1e-9).floor();
-    let extra = (cutter.radius / r.stepover).ceil();
+    let extra = ((cutter.radius + margin) / r.stepover).ceil();
     let paths = last + 1.0 + 2.0 * extra;
     if paths > MAX_PATHS as f64 {
         return Err(RasterError::TooManyPaths {
@@ -380,14 +442,17 @@ fn scan_planes(
         });
     }
     let (last, extra) = (last as i64, extra as i64);
-    let mut summary = Summary::new(r.along);
+    // The figures (slopes, curvatures, the tool's fit) stay the
+    // aperture's own.
+    let reach = aperture.grown(margin);
+    let mut summary = Summary::within(r.along, *aperture);
     let mut lines = Vec::new();
     for k in sampled(-extra, last + extra, last, most) {
         let mut v = v0 + k as f64 * r.stepover;
         if k == last {
             v = v.min(v1);
         }
-        let spans = cutter.spans(aperture, v, (u0, u1), &mut summary)?;
+        let spans = cutter.spans(aperture, &reach, v, (u0, u1), &mut summary)?;
         if !spans.is_empty() {
             lines.push((v, spans));
         }
@@ -418,7 +483,9 @@ fn sampled(first: i64, end: i64, keep: i64, most: usize) -> Vec<i64> {
 
 /// Plans the raster over `aperture`: path planes at v0 + k·stepover (v is y
 /// when cutting along x), each pass running between the points where the
-/// contact point meets the aperture edge.
+/// contact point meets the edge of the aperture grown by the rim's reach
+/// (`rim_reach`), or stops short of it where the surface is undefined
+/// beyond the aperture.
 pub fn plan_raster(
     r: &Raster,
     tool: &RasterTool,
@@ -765,10 +832,13 @@ enum Half {
 
 /// One point of a ball plane's scan.
 enum Probe {
-    /// The contact lies in the aperture.
+    /// The contact lies in the reach (the aperture grown to cut its rim).
     In(Contact),
     /// The contact lies outside it.
     Out,
+    /// The contact failed outside the aperture: the surface has no
+    /// continuation there to cut the rim with.
+    Lost,
     /// No contact was found.
     Fail(RasterError),
 }
@@ -951,9 +1021,7 @@ impl<'a> Cutter<'a> {
         if s.steps == MAX_STEPS || g.abs() <= 1e-16 * scale {
             return self.conclude(plane, s);
         }
-        let zu = self.lean(&l);
-        let dq = l.zvv / w - l.zv * (zu * l.zuv + l.zv * l.zvv) / (w2 * w);
-        let jac = 1.0 - rho * dq;
+        let jac = self.plane_rate(&l, w2, w);
         if jac.is_nan() || jac <= 0.0 {
             // The plane's offset folds over: the tool is too large for
             // the hollow here, or no contact lies on this plane.
@@ -975,6 +1043,31 @@ impl<'a> Cutter<'a> {
             step: -g / jac,
             halvings: 0,
         };
+    }
+
+    /// g'(v) = 1 − ρ ∂(z_v/W)/∂v at the surface `l` (W² `w2`, W `w`):
+    /// how fast the tool centre's v moves with its contact's v across the
+    /// cut, the Newton solve's slope.
+    #[inline(always)]
+    fn plane_rate(&self, l: &Local, w2: f64, w: f64) -> f64 {
+        let zu = self.lean(l);
+        let dq = l.zvv / w - l.zv * (zu * l.zuv + l.zv * l.zvv) / (w2 * w);
+        1.0 - self.radius * dq
+    }
+
+    /// How many stepovers apart the contacts of neighbouring planes lie
+    /// at a contact with the surface `l` there: 1/g'(v) (`plane_rate`),
+    /// below 1 where the section across the cut is convex, above 1 where
+    /// it is concave, infinite where the offset folds over.
+    fn spread(&self, l: &Local) -> f64 {
+        let zu = self.lean(l);
+        let w2 = 1.0 + zu * zu + l.zv * l.zv;
+        let rate = self.plane_rate(l, w2, w2.sqrt());
+        if rate > 0.0 {
+            1.0 / rate
+        } else {
+            f64::INFINITY
+        }
     }
 
     /// The end solve `s` has reached: solved, or why there is no contact.
@@ -1035,24 +1128,59 @@ impl<'a> Cutter<'a> {
     }
 
     /// The spans of the plane at v: runs of contact positions whose contact
-    /// point lies in the aperture, their ends refined to the edge.
+    /// point lies in `reach` (the aperture grown to cut its rim), their
+    /// ends refined to its edge. Where a contact fails beyond the aperture
+    /// on this plane (a surface undefined there, a tool that finds no
+    /// contact), the surface has no continuation to cut the rim with, and
+    /// the plane's contacts are taken in the aperture only, as far as its
+    /// edge: the contacts next to a failure would be sampled where the
+    /// solve is ill-conditioned (a conic near its root, its slope
+    /// unbounded).
     fn spans(
         &self,
         aperture: &Domain,
+        reach: &Domain,
         v: f64,
         (u0, u1): (f64, f64),
         summary: &mut Summary,
     ) -> Result<Vec<(Contact, Contact)>, RasterError> {
+        match self.spans_in(aperture, reach, v, (u0, u1), summary)? {
+            Some(spans) => Ok(spans),
+            None => Ok(self
+                .spans_in(aperture, aperture, v, (u0, u1), summary)?
+                .unwrap_or_default()),
+        }
+    }
+
+    /// `spans` with contacts taken as far as `reach`; `None` if a contact
+    /// beyond the aperture failed and `reach` is larger than the aperture.
+    fn spans_in(
+        &self,
+        aperture: &Domain,
+        reach: &Domain,
+        v: f64,
+        (u0, u1): (f64, f64),
+        summary: &mut Summary,
+    ) -> Result<Option<Vec<(Contact, Contact)>>, RasterError> {
         // The ball's centre is up to a radius along the cut from its
         // contact; the knife's is at the contact's u.
         let margin = if self.ball { self.radius } else { 0.0 };
-        let (a, b) = (u0 - margin, u1 + margin);
+        let ((rx0, rx1), (ry0, ry1)) = reach.bounds();
+        let (ru0, ru1) = match self.along {
+            Axis::X => (rx0, rx1),
+            Axis::Y => (ry0, ry1),
+        };
+        let (a, b) = (u0.min(ru0) - margin, u1.max(ru1) + margin);
         let at = |i: usize| a + (b - a) * i as f64 / SCAN as f64;
         let inside = |c: &Contact| {
             let (x, y) = xy(self.along, c.u, c.v);
-            aperture.contains(x, y)
+            reach.contains(x, y)
         };
-        let scan = self.probe_plane(aperture, v, &at, &inside)?;
+        let grown = reach != aperture;
+        let scan = self.probe_plane(aperture, reach, v, &at, &inside)?;
+        if grown && scan.iter().any(|p| matches!(p, Probe::Lost)) {
+            return Ok(None);
+        }
         let scan: Vec<Option<Contact>> = scan
             .into_iter()
             .map(|p| match p {
@@ -1061,7 +1189,9 @@ impl<'a> Cutter<'a> {
             })
             .collect();
         // Moves from an inside contact towards an outside position until
-        // the contact sits on the aperture edge.
+        // the contact sits on the edge of the reach; a contact that fails
+        // on the way counts as outside, and is noted.
+        let lost = std::cell::Cell::new(false);
         let refine = |mut c_in: Contact, mut t_out: f64| {
             for _ in 0..64 {
                 let mid = 0.5 * (c_in.u + t_out);
@@ -1070,6 +1200,33 @@ impl<'a> Cutter<'a> {
                 }
                 match self.contact(v, mid, c_in.v) {
                     Ok(c) if inside(&c) => c_in = c,
+                    Ok(_) => t_out = mid,
+                    Err(e) => {
+                        let in_reach = |(x, y): (f64, f64)| reach.contains(x, y);
+                        if e.place().is_none_or(in_reach) {
+                            lost.set(true);
+                        }
+                        t_out = mid;
+                    }
+                }
+            }
+            c_in
+        };
+        let in_aperture = |c: &Contact| {
+            let (x, y) = xy(self.along, c.u, c.v);
+            aperture.contains(x, y)
+        };
+        // The contact on the aperture's edge between two contacts of the
+        // plane, one in the aperture and one out of it, by bisection.
+        let on_edge = |p: &Contact, q: &Contact| {
+            let (mut c_in, mut t_out) = if in_aperture(p) { (*p, q.u) } else { (*q, p.u) };
+            for _ in 0..64 {
+                let mid = 0.5 * (c_in.u + t_out);
+                if mid == c_in.u || mid == t_out {
+                    break;
+                }
+                match self.contact(v, mid, c_in.v) {
+                    Ok(c) if in_aperture(&c) => c_in = c,
                     _ => t_out = mid,
                 }
             }
@@ -1088,6 +1245,7 @@ impl<'a> Cutter<'a> {
             }
             for c in scan[i..=j].iter().flatten() {
                 summary.see(c, self);
+                summary.see_spread(c, self);
             }
             let start = if i > 0 {
                 refine(first, at(i - 1))
@@ -1102,6 +1260,20 @@ impl<'a> Cutter<'a> {
             };
             summary.see(&start, self);
             summary.see(&end, self);
+            if grown {
+                // The figures are the aperture's own: where the span
+                // crosses the aperture's edge, the contact on the edge is
+                // seen too (a convex lens is steepest there).
+                let run: Vec<Contact> = std::iter::once(start)
+                    .chain(scan[i..=j].iter().flatten().copied())
+                    .chain(std::iter::once(end))
+                    .collect();
+                for w in run.windows(2) {
+                    if in_aperture(&w[0]) != in_aperture(&w[1]) {
+                        summary.see(&on_edge(&w[0], &w[1]), self);
+                    }
+                }
+            }
             // A plane that only grazes the aperture (its contacts meeting
             // the edge at one point, to rounding) has nothing to cut.
             if end.u - start.u > MIN_SPAN {
@@ -1109,15 +1281,21 @@ impl<'a> Cutter<'a> {
             }
             i = j + 1;
         }
-        Ok(spans)
+        if grown && lost.get() {
+            return Ok(None);
+        }
+        Ok(Some(spans))
     }
 
     /// The contact at each of the `SCAN + 1` positions `at(i)` of the
-    /// plane at v: `In` inside the aperture, `Out` outside, `Fail` where
-    /// the solve failed; or the error that stops the plane.
+    /// plane at v: `In` where `inside` holds (in `reach`), `Out` outside
+    /// (or failed outside `reach`), `Lost` where it failed in `reach` but
+    /// outside the aperture, `Fail` where it failed elsewhere; or the
+    /// error that stops the plane.
     fn probe_plane(
         &self,
         aperture: &Domain,
+        reach: &Domain,
         v: f64,
         at: &dyn Fn(usize) -> f64,
         inside: &dyn Fn(&Contact) -> bool,
@@ -1159,7 +1337,21 @@ impl<'a> Cutter<'a> {
                         y,
                     });
                 }
-                Err(e) => Probe::Fail(e),
+                // A contact that fails outside the aperture (a surface
+                // undefined beyond it, a tool too large for it there) is
+                // not an error: outside the reach it is a contact outside;
+                // in it, the rim's continuation is lost, and the plane
+                // then cuts as far as the aperture's edge only (`spans`).
+                Err(e) => match e.place() {
+                    Some((x, y)) if !aperture.contains(x, y) => {
+                        if reach.contains(x, y) {
+                            Probe::Lost
+                        } else {
+                            Probe::Out
+                        }
+                    }
+                    _ => Probe::Fail(e),
+                },
             };
             guess = match probe {
                 Probe::In(c) => c.v,
@@ -1485,6 +1677,12 @@ struct Summary {
     /// steeper cannot have a larger slope (atan is monotonic), so its
     /// arctangent is never taken (most contacts' are not).
     steepest: [f64; 2],
+    /// The aperture whose figures these are: contacts the planes take
+    /// beyond it (to cut its rim) are not counted.
+    aperture: Option<Domain>,
+    /// The largest spread (`Cutter::spread`) at the planes' scanned
+    /// contacts in the aperture (1 if none is above 1).
+    spread: f64,
 }
 
 impl Summary {
@@ -1501,11 +1699,24 @@ impl Summary {
             concave_along: None,
             tool_limit: None,
             steepest: [f64::NEG_INFINITY; 2],
+            aperture: None,
+            spread: 1.0,
+        }
+    }
+
+    /// A summary of the contacts inside `aperture` only.
+    fn within(along: Axis, aperture: Domain) -> Summary {
+        Summary {
+            aperture: Some(aperture),
+            ..Summary::new(along)
         }
     }
 
     fn see(&mut self, c: &Contact, cutter: &Cutter) {
         let (x, y) = xy(self.along, c.u, c.v);
+        if self.aperture.is_some_and(|a| !a.contains(x, y)) {
+            return;
+        }
         let at = |value: f64| Extremum { value, x, y };
         for (k, (slope, extremum)) in [
             (c.l.zu.abs(), &mut self.slope_along),
@@ -1545,6 +1756,15 @@ impl Summary {
             if smaller(&self.tool_limit, r_tool) {
                 self.tool_limit = Some(at(r_tool));
             }
+        }
+    }
+
+    /// Takes the spread at a contact of a plane's scan (`Cutter::spread`)
+    /// into `spread`, if the contact lies in the aperture.
+    fn see_spread(&mut self, c: &Contact, cutter: &Cutter) {
+        let (x, y) = xy(self.along, c.u, c.v);
+        if self.aperture.is_none_or(|a| a.contains(x, y)) {
+            self.spread = self.spread.max(cutter.spread(&c.l));
         }
     }
 

@@ -34,6 +34,23 @@ impl Domain {
             } => x >= x0 && x <= x1 && y >= y0 && y <= y1,
         }
     }
+    /// The domain grown by `margin` (mm) all round: a disc or ring's outer
+    /// radius larger (and a ring's hole smaller), a rectangle wider.
+    pub fn grown(&self, margin: f64) -> Domain {
+        match *self {
+            Domain::Circle { radius } => Domain::Circle {
+                radius: radius + margin,
+            },
+            Domain::Annulus { inner, outer } => Domain::Annulus {
+                inner: (inner - margin).max(0.0),
+                outer: outer + margin,
+            },
+            Domain::Rect { x, y } => Domain::Rect {
+                x: (x.0 - margin, x.1 + margin),
+                y: (y.0 - margin, y.1 + margin),
+            },
+        }
+    }
     /// The bounding box ((x0, x1), (y0, y1)).
     pub fn bounds(&self) -> ((f64, f64), (f64, f64)) {
         match *self {

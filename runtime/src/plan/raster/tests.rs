@@ -59,6 +59,24 @@ impl SurfaceFn for Ramp {
     }
 }
 
+/// A surface defined on the disc of `radius` about the axis only (NaN
+/// beyond it), like a conic at its root.
+struct Only<S> {
+    surface: S,
+    radius: f64,
+}
+
+impl<S: SurfaceFn> SurfaceFn for Only<S> {
+    fn eval_batch(&self, xs: &[f64], ys: &[f64], out: &mut [f64]) {
+        self.surface.eval_batch(xs, ys, out);
+        for (i, (&x, &y)) in xs.iter().zip(ys).enumerate() {
+            if x.hypot(y) > self.radius {
+                out[6 * i..6 * i + 6].fill(f64::NAN);
+            }
+        }
+    }
+}
+
 /// Lin's microshaper: nose radius 85 µm (seed 000, Fig. 1).
 const LIN_NOSE: f64 = 0.085;
 const KNIFE: RasterTool = RasterTool::Knife {
@@ -329,13 +347,17 @@ fn lin_jobs_plan() {
             path.max_slope_across.value.to_degrees(),
             path.safe_z
         );
-        // Planes at −0.8 + 0.01 k. The knife's contact on the plane
-        // at v lies ρ sin φ nearer the axis, φ the slope across, so
-        // planes out to 0.8 mm + ρ sin φ(0.8 mm) cut (φ at the edge on
-        // the y axis, where the contact is nearest the axis).
-        let phi = (0.8 / (radius * radius - (1.0 + k) * 0.64f64).sqrt()).atan();
-        let reach = 0.8 + LIN_NOSE * phi.sin();
-        let planes = (-9..=169)
+        // Planes at −0.8 + 0.01 k. Their contacts are taken a stepover
+        // beyond the aperture, out to 0.81 mm (on a convex lens the
+        // contacts of neighbouring planes lie closer than their planes).
+        // The knife's contact on the plane at v lies ρ sin φ nearer the
+        // axis, φ the slope across, so planes out to 0.81 mm +
+        // ρ sin φ(0.81 mm) cut (φ at the reach's edge on the y axis,
+        // where the contact is nearest the axis).
+        let q = 0.81f64;
+        let phi = (q / (radius * radius - (1.0 + k) * q * q).sqrt()).atan();
+        let reach = q + LIN_NOSE * phi.sin();
+        let planes = (-12..=172)
             .filter(|&j| (-0.8 + 0.01 * f64::from(j)).abs() < reach)
             .count();
         eprintln!("  {planes} planes reach {reach:.5} mm");
@@ -365,7 +387,8 @@ fn oblate_ellipsoid_aperture_is_limited_by_the_conic_root() {
     let surf = convex(3.0, 10.0);
     let limit = 3.0 / 11f64.sqrt();
     let r = raster(Axis::X, 0.01, 1e-5);
-    assert!(plan_raster(&r, &KNIFE, &surf, &Domain::Circle { radius: 0.9 }).is_ok());
+    let got = plan_raster(&r, &KNIFE, &surf, &Domain::Circle { radius: 0.9 });
+    assert!(got.is_ok(), "{:?}", got.err());
     match plan_raster(&r, &KNIFE, &surf, &Domain::Circle { radius: 0.95 }) {
         Err(RasterError::Undefined { x, y }) => {
             let q = x.hypot(y);
@@ -537,17 +560,34 @@ fn plans_beyond_reach_give_errors() {
         Err(RasterError::ToleranceUnreachable { .. })
     ));
     // The one plane of a tiny aperture only touches its edge (on a
-    // surface level across the cut, the contact is on the plane).
+    // surface level across the cut, the contact is on the plane), and
+    // the surface has no continuation beyond the aperture to cut its rim
+    // with (defined on the aperture only), so nothing is cut.
     assert_eq!(
         plan_raster(
             &base,
             &KNIFE,
-            &Ramp { a: 0.1, b: 0.0 },
+            &Only {
+                surface: Ramp { a: 0.1, b: 0.0 },
+                radius: 0.001
+            },
             &Domain::Circle { radius: 0.001 }
         )
         .unwrap_err(),
         RasterError::NothingToCut
     );
+    // Where it has one, the plane at the edge cuts the rim: its contacts
+    // run out to the aperture grown by a stepover.
+    let rim = plan_raster(
+        &base,
+        &KNIFE,
+        &Ramp { a: 0.1, b: 0.0 },
+        &Domain::Circle { radius: 0.001 },
+    )
+    .unwrap();
+    let reach = 0.001 + base.stepover;
+    let half = (reach * reach - 0.001f64 * 0.001).sqrt();
+    assert!((rim.passes[0][0][0] + half).abs() < 1e-12, "{rim:?}");
 }
 
 /// A concave sphere R = 1 mm: the cross-section at x = u, the knife
@@ -641,44 +681,97 @@ fn the_pre_plan_check_agrees_with_the_planner() {
     }
 }
 
-/// Each pass starts and ends with the contact point exactly on the
-/// aperture edge.
+/// The ball's contact for the centre `p` on its plane (along x): where the
+/// normal through the centre meets the surface, by bisection on the
+/// contact's x.
+fn ball_contact_of(ball: &RasterTool, surf: &dyn SurfaceFn, p: [f64; 3]) -> [f64; 3] {
+    let rho = ball.radius();
+    let on = |t: f64| tool_contact(ball, surf, Axis::X, p[1], t).unwrap();
+    let (mut lo, mut hi) = (p[0] - rho, p[0] + rho);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if on(mid).centre[0] < p[0] {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    on(0.5 * (lo + hi)).contact
+}
+
+/// Each pass starts and ends with the contact point exactly on the edge of
+/// the rim's reach: the aperture (0.8 mm) grown by a stepover (0.05 mm) on
+/// a convex lens, whose neighbouring planes' contacts lie closer together
+/// than their planes, so every point of the rim lies between two planes'
+/// contacts.
 #[test]
-fn passes_end_where_the_contact_reaches_the_edge() {
+fn passes_end_where_the_contact_reaches_a_stepover_beyond_the_edge() {
     let surf = convex(1.0, -20.0);
     let r = raster(Axis::X, 0.05, 1e-5);
-    let path = plan_raster(&r, &KNIFE, &surf, &Domain::Circle { radius: 0.8 }).unwrap();
+    let aperture = Domain::Circle { radius: 0.8 };
+    let path = plan_raster(&r, &KNIFE, &surf, &aperture).unwrap();
     for pass in &path.passes {
         for p in [pass[0], *pass.last().unwrap()] {
             // The knife's contact is at the centre's x.
             let c = tool_contact(&KNIFE, &surf, Axis::X, p[1], p[0]).unwrap();
             assert!(distance3(p, c.centre) < 1e-15);
             assert!(
-                (c.contact[0].hypot(c.contact[1]) - 0.8).abs() < 1e-9,
+                (c.contact[0].hypot(c.contact[1]) - 0.85).abs() < 1e-9,
                 "{c:?}"
             );
         }
     }
     let ball = RasterTool::Ball { radius: 0.1 };
-    let path = plan_raster(&r, &ball, &surf, &Domain::Circle { radius: 0.8 }).unwrap();
+    let path = plan_raster(&r, &ball, &surf, &aperture).unwrap();
     for pass in &path.passes {
         for p in [pass[0], *pass.last().unwrap()] {
-            // Recover the contact: the ball touches where the normal
-            // through the centre meets the surface.
-            let on = |t: f64| tool_contact(&ball, &surf, Axis::X, p[1], t).unwrap();
-            let (mut lo, mut hi) = (p[0] - 0.1, p[0] + 0.1);
-            for _ in 0..200 {
-                let mid = 0.5 * (lo + hi);
-                if on(mid).centre[0] < p[0] {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            let c = on(0.5 * (lo + hi)).contact;
-            assert!((c[0].hypot(c[1]) - 0.8).abs() < 1e-9, "{c:?}");
+            let c = ball_contact_of(&ball, &surf, p);
+            assert!((c[0].hypot(c[1]) - 0.85).abs() < 1e-9, "{c:?}");
         }
     }
+}
+
+/// In a bowl the contacts of neighbouring planes lie further apart than
+/// their planes: on a concave sphere of radius R a ball of radius ρ has its
+/// centre on the line from the sphere's centre through its contact, so the
+/// contacts are the planes scaled by R/(R − ρ), here 2 (R = 1 mm, ρ =
+/// 0.5 mm), and a stepover's reach would leave the last plane's contact
+/// inside the rim. The passes run out to the aperture grown by the
+/// contacts' spacing, 2 stepovers (0.8 + 0.1 mm); the figures stay the
+/// aperture's own (the steepest slope along the cut is the edge's,
+/// atan(0.8/0.6)).
+#[test]
+fn in_a_bowl_passes_reach_as_far_beyond_the_edge_as_the_contacts_spread() {
+    let bowl = Conic {
+        radius: 1.0,
+        k: 0.0,
+        s: 1.0,
+    };
+    let ball = RasterTool::Ball { radius: 0.5 };
+    let r = raster(Axis::X, 0.05, 1e-5);
+    let path = plan_raster(&r, &ball, &bowl, &Domain::Circle { radius: 0.8 }).unwrap();
+    for pass in &path.passes {
+        for p in [pass[0], *pass.last().unwrap()] {
+            let c = ball_contact_of(&ball, &bowl, p);
+            assert!((c[0].hypot(c[1]) - 0.9).abs() < 1e-9, "{c:?}");
+        }
+    }
+    // The outermost planes: centres within 0.9 × (R − ρ)/R = 0.45 mm of
+    // the axis, planes at −0.8 + 0.05 k; the one at 0.4 mm, which would
+    // only graze the aperture's own edge (its contacts 0.8 mm out), cuts.
+    let outer = path
+        .passes
+        .iter()
+        .map(|p| p[0][1].abs())
+        .fold(0.0, f64::max);
+    assert!(outer > 0.4 - 1e-12 && outer < 0.45 + 1e-12, "{outer}");
+    let want = (0.8f64 / 0.6).atan();
+    assert!(
+        (path.max_slope_along.value - want).abs() < 1e-9,
+        "{} against {want}",
+        path.max_slope_along.value
+    );
+    assert!(path.max_slope_along.x.hypot(path.max_slope_along.y) <= 0.8 + 1e-12);
 }
 
 /// The exact raise of the knife tip above S when the nose is centred
