@@ -216,6 +216,9 @@ pub struct FollowingSimulation {
     ahead: Vec<SpiralPoint>,
     /// The point before the last one run (led: the path a period back).
     prior: Option<SpiralPoint>,
+    /// The command (mm) at and above which the nose cuts air
+    /// (`cutting_below`; infinite: it cuts everywhere).
+    air: f64,
     /// The last point in part coordinates (x cos c, x sin c; mm), worked
     /// out once per point.
     last_xy: (f64, f64),
@@ -276,6 +279,7 @@ impl FollowingSimulation {
             lead: None,
             ahead: Vec::new(),
             prior: None,
+            air: f64::INFINITY,
             last_xy: (0.0, 0.0),
             last_error: None,
             features: features.to_vec(),
@@ -302,6 +306,16 @@ impl FollowingSimulation {
     pub fn led(mut self, servo: &SecondOrderServo) -> FollowingSimulation {
         let wn = 2.0 * std::f64::consts::PI * servo.natural_frequency_hz;
         self.lead = Some((2.0 * servo.damping / wn, 1.0 / (wn * wn)));
+        self
+    }
+
+    /// The same simulation with the error gathered only where the nose
+    /// cuts: a move whose ends both command `level` (mm) or higher (a
+    /// settling plateau, a lenslet's continuation over the land: the
+    /// trajectory above the part's top) cuts air, and the servo's error
+    /// there leaves no mark. The servo still runs through it.
+    pub fn cutting_below(mut self, level: f64) -> FollowingSimulation {
+        self.air = level;
         self
     }
 
@@ -396,12 +410,20 @@ impl FollowingSimulation {
         };
         // The four kinds of move get a loop each, so the per-sample work
         // carries no test that cannot change within the move.
+        // A move wholly in the air (`cutting_below`) cuts nothing: the
+        // servo runs, its error is not gathered.
+        let in_air = q.w.min(p.w) >= self.air;
         let acc = match (one_bin, lenslet.is_some()) {
-            (true, true) => self.samples::<true, true>(&mv),
-            (true, false) => self.samples::<true, false>(&mv),
-            (false, true) => self.samples::<false, true>(&mv),
-            (false, false) => self.samples::<false, false>(&mv),
+            _ if in_air => self.samples::<true, false, false>(&mv),
+            (true, true) => self.samples::<true, true, true>(&mv),
+            (true, false) => self.samples::<true, false, true>(&mv),
+            (false, true) => self.samples::<false, true, true>(&mv),
+            (false, false) => self.samples::<false, false, true>(&mv),
         };
+        if in_air {
+            self.last_error = None;
+            return;
+        }
         if acc.bin.0 > 0 {
             self.by_radius
                 .add_many(bin, acc.bin.0, acc.bin.1, acc.bin.2);
@@ -417,9 +439,12 @@ impl FollowingSimulation {
 
     /// Steps the servo over the samples of one move, gathering the errors
     /// in the move's one bin of radius (`ONE_BIN`, else each in its own)
-    /// and, `IN_LENSLET`, for the lenslet under it.
+    /// and, `IN_LENSLET`, for the lenslet under it; none unless `CUTTING`.
     #[inline(always)]
-    fn samples<const ONE_BIN: bool, const IN_LENSLET: bool>(&mut self, mv: &Move) -> MoveAcc {
+    fn samples<const ONE_BIN: bool, const IN_LENSLET: bool, const CUTTING: bool>(
+        &mut self,
+        mv: &Move,
+    ) -> MoveAcc {
         let Move {
             q,
             p,
@@ -462,12 +487,13 @@ impl FollowingSimulation {
             let command = q.w + f * dw;
             let error = pos - command;
             let radius = || (q.x + f * (p.x - q.x)).abs();
-            if error.abs() > max_error {
+            if CUTTING && error.abs() > max_error {
                 // Rare once the spiral is under way: a branch, not a
                 // select the peak's radius would be computed for.
                 (max_error, max_error_at) = new_peak(error, radius());
             }
-            if ONE_BIN {
+            if !CUTTING {
+            } else if ONE_BIN {
                 acc.bin.0 += 1;
                 acc.bin.1 = acc.bin.1.min(error);
                 acc.bin.2 = acc.bin.2.max(error);

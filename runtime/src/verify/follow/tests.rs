@@ -334,3 +334,31 @@ fn a_led_held_command_is_followed_exactly() {
     assert!(f.samples > 3900);
     assert!(f.max_error < 1e-12, "{}", f.max_error);
 }
+
+#[test]
+fn errors_in_the_air_are_not_gathered() {
+    // A step up to a plateau and back: driven as printed the servo lags
+    // the step by microns. Cutting below the plateau, the moves held on it
+    // (both ends at or above it) cut air and are not counted; the error
+    // entering and leaving it is.
+    let dt = 1.0 / 20e3;
+    let w = |t: f64| if (0.01..0.02).contains(&t) { 0.01 } else { 0.0 };
+    let pts = circle(1.0, 100.0, 4.0 * dt, 1000, w);
+    let run = |air: Option<f64>| {
+        let sim = FollowingSimulation::new(&servo(), 20e3, &[], RadialBins::new(0.0, 2.0, 4))
+            .expect("valid");
+        let mut sim = match air {
+            Some(level) => sim.cutting_below(level),
+            None => sim,
+        };
+        sim.extend(&pts);
+        sim.finish()
+    };
+    let (all, cut) = (run(None), run(Some(0.01)));
+    assert!(all.max_error > 1e-3, "{}", all.max_error);
+    // Counted: the moves onto and off the plateau, not the ringing on it.
+    assert!(cut.max_error > 1e-3, "{}", cut.max_error);
+    let ringing_on_the_plateau = run(Some(0.0)).max_error;
+    assert_eq!(ringing_on_the_plateau, 0.0);
+    assert_eq!(run(Some(f64::INFINITY)).max_error, all.max_error);
+}
