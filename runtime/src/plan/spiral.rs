@@ -66,7 +66,8 @@ impl SpindleSpeed {
     }
 }
 
-/// A fast-tool-servo spiral, from `start_radius` in to `end_radius`.
+/// A fast-tool-servo spiral, from `start_radius` in to `end_radius` (at
+/// or past the axis: 0 or negative, the nose centre beyond it).
 #[derive(Clone, Debug, PartialEq)]
 pub struct FtsSpiral {
     /// Radial feed per revolution (mm).
@@ -102,6 +103,13 @@ impl FtsSpiral {
         if self.feed_per_rev <= 0.0 || b <= a {
             return 0.0;
         }
+        // Past the axis (a negative end radius) the spindle turns as at
+        // the axis: at its speed, or at the cap.
+        let past_axis = (-self.end_radius).max(0.0)
+            / match self.speed {
+                SpindleSpeed::Constant(w) => w,
+                SpindleSpeed::SurfaceSpeed { max, .. } => max,
+            };
         let integral = match self.speed {
             SpindleSpeed::Constant(w) => (b - a) / w,
             SpindleSpeed::SurfaceSpeed { speed, max } => {
@@ -109,7 +117,7 @@ impl FtsSpiral {
                 (b * b - capped_below * capped_below) / (2.0 * speed) + (capped_below - a) / max
             }
         };
-        std::f64::consts::TAU / self.feed_per_rev * integral
+        std::f64::consts::TAU / self.feed_per_rev * (integral + past_axis)
     }
 }
 
@@ -663,7 +671,12 @@ impl Planner<'_> {
                 "feed, tolerance, seed arc and nose radius must be positive",
             ));
         }
-        if !(s.start_radius.is_finite() && s.end_radius >= 0.0 && s.start_radius > s.end_radius) {
+        // The spiral may end past the axis (a negative radius: the nose
+        // centre beyond it, where the surface slopes at the axis).
+        if !(s.start_radius.is_finite()
+            && s.end_radius > -s.start_radius
+            && s.start_radius > s.end_radius)
+        {
             return Err(FtsError::Invalid(
                 "the spiral must run inwards from its start radius",
             ));

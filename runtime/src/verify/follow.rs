@@ -9,7 +9,22 @@
 //! surface's Sdq, seed 003).
 //!
 //! Points arrive in spiral order, in chunks, as the planner hands them
-//! over: the simulation keeps only the servo's state.
+//! over: the simulation keeps only the servo's state (and, led, the few
+//! points of the next data period).
+//!
+//! Led ([`FollowingSimulation::led`]): the servo is driven not by the
+//! commanded position r(t) itself but by its inverse model applied to it,
+//! u = r + (2ζ/ωn) ṙ + r̈/ωn² (velocity and acceleration feed-forward), so
+//! that G(s) u = r. The command held over each data period is u weighted
+//! by the triangle of two periods' width centred half a period ahead (the
+//! half-period lead that undoes the hold's delay): the held commands then
+//! keep u's area and its first moment wherever r bends (r is linear in
+//! time between points, so its velocity steps at them and r̈ is impulses
+//! there), and the servo's response to them differs from r only to second
+//! order in the period. Worked out exactly on the commanded path: the
+//! triangle's mean of r piece by piece, of ṙ and r̈ by parts (the
+//! triangle's slopes and corners on r). The error is still the servo's
+//! position minus r(t).
 
 use crate::machine::servo::SecondOrderServo;
 use crate::plan::spiral::SpiralPoint;
@@ -155,9 +170,12 @@ fn new_peak(error: f64, radius: f64) -> (f64, f64) {
 }
 
 /// One move's ends and rates.
-struct Move {
+struct Move<'a> {
     q: SpiralPoint,
     p: SpiralPoint,
+    /// `p` and the points after it known so far (led: up to a data period
+    /// past `p`, or the end of the spiral).
+    from_p: &'a [SpiralPoint],
     /// 1 / the move's duration (1/s).
     per_second: f64,
     /// The tool's travel over the part in one sample (mm).
@@ -192,6 +210,15 @@ pub struct FollowingSimulation {
     next: f64,
     k: u64,
     last: Option<SpiralPoint>,
+    /// Led: the feed-forward gains (2ζ/ωn in s, 1/ωn² in s²), and the
+    /// points received whose moves wait for the path a data period on.
+    lead: Option<(f64, f64)>,
+    ahead: Vec<SpiralPoint>,
+    /// The point before the last one run (led: the path a period back).
+    prior: Option<SpiralPoint>,
+    /// The command (mm) at and above which the nose cuts air
+    /// (`cutting_below`; infinite: it cuts everywhere).
+    air: f64,
     /// The last point in part coordinates (x cos c, x sin c; mm), worked
     /// out once per point.
     last_xy: (f64, f64),
@@ -249,6 +276,10 @@ impl FollowingSimulation {
             next: 0.0,
             k: 0,
             last: None,
+            lead: None,
+            ahead: Vec::new(),
+            prior: None,
+            air: f64::INFINITY,
             last_xy: (0.0, 0.0),
             last_error: None,
             features: features.to_vec(),
@@ -269,6 +300,25 @@ impl FollowingSimulation {
         })
     }
 
+    /// The same simulation with the servo led by its inverse model (see
+    /// the module's doc): feed-forward of the commanded velocity and
+    /// acceleration, so its output tracks the commanded path.
+    pub fn led(mut self, servo: &SecondOrderServo) -> FollowingSimulation {
+        let wn = 2.0 * std::f64::consts::PI * servo.natural_frequency_hz;
+        self.lead = Some((2.0 * servo.damping / wn, 1.0 / (wn * wn)));
+        self
+    }
+
+    /// The same simulation with the error gathered only where the nose
+    /// cuts: a move whose ends both command `level` (mm) or higher (a
+    /// settling plateau, a lenslet's continuation over the land: the
+    /// trajectory above the part's top) cuts air, and the servo's error
+    /// there leaves no mark. The servo still runs through it.
+    pub fn cutting_below(mut self, level: f64) -> FollowingSimulation {
+        self.air = level;
+        self
+    }
+
     fn lenslet_at(&self, x: f64, y: f64) -> Option<usize> {
         let key = (
             (x / self.cell).floor() as i64,
@@ -283,21 +333,48 @@ impl FollowingSimulation {
     /// Runs the servo over the next points of the spiral.
     pub fn extend(&mut self, points: &[SpiralPoint]) {
         for &p in points {
-            let xy = (p.x * p.c.cos(), p.x * p.c.sin());
-            let Some(q) = self.last else {
-                self.state = Some(Vector2::new(p.w, 0.0));
-                self.t0 = p.t;
-                self.next = p.t;
-                self.last = Some(p);
-                self.last_xy = xy;
+            if self.lead.is_none() {
+                self.run_to(p, &[p]);
                 continue;
-            };
-            if p.t - q.t > 0.0 {
-                self.run_move(q, self.last_xy, p, xy);
             }
+            self.ahead.push(p);
+            self.run_known(false);
+        }
+    }
+
+    /// Led: runs the moves into the points waiting whose data periods'
+    /// path is known (a point two data periods past them, or, `end`, the
+    /// end of the spiral, past which the path holds still).
+    fn run_known(&mut self, end: bool) {
+        let ahead = std::mem::take(&mut self.ahead);
+        let horizon = ahead.last().map_or(f64::NEG_INFINITY, |p| p.t);
+        let mut used = 0;
+        while used < ahead.len() && (end || horizon >= ahead[used].t + 2.0 * self.dt) {
+            self.run_to(ahead[used], &ahead[used..]);
+            used += 1;
+        }
+        self.ahead = ahead;
+        self.ahead.drain(..used);
+    }
+
+    /// Runs the servo from the last point to `p`, the first of `from_p`
+    /// (the points known from `p` on).
+    fn run_to(&mut self, p: SpiralPoint, from_p: &[SpiralPoint]) {
+        let xy = (p.x * p.c.cos(), p.x * p.c.sin());
+        let Some(q) = self.last else {
+            self.state = Some(Vector2::new(p.w, 0.0));
+            self.t0 = p.t;
+            self.next = p.t;
             self.last = Some(p);
             self.last_xy = xy;
+            return;
+        };
+        if p.t - q.t > 0.0 {
+            self.run_move(q, self.last_xy, p, xy, from_p);
         }
+        self.prior = self.last;
+        self.last = Some(p);
+        self.last_xy = xy;
     }
 
     /// The servo's samples over one move from `q` to `p` (later than `q`),
@@ -308,6 +385,7 @@ impl FollowingSimulation {
         (xq, yq): (f64, f64),
         p: SpiralPoint,
         (xp, yp): (f64, f64),
+        from_p: &[SpiralPoint],
     ) {
         let span = p.t - q.t;
         // Per move, not per sample: the tool's speed over the part
@@ -326,17 +404,26 @@ impl FollowingSimulation {
         let mv = Move {
             q,
             p,
+            from_p,
             per_second: 1.0 / span,
             step,
         };
         // The four kinds of move get a loop each, so the per-sample work
         // carries no test that cannot change within the move.
+        // A move wholly in the air (`cutting_below`) cuts nothing: the
+        // servo runs, its error is not gathered.
+        let in_air = q.w.min(p.w) >= self.air;
         let acc = match (one_bin, lenslet.is_some()) {
-            (true, true) => self.samples::<true, true>(&mv),
-            (true, false) => self.samples::<true, false>(&mv),
-            (false, true) => self.samples::<false, true>(&mv),
-            (false, false) => self.samples::<false, false>(&mv),
+            _ if in_air => self.samples::<true, false, false>(&mv),
+            (true, true) => self.samples::<true, true, true>(&mv),
+            (true, false) => self.samples::<true, false, true>(&mv),
+            (false, true) => self.samples::<false, true, true>(&mv),
+            (false, false) => self.samples::<false, false, true>(&mv),
         };
+        if in_air {
+            self.last_error = None;
+            return;
+        }
         if acc.bin.0 > 0 {
             self.by_radius
                 .add_many(bin, acc.bin.0, acc.bin.1, acc.bin.2);
@@ -352,12 +439,16 @@ impl FollowingSimulation {
 
     /// Steps the servo over the samples of one move, gathering the errors
     /// in the move's one bin of radius (`ONE_BIN`, else each in its own)
-    /// and, `IN_LENSLET`, for the lenslet under it.
+    /// and, `IN_LENSLET`, for the lenslet under it; none unless `CUTTING`.
     #[inline(always)]
-    fn samples<const ONE_BIN: bool, const IN_LENSLET: bool>(&mut self, mv: &Move) -> MoveAcc {
+    fn samples<const ONE_BIN: bool, const IN_LENSLET: bool, const CUTTING: bool>(
+        &mut self,
+        mv: &Move,
+    ) -> MoveAcc {
         let Move {
             q,
             p,
+            from_p,
             per_second,
             step,
         } = *mv;
@@ -372,6 +463,15 @@ impl FollowingSimulation {
         let (mut pos, mut vel) = (state.x, state.y);
         let dw = p.w - q.w;
         let (t0, dt) = (self.t0, self.dt);
+        let lead = self.lead;
+        let path = Path {
+            prior: self.prior.unwrap_or(q),
+            q,
+            from_p,
+        };
+        // Led, where the triangle lies within the move: its mean of r is r
+        // half a period on, ṙ is the move's own and r̈ nothing.
+        let (half, velocity) = (0.5 * dt * per_second * dw, dw * per_second);
         let (mut k, mut next) = (self.k, self.next);
         let (mut max_error, mut max_error_at) = (self.max_error, self.max_error_at);
         let mut last_error = self.last_error;
@@ -387,12 +487,13 @@ impl FollowingSimulation {
             let command = q.w + f * dw;
             let error = pos - command;
             let radius = || (q.x + f * (p.x - q.x)).abs();
-            if error.abs() > max_error {
+            if CUTTING && error.abs() > max_error {
                 // Rare once the spiral is under way: a branch, not a
                 // select the peak's radius would be computed for.
                 (max_error, max_error_at) = new_peak(error, radius());
             }
-            if ONE_BIN {
+            if !CUTTING {
+            } else if ONE_BIN {
                 acc.bin.0 += 1;
                 acc.bin.1 = acc.bin.1.min(error);
                 acc.bin.2 = acc.bin.2.max(error);
@@ -409,9 +510,16 @@ impl FollowingSimulation {
                 }
             }
             last_error = Some(error);
+            let drive = match lead {
+                None => command,
+                Some((c1, _)) if next - 0.5 * dt >= q.t && next + 1.5 * dt <= p.t => {
+                    command + half + c1 * velocity
+                }
+                Some((c1, c2)) => path.held_command(next + 0.5 * dt, dt, c1, c2),
+            };
             (pos, vel) = (
-                p00 * pos + p01 * vel + g0 * command,
-                p10 * pos + p11 * vel + g1 * command,
+                p00 * pos + p01 * vel + g0 * drive,
+                p10 * pos + p11 * vel + g1 * drive,
             );
             k += 1;
             next = t0 + k as f64 * dt;
@@ -424,7 +532,8 @@ impl FollowingSimulation {
     }
 
     /// What the servo did.
-    pub fn finish(self) -> Following {
+    pub fn finish(mut self) -> Following {
+        self.run_known(true);
         let lenslets = self
             .features
             .iter()
@@ -448,6 +557,82 @@ impl FollowingSimulation {
             lenslets,
             by_radius: self.by_radius,
         }
+    }
+}
+
+/// The commanded path about one sample, for the led servo: linear in
+/// time through `prior`, `q` and the points `from_p` after it, held before
+/// the first and after the last.
+struct Path<'a> {
+    prior: SpiralPoint,
+    q: SpiralPoint,
+    from_p: &'a [SpiralPoint],
+}
+
+impl Path<'_> {
+    fn len(&self) -> usize {
+        self.from_p.len() + 2
+    }
+
+    fn point(&self, i: usize) -> SpiralPoint {
+        match i {
+            0 => self.prior,
+            1 => self.q,
+            _ => self.from_p[i - 2],
+        }
+    }
+
+    /// r(t) (mm).
+    fn at(&self, t: f64) -> f64 {
+        let first = self.point(0);
+        if t <= first.t {
+            return first.w;
+        }
+        for i in 1..self.len() {
+            let b = self.point(i);
+            if t < b.t {
+                let a = self.point(i - 1);
+                return a.w + (t - a.t) * (b.w - a.w) / (b.t - a.t);
+            }
+        }
+        self.point(self.len() - 1).w
+    }
+
+    /// ∫ weight(t) r(t) dt over [a, b], `weight` linear there: by
+    /// Simpson's rule on each piece between points, exact (the integrand
+    /// is quadratic on each).
+    fn integral(&self, a: f64, b: f64, weight: &impl Fn(f64) -> f64) -> f64 {
+        let piece = |from: f64, to: f64| {
+            let m = 0.5 * (from + to);
+            (to - from) / 6.0
+                * (weight(from) * self.at(from)
+                    + 4.0 * weight(m) * self.at(m)
+                    + weight(to) * self.at(to))
+        };
+        let (mut sum, mut from) = (0.0, a);
+        for i in 0..self.len() {
+            let t = self.point(i).t;
+            if t > from && t < b {
+                sum += piece(from, t);
+                from = t;
+            }
+        }
+        sum + piece(from, b)
+    }
+
+    /// The led servo's held command for the data period whose triangle is
+    /// centred at `c` (s; half a period after the period starts): u = r +
+    /// c1 ṙ + c2 r̈ weighted by the triangle τ(t) = (1 − |t − c|/dt)/dt
+    /// over [c − dt, c + dt]. By parts, ∫τṙ = (∫ r over [c, c + dt] −
+    /// ∫ r over [c − dt, c]) / dt² and ∫τr̈ = (r(c − dt) − 2r(c) +
+    /// r(c + dt)) / dt².
+    fn held_command(&self, c: f64, dt: f64, c1: f64, c2: f64) -> f64 {
+        let triangle = |t: f64| (1.0 - (t - c).abs() / dt) / dt;
+        let one = |_: f64| 1.0;
+        let mean = self.integral(c - dt, c, &triangle) + self.integral(c, c + dt, &triangle);
+        let slope = (self.integral(c, c + dt, &one) - self.integral(c - dt, c, &one)) / (dt * dt);
+        let bend = (self.at(c - dt) - 2.0 * self.at(c) + self.at(c + dt)) / (dt * dt);
+        mean + c1 * slope + c2 * bend
     }
 }
 

@@ -317,7 +317,7 @@ impl Following {
         height_map: HeightMap,
     ) -> Following {
         Following {
-            kind: "fast-tool-servo following: the machine's servo model driven by the commanded positions, as printed, at its data rate",
+            kind: "fast-tool-servo following: the machine's servo model driven at its data rate by the commanded positions, as printed, led by its inverse model (velocity and acceleration feed-forward); the error is its position minus the command, where the nose cuts (not where it is held over the land)",
             data_rate_hz: data_rate,
             servo_samples: f.samples,
             max_following_error_nm: AtRadius {

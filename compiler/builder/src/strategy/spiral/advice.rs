@@ -138,7 +138,7 @@ enum Verdict {
 
 /// Plans the job at `speed` (in its own unit) up to its first refusal,
 /// its servo (`lag_limit`, mm: where it is gated) simulated on the
-/// commands as printed.
+/// commands as printed, led as the build leads it (`servo::following`).
 fn check(spec: &SpiralSpec, unit: Unit, speed: f64, lag_limit: Option<f64>) -> Verdict {
     let speed = unit.speed(spec.spiral.speed, speed);
     let Ok(at) = spec.at_speed(speed, &|tape| evaluator(tape).0) else {

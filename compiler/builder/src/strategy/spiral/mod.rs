@@ -214,6 +214,12 @@ pub(crate) fn lower(
         &design,
     );
 
+    let end = -past_axis(
+        evaluate(&trajectory.tape).as_ref(),
+        rho,
+        start,
+        p.machine_params.resolution,
+    );
     let mut spiral = FtsSpiral {
         feed_per_rev: st.feed * 2.0 * std::f64::consts::PI,
         speed,
@@ -222,7 +228,7 @@ pub(crate) fn lower(
         seed_arc: st.seed_arc.unwrap_or(0.1),
         min_interval: 1.0 / fast.data_rate(),
         start_radius: start,
-        end_radius: 0.0,
+        end_radius: end,
         chords: ChordPlacement::OnPath,
     };
     // W's chords stray from the path by up to their share of the tolerance.
@@ -272,6 +278,26 @@ fn fastest(speed: SpindleSpeed, start: f64) -> f64 {
 /// offset its lenslets continued and lifted over the land; less a
 /// `compensate` block's correction) and what the planner knows of it
 /// beforehand; `part_top` is the design's highest.
+/// How far (mm) the nose centre must go past the spindle axis for the
+/// axis itself to be cut: where the trajectory slopes there (a lenslet
+/// centred off the axis, over it), the contact along each uphill ray lies
+/// ρ·sin(atan g) ahead of the centre, g the slope at the axis, so a spiral
+/// ending at radius 0 never reaches the axis from those rays and leaves a
+/// nub there (issue #29: 2.6 µm on a hex array's lenslet at x = −0.25 mm).
+/// None (0) where the trajectory is level at the axis (or undefined
+/// there), or the distance is below the machine's `resolution`; never
+/// past the spiral's own start.
+fn past_axis(trajectory: &dyn SurfaceFn, rho: f64, start: f64, resolution: f64) -> f64 {
+    let at_axis = trajectory.eval(0.0, 0.0);
+    let g = at_axis[1].hypot(at_axis[2]);
+    let reach = rho * g / (1.0 + g * g).sqrt();
+    if reach.is_finite() && reach >= resolution {
+        reach.min(0.5 * start.max(0.0))
+    } else {
+        0.0
+    }
+}
+
 fn settled_trajectory(
     surface: &Object,
     settling: Option<&Settling>,
@@ -612,3 +638,6 @@ fn settling_at(
         offset,
     })
 }
+
+#[cfg(test)]
+mod tests;

@@ -28,7 +28,10 @@ pub(super) fn as_printed(
 
 /// The fast axis's servo following along `spiral` (the job's, or at a
 /// trial speed, with the `bounds` its trajectory has there), simulated
-/// over radial bins, where it has a servo model.
+/// over radial bins, where it has a servo model: the servo led by its
+/// inverse model (velocity and acceleration feed-forward of the commanded
+/// path, `FollowingSimulation::led`), as a fast tool servo's controller
+/// drives it.
 pub(super) fn following(
     spec: &SpiralSpec,
     spiral: &lensc_runtime::plan::spiral::FtsSpiral,
@@ -42,6 +45,21 @@ pub(super) fn following(
         servo,
         data_rate,
         bounds.features.as_deref().unwrap_or_default(),
-        RadialBins::new(r0.min(r1), r0.max(r1), crate::plots::FOLLOWING_BINS),
+        // From the axis where the spiral reaches or passes it.
+        RadialBins::new(
+            if spiral.end_radius <= 0.0 {
+                0.0
+            } else {
+                r0.min(r1)
+            },
+            r0.max(r1),
+            crate::plots::FOLLOWING_BINS,
+        ),
     )
+    .map(|sim| {
+        // Only where the nose cuts: above the part's top (the settling
+        // plateau and the lenslets' continuations) it cuts air.
+        sim.led(servo)
+            .cutting_below(bounds.part_top + spec.nose_radius + 1e-9)
+    })
 }
