@@ -165,6 +165,26 @@ fn legendre(t: f64, n: usize) -> Vec<f64> {
     p
 }
 
+/// Room for P_0 … P_n at the highest order either basis fits.
+const ORDERS: usize = 1 + if MAX_RADIAL_ORDER > MAX_MAP_ORDER {
+    MAX_RADIAL_ORDER
+} else {
+    MAX_MAP_ORDER
+};
+
+/// P_0(t) … P_n(t) into `p`, by the operations of `legendre`.
+fn legendre_into(t: f64, n: usize, p: &mut [f64; ORDERS]) {
+    p[0] = 1.0;
+    if n >= 1 {
+        p[1] = t;
+    }
+    for k in 1..n {
+        let a = (2 * k + 1) as f64 / (k + 1) as f64;
+        let b = k as f64 / (k + 1) as f64;
+        p[k + 1] = a * (t * p[k]) - b * p[k - 1];
+    }
+}
+
 /// A fitted correction: its basis and one coefficient per term (mm),
 /// placement terms zero.
 #[derive(Clone, Debug, PartialEq)]
@@ -180,11 +200,29 @@ pub struct Correction {
 }
 
 impl Correction {
-    /// The correction's height at (x, y) (mm).
+    /// The correction's height at (x, y) (mm): each term's value times
+    /// its coefficient, summed in the terms' order (the same operations as
+    /// `Basis::values` and a dot product, without allocating: a
+    /// compensated build asks it at every measured point).
     pub fn at(&self, x: f64, y: f64) -> f64 {
-        let mut v = Vec::new();
-        self.basis.values(x, y, &mut v);
-        v.iter().zip(&self.coefficients).map(|(a, c)| a * c).sum()
+        let (u, v) = self.basis.coords(x, y);
+        let n = self.basis.order();
+        let (mut pu, mut pv) = ([0.0; ORDERS], [0.0; ORDERS]);
+        legendre_into(u, n, &mut pu);
+        legendre_into(v, n, &mut pv);
+        let mut sum = -0.0;
+        let mut k = 0;
+        for total in 0..=n {
+            for i in (0..=total).rev() {
+                let j = total - i;
+                if j > 0 && matches!(self.basis, Basis::Radial { .. }) {
+                    continue;
+                }
+                sum += pu[i] * pv[j] * self.coefficients[k];
+                k += 1;
+            }
+        }
+        sum
     }
 
     /// The correction as a node of `g` over its coordinates `x`, `y`,

@@ -146,7 +146,14 @@ pub(crate) fn corrected(
     let format = m.format;
     let (data, stride) = thinned(m.data);
     let surface_name = p.surface_name.clone();
-    let f = kernel(&design.tape);
+    // A map or a profile is registered by least squares on heights and
+    // slopes alone (`register::register_heights`); a cloud's closest
+    // points take the second derivatives too.
+    let f = if matches!(data, lensc_measure::Measured::Cloud(_)) {
+        kernel(&design.tape)
+    } else {
+        kernel(&design.tape.slopes_only())
+    };
     let opts = measure::Options {
         units: TextUnits(c.units),
         from_job: true,

@@ -138,6 +138,8 @@ fn heights(kernel: &dyn SurfaceFn, xy: impl Iterator<Item = (f64, f64)>, out: &m
 
 /// A raster on a mill: s along the cut (x or y), u across, h = z.
 pub struct RasterFrame<'a> {
+    /// The design; only its height is read (a kernel of
+    /// `SurfaceTape::height_only` does no other work).
     pub kernel: &'a (dyn SurfaceFn + Sync),
     pub along_x: bool,
     pub window: Window,
@@ -183,6 +185,8 @@ fn turned(s: f64) -> (f64, f64) {
 /// A spiral on a lathe: s the spindle angle, u the radius, h the height
 /// of the nose centre (the fast axis or Z).
 pub struct LatheFrame<'a> {
+    /// The design; only its height is read (a kernel of
+    /// `SurfaceTape::height_only` does no other work).
     pub kernel: &'a (dyn SurfaceFn + Sync),
     pub window: Window,
     pub domain: Domain,
@@ -245,6 +249,8 @@ impl Frame for LatheFrame<'_> {
 /// A helix on a roller: s the spindle angle, u the axial position (design
 /// x), h the nose centre's distance from the roller axis.
 pub struct RollerFrame<'a> {
+    /// The design; only its height is read (a kernel of
+    /// `SurfaceTape::height_only` does no other work).
     pub kernel: &'a (dyn SurfaceFn + Sync),
     pub window: Window,
     pub roller_radius: f64,

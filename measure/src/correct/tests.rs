@@ -174,3 +174,29 @@ fn jit_and_interpreter_agree() {
         }
     }
 }
+
+/// `at` is the dot product of the terms' values (`Basis::values`) with
+/// the coefficients, bit for bit, for both bases up to their highest
+/// orders.
+#[test]
+fn at_is_the_terms_dot_the_coefficients() {
+    for basis in [
+        Basis::radial(1.5, 0.08),
+        Basis::radial(1.5, 1e-3),
+        Basis::map((-1.0, 2.0), (-0.5, 1.5), 0.3),
+        Basis::map((-1.0, 2.0), (-0.5, 1.5), 1e-3),
+    ] {
+        let c = sample_correction(basis);
+        let mut row = Vec::new();
+        for k in 0..50 {
+            let (x, y) = (-1.0 + 0.06 * k as f64, 1.5 - 0.04 * k as f64);
+            basis.values(x, y, &mut row);
+            let want: f64 = row.iter().zip(&c.coefficients).map(|(a, c)| a * c).sum();
+            assert_eq!(
+                c.at(x, y).to_bits(),
+                want.to_bits(),
+                "{basis:?} at ({x}, {y})"
+            );
+        }
+    }
+}

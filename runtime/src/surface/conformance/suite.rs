@@ -1100,6 +1100,42 @@ impl<B: Backend> Conformance<B> {
             }
         }
     }
+
+    /// A tape's height alone (`SurfaceTape::height_only`) and its height
+    /// and slopes alone (`SurfaceTape::slopes_only`) give those outputs
+    /// bit for bit as the whole tape does, loops included, in batches of
+    /// every length (both lanes and the odd point), and NaN for the rest.
+    pub fn heights_and_slopes_alone_keep_their_bits() {
+        let same = |a: f64, b: f64| a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan());
+        let looped = tape(|g| newton_like(g, 6, true));
+        let tapes = [tape(trig_and_exp), tape(every_other_operation), looped];
+        for whole in tapes {
+            let all = B::build(&whole);
+            for (part, kept) in [(whole.height_only(), 1), (whole.slopes_only(), 3)] {
+                assert!(part.live_nodes().len() < whole.live_nodes().len());
+                let part = B::build(&part);
+                for n in [1, 2, 7, 100] {
+                    let (xs, ys): (Vec<f64>, Vec<f64>) = points(n).into_iter().unzip();
+                    let (mut a, mut h) = (vec![0.0; 6 * n], vec![0.0; 6 * n]);
+                    all.eval_batch(&xs, &ys, &mut a);
+                    part.eval_batch(&xs, &ys, &mut h);
+                    for i in 0..n {
+                        for k in 0..kept {
+                            assert!(
+                                same(a[6 * i + k], h[6 * i + k]),
+                                "batch of {n}, point {i}, output {k}: {:e} whole, {:e} alone",
+                                a[6 * i + k],
+                                h[6 * i + k]
+                            );
+                        }
+                        for k in kept..6 {
+                            assert!(h[6 * i + k].is_nan(), "output {k} is not computed");
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// One Newton-like step over the estimate `p`, with every kind of
@@ -1375,6 +1411,7 @@ macro_rules! surface_fn_tests {
             derivatives_agree_with_finite_differences,
             loops_give_the_bits_of_their_steps_written_out,
             axial_sections_keep_the_x_outputs_bit_for_bit,
+            heights_and_slopes_alone_keep_their_bits,
         );
         $crate::surface::conformance::surface_fn_test!(
             #[should_panic(expected = "six values per point")]

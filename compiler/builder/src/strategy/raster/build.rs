@@ -168,8 +168,10 @@ pub(super) fn build(spec: &RasterSpec, cx: &BuildContext) -> Result<Built, Vec<D
     // The program as written: its text read as the controller reads it.
     let executed = parts::executed_moves(head, &text, false);
     height_map::sweep_mill_program(sweep.path(), &executed, along_x);
+    // The height alone: the frame asks nothing else of the design.
+    let heights = evaluator(&lowered.tape.height_only()).0;
     let frame = height_map::RasterFrame {
-        kernel: kernel.as_ref(),
+        kernel: heights.as_ref(),
         along_x,
         window,
         domain: lowered.domain,

@@ -193,7 +193,8 @@ fn simulated_height_map(
     plots: &mut crate::plots::PlotSeries,
 ) -> report::HeightMap {
     let lowered = &spec.head.surface.lowered;
-    let design = evaluator(&lowered.tape).0;
+    // The height alone: the frame asks nothing else of the design.
+    let design = evaluator(&lowered.tape.height_only()).0;
     let frame = LatheFrame::new(
         design.as_ref(),
         window,
