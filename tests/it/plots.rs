@@ -225,8 +225,12 @@ fn an_fts_job_plots_following_error_and_height_map() {
     let (_, s, report) = &all[0];
     let f = s.following.as_ref().expect("following series");
     assert_eq!(f.by_radius.bins.len(), plots::FOLLOWING_BINS);
+    // Every sample is simulated; only those where the nose cuts are
+    // gathered (moves wholly above the part's top, the settling plateau
+    // and the land, are not: issue #29), so the bins hold fewer.
     let binned: u64 = f.by_radius.bins.iter().map(|b| b.samples).sum();
-    assert_eq!(binned, report["simulation"]["servo_samples"]);
+    let simulated = report["simulation"]["servo_samples"].as_u64().expect("samples");
+    assert!(binned > 0 && binned < simulated, "{binned} of {simulated}");
     // Each bin holding samples is a stroke from its least to its largest.
     let used = f.by_radius.bins.iter().filter(|b| b.samples > 0).count();
     assert!(used > plots::FOLLOWING_BINS / 2, "{used}");

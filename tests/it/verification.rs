@@ -658,11 +658,13 @@ fn the_report_says_what_area_was_judged() {
 /// Issue #29: a hex array's lenslets are judged one by one. On the
 /// issue's 5 × 5 hex array (pitch 1 mm) the middle row is shifted a
 /// quarter pitch, so the spindle axis lies 0.25 mm off lenslet 12's
-/// centre: the spiral leaves a nub of 2.6 µm there that no pass's contact
-/// touches. Before, a hex grid had no lenslets in its report, the land
+/// centre: the spiral left a nub of 2.6 µm there that no pass's contact
+/// touched. Before, a hex grid had no lenslets in its report, the land
 /// (held above by the settling offset) swamped its figures, and the nub
-/// went unnamed; now lenslet 12 is the worst, its residual shows, and
-/// the gate fails the job naming it.
+/// went unnamed; then lenslet 12 was the worst, its residual showed, and
+/// the gate failed the job naming it; now the spiral runs past the axis
+/// and the nub is cut (the gate failing a lenslet by name is tested in
+/// `lenslet_kinds`).
 #[test]
 fn a_hex_array_is_judged_lenslet_by_lenslet_and_its_axis_nub_named() {
     let source = "surface l = sphere { radius: 3 mm, sense: concave, aperture: circle(diameter: 0.9 mm) }\n\
@@ -678,15 +680,15 @@ fn a_hex_array_is_judged_lenslet_by_lenslet_and_its_axis_nub_named() {
     let out_dir = dir.path().to_str().expect("utf8");
     let gated = lensc(dir.path(), &["build", "job.lens", "--out", out_dir]);
     let stderr = text(&gated.stderr);
-    assert_eq!(gated.status.code(), Some(1), "{stderr}");
-    assert!(
-        stderr.contains("lenslet 12 (centre x = -0.25, y = 0 mm) misses `max_residual`"),
-        "{stderr}"
-    );
+    // Since the spiral ends past the axis where the surface slopes there
+    // (issue #29: `past_axis`), the nub is cut: lenslet 12 is still the
+    // worst, named, and within its limits (it missed by 2.3 um before).
+    assert_eq!(gated.status.code(), Some(0), "{stderr}");
     assert!(
         stderr.contains("the worst 12 at x -0.25, y 0 mm"),
         "{stderr}"
     );
+    assert!(stderr.contains("every one within its limits"), "{stderr}");
     // Held to 5 um, the job passes and its report is written.
     let r = report_of(
         &source.replace("max_residual: 300 nm", "max_residual: 5 um"),
@@ -699,8 +701,7 @@ fn a_hex_array_is_judged_lenslet_by_lenslet_and_its_axis_nub_named() {
     assert_eq!(twelve["index"], 12);
     assert_eq!(twelve["centre_mm"], serde_json::json!([-0.25, 0.0]));
     let nub = &twelve["residual_beyond_scallops_nm"];
-    assert!(num(&nub["value"]) > 2000.0, "{nub}");
-    assert!(num(&nub["x_mm"]).hypot(num(&nub["y_mm"])) < 0.01, "{nub}");
+    assert!(num(&nub["value"]) < 300.0, "{nub}");
     assert_eq!(h["worst_lenslet"]["index"], 12, "{}", h["worst_lenslet"]);
     // Every other lenslet's residual stays within its scallops' reach.
     for l in lenslets.iter().filter(|l| l["index"] != 12) {

@@ -394,12 +394,12 @@ fn scan_planes(
     // than their planes (a flat or convex section across the cut); where
     // they spread further (a concave one: a ball in a bowl), the planes
     // are scanned again with the reach their spread asks for.
-    let (lines, summary) = scan_reach(r, cutter, aperture, r.stepover)?;
+    let (lines, summary) = scan_reach(r, cutter, aperture, r.stepover, most)?;
     let reach = rim_reach(r.stepover, cutter.radius, summary.spread);
     if reach <= r.stepover {
         return Ok((lines, summary));
     }
-    scan_reach(r, cutter, aperture, reach)
+    scan_reach(r, cutter, aperture, reach, most)
 }
 
 /// How far (mm) beyond the aperture the contacts are taken: the largest
@@ -417,12 +417,13 @@ fn rim_reach(stepover: f64, tool_radius: f64, spread: f64) -> f64 {
 }
 
 /// The planes' scan (`scan_planes`) with contacts taken up to `margin`
-/// (mm) beyond the aperture.
+/// (mm) beyond the aperture, over at most `most` planes (`sampled`).
 fn scan_reach(
     r: &Raster,
     cutter: &Cutter,
     aperture: &Domain,
     margin: f64,
+    most: usize,
 ) -> Result<(Vec<Line>, Summary), RasterError> {
     let ((x0, x1), (y0, y1)) = aperture.bounds();
     let ((u0, u1), (v0, v1)) = match r.along {

@@ -54,7 +54,8 @@ pub struct Following {
     pub max_error: f64,
     pub max_error_at: f64,
     pub lenslets: Vec<LensletFollowing>,
-    /// Every sample's error gathered in bins of radius, for plots.
+    /// Every sample's error where the nose cuts (`cutting_below`)
+    /// gathered in bins of radius, for plots.
     pub by_radius: RadialBins,
 }
 
