@@ -229,11 +229,25 @@ fn an_fts_job_plots_following_error_and_height_map() {
     // gathered (moves wholly above the part's top, the settling plateau
     // and the land, are not: issue #29), so the bins hold fewer.
     let binned: u64 = f.by_radius.bins.iter().map(|b| b.samples).sum();
-    let simulated = report["simulation"]["servo_samples"].as_u64().expect("samples");
+    let simulated = report["simulation"]["servo_samples"]
+        .as_u64()
+        .expect("samples");
     assert!(binned > 0 && binned < simulated, "{binned} of {simulated}");
     // Each bin holding samples is a stroke from its least to its largest.
     let used = f.by_radius.bins.iter().filter(|b| b.samples > 0).count();
-    assert!(used > plots::FOLLOWING_BINS / 2, "{used}");
+    // Only the radii where the nose cuts hold samples: the 2 × 2 corner's
+    // lenslets (centres 2.475 mm from the axis, 1.7 mm across) lie at
+    // 1.625 .. 3.325 mm of the spiral's 0 .. 4.95 mm.
+    let width = (f.by_radius.to - f.by_radius.from) / plots::FOLLOWING_BINS as f64;
+    let radii: Vec<f64> = (f.by_radius.bins.iter().enumerate())
+        .filter(|(_, b)| b.samples > 0)
+        .map(|(i, _)| f.by_radius.from + (i as f64 + 0.5) * width)
+        .collect();
+    let (inner, outer) = (radii[0], radii[radii.len() - 1]);
+    assert!(
+        inner > 1.6 && outer < 3.35 && used * 5 > plots::FOLLOWING_BINS,
+        "{used} bins from {inner} to {outer} mm"
+    );
     assert_eq!(polylines(&svg, "#1F77B4"), vec![2 * used, 2]);
     let peak = f
         .by_radius
