@@ -9,12 +9,9 @@
 //! derivatives as it plans the design. Every refusal is a coded
 //! diagnostic at the block's `measurement`, naming the file.
 
-use std::path::Path;
-
 use lensc_grammar::Diagnostic;
 use lensc_lang::codes;
 use lensc_lang::lower::surface::LoweredSurface;
-use lensc_lang::sandbox;
 use lensc_lang::schema::CompensateParams;
 use lensc_lang::value::Stated;
 use lensc_measure::correct::{self, Basis, Correction};
@@ -325,52 +322,16 @@ fn thinned(data: lensc_measure::Measured) -> (lensc_measure::Measured, usize) {
     (lensc_measure::Measured::Map(thin), k)
 }
 
-/// The measurement's bytes, read as the loader reads a `use`d file:
-/// relative to the job's file, beneath the project root, a regular file,
-/// at most `MAX_MEASUREMENT_BYTES`.
+/// The measurement's bytes (`job_file::read`: beneath the root, at most
+/// `MAX_MEASUREMENT_BYTES`).
 fn read(p: &Of, m: &Stated<String>) -> Result<Vec<u8>, Diagnostic> {
-    let job = p.job;
-    let base = job
-        .path
-        .as_deref()
-        .and_then(Path::parent)
-        .unwrap_or(Path::new(""));
-    let full = base.join(&m.value);
-    let resolved = sandbox::resolve(&full);
-    let root = job
-        .root
-        .as_ref()
-        .map(|r| r.path().to_path_buf())
-        .unwrap_or_else(|| sandbox::resolve(Path::new(".")));
-    let e = if !sandbox::inside(&resolved, &root) {
-        sandbox::ReadError::OutsideRoot {
-            resolved: resolved.clone(),
-            root,
-        }
-    } else {
-        let read = match &job.root {
-            Some(r) => r.read(&resolved, MAX_MEASUREMENT_BYTES),
-            None => sandbox::read_regular(&resolved, MAX_MEASUREMENT_BYTES),
-        };
-        match read {
-            Ok(b) => return Ok(b),
-            Err(e) => e,
-        }
-    };
-    Err(Diagnostic::error(
-        e.code(),
-        format!("cannot read the measurement `{}`: {e}", full.display()),
-        m.site.0,
-        m.site.1,
+    crate::job_file::read(
+        p.job,
+        m,
+        "the measurement",
+        MAX_MEASUREMENT_BYTES,
+        "measurements of at most 256 MiB are read",
     )
-    .with_label("named here")
-    .with_help(match e {
-        sandbox::ReadError::OutsideRoot { .. } => {
-            "a job reads only files under its project root (the directory of the file given on the command line unless `--root DIR`)"
-        }
-        sandbox::ReadError::TooLarge { .. } => "measurements of at most 256 MiB are read",
-        _ => "the path is relative to the job's file",
-    }))
 }
 
 /// The basis over the aperture and the width of the cells the error is

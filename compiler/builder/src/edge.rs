@@ -7,8 +7,6 @@
 //! program header and the report. Every refusal is a coded diagnostic at
 //! the tool's `edge_profile`, naming the file.
 
-use std::path::Path;
-
 use lensc_grammar::Diagnostic;
 use lensc_lang::check::trim_num;
 use lensc_lang::codes;
@@ -155,50 +153,14 @@ fn deg(a: f64) -> String {
     trim_num((a.to_degrees() * 1e3).round() / 1e3)
 }
 
-/// The file's bytes, read as the loader reads a `use`d file: relative to
-/// the job's file, beneath the project root, a regular file, at most
-/// `sandbox::MAX_FILE_BYTES`.
+/// The edge profile's bytes (`job_file::read`: beneath the root, at most
+/// `sandbox::MAX_FILE_BYTES`).
 fn read(p: &Parts, m: &Stated<String>) -> Result<Vec<u8>, Diagnostic> {
-    let job = p.job;
-    let base = job
-        .path
-        .as_deref()
-        .and_then(Path::parent)
-        .unwrap_or(Path::new(""));
-    let full = base.join(&m.value);
-    let resolved = sandbox::resolve(&full);
-    let root = job
-        .root
-        .as_ref()
-        .map(|r| r.path().to_path_buf())
-        .unwrap_or_else(|| sandbox::resolve(Path::new(".")));
-    let e = if !sandbox::inside(&resolved, &root) {
-        sandbox::ReadError::OutsideRoot {
-            resolved: resolved.clone(),
-            root,
-        }
-    } else {
-        let read = match &job.root {
-            Some(r) => r.read(&resolved, sandbox::MAX_FILE_BYTES),
-            None => sandbox::read_regular(&resolved, sandbox::MAX_FILE_BYTES),
-        };
-        match read {
-            Ok(b) => return Ok(b),
-            Err(e) => e,
-        }
-    };
-    Err(Diagnostic::error(
-        e.code(),
-        format!("cannot read the edge profile `{}`: {e}", full.display()),
-        m.site.0,
-        m.site.1,
+    crate::job_file::read(
+        p.job,
+        m,
+        "the edge profile",
+        sandbox::MAX_FILE_BYTES,
+        "files of at most 16 MiB are read",
     )
-    .with_label("named here")
-    .with_help(match e {
-        sandbox::ReadError::OutsideRoot { .. } => {
-            "a job reads only files under its project root (the directory of the file given on the command line unless `--root DIR`)"
-        }
-        sandbox::ReadError::TooLarge { .. } => "files of at most 16 MiB are read",
-        _ => "the path is relative to the job's file",
-    }))
 }

@@ -19,6 +19,7 @@ pub mod edge;
 pub mod evaluate;
 pub mod height_map;
 pub mod job;
+pub(crate) mod job_file;
 pub mod json_schema;
 pub mod measure;
 pub mod output;
