@@ -86,9 +86,12 @@ impl<'a> Checker<'a> {
                     f.name_span,
                 )
                 .with_label("unknown parameter");
-                d = d.with_help(match did_you_mean(&f.name, params.iter().map(|p| p.name)) {
-                    Some(s) => format!("did you mean `{s}`?"),
-                    None => match family {
+                let named_elsewhere = named_as_elsewhere(params, f);
+                let near = did_you_mean(&f.name, params.iter().map(|p| p.name));
+                d = d.with_help(match (named_elsewhere, near) {
+                    (Some(h), _) => h,
+                    (None, Some(s)) => format!("did you mean `{s}`?"),
+                    (None, None) => match family {
                         Some(fam) => format!(
                             "{owner} takes: {}, and {}",
                             param_list(params),
@@ -410,5 +413,49 @@ impl<'a> Checker<'a> {
             .with_label("wrong kind of value")
             .with_help(format!("`{}`: {}", f.name, p.doc)),
         );
+    }
+}
+
+/// Help for a parameter named as other tools and drawings name it, where
+/// the kind takes the same thing under another name and form: a ball's or
+/// a circle's `radius` where lensc takes its `diameter` (a spelling guess
+/// would not say the value doubles), a rectangle's `width` and `height`
+/// where lensc takes the ranges `x` and `y`. `None` where the kind takes
+/// no such parameter.
+fn named_as_elsewhere(params: &[Param], f: &Field) -> Option<String> {
+    let takes = |name: &str| params.iter().any(|p| p.name == name);
+    let length = match f.value {
+        Value::Num(v, Dim::LENGTH) if v.is_finite() && v > 0.0 => Some(v),
+        _ => None,
+    };
+    match f.name.as_str() {
+        "radius" if takes("diameter") => Some(match length {
+            Some(r) => format!(
+                "this is sized by its `diameter`, twice the radius: `diameter: {} mm`",
+                trim_num(2.0 * r)
+            ),
+            None => "this is sized by its `diameter`, twice the radius".into(),
+        }),
+        "width" | "height" if takes("x") && takes("y") => {
+            let (axis, other) = if f.name == "width" {
+                ("x", "y")
+            } else {
+                ("y", "x")
+            };
+            Some(match length {
+                Some(w) => format!(
+                    "a rectangle is given by its ranges `x` and `y`: `{axis}: {} mm .. {} mm` is a {} of {} mm centred on the axis (and `{other}: …` likewise)",
+                    trim_num(-w / 2.0),
+                    trim_num(w / 2.0),
+                    f.name,
+                    trim_num(w)
+                ),
+                None => format!(
+                    "a rectangle is given by its ranges `x` and `y`: the {} is `{axis}: lo .. hi`",
+                    f.name
+                ),
+            })
+        }
+        _ => None,
     }
 }
