@@ -95,8 +95,9 @@ fn a_smooth_pass_becomes_one_spline_within_its_limit() {
 
 /// The fit's deviation check steps only the points that can raise the
 /// worst: a fit of a 400-chord pass (801 points and chords' arc middles,
-/// checked as fitted and as printed) takes under three evaluations of
-/// the curve per planned point; stepping every one takes several each
+/// checked as fitted and as printed) takes at most 1.5 evaluations of the
+/// curve per point checked (measured: 2043 and 1845, for 40 and 8 control
+/// points); stepping every point took about 10 per point checked
 /// (`the_pruned_check_finds_the_worst_of_every_point` counts both).
 #[test]
 fn the_fit_checks_a_pass_with_few_evaluations_per_point() {
