@@ -171,10 +171,13 @@ pub fn fit_splines(
                     points.push(p);
                 }
             }
-            if let Some((spline, deviation)) = fit_run(&points, fit)
-                && lines_arcs
-                    .as_ref()
-                    .is_none_or(|l| spline.points.len() + spline.order < l.len())
+            // A spline of n control points takes n + ORDER blocks: fewer
+            // than the lines and arcs' if n is below this.
+            let fewer = lines_arcs
+                .as_ref()
+                .map_or(usize::MAX, |l| l.len().saturating_sub(ORDER));
+            if let Some((spline, deviation)) = fit_run(&points, fit, fewer)
+                && spline.points.len() < fewer
             {
                 summary.splines += 1;
                 summary.lines_replaced += run_end - i;
@@ -261,8 +264,10 @@ fn run(moves: &[Move], i: usize, at: [f64; 3]) -> (usize, Option<Feed>) {
 
 /// The spline with the fewest control points that holds `points` within
 /// the fit's limits, and its largest deviation; none if it would not save
-/// blocks.
-fn fit_run(points: &[[f64; 3]], fit: &SplineFit) -> Option<(Spline, f64)> {
+/// blocks. The search stops, with none, once what it would find takes
+/// `fewer` control points or more (where the run's lines and arcs would
+/// be written instead); what it finds otherwise is the same.
+fn fit_run(points: &[[f64; 3]], fit: &SplineFit, fewer: usize) -> Option<(Spline, f64)> {
     let lines = points.len() - 1;
     // A spline of n control points takes n + 4 blocks: it must take fewer
     // than half the lines' blocks to be worth writing.
@@ -273,15 +278,20 @@ fn fit_run(points: &[[f64; 3]], fit: &SplineFit) -> Option<(Spline, f64)> {
     let params = chord_params(points);
     let arcs = arc_middles(points);
     let try_n = |n: usize| fitted(points, &params, &arcs, n, fit);
-    // Doubling, then halving the interval between a failure and a success.
+    // Doubling, then halving the interval between a failure and a success:
+    // what is found takes more control points than the last failure.
     let mut fail = ORDER - 1;
+    let too_many = |fail: usize| fail + 1 >= fewer;
+    if too_many(fail) {
+        return None;
+    }
     let mut n = ORDER;
     let mut best = loop {
         if let Some(b) = try_n(n) {
             break b;
         }
         fail = n;
-        if n == most {
+        if n == most || too_many(fail) {
             return None;
         }
         n = (n * 2).min(most);
@@ -294,6 +304,7 @@ fn fit_run(points: &[[f64; 3]], fit: &SplineFit) -> Option<(Spline, f64)> {
                 best = b;
                 ok = mid;
             }
+            None if too_many(mid) => return None,
             None => fail = mid,
         }
     }
@@ -400,15 +411,15 @@ fn fitted(
     };
     let ctrl = least_squares(points, &u, &knots, n)?;
     let o = [fit.control.x, fit.control.y, fit.control.z];
-    let check = |ctrl: &[[f64; 3]]| deviation(ctrl, &knots, points, &u, arcs);
-    if check(&ctrl) > fit.tolerance {
+    let check = |ctrl: &[[f64; 3]], limit| deviation(ctrl, &knots, points, &u, arcs, limit);
+    if check(&ctrl, fit.tolerance) > fit.tolerance {
         return None;
     }
     let printed: Vec<[f64; 3]> = ctrl
         .iter()
         .map(|p| std::array::from_fn(|i| round(p[i] + o[i]) - o[i]))
         .collect();
-    let worst = check(&printed);
+    let worst = check(&printed, fit.tolerance + fit.rounding());
     (worst <= fit.tolerance + fit.rounding()).then_some((
         Spline {
             order: ORDER,
@@ -501,6 +512,8 @@ fn basis(knots: &[f64], s: usize, t: f64) -> [f64; ORDER] {
 
 /// The curve's point at `t`.
 fn point(ctrl: &[[f64; 3]], knots: &[f64], t: f64) -> [f64; 3] {
+    #[cfg(test)]
+    tests::EVALUATIONS.with(|c| c.set(c.get() + 1));
     let s = span(knots, ctrl.len(), t);
     let b = basis(knots, s, t);
     let mut p = [0.0; 3];
@@ -611,26 +624,34 @@ fn least_squares(points: &[[f64; 3]], u: &[f64], knots: &[f64], n: usize) -> Opt
 
 /// The largest distance from the curve of the planned points and of the
 /// chords' arc middles, each found by a few Newton steps on the distance
-/// from its parameter (the curve's derivatives by central differences).
+/// from its parameter (the curve's derivatives by central differences);
+/// once it is known to exceed `limit`, any distance above `limit` (the
+/// fit fails whatever the rest are).
+///
+/// A point's Newton steps only lower its distance from the one at its
+/// own parameter, so a point no farther there than the worst already
+/// found cannot raise the worst: the points are taken farthest first and
+/// the steps stop at the first that cannot (the worst is the same, to the
+/// bit, as stepping every point).
 fn deviation(
     ctrl: &[[f64; 3]],
     knots: &[f64],
     points: &[[f64; 3]],
     u: &[f64],
     arcs: &[[f64; 3]],
+    limit: f64,
 ) -> f64 {
     let end = u[u.len() - 1];
     let h = end * 1e-5;
-    let nearest = |q: [f64; 3], t0: f64, lo: f64, hi: f64| {
+    // The distance from q of the curve's nearest point, from `t0` (where
+    // the curve is `first` from q) within [lo, hi].
+    let nearest = |q: [f64; 3], t0: f64, first: f64, lo: f64, hi: f64| {
         let mut t = t0;
-        let mut best = dist(point(ctrl, knots, t), q);
+        let mut p = point(ctrl, knots, t);
+        let mut best = first;
         for _ in 0..4 {
             let (a, b) = ((t - h).max(0.0), (t + h).min(end));
-            let (pa, pb, p) = (
-                point(ctrl, knots, a),
-                point(ctrl, knots, b),
-                point(ctrl, knots, t),
-            );
+            let (pa, pb) = (point(ctrl, knots, a), point(ctrl, knots, b));
             let d1 = scale(sub(pb, pa), 1.0 / (b - a));
             let d2 = scale(add(sub(pb, scale(p, 2.0)), pa), 4.0 / ((b - a) * (b - a)));
             let e = sub(p, q);
@@ -640,7 +661,8 @@ fn deviation(
                 break;
             }
             t = (t - g / gp).clamp(lo, hi);
-            let d = dist(point(ctrl, knots, t), q);
+            p = point(ctrl, knots, t);
+            let d = dist(p, q);
             if d >= best {
                 break;
             }
@@ -649,14 +671,29 @@ fn deviation(
         best
     };
     let last = u.len() - 1;
+    // Each point with its parameter, its Newton bounds and its distance
+    // at the parameter.
+    let mut starts: Vec<([f64; 3], f64, f64, f64, f64)> = points
+        .iter()
+        .enumerate()
+        .map(|(k, &q)| (q, u[k], u[k.saturating_sub(1)], u[(k + 1).min(last)]))
+        .chain(
+            arcs.iter()
+                .enumerate()
+                .map(|(k, &q)| (q, (u[k] + u[k + 1]) / 2.0, u[k], u[k + 1])),
+        )
+        .map(|(q, t0, lo, hi)| (q, t0, dist(point(ctrl, knots, t0), q), lo, hi))
+        .collect();
+    starts.sort_unstable_by(|a, b| b.2.total_cmp(&a.2));
     let mut worst: f64 = 0.0;
-    for (k, &q) in points.iter().enumerate() {
-        let lo = u[k.saturating_sub(1)];
-        let hi = u[(k + 1).min(last)];
-        worst = worst.max(nearest(q, u[k], lo, hi));
-    }
-    for (k, &q) in arcs.iter().enumerate() {
-        worst = worst.max(nearest(q, (u[k] + u[k + 1]) / 2.0, u[k], u[k + 1]));
+    for (q, t0, first, lo, hi) in starts {
+        if first <= worst {
+            break;
+        }
+        worst = worst.max(nearest(q, t0, first, lo, hi));
+        if worst > limit {
+            break;
+        }
     }
     worst
 }

@@ -20,6 +20,9 @@
 /// The most straight moves one span of a curve is sampled into.
 const MOST_PIECES_PER_SPAN: usize = 4096;
 
+/// The highest rank a curve is read with: Fanuc's P4 (Siemens' SD=3).
+pub(crate) const MOST_RANK: usize = 4;
+
 /// A NURBS curve being read, block by block.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Nurbs {
@@ -39,6 +42,11 @@ impl Nurbs {
     pub(crate) fn refusal(&self) -> Option<String> {
         let k = self.order;
         let n = self.points.len();
+        if !(2..=MOST_RANK).contains(&k) {
+            return Some(format!(
+                "a NURBS curve of rank {k}: the control takes ranks 2 to {MOST_RANK}"
+            ));
+        }
         if n < k {
             return Some(format!(
                 "a NURBS curve of rank {k} needs at least {k} control points; this one has {n}"
@@ -76,23 +84,23 @@ impl Nurbs {
     }
 
     /// The curve at `t`, by the manual's rational form with the basis by
-    /// de Boor–Cox's recursion over the span holding `t`.
+    /// de Boor–Cox's recursion over the span holding `t` (a rank of at
+    /// most [`MOST_RANK`], as [`Nurbs::refusal`] holds it; knots never
+    /// decreasing).
     pub(crate) fn at(&self, t: f64) -> [f64; 3] {
         let k = self.order;
         let n = self.points.len();
         let x = &self.knots;
-        // The span i with x[i] <= t < x[i+1], among the curve's (k-1 .. n-1).
-        let mut s = k - 1;
-        while s + 1 < n && x[s + 1] <= t {
-            s += 1;
-        }
+        // The span i with x[i] <= t < x[i+1], among the curve's (k-1 .. n-1):
+        // past every knot x[k..n] at or before t.
+        let s = k - 1 + x[k..n].partition_point(|v| *v <= t);
         // N[j] for the basis functions i = s-k+1+j of rank r, built up
         // from rank 1 (1 on span s only).
-        let mut basis = vec![0.0; k];
+        let mut basis = [0.0; MOST_RANK];
         basis[k - 1] = 1.0;
         for r in 2..=k {
-            let mut next = vec![0.0; k];
-            for (j, slot) in next.iter_mut().enumerate() {
+            let mut next = [0.0; MOST_RANK];
+            for (j, slot) in next[..k].iter_mut().enumerate() {
                 let i = s + 1 + j - k;
                 let a = ratio(t - x[i], x[i + r - 1] - x[i]) * basis[j];
                 let right = if j + 1 < k { basis[j + 1] } else { 0.0 };
@@ -102,7 +110,7 @@ impl Nurbs {
             basis = next;
         }
         let (mut num, mut den) = ([0.0; 3], 0.0);
-        for (j, nb) in basis.iter().enumerate() {
+        for (j, nb) in basis[..k].iter().enumerate() {
             let i = s + 1 + j - k;
             let w = nb * self.weights[i];
             den += w;
@@ -151,12 +159,15 @@ impl Nurbs {
         self.points[self.points.len() - 1]
     }
 
-    /// Whether `pieces` equal chords of [a, b] lie within the tolerance.
+    /// Whether `pieces` equal chords of [a, b] lie within the tolerance
+    /// (a chord's end is the next chord's start, evaluated once).
     fn within(&self, a: f64, b: f64, pieces: usize) -> bool {
         let h = (b - a) / pieces as f64;
+        let mut p1 = self.at(a + h * 0.0);
         (0..pieces).all(|p| {
             let (t0, t1) = (a + h * p as f64, a + h * (p + 1) as f64);
-            let (p0, p1) = (self.at(t0), self.at(t1));
+            let p0 = p1;
+            p1 = self.at(t1);
             [0.25, 0.5, 0.75].iter().all(|f| {
                 let c = self.at(t0 + (t1 - t0) * f);
                 let chord = [
