@@ -1,7 +1,9 @@
 //! `lensc measure FILE PART [--job NAME]`: a measured part held to its
 //! job's design (`lensc_build::measure`): the job lowered as `build`
 //! lowers it, the measurement read under the project's file rules,
-//! registered and figured; `JOB.measure.json` and `JOB.error_map.svg`
+//! registered and figured (with `--lenslet`, the lenslet named checked
+//! against the job's array before the file is read, the error pointing at
+//! the job); `JOB.measure.json` and `JOB.error_map.svg`
 //! written as one unit, or nothing and a coded error naming the file.
 
 use std::path::Path;
@@ -49,6 +51,19 @@ pub fn run(
             return 1;
         }
     };
+    // The lenslet named must be one of the job's array's: said over the
+    // job, before the measurement is read.
+    if let Some(pick) = opts.lenslet
+        && let Err(f) = measure::lenslet_of(spec.head(), pick)
+    {
+        let (file_id, span) = spec.head().site;
+        let mut d = Diagnostic::error(f.code, f.message.clone(), file_id, span);
+        if let Some(h) = &f.help {
+            d = d.with_help(h.clone());
+        }
+        out.diagnostics(&c, &[d]);
+        return 1;
+    }
     let root = out.root.clone().unwrap_or_else(|| {
         file.parent()
             .filter(|p| !p.as_os_str().is_empty())
@@ -93,6 +108,20 @@ pub fn run(
         eprintln!(
             "{name}: error along the normal PV {:.2} nm, RMS {:.2} nm; decentre {:.3}, {:.3} µm, tilt {:.1}, {:.1} µrad",
             f.pv_nm, f.rms_nm, r.decentre_x_um, r.decentre_y_um, r.tilt_x_urad, r.tilt_y_urad
+        );
+    }
+    if let (Some(l), MessageFormat::Human) = (&outcome.report.lenslet, out.format) {
+        eprintln!(
+            "{name}: lenslet {} (row {}, column {}; centre x = {}, y = {} mm), {:.1} % of its aperture measured; the field's {} found at x = {:.4}, y = {:.4} mm",
+            l.index,
+            l.row,
+            l.column,
+            l.centre_mm[0],
+            l.centre_mm[1],
+            100.0 * l.aperture_covered,
+            l.reference,
+            l.found_at_mm[0],
+            l.found_at_mm[1]
         );
     }
     if let Some(l) = &outcome.report.lenslets {
