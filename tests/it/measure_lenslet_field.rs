@@ -407,7 +407,7 @@ fn a_field_that_covers_too_little_of_the_lenslet_is_e0370() {
     assert!(
         stderr.contains("E0370")
             && stderr.contains("field.x3p")
-            && stderr.contains("cover 0.0 % of lenslet 23 (row 2, column 3; centre x = -5.25, y = -8.75 mm)'s aperture"),
+            && stderr.contains("cover 0.0 % of the aperture of lenslet 23 (row 2, column 3; centre x = -5.25, y = -8.75 mm), a disc 1.7 mm across"),
         "{stderr}"
     );
     assert!(

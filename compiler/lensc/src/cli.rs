@@ -278,13 +278,13 @@ pub enum Command {
         #[arg(long, conflicts_with = "lenslet")]
         per_lenslet: bool,
         /// The map is one lenslet's field (an instrument's field of view):
-        /// hold it to that lenslet's design alone. N is its index in the
-        /// array as the reports number them (from 0, row by row from the
-        /// least y, along each row from the least x), or ROW,COLUMN (each
-        /// from 0, in that order). The map's middle pixel (the file's
+        /// hold it to that lenslet's design alone. LENSLET is its index in
+        /// the array as the reports number them (`23`: from 0, row by row
+        /// from the least y, along each row from the least x), or its row
+        /// and column (`2,3`: each from 0, in that order). The map's middle pixel (the file's
         /// origin with --keep-origin) is taken to lie on the lenslet's
         /// centre unless --at says where it lay.
-        #[arg(long, value_name = "N|ROW,COLUMN", value_parser = parse_lenslet)]
+        #[arg(long, value_name = "LENSLET", value_parser = parse_lenslet)]
         lenslet: Option<LensletPick>,
         /// With --lenslet: where the map's middle pixel (the file's origin
         /// with --keep-origin) lay on the part, in the job's x and y, each

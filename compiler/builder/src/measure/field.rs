@@ -163,7 +163,7 @@ pub(super) fn measure(
         return Err(fail(
             codes::FIELD_MISSES_LENSLET,
             format!(
-                "{file}: placed with {reference} at x = {}, y = {} mm, the map's valid pixels cover {:.1} % of {lenslet_words}'s aperture ({}); at least {:.1} % is needed (--min-valid)",
+                "{file}: placed with {reference} at x = {}, y = {} mm, the map's valid pixels cover {:.1} % of the aperture of {lenslet_words}, {}; at least {:.1} % is needed (--min-valid)",
                 place.0,
                 place.1,
                 100.0 * covered,
@@ -204,7 +204,7 @@ pub(super) fn measure(
     let raster = super::raster(&p.inside, &errors, Some(grid.dx.max(grid.dy)));
     let mut registration = placed::registration_report(&reg);
     registration.method = format!(
-        "{}, on the map's pixels within {lenslet_words}'s aperture widened by a fifth, against the design seen from its centre, started with {reference} at x = {}, y = {} mm ({placed_by})",
+        "{}, on the map's pixels within the aperture of {lenslet_words} widened by a fifth, against the design seen from its centre, started with {reference} at x = {}, y = {} mm ({placed_by})",
         registration.method, place.0, place.1
     );
     let mut caption = super::caption(&form, &registration, &raster);

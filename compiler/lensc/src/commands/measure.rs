@@ -112,7 +112,7 @@ pub fn run(
     }
     if let (Some(l), MessageFormat::Human) = (&outcome.report.lenslet, out.format) {
         eprintln!(
-            "{name}: lenslet {} (row {}, column {}; centre x = {}, y = {} mm), {:.1} % of its aperture measured; the field's {} found at x = {:.4}, y = {:.4} mm",
+            "{name}: lenslet {} (row {}, column {}; centre x = {}, y = {} mm), {:.1} % of its aperture measured; {} found on the part at x = {:.4}, y = {:.4} mm",
             l.index,
             l.row,
             l.column,
