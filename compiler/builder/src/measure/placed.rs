@@ -339,7 +339,7 @@ pub fn register_measurement(
     } else {
         register::register_heights(f, &p.inside, fit)
     };
-    let reg = reg.map_err(|e| not_registered(file, surface_name, e))?;
+    let reg = reg.map_err(|e| not_registered(file, &format!("`{surface_name}`"), e))?;
     // The error along the normal, at each registered point.
     let pred = register::predict(f, &p.inside, &reg.values);
     let errors: Vec<f64> = p
@@ -355,7 +355,7 @@ pub fn register_measurement(
         .map(|(q, h)| q[2] - h[0])
         .collect();
     let form = form_error(&p.inside, &errors);
-    departs(&pred, &form, file, surface_name)?;
+    departs(&pred, &form, file, &format!("`{surface_name}`"))?;
     Ok(Registered {
         points: p,
         registration: reg,
@@ -366,22 +366,22 @@ pub fn register_measurement(
     })
 }
 
-/// The coded failure for a registration of the file `file` to
-/// `surface_name` that failed with `e`.
-pub(crate) fn not_registered(file: &str, surface_name: &str, e: RegisterError) -> Failure {
+/// The coded failure for a registration of the file `file` to `what`
+/// (the surface's name in backquotes, or more) that failed with `e`.
+pub(crate) fn not_registered(file: &str, what: &str, e: RegisterError) -> Failure {
     use lensc_lang::codes;
     match e {
         RegisterError::TooFewPoints { points } => fail(
             codes::MEASURE_TOO_LITTLE,
             format!(
-                "{file}: {points} valid points inside the aperture of `{surface_name}`: too few to register"
+                "{file}: {points} valid points inside the aperture of {what}: too few to register"
             ),
             None,
         ),
         RegisterError::NotConverged { iterations, rms } => fail(
             codes::MEASURE_NOT_CONVERGED,
             format!(
-                "{file}: the registration to `{surface_name}` did not converge in {iterations} iterations{}",
+                "{file}: the registration to {what} did not converge in {iterations} iterations{}",
                 if rms.is_finite() {
                     format!(" (residual RMS {:.1} nm)", rms * 1e6)
                 } else {
@@ -395,7 +395,7 @@ pub(crate) fn not_registered(file: &str, surface_name: &str, e: RegisterError) -
         RegisterError::Undefined { points } => fail(
             codes::MEASURE_NOT_CONVERGED,
             format!(
-                "{file}: the registration to `{surface_name}` moved {points} measured points where the design has no value"
+                "{file}: the registration to {what} moved {points} measured points where the design has no value"
             ),
             Some(
                 "centre the map in the instrument's software, or check that it measures this surface",
@@ -412,7 +412,7 @@ pub(crate) fn departs(
     pred: &[[f64; 3]],
     form: &report::FormError,
     file: &str,
-    surface_name: &str,
+    what: &str,
 ) -> Result<(), Failure> {
     use lensc_lang::codes;
     let (lo, hi) = pred
@@ -425,7 +425,7 @@ pub(crate) fn departs(
         return Err(fail(
             codes::MEASURE_MISMATCH,
             format!(
-                "{file}: after registration the measurement departs from `{surface_name}` by {:.3} µm RMS, more than a quarter of the design's {:.3} µm sag range over the measured points: heights in other units, or another surface",
+                "{file}: after registration the measurement departs from {what} by {:.3} µm RMS, more than a quarter of the design's {:.3} µm sag range over the measured points: heights in other units, or another surface",
                 form.rms_nm / 1000.0,
                 sag_range * 1000.0
             ),
