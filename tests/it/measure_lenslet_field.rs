@@ -520,3 +520,70 @@ fn a_lenslet_not_of_revolution_is_clocked() {
         r["form_error"]
     );
 }
+
+/// A field 350 µm off the lenslet's centre holds 88 % of it: found there
+/// from the lenslet's nominal centre (the pixels taken again where it was
+/// found), and measured with W0037; an `--at` 400 µm wrong is corrected
+/// the same way, the whole lenslet then covered and no finding.
+#[test]
+fn a_field_off_the_lenslet_is_found_and_a_part_covered_is_w0037() {
+    let dir = project();
+    let at = (CENTRE.0 + 0.35, CENTRE.1);
+    let made = Made {
+        field_at: at,
+        noise: 1e-6,
+        ..Made::default()
+    };
+    let m = field(dir.path(), &made);
+    let (code, stderr, report) = measure(dir.path(), &m, &["--lenslet", "23"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stderr.contains("W0037") && stderr.contains("cover 88."),
+        "{stderr}"
+    );
+    let r = report.expect("report");
+    let l = &r["lenslet"];
+    close(&l["found_at_mm"][0], at.0, 1e-6, &format!("found x: {l:#}"));
+    close(&l["found_at_mm"][1], at.1, 1e-6, &format!("found y: {l:#}"));
+    assert_eq!(l["finding"]["code"], "W0037", "{l:#}");
+    within(&l["aperture_covered"], 0.882, 0.01, "covered");
+    within(&r["form_error"]["rms_nm"], 1.0, 0.05, "RMS");
+    holds_to_schema(&r);
+
+    let centred = field(
+        dir.path(),
+        &Made {
+            noise: 1e-6,
+            ..Made::default()
+        },
+    );
+    let wrong = format!("{}mm,{}mm", CENTRE.0 - 0.4, CENTRE.1);
+    let (code, stderr, report) =
+        measure(dir.path(), &centred, &["--lenslet", "23", "--at", &wrong]);
+    assert_eq!(code, 0, "{stderr}");
+    let r = report.expect("report");
+    let l = &r["lenslet"];
+    close(
+        &l["found_at_mm"][0],
+        CENTRE.0,
+        1e-6,
+        &format!("found x: {l:#}"),
+    );
+    close(
+        &l["found_at_mm"][1],
+        CENTRE.1,
+        1e-6,
+        &format!("found y: {l:#}"),
+    );
+    close(
+        &r["registration"]["decentre_x_um"],
+        -400.0,
+        1e-3,
+        "decentre x",
+    );
+    assert!(
+        num(&l["aperture_covered"]) > 0.99 && l.get("finding").is_none(),
+        "{l:#}"
+    );
+    within(&r["form_error"]["rms_nm"], 1.0, 0.05, "RMS");
+}

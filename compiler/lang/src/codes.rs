@@ -207,6 +207,10 @@ pub const LINK_TOO_SLOW: &str = "W0050";
 /// cannot be registered (too few valid points under the mask, or a
 /// registration that does not settle); the others are measured.
 pub const LENSLET_NOT_REGISTERED: &str = "W0036";
+/// `lensc measure --lenslet`: the field's valid pixels cover less than
+/// 95 % of the lenslet's aperture (but at least `--min-valid`): its
+/// figures describe the part measured.
+pub const FIELD_PART_OF_LENSLET: &str = "W0037";
 /// E0195 under `lensc build --accept=warn`: the program is written.
 pub const ACCEPTANCE_MISSED_WARNING: &str = "W0020";
 /// E0196 under `lensc build --accept=warn`: the program is written.
@@ -474,6 +478,7 @@ pub const ALL: &[&str] = &[
     LENSLET_NOT_IN_ARRAY,
     FIELD_MISSES_LENSLET,
     LENSLET_NOT_REGISTERED,
+    FIELD_PART_OF_LENSLET,
     IMPORT_UNSUPPORTED_SURFACE,
     IMPORT_PARAMETER_DROPPED,
     IMPORT_NO_SEMI_DIAMETER,

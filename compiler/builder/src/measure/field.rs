@@ -12,7 +12,9 @@
 //! decentre found is where the lenslet's centre lies from where the field
 //! was placed. Refused, with a code, on a surface that is not an array
 //! (E0368), a lenslet the array does not have (E0369) and a field whose
-//! valid pixels cover less than `--min-valid` of the lenslet (E0370).
+//! valid pixels cover less than `--min-valid` of the lenslet (E0370);
+//! one that covers less than 95 % of it is measured with a finding
+//! (W0037).
 
 use lensc_lang::codes;
 use lensc_measure::map::{Measured, Measurement};
@@ -24,6 +26,10 @@ use lensc_runtime::verify::lenslets::Lenslets;
 use super::lenslets::{FromCentre, MARGIN, rows_and_columns};
 use super::placed::{self, Failure, LensletPick, Options, fail};
 use super::{Outcome, report};
+
+/// Below this share of the lenslet's aperture covered, its figures are
+/// said to describe only the part measured (W0037).
+const WHOLE: f64 = 0.95;
 use crate::job::JobHead;
 
 /// The lenslet `pick` names in the array of the job `head`: its index, or
@@ -88,6 +94,44 @@ pub fn lenslet_of(head: &JobHead, pick: LensletPick) -> Result<usize, Failure> {
     }
 }
 
+/// Where the registration `reg` puts the map's reference point, placed
+/// at `off` from the lenslet's centre, the lenslet at its design centre:
+/// R(γ)(off − d), from the lenslet's centre.
+fn where_found(reg: &register::Registration, off: (f64, f64)) -> (f64, f64) {
+    let (d, gamma) = (reg.decentre(), reg.values[5]);
+    let (s, co) = gamma.sin_cos();
+    let (ex, ey) = (off.0 - d.0, off.1 - d.1);
+    (co * ex + s * ey, -s * ex + co * ey)
+}
+
+/// E0370: placed with `reference` at `place` on the part, the field's
+/// valid pixels cover `covered` of the lenslet's `aperture`.
+fn misses(
+    file: &str,
+    (reference, place): (&str, (f64, f64)),
+    covered: f64,
+    lenslet_words: &str,
+    aperture: &Domain,
+    opts: &Options,
+) -> Failure {
+    fail(
+        codes::FIELD_MISSES_LENSLET,
+        format!(
+            "{file}: placed with {reference} at x = {}, y = {} mm, the map's valid pixels cover {:.1} % of the aperture of {lenslet_words}, {}; at least {:.1} % is needed (--min-valid)",
+            place.0,
+            place.1,
+            100.0 * covered,
+            placed::aperture_words(aperture),
+            100.0 * opts.min_valid
+        ),
+        Some(if opts.at.is_some() {
+            "check --at: it is where the field's reference point lay on the part, in the job's x and y (mm)"
+        } else {
+            "the map is taken to be centred on the lenslet: give where it lay on the part with --at X,Y, or measure the lenslet again with the field on it"
+        }),
+    )
+}
+
 /// The area of an aperture (mm²).
 fn area(d: &Domain) -> f64 {
     use std::f64::consts::PI;
@@ -132,24 +176,29 @@ pub(super) fn measure(
     let off = (place.0 - c.0, place.1 - c.1);
     let aperture = lenslets.aperture();
     let wide = lenslets.widened(MARGIN).map_or(aperture, |w| w.aperture());
-    let within = |x: f64, y: f64| {
-        let (u, v) = (x + off.0, y + off.1);
-        wide.contains(u, v) && domain.contains(u + c.0, v + c.1)
-    };
-    let p = placed::points(Measured::Map(map), opts, &within);
-    let grid = p.map.as_ref().expect("a map's points keep their map");
-    // How much of the lenslet's aperture the valid pixels cover.
-    let mut under = 0usize;
-    for j in 0..grid.ny {
-        for i in 0..grid.nx {
-            if grid.valid[j * grid.nx + i]
-                && aperture.contains(grid.x(i) + off.0, grid.y(j) + off.1)
-            {
-                under += 1;
+    // The map's pixels on the lenslet with the map's reference point at
+    // `off` from its centre, and the share of its aperture they cover.
+    let select = |off: (f64, f64)| {
+        let within = |x: f64, y: f64| {
+            let (u, v) = (x + off.0, y + off.1);
+            wide.contains(u, v) && domain.contains(u + c.0, v + c.1)
+        };
+        let p = placed::points(Measured::Map(map.clone()), opts, &within);
+        let grid = p.map.as_ref().expect("a map's points keep their map");
+        let mut under = 0usize;
+        for j in 0..grid.ny {
+            for i in 0..grid.nx {
+                if grid.valid[j * grid.nx + i]
+                    && aperture.contains(grid.x(i) + off.0, grid.y(j) + off.1)
+                {
+                    under += 1;
+                }
             }
         }
-    }
-    let covered = (under as f64 * grid.dx * grid.dy / area(&aperture)).min(1.0);
+        let covered = (under as f64 * grid.dx * grid.dy / area(&aperture)).min(1.0);
+        (p, covered)
+    };
+    let (mut p, mut covered) = select(off);
     let reference = if opts.keep_origin {
         "the file's origin (--keep-origin)"
     } else {
@@ -160,32 +209,63 @@ pub(super) fn measure(
         c.0, c.1
     );
     if covered < opts.min_valid {
-        return Err(fail(
-            codes::FIELD_MISSES_LENSLET,
-            format!(
-                "{file}: placed with {reference} at x = {}, y = {} mm, the map's valid pixels cover {:.1} % of the aperture of {lenslet_words}, {}; at least {:.1} % is needed (--min-valid)",
-                place.0,
-                place.1,
-                100.0 * covered,
-                placed::aperture_words(&aperture),
-                100.0 * opts.min_valid
-            ),
-            Some(if opts.at.is_some() {
-                "check --at: it is where the field's reference point lay on the part, in the job's x and y (mm)"
-            } else {
-                "the map is taken to be centred on the lenslet: give where it lay on the part with --at X,Y, or measure the lenslet again with the field on it"
-            }),
+        return Err(misses(
+            file,
+            (reference, place),
+            covered,
+            &lenslet_words,
+            &aperture,
+            opts,
         ));
     }
-    let local: Vec<[f64; 3]> = p
-        .inside
-        .iter()
-        .map(|q| [q[0] + off.0, q[1] + off.1, q[2]])
-        .collect();
     let g = FromCentre { f, centre: c };
     let target = format!("{lenslet_words} of `{surface_name}`");
-    let reg = register::register_heights(&g, &local, Fit::default())
+    let shifted = |p: &placed::Points, off: (f64, f64)| -> Vec<[f64; 3]> {
+        p.inside
+            .iter()
+            .map(|q| [q[0] + off.0, q[1] + off.1, q[2]])
+            .collect()
+    };
+    let mut local = shifted(&p, off);
+    let mut reg = register::register_heights(&g, &local, Fit::default())
         .map_err(|e| placed::not_registered(file, &target, e))?;
+    // Found more than a pixel from where it was placed: the pixels are
+    // taken again where the registration puts the field, and registered
+    // again from there (in the frame of the first placement: a shift s of
+    // the points' origin is a decentre d − s and a piston p + t·s).
+    let pixel = map.dx.max(map.dy);
+    let moved_to = where_found(&reg, off);
+    let s_shift = (moved_to.0 - off.0, moved_to.1 - off.1);
+    if s_shift.0.hypot(s_shift.1) > pixel {
+        (p, covered) = select(moved_to);
+        let again = register::register_heights(&g, &shifted(&p, moved_to), Fit::default())
+            .map_err(|e| placed::not_registered(file, &target, e))?;
+        reg = again;
+        let (tx, ty) = reg.tilt();
+        reg.values[3] -= s_shift.0;
+        reg.values[4] -= s_shift.1;
+        reg.values[0] += tx * s_shift.0 + ty * s_shift.1;
+        local = shifted(&p, off);
+        if covered < opts.min_valid {
+            let at = (c.0 + moved_to.0, c.1 + moved_to.1);
+            return Err(misses(
+                file,
+                (reference, at),
+                covered,
+                &lenslet_words,
+                &aperture,
+                opts,
+            ));
+        }
+    }
+    // Where the field was found: how much of the lenslet it covers.
+    let finding = (covered < WHOLE).then(|| report::Finding {
+        code: codes::FIELD_PART_OF_LENSLET.to_owned(),
+        message: format!(
+            "{file}: the map's valid pixels cover {:.1} % of the aperture of {lenslet_words}: its figures describe that part of it only",
+            100.0 * covered
+        ),
+    });
     let pred = register::predict(&g, &local, &reg.values);
     let errors: Vec<f64> = local
         .iter()
@@ -194,14 +274,10 @@ pub(super) fn measure(
         .collect();
     let form = placed::form_error(&p.inside, &errors);
     placed::departs(&pred, &form, file, &target)?;
-    // Where the registration puts the map's reference point on the part,
-    // the lenslet at its centre: c + R(γ)(off − d).
-    let (d, gamma) = (reg.decentre(), reg.values[5]);
-    let (s, co) = gamma.sin_cos();
-    let (ex, ey) = (off.0 - d.0, off.1 - d.1);
-    let found = (c.0 + co * ex + s * ey, c.1 - s * ex + co * ey);
+    let found = where_found(&reg, off);
+    let found = (c.0 + found.0, c.1 + found.1);
     let (texture, texture_skipped) = super::texture_of(&p, &errors, opts.cutoff);
-    let raster = super::raster(&p.inside, &errors, Some(grid.dx.max(grid.dy)));
+    let raster = super::raster(&p.inside, &errors, Some(map.dx.max(map.dy)));
     let mut registration = placed::registration_report(&reg);
     registration.method = format!(
         "{}, on the map's pixels within the aperture of {lenslet_words} widened by a fifth, against the design seen from its centre, started with {reference} at x = {}, y = {} mm ({placed_by})",
@@ -242,7 +318,7 @@ pub(super) fn measure(
             instrument: m.instrument,
             points: p.total,
             valid_points: p.valid,
-            pixel_um: Some([grid.dx * 1000.0, grid.dy * 1000.0]),
+            pixel_um: Some([map.dx * 1000.0, map.dy * 1000.0]),
             extent_mm: p.extent,
             centred: !opts.keep_origin,
         },
@@ -268,6 +344,7 @@ pub(super) fn measure(
             found_at_mm: [found.0, found.1],
             aperture_covered: covered,
             min_covered: opts.min_valid,
+            finding,
         }),
     };
     Ok(Outcome { report, svg })

@@ -69,6 +69,10 @@ pub struct LensletField {
     /// (`--min-valid`).
     pub aperture_covered: f64,
     pub min_covered: f64,
+    /// Under 95 % covered: a coded finding (W0037) that the figures
+    /// describe only the part of the lenslet measured.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub finding: Option<Finding>,
 }
 
 /// `--per-lenslet`: each lenslet of the array the map reaches, registered

@@ -110,6 +110,14 @@ pub fn run(
             f.pv_nm, f.rms_nm, r.decentre_x_um, r.decentre_y_um, r.tilt_x_urad, r.tilt_y_urad
         );
     }
+    if let Some(f) = outcome
+        .report
+        .lenslet
+        .as_ref()
+        .and_then(|l| l.finding.as_ref())
+    {
+        warn(out, part, &bytes, &[f]);
+    }
     if let (Some(l), MessageFormat::Human) = (&outcome.report.lenslet, out.format) {
         eprintln!(
             "{name}: lenslet {} (row {}, column {}; centre x = {}, y = {} mm), {:.1} % of its aperture measured; {} found on the part at x = {:.4}, y = {:.4} mm",
@@ -144,7 +152,7 @@ pub fn run(
     0
 }
 
-/// Prints each lenslet's finding (W0036) as a warning over the
+/// Prints each lenslet's finding (W0036, W0037) as a warning over the
 /// measurement file.
 fn warn(out: &Output, part: &Path, bytes: &[u8], findings: &[&measure::report::Finding]) {
     let text = std::str::from_utf8(bytes)
@@ -155,8 +163,13 @@ fn warn(out: &Output, part: &Path, bytes: &[u8], findings: &[&measure::report::F
     let diags: Vec<Diagnostic> = findings
         .iter()
         .map(|f| {
-            Diagnostic::warning(lensc_lang::codes::LENSLET_NOT_REGISTERED, f.message.clone(), id, Span::new(0, 0))
-                .with_help("measure that lenslet again, or lower --min-valid knowing what its figures then cover")
+            if f.code == lensc_lang::codes::FIELD_PART_OF_LENSLET {
+                Diagnostic::warning(lensc_lang::codes::FIELD_PART_OF_LENSLET, f.message.clone(), id, Span::new(0, 0))
+                    .with_help("centre the field on the lenslet (or give where it lay with --at) to measure all of it")
+            } else {
+                Diagnostic::warning(lensc_lang::codes::LENSLET_NOT_REGISTERED, f.message.clone(), id, Span::new(0, 0))
+                    .with_help("measure that lenslet again, or lower --min-valid knowing what its figures then cover")
+            }
         })
         .collect();
     let _ = match out.format {
