@@ -40,6 +40,7 @@ mod linear;
 mod list;
 mod lsp;
 mod measure;
+mod measure_lenslet_field;
 mod measure_lenslets;
 mod nurbs_linuxcnc;
 mod plots;

@@ -162,6 +162,48 @@ fn each_lenslet_is_registered_on_its_own_and_recovers_its_own_error() {
         .expect("the report holds to docs/measure.schema.json");
 }
 
+/// Known roughness on every lenslet: a cosine of 4 nm along x, 10 pixels
+/// (0.2 mm) a period, measured with a cutoff of 0.8 mm that passes it
+/// whole. Each lenslet's texture holds it: Sq 4/√2 nm, Sa 4 × 0.6472 nm
+/// (the mean |cos| of 10 samples a period from the crest), Sdq by central
+/// differences A sin(2π/10)/(Δ√2), each within 3 % (the registration
+/// takes a little of it into the tilt over a lenslet's ten periods), and
+/// its form error RMS the cosine's.
+#[test]
+fn each_lenslets_texture_is_the_roughness_added() {
+    let dir = project();
+    let mut m = map(dir.path(), &|_, _| true);
+    let a = 4e-6;
+    let cosine = |k: usize| a * (2.0 * std::f64::consts::PI * (k % N) as f64 / 10.0).cos();
+    for (k, z) in m.z.iter_mut().enumerate() {
+        *z += cosine(k);
+    }
+    let (report, _) = measured(dir.path(), &m, &["--cutoff", "0.8mm"]);
+    let mean_abs = (0..10)
+        .map(|i| (2.0 * std::f64::consts::PI * i as f64 / 10.0).cos().abs())
+        .sum::<f64>()
+        / 10.0;
+    let sdq = a * (2.0 * std::f64::consts::PI / 10.0).sin() / (PIXEL * 2f64.sqrt());
+    let each = report["lenslets"]["each"].as_array().expect("each");
+    assert_eq!(each.len(), 4);
+    for e in each {
+        let t = &e["texture"];
+        let share = |got: &serde_json::Value, want: f64, what: &str| {
+            let got = num(got);
+            assert!(
+                (got - want).abs() <= 0.03 * want,
+                "lenslet {} {what}: {got} against {want}: {e:#}",
+                e["index"]
+            );
+        };
+        share(&t["cutoff_mm"], 0.8, "cutoff");
+        share(&t["sq_nm"], 4.0 / 2f64.sqrt(), "Sq");
+        share(&t["sa_nm"], 4.0 * mean_abs, "Sa");
+        share(&t["sdq"], sdq, "Sdq");
+        share(&e["form_error"]["rms_nm"], 4.0 / 2f64.sqrt(), "RMS");
+    }
+}
+
 #[test]
 fn a_lenslet_the_mask_leaves_too_little_of_is_a_finding_not_a_failure() {
     let dir = project();

@@ -155,6 +155,13 @@ pub const EDGE_DEVIATION: &str = "E0376";
 /// `lensc measure --per-lenslet`: the job's surface is not an array of
 /// lenslets, or the measurement is not a map.
 pub const PER_LENSLET_UNAVAILABLE: &str = "E0368";
+/// `lensc measure --lenslet`: the array has no such lenslet (an index, or
+/// a row or column, past its last).
+pub const LENSLET_NOT_IN_ARRAY: &str = "E0369";
+/// `lensc measure --lenslet`: the map's valid pixels, placed where the
+/// field was said to lie, cover less than the stated share of the
+/// lenslet's aperture.
+pub const FIELD_MISSES_LENSLET: &str = "E0370";
 
 /// The simulated part misses one of its job's acceptance criteria (the
 /// message names which, by how much and where); no program is written.
@@ -200,6 +207,10 @@ pub const LINK_TOO_SLOW: &str = "W0050";
 /// cannot be registered (too few valid points under the mask, or a
 /// registration that does not settle); the others are measured.
 pub const LENSLET_NOT_REGISTERED: &str = "W0036";
+/// `lensc measure --lenslet`: the field's valid pixels cover less than
+/// 95 % of the lenslet's aperture (but at least `--min-valid`): its
+/// figures describe the part measured.
+pub const FIELD_PART_OF_LENSLET: &str = "W0037";
 /// E0195 under `lensc build --accept=warn`: the program is written.
 pub const ACCEPTANCE_MISSED_WARNING: &str = "W0020";
 /// E0196 under `lensc build --accept=warn`: the program is written.
@@ -464,7 +475,10 @@ pub const ALL: &[&str] = &[
     EDGE_ANGLES,
     EDGE_DEVIATION,
     PER_LENSLET_UNAVAILABLE,
+    LENSLET_NOT_IN_ARRAY,
+    FIELD_MISSES_LENSLET,
     LENSLET_NOT_REGISTERED,
+    FIELD_PART_OF_LENSLET,
     IMPORT_UNSUPPORTED_SURFACE,
     IMPORT_PARAMETER_DROPPED,
     IMPORT_NO_SEMI_DIAMETER,

@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 
 use clap::{Parser, Subcommand, ValueEnum};
+use lensc_build::measure::LensletPick;
 use lensc_lang::schema::Category;
 
 #[derive(Parser)]
@@ -274,8 +275,23 @@ pub enum Command {
         /// its error PV and RMS and its texture, in the report's
         /// `lenslets`; a lenslet the mask leaves too little of is a
         /// finding (W0036), not an error.
-        #[arg(long)]
+        #[arg(long, conflicts_with = "lenslet")]
         per_lenslet: bool,
+        /// The map is one lenslet's field (an instrument's field of view):
+        /// hold it to that lenslet's design alone. LENSLET is its index in
+        /// the array as the reports number them (`23`: from 0, row by row
+        /// from the least y, along each row from the least x), or its row
+        /// and column (`2,3`: each from 0, in that order). The map's middle pixel (the file's
+        /// origin with --keep-origin) is taken to lie on the lenslet's
+        /// centre unless --at says where it lay.
+        #[arg(long, value_name = "LENSLET", value_parser = parse_lenslet)]
+        lenslet: Option<LensletPick>,
+        /// With --lenslet: where the map's middle pixel (the file's origin
+        /// with --keep-origin) lay on the part, in the job's x and y, each
+        /// with its unit (`1.75mm,-1.75mm`); the registration finds the
+        /// field's place from there.
+        #[arg(long, value_name = "X,Y", requires = "lenslet", allow_hyphen_values = true, value_parser = parse_point)]
+        at: Option<(f64, f64)>,
     },
     /// Explain a diagnostic code (`E0147`), with an example that causes it
     /// and its fix.
@@ -402,11 +418,49 @@ pub fn parse_percent(text: &str) -> Result<f64, String> {
     }
 }
 
+/// A lenslet of an array: `7` (its index) or `3,5` (its row and column),
+/// each from 0.
+pub fn parse_lenslet(text: &str) -> Result<LensletPick, String> {
+    let whole = |t: &str| t.trim().parse::<usize>().ok();
+    let bad = || {
+        format!(
+            "`{text}` is not a lenslet: write its index (`7`) or its row and column (`3,5`), each from 0"
+        )
+    };
+    match text.split_once(',') {
+        None => whole(text).map(LensletPick::Index).ok_or_else(bad),
+        Some((r, c)) => match (whole(r), whole(c)) {
+            (Some(r), Some(c)) => Ok(LensletPick::RowColumn(r, c)),
+            _ => Err(bad()),
+        },
+    }
+}
+
+/// A point on the part: two lengths with their units, `X,Y`, in mm.
+pub fn parse_point(text: &str) -> Result<(f64, f64), String> {
+    let Some((x, y)) = text.split_once(',') else {
+        return Err(format!(
+            "`{text}` is not a point: write its x and y with their units (`1.75mm,-1.75mm`)"
+        ));
+    };
+    Ok((signed_length(x)?, signed_length(y)?))
+}
+
 /// A length with its unit (`0.08mm`, `80um`, `80 µm`), in mm.
 pub fn parse_length(text: &str) -> Result<f64, String> {
+    let mm = signed_length(text)?;
+    if mm > 0.0 {
+        Ok(mm)
+    } else {
+        Err(format!("`{text}` is not a positive length"))
+    }
+}
+
+/// A finite length of either sign with its unit, in mm.
+fn signed_length(text: &str) -> Result<f64, String> {
     let t = text.trim();
     let split = t
-        .find(|c: char| !(c.is_ascii_digit() || c == '.' || c == 'e' || c == '-'))
+        .find(|c: char| !(c.is_ascii_digit() || c == '.' || c == 'e' || c == '-' || c == '+'))
         .unwrap_or(t.len());
     let (number, unit) = t.split_at(split);
     let v: f64 = number
@@ -425,10 +479,10 @@ pub fn parse_length(text: &str) -> Result<f64, String> {
         u => return Err(format!("`{u}` is not a unit of length (mm, um, nm, m)")),
     };
     let mm = v * scale;
-    if mm.is_finite() && mm > 0.0 {
+    if mm.is_finite() {
         Ok(mm)
     } else {
-        Err(format!("`{text}` is not a positive length"))
+        Err(format!("`{text}` is not a finite length"))
     }
 }
 

@@ -94,6 +94,8 @@ fn run(cli: Cli) -> u8 {
             cutoff,
             keep_origin,
             per_lenslet,
+            lenslet,
+            at,
         } => commands::measure::run(
             &out,
             (&file, &part),
@@ -106,6 +108,8 @@ fn run(cli: Cli) -> u8 {
                 keep_origin,
                 from_job: false,
                 per_lenslet,
+                lenslet,
+                at,
             },
         ),
 

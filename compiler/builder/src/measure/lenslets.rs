@@ -22,9 +22,9 @@ use super::placed::{Options, form_error};
 use super::report;
 
 /// The design `f` seen from a lenslet's centre: g(u, v) = f(u + cx, v + cy).
-struct FromCentre<'a> {
-    f: &'a dyn SurfaceFn,
-    centre: (f64, f64),
+pub(super) struct FromCentre<'a> {
+    pub(super) f: &'a dyn SurfaceFn,
+    pub(super) centre: (f64, f64),
 }
 
 impl SurfaceFn for FromCentre<'_> {
@@ -37,7 +37,7 @@ impl SurfaceFn for FromCentre<'_> {
 
 /// How far beyond its aperture a lenslet's points reach, as a factor of
 /// the aperture about its centre.
-const MARGIN: f64 = 1.2;
+pub(super) const MARGIN: f64 = 1.2;
 
 /// A lenslet's map points: its points in the measurement's frame (valid
 /// ones), their pixels, and how many of the map's pixels (valid or not)
@@ -89,6 +89,7 @@ pub(super) fn measure(
         }
     }
     let (tx, ty) = whole.tilt();
+    let places = rows_and_columns(lenslets.centres());
     let mut each = Vec::new();
     for (k, s) in shares.into_iter().enumerate() {
         if s.in_aperture == 0 {
@@ -98,6 +99,8 @@ pub(super) fn measure(
         let share = s.points.len() as f64 / s.in_aperture as f64;
         let mut out = report::LensletMeasured {
             index: k,
+            row: places[k].0,
+            column: places[k].1,
             centre_mm: [c.0, c.1],
             points_in_aperture: s.in_aperture,
             valid_share: share,
@@ -204,9 +207,43 @@ pub(super) fn measure(
     }
 }
 
+/// Each lenslet's row and column in its array, from 0: its row the rank
+/// of its y among the array's distinct y (the row of least y is 0), its
+/// column the rank of its x among the lenslets of its row. Centres whose
+/// y differ by less than a nanometre share a row.
+pub(super) fn rows_and_columns(centres: &[(f64, f64)]) -> Vec<(usize, usize)> {
+    const SAME: f64 = 1e-6; // mm
+    let mut ys: Vec<f64> = centres.iter().map(|c| c.1).collect();
+    ys.sort_by(f64::total_cmp);
+    ys.dedup_by(|b, a| (*b - *a).abs() < SAME);
+    let rows: Vec<usize> = centres
+        .iter()
+        .map(|c| ys.partition_point(|r| *r < c.1 - SAME))
+        .collect();
+    // In order of row, then x, then index: a row's columns count up.
+    let mut order: Vec<usize> = (0..centres.len()).collect();
+    order.sort_by(|&a, &b| {
+        rows[a]
+            .cmp(&rows[b])
+            .then(centres[a].0.total_cmp(&centres[b].0))
+            .then(a.cmp(&b))
+    });
+    let mut out = vec![(0, 0); centres.len()];
+    let mut column = 0;
+    for (n, &k) in order.iter().enumerate() {
+        column = if n > 0 && rows[order[n - 1]] == rows[k] {
+            column + 1
+        } else {
+            0
+        };
+        out[k] = (rows[k], column);
+    }
+    out
+}
+
 /// A lenslet's texture: its residual on the map's pixels over the box
 /// its points span, through the same filter as the whole map's.
-fn texture(
+pub(super) fn texture(
     m: &HeightMap,
     pixels: &[(usize, usize)],
     errors: &[f64],

@@ -5,9 +5,11 @@
 //! on the aperture, is enough of it valid), registered to the design, and
 //! reported: the error along the surface normal with its PV and RMS, the
 //! texture after form removal, a turned part's set-up errors, and the
-//! error map as an SVG picture. Every refusal is a `Failure`, a coded
+//! error map as an SVG picture; with `--lenslet`, a map of one lenslet's
+//! field held to that lenslet alone (`field`). Every refusal is a `Failure`, a coded
 //! error in words that names the file; nothing is written then.
 
+mod field;
 mod lenslets;
 pub mod placed;
 pub mod report;
@@ -20,8 +22,10 @@ use lensc_runtime::surface::ir::SurfaceFn;
 use lensc_runtime::verify::heightmap::ErrorRaster;
 
 use crate::strategy::JobSpec;
+pub use field::lenslet_of;
 pub use placed::{
-    Failure, MAX_MEASUREMENT_BYTES, Options, read_failure, read_file, register_measurement,
+    Failure, LensletPick, MAX_MEASUREMENT_BYTES, Options, read_failure, read_file,
+    register_measurement,
 };
 use placed::{Points, Registered, fail, registration_report};
 use report::MeasureReport;
@@ -47,6 +51,17 @@ pub fn measure(
     let surface_name = head.names.surface.clone();
     let lowered = head.surface.design();
     let (f, _) = crate::evaluate::evaluator(&lowered.tape);
+    if let Some(pick) = opts.lenslet {
+        return field::measure(
+            head,
+            f.as_ref(),
+            &lowered.domain,
+            (file, bytes),
+            m,
+            pick,
+            opts,
+        );
+    }
     let format = m.format;
     // Lenslet by lenslet: only a map of an array.
     let array = if opts.per_lenslet {
@@ -145,6 +160,7 @@ pub fn measure(
         texture_skipped,
         setup,
         lenslets,
+        lenslet: None,
     };
     Ok(Outcome { report, svg })
 }

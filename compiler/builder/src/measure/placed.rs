@@ -35,6 +35,23 @@ pub struct Options {
     /// Register each lenslet of the job's array on its own too
     /// (`--per-lenslet`).
     pub per_lenslet: bool,
+    /// The map is one lenslet's field (`--lenslet`): register it to that
+    /// lenslet's design alone.
+    pub lenslet: Option<LensletPick>,
+    /// Where on the part (mm, the design's x and y) the map's reference
+    /// point lay (`--at`): its middle pixel, or the file's origin with
+    /// `keep_origin`. `None`: on the picked lenslet's centre.
+    pub at: Option<(f64, f64)>,
+}
+
+/// A lenslet of an array as a user names it: its index in the array (as
+/// the build report and `--per-lenslet` number them, from 0, row by row
+/// from the least y, along each row from the least x), or its row and
+/// column (from 0, in the same order).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LensletPick {
+    Index(usize),
+    RowColumn(usize, usize),
 }
 
 impl Default for Options {
@@ -46,6 +63,8 @@ impl Default for Options {
             keep_origin: false,
             from_job: false,
             per_lenslet: false,
+            lenslet: None,
+            at: None,
         }
     }
 }
@@ -320,26 +339,7 @@ pub fn register_measurement(
     } else {
         register::register_heights(f, &p.inside, fit)
     };
-    let reg = reg.map_err(|e| match e {
-        RegisterError::TooFewPoints { points } => fail(
-            codes::MEASURE_TOO_LITTLE,
-            format!("{file}: {points} valid points inside the aperture of `{surface_name}`: too few to register"),
-            None,
-        ),
-        RegisterError::NotConverged { iterations, rms } => fail(
-            codes::MEASURE_NOT_CONVERGED,
-            format!(
-                "{file}: the registration to `{surface_name}` did not converge in {iterations} iterations{}",
-                if rms.is_finite() { format!(" (residual RMS {:.1} nm)", rms * 1e6) } else { String::new() }
-            ),
-            Some("centre the map in the instrument's software, or check that it measures this surface"),
-        ),
-        RegisterError::Undefined { points } => fail(
-            codes::MEASURE_NOT_CONVERGED,
-            format!("{file}: the registration to `{surface_name}` moved {points} measured points where the design has no value"),
-            Some("centre the map in the instrument's software, or check that it measures this surface"),
-        ),
-    })?;
+    let reg = reg.map_err(|e| not_registered(file, &format!("`{surface_name}`"), e))?;
     // The error along the normal, at each registered point.
     let pred = register::predict(f, &p.inside, &reg.values);
     let errors: Vec<f64> = p
@@ -355,6 +355,66 @@ pub fn register_measurement(
         .map(|(q, h)| q[2] - h[0])
         .collect();
     let form = form_error(&p.inside, &errors);
+    departs(&pred, &form, file, &format!("`{surface_name}`"))?;
+    Ok(Registered {
+        points: p,
+        registration: reg,
+        errors,
+        vertical,
+        form,
+        share,
+    })
+}
+
+/// The coded failure for a registration of the file `file` to `what`
+/// (the surface's name in backquotes, or more) that failed with `e`.
+pub(crate) fn not_registered(file: &str, what: &str, e: RegisterError) -> Failure {
+    use lensc_lang::codes;
+    match e {
+        RegisterError::TooFewPoints { points } => fail(
+            codes::MEASURE_TOO_LITTLE,
+            format!(
+                "{file}: {points} valid points inside the aperture of {what}: too few to register"
+            ),
+            None,
+        ),
+        RegisterError::NotConverged { iterations, rms } => fail(
+            codes::MEASURE_NOT_CONVERGED,
+            format!(
+                "{file}: the registration to {what} did not converge in {iterations} iterations{}",
+                if rms.is_finite() {
+                    format!(" (residual RMS {:.1} nm)", rms * 1e6)
+                } else {
+                    String::new()
+                }
+            ),
+            Some(
+                "centre the map in the instrument's software, or check that it measures this surface",
+            ),
+        ),
+        RegisterError::Undefined { points } => fail(
+            codes::MEASURE_NOT_CONVERGED,
+            format!(
+                "{file}: the registration to {what} moved {points} measured points where the design has no value"
+            ),
+            Some(
+                "centre the map in the instrument's software, or check that it measures this surface",
+            ),
+        ),
+    }
+}
+
+/// E0364 when the error left after registration (`form`) is more than a
+/// quarter of the design's sag range over the points (`pred`, the heights
+/// the registered design predicts) and over 1 µm RMS: heights in other
+/// units, or another surface.
+pub(crate) fn departs(
+    pred: &[[f64; 3]],
+    form: &report::FormError,
+    file: &str,
+    what: &str,
+) -> Result<(), Failure> {
+    use lensc_lang::codes;
     let (lo, hi) = pred
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), h| {
@@ -365,7 +425,7 @@ pub fn register_measurement(
         return Err(fail(
             codes::MEASURE_MISMATCH,
             format!(
-                "{file}: after registration the measurement departs from `{surface_name}` by {:.3} µm RMS, more than a quarter of the design's {:.3} µm sag range over the measured points: heights in other units, or another surface",
+                "{file}: after registration the measurement departs from {what} by {:.3} µm RMS, more than a quarter of the design's {:.3} µm sag range over the measured points: heights in other units, or another surface",
                 form.rms_nm / 1000.0,
                 sag_range * 1000.0
             ),
@@ -374,14 +434,7 @@ pub fn register_measurement(
             ),
         ));
     }
-    Ok(Registered {
-        points: p,
-        registration: reg,
-        errors,
-        vertical,
-        form,
-        share,
-    })
+    Ok(())
 }
 
 pub(crate) fn aperture_words(d: &lensc_runtime::surface::analysis::Domain) -> String {

@@ -32,6 +32,47 @@ pub struct MeasureReport {
     /// (`--per-lenslet`), in the array's order: those the map reaches.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lenslets: Option<Lenslets>,
+    /// `--lenslet`: the map is one lenslet's field, registered to that
+    /// lenslet's design alone; `registration`, `form_error` and `texture`
+    /// above are then that lenslet's (its decentre: where its centre lies
+    /// from where the field was placed on it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lenslet: Option<LensletField>,
+}
+
+/// `--lenslet`: which lenslet the field was held to, where the field was
+/// taken to lie and where its registration puts it.
+#[derive(Clone, Debug, Serialize, JsonSchema)]
+#[schemars(deny_unknown_fields)]
+pub struct LensletField {
+    /// Its index in its array, from 0 (as `lenslets.each` and the build
+    /// report number them), and its row and column, from 0: rows from the
+    /// least y, columns along a row from the least x.
+    pub index: usize,
+    pub row: usize,
+    pub column: usize,
+    /// Its centre in the design (mm).
+    pub centre_mm: [f64; 2],
+    /// Which point of the map was placed on the part: its middle pixel,
+    /// or the file's origin (`--keep-origin`).
+    pub reference: String,
+    /// Where that point was taken to lie on the part (mm, the design's x
+    /// and y), and what said so: `--at`, or the lenslet's centre.
+    pub placed_at_mm: [f64; 2],
+    pub placed_by: String,
+    /// Where the registration puts that point on the part (mm), the
+    /// lenslet taken to sit at its design centre: `placed_at_mm` less the
+    /// decentre found (turned by the clocking found, if any).
+    pub found_at_mm: [f64; 2],
+    /// The share of the lenslet's aperture (by area) under the map's
+    /// valid pixels where it was placed, and the least share required
+    /// (`--min-valid`).
+    pub aperture_covered: f64,
+    pub min_covered: f64,
+    /// Under 95 % covered: a coded finding (W0037) that the figures
+    /// describe only the part of the lenslet measured.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub finding: Option<Finding>,
 }
 
 /// `--per-lenslet`: each lenslet of the array the map reaches, registered
@@ -60,6 +101,10 @@ pub struct LensletMeasured {
     /// Its index in its array, from 0: row by row from the least y, along
     /// each row from the least x (as the build report's lenslets).
     pub index: usize,
+    /// Its row and column in the array, from 0: rows from the least y,
+    /// columns along a row from the least x (`--lenslet ROW,COLUMN`).
+    pub row: usize,
+    pub column: usize,
     /// Its centre in the design (mm).
     pub centre_mm: [f64; 2],
     /// Map points inside its aperture widened by a fifth (valid or not),

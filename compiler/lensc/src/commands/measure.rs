@@ -1,7 +1,9 @@
 //! `lensc measure FILE PART [--job NAME]`: a measured part held to its
 //! job's design (`lensc_build::measure`): the job lowered as `build`
 //! lowers it, the measurement read under the project's file rules,
-//! registered and figured; `JOB.measure.json` and `JOB.error_map.svg`
+//! registered and figured (with `--lenslet`, the lenslet named checked
+//! against the job's array before the file is read, the error pointing at
+//! the job); `JOB.measure.json` and `JOB.error_map.svg`
 //! written as one unit, or nothing and a coded error naming the file.
 
 use std::path::Path;
@@ -49,6 +51,19 @@ pub fn run(
             return 1;
         }
     };
+    // The lenslet named must be one of the job's array's: said over the
+    // job, before the measurement is read.
+    if let Some(pick) = opts.lenslet
+        && let Err(f) = measure::lenslet_of(spec.head(), pick)
+    {
+        let (file_id, span) = spec.head().site;
+        let mut d = Diagnostic::error(f.code, f.message.clone(), file_id, span);
+        if let Some(h) = &f.help {
+            d = d.with_help(h.clone());
+        }
+        out.diagnostics(&c, &[d]);
+        return 1;
+    }
     let root = out.root.clone().unwrap_or_else(|| {
         file.parent()
             .filter(|p| !p.as_os_str().is_empty())
@@ -95,6 +110,28 @@ pub fn run(
             f.pv_nm, f.rms_nm, r.decentre_x_um, r.decentre_y_um, r.tilt_x_urad, r.tilt_y_urad
         );
     }
+    if let Some(f) = outcome
+        .report
+        .lenslet
+        .as_ref()
+        .and_then(|l| l.finding.as_ref())
+    {
+        warn(out, part, &bytes, &[f]);
+    }
+    if let (Some(l), MessageFormat::Human) = (&outcome.report.lenslet, out.format) {
+        eprintln!(
+            "{name}: lenslet {} (row {}, column {}; centre x = {}, y = {} mm), {:.1} % of its aperture measured; {} found on the part at x = {:.4}, y = {:.4} mm",
+            l.index,
+            l.row,
+            l.column,
+            l.centre_mm[0],
+            l.centre_mm[1],
+            100.0 * l.aperture_covered,
+            l.reference,
+            l.found_at_mm[0],
+            l.found_at_mm[1]
+        );
+    }
     if let Some(l) = &outcome.report.lenslets {
         let findings: Vec<_> = l.each.iter().filter_map(|e| e.finding.as_ref()).collect();
         if !findings.is_empty() {
@@ -115,7 +152,7 @@ pub fn run(
     0
 }
 
-/// Prints each lenslet's finding (W0036) as a warning over the
+/// Prints each lenslet's finding (W0036, W0037) as a warning over the
 /// measurement file.
 fn warn(out: &Output, part: &Path, bytes: &[u8], findings: &[&measure::report::Finding]) {
     let text = std::str::from_utf8(bytes)
@@ -126,8 +163,13 @@ fn warn(out: &Output, part: &Path, bytes: &[u8], findings: &[&measure::report::F
     let diags: Vec<Diagnostic> = findings
         .iter()
         .map(|f| {
-            Diagnostic::warning(lensc_lang::codes::LENSLET_NOT_REGISTERED, f.message.clone(), id, Span::new(0, 0))
-                .with_help("measure that lenslet again, or lower --min-valid knowing what its figures then cover")
+            if f.code == lensc_lang::codes::FIELD_PART_OF_LENSLET {
+                Diagnostic::warning(lensc_lang::codes::FIELD_PART_OF_LENSLET, f.message.clone(), id, Span::new(0, 0))
+                    .with_help("centre the field on the lenslet (or give where it lay with --at) to measure all of it")
+            } else {
+                Diagnostic::warning(lensc_lang::codes::LENSLET_NOT_REGISTERED, f.message.clone(), id, Span::new(0, 0))
+                    .with_help("measure that lenslet again, or lower --min-valid knowing what its figures then cover")
+            }
         })
         .collect();
     let _ = match out.format {
