@@ -86,10 +86,7 @@ pub(crate) struct Of<'a> {
 /// The kernel a correction is made with: the JIT, or the interpreter
 /// should cranelift refuse the tape (as the build evaluates surfaces).
 fn kernel(tape: &SurfaceTape) -> Box<dyn SurfaceFn + Sync> {
-    match lensc_runtime::surface::jit::JitSurface::compile(tape) {
-        Ok(j) => Box::new(j),
-        Err(_) => Box::new(lensc_runtime::surface::ir::Interpreter::new(tape)),
-    }
+    crate::evaluate::evaluator(tape).0
 }
 
 /// The strategies whose cut is a surface of revolution (a lathe without a
@@ -106,7 +103,13 @@ const TURNED: [&str; 2] = ["profile_turning", "profile_grinding"];
 pub struct Applied {
     pub fitted: Correction,
     pub gain: f64,
+    /// Tells corrections apart (a simulation keeps, per thread, the
+    /// correction along the column it last asked: `height_map`).
+    pub(crate) id: u64,
 }
+
+/// The next `Applied::id`.
+static NEXT_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
 impl Applied {
     /// `tape` less the correction (`corrected_tape`).
@@ -263,6 +266,7 @@ pub(crate) fn corrected(
     let applied = Applied {
         fitted,
         gain: c.gain,
+        id: NEXT_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
     };
     Ok((corrected, report, applied))
 }

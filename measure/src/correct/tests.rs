@@ -200,3 +200,73 @@ fn at_is_the_terms_dot_the_coefficients() {
         }
     }
 }
+
+/// Along any line, the correction `along` it agrees with `at` at every
+/// point to 1e-12 of the correction's largest value, for both bases at
+/// their highest orders, lines through the centre (a lathe's rays) and
+/// off it (a raster's rows, a window away from the centre).
+#[test]
+fn along_a_line_is_the_correction_at_its_points() {
+    for basis in [
+        Basis::radial(1.5, 0.08),
+        Basis::radial(1.5, 1e-3),
+        Basis::map((-1.0, 2.0), (-0.5, 1.5), 0.3),
+        Basis::map((-1.0, 2.0), (-0.5, 1.5), 1e-3),
+        Basis::map((20.0, 30.0), (-5.0, 5.0), 1.0),
+    ] {
+        let c = sample_correction(basis);
+        let ((x0, x1), (y0, y1)) = match basis {
+            Basis::Radial { radius, .. } => ((-radius, radius), (-radius, radius)),
+            Basis::Map { centre, half, .. } => (
+                (centre.0 - half.0, centre.0 + half.0),
+                (centre.1 - half.1, centre.1 + half.1),
+            ),
+        };
+        let mut points = Vec::new();
+        for k in 0..400 {
+            let (x, y) = (
+                x0 + (x1 - x0) * (k % 20) as f64 / 19.0,
+                y0 + (y1 - y0) * (k / 20) as f64 / 19.0,
+            );
+            points.push((x, y));
+        }
+        let largest = points
+            .iter()
+            .map(|&(x, y)| c.at(x, y).abs())
+            .fold(0.0, f64::max);
+        let mid = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
+        let lines = [
+            // A lathe's ray at 0.7 rad, from the axis.
+            ((0.0, 0.0), (0.7f64.cos(), 0.7f64.sin())),
+            // A raster's column (x fixed, t = y) and row (t = x).
+            ((x0 + 0.3 * (x1 - x0), 0.0), (0.0, 1.0)),
+            ((0.0, y0 + 0.8 * (y1 - y0)), (1.0, 0.0)),
+            // Askew through the middle, parameter scaled.
+            (mid, (0.3, -0.2)),
+        ];
+        for (origin, dir) in lines {
+            let along = c.along(origin, dir);
+            let mut checked = 0;
+            for k in 0..=200 {
+                // Over the aperture's span along the line, and past it.
+                let t = -8.0 * (x1 - x0).max(y1 - y0) / 2.0 / dir.0.hypot(dir.1)
+                    * (1.0 - k as f64 / 100.0)
+                    / 4.0;
+                let (x, y) = (origin.0 + t * dir.0, origin.1 + t * dir.1);
+                if x < x0 || x > x1 || y < y0 || y > y1 {
+                    continue;
+                }
+                let (got, want) = (along.at(t), c.at(x, y));
+                assert!(
+                    (got - want).abs() <= 1e-12 * largest,
+                    "{basis:?} along {origin:?} + t {dir:?} at t = {t}: {got} vs {want}"
+                );
+                checked += 1;
+            }
+            assert!(
+                checked >= 20,
+                "{basis:?} along {origin:?}: {checked} points"
+            );
+        }
+    }
+}

@@ -194,9 +194,9 @@ fn simulated_height_map(
 ) -> report::HeightMap {
     let lowered = &spec.head.surface.lowered;
     // The height alone: the frame asks nothing else of the design.
-    let design = evaluator(&lowered.tape.height_only()).0;
+    let design = height_map::DesignHeights::of(&spec.head.surface);
     let frame = LatheFrame::new(
-        design.as_ref(),
+        &design,
         window,
         lowered.domain,
         // The default window is the disc the spiral cuts; one the job
