@@ -104,6 +104,12 @@ impl Compiled {
         Ok(fresh)
     }
 
+    /// Drops every kept kernel (a bench that times a build as a fresh
+    /// process makes it, compilations included).
+    pub fn clear(&self) {
+        self.kept.lock().unwrap_or_else(|e| e.into_inner()).clear();
+    }
+
     /// A kept kernel for `key`, made the most recent.
     fn find(&self, key: &Key) -> Option<Shared> {
         let mut kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
