@@ -430,6 +430,98 @@ impl Correction {
     }
 }
 
+/// A correction's sections along the rays from the origin (a lathe's
+/// spindle axis): each a polynomial in the radius u (`Rays::section`),
+/// Σ_k u^k Σ_{a+b=k} m_ab cos^a θ sin^b θ, from the correction written
+/// once as monomials x^a y^b about the origin (a radial correction's
+/// section is the same along every ray).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Rays {
+    order: usize,
+    /// Map: m_ab at a·(order + 1) + b. Radial: the section itself.
+    m: Vec<f64>,
+    radial: bool,
+}
+
+impl Correction {
+    /// The correction's sections along rays from the origin, or `None`
+    /// where a map's centre lies beyond its half-widths from the origin
+    /// (there its monomials about the origin would cancel to a loss of
+    /// digits; such a part is not turned about its axis).
+    pub fn rays(&self) -> Option<Rays> {
+        let n = self.basis.order();
+        match self.basis {
+            Basis::Radial { .. } => {
+                let along = self.along((0.0, 0.0), (1.0, 0.0));
+                Some(Rays {
+                    order: n,
+                    m: along.a[..along.terms].to_vec(),
+                    radial: true,
+                })
+            }
+            Basis::Map { centre, half, .. } => {
+                if centre.0.abs() > half.0 || centre.1.abs() > half.1 {
+                    return None;
+                }
+                let linear = |c0: f64, c1: f64| {
+                    let mut p = [0.0; ALONG_TERMS];
+                    (p[0], p[1]) = (c0, c1);
+                    p
+                };
+                let px = legendre_along(&linear(-centre.0 / half.0, 1.0 / half.0), 1, n);
+                let py = legendre_along(&linear(-centre.1 / half.1, 1.0 / half.1), 1, n);
+                let mut m = vec![0.0; (n + 1) * (n + 1)];
+                for d in 0..=n {
+                    for i in (0..=d).rev() {
+                        let j = d - i;
+                        let c = self.coefficients[d * (d + 1) / 2 + (d - i)];
+                        if c == 0.0 {
+                            continue;
+                        }
+                        for a in 0..=i {
+                            for b in 0..=j {
+                                m[a * (n + 1) + b] += c * px[i][a] * py[j][b];
+                            }
+                        }
+                    }
+                }
+                Some(Rays {
+                    order: n,
+                    m,
+                    radial: false,
+                })
+            }
+        }
+    }
+}
+
+impl Rays {
+    /// The section along the ray (cos θ, sin θ): coefficients of u^k,
+    /// lowest first, times `scale`, and how many there are.
+    pub fn section(&self, cos: f64, sin: f64, scale: f64, out: &mut [f64]) -> usize {
+        if self.radial {
+            for (o, m) in out.iter_mut().zip(&self.m) {
+                *o = scale * m;
+            }
+            return self.m.len();
+        }
+        let n = self.order;
+        let (mut cp, mut sp) = ([1.0; ORDERS], [1.0; ORDERS]);
+        for k in 1..=n {
+            cp[k] = cp[k - 1] * cos;
+            sp[k] = sp[k - 1] * sin;
+        }
+        for (k, o) in out.iter_mut().enumerate().take(n + 1) {
+            let mut h = 0.0;
+            for a in 0..=k {
+                h += self.m[a * (n + 1) + (k - a)] * cp[a] * sp[k - a];
+            }
+            *o = scale * h;
+        }
+        n + 1
+    }
+}
+
 /// P_0 … P_n of the node `t`, by the recurrence `legendre` uses.
 fn legendre_nodes(g: &mut Graph, t: Id, n: usize) -> Vec<Id> {
     let mut p = vec![g.constant_node(1.0)];

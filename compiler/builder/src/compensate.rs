@@ -116,6 +116,31 @@ impl Applied {
     pub fn tape(&self, tape: &SurfaceTape) -> SurfaceTape {
         corrected_tape(tape, &self.fitted, self.gain)
     }
+
+    /// The correction as a spiral's planner takes it out along each ray
+    /// from the spindle axis (`Correction::rays`), or `None` where its
+    /// sections there would lose digits.
+    pub fn along_rays(&self) -> Option<AlongRays> {
+        Some(AlongRays {
+            rays: self.fitted.rays()?,
+            gain: self.gain,
+        })
+    }
+}
+
+/// A correction taken out along a lathe's rays: its sections, times the
+/// gain.
+pub struct AlongRays {
+    rays: lensc_measure::correct::Rays,
+    gain: f64,
+}
+
+impl lensc_runtime::plan::spiral::RayCorrection for AlongRays {
+    fn section(&self, cos: f64, sin: f64) -> lensc_runtime::plan::spiral::RaySection {
+        let mut a = [0.0; lensc_runtime::plan::spiral::RAY_TERMS];
+        let terms = self.rays.section(cos, sin, self.gain, &mut a);
+        lensc_runtime::plan::spiral::RaySection { a, terms }
+    }
 }
 
 /// The surface to cut instead of `design`, the iteration for the report
