@@ -6,8 +6,11 @@
 //! polynomials over the whole aperture (`lensc_measure::correct`, which
 //! states the method); the surface cut is the design less `gain` times
 //! that fit, one IR tape, so every strategy plans it with exact
-//! derivatives as it plans the design. Every refusal is a coded
-//! diagnostic at the block's `measurement`, naming the file.
+//! derivatives as it plans the design (a spiral's planner and every
+//! height-map simulation take the same polynomial out themselves, along
+//! rays and columns where it has a few terms: `AlongRays`,
+//! `height_map::DesignHeights`). Every refusal is a coded diagnostic at
+//! the block's `measurement`, naming the file.
 
 use lensc_grammar::Diagnostic;
 use lensc_lang::codes;
