@@ -292,6 +292,236 @@ impl Correction {
     }
 }
 
+/// The most coefficients a correction along a line has: a radial term
+/// P_k(2ρ² − 1) is of degree 2k in the distance along a line.
+pub const ALONG_TERMS: usize = 2 * MAX_RADIAL_ORDER + 1;
+
+/// A correction along one line, (x, y) = origin + t · direction: a
+/// polynomial in t, Σ_m a_m (t − t0)^m, t0 the line's point nearest the
+/// basis's centre (so that the powers stay near the unit over the
+/// aperture, and the sum does not cancel). Where a simulation asks the
+/// correction at many points of one line (a column of its grid: a ray of
+/// a lathe, a row of a raster), each costs a few operations
+/// (`Along::at`) instead of the two Legendre recurrences and the sum of
+/// every term that `Correction::at` costs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Along {
+    t0: f64,
+    a: [f64; ALONG_TERMS],
+    terms: usize,
+}
+
+impl Along {
+    /// The correction at t along the line (Horner's rule).
+    pub fn at(&self, t: f64) -> f64 {
+        let d = t - self.t0;
+        let mut v = 0.0;
+        for &a in self.a[..self.terms].iter().rev() {
+            v = v * d + a;
+        }
+        v
+    }
+}
+
+/// A polynomial in the line's parameter, as coefficients of the powers
+/// of (t − t0), lowest first; at most `ALONG_TERMS`.
+type Poly = [f64; ALONG_TERMS];
+
+/// p · q, its terms beyond `ALONG_TERMS` dropped (none are: every product
+/// taken here is of degree at most 2 × `MAX_RADIAL_ORDER`).
+fn poly_mul(p: &Poly, q: &Poly, dp: usize, dq: usize) -> Poly {
+    let mut r = [0.0; ALONG_TERMS];
+    for i in 0..=dp {
+        for j in 0..=dq.min(ALONG_TERMS - 1 - i) {
+            r[i + j] += p[i] * q[j];
+        }
+    }
+    r
+}
+
+/// P_0(s) … P_n(s) for s = `s` a polynomial of degree `ds` in the line's
+/// parameter, by Bonnet's recurrence on polynomials.
+fn legendre_along(s: &Poly, ds: usize, n: usize) -> Vec<Poly> {
+    let mut p = vec![[0.0; ALONG_TERMS]];
+    p[0][0] = 1.0;
+    if n >= 1 {
+        p.push(*s);
+    }
+    for k in 1..n {
+        let a = (2 * k + 1) as f64 / (k + 1) as f64;
+        let b = k as f64 / (k + 1) as f64;
+        let sp = poly_mul(s, &p[k], ds, ds * k);
+        let mut next = [0.0; ALONG_TERMS];
+        for m in 0..ALONG_TERMS {
+            next[m] = a * sp[m] - b * p[k - 1][m];
+        }
+        p.push(next);
+    }
+    p
+}
+
+impl Correction {
+    /// The correction along the line origin + t · direction (`Along`):
+    /// the same polynomial as `at`, its terms composed with the line
+    /// (exact but for rounding: it agrees with `at` to about 1e-13 of the
+    /// correction's size, tested).
+    pub fn along(&self, origin: (f64, f64), direction: (f64, f64)) -> Along {
+        let n = self.basis.order();
+        let (dx, dy) = direction;
+        let len2 = dx * dx + dy * dy;
+        let centre = match self.basis {
+            Basis::Radial { .. } => (0.0, 0.0),
+            Basis::Map { centre, .. } => centre,
+        };
+        // The parameter of the line's point nearest the centre.
+        let t0 = if len2 > 0.0 {
+            ((centre.0 - origin.0) * dx + (centre.1 - origin.1) * dy) / len2
+        } else {
+            0.0
+        };
+        let (x0, y0) = (origin.0 + t0 * dx, origin.1 + t0 * dy);
+        let linear = |c0: f64, c1: f64| {
+            let mut p = [0.0; ALONG_TERMS];
+            (p[0], p[1]) = (c0, c1);
+            p
+        };
+        let mut a = [0.0; ALONG_TERMS];
+        let terms;
+        match self.basis {
+            Basis::Radial { radius, .. } => {
+                // 2ρ² − 1 along the line, ρ² = ((x0 + dx d)² + (y0 + dy d)²)/R².
+                let k = 2.0 / (radius * radius);
+                let mut s = [0.0; ALONG_TERMS];
+                s[0] = k * (x0 * x0 + y0 * y0) - 1.0;
+                s[1] = k * 2.0 * (x0 * dx + y0 * dy);
+                s[2] = k * len2;
+                let p = legendre_along(&s, 2, n);
+                for (c, pk) in self.coefficients.iter().zip(&p) {
+                    for m in 0..ALONG_TERMS {
+                        a[m] += c * pk[m];
+                    }
+                }
+                terms = 2 * n + 1;
+            }
+            Basis::Map { centre, half, .. } => {
+                let u = linear((x0 - centre.0) / half.0, dx / half.0);
+                let v = linear((y0 - centre.1) / half.1, dy / half.1);
+                let pu = legendre_along(&u, 1, n);
+                let pv = legendre_along(&v, 1, n);
+                for (i, p_i) in pu.iter().enumerate() {
+                    // Σ_j c_ij P_j(v), then times P_i(u).
+                    let mut q = [0.0; ALONG_TERMS];
+                    for (j, p_j) in pv.iter().enumerate().take(n - i + 1) {
+                        let d = i + j;
+                        let c = self.coefficients[d * (d + 1) / 2 + (d - i)];
+                        for m in 0..=j {
+                            q[m] += c * p_j[m];
+                        }
+                    }
+                    let t = poly_mul(p_i, &q, i, n - i);
+                    for m in 0..=n {
+                        a[m] += t[m];
+                    }
+                }
+                terms = n + 1;
+            }
+        }
+        Along { t0, a, terms }
+    }
+}
+
+/// A correction's sections along the rays from the origin (a lathe's
+/// spindle axis): each a polynomial in the radius u (`Rays::section`),
+/// Σ_k u^k Σ_{a+b=k} m_ab cos^a θ sin^b θ, from the correction written
+/// once as monomials x^a y^b about the origin (a radial correction's
+/// section is the same along every ray).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Rays {
+    order: usize,
+    /// Map: m_ab at a·(order + 1) + b. Radial: the section itself.
+    m: Vec<f64>,
+    radial: bool,
+}
+
+impl Correction {
+    /// The correction's sections along rays from the origin, or `None`
+    /// where a map's centre lies beyond its half-widths from the origin
+    /// (there its monomials about the origin would cancel to a loss of
+    /// digits; such a part is not turned about its axis).
+    pub fn rays(&self) -> Option<Rays> {
+        let n = self.basis.order();
+        match self.basis {
+            Basis::Radial { .. } => {
+                let along = self.along((0.0, 0.0), (1.0, 0.0));
+                Some(Rays {
+                    order: n,
+                    m: along.a[..along.terms].to_vec(),
+                    radial: true,
+                })
+            }
+            Basis::Map { centre, half, .. } => {
+                if centre.0.abs() > half.0 || centre.1.abs() > half.1 {
+                    return None;
+                }
+                let linear = |c0: f64, c1: f64| {
+                    let mut p = [0.0; ALONG_TERMS];
+                    (p[0], p[1]) = (c0, c1);
+                    p
+                };
+                let px = legendre_along(&linear(-centre.0 / half.0, 1.0 / half.0), 1, n);
+                let py = legendre_along(&linear(-centre.1 / half.1, 1.0 / half.1), 1, n);
+                let mut m = vec![0.0; (n + 1) * (n + 1)];
+                for d in 0..=n {
+                    for i in (0..=d).rev() {
+                        let j = d - i;
+                        let c = self.coefficients[d * (d + 1) / 2 + (d - i)];
+                        if c == 0.0 {
+                            continue;
+                        }
+                        for a in 0..=i {
+                            for b in 0..=j {
+                                m[a * (n + 1) + b] += c * px[i][a] * py[j][b];
+                            }
+                        }
+                    }
+                }
+                Some(Rays {
+                    order: n,
+                    m,
+                    radial: false,
+                })
+            }
+        }
+    }
+}
+
+impl Rays {
+    /// The section along the ray (cos θ, sin θ): coefficients of u^k,
+    /// lowest first, times `scale`, and how many there are.
+    pub fn section(&self, cos: f64, sin: f64, scale: f64, out: &mut [f64]) -> usize {
+        if self.radial {
+            for (o, m) in out.iter_mut().zip(&self.m) {
+                *o = scale * m;
+            }
+            return self.m.len();
+        }
+        let n = self.order;
+        let (mut cp, mut sp) = ([1.0; ORDERS], [1.0; ORDERS]);
+        for k in 1..=n {
+            cp[k] = cp[k - 1] * cos;
+            sp[k] = sp[k - 1] * sin;
+        }
+        for (k, o) in out.iter_mut().enumerate().take(n + 1) {
+            let mut h = 0.0;
+            for a in 0..=k {
+                h += self.m[a * (n + 1) + (k - a)] * cp[a] * sp[k - a];
+            }
+            *o = scale * h;
+        }
+        n + 1
+    }
+}
+
 /// P_0 … P_n of the node `t`, by the recurrence `legendre` uses.
 fn legendre_nodes(g: &mut Graph, t: Id, n: usize) -> Vec<Id> {
     let mut p = vec![g.constant_node(1.0)];

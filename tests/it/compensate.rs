@@ -671,6 +671,71 @@ fn a_compensated_spiral_follows_the_corrected_surface() {
     );
 }
 
+/// A compensated spiral's planner takes the correction out along each ray
+/// from the declared trajectory's kernel (`Prepared::of`: the
+/// correction's section there, a polynomial in the radius): it plans the
+/// points the corrected trajectory's own kernel plans, to a picometre
+/// (here 40 nm of astigmatism, order 6).
+#[test]
+fn a_compensated_spiral_plans_along_rays_what_the_corrected_kernel_plans() {
+    let plain = project_of(&STS.replace("COMPENSATE", ""), &[]);
+    let design = spiral_trajectory(plain.path());
+    let n = 301;
+    let dx = 6.0 / (n - 1) as f64;
+    let mut z = Vec::with_capacity(n * n);
+    for j in 0..n {
+        for i in 0..n {
+            let (x, y) = (-3.0 + i as f64 * dx, -3.0 + j as f64 * dx);
+            z.push(if x.hypot(y) <= 2.98 {
+                design.eval(x, y)[0] + 40e-6 * (x * x - y * y) / 9.0
+            } else {
+                f64::NAN
+            });
+        }
+    }
+    let part = lensc_measure::write::x3p(&HeightMap::from_heights(n, n, (dx, dx), z), "dome");
+    let block = ", compensate: { measurement: \"part.x3p\", gain: 1, smoothing: 1 mm }";
+    let dir = project_of(&STS.replace("COMPENSATE", block), &[("part.x3p", &part)]);
+    let c = driver::check_path(&RealFs, &dir.path().join("job.lens")).expect("checks");
+    let (spec, _) = lensc_build::pipeline::lower(&c.checked.jobs[0], None, &Default::default())
+        .unwrap_or_else(|d| panic!("lowers: {d:?}"));
+    let lensc_build::strategy::JobSpec::Spiral(s) = spec else {
+        panic!("a spiral job")
+    };
+    let along_rays = lensc_build::strategy::spiral::Prepared::of(&s);
+    assert!(
+        along_rays.less.is_some(),
+        "the correction is taken out along rays"
+    );
+    let whole = lensc_build::strategy::spiral::Prepared {
+        spec: &s,
+        kernel: lensc_build::evaluate::evaluator(&s.trajectory.tape).0,
+        less: None,
+    };
+    let plan = |p: &lensc_build::strategy::spiral::Prepared| {
+        let mut points = Vec::new();
+        p.planner()
+            .plan(&s.fast_axis, |pts| points.extend_from_slice(pts))
+            .expect("plans");
+        points
+    };
+    let (a, b) = (plan(&along_rays), plan(&whole));
+    assert!(a.len() > 10_000, "{} points", a.len());
+    assert_eq!(a.len(), b.len());
+    let worst = a
+        .iter()
+        .zip(&b)
+        .map(|(p, q)| {
+            assert_eq!((p.x, p.c), (q.x, q.c));
+            (p.w - q.w).abs()
+        })
+        .fold(0.0, f64::max);
+    assert!(
+        worst <= 1e-9,
+        "the nose centres differ by up to {worst:e} mm"
+    );
+}
+
 /// Lin's paraboloid (examples/lin2022_scraping.lens: R = 1 mm, k = −1,
 /// 1.6 mm across, the 85 µm microshaper knife on the generic mill, 10 µm
 /// stepover, 200 nm chord tolerance) as a raster job.

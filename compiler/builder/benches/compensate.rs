@@ -47,6 +47,8 @@ fn provenance() -> Provenance {
 /// check and lowering alone (for the compensated job, where the
 /// measurement is read, registered and fitted).
 fn build(file: &Path, dir: &Path) -> (u64, f64) {
+    // As a fresh `lensc build` process: no kernel compiled before.
+    lensc_build::evaluate::compiled::COMPILED.clear();
     let cpu = timing::cpu_seconds();
     let c = lensc_build::driver::check_path(&lensc_lang::loader::RealFs, file).expect("reads");
     assert!(!c.has_errors(), "checks");

@@ -200,6 +200,7 @@ fn simulate_roller(spec: &JobSpec, passes: &[Vec<[f64; 3]>]) -> usize {
     }
     let frame = RollerFrame {
         kernel: kernel.as_ref(),
+        correction: None,
         window,
         roller_radius: helix.roller_radius,
         y_start: helix.y_start,

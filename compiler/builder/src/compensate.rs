@@ -6,8 +6,11 @@
 //! polynomials over the whole aperture (`lensc_measure::correct`, which
 //! states the method); the surface cut is the design less `gain` times
 //! that fit, one IR tape, so every strategy plans it with exact
-//! derivatives as it plans the design. Every refusal is a coded
-//! diagnostic at the block's `measurement`, naming the file.
+//! derivatives as it plans the design (a spiral's planner and every
+//! height-map simulation take the same polynomial out themselves, along
+//! rays and columns where it has a few terms: `AlongRays`,
+//! `height_map::DesignHeights`). Every refusal is a coded diagnostic at
+//! the block's `measurement`, naming the file.
 
 use lensc_grammar::Diagnostic;
 use lensc_lang::codes;
@@ -86,10 +89,7 @@ pub(crate) struct Of<'a> {
 /// The kernel a correction is made with: the JIT, or the interpreter
 /// should cranelift refuse the tape (as the build evaluates surfaces).
 fn kernel(tape: &SurfaceTape) -> Box<dyn SurfaceFn + Sync> {
-    match lensc_runtime::surface::jit::JitSurface::compile(tape) {
-        Ok(j) => Box::new(j),
-        Err(_) => Box::new(lensc_runtime::surface::ir::Interpreter::new(tape)),
-    }
+    crate::evaluate::evaluator(tape).0
 }
 
 /// The strategies whose cut is a surface of revolution (a lathe without a
@@ -106,12 +106,43 @@ const TURNED: [&str; 2] = ["profile_turning", "profile_grinding"];
 pub struct Applied {
     pub fitted: Correction,
     pub gain: f64,
+    /// Tells corrections apart (a simulation keeps, per thread, the
+    /// correction along the column it last asked: `height_map`).
+    pub(crate) id: u64,
 }
+
+/// The next `Applied::id`.
+static NEXT_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
 impl Applied {
     /// `tape` less the correction (`corrected_tape`).
     pub fn tape(&self, tape: &SurfaceTape) -> SurfaceTape {
         corrected_tape(tape, &self.fitted, self.gain)
+    }
+
+    /// The correction as a spiral's planner takes it out along each ray
+    /// from the spindle axis (`Correction::rays`), or `None` where its
+    /// sections there would lose digits.
+    pub fn along_rays(&self) -> Option<AlongRays> {
+        Some(AlongRays {
+            rays: self.fitted.rays()?,
+            gain: self.gain,
+        })
+    }
+}
+
+/// A correction taken out along a lathe's rays: its sections, times the
+/// gain.
+pub struct AlongRays {
+    rays: lensc_measure::correct::Rays,
+    gain: f64,
+}
+
+impl lensc_runtime::plan::spiral::RayCorrection for AlongRays {
+    fn section(&self, cos: f64, sin: f64) -> lensc_runtime::plan::spiral::RaySection {
+        let mut a = [0.0; lensc_runtime::plan::spiral::RAY_TERMS];
+        let terms = self.rays.section(cos, sin, self.gain, &mut a);
+        lensc_runtime::plan::spiral::RaySection { a, terms }
     }
 }
 
@@ -263,6 +294,7 @@ pub(crate) fn corrected(
     let applied = Applied {
         fitted,
         gain: c.gain,
+        id: NEXT_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
     };
     Ok((corrected, report, applied))
 }

@@ -6,6 +6,8 @@ use lensc_grammar::{Diagnostic, Severity};
 use lensc_lang::Checked;
 use lensc_runtime::surface::ir::SurfaceFn;
 
+pub mod compiled;
+
 /// Where `lensc sample` evaluates a surface.
 pub enum SamplePoints {
     /// n × n over the domain's bounding box, points inside the domain.
@@ -22,14 +24,15 @@ pub type Sample = [f64; 7];
 /// The backend that evaluates surfaces: a JIT kernel, or the reference
 /// interpreter should cranelift refuse the tape (they agree to 1e-13, see
 /// `lensc_runtime::surface::conformance` and tests/it/surface_kinds.rs).
-/// The second value names the backend used (reports carry it).
+/// The second value names the backend used (reports carry it). A tape
+/// compiled before is not compiled again (`compiled`).
 pub fn evaluator(
     tape: &lensc_runtime::surface::ir::SurfaceTape,
 ) -> (
     Box<dyn lensc_runtime::surface::ir::SurfaceFn + Sync>,
     crate::report::Backend,
 ) {
-    match lensc_runtime::surface::jit::JitSurface::compile(tape) {
+    match compiled::COMPILED.kernel(tape) {
         Ok(j) => (Box::new(j), crate::report::Backend::Jit),
         Err(_) => (
             Box::new(lensc_runtime::surface::ir::Interpreter::new(tape)),

@@ -136,11 +136,82 @@ fn heights(kernel: &dyn SurfaceFn, xy: impl Iterator<Item = (f64, f64)>, out: &m
     }
 }
 
+/// The design heights a frame compares the cut with: the design's height
+/// alone (a kernel of `SurfaceTape::height_only`) and, for a compensated
+/// job, the correction it cuts less (the surface aimed at is the design
+/// less `gain` times the correction: `compensate::corrected_tape`). The
+/// correction is not in the kernel: the simulation asks ten million
+/// heights of a 10 mm part, and a correction of 66 terms cost about as
+/// much a point as the off-axis design's height (`benches/compensate.rs`);
+/// along one column every frame's (x, y) is a line in u, where the
+/// correction is a polynomial of u of a few terms (`Correction::along`).
+pub struct DesignHeights {
+    pub kernel: Box<dyn SurfaceFn + Sync>,
+    pub correction: Option<crate::compensate::Applied>,
+}
+
+impl DesignHeights {
+    /// The heights of the surface a job aims at.
+    pub fn of(surface: &crate::job::SurfaceSpec) -> DesignHeights {
+        match (&surface.design, &surface.correction) {
+            (Some(design), Some(c)) => DesignHeights {
+                kernel: crate::evaluate::evaluator(&design.tape.height_only()).0,
+                correction: Some(c.clone()),
+            },
+            _ => DesignHeights {
+                kernel: crate::evaluate::evaluator(&surface.lowered.tape.height_only()).0,
+                correction: None,
+            },
+        }
+    }
+}
+
+thread_local! {
+    /// The correction along the line a frame's column lies on, for the
+    /// column last asked (its cells are asked a few at a time): the
+    /// correction's `id`, the line's origin and direction (bits) and the
+    /// polynomial along it.
+    static ALONG: std::cell::RefCell<Option<(u64, [u64; 4], lensc_measure::correct::Along)>> =
+        const { std::cell::RefCell::new(None) };
+}
+
+/// Takes `gain` times the correction out of the design heights `out` at
+/// the frame's (s, u) `points`: along each column's line, origin + u ·
+/// direction (every frame's (x, y) is affine in u at a given s).
+fn less_correction(
+    frame: &dyn Frame,
+    c: &crate::compensate::Applied,
+    points: &[(f64, f64)],
+    out: &mut [f64],
+) {
+    ALONG.with(|cell| {
+        let mut last = cell.borrow_mut();
+        let mut s_last = f64::NAN;
+        for (&(s, u), o) in points.iter().zip(out.iter_mut()) {
+            if s.to_bits() != s_last.to_bits() {
+                s_last = s;
+                let origin = frame.xy(s, 0.0);
+                let end = frame.xy(s, 1.0);
+                let direction = (end.0 - origin.0, end.1 - origin.1);
+                let key = [origin.0, origin.1, direction.0, direction.1].map(f64::to_bits);
+                if !last.as_ref().is_some_and(|l| l.0 == c.id && l.1 == key) {
+                    *last = Some((c.id, key, c.fitted.along(origin, direction)));
+                }
+            }
+            let along = &last.as_ref().expect("set for this column").2;
+            *o -= c.gain * along.at(u);
+        }
+    })
+}
+
 /// A raster on a mill: s along the cut (x or y), u across, h = z.
 pub struct RasterFrame<'a> {
     /// The design; only its height is read (a kernel of
     /// `SurfaceTape::height_only` does no other work).
     pub kernel: &'a (dyn SurfaceFn + Sync),
+    /// A compensated job's correction, taken out of the kernel's heights
+    /// (`DesignHeights`).
+    pub correction: Option<&'a crate::compensate::Applied>,
     pub along_x: bool,
     pub window: Window,
     pub domain: Domain,
@@ -151,6 +222,9 @@ pub struct RasterFrame<'a> {
 impl Frame for RasterFrame<'_> {
     fn design(&self, points: &[(f64, f64)], out: &mut [f64]) {
         heights(self.kernel, points.iter().map(|&(s, u)| self.xy(s, u)), out);
+        if let Some(c) = self.correction {
+            less_correction(self, c, points, out);
+        }
     }
     fn xy(&self, s: f64, u: f64) -> (f64, f64) {
         if self.along_x { (s, u) } else { (u, s) }
@@ -188,6 +262,9 @@ pub struct LatheFrame<'a> {
     /// The design; only its height is read (a kernel of
     /// `SurfaceTape::height_only` does no other work).
     pub kernel: &'a (dyn SurfaceFn + Sync),
+    /// A compensated job's correction, taken out of the kernel's heights
+    /// (`DesignHeights`).
+    pub correction: Option<&'a crate::compensate::Applied>,
     pub window: Window,
     pub domain: Domain,
     /// The radius the spiral starts at (mm): the job cuts nothing beyond.
@@ -202,7 +279,7 @@ pub struct LatheFrame<'a> {
 
 impl<'a> LatheFrame<'a> {
     pub fn new(
-        kernel: &'a (dyn SurfaceFn + Sync),
+        heights: &'a DesignHeights,
         window: Window,
         domain: Domain,
         reach: f64,
@@ -210,7 +287,8 @@ impl<'a> LatheFrame<'a> {
         lenslets: Option<&'a Lenslets>,
     ) -> LatheFrame<'a> {
         LatheFrame {
-            kernel,
+            kernel: heights.kernel.as_ref(),
+            correction: heights.correction.as_ref(),
             window,
             domain,
             reach,
@@ -223,6 +301,9 @@ impl<'a> LatheFrame<'a> {
 impl Frame for LatheFrame<'_> {
     fn design(&self, points: &[(f64, f64)], out: &mut [f64]) {
         heights(self.kernel, points.iter().map(|&(s, u)| self.xy(s, u)), out);
+        if let Some(c) = self.correction {
+            less_correction(self, c, points, out);
+        }
     }
     fn xy(&self, s: f64, u: f64) -> (f64, f64) {
         let (cos, sin) = turned(s);
@@ -252,6 +333,9 @@ pub struct RollerFrame<'a> {
     /// The design; only its height is read (a kernel of
     /// `SurfaceTape::height_only` does no other work).
     pub kernel: &'a (dyn SurfaceFn + Sync),
+    /// A compensated job's correction, taken out of the kernel's heights
+    /// (`DesignHeights`).
+    pub correction: Option<&'a crate::compensate::Applied>,
     pub window: Window,
     pub roller_radius: f64,
     /// Design y under spindle angle 0 (`RollerHelix::y_start`).
@@ -264,6 +348,9 @@ pub struct RollerFrame<'a> {
 impl Frame for RollerFrame<'_> {
     fn design(&self, points: &[(f64, f64)], out: &mut [f64]) {
         heights(self.kernel, points.iter().map(|&(s, u)| self.xy(s, u)), out);
+        if let Some(c) = self.correction {
+            less_correction(self, c, points, out);
+        }
         for o in out.iter_mut() {
             *o += self.roller_radius;
         }
@@ -432,4 +519,153 @@ pub fn summary(map: &HeightMap) -> Option<String> {
         trim_num((c.pv * 1e7).round() / 10.0),
         trim_num((s.pv * 1e7).round() / 10.0)
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::compensate::{Applied, corrected_tape};
+    use lensc_measure::correct::{Basis, Correction};
+    use lensc_runtime::surface::ir::{Graph, SurfaceTape};
+
+    /// A design (a paraboloid with a tilt) and a correction of order 10
+    /// across its 10 mm map, every term non-zero.
+    fn design_and_correction(basis: Basis) -> (SurfaceTape, Applied) {
+        let mut g = Graph::new();
+        let (x, y) = (g.x(), g.y());
+        let r2 = {
+            let x2 = g.mul(x, x);
+            let y2 = g.mul(y, y);
+            g.add(x2, y2)
+        };
+        let k = g.constant_node(0.01);
+        let sag = g.mul(k, r2);
+        let t = g.constant_node(0.003);
+        let tilt = g.mul(t, x);
+        let z = g.add(sag, tilt);
+        let design = SurfaceTape::new(g, z);
+        let n = basis.terms().len();
+        let fitted = Correction {
+            basis,
+            coefficients: (0..n)
+                .map(|k| 2e-5 * (1.0 + k as f64).recip() * if k % 3 == 0 { -1.0 } else { 1.0 })
+                .collect(),
+            fit_residual_rms: 0.0,
+            cells: 0,
+        };
+        let applied = Applied {
+            fitted,
+            gain: 0.8,
+            // Each correction its own (the per-thread line is known by it).
+            id: basis.terms().len() as u64,
+        };
+        (design, applied)
+    }
+
+    /// Every frame's heights of a compensated job, the design's kernel
+    /// less the correction along each column, are the corrected tape's
+    /// heights (`compensate::corrected_tape`) to 1e-12 of the correction,
+    /// column after column (the per-thread line follows the column), for
+    /// a map's and a turned part's correction.
+    fn raster(h: &DesignHeights, along_x: bool, window: Window, domain: Domain) -> RasterFrame<'_> {
+        RasterFrame {
+            kernel: h.kernel.as_ref(),
+            correction: h.correction.as_ref(),
+            along_x,
+            window,
+            domain,
+            lenslets: None,
+        }
+    }
+
+    fn roller(h: &DesignHeights, window: Window, domain: Domain) -> RollerFrame<'_> {
+        RollerFrame {
+            kernel: h.kernel.as_ref(),
+            correction: h.correction.as_ref(),
+            window,
+            roller_radius: 10.0,
+            y_start: -5.0,
+            domain,
+            lenslets: None,
+        }
+    }
+
+    #[test]
+    fn a_frame_takes_the_correction_out_as_the_corrected_tape_does() {
+        let domain = Domain::Circle { radius: 5.0 };
+        let window = Window {
+            x: (-5.0, 5.0),
+            y: (-5.0, 5.0),
+            spacing: 0.01,
+            given: false,
+            whole: true,
+        };
+        for basis in [
+            Basis::map((-5.0, 5.0), (-5.0, 5.0), 1.0),
+            Basis::radial(5.0, 1.0),
+        ] {
+            let (design, applied) = design_and_correction(basis);
+            let corrected = corrected_tape(&design, &applied.fitted, applied.gain);
+            let split = DesignHeights {
+                kernel: crate::evaluate::evaluator(&design.height_only()).0,
+                correction: Some(applied.clone()),
+            };
+            let whole = DesignHeights {
+                kernel: crate::evaluate::evaluator(&corrected.height_only()).0,
+                correction: None,
+            };
+            let bare = DesignHeights {
+                kernel: crate::evaluate::evaluator(&design.height_only()).0,
+                correction: None,
+            };
+            let lathe = |h| LatheFrame::new(h, window, domain, 5.0, &[], None);
+            let frames: [(Box<dyn Frame + '_>, Box<dyn Frame + '_>); 4] = [
+                (Box::new(lathe(&split)), Box::new(lathe(&whole))),
+                (
+                    Box::new(raster(&split, true, window, domain)),
+                    Box::new(raster(&whole, true, window, domain)),
+                ),
+                (
+                    Box::new(raster(&split, false, window, domain)),
+                    Box::new(raster(&whole, false, window, domain)),
+                ),
+                (
+                    Box::new(roller(&split, window, domain)),
+                    Box::new(roller(&whole, window, domain)),
+                ),
+            ];
+            let largest = 0.8 * 2e-5 * basis.terms().len() as f64;
+            for (k, (split, whole)) in frames.iter().enumerate() {
+                let mut compared = 0;
+                // Columns one after another, a few cells each, and back.
+                for column in [0.3, 1.7, -2.2, 0.3, 0.95] {
+                    let s = if k == 3 { column / 10.0 + 0.5 } else { column };
+                    let points: Vec<(f64, f64)> =
+                        (0..9).map(|i| (s, -3.5 + 0.8 * i as f64)).collect();
+                    let (mut a, mut b) = (vec![0.0; 9], vec![0.0; 9]);
+                    split.design(&points, &mut a);
+                    whole.design(&points, &mut b);
+                    for (p, (a, b)) in points.iter().zip(a.iter().zip(&b)) {
+                        assert!(
+                            (a - b).abs() <= 1e-12 * largest,
+                            "{basis:?} frame {k} at {p:?}: {a} vs {b}"
+                        );
+                        compared += 1;
+                    }
+                }
+                assert_eq!(compared, 45);
+            }
+            // The correction is there to be taken out: the design alone
+            // differs from the surface aimed at.
+            let (mut a, mut b) = ([0.0], [0.0]);
+            lathe(&bare).design(&[(0.3, 2.0)], &mut a);
+            lathe(&split).design(&[(0.3, 2.0)], &mut b);
+            assert!(
+                (a[0] - b[0]).abs() > 1e-7,
+                "{basis:?}: {} vs {}",
+                a[0],
+                b[0]
+            );
+        }
+    }
 }

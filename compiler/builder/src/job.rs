@@ -237,6 +237,10 @@ pub struct SurfaceSpec {
     /// measured against) and the iteration for the report.
     pub design: Option<LoweredSurface>,
     pub compensation: Option<crate::compensate::Compensation>,
+    /// With a `compensate` block: the correction `lowered` is the design
+    /// less (a simulation takes it out of the design's heights itself:
+    /// `height_map::DesignHeights`).
+    pub correction: Option<crate::compensate::Applied>,
     /// An array's lenslets (also an array wrapped on a roller, in the
     /// design's coordinates), each judged on its own; none for other
     /// surfaces.
@@ -557,6 +561,7 @@ impl<'a> Parts<'a> {
                     lowered,
                     design,
                     compensation,
+                    correction: self.correction(),
                     lenslets: lensc_lang::lower::surface::array_cells(self.surface).and_then(
                         |(centres, aperture)| {
                             lensc_runtime::verify::lenslets::Lenslets::new(centres, aperture)

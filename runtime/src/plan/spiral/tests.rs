@@ -40,6 +40,7 @@ fn planner<'a>(spiral: &'a FtsSpiral, d: &'a Dimple, rho: f64) -> Planner<'a> {
     Planner {
         spiral,
         surface: d,
+        less: None,
         nose_radius: rho,
         bounds: TrajectoryBounds {
             z_max: d.h,
@@ -278,6 +279,7 @@ fn a_slope_that_is_not_a_number_is_undefined_not_a_lost_nose() {
     let p = Planner {
         spiral: &s,
         surface: &d,
+        less: None,
         nose_radius: 0.496,
         bounds: TrajectoryBounds {
             z_max: d.0.h,

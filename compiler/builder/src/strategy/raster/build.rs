@@ -169,9 +169,10 @@ pub(super) fn build(spec: &RasterSpec, cx: &BuildContext) -> Result<Built, Vec<D
     let executed = parts::executed_moves(head, &text, false);
     height_map::sweep_mill_program(sweep.path(), &executed, along_x);
     // The height alone: the frame asks nothing else of the design.
-    let heights = evaluator(&lowered.tape.height_only()).0;
+    let heights = height_map::DesignHeights::of(&head.surface);
     let frame = height_map::RasterFrame {
-        kernel: heights.as_ref(),
+        kernel: heights.kernel.as_ref(),
+        correction: heights.correction.as_ref(),
         along_x,
         window,
         domain: lowered.domain,

@@ -101,9 +101,10 @@ pub(super) fn build(spec: &RollerSpec, cx: &BuildContext) -> Result<Built, Vec<D
     let section = report::RollerHelix::new(&path, &limited, &spec.check, &spec.tool, helix);
     let cut = (section.cut_points, section.cutting_time_s);
     // The height alone: the frame asks nothing else of the design.
-    let heights = evaluator(&lowered.tape.height_only()).0;
+    let heights = crate::height_map::DesignHeights::of(&head.surface);
     let frame = RollerFrame {
-        kernel: heights.as_ref(),
+        kernel: heights.kernel.as_ref(),
+        correction: heights.correction.as_ref(),
         window,
         roller_radius: helix.roller_radius,
         y_start: helix.y_start,

@@ -155,6 +155,7 @@ fn check(spec: &SpiralSpec, unit: Unit, speed: f64, lag_limit: Option<f64>) -> V
     let planner = Planner {
         spiral: &at.spiral,
         surface: kernel.as_ref(),
+        less: None,
         nose_radius: spec.nose_radius,
         bounds,
     };

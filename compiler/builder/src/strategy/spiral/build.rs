@@ -24,24 +24,43 @@ use crate::output::Built;
 use crate::report;
 use crate::spool::Sink;
 
-/// A spiral job ready to plan: its spec and the trajectory's kernel.
+/// A spiral job ready to plan: its spec and the trajectory's kernel (for
+/// a compensated job, the trajectory as declared, the correction taken
+/// out along each ray: `less`).
 pub struct Prepared<'s> {
     pub spec: &'s SpiralSpec,
     pub kernel: Box<dyn SurfaceFn + Sync>,
+    pub less: Option<crate::compensate::AlongRays>,
 }
 
 impl<'s> Prepared<'s> {
     /// Compiles the trajectory the nose centre follows.
     pub fn of(spec: &'s SpiralSpec) -> Prepared<'s> {
-        Prepared {
-            spec,
-            kernel: evaluator(&spec.trajectory.tape).0,
+        let along_rays = match (&spec.trajectory_declared, &spec.correction) {
+            (Some(declared), Some(c)) => c.along_rays().map(|r| (declared, r)),
+            _ => None,
+        };
+        match along_rays {
+            Some((declared, rays)) => Prepared {
+                spec,
+                kernel: evaluator(&declared.tape).0,
+                less: Some(rays),
+            },
+            None => Prepared {
+                spec,
+                kernel: evaluator(&spec.trajectory.tape).0,
+                less: None,
+            },
         }
     }
     pub fn planner(&self) -> Planner<'_> {
         Planner {
             spiral: &self.spec.spiral,
             surface: self.kernel.as_ref(),
+            less: self
+                .less
+                .as_ref()
+                .map(|l| l as &dyn lensc_runtime::plan::spiral::RayCorrection),
             nose_radius: self.spec.nose_radius,
             bounds: self.spec.bounds.clone(),
         }
@@ -194,9 +213,9 @@ fn simulated_height_map(
 ) -> report::HeightMap {
     let lowered = &spec.head.surface.lowered;
     // The height alone: the frame asks nothing else of the design.
-    let design = evaluator(&lowered.tape.height_only()).0;
+    let design = height_map::DesignHeights::of(&spec.head.surface);
     let frame = LatheFrame::new(
-        design.as_ref(),
+        &design,
         window,
         lowered.domain,
         // The default window is the disc the spiral cuts; one the job

@@ -43,6 +43,10 @@ pub struct SpiralSpec {
     /// settling offset its lenslets continued and lifted over the land;
     /// with a `compensate` block, less the correction.
     pub trajectory: LoweredSurface,
+    /// With a `compensate` block, the trajectory before the correction
+    /// is taken out (the planner takes it out along each ray:
+    /// `build::Prepared`).
+    pub trajectory_declared: Option<LoweredSurface>,
     /// The correction of a `compensate` block, taken out of every
     /// trajectory made from `surface_object`.
     pub correction: Option<crate::compensate::Applied>,
@@ -89,7 +93,7 @@ impl SpiralSpec {
         let v = fastest(speed, spiral.start_radius);
         let settling = settling_at(&self.surface_object, settling.time, settling.band, v)
             .ok_or(LowerError::Unsupported("no settling offset at this speed"))?;
-        let (trajectory, bounds) = settled_trajectory(
+        let (trajectory, bounds, _) = settled_trajectory(
             &self.surface_object,
             Some(&settling),
             self.correction.as_ref(),
@@ -197,7 +201,7 @@ pub(crate) fn lower(
     let design =
         lensc_runtime::surface::analysis::analyse(design_kernel.as_ref(), &lowered.domain, 201);
     let correction = p.correction();
-    let (trajectory, bounds) = settled_trajectory(
+    let (trajectory, bounds, trajectory_declared) = settled_trajectory(
         surface,
         settling.as_ref(),
         correction.as_ref(),
@@ -255,6 +259,7 @@ pub(crate) fn lower(
         nose_radius: rho,
         fast_axis,
         trajectory,
+        trajectory_declared,
         correction,
         servo,
         settling,
@@ -305,7 +310,7 @@ fn settled_trajectory(
     domain: &Domain,
     part_top: f64,
     evaluate: Evaluate,
-) -> Result<(LoweredSurface, TrajectoryBounds), LowerError> {
+) -> Result<(LoweredSurface, TrajectoryBounds, Option<LoweredSurface>), LowerError> {
     let mut trajectory = match settling {
         Some(s) => lensc_lang::lower::surface::lower_trajectory(surface, s.offset)?,
         None => lensc_lang::lower::surface::lower_surface(surface)?,
@@ -313,7 +318,12 @@ fn settled_trajectory(
     // The trajectory is made from the surface as declared: a correction
     // is taken out of it as out of the design (without, a compensated
     // spiral cut the design and only its header said otherwise).
+    let mut declared = None;
     if let Some(c) = correction {
+        declared = Some(LoweredSurface {
+            tape: trajectory.tape.clone(),
+            domain: trajectory.domain,
+        });
         trajectory.tape = c.tape(&trajectory.tape);
     }
     let analysis = {
@@ -328,7 +338,7 @@ fn settled_trajectory(
         features: settling.and_then(|s| settled_features(surface, s)),
         part_top,
     };
-    Ok((trajectory, bounds))
+    Ok((trajectory, bounds, declared))
 }
 
 /// The axis that carries the surface: a fast tool servo, or a slow tool
