@@ -233,6 +233,9 @@ impl Frame for TileFrame<'_> {
                     .any(|&disc| super::heightmap::in_disc(disc, x, y))
             })
     }
+    fn column_reach(&self, s: f64, discs: &[(f64, f64, f64)]) -> Option<(f64, f64)> {
+        self.base.column_reach(s, discs)
+    }
     fn features(&self) -> &[(f64, f64, f64)] {
         match &self.own {
             Some(own) => &own.disc,
@@ -272,7 +275,7 @@ pub fn simulate(
             let parallel = tiles.len() == 1;
             match cutter {
                 Cutter::Nose { radius } => {
-                    let mut sweep = Sweep::new(g, radius);
+                    let mut sweep = Sweep::within(g, radius, &tile_frame);
                     let s_range = (g.s(0), g.s(g.ns.saturating_sub(1)));
                     let band = sweep.band();
                     recorder.replay(&mut sweep, band, Some(s_range), g.period);
