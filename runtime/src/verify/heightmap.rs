@@ -105,6 +105,15 @@ pub trait Frame: Sync {
         let (x2, y2) = self.xy(s, u + g.du);
         ((x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0)).abs()
     }
+    /// The range of u (mm) in the column at `s` outside which no point
+    /// is both `inside` and in one of `discs` (when there are any), found
+    /// without asking either: a column's rows, contacts and cusps beyond
+    /// it are then known to be outside without being tried. It may hold
+    /// points outside, never leave one inside out. `None` when the frame
+    /// cannot tell (every row is tried).
+    fn column_reach(&self, _s: f64, _discs: &[(f64, f64, f64)]) -> Option<(f64, f64)> {
+        None
+    }
 }
 
 /// Where the nose's centre goes, as a program commands it: what a
@@ -145,6 +154,9 @@ pub struct Sweep {
     last: Option<(f64, f64, f64)>,
     /// Columns' range of s (non-periodic), for a quick reject.
     s_range: (f64, f64),
+    /// Per column, whether any of its rows can be in the window (see
+    /// [`Sweep::within`]); a column that cannot gathers no passes.
+    live: Vec<bool>,
 }
 
 /// The band of step-over coordinates (u) whose passes, with a nose of
@@ -163,7 +175,21 @@ impl Sweep {
             columns: vec![Vec::new(); grid.ns],
             last: None,
             s_range: (grid.s(0), grid.s(grid.ns.saturating_sub(1))),
+            live: vec![true; grid.ns],
         }
+    }
+
+    /// A sweep of the columns whose rows `frame` can hold a cell of (its
+    /// window and features, by [`Frame::column_reach`]): the others are
+    /// left uncut, as every cell of theirs is outside (a lenslet's tile
+    /// covers the polar square around its disc, whose corner columns
+    /// miss it).
+    pub fn within(grid: Grid, nose_radius: f64, frame: &dyn Frame) -> Sweep {
+        let mut sweep = Sweep::new(grid, nose_radius);
+        for (j, live) in sweep.live.iter_mut().enumerate() {
+            *live = reach_of_rows(&grid, frame, grid.s(j)).is_some();
+        }
+        sweep
     }
 
     /// The tool leaves the part: the next point starts a new pass.
@@ -220,6 +246,9 @@ impl Sweep {
             let j_hi = (j_hi as usize).min(g.j0 + g.ns - 1);
             for jg in j_lo..=j_hi {
                 let (j, s) = (jg - g.j0, base + jg as f64 * g.ds);
+                if !self.live[j] {
+                    continue;
+                }
                 let t = if b.0 == a.0 {
                     0.0
                 } else {
@@ -305,17 +334,19 @@ fn finish_columns(
     layout: &RasterLayout,
 ) -> TileBlocks {
     let totals = Totals::gather(g, columns, frame, feature);
-    // Each block's worst, the first of equals in column order.
-    let mut worst: std::collections::BTreeMap<usize, f64> = Default::default();
+    // Each block's worst, the first of equals in column order (NaN: no
+    // cell yet).
+    let mut worst = vec![f64::NAN; layout.len()];
     let mut uncut = std::collections::BTreeSet::new();
     for (j, c) in columns.iter().enumerate() {
         for (i, &e) in c.errors.iter().enumerate() {
             if let Some(b) = layout.block(frame, g.s(j), g.u(i), e) {
-                let w = worst.entry(b).or_insert(e);
-                if e.abs() > w.abs() {
+                let w = &mut worst[b];
+                if w.is_nan() || e.abs() > w.abs() {
                     *w = e;
                 }
             } else if e.is_nan()
+                && c.may_hold(i)
                 && uncut_part_cell(frame, g.s(j), g.u(i))
                 && let Some(b) = layout.block_of(frame, g.s(j), g.u(i))
             {
@@ -325,7 +356,11 @@ fn finish_columns(
     }
     (
         totals,
-        worst.into_iter().collect(),
+        worst
+            .into_iter()
+            .enumerate()
+            .filter(|(_, e)| !e.is_nan())
+            .collect(),
         uncut.into_iter().collect(),
     )
 }
@@ -373,6 +408,28 @@ struct Column {
     /// Per cusp between neighbouring passes: where and the scallop height
     /// above the neighbours' contacts.
     cusps: Vec<(f64, f64)>,
+    /// The rows (from, to) that may hold a cell of the window: those
+    /// beyond are outside it (see [`Frame::column_reach`]).
+    rows: (usize, usize),
+}
+
+impl Column {
+    /// Whether row `i` may hold a cell of the window (those that cannot
+    /// are uncut and not counted, without asking the frame).
+    fn may_hold(&self, i: usize) -> bool {
+        i >= self.rows.0 && i < self.rows.1
+    }
+}
+
+/// The range of u in the column at `s` that may hold a cell of `frame`'s
+/// window and features ([`Frame::column_reach`]) within `g`'s rows, or
+/// `None` when none can.
+fn reach_of_rows(g: &Grid, frame: &dyn Frame, s: f64) -> Option<(f64, f64)> {
+    let (lo, hi) = frame
+        .column_reach(s, frame.features())
+        .unwrap_or((f64::NEG_INFINITY, f64::INFINITY));
+    let (lo, hi) = (lo.max(g.u(0)), hi.min(g.u_end()));
+    (lo <= hi).then_some((lo, hi))
 }
 
 /// The lower envelope of the circles of radius `r` about `centres` (sorted
@@ -386,10 +443,13 @@ fn envelope(centres: &[(f64, f64)], r: f64) -> Vec<(usize, f64)> {
     let crossing = |j: usize, k: usize| -> f64 {
         let ((uj, hj), (uk, hk)) = (centres[j], centres[k]);
         let (from, to) = (uk - r, uj + r);
-        if from >= to || hk <= circle(j, from) {
+        // A circle is nowhere above its centre: k lower than j's centre
+        // is the first test's only chance, higher the second's (the same
+        // answers, without the square root that cannot change them).
+        if from >= to || (hk <= hj && hk <= circle(j, from)) {
             return from;
         }
-        if circle(k, to) >= hj {
+        if hk >= hj && circle(k, to) >= hj {
             return to;
         }
         // The lower crossing of two equal circles.
@@ -435,21 +495,38 @@ fn envelope(centres: &[(f64, f64)], r: f64) -> Vec<(usize, f64)> {
 }
 
 fn column(g: &Grid, r: f64, j: usize, mut centres: Vec<(f64, f64)>, frame: &dyn Frame) -> Column {
+    // A column none of whose points can be in the window is all outside:
+    // no cell, contact or cusp of it counts.
+    let Some(reach) = reach_of_rows(g, frame, g.s(j)) else {
+        return Column {
+            errors: vec![f64::NAN; g.nu],
+            valleys: Vec::new(),
+            cusps: Vec::new(),
+            rows: (0, 0),
+        };
+    };
     centres.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
     centres.dedup_by(|later, kept| (later.0 - kept.0).abs() < 1e-12);
     let pieces = envelope(&centres, r);
+    let from = (0..g.nu).position(|i| g.u(i) >= reach.0).unwrap_or(g.nu);
+    let to = (0..g.nu)
+        .rposition(|i| g.u(i) <= reach.1)
+        .map_or(0, |i| i + 1);
     let cut = ColumnCut {
         s: g.s(j),
         r,
         centres,
         pieces,
         frame,
+        reach,
+        rows: (from, to.max(from)),
     };
     let valleys = cut.valleys(g);
     Column {
         errors: cut.errors(g),
         cusps: cut.cusps(g, &valleys),
         valleys: valleys.into_iter().filter(|v| !v.1.is_nan()).collect(),
+        rows: cut.rows,
     }
 }
 
@@ -463,6 +540,10 @@ struct ColumnCut<'a> {
     centres: Vec<(f64, f64)>,
     pieces: Vec<(usize, f64)>,
     frame: &'a dyn Frame,
+    /// The range of u that may be in the window (`reach_of_rows`), and
+    /// the rows within it: outside, no point is.
+    reach: (f64, f64),
+    rows: (usize, usize),
 }
 
 impl ColumnCut<'_> {
@@ -489,6 +570,7 @@ impl ColumnCut<'_> {
     }
 
     /// The design's height at (s, u).
+    #[cfg(test)]
     fn design_at(&self, u: f64) -> f64 {
         let mut dz = [0.0];
         self.frame.design(&[(self.s, u)], &mut dz);
@@ -500,7 +582,12 @@ impl ColumnCut<'_> {
     fn errors(&self, g: &Grid) -> Vec<f64> {
         let mut cut = vec![f64::NAN; g.nu];
         let mut p = 0;
-        for (i, c) in cut.iter_mut().enumerate() {
+        for (i, c) in cut
+            .iter_mut()
+            .enumerate()
+            .take(self.rows.1)
+            .skip(self.rows.0)
+        {
             let u = g.u(i);
             while p < self.pieces.len() && self.end(p) <= u {
                 p += 1;
@@ -510,7 +597,9 @@ impl ColumnCut<'_> {
             }
         }
         // The design only where the cut is (the window, its lenslets).
-        let rows: Vec<usize> = (0..g.nu).filter(|&i| !cut[i].is_nan()).collect();
+        let rows: Vec<usize> = (self.rows.0..self.rows.1)
+            .filter(|&i| !cut[i].is_nan())
+            .collect();
         let points: Vec<(f64, f64)> = rows.iter().map(|&i| (self.s, g.u(i))).collect();
         let mut design = vec![0.0; rows.len()];
         self.frame.design(&points, &mut design);
@@ -530,13 +619,18 @@ impl ColumnCut<'_> {
         let (s, r) = (self.s, self.r);
         let (u_lo, u_hi) = (g.u0, g.u_end());
         let mut valleys: Vec<(f64, f64)> = vec![(f64::NAN, f64::NAN); self.pieces.len()];
-        // Each piece's span within the rows, where it has one.
+        // Each piece's span within the rows, where it has one and it
+        // reaches the window: a contact beyond the reach is outside it.
+        let reach = self.reach;
         let spans: Vec<(usize, f64, f64)> = (0..self.pieces.len())
             .filter_map(|q| {
                 let (cu, _) = self.centres[self.pieces[q].0];
                 let a = self.pieces[q].1.max(cu - r).max(u_lo);
                 let b = self.end(q).min(cu + r).min(u_hi);
-                (b.partial_cmp(&a) == Some(std::cmp::Ordering::Greater)).then_some((q, a, b))
+                (b.partial_cmp(&a) == Some(std::cmp::Ordering::Greater)
+                    && b >= reach.0
+                    && a <= reach.1)
+                    .then_some((q, a, b))
             })
             .collect();
         let probes: Vec<(f64, f64)> = spans
@@ -595,7 +689,10 @@ impl ColumnCut<'_> {
     /// and how high above the mean of the two valleys.
     fn cusps(&self, g: &Grid, valleys: &[(f64, f64)]) -> Vec<(f64, f64)> {
         let (u_lo, u_hi) = (g.u0, g.u_end());
-        let mut cusps = Vec::new();
+        // Each cusp's piece, where and its height above the mean of the
+        // two valleys but for the design's height, asked of all at once.
+        let mut found: Vec<(f64, f64)> = Vec::new();
+        let mut points: Vec<(f64, f64)> = Vec::new();
         for q in 1..self.pieces.len() {
             let u = self.pieces[q].1;
             let (cu_a, cu_b) = (
@@ -612,10 +709,17 @@ impl ColumnCut<'_> {
             if !self.in_window(u) {
                 continue;
             }
-            let e = self.height(q, u) - self.design_at(u);
-            cusps.push((u, e - (va + vb) / 2.0));
+            found.push((self.height(q, u), (va + vb) / 2.0));
+            points.push((self.s, u));
         }
-        cusps
+        let mut design = vec![0.0; points.len()];
+        self.frame.design(&points, &mut design);
+        found
+            .iter()
+            .zip(&points)
+            .zip(&design)
+            .map(|((&(h, mean), &(_, u)), d)| (u, (h - d) - mean))
+            .collect()
     }
 }
 
@@ -963,6 +1067,9 @@ impl Totals {
         for (j, c) in columns.iter().enumerate() {
             let s = g.s(j);
             for (i, &e) in c.errors.iter().enumerate() {
+                if e.is_nan() && !c.may_hold(i) {
+                    continue;
+                }
                 let (x, y) = frame.xy(s, g.u(i));
                 if e.is_nan() {
                     if frame.inside(x, y) && in_features(features, x, y) {

@@ -355,6 +355,7 @@ impl BallSweep {
             errors: cut,
             valleys: valleys.into_iter().filter(|v| !v.1.is_nan()).collect(),
             cusps,
+            rows: (0, g.nu),
         }
     }
 }

@@ -436,6 +436,8 @@ fn contacts_found_for_a_whole_column_at_once_are_those_found_piece_by_piece() {
             centres,
             pieces,
             frame: &frame,
+            reach: (f64::NEG_INFINITY, f64::INFINITY),
+            rows: (0, g.nu),
         };
         let (batched, brute) = (cut.valleys(&g), valleys_one_piece_at_a_time(&cut, &g));
         let bits = |v: &[(f64, f64)]| -> Vec<(u64, u64)> {

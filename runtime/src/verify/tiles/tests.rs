@@ -269,3 +269,93 @@ fn a_lathe_s_tiles_skip_the_turns_that_miss_them_and_keep_the_figures() {
     assert!(!misses((0.2, 0.5), p, (1.0, 9.0)));
     assert!(misses((0.2, 0.5), None, (6.3, 6.7)));
 }
+
+/// Lenslets on a lathe (`Turned`'s design), each a disc: with `reach`, the
+/// frame tells each column's chord of the discs (the line u (cos s, sin
+/// s) across each, the radii a little wider), as a lathe's frame does.
+struct TurnedLenslets {
+    discs: Vec<(f64, f64, f64)>,
+    reach: bool,
+}
+impl Frame for TurnedLenslets {
+    fn design(&self, points: &[(f64, f64)], out: &mut [f64]) {
+        Turned.design(points, out)
+    }
+    fn xy(&self, s: f64, u: f64) -> (f64, f64) {
+        Turned.xy(s, u)
+    }
+    fn inside(&self, x: f64, y: f64) -> bool {
+        Turned.inside(x, y)
+    }
+    fn features(&self) -> &[(f64, f64, f64)] {
+        &self.discs
+    }
+    fn column_reach(&self, s: f64, discs: &[(f64, f64, f64)]) -> Option<(f64, f64)> {
+        if !self.reach {
+            return None;
+        }
+        let (cos, sin) = (s.cos(), s.sin());
+        let (lo, hi) = discs.iter().fold(
+            (f64::INFINITY, f64::NEG_INFINITY),
+            |(lo, hi), &(cx, cy, r)| {
+                let (along, across) = (cx * cos + cy * sin, cx * sin - cy * cos);
+                let r = r * (1.0 + 1e-9) + 1e-12;
+                if across.abs() > r {
+                    return (lo, hi);
+                }
+                let half = (r * r - across * across).sqrt();
+                (lo.min(along - half), hi.max(along + half))
+            },
+        );
+        Some((lo, hi))
+    }
+}
+
+/// A lathe's lenslets tile by tile, each over the polar square around
+/// its disc: with the frame telling each column's chord of the discs,
+/// the corner columns gather no passes and rows, contacts and cusps
+/// beyond the chord are not tried, and the map is the same, bit for bit
+/// (every figure, every lenslet's, the downsampled map), as with every
+/// row of every column tried.
+#[test]
+fn rows_beyond_a_column_s_chord_of_the_lenslets_are_not_tried_and_change_no_figure() {
+    let nose = 0.02;
+    let discs = vec![
+        (1.03 * 0.3f64.cos(), 1.03 * 0.3f64.sin(), 0.018),
+        (1.025 * 0.42f64.cos(), 1.025 * 0.42f64.sin(), 0.015),
+    ];
+    let window = crate::verify::window::Window::given(
+        (0.85, 1.05),
+        (0.25, 0.45),
+        Some(0.001),
+        ((0.85, 1.05), (0.25, 0.45)),
+    );
+    let tiles = window.polar_tiles(&discs);
+    assert_eq!(tiles.len(), 2, "lenslet by lenslet");
+    let mut recorder = Recorder::new(Recorder::band_of(&tiles, nose));
+    spiral(&mut recorder, nose);
+    let layout = RasterLayout::new(window.x, window.y, 0.0015, 64);
+    let map = |reach: bool| {
+        let frame = TurnedLenslets {
+            discs: discs.clone(),
+            reach,
+        };
+        let cutter = Cutter::Nose { radius: nose };
+        simulate(&recorder, &tiles, window.polar(), cutter, &frame, layout)
+    };
+    let (tried, told) = (map(false), map(true));
+    assert_eq!(format!("{:?}", told.map), format!("{:?}", tried.map));
+    let bits = |c: &[f64]| c.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&told.raster.cells), bits(&tried.raster.cells));
+    assert_eq!(told.raster.uncut, tried.raster.uncut);
+    // Both lenslets cut, with contacts and scallops.
+    assert_eq!(told.map.features.len(), 2);
+    let scallops: Vec<usize> = told
+        .map
+        .features
+        .iter()
+        .map(|f| f.contact.map_or(0, |_| f.scallops.map_or(0, |s| s.count)))
+        .collect();
+    assert!(scallops.iter().all(|&n| n > 20), "{scallops:?}");
+    assert!(told.map.cells > 1500, "{}", told.map.cells);
+}
