@@ -731,7 +731,11 @@ mod tests {
             x: (-17.5, 17.5),
             y: (-17.5, 17.5),
         };
-        let frame = LatheFrame::new(&Level, window, domain, 24.7, &discs, None);
+        let design = DesignHeights {
+            kernel: Box::new(Level),
+            correction: None,
+        };
+        let frame = LatheFrame::new(&design, window, domain, 24.7, &discs, None);
         let mut angles: Vec<f64> = (0..2000).map(|k| k as f64 * TAU / 2000.0).collect();
         for &(cx, cy, r) in &discs[..30] {
             let (mid, half) = (cy.atan2(cx), (r / cx.hypot(cy)).asin());
