@@ -245,11 +245,14 @@ fn spiral_project((machine, strategy): (&str, &str), tool: &str) -> tempfile::Te
     dir
 }
 
+/// A commanded nose-centre point (C rad, X, W), or None for a rapid.
+type Commanded = Option<(f64, f64, f64)>;
+
 /// The nose-centre points a spiral's output commands, as (C rad, X, W),
 /// read from its text alone: the program's moves as the controller reads
 /// them (Z carrying W), or, where the dialect drives the fast tool servo
 /// from a table, the table's rows (C X W). Rapids start a new pass (None).
-fn spiral_points(dir: &Path, args: &[&str]) -> (Vec<Option<(f64, f64, f64)>>, serde_json::Value) {
+fn spiral_points(dir: &Path, args: &[&str]) -> (Vec<Commanded>, serde_json::Value) {
     let mut all = vec!["build", "job.lens"];
     all.extend_from_slice(args);
     let out = lensc(dir, &all);

@@ -453,7 +453,9 @@ impl Planner<'_> {
             // w″ with the circle's L″ (the edge's differs by δ″, far
             // below R's): negative where the section is smooth.
             let second = curve - rho * rho / (root * root * root);
-            if !(second < 0.0) {
+            // Not negative (or not a number): a corner, where the
+            // circle's contact stands.
+            if second.is_nan() || second >= 0.0 {
                 break;
             }
             let step = -slope / second;
