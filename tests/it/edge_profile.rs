@@ -203,3 +203,252 @@ fn bad_edge_profiles_are_coded_errors_at_the_tool() {
     let err = refused(named, &[("edge.txt", "-45 0\n0 50\n45 0\n")], "E0376");
     assert!(err.contains("50 um"), "{err}");
 }
+
+/// A 12 mm convex sphere tilted 1° on the spindle, 2 mm across: not of
+/// revolution about the spindle axis, so the fast axis (or Z) rises and
+/// falls every turn and the radial slope, the edge's angle of contact,
+/// changes round each revolution (−4.8° .. 0° and beyond by ±1°).
+/// `MACHINE`, `STRATEGY` and `TOOL` are filled in.
+const TILTED: &str = "use std::machines::MACHINE
+
+surface lens = sphere { radius: 12 mm, sense: convex, aperture: circle(diameter: 2.4 mm) }
+surface tilted_lens = tilt(lens, about: y, angle: 1 deg, aperture: circle(diameter: 2 mm))
+
+tool diamond = round_nose { nose_radius: 0.5 mm, clearance: 10°TOOL }
+
+strategy spiral = STRATEGY
+
+job tilted { surface: tilted_lens, tool: diamond, machine: MACHINE, strategy: spiral, accept: none }
+";
+
+/// A slow tool servo's spiral (Z carries the surface) and a fast tool
+/// servo's (W in the table beside the program), each with its machine.
+const STS: (&str, &str) = (
+    "moore_nanotech_450fg",
+    "spiral_turning { feed: 10 um/rev, spindle_speed: 50 rpm, chord_tolerance: 2 nm }",
+);
+const FTS: (&str, &str) = (
+    "nanoform_x_fts5000",
+    "fts_spiral { feed: 10 um/rev, spindle_speed: 300 rpm, chord_tolerance: 2 nm }",
+);
+
+/// TILTED on `machine` with `strategy`, its tool given `tool`, and the
+/// edge's file.
+fn spiral_project((machine, strategy): (&str, &str), tool: &str) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().expect("tmp");
+    let job = TILTED
+        .replace("MACHINE", machine)
+        .replace("STRATEGY", strategy)
+        .replace("TOOL", tool);
+    std::fs::write(dir.path().join("job.lens"), job).expect("write");
+    std::fs::write(dir.path().join("edge.txt"), wavy_text()).expect("write");
+    dir
+}
+
+/// A commanded nose-centre point (C rad, X, W), or None for a rapid.
+type Commanded = Option<(f64, f64, f64)>;
+
+/// The nose-centre points a spiral's output commands, as (C rad, X, W),
+/// read from its text alone: the program's moves as the controller reads
+/// them (Z carrying W), or, where the dialect drives the fast tool servo
+/// from a table, the table's rows (C X W). Rapids start a new pass (None).
+fn spiral_points(dir: &Path, args: &[&str]) -> (Vec<Commanded>, serde_json::Value) {
+    let mut all = vec!["build", "job.lens"];
+    all.extend_from_slice(args);
+    let out = lensc(dir, &all);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let report: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("out/tilted.report.json")).expect("report"),
+    )
+    .expect("json");
+    if let Ok(table) = std::fs::read_to_string(dir.join("out/tilted.fts")) {
+        let mut pts = vec![None];
+        for l in table.lines().filter(|l| !l.starts_with('#')) {
+            let v: Vec<f64> = l.split(' ').map(|v| v.parse().expect("number")).collect();
+            pts.push(Some((v[0].to_radians(), v[1], v[2])));
+        }
+        return (pts, report);
+    }
+    let program = std::fs::read_to_string(dir.join("out/tilted.ngc")).expect("program");
+    let c = driver::check_path(&RealFs, &dir.join("job.lens")).expect("checks");
+    let (spec, _) = lensc_build::pipeline::lower(&c.checked.jobs[0], None, &Default::default())
+        .expect("lowers");
+    let machine = MachineLimits {
+        lathe: true,
+        travel: [None; 4],
+        max_feed: None,
+        max_spindle_rpm: None,
+    };
+    let mut moves = reader::read_moves(&program, &spec.head().dialect, &machine).1;
+    let offset = reader::header_control_offset(&program).expect("control point");
+    reader::to_tool_centre(&mut moves, offset);
+    let mut at = [0.0; 4];
+    let mut pts = Vec::new();
+    for m in &moves {
+        for (a, v) in at.iter_mut().zip(m.to) {
+            if let Some(v) = v {
+                *a = v;
+            }
+        }
+        match m.path {
+            reader::Path::Rapid => pts.push(None),
+            reader::Path::Line => pts.push(Some((at[3].to_radians(), at[0], at[2]))),
+            reader::Path::Arc { .. } => panic!("an arc in a spiral"),
+        }
+    }
+    (pts, report)
+}
+
+/// The contact PV (nm: the path's form error, scallops left out) of the
+/// part the spiral `pts` cut with `nose`, on a polar grid of 90 spindle
+/// angles and radii 0.02 .. 0.9 mm every 2 µm, against the design (the
+/// job's own surface, compiled).
+fn spiral_cut_pv(dir: &Path, pts: &[Option<(f64, f64, f64)>], edge: Option<&EdgeProfile>) -> f64 {
+    use lensc_runtime::verify::heightmap::{Frame, Grid, Sweep};
+    let c = driver::check_path(&RealFs, &dir.join("job.lens")).expect("checks");
+    let (spec, _) = lensc_build::pipeline::lower(&c.checked.jobs[0], None, &Default::default())
+        .expect("lowers");
+    let design = lensc_build::evaluate::evaluator(&spec.head().surface.lowered.tape).0;
+    let n_s = 90;
+    let grid = Grid {
+        s0: 0.0,
+        ds: 2.0 * PI / n_s as f64,
+        ns: n_s,
+        u0: 0.02,
+        du: 0.002,
+        nu: 441,
+        period: Some(2.0 * PI),
+        j0: 0,
+        i0: 0,
+    };
+    let mut sweep = Sweep::with_edge(grid, 0.5, edge.map(|e| std::sync::Arc::new(e.clone())));
+    for p in pts {
+        match *p {
+            None => sweep.lift(),
+            Some((c, x, w)) => sweep.point(c, x, w),
+        }
+    }
+    struct Part<'a>(&'a (dyn lensc_runtime::surface::ir::SurfaceFn + Sync));
+    impl Frame for Part<'_> {
+        fn design(&self, points: &[(f64, f64)], out: &mut [f64]) {
+            for (o, &(s, u)) in out.iter_mut().zip(points) {
+                *o = self.0.eval(u * s.cos(), u * s.sin())[0];
+            }
+        }
+        fn xy(&self, s: f64, u: f64) -> (f64, f64) {
+            (u * s.cos(), u * s.sin())
+        }
+        fn inside(&self, x: f64, y: f64) -> bool {
+            x.hypot(y) <= 0.9
+        }
+    }
+    let map = sweep.finish(&Part(design.as_ref()));
+    assert_eq!(map.uncut, 0);
+    map.contact.expect("contacts").pv * 1e6
+}
+
+/// Spiral turning with a slow or a fast tool servo: the program (or the
+/// servo's table) planned for a circle, cut by the wavy edge, prints the
+/// waviness into the part; planned for the measured edge, it does not.
+/// Each read back from its text and swept with the edge; the build's own
+/// simulation sweeps the measured edge too.
+fn spiral_compensated(servo: (&str, &str), args: &[&str]) -> [f64; 3] {
+    let edge_text = wavy_text();
+    let edge = EdgeProfile::from_samples(&lensc_runtime::machine::edge::parse(&edge_text).unwrap())
+        .unwrap();
+    let plain = spiral_project(servo, "");
+    let (pts, plain_report) = spiral_points(plain.path(), args);
+    let circle = spiral_cut_pv(plain.path(), &pts, None);
+    let uncompensated = spiral_cut_pv(plain.path(), &pts, Some(&edge));
+    let named = spiral_project(servo, ", edge_profile: \"edge.txt\"");
+    let (pts, report) = spiral_points(named.path(), args);
+    let compensated = spiral_cut_pv(named.path(), &pts, Some(&edge));
+    eprintln!(
+        "{}: contact PV nm: circle {circle:.2}, wavy edge uncompensated {uncompensated:.2}, compensated {compensated:.2}",
+        servo.1
+    );
+    // The build's simulation of the whole part sweeps the measured edge:
+    // the compensated program's form is the circle's, within the
+    // chords' few nanometres (swept with a circle it would show the
+    // waviness, inverted).
+    let pv = |r: &serde_json::Value| {
+        r["simulation"]["height_map"]["contact"]["pv_nm"]
+            .as_f64()
+            .expect("pv")
+    };
+    assert!(
+        (pv(&report) - pv(&plain_report)).abs() < 2.0,
+        "{} vs {}",
+        pv(&report),
+        pv(&plain_report)
+    );
+    let md5 = lensc_measure::md5_hex(edge_text.as_bytes());
+    assert_eq!(report["toolpath"]["edge_profile"]["md5"], md5.as_str());
+    assert!(plain_report["toolpath"]["edge_profile"].is_null());
+    [circle, uncompensated, compensated]
+}
+
+#[test]
+fn a_slow_tool_servo_spiral_compensates_a_measured_edge_off_the_axis() {
+    let [circle, uncompensated, compensated] = spiral_compensated(STS, &[]);
+    assert!(circle < 2.0, "{circle}");
+    assert!(uncompensated > 30.0, "{uncompensated}");
+    assert!(compensated < 2.0, "{compensated}");
+}
+
+#[test]
+fn a_fast_tool_servo_table_compensates_a_measured_edge_off_the_axis() {
+    let [circle, uncompensated, compensated] =
+        spiral_compensated(FTS, &["--dialect", "ultra_precision_lathe_gcode"]);
+    assert!(circle < 2.0, "{circle}");
+    assert!(uncompensated > 30.0, "{uncompensated}");
+    assert!(compensated < 2.0, "{compensated}");
+}
+
+/// Builds `job` (with the wavy edge beside it); asserts exit 1, `code`
+/// at the tool's `edge_profile`, nothing written; returns stderr.
+fn job_refused(job: &str, edge: &str, code: &str) -> String {
+    let dir = tempfile::tempdir().expect("tmp");
+    std::fs::write(dir.path().join("job.lens"), job).expect("write");
+    std::fs::write(dir.path().join("edge.txt"), edge).expect("write");
+    let out = lensc(dir.path(), &["build", "job.lens"]);
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains(&format!("[{code}]")), "{code}: {err}");
+    assert!(
+        err.contains("edge_profile: \"edge.txt\""),
+        "the field is shown: {err}"
+    );
+    let written = std::fs::read_dir(dir.path().join("out")).map_or(0, |d| d.count());
+    assert_eq!(written, 0, "nothing is written: {err}");
+    err
+}
+
+#[test]
+fn a_spiral_whose_contact_angles_the_edge_does_not_cover_is_refused() {
+    // Measured over ±3°; the tilted lens meets the nose at up to −5.8°.
+    let job = TILTED
+        .replace("MACHINE", STS.0)
+        .replace("STRATEGY", STS.1)
+        .replace("TOOL", ", edge_profile: \"edge.txt\"");
+    let err = job_refused(&job, "-3 0\n0 0.01\n3 0\n", "E0375");
+    assert!(err.contains("covers only -3° .. 3°"), "{err}");
+    assert!(err.contains("the spiral meets the nose at -5."), "{err}");
+}
+
+#[test]
+fn a_roller_helix_refuses_a_measured_edge() {
+    // Roller helix turning places a circle's nose (its own contact
+    // search, ridges and scanned sections): refused, not cut as a circle.
+    let job = std::fs::read_to_string(crate::common::root().join("tests/jobs/roller_small.lens"))
+        .expect("job")
+        .replace(
+            "included_angle: 100 deg }",
+            "included_angle: 100 deg, edge_profile: \"edge.txt\" }",
+        );
+    let err = job_refused(&job, &wavy_text(), "E0375");
+    assert!(
+        err.contains("`roller_helix` does not compensate a measured edge"),
+        "{err}"
+    );
+}

@@ -141,8 +141,79 @@ pub(crate) fn not_compensated(p: &Parts, strategy: &str) -> Option<Diagnostic> {
         )
         .with_label("the edge profile this tool names")
         .with_help(
-            "only `profile_turning` offsets its path by the edge's deviation at the angle of contact; leave `edge_profile` out of a tool for other strategies (the nose is then taken as a circle)",
+            "`profile_turning`, `spiral_turning` and `fts_spiral` place the nose by the edge's deviation at the angle of contact; leave `edge_profile` out of a tool for other strategies (the nose is then taken as a circle)",
         ),
+    )
+}
+
+/// Radii and spindle angles at which a spiral's angles of contact are
+/// scanned (`uncovered_spiral`).
+const SPIRAL_SCAN: (usize, usize) = (256, 360);
+
+/// E0375 for a spiral whose angles of contact the measured edge does not
+/// cover. The edge lies in the plane of the spindle axis and the ray the
+/// tool is over (`lensc_runtime::plan::spiral`), so it touches the
+/// trajectory at atan of its slope along the ray, outwards: scanned on a
+/// polar grid over `radii` (the spiral's end and start, mm) within the
+/// surface's `domain`.
+pub(crate) fn uncovered_spiral(
+    p: &Parts,
+    edge: &EdgeProfile,
+    trajectory: &dyn lensc_runtime::surface::ir::SurfaceFn,
+    domain: &lensc_runtime::surface::analysis::Domain,
+    radii: (f64, f64),
+) -> Option<Diagnostic> {
+    let named = p.tool_params.edge_profile.as_ref()?;
+    let (n_r, n_c) = SPIRAL_SCAN;
+    let (r0, r1) = (radii.0.max(0.0), radii.1);
+    // (angle, radius, spindle angle) of the least and the greatest.
+    let (mut lo, mut hi) = ((f64::INFINITY, 0.0, 0.0), (f64::NEG_INFINITY, 0.0, 0.0));
+    for i in 0..=n_r {
+        let r = r0 + (r1 - r0) * i as f64 / n_r as f64;
+        for k in 0..n_c {
+            let c = std::f64::consts::TAU * k as f64 / n_c as f64;
+            let (x, y) = (r * c.cos(), r * c.sin());
+            if !domain.contains(x, y) {
+                continue;
+            }
+            let o = trajectory.eval(x, y);
+            let a = (o[1] * c.cos() + o[2] * c.sin()).atan();
+            if !a.is_finite() {
+                continue;
+            }
+            if a < lo.0 {
+                lo = (a, r, c);
+            }
+            if a > hi.0 {
+                hi = (a, r, c);
+            }
+        }
+    }
+    let (m0, m1) = edge.range();
+    let far = if lo.0 < m0 {
+        lo
+    } else if hi.0 > m1 {
+        hi
+    } else {
+        return None;
+    };
+    Some(
+        Diagnostic::error(
+            codes::EDGE_ANGLES,
+            format!(
+                "the spiral meets the nose at {}° .. {}° from its axis (the far end at r = {} mm, C = {}°), but the tool's edge profile covers only {}° .. {}°: the path cannot be compensated beyond the measured edge",
+                deg(lo.0),
+                deg(hi.0),
+                trim_num((far.1 * 1e4).round() / 1e4),
+                trim_num((far.2.to_degrees() * 1e2).round() / 1e2),
+                deg(m0),
+                deg(m1)
+            ),
+            named.site.0,
+            named.site.1,
+        )
+        .with_label("the edge profile this tool names")
+        .with_help("measure the edge over the angles the cut uses (the surface's slope along the ray from the spindle axis is the angle of contact), or cut a smaller `from`"),
     )
 }
 

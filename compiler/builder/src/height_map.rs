@@ -66,20 +66,14 @@ impl Simulation {
     /// A simulation of a round nose of `nose_radius` whose edge lies
     /// across the cut (a knife, a lathe's diamond).
     pub fn new(grid: Grid, tiles: Vec<Tile>, nose_radius: f64) -> Simulation {
-        Simulation::of(
-            grid,
-            tiles,
-            Cutter::Nose {
-                radius: nose_radius,
-            },
-        )
+        Simulation::of(grid, tiles, Cutter::nose(nose_radius))
     }
 
     /// A simulation of `cutter`.
     pub fn of(grid: Grid, tiles: Vec<Tile>, cutter: Cutter) -> Simulation {
         Simulation {
             grid,
-            recorder: Recorder::new(Recorder::band_of(&tiles, cutter.radius())),
+            recorder: Recorder::new(Recorder::band_of(&tiles, cutter.reach())),
             tiles,
             cutter,
         }

@@ -306,19 +306,43 @@ impl<'a> Nose<'a> {
     /// `x`, if the nose reaches `x`: the θ in (−90°, 90°) where
     /// c.x + ρ(θ) sin θ = x, by Newton from the circle's.
     pub fn bottom(&self, c: (f64, f64), x: f64) -> Option<f64> {
-        let dx = x - c.0;
+        self.lift(x - c.0).map(|(l, _)| c.1 - l)
+    }
+
+    /// How far below its centre the nose's edge lies at the horizontal
+    /// offset `d` from it (mm), and how that depth changes with `d`: L(d)
+    /// = ρ(θ) cos θ and dL/dd, θ in (−90°, 90°) the edge's angle where
+    /// ρ(θ) sin θ = d (Newton from the circle's asin(d/R)); `None` beyond
+    /// the nose's reach. A circle's: sqrt(R² − d²) and −d/sqrt(R² − d²).
+    pub fn lift(&self, d: f64) -> Option<(f64, f64)> {
         let Some(_) = self.edge else {
             let rho = self.radius;
-            return (dx.abs() <= rho).then(|| c.1 - (rho * rho - dx * dx).sqrt());
+            if d.abs() > rho {
+                return None;
+            }
+            let root = (rho * rho - d * d).sqrt();
+            return Some((root, -d / root));
         };
-        let reach = self.reach();
-        if dx.abs() > reach {
+        let theta = self.angle_at(d)?;
+        let (r, dr) = self.rho(theta);
+        let (sin, cos) = theta.sin_cos();
+        Some((r * cos, (dr * cos - r * sin) / (dr * sin + r * cos)))
+    }
+
+    /// The edge's angle θ in (−90°, 90°) whose point lies `d` (mm) from
+    /// the nose centre across it: ρ(θ) sin θ = d, by Newton from the
+    /// circle's; `None` beyond the reach or where Newton does not land.
+    pub fn angle_at(&self, d: f64) -> Option<f64> {
+        if d.abs() > self.reach() {
             return None;
         }
-        let mut theta = (dx / self.radius).clamp(-1.0, 1.0).asin();
+        let mut theta = (d / self.radius).clamp(-1.0, 1.0).asin();
+        if self.edge.is_none() {
+            return Some(theta);
+        }
         for _ in 0..20 {
             let (r, dr) = self.rho(theta);
-            let f = r * theta.sin() - dx;
+            let f = r * theta.sin() - d;
             let slope = dr * theta.sin() + r * theta.cos();
             if slope <= 0.0 || !slope.is_finite() {
                 break;
@@ -330,10 +354,7 @@ impl<'a> Nose<'a> {
             }
         }
         let (r, _) = self.rho(theta);
-        if (r * theta.sin() - dx).abs() > 1e-9 {
-            return None;
-        }
-        Some(c.1 - r * theta.cos())
+        ((r * theta.sin() - d).abs() <= 1e-9).then_some(theta)
     }
 }
 

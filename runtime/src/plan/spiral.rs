@@ -14,6 +14,23 @@
 //! past its rim up to the settling offset h above the land (eqs 6–7), the
 //! land itself at h, so the servo has settled before the cut begins.
 //!
+//! A measured edge (`machine::edge`). The tool's edge lies in its XZ
+//! plane, which at spindle angle θ is the plane of the ray and the
+//! spindle axis, +X along the ray outwards; so the ray's section meets the
+//! edge, and the centre height is the same envelope with the edge's depth
+//! L(d) below its centre (`Nose::lift`) for the circle's sqrt(ρ² − d²):
+//!   w = max over u of  z(u) + L(u − x).
+//! On a smooth section the edge touches where the slope along the ray,
+//! ∂z/∂u, is the edge's own: at the angle θ = atan(∂z/∂u) from the
+//! tool's axis (positive towards +X, to within tan(θ − φ) = ρ′/ρ), so
+//! the edge angle is set by the radial slope alone. A slope across the
+//! ray (the surface rising in the cutting direction: a tilted or off-axis
+//! surface, a lenslet off the axis) does not move that point: the edge is
+//! a curve in the ray's plane and is swept through that plane, so the
+//! section it leaves there is the edge itself, wherever the surface goes
+//! next (its rake and clearance faces are the tool's `clearance`
+//! check's). `Planner::edged` starts from the circle's contact.
+//!
 //! Sampling. X and C move together linearly in the program, which is the
 //! Archimedean spiral itself, so only W needs sampling: from seeds a fixed
 //! arc apart, each interval is halved until the W midpoint lies within the
@@ -26,6 +43,7 @@
 
 use std::ops::ControlFlow;
 
+use crate::machine::edge::{EdgeProfile, Nose};
 use crate::plan::chords::{self, Band, ChordPlacement};
 use crate::plan::envelope;
 use crate::surface::ir::SurfaceFn;
@@ -347,6 +365,10 @@ pub struct Planner<'a> {
     /// (`RayCorrection`); none where `surface` is the trajectory itself.
     pub less: Option<&'a dyn RayCorrection>,
     pub nose_radius: f64,
+    /// The nose's measured edge, if the tool names one: each centre is
+    /// then the lowest that clears the section with that edge (module
+    /// doc, "A measured edge").
+    pub edge: Option<&'a EdgeProfile>,
     pub bounds: TrajectoryBounds,
 }
 
@@ -381,6 +403,16 @@ impl Planner<'_> {
     /// own radius does. The height is the same to far below a picometre
     /// from any start (seed 003's programs came out byte for byte the same).
     fn centre_near(&self, c: f64, hint: Option<f64>) -> (f64, f64) {
+        let (w, d) = self.circle_near(c, hint);
+        match self.edge {
+            Some(edge) if w.is_finite() => self.edged(c, edge, w, d),
+            _ => (w, d),
+        }
+    }
+
+    /// The nose-centre height at spindle angle c were the nose a circle
+    /// of radius ρ, and the contact's offset along the ray (`centre_near`).
+    fn circle_near(&self, c: f64, hint: Option<f64>) -> (f64, f64) {
         let x = self.radius(c);
         let (cos, sin) = (c.cos(), c.sin());
         let ray = Ray {
@@ -430,6 +462,70 @@ impl Planner<'_> {
             return (f64::NAN, 0.0);
         }
         (w, at - x)
+    }
+
+    /// The nose-centre height at spindle angle c with the measured
+    /// `edge`, from the circle's height `w_circle` and contact offset `d`:
+    /// the greatest of w(u) = z(u) + L(u − x) (L the edge's depth below
+    /// its centre at that offset, `Nose::lift`) found by Newton's method
+    /// from the circle's contact, each step kept only where it raises w.
+    /// On a smooth section that is the edge's contact (w′ = 0); at a
+    /// corner of the trajectory the circle's contact is the corner, where
+    /// the edge touches too, and w there is the edge's depth at it. The
+    /// contact's offset is returned as the circle's is.
+    fn edged(&self, c: f64, edge: &EdgeProfile, w_circle: f64, d: f64) -> (f64, f64) {
+        let x = self.radius(c);
+        let nose = Nose {
+            radius: self.nose_radius,
+            edge: Some(edge),
+        };
+        let (cos, sin) = (c.cos(), c.sin());
+        let ray = Ray {
+            surface: self.surface,
+            cos,
+            sin,
+            less: self.less.map(|l| l.section(cos, sin)),
+        };
+        let rho = self.nose_radius;
+        let at = |u: f64| {
+            let p = ray.point(u);
+            let (l, dl) = nose.lift(u - x)?;
+            let w = p.z + l;
+            w.is_finite().then_some((w, p.dz + dl, p.d2z))
+        };
+        // Where the circle touched: its height there with the edge.
+        let u0 = x + d;
+        let Some((mut best_w, mut slope, mut curve)) = at(u0) else {
+            // The edge does not reach the circle's contact (it reaches
+            // past R·sin of the steepest slope everywhere, so never): no
+            // height rather than the circle's.
+            let _ = w_circle;
+            return (f64::NAN, d);
+        };
+        let mut best_u = u0;
+        for _ in 0..6 {
+            let off = best_u - x;
+            let root = (rho * rho - off * off).max(1e-30).sqrt();
+            // w″ with the circle's L″ (the edge's differs by δ″, far
+            // below R's): negative where the section is smooth.
+            let second = curve - rho * rho / (root * root * root);
+            // Not negative (or not a number): a corner, where the
+            // circle's contact stands.
+            if second.is_nan() || second >= 0.0 {
+                break;
+            }
+            let step = -slope / second;
+            let next = best_u + step;
+            let Some((w, s, k)) = at(next) else { break };
+            if w < best_w {
+                break;
+            }
+            (best_w, best_u, slope, curve) = (w, next, s, k);
+            if step.abs() <= 1e-10 {
+                break;
+            }
+        }
+        (best_w, best_u - x)
     }
 
     /// Points of revolution `k` (its first point, not its last: the next

@@ -16,28 +16,61 @@
 //! once, so the envelope takes them in order of u, and its corners are the
 //! scallop cusps, found exactly, whatever the grid.
 //!
+//! A nose whose edge was measured (`machine::edge`) is swept as that
+//! edge: each pass leaves the edge's lower side, its depth L(d) below the
+//! centre at offset d across it (`Nose::lift`), instead of the circle's;
+//! two copies of it, convex as any round nose's is (its waviness bends it
+//! far less than its radius does), still cross once, found from the
+//! circles' crossing by the secant method.
+//!
 //! The grid's columns are positions along the cut and its rows positions
 //! across; on a lathe they are angles and radii (a polar grid), masked to
 //! the window the user asked for.
 
 use rayon::prelude::*;
+use std::sync::Arc;
+
+use crate::machine::edge::{EdgeProfile, Nose};
 
 mod ball;
 pub use ball::BallSweep;
 
 /// The cutter a height map sweeps: a round nose whose edge lies across
-/// the cut (a knife, a lathe's diamond), or a ball (a ball-end mill),
-/// which reaches its radius along the path as well.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// the cut (a knife, a lathe's diamond), as measured where its `edge`
+/// is given, or a ball (a ball-end mill), which reaches its radius along
+/// the path as well.
+#[derive(Clone, Debug, PartialEq)]
 pub enum Cutter {
-    Nose { radius: f64 },
-    Ball { radius: f64 },
+    Nose {
+        radius: f64,
+        edge: Option<Arc<EdgeProfile>>,
+    },
+    Ball {
+        radius: f64,
+    },
 }
 
 impl Cutter {
+    /// A round nose that is a circle of `radius`.
+    pub fn nose(radius: f64) -> Cutter {
+        Cutter::Nose { radius, edge: None }
+    }
+
     pub fn radius(&self) -> f64 {
         match *self {
-            Cutter::Nose { radius } | Cutter::Ball { radius } => radius,
+            Cutter::Nose { radius, .. } | Cutter::Ball { radius } => radius,
+        }
+    }
+
+    /// How far from its centre the cutter reaches (mm): its radius, or a
+    /// measured edge's farthest point.
+    pub fn reach(&self) -> f64 {
+        match self {
+            Cutter::Nose {
+                radius,
+                edge: Some(e),
+            } => radius + e.largest().0,
+            _ => self.radius(),
         }
     }
 }
@@ -146,6 +179,8 @@ impl NosePath for Sweep {
 pub struct Sweep {
     grid: Grid,
     radius: f64,
+    /// The nose's measured edge, if any (the module doc).
+    edge: Option<Arc<EdgeProfile>>,
     /// The band of u whose circles can reach the rows.
     band: (f64, f64),
     /// Per column, the (u, h) of every pass crossing it.
@@ -168,10 +203,18 @@ pub fn band(grid: &Grid, nose_radius: f64) -> (f64, f64) {
 
 impl Sweep {
     pub fn new(grid: Grid, nose_radius: f64) -> Sweep {
+        Sweep::with_edge(grid, nose_radius, None)
+    }
+
+    /// A sweep of a nose of `nose_radius` whose edge, where `edge` is
+    /// given, is the one measured.
+    pub fn with_edge(grid: Grid, nose_radius: f64, edge: Option<Arc<EdgeProfile>>) -> Sweep {
+        let reach = nose_radius + edge.as_ref().map_or(0.0, |e| e.largest().0);
         Sweep {
             grid,
             radius: nose_radius,
-            band: band(&grid, nose_radius),
+            edge,
+            band: band(&grid, reach),
             columns: vec![Vec::new(); grid.ns],
             last: None,
             s_range: (grid.s(0), grid.s(grid.ns.saturating_sub(1))),
@@ -184,8 +227,13 @@ impl Sweep {
     /// left uncut, as every cell of theirs is outside (a lenslet's tile
     /// covers the polar square around its disc, whose corner columns
     /// miss it).
-    pub fn within(grid: Grid, nose_radius: f64, frame: &dyn Frame) -> Sweep {
-        let mut sweep = Sweep::new(grid, nose_radius);
+    pub fn within(
+        grid: Grid,
+        nose_radius: f64,
+        edge: Option<Arc<EdgeProfile>>,
+        frame: &dyn Frame,
+    ) -> Sweep {
+        let mut sweep = Sweep::with_edge(grid, nose_radius, edge);
         for (j, live) in sweep.live.iter_mut().enumerate() {
             *live = reach_of_rows(&grid, frame, grid.s(j)).is_some();
         }
@@ -304,22 +352,29 @@ impl Sweep {
         let columns = if parallel {
             self.columns(frame)
         } else {
-            let r = self.radius;
+            let nose = Nose {
+                radius: self.radius,
+                edge: self.edge.as_deref(),
+            };
             self.columns
                 .into_iter()
                 .enumerate()
-                .map(|(j, centres)| column(&g, r, j, centres, frame))
+                .map(|(j, centres)| column(&g, &nose, j, centres, frame))
                 .collect()
         };
         finish_columns(&g, &columns, frame, feature, layout)
     }
 
     fn columns(self, frame: &dyn Frame) -> Vec<Column> {
-        let (g, r) = (self.grid, self.radius);
+        let g = self.grid;
+        let nose = Nose {
+            radius: self.radius,
+            edge: self.edge.as_deref(),
+        };
         self.columns
             .into_par_iter()
             .enumerate()
-            .map(|(j, centres)| column(&g, r, j, centres, frame))
+            .map(|(j, centres)| column(&g, &nose, j, centres, frame))
             .collect()
     }
 }
@@ -432,12 +487,16 @@ fn reach_of_rows(g: &Grid, frame: &dyn Frame, s: f64) -> Option<(f64, f64)> {
     (lo <= hi).then_some((lo, hi))
 }
 
-/// The lower envelope of the circles of radius `r` about `centres` (sorted
-/// by u, distinct): per piece, the circle's index and where it starts.
-fn envelope(centres: &[(f64, f64)], r: f64) -> Vec<(usize, f64)> {
+/// The lower envelope of the noses about `centres` (sorted by u,
+/// distinct): per piece, the nose's index and where it starts. Circles
+/// cross where the closed form says; a measured edge's copies near there
+/// (`edge_crossing`).
+fn envelope(centres: &[(f64, f64)], nose: &Nose) -> Vec<(usize, f64)> {
+    let r = nose.reach();
+    let rho = nose.radius;
     let circle = |k: usize, u: f64| {
         let (cu, ch) = centres[k];
-        ch - (r * r - (u - cu) * (u - cu)).max(0.0).sqrt()
+        ch - nose.lift(u - cu).map_or(0.0, |l| l.0)
     };
     // Where k (right of j) starts to be lower than j.
     let crossing = |j: usize, k: usize| -> f64 {
@@ -455,10 +514,16 @@ fn envelope(centres: &[(f64, f64)], r: f64) -> Vec<(usize, f64)> {
         // The lower crossing of two equal circles.
         let (du, dh) = (uk - uj, hk - hj);
         let d = du.hypot(dh);
-        let q = (r * r - d * d / 4.0).max(0.0).sqrt();
+        let q = (rho * rho - d * d / 4.0).max(0.0).sqrt();
         let u = (uj + uk) / 2.0 + q * dh / d;
         if u > from && u < to {
-            return u;
+            if nose.edge.is_none() {
+                return u;
+            }
+            let gap = |x: f64| circle(k, x) - circle(j, x);
+            if let Some(x) = edge_crossing(&gap, u, from, to) {
+                return x;
+            }
         }
         let (mut a, mut b) = (from, to);
         for _ in 0..80 {
@@ -494,7 +559,40 @@ fn envelope(centres: &[(f64, f64)], r: f64) -> Vec<(usize, f64)> {
     stack
 }
 
-fn column(g: &Grid, r: f64, j: usize, mut centres: Vec<(f64, f64)>, frame: &dyn Frame) -> Column {
+/// Where two copies of a measured edge cross, `gap` the height of the
+/// later one less the earlier's (it falls through zero there): by the
+/// secant method from the circles' crossing `u`, within (`from`, `to`);
+/// `None` if it does not settle there (the caller bisects).
+fn edge_crossing(gap: &dyn Fn(f64) -> f64, u: f64, from: f64, to: f64) -> Option<f64> {
+    let (mut a, mut b) = (u, u + 1e-6);
+    let (mut ga, mut gb) = (gap(a), gap(b));
+    for _ in 0..30 {
+        if gb == 0.0 {
+            return Some(b);
+        }
+        if gb == ga || !gb.is_finite() {
+            break;
+        }
+        let next = b - gb * (b - a) / (gb - ga);
+        if !(next > from && next < to) {
+            return None;
+        }
+        (a, ga) = (b, gb);
+        (b, gb) = (next, gap(next));
+        if (b - a).abs() < 1e-13 {
+            return Some(b);
+        }
+    }
+    None
+}
+
+fn column(
+    g: &Grid,
+    nose: &Nose,
+    j: usize,
+    mut centres: Vec<(f64, f64)>,
+    frame: &dyn Frame,
+) -> Column {
     // A column none of whose points can be in the window is all outside:
     // no cell, contact or cusp of it counts.
     let Some(reach) = reach_of_rows(g, frame, g.s(j)) else {
@@ -507,14 +605,15 @@ fn column(g: &Grid, r: f64, j: usize, mut centres: Vec<(f64, f64)>, frame: &dyn 
     };
     centres.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
     centres.dedup_by(|later, kept| (later.0 - kept.0).abs() < 1e-12);
-    let pieces = envelope(&centres, r);
+    let pieces = envelope(&centres, nose);
     let from = (0..g.nu).position(|i| g.u(i) >= reach.0).unwrap_or(g.nu);
     let to = (0..g.nu)
         .rposition(|i| g.u(i) <= reach.1)
         .map_or(0, |i| i + 1);
     let cut = ColumnCut {
         s: g.s(j),
-        r,
+        r: nose.reach(),
+        nose: *nose,
         centres,
         pieces,
         frame,
@@ -535,8 +634,10 @@ fn column(g: &Grid, r: f64, j: usize, mut centres: Vec<(f64, f64)>, frame: &dyn 
 struct ColumnCut<'a> {
     /// The column (mm, or rad).
     s: f64,
-    /// The tool radius (mm).
+    /// How far the tool reaches from its centre (mm): its radius, or a
+    /// measured edge's farthest point.
     r: f64,
+    nose: Nose<'a>,
     centres: Vec<(f64, f64)>,
     pieces: Vec<(usize, f64)>,
     frame: &'a dyn Frame,
@@ -550,12 +651,7 @@ impl ColumnCut<'_> {
     /// The height piece `p`'s circle cuts at u (NaN beyond its reach).
     fn height(&self, p: usize, u: f64) -> f64 {
         let (cu, ch) = self.centres[self.pieces[p].0];
-        let d = u - cu;
-        if d.abs() > self.r {
-            f64::NAN
-        } else {
-            ch - (self.r * self.r - d * d).sqrt()
-        }
+        self.nose.lift(u - cu).map_or(f64::NAN, |l| ch - l.0)
     }
 
     /// Where piece `p` ends: where the next begins.

@@ -275,9 +275,9 @@ pub fn simulate(
             let tile_frame = TileFrame::new(frame, tile.feature);
             let global = |f: usize| tile.feature.unwrap_or(f);
             let parallel = tiles.len() == 1;
-            match cutter {
-                Cutter::Nose { radius } => {
-                    let mut sweep = Sweep::within(g, radius, &tile_frame);
+            match &cutter {
+                Cutter::Nose { radius, edge } => {
+                    let mut sweep = Sweep::within(g, *radius, edge.clone(), &tile_frame);
                     let s_range = (g.s(0), g.s(g.ns.saturating_sub(1)));
                     let band = sweep.band();
                     recorder.replay(&mut sweep, band, Some(s_range), g.period);
@@ -285,6 +285,7 @@ pub fn simulate(
                 }
                 // A ball reaches columns its radius from its centre.
                 Cutter::Ball { radius } => {
+                    let radius = *radius;
                     let mut sweep = BallSweep::new(g, radius);
                     let s_range = (g.s0 - radius, g.s(g.ns.saturating_sub(1)) + radius);
                     let band = sweep.band();

@@ -209,8 +209,10 @@ pub fn lower_job(
     if let Err(d) = crate::job::simulate(&p.params) {
         errors.push(d);
     }
-    // Only profile turning offsets its path for a measured edge.
-    if !<turning::TurningSpec as Strategy>::NAMES.contains(&strategy) {
+    // Only profile and spiral turning place the nose by a measured edge.
+    if !<turning::TurningSpec as Strategy>::NAMES.contains(&strategy)
+        && !<spiral::SpiralSpec as Strategy>::NAMES.contains(&strategy)
+    {
         errors.extend(crate::edge::not_compensated(&p, strategy));
     }
     if let Err(d) = crate::job::accept::lower(&p.params) {

@@ -96,6 +96,28 @@ fn the_lowest_point_is_on_the_edge() {
 }
 
 #[test]
+fn the_depth_below_the_centre_and_its_slope_match_finite_differences() {
+    let e = wavy(50e-6, 4.0, 1.0, 0.5);
+    let nose = Nose {
+        radius: 0.5,
+        edge: Some(&e),
+    };
+    let h = 1e-7;
+    for d in [-0.4, -0.12, 0.0, 0.07, 0.33] {
+        let (l, slope) = nose.lift(d).unwrap();
+        assert_eq!(nose.bottom((0.0, 0.0), d), Some(-l));
+        let fd = (nose.lift(d + h).unwrap().0 - nose.lift(d - h).unwrap().0) / (2.0 * h);
+        assert!((fd - slope).abs() < 1e-6, "at {d}: {fd} vs {slope}");
+        // The wavy edge's depth is the circle's plus about δ / cos θ.
+        let circle = Nose::circle(0.5).lift(d).unwrap().0;
+        let theta = (d / 0.5_f64).asin();
+        let expected = e.deviation(theta).0 / theta.cos();
+        assert!((l - circle - expected).abs() < 2e-7, "at {d}");
+    }
+    assert_eq!(nose.lift(0.6), None);
+}
+
+#[test]
 fn the_text_format_reads_a_certificate() {
     let text =
         "# edge of insert 4711\nangle_deg, deviation_um\n-60, 0.01\n0;0.02\n60\t-0.03 # end\n\n";

@@ -42,6 +42,7 @@ fn planner<'a>(spiral: &'a FtsSpiral, d: &'a Dimple, rho: f64) -> Planner<'a> {
         surface: d,
         less: None,
         nose_radius: rho,
+        edge: None,
         bounds: TrajectoryBounds {
             z_max: d.h,
             max_slope: slope,
@@ -281,6 +282,7 @@ fn a_slope_that_is_not_a_number_is_undefined_not_a_lost_nose() {
         surface: &d,
         less: None,
         nose_radius: 0.496,
+        edge: None,
         bounds: TrajectoryBounds {
             z_max: d.0.h,
             max_slope: slope,
@@ -461,5 +463,88 @@ fn a_feature_around_the_spindle_spans_every_revolution_whole() {
         summary.max_acceleration < 1.0,
         "{}",
         summary.max_acceleration
+    );
+}
+
+/// A 50 nm sinusoid of 4 periods over ±45°, sampled every 0.5°.
+fn wavy_edge() -> crate::machine::edge::EdgeProfile {
+    use crate::machine::edge::{EdgeProfile, Sample};
+    let samples: Vec<Sample> = (0..=180)
+        .map(|i| {
+            let a = -45.0 + 0.5 * i as f64;
+            Sample {
+                angle_deg: a,
+                deviation_um: 0.05 * (4.0 * std::f64::consts::PI * a / 45.0).sin(),
+                line: i + 1,
+                at: 0,
+            }
+        })
+        .collect();
+    EdgeProfile::from_samples(&samples).unwrap()
+}
+
+#[test]
+fn with_a_measured_edge_the_centre_is_the_brute_force_envelope() {
+    // A dimple off the axis (not of revolution about it) with a plateau
+    // round it: smooth contacts on the sphere, corners at its rim.
+    let d = Dimple {
+        r: 2.0,
+        h: 0.05,
+        cx: 0.3,
+    };
+    let s = spiral();
+    let edge = wavy_edge();
+    let p = Planner {
+        edge: Some(&edge),
+        ..planner(&s, &d, 0.496)
+    };
+    let circle = planner(&s, &d, 0.496);
+    let nose = crate::machine::edge::Nose {
+        radius: 0.496,
+        edge: Some(&edge),
+    };
+    let mut worst: f64 = 0.0;
+    let mut moved: f64 = 0.0;
+    for k in 0..60 {
+        let c = 0.37 + 11.3 * k as f64;
+        let x = p.radius(c);
+        let ray = Ray {
+            surface: &d,
+            cos: c.cos(),
+            sin: c.sin(),
+        };
+        // max over u of z(u) + L(u − x), sampled every 5 nm and refined
+        // by golden section about the best sample.
+        let f = |u: f64| {
+            nose.lift(u - x)
+                .map_or(f64::NEG_INFINITY, |(l, _)| ray.point(u).z + l)
+        };
+        let n = 60_000;
+        let (a, b) = (x - 0.3, x + 0.3);
+        let best = (0..=n)
+            .map(|i| a + (b - a) * i as f64 / n as f64)
+            .max_by(|u, v| f(*u).total_cmp(&f(*v)))
+            .unwrap();
+        let (mut lo, mut hi) = (best - 1e-5, best + 1e-5);
+        for _ in 0..100 {
+            let (m1, m2) = (lo + 0.382 * (hi - lo), hi - 0.382 * (hi - lo));
+            if f(m1) < f(m2) {
+                lo = m1;
+            } else {
+                hi = m2;
+            }
+        }
+        let brute = f(lo).max(f(best));
+        let w = p.centre(c);
+        worst = worst.max((w - brute).abs());
+        moved = moved.max((w - circle.centre(c)).abs());
+    }
+    // Within a picometre of the envelope; tens of nanometres from the
+    // circle's.
+    assert!(worst < 1e-9, "off the envelope by {} nm", worst * 1e6);
+    assert!(
+        moved > 20e-6,
+        "the edge moved the centre {} nm",
+        moved * 1e6
     );
 }

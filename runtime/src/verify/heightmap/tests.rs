@@ -429,10 +429,11 @@ fn contacts_found_for_a_whole_column_at_once_are_those_found_piece_by_piece() {
             })
             .collect();
         centres.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let pieces = envelope(&centres, r);
+        let pieces = envelope(&centres, &Nose::circle(r));
         let cut = ColumnCut {
             s,
             r,
+            nose: Nose::circle(r),
             centres,
             pieces,
             frame: &frame,
@@ -447,4 +448,75 @@ fn contacts_found_for_a_whole_column_at_once_are_those_found_piece_by_piece() {
         contacts += batched.iter().filter(|v| !v.1.is_nan()).count();
     }
     assert!(contacts > 20, "{contacts}");
+}
+
+#[test]
+fn a_measured_edge_leaves_the_brute_force_envelope_of_its_copies() {
+    use crate::machine::edge::{EdgeProfile, Sample};
+    // A 50 nm sinusoid of 4 periods over ±45° on a 0.5 mm nose.
+    let samples: Vec<Sample> = (0..=180)
+        .map(|i| {
+            let a = -45.0 + 0.5 * i as f64;
+            Sample {
+                angle_deg: a,
+                deviation_um: 0.05 * (4.0 * std::f64::consts::PI * a / 45.0).sin(),
+                line: i + 1,
+                at: 0,
+            }
+        })
+        .collect();
+    let edge = Arc::new(EdgeProfile::from_samples(&samples).unwrap());
+    let nose = Nose {
+        radius: 0.5,
+        edge: Some(&edge),
+    };
+    // Passes 20 µm apart down a slope of 0.3 (contacts at about −17°)
+    // with a bow: heights that no circle formula gives.
+    let centre = |k: i32| {
+        let u = k as f64 * 0.02;
+        (u, 0.5 - 0.3 * u + 0.2 * u * u)
+    };
+    let g = grid(41, 0.005);
+    let mut sweep = Sweep::with_edge(g, 0.5, Some(edge.clone()));
+    for k in -30..=40 {
+        let (u, h) = centre(k);
+        sweep.lift();
+        sweep.point(-0.01, u, h);
+        sweep.point(0.3, u, h);
+    }
+    let frame = Flat {
+        z: |_, _| 0.0,
+        window: (0.0, 0.2, 0.0, 0.2),
+    };
+    let map = sweep.finish(&frame);
+    let mut worst: f64 = 0.0;
+    for i in 0..g.nu {
+        let u = g.u(i);
+        let brute = (-30..=40)
+            .filter_map(|k| {
+                let (cu, ch) = centre(k);
+                nose.lift(u - cu).map(|(l, _)| ch - l)
+            })
+            .fold(f64::INFINITY, f64::min);
+        for j in 0..g.ns {
+            worst = worst.max((map.errors[j * g.nu + i] - brute).abs());
+        }
+    }
+    assert!(worst < 1e-12, "off by {worst} mm");
+    // The circle's map differs by the waviness.
+    let mut circle = Sweep::new(g, 0.5);
+    for k in -30..=40 {
+        let (u, h) = centre(k);
+        circle.lift();
+        circle.point(-0.01, u, h);
+        circle.point(0.3, u, h);
+    }
+    let circle = circle.finish(&frame);
+    let apart = map
+        .errors
+        .iter()
+        .zip(&circle.errors)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(apart > 20e-6, "{apart}");
 }

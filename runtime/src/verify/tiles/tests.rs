@@ -79,7 +79,7 @@ fn tiled(threads: usize) -> TiledMap {
             &recorder,
             &tiles,
             GRID,
-            Cutter::Nose { radius: NOSE },
+            Cutter::nose(NOSE),
             &frame(),
             layout,
         )
@@ -241,15 +241,7 @@ fn a_lathe_s_tiles_skip_the_turns_that_miss_them_and_keep_the_figures() {
     let mut recorder = Recorder::new(Recorder::band_of(&tiles, nose));
     spiral(&mut recorder, nose);
     let layout = RasterLayout::new((-1.1, 1.1), (-1.1, 1.1), 0.01, 16);
-    let m = simulate(
-        &recorder,
-        &tiles,
-        grid,
-        Cutter::Nose { radius: nose },
-        &Turned,
-        layout,
-    )
-    .map;
+    let m = simulate(&recorder, &tiles, grid, Cutter::nose(nose), &Turned, layout).map;
     assert_eq!((m.cells, m.uncut), (whole.cells, whole.uncut));
     assert!(whole.cells > 10_000 && whole.uncut == 0, "{}", whole.uncut);
     for (a, b) in [(m.surface, whole.surface), (m.contact, whole.contact)] {

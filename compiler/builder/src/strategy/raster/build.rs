@@ -141,9 +141,7 @@ pub(super) fn build(spec: &RasterSpec, cx: &BuildContext) -> Result<Built, Vec<D
     // along the path too (see lensc_runtime::verify::heightmap).
     let (cutter, edge) = match tool {
         RasterTool::Knife { nose_radius } => (
-            Cutter::Nose {
-                radius: nose_radius,
-            },
+            Cutter::nose(nose_radius),
             "the knife's edge in its rake face, across the cut, as the planner places it",
         ),
         RasterTool::Ball { radius } => (
@@ -153,7 +151,7 @@ pub(super) fn build(spec: &RasterSpec, cx: &BuildContext) -> Result<Built, Vec<D
     };
     let along_x = raster.along == Axis::X;
     // The whole part by default, as fine as its cutter's budget allows.
-    let budget = match cutter {
+    let budget = match &cutter {
         Cutter::Nose { .. } => height_map::WHOLE_CELLS_NOSE,
         Cutter::Ball { .. } => height_map::WHOLE_CELLS_BALL,
     };
@@ -164,7 +162,7 @@ pub(super) fn build(spec: &RasterSpec, cx: &BuildContext) -> Result<Built, Vec<D
         |w| split(&w.cartesian(along_x), None),
     );
     let grid = window.cartesian(along_x);
-    let mut sweep = Simulation::of(grid, split(&grid, None), cutter);
+    let mut sweep = Simulation::of(grid, split(&grid, None), cutter.clone());
     // The program as written: its text read as the controller reads it.
     let executed = parts::executed_moves(head, &text, false);
     height_map::sweep_mill_program(sweep.path(), &executed, along_x);

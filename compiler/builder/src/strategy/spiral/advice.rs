@@ -157,6 +157,7 @@ fn check(spec: &SpiralSpec, unit: Unit, speed: f64, lag_limit: Option<f64>) -> V
         surface: kernel.as_ref(),
         less: None,
         nose_radius: spec.nose_radius,
+        edge: spec.edge.as_ref().map(|(m, _)| &m.profile),
         bounds,
     };
     let (mut printed, resolution) = (Vec::new(), spec.head.resolution);

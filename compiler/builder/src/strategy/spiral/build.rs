@@ -15,7 +15,7 @@ use lensc_runtime::emit::spiral::FtsProgram;
 use lensc_runtime::plan::spiral::{FtsError, FtsSummary, Planner, SpindleSpeed};
 use lensc_runtime::post::Provenance;
 use lensc_runtime::surface::ir::SurfaceFn;
-use lensc_runtime::verify::heightmap::NosePath;
+use lensc_runtime::verify::heightmap::{Cutter, NosePath};
 
 use crate::context::{self as parts, BuildContext};
 use crate::evaluate::evaluator;
@@ -62,6 +62,7 @@ impl<'s> Prepared<'s> {
                 .as_ref()
                 .map(|l| l as &dyn lensc_runtime::plan::spiral::RayCorrection),
             nose_radius: self.spec.nose_radius,
+            edge: self.spec.edge.as_ref().map(|(m, _)| &m.profile),
             bounds: self.spec.bounds.clone(),
         }
     }
@@ -107,10 +108,17 @@ pub(super) fn build(spec: &SpiralSpec, cx: &BuildContext) -> Result<Built, Vec<D
         height_map::WHOLE_CELLS_NOSE,
         |w| w.polar_tiles(&p.lenslets),
     );
-    let mut sweep = Simulation::new(
+    // The nose as measured, where the tool names its edge.
+    let mut sweep = Simulation::of(
         window.polar(),
         window.polar_tiles(&p.lenslets),
-        p.nose_radius,
+        Cutter::Nose {
+            radius: p.nose_radius,
+            edge: p
+                .edge
+                .as_ref()
+                .map(|(m, _)| std::sync::Arc::new(m.profile.clone())),
+        },
     );
     let mut printed = Vec::new();
     let planned = Prepared::of(spec).planner().plan(&p.fast_axis, |pts| {
@@ -189,13 +197,14 @@ fn axis_words(spec: &SpiralSpec) -> &'static str {
 
 /// The spiral's section of the report: a fast or a slow tool servo's.
 fn toolpath(spec: &SpiralSpec, summary: &FtsSummary) -> report::Toolpath {
-    let spiral = report::Spiral::new(
+    let mut spiral = report::Spiral::new(
         summary,
         &spec.spiral,
         spec.settling.as_ref(),
         spec.servo.as_ref(),
         spec.nose_radius,
     );
+    spiral.edge_profile = spec.edge.as_ref().map(|(_, r)| r.clone());
     if spec.slow {
         report::Toolpath::SpiralTurning(spiral)
     } else {
@@ -329,6 +338,14 @@ fn header_lines(spec: &SpiralSpec, prov: &Provenance, table: Option<&str>) -> Ve
         lensc_runtime::emit::x_word(&head.dialect)
     );
     let mut lines = parts::nose_centre_header(head, prov, &units, spec.nose_radius);
+    if let Some((m, _)) = &spec.edge
+        && let Some(tool) = lines.last_mut()
+    {
+        tool.push_str(&format!(
+            ", edge profile {}: each centre clears the surface with the measured edge at its angle of contact",
+            m.source
+        ));
+    }
     lines.push(format!(
         "strategy {}: {servo_words} spiral from r = {} mm, feed {} um/rev, {speed}, path tolerance {} nm [chords {}, blending {} nm]",
         head.names.strategy,

@@ -15,6 +15,7 @@ mod servo;
 
 use lensc_grammar::Diagnostic;
 use lensc_runtime::machine::servo::SecondOrderServo;
+use lensc_runtime::machine::tool::MeasuredEdge;
 use lensc_runtime::plan::chords::ChordPlacement;
 use lensc_runtime::plan::spiral::{FastAxis, FtsSpiral, SpindleSpeed, TrajectoryBounds};
 use lensc_runtime::post::Dialect;
@@ -38,6 +39,10 @@ pub struct SpiralSpec {
     pub spiral: FtsSpiral,
     pub bounds: TrajectoryBounds,
     pub nose_radius: f64,
+    /// The nose's measured edge, if the tool names one (the planner
+    /// clears the trajectory with it, the simulation sweeps it), and its
+    /// section of the report.
+    pub edge: Option<(MeasuredEdge, crate::edge::EdgeReport)>,
     pub fast_axis: FastAxis,
     /// The surface the nose centre follows: the design, or with a
     /// settling offset its lenslets continued and lifted over the land;
@@ -217,6 +222,7 @@ pub(crate) fn lower(
         &lowered,
         &design,
     );
+    let edge = crate::edge::measured_edge(p).map_err(|d| vec![d])?;
 
     let end = -past_axis(
         evaluate(&trajectory.tape).as_ref(),
@@ -247,6 +253,16 @@ pub(crate) fn lower(
         },
     );
     errors.extend(machine_limits(p, &spiral));
+    if let Some((measured, _)) = &edge {
+        let kernel = evaluate(&trajectory.tape);
+        errors.extend(crate::edge::uncovered_spiral(
+            p,
+            &measured.profile,
+            kernel.as_ref(),
+            &lowered.domain,
+            (spiral.end_radius, spiral.start_radius),
+        ));
+    }
     all_clear(errors)?;
 
     let retract = st.retract.unwrap_or(1.0);
@@ -257,6 +273,7 @@ pub(crate) fn lower(
         spiral,
         bounds,
         nose_radius: rho,
+        edge,
         fast_axis,
         trajectory,
         trajectory_declared,

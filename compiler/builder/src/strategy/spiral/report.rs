@@ -29,6 +29,9 @@ pub struct Spiral {
     pub chords_over_tolerance: Option<ChordsOverTolerance>,
     /// The tool's nose radius (mm).
     pub nose_radius_mm: f64,
+    /// The measured edge the spiral was planned and simulated with, or
+    /// null if the nose is taken as a circle.
+    pub edge_profile: Option<crate::edge::EdgeReport>,
     /// The axis that carries the surface (the fast tool servo's, or Z).
     pub fast_axis: FastAxis,
     /// The highest spindle speed reached (rpm).
@@ -74,6 +77,7 @@ impl Spiral {
                 at_radius_mm: o.at_radius,
             }),
             nose_radius_mm: rho,
+            edge_profile: None,
             fast_axis: FastAxis {
                 w_min_mm: s.w_min,
                 w_max_mm: s.w_max,
