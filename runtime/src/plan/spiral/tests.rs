@@ -512,6 +512,7 @@ fn with_a_measured_edge_the_centre_is_the_brute_force_envelope() {
             surface: &d,
             cos: c.cos(),
             sin: c.sin(),
+            less: None,
         };
         // max over u of z(u) + L(u − x), sampled every 5 nm and refined
         // by golden section about the best sample.

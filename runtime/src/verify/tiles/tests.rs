@@ -332,7 +332,10 @@ fn rows_beyond_a_column_s_chord_of_the_lenslets_are_not_tried_and_change_no_figu
             discs: discs.clone(),
             reach,
         };
-        let cutter = Cutter::Nose { radius: nose };
+        let cutter = Cutter::Nose {
+            radius: nose,
+            edge: None,
+        };
         simulate(&recorder, &tiles, window.polar(), cutter, &frame, layout)
     };
     let (tried, told) = (map(false), map(true));
