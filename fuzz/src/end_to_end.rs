@@ -16,7 +16,7 @@ use std::time::{Duration, Instant};
 use crate::harness::{Depth, Fault};
 
 /// One in this many `.lens` inputs also runs through the binary.
-pub const SHARE: usize = 50;
+pub const SHARE: u64 = 50;
 
 /// How long one run of the binary may take.
 const RUN: Duration = Duration::from_secs(30);
@@ -67,8 +67,12 @@ impl Project {
                 if let Depth::BuildAs {
                     dialect,
                     max_program_size,
+                    accept_warn,
                 } = depth
                 {
+                    if accept_warn {
+                        cmd.arg("--accept").arg("warn");
+                    }
                     if let Some(d) = dialect {
                         cmd.arg("--dialect").arg(d);
                     }

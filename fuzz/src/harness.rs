@@ -126,10 +126,13 @@ pub enum Depth {
     /// Also build every job of a clean file and write its files.
     Build,
     /// Build as `Build`, in this dialect instead of each machine's own
-    /// (`--dialect`) and to this largest program (`--max-program-size`).
+    /// (`--dialect`), to this largest program (`--max-program-size`), and
+    /// a part that misses its acceptance criteria written all the same if
+    /// `accept_warn` (`--accept warn`).
     BuildAs {
         dialect: Option<&'static str>,
         max_program_size: Option<u64>,
+        accept_warn: bool,
     },
     /// Not a `.lens` file: a program for `lensc verify` (the number picks
     /// the machine and dialect it is read by if its header names none).
@@ -216,9 +219,15 @@ pub fn run(fs: &MemFs, bytes: &[u8], depth: Depth, out_dir: &Path) -> Result<Rea
                 Depth::BuildAs {
                     dialect,
                     max_program_size,
+                    accept_warn,
                 } => driver::Request {
                     dialect,
                     max_program_size,
+                    accept: if accept_warn {
+                        lensc_build::accept::Mode::Warn
+                    } else {
+                        lensc_build::accept::Mode::Gate
+                    },
                     ..driver::Request::default()
                 },
                 _ => driver::Request::default(),

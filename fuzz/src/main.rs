@@ -81,11 +81,16 @@ struct Cli {
     /// What the inputs go through.
     #[arg(long, value_enum, default_value_t = Target::Mixed)]
     target: Target,
-    /// The `lensc` binary the `lsp` target starts; with it, one in 50
-    /// `.lens` inputs of the other targets also runs through it end to end
-    /// (`end_to_end`).
+    /// The `lensc` binary the `lsp` target starts; with it, one in
+    /// `--end-to-end-every` `.lens` inputs of the other targets also runs
+    /// through it end to end (`end_to_end`).
     #[arg(long, value_name = "PATH")]
     lensc: Option<PathBuf>,
+    /// With `--lensc`, one `.lens` input in N also runs through the binary
+    /// (a process started each time: the campaign's check target, at
+    /// thousands of inputs a second, runs one in 1,000).
+    #[arg(long, value_name = "N", default_value_t = end_to_end::SHARE)]
+    end_to_end_every: u64,
     /// Cores the summary's projection of the campaign assumes (default:
     /// the lanes).
     #[arg(long, value_name = "N")]
@@ -233,7 +238,19 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         };
     }
-    let scratch = match tempfile::tempdir() {
+    // Builds write and sync their files: in memory where the machine has
+    // a tmpfs (the same writes, without a disk's sync in each build's
+    // time: a third of a build input's wall time on /tmp here).
+    let shm = Path::new("/dev/shm");
+    let scratch = if shm.is_dir() {
+        tempfile::Builder::new()
+            .prefix("lensc-fuzz-")
+            .tempdir_in(shm)
+            .or_else(|_| tempfile::tempdir())
+    } else {
+        tempfile::tempdir()
+    };
+    let scratch = match scratch {
         Ok(d) => d,
         Err(e) => {
             eprintln!("fuzz: cannot make a temporary output directory: {e}");
@@ -250,6 +267,7 @@ fn main() -> ExitCode {
         corpora: &corpora,
     };
     let start = Instant::now();
+    let cpu_at_start = cpu_seconds();
     let lanes_run;
     if let Some(range) = cli.replay.as_deref() {
         let Some(range) = parse_range(range) else {
@@ -315,6 +333,7 @@ fn main() -> ExitCode {
     summary(
         c,
         start.elapsed(),
+        cpu_seconds().map(|now| now - cpu_at_start.unwrap_or(0.0)),
         distinct,
         lanes_run,
         cli.cores.unwrap_or(lanes_run),
@@ -352,6 +371,10 @@ fn worker_command(cli: &Cli, seed: u64) -> Vec<String> {
     if let Some(p) = &cli.lensc {
         c.extend(["--lensc".into(), p.display().to_string()]);
     }
+    c.extend([
+        "--end-to-end-every".into(),
+        cli.end_to_end_every.to_string(),
+    ]);
     c
 }
 
@@ -435,7 +458,9 @@ impl<'a> Worker<'a> {
             if let Some(lensc) = &cli.lensc
                 && r.kind != Kind::Hung
                 && depth.is_lens()
-                && Rng::for_input(self.seed ^ END_TO_END, index).below(end_to_end::SHARE) == 0
+                && Rng::for_input(self.seed ^ END_TO_END, index)
+                    .below(cli.end_to_end_every.max(1) as usize)
+                    == 0
             {
                 let project = project.get_or_insert_with(|| {
                     end_to_end::Project::new(lensc, self.out.join("project"), self.fs.files())
@@ -475,14 +500,23 @@ fn input_for(
             (source, bytes, depth)
         }
         Target::Build => {
-            let dialect = rng.chance(0.3).then(|| *rng.pick(DIALECTS));
+            let job = small_jobs::job(&mut rng);
+            // Mostly a dialect the machine offers (its own, or another it
+            // lists); now and then any dialect, which a machine that does
+            // not offer it refuses with a coded error.
+            let dialect = if rng.chance(0.35) {
+                Some(*rng.pick(job.dialects))
+            } else {
+                rng.chance(0.04).then(|| *rng.pick(DIALECTS))
+            };
             let max_program_size = rng.chance(0.15).then(|| rng.log_uniform(1e3, 1e8) as u64);
             (
                 Source::SmallJob,
-                small_jobs::file(&mut rng).into_bytes(),
+                job.text.into_bytes(),
                 Depth::BuildAs {
                     dialect,
                     max_program_size,
+                    accept_warn: rng.chance(0.15),
                 },
             )
         }
@@ -742,6 +776,22 @@ fn strategy_of(bytes: &[u8]) -> &'static str {
         .unwrap_or("other")
 }
 
+/// CPU seconds (user and system) of this process and of the children it
+/// has waited for (the workers, and the `lensc` runs they waited for),
+/// from `/proc/self/stat` (in its clock ticks, 100 a second on Linux):
+/// what the summary's projection on quiet cores is made from, since the
+/// wall time of a lane on a loaded machine is mostly waiting for a core.
+fn cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // The fields after the command name (which may hold spaces), from
+    // the state (field 3): utime, stime, cutime, cstime are fields 14-17.
+    let fields: Vec<&str> = stat.rsplit_once(')')?.1.split_whitespace().collect();
+    let ticks: Option<Vec<f64>> = (11..15)
+        .map(|i| fields.get(i)?.parse::<f64>().ok())
+        .collect();
+    Some(ticks?.iter().sum::<f64>() / 100.0)
+}
+
 /// Hours, or minutes under an hour, for a person.
 fn span(seconds: f64) -> String {
     if !seconds.is_finite() {
@@ -755,7 +805,15 @@ fn span(seconds: f64) -> String {
 
 /// The run's figures, on stdout (a full disk or a closed pipe loses them
 /// quietly rather than panicking).
-fn summary(c: &Counts, elapsed: Duration, distinct: usize, lanes: u64, cores: u64, target: Target) {
+fn summary(
+    c: &Counts,
+    elapsed: Duration,
+    cpu: Option<f64>,
+    distinct: usize,
+    lanes: u64,
+    cores: u64,
+    target: Target,
+) {
     let secs = elapsed.as_secs_f64().max(1e-9);
     let check_only = c.checked.saturating_sub(c.build_inputs);
     let get = |s| c.inputs.get(&s).copied().unwrap_or(0);
@@ -861,6 +919,39 @@ fn summary(c: &Counts, elapsed: Duration, distinct: usize, lanes: u64, cores: u6
             "  projection        on {cores} core(s) at this run's rate per lane: {}",
             goals.join(", ")
         );
+    }
+    // The same goals from the CPU time the run took (the workers and the
+    // binaries they ran): on `cores` quiet cores each lane has a core of
+    // its own, whatever the load was here.
+    if let Some(cpu) = cpu.filter(|&t| t > 0.0 && total > 0) {
+        let mut line = format!(
+            "  CPU               {cpu:.1} s ({:.0} % of {lanes} lane(s)' wall time), {:.3} ms an input",
+            100.0 * cpu / lane_secs,
+            cpu * 1e3 / total as f64
+        );
+        if c.built > 0 {
+            line.push_str(&format!(
+                ", {:.1} ms a job built",
+                cpu * 1e3 / c.built as f64
+            ));
+        }
+        let mut goals = Vec::new();
+        if target == Target::Check {
+            goals.push(format!(
+                "10 M checks in {}",
+                span(GOAL_CHECKS * cpu / check_only.max(1) as f64 / cores as f64)
+            ));
+        }
+        if target == Target::Build && c.built > 0 {
+            goals.push(format!(
+                "100 k builds in {}",
+                span(GOAL_BUILDS * cpu / c.built as f64 / cores as f64)
+            ));
+        }
+        if !goals.is_empty() {
+            line.push_str(&format!("; on {cores} quiet core(s): {}", goals.join(", ")));
+        }
+        let _ = writeln!(out, "{line}");
     }
     let _ = writeln!(
         out,

@@ -20,7 +20,9 @@ use crate::mutate::{Corpus, mutant};
 use crate::rng::Rng;
 
 /// The measurement files mutations start from: every peer file a reader
-/// takes, and two maps lensc writes (one with invalid points).
+/// takes, two maps lensc writes (one with invalid points), and points and
+/// profiles in each text spelling (`.xyz`, `.csv` with a header, `.txt`,
+/// `.prf` with semicolons).
 pub fn corpus(root: &Path) -> std::io::Result<Corpus> {
     let mut files = Corpus::under(root, &["tests/measure/peer"], |_| true)?.files;
     files.retain(|(name, bytes)| lensc_measure::read::detect(name, bytes).is_some());
@@ -47,7 +49,30 @@ pub fn corpus(root: &Path) -> std::io::Result<Corpus> {
         "profile.txt".into(),
         b"0 0\n0.1 0.002\n0.2 0.008\n0.3 0.018\n".to_vec(),
     ));
+    // The text readers' other spellings: a CSV with a header, a comment, an
+    // invalid height and an intensity column; a `.prf` profile with
+    // semicolons and tabs.
+    files.push((
+        "points.csv".into(),
+        format!(
+            "x,y,z,intensity\n# lensc fuzz\n{}0.5,0.5,NaN,7\n",
+            m_csv(&map)
+        )
+        .into_bytes(),
+    ));
+    files.push((
+        "profile.prf".into(),
+        b"x;z\n0;0\n0.1;\t0.002\n% a comment\n0.2;0.008\n0.3;BAD\n".to_vec(),
+    ));
     Ok(Corpus { files })
+}
+
+/// A map's valid points as x,y,z,intensity lines.
+fn m_csv(m: &HeightMap) -> String {
+    m.points()
+        .iter()
+        .map(|[x, y, z]| format!("{x},{y},{z},1\n"))
+        .collect()
 }
 
 /// A map's valid points as x y z text.
@@ -61,22 +86,45 @@ fn points_text(m: &HeightMap) -> String {
 /// Input `rng` makes of the corpus: the file's name (its extension picks
 /// the text readers) and bytes.
 pub fn input(corpus: &Corpus, rng: &mut Rng) -> (String, Vec<u8>) {
-    let (name, bytes) = rng.pick(&corpus.files).clone();
+    let (name, bytes) = rng.pick(&corpus.files);
     if bytes.starts_with(b"PK\x03\x04")
         && rng.chance(0.5)
-        && let Some(inside) = mutate_inside(&bytes, rng)
+        && let Some(inside) = mutate_inside(name, bytes, rng)
     {
-        return (name, inside);
+        return (name.clone(), inside);
     }
     let one = Corpus {
-        files: vec![(name.clone(), bytes)],
+        files: vec![(name.clone(), bytes.clone())],
     };
-    (name, mutant(&one, rng))
+    (name.clone(), mutant(&one, rng))
 }
 
-/// An archive with one of its entries mutated and the archive written
-/// again (entries stored), or `None` if it cannot be opened.
-fn mutate_inside(bytes: &[u8], rng: &mut Rng) -> Option<Vec<u8>> {
+/// An archive's files: name and bytes.
+type Entries = std::rc::Rc<Vec<(String, Vec<u8>)>>;
+
+thread_local! {
+    /// Each archive of the corpus unpacked once, by name (`None`: it
+    /// cannot be opened): unpacking the 3 MB X3P again for every input
+    /// was most of this target's time.
+    static UNPACKED: std::cell::RefCell<std::collections::HashMap<String, Option<Entries>>> =
+        Default::default();
+}
+
+/// The files of archive `name` (`bytes`), unpacked the first time.
+fn unpacked(name: &str, bytes: &[u8]) -> Option<Entries> {
+    UNPACKED.with(|u| {
+        if let Some(e) = u.borrow().get(name) {
+            return e.clone();
+        }
+        let e = unpack(bytes).map(std::rc::Rc::new);
+        u.borrow_mut().insert(name.to_string(), e.clone());
+        e
+    })
+}
+
+/// The files of an archive, or `None` if it cannot be opened or holds
+/// none.
+fn unpack(bytes: &[u8]) -> Option<Vec<(String, Vec<u8>)>> {
     let mut zip = zip::ZipArchive::new(std::io::Cursor::new(bytes)).ok()?;
     let mut entries = Vec::new();
     for i in 0..zip.len() {
@@ -88,20 +136,25 @@ fn mutate_inside(bytes: &[u8], rng: &mut Rng) -> Option<Vec<u8>> {
         f.read_to_end(&mut data).ok()?;
         entries.push((f.name().to_string(), data));
     }
-    if entries.is_empty() {
-        return None;
-    }
+    (!entries.is_empty()).then_some(entries)
+}
+
+/// Archive `name` (`bytes`) with one of its entries mutated and the
+/// archive written again (entries stored), or `None` if it cannot be
+/// opened.
+fn mutate_inside(name: &str, bytes: &[u8], rng: &mut Rng) -> Option<Vec<u8>> {
+    let entries = unpacked(name, bytes)?;
     let k = rng.below(entries.len());
     let one = Corpus {
         files: vec![entries[k].clone()],
     };
-    entries[k].1 = mutant(&one, rng);
+    let changed = mutant(&one, rng);
     let mut out = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
     let stored =
         zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Stored);
-    for (name, data) in &entries {
+    for (i, (name, data)) in entries.iter().enumerate() {
         out.start_file(name.as_str(), stored).ok()?;
-        out.write_all(data).ok()?;
+        out.write_all(if i == k { &changed } else { data }).ok()?;
     }
     out.finish().ok().map(|c| c.into_inner())
 }

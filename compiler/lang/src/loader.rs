@@ -7,6 +7,7 @@
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, OnceLock};
 
 use lensc_grammar::ast::{self, Ident, ItemKind, Span, UseTarget};
 use lensc_grammar::diagnostic::codes as syntax_codes;
@@ -70,8 +71,25 @@ pub enum Import {
 
 pub struct ParsedFile {
     pub id: FileId,
-    pub ast: ast::File,
+    /// Its syntax tree; a standard-library module's is parsed once in a
+    /// process and shared by every load (`std_tree`).
+    pub ast: Arc<ast::File>,
     pub imports: Vec<Import>,
+}
+
+/// The syntax tree of standard-library module `index` (of `STDLIB`),
+/// parsed the first time a load in this process asks for it and shared
+/// after: every check loads the prelude (the 20 KB of `dialects`), the
+/// language server checks on every change, and the fuzzer checks
+/// thousands of files a second, each of which parsed it again. A tree
+/// does not depend on the file id it is loaded under (ids are carried by
+/// diagnostics only) and the standard library parses without any
+/// (`tests::the_standard_library_parses_clean_and_once`).
+fn std_tree(index: usize) -> Arc<ast::File> {
+    static TREES: [OnceLock<Arc<ast::File>>; STDLIB.len()] =
+        [const { OnceLock::new() }; STDLIB.len()];
+    let (_, text) = STDLIB[index];
+    Arc::clone(TREES[index].get_or_init(|| Arc::new(lensc_grammar::parse(text, FileId(0)).0)))
 }
 
 pub struct Loaded {
@@ -213,7 +231,7 @@ impl Loader<'_> {
         self.keys.insert(key.clone(), id);
         self.loaded.files.push(ParsedFile {
             id,
-            ast: ast::File::default(),
+            ast: Arc::default(),
             imports: Vec::new(),
         });
         if let Some(at) = utf8_error {
@@ -229,8 +247,18 @@ impl Loader<'_> {
             );
             return id;
         }
-        let (ast, mut diags) = lensc_grammar::parse(&self.loaded.sources.get(id).text, id);
-        self.loaded.diags.append(&mut diags);
+        let std_index = match &key {
+            Key::Std(name) => STDLIB.iter().position(|(n, _)| n == name),
+            Key::Path(_) => None,
+        };
+        let ast = match std_index {
+            Some(i) => std_tree(i),
+            None => {
+                let (ast, mut diags) = lensc_grammar::parse(&self.loaded.sources.get(id).text, id);
+                self.loaded.diags.append(&mut diags);
+                Arc::new(ast)
+            }
+        };
         self.on_stack.insert(key.clone(), self.stack.len());
         self.stack.push((key.clone(), id));
         let mut imports = Vec::new();
@@ -462,4 +490,33 @@ fn outside_root(
         "a job file reads only files under its project root (by default the directory of \
          the file given on the command line); give `--root DIR` to widen it",
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every standard-library module parses without a diagnostic (what
+    /// `std_tree` relies on to share one tree), and two loads share the
+    /// prelude's tree rather than parsing it each time.
+    #[test]
+    fn the_standard_library_parses_clean_and_once() {
+        for (name, text) in STDLIB {
+            let (_, diags) = lensc_grammar::parse(text, FileId(0));
+            assert!(diags.is_empty(), "std::{name}: {diags:?}");
+        }
+        let fs = RealFs;
+        let a = load_text(&fs, "a.lens", b"use std::machines::linuxcnc_lathe\n");
+        let b = load_text(&fs, "b.lens", b"let x = 1 mm\n");
+        let prelude = |l: &Loaded| {
+            let i = l
+                .sources
+                .iter()
+                .position(|(_, f)| f.name == format!("std/{PRELUDE}.lens"))
+                .expect("the prelude is loaded");
+            Arc::clone(&l.files[i].ast)
+        };
+        assert!(!prelude(&a).items.is_empty());
+        assert!(Arc::ptr_eq(&prelude(&a), &prelude(&b)));
+    }
 }

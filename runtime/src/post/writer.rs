@@ -254,9 +254,14 @@ impl ProgramWriter {
         let has = |c: char| axes.contains(c).then_some(c);
         let axis_decimals = [decimals, decimals, decimals, dialect.c_decimals];
         let limits = integer_limits(dialect);
+        // The F word's own format, else the dialect's most decimals of any
+        // word (as the reader holds F: a Fanuc lathe's per-revolution feed
+        // of 0.018182 mm was written with six decimals and refused), at
+        // most six.
         let feed_decimals = dialect
             .format_of('F')
             .and_then(|f| f.decimals)
+            .or(dialect.max_decimals)
             .map_or(FEED_DECIMALS, |d| d.min(FEED_DECIMALS));
         let x_scale = if setup == Setup::Lathe && dialect.lathe_x_diameter {
             2.0

@@ -405,6 +405,50 @@ fn feeds_are_held_to_their_integer_digits_in_each_mode() {
     assert!(text.contains(" F999.\n"), "{text}");
 }
 
+/// A dialect's `max_decimals` holds every word without a format of its
+/// own, F included, as the reader holds them (a Fanuc lathe's 18.182
+/// um/rev was written `F0.018182`, six decimals, and the build's read-back
+/// refused its own program, E0305; found by the fuzzer's dialect draws).
+#[test]
+fn a_feed_is_printed_within_the_dialects_most_decimals() {
+    let mut d = fanuc_like();
+    d.max_decimals = Some(4);
+    let text = written_in(
+        &d,
+        Setup::Lathe,
+        "XZ",
+        &[
+            M::Rapid(P::xz(1.0, 0.1)),
+            M::Linear {
+                to: P::xz(1.0, 0.0),
+                feed: Some(F::PerRevolution(0.018182 / (2.0 * PI))),
+            },
+            M::Linear {
+                to: P::xz(0.5, 0.0),
+                feed: Some(F::PerTime(537.238_3 / 60.0)),
+            },
+        ],
+    )
+    .expect("writes");
+    assert!(text.contains(" F0.0182\n"), "{text}");
+    assert!(text.contains(" F537.2383\n"), "{text}");
+    // Without the limit, six decimals as before.
+    let text = written_in(
+        &fanuc_like(),
+        Setup::Lathe,
+        "XZ",
+        &[
+            M::Rapid(P::xz(1.0, 0.1)),
+            M::Linear {
+                to: P::xz(1.0, 0.0),
+                feed: Some(F::PerRevolution(0.018182 / (2.0 * PI))),
+            },
+        ],
+    )
+    .expect("writes");
+    assert!(text.contains(" F0.018182\n"), "{text}");
+}
+
 #[test]
 fn word_formats_refuse_a_point_in_an_integer_word_and_too_many_digits() {
     let d = fanuc_like();
