@@ -600,7 +600,13 @@ impl ColumnCut<'_> {
             // when its least error is at that edge.
             let clipped = (best_u == a && a > self.pieces[q].1.max(cu - r))
                 || (best_u == b && b < self.end(q).min(cu + r));
-            if !clipped && self.in_window(best_u) {
+            // A piece whose least error is where a neighbour's begins has
+            // its contact cut away by that neighbour: a sliver between two
+            // deeper cuts (the nose on the opposite ray near the axis), its
+            // least the cusp, not a contact.
+            let at_neighbour = (best_u == a && q > 0 && a == self.pieces[q].1)
+                || (best_u == b && q + 1 < n && b == self.end(q));
+            if !clipped && !at_neighbour && self.in_window(best_u) {
                 valleys[q] = (best_u, least);
             }
         }
