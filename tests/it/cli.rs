@@ -1015,7 +1015,7 @@ fn a_stated_spiral_start_that_leaves_the_rim_proud_is_refused() {
     // beyond the highest scallop, as each lenslet's does.
     let (code, said, _) = build_text(&spiral_rim_from("4.05 mm"), &[], "dome_sts");
     assert_eq!(code, Some(1), "{said}");
-    assert!(said.contains("error[E0195]"), "{said}");
+    assert!(said.contains("[E0195] Error"), "{said}");
     assert!(
         said.contains("misses `max_residual`: 28.0")
             && said.contains("highest where no contact reached, at the rim at x = 4"),
