@@ -925,3 +925,133 @@ fn a_build_summarises_each_job_and_writes_all_or_nothing_unless_keep_going() {
     let wrote = format!("  wrote     {}", kept.join("good.ngc").display());
     assert!(stderr.contains(&wrote), "{stderr}");
 }
+
+/// Builds `source` (a `.lens` text) in a temporary directory with `args`
+/// added; its exit code, stderr and the report of job `job`, if written.
+fn build_text(
+    source: &str,
+    args: &[&str],
+    job: &str,
+) -> (Option<i32>, String, Option<serde_json::Value>) {
+    let dir = tempfile::tempdir().expect("tmp");
+    let file = dir.path().join("job.lens");
+    std::fs::write(&file, source).expect("write");
+    let out_dir = dir.path().join("out");
+    let mut all = vec![
+        "build",
+        file.to_str().expect("utf8"),
+        "--out",
+        out_dir.to_str().expect("utf8"),
+    ];
+    all.extend(args);
+    let out = lensc(&root(), &all);
+    let report = std::fs::read_to_string(out_dir.join(format!("{job}.report.json")))
+        .ok()
+        .map(|t| serde_json::from_str(&t).expect("json"));
+    (out.status.code(), text(&out.stderr), report)
+}
+
+/// `tests/jobs/spiral_rim.lens` with its spiral's `from` stated.
+fn spiral_rim_from(from: &str) -> String {
+    std::fs::read_to_string(root().join("tests/jobs/spiral_rim.lens"))
+        .expect("read")
+        .replace(
+            "spindle_speed: 60 rpm }",
+            &format!("spindle_speed: 60 rpm, from: {from} }}"),
+        )
+}
+
+fn figure(report: &serde_json::Value, path: &[&str]) -> f64 {
+    let mut v = &report["simulation"]["height_map"];
+    for p in path {
+        v = &v[p];
+    }
+    v.as_f64().unwrap_or_else(|| panic!("{path:?} in {v}"))
+}
+
+#[test]
+fn spirals_are_cut_to_their_rims_by_default() {
+    // Issue #29: the spiral started with the nose centre on the rim. The
+    // dome's contact lay 0.2 mm inside it and the flank left the rim 47
+    // um proud (judged at the contacts only, the build passed); the
+    // plate failed on its first revolution's cusp taken for a contact.
+    // The default start now puts the first revolution's contacts a feed
+    // beyond the rim.
+    let dir = tempfile::tempdir().expect("tmp");
+    let out = lensc(
+        &root(),
+        &[
+            "build",
+            "tests/jobs/spiral_rim.lens",
+            "--out",
+            dir.path().to_str().expect("utf8"),
+        ],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    for job in ["dome_sts", "plate_sts"] {
+        let report: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(dir.path().join(format!("{job}.report.json")))
+                .expect("report"),
+        )
+        .expect("json");
+        assert_eq!(report["acceptance"]["judged"]["area"], "whole_part");
+        // Every cell, the rim's too, within the scallop (25 nm on the
+        // flat for 10 um under 0.5 mm; the dome's steepest 31 nm) and the
+        // default residual beyond it.
+        let surface = figure(&report, &["surface", "max_residual_nm", "value"]);
+        assert!(surface < 40.0, "{job}: {surface}");
+        let beyond = figure(&report, &["residual_beyond_scallops_nm", "value"]);
+        assert!(beyond < 11.0, "{job}: {beyond}");
+    }
+    let dome = std::fs::read_to_string(dir.path().join("dome_sts.ngc")).expect("program");
+    assert!(dome.contains("spiral from r = 4.22"), "{}", &dome[..2000]);
+}
+
+#[test]
+fn a_stated_spiral_start_that_leaves_the_rim_proud_is_refused() {
+    // Issue #29: `from: 4.05 mm` on the dome puts the contact 0.15 mm
+    // inside the rim, left 28 um proud; its contacts were fine, so the
+    // build passed. The whole part's residual now counts every cell
+    // beyond the highest scallop, as each lenslet's does.
+    let (code, said, _) = build_text(&spiral_rim_from("4.05 mm"), &[], "dome_sts");
+    assert_eq!(code, Some(1), "{said}");
+    assert!(said.contains("[E0195] Error"), "{said}");
+    assert!(
+        said.contains("misses `max_residual`: 28.0")
+            && said.contains("highest where no contact reached, at the rim at x = 4"),
+        "{said}"
+    );
+}
+
+#[test]
+fn a_spirals_axis_is_judged_as_cut_from_both_sides() {
+    // Issue #29: the dome from 4.25 mm showed 95 nm at (0, 0), f²/2ρ of
+    // the revolution on the cell's own ray a feed away, while the nose on
+    // the opposite ray (its edge a circle through the axis) and the
+    // spiral's last point cut it: within the scallop.
+    let (code, said, report) =
+        build_text(&spiral_rim_from("4.25 mm"), &["--accept=warn"], "dome_sts");
+    assert_eq!(code, Some(0), "{said}");
+    let report = report.expect("report");
+    let surface = figure(&report, &["surface", "max_residual_nm", "value"]);
+    assert!(surface < 40.0, "{surface}");
+    assert_eq!(report["acceptance"]["passed"], true);
+}
+
+#[test]
+fn a_spirals_first_cusp_is_no_contact() {
+    // Issue #29: with `from: 4 mm` (the old default) the plate's first
+    // revolution's contact was searched over its whole half circle, five
+    // samples 0.125 mm apart, and the cusp with the second revolution
+    // passed for it: 27.2 nm at (3.6766, -1.552). Its contact lies 5 um
+    // beyond the cusp, 2.97 nm; the rim the first revolution leaves is
+    // judged as material beyond the scallops.
+    let (code, said, report) =
+        build_text(&spiral_rim_from("4 mm"), &["--accept=warn"], "plate_sts");
+    assert_eq!(code, Some(0), "{said}");
+    let report = report.expect("report");
+    let contact = figure(&report, &["contact", "max_residual_nm", "value"]);
+    assert!(contact < 5.0, "{contact}");
+    let beyond = figure(&report, &["residual_beyond_scallops_nm", "value"]);
+    assert!(beyond > 100.0, "{beyond}");
+}

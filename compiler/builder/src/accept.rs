@@ -19,6 +19,7 @@ use crate::strategy::JobSpec;
 use lensc_grammar::{Diagnostic, FileId, Span};
 use lensc_lang::check::trim_num;
 use lensc_lang::codes;
+use lensc_runtime::surface::analysis::Domain;
 
 use crate::output::Built;
 use crate::report::{
@@ -73,7 +74,7 @@ pub fn gate(spec: &JobSpec, built: &mut Built, mode: Mode) -> Vec<Diagnostic> {
                 None => continue,
             },
         };
-        let r = judge(c, &limit, built);
+        let r = judge(c, &limit, built, &head.surface.lowered.domain);
         // A following error is held to its default only where the job
         // simulates one (a fast tool servo with a servo model).
         if stated.is_none() && c == Criterion::MaxFollowingError && r.unmeasured.is_some() {
@@ -251,12 +252,12 @@ fn unit(c: Criterion, fraction: bool) -> (&'static str, f64) {
 }
 
 /// `c` measured on `built` and compared with `limit`.
-fn judge(c: Criterion, limit: &Limit, built: &Built) -> CriterionResult {
+fn judge(c: Criterion, limit: &Limit, built: &Built, domain: &Domain) -> CriterionResult {
     let (unit, factor) = unit(c, limit.fraction);
     // In the report's unit, without the scaling's last-digit noise (50
     // nm, not 49.99999999999999).
     let limit_shown = round_to(limit.value * factor, 1e-9);
-    let measured = measure(c, limit.fraction, built);
+    let measured = measure(c, limit.fraction, built, domain);
     let (value, at, unmeasured) = match measured {
         Ok(m) => (Some(m.value), m.at, None),
         Err(why) => (None, Vec::new(), Some(why)),
@@ -316,7 +317,12 @@ const NO_CONTACT: &str = "no pass's contact fell in the simulation window";
 const NO_RADIUS: &str = "the simulated profile cut no radius";
 
 /// The figure `c` of `built`'s simulated part.
-fn measure(c: Criterion, fraction: bool, built: &Built) -> Result<Measured, &'static str> {
+fn measure(
+    c: Criterion,
+    fraction: bool,
+    built: &Built,
+    domain: &Domain,
+) -> Result<Measured, &'static str> {
     let sim = &built.report.simulation;
     let m = |value: f64, at: Vec<Place>| Ok(Measured { value, at });
     match c {
@@ -356,13 +362,13 @@ fn measure(c: Criterion, fraction: bool, built: &Built) -> Result<Measured, &'st
             };
             m(value, at.into_iter().collect())
         }
-        _ => form_figure(c, form(sim)?),
+        _ => form_figure(c, form(sim)?, domain),
     }
 }
 
 /// A form criterion (PV, RMS, gouge, residual) of a height map's
 /// contacts (its gouge over every cell too) or of a profile.
-fn form_figure(c: Criterion, form: Form) -> Result<Measured, &'static str> {
+fn form_figure(c: Criterion, form: Form, domain: &Domain) -> Result<Measured, &'static str> {
     let m = |value: f64, at: Vec<Place>| Ok(Measured { value, at });
     match form {
         Form::Map(h) => {
@@ -376,10 +382,21 @@ fn form_figure(c: Criterion, form: Form) -> Result<Measured, &'static str> {
                     ],
                 ),
                 Criterion::FormRms => m(f.rms_nm, Vec::new()),
-                Criterion::MaxResidual => m(
-                    f.max_residual_nm.value,
-                    vec![point("highest", &f.max_residual_nm)],
-                ),
+                Criterion::MaxResidual => {
+                    // At the contacts, or at any cell beyond the highest
+                    // scallop (a rim or an axis no contact reaches), the
+                    // larger: as each lenslet is judged.
+                    let r = crate::report::max_residual(Some(f), h.residual_beyond_scallops_nm)
+                        .unwrap_or(f.max_residual_nm);
+                    let what = if r.value <= f.max_residual_nm.value {
+                        "highest"
+                    } else if at_rim(domain, r.x_mm, r.y_mm) {
+                        "highest_where_no_contact_reached,_at_the_rim"
+                    } else {
+                        "highest_where_no_contact_reached"
+                    };
+                    m(r.value, vec![point(what, &r)])
+                }
                 _ => {
                     // The deepest cut at the contacts or at any cell.
                     let mut g = f.max_gouge_nm;
@@ -406,6 +423,24 @@ fn form_figure(c: Criterion, form: Form) -> Result<Measured, &'static str> {
                 Criterion::MaxResidual => m(res.value, vec![radius("highest", res.at_radius_mm)]),
                 _ => m(gouge.value, vec![radius("deepest", gouge.at_radius_mm)]),
             }
+        }
+    }
+}
+
+/// Whether (x, y) (mm) lies at the rim of the aperture `domain`: within
+/// 1 % of the edge's distance from the spindle axis along its ray, or of
+/// the rectangle's size from its sides.
+fn at_rim(domain: &Domain, x: f64, y: f64) -> bool {
+    match *domain {
+        Domain::Circle { radius } | Domain::Annulus { outer: radius, .. } => {
+            x.hypot(y) >= 0.99 * radius
+        }
+        Domain::Rect {
+            x: (x0, x1),
+            y: (y0, y1),
+        } => {
+            let m = 0.01 * (x1 - x0).max(y1 - y0);
+            x - x0 <= m || x1 - x <= m || y - y0 <= m || y1 - y <= m
         }
     }
 }

@@ -325,6 +325,135 @@ pub trait RayCorrection: Sync {
     fn section(&self, cos: f64, sin: f64) -> RaySection;
 }
 
+/// The nose-centre height with the centre at radius `x` over `ray`, and
+/// the contact's offset along the ray from x; `hint`, a neighbouring
+/// point's offset, starts Newton's method nearer the contact. NaN height
+/// (offset 0) where the trajectory is undefined near x.
+fn nose_on_ray(
+    ray: &Ray,
+    bounds: &TrajectoryBounds,
+    rho: f64,
+    x: f64,
+    hint: Option<f64>,
+) -> (f64, f64) {
+    let reach = rho * bounds.max_slope.sin() * 1.05 + 1e-9;
+    let start = match hint {
+        Some(h) if h != 0.0 && h.abs() < reach => x + h,
+        _ => x,
+    };
+    let here = ray.point(start);
+    if start == x && here.z >= bounds.z_max && here.dz == 0.0 {
+        // Nothing within reach can rise above the highest level.
+        return (here.z + rho, 0.0);
+    }
+    // Newton on φ′ from u = start, where the surface is already
+    // evaluated; should a step leave the reach or φ not be concave
+    // there (a corner of the trajectory), the bracketed search takes
+    // over.
+    let (mut u, mut p) = (start, here);
+    for _ in 0..8 {
+        let d = u - x;
+        let root = (rho * rho - d * d).sqrt();
+        let dphi = p.dz - d / root;
+        let ddphi = p.d2z - rho * rho / (root * root * root);
+        let step = -dphi / ddphi;
+        let next = u + step;
+        if !(ddphi < 0.0 && (next - x).abs() < reach) {
+            break;
+        }
+        if step.abs() <= 1e-9 {
+            // Converged: φ at u is exact to ~φ″·step², far below a pm.
+            return (p.z + root, u - x);
+        }
+        u = next;
+        p = ray.point(u);
+    }
+    let (w, at) = envelope::piece_max(ray, rho, x, x - reach, x + reach);
+    if at.is_nan() {
+        // A slope that is not a number (the trajectory undefined near
+        // x) leaves no contact: the height is unknown here, not the
+        // last guess's (which lost the nose radius).
+        return (f64::NAN, 0.0);
+    }
+    (w, at - x)
+}
+
+/// How many spindle angles around [`rim_start`] solves at.
+const RIM_ANGLES: usize = 720;
+
+/// The radius (mm) a spiral starts at for its rim to be cut: at every
+/// spindle angle θ of the first revolution, whose nose centre lies at
+/// x(θ) = r₀ − fθ/2π, the contact lies at least a feed f beyond `edge(θ)`,
+/// the aperture's farthest point along the ray at θ (`None`: the ray
+/// misses the aperture). Where the surface falls away outward the
+/// contact lies ρ·sin(atan g) inside the nose centre, and a spiral started
+/// with its centre on the edge leaves the rim beyond its contact to the
+/// nose's flank (issue #29: a dome of R 10 mm under a 0.5 mm nose stood
+/// 47 µm proud at its rim). A point of the rim then lies between the
+/// contacts of two revolutions and is left no higher than a scallop.
+/// Where the trajectory has no continuation that far (its contact is
+/// undefined), that angle's contact is put on the edge instead. `None`
+/// if no start puts every contact of the first revolution on a defined
+/// trajectory. `feed` is per revolution (mm).
+pub fn rim_start(
+    surface: &dyn SurfaceFn,
+    bounds: &TrajectoryBounds,
+    rho: f64,
+    feed: f64,
+    edge: &dyn Fn(f64) -> Option<f64>,
+) -> Option<f64> {
+    let contact = |x: f64, c: f64| {
+        let ray = Ray {
+            surface,
+            cos: c.cos(),
+            sin: c.sin(),
+            less: None,
+        };
+        let (w, d) = nose_on_ray(&ray, bounds, rho, x, None);
+        w.is_finite().then_some(x + d)
+    };
+    let turn = std::f64::consts::TAU;
+    let mut start = f64::NEG_INFINITY;
+    for k in 0..RIM_ANGLES {
+        let c = turn * k as f64 / RIM_ANGLES as f64;
+        let Some(r) = edge(c) else { continue };
+        let x = rim_centre(&|x| contact(x, c), r + feed, rho)
+            .or_else(|| rim_centre(&|x| contact(x, c), r, rho))?;
+        // The first revolution reaches angle c a fraction of a feed in.
+        start = start.max(x + feed * c / turn);
+    }
+    // Every contact of the first revolution on the trajectory.
+    let defined = (0..RIM_ANGLES).all(|k| {
+        let c = turn * k as f64 / RIM_ANGLES as f64;
+        contact(start - feed * c / turn, c).is_some()
+    });
+    (start.is_finite() && defined).then_some(start)
+}
+
+/// The least nose-centre radius (mm, to a nanometre) whose contact along
+/// the ray lies at `target` or beyond, `contact(x)` being the contact's
+/// radius with the centre at x (`None` where undefined, taken as beyond:
+/// the answer must then be checked); searched within 1.1 ρ of the target,
+/// never inside the axis.
+fn rim_centre(contact: &dyn Fn(f64) -> Option<f64>, target: f64, rho: f64) -> Option<f64> {
+    let (mut lo, mut hi) = ((target - 1.1 * rho).max(0.0), target + 1.1 * rho);
+    let reaches = |x: f64| contact(x).is_none_or(|u| u >= target);
+    if reaches(lo) {
+        return None;
+    }
+    while hi - lo > 1e-6 {
+        let m = 0.5 * (lo + hi);
+        if reaches(m) {
+            hi = m;
+        } else {
+            lo = m;
+        }
+    }
+    contact(hi)
+        .is_some_and(|u| u >= target - 1e-6)
+        .then_some(hi)
+}
+
 /// The section of a surface along the ray at angle θ: z, dz/du, d²z/du²,
 /// less a correction's section there, if any.
 struct Ray<'a> {
@@ -421,47 +550,7 @@ impl Planner<'_> {
             sin,
             less: self.less.map(|l| l.section(cos, sin)),
         };
-        let rho = self.nose_radius;
-        let reach = rho * self.bounds.max_slope.sin() * 1.05 + 1e-9;
-        let start = match hint {
-            Some(h) if h != 0.0 && h.abs() < reach => x + h,
-            _ => x,
-        };
-        let here = ray.point(start);
-        if start == x && here.z >= self.bounds.z_max && here.dz == 0.0 {
-            // Nothing within reach can rise above the highest level.
-            return (here.z + rho, 0.0);
-        }
-        // Newton on φ′ from u = start, where the surface is already
-        // evaluated; should a step leave the reach or φ not be concave
-        // there (a corner of the trajectory), the bracketed search takes
-        // over.
-        let (mut u, mut p) = (start, here);
-        for _ in 0..8 {
-            let d = u - x;
-            let root = (rho * rho - d * d).sqrt();
-            let dphi = p.dz - d / root;
-            let ddphi = p.d2z - rho * rho / (root * root * root);
-            let step = -dphi / ddphi;
-            let next = u + step;
-            if !(ddphi < 0.0 && (next - x).abs() < reach) {
-                break;
-            }
-            if step.abs() <= 1e-9 {
-                // Converged: φ at u is exact to ~φ″·step², far below a pm.
-                return (p.z + root, u - x);
-            }
-            u = next;
-            p = ray.point(u);
-        }
-        let (w, at) = envelope::piece_max(&ray, rho, x, x - reach, x + reach);
-        if at.is_nan() {
-            // A slope that is not a number (the trajectory undefined near
-            // x) leaves no contact: the height is unknown here, not the
-            // last guess's (which lost the nose radius).
-            return (f64::NAN, 0.0);
-        }
-        (w, at - x)
+        nose_on_ray(&ray, &self.bounds, self.nose_radius, x, hint)
     }
 
     /// The nose-centre height at spindle angle c with the measured

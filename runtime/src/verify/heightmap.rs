@@ -716,13 +716,29 @@ impl ColumnCut<'_> {
         let (u_lo, u_hi) = (g.u0, g.u_end());
         let mut valleys: Vec<(f64, f64)> = vec![(f64::NAN, f64::NAN); self.pieces.len()];
         // Each piece's span within the rows, where it has one and it
-        // reaches the window: a contact beyond the reach is outside it.
+        // reaches the window (a contact beyond the reach is outside it). The first
+        // and last pieces run on to their circle's end, a nose radius from
+        // its centre, where their neighbours' are a feed long; their
+        // contacts lie within about a neighbour's length of the cusp, so
+        // they are searched within two of it (a contact found at that
+        // bound is beyond it, and none): over the whole half circle, the
+        // samples lay far apart and the cusp itself, at the span's end,
+        // passed for the contact (issue #29: a 27 nm "contact" at the first
+        // revolution's cusp under a 10 µm feed and 0.5 mm nose).
         let reach = self.reach;
-        let spans: Vec<(usize, f64, f64)> = (0..self.pieces.len())
+        let n = self.pieces.len();
+        let length = |q: usize| self.end(q) - self.pieces[q].1;
+        let spans: Vec<(usize, f64, f64)> = (0..n)
             .filter_map(|q| {
                 let (cu, _) = self.centres[self.pieces[q].0];
-                let a = self.pieces[q].1.max(cu - r).max(u_lo);
-                let b = self.end(q).min(cu + r).min(u_hi);
+                let mut a = self.pieces[q].1.max(cu - r).max(u_lo);
+                let mut b = self.end(q).min(cu + r).min(u_hi);
+                if n > 1 && q + 1 == n {
+                    b = b.min(self.pieces[q].1 + 2.0 * length(q - 1));
+                }
+                if n > 1 && q == 0 {
+                    a = a.max(self.end(q) - 2.0 * length(1));
+                }
                 (b.partial_cmp(&a) == Some(std::cmp::Ordering::Greater)
                     && b >= reach.0
                     && a <= reach.1)
@@ -774,7 +790,13 @@ impl ColumnCut<'_> {
             // when its least error is at that edge.
             let clipped = (best_u == a && a > self.pieces[q].1.max(cu - r))
                 || (best_u == b && b < self.end(q).min(cu + r));
-            if !clipped && self.in_window(best_u) {
+            // A piece whose least error is where a neighbour's begins has
+            // its contact cut away by that neighbour: a sliver between two
+            // deeper cuts (the nose on the opposite ray near the axis), its
+            // least the cusp, not a contact.
+            let at_neighbour = (best_u == a && q > 0 && a == self.pieces[q].1)
+                || (best_u == b && q + 1 < n && b == self.end(q));
+            if !clipped && !at_neighbour && self.in_window(best_u) {
                 valleys[q] = (best_u, least);
             }
         }

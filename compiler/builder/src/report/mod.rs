@@ -387,6 +387,13 @@ pub struct HeightMap {
     pub contact: Option<Figures>,
     /// The scallops between passes.
     pub scallops: ScallopReport,
+    /// The most material left above the design at any cell less the
+    /// highest scallop (nm, ≥ 0; 0 without scallops: the whole residual),
+    /// and where: material no pass's contact reached and no scallop
+    /// explains, such as a rim left to the nose's flank or a nub on the
+    /// spindle axis. The gate's `max_residual` is the larger of this and
+    /// the contacts' (as for each lenslet). Null if no cell was cut.
+    pub residual_beyond_scallops_nm: Option<AtPoint>,
     /// RMS roughness along the cut (nm), null if not measured.
     pub rq_cutting_direction_nm: Option<f64>,
     /// RMS roughness across the cut (nm), null if not measured.
@@ -456,6 +463,10 @@ impl HeightMap {
                 flat_theory_nm: Map::flat_scallop(map.nose_radius, stepover) * 1e6,
                 simulated: map.scallops.as_ref().map(Scallops::from),
             },
+            residual_beyond_scallops_nm: beyond_scallops(
+                map.surface.as_ref(),
+                map.scallops.as_ref(),
+            ),
             rq_cutting_direction_nm: finite(map.rq_cutting * 1e6),
             rq_stepover_direction_nm: finite(map.rq_stepover * 1e6),
             worst_lenslet: worst_lenslet(&lenslets),
@@ -620,23 +631,47 @@ pub struct LensletHeightMap {
 
 impl From<&FeatureFigures> for LensletHeightMap {
     fn from(f: &FeatureFigures) -> LensletHeightMap {
-        let scallop = f.scallops.as_ref().map_or(0.0, |s| s.max.max(0.0));
         LensletHeightMap {
             index: f.index,
             centre_mm: [f.centre.0, f.centre.1],
             surface: f.surface.as_ref().map(Figures::from),
             contact: f.contact.as_ref().map(Figures::from),
             scallops: f.scallops.as_ref().map(Scallops::from),
-            residual_beyond_scallops_nm: f.surface.as_ref().map(|s| {
-                let (v, (x, y)) = s.max_residual;
-                AtPoint {
-                    value: (v - scallop).max(0.0) * 1e6,
-                    x_mm: x,
-                    y_mm: y,
-                }
-            }),
+            residual_beyond_scallops_nm: beyond_scallops(f.surface.as_ref(), f.scallops.as_ref()),
         }
     }
+}
+
+/// The most material left above the design at any cell less the highest
+/// scallop (nm, ≥ 0; without scallops the whole residual), and where:
+/// material no pass's contact reached and no scallop explains (a rim left
+/// to the nose's flank, the nub a spiral leaves on the spindle axis).
+/// `None` if no cell was cut. The whole part's and each lenslet's alike.
+fn beyond_scallops(
+    surface: Option<&ErrorFigures>,
+    scallops: Option<&lensc_runtime::verify::heightmap::Scallops>,
+) -> Option<AtPoint> {
+    let scallop = scallops.map_or(0.0, |s| s.max.max(0.0));
+    surface.map(|s| {
+        let (v, (x, y)) = s.max_residual;
+        AtPoint {
+            value: (v - scallop).max(0.0) * 1e6,
+            x_mm: x,
+            y_mm: y,
+        }
+    })
+}
+
+/// The most material left above the design (nm) and where: at the
+/// contacts, or at any cell beyond the highest scallop where that is
+/// more; `None` without contacts. What the gate holds to `max_residual`,
+/// on the whole part and on each lenslet.
+pub fn max_residual(contact: Option<&Figures>, beyond: Option<AtPoint>) -> Option<AtPoint> {
+    let c = contact?.max_residual_nm;
+    Some(match beyond {
+        Some(b) if b.value > c.value => b,
+        _ => c,
+    })
 }
 
 /// The worst lenslet of a height map: the one with the largest form
@@ -666,10 +701,7 @@ impl LensletHeightMap {
     /// at any cell beyond its highest scallop, the larger; `None` without
     /// contacts.
     pub fn max_residual_nm(&self) -> Option<f64> {
-        let beyond = self.residual_beyond_scallops_nm.map_or(0.0, |a| a.value);
-        self.contact
-            .as_ref()
-            .map(|c| c.max_residual_nm.value.max(beyond))
+        max_residual(self.contact.as_ref(), self.residual_beyond_scallops_nm).map(|a| a.value)
     }
 
     /// The deepest cut below the design (nm), at its contacts or any of

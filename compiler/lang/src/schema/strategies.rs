@@ -65,7 +65,7 @@ const SPIRAL_FROM: Param = opt(
     "from",
     LENGTH,
     Check::NonNegative,
-    "radius where the spiral starts; default the outermost point of the surface",
+    "radius where the spiral starts; default where the first revolution's contacts lie a feed beyond the aperture all round, never inside its outermost point",
 );
 
 pub(super) const FTS_SPIRAL: Kind = Kind {

@@ -549,3 +549,63 @@ fn with_a_measured_edge_the_centre_is_the_brute_force_envelope() {
         moved * 1e6
     );
 }
+
+/// A sphere of radius R about the origin, convex (a dome, falling away
+/// outward) or concave (a bowl), with no plateau.
+struct Sphere {
+    r: f64,
+    convex: bool,
+}
+
+impl SurfaceFn for Sphere {
+    fn eval_batch(&self, xs: &[f64], ys: &[f64], out: &mut [f64]) {
+        let bowl = Dimple {
+            r: self.r,
+            h: f64::INFINITY,
+            cx: 0.0,
+        };
+        bowl.eval_batch(xs, ys, out);
+        if self.convex {
+            out.iter_mut().for_each(|v| *v = -*v);
+        }
+    }
+}
+
+/// The default start of a spiral (issue #29): the first revolution's
+/// contact a feed beyond the edge at every angle. On a sphere the nose
+/// centre lies on the normal through the contact, at x = u (R ± ρ)/R, so
+/// the start is that of u = edge + f, plus the feed the first revolution
+/// has advanced by its last angle solved (719/720 of a turn).
+#[test]
+fn the_default_start_puts_the_first_revolutions_contacts_a_feed_beyond_the_rim() {
+    let (rho, feed, edge) = (0.5, 0.01, 4.0);
+    let turned = feed * 719.0 / 720.0;
+    for (convex, ratio) in [(true, 10.5 / 10.0), (false, 9.5 / 10.0)] {
+        let s = Sphere { r: 10.0, convex };
+        let bounds = TrajectoryBounds {
+            z_max: if convex { 0.0 } else { 1.0 },
+            max_slope: 0.5,
+            features: None,
+            part_top: 0.0,
+        };
+        let start = rim_start(&s, &bounds, rho, feed, &|_| Some(edge)).expect("a start");
+        let expected = (edge + feed) * ratio + turned;
+        assert!(
+            (start - expected).abs() < 1e-5,
+            "{convex}: {start} {expected}"
+        );
+        // Every contact of the first revolution at least a feed beyond.
+        for k in 0..36 {
+            let c = std::f64::consts::TAU * k as f64 / 36.0;
+            let x = start - feed * c / std::f64::consts::TAU;
+            let ray = Ray {
+                surface: &s,
+                cos: c.cos(),
+                sin: c.sin(),
+                less: None,
+            };
+            let (_, d) = nose_on_ray(&ray, &bounds, rho, x, None);
+            assert!(x + d >= edge + feed - 1e-6, "{convex} at {c}: {}", x + d);
+        }
+    }
+}

@@ -12,7 +12,7 @@ use lensc_lang::check::trim_num;
 use lensc_lang::codes;
 use lensc_lang::lower::exact_in;
 use lensc_runtime::emit::spiral::FtsProgram;
-use lensc_runtime::plan::spiral::{FtsError, FtsSummary, Planner, SpindleSpeed};
+use lensc_runtime::plan::spiral::{FtsError, FtsSummary, Planner, SpindleSpeed, SpiralPoint};
 use lensc_runtime::post::Provenance;
 use lensc_runtime::surface::ir::SurfaceFn;
 use lensc_runtime::verify::heightmap::{Cutter, NosePath};
@@ -121,11 +121,16 @@ pub(super) fn build(spec: &SpiralSpec, cx: &BuildContext) -> Result<Built, Vec<D
         },
     );
     let mut printed = Vec::new();
+    // The points within a nose radius of the axis, swept again on the
+    // opposite ray (`across_axis`).
+    let mut near_axis = Vec::new();
+    let rho = p.nose_radius;
     let planned = Prepared::of(spec).planner().plan(&p.fast_axis, |pts| {
         as_printed(pts, head.resolution, &mut printed);
         for q in &printed {
             sweep.path().point(q.c, q.x, q.w);
         }
+        near_axis.extend(printed.iter().filter(|q| q.x.abs() < rho));
         if let Some(sim) = following.as_mut() {
             sim.extend(&printed);
         }
@@ -151,6 +156,7 @@ pub(super) fn build(spec: &SpiralSpec, cx: &BuildContext) -> Result<Built, Vec<D
             site,
         )]
     })?;
+    across_axis(sweep.path(), &near_axis);
     let mut sink = sink.written(head)?;
     if let Some(t) = table_sink.as_mut() {
         t.push(program.take_table_text());
@@ -178,6 +184,22 @@ pub(super) fn build(spec: &SpiralSpec, cx: &BuildContext) -> Result<Built, Vec<D
         .into_iter()
         .collect();
     Ok(built)
+}
+
+/// The nose swept again over the opposite ray, for the points `near`
+/// (within a nose radius of the spindle axis, in order): its edge is a
+/// circle in the plane through the axis, so the nose at spindle angle c,
+/// centre at radius x, lies on the ray at c + π at radius −x as well, and
+/// within ρ of the axis it cuts that ray too. Without, a polar map's cell
+/// on the axis saw only the revolution on its own ray, up to a feed away
+/// (a dome's axis, cut by the spiral's last point, showed 95 nm: f²/2ρ at
+/// 10 µm/rev under a 0.5 mm nose).
+fn across_axis(path: &mut dyn NosePath, near: &[SpiralPoint]) {
+    path.lift();
+    for q in near {
+        path.point(q.c + std::f64::consts::PI, -q.x, q.w);
+    }
+    path.lift();
 }
 
 /// The table a fast tool servo's controller reads its motion from

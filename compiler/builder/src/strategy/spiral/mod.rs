@@ -199,22 +199,47 @@ pub(crate) fn lower(
     let clearance = p.tool_needs(p.tool_params.clearance, "clearance")?;
 
     let lowered = p.lowered().map_err(|d| vec![d])?;
-    // The spiral starts where the surface's farthest point from the axis is.
-    let start = st.from.unwrap_or(outer_radius(&lowered.domain));
-    let settling = settling_offset(p, &st, servo, fast, fastest(speed, start))?;
     let design_kernel = evaluate(&lowered.tape);
     let design =
         lensc_runtime::surface::analysis::analyse(design_kernel.as_ref(), &lowered.domain, 201);
     let correction = p.correction();
-    let (trajectory, bounds, trajectory_declared) = settled_trajectory(
-        surface,
-        settling.as_ref(),
-        correction.as_ref(),
-        &lowered.domain,
-        design.sag_max.value,
-        evaluate,
-    )
-    .map_err(|e| vec![RuntimeError::Trajectory(e).at(p.site())])?;
+    // The settling offset and the trajectory with the spiral from `start`
+    // (the settling offset follows the fastest surface speed).
+    let trajectory_from = |start: f64| -> Result<_, Vec<Diagnostic>> {
+        let settling = settling_offset(p, &st, servo, fast, fastest(speed, start))?;
+        let (trajectory, bounds, declared) = settled_trajectory(
+            surface,
+            settling.as_ref(),
+            correction.as_ref(),
+            &lowered.domain,
+            design.sag_max.value,
+            evaluate,
+        )
+        .map_err(|e| vec![RuntimeError::Trajectory(e).at(p.site())])?;
+        Ok((settling, trajectory, bounds, declared))
+    };
+    // The spiral starts where the user states (`from`), or by default far
+    // enough out for its first revolution's contacts to lie a feed beyond
+    // the aperture all round (`default_start`), never inside the
+    // surface's farthest point from the axis.
+    let outer = outer_radius(&lowered.domain);
+    let (start, (settling, trajectory, bounds, trajectory_declared)) = match st.from {
+        Some(from) => (from, trajectory_from(from)?),
+        None => {
+            let first = trajectory_from(outer)?;
+            let start = default_start(
+                evaluate(&first.1.tape).as_ref(),
+                &first.2,
+                (rho, st.feed * 2.0 * std::f64::consts::PI),
+                &lowered.domain,
+            )
+            .max(outer);
+            match first.0 {
+                Some(_) if start > outer => (start, trajectory_from(start)?),
+                _ => (start, first),
+            }
+        }
+    };
     let mut errors = tool_checks(
         p,
         (rho, clearance),
@@ -434,6 +459,46 @@ fn lenslets(surface: &Object) -> Vec<(f64, f64, f64)> {
         .zip(lensc_lang::lower::surface::array_centres(surface))
         .map(|((_, rim), centres)| centres.into_iter().map(|(x, y)| (x, y, rim)).collect())
         .unwrap_or_default()
+}
+
+/// The spiral's default start radius (mm): where its first revolution's
+/// contacts lie a feed beyond the aperture at every spindle angle
+/// (`plan::spiral::rim_start`), the nose being `(ρ, feed per revolution)`;
+/// the surface's farthest point from the axis where no start puts every
+/// contact on the trajectory (the nose centre on the edge, as before
+/// issue #29).
+fn default_start(
+    trajectory: &dyn SurfaceFn,
+    bounds: &TrajectoryBounds,
+    (rho, feed): (f64, f64),
+    domain: &Domain,
+) -> f64 {
+    let edge = |c: f64| edge_along(domain, c);
+    lensc_runtime::plan::spiral::rim_start(trajectory, bounds, rho, feed, &edge)
+        .unwrap_or_else(|| outer_radius(domain))
+}
+
+/// The aperture's farthest point (mm from the axis) along the ray at
+/// angle `c` (rad), `None` if the ray misses it.
+fn edge_along(domain: &Domain, c: f64) -> Option<f64> {
+    match *domain {
+        Domain::Circle { radius } | Domain::Annulus { outer: radius, .. } => Some(radius),
+        Domain::Rect { x, y } => {
+            // The ray t·(cos c, sin c), t ≥ 0, within each slab.
+            let slab = |(a, b): (f64, f64), d: f64| -> Option<(f64, f64)> {
+                if d.abs() < 1e-15 {
+                    (a <= 0.0 && 0.0 <= b).then_some((0.0, f64::INFINITY))
+                } else {
+                    let (t0, t1) = (a / d, b / d);
+                    Some((t0.min(t1), t0.max(t1)))
+                }
+            };
+            let (x0, x1) = slab(x, c.cos())?;
+            let (y0, y1) = slab(y, c.sin())?;
+            let (lo, hi) = (x0.max(y0).max(0.0), x1.min(y1));
+            (hi >= lo && hi.is_finite()).then_some(hi)
+        }
+    }
 }
 
 /// How far from the spindle axis the surface's farthest point lies (mm).
