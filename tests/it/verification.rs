@@ -662,9 +662,11 @@ fn the_report_says_what_area_was_judged() {
 /// touched. Before, a hex grid had no lenslets in its report, the land
 /// (held above by the settling offset) swamped its figures, and the nub
 /// went unnamed; then lenslet 12 was the worst, its residual showed, and
-/// the gate failed the job naming it; now the spiral runs past the axis
-/// and the nub is cut (the gate failing a lenslet by name is tested in
-/// `lenslet_kinds`).
+/// the gate failed the job naming it; then the spiral ran past the axis
+/// and the nub was cut, lenslet 12 still the worst; now the points within
+/// a nose radius of the axis are swept on the opposite ray too (the nose
+/// reaches across the axis there), so lenslet 12 is no longer the worst
+/// (the gate failing a lenslet by name is tested in `lenslet_kinds`).
 #[test]
 fn a_hex_array_is_judged_lenslet_by_lenslet_and_its_axis_nub_named() {
     let source = "surface l = sphere { radius: 3 mm, sense: concave, aperture: circle(diameter: 0.9 mm) }\n\
@@ -681,13 +683,11 @@ fn a_hex_array_is_judged_lenslet_by_lenslet_and_its_axis_nub_named() {
     let gated = lensc(dir.path(), &["build", "job.lens", "--out", out_dir]);
     let stderr = text(&gated.stderr);
     // Since the spiral ends past the axis where the surface slopes there
-    // (issue #29: `past_axis`), the nub is cut: lenslet 12 is still the
-    // worst, named, and within its limits (it missed by 2.3 um before).
+    // (issue #29: `past_axis`), the nub is cut: the worst lenslet is
+    // named and every one is within its limits (lenslet 12 missed by
+    // 2.3 um before).
     assert_eq!(gated.status.code(), Some(0), "{stderr}");
-    assert!(
-        stderr.contains("the worst 12 at x -0.25, y 0 mm"),
-        "{stderr}"
-    );
+    assert!(stderr.contains("the worst "), "{stderr}");
     assert!(stderr.contains("every one within its limits"), "{stderr}");
     // Held to 5 um, the job passes and its report is written.
     let r = report_of(
@@ -702,22 +702,23 @@ fn a_hex_array_is_judged_lenslet_by_lenslet_and_its_axis_nub_named() {
     assert_eq!(twelve["centre_mm"], serde_json::json!([-0.25, 0.0]));
     let nub = &twelve["residual_beyond_scallops_nm"];
     assert!(num(&nub["value"]) < 300.0, "{nub}");
-    assert_eq!(h["worst_lenslet"]["index"], 12, "{}", h["worst_lenslet"]);
-    // Every other lenslet's residual stays within its scallops' reach.
-    for l in lenslets.iter().filter(|l| l["index"] != 12) {
+    // Every lenslet's residual stays within its scallops' reach, and the
+    // stderr's worst is the report's.
+    for l in lenslets {
         assert!(
             num(&l["residual_beyond_scallops_nm"]["value"]) < 300.0,
             "{l}"
         );
     }
-    // Each form criterion judged on all 25, lenslet 12 the worst residual.
+    let worst = &h["worst_lenslet"]["index"];
+    assert!(stderr.contains(&format!("the worst {worst} at")), "{stderr}");
+    // Each form criterion judged on all 25.
     let judged = r["acceptance"]["lenslets"].as_array().expect("judged");
     let residual = judged
         .iter()
         .find(|c| c["criterion"] == "max_residual")
         .expect("max_residual");
     assert_eq!(residual["judged"], 25);
-    assert_eq!(residual["worst"]["index"], 12);
     assert_eq!(residual["passed"], true, "{residual}");
 }
 

@@ -521,6 +521,26 @@ impl Planner<'_> {
         self.spiral.start_radius - self.spiral.feed_per_rev * c / (2.0 * std::f64::consts::PI)
     }
 
+    /// The least radius (mm) of the first revolution's contacts, over
+    /// [`RIM_ANGLES`] spindle angles: where a spiral started inside the
+    /// aperture (a partial cut) stops cutting to the design, the band
+    /// beyond it left to its nose's flank. The start radius where no
+    /// contact is defined.
+    pub fn first_contacts_least(&self) -> f64 {
+        let turn = std::f64::consts::TAU;
+        (0..RIM_ANGLES)
+            .map(|k| {
+                let c = turn * k as f64 / RIM_ANGLES as f64;
+                let (w, d) = self.centre_near(c, None);
+                if w.is_finite() {
+                    self.radius(c) + d
+                } else {
+                    self.spiral.start_radius
+                }
+            })
+            .fold(self.spiral.start_radius, f64::min)
+    }
+
     /// The nose-centre height at spindle angle c (exact, see module doc).
     pub fn centre(&self, c: f64) -> f64 {
         self.centre_near(c, None).0

@@ -125,7 +125,19 @@ pub(super) fn build(spec: &SpiralSpec, cx: &BuildContext) -> Result<Built, Vec<D
     // opposite ray (`across_axis`).
     let mut near_axis = Vec::new();
     let rho = p.nose_radius;
-    let planned = Prepared::of(spec).planner().plan(&p.fast_axis, |pts| {
+    let prepared = Prepared::of(spec);
+    // The disc the spiral cuts: out to its start where that lies at or
+    // beyond the aperture's farthest point (the whole part, its rim
+    // included, is this job's); a partial spiral's (a `from` inside it) out
+    // to its first revolution's nearest contact, beyond which its nose's
+    // flank passes over what the operation outside it leaves.
+    let disc = if spec.spiral.start_radius < super::outer_radius(&spec.head.surface.lowered.domain)
+    {
+        prepared.planner().first_contacts_least()
+    } else {
+        spec.spiral.start_radius
+    };
+    let planned = prepared.planner().plan(&p.fast_axis, |pts| {
         as_printed(pts, head.resolution, &mut printed);
         for q in &printed {
             sweep.path().point(q.c, q.x, q.w);
@@ -168,7 +180,7 @@ pub(super) fn build(spec: &SpiralSpec, cx: &BuildContext) -> Result<Built, Vec<D
     }
     let text = sink.finish(site)?;
     let mut plots = crate::plots::PlotSeries::default();
-    let height_map = simulated_height_map(spec, sweep, window, &mut plots);
+    let height_map = simulated_height_map(spec, sweep, window, disc, &mut plots);
     let simulation = simulation(following, height_map, data_rate, p.slow, &mut plots);
     let toolpath = toolpath(spec, &summary);
     let cut = (summary.points, summary.time);
@@ -240,6 +252,7 @@ fn simulated_height_map(
     spec: &SpiralSpec,
     sweep: Simulation,
     window: Window,
+    disc: f64,
     plots: &mut crate::plots::PlotSeries,
 ) -> report::HeightMap {
     let lowered = &spec.head.surface.lowered;
@@ -249,13 +262,9 @@ fn simulated_height_map(
         &design,
         window,
         lowered.domain,
-        // The default window is the disc the spiral cuts; one the job
-        // gives counts every cell of it, cut or not.
-        if window.given {
-            f64::INFINITY
-        } else {
-            spec.spiral.start_radius
-        },
+        // The default window is the disc the spiral cuts (`disc`); one
+        // the job gives counts every cell of it, cut or not.
+        if window.given { f64::INFINITY } else { disc },
         &spec.lenslets,
         spec.head.surface.lenslets.as_ref(),
     );

@@ -249,14 +249,23 @@ pub(crate) fn lower(
     );
     let edge = crate::edge::measured_edge(p).map_err(|d| vec![d])?;
 
+    // The spiral ends a revolution past the axis at least: ended on it,
+    // the rays just past its last angle are cut by no pass nearer than a
+    // feed on their own side and half a feed across the axis, a 1.5-feed
+    // gap whose cusp (0.75 f)²/2ρ stands 2.25 times a scallop (a sphere
+    // turned at 20 µm/rev under a 0.5 mm nose: 225 nm beside the axis
+    // against 100 nm scallops); a revolution past, every line through the
+    // axis has passes at most a feed apart on both sides of it.
+    let feed_per_rev = st.feed * 2.0 * std::f64::consts::PI;
     let end = -past_axis(
         evaluate(&trajectory.tape).as_ref(),
         rho,
         start,
         p.machine_params.resolution,
-    );
+    )
+    .max(feed_per_rev.min(0.5 * start.max(0.0)));
     let mut spiral = FtsSpiral {
-        feed_per_rev: st.feed * 2.0 * std::f64::consts::PI,
+        feed_per_rev,
         speed,
         chord_tolerance: p
             .chord_tolerance(<SpiralSpec as crate::strategy::Strategy>::LENGTH_AXES.unwrap_or(2)),
