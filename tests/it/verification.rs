@@ -711,7 +711,10 @@ fn a_hex_array_is_judged_lenslet_by_lenslet_and_its_axis_nub_named() {
         );
     }
     let worst = &h["worst_lenslet"]["index"];
-    assert!(stderr.contains(&format!("the worst {worst} at")), "{stderr}");
+    assert!(
+        stderr.contains(&format!("the worst {worst} at")),
+        "{stderr}"
+    );
     // Each form criterion judged on all 25.
     let judged = r["acceptance"]["lenslets"].as_array().expect("judged");
     let residual = judged

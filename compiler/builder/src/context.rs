@@ -12,13 +12,13 @@ use lensc_runtime::post::ProgramError;
 use lensc_runtime::post::Provenance;
 
 use crate::diagnostics::RuntimeError;
-use crate::evaluate::surface_analysis;
 use crate::output::Destination;
 use crate::output::{Built, ProgramText};
 use crate::plots::PlotSeries;
 use crate::progress::Meter;
 use crate::read_back::ReadBack;
 use crate::report;
+use crate::report::surface_analysis;
 use crate::spool::ProgramSink;
 use lensc_lang::codes;
 

@@ -21,6 +21,16 @@ pub enum SamplePoints {
 /// One sample: x, y, z (mm), dz/dx, dz/dy, curvature along x and y (1/mm).
 pub type Sample = [f64; 7];
 
+/// The evaluator of a surface.
+#[derive(Clone, Copy, Debug, serde::Serialize, schemars::JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Backend {
+    /// Compiled to machine code by cranelift.
+    Jit,
+    /// The reference interpreter (cranelift refused the tape).
+    Interpreter,
+}
+
 /// The backend that evaluates surfaces: a JIT kernel, or the reference
 /// interpreter should cranelift refuse the tape (they agree to 1e-13, see
 /// `lensc_runtime::surface::conformance` and tests/it/surface_kinds.rs).
@@ -30,13 +40,13 @@ pub fn evaluator(
     tape: &lensc_runtime::surface::ir::SurfaceTape,
 ) -> (
     Box<dyn lensc_runtime::surface::ir::SurfaceFn + Sync>,
-    crate::report::Backend,
+    Backend,
 ) {
     match compiled::COMPILED.kernel(tape) {
-        Ok(j) => (Box::new(j), crate::report::Backend::Jit),
+        Ok(j) => (Box::new(j), Backend::Jit),
         Err(_) => (
             Box::new(lensc_runtime::surface::ir::Interpreter::new(tape)),
-            crate::report::Backend::Interpreter,
+            Backend::Interpreter,
         ),
     }
 }
@@ -76,19 +86,6 @@ pub fn declared_surface(
             crate::diagnostics::lowering_words(&e)
         )
     })
-}
-
-/// The analysis of a surface as the reports carry it (and `lensc
-/// analyse` prints it), on a `grid` per side.
-pub fn surface_analysis(
-    name: &str,
-    kind: &str,
-    l: &lensc_lang::lower::surface::LoweredSurface,
-    grid: usize,
-) -> crate::report::SurfaceAnalysis {
-    let (f, backend) = evaluator(&l.tape);
-    let a = lensc_runtime::surface::analysis::analyse(f.as_ref(), &l.domain, grid);
-    crate::report::SurfaceAnalysis::new(name, kind, &l.domain, grid, backend, &a)
 }
 
 /// Evaluates a declared surface at the requested points.

@@ -980,14 +980,21 @@ impl SurfaceAnalysis {
     }
 }
 
-/// The evaluator of a surface.
-#[derive(Clone, Copy, Debug, Serialize, JsonSchema)]
-#[serde(rename_all = "snake_case")]
-pub enum Backend {
-    /// Compiled to machine code by cranelift.
-    Jit,
-    /// The reference interpreter (cranelift refused the tape).
-    Interpreter,
+/// The evaluator of a surface (defined beside the evaluation, which
+/// names it without importing the report).
+pub use crate::evaluate::Backend;
+
+/// The analysis of a surface as the reports carry it (and `lensc
+/// analyse` prints it), on a `grid` per side.
+pub fn surface_analysis(
+    name: &str,
+    kind: &str,
+    l: &lensc_lang::lower::surface::LoweredSurface,
+    grid: usize,
+) -> SurfaceAnalysis {
+    let (f, backend) = crate::evaluate::evaluator(&l.tape);
+    let a = lensc_runtime::surface::analysis::analyse(f.as_ref(), &l.domain, grid);
+    SurfaceAnalysis::new(name, kind, &l.domain, grid, backend, &a)
 }
 
 /// A surface's domain.

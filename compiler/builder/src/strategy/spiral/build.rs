@@ -168,7 +168,14 @@ pub(super) fn build(spec: &SpiralSpec, cx: &BuildContext) -> Result<Built, Vec<D
             site,
         )]
     })?;
-    across_axis(sweep.path(), &near_axis);
+    // A measured edge lies mirrored on the opposite ray (its +X offsets
+    // point toward the axis there), which the sweep does not model: such
+    // a nose is swept on its own ray only, which the revolution past the
+    // axis covers from both sides (the simulation errs toward material
+    // left, never toward a cut it did not make).
+    if spec.edge.is_none() {
+        across_axis(sweep.path(), &near_axis);
+    }
     let mut sink = sink.written(head)?;
     if let Some(t) = table_sink.as_mut() {
         t.push(program.take_table_text());
