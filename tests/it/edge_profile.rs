@@ -157,15 +157,18 @@ fn a_measured_edge_is_compensated_through_the_written_program() {
 /// tool's `edge_profile` shown, nothing written; returns stderr.
 fn refused(tool: &str, files: &[(&str, &str)], code: &str) -> String {
     let dir = project(tool, files);
-    let out = lensc(dir.path(), &["build", "job.lens"]);
+    build_refused(dir.path(), code, "edge_profile: \"")
+}
+
+/// Builds `job.lens` in `dir`; asserts exit 1, `code`, the field text
+/// `shown` in the diagnostic, nothing written; returns stderr.
+fn build_refused(dir: &std::path::Path, code: &str, shown: &str) -> String {
+    let out = lensc(dir, &["build", "job.lens"]);
     let err = text(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(err.contains(&format!("[{code}]")), "{code}: {err}");
-    assert!(
-        err.contains("edge_profile: \""),
-        "the field is shown: {err}"
-    );
-    let written = std::fs::read_dir(dir.path().join("out")).map_or(0, |d| d.count());
+    assert!(err.contains(shown), "the field is shown: {err}");
+    let written = std::fs::read_dir(dir.join("out")).map_or(0, |d| d.count());
     assert_eq!(written, 0, "nothing is written: {err}");
     err
 }
@@ -411,17 +414,7 @@ fn job_refused(job: &str, edge: &str, code: &str) -> String {
     let dir = tempfile::tempdir().expect("tmp");
     std::fs::write(dir.path().join("job.lens"), job).expect("write");
     std::fs::write(dir.path().join("edge.txt"), edge).expect("write");
-    let out = lensc(dir.path(), &["build", "job.lens"]);
-    let err = text(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
-    assert!(err.contains(&format!("[{code}]")), "{code}: {err}");
-    assert!(
-        err.contains("edge_profile: \"edge.txt\""),
-        "the field is shown: {err}"
-    );
-    let written = std::fs::read_dir(dir.path().join("out")).map_or(0, |d| d.count());
-    assert_eq!(written, 0, "nothing is written: {err}");
-    err
+    build_refused(dir.path(), code, "edge_profile: \"edge.txt\"")
 }
 
 #[test]
