@@ -129,9 +129,16 @@ pub fn fit_splines(
     if no_y {
         at[1] = 0.0;
     }
+    // The feed mode in force: a spline is written fed per minute only
+    // (the writer's `spline_blocks`), so a run fed per revolution, stated
+    // or in force, is written as lines and arcs.
+    let mut per_revolution = false;
     let mut i = 0;
     while i < moves.len() {
         let (run_end, feed) = run(moves, i, at);
+        if let Some(f) = feed {
+            per_revolution = matches!(f, Feed::PerRevolution(_));
+        }
         // The run as lines and arcs, where those are the other way.
         let lines_arcs = otherwise.filter(|_| run_end > i).map(|o| {
             let mut stream = Vec::with_capacity(run_end - i + 1);
@@ -161,7 +168,7 @@ pub fn fit_splines(
             }
             opt
         });
-        if run_end - i >= FEWEST_LINES {
+        if run_end - i >= FEWEST_LINES && !per_revolution {
             let mut points = Vec::with_capacity(run_end - i + 1);
             points.push(at);
             let mut p = at;
@@ -197,6 +204,9 @@ pub fn fit_splines(
             if let Move::Rapid(to) | Move::Linear { to, .. } | Move::Arc { to, .. } = m {
                 at = merged(at, &to);
             }
+            if let Move::Linear { feed: Some(f), .. } | Move::Arc { feed: Some(f), .. } = m {
+                per_revolution = matches!(f, Feed::PerRevolution(_));
+            }
             out.push(Step::Move(m));
         }
         i = run_end.max(i + 1);
@@ -223,8 +233,9 @@ fn merged(at: [f64; 3], to: &Position) -> [f64; 3] {
 }
 
 /// Where the run of straight cutting moves starting at `moves[i]` (from
-/// `at`) ends (exclusive), and its feed: one feed per minute, no C, a
-/// known start, no corner.
+/// `at`) ends (exclusive), and its feed: one feed (per minute or per
+/// revolution: only the first is fitted as a spline, the second is still
+/// a run of lines and arcs), no C, a known start, no corner.
 fn run(moves: &[Move], i: usize, at: [f64; 3]) -> (usize, Option<Feed>) {
     if at.iter().any(|v| v.is_nan()) {
         return (i, None);
@@ -238,7 +249,7 @@ fn run(moves: &[Move], i: usize, at: [f64; 3]) -> (usize, Option<Feed>) {
             break;
         }
         match (f, feed) {
-            (Some(Feed::PerTime(v)), _) if j == i => feed = Some(Feed::PerTime(*v)),
+            (Some(f @ (Feed::PerTime(_) | Feed::PerRevolution(_))), _) if j == i => feed = Some(*f),
             (None, _) => {}
             (Some(f), Some(g)) if *f == g => {}
             _ => break,

@@ -417,3 +417,43 @@ fn a_lathe_profile_without_y_is_fitted_in_y_zero() {
     let worst = worst_from_circle(s, 1.0);
     assert!(worst <= summary.limit, "{worst:e} over {:e}", summary.limit);
 }
+
+/// A profile fed per revolution (a lathe's G95, every move stating its
+/// feed as the turning planner gives it): the writer's splines are fed per
+/// minute only, so no spline is fitted, but the run is still written as
+/// the optimiser's lines and arcs (it was left as 400 lines, 25 times the
+/// program `lines_arcs` writes).
+#[test]
+fn a_run_fed_per_revolution_is_lines_and_arcs_never_a_spline() {
+    use crate::moves::Plane;
+    let mut moves = pass(4.0, 0.7, 400);
+    for m in &mut moves {
+        if let Move::Linear { feed, .. } = m {
+            *feed = Some(Feed::PerRevolution(3e-3 / std::f64::consts::TAU));
+        }
+    }
+    let planes = [Plane::Zx];
+    let o = Otherwise {
+        arc_planes: &planes,
+        above: false,
+    };
+    let (steps, summary) = fit_splines(&moves, &FIT, Some(o));
+    assert_eq!(summary.splines, 0, "{summary:?}");
+    let (opt, _) = crate::plan::optimise::optimise_within(&moves, FIT.tolerance, &planes, false);
+    assert!(opt.len() < 8, "{}", opt.len());
+    let written: Vec<Move> = steps
+        .iter()
+        .map(|s| match s {
+            Step::Move(m) => *m,
+            Step::Spline(_) => unreachable!(),
+        })
+        .collect();
+    assert_eq!(format!("{written:?}"), format!("{opt:?}"));
+    // Without arcs it stays lines: still no spline.
+    let o = Otherwise {
+        arc_planes: &[],
+        above: false,
+    };
+    let (_, summary) = fit_splines(&moves, &FIT, Some(o));
+    assert_eq!(summary.splines, 0, "{summary:?}");
+}
