@@ -1,5 +1,6 @@
 //! A round nose's measured edge (`edge_profile`), through the `lensc`
-//! binary: a turned conic cut by a tool whose edge carries a 50 nm
+//! binary: a turned conic, a tilted lens on a spiral and a pattern on a
+//! roller helix, each cut by a tool whose edge carries a 50 nm
 //! waviness. Each program is read back from its text by the controller
 //! reader and swept with the real, wavy edge (`program_cut_by`): the
 //! program planned for a circle prints the waviness into the part, the
