@@ -278,7 +278,7 @@ impl Registered {
 /// registration does not converge, or when what is left departs from the
 /// design more than a part could (other units, another surface).
 pub fn register_measurement(
-    f: &dyn SurfaceFn,
+    f: &(dyn SurfaceFn + Sync),
     domain: &lensc_runtime::surface::analysis::Domain,
     surface_name: &str,
     file: &str,
@@ -337,7 +337,7 @@ pub fn register_measurement(
     let reg = if p.cloud {
         register::register_cloud(f, &p.inside, fit)
     } else {
-        register::register_heights(f, &p.inside, fit)
+        register::register_heights_parallel(f, &p.inside, fit)
     };
     let reg = reg.map_err(|e| not_registered(file, &format!("`{surface_name}`"), e))?;
     // The error along the normal, at each registered point.

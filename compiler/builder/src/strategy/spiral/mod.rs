@@ -19,8 +19,8 @@ use lensc_runtime::machine::tool::MeasuredEdge;
 use lensc_runtime::plan::chords::ChordPlacement;
 use lensc_runtime::plan::spiral::{FastAxis, FtsSpiral, SpindleSpeed, TrajectoryBounds};
 use lensc_runtime::post::Dialect;
-use lensc_runtime::surface::analysis::Domain;
-use lensc_runtime::surface::ir::SurfaceFn;
+use lensc_runtime::surface::analysis::{Domain, SurfaceAnalysis};
+use lensc_runtime::surface::ir::{SurfaceFn, SurfaceTape};
 
 use crate::diagnostics::RuntimeError;
 use crate::job::{Evaluate, JobHead, Parts, all_clear};
@@ -102,7 +102,7 @@ impl SpiralSpec {
             &self.surface_object,
             Some(&settling),
             self.correction.as_ref(),
-            &self.head.surface.lowered.domain,
+            (&self.head.surface.lowered.domain, None),
             self.bounds.part_top,
             evaluate,
         )?;
@@ -211,7 +211,7 @@ pub(crate) fn lower(
             surface,
             settling.as_ref(),
             correction.as_ref(),
-            &lowered.domain,
+            (&lowered.domain, Some((&lowered.tape, &design))),
             design.sag_max.value,
             evaluate,
         )
@@ -354,11 +354,15 @@ fn past_axis(trajectory: &dyn SurfaceFn, rho: f64, start: f64, resolution: f64) 
     }
 }
 
+/// `known`: a tape already analysed over `domain` (the surface lowered),
+/// whose analysis stands for the trajectory's where the trajectory is
+/// that very tape (no settling offset: the surface itself, corrected or
+/// not), rather than analysing the same tape again.
 fn settled_trajectory(
     surface: &Object,
     settling: Option<&Settling>,
     correction: Option<&crate::compensate::Applied>,
-    domain: &Domain,
+    (domain, known): (&Domain, Option<(&SurfaceTape, &SurfaceAnalysis)>),
     part_top: f64,
     evaluate: Evaluate,
 ) -> Result<(LoweredSurface, TrajectoryBounds, Option<LoweredSurface>), LowerError> {
@@ -377,9 +381,15 @@ fn settled_trajectory(
         });
         trajectory.tape = c.tape(&trajectory.tape);
     }
-    let analysis = {
-        let k = evaluate(&trajectory.tape);
-        lensc_runtime::surface::analysis::analyse(k.as_ref(), domain, 201)
+    let same = |t: &SurfaceTape| {
+        t.outputs == trajectory.tape.outputs && t.graph.nodes() == trajectory.tape.graph.nodes()
+    };
+    let analysis = match known {
+        Some((tape, analysis)) if same(tape) => analysis.clone(),
+        _ => {
+            let k = evaluate(&trajectory.tape);
+            lensc_runtime::surface::analysis::analyse(k.as_ref(), domain, 201)
+        }
     };
     let bounds = TrajectoryBounds {
         z_max: analysis.sag_max.value,
