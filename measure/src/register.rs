@@ -377,6 +377,19 @@ fn levenberg_marquardt(
                 });
             }
         } else {
+            // A step that moves nothing that matters, or leaves the sum
+            // within rounding of the best, and still does not lower it:
+            // the best is the minimum as far as the sums can tell (more
+            // damping would only try smaller steps of the same).
+            if step_vanished(&step, &p, pts) || tssr - ssr <= 1e-15 * ssr + f64::MIN_POSITIVE {
+                return Ok(Registration {
+                    values: p,
+                    fitted: on,
+                    left_out,
+                    iterations: it,
+                    method: "least squares on the heights (Levenberg-Marquardt, exact surface derivatives)",
+                });
+            }
             lambda *= 10.0;
             if lambda > 1e12 {
                 break;
