@@ -195,6 +195,7 @@ pub(crate) fn corrected(
         data,
         format,
         &opts,
+        None,
     )
     .map_err(at)?;
     // Each measured point in the design's frame, with its error along z.

@@ -25,6 +25,7 @@ use lensc_runtime::verify::lenslets::Lenslets;
 
 use super::lenslets::{FromCentre, MARGIN, rows_and_columns};
 use super::placed::{self, Failure, LensletPick, Options, fail};
+use super::steps::{SteppedRims, register_clear};
 use super::{Outcome, report};
 
 /// Below this share of the lenslet's aperture covered, its figures are
@@ -226,21 +227,30 @@ pub(super) fn measure(
             .map(|q| [q[0] + off.0, q[1] + off.1, q[2]])
             .collect()
     };
+    // Rims that step onto the land: the fit stays clear of them.
+    let rims = SteppedRims::of(f, lenslets);
+    let pixel = map.dx.max(map.dy);
+    let fit = |pts: &[[f64; 3]]| {
+        register_clear(
+            &g,
+            pts,
+            Fit::default(),
+            rims.as_ref().map(|r| (r, c)),
+            pixel,
+        )
+        .map_err(|e| placed::not_registered(file, &target, e))
+    };
     let mut local = shifted(&p, off);
-    let mut reg = register::register_heights(&g, &local, Fit::default())
-        .map_err(|e| placed::not_registered(file, &target, e))?;
+    let mut reg = fit(&local)?;
     // Found more than a pixel from where it was placed: the pixels are
     // taken again where the registration puts the field, and registered
     // again from there (in the frame of the first placement: a shift s of
     // the points' origin is a decentre d − s and a piston p + t·s).
-    let pixel = map.dx.max(map.dy);
     let moved_to = where_found(&reg, off);
     let s_shift = (moved_to.0 - off.0, moved_to.1 - off.1);
     if s_shift.0.hypot(s_shift.1) > pixel {
         (p, covered) = select(moved_to);
-        let again = register::register_heights(&g, &shifted(&p, moved_to), Fit::default())
-            .map_err(|e| placed::not_registered(file, &target, e))?;
-        reg = again;
+        reg = fit(&shifted(&p, moved_to))?;
         let (tx, ty) = reg.tilt();
         reg.values[3] -= s_shift.0;
         reg.values[4] -= s_shift.1;

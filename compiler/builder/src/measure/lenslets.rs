@@ -20,6 +20,7 @@ use lensc_runtime::verify::lenslets::Lenslets;
 
 use super::placed::{Options, form_error};
 use super::report;
+use super::steps::{SteppedRims, register_clear};
 
 /// The design `f` seen from a lenslet's centre: g(u, v) = f(u + cx, v + cy).
 pub(super) struct FromCentre<'a> {
@@ -64,6 +65,7 @@ pub(super) fn measure(
     lenslets: &Lenslets,
     m: &HeightMap,
     whole: &Registration,
+    rims: Option<&SteppedRims>,
     opts: &Options,
 ) -> report::Lenslets {
     // Each lenslet with a margin of the land about it (a fifth of its
@@ -134,7 +136,13 @@ pub(super) fn measure(
             .map(|q| [q[0] - at.0, q[1] - at.1, q[2]])
             .collect();
         let g = FromCentre { f, centre: c };
-        let reg = match register::register_heights(&g, &local, Fit::default()) {
+        let reg = match register_clear(
+            &g,
+            &local,
+            Fit::default(),
+            rims.map(|r| (r, c)),
+            m.dx.max(m.dy),
+        ) {
             Ok(r) => r,
             Err(e) => {
                 let why = match e {

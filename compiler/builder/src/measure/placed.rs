@@ -276,7 +276,10 @@ impl Registered {
 /// `f` over `domain` (the surface `surface_name`): refused, with its code,
 /// when too little of it lies on the aperture or is valid, when the
 /// registration does not converge, or when what is left departs from the
-/// design more than a part could (other units, another surface).
+/// design more than a part could (other units, another surface). A map
+/// of an array whose rims step onto the land (`rims`) is registered clear
+/// of them (`steps::register_clear`).
+#[allow(clippy::too_many_arguments)]
 pub fn register_measurement(
     f: &dyn SurfaceFn,
     domain: &lensc_runtime::surface::analysis::Domain,
@@ -285,6 +288,7 @@ pub fn register_measurement(
     data: Measured,
     format: Format,
     opts: &Options,
+    rims: Option<&super::steps::SteppedRims>,
 ) -> Result<Registered, Failure> {
     use lensc_lang::codes;
     let domain = *domain;
@@ -337,7 +341,8 @@ pub fn register_measurement(
     let reg = if p.cloud {
         register::register_cloud(f, &p.inside, fit)
     } else {
-        register::register_heights(f, &p.inside, fit)
+        let pixel = p.map.as_ref().map_or(0.0, |m| m.dx.max(m.dy));
+        super::steps::register_clear(f, &p.inside, fit, rims.map(|r| (r, (0.0, 0.0))), pixel)
     };
     let reg = reg.map_err(|e| not_registered(file, &format!("`{surface_name}`"), e))?;
     // The error along the normal, at each registered point.
