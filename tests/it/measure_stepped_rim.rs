@@ -175,6 +175,12 @@ fn a_stepped_rim_lenslets_field_recovers_its_placement() {
     let r = report.expect("report");
     let reg = &r["registration"];
     recovers(reg, CUT, "--lenslet 1");
+    // The report says what was left out.
+    let method = reg["method"].as_str().expect("method");
+    assert!(
+        method.contains("leaving out the pixels within 13.5 µm of the lenslets' rims, which step onto the land by up to 12.1 µm"),
+        "{method}"
+    );
     close(
         &reg["clocking_urad"],
         0.0,
@@ -204,6 +210,16 @@ fn a_stepped_rim_array_is_registered_lenslet_by_lenslet() {
     let r = report.expect("report");
     let l = &r["lenslets"];
     assert_eq!(l["not_registered"], 0, "{l:#}");
+    let method = l["method"].as_str().expect("method");
+    assert!(
+        method.contains("the pixels within three pixels (30.0 µm) of the lenslets' rims"),
+        "{method}"
+    );
+    let whole = r["registration"]["method"].as_str().expect("method");
+    assert!(
+        whole.contains("within 30.0 µm of the lenslets' rims"),
+        "{whole}"
+    );
     let each = l["each"].as_array().expect("each");
     assert_eq!(each.len(), 4, "{l:#}");
     for e in each {

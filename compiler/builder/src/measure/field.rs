@@ -8,7 +8,8 @@
 //! (the margin of land that tells a sphere's decentre from its tilt) and
 //! on the design are registered to the design seen from the lenslet's
 //! centre (piston, tilt, decentre; clocking where the lenslet is not of
-//! revolution), starting from the lenslet's nominal place; the
+//! revolution), starting from the lenslet's nominal place (clear of its
+//! rim where it steps onto the land: `steps`); the
 //! decentre found is where the lenslet's centre lies from where the field
 //! was placed. Refused, with a code, on a surface that is not an array
 //! (E0368), a lenslet the array does not have (E0369) and a field whose
@@ -241,7 +242,7 @@ pub(super) fn measure(
         .map_err(|e| placed::not_registered(file, &target, e))
     };
     let mut local = shifted(&p, off);
-    let mut reg = fit(&local)?;
+    let (mut reg, mut band) = fit(&local)?;
     // Found more than a pixel from where it was placed: the pixels are
     // taken again where the registration puts the field, and registered
     // again from there (in the frame of the first placement: a shift s of
@@ -250,7 +251,7 @@ pub(super) fn measure(
     let s_shift = (moved_to.0 - off.0, moved_to.1 - off.1);
     if s_shift.0.hypot(s_shift.1) > pixel {
         (p, covered) = select(moved_to);
-        reg = fit(&shifted(&p, moved_to))?;
+        (reg, band) = fit(&shifted(&p, moved_to))?;
         let (tx, ty) = reg.tilt();
         reg.values[3] -= s_shift.0;
         reg.values[4] -= s_shift.1;
@@ -293,6 +294,9 @@ pub(super) fn measure(
         "{}, on the map's pixels within the aperture of {lenslet_words} widened by a fifth, against the design seen from its centre, started with {reference} at x = {}, y = {} mm ({placed_by})",
         registration.method, place.0, place.1
     );
+    if let (Some(r), Some(band)) = (&rims, band) {
+        registration.method.push_str(&r.words(band));
+    }
     let mut caption = super::caption(&form, &registration, &raster);
     caption.push_str(&format!(
         " The map is one lenslet's field: {lenslet_words}, its aperture {:.1} % covered; the registration puts {reference} at x = {:.4}, y = {:.4} mm on the part (placed at {}, {} by {placed_by}).",

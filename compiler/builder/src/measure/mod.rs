@@ -115,6 +115,7 @@ pub fn measure(
         errors,
         form,
         share,
+        clear_of_rims,
         ..
     } = placed;
     let (texture, texture_skipped) = texture_of(&p, &errors, opts.cutoff);
@@ -125,7 +126,10 @@ pub fn measure(
         .then(|| setup_of(f.as_ref(), &p, &errors, &reg))
         .flatten();
     let raster = raster(&p.inside, &errors, p.map.as_ref().map(|m| m.dx.max(m.dy)));
-    let registration = registration_report(&reg);
+    let mut registration = registration_report(&reg);
+    if let (Some(r), Some(band)) = (&rims, clear_of_rims) {
+        registration.method.push_str(&r.words(band));
+    }
     let mut caption = caption(&form, &registration, &raster);
     if let Some(l) = &lenslets {
         caption.push_str(&lenslets_caption(l));

@@ -255,6 +255,9 @@ pub struct Registered {
     pub form: report::FormError,
     /// The share of the measured aperture that is valid.
     pub share: f64,
+    /// How far either side of an array's stepped rims (mm) the pixels
+    /// were left out of the registration (`steps`); none without them.
+    pub(crate) clear_of_rims: Option<f64>,
 }
 
 impl Registered {
@@ -339,12 +342,13 @@ pub fn register_measurement(
         ..Fit::default()
     };
     let reg = if p.cloud {
-        register::register_cloud(f, &p.inside, fit)
+        register::register_cloud(f, &p.inside, fit).map(|r| (r, None))
     } else {
         let pixel = p.map.as_ref().map_or(0.0, |m| m.dx.max(m.dy));
         super::steps::register_clear(f, &p.inside, fit, rims.map(|r| (r, (0.0, 0.0))), pixel)
     };
-    let reg = reg.map_err(|e| not_registered(file, &format!("`{surface_name}`"), e))?;
+    let (reg, clear_of_rims) =
+        reg.map_err(|e| not_registered(file, &format!("`{surface_name}`"), e))?;
     // The error along the normal, at each registered point.
     let pred = register::predict(f, &p.inside, &reg.values);
     let errors: Vec<f64> = p
@@ -368,6 +372,7 @@ pub fn register_measurement(
         vertical,
         form,
         share,
+        clear_of_rims,
     })
 }
 

@@ -72,6 +72,16 @@ impl SteppedRims {
         })
     }
 
+    /// The registration's method says so: the pixels within `band` (mm)
+    /// of the rims left out.
+    pub fn words(&self, band: f64) -> String {
+        format!(
+            ", leaving out the pixels within {:.1} µm of the lenslets' rims, which step onto the land by up to {:.1} µm",
+            band * 1000.0,
+            self.largest * 1000.0
+        )
+    }
+
     /// How far (mm) the part's point (x, y) lies from the rim of the
     /// lenslet whose aperture, widened half again, holds it; infinite
     /// elsewhere (on the land, farther than half an aperture from a rim).
@@ -143,16 +153,17 @@ fn from_rim(d: &Domain, u: f64, v: f64) -> f64 {
 /// the pixels within `band` of a rim where its start places them (three
 /// pixels at first); a fit that moved no point by more than half that
 /// band is the registration; otherwise the next starts where it ended,
-/// its band twice the farthest move (and at least three pixels).
+/// its band twice the farthest move (and at least three pixels). The
+/// registration, and the band of its last fit (none without rims).
 pub(crate) fn register_clear(
     f: &dyn SurfaceFn,
     pts: &[[f64; 3]],
     fit: Fit,
     rims: Option<(&SteppedRims, (f64, f64))>,
     pixel: f64,
-) -> Result<Registration, RegisterError> {
+) -> Result<(Registration, Option<f64>), RegisterError> {
     let Some((rims, origin)) = rims else {
-        return register::register_heights(f, pts, fit);
+        return register::register_heights(f, pts, fit).map(|r| (r, None));
     };
     let least = BAND_PIXELS * pixel;
     let mut band = least;
@@ -175,7 +186,7 @@ pub(crate) fn register_clear(
             .fold(0.0f64, f64::max);
         if moved <= band / 2.0 {
             reg.iterations = iterations;
-            return Ok(reg);
+            return Ok((reg, Some(band)));
         }
         start = reg.values;
         band = least.max(2.0 * moved);
