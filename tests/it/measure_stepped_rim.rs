@@ -18,6 +18,18 @@ use lensc_measure::HeightMap;
 
 use crate::common::{lensc, root, text};
 
+/// The corner's job as it is: spherical lenslets whose rims meet the land
+/// all round.
+fn smooth_project() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().expect("tmp");
+    std::fs::copy(
+        root().join("tests/jobs/fts_small_array.lens"),
+        dir.path().join("job.lens"),
+    )
+    .expect("copy job");
+    dir
+}
+
 /// The corner's job with the biconic lenslet.
 fn project() -> tempfile::TempDir {
     let src = std::fs::read_to_string(root().join("tests/jobs/fts_small_array.lens"))
@@ -226,5 +238,20 @@ fn a_stepped_rim_array_is_registered_lenslet_by_lenslet() {
         let k = e["index"].as_u64().expect("index") as usize;
         recovers(&e["registration"], placed[k], &format!("lenslet {k}"));
         assert!(num(&e["form_error"]["rms_nm"]) < 1.0, "lenslet {k}: {e:#}");
+    }
+}
+
+/// Spherical lenslets meet the land all round: no rim steps, and every
+/// pixel is registered, as before (the methods say nothing of rims).
+#[test]
+fn rims_that_meet_the_land_leave_no_pixel_out() {
+    let dir = smooth_project();
+    let m = map(dir.path(), 351, 0.02, (0.0, 0.0), &[Placed::default(); 4]);
+    let (code, stderr, report) = measure(dir.path(), &m, &["--per-lenslet"]);
+    assert_eq!(code, 0, "{stderr}");
+    let r = report.expect("report");
+    for method in [&r["registration"]["method"], &r["lenslets"]["method"]] {
+        let method = method.as_str().expect("method");
+        assert!(!method.contains("rims"), "{method}");
     }
 }
