@@ -85,6 +85,11 @@ pub struct Options {
     /// Fit the y parameters (tilt, decentre) and clocking (false for a
     /// profile along x).
     pub two_d: bool,
+    /// The placement to start from, in the order of `PARAMETERS` (zero
+    /// unless given): a registration carried on from one found before.
+    /// Its piston is moved by the mean height difference there first;
+    /// a parameter that is not fitted starts (and stays) at zero.
+    pub start: [f64; 6],
 }
 
 impl Default for Options {
@@ -92,6 +97,7 @@ impl Default for Options {
         Options {
             max_iterations: 60,
             two_d: true,
+            start: [0.0; 6],
         }
     }
 }
@@ -343,11 +349,16 @@ fn levenberg_marquardt(
         return Err(RegisterError::TooFewPoints { points: pts.len() });
     }
     let mut buf = Vec::new();
-    let mut p = [0.0; 6];
+    let mut p = opts.start;
     // The piston to start from: the mean height difference.
     let (a0, g0, _) = normal_equations(eval, pts, &p, &mut buf)?;
     let (on, left_out) = determinable(&a0, opts.two_d);
-    p[0] = g0[0] / a0[0][0];
+    p[0] += g0[0] / a0[0][0];
+    for k in 1..6 {
+        if !on[k] {
+            p[k] = 0.0;
+        }
+    }
     let (mut a, mut g, mut ssr) = normal_equations(eval, pts, &p, &mut buf)?;
     let mut lambda = 1e-4;
     for it in 1..=opts.max_iterations {

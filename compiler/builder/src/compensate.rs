@@ -199,6 +199,7 @@ pub(crate) fn corrected(
         data,
         format,
         &opts,
+        None,
     )
     .map_err(at)?;
     // Each measured point in the design's frame, with its error along z.
