@@ -146,6 +146,11 @@ fn from_rim(d: &Domain, u: f64, v: f64) -> f64 {
     }
 }
 
+/// A registration of heights to the design (`register::register_heights`
+/// or its parallel form) under the given options.
+pub(crate) type HeightFit<'a> =
+    dyn Fn(&[[f64; 3]], Fit) -> Result<Registration, RegisterError> + 'a;
+
 /// Registers the heights `pts` to the design by `heights` (the design's
 /// `register::register_heights`, or its parallel form), leaving out the pixels (`pixel`
 /// apart, mm) near the stepped rims `rims`, if any: a point (u, v) of
@@ -156,7 +161,7 @@ fn from_rim(d: &Domain, u: f64, v: f64) -> f64 {
 /// its band twice the farthest move (and at least three pixels). The
 /// registration, and the band of its last fit (none without rims).
 pub(crate) fn register_clear(
-    heights: &dyn Fn(&[[f64; 3]], Fit) -> Result<Registration, RegisterError>,
+    heights: &HeightFit,
     pts: &[[f64; 3]],
     fit: Fit,
     rims: Option<(&SteppedRims, (f64, f64))>,
