@@ -357,6 +357,42 @@ pub fn check_raster(
     })
 }
 
+/// The planes a raster cuts, as its planner's first phase finds them
+/// (`scan_planes`), the rim's planes among them: those beyond the
+/// aperture whose contacts reach its rim (`rim_reach`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlaneSpans {
+    /// Each scanned plane that cuts: its v and its spans, each from its
+    /// first contact to its last, (u, v) (v is y when cutting along x).
+    pub planes: Vec<(f64, Vec<[(f64, f64); 2]>)>,
+    /// How many of the raster's planes each scanned one stands for: 1
+    /// when every plane is scanned.
+    pub weight: f64,
+}
+
+/// The planes `r` cuts over `aperture` and their spans, from the scan
+/// `check_raster` makes (the same planes, so it fails only where that
+/// does): what the estimate counts a program by.
+pub fn plane_spans(
+    r: &Raster,
+    tool: &RasterTool,
+    surface: &dyn SurfaceFn,
+    aperture: &Domain,
+) -> Result<PlaneSpans, RasterError> {
+    let cutter = Cutter::new(tool, surface, r.along);
+    let (lines, summary) = scan_planes(r, tool, &cutter, aperture, CHECK_PLANES)?;
+    Ok(PlaneSpans {
+        planes: lines
+            .into_iter()
+            .map(|(v, spans)| {
+                let ends = spans.iter().map(|(a, b)| [(a.u, a.v), (b.u, b.v)]);
+                (v, ends.collect())
+            })
+            .collect(),
+        weight: summary.weight,
+    })
+}
+
 /// The knife's flank must clear the steepest slope along the cut:
 /// `ClearanceTooSmall` unless `clearance` (rad) is above `slope_along`.
 /// Lowering applies it to the planes' scan, the build to the planned path.
@@ -448,7 +484,9 @@ fn scan_reach(
     let reach = aperture.grown(margin);
     let mut summary = Summary::within(r.along, *aperture);
     let mut lines = Vec::new();
-    for k in sampled(-extra, last + extra, last, most) {
+    let ks = sampled(-extra, last + extra, last, most);
+    summary.weight = paths / ks.len().max(1) as f64;
+    for k in ks {
         let mut v = v0 + k as f64 * r.stepover;
         if k == last {
             v = v.min(v1);
@@ -1688,6 +1726,9 @@ struct Summary {
     /// The largest spread (`Cutter::spread`) at the planes' scanned
     /// contacts in the aperture (1 if none is above 1).
     spread: f64,
+    /// How many of the raster's planes each scanned plane stands for: 1
+    /// when every plane is scanned (`sampled`).
+    weight: f64,
 }
 
 impl Summary {
@@ -1706,6 +1747,7 @@ impl Summary {
             steepest: [f64::NEG_INFINITY; 2],
             aperture: None,
             spread: 1.0,
+            weight: 1.0,
         }
     }
 
