@@ -357,14 +357,17 @@ pub fn check_raster(
     })
 }
 
+/// A plane's span of contacts, from its first to its last, each (u, v)
+/// (v is y when cutting along x).
+pub type ContactSpan = [(f64, f64); 2];
+
 /// The planes a raster cuts, as its planner's first phase finds them
 /// (`scan_planes`), the rim's planes among them: those beyond the
 /// aperture whose contacts reach its rim (`rim_reach`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct PlaneSpans {
-    /// Each scanned plane that cuts: its v and its spans, each from its
-    /// first contact to its last, (u, v) (v is y when cutting along x).
-    pub planes: Vec<(f64, Vec<[(f64, f64); 2]>)>,
+    /// Each scanned plane that cuts: its v and its spans.
+    pub planes: Vec<(f64, Vec<ContactSpan>)>,
     /// How many of the raster's planes each scanned one stands for: 1
     /// when every plane is scanned.
     pub weight: f64,
