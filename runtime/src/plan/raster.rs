@@ -348,13 +348,38 @@ pub fn check_raster(
     surface: &dyn SurfaceFn,
     aperture: &Domain,
 ) -> Result<RasterScan, RasterError> {
+    check_raster_planes(r, tool, surface, aperture).map(|(scan, _)| scan)
+}
+
+/// [`check_raster`], with the planes its scan found cutting and their
+/// spans: what the estimate counts a program by, at no second scan.
+pub fn check_raster_planes(
+    r: &Raster,
+    tool: &RasterTool,
+    surface: &dyn SurfaceFn,
+    aperture: &Domain,
+) -> Result<(RasterScan, PlaneSpans), RasterError> {
     let cutter = Cutter::new(tool, surface, r.along);
-    let (_, summary) = scan_planes(r, tool, &cutter, aperture, CHECK_PLANES)?;
-    Ok(RasterScan {
+    let (lines, summary) = scan_planes(r, tool, &cutter, aperture, CHECK_PLANES)?;
+    let scan = RasterScan {
         max_slope_along: summary.slope_along,
         max_slope_across: summary.slope_across,
         min_concave_radius_along: summary.concave_along,
-    })
+    };
+    let planes = lines
+        .into_iter()
+        .map(|(v, spans)| {
+            let ends = spans.iter().map(|(a, b)| [(a.u, a.v), (b.u, b.v)]);
+            (v, ends.collect())
+        })
+        .collect();
+    Ok((
+        scan,
+        PlaneSpans {
+            planes,
+            weight: summary.weight,
+        },
+    ))
 }
 
 /// A plane's span of contacts, from its first to its last, each (u, v)
@@ -363,37 +388,14 @@ pub type ContactSpan = [(f64, f64); 2];
 
 /// The planes a raster cuts, as its planner's first phase finds them
 /// (`scan_planes`), the rim's planes among them: those beyond the
-/// aperture whose contacts reach its rim (`rim_reach`).
-#[derive(Clone, Debug, PartialEq)]
+/// aperture whose contacts reach its rim (`rim_reach`). By default none.
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct PlaneSpans {
     /// Each scanned plane that cuts: its v and its spans.
     pub planes: Vec<(f64, Vec<ContactSpan>)>,
     /// How many of the raster's planes each scanned one stands for: 1
     /// when every plane is scanned.
     pub weight: f64,
-}
-
-/// The planes `r` cuts over `aperture` and their spans, from the scan
-/// `check_raster` makes (the same planes, so it fails only where that
-/// does): what the estimate counts a program by.
-pub fn plane_spans(
-    r: &Raster,
-    tool: &RasterTool,
-    surface: &dyn SurfaceFn,
-    aperture: &Domain,
-) -> Result<PlaneSpans, RasterError> {
-    let cutter = Cutter::new(tool, surface, r.along);
-    let (lines, summary) = scan_planes(r, tool, &cutter, aperture, CHECK_PLANES)?;
-    Ok(PlaneSpans {
-        planes: lines
-            .into_iter()
-            .map(|(v, spans)| {
-                let ends = spans.iter().map(|(a, b)| [(a.u, a.v), (b.u, b.v)]);
-                (v, ends.collect())
-            })
-            .collect(),
-        weight: summary.weight,
-    })
 }
 
 /// The knife's flank must clear the steepest slope along the cut:

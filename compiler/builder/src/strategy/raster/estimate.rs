@@ -14,13 +14,13 @@ const RASTER_PASS: f64 = 3.0 * 17.0;
 
 /// A raster: a pass per span of each plane the planner cuts, the rim's
 /// planes beyond the aperture and each pass's run on to the rim's reach
-/// included (the planner's own scan of its planes,
-/// [`plane_spans`]), each bisected from its whole span until its chords
-/// meet the chords' share of the tolerance, `max_step` and Lin's step;
-/// passes sampled up to 256, each at the spacing of 512 points across the
-/// aperture along the cut.
+/// included (the planes lowering's scan found, `check_raster_planes`),
+/// each bisected from its whole span until its chords meet the chords'
+/// share of the tolerance, `max_step` and Lin's step; passes sampled up
+/// to 256, each at the spacing of 512 points across the aperture along
+/// the cut.
 pub(crate) fn estimate(s: &super::RasterSpec, evaluate: Evaluate) -> Estimate {
-    use lensc_runtime::plan::raster::{Axis, lin_step, plane_spans, section_radius};
+    use lensc_runtime::plan::raster::{Axis, lin_step, section_radius};
     const PASSES: usize = 256;
     const ALONG: usize = 512;
     let r = &s.raster;
@@ -32,15 +32,7 @@ pub(crate) fn estimate(s: &super::RasterSpec, evaluate: Evaluate) -> Estimate {
         Axis::X => (x0, x1),
         Axis::Y => (y0, y1),
     };
-    // Lowering scanned the same planes (`check_raster`) and refused the
-    // job where that failed; should it fail here all the same, the
-    // planner's scan refuses the build with its error.
-    let scan = plane_spans(r, &s.tool, k.as_ref(), domain).unwrap_or(
-        lensc_runtime::plan::raster::PlaneSpans {
-            planes: Vec::new(),
-            weight: 1.0,
-        },
-    );
+    let scan = &s.planes;
     let stride = scan.planes.len().div_ceil(PASSES).max(1);
     let sampled = scan.planes.len().div_ceil(stride);
     let weight = scan.weight * scan.planes.len() as f64 / sampled.max(1) as f64;
