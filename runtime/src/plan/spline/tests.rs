@@ -457,3 +457,55 @@ fn a_run_fed_per_revolution_is_lines_and_arcs_never_a_spline() {
     let (_, summary) = fit_splines(&moves, &FIT, Some(o));
     assert_eq!(summary.splines, 0, "{summary:?}");
 }
+
+/// Many passes, some fitted, some kept as lines and arcs, some too short
+/// or too coarse: the runs fitted in parallel come out as fitted one
+/// after the other, to the bit, on one thread or four.
+#[test]
+fn runs_fitted_in_parallel_are_the_runs_fitted_in_order() {
+    use crate::moves::Plane;
+    let mut moves = Vec::new();
+    for k in 0..24 {
+        let (r, w, n) = match k % 4 {
+            0 => (1.0, 0.7, 400),
+            1 => (0.5, 0.45, 120),
+            2 => (3.0, 1.0, 10),
+            _ => (0.2, 0.19, 30),
+        };
+        let mut pass = pass(r, w, n);
+        // Each pass a little further along Y, after a lift.
+        for m in &mut pass {
+            if let Move::Rapid(to) | Move::Linear { to, .. } = m {
+                to.y += k as f64 * 0.01;
+            }
+        }
+        moves.push(Move::Rapid(Position::xyz(-w, 0.5 + k as f64 * 0.01, 1.0)));
+        moves.extend(pass);
+    }
+    let planes = [Plane::Zx];
+    for o in [
+        None,
+        Some(Otherwise {
+            arc_planes: &[],
+            above: false,
+        }),
+        Some(Otherwise {
+            arc_planes: &planes,
+            above: true,
+        }),
+    ] {
+        let serial = fit_splines_serial(&moves, &FIT, o);
+        assert!(serial.1.splines >= 6, "{:?}", serial.1);
+        for threads in [1, 4] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("a pool");
+            let parallel = pool.install(|| fit_splines(&moves, &FIT, o));
+            // Compared as printed (a move's unstated C is NaN, which no
+            // NaN equals): every step and figure, to the last digit.
+            let (p, s) = (format!("{parallel:?}"), format!("{serial:?}"));
+            assert!(p == s, "{threads} threads: the steps differ");
+        }
+    }
+}

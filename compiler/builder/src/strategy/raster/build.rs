@@ -163,8 +163,9 @@ pub(super) fn build(spec: &RasterSpec, cx: &BuildContext) -> Result<Built, Vec<D
     );
     let grid = window.cartesian(along_x);
     let mut sweep = Simulation::of(grid, split(&grid, None), cutter.clone());
-    // The program as written: its text read as the controller reads it.
-    let executed = parts::executed_moves(head, &text, false);
+    // The program as written: its text read as the controller reads it,
+    // once, for the read-back too.
+    let (findings, executed) = parts::read_program(head, &text, false, cx.read);
     height_map::sweep_mill_program(sweep.path(), &executed, along_x);
     // The height alone: the frame asks nothing else of the design.
     let heights = height_map::DesignHeights::of(&head.surface);
@@ -206,6 +207,7 @@ pub(super) fn build(spec: &RasterSpec, cx: &BuildContext) -> Result<Built, Vec<D
     let cut = (path.point_count, time);
     let mut built = parts::built(head, prov, text, toolpath, simulation, plots, cut);
     built.warnings = crate::plausibility::air_warnings(head, &moves);
+    built.read_findings = findings;
     Ok(built)
 }
 
