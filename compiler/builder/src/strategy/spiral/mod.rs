@@ -104,6 +104,7 @@ impl SpiralSpec {
             self.correction.as_ref(),
             &self.head.surface.lowered.domain,
             self.bounds.part_top,
+            None,
             evaluate,
         )?;
         Ok(AtSpeed {
@@ -213,6 +214,7 @@ pub(crate) fn lower(
             correction.as_ref(),
             &lowered.domain,
             design.sag_max.value,
+            Some((design.sag_max.value, design.max_slope.value)),
             evaluate,
         )
         .map_err(|e| vec![RuntimeError::Trajectory(e).at(p.site())])?;
@@ -363,6 +365,7 @@ fn settled_trajectory(
     correction: Option<&crate::compensate::Applied>,
     domain: &Domain,
     part_top: f64,
+    design: Option<(f64, f64)>,
     evaluate: Evaluate,
 ) -> Result<(LoweredSurface, TrajectoryBounds, Option<LoweredSurface>), LowerError> {
     let mut trajectory = match settling {
@@ -380,15 +383,22 @@ fn settled_trajectory(
         });
         trajectory.tape = c.tape(&trajectory.tape);
     }
-    let analysis = {
-        let k = evaluate(&trajectory.tape);
-        lensc_runtime::surface::analysis::analyse(k.as_ref(), domain, 201)
+    // Neither settled nor corrected, the trajectory is the design, whose
+    // analysis on this domain (`design`: its highest point and steepest
+    // slope), where given, is not made again.
+    let (z_max, slope) = match design {
+        Some(known) if settling.is_none() && correction.is_none() => known,
+        _ => {
+            let k = evaluate(&trajectory.tape);
+            let a = lensc_runtime::surface::analysis::analyse(k.as_ref(), domain, 201);
+            (a.sag_max.value, a.max_slope.value)
+        }
     };
     let bounds = TrajectoryBounds {
-        z_max: analysis.sag_max.value,
+        z_max,
         // Margin over the sampled steepest slope: the contact search
         // window must contain the contact.
-        max_slope: (analysis.max_slope.value * 1.1).min(1.5),
+        max_slope: (slope * 1.1).min(1.5),
         features: settling.and_then(|s| settled_features(surface, s)),
         part_top,
     };
