@@ -223,6 +223,9 @@ pub(crate) fn lower(
     // the aperture all round (`default_start`), never inside the
     // surface's farthest point from the axis.
     let outer = outer_radius(&lowered.domain);
+    if let Some(e) = beyond_travel(p, outer, st.from) {
+        return Err(vec![e]);
+    }
     let (start, (settling, trajectory, bounds, trajectory_declared)) = match st.from {
         Some(from) => (from, trajectory_from(from)?),
         None => {
@@ -598,6 +601,42 @@ fn machine_limits(p: &Parts, spiral: &FtsSpiral) -> Vec<Diagnostic> {
         ));
     }
     errors
+}
+
+/// E0141 when the spiral would start (at `from`, or the part's farthest
+/// point from the axis, `outer`) beyond the machine's X travel: refused
+/// before anything is planned, since the work of finding the start (the
+/// rim's contacts) and the settling grows with the part's size (issue
+/// #33: an array at a pitch of 4,294,967,297 mm hung `lensc check`).
+fn beyond_travel(p: &Parts, outer: f64, from: Option<f64>) -> Option<Diagnostic> {
+    // A lathe's travel states X (the checker requires it).
+    let (tx0, tx1) = p.machine_params.travel[0]?;
+    let start = from.unwrap_or(outer);
+    if start <= tx1 {
+        return None;
+    }
+    let what = match from {
+        Some(_) => format!(
+            "the spiral starts {} mm from the spindle axis",
+            trim_num(start)
+        ),
+        None => format!(
+            "the part reaches {} mm from the spindle axis (it is {} mm across)",
+            trim_num(outer),
+            trim_num(2.0 * outer)
+        ),
+    };
+    Some(
+        p.error(
+            codes::OUT_OF_TRAVEL,
+            format!(
+                "{what}, beyond the machine's X travel {} .. {} mm",
+                trim_num(tx0),
+                trim_num(tx1)
+            ),
+        )
+        .with_help("check the part's size and its units (`pitch: 4 mm`, not `4 m`); or use a machine with more travel"),
+    )
 }
 
 /// The fast axis's second-order servo model, from its resonance and peak
