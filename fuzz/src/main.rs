@@ -972,3 +972,37 @@ fn summary(
         c.panics, c.hangs, c.aborts, c.restarts, c.uncoded, distinct
     );
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every build input carries a program size limit within the
+    /// fuzzer's ceiling, so a number made extreme (seed 29's input 49753,
+    /// a 1 nm roller pitch and a 110 MB program) meets the size estimate
+    /// and not the hang limit.
+    #[test]
+    fn every_build_input_is_limited_to_the_program_ceiling() {
+        let empty = || Corpus { files: Vec::new() };
+        let corpora = Corpora {
+            lens: empty(),
+            programs: empty(),
+            prescriptions: empty(),
+            measurements: empty(),
+        };
+        for index in (0..2_000).chain([49_753]) {
+            let (_, _, depth) = input_for(Target::Build, 29, index, 0, &corpora);
+            let Depth::BuildAs {
+                max_program_size, ..
+            } = depth
+            else {
+                panic!("input {index}: not a build");
+            };
+            let limit = max_program_size.expect("a limit");
+            assert!(
+                (1_000..=BUILD_PROGRAM_CEILING).contains(&limit),
+                "input {index}: {limit}"
+            );
+        }
+    }
+}
