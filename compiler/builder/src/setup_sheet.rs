@@ -273,7 +273,11 @@ pub fn sheet(head: &JobHead, built: &Built) -> String {
             ""
         }
     ));
-    if lathe {
+    if control.machine_kind == "grinder_2axis" {
+        check(
+            "the wheel stands clear of the part: the program's first moves are rapids".to_string(),
+        );
+    } else if lathe {
         check(
             "the turret is clear of the part: the tool call indexes where the machine stands"
                 .to_string(),
@@ -281,6 +285,14 @@ pub fn sheet(head: &JobHead, built: &Built) -> String {
     } else {
         check(
             "the machine stands clear above the part: the program's first move is a rapid"
+                .to_string(),
+        );
+    }
+    if control.machine_kind == "grinder_2axis" {
+        // Seed 001's grinder turns the wheel on an air spindle of its own
+        // (about 30,000 rpm); the program's S word and M3 turn the work.
+        check(
+            "the wheel's own spindle runs at its grinding speed: this program starts only the work spindle"
                 .to_string(),
         );
     }

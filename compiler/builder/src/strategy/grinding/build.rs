@@ -60,12 +60,12 @@ pub(super) fn build(spec: &GrindingSpec, cx: &BuildContext) -> Result<Built, Vec
         exact_in(grinding.wheel_diameter, "mm")
     ));
     header.push(format!(
-        "strategy {}: profile grinding from x = {} to {} mm, interval {} um, feed {} um/s, smoothness {}; {} intervals, each at its own feed",
+        "strategy {}: profile grinding from x = {} to {} mm, interval {} um, feed {}, smoothness {}; {} intervals, each at its own feed",
         head.names.strategy,
         exact_in(grinding.start, "mm"),
         exact_in(grinding.end, "mm"),
         exact_in(grinding.interval, "um"),
-        exact_in(feed, "um/s"),
+        feed_as_stated(feed),
         exact_in(grinding.smoothness, ""),
         path.segments
     ));
@@ -116,4 +116,29 @@ pub(super) fn build(spec: &GrindingSpec, cx: &BuildContext) -> Result<Built, Vec
     );
     built.warnings = crate::plausibility::air_warnings(head, &stream);
     Ok(built)
+}
+
+/// The feed in um/s (seed 001's unit) or mm/min (the program's F word),
+/// whichever states it exactly in fewer digits: a job's `20 mm/min` is
+/// 333.333… um/s, which no short decimal in um/s reads back to.
+fn feed_as_stated(feed: f64) -> String {
+    let [um_s, mm_min] = ["um/s", "mm/min"].map(|unit| format!("{} {unit}", exact_in(feed, unit)));
+    if mm_min.len() < um_s.len() {
+        mm_min
+    } else {
+        um_s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::feed_as_stated;
+
+    #[test]
+    fn a_feed_is_stated_in_the_unit_that_prints_it_exactly() {
+        let per_min = 1.0 / 60.0;
+        assert_eq!(feed_as_stated(20.0 * per_min), "20 mm/min");
+        assert_eq!(feed_as_stated(20e-3), "20 um/s");
+        assert_eq!(feed_as_stated(10e-3), "10 um/s");
+    }
 }
