@@ -95,9 +95,14 @@ pub fn parameters(m: &HeightMap) -> Option<Texture> {
 
 /// The Gaussian-filtered surface (separable; normalised over valid points).
 pub fn gaussian(m: &HeightMap, lambda_c: f64) -> Vec<f64> {
-    let kernel = |d: f64| -> Vec<f64> {
-        // Truncated where the weight is below 1e-6 of its peak (|x| ≤ 1.3 λc).
-        let half = ((1.3 * lambda_c / d).ceil() as usize).max(1);
+    let kernel = |d: f64, n: usize| -> Vec<f64> {
+        // Truncated where the weight is below 1e-6 of its peak (|x| ≤ 1.3 λc),
+        // and at the map's own `n` points along it: an offset of n or more
+        // meets no point, so the cut changes nothing (a cutoff of 1 m over
+        // 1 nm pixels counted 1.3e12, `as usize` unchecked: an abort on
+        // its allocation).
+        let half = lensc_runtime::plan::count::steps_over(1.3 * lambda_c, d, 1, n.max(1))
+            .unwrap_or(n.max(1));
         (0..=2 * half)
             .map(|k| {
                 let x = (k as f64 - half as f64) * d / (ALPHA * lambda_c);
@@ -105,7 +110,7 @@ pub fn gaussian(m: &HeightMap, lambda_c: f64) -> Vec<f64> {
             })
             .collect()
     };
-    let (kx, ky) = (kernel(m.dx), kernel(m.dy));
+    let (kx, ky) = (kernel(m.dx, m.nx), kernel(m.dy, m.ny));
     let (z1, ok1) = regression_pass(m, &m.z, &m.valid, &kx, true);
     let (z2, _) = regression_pass(m, &z1, &ok1, &ky, false);
     z2
@@ -202,6 +207,24 @@ mod tests {
         }
         // Without the filter the waviness dominates.
         assert!(parameters(&m).unwrap().sq > 1.3 * a / 2f64.sqrt());
+    }
+
+    /// A cutoff far longer than the map, over fine pixels, is cut at the
+    /// map's own length (issue #33: a 1 m cutoff over 1 nm pixels counted
+    /// a kernel of 2.6e9 weights, 21 GB allocated for 40 pixels): the
+    /// regression of a tilted plane is the plane itself, whatever the
+    /// kernel, so its roughness is nothing.
+    #[test]
+    fn a_cutoff_longer_than_the_map_is_cut_at_the_map() {
+        let (nx, ny, d) = (40, 30, 1e-6);
+        let z: Vec<f64> = (0..ny)
+            .flat_map(|j| (0..nx).map(move |i| 1e-6 * i as f64 - 2e-6 * j as f64))
+            .collect();
+        let m = HeightMap::from_heights(nx, ny, (d, d), z.clone());
+        let w = gaussian(&m, 1000.0);
+        for (got, want) in w.iter().zip(&z) {
+            assert!((got - want).abs() < 1e-12, "{got:e} vs {want:e}");
+        }
     }
 
     #[test]

@@ -47,18 +47,21 @@ pub struct SetUp {
 /// in rings `ring` wide. `None` with fewer than four rings.
 pub fn fit(f: &dyn SurfaceFn, r: &[f64], e: &[f64], ring: f64) -> Option<SetUp> {
     let rmax = r.iter().cloned().fold(0.0, f64::max);
-    let nb = (rmax / ring).ceil() as usize + 1;
-    let (mut rs, mut es, mut cnt) = (vec![0.0; nb], vec![0.0; nb], vec![0usize; nb]);
+    // Only the rings that hold points, in order out from the centre: as
+    // many as the points at most, however narrow the ring (a map's 1 pm
+    // pixels 10 mm out counted 1e10 rings, each allocated, `as usize`
+    // unchecked: an abort). A ring's index saturates, NaN to 0.
+    let mut sums: std::collections::BTreeMap<usize, (f64, f64, usize)> = Default::default();
     for (ri, ei) in r.iter().zip(e) {
-        let b = ((ri / ring) as usize).min(nb - 1);
-        rs[b] += ri;
-        es[b] += ei;
-        cnt[b] += 1;
+        let sum = sums.entry((ri / ring) as usize).or_default();
+        sum.0 += ri;
+        sum.1 += ei;
+        sum.2 += 1;
     }
     // (mean radius, mean error, count) of each ring that holds points
-    let rings: Vec<(f64, f64, f64)> = (0..nb)
-        .filter(|b| cnt[*b] > 0)
-        .map(|b| (rs[b] / cnt[b] as f64, es[b] / cnt[b] as f64, cnt[b] as f64))
+    let rings: Vec<(f64, f64, f64)> = sums
+        .values()
+        .map(|&(rs, es, cnt)| (rs / cnt as f64, es / cnt as f64, cnt as f64))
         .collect();
     let z = |x: f64| f.eval(x.abs(), 0.0);
     let model = |p: &[f64; 2], rr: f64| p[0] + z(rr - p[1])[0] - z(rr)[0];
@@ -218,6 +221,25 @@ mod tests {
         let s = fit(&f, &r, &e, 5e-4).expect("fits");
         assert!((s.centre_height - h).abs() <= 0.05 * h, "{s:?}");
         assert!((s.x_offset - dx).abs() <= 0.05 * dx.abs(), "{s:?}");
+    }
+
+    /// Rings far narrower than the points' spread are counted by the
+    /// points they hold, not allocated out to the farthest (issue #33: a
+    /// map's 1 pm pixels 0.8 mm out asked for 8e8 rings in each of three
+    /// vectors, 1e-15 mm for 8e14, an abort): the same fit as at a ring the
+    /// points' own spacing, where every point is its own ring either way.
+    #[test]
+    fn rings_narrower_than_any_point_spacing_are_not_allocated() {
+        let f = crate::register::tests::asphere(0.0);
+        let r: Vec<f64> = (1..=4000).map(|k| 0.8 * k as f64 / 4000.0).collect();
+        let e: Vec<f64> = r.iter().map(|&rr| 1e-5 + 1e-3 * rr).collect();
+        let fine = fit(&f, &r, &e, 1e-15).expect("fits");
+        let own = fit(&f, &r, &e, 1e-7).expect("fits");
+        assert_eq!(fine.rings, own.rings);
+        assert!(
+            (fine.x_offset - own.x_offset).abs() < 1e-12,
+            "{fine:?} {own:?}"
+        );
     }
 
     /// A part with no set-up error shows neither.

@@ -241,3 +241,62 @@ fn reports_in(dir: &std::path::Path) -> Vec<serde_json::Value> {
     assert!(!reports.is_empty(), "{}: no report", dir.display());
     reports
 }
+
+/// Issue #33: every strategy refuses a part beyond the machine's travel in
+/// `check`, before anything is planned, as the spiral did (E0141, naming
+/// the part's reach and the travel). Until then the turning, grinding and
+/// raster jobs here were refused only by their planned path, at `build`,
+/// and the roller's by the read-back of its program (E0313): `check`
+/// passed all four.
+#[test]
+fn check_refuses_a_part_beyond_the_travel_for_every_strategy() {
+    // Each file, how many axes it is beyond, and what the refusals say.
+    let cases: [(&str, usize, &[&str]); 4] = [
+        (
+            "turning_part_beyond_travel.lens",
+            1,
+            &[
+                "reaches 200 mm from the spindle axis",
+                "X travel -10 .. 150 mm",
+            ],
+        ),
+        (
+            "grinding_part_beyond_travel.lens",
+            1,
+            &[
+                "reaches 200 mm from the spindle axis",
+                "X travel -50 .. 50 mm",
+            ],
+        ),
+        (
+            "raster_part_beyond_travel.lens",
+            2,
+            &["X travel -250 .. 250 mm", "Y travel -200 .. 200 mm"],
+        ),
+        (
+            "roller_blank_beyond_travel.lens",
+            2,
+            &[
+                "starts outside it at X 302.427567 mm",
+                "Z travel -150 .. 150 mm",
+            ],
+        ),
+    ];
+    for (file, axes, says) in cases {
+        let rel = format!("tests/bad_builds/{file}");
+        let out = lensc(&root(), &["check", &rel]);
+        let stderr = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{rel}: {stderr}");
+        let refusals: Vec<&str> = stderr
+            .lines()
+            .filter(|l| l.starts_with("[E0141]") && l.contains("beyond the machine's"))
+            .collect();
+        assert_eq!(refusals.len(), axes, "{rel}: {stderr}");
+        for words in says {
+            assert!(
+                refusals.iter().any(|l| l.contains(words)),
+                "{rel}: {words}: {stderr}"
+            );
+        }
+    }
+}

@@ -16,6 +16,7 @@ pub mod chords;
 pub mod estimate;
 pub mod interpolation;
 pub mod tolerance;
+pub mod travel;
 pub mod window;
 
 pub use estimate::{DEFAULT_MAX_PROGRAM_SIZE, Estimate, Limits, MAX_POINTS, refusals};

@@ -294,6 +294,12 @@ pub fn binary_search(points: &[(f64, f64)], rho: f64, x: f64, tolerance: f64) ->
     let (mut gouges, mut clears) = (below + rho - tolerance, high + rho);
     while clears - gouges > tolerance {
         let m = 0.5 * (gouges + clears);
+        // A bracket as narrow as the heights' floating point can halve
+        // no further: a `tolerance` below their spacing (1e-15 mm at
+        // 1 mm) looped for ever.
+        if m <= gouges || m >= clears {
+            break;
+        }
         if min_distance(window, x, m) < rho {
             gouges = m;
         } else {

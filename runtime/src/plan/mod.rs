@@ -4,6 +4,7 @@
 
 pub mod approach;
 pub mod chords;
+pub mod count;
 pub mod envelope;
 pub mod grinding;
 pub mod optimise;

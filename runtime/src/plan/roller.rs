@@ -734,6 +734,17 @@ const SURVEY_STEP: f64 = 0.01;
 /// Largest number of survey samples along either direction.
 const SURVEY_MAX: usize = 4097;
 
+/// The survey's samples over `len` mm at most `step` apart: one more
+/// than the steps, from 2 to [`SURVEY_MAX`]. Counted by `count::steps_over`:
+/// a nose of 1e-300 mm made the steps 1.6e301, `as usize` saturated and
+/// the `+ 1` overflowed (a panic in a debug build, 2 samples in a release
+/// one, a survey that could miss the design's top).
+fn survey_samples(len: f64, step: f64) -> usize {
+    crate::plan::count::steps_over(len, step, 1, SURVEY_MAX)
+        .map_or(SURVEY_MAX, |n| n + 1)
+        .clamp(2, SURVEY_MAX)
+}
+
 /// The number of steps of a pass (its points are steps + 1) and its total
 /// spindle angle.
 fn pass_steps(h: &RollerHelix, pass: &HelixPass) -> Result<(usize, f64), RollerError> {
@@ -962,7 +973,7 @@ fn survey_reach(
 ) -> Result<Survey, RollerError> {
     let r_r = h.roller_radius;
     let step = SURVEY_STEP.min(rho / 16.0);
-    let count = |len: f64| ((len / step).ceil() as usize + 1).clamp(2, SURVEY_MAX);
+    let count = |len: f64| survey_samples(len, step);
     let x_range = (h.z_start - rho, h.z_end + rho);
     let region = DesignRegion {
         x: x_range,

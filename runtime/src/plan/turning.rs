@@ -10,6 +10,7 @@ use crate::machine::tool::RoundNoseTool;
 use crate::moves::{Move, Position};
 use crate::plan::approach;
 use crate::plan::chords::{self, Band, ChordPlacement};
+use crate::plan::count;
 use crate::plan::envelope::{self, Pieces};
 use crate::surface::Profile;
 use crate::surface::SurfaceInfo;
@@ -195,7 +196,25 @@ pub enum PlanError {
     /// smooth profile: not on a profile with corners (at this radius) nor
     /// with Lei's searches (`corner_at` None).
     EdgeNotCompensated { corner_at: Option<f64> },
+    /// Lei's searches would take more than [`MAX_SEARCH_COUNT`]: the
+    /// profile discretised every `step` mm over `span` mm (`parameter`
+    /// `search_spacing`), or the sequential search's descent in steps of
+    /// `step` mm over `span` mm at each centre (`search_step`); `count`
+    /// is the span over the step (infinite or NaN where it is no number).
+    SearchTooFine {
+        parameter: &'static str,
+        span: f64,
+        step: f64,
+        count: f64,
+    },
 }
+
+/// The most points Lei's searches discretise a profile into, and the most
+/// steps the sequential search descends at one centre: 200 million, the
+/// most points lensc plans for one job (its up-front estimate's limit),
+/// 3.2 GB of discretised points. A finer `search_spacing` aborted on its
+/// allocation; a finer `search_step` descended for ever.
+pub const MAX_SEARCH_COUNT: usize = 200_000_000;
 
 /// Number of radii at which the profile is scanned for curvature and slope.
 const SCAN_POINTS: usize = 4096;
@@ -211,6 +230,8 @@ pub struct ProfileScan {
     pub max_slope: (f64, f64),
     /// The cutting feed (mm/s).
     pub feed_speed: f64,
+    /// The profile's lowest and highest z over the cut (mm).
+    pub sag: (f64, f64),
 }
 
 /// Checks a turning job against its profile before planning: the profile
@@ -242,6 +263,12 @@ pub fn check_profile_turning(
         });
     }
     errors.extend(rate_errors(&job.machine, strat, feed_speed));
+    errors.extend(search_errors(
+        strat,
+        rho,
+        cut_range(start, strat.end_radius, rho),
+        scan.sag,
+    ));
     if let Some(e) = &job.tool.edge {
         errors.extend(edge_coverage(profile, &e.profile, start, strat.end_radius));
         if strat.location != ToolLocation::Exact {
@@ -267,12 +294,7 @@ pub fn plan_profile_turning(
     let start = strat.start_radius.unwrap_or(job.surface.aperture_radius);
     let end = strat.end_radius;
 
-    // The profile the nose can touch: the cut range and, at the centre,
-    // its mirror image across the axis.
-    let (lo, hi) = {
-        let (a, b) = (start.min(end), start.max(end));
-        (if a <= 0.0 { a - rho } else { a }, b)
-    };
+    let (lo, hi) = cut_range(start, end, rho);
     let pieces = envelope::split_at_corners(profile, lo, hi);
     if job.tool.edge.is_some()
         && let Some(c) = pieces.corners.first()
@@ -359,12 +381,14 @@ fn scan_profile(
 ) -> Result<ProfileScan, PlanError> {
     let mut min_concave: Option<(f64, f64)> = None;
     let mut max_slope = (0.0f64, 0.0f64);
+    let mut sag = (f64::INFINITY, f64::NEG_INFINITY);
     for i in 0..=SCAN_POINTS {
         let r = end + (start - end) * i as f64 / SCAN_POINTS as f64;
         let p = profile.point(r);
         if !(p.z.is_finite() && p.dz.is_finite() && p.d2z.is_finite()) {
             return Err(PlanError::Undefined { at_radius: r });
         }
+        sag = (sag.0.min(p.z), sag.1.max(p.z));
         let slope = p.dz.atan().abs();
         if slope > max_slope.0 {
             max_slope = (slope, r);
@@ -380,7 +404,54 @@ fn scan_profile(
         min_concave,
         max_slope,
         feed_speed,
+        sag,
     })
+}
+
+/// The profile the nose can touch: the cut range from `start` to `end`
+/// and, at the centre, its mirror image across the axis.
+fn cut_range(start: f64, end: f64, rho: f64) -> (f64, f64) {
+    let (a, b) = (start.min(end), start.max(end));
+    (if a <= 0.0 { a - rho } else { a }, b)
+}
+
+/// Lei's searches counted before anything is allocated or looped over:
+/// the discretised profile's points over `range` (as `cut_path` takes
+/// them), and the sequential search's descent at one centre, from ρ over
+/// the highest point to ρ under the lowest of `sag`.
+fn search_errors(
+    strat: &ProfileTurning,
+    rho: f64,
+    range: (f64, f64),
+    sag: (f64, f64),
+) -> Vec<PlanError> {
+    let (spacing, descent) = match strat.location {
+        ToolLocation::Exact => return Vec::new(),
+        ToolLocation::Sequential { spacing, step } => (spacing, Some(step)),
+        ToolLocation::Binary { spacing, .. } => (spacing, None),
+    };
+    let span = range.1 - range.0;
+    let mut errors = Vec::new();
+    if count::steps_over(span, spacing, 1, MAX_SEARCH_COUNT).is_none() {
+        errors.push(PlanError::SearchTooFine {
+            parameter: "search_spacing",
+            span,
+            step: spacing,
+            count: span / spacing,
+        });
+    }
+    if let Some(step) = descent {
+        let depth = sag.1 - sag.0 + 2.0 * rho;
+        if count::steps_over(depth, step, 1, MAX_SEARCH_COUNT).is_none() {
+            errors.push(PlanError::SearchTooFine {
+                parameter: "search_step",
+                span: depth,
+                step,
+                count: depth / step,
+            });
+        }
+    }
+    errors
 }
 
 /// The feed and spindle speed the machine cannot give.
@@ -752,7 +823,10 @@ fn cut_path(section: &Section, nose: &Nose, strat: &ProfileTurning) -> Vec<Vecto
     );
     let discretised = |spacing: f64| -> Vec<(f64, f64)> {
         let (a, b) = (pieces.bounds[0], pieces.bounds[pieces.bounds.len() - 1]);
-        let n = (((b - a) / spacing).ceil() as usize).max(1);
+        // Counted by `check_profile_turning` (`search_errors`) over the
+        // same range: a count it refused never gets here.
+        let n = count::steps_over(b - a, spacing, 1, MAX_SEARCH_COUNT)
+            .expect("the discretisation was counted before planning");
         (0..=n)
             .map(|i| {
                 let u = a + (b - a) * i as f64 / n as f64;

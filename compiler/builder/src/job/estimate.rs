@@ -129,7 +129,7 @@ fn over(estimate: f64, limit: u64) -> bool {
 }
 
 /// A count in words: "3.2 million".
-fn count(n: f64) -> String {
+pub(crate) fn count(n: f64) -> String {
     match n {
         n if !n.is_finite() => "infinitely many".into(),
         n if n >= 1e12 => format!("{:.3e}", n),

@@ -133,3 +133,29 @@ fn reference_searches_agree_with_the_exact_height() {
         );
     }
 }
+
+/// A bracket below the heights' floating-point spacing cannot be halved:
+/// the binary search stops where the midpoint is one of its ends, at a
+/// height that clears, instead of halving for ever (issue #33: a
+/// `search_step` of 1e-15 mm hung a build).
+#[test]
+fn the_binary_search_stops_where_floating_point_cannot_halve() {
+    let a = lei();
+    let pieces = split_at_corners(&a, 0.0, 2.0 * 0.554);
+    let rho = 0.5;
+    let n = 2_000;
+    let pts: Vec<(f64, f64)> = (0..=n)
+        .map(|i| {
+            let u = 1.108 * i as f64 / n as f64;
+            (u, a.point(u).z)
+        })
+        .collect();
+    for x in [0.2, 0.554] {
+        let (exact, _) = centre_height(&a, &pieces, rho, x);
+        let b = binary_search(points_near(&pts, x, rho), rho, x, 1e-300);
+        assert!(
+            b <= exact + 1e-9 && exact - b < 1e-4,
+            "binary {b} vs {exact}"
+        );
+    }
+}

@@ -598,3 +598,16 @@ fn a_measured_edge_over_concave_corners_is_refused() {
     // The circle is planned.
     plan_roller_helix(&h, 0.5, &groove).expect("plans");
 }
+
+/// The survey's samples are counted, never wrapped (issue #33): a nose of
+/// 1e-300 mm made its spacing 6e-302 mm, `as usize + 1` overflowed (a
+/// panic in a debug build of `lensc build`, 2 samples in a release one);
+/// the count is capped at `SURVEY_MAX` as for any long roller.
+#[test]
+fn survey_samples_saturate_at_their_cap() {
+    assert_eq!(survey_samples(1.0, 0.01), 101);
+    assert_eq!(survey_samples(0.0, 0.01), 2);
+    assert_eq!(survey_samples(100.0, 0.01), SURVEY_MAX);
+    assert_eq!(survey_samples(1.0, 1e-300 / 16.0), SURVEY_MAX);
+    assert_eq!(survey_samples(f64::INFINITY, 0.01), SURVEY_MAX);
+}

@@ -12,7 +12,7 @@ use std::f64::consts::PI;
 
 /// A convex asphere (R 8 mm, k −1, A4, A6) over a 3 mm radius: slopes
 /// from 0 to about 21° at the rim.
-fn asphere() -> RotationalSurface {
+pub(super) fn asphere() -> RotationalSurface {
     RotationalSurface {
         radius: 8.0,
         conic: -1.0,
@@ -38,7 +38,7 @@ fn wavy_edge(periods: f64) -> EdgeProfile {
     EdgeProfile::from_samples(&samples).unwrap()
 }
 
-fn job(edge: Option<EdgeProfile>) -> TurningJob {
+pub(super) fn job(edge: Option<EdgeProfile>) -> TurningJob {
     TurningJob {
         name: "edge".into(),
         surface_name: "s".into(),

@@ -47,3 +47,62 @@ fn samples_stay_within_chord_tolerance() {
     assert_eq!(pts[0].x, f(2.0).x);
     assert_eq!(pts.last().unwrap().x, 0.0);
 }
+
+/// Lei's searches are counted before planning (issue #33): a
+/// `search_spacing` of 1e-12 mm asks for 3.5e12 discretised points here
+/// (`lensc build` aborted on their allocation); a `search_step` of
+/// 1e-15 mm over 1e12 steps at each centre (a build ran on past a
+/// minute). Each is refused
+/// (`SearchTooFine`) naming its parameter and count, by the check and by
+/// the planner, before anything is allocated.
+#[test]
+fn searches_too_fine_to_count_are_refused_before_planning() {
+    let s = super::edge_tests::asphere();
+    let mut job = super::edge_tests::job(None);
+    job.strategy.location = ToolLocation::Sequential {
+        spacing: 1e-12,
+        step: 1e-15,
+    };
+    for errors in [
+        check_profile_turning(&job, &s).expect_err("refused"),
+        plan_profile_turning(&job, &s).expect_err("refused"),
+    ] {
+        let found: Vec<(&str, f64)> = errors
+            .iter()
+            .filter_map(|e| match e {
+                PlanError::SearchTooFine {
+                    parameter, count, ..
+                } => Some((*parameter, *count)),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(found.len(), 2, "{errors:?}");
+        assert_eq!(found[0].0, "search_spacing");
+        assert!(found[0].1 > 3e12, "{found:?}");
+        assert_eq!(found[1].0, "search_step");
+        assert!(found[1].1 > 1e12, "{found:?}");
+    }
+    // A binary search's spacing is counted the same way; its tolerance
+    // only halves a bracket, which stops where floating point does.
+    job.strategy.location = ToolLocation::Binary {
+        spacing: 1e-300,
+        tolerance: 1e-300,
+    };
+    let errors = check_profile_turning(&job, &s).expect_err("refused");
+    assert!(
+        matches!(
+            errors[..],
+            [PlanError::SearchTooFine {
+                parameter: "search_spacing",
+                ..
+            }]
+        ),
+        "{errors:?}"
+    );
+    // At Lei's own spacing and step the job is counted and planned.
+    job.strategy.location = ToolLocation::Sequential {
+        spacing: 1e-3,
+        step: 1e-4,
+    };
+    assert!(check_profile_turning(&job, &s).is_ok());
+}

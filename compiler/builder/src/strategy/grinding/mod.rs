@@ -15,6 +15,7 @@ use lensc_runtime::post::Dialect;
 use lensc_runtime::surface::SectionAlongX;
 use lensc_runtime::surface::analysis::Domain;
 
+use crate::job::travel::{TravelAxis, part_beyond_travel};
 use crate::job::{Evaluate, JobHead, Parts, all_clear};
 use lensc_lang::schema::strategies::ProfileGrindingParams;
 
@@ -84,6 +85,12 @@ pub(crate) fn lower(
         end: st.to.unwrap_or(edge),
     };
     let mut errors: Vec<Diagnostic> = p.feed_error("grinding", feed).into_iter().collect();
+    // The part against the X travel before its stations are scanned.
+    let radii = (grinding.start, grinding.end);
+    if let Some(e) = part_beyond_travel(p, TravelAxis::Radius, radii, wheel_diameter / 2.0) {
+        errors.push(e);
+        return Err(errors);
+    }
     // The checks the planner makes first, on its own contact stations.
     let kernel = evaluate(&lowered.tape);
     if let Err(e) = check_profile_grinding(&grinding, &SectionAlongX(kernel.as_ref())) {

@@ -17,6 +17,7 @@ use lensc_runtime::plan::raster::{
 };
 use lensc_runtime::post::Dialect;
 
+use crate::job::travel::{TravelAxis, part_beyond_travel};
 use crate::job::{Evaluate, JobHead, Parts, all_clear};
 use lensc_lang::codes;
 use lensc_lang::schema::strategies::RasterParams;
@@ -134,6 +135,21 @@ pub(crate) fn lower(
     let feed = st.feed;
     let clearance = t.clearance;
     let mut errors: Vec<Diagnostic> = p.feed_error("cutting", feed).into_iter().collect();
+    // The part against the X and Y travel before its planes are scanned:
+    // the tool's centre meets it within its radius.
+    let (x, y) = crate::job::window::domain_extent(&lowered.domain);
+    let radius = match tool {
+        RasterTool::Ball { radius } => radius,
+        RasterTool::Knife { nose_radius } => nose_radius,
+    };
+    let beyond: Vec<Diagnostic> = [(0, x), (1, y)]
+        .into_iter()
+        .filter_map(|(axis, span)| part_beyond_travel(p, TravelAxis::Along(axis), span, radius))
+        .collect();
+    if !beyond.is_empty() {
+        errors.extend(beyond);
+        return Err(errors);
+    }
     let spindle_speed = st.spindle_speed.map(|s| s.value);
     errors.extend(raster_spindle_error(p, &tool, st.spindle_speed));
     // The checks the planner makes first, on the planes it cuts (kept

@@ -20,6 +20,7 @@ use lensc_runtime::post::Dialect;
 use lensc_runtime::surface::analysis::Domain;
 use lensc_runtime::surface::ir::SurfaceFn;
 
+use crate::job::travel::{TravelAxis, part_beyond_travel};
 use crate::job::{Evaluate, JobHead, Parts, all_clear};
 use lensc_lang::check::trim_num;
 use lensc_lang::codes;
@@ -189,9 +190,20 @@ pub(crate) fn lower(
         ..helix
     };
     let retract = st.retract.unwrap_or(1.0);
+    let safe_x = helix.blank_radius + rt.nose_radius + retract;
+    let beyond: Vec<Diagnostic> = start_beyond_travel(p, &helix, safe_x)
+        .into_iter()
+        .chain(part_beyond_travel(
+            p,
+            TravelAxis::Along(2),
+            (helix.z_start, helix.z_end),
+            0.0,
+        ))
+        .collect();
+    all_clear(beyond)?;
     Ok(RollerSpec {
         head: p.head(dialect, lowered),
-        safe_x: helix.blank_radius + rt.nose_radius + retract,
+        safe_x,
         helix,
         tool: rt,
         check,
@@ -201,6 +213,33 @@ pub(crate) fn lower(
         edge,
         edge_site: p.tool_params.edge_profile.as_ref().map(|e| e.site),
     })
+}
+
+/// E0141 when the tool's first move, X out to `safe_x` (the blank's
+/// radius, the nose's and the retract: outside the blank, where every
+/// pass starts), is beyond the machine's X travel: the program could not
+/// start, whatever the helix.
+fn start_beyond_travel(p: &Parts, helix: &RollerHelix, safe_x: f64) -> Option<Diagnostic> {
+    let (lo, hi) = p.machine_params.travel[0]?;
+    let (_, offset) = crate::job::ControlPoint::of(&p.machine_params, &p.tool_params);
+    let programmed = safe_x + offset.x;
+    if programmed.is_nan() || programmed <= hi {
+        return None;
+    }
+    Some(
+        p.error(
+            codes::OUT_OF_TRAVEL,
+            format!(
+                "the blank reaches {} mm from the spindle axis (it is {} mm across), and each pass starts outside it at X {} mm, beyond the machine's X travel {} .. {} mm",
+                trim_num(helix.blank_radius),
+                trim_num(2.0 * helix.blank_radius),
+                trim_num(programmed),
+                trim_num(lo),
+                trim_num(hi)
+            ),
+        )
+        .with_help("check the roller's radius, the blank's and their units (`radius: 30 mm`, not `30 cm`); or use a machine with more travel"),
+    )
 }
 
 /// The largest sag (mm) of a chord `arc` mm long around the roller where

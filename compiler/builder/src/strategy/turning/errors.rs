@@ -4,11 +4,31 @@ use lensc_lang::check::trim_num;
 use lensc_lang::codes;
 
 use crate::diagnostics::{Coded, coded, rpm, um};
-use lensc_runtime::plan::turning::PlanError;
+use lensc_runtime::plan::turning::{MAX_SEARCH_COUNT, PlanError};
 
 /// A profile-turning planner error as its diagnostic at `site`.
 pub(crate) fn error(e: PlanError, site: (FileId, Span)) -> Diagnostic {
     coded_error(e).at(site)
+}
+
+/// A length (mm) as written, in exponent form where `trim_num` would
+/// round it to nothing (1e-12 mm).
+fn small_mm(v: f64) -> String {
+    if v != 0.0 && v.abs() < 1e-6 {
+        format!("{v:e}")
+    } else {
+        trim_num(v)
+    }
+}
+
+/// A count in words, "about" where it is a number.
+fn about(n: f64) -> String {
+    let words = crate::job::estimate::count(n);
+    if n.is_finite() {
+        format!("about {words}")
+    } else {
+        words
+    }
 }
 
 /// An angle (rad) in degrees as written.
@@ -79,6 +99,31 @@ fn coded_error(e: PlanError) -> Coded {
             },
         )
         .help("leave the tool's `edge_profile` out for this job (the nose is then a circle), or cut with `search` left out"),
+        PlanError::SearchTooFine {
+            parameter,
+            span,
+            step,
+            count,
+        } => coded(
+            codes::TOO_MANY_POINTS,
+            match parameter {
+                "search_step" => format!(
+                    "the sequential search would descend {} steps of {} mm at each point ({} mm, from a nose radius over the profile's highest point to one under its lowest), more than the {} lensc takes",
+                    about(count),
+                    small_mm(step),
+                    trim_num(span),
+                    crate::job::estimate::count(MAX_SEARCH_COUNT as f64)
+                ),
+                _ => format!(
+                    "the search would discretise the profile into {} points {} mm apart ({} mm), more than the {} lensc plans for one job",
+                    about(count),
+                    small_mm(step),
+                    trim_num(span),
+                    crate::job::estimate::count(MAX_SEARCH_COUNT as f64)
+                ),
+            },
+        )
+        .help(format!("make `{parameter}` coarser: the count scales with its inverse")),
         PlanError::Undefined { at_radius } => coded(
             codes::UNDEFINED_ON_PATH,
             format!(

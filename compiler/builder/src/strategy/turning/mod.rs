@@ -17,6 +17,7 @@ use lensc_runtime::plan::turning::{
 use lensc_runtime::post::Dialect;
 use lensc_runtime::surface::{SectionAlongX, SurfaceInfo};
 
+use crate::job::travel::{TravelAxis, part_beyond_travel};
 use crate::job::{Evaluate, JobHead, Parts};
 use lensc_grammar::{FileId, Span};
 use lensc_lang::check::trim_num;
@@ -79,6 +80,19 @@ pub(crate) fn lower(
         }
         None => None,
     };
+    // The part against the X travel before its profile is scanned: the
+    // cut runs in from `from` (the aperture's edge) to `to`.
+    let from = job
+        .strategy
+        .start_radius
+        .unwrap_or(job.surface.aperture_radius);
+    let radii = (
+        from.min(job.strategy.end_radius),
+        from.max(job.strategy.end_radius),
+    );
+    if let Some(e) = part_beyond_travel(p, TravelAxis::Radius, radii, job.tool.nose_radius) {
+        return Err(vec![e]);
+    }
     let lowered = p.lowered().map_err(|d| vec![d])?;
     // The checks the planner would make first, on the section it follows.
     let kernel = evaluate(&lowered.tape);
