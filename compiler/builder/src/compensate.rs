@@ -77,13 +77,15 @@ pub struct Compensation {
 }
 
 /// What a correction needs of its job: the job itself (where its file is,
-/// its root), its surface's name, its strategy's kind and its tool's
-/// radius (nose or ball), if it has one.
+/// its root), its surface's name, its strategy's kind, its tool's radius
+/// (nose or ball), if it has one, and an array's lenslets (whose rims
+/// may step onto the land).
 pub(crate) struct Of<'a> {
     pub job: &'a CheckedJob,
     pub surface_name: String,
     pub strategy_kind: &'static str,
     pub tool_radius: Option<f64>,
+    pub lenslets: Option<lensc_runtime::verify::lenslets::Lenslets>,
 }
 
 /// The kernel a correction is made with: the JIT, or the interpreter
@@ -191,6 +193,14 @@ pub(crate) fn corrected(
         from_job: true,
         ..measure::Options::default()
     };
+    // A map of an array whose rims step onto the land is registered clear
+    // of them, as `lensc measure` registers it.
+    let rims = match (&data, p.lenslets.as_ref()) {
+        (lensc_measure::Measured::Map(_), Some(l)) => {
+            crate::measure::steps::SteppedRims::of(f.as_ref(), l)
+        }
+        _ => None,
+    };
     let placed = measure::register_measurement(
         f.as_ref(),
         &design.domain,
@@ -199,7 +209,7 @@ pub(crate) fn corrected(
         data,
         format,
         &opts,
-        None,
+        rims.as_ref(),
     )
     .map_err(at)?;
     // Each measured point in the design's frame, with its error along z.
@@ -273,7 +283,13 @@ pub(crate) fn corrected(
         md5,
         points: placed.inside().len(),
         valid_share: placed.share,
-        registration: placed.registration_report(),
+        registration: {
+            let mut r = placed.registration_report();
+            if let (Some(rims), Some(band)) = (&rims, placed.clear_of_rims) {
+                r.method.push_str(&rims.words(band));
+            }
+            r
+        },
         measured_pv_nm: measured_pv * 1e6,
         measured_rms_nm: measured_rms * 1e6,
         gain: c.gain,
