@@ -20,7 +20,7 @@ use lensc_lang::value::Stated;
 use lensc_measure::correct::{self, Basis, Correction};
 use lensc_measure::read::TextUnits;
 use lensc_runtime::surface::analysis::{self, Domain};
-use lensc_runtime::surface::ir::{SurfaceTape, Var};
+use lensc_runtime::surface::ir::SurfaceTape;
 
 use crate::measure::placed::{self as measure, Failure, MAX_MEASUREMENT_BYTES};
 use lensc_lang::check::CheckedJob;
@@ -428,16 +428,11 @@ fn basis(domain: &Domain, radial: bool, smoothing: f64) -> (Basis, f64) {
 }
 
 /// The design's tape less `gain` × the correction, value and derivatives
-/// (the correction's derivatives taken by the graph, exactly).
+/// (the correction's own, exact: `Correction::nodes`).
 pub fn corrected_tape(design: &SurfaceTape, fitted: &Correction, gain: f64) -> SurfaceTape {
     let mut g = design.graph.clone();
     let (x, y) = (g.x(), g.y());
-    let c = fitted.node(&mut g, x, y, gain);
-    let cx = g.derivative(c, Var::X);
-    let cy = g.derivative(c, Var::Y);
-    let cxx = g.derivative(cx, Var::X);
-    let cxy = g.derivative(cx, Var::Y);
-    let cyy = g.derivative(cy, Var::Y);
+    let [c, cx, cy, cxx, cxy, cyy] = fitted.nodes(&mut g, x, y, gain);
     let o = design.outputs;
     let outputs = [
         g.sub(o[0], c),
