@@ -559,7 +559,8 @@ impl Correction {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Rays {
     order: usize,
-    /// Map: m_ab at a·(order + 1) + b. Radial: the section itself.
+    /// Map: m_ab (of x^a y^b) by degree, m_{a, k−a} at k(k + 1)/2 + a.
+    /// Radial: the section itself.
     m: Vec<f64>,
     radial: bool,
 }
@@ -606,9 +607,17 @@ impl Correction {
                         }
                     }
                 }
+                // By degree: the terms of u^k, m_{a, k−a} for a = 0..=k,
+                // one after another (`section` runs along them).
+                let mut by_degree = Vec::with_capacity((n + 1) * (n + 2) / 2);
+                for k in 0..=n {
+                    for a in 0..=k {
+                        by_degree.push(m[a * (n + 1) + (k - a)]);
+                    }
+                }
                 Some(Rays {
                     order: n,
-                    m,
+                    m: by_degree,
                     radial: false,
                 })
             }
@@ -632,10 +641,14 @@ impl Rays {
             cp[k] = cp[k - 1] * cos;
             sp[k] = sp[k - 1] * sin;
         }
+        let mut terms = self.m.as_slice();
         for (k, o) in out.iter_mut().enumerate().take(n + 1) {
+            let (row, rest) = terms.split_at(k + 1);
+            terms = rest;
             let mut h = 0.0;
-            for a in 0..=k {
-                h += self.m[a * (n + 1) + (k - a)] * cp[a] * sp[k - a];
+            // m_{a, k−a} cos^a θ sin^(k−a) θ, a = 0..=k.
+            for ((m, c), s) in row.iter().zip(&cp[..=k]).zip(sp[..=k].iter().rev()) {
+                h += m * c * s;
             }
             *o = scale * h;
         }
