@@ -338,11 +338,54 @@ pub fn register_heights_parallel(
     levenberg_marquardt(&|q, p, out| moved_and_evaluated(f, q, p, out), pts, opts)
 }
 
-/// `register_heights`, the surface evaluated by `eval`.
+/// A map of more points than this is first registered on every k-th
+/// point (k the least that brings it under), and that placement is the
+/// start of the registration on all of them: the valley along which a
+/// decentre trades against tilt (nearly one on an off-axis segment) is
+/// crawled on a quarter of the points or fewer, and the whole map's
+/// last few steps take the rest.
+pub const COARSE_POINTS: usize = 16_000;
+
+/// `register_heights`, the surface evaluated by `eval`: on a large map,
+/// on every k-th point first (`COARSE_POINTS`), then on all from there.
 fn levenberg_marquardt(
     eval: Evaluation,
     pts: &[[f64; 3]],
     opts: Options,
+) -> Result<Registration, RegisterError> {
+    let k = pts.len().div_ceil(COARSE_POINTS);
+    if k < 2 {
+        return levenberg_marquardt_on(eval, pts, opts, 1e-4);
+    }
+    let coarse: Vec<[f64; 3]> = pts.iter().step_by(k).copied().collect();
+    match levenberg_marquardt_on(eval, &coarse, opts, 1e-4) {
+        Ok(first) => {
+            // From the coarse placement, steps of Gauss–Newton's length
+            // are tried first (the damping is raised should one fail).
+            let mut fine = levenberg_marquardt_on(
+                eval,
+                pts,
+                Options {
+                    start: first.values,
+                    ..opts
+                },
+                1e-10,
+            )?;
+            fine.iterations += first.iterations;
+            Ok(fine)
+        }
+        // Whatever stopped the coarse fit, the whole map decides.
+        Err(_) => levenberg_marquardt_on(eval, pts, opts, 1e-4),
+    }
+}
+
+/// Levenberg–Marquardt on all of `pts` from the damping `lambda`, until
+/// a step moves the placement by less than `SETTLED` (`settled`).
+fn levenberg_marquardt_on(
+    eval: Evaluation,
+    pts: &[[f64; 3]],
+    opts: Options,
+    lambda: f64,
 ) -> Result<Registration, RegisterError> {
     let requested = if opts.two_d { 6 } else { 3 };
     if pts.len() <= requested {
@@ -368,7 +411,8 @@ fn levenberg_marquardt(
         iterations: it,
         method: "least squares on the heights (Levenberg-Marquardt, exact surface derivatives)",
     };
-    let mut lambda = 1e-4;
+    let extent = extent(pts);
+    let mut lambda = lambda;
     for it in 1..=opts.max_iterations {
         let Some(step) = damped_step(&a, &g, lambda, &on) else {
             lambda *= 10.0;
@@ -380,7 +424,9 @@ fn levenberg_marquardt(
         }
         let (ta, tg, tssr) = normal_equations(eval, pts, &trial, &mut buf)?;
         if tssr <= ssr {
-            let small = step_vanished(&step, &p, pts);
+            // Settled, unless damping alone made the step small.
+            let small = lambda <= NEAR_GAUSS_NEWTON && settled(&step, extent)
+                || step_vanished(&step, &p, pts);
             p = trial;
             (a, g) = (ta, tg);
             let gain = ssr - tssr;
@@ -390,11 +436,19 @@ fn levenberg_marquardt(
                 return Ok(found(p, it));
             }
         } else {
-            // A step that moves nothing that matters, or leaves the sum
+            // A step of Gauss–Newton's length (little damped) that moves
+            // nothing that matters (the placement, or the heights it
+            // predicts: `SETTLED` RMS), or any step that leaves the sum
             // within rounding of the best, and still does not lower it:
             // the best is the minimum as far as the sums can tell (more
-            // damping would only try smaller steps of the same).
-            if step_vanished(&step, &p, pts) || tssr - ssr <= 1e-15 * ssr + f64::MIN_POSITIVE {
+            // damping would only try smaller steps of the same). A step
+            // made small by damping alone says nothing of the minimum.
+            let near_gauss_newton = lambda <= NEAR_GAUSS_NEWTON;
+            if near_gauss_newton
+                && (settled(&step, extent) || moves_heights(&a, &step, pts.len()) < SETTLED)
+                || step_vanished(&step, &p, pts)
+                || tssr - ssr <= 1e-15 * ssr + f64::MIN_POSITIVE
+            {
                 return Ok(found(p, it));
             }
             lambda *= 10.0;
@@ -409,13 +463,55 @@ fn levenberg_marquardt(
     })
 }
 
-/// Whether a step moved nothing that matters: 1e-7 nm of piston or
-/// decentre, 1e-7 nm over the measured extent of tilt or clocking.
-fn step_vanished(step: &[f64; 6], _p: &[f64; 6], pts: &[[f64; 3]]) -> bool {
-    let extent = pts
-        .iter()
+/// A placement has settled when a step moves no point of the part by
+/// more than this (mm): 1 pm, a thousandth of the nanometre the
+/// registration is reported to, and far under any instrument's noise.
+/// (The steps along a decentre–tilt valley shrink by about a quarter
+/// each: the placement then lies within a picometre of where the steps
+/// would end.)
+pub const SETTLED: f64 = 1e-9;
+
+/// The most damping under which a rejected step is still taken as the
+/// one Gauss–Newton would make (its length within a thousandth of it,
+/// near enough to judge whether the placement still moves).
+const NEAR_GAUSS_NEWTON: f64 = 1e-3;
+
+/// The RMS (mm) by which a step moves the heights the placement
+/// predicts at the points, to first order: √(δᵀ JᵀJ δ / n).
+fn moves_heights(a: &[[f64; 6]; 6], step: &[f64; 6], n: usize) -> f64 {
+    let mut s = 0.0;
+    for m in 0..6 {
+        for k in 0..6 {
+            s += step[m] * a[m][k] * step[k];
+        }
+    }
+    (s.max(0.0) / n.max(1) as f64).sqrt()
+}
+
+/// The farthest a point lies from the origin along x or y (mm, at least
+/// 1 µm): what a tilt or clocking moves a point by, per radian.
+fn extent(pts: &[[f64; 3]]) -> f64 {
+    pts.iter()
         .map(|q| q[0].abs().max(q[1].abs()))
-        .fold(1e-3, f64::max);
+        .fold(1e-3, f64::max)
+}
+
+/// Whether a step moved the placement by less than `SETTLED`: piston
+/// and decentre themselves, tilt and clocking over the measured `extent`.
+fn settled(step: &[f64; 6], extent: f64) -> bool {
+    step[0].abs() < SETTLED
+        && step[1].abs() * extent < SETTLED
+        && step[2].abs() * extent < SETTLED
+        && step[3].abs() < SETTLED
+        && step[4].abs() < SETTLED
+        && step[5].abs() * extent < SETTLED
+}
+
+/// Whether a step moved nothing at all: 1e-7 nm of piston or decentre,
+/// 1e-7 nm over the measured extent of tilt or clocking (iterative
+/// closest point's rule, and Levenberg–Marquardt's however damped).
+fn step_vanished(step: &[f64; 6], _p: &[f64; 6], pts: &[[f64; 3]]) -> bool {
+    let extent = extent(pts);
     let tol = 1e-13; // mm
     step[0].abs() < tol
         && step[1].abs() * extent < tol

@@ -446,10 +446,11 @@ fn bad_measurements_are_coded_errors_at_the_compensate_block() {
     refused("nowhere.x3p", None, "0.5 mm", "E0103");
     refused("../outside.x3p", None, "0.5 mm", "E0107");
     // Heights in µm where X3P states metres: 1000 times the part, which
-    // no placement brings onto the design.
+    // no placement brings onto the design (the registration settles
+    // where it departs from the design by 0.1 m RMS: other units).
     let mut thousand = map(&part, 101, 0.06, 2.95, plain);
     thousand.z.iter_mut().for_each(|z| *z *= 1000.0);
-    refused("um.x3p", Some(&x3p(&thousand)), "0.5 mm", "E0365");
+    refused("um.x3p", Some(&x3p(&thousand)), "0.5 mm", "E0364");
     // Pixels in mm where the instrument meant µm: a map 6 m across.
     let mut wide = map(&part, 101, 0.06, 2.95, plain);
     (wide.dx, wide.dy) = (60.0, 60.0);

@@ -20,7 +20,7 @@ use lensc_lang::value::Stated;
 use lensc_measure::correct::{self, Basis, Correction};
 use lensc_measure::read::TextUnits;
 use lensc_runtime::surface::analysis::{self, Domain};
-use lensc_runtime::surface::ir::{SurfaceTape, Var};
+use lensc_runtime::surface::ir::SurfaceTape;
 
 use crate::measure::placed::{self as measure, Failure, MAX_MEASUREMENT_BYTES};
 use lensc_lang::check::CheckedJob;
@@ -77,13 +77,15 @@ pub struct Compensation {
 }
 
 /// What a correction needs of its job: the job itself (where its file is,
-/// its root), its surface's name, its strategy's kind and its tool's
-/// radius (nose or ball), if it has one.
+/// its root), its surface's name, its strategy's kind, its tool's radius
+/// (nose or ball), if it has one, and an array's lenslets (whose rims
+/// may step onto the land).
 pub(crate) struct Of<'a> {
     pub job: &'a CheckedJob,
     pub surface_name: String,
     pub strategy_kind: &'static str,
     pub tool_radius: Option<f64>,
+    pub lenslets: Option<lensc_runtime::verify::lenslets::Lenslets>,
 }
 
 /// The kernel a correction is made with: the JIT, or the interpreter
@@ -191,6 +193,14 @@ pub(crate) fn corrected(
         from_job: true,
         ..measure::Options::default()
     };
+    // A map of an array whose rims step onto the land is registered clear
+    // of them, as `lensc measure` registers it.
+    let rims = match (&data, p.lenslets.as_ref()) {
+        (lensc_measure::Measured::Map(_), Some(l)) => {
+            crate::measure::steps::SteppedRims::of(f.as_ref(), l)
+        }
+        _ => None,
+    };
     let placed = measure::register_measurement(
         f.as_ref(),
         &design.domain,
@@ -199,7 +209,7 @@ pub(crate) fn corrected(
         data,
         format,
         &opts,
-        None,
+        rims.as_ref(),
     )
     .map_err(at)?;
     // Each measured point in the design's frame, with its error along z.
@@ -273,7 +283,13 @@ pub(crate) fn corrected(
         md5,
         points: placed.inside().len(),
         valid_share: placed.share,
-        registration: placed.registration_report(),
+        registration: {
+            let mut r = placed.registration_report();
+            if let (Some(rims), Some(band)) = (&rims, placed.clear_of_rims) {
+                r.method.push_str(&rims.words(band));
+            }
+            r
+        },
         measured_pv_nm: measured_pv * 1e6,
         measured_rms_nm: measured_rms * 1e6,
         gain: c.gain,
@@ -412,16 +428,11 @@ fn basis(domain: &Domain, radial: bool, smoothing: f64) -> (Basis, f64) {
 }
 
 /// The design's tape less `gain` × the correction, value and derivatives
-/// (the correction's derivatives taken by the graph, exactly).
+/// (the correction's own, exact: `Correction::nodes`).
 pub fn corrected_tape(design: &SurfaceTape, fitted: &Correction, gain: f64) -> SurfaceTape {
     let mut g = design.graph.clone();
     let (x, y) = (g.x(), g.y());
-    let c = fitted.node(&mut g, x, y, gain);
-    let cx = g.derivative(c, Var::X);
-    let cy = g.derivative(c, Var::Y);
-    let cxx = g.derivative(cx, Var::X);
-    let cxy = g.derivative(cx, Var::Y);
-    let cyy = g.derivative(cy, Var::Y);
+    let [c, cx, cy, cxx, cxy, cyy] = fitted.nodes(&mut g, x, y, gain);
     let o = design.outputs;
     let outputs = [
         g.sub(o[0], c),

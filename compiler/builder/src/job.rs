@@ -448,6 +448,11 @@ impl<'a> Parts<'a> {
                 .tool_params
                 .nose_radius
                 .or(self.tool_params.diameter.map(|d| d / 2.0)),
+            lenslets: lensc_lang::lower::surface::array_cells(self.surface).and_then(
+                |(centres, aperture)| {
+                    lensc_runtime::verify::lenslets::Lenslets::new(centres, aperture)
+                },
+            ),
         };
         let (corrected, report, applied) = crate::compensate::corrected(&of, &design, c)?;
         *self.compensated.borrow_mut() = Some((design, report));
