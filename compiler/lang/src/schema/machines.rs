@@ -200,6 +200,12 @@ pub(super) const FTS_LATHE: Kind = Kind {
                     Check::Positive,
                     "settling band as a fraction of the step; default 0.002 (0.2 %)",
                 ),
+                opt(
+                    "feed_forward",
+                    Ty::Word(&["none", "inverse_model"]),
+                    Check::Any,
+                    "whether the controller leads the servo: `inverse_model` (it feeds the commanded velocity and acceleration forward through the servo's inverse model, so the servo follows the commanded path) or `none` (it does not: lensc writes the pre-compensated command, the inverse model applied to the path, and judges the servo unled on it); default none",
+                ),
             ]),
             Check::Any,
             "the fast tool servo (W axis) and its second-order model",
@@ -346,6 +352,10 @@ pub struct FastAxisParams {
     pub data_rate: Option<f64>,
     /// Settling band as a fraction of the step.
     pub settling_band: Option<f64>,
+    /// The controller leads the servo by its inverse model
+    /// (`feed_forward: inverse_model`); otherwise (`none`, the default)
+    /// the program must.
+    pub controller_leads: bool,
 }
 
 /// A slow tool servo's Z (`z_axis { … }`).
@@ -377,6 +387,7 @@ impl MachineParams {
                 damping: f.num("damping"),
                 data_rate: f.num("data_rate"),
                 settling_band: f.num("settling_band"),
+                controller_leads: f.word("feed_forward") == Some("inverse_model"),
             }),
             z_axis: r.block("z_axis", |z| ZAxisParams {
                 max_acceleration: z.required_num("max_acceleration"),

@@ -160,19 +160,29 @@ fn check(spec: &SpiralSpec, unit: Unit, speed: f64, lag_limit: Option<f64>) -> V
         edge: spec.edge.as_ref().map(|(m, _)| &m.profile),
         bounds,
     };
-    let (mut printed, resolution) = (Vec::new(), spec.head.resolution);
+    let resolution = spec.head.resolution;
+    let mut commands = super::servo::Commands::of(spec, data_rate);
     let planned = match following.as_mut() {
         Some(sim) => planner.check_with(&spec.fast_axis, |pts| {
-            super::servo::as_printed(pts, resolution, &mut printed);
-            sim.extend(&printed);
+            commands.next(pts);
+            commands.drive(sim, resolution);
         }),
         None => planner.check(&spec.fast_axis),
     };
+    if let (Some(sim), Ok(_)) = (following.as_mut(), &planned) {
+        commands.finish();
+        commands.drive(sim, resolution);
+    }
     match planned {
         Ok(_) => match (following, lag_limit) {
             (Some(sim), Some(limit)) => {
-                let lag = sim.finish().max_error;
-                if lag > limit {
+                let f = sim.finish();
+                let lag = f.max_error;
+                let most = spec.fast_axis.max_acceleration;
+                if super::servo::program_leads(spec) && f.max_acceleration > most {
+                    // The lead the program writes drives the servo too hard.
+                    Verdict::Fails(f.max_acceleration / most, None)
+                } else if lag > limit {
                     Verdict::Fails(lag / limit, Some(LagMissed { lag, limit }))
                 } else {
                     Verdict::Passes

@@ -1,6 +1,7 @@
 //! The spiral planner's errors in the words a user reads: the help names
 //! speeds in the kind the job gives them, and a refused acceleration
-//! carries what a search over the real check found (`advice`).
+//! carries what a search over the real check found (`advice`); a lead
+//! the program cannot give its servo is refused (`lead_refused`).
 use lensc_grammar::{Diagnostic, FileId, Span};
 use lensc_lang::check::trim_num;
 use lensc_lang::codes;
@@ -99,4 +100,44 @@ fn coded_error(
         }
         FtsError::Invalid(why) => coded(codes::UNSUPPORTED_COMBINATION, why.to_string()),
     }
+}
+
+/// Where the program leads the servo itself (`servo::program_leads`):
+/// E0192 if the commands it writes (lowest and highest, `range`, mm) span
+/// more than the servo's stroke, or drive the servo (as simulated,
+/// `followed`) beyond its acceleration limit.
+pub(crate) fn lead_refused(
+    spec: &super::SpiralSpec,
+    range: (f64, f64),
+    followed: Option<&lensc_runtime::verify::follow::Following>,
+) -> Option<Coded> {
+    let axis = &spec.fast_axis;
+    let help = "the servo has no feed-forward (`feed_forward: none`), so lensc writes the command that leads it, the path plus its velocity and acceleration through the servo's inverse model; that command is larger and faster than the path wherever the path's content nears the servo's natural frequency: lower the spindle or surface speed, or give the machine a servo its controller leads (`feed_forward: inverse_model`) if it has one";
+    let spread = range.1 - range.0;
+    if spread > axis.stroke {
+        return Some(
+            coded(
+                codes::LEAD_REFUSED,
+                format!(
+                    "the command that leads the fast axis spans {} um, more than its {} um stroke",
+                    um(spread),
+                    um(axis.stroke)
+                ),
+            )
+            .help(help),
+        );
+    }
+    let f = followed?;
+    (f.max_acceleration > axis.max_acceleration).then(|| {
+        coded(
+            codes::LEAD_REFUSED,
+            format!(
+                "the command that leads the fast axis drives it at {} m/s² (at r = {} mm), above its {} m/s² limit",
+                trim_num(f.max_acceleration / 1000.0),
+                trim_num(f.max_acceleration_at),
+                trim_num(axis.max_acceleration / 1000.0)
+            ),
+        )
+        .help(help)
+    })
 }

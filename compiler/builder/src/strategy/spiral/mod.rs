@@ -57,6 +57,10 @@ pub struct SpiralSpec {
     pub correction: Option<crate::compensate::Applied>,
     /// The fast axis's servo model (none for a slow tool servo).
     pub servo: Option<SecondOrderServo>,
+    /// The fast axis's controller leads its servo by the servo's inverse
+    /// model (`feed_forward: inverse_model`); otherwise the program does
+    /// (`servo::Commands`).
+    pub controller_leads: bool,
     pub settling: Option<Settling>,
     /// The fast axis's position (mm) clear of the part.
     pub safe_w: f64,
@@ -313,6 +317,7 @@ pub(crate) fn lower(
         trajectory_declared,
         correction,
         servo,
+        controller_leads: matches!(fast, Carrier::Servo(f) if f.controller_leads),
         settling,
         safe_w,
         lenslets: lenslets(surface),

@@ -1,0 +1,208 @@
+//! A fast tool servo whose controller feeds nothing forward (issue #29,
+//! `feed_forward: none`): lensc leads it itself, writing the command the
+//! servo needs, and the command as printed is what is judged. Here the
+//! tables two builds write are read back from their text and the servo run
+//! unled on each, as its machine would run it.
+
+use crate::common::{lensc, root, text};
+use lensc_runtime::machine::servo::SecondOrderServo;
+use lensc_runtime::plan::spiral::SpiralPoint;
+use lensc_runtime::verify::follow::{FollowingSimulation, RadialBins};
+
+/// Seed 003's 2 × 2 corner at a constant 300 rpm, its servo's controller
+/// leading it or not (`feed_forward`), with no settling plateau (so every
+/// move cuts), held to 100 nm of following error.
+fn job(feed_forward: &str) -> String {
+    format!(
+        "surface lenslet = sphere {{ radius: 20 mm, sense: concave, aperture: circle(diameter: 1.7 mm) }}
+surface corner = grid(lenslet, pitch_x: 3.5 mm, pitch_y: 3.5 mm, count_x: 2, count_y: 2)
+use std::machines::nanoform_x_fts5000
+use std::tools::diamond_r496um
+machine servo = nanoform_x_fts5000 {{ fast_axis: {{ stroke: 5 mm, max_acceleration: 25 G, resonance: 1367 Hz, resonant_peak: 1.0, data_rate: 20 kHz, feed_forward: {feed_forward} }} }}
+strategy s = fts_spiral {{ feed: 50 um/rev, spindle_speed: 300 rpm, settle: none, chord_tolerance: 50 nm }}
+job corner {{ surface: corner, tool: diamond_r496um, machine: servo, strategy: s, accept: {{ form_pv: 200 nm, form_rms: 10 nm, max_residual: 200 nm, max_following_error: 100 nm }} }}
+"
+    )
+}
+
+/// Builds `source` with the table-writing dialect: the exit code, the
+/// table's rows (C in degrees, X, W in mm), the program's header and the
+/// report.
+fn build(source: &str) -> (i32, Vec<[f64; 3]>, String, serde_json::Value) {
+    let dir = tempfile::tempdir().expect("tmp");
+    let file = dir.path().join("corner.lens");
+    std::fs::write(&file, source).expect("write");
+    let out = lensc(
+        &root(),
+        &[
+            "build",
+            file.to_str().expect("utf8"),
+            "--dialect",
+            "ultra_precision_lathe_gcode",
+            "--accept",
+            "warn",
+            "--out",
+            dir.path().to_str().expect("utf8"),
+        ],
+    );
+    let code = out.status.code().unwrap_or(-1);
+    let read = |name: &str| std::fs::read_to_string(dir.path().join(name));
+    let table = read("corner.fts").unwrap_or_else(|_| panic!("{}", text(&out.stderr)));
+    let rows = table
+        .lines()
+        .filter_map(|l| {
+            let v: Vec<f64> = l
+                .split_whitespace()
+                .map(|w| w.parse::<f64>())
+                .collect::<Result<_, _>>()
+                .ok()?;
+            (v.len() == 3).then(|| [v[0], v[1], v[2]])
+        })
+        .collect();
+    let report = serde_json::from_str(&read("corner.report.json").expect("report")).expect("json");
+    (code, rows, read("corner.nc").expect("program"), report)
+}
+
+/// The rows as the servo takes them: at 300 rpm, C (degrees from the
+/// start) is the time.
+fn points(rows: &[[f64; 3]]) -> Vec<SpiralPoint> {
+    let per_degree = 60.0 / 300.0 / 360.0;
+    rows.iter()
+        .map(|&[c, x, w]| SpiralPoint {
+            x,
+            c: c.to_radians(),
+            w,
+            t: c * per_degree,
+        })
+        .collect()
+}
+
+/// The largest |servo position − path| (mm) of the servo, unled, driven
+/// by `commands`, the path being `path` (the same points' W).
+fn unled_error(commands: &[SpiralPoint], path: &[SpiralPoint]) -> f64 {
+    let servo = SecondOrderServo::from_resonance(1367.0, 1.0).expect("servo");
+    let mut sim =
+        FollowingSimulation::new(&servo, 20e3, &[], RadialBins::new(0.0, 5.0, 10)).expect("valid");
+    let aims: Vec<f64> = path.iter().map(|p| p.w).collect();
+    sim.extend_toward(commands, &aims);
+    sim.finish().max_error
+}
+
+fn following_nm(report: &serde_json::Value) -> f64 {
+    report["simulation"]["max_following_error_nm"]["value"]
+        .as_f64()
+        .expect("following error")
+}
+
+#[test]
+fn a_servo_without_feed_forward_is_led_by_the_table_and_judged_from_its_text() {
+    let (ctl_code, ctl_rows, ctl_header, ctl_report) = build(&job("inverse_model"));
+    let (code, rows, header, report) = build(&job("none"));
+    assert_eq!(ctl_code, 0, "{ctl_report}");
+    assert_eq!(code, 0, "{report}");
+    // Same spiral, with points added a data period beside its bends.
+    assert!(
+        rows.len() > ctl_rows.len(),
+        "{} {}",
+        rows.len(),
+        ctl_rows.len()
+    );
+    let (path, led) = (points(&ctl_rows), points(&rows));
+    // The path under each of the led table's rows: the controller-led
+    // table (the path itself) at the row's time, linear between its rows.
+    let under: Vec<SpiralPoint> = led
+        .iter()
+        .map(|p| {
+            let i = path
+                .partition_point(|q| q.t <= p.t)
+                .clamp(1, path.len() - 1);
+            let (a, b) = (path[i - 1], path[i]);
+            let f = if b.t > a.t {
+                ((p.t - a.t) / (b.t - a.t)).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            SpiralPoint {
+                w: a.w + f * (b.w - a.w),
+                ..*p
+            }
+        })
+        .collect();
+    // The path's own table, run on a servo with no feed-forward, misses
+    // the 100 nm four times over (420 nm); the table lensc leads it by
+    // keeps it (62 nm; the controller's lead, 32 nm).
+    let unled = unled_error(&path, &path);
+    let by_table = unled_error(&led, &under);
+    eprintln!(
+        "unled on the path {} nm, on the led table {} nm; reported {} nm (controller-led {} nm)",
+        unled * 1e6,
+        by_table * 1e6,
+        following_nm(&report),
+        following_nm(&ctl_report)
+    );
+    assert!(unled > 4.0 * 100e-6, "{unled}");
+    assert!(by_table < 100e-6, "{by_table}");
+    // The report's figure is the one the text gives (to the nanometre the
+    // table prints; the report's simulation starts from the same rows).
+    assert!((following_nm(&report) - by_table * 1e6).abs() < 1.0);
+    // The header (and with it the set-up sheet) says who leads the servo.
+    assert!(
+        header.contains("feed_forward none: the servo led by this program"),
+        "{header}"
+    );
+    assert!(
+        ctl_header.contains("feed_forward inverse_model: the servo led by its controller"),
+        "{ctl_header}"
+    );
+}
+
+#[test]
+fn a_lead_beyond_the_servo_is_refused() {
+    // The same corner on a servo of 20 Hz with a 50 µm stroke: the path
+    // spans less than the stroke, and a controller that leads the servo
+    // is given the path; a servo with no feed-forward needs a lead that
+    // spans far more (E0192), and nothing is written.
+    let slow = |ff: &str| {
+        job(ff)
+            .replace(
+                "machine servo = nanoform_x_fts5000 {",
+                "machine servo = fts_lathe { dialect: ultra_precision_lathe_gcode, resolution: 1 nm, travel: { x: -10 mm .. 220 mm, z: -150 mm .. 150 mm }, max_feed: 1000 mm/min, spindle: { max_speed: 1000 rpm },",
+            )
+            .replace("stroke: 5 mm", "stroke: 50 um")
+            .replace(
+                "resonance: 1367 Hz, resonant_peak: 1.0",
+                "natural_frequency: 20 Hz, damping: 0.5",
+            )
+            .replace("max_following_error: 100 nm", "max_following_error: 1 mm")
+    };
+    let run = |ff: &str| {
+        let dir = tempfile::tempdir().expect("tmp");
+        let file = dir.path().join("corner.lens");
+        std::fs::write(&file, slow(ff)).expect("write");
+        let out = lensc(
+            &root(),
+            &[
+                "build",
+                file.to_str().expect("utf8"),
+                "--accept",
+                "warn",
+                "--out",
+                dir.path().to_str().expect("utf8"),
+            ],
+        );
+        (
+            out.status.code(),
+            text(&out.stderr),
+            dir.path().join("corner.nc").exists(),
+        )
+    };
+    let (code, said, written) = run("inverse_model");
+    assert_eq!((code, written), (Some(0), true), "{said}");
+    let (code, said, written) = run("none");
+    assert_eq!(code, Some(1), "{said}");
+    assert!(
+        said.contains("E0192") && said.contains("more than its 50 um stroke"),
+        "{said}"
+    );
+    assert!(!written);
+}
