@@ -206,3 +206,76 @@ fn a_lead_beyond_the_servo_is_refused() {
     );
     assert!(!written);
 }
+
+/// Builds `source` (as `corner.lens`) in its machine's own dialect: the
+/// exit code, what it said and the program written, if any.
+fn build_own(source: &str) -> (Option<i32>, String, Option<String>) {
+    let dir = tempfile::tempdir().expect("tmp");
+    let file = dir.path().join("corner.lens");
+    std::fs::write(&file, source).expect("write");
+    let out = lensc(
+        &root(),
+        &[
+            "build",
+            file.to_str().expect("utf8"),
+            "--color",
+            "never",
+            "--accept",
+            "warn",
+            "--out",
+            dir.path().to_str().expect("utf8"),
+        ],
+    );
+    let program = std::fs::read_to_string(dir.path().join("corner.ngc")).ok();
+    (out.status.code(), text(&out.stderr), program)
+}
+
+#[test]
+fn a_lead_faster_than_the_machine_s_feed_is_refused_with_the_speed_that_fits() {
+    // The corner on the standard library's servo lathe, whose dialect
+    // (LinuxCNC) programs the fast axis on Z, each move held by the
+    // controller to the machine's 1000 mm/min: at 5 m/min the lead's
+    // moves beside the lenslets' rims would run at 1034.6 mm/min (the
+    // read-back refused it, E0314, before the plan measured them).
+    let job = |speed: &str| {
+        format!(
+            "surface lenslet = sphere {{ radius: 20 mm, sense: concave, aperture: circle(diameter: 1.7 mm) }}
+surface corner = grid(lenslet, pitch_x: 3.5 mm, pitch_y: 3.5 mm, count_x: 2, count_y: 2)
+use std::machines::nanoform_x_fts5000
+use std::tools::diamond_r496um
+strategy coarse = fts_spiral {{ feed: 50 um/rev, surface_speed: {speed} m/min, spindle_cap: 1000 rpm, settling_time: 1 ms, chord_tolerance: 50 nm }}
+job corner {{ surface: corner, tool: diamond_r496um, machine: nanoform_x_fts5000, strategy: coarse, accept: none }}
+"
+        )
+    };
+    let (code, said, program) = build_own(&job("5"));
+    assert_eq!(code, Some(1), "{said}");
+    assert!(program.is_none(), "nothing is written");
+    assert!(
+        said.contains("E0192")
+            && said.contains("the command that leads the fast axis")
+            && said.contains("above the machine's `max_feed` of 1000 mm/min"),
+        "{said}"
+    );
+    // The move's feed, as the plan measured it.
+    let feed: f64 = said
+        .split("written on Z, at ")
+        .nth(1)
+        .and_then(|s| s.split(" mm/min").next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("{said}"));
+    assert!(feed > 1000.0 && feed < 1100.0, "{feed}");
+    // The speed the help names, planned and checked: built at it, every
+    // move fits, and the read-back (the controller's view) passes it.
+    let advised = said
+        .split("a surface speed of ")
+        .nth(1)
+        .and_then(|s| s.split(" m/min").next())
+        .unwrap_or_else(|| panic!("{said}"));
+    let speed: f64 = advised.parse().expect("a speed");
+    assert!(speed < 5.0 && speed > 4.0, "{speed}");
+    let (code, said, program) = build_own(&job(advised));
+    assert_eq!(code, Some(0), "{said}");
+    let program = program.expect("written");
+    assert!(program.contains("G93"), "inverse time");
+}

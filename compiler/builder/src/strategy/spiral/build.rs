@@ -189,6 +189,14 @@ pub(super) fn build(spec: &SpiralSpec, cx: &BuildContext) -> Result<Built, Vec<D
     if spec.edge.is_none() {
         across_axis(sweep.path(), &near_axis);
     }
+    // Every move written as a move within the machine's feed (the lead's
+    // short moves beside a bend are the fastest).
+    if let Some(fastest) = commands.over_max_feed(spec) {
+        let advice = super::advice::search_feed(spec, fastest.0);
+        return Err(vec![
+            super::errors::feed_refused(spec, fastest, advice).at(site),
+        ]);
+    }
     let mut sink = sink.written(head)?;
     if let Some(t) = table_sink.as_mut() {
         t.push(program.take_table_text());

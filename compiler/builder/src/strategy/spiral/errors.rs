@@ -51,42 +51,7 @@ fn coded_error(
             max,
             at_radius,
         } => {
-            let words = |v: f64| match speed {
-                SpindleSpeed::Constant(_) => format!("{} rpm", rpm(v)),
-                SpindleSpeed::SurfaceSpeed { .. } => format!("{} m/min", trim_num(v * 0.06)),
-            };
-            let kind = match speed {
-                SpindleSpeed::Constant(_) => "spindle speed",
-                SpindleSpeed::SurfaceSpeed { .. } => "surface speed",
-            };
-            let help = match advice {
-                Some(SpeedAdvice::Found {
-                    passes,
-                    fails,
-                    lag: None,
-                }) => format!(
-                    "the highest speed found that respects it is a {kind} of {} (planned and checked; {} is refused)",
-                    words(passes),
-                    words(fails)
-                ),
-                Some(SpeedAdvice::Found {
-                    passes,
-                    fails,
-                    lag: Some(l),
-                }) => format!(
-                    "the highest speed found that respects it is a {kind} of {} (planned and checked; {} is refused); there the servo lags {} nm, over the job's {} nm `max_following_error`: state `max_following_error: {} nm` to accept the lag, or lower the speed further (the lag falls about in proportion)",
-                    words(passes),
-                    words(fails),
-                    trim_num((l.lag * 1e7).round() / 10.0),
-                    trim_num(l.limit * 1e6),
-                    trim_num(super::advice::accepted_lag_nm(l.lag))
-                ),
-                Some(SpeedAdvice::NotFound { lowest_tried }) => format!(
-                    "no {kind} tried respects it, down to {}: the acceleration does not fall with the speed there (a spindle cap, or the path itself)",
-                    words(lowest_tried)
-                ),
-                None => format!("lower the {kind}"),
-            };
+            let help = advice_help(speed, advice, "the acceleration");
             coded(
                 codes::ACCELERATION_EXCEEDED,
                 format!(
@@ -140,4 +105,83 @@ pub(crate) fn lead_refused(
         )
         .help(help)
     })
+}
+
+/// The help of a refusal a slower spindle cures: the speed a search
+/// found (`advice`), in the kind the job gives (`speed`); `what` is
+/// the figure over its limit.
+fn advice_help(speed: &SpindleSpeed, advice: Option<SpeedAdvice>, what: &str) -> String {
+    let words = |v: f64| match speed {
+        SpindleSpeed::Constant(_) => format!("{} rpm", rpm(v)),
+        SpindleSpeed::SurfaceSpeed { .. } => format!("{} m/min", trim_num(v * 0.06)),
+    };
+    let kind = match speed {
+        SpindleSpeed::Constant(_) => "spindle speed",
+        SpindleSpeed::SurfaceSpeed { .. } => "surface speed",
+    };
+    match advice {
+        Some(SpeedAdvice::Found {
+            passes,
+            fails,
+            lag: None,
+        }) => format!(
+            "the highest speed found that respects it is a {kind} of {} (planned and checked; {} is refused)",
+            words(passes),
+            words(fails)
+        ),
+        Some(SpeedAdvice::Found {
+            passes,
+            fails,
+            lag: Some(l),
+        }) => format!(
+            "the highest speed found that respects it is a {kind} of {} (planned and checked; {} is refused); there the servo lags {} nm, over the job's {} nm `max_following_error`: state `max_following_error: {} nm` to accept the lag, or lower the speed further (the lag falls about in proportion)",
+            words(passes),
+            words(fails),
+            trim_num((l.lag * 1e7).round() / 10.0),
+            trim_num(l.limit * 1e6),
+            trim_num(super::advice::accepted_lag_nm(l.lag))
+        ),
+        Some(SpeedAdvice::NotFound { lowest_tried }) => format!(
+            "no {kind} tried respects it, down to {}: {what} does not fall with the speed there (a spindle cap, or the path itself)",
+            words(lowest_tried)
+        ),
+        None => format!("lower the {kind}"),
+    }
+}
+
+/// E0192 where the program writes the surface's axis as moves
+/// (`servo::writes_moves`) and the fastest of them (`fastest`: its feed,
+/// mm/s, and radius, mm) feeds above the machine's `max_feed`: the
+/// controller holds every move to the axis's velocity limit, so that move
+/// would run slower than planned, late against the spindle. `advice`:
+/// the speed a search found at which every move fits.
+pub(crate) fn feed_refused(
+    spec: &super::SpiralSpec,
+    fastest: (f64, f64),
+    advice: SpeedAdvice,
+) -> Coded {
+    let (feed, at) = fastest;
+    let led = if super::servo::program_leads(spec) {
+        "the command that leads the fast axis (the path through the servo's inverse model, `feed_forward: none`)"
+    } else {
+        "the surface's axis"
+    };
+    let axis = if spec.slow {
+        "Z"
+    } else {
+        "the fast axis, written on Z,"
+    };
+    coded(
+        codes::LEAD_REFUSED,
+        format!(
+            "{led} moves {axis} at {} mm/min (at r = {} mm), above the machine's `max_feed` of {} mm/min",
+            trim_num((feed * 60.0 * 10.0).round() / 10.0),
+            trim_num((at * 1e4).round() / 1e4),
+            trim_num(spec.max_feed * 60.0)
+        ),
+    )
+    .help(format!(
+        "the controller holds every move to the axis's velocity limit, so this move would run late against the spindle; {}",
+        advice_help(&spec.spiral.speed, Some(advice), "the feed")
+    ))
 }

@@ -73,6 +73,10 @@ pub struct SpiralSpec {
     /// The machine's spindle limit (rad/s): no move of the program may
     /// turn C faster, as printed.
     pub max_spindle_speed: f64,
+    /// The machine's fastest feed (mm/s): where the program writes the
+    /// surface's axis as moves (no servo table), no move it writes, led or
+    /// not, may be faster (`servo::Commands::fastest`).
+    pub max_feed: f64,
 }
 
 /// A spiral job at another speed: what a search for the highest speed
@@ -323,6 +327,7 @@ pub(crate) fn lower(
         lenslets: lenslets(surface),
         surface_object: surface.clone(),
         max_spindle_speed: p.max_spindle_speed(),
+        max_feed: p.machine_params.max_feed,
     })
 }
 

@@ -35,6 +35,14 @@ pub(super) fn program_leads(spec: &SpiralSpec) -> bool {
     !spec.slow && spec.servo.is_some() && !spec.controller_leads
 }
 
+/// Whether the program writes the axis that carries the surface as its
+/// own moves, each held to the machine's `max_feed` by the controller
+/// (LinuxCNC programs the fast axis on Z), rather than into a servo table
+/// beside it.
+pub(super) fn writes_moves(spec: &SpiralSpec) -> bool {
+    spec.slow || spec.head.dialect.fts_table.is_none()
+}
+
 /// The commands a spiral's points are printed as, batch by batch: the
 /// planned path, or where the program leads the servo
 /// (`program_leads`), the path led by the servo's inverse model, a point
@@ -49,6 +57,13 @@ pub(super) struct Commands {
     aims: Vec<f64>,
     /// The lowest and highest command (mm) led so far.
     pub range: (f64, f64),
+    /// The fastest move between two commands as printed so far: its feed
+    /// (mm/s, its X and W travel over its planned time, as the controller
+    /// reads an inverse-time move) and radius (mm).
+    pub fastest: Option<(f64, f64)>,
+    /// The last command as printed, the start of the next move.
+    last: Option<lensc_runtime::plan::spiral::SpiralPoint>,
+    resolution: f64,
 }
 
 impl Commands {
@@ -65,6 +80,9 @@ impl Commands {
             printed: Vec::new(),
             aims: Vec::new(),
             range: (f64::INFINITY, f64::NEG_INFINITY),
+            fastest: None,
+            last: None,
+            resolution,
         }
     }
 
@@ -74,7 +92,7 @@ impl Commands {
         let Some(lead) = self.lead.as_mut() else {
             self.path.extend_from_slice(points);
             self.commands.clone_from(&self.path);
-            return;
+            return self.account();
         };
         lead.extend(points, &mut self.commands, &mut self.path);
         self.account();
@@ -95,6 +113,31 @@ impl Commands {
         for c in &self.commands {
             self.range = (self.range.0.min(c.w), self.range.1.max(c.w));
         }
+        // Each move's feed from the positions as printed (rounded to the
+        // resolution, as the controller reads them) over its planned time:
+        // the program never prints a move faster than planned
+        // (`inverse_time_not_faster`), so the controller's feed is at most
+        // this.
+        as_printed(&self.commands, self.resolution, &mut self.printed);
+        for q in &self.printed {
+            if let Some(p) = self.last
+                && q.t > p.t
+            {
+                let feed = (q.x - p.x).hypot(q.w - p.w) / (q.t - p.t);
+                if self.fastest.is_none_or(|(f, _)| feed > f) {
+                    self.fastest = Some((feed, q.x.abs()));
+                }
+            }
+            self.last = Some(*q);
+        }
+    }
+
+    /// The fastest move's feed (mm/s) and radius where it is above the
+    /// machine's `max_feed` and the program writes the surface's axis as
+    /// moves (`writes_moves`).
+    pub fn over_max_feed(&self, spec: &SpiralSpec) -> Option<(f64, f64)> {
+        self.fastest
+            .filter(|&(feed, _)| writes_moves(spec) && feed > spec.max_feed)
     }
 
     /// Runs `sim` on the batch's commands as printed (at `resolution`,
