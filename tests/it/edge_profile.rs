@@ -230,19 +230,29 @@ const STS: (&str, &str) = (
     "moore_nanotech_450fg",
     "spiral_turning { feed: 10 um/rev, spindle_speed: 50 rpm, chord_tolerance: 2 nm }",
 );
+// Its controller leads the servo (`feed_forward: inverse_model`, as
+// machine `led`): the table's W is then the path, which this test sweeps
+// as the nose's. Where lensc leads the servo itself the table holds the
+// led command, the servo's input and not where the nose goes
+// (tests/it/servo_lead.rs judges that table through the servo).
 const FTS: (&str, &str) = (
     "nanoform_x_fts5000",
-    "fts_spiral { feed: 10 um/rev, spindle_speed: 300 rpm, chord_tolerance: 2 nm }",
+    "fts_spiral { feed: 10 um/rev, spindle_speed: 300 rpm, chord_tolerance: 2 nm }
+machine led = nanoform_x_fts5000 { fast_axis: { stroke: 5 mm, max_acceleration: 25 G, resonance: 1367 Hz, resonant_peak: 1.0, data_rate: 20 kHz, feed_forward: inverse_model } }",
 );
 
 /// TILTED on `machine` with `strategy`, its tool given `tool`, and the
 /// edge's file.
 fn spiral_project((machine, strategy): (&str, &str), tool: &str) -> tempfile::TempDir {
     let dir = tempfile::tempdir().expect("tmp");
-    let job = TILTED
+    let mut job = TILTED
         .replace("MACHINE", machine)
         .replace("STRATEGY", strategy)
         .replace("TOOL", tool);
+    // A strategy that brings its own machine (`led`) is cut on it.
+    if strategy.contains("\nmachine led = ") {
+        job = job.replace(&format!("machine: {machine},"), "machine: led,");
+    }
     std::fs::write(dir.path().join("job.lens"), job).expect("write");
     std::fs::write(dir.path().join("edge.txt"), wavy_text()).expect("write");
     dir

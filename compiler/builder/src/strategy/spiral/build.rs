@@ -166,7 +166,7 @@ pub(super) fn build(spec: &SpiralSpec, cx: &BuildContext) -> Result<Built, Vec<D
         commands.finish();
         write(&mut commands, 0);
     }
-    let summary = planned.map_err(|error| {
+    let mut summary = planned.map_err(|error| {
         let advice = match error {
             FtsError::AccelerationExceeded { acceleration, .. } => {
                 Some(super::advice::search(spec, acceleration))
@@ -189,6 +189,9 @@ pub(super) fn build(spec: &SpiralSpec, cx: &BuildContext) -> Result<Built, Vec<D
     if spec.edge.is_none() {
         across_axis(sweep.path(), &near_axis);
     }
+    // The points the program cuts: the planned path's, and the lead's
+    // added beside its bends.
+    summary.points = commands.written;
     // Every move written as a move within the machine's feed (the lead's
     // short moves beside a bend are the fastest).
     if let Some(fastest) = commands.over_max_feed(spec) {

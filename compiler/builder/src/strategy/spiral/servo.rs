@@ -64,6 +64,9 @@ pub(super) struct Commands {
     /// The last command as printed, the start of the next move.
     last: Option<lensc_runtime::plan::spiral::SpiralPoint>,
     resolution: f64,
+    /// The commands made so far: the points the program cuts, the lead's
+    /// added points beside bends included.
+    pub written: usize,
 }
 
 impl Commands {
@@ -83,6 +86,7 @@ impl Commands {
             fastest: None,
             last: None,
             resolution,
+            written: 0,
         }
     }
 
@@ -110,6 +114,7 @@ impl Commands {
     }
 
     fn account(&mut self) {
+        self.written += self.commands.len();
         for c in &self.commands {
             self.range = (self.range.0.min(c.w), self.range.1.max(c.w));
         }
