@@ -17,6 +17,11 @@
 //! A parameter the data cannot determine is not fitted, and the result
 //! says so: clocking on a surface of revolution (its column vanishes),
 //! decentre against tilt on a sphere (one is the other), y on a profile.
+//!
+//! `register_heights_parallel` evaluates the surface on every core, over
+//! fixed chunks of the points; the normal equations are summed on one
+//! thread in the points' order, so its registration is `register_heights`'s
+//! bit for bit, however many threads there are.
 
 use lensc_runtime::surface::ir::SurfaceFn;
 use nalgebra::{DMatrix, DVector};
@@ -80,6 +85,11 @@ pub struct Options {
     /// Fit the y parameters (tilt, decentre) and clocking (false for a
     /// profile along x).
     pub two_d: bool,
+    /// The placement to start from, in the order of `PARAMETERS` (zero
+    /// unless given): a registration carried on from one found before.
+    /// Its piston is moved by the mean height difference there first;
+    /// a parameter that is not fitted starts (and stays) at zero.
+    pub start: [f64; 6],
 }
 
 impl Default for Options {
@@ -87,6 +97,7 @@ impl Default for Options {
         Options {
             max_iterations: 60,
             two_d: true,
+            start: [0.0; 6],
         }
     }
 }
@@ -129,16 +140,68 @@ type Normal = ([[f64; 6]; 6], [f64; 6], f64);
 /// Which parameters are fitted, and why the others are not.
 type Freedom = ([bool; 6], Vec<(&'static str, &'static str)>);
 
-/// Normal equations at `p`: JᵀJ, Jᵀr and Σr², with J = ∂h/∂p.
-fn normal_equations(
+/// The points a registration moves and evaluates together, on one
+/// thread: the chunks are fixed by the points alone, never by the number
+/// of threads.
+pub const CHUNK: usize = 4096;
+
+/// The surface (six outputs a point) at each point moved by `p`, into
+/// `out`, with the moved (u, v): the points' fixed chunks moved and
+/// evaluated in parallel. Each point's figures are its own (no sum runs
+/// across points), so they are the same bits on one thread or many.
+pub fn moved_and_evaluated(
+    f: &(dyn SurfaceFn + Sync),
+    pts: &[[f64; 3]],
+    p: &[f64; 6],
+    out: &mut Vec<f64>,
+) -> (Vec<f64>, Vec<f64>) {
+    use rayon::prelude::*;
+    let (mut us, mut vs) = (vec![0.0; pts.len()], vec![0.0; pts.len()]);
+    out.resize(6 * pts.len(), 0.0);
+    pts.par_chunks(CHUNK)
+        .zip(us.par_chunks_mut(CHUNK))
+        .zip(vs.par_chunks_mut(CHUNK))
+        .zip(out.par_chunks_mut(6 * CHUNK))
+        .for_each(|(((q, u), v), o)| {
+            // As `moved`, point by point.
+            let (s, c) = p[5].sin_cos();
+            for (k, q) in q.iter().enumerate() {
+                let (x, y) = (q[0] - p[3], q[1] - p[4]);
+                (u[k], v[k]) = (c * x + s * y, -s * x + c * y);
+            }
+            f.eval_batch(u, v, o);
+        });
+    (us, vs)
+}
+
+/// How a registration evaluates the surface at the points moved by a
+/// placement: the six outputs a point into the buffer, and the moved
+/// (u, v).
+type Evaluation<'a> = &'a dyn Fn(&[[f64; 3]], &[f64; 6], &mut Vec<f64>) -> (Vec<f64>, Vec<f64>);
+
+/// The surface at the points moved by `p`, on this thread: one batch.
+fn evaluated(
     f: &dyn SurfaceFn,
+    pts: &[[f64; 3]],
+    p: &[f64; 6],
+    out: &mut Vec<f64>,
+) -> (Vec<f64>, Vec<f64>) {
+    let (us, vs) = moved(pts, p);
+    out.resize(6 * pts.len(), 0.0);
+    f.eval_batch(&us, &vs, out);
+    (us, vs)
+}
+
+/// Normal equations at `p`: JᵀJ, Jᵀr and Σr², with J = ∂h/∂p. The sums
+/// run over the points in their order on one thread, so the equations
+/// are the same bits however the surface was evaluated (`Evaluation`).
+fn normal_equations(
+    eval: Evaluation,
     pts: &[[f64; 3]],
     p: &[f64; 6],
     buf: &mut Vec<f64>,
 ) -> Result<Normal, RegisterError> {
-    let (us, vs) = moved(pts, p);
-    buf.resize(6 * pts.len(), 0.0);
-    f.eval_batch(&us, &vs, buf);
+    let (us, vs) = eval(pts, p, buf);
     let (s, c) = p[5].sin_cos();
     let mut a = [[0.0; 6]; 6];
     let mut g = [0.0; 6];
@@ -261,17 +324,42 @@ pub fn register_heights(
     pts: &[[f64; 3]],
     opts: Options,
 ) -> Result<Registration, RegisterError> {
+    levenberg_marquardt(&|q, p, out| evaluated(f, q, p, out), pts, opts)
+}
+
+/// `register_heights` with the surface evaluated on every core, the
+/// points in fixed chunks (`moved_and_evaluated`): the same registration,
+/// bit for bit, however many threads there are.
+pub fn register_heights_parallel(
+    f: &(dyn SurfaceFn + Sync),
+    pts: &[[f64; 3]],
+    opts: Options,
+) -> Result<Registration, RegisterError> {
+    levenberg_marquardt(&|q, p, out| moved_and_evaluated(f, q, p, out), pts, opts)
+}
+
+/// `register_heights`, the surface evaluated by `eval`.
+fn levenberg_marquardt(
+    eval: Evaluation,
+    pts: &[[f64; 3]],
+    opts: Options,
+) -> Result<Registration, RegisterError> {
     let requested = if opts.two_d { 6 } else { 3 };
     if pts.len() <= requested {
         return Err(RegisterError::TooFewPoints { points: pts.len() });
     }
     let mut buf = Vec::new();
-    let mut p = [0.0; 6];
+    let mut p = opts.start;
     // The piston to start from: the mean height difference.
-    let (a0, g0, _) = normal_equations(f, pts, &p, &mut buf)?;
+    let (a0, g0, _) = normal_equations(eval, pts, &p, &mut buf)?;
     let (on, left_out) = determinable(&a0, opts.two_d);
-    p[0] = g0[0] / a0[0][0];
-    let (mut a, mut g, mut ssr) = normal_equations(f, pts, &p, &mut buf)?;
+    p[0] += g0[0] / a0[0][0];
+    for k in 1..6 {
+        if !on[k] {
+            p[k] = 0.0;
+        }
+    }
+    let (mut a, mut g, mut ssr) = normal_equations(eval, pts, &p, &mut buf)?;
     let mut lambda = 1e-4;
     for it in 1..=opts.max_iterations {
         let Some(step) = damped_step(&a, &g, lambda, &on) else {
@@ -282,7 +370,7 @@ pub fn register_heights(
         for k in 0..6 {
             trial[k] += step[k];
         }
-        let (ta, tg, tssr) = normal_equations(f, pts, &trial, &mut buf)?;
+        let (ta, tg, tssr) = normal_equations(eval, pts, &trial, &mut buf)?;
         if tssr <= ssr {
             let small = step_vanished(&step, &p, pts);
             p = trial;
@@ -300,6 +388,19 @@ pub fn register_heights(
                 });
             }
         } else {
+            // A step that moves nothing that matters, or leaves the sum
+            // within rounding of the best, and still does not lower it:
+            // the best is the minimum as far as the sums can tell (more
+            // damping would only try smaller steps of the same).
+            if step_vanished(&step, &p, pts) || tssr - ssr <= 1e-15 * ssr + f64::MIN_POSITIVE {
+                return Ok(Registration {
+                    values: p,
+                    fitted: on,
+                    left_out,
+                    iterations: it,
+                    method: "least squares on the heights (Levenberg-Marquardt, exact surface derivatives)",
+                });
+            }
             lambda *= 10.0;
             if lambda > 1e12 {
                 break;

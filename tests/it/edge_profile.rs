@@ -1,5 +1,6 @@
 //! A round nose's measured edge (`edge_profile`), through the `lensc`
-//! binary: a turned conic cut by a tool whose edge carries a 50 nm
+//! binary: a turned conic, a tilted lens on a spiral and a pattern on a
+//! roller helix, each cut by a tool whose edge carries a 50 nm
 //! waviness. Each program is read back from its text by the controller
 //! reader and swept with the real, wavy edge (`program_cut_by`): the
 //! program planned for a circle prints the waviness into the part, the
@@ -439,19 +440,192 @@ fn a_spiral_whose_contact_angles_the_edge_does_not_cover_is_refused() {
     assert!(err.contains("the spiral meets the nose at -5."), "{err}");
 }
 
+/// A pattern that varies along the roller only (axial slopes to ±5.7°,
+/// the same all the way round, so the helix's chords around the roller
+/// lie on the path), wrapped onto seed 002's 3 mm roller and cut over
+/// 1 mm of its length by table 1's 1.417567 mm nose whose tool line is
+/// `TOOL`.
+const ROLLER: &str = "surface pattern = freeform {
+    z(x, y) = 0.02 mm * sin(5 rad/mm * x) - 0.04 mm
+    domain: rect(x: 0 mm .. 6.283185307179586 mm, y: 0 mm .. 18.84955592153876 mm)
+}
+surface on_roller = wrap(pattern, onto: roller(radius: 3 mm))
+use std::machines::moore_nanotech_450fg
+tool diamond = round_nose { nose_radius: 1.417567 mm, clearance: 12.5 deg, included_angle: 100 degTOOL }
+strategy fine = roller_helix {
+    finish: { c_step: 1 deg, pitch: 20 um }
+    z: 0.5 mm .. 1.5 mm
+    spindle_speed: 60 rpm
+    blank_radius: 3.01 mm
+}
+job roller { surface: on_roller, tool: diamond, machine: moore_nanotech_450fg, strategy: fine, accept: none }
+";
+
+/// ROLLER, its tool given `tool`, and the wavy edge's file.
+fn roller_project(tool: &str) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().expect("tmp");
+    std::fs::write(dir.path().join("job.lens"), ROLLER.replace("TOOL", tool)).expect("write");
+    std::fs::write(dir.path().join("edge.txt"), wavy_text()).expect("write");
+    dir
+}
+
+/// Builds the roller project in `dir`: the nose-centre points its
+/// program commands, as (C rad, Z, X) read from its text by the
+/// controller reader (a rapid, None, starts a pass), and its report.
+fn roller_points(dir: &Path) -> (Vec<Commanded>, serde_json::Value) {
+    let out = lensc(dir, &["build", "job.lens"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let report: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("out/roller.report.json")).expect("report"),
+    )
+    .expect("json");
+    let program = std::fs::read_to_string(dir.join("out/roller.ngc")).expect("program");
+    let c = driver::check_path(&RealFs, &dir.join("job.lens")).expect("checks");
+    let (spec, _) = lensc_build::pipeline::lower(&c.checked.jobs[0], None, &Default::default())
+        .expect("lowers");
+    let machine = MachineLimits {
+        lathe: true,
+        travel: [None; 4],
+        max_feed: None,
+        max_spindle_rpm: None,
+    };
+    let mut moves = reader::read_moves(&program, &spec.head().dialect, &machine).1;
+    let offset = reader::header_control_offset(&program).expect("control point");
+    reader::to_tool_centre(&mut moves, offset);
+    let mut at = [0.0; 4];
+    let mut pts = Vec::new();
+    for m in &moves {
+        for (a, v) in at.iter_mut().zip(m.to) {
+            if let Some(v) = v {
+                *a = v;
+            }
+        }
+        match m.path {
+            reader::Path::Rapid => pts.push(None),
+            reader::Path::Line => pts.push(Some((at[3].to_radians(), at[2], at[0]))),
+            reader::Path::Arc { .. } => panic!("an arc in a helix"),
+        }
+    }
+    (pts, report)
+}
+
+/// The contact PV (nm: the path's form error, scallops left out) of the
+/// roller the helix `pts` cut with `nose`, on a grid of 90 spindle
+/// angles and design x 0.7 .. 1.3 mm every 2 µm, against the pattern
+/// (radius 3 mm + 0.02 sin 5x − 0.04).
+fn roller_cut_pv(pts: &[Commanded], edge: Option<&EdgeProfile>) -> f64 {
+    use lensc_runtime::verify::heightmap::{Frame, Grid, Sweep};
+    let n_s = 90;
+    let grid = Grid {
+        s0: 0.0,
+        ds: 2.0 * PI / n_s as f64,
+        ns: n_s,
+        u0: 0.7,
+        du: 0.002,
+        nu: 301,
+        period: Some(2.0 * PI),
+        j0: 0,
+        i0: 0,
+    };
+    let mut sweep = Sweep::with_edge(grid, 1.417567, edge.map(|e| std::sync::Arc::new(e.clone())));
+    for p in pts {
+        match *p {
+            None => sweep.lift(),
+            Some((c, z, x)) => sweep.point(c, z, x),
+        }
+    }
+    struct Roller;
+    impl Frame for Roller {
+        fn design(&self, points: &[(f64, f64)], out: &mut [f64]) {
+            for (o, &(_, u)) in out.iter_mut().zip(points) {
+                *o = 3.0 + 0.02 * (5.0 * u).sin() - 0.04;
+            }
+        }
+        fn xy(&self, s: f64, u: f64) -> (f64, f64) {
+            (u, 3.0 * s)
+        }
+        fn inside(&self, _x: f64, _y: f64) -> bool {
+            true
+        }
+    }
+    let map = sweep.finish(&Roller);
+    assert_eq!(map.uncut, 0);
+    map.contact.expect("contacts").pv * 1e6
+}
+
 #[test]
-fn a_roller_helix_refuses_a_measured_edge() {
-    // Roller helix turning places a circle's nose (its own contact
-    // search, ridges and scanned sections): refused, not cut as a circle.
-    let job = std::fs::read_to_string(crate::common::root().join("tests/jobs/roller_small.lens"))
-        .expect("job")
+fn a_roller_helix_compensates_a_measured_edge() {
+    // The helix planned for a circle, cut by the wavy edge, prints the
+    // waviness into the roller (the axial slope sweeps the angle of
+    // contact over ±5.7°); planned for the measured edge, it does not.
+    // Each program read back from its text and swept with the edge.
+    let edge_text = wavy_text();
+    let edge = EdgeProfile::from_samples(&lensc_runtime::machine::edge::parse(&edge_text).unwrap())
+        .unwrap();
+    let plain = roller_project("");
+    let (pts, plain_report) = roller_points(plain.path());
+    let circle = roller_cut_pv(&pts, None);
+    let uncompensated = roller_cut_pv(&pts, Some(&edge));
+    let named = roller_project(", edge_profile: \"edge.txt\"");
+    let (pts, report) = roller_points(named.path());
+    let compensated = roller_cut_pv(&pts, Some(&edge));
+    eprintln!(
+        "roller helix: contact PV nm: circle {circle:.2}, wavy edge uncompensated {uncompensated:.2}, compensated {compensated:.2}"
+    );
+    assert!(circle < 5.0, "{circle}");
+    assert!(uncompensated > 50.0, "{uncompensated}");
+    assert!(compensated < 5.0, "{compensated}");
+    // The build's own simulation sweeps the measured edge: the
+    // compensated roller's form is the circle's.
+    let pv = |r: &serde_json::Value| {
+        r["simulation"]["height_map"]["contact"]["pv_nm"]
+            .as_f64()
+            .expect("pv")
+    };
+    eprintln!(
+        "report contact PV nm: plain {:.2}, compensated {:.2}",
+        pv(&plain_report),
+        pv(&report)
+    );
+    assert!(
+        (pv(&report) - pv(&plain_report)).abs() < 2.0,
+        "{} vs {}",
+        pv(&report),
+        pv(&plain_report)
+    );
+    let md5 = lensc_measure::md5_hex(edge_text.as_bytes());
+    assert_eq!(report["toolpath"]["edge_profile"]["md5"], md5.as_str());
+    assert!(plain_report["toolpath"]["edge_profile"].is_null());
+    let program = std::fs::read_to_string(named.path().join("out/roller.ngc")).expect("program");
+    assert!(
+        program.contains(&format!("edge profile edge.txt md5 {md5}")),
+        "the header names the edge"
+    );
+}
+
+#[test]
+fn a_roller_helix_whose_contact_angles_the_edge_does_not_cover_is_refused() {
+    // Measured over ±3°; the pattern meets the nose at up to ±5.7°.
+    let job = ROLLER.replace("TOOL", ", edge_profile: \"edge.txt\"");
+    let err = job_refused(&job, "-3 0\n0 0.01\n3 0\n", "E0375");
+    assert!(err.contains("covers only -3° .. 3°"), "{err}");
+    assert!(err.contains("the helix meets the nose at -5.7"), "{err}");
+}
+
+#[test]
+fn a_roller_helix_over_concave_corners_refuses_a_measured_edge() {
+    // A V-groove along the roller: its corner makes the planner scan each
+    // nose window, a circle's search, so the edge is refused, not cut as
+    // a circle.
+    let job = ROLLER
         .replace(
-            "included_angle: 100 deg }",
-            "included_angle: 100 deg, edge_profile: \"edge.txt\" }",
-        );
+            "0.02 mm * sin(5 rad/mm * x) - 0.04 mm",
+            "0.02 * abs(x - 1 mm) - 0.04 mm",
+        )
+        .replace("TOOL", ", edge_profile: \"edge.txt\"");
     let err = job_refused(&job, &wavy_text(), "E0375");
     assert!(
-        err.contains("`roller_helix` does not compensate a measured edge"),
+        err.contains("a measured edge is compensated only along smooth sections"),
         "{err}"
     );
 }

@@ -280,3 +280,67 @@ fn verify_survives_the_programs_the_fuzzer_found() {
         }
     }
 }
+
+/// The jobs the fuzzer's `check` target found (`tests/fuzz_crashes/`,
+/// issue #33): a `simulate` window from -1e308 mm, whose grid's counts
+/// overflowed and were counted out into 1.8e13 tiles (an abort on a
+/// petabyte's allocation), refused as too many cells (E0149); and arrays
+/// 4,300 km across (a pitch of 4,294,967,297 mm), whose rim search looped
+/// for ever, refused as beyond the machine's X travel (E0141), naming
+/// both. Each within a bound no finished check comes near (60 s; they
+/// take a fraction of a second), the process killed past it.
+#[test]
+fn check_refuses_the_jobs_the_fuzzer_found() {
+    let expected = [
+        ("check_window_from_1e308_mm.lens", "E0149"),
+        ("check_hex_array_4300_km.lens", "E0141"),
+        ("check_grid_array_pitch_y_4300_km.lens", "E0141"),
+        ("check_settled_array_4300_km_at_1e-9_rpm.lens", "E0141"),
+    ];
+    let dir = common::root().join("tests/fuzz_crashes");
+    for (file, code) in expected {
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_lensc"))
+            .current_dir(&dir)
+            .args(["check", "--message-format", "json", file])
+            .env("NO_COLOR", "1")
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("run lensc");
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+        while child.try_wait().expect("wait").is_none() {
+            if std::time::Instant::now() > deadline {
+                child.kill().expect("kill");
+                child.wait().expect("reap");
+                panic!("{file}: `lensc check` still running after 60 s");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        let out = child.wait_with_output().expect("output");
+        let stdout = common::text(&out.stdout);
+        assert_eq!(
+            out.status.code(),
+            Some(1),
+            "{file}: {}",
+            common::text(&out.stderr)
+        );
+        let codes: Vec<String> = stdout
+            .lines()
+            .map(|l| {
+                let v: serde_json::Value = serde_json::from_str(l).expect("a JSON line");
+                v["code"].as_str().unwrap_or("").to_string()
+            })
+            .collect();
+        assert!(codes.iter().any(|c| c == code), "{file}: {stdout}");
+        if code == "E0141" {
+            assert!(
+                stdout.contains("mm across") || stdout.contains("starts"),
+                "{file}: {stdout}"
+            );
+            assert!(
+                stdout.contains("X travel -10 .. 220 mm"),
+                "{file}: {stdout}"
+            );
+        }
+    }
+}

@@ -42,6 +42,7 @@ mod lsp;
 mod measure;
 mod measure_lenslet_field;
 mod measure_lenslets;
+mod measure_stepped_rim;
 mod nurbs_linuxcnc;
 mod plots;
 mod progress;

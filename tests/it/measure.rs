@@ -227,6 +227,45 @@ fn bad_measurements_are_coded_errors_naming_the_file() {
     assert!(err.contains("--units"), "{err}");
 }
 
+/// A refusal over a binary file (an X3P, a MetroPro `.dat`), or one at
+/// no byte of the file, shows no line of it (it used to draw an empty
+/// `1 │` line over the binary's first byte): the message names the file
+/// and the line under it the byte, where one is known. A text file's
+/// refusal at a byte still shows its line.
+#[test]
+fn a_binary_files_refusal_names_the_byte_without_a_source_line() {
+    let peer = |n: &str| std::fs::read(root().join("tests/measure/peer").join(n)).unwrap();
+    // A MetroPro header whose size (bytes 6 to 9) says 835.
+    let mut dat = peer("metropro-1.dat");
+    dat[6..10].copy_from_slice(&835u32.to_be_bytes());
+    let err = refused("header.dat", &dat, "E0360", &[]);
+    assert!(err.contains("header size 835"), "{err}");
+    assert!(err.contains("--> header.dat, byte 6"), "{err}");
+    assert!(!err.contains('│'), "no source line: {err}");
+    // Not a measurement at all, and one of another part: at no byte.
+    for (name, bytes, code) in [
+        ("part.bin", b"\x00\x01 nothing here".to_vec(), "E0360"),
+        ("pyramid.x3p", peer("pyramid.x3p"), "E0364"),
+    ] {
+        let err = refused(name, &bytes, code, &[]);
+        assert!(err.contains(&format!("--> {name}\n")), "{err}");
+        assert!(!err.contains('│'), "no source line: {err}");
+    }
+    // A MetroPro ASCII export whose third header line has two numbers of five.
+    let asc = String::from_utf8(peer("metropro-1-window.asc")).unwrap();
+    let mut lines: Vec<&str> = asc.split_inclusive('\n').collect();
+    let at: usize = lines[..2].iter().map(|l| l.len()).sum();
+    lines[2] = "0 0 x\n";
+    let err = refused("window.asc", lines.concat().as_bytes(), "E0360", &[]);
+    assert!(
+        err.contains(&format!(
+            "header line 3 has 2 numbers, 5 expected (at byte {at})"
+        )),
+        "{err}"
+    );
+    assert!(err.contains("3 │ 0 0 x"), "the line shown: {err}");
+}
+
 #[test]
 fn a_measurement_outside_the_project_root_is_refused() {
     let dir = tempfile::tempdir().expect("tmp");

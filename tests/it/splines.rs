@@ -183,3 +183,44 @@ fn a_siemens_b_spline_program_reads_clean_and_cuts_the_lines_form() {
         "{err}"
     );
 }
+
+/// A build reads its program's text once, for the simulation and the
+/// read-back both (the reader's findings by the job's machine kept from
+/// the simulation's reading): the spline program's NURBS blocks, sampled
+/// finely, were read twice.
+#[test]
+fn a_raster_build_reads_its_program_once() {
+    let c = lensc_lang::check_text(&lensc_lang::loader::RealFs, "jobs.lens", JOBS.as_bytes());
+    assert!(!c.has_errors());
+    let prov = lensc_runtime::post::Provenance {
+        source: "jobs.lens".into(),
+        source_hash: 0,
+        lensc_version: "test".into(),
+    };
+    for job in &c.checked.jobs {
+        let limits = lensc_build::job::Limits::default();
+        let (spec, _) = lensc_build::pipeline::lower(job, None, &limits).expect("lowers");
+        let before = lensc_runtime::reader::reads_on_this_thread();
+        let built = lensc_build::pipeline::build_and_read_back(
+            job,
+            &spec,
+            &prov,
+            lensc_build::output::Destination::Memory,
+        )
+        .unwrap_or_else(|_| panic!("{} builds", job.name.name));
+        let reads = lensc_runtime::reader::reads_on_this_thread() - before;
+        assert_eq!(
+            reads, 1,
+            "{}: its program read {reads} times",
+            job.name.name
+        );
+        // What it read is what the controller's reader finds: nothing.
+        let text = built.program.text().expect("text");
+        let machine = lensc_lang::lower::read_back::job_machine(job);
+        let dialect = &spec.head().dialect;
+        assert_eq!(
+            lensc_runtime::reader::read(&text, dialect, &machine),
+            vec![]
+        );
+    }
+}

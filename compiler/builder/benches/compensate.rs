@@ -198,4 +198,14 @@ fn main() {
         best[1].0 / best[0].0,
         best[1].1 / best[0].1
     );
+    // The ratios mean little on a loaded machine: say how loaded it was.
+    println!(
+        "load average (1, 5, 15 min): {}",
+        std::fs::read_to_string("/proc/loadavg")
+            .unwrap_or_default()
+            .split_whitespace()
+            .take(3)
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
 }

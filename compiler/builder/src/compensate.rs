@@ -169,8 +169,12 @@ pub(crate) fn corrected(
         d
     };
     let bytes = read(p, &c.measurement)?;
-    let m = lensc_measure::read::read(file, &bytes, TextUnits(c.units))
-        .map_err(|e| at(measure::read_failure(file, &e)))?;
+    // The file's MD5 (which measurement this is) beside its reading.
+    let (md5, m) = rayon::join(
+        || lensc_measure::md5_hex(&bytes),
+        || lensc_measure::read::read(file, &bytes, TextUnits(c.units)),
+    );
+    let m = m.map_err(|e| at(measure::read_failure(file, &e)))?;
     let format = m.format;
     let (data, stride) = thinned(m.data);
     let surface_name = p.surface_name.clone();
@@ -195,6 +199,7 @@ pub(crate) fn corrected(
         data,
         format,
         &opts,
+        None,
     )
     .map_err(at)?;
     // Each measured point in the design's frame, with its error along z.
@@ -223,9 +228,29 @@ pub(crate) fn corrected(
             })
         })?;
     // A polynomial carried beyond its points can swing: one that swings
-    // far beyond the error it was fitted to follows no measurement.
+    // far beyond the error it was fitted to follows no measurement. How
+    // far it swings, the surface it makes and whether the tool can follow
+    // it, beside the next part's prediction (should the machine repeat
+    // the measured error); each refusal as it would be made in turn.
     let (measured_pv, measured_rms) = pv_rms(&placed.vertical);
-    let swing = correction_pv(&fitted, &design.domain);
+    let (gain, tool_radius) = (c.gain, p.tool_radius);
+    let ((swing, corrected, followed), predicted) = rayon::join(
+        || {
+            let swing = correction_pv(&fitted, &design.domain);
+            let corrected = LoweredSurface {
+                tape: corrected_tape(&design.tape, &fitted, gain),
+                domain: design.domain,
+            };
+            let followed = curvature_check(tool_radius, design, &corrected, file, &surface_name);
+            (swing, corrected, followed)
+        },
+        || -> Vec<f64> {
+            xy.iter()
+                .zip(&placed.vertical)
+                .map(|(&(x, y), e)| e - gain * fitted.at(x, y))
+                .collect()
+        },
+    );
     if swing > 2.0 * measured_pv + 1e-6 {
         return Err(at(Failure {
             code: codes::COMPENSATE_UNFITTED,
@@ -240,24 +265,12 @@ pub(crate) fn corrected(
             ),
         }));
     }
-    let tape = corrected_tape(&design.tape, &fitted, c.gain);
-    let corrected = LoweredSurface {
-        tape,
-        domain: design.domain,
-    };
-    curvature_check(p, design, &corrected, file, &surface_name).map_err(at)?;
-    // What the next part is predicted to be, should the machine repeat
-    // the measured error.
-    let predicted: Vec<f64> = xy
-        .iter()
-        .zip(&placed.vertical)
-        .map(|(&(x, y), e)| e - c.gain * fitted.at(x, y))
-        .collect();
+    followed.map_err(at)?;
     let (predicted_pv, predicted_rms) = pv_rms(&predicted);
     let report = Compensation {
         measurement: file.to_owned(),
         format: format.name().to_owned(),
-        md5: lensc_measure::md5_hex(&bytes),
+        md5,
         points: placed.inside().len(),
         valid_share: placed.share,
         registration: placed.registration_report(),
@@ -422,16 +435,16 @@ pub fn corrected_tape(design: &SurfaceTape, fitted: &Correction, gain: f64) -> S
 }
 
 /// E0366 when the corrected surface curves (concave, towards the tool)
-/// more tightly than the tool's nose or ball, where the design did not:
-/// the tool cannot follow the correction.
+/// more tightly than the tool's nose or ball (`tool_radius`), where the
+/// design did not: the tool cannot follow the correction.
 fn curvature_check(
-    p: &Of,
+    tool_radius: Option<f64>,
     design: &LoweredSurface,
     corrected: &LoweredSurface,
     file: &str,
     surface_name: &str,
 ) -> Result<(), Failure> {
-    let Some(tool) = p.tool_radius.filter(|r| r.is_finite() && *r > 0.0) else {
+    let Some(tool) = tool_radius.filter(|r| r.is_finite() && *r > 0.0) else {
         return Ok(());
     };
     let tightest = |l: &LoweredSurface| {

@@ -113,6 +113,7 @@ pub(crate) fn built(
         plots,
         warnings: Vec::new(),
         read_back: None,
+        read_findings: None,
     }
 }
 
@@ -191,19 +192,44 @@ pub(crate) fn executed_moves(
     text: &str,
     lathe: bool,
 ) -> Vec<lensc_runtime::reader::Executed> {
-    let machine = lensc_runtime::reader::MachineLimits {
+    read_program(head, text, lathe, None).1
+}
+
+/// `text` read once as the controller reads it, for the simulation and
+/// the read-back both: the moves it makes (as `executed_moves`) and, when
+/// the build reads its program back (`read`: the job's dialect and
+/// machine), the reader's findings by the read-back's rules, which the
+/// read-back takes instead of reading the text a second time. The reader
+/// reads the text alone, whoever asks (the fitter's splines are read from
+/// their printed blocks).
+pub(crate) fn read_program(
+    head: &JobHead,
+    text: &str,
+    lathe: bool,
+    read: Option<&ReadBack>,
+) -> (
+    Option<Vec<lensc_runtime::reader::Finding>>,
+    Vec<lensc_runtime::reader::Executed>,
+) {
+    let relaxed = lensc_runtime::reader::MachineLimits {
         lathe,
         travel: [None; 4],
         max_feed: None,
         max_spindle_rpm: None,
     };
-    let mut moves = lensc_runtime::reader::read_moves(text, &head.dialect, &machine).1;
+    // The machine's travel, feed and speed only add findings: the moves
+    // are the same read by either. A read-back of another kind of machine
+    // than `lathe` says is not shared (the text is read as `lathe` says,
+    // and the read-back reads it again).
+    let by = read.filter(|r| r.machine.lathe == lathe);
+    let machine = by.map_or(&relaxed, |r| &r.machine);
+    let (found, mut moves) = lensc_runtime::reader::read_moves(text, &head.dialect, machine);
     // As `lensc verify` would: the control point the program's header
     // states, taken off again, so the cut is the tool centre's.
     if let Some(offset) = lensc_runtime::reader::header_control_offset(text) {
         lensc_runtime::reader::to_tool_centre(&mut moves, offset);
     }
-    moves
+    (by.map(|_| found), moves)
 }
 
 /// What a lathe or grinder program cuts, read from its text as the

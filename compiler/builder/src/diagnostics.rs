@@ -76,7 +76,8 @@ impl RuntimeError<'_> {
                 ..coded(
                     codes::SIMULATION_TOO_LARGE,
                     format!(
-                        "the simulation would have {} cells, its columns {} rows long: more than the {} cells (its time) or {} rows a column (a tile's memory) it takes",
+                        "the simulation would have {}{} cells, its columns {} rows long: more than the {} cells (its time) or {} rows a column (a tile's memory) it takes",
+                        if e.at_least { "at least " } else { "" },
                         e.cells,
                         e.rows,
                         TooManyCells::CELLS,

@@ -141,7 +141,7 @@ pub(crate) fn not_compensated(p: &Parts, strategy: &str) -> Option<Diagnostic> {
         )
         .with_label("the edge profile this tool names")
         .with_help(
-            "`profile_turning`, `spiral_turning` and `fts_spiral` place the nose by the edge's deviation at the angle of contact; leave `edge_profile` out of a tool for other strategies (the nose is then taken as a circle)",
+            "`profile_turning`, `spiral_turning`, `fts_spiral` and `roller_helix` place the nose by the edge's deviation at the angle of contact; leave `edge_profile` out of a tool for other strategies (the nose is then taken as a circle)",
         ),
     )
 }
@@ -166,37 +166,21 @@ pub(crate) fn uncovered_spiral(
     let named = p.tool_params.edge_profile.as_ref()?;
     let (n_r, n_c) = SPIRAL_SCAN;
     let (r0, r1) = (radii.0.max(0.0), radii.1);
-    // (angle, radius, spindle angle) of the least and the greatest.
-    let (mut lo, mut hi) = ((f64::INFINITY, 0.0, 0.0), (f64::NEG_INFINITY, 0.0, 0.0));
-    for i in 0..=n_r {
+    let contacts = (0..=n_r).flat_map(|i| {
         let r = r0 + (r1 - r0) * i as f64 / n_r as f64;
-        for k in 0..n_c {
+        (0..n_c).filter_map(move |k| {
             let c = std::f64::consts::TAU * k as f64 / n_c as f64;
             let (x, y) = (r * c.cos(), r * c.sin());
             if !domain.contains(x, y) {
-                continue;
+                return None;
             }
             let o = trajectory.eval(x, y);
-            let a = (o[1] * c.cos() + o[2] * c.sin()).atan();
-            if !a.is_finite() {
-                continue;
-            }
-            if a < lo.0 {
-                lo = (a, r, c);
-            }
-            if a > hi.0 {
-                hi = (a, r, c);
-            }
-        }
-    }
+            Some(((o[1] * c.cos() + o[2] * c.sin()).atan(), r, c))
+        })
+    });
+    let (lo, hi) = extremes(contacts);
     let (m0, m1) = edge.range();
-    let far = if lo.0 < m0 {
-        lo
-    } else if hi.0 > m1 {
-        hi
-    } else {
-        return None;
-    };
+    let far = beyond(edge, lo, hi)?;
     Some(
         Diagnostic::error(
             codes::EDGE_ANGLES,
@@ -214,6 +198,85 @@ pub(crate) fn uncovered_spiral(
         )
         .with_label("the edge profile this tool names")
         .with_help("measure the edge over the angles the cut uses (the surface's slope along the ray from the spindle axis is the angle of contact), or cut a smaller `from`"),
+    )
+}
+
+/// The least and the greatest angle of contact among `contacts`, each
+/// (angle rad, and where: two coordinates); angles not finite skipped.
+fn extremes(contacts: impl Iterator<Item = (f64, f64, f64)>) -> ((f64, f64, f64), (f64, f64, f64)) {
+    let (mut lo, mut hi) = ((f64::INFINITY, 0.0, 0.0), (f64::NEG_INFINITY, 0.0, 0.0));
+    for a in contacts.filter(|a| a.0.is_finite()) {
+        if a.0 < lo.0 {
+            lo = a;
+        }
+        if a.0 > hi.0 {
+            hi = a;
+        }
+    }
+    (lo, hi)
+}
+
+/// The extreme of `lo`, `hi` that lies beyond the angles `edge` covers,
+/// if either does.
+fn beyond(edge: &EdgeProfile, lo: (f64, f64, f64), hi: (f64, f64, f64)) -> Option<(f64, f64, f64)> {
+    let (m0, m1) = edge.range();
+    if lo.0 < m0 {
+        Some(lo)
+    } else if hi.0 > m1 {
+        Some(hi)
+    } else {
+        None
+    }
+}
+
+/// Axial positions and angles around the roller at which a roller
+/// helix's angles of contact are scanned (`uncovered_roller`).
+const ROLLER_SCAN: (usize, usize) = (256, 360);
+
+/// E0375 for a roller helix whose angles of contact the measured edge
+/// does not cover. The edge lies in the cutting plane, through the roller
+/// axis (`lensc_runtime::plan::roller`, "Measured edge"), so it touches
+/// the design at atan of its axial slope ∂z/∂x, + towards +Z: scanned on
+/// a grid over design x in `x` (where the contacts lie: the helix's axial
+/// range widened by what the nose reaches) and design y in `y` (the
+/// design's extent around the roller).
+pub(crate) fn uncovered_roller(
+    p: &Parts,
+    edge: &EdgeProfile,
+    design: &dyn lensc_runtime::surface::ir::SurfaceFn,
+    x: (f64, f64),
+    y: (f64, f64),
+) -> Option<Diagnostic> {
+    let named = p.tool_params.edge_profile.as_ref()?;
+    let (n_x, n_y) = ROLLER_SCAN;
+    let at = |(a, b): (f64, f64), i: usize, n: usize| a + (b - a) * i as f64 / n as f64;
+    let contacts = (0..=n_x).flat_map(|i| {
+        let u = at(x, i, n_x);
+        (0..=n_y).map(move |j| {
+            let v = at(y, j, n_y);
+            (design.eval(u, v)[1].atan(), u, v)
+        })
+    });
+    let (lo, hi) = extremes(contacts);
+    let far = beyond(edge, lo, hi)?;
+    let (m0, m1) = edge.range();
+    Some(
+        Diagnostic::error(
+            codes::EDGE_ANGLES,
+            format!(
+                "the helix meets the nose at {}° .. {}° from its axis (the far end at design x = {} mm, y = {} mm), but the tool's edge profile covers only {}° .. {}°: the path cannot be compensated beyond the measured edge",
+                deg(lo.0),
+                deg(hi.0),
+                trim_num((far.1 * 1e4).round() / 1e4),
+                trim_num((far.2 * 1e4).round() / 1e4),
+                deg(m0),
+                deg(m1)
+            ),
+            named.site.0,
+            named.site.1,
+        )
+        .with_label("the edge profile this tool names")
+        .with_help("measure the edge over the angles the cut uses (the design's slope along the roller axis is the angle of contact, + towards +Z), or cut a shorter `z` range"),
     )
 }
 

@@ -46,6 +46,11 @@ pub struct Built {
     /// The dialect and machine its program was read back by, when it was
     /// (`lensc view` reads its moves by the same).
     pub read_back: Option<crate::reading::ReadBack>,
+    /// The reader's findings in an in-memory program, where the build
+    /// read its text once for the simulation and the read-back both
+    /// (`context::read_program`): the read-back takes them instead of
+    /// reading the text again.
+    pub read_findings: Option<Vec<lensc_runtime::reader::Finding>>,
 }
 
 /// A program's text: in memory, or spooled as it was written to a

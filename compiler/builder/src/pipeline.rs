@@ -353,7 +353,8 @@ fn build_job(
 /// The reader's findings in `b`'s program (`job` lowered to `spec`) as
 /// errors, if it refuses it.
 fn read_back(job: &CheckedJob, spec: &JobSpec, b: &mut Built) -> Result<(), Vec<Diagnostic>> {
-    let refused = crate::read_back::findings(job, spec.head(), &mut b.program);
+    let read = b.read_findings.take();
+    let refused = crate::read_back::findings(job, spec.head(), &mut b.program, read);
     if refused.is_empty() {
         Ok(())
     } else {

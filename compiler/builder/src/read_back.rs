@@ -33,22 +33,35 @@ pub use crate::reading::ReadBack;
 
 /// The reader's findings in `program` as errors at the job; none if it
 /// reads clean. A program read as it was spooled is not read again: its
-/// reader's findings are taken once it has read the whole text.
+/// reader's findings are taken once it has read the whole text; nor one
+/// in memory whose builder read its text for the simulation by the
+/// read-back's rules (`read`, its findings: `context::read_program`).
 pub(crate) fn findings(
     job: &CheckedJob,
     head: &JobHead,
     program: &mut ProgramText,
+    read: Option<Vec<reader::Finding>>,
 ) -> Vec<Diagnostic> {
     let machine = job_machine(job);
-    let found = match program {
-        ProgramText::Memory(text) => Ok(reader::read(text, &head.dialect, &machine)),
-        ProgramText::Spooled {
-            read: read @ Some(_),
-            ..
-        } => Ok(read.take().map(ReadAlong::finish).unwrap_or_default()),
-        ProgramText::Spooled { file, .. } => std::fs::File::open(file.path())
+    let found = match (program, read) {
+        (ProgramText::Memory(_), Some(found)) => Ok(found),
+        (ProgramText::Memory(text), None) => Ok(reader::read(text, &head.dialect, &machine)),
+        (
+            ProgramText::Spooled {
+                read: read @ Some(_),
+                ..
+            },
+            _,
+        ) => Ok(read.take().map(ReadAlong::finish).unwrap_or_default()),
+        (ProgramText::Spooled { file, .. }, _) => std::fs::File::open(file.path())
             .and_then(|f| reader::read_from(BufReader::new(f), &head.dialect, &machine)),
     };
+    diagnostics(head, found)
+}
+
+/// The reader's findings (or why the text could not be read) as errors at
+/// the job.
+fn diagnostics(head: &JobHead, found: std::io::Result<Vec<reader::Finding>>) -> Vec<Diagnostic> {
     let name = head.program_name();
     match found {
         Ok(found) => found

@@ -86,8 +86,10 @@ fn header_comments(lines: &[String]) -> Vec<String> {
         let Some(text) = lensc_runtime::reader::comment_text(line) else {
             continue;
         };
+        // A line folded at ", " ends in ","; one folded between words
+        // does not: either way the next starts with two spaces.
         match (out.last_mut(), text.strip_prefix("  ")) {
-            (Some(last), Some(rest)) if last.ends_with(',') => {
+            (Some(last), Some(rest)) => {
                 last.push(' ');
                 last.push_str(rest.trim_start());
             }

@@ -8,6 +8,11 @@ use lensc_runtime::surface::ir::{Graph, Interpreter, SurfaceTape};
 /// A hyperbolic asphere (R 2 mm, k −3, A4 0.01 mm⁻³), convex, plus
 /// `xy` · x·y (a non-rotational term when not zero).
 pub(crate) fn asphere(xy: f64) -> Interpreter {
+    Interpreter::new(&asphere_tape(xy))
+}
+
+/// `asphere`'s tape.
+fn asphere_tape(xy: f64) -> SurfaceTape {
     let mut g = Graph::new();
     let (x, y) = (g.x(), g.y());
     let r2 = {
@@ -34,7 +39,7 @@ pub(crate) fn asphere(xy: f64) -> Interpreter {
         let term = g.mul(k, xyn);
         z = g.add(z, term);
     }
-    Interpreter::new(&SurfaceTape::new(g, z))
+    SurfaceTape::new(g, z)
 }
 
 /// A map of the design placed by `p`, over a disc of radius 0.8 mm.
@@ -187,4 +192,48 @@ fn too_few_iterations_is_not_converged_not_a_guess() {
     );
     let e = register_heights(&f, &pts[..4], Options::default()).unwrap_err();
     assert_eq!(e, RegisterError::TooFewPoints { points: 4 });
+}
+
+/// The registration with its surface evaluated in parallel is the serial
+/// one, bit for bit, on one thread or three, through the interpreter and
+/// the JIT: only evaluations run in parallel (each point's its own), the
+/// sums run over the points in order.
+#[test]
+fn a_parallel_registration_is_the_serial_one_bit_for_bit() {
+    let f = asphere(0.05);
+    let truth = [-1e-4, 30e-6, 10e-6, -2e-3, 4e-3, 0.01];
+    // Some 20,000 points, several chunks and a part of one; a little
+    // noise, so the sums carry rounding that an order of summing shows.
+    let mut pts = synthetic_map(&f, &truth, 161);
+    assert!(pts.len() > 4 * CHUNK && !pts.len().is_multiple_of(CHUNK));
+    let mut seed: u64 = 0x2545_f491_4f6c_dd1d;
+    for q in &mut pts {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        q[2] += ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 1e-6;
+    }
+    let jit = lensc_runtime::surface::jit::JitSurface::compile(&asphere_tape(0.05))
+        .expect("the kernel compiles");
+    let kernels: [&(dyn SurfaceFn + Sync); 2] = [&f, &jit];
+    for k in kernels {
+        let serial = register_heights(k, &pts, Options::default()).expect("converges");
+        for threads in [1, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("a pool");
+            let parallel = pool
+                .install(|| register_heights_parallel(k, &pts, Options::default()))
+                .expect("converges");
+            assert_eq!(parallel.iterations, serial.iterations);
+            for (a, b) in parallel.values.iter().zip(&serial.values) {
+                assert_eq!(
+                    a.to_bits(),
+                    b.to_bits(),
+                    "{threads} threads: {a:e} against {b:e}"
+                );
+            }
+        }
+    }
 }

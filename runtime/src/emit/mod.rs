@@ -23,7 +23,8 @@ pub struct Emitted {
 }
 
 /// The header line of a program written with splines: which, how many,
-/// how close, and the control option they need.
+/// how close, and the control option they need (none where none was
+/// written).
 pub fn spline_words(dialect: &crate::dialect::Dialect, s: &crate::plan::spline::Summary) -> String {
     use crate::plan::spline::ORDER;
     let form = match dialect.spline {
@@ -32,18 +33,26 @@ pub fn spline_words(dialect: &crate::dialect::Dialect, s: &crate::plan::spline::
         }
         _ => format!("NURBS (G06.2, order {ORDER})"),
     };
+    let option = if dialect.spline_option.is_empty() {
+        "spline interpolation"
+    } else {
+        &dialect.spline_option
+    };
     format!(
-        "interpolation: {form} where shorter than lines and arcs: {} splines for {} straight moves, {} blocks of moves from {} planned, largest deviation {} nm (limit {} nm); needs the control's {}",
+        "interpolation: {form} where shorter than lines and arcs: {} splines for {} straight moves, {} blocks of moves from {} planned, largest deviation {} nm (limit {} nm); {}",
         s.splines,
         s.lines_replaced,
         s.blocks_after,
         s.blocks_before,
         crate::post::header::num((s.max_deviation * 1e7).round() / 10.0),
         crate::post::header::num((s.limit * 1e7).round() / 10.0),
-        if dialect.spline_option.is_empty() {
-            "spline interpolation"
+        // A program with no spline in it runs without the option: a
+        // machinist told it needs one would not load it on a control
+        // without.
+        if s.splines == 0 {
+            format!("no spline written: runs without the control's {option}")
         } else {
-            &dialect.spline_option
+            format!("needs the control's {option}")
         }
     )
 }

@@ -11,7 +11,12 @@
 //! concave, so its maximum is either an end of the piece or the single root
 //! of φ′(u) = z′(u) − (u − x)/sqrt(ρ² − (u − x)²) (the normal-offset
 //! contact). A profile's corners split it into such pieces.
+//!
+//! A measured edge (`machine::edge`) replaces sqrt(ρ² − d²) by its own
+//! depth L(d) below the centre; `edged_max` finds that envelope's height
+//! from the circle's contact, for every strategy that places a nose by it.
 
+use crate::machine::edge::Nose;
 use crate::surface::Profile;
 
 /// A profile split at its corners into smooth pieces.
@@ -315,3 +320,48 @@ fn min_distance(points: &[(f64, f64)], x: f64, h: f64) -> f64 {
 
 #[cfg(test)]
 mod tests;
+
+/// The nose-centre height over `profile` at `x` with the measured edge of
+/// `nose`, from the circle's contact `u0`: the greatest of w(u) = z(u) +
+/// L(u − x) (L the edge's depth below its centre at that offset,
+/// `Nose::lift`) found by Newton's method from the circle's contact, each
+/// step kept only where it raises w; and the contact's u. On a smooth
+/// section that is the edge's contact (w′ = 0); at a corner of the
+/// profile the circle's contact is the corner, where the edge touches
+/// too, and w there is the edge's depth at it. `None` where the edge does
+/// not reach `u0` or the profile is undefined there.
+pub fn edged_max(profile: &dyn Profile, nose: &Nose, x: f64, u0: f64) -> Option<(f64, f64)> {
+    let rho = nose.radius;
+    let at = |u: f64| {
+        let p = profile.point(u);
+        let (l, dl) = nose.lift(u - x)?;
+        let w = p.z + l;
+        w.is_finite().then_some((w, p.dz + dl, p.d2z))
+    };
+    // Where the circle touched: its height there with the edge.
+    let (mut best_w, mut slope, mut curve) = at(u0)?;
+    let mut best_u = u0;
+    for _ in 0..6 {
+        let off = best_u - x;
+        let root = (rho * rho - off * off).max(1e-30).sqrt();
+        // w″ with the circle's L″ (the edge's differs by δ″, far below
+        // R's): negative where the section is smooth.
+        let second = curve - rho * rho / (root * root * root);
+        // Not negative (or not a number): a corner, where the circle's
+        // contact stands.
+        if second.is_nan() || second >= 0.0 {
+            break;
+        }
+        let step = -slope / second;
+        let next = best_u + step;
+        let Some((w, s, k)) = at(next) else { break };
+        if w < best_w {
+            break;
+        }
+        (best_w, best_u, slope, curve) = (w, next, s, k);
+        if step.abs() <= 1e-10 {
+            break;
+        }
+    }
+    Some((best_w, best_u))
+}

@@ -348,13 +348,54 @@ pub fn check_raster(
     surface: &dyn SurfaceFn,
     aperture: &Domain,
 ) -> Result<RasterScan, RasterError> {
+    check_raster_planes(r, tool, surface, aperture).map(|(scan, _)| scan)
+}
+
+/// [`check_raster`], with the planes its scan found cutting and their
+/// spans: what the estimate counts a program by, at no second scan.
+pub fn check_raster_planes(
+    r: &Raster,
+    tool: &RasterTool,
+    surface: &dyn SurfaceFn,
+    aperture: &Domain,
+) -> Result<(RasterScan, PlaneSpans), RasterError> {
     let cutter = Cutter::new(tool, surface, r.along);
-    let (_, summary) = scan_planes(r, tool, &cutter, aperture, CHECK_PLANES)?;
-    Ok(RasterScan {
+    let (lines, summary) = scan_planes(r, tool, &cutter, aperture, CHECK_PLANES)?;
+    let scan = RasterScan {
         max_slope_along: summary.slope_along,
         max_slope_across: summary.slope_across,
         min_concave_radius_along: summary.concave_along,
-    })
+    };
+    let planes = lines
+        .into_iter()
+        .map(|(v, spans)| {
+            let ends = spans.iter().map(|(a, b)| [(a.u, a.v), (b.u, b.v)]);
+            (v, ends.collect())
+        })
+        .collect();
+    Ok((
+        scan,
+        PlaneSpans {
+            planes,
+            weight: summary.weight,
+        },
+    ))
+}
+
+/// A plane's span of contacts, from its first to its last, each (u, v)
+/// (v is y when cutting along x).
+pub type ContactSpan = [(f64, f64); 2];
+
+/// The planes a raster cuts, as its planner's first phase finds them
+/// (`scan_planes`), the rim's planes among them: those beyond the
+/// aperture whose contacts reach its rim (`rim_reach`). By default none.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PlaneSpans {
+    /// Each scanned plane that cuts: its v and its spans.
+    pub planes: Vec<(f64, Vec<ContactSpan>)>,
+    /// How many of the raster's planes each scanned one stands for: 1
+    /// when every plane is scanned.
+    pub weight: f64,
 }
 
 /// The knife's flank must clear the steepest slope along the cut:
@@ -448,7 +489,9 @@ fn scan_reach(
     let reach = aperture.grown(margin);
     let mut summary = Summary::within(r.along, *aperture);
     let mut lines = Vec::new();
-    for k in sampled(-extra, last + extra, last, most) {
+    let ks = sampled(-extra, last + extra, last, most);
+    summary.weight = paths / ks.len().max(1) as f64;
+    for k in ks {
         let mut v = v0 + k as f64 * r.stepover;
         if k == last {
             v = v.min(v1);
@@ -1688,6 +1731,9 @@ struct Summary {
     /// The largest spread (`Cutter::spread`) at the planes' scanned
     /// contacts in the aperture (1 if none is above 1).
     spread: f64,
+    /// How many of the raster's planes each scanned plane stands for: 1
+    /// when every plane is scanned (`sampled`).
+    weight: f64,
 }
 
 impl Summary {
@@ -1706,6 +1752,7 @@ impl Summary {
             steepest: [f64::NEG_INFINITY; 2],
             aperture: None,
             spread: 1.0,
+            weight: 1.0,
         }
     }
 

@@ -40,6 +40,17 @@
 //! from numerical gradients of a discretised section, offset by ρ, then
 //! interpolated — is kept as the reference `liu_offset` / `liu_centre`.
 //!
+//! Measured edge (`machine::edge`, `plan_roller_helix_edged`). The nose's
+//! edge lies in the cutting plane with the tool's axis pointing at the
+//! roller axis (−X), its angles counted positive towards +Z (along the
+//! roller, the way the helix advances). The lowest centre that clears the
+//! section is then X = R_r + max over u of z(u, y) + L(u − x), L the
+//! edge's depth below its centre at that axial offset: the same envelope,
+//! found by `envelope::edged_max` from the circle's contact. The edge
+//! touches a smooth section at θ = atan(∂z/∂x), the axial slope; the slope
+//! around the roller does not move that point (the edge lies across the
+//! cut). Sections with concave corners (scanned) are refused with an edge.
+//!
 //! Passes. The paper's blank (3.01 mm for a 3 mm roller) is turned "layer
 //! by layer", the X axis offset by the depth of cut each cycle, first
 //! rough (1°, 0.1 mm pitch) then finish (0.1°, 0.005 mm). Here each
@@ -62,6 +73,7 @@ use std::ops::ControlFlow;
 
 use rayon::prelude::*;
 
+use crate::machine::edge::Nose;
 use crate::plan::chords::{self, ChordPlacement};
 use crate::plan::envelope;
 use crate::surface::ir::SurfaceFn;
@@ -202,6 +214,9 @@ pub enum RollerError {
     },
     /// The design is undefined where the nose must go.
     Undefined { pass: usize, c: f64, z: f64, y: f64 },
+    /// A measured edge over sections with concave corners or steps (the
+    /// survey's count): the scanned contact search places a circle only.
+    EdgeAtCorners { corners: usize },
 }
 
 /// The largest number of points in one pass.
@@ -869,22 +884,47 @@ pub fn plan_roller_helix_sectioned(
     nose_radius: f64,
     design: &(dyn SurfaceFn + Sync),
     section: &(dyn SurfaceFn + Sync),
+    sink: impl FnMut(usize, &[RollerPoint]) + Send,
+) -> Result<RollerPath, RollerError> {
+    plan_roller_helix_edged(h, &Nose::circle(nose_radius), design, section, sink)
+}
+
+/// `plan_roller_helix_sectioned` with the nose as measured: where `nose`
+/// has an edge, each centre is the lowest that clears the axial section
+/// with that edge (`envelope::edged_max` from the circle's contact; the
+/// module doc, "Measured edge"). A design whose sections have concave
+/// corners or steps is refused with an edge (`RollerError::EdgeAtCorners`):
+/// its scanned contact search places a circle only.
+pub fn plan_roller_helix_edged(
+    h: &RollerHelix,
+    nose: &Nose,
+    design: &(dyn SurfaceFn + Sync),
+    section: &(dyn SurfaceFn + Sync),
     mut sink: impl FnMut(usize, &[RollerPoint]) + Send,
 ) -> Result<RollerPath, RollerError> {
-    validate(h, nose_radius)?;
-    let rho = nose_radius;
+    let rho = nose.radius;
+    validate(h, rho)?;
     let wrap = match h.design_length_around {
         Some(l) => Some(check_wrap(h.roller_radius, l)?),
         None => None,
     };
     let s = survey_reach(h, rho, design)?;
     let scanned = s.corners > 0;
+    if scanned && nose.edge.is_some() {
+        return Err(RollerError::EdgeAtCorners { corners: s.corners });
+    }
     let centre = |y: f64, x: f64, start: f64| {
         let section = AxialSection { design: section, y };
-        if scanned {
+        let (w, u) = if scanned {
             (centre_height_scanned(&section, rho, x), x)
         } else {
             centre_height_from(&section, rho, x, start)
+        };
+        match nose.edge {
+            Some(_) if w.is_finite() => {
+                envelope::edged_max(&section, nose, x, u).unwrap_or((f64::NAN, u))
+            }
+            _ => (w, u),
         }
     };
     let mut summaries = Vec::with_capacity(h.passes.len());

@@ -109,9 +109,112 @@ pub struct Otherwise<'a> {
 /// Fits every run of straight cutting moves of `moves` it can; with
 /// `otherwise`, every run is written as the optimiser's lines and arcs
 /// where those take no more blocks than its spline (or it has none).
+///
+/// The runs are fitted in parallel (rayon), each from where the moves
+/// before it leave the tool; the steps are put together in order, and a
+/// run whose start the steps before it do not leave where the moves do
+/// is fitted again from there: the steps are the same, to the bit,
+/// whatever the threads (`fit_splines_serial` fits one run after the
+/// other, as the tests compare).
 pub fn fit_splines(
     moves: &[Move],
     fit: &SplineFit,
+    otherwise: Option<Otherwise<'_>>,
+) -> (Vec<Step>, Summary) {
+    use rayon::prelude::*;
+    let start = start_of(moves);
+    // Where each run starts (its first move and where the tool is), the
+    // tool followed through the moves as they are.
+    let mut runs = Vec::new();
+    let (mut i, mut at) = (0, start);
+    while i < moves.len() {
+        let (end, _) = run(moves, i, at);
+        if end > i {
+            runs.push((i, at));
+        }
+        let next = end.max(i + 1);
+        for m in &moves[i..next] {
+            if let Move::Rapid(to) | Move::Linear { to, .. } | Move::Arc { to, .. } = m {
+                at = merged(at, to);
+            }
+        }
+        i = next;
+    }
+    if runs.len() < 2 {
+        return fit_splines_serial(moves, fit, otherwise);
+    }
+    let no_y = !start[1].is_nan();
+    let pieces: Vec<Piece> = runs
+        .par_iter()
+        .map(|&(i, at)| piece(moves, i, at, no_y, fit, otherwise))
+        .collect();
+    let mut taken = runs.iter().zip(pieces).peekable();
+    assemble(
+        moves,
+        fit,
+        start,
+        |i, at| {
+            while taken.next_if(|((j, _), _)| *j < i).is_some() {}
+            match taken.peek() {
+                Some(((j, a), _)) if *j == i && same(*a, at) => taken.next().map(|(_, p)| p),
+                _ => None,
+            }
+        },
+        otherwise,
+    )
+}
+
+/// `fit_splines` one run after the other, on this thread.
+pub fn fit_splines_serial(
+    moves: &[Move],
+    fit: &SplineFit,
+    otherwise: Option<Otherwise<'_>>,
+) -> (Vec<Step>, Summary) {
+    assemble(moves, fit, start_of(moves), |_, _| None, otherwise)
+}
+
+/// Whether two positions are the same to the bit (an unknown axis, NaN,
+/// the same as another).
+fn same(a: [f64; 3], b: [f64; 3]) -> bool {
+    a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+}
+
+/// Whether no move of `moves` states Y (a lathe's).
+fn no_y(moves: &[Move]) -> bool {
+    moves.iter().all(|m| match m {
+        Move::Rapid(to) | Move::Linear { to, .. } | Move::Arc { to, .. } => to.y.is_nan(),
+        _ => true,
+    })
+}
+
+/// Where the tool is before `moves`: unknown, but in Y = 0 if no move
+/// states Y (a lathe's moves: the curve lies in Y = 0).
+fn start_of(moves: &[Move]) -> [f64; 3] {
+    let mut at = [f64::NAN; 3];
+    if no_y(moves) {
+        at[1] = 0.0;
+    }
+    at
+}
+
+/// What one run (or one move that is no run) is written as: where it
+/// ends in the moves (exclusive), its steps, where they leave the tool,
+/// and its spline's straight moves replaced and deviation, if fitted.
+struct Piece {
+    end: usize,
+    steps: Vec<Step>,
+    at: [f64; 3],
+    fitted: Option<(usize, f64)>,
+}
+
+/// The steps from `start`, run by run, each taken from `ready` (fitted
+/// ahead, from the move it starts at and where the tool is) or fitted
+/// here.
+fn assemble(
+    moves: &[Move],
+    fit: &SplineFit,
+    start: [f64; 3],
+    mut ready: impl FnMut(usize, [f64; 3]) -> Option<Piece>,
     otherwise: Option<Otherwise<'_>>,
 ) -> (Vec<Step>, Summary) {
     let mut out = Vec::with_capacity(moves.len() / 4);
@@ -120,86 +223,19 @@ pub fn fit_splines(
         limit: fit.tolerance + fit.rounding(),
         ..Summary::default()
     };
-    let mut at = [f64::NAN; 3];
-    // A lathe's moves never state Y: the curve lies in Y = 0.
-    let no_y = moves.iter().all(|m| match m {
-        Move::Rapid(to) | Move::Linear { to, .. } | Move::Arc { to, .. } => to.y.is_nan(),
-        _ => true,
-    });
-    if no_y {
-        at[1] = 0.0;
-    }
+    let no_y = !start[1].is_nan();
+    let mut at = start;
     let mut i = 0;
     while i < moves.len() {
-        let (run_end, feed) = run(moves, i, at);
-        // The run as lines and arcs, where those are the other way.
-        let lines_arcs = otherwise.filter(|_| run_end > i).map(|o| {
-            let mut stream = Vec::with_capacity(run_end - i + 1);
-            stream.push(Move::Rapid(if no_y {
-                Position::xz(at[0], at[2])
-            } else {
-                Position::xyz(at[0], at[1], at[2])
-            }));
-            stream.extend_from_slice(&moves[i..run_end]);
-            // The optimiser starts a run at a stated feed: a run that
-            // keeps the feed in force is given one for the fit (any: one
-            // feed for the whole run), and keeps the one in force again.
-            let first_feed = match moves[i] {
-                Move::Linear { feed, .. } => feed,
-                _ => None,
-            };
-            if let Some(Move::Linear { feed, .. }) = stream.get_mut(1)
-                && feed.is_none()
-            {
-                *feed = Some(Feed::PerTime(1.0));
-            }
-            let (mut opt, _) =
-                super::optimise::optimise_within(&stream, fit.tolerance, o.arc_planes, o.above);
-            opt.remove(0);
-            if let Some(Move::Linear { feed, .. } | Move::Arc { feed, .. }) = opt.first_mut() {
-                *feed = first_feed;
-            }
-            opt
-        });
-        if run_end - i >= FEWEST_LINES {
-            let mut points = Vec::with_capacity(run_end - i + 1);
-            points.push(at);
-            let mut p = at;
-            for m in &moves[i..run_end] {
-                if let Move::Linear { to, .. } = m {
-                    p = merged(p, to);
-                    points.push(p);
-                }
-            }
-            // A spline of n control points takes n + ORDER blocks: fewer
-            // than the lines and arcs' if n is below this.
-            let fewer = lines_arcs
-                .as_ref()
-                .map_or(usize::MAX, |l| l.len().saturating_sub(ORDER));
-            if let Some((spline, deviation)) = fit_run(&points, fit, fewer)
-                && spline.points.len() < fewer
-            {
-                summary.splines += 1;
-                summary.lines_replaced += run_end - i;
-                summary.max_deviation = summary.max_deviation.max(deviation);
-                out.push(Step::Spline(Spline { feed, ..spline }));
-                at = p;
-                i = run_end;
-                continue;
-            }
+        let p = ready(i, at).unwrap_or_else(|| piece(moves, i, at, no_y, fit, otherwise));
+        if let Some((lines, deviation)) = p.fitted {
+            summary.splines += 1;
+            summary.lines_replaced += lines;
+            summary.max_deviation = summary.max_deviation.max(deviation);
         }
-        // Not fitted: the run as lines and arcs, or as it is (or the one
-        // move that is no run).
-        let kept = lines_arcs
-            .as_deref()
-            .unwrap_or(&moves[i..run_end.max(i + 1)]);
-        for &m in kept {
-            if let Move::Rapid(to) | Move::Linear { to, .. } | Move::Arc { to, .. } = m {
-                at = merged(at, &to);
-            }
-            out.push(Step::Move(m));
-        }
-        i = run_end.max(i + 1);
+        out.extend(p.steps);
+        at = p.at;
+        i = p.end;
     }
     summary.blocks_after = out
         .iter()
@@ -209,6 +245,106 @@ pub fn fit_splines(
         })
         .sum();
     (out, summary)
+}
+
+/// The run of straight cutting moves starting at `moves[i]` (from `at`)
+/// as a spline, or as lines and arcs, or as it is (or the one move that is
+/// no run).
+fn piece(
+    moves: &[Move],
+    i: usize,
+    at: [f64; 3],
+    no_y: bool,
+    fit: &SplineFit,
+    otherwise: Option<Otherwise<'_>>,
+) -> Piece {
+    let (run_end, feed) = run(moves, i, at);
+    // The run as lines and arcs, where those are the other way.
+    let lines_arcs = otherwise.filter(|_| run_end > i).map(|o| {
+        let mut stream = Vec::with_capacity(run_end - i + 1);
+        stream.push(Move::Rapid(if no_y {
+            Position::xz(at[0], at[2])
+        } else {
+            Position::xyz(at[0], at[1], at[2])
+        }));
+        stream.extend_from_slice(&moves[i..run_end]);
+        // The optimiser starts a run at a stated feed: a run that
+        // keeps the feed in force is given one for the fit (any: one
+        // feed for the whole run), and keeps the one in force again.
+        let first_feed = match moves[i] {
+            Move::Linear { feed, .. } => feed,
+            _ => None,
+        };
+        if let Some(Move::Linear { feed, .. }) = stream.get_mut(1)
+            && feed.is_none()
+        {
+            *feed = Some(Feed::PerTime(1.0));
+        }
+        let (mut opt, _) =
+            super::optimise::optimise_within(&stream, fit.tolerance, o.arc_planes, o.above);
+        opt.remove(0);
+        if let Some(Move::Linear { feed, .. } | Move::Arc { feed, .. }) = opt.first_mut() {
+            *feed = first_feed;
+        }
+        opt
+    });
+    if run_end - i >= FEWEST_LINES && !fed_per_revolution(moves, i, feed) {
+        let mut points = Vec::with_capacity(run_end - i + 1);
+        points.push(at);
+        let mut p = at;
+        for m in &moves[i..run_end] {
+            if let Move::Linear { to, .. } = m {
+                p = merged(p, to);
+                points.push(p);
+            }
+        }
+        // A spline of n control points takes n + ORDER blocks: fewer
+        // than the lines and arcs' if n is below this.
+        let fewer = lines_arcs
+            .as_ref()
+            .map_or(usize::MAX, |l| l.len().saturating_sub(ORDER));
+        if let Some((spline, deviation)) = fit_run(&points, fit, fewer)
+            && spline.points.len() < fewer
+        {
+            return Piece {
+                end: run_end,
+                steps: vec![Step::Spline(Spline { feed, ..spline })],
+                at: p,
+                fitted: Some((run_end - i, deviation)),
+            };
+        }
+    }
+    // Not fitted: the run as lines and arcs, or as it is (or the one
+    // move that is no run).
+    let kept = lines_arcs
+        .as_deref()
+        .unwrap_or(&moves[i..run_end.max(i + 1)]);
+    let mut at = at;
+    for &m in kept {
+        if let Move::Rapid(to) | Move::Linear { to, .. } | Move::Arc { to, .. } = m {
+            at = merged(at, &to);
+        }
+    }
+    Piece {
+        end: run_end.max(i + 1),
+        steps: kept.iter().map(|&m| Step::Move(m)).collect(),
+        at,
+        fitted: None,
+    }
+}
+
+/// Whether the run starting at `moves[i]` with the feed `feed` (its own,
+/// if it states one) is fed per revolution, stated or in force (the last
+/// feed stated before it): a spline is written fed per minute only (the
+/// writer's `spline_blocks`), so such a run is written as lines and arcs.
+fn fed_per_revolution(moves: &[Move], i: usize, feed: Option<Feed>) -> bool {
+    let in_force = feed.or_else(|| {
+        moves[..i].iter().rev().find_map(|m| match m {
+            Move::Linear { feed, .. } | Move::Arc { feed, .. } => *feed,
+            _ => None,
+        })
+    });
+    matches!(in_force, Some(Feed::PerRevolution(_)))
 }
 
 /// `at` moved to `to` (an axis `to` leaves alone stays).
@@ -223,8 +359,9 @@ fn merged(at: [f64; 3], to: &Position) -> [f64; 3] {
 }
 
 /// Where the run of straight cutting moves starting at `moves[i]` (from
-/// `at`) ends (exclusive), and its feed: one feed per minute, no C, a
-/// known start, no corner.
+/// `at`) ends (exclusive), and its feed: one feed (per minute or per
+/// revolution: only the first is fitted as a spline, the second is still
+/// a run of lines and arcs), no C, a known start, no corner.
 fn run(moves: &[Move], i: usize, at: [f64; 3]) -> (usize, Option<Feed>) {
     if at.iter().any(|v| v.is_nan()) {
         return (i, None);
@@ -238,7 +375,7 @@ fn run(moves: &[Move], i: usize, at: [f64; 3]) -> (usize, Option<Feed>) {
             break;
         }
         match (f, feed) {
-            (Some(Feed::PerTime(v)), _) if j == i => feed = Some(Feed::PerTime(*v)),
+            (Some(f @ (Feed::PerTime(_) | Feed::PerRevolution(_))), _) if j == i => feed = Some(*f),
             (None, _) => {}
             (Some(f), Some(g)) if *f == g => {}
             _ => break,

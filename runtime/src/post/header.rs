@@ -27,25 +27,36 @@ pub fn write_comment(out: &mut String, text: &str) {
         })
         .collect();
     // RS274NGC lines are limited (LinuxCNC: 256 characters): long
-    // text is folded at ", " into several comments.
+    // text is folded at ", " into several comments, the line ending in
+    // "," and the next starting with two spaces. A piece with no ", " in
+    // it longer than a line is folded between words (the line ends
+    // without ","), or by characters where a word is longer than a line.
     const WIDTH: usize = 120;
     let mut line = String::new();
-    let pieces = clean.split(", ").flat_map(|p| {
-        // A piece with no ", " in it longer than a line: cut by characters.
-        let chars: Vec<char> = p.chars().collect();
-        chars
-            .chunks(WIDTH)
-            .map(|c| c.iter().collect::<String>())
-            .collect::<Vec<_>>()
-    });
-    for (i, piece) in pieces.enumerate() {
-        if i > 0 && line.chars().count() + piece.chars().count() + 2 > WIDTH {
+    for (i, piece) in clean.split(", ").enumerate() {
+        let whole = piece.chars().count();
+        if i > 0 && line.chars().count() + whole + 2 > WIDTH {
             let _ = writeln!(out, "({line},)");
             line = String::from("  ");
         } else if i > 0 {
             line.push_str(", ");
         }
-        line.push_str(&piece);
+        let mut rest = piece;
+        while line.chars().count() + rest.chars().count() > WIDTH {
+            let room = WIDTH.saturating_sub(line.chars().count()).max(1);
+            let cut = rest.char_indices().nth(room).map_or(rest.len(), |(b, _)| b);
+            // The last space within the room, or (a word longer than a
+            // line) the room's end.
+            let at = match rest[..cut].rfind(' ') {
+                Some(b) if b > 0 => b,
+                _ => cut,
+            };
+            line.push_str(&rest[..at]);
+            let _ = writeln!(out, "({line})");
+            line = String::from("  ");
+            rest = rest[at..].trim_start_matches(' ');
+        }
+        line.push_str(rest);
     }
     let _ = writeln!(out, "({line})");
 }
@@ -113,6 +124,31 @@ pub fn duration(secs: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_long_piece_is_folded_between_words_never_inside_one() {
+        // The spline header's last piece: 130 characters with no ", ".
+        let piece = "largest deviation 0 nm (limit 2.4 nm); no spline written: runs without the control's spline interpolation option (BSPLINE)";
+        let mut out = String::new();
+        write_comment(&mut out, &format!("interpolation: B spline, {piece}"));
+        let lines: Vec<&str> = out.lines().collect();
+        assert!(lines.iter().all(|l| l.chars().count() <= 122), "{out}");
+        // Every word whole: the text back from the lines, joined at their
+        // folds, is the text written (brackets for parentheses).
+        let words: Vec<&str> = lines
+            .iter()
+            .flat_map(|l| l.trim_matches(|c| c == '(' || c == ')').split_whitespace())
+            .collect();
+        let written = format!("interpolation: B spline, {piece}")
+            .replace('(', "[")
+            .replace(')', "]");
+        assert_eq!(
+            words.join(" "),
+            written.split_whitespace().collect::<Vec<_>>().join(" "),
+            "{out}"
+        );
+        assert!(out.contains("[BSPLINE]"), "{out}");
+    }
 
     #[test]
     fn exact_reads_back_and_never_writes_minus_zero() {

@@ -305,8 +305,22 @@ pub struct Reader {
     pre_cut: Vec<(f64, usize, (usize, usize))>,
 }
 
+std::thread_local! {
+    /// Programs this thread has begun to read (`reads_on_this_thread`).
+    static READS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
+/// How many programs this thread has begun to read: a build reads its
+/// program's text once, for the simulation and the read-back both, and
+/// the tests hold it to that.
+#[doc(hidden)]
+pub fn reads_on_this_thread() -> usize {
+    READS.with(|r| r.get())
+}
+
 impl Reader {
     pub fn new(dialect: &Dialect, machine: &MachineLimits) -> Reader {
+        READS.with(|r| r.set(r.get() + 1));
         Reader {
             state: modal::State::new(dialect, machine),
             findings: Vec::new(),

@@ -123,34 +123,49 @@ impl Nurbs {
 
     /// The curve as points whose chords stay within the reader's spline
     /// tolerance of it: each knot span halved until the chord's middle
-    /// and quarters lie that close to the curve.
+    /// and quarters lie that close to the curve. The spans are sampled in
+    /// parallel (rayon), each alone, and put together in order: the
+    /// points are the same whatever the threads.
     pub(crate) fn sampled(&self) -> Vec<[f64; 3]> {
+        use rayon::prelude::*;
         let x = &self.knots;
         let (first, last) = (x[0], x[x.len() - 1]);
-        let mut out = vec![self.at(first)];
-        let mut breaks: Vec<f64> = x.iter().copied().filter(|v| *v > first).collect();
-        breaks.dedup();
-        let mut from = first;
-        for to in breaks {
-            let mut pieces = 1;
-            while pieces < MOST_PIECES_PER_SPAN && !self.within(from, to, pieces) {
-                pieces *= 2;
-            }
-            for p in 1..=pieces {
+        let mut ends = vec![first];
+        ends.extend(x.iter().copied().filter(|v| *v > first));
+        ends.dedup();
+        let spans: Vec<Vec<[f64; 3]>> = ends
+            .par_windows(2)
+            .map(|w| self.span_sampled(w[0], w[1], last))
+            .collect();
+        let mut out = Vec::with_capacity(1 + spans.iter().map(Vec::len).sum::<usize>());
+        out.push(self.at(first));
+        for s in spans {
+            out.extend(s);
+        }
+        out
+    }
+
+    /// The points after `from` to `to` (a knot span) of `sampled`: the span
+    /// halved until its chords lie within the tolerance.
+    fn span_sampled(&self, from: f64, to: f64, last: f64) -> Vec<[f64; 3]> {
+        let mut pieces = 1;
+        while pieces < MOST_PIECES_PER_SPAN && !self.within(from, to, pieces) {
+            pieces *= 2;
+        }
+        (1..=pieces)
+            .map(|p| {
                 let t = if p == pieces {
                     to
                 } else {
                     from + (to - from) * p as f64 / pieces as f64
                 };
-                out.push(if t == last {
+                if t == last {
                     self.end_point()
                 } else {
                     self.at(t)
-                });
-            }
-            from = to;
-        }
-        out
+                }
+            })
+            .collect()
     }
 
     /// The last control point: where a clamped curve ends (the basis at
@@ -250,6 +265,42 @@ mod tests {
         }
         // A straight line needs one chord per span.
         assert_eq!(c.sampled().len(), 3);
+    }
+
+    /// A cubic of many spans sampled with its spans in parallel: the
+    /// same points, to the bit, on one thread or four, each span's points
+    /// those of the span sampled alone, in order.
+    #[test]
+    fn spans_sampled_in_parallel_are_the_spans_in_order() {
+        let n = 40;
+        let pts: Vec<[f64; 3]> = (0..n)
+            .map(|i| {
+                let a = i as f64 * 0.1;
+                [a.cos(), a.sin(), 0.01 * a * a]
+            })
+            .collect();
+        let mut knots = vec![0.0; 4];
+        knots.extend((1..n - 3).map(|j| j as f64 * 0.25));
+        knots.extend([(n - 3) as f64 * 0.25; 4]);
+        let c = curve(4, &pts, &vec![1.0; n], &knots);
+        assert_eq!(c.refusal(), None);
+        let last = knots[knots.len() - 1];
+        let mut serial = vec![c.at(0.0)];
+        for j in 0..n - 3 {
+            let (a, b) = (j as f64 * 0.25, (j + 1) as f64 * 0.25);
+            serial.extend(c.span_sampled(a, b, last));
+        }
+        assert!(serial.len() > 10 * (n - 3), "{}", serial.len());
+        for threads in [1, 4] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("a pool");
+            let sampled = pool.install(|| c.sampled());
+            let bits =
+                |v: &[[f64; 3]]| -> Vec<u64> { v.iter().flatten().map(|x| x.to_bits()).collect() };
+            assert_eq!(bits(&sampled), bits(&serial), "{threads} threads");
+        }
     }
 
     #[test]

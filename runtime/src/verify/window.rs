@@ -62,6 +62,25 @@ pub fn split_columns(grid: &Grid, feature: Option<usize>, most: usize) -> Vec<Ti
         .collect()
 }
 
+/// One more than the most cells a simulation may have: the bound on a
+/// grid's count of columns or rows, a grid that many wide being refused
+/// whatever its other side ([`check_cells`]).
+const OVER: usize = MAX_CELLS + 1;
+
+/// The number of whole grid steps in `steps` (a width over a spacing),
+/// at most [`OVER`], and `OVER` for what is not a number. Counts are taken
+/// from floating point here and nowhere else: `as usize` alone saturates
+/// at `usize::MAX`, and the `+ 1` after it wrapped to 0 (a window from
+/// -1e308 mm had no rows and 1.8e19 columns, counted out into 1.8e13
+/// tiles: `lensc check` aborted on a petabyte's allocation).
+fn steps(steps: f64) -> usize {
+    if steps.is_nan() || steps >= OVER as f64 {
+        OVER
+    } else {
+        steps.max(0.0) as usize
+    }
+}
+
 /// The spacing of a window the job gives without one (mm).
 pub const DEFAULT_SPACING: f64 = 1e-3;
 
@@ -94,6 +113,9 @@ pub struct TooManyCells {
     pub tiles: usize,
     /// The longest column's rows.
     pub rows: usize,
+    /// A grid's side reached the bound its count is taken to ([`steps`]):
+    /// `cells` and `rows` are then the least there would be.
+    pub at_least: bool,
 }
 
 impl TooManyCells {
@@ -106,7 +128,8 @@ impl std::fmt::Display for TooManyCells {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "{} cells (tiles: {}), columns of {} rows: more than {} cells or {} rows a column",
+            "{}{} cells (tiles: {}), columns of {} rows: more than {} cells or {} rows a column",
+            if self.at_least { "at least " } else { "" },
             self.cells,
             self.tiles,
             self.rows,
@@ -132,6 +155,7 @@ pub fn check_cells(tiles: &[Tile]) -> Result<(), TooManyCells> {
         cells,
         tiles: tiles.len(),
         rows,
+        at_least: tiles.iter().any(|t| t.grid.ns.max(t.grid.nu) >= OVER),
     })
 }
 
@@ -200,9 +224,23 @@ impl Window {
         if squares.len() < 2 {
             return split(&self.polar(), None);
         }
-        squares
+        let grids: Vec<(usize, Grid)> = squares.iter().map(|&(k, w)| (k, w.polar())).collect();
+        let cells = grids.iter().fold(0usize, |n, (_, g)| {
+            n.saturating_add(g.ns.saturating_mul(g.nu))
+        });
+        if cells > MAX_CELLS {
+            // Refused whole (`check_cells`): not worth counting out.
+            return grids
+                .iter()
+                .map(|&(k, grid)| Tile {
+                    grid,
+                    feature: Some(k),
+                })
+                .collect();
+        }
+        grids
             .iter()
-            .flat_map(|&(k, square)| split(&square.polar(), Some(k)))
+            .flat_map(|&(k, grid)| split(&grid, Some(k)))
             .collect()
     }
 
@@ -212,7 +250,7 @@ impl Window {
 
     /// Columns along x (`along_x`) or y, rows across.
     pub fn cartesian(&self, along_x: bool) -> Grid {
-        let count = |r: (f64, f64)| ((r.1 - r.0) / self.spacing + 1e-9).floor() as usize + 1;
+        let count = |r: (f64, f64)| steps(((r.1 - r.0) / self.spacing + 1e-9).floor()) + 1;
         let (s, u) = if along_x {
             (self.x, self.y)
         } else {
@@ -241,21 +279,22 @@ impl Window {
             (self.x.0, self.y.1),
         ];
         let r_max = corners.iter().map(|c| c.0.hypot(c.1)).fold(0.0, f64::max);
+        // `clamp` would panic on a range that is not a number.
         let near = (
-            0.0f64.clamp(self.x.0, self.x.1),
-            0.0f64.clamp(self.y.0, self.y.1),
+            0.0f64.max(self.x.0).min(self.x.1),
+            0.0f64.max(self.y.0).min(self.y.1),
         );
         let r_min = near.0.hypot(near.1);
-        let nu = ((r_max - r_min) / self.spacing).floor() as usize + 1;
+        let nu = steps(((r_max - r_min) / self.spacing).floor()) + 1;
         if r_min < self.spacing {
-            let ns = (TAU * r_max / self.spacing).ceil().max(8.0) as usize;
+            let ns = steps((TAU * r_max / self.spacing).ceil().max(8.0));
             return Grid {
                 s0: 0.0,
                 ds: TAU / ns as f64,
                 ns,
                 u0: 0.0,
                 du: self.spacing,
-                nu: (r_max / self.spacing).floor() as usize + 1,
+                nu: steps((r_max / self.spacing).floor()) + 1,
                 period: Some(TAU),
                 j0: 0,
                 i0: 0,
@@ -275,7 +314,7 @@ impl Window {
         Grid {
             s0: mid + lo,
             ds,
-            ns: ((hi - lo) / ds).ceil() as usize + 1,
+            ns: steps(((hi - lo) / ds).ceil()) + 1,
             u0: r_min,
             du: self.spacing,
             nu,
@@ -294,10 +333,10 @@ impl Window {
         Grid {
             s0: (self.y.0 - y_start) / roller_radius,
             ds,
-            ns: (span / ds + 1e-9).floor() as usize + 1,
+            ns: steps((span / ds + 1e-9).floor()) + 1,
             u0: self.x.0,
             du: self.spacing,
-            nu: ((self.x.1 - self.x.0) / self.spacing + 1e-9).floor() as usize + 1,
+            nu: steps(((self.x.1 - self.x.0) / self.spacing + 1e-9).floor()) + 1,
             period: Some(TAU),
             j0: 0,
             i0: 0,
@@ -329,6 +368,36 @@ mod tests {
     /// whose tiles stay within the budget: a 4 mm square at 2 µm is 4
     /// million cells, at 5 µm 641 601; a budget no spacing meets takes the
     /// coarsest.
+    /// A window from -1e308 mm (a fuzzed job's, issue #33): its counts
+    /// overflowed `usize` (`as usize` saturates, the `+ 1` wrapped to 0),
+    /// a grid of no rows passed as small and was counted out into 1.8e13
+    /// tiles, aborting `lensc check` on a petabyte's allocation. Every
+    /// count is bounded, the grid stays one tile and is refused; a window
+    /// of infinite extent likewise.
+    #[test]
+    fn a_window_of_1e308_mm_is_one_tile_refused() {
+        let extent = ((-0.4, 0.4), (-0.4, 0.4));
+        for x in [(-1e308, 1e5), (f64::NEG_INFINITY, 1e5)] {
+            let w = Window::given(x, (-0.05, -0.0), None, extent);
+            for tiles in [
+                w.polar_tiles(&[]),
+                split(&w.cartesian(true), None),
+                split(&w.roller(5.0, 0.0), None),
+            ] {
+                assert_eq!(tiles.len(), 1, "{x:?}");
+                assert!(tiles[0].grid.nu >= 1 && tiles[0].grid.ns >= 1, "{x:?}");
+                let e = check_cells(&tiles).unwrap_err();
+                assert!(e.cells > MAX_CELLS && e.at_least, "{x:?}: {e}");
+            }
+        }
+        // Lenslet by lenslet, squares whose cells between them are too
+        // many stay one tile each.
+        let w = Window::given((-1e5, 1e5), (-1e5, 1e5), None, extent);
+        let tiles = w.polar_tiles(&[(-5e4, 0.0, 4e4), (5e4, 0.0, 4e4)]);
+        assert_eq!(tiles.len(), 2);
+        assert!(check_cells(&tiles).is_err());
+    }
+
     #[test]
     fn the_default_window_is_the_whole_part_within_its_budget() {
         let extent = ((-2.0, 2.0), (-2.0, 2.0));

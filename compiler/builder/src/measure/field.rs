@@ -8,7 +8,8 @@
 //! (the margin of land that tells a sphere's decentre from its tilt) and
 //! on the design are registered to the design seen from the lenslet's
 //! centre (piston, tilt, decentre; clocking where the lenslet is not of
-//! revolution), starting from the lenslet's nominal place; the
+//! revolution), starting from the lenslet's nominal place (clear of its
+//! rim where it steps onto the land: `steps`); the
 //! decentre found is where the lenslet's centre lies from where the field
 //! was placed. Refused, with a code, on a surface that is not an array
 //! (E0368), a lenslet the array does not have (E0369) and a field whose
@@ -25,6 +26,7 @@ use lensc_runtime::verify::lenslets::Lenslets;
 
 use super::lenslets::{FromCentre, MARGIN, rows_and_columns};
 use super::placed::{self, Failure, LensletPick, Options, fail};
+use super::steps::{SteppedRims, register_clear};
 use super::{Outcome, report};
 
 /// Below this share of the lenslet's aperture covered, its figures are
@@ -226,21 +228,30 @@ pub(super) fn measure(
             .map(|q| [q[0] + off.0, q[1] + off.1, q[2]])
             .collect()
     };
+    // Rims that step onto the land: the fit stays clear of them.
+    let rims = SteppedRims::of(f, lenslets);
+    let pixel = map.dx.max(map.dy);
+    let fit = |pts: &[[f64; 3]]| {
+        register_clear(
+            &|pts, fit| register::register_heights(&g, pts, fit),
+            pts,
+            Fit::default(),
+            rims.as_ref().map(|r| (r, c)),
+            pixel,
+        )
+        .map_err(|e| placed::not_registered(file, &target, e))
+    };
     let mut local = shifted(&p, off);
-    let mut reg = register::register_heights(&g, &local, Fit::default())
-        .map_err(|e| placed::not_registered(file, &target, e))?;
+    let (mut reg, mut band) = fit(&local)?;
     // Found more than a pixel from where it was placed: the pixels are
     // taken again where the registration puts the field, and registered
     // again from there (in the frame of the first placement: a shift s of
     // the points' origin is a decentre d − s and a piston p + t·s).
-    let pixel = map.dx.max(map.dy);
     let moved_to = where_found(&reg, off);
     let s_shift = (moved_to.0 - off.0, moved_to.1 - off.1);
     if s_shift.0.hypot(s_shift.1) > pixel {
         (p, covered) = select(moved_to);
-        let again = register::register_heights(&g, &shifted(&p, moved_to), Fit::default())
-            .map_err(|e| placed::not_registered(file, &target, e))?;
-        reg = again;
+        (reg, band) = fit(&shifted(&p, moved_to))?;
         let (tx, ty) = reg.tilt();
         reg.values[3] -= s_shift.0;
         reg.values[4] -= s_shift.1;
@@ -283,6 +294,9 @@ pub(super) fn measure(
         "{}, on the map's pixels within the aperture of {lenslet_words} widened by a fifth, against the design seen from its centre, started with {reference} at x = {}, y = {} mm ({placed_by})",
         registration.method, place.0, place.1
     );
+    if let (Some(r), Some(band)) = (&rims, band) {
+        registration.method.push_str(&r.words(band));
+    }
     let mut caption = super::caption(&form, &registration, &raster);
     caption.push_str(&format!(
         " The map is one lenslet's field: {lenslet_words}, its aperture {:.1} % covered; the registration puts {reference} at x = {:.4}, y = {:.4} mm on the part (placed at {}, {} by {placed_by}).",

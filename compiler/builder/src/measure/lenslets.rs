@@ -6,7 +6,8 @@
 //! a lenslet tells its decentre from a tilt); each lenslet's points are then
 //! registered to the design seen from that lenslet's centre (piston,
 //! tilt, decentre; clocking where its surface is not of revolution),
-//! starting from where the whole array's registration puts it, and its
+//! starting from where the whole array's registration puts it (clear of
+//! rims that step onto the land: `steps`), and its
 //! error along the normal, PV, RMS and texture are figured from its own
 //! registration. A lenslet with too few valid points, or whose
 //! registration does not settle, is a coded finding (W0036) in the report,
@@ -20,6 +21,7 @@ use lensc_runtime::verify::lenslets::Lenslets;
 
 use super::placed::{Options, form_error};
 use super::report;
+use super::steps::{SteppedRims, register_clear};
 
 /// The design `f` seen from a lenslet's centre: g(u, v) = f(u + cx, v + cy).
 pub(super) struct FromCentre<'a> {
@@ -64,6 +66,7 @@ pub(super) fn measure(
     lenslets: &Lenslets,
     m: &HeightMap,
     whole: &Registration,
+    rims: Option<&SteppedRims>,
     opts: &Options,
 ) -> report::Lenslets {
     // Each lenslet with a margin of the land about it (a fifth of its
@@ -134,7 +137,13 @@ pub(super) fn measure(
             .map(|q| [q[0] - at.0, q[1] - at.1, q[2]])
             .collect();
         let g = FromCentre { f, centre: c };
-        let reg = match register::register_heights(&g, &local, Fit::default()) {
+        let (reg, _) = match register_clear(
+            &|pts, fit| register::register_heights(&g, pts, fit),
+            &local,
+            Fit::default(),
+            rims.map(|r| (r, c)),
+            m.dx.max(m.dy),
+        ) {
             Ok(r) => r,
             Err(e) => {
                 let why = match e {
@@ -197,8 +206,16 @@ pub(super) fn measure(
             _ => Some((k, pv)),
         })
         .map(|(k, _)| k);
+    let mut method: String = "each map point given to the nearest lenslet whose aperture, widened by a fifth (a margin of the land about it), holds it where the whole array's registration places it; each lenslet's points registered on their own to the design seen from its centre (least squares on the heights: piston, tilt, decentre, and clocking off a surface of revolution), starting where the whole array's registration puts it".into();
+    if let Some(r) = rims {
+        method.push_str(&format!(
+            "; the pixels within three pixels ({:.1} µm) of the lenslets' rims, which step onto the land by up to {:.1} µm, left out of each fit (more while its placement still moved)",
+            super::steps::BAND_PIXELS * m.dx.max(m.dy) * 1000.0,
+            r.largest * 1000.0
+        ));
+    }
     report::Lenslets {
-        method: "each map point given to the nearest lenslet whose aperture, widened by a fifth (a margin of the land about it), holds it where the whole array's registration places it; each lenslet's points registered on their own to the design seen from its centre (least squares on the heights: piston, tilt, decentre, and clocking off a surface of revolution), starting where the whole array's registration puts it".into(),
+        method,
         in_array: lenslets.len(),
         reached: each.len(),
         not_registered: each.iter().filter(|l| l.finding.is_some()).count(),

@@ -13,6 +13,7 @@ mod field;
 mod lenslets;
 pub mod placed;
 pub mod report;
+pub mod steps;
 
 use lensc_measure::map::Measured;
 use lensc_measure::register;
@@ -92,6 +93,12 @@ pub fn measure(
         Measured::Cloud(_) => "point_cloud",
         Measured::Profile(_) => "profile",
     };
+    // An array whose rims step onto the land: its map is registered
+    // clear of them.
+    let rims = match (&m.data, head.surface.lenslets.as_ref()) {
+        (Measured::Map(_), Some(l)) => steps::SteppedRims::of(f.as_ref(), l),
+        _ => None,
+    };
     let placed = register_measurement(
         f.as_ref(),
         &lowered.domain,
@@ -100,6 +107,7 @@ pub fn measure(
         m.data,
         format,
         opts,
+        rims.as_ref(),
     )?;
     let Registered {
         points: p,
@@ -107,17 +115,21 @@ pub fn measure(
         errors,
         form,
         share,
+        clear_of_rims,
         ..
     } = placed;
     let (texture, texture_skipped) = texture_of(&p, &errors, opts.cutoff);
     let lenslets = array
         .zip(p.map.as_ref())
-        .map(|(l, map)| lenslets::measure(f.as_ref(), l, map, &reg, opts));
+        .map(|(l, map)| lenslets::measure(f.as_ref(), l, map, &reg, rims.as_ref(), opts));
     let setup = (spec.setup() == Setup::Lathe)
         .then(|| setup_of(f.as_ref(), &p, &errors, &reg))
         .flatten();
     let raster = raster(&p.inside, &errors, p.map.as_ref().map(|m| m.dx.max(m.dy)));
-    let registration = registration_report(&reg);
+    let mut registration = registration_report(&reg);
+    if let (Some(r), Some(band)) = (&rims, clear_of_rims) {
+        registration.method.push_str(&r.words(band));
+    }
     let mut caption = caption(&form, &registration, &raster);
     if let Some(l) = &lenslets {
         caption.push_str(&lenslets_caption(l));

@@ -255,6 +255,9 @@ pub struct Registered {
     pub form: report::FormError,
     /// The share of the measured aperture that is valid.
     pub share: f64,
+    /// How far either side of an array's stepped rims (mm) the pixels
+    /// were left out of the registration (`steps`); none without them.
+    pub(crate) clear_of_rims: Option<f64>,
 }
 
 impl Registered {
@@ -276,15 +279,19 @@ impl Registered {
 /// `f` over `domain` (the surface `surface_name`): refused, with its code,
 /// when too little of it lies on the aperture or is valid, when the
 /// registration does not converge, or when what is left departs from the
-/// design more than a part could (other units, another surface).
+/// design more than a part could (other units, another surface). A map
+/// of an array whose rims step onto the land (`rims`) is registered clear
+/// of them (`steps::register_clear`).
+#[allow(clippy::too_many_arguments)]
 pub fn register_measurement(
-    f: &dyn SurfaceFn,
+    f: &(dyn SurfaceFn + Sync),
     domain: &lensc_runtime::surface::analysis::Domain,
     surface_name: &str,
     file: &str,
     data: Measured,
     format: Format,
     opts: &Options,
+    rims: Option<&super::steps::SteppedRims>,
 ) -> Result<Registered, Failure> {
     use lensc_lang::codes;
     let domain = *domain;
@@ -335,11 +342,19 @@ pub fn register_measurement(
         ..Fit::default()
     };
     let reg = if p.cloud {
-        register::register_cloud(f, &p.inside, fit)
+        register::register_cloud(f, &p.inside, fit).map(|r| (r, None))
     } else {
-        register::register_heights(f, &p.inside, fit)
+        let pixel = p.map.as_ref().map_or(0.0, |m| m.dx.max(m.dy));
+        super::steps::register_clear(
+            &|pts, fit| register::register_heights_parallel(f, pts, fit),
+            &p.inside,
+            fit,
+            rims.map(|r| (r, (0.0, 0.0))),
+            pixel,
+        )
     };
-    let reg = reg.map_err(|e| not_registered(file, &format!("`{surface_name}`"), e))?;
+    let (reg, clear_of_rims) =
+        reg.map_err(|e| not_registered(file, &format!("`{surface_name}`"), e))?;
     // The error along the normal, at each registered point.
     let pred = register::predict(f, &p.inside, &reg.values);
     let errors: Vec<f64> = p
@@ -363,6 +378,7 @@ pub fn register_measurement(
         vertical,
         form,
         share,
+        clear_of_rims,
     })
 }
 

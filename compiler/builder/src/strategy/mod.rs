@@ -209,9 +209,11 @@ pub fn lower_job(
     if let Err(d) = crate::job::simulate(&p.params) {
         errors.push(d);
     }
-    // Only profile and spiral turning place the nose by a measured edge.
+    // Only profile, spiral and roller helix turning place the nose by a
+    // measured edge (raster's ball ends and grinding's wheels take none).
     if !<turning::TurningSpec as Strategy>::NAMES.contains(&strategy)
         && !<spiral::SpiralSpec as Strategy>::NAMES.contains(&strategy)
+        && !<roller::RollerSpec as Strategy>::NAMES.contains(&strategy)
     {
         errors.extend(crate::edge::not_compensated(&p, strategy));
     }

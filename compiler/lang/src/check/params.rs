@@ -420,7 +420,8 @@ impl<'a> Checker<'a> {
 /// the kind takes the same thing under another name and form: a ball's or
 /// a circle's `radius` where lensc takes its `diameter` (a spelling guess
 /// would not say the value doubles), a rectangle's `width` and `height`
-/// where lensc takes the ranges `x` and `y`. `None` where the kind takes
+/// where lensc takes the ranges `x` and `y`, a job's `dialect`, which
+/// `lensc build --dialect` chooses. `None` where the kind takes
 /// no such parameter.
 fn named_as_elsewhere(params: &[Param], f: &Field) -> Option<String> {
     let takes = |name: &str| params.iter().any(|p| p.name == name);
@@ -456,6 +457,16 @@ fn named_as_elsewhere(params: &[Param], f: &Field) -> Option<String> {
                 ),
             })
         }
+        "dialect" if takes("machine") && takes("strategy") => Some(match match &f.value {
+            Value::Word(w) => Some(w),
+            Value::Object(o) => o.name.as_ref(),
+            _ => None,
+        } {
+            Some(w) => format!(
+                "a job's program is written in its machine's dialect; another the machine offers (its `other_dialects`) is chosen when building: `lensc build FILE --dialect {w}`"
+            ),
+            _ => "a job's program is written in its machine's dialect; another the machine offers (its `other_dialects`) is chosen when building: `lensc build FILE --dialect NAME`".into(),
+        }),
         _ => None,
     }
 }

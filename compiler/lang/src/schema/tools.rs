@@ -53,7 +53,7 @@ pub(super) const ROUND_NOSE: Kind = Kind {
             "edge_profile",
             Ty::Text,
             Check::Any,
-            "the edge as measured: a text file of angle (deg, from the tool's axis, + towards +X) and deviation from the nose circle (um, + proud) a line, relative to the job's file; profile turning offsets the path by R + δ at the angle of contact, spiral turning and the fast tool servo clear each ray's section with this edge, and the simulation cuts with it (docs/language/edge-profile.md); default none, a perfect circle",
+            "the edge as measured: a text file of angle (deg, from the tool's axis, + towards +X) and deviation from the nose circle (um, + proud) a line, relative to the job's file; profile turning offsets the path by R + δ at the angle of contact, spiral turning and the fast tool servo clear each ray's section with this edge, the roller helix each axial section (+ towards +Z, along the roller), and the simulation cuts with it (docs/language/edge-profile.md); default none, a perfect circle",
         ),
         CONTROL_POINT,
     ],

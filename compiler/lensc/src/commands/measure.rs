@@ -152,9 +152,30 @@ pub fn run(
     0
 }
 
-/// Prints each lenslet's finding (W0036, W0037) as a warning over the
-/// measurement file.
+/// Prints each lenslet's finding (W0036, W0037) as a warning naming the
+/// measurement file: a finding is of the whole map, at no byte of it, so
+/// no line of the file is shown (`plain`).
 fn warn(out: &Output, part: &Path, bytes: &[u8], findings: &[&measure::report::Finding]) {
+    let help = |code: &str| {
+        if code == lensc_lang::codes::FIELD_PART_OF_LENSLET {
+            "centre the field on the lenslet (or give where it lay with --at) to measure all of it"
+        } else {
+            "measure that lenslet again, or lower --min-valid knowing what its figures then cover"
+        }
+    };
+    if out.format == MessageFormat::Human {
+        for f in findings {
+            plain(
+                "warning",
+                &f.code,
+                &f.message,
+                Some(help(&f.code)),
+                part,
+                None,
+            );
+        }
+        return;
+    }
     let text = std::str::from_utf8(bytes)
         .map(str::to_owned)
         .unwrap_or_default();
@@ -163,32 +184,56 @@ fn warn(out: &Output, part: &Path, bytes: &[u8], findings: &[&measure::report::F
     let diags: Vec<Diagnostic> = findings
         .iter()
         .map(|f| {
-            if f.code == lensc_lang::codes::FIELD_PART_OF_LENSLET {
-                Diagnostic::warning(lensc_lang::codes::FIELD_PART_OF_LENSLET, f.message.clone(), id, Span::new(0, 0))
-                    .with_help("centre the field on the lenslet (or give where it lay with --at) to measure all of it")
+            let code = if f.code == lensc_lang::codes::FIELD_PART_OF_LENSLET {
+                lensc_lang::codes::FIELD_PART_OF_LENSLET
             } else {
-                Diagnostic::warning(lensc_lang::codes::LENSLET_NOT_REGISTERED, f.message.clone(), id, Span::new(0, 0))
-                    .with_help("measure that lenslet again, or lower --min-valid knowing what its figures then cover")
-            }
+                lensc_lang::codes::LENSLET_NOT_REGISTERED
+            };
+            Diagnostic::warning(code, f.message.clone(), id, Span::new(0, 0)).with_help(help(code))
         })
         .collect();
-    let _ = match out.format {
-        MessageFormat::Human => {
-            render::human(&diags, &sources, out.color, &mut std::io::stderr().lock())
-        }
-        MessageFormat::Json => render::json_lines(&diags, &sources, &mut std::io::stdout().lock()),
-    };
+    let _ = render::json_lines(&diags, &sources, &mut std::io::stdout().lock());
 }
 
-/// Prints a refusal over the measurement file (its text, when it is
-/// text) and returns exit code 1.
+/// A diagnostic about the measurement file `part` with no line of it to
+/// show: the file is binary (an X3P, a MetroPro `.dat`), or what is wrong
+/// lies at no byte of it (a registration, a mask). The message names the
+/// file; the line under it names the byte, where one is known.
+fn plain(
+    severity: &str,
+    code: &str,
+    message: &str,
+    help: Option<&str>,
+    part: &Path,
+    at: Option<usize>,
+) {
+    eprintln!("{severity}[{code}]: {message}");
+    match at {
+        Some(at) => eprintln!("  --> {}, byte {at}", part.display()),
+        None => eprintln!("  --> {}", part.display()),
+    }
+    if let Some(h) = help {
+        eprintln!("  help: {h}");
+    }
+}
+
+/// Prints a refusal over the measurement file and returns exit code 1:
+/// with the line it points at where the file is text and the failure lies
+/// at a byte of it; otherwise named in words (`plain`), with no line.
 fn refuse(out: &Output, part: &Path, bytes: &[u8], f: &Failure) -> u8 {
-    let text = std::str::from_utf8(bytes)
-        .map(str::to_owned)
-        .unwrap_or_default();
-    let at = f.at.filter(|a| *a <= text.len()).unwrap_or(0);
+    let text = std::str::from_utf8(bytes).ok();
+    let shown = text.zip(f.at).filter(|(t, a)| *a <= t.len());
+    if out.format == MessageFormat::Human && shown.is_none() {
+        plain("error", f.code, &f.message, f.help.as_deref(), part, f.at);
+        return 1;
+    }
+    let at = shown.map_or(f.at.unwrap_or(0), |(_, a)| a);
     let mut sources = SourceMap::default();
-    let id = sources.add(part.display().to_string(), Some(part.to_path_buf()), text);
+    let id = sources.add(
+        part.display().to_string(),
+        Some(part.to_path_buf()),
+        text.unwrap_or_default().to_owned(),
+    );
     let mut d = Diagnostic::error(f.code, f.message.clone(), id, Span::new(at, at));
     if let Some(h) = &f.help {
         d = d.with_help(h.clone());

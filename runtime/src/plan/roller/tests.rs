@@ -501,3 +501,100 @@ fn invalid_input_is_refused_with_its_figures() {
         Err(RollerError::Invalid { .. })
     ));
 }
+
+/// A 50 nm sinusoid of 4 periods over ±45°, sampled every 0.5°.
+fn wavy_edge() -> crate::machine::edge::EdgeProfile {
+    use crate::machine::edge::{EdgeProfile, Sample};
+    let samples: Vec<Sample> = (0..=180)
+        .map(|i| {
+            let a = -45.0 + 0.5 * i as f64;
+            Sample {
+                angle_deg: a,
+                deviation_um: 0.05 * (4.0 * std::f64::consts::PI * a / 45.0).sin(),
+                line: i + 1,
+                at: 0,
+            }
+        })
+        .collect();
+    EdgeProfile::from_samples(&samples).unwrap()
+}
+
+#[test]
+fn with_a_measured_edge_each_centre_is_the_brute_force_envelope() {
+    // Job 1's pattern (axial slopes to ±5.7°) over half a millimetre,
+    // rough pass only: every point's X is the lowest that clears the
+    // axial section with the wavy edge, found by brute force.
+    let h = RollerHelix {
+        z_end: 1.0,
+        ..rough_only(job1())
+    };
+    let edge = wavy_edge();
+    let nose = Nose {
+        radius: RHO1,
+        edge: Some(&edge),
+    };
+    let mut points = Vec::new();
+    plan_roller_helix_edged(&h, &nose, &Sinusoid, &Sinusoid, |_, pts| {
+        points.extend_from_slice(pts)
+    })
+    .expect("plans");
+    let circle = plan_roller_helix(&h, RHO1, &Sinusoid).expect("plans");
+    assert_eq!(points.len(), circle.points[0].len());
+    let (mut worst, mut moved): (f64, f64) = (0.0, 0.0);
+    for (p, q) in points.iter().zip(&circle.points[0]).step_by(37) {
+        let section = AxialSection {
+            design: &Sinusoid,
+            y: h.design_y(p.c),
+        };
+        // max over u of z(u) + L(u − z), sampled every 10 nm and refined
+        // by golden section about the best sample.
+        let f = |u: f64| {
+            nose.lift(u - p.z)
+                .map_or(f64::NEG_INFINITY, |(l, _)| section.point(u).z + l)
+        };
+        let n = 60_000;
+        let (a, b) = (p.z - 0.3, p.z + 0.3);
+        let best = (0..=n)
+            .map(|i| a + (b - a) * i as f64 / n as f64)
+            .max_by(|u, v| f(*u).total_cmp(&f(*v)))
+            .unwrap();
+        let (mut lo, mut hi) = (best - 1e-5, best + 1e-5);
+        for _ in 0..100 {
+            let (m1, m2) = (lo + 0.382 * (hi - lo), hi - 0.382 * (hi - lo));
+            if f(m1) < f(m2) {
+                lo = m1;
+            } else {
+                hi = m2;
+            }
+        }
+        let brute = h.roller_radius + f(lo).max(f(best));
+        worst = worst.max((p.x - brute).abs());
+        moved = moved.max((p.x - q.x).abs());
+    }
+    // Within a picometre of the envelope; tens of nanometres from the
+    // circle's.
+    assert!(worst < 1e-9, "off the envelope by {} nm", worst * 1e6);
+    assert!(moved > 20e-6, "the edge moved X {} nm", moved * 1e6);
+}
+
+#[test]
+fn a_measured_edge_over_concave_corners_is_refused() {
+    // The V-groove's corner makes the planner scan each window: that
+    // search places a circle only, so an edge is refused, not ignored.
+    let h = RollerHelix {
+        z_end: 1.0,
+        design_length_around: None,
+        blank_radius: 4.0,
+        ..rough_only(job1())
+    };
+    let edge = wavy_edge();
+    let nose = Nose {
+        radius: 0.5,
+        edge: Some(&edge),
+    };
+    let groove = Groove { k: 0.05, x0: 0.75 };
+    let e = plan_roller_helix_edged(&h, &nose, &groove, &groove, |_, _| {}).expect_err("refused");
+    assert!(matches!(e, RollerError::EdgeAtCorners { .. }), "{e:?}");
+    // The circle is planned.
+    plan_roller_helix(&h, 0.5, &groove).expect("plans");
+}

@@ -609,3 +609,26 @@ fn the_default_start_puts_the_first_revolutions_contacts_a_feed_beyond_the_rim()
         }
     }
 }
+
+/// Far from the axis (2^34 mm: an array 4,300 km across, a fuzzed job's,
+/// issue #33) neighbouring floats lie 3.8 µm apart, more than the
+/// nanometre the rim's bisection stopped at: its midpoint was one of its
+/// ends and it looped for ever (`lensc check` hung). It stops when no
+/// float lies between, within `RIM_BISECTIONS` halvings.
+#[test]
+fn the_rim_search_ends_far_from_the_axis() {
+    let calls = std::cell::Cell::new(0usize);
+    let contact = |x: f64| {
+        calls.set(calls.get() + 1);
+        assert!(calls.get() < 1_000, "the bisection does not end");
+        Some(x)
+    };
+    let target = 2f64.powi(34) + 0.5;
+    let found = rim_centre(&contact, target, 0.5).expect("a centre");
+    assert!(found >= target && found - target < 1e-5, "{found}");
+    assert!(calls.get() <= RIM_BISECTIONS + 2, "{} calls", calls.get());
+    // Near the axis, the nanometre as before.
+    calls.set(0);
+    let found = rim_centre(&contact, 4.01, 0.5).expect("a centre");
+    assert!((found - 4.01).abs() <= 1e-6, "{found}");
+}

@@ -417,3 +417,95 @@ fn a_lathe_profile_without_y_is_fitted_in_y_zero() {
     let worst = worst_from_circle(s, 1.0);
     assert!(worst <= summary.limit, "{worst:e} over {:e}", summary.limit);
 }
+
+/// A profile fed per revolution (a lathe's G95, every move stating its
+/// feed as the turning planner gives it): the writer's splines are fed per
+/// minute only, so no spline is fitted, but the run is still written as
+/// the optimiser's lines and arcs (it was left as 400 lines, 25 times the
+/// program `lines_arcs` writes).
+#[test]
+fn a_run_fed_per_revolution_is_lines_and_arcs_never_a_spline() {
+    use crate::moves::Plane;
+    let mut moves = pass(4.0, 0.7, 400);
+    for m in &mut moves {
+        if let Move::Linear { feed, .. } = m {
+            *feed = Some(Feed::PerRevolution(3e-3 / std::f64::consts::TAU));
+        }
+    }
+    let planes = [Plane::Zx];
+    let o = Otherwise {
+        arc_planes: &planes,
+        above: false,
+    };
+    let (steps, summary) = fit_splines(&moves, &FIT, Some(o));
+    assert_eq!(summary.splines, 0, "{summary:?}");
+    let (opt, _) = crate::plan::optimise::optimise_within(&moves, FIT.tolerance, &planes, false);
+    assert!(opt.len() < 8, "{}", opt.len());
+    let written: Vec<Move> = steps
+        .iter()
+        .map(|s| match s {
+            Step::Move(m) => *m,
+            Step::Spline(_) => unreachable!(),
+        })
+        .collect();
+    assert_eq!(format!("{written:?}"), format!("{opt:?}"));
+    // Without arcs it stays lines: still no spline.
+    let o = Otherwise {
+        arc_planes: &[],
+        above: false,
+    };
+    let (_, summary) = fit_splines(&moves, &FIT, Some(o));
+    assert_eq!(summary.splines, 0, "{summary:?}");
+}
+
+/// Many passes, some fitted, some kept as lines and arcs, some too short
+/// or too coarse: the runs fitted in parallel come out as fitted one
+/// after the other, to the bit, on one thread or four.
+#[test]
+fn runs_fitted_in_parallel_are_the_runs_fitted_in_order() {
+    use crate::moves::Plane;
+    let mut moves = Vec::new();
+    for k in 0..24 {
+        let (r, w, n) = match k % 4 {
+            0 => (1.0, 0.7, 400),
+            1 => (0.5, 0.45, 120),
+            2 => (3.0, 1.0, 10),
+            _ => (0.2, 0.19, 30),
+        };
+        let mut pass = pass(r, w, n);
+        // Each pass a little further along Y, after a lift.
+        for m in &mut pass {
+            if let Move::Rapid(to) | Move::Linear { to, .. } = m {
+                to.y += k as f64 * 0.01;
+            }
+        }
+        moves.push(Move::Rapid(Position::xyz(-w, 0.5 + k as f64 * 0.01, 1.0)));
+        moves.extend(pass);
+    }
+    let planes = [Plane::Zx];
+    for o in [
+        None,
+        Some(Otherwise {
+            arc_planes: &[],
+            above: false,
+        }),
+        Some(Otherwise {
+            arc_planes: &planes,
+            above: true,
+        }),
+    ] {
+        let serial = fit_splines_serial(&moves, &FIT, o);
+        assert!(serial.1.splines >= 6, "{:?}", serial.1);
+        for threads in [1, 4] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("a pool");
+            let parallel = pool.install(|| fit_splines(&moves, &FIT, o));
+            // Compared as printed (a move's unstated C is NaN, which no
+            // NaN equals): every step and figure, to the last digit.
+            let (p, s) = (format!("{parallel:?}"), format!("{serial:?}"));
+            assert!(p == s, "{threads} threads: the steps differ");
+        }
+    }
+}

@@ -584,7 +584,14 @@ impl ColumnCut<'_> {
 
     /// A run's contact: its least error, refined by the parabola through
     /// it and its neighbours; (NaN, NaN) where the least lies on a run's
-    /// end that no other pass bounds (the window's edge or uncut cells).
+    /// end that no other pass bounds (the window's edge or uncut cells)
+    /// and the pass's own cut, a row beyond that end, is lower or cannot
+    /// be told: its contact lies outside the window, and the rows inside
+    /// are the flank of its scallop (as the knife's contact counts only
+    /// where its least lies in the window, [`super::ColumnCut::valleys`]).
+    /// A run of one row is judged so too: where the window's edge crosses
+    /// a column just past a cusp, the one row of the pass beyond is that
+    /// scallop's top, not a contact (issue #29).
     fn valley(&self, g: &Grid, errors: &[f64], run: &Run) -> (f64, f64) {
         let m = (run.first..=run.last)
             .min_by(|&x, &y| errors[x].total_cmp(&errors[y]))
@@ -592,7 +599,13 @@ impl ColumnCut<'_> {
         let bounded = |i: usize| i.checked_sub(1).is_some_and(|k| !errors[k].is_nan());
         let open_start = m == run.first && !bounded(run.first);
         let open_end = m == run.last && errors.get(run.last + 1).is_none_or(|e| e.is_nan());
-        if (open_start || open_end) && run.first != run.last {
+        // The pass's error a row beyond `u`, no lower than the least:
+        // the least is a contact.
+        let rises = |u: f64| {
+            let beyond = self.cut(run.pass, u) - self.design_at(u);
+            beyond >= errors[m]
+        };
+        if (open_start && !rises(g.u(m) - g.du)) || (open_end && !rises(g.u(m) + g.du)) {
             return (f64::NAN, f64::NAN);
         }
         let (mut best_u, mut best) = (g.u(m), errors[m]);
@@ -863,6 +876,71 @@ mod tests {
         assert_eq!(fast.scallops, brute.scallops);
         assert_eq!(fast_blocks, brute_blocks);
         assert_eq!(fast, brute);
+    }
+
+    /// A flat design judged in a circle (the whole part's window).
+    struct FlatDisc;
+    impl Frame for FlatDisc {
+        fn design(&self, points: &[(f64, f64)], out: &mut [f64]) {
+            out[..points.len()].fill(0.0);
+        }
+        fn xy(&self, s: f64, u: f64) -> (f64, f64) {
+            (s, u)
+        }
+        fn inside(&self, x: f64, y: f64) -> bool {
+            (x - 0.5).hypot(y - 0.3) <= 0.28
+        }
+    }
+
+    /// A ball of 0.1 mm rastered on the flat exactly, passes 15 µm apart
+    /// on every tenth row: each pass's contact is its centre's row, with
+    /// no error; between passes the scallops, 281 nm high. Where the
+    /// circular window's edge crosses a column just past a cusp, the
+    /// rows inside it of the pass beyond the edge are the flank of its
+    /// scallop (one row of them in some columns), and its contact lies
+    /// outside: read as a contact, a scallop's height became the residual
+    /// at the passes' contacts (issue #29: 551 nm on a dome whose contacts
+    /// are 401 nm at most). Equally, a pass whose centre's row is the
+    /// window's first or last has its contact there, and it counts: one
+    /// contact per pass and column whose centre lies in the window, no
+    /// more, no fewer.
+    #[test]
+    fn a_scallop_at_the_window_edge_is_not_a_contact() {
+        let g = Grid {
+            s0: 0.2,
+            ds: 0.004,
+            ns: 151,
+            u0: 0.0,
+            du: 0.0015,
+            nu: 401,
+            period: None,
+            j0: 0,
+            i0: 0,
+        };
+        let (r, step) = (0.1, 0.015);
+        let mut sweep = BallSweep::new(g, r);
+        for p in 0..=40 {
+            sweep.lift();
+            for k in 0..=30 {
+                sweep.point(0.1 + k as f64 * 0.03, p as f64 * step, r);
+            }
+        }
+        let layout = RasterLayout::new((0.2, 0.8), (0.0, 0.6), 0.01, 64);
+        let (totals, _, _) = sweep.finish_tile(&FlatDisc, &|f| f, &layout, false);
+        let map = super::super::HeightMap::of(g, r, totals, &FlatDisc, Vec::new());
+        let scallop = super::super::HeightMap::flat_scallop(r, step);
+        let surface = map.surface.expect("cut");
+        assert!(
+            surface.max_residual.0 > 0.95 * scallop,
+            "{surface:?} {scallop}"
+        );
+        let contact = map.contact.expect("contacts");
+        assert!(contact.max_residual.0 < 1e-9, "{contact:?}");
+        let centres = (0..g.ns)
+            .flat_map(|j| (0..=40).map(move |p| (g.s(j), g.u(10 * p))))
+            .filter(|&(s, u)| FlatDisc.inside(s, u))
+            .count();
+        assert_eq!(contact.count, centres, "{contact:?}");
     }
 
     /// False position finds where two passes' cuts meet as bisection

@@ -163,8 +163,9 @@ pub(super) fn build(spec: &RasterSpec, cx: &BuildContext) -> Result<Built, Vec<D
     );
     let grid = window.cartesian(along_x);
     let mut sweep = Simulation::of(grid, split(&grid, None), cutter.clone());
-    // The program as written: its text read as the controller reads it.
-    let executed = parts::executed_moves(head, &text, false);
+    // The program as written: its text read as the controller reads it,
+    // once, for the read-back too.
+    let (findings, executed) = parts::read_program(head, &text, false, cx.read);
     height_map::sweep_mill_program(sweep.path(), &executed, along_x);
     // The height alone: the frame asks nothing else of the design.
     let heights = height_map::DesignHeights::of(&head.surface);
@@ -206,6 +207,7 @@ pub(super) fn build(spec: &RasterSpec, cx: &BuildContext) -> Result<Built, Vec<D
     let cut = (path.point_count, time);
     let mut built = parts::built(head, prov, text, toolpath, simulation, plots, cut);
     built.warnings = crate::plausibility::air_warnings(head, &moves);
+    built.read_findings = findings;
     Ok(built)
 }
 
@@ -213,8 +215,10 @@ pub(super) fn build(spec: &RasterSpec, cx: &BuildContext) -> Result<Built, Vec<D
 /// (Klartext's `BLK FORM`): a box holding every cutting move's contact
 /// (the tool centre less the ball's or nose's radius in Z) where it ends,
 /// where it starts in X and Y, and the top of every arc in the ZX or YZ
-/// plane as if it passed over its centre; 1 mm deeper than the lowest
-/// contact. None without a cut.
+/// plane that passes over its centre and the bottom of every one that
+/// passes under it (a bowl's arcs: their ends are their highest); 1 mm
+/// deeper than the lowest contact.
+/// None without a cut.
 fn blank(
     moves: &[lensc_runtime::moves::Move],
     tool: RasterTool,
@@ -248,21 +252,32 @@ fn blank(
                 // Where it starts in X and Y (in Z it may start in the
                 // air: a plunge's start is the safe height).
                 take([at[0], at[1], f64::NAN]);
+                let from = at;
                 moved(to, &mut at);
                 take([at[0], at[1], at[2] - r]);
                 if let Move::Arc {
                     centre,
-                    plane: Plane::Zx | Plane::Yz,
+                    plane: plane @ (Plane::Zx | Plane::Yz),
                     ..
                 } = m
                 {
-                    let across = if centre.x.is_nan() {
-                        at[1] - centre.y
-                    } else {
-                        at[0] - centre.x
+                    // The arc in its plane as (across, z): a minor arc,
+                    // as the simulation and the read-back take it.
+                    let (i, o) = match plane {
+                        Plane::Zx => (0, centre.x),
+                        _ => (1, centre.y),
                     };
-                    let radius = across.hypot(at[2] - centre.z);
-                    take([f64::NAN, f64::NAN, centre.z + radius - r]);
+                    let (a, b) = (
+                        (from[i] - o, from[2] - centre.z),
+                        (at[i] - o, at[2] - centre.z),
+                    );
+                    let radius = b.0.hypot(b.1);
+                    if passes_straight(a, b, 1.0) {
+                        take([f64::NAN, f64::NAN, centre.z + radius - r]);
+                    }
+                    if passes_straight(a, b, -1.0) {
+                        take([f64::NAN, f64::NAN, centre.z - radius - r]);
+                    }
                 }
             }
             _ => {}
@@ -272,6 +287,22 @@ fn blank(
     (0..3)
         .all(|i| min[i] <= max[i])
         .then_some(lensc_runtime::moves::Blank { min, max })
+}
+
+/// Whether the minor arc from `a` to `b` (each from the centre, as
+/// (across, z)) passes straight over its centre (`up` 1) or straight
+/// under it (`up` -1): that point of the circle lies between the ends, on
+/// the arc's side of the turn.
+fn passes_straight(a: (f64, f64), b: (f64, f64), up: f64) -> bool {
+    let cross = |p: (f64, f64), q: (f64, f64)| p.0 * q.1 - p.1 * q.0;
+    let top = (0.0, up);
+    let turn = cross(a, b);
+    let (first, second) = (cross(a, top), cross(top, b));
+    if turn >= 0.0 {
+        first >= 0.0 && second >= 0.0
+    } else {
+        first <= 0.0 && second <= 0.0
+    }
 }
 
 /// The program's header: provenance, units, surface, the tool, the raster
@@ -310,4 +341,49 @@ fn header_lines(
         lensc_runtime::post::header::duration(path.cut_length / spec.feed)
     ));
     header
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lensc_runtime::moves::{Move, Plane, Position};
+
+    /// One pass across a circle of radius 10 mm about (0, 0, `centre_z`),
+    /// from x = -1 to 1 mm, as a Klartext raster writes it.
+    fn pass(centre_z: f64, z_ends: f64) -> Vec<Move> {
+        let at = |x: f64, z: f64| Position {
+            x,
+            y: 0.0,
+            z,
+            c: f64::NAN,
+        };
+        vec![
+            Move::Rapid(at(-1.0, z_ends)),
+            Move::Arc {
+                to: at(1.0, z_ends),
+                centre: at(0.0, centre_z),
+                plane: Plane::Zx,
+                ccw: centre_z > z_ends,
+                feed: None,
+            },
+        ]
+    }
+
+    #[test]
+    fn a_bowls_blank_tops_at_its_arcs_ends_and_a_domes_at_its_crown() {
+        let ball = RasterTool::Ball { radius: 0.5 };
+        let end = 99f64.sqrt();
+        // A bowl: the arc passes under its centre, its ends are its top
+        // (this blank was 19.5 mm tall: the circle's top, not the arc's).
+        let bowl = blank(&pass(10.0, 10.0 - end), ball).unwrap();
+        assert!((bowl.max[2] - (10.0 - end - 0.5)).abs() < 1e-12, "{bowl:?}");
+        assert!((bowl.min[2] - (0.0 - 0.5 - 1.0)).abs() < 1e-12, "{bowl:?}");
+        // A dome: the arc passes over its centre, its crown is its top.
+        let dome = blank(&pass(-10.0, end - 10.0), ball).unwrap();
+        assert!((dome.max[2] - (0.0 - 0.5)).abs() < 1e-12, "{dome:?}");
+        assert!(
+            (dome.min[2] - (end - 10.0 - 0.5 - 1.0)).abs() < 1e-12,
+            "{dome:?}"
+        );
+    }
 }

@@ -12,7 +12,9 @@ pub mod report;
 use lensc_grammar::Diagnostic;
 use lensc_runtime::plan::chords::ChordPlacement;
 use lensc_runtime::plan::optimise;
-use lensc_runtime::plan::raster::{Axis, Raster, RasterTool, check_clearance, check_raster};
+use lensc_runtime::plan::raster::{
+    Axis, PlaneSpans, Raster, RasterTool, check_clearance, check_raster_planes,
+};
 use lensc_runtime::post::Dialect;
 
 use crate::job::{Evaluate, JobHead, Parts, all_clear};
@@ -35,6 +37,9 @@ pub struct RasterSpec {
     /// The cutter's spindle speed (rad/s); none for a knife, which cuts
     /// with the spindle held still.
     pub spindle_speed: Option<f64>,
+    /// The planes lowering's scan found cutting, the rim's among them:
+    /// what the estimate counts.
+    pub planes: PlaneSpans,
 }
 
 impl crate::strategy::Strategy for RasterSpec {
@@ -131,13 +136,19 @@ pub(crate) fn lower(
     let mut errors: Vec<Diagnostic> = p.feed_error("cutting", feed).into_iter().collect();
     let spindle_speed = st.spindle_speed.map(|s| s.value);
     errors.extend(raster_spindle_error(p, &tool, st.spindle_speed));
-    // The checks the planner makes first, on the planes it cuts.
+    // The checks the planner makes first, on the planes it cuts (kept
+    // for the estimate).
     let kernel = evaluate(&lowered.tape);
-    let scanned = check_raster(&raster, &tool, kernel.as_ref(), &lowered.domain)
-        .and_then(|scan| clearance.map_or(Ok(()), |c| check_clearance(c, scan.max_slope_along)));
-    if let Err(e) = scanned {
+    let scanned = check_raster_planes(&raster, &tool, kernel.as_ref(), &lowered.domain).and_then(
+        |(scan, planes)| {
+            clearance.map_or(Ok(()), |c| check_clearance(c, scan.max_slope_along))?;
+            Ok(planes)
+        },
+    );
+    let planes = scanned.unwrap_or_else(|e| {
         errors.push(errors::error(e, p.site()));
-    }
+        PlaneSpans::default()
+    });
     all_clear(errors)?;
     Ok(RasterSpec {
         head: p.head(dialect, lowered),
@@ -147,6 +158,7 @@ pub(crate) fn lower(
         clearance,
         feed,
         spindle_speed,
+        planes,
     })
 }
 

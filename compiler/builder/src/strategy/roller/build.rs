@@ -1,8 +1,9 @@
 //! Building a roller helix job (seed 002): a flat design wrapped onto a
 //! roller, cut on a slow-tool-servo lathe along a helix (Liu et al. eq 5),
 //! rough then finish, the nose centre exact in the cutting plane (the
-//! section-4 tool checks were made in lowering); the program streamed like
-//! the spiral's, the cut simulated as a height map.
+//! section-4 tool checks were made in lowering), placed by the tool's
+//! measured edge where it names one; the program streamed like the
+//! spiral's, the cut simulated as a height map swept by the same edge.
 
 use super::RollerSpec;
 use lensc_grammar::Diagnostic;
@@ -10,8 +11,10 @@ use lensc_lang::check::trim_num;
 use lensc_lang::codes;
 use lensc_lang::lower::exact_in;
 use lensc_runtime::emit::roller::{RollerLimits, RollerProgram};
-use lensc_runtime::plan::roller::plan_roller_helix_sectioned;
+use lensc_runtime::machine::edge::Nose;
+use lensc_runtime::plan::roller::plan_roller_helix_edged;
 use lensc_runtime::post::Provenance;
+use lensc_runtime::verify::heightmap::Cutter;
 use lensc_runtime::verify::heightmap::NosePath;
 
 use crate::context::{self as parts, BuildContext};
@@ -62,11 +65,18 @@ pub(super) fn build(spec: &RollerSpec, cx: &BuildContext) -> Result<Built, Vec<D
         |w| split(&w.roller(helix.roller_radius, helix.y_start), None),
     );
     let grid = window.roller(helix.roller_radius, helix.y_start);
-    let mut sweep = Simulation::new(grid, split(&grid, None), rho);
+    // The nose as measured, where the tool names its edge: the planner
+    // places each centre by it and the simulation sweeps it.
+    let edge = spec.edge.as_ref().map(|(m, _)| &m.profile);
+    let cutter = Cutter::Nose {
+        radius: rho,
+        edge: edge.map(|e| std::sync::Arc::new(e.clone())),
+    };
+    let mut sweep = Simulation::of(grid, split(&grid, None), cutter);
     let mut current_pass = usize::MAX;
-    let planned = plan_roller_helix_sectioned(
+    let planned = plan_roller_helix_edged(
         helix,
-        rho,
+        &Nose { radius: rho, edge },
         kernel.as_ref(),
         section.as_ref(),
         |pass, pts| {
@@ -83,7 +93,8 @@ pub(super) fn build(spec: &RollerSpec, cx: &BuildContext) -> Result<Built, Vec<D
             sink.planned(pts.len());
         },
     );
-    let mut path = planned.map_err(|e| vec![super::errors::error(e, site)])?;
+    let mut path =
+        planned.map_err(|e| vec![super::errors::planned_error(e, site, spec.edge_site)])?;
     let limited = program.feed_limited().to_vec();
     let mut sink = sink.written(head)?;
     sink.push(
@@ -98,7 +109,8 @@ pub(super) fn build(spec: &RollerSpec, cx: &BuildContext) -> Result<Built, Vec<D
             .time
             .map(|t| t + l.added_time * pass.cycle_offsets.len() as f64);
     }
-    let section = report::RollerHelix::new(&path, &limited, &spec.check, &spec.tool, helix);
+    let mut section = report::RollerHelix::new(&path, &limited, &spec.check, &spec.tool, helix);
+    section.edge_profile = spec.edge.as_ref().map(|(_, r)| r.clone());
     let cut = (section.cut_points, section.cutting_time_s);
     // The height alone: the frame asks nothing else of the design.
     let heights = crate::height_map::DesignHeights::of(&head.surface);
@@ -205,6 +217,14 @@ fn header_lines(spec: &RollerSpec, prov: &Provenance, pace: Option<f64>) -> Vec<
         lensc_runtime::emit::x_word(&head.dialect)
     );
     let mut lines = parts::nose_centre_header(head, prov, &units, spec.tool.nose_radius);
+    if let Some((m, _)) = &spec.edge
+        && let Some(tool) = lines.last_mut()
+    {
+        tool.push_str(&format!(
+            ", edge profile {}: each centre clears the design with the measured edge at its angle of contact (+ towards +Z)",
+            m.source
+        ));
+    }
     lines.push(format!(
         "strategy {}: roller helix from z = {} to {} mm at {} rpm, C 0 at design y = {} mm; passes: {}",
         head.names.strategy,

@@ -11,6 +11,23 @@ pub(crate) fn error(e: RollerError, site: (FileId, Span)) -> Diagnostic {
     coded_error(e).at(site)
 }
 
+/// A roller planner error as its diagnostic: an edge's at the tool's
+/// `edge_profile` (`edge_site`, where it names one), the rest at `site`.
+pub(crate) fn planned_error(
+    e: RollerError,
+    site: (FileId, Span),
+    edge_site: Option<(FileId, Span)>,
+) -> Diagnostic {
+    match (&e, edge_site) {
+        (RollerError::EdgeAtCorners { .. }, Some(at)) => Coded {
+            label: "the edge profile this tool names",
+            ..coded_error(e)
+        }
+        .at(at),
+        _ => error(e, site),
+    }
+}
+
 fn coded_error(e: RollerError) -> Coded {
     match e {
         RollerError::NoseTooLarge {
@@ -79,5 +96,12 @@ fn coded_error(e: RollerError) -> Coded {
             ),
         )
         .help("each pass must leave no more material than the one before it"),
+        RollerError::EdgeAtCorners { corners } => coded(
+            codes::EDGE_ANGLES,
+            format!(
+                "the design's sections along the roller have concave corners or steps ({corners} found by the planner's survey): a measured edge is compensated only along smooth sections, where one angle of the edge touches them"
+            ),
+        )
+        .help("leave the tool's `edge_profile` out for this job (the nose is then a circle)"),
     }
 }

@@ -2,7 +2,8 @@
 //! on a slow-tool-servo lathe. The section-4 tool checks (Liu et al.: the
 //! nose against the design's concave radius in the cutting plane, the
 //! clearance and included angles against its slopes) and the spindle limit
-//! are made here, before the helix is planned.
+//! are made here, before the helix is planned; so is a measured edge's
+//! (`edge_profile`) cover of the angles of contact.
 
 mod build;
 pub(crate) mod errors;
@@ -10,6 +11,7 @@ mod estimate;
 pub mod report;
 
 use lensc_grammar::Diagnostic;
+use lensc_runtime::machine::tool::MeasuredEdge;
 use lensc_runtime::plan::chords::ChordPlacement;
 use lensc_runtime::plan::roller::{
     DesignRegion, HelixPass, RollerHelix, RollerTool, ToolCheck, check_roller_tool,
@@ -40,6 +42,11 @@ pub struct RollerSpec {
     /// The machine's feed limit (mm/s): moves the spindle's pace would
     /// take faster are slowed to it.
     pub max_feed: f64,
+    /// The nose's measured edge, if the tool names one (the planner
+    /// places each centre by it, the simulation sweeps it), its report,
+    /// and where the tool names it.
+    pub edge: Option<(MeasuredEdge, crate::edge::EdgeReport)>,
+    pub edge_site: Option<(lensc_grammar::FileId, lensc_grammar::Span)>,
 }
 
 impl crate::strategy::Strategy for RollerSpec {
@@ -124,8 +131,25 @@ pub(crate) fn lower(
     let mut errors = tool_errors(p, &rt, &check);
     let spindle_speed = st.spindle_speed;
     errors.extend(p.spindle_limit(spindle_speed));
-    all_clear(errors)?;
+    let edge = crate::edge::measured_edge(p).map_err(|d| vec![d])?;
     let (z_start, z_end) = st.z.unwrap_or(design_x);
+    if let Some((measured, _)) = &edge {
+        // The contacts lie within ρ·sin of the steepest axial slope of
+        // the nose centres' axial range.
+        let reach = rt.nose_radius * check.max_slope_axial.sin();
+        let x = (
+            (z_start - reach).max(design_x.0),
+            (z_end + reach).min(design_x.1),
+        );
+        errors.extend(crate::edge::uncovered_roller(
+            p,
+            &measured.profile,
+            kernel.as_ref(),
+            x,
+            design_y,
+        ));
+    }
+    all_clear(errors)?;
     let helix = RollerHelix {
         roller_radius,
         // Spindle angle 0 is the design's first row: a design centred on
@@ -174,6 +198,8 @@ pub(crate) fn lower(
         design_y,
         spindle_speed,
         max_feed: p.machine_params.max_feed,
+        edge,
+        edge_site: p.tool_params.edge_profile.as_ref().map(|e| e.site),
     })
 }
 

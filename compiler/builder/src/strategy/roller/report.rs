@@ -27,6 +27,9 @@ pub struct RollerHelix {
     /// Arc (mm) around the roller left undesigned where the design wraps,
     /// or null if the design does not wrap.
     pub wrap_gap_mm: Option<f64>,
+    /// The measured edge each nose centre was placed by, or null for a
+    /// nose taken as a circle.
+    pub edge_profile: Option<crate::edge::EdgeReport>,
 }
 
 impl RollerHelix {
@@ -73,6 +76,7 @@ impl RollerHelix {
                 half_included_angle_deg: tool.opening_angle.to_degrees() / 2.0,
             },
             wrap_gap_mm: path.wrap.map(|w| w.gap),
+            edge_profile: None,
         }
     }
 }

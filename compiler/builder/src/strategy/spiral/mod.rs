@@ -19,8 +19,8 @@ use lensc_runtime::machine::tool::MeasuredEdge;
 use lensc_runtime::plan::chords::ChordPlacement;
 use lensc_runtime::plan::spiral::{FastAxis, FtsSpiral, SpindleSpeed, TrajectoryBounds};
 use lensc_runtime::post::Dialect;
-use lensc_runtime::surface::analysis::Domain;
-use lensc_runtime::surface::ir::SurfaceFn;
+use lensc_runtime::surface::analysis::{Domain, SurfaceAnalysis};
+use lensc_runtime::surface::ir::{SurfaceFn, SurfaceTape};
 
 use crate::diagnostics::RuntimeError;
 use crate::job::{Evaluate, JobHead, Parts, all_clear};
@@ -110,7 +110,7 @@ impl SpiralSpec {
             &self.surface_object,
             Some(&settling),
             self.correction.as_ref(),
-            &self.head.surface.lowered.domain,
+            (&self.head.surface.lowered.domain, None),
             self.bounds.part_top,
             evaluate,
         )?;
@@ -219,7 +219,7 @@ pub(crate) fn lower(
             surface,
             settling.as_ref(),
             correction.as_ref(),
-            &lowered.domain,
+            (&lowered.domain, Some((&lowered.tape, &design))),
             design.sag_max.value,
             evaluate,
         )
@@ -231,6 +231,9 @@ pub(crate) fn lower(
     // the aperture all round (`default_start`), never inside the
     // surface's farthest point from the axis.
     let outer = outer_radius(&lowered.domain);
+    if let Some(e) = beyond_travel(p, outer, st.from) {
+        return Err(vec![e]);
+    }
     let (start, (settling, trajectory, bounds, trajectory_declared)) = match st.from {
         Some(from) => (from, trajectory_from(from)?),
         None => {
@@ -364,11 +367,15 @@ fn past_axis(trajectory: &dyn SurfaceFn, rho: f64, start: f64, resolution: f64) 
     }
 }
 
+/// `known`: a tape already analysed over `domain` (the surface lowered),
+/// whose analysis stands for the trajectory's where the trajectory is
+/// that very tape (no settling offset: the surface itself, corrected or
+/// not), rather than analysing the same tape again.
 fn settled_trajectory(
     surface: &Object,
     settling: Option<&Settling>,
     correction: Option<&crate::compensate::Applied>,
-    domain: &Domain,
+    (domain, known): (&Domain, Option<(&SurfaceTape, &SurfaceAnalysis)>),
     part_top: f64,
     evaluate: Evaluate,
 ) -> Result<(LoweredSurface, TrajectoryBounds, Option<LoweredSurface>), LowerError> {
@@ -387,9 +394,15 @@ fn settled_trajectory(
         });
         trajectory.tape = c.tape(&trajectory.tape);
     }
-    let analysis = {
-        let k = evaluate(&trajectory.tape);
-        lensc_runtime::surface::analysis::analyse(k.as_ref(), domain, 201)
+    let same = |t: &SurfaceTape| {
+        t.outputs == trajectory.tape.outputs && t.graph.nodes() == trajectory.tape.graph.nodes()
+    };
+    let analysis = match known {
+        Some((tape, analysis)) if same(tape) => analysis.clone(),
+        _ => {
+            let k = evaluate(&trajectory.tape);
+            lensc_runtime::surface::analysis::analyse(k.as_ref(), domain, 201)
+        }
     };
     let bounds = TrajectoryBounds {
         z_max: analysis.sag_max.value,
@@ -598,6 +611,42 @@ fn machine_limits(p: &Parts, spiral: &FtsSpiral) -> Vec<Diagnostic> {
         ));
     }
     errors
+}
+
+/// E0141 when the spiral would start (at `from`, or the part's farthest
+/// point from the axis, `outer`) beyond the machine's X travel: refused
+/// before anything is planned, since the work of finding the start (the
+/// rim's contacts) and the settling grows with the part's size (issue
+/// #33: an array at a pitch of 4,294,967,297 mm hung `lensc check`).
+fn beyond_travel(p: &Parts, outer: f64, from: Option<f64>) -> Option<Diagnostic> {
+    // A lathe's travel states X (the checker requires it).
+    let (tx0, tx1) = p.machine_params.travel[0]?;
+    let start = from.unwrap_or(outer);
+    if start <= tx1 {
+        return None;
+    }
+    let what = match from {
+        Some(_) => format!(
+            "the spiral starts {} mm from the spindle axis",
+            trim_num(start)
+        ),
+        None => format!(
+            "the part reaches {} mm from the spindle axis (it is {} mm across)",
+            trim_num(outer),
+            trim_num(2.0 * outer)
+        ),
+    };
+    Some(
+        p.error(
+            codes::OUT_OF_TRAVEL,
+            format!(
+                "{what}, beyond the machine's X travel {} .. {} mm",
+                trim_num(tx0),
+                trim_num(tx1)
+            ),
+        )
+        .with_help("check the part's size and its units (`pitch: 4 mm`, not `4 m`); or use a machine with more travel"),
+    )
 }
 
 /// The fast axis's second-order servo model, from its resonance and peak
