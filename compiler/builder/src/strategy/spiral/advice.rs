@@ -141,6 +141,18 @@ fn following_limit(spec: &SpiralSpec) -> Option<f64> {
     )
 }
 
+/// Whether the job as written is refused by the planner (E0147) or by
+/// the checks the build makes of the commands it writes (the lead's
+/// acceleration, a move faster than the machine's feed: E0192), its lag
+/// not gated: what the speed the advice names as refused must meet.
+pub fn refused_as_written(spec: &SpiralSpec) -> bool {
+    let unit = Unit::of(spec.spiral.speed);
+    matches!(
+        check(spec, unit, unit.shown(spec.spiral.speed), None),
+        Verdict::Fails(..)
+    )
+}
+
 enum Verdict {
     Passes,
     /// Refused: by how much (the acceleration or the lag over its limit;
