@@ -17,6 +17,11 @@
 # (or CAP has passed), then each other target for OTHERS seconds (default
 # 300). CAP defaults to 8 hours; the fuzzer's summary projects, at the
 # rates it measures, how long each goal takes on the cores it is given.
+# A campaign run in legs (a session is shorter than the goals take) states
+# what is left: CHECK_GOAL and BUILD_GOAL (default the issue's), ORDER
+# (default "check build"). TIMEOUT (default 10 s) is the hang limit of one
+# input; on a machine shared with other work a worker may be starved for
+# longer than a quiet machine's 10 s without hanging.
 #
 # Each lane is a worker process: an abort (exit 134: an allocation that
 # fails, a stack overflow) loses the one input it was on, which is saved
@@ -52,7 +57,7 @@ run() {
         echo "== $target: $left s, seed $seed ${flags[*]}"
         log=$(mktemp)
         "$fuzz" --target "$target" --seconds "$left" --seed "$seed" --jobs 2 \
-            --lensc "$lensc" "${flags[@]}" 2>&1 | tee "$log"
+            --timeout "${TIMEOUT:-10}" --lensc "$lensc" "${flags[@]}" 2>&1 | tee "$log"
         rc=${PIPESTATUS[0]}
         [ "$rc" -ne 0 ] && status=1
         summary+="$target (seed $seed, exit $rc, $(( $(date +%s) - began )) s):"$'\n'"$(grep -E '^  (inputs|through|end to end|time by|an hour|projection|CPU|panics)' "$log")"$'\n'
@@ -76,8 +81,14 @@ run() {
 if [ "$goals" -eq 1 ]; then
     cap=${1:-28800}
     began=$(date +%s)
-    run check $(( cap / 2 )) 10000000
-    run build $(( cap - ($(date +%s) - began) )) "" 100000
+    for target in ${ORDER:-check build}; do
+        case $target in
+            check) [ "${CHECK_GOAL:-10000000}" -gt 0 ] &&
+                run check $(( cap / 2 )) "${CHECK_GOAL:-10000000}" ;;
+            build) [ "${BUILD_GOAL:-100000}" -gt 0 ] &&
+                run build $(( cap - ($(date +%s) - began) )) "" "${BUILD_GOAL:-100000}" ;;
+        esac
+    done
     for target in verify import lsp measure; do
         run "$target" "${OTHERS:-300}"
     done

@@ -161,6 +161,11 @@ const DIALECTS: &[&str] = &[
 const GOAL_CHECKS: f64 = 10e6;
 const GOAL_BUILDS: f64 = 100e3;
 
+/// The largest program (bytes) a build input may write: 10 MB builds in
+/// about 2 s on a quiet core, well inside the hang limit; the size
+/// estimate refuses a larger one before planning (E0161).
+const BUILD_PROGRAM_CEILING: u64 = 10_000_000;
+
 /// Seconds between lines of progress.
 const PROGRESS_EVERY: u64 = 30;
 
@@ -509,7 +514,15 @@ fn input_for(
             } else {
                 rng.chance(0.04).then(|| *rng.pick(DIALECTS))
             };
-            let max_program_size = rng.chance(0.15).then(|| rng.log_uniform(1e3, 1e8) as u64);
+            // A drawn size limit now and then; otherwise the fuzzer's own
+            // ceiling, so that a number made extreme (a 1 nm pitch) meets
+            // the size estimate's refusal rather than the hang limit: a
+            // 110 MB program legitimately takes 23 s to build.
+            let max_program_size = Some(if rng.chance(0.15) {
+                rng.log_uniform(1e3, BUILD_PROGRAM_CEILING as f64) as u64
+            } else {
+                BUILD_PROGRAM_CEILING
+            });
             (
                 Source::SmallJob,
                 job.text.into_bytes(),

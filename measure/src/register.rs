@@ -360,6 +360,14 @@ fn levenberg_marquardt(
         }
     }
     let (mut a, mut g, mut ssr) = normal_equations(eval, pts, &p, &mut buf)?;
+    // The registration at `p` after `it` iterations.
+    let found = |p: [f64; 6], it: usize| Registration {
+        values: p,
+        fitted: on,
+        left_out: left_out.clone(),
+        iterations: it,
+        method: "least squares on the heights (Levenberg-Marquardt, exact surface derivatives)",
+    };
     let mut lambda = 1e-4;
     for it in 1..=opts.max_iterations {
         let Some(step) = damped_step(&a, &g, lambda, &on) else {
@@ -379,13 +387,7 @@ fn levenberg_marquardt(
             ssr = tssr;
             lambda = (lambda / 10.0).max(1e-12);
             if small || gain <= 1e-15 * ssr + f64::MIN_POSITIVE {
-                return Ok(Registration {
-                    values: p,
-                    fitted: on,
-                    left_out,
-                    iterations: it,
-                    method: "least squares on the heights (Levenberg-Marquardt, exact surface derivatives)",
-                });
+                return Ok(found(p, it));
             }
         } else {
             // A step that moves nothing that matters, or leaves the sum
@@ -393,13 +395,7 @@ fn levenberg_marquardt(
             // the best is the minimum as far as the sums can tell (more
             // damping would only try smaller steps of the same).
             if step_vanished(&step, &p, pts) || tssr - ssr <= 1e-15 * ssr + f64::MIN_POSITIVE {
-                return Ok(Registration {
-                    values: p,
-                    fitted: on,
-                    left_out,
-                    iterations: it,
-                    method: "least squares on the heights (Levenberg-Marquardt, exact surface derivatives)",
-                });
+                return Ok(found(p, it));
             }
             lambda *= 10.0;
             if lambda > 1e12 {

@@ -344,3 +344,30 @@ fn check_refuses_the_jobs_the_fuzzer_found() {
         }
     }
 }
+
+/// The build input the campaign's build target reported as a hang (issue
+/// #33): a roller helix whose pitch a number made extreme turned into
+/// 1 nm (116,519 revolutions), which is no hang but a legitimately huge
+/// job (23 s, a 110 MB program). Under the fuzzer's program ceiling of
+/// 10 MB the size estimate refuses it before planning (E0161), in a
+/// fraction of the time the build took, and nothing is written.
+#[test]
+fn a_roller_pitch_of_1_nm_is_refused_by_its_size_estimate() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let out = dir.path().to_str().expect("utf-8");
+    let o = common::lensc(
+        &common::root().join("tests/fuzz_crashes"),
+        &[
+            "build",
+            "build_roller_pitch_1_nm.lens",
+            "--out",
+            out,
+            "--max-program-size",
+            "10MB",
+        ],
+    );
+    let stderr = common::text(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("[E0161]"), "{stderr}");
+    assert_eq!(std::fs::read_dir(dir.path()).expect("out").count(), 0);
+}
