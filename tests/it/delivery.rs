@@ -49,6 +49,7 @@ const MILL: MachineLimits = MachineLimits {
     travel: [None; 4],
     max_feed: None,
     max_spindle_rpm: None,
+    servo: None,
 };
 
 #[test]

@@ -88,6 +88,7 @@ fn cut_pv(dir: &Path, program: &str, nose: &Nose) -> f64 {
         travel: [None; 4],
         max_feed: None,
         max_spindle_rpm: None,
+        servo: None,
     };
     let mut moves = reader::read_moves(program, &spec.head().dialect, &machine).1;
     let offset = reader::header_control_offset(program).expect("control point");
@@ -292,6 +293,7 @@ fn spiral_points(dir: &Path, args: &[&str]) -> (Vec<Commanded>, serde_json::Valu
         travel: [None; 4],
         max_feed: None,
         max_spindle_rpm: None,
+        servo: None,
     };
     let mut moves = reader::read_moves(&program, &spec.head().dialect, &machine).1;
     let offset = reader::header_control_offset(&program).expect("control point");
@@ -488,6 +490,7 @@ fn roller_points(dir: &Path) -> (Vec<Commanded>, serde_json::Value) {
         travel: [None; 4],
         max_feed: None,
         max_spindle_rpm: None,
+        servo: None,
     };
     let mut moves = reader::read_moves(&program, &spec.head().dialect, &machine).1;
     let offset = reader::header_control_offset(&program).expect("control point");

@@ -6,6 +6,7 @@ fn lathe() -> MachineLimits {
         travel: [Some((-10.0, 150.0)), None, Some((-100.0, 100.0)), None],
         max_feed: Some(2000.0),
         max_spindle_rpm: Some(3000.0),
+        servo: None,
     }
 }
 
@@ -138,6 +139,7 @@ fn heidenhain_reads_arc_centres_where_they_are() {
         ],
         max_feed: Some(5000.0),
         max_spindle_rpm: None,
+        servo: None,
     };
     // The centre (X0.2, Z-10) is the circle's, not an offset from the start.
     let good = "%J G71 *\nN1 ; +Z out of the material *\nN2 G17 G90 G40 *\nN3 T1 G17 S1000 *\nN4 M3 *\nN5 G00 Z1. *\nN6 G00 X-1. Y0. *\nN7 G94 G01 Z-0.1 F100. *\nN8 G18 G03 X1.5 Z-0.1126 I0.2 K-10. *\nN9 G00 Z1. *\nN10 M30 *\nN99999999 %J G71 *\n";
@@ -437,6 +439,7 @@ fn linuxcnc_reads_splines_as_moves_along_the_curve() {
         travel: [None; 4],
         max_feed: None,
         max_spindle_rpm: None,
+        servo: None,
     };
     let program = |moves: &str| {
         format!(
@@ -539,6 +542,7 @@ fn heidenhain_iso_reads_g36_and_the_blank() {
         ],
         max_feed: Some(5000.0),
         max_spindle_rpm: Some(12000.0),
+        servo: None,
     };
     let good = "%J G71 *\nN1 ; +Z out of the material *\nN2 G17 G90 G40 G94 *\nN3 G30 G17 X-1 Y-1 Z-2 *\nN4 G31 G90 X1 Y1 Z0.5 *\nN5 T1 G17 *\nN6 G36 S0 *\nN7 G00 Z1. *\nN8 G00 X-1. Y0. *\nN9 G01 Z-0.1 F100. *\nN10 G01 X1. *\nN11 G00 Z1. *\nN12 M5 *\nN13 G00 Z0 M91 *\nN14 M30 *\nN99999999 %J G71 *\n";
     assert_eq!(rules(good, &d, &mill), vec![]);
@@ -566,6 +570,7 @@ fn mill() -> MachineLimits {
         ],
         max_feed: Some(5000.0),
         max_spindle_rpm: Some(12000.0),
+        servo: None,
     }
 }
 
@@ -789,6 +794,7 @@ fn nurbs_mill() -> MachineLimits {
         ],
         max_feed: Some(5000.0),
         max_spindle_rpm: Some(20000.0),
+        servo: None,
     }
 }
 
@@ -877,6 +883,7 @@ fn linuxcnc_reads_a_nurbs_block_as_the_interpreter_evaluates_it() {
         travel: [None; 4],
         max_feed: None,
         max_spindle_rpm: None,
+        servo: None,
     };
     let program = |moves: &str| {
         format!(

@@ -64,6 +64,14 @@ pub fn search_feed(spec: &SpiralSpec, feed: f64) -> SpeedAdvice {
     search_below(spec, feed / spec.max_feed)
 }
 
+/// The highest speed that passes, below the job's own, whose fastest
+/// servo move, the servo written on its own letter, drove it at `velocity`
+/// (mm/s) over its `max_velocity` (E0192).
+pub fn search_servo(spec: &SpiralSpec, velocity: f64) -> SpeedAdvice {
+    let most = spec.servo_axis.map_or(f64::INFINITY, |(_, v)| v);
+    search_below(spec, velocity / most)
+}
+
 /// The search below the job's speed, which failed by `excess` (its
 /// acceleration or feed over the limit).
 fn search_below(spec: &SpiralSpec, excess: f64) -> SpeedAdvice {
@@ -211,6 +219,13 @@ fn check(spec: &SpiralSpec, unit: Unit, speed: f64, lag_limit: Option<f64>) -> V
     }
     if let (Ok(_), Some((feed, _))) = (&planned, commands.over_max_feed(spec)) {
         return Verdict::Fails(feed / spec.max_feed, None);
+    }
+    if let (Ok(_), Some((v, _)), Some((_, most))) = (
+        &planned,
+        commands.over_servo_velocity(spec),
+        spec.servo_axis,
+    ) {
+        return Verdict::Fails(v / most, None);
     }
     match planned {
         Ok(_) => match following {

@@ -89,6 +89,9 @@ pub(super) fn build(spec: &SpiralSpec, cx: &BuildContext) -> Result<Built, Vec<D
         table_name.as_deref(),
     )
     .map_err(not_printable)?;
+    if let Some(letter) = super::servo::servo_letter(spec) {
+        program.servo_on(letter);
+    }
     program.hold_spindle_under(spec.max_spindle_speed);
     program.call_tool(&head.start).map_err(not_printable)?;
     let mut sink = cx.sink(head)?;
@@ -198,6 +201,13 @@ pub(super) fn build(spec: &SpiralSpec, cx: &BuildContext) -> Result<Built, Vec<D
         let advice = super::advice::search_feed(spec, fastest.0);
         return Err(vec![
             super::errors::feed_refused(spec, fastest, advice).at(site),
+        ]);
+    }
+    // The servo on its own letter within its own velocity limit.
+    if let Some(fastest) = commands.over_servo_velocity(spec) {
+        let advice = super::advice::search_servo(spec, fastest.0);
+        return Err(vec![
+            super::errors::servo_velocity_refused(spec, fastest, advice).at(site),
         ]);
     }
     let mut sink = sink.written(head)?;
@@ -390,6 +400,11 @@ fn header_lines(spec: &SpiralSpec, prov: &Provenance, table: Option<&str>) -> Ve
             "Z held at 0 while the fast tool servo follows the table {table} [rows C X W, one per point]"
         );
         ("fast-tool-servo", table_words.as_str())
+    } else if let Some(letter) = super::servo::servo_letter(spec) {
+        table_words = format!(
+            "Z the slide, held at 0 while the fast tool servo moves on its own axis {letter} [the tool tip at Z + {letter}]"
+        );
+        ("fast-tool-servo", table_words.as_str())
     } else {
         ("fast-tool-servo", "Z the fast tool servo's axis")
     };
@@ -426,11 +441,14 @@ fn header_lines(spec: &SpiralSpec, prov: &Provenance, table: Option<&str>) -> Ve
         trim_num(spiral.chord_tolerance * lensc_runtime::plan::optimise::BLEND_SHARE * 1e6)
     ));
     let lead = if super::servo::program_leads(spec) {
-        ", feed_forward none: the servo led by this program [its W written as the servo's inverse model of the path]"
+        match super::servo::servo_letter(spec) {
+            Some('W') | None => ", feed_forward none: the servo led by this program [its W written as the servo's inverse model of the path]".to_string(),
+            Some(l) => format!(", feed_forward none: the servo led by this program [its {l} written as the servo's inverse model of the path]"),
+        }
     } else if spec.controller_leads && !slow {
-        ", feed_forward inverse_model: the servo led by its controller [its W the path]"
+        ", feed_forward inverse_model: the servo led by its controller [its W the path]".to_string()
     } else {
-        ""
+        String::new()
     };
     lines.push(format!(
         "machine {}: {} {servo_words} lathe{lead}",

@@ -185,3 +185,37 @@ pub(crate) fn feed_refused(
         advice_help(&spec.spiral.speed, Some(advice), "the feed")
     ))
 }
+
+/// E0192 where the servo is written on its own letter
+/// (`servo::servo_letter`) and its fastest move (`fastest`: its velocity,
+/// mm/s, and radius, mm) drives it above its `max_velocity`: the
+/// controller slows the whole move, C with it, to hold the servo's axis
+/// to its limit, so the move runs later than the lead it carries was
+/// worked out for. `advice`: the speed a search found at which every
+/// servo move fits.
+pub(crate) fn servo_velocity_refused(
+    spec: &super::SpiralSpec,
+    fastest: (f64, f64),
+    advice: SpeedAdvice,
+) -> Coded {
+    let (velocity, at) = fastest;
+    let (letter, most) = spec.servo_axis.unwrap_or(('W', f64::INFINITY));
+    let led = if super::servo::program_leads(spec) {
+        "the command that leads the fast axis (the path through the servo's inverse model, `feed_forward: none`)"
+    } else {
+        "the fast axis's path"
+    };
+    coded(
+        codes::LEAD_REFUSED,
+        format!(
+            "{led} drives the servo, written on {letter}, at {} mm/min (at r = {} mm), above its `max_velocity` of {} mm/min",
+            trim_num((velocity * 60.0 * 10.0).round() / 10.0),
+            trim_num((at * 1e4).round() / 1e4),
+            trim_num(most * 60.0)
+        ),
+    )
+    .help(format!(
+        "the controller holds the servo's axis to its velocity limit by slowing the whole move, the spindle with it, so this move would run late against the timing its lead was worked out for; {}",
+        advice_help(&spec.spiral.speed, Some(advice), "the servo's velocity")
+    ))
+}

@@ -77,6 +77,11 @@ pub struct SpiralSpec {
     /// surface's axis as moves (no servo table), no move it writes, led or
     /// not, may be faster (`servo::Commands::fastest`).
     pub max_feed: f64,
+    /// A fast tool servo the control programs as its own axis: its letter
+    /// and velocity limit (mm/s). Where the program writes the fast axis
+    /// as moves, the servo's motion goes on that letter, held to that
+    /// limit, and the Z slide holds still (`servo::Commands`).
+    pub servo_axis: Option<(char, f64)>,
 }
 
 /// A spiral job at another speed: what a search for the highest speed
@@ -331,6 +336,10 @@ pub(crate) fn lower(
         surface_object: surface.clone(),
         max_spindle_speed: p.max_spindle_speed(),
         max_feed: p.machine_params.max_feed,
+        servo_axis: match fast {
+            Carrier::Servo(f) => f.own_axis,
+            Carrier::SlowZ(_) => None,
+        },
     })
 }
 

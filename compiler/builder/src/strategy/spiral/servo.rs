@@ -43,6 +43,17 @@ pub(super) fn writes_moves(spec: &SpiralSpec) -> bool {
     spec.slow || spec.head.dialect.fts_table.is_none()
 }
 
+/// The letter the program writes a fast tool servo's motion on where it
+/// writes the fast axis as moves (`writes_moves`) and the machine gives
+/// the servo an axis of its own (`fast_axis { letter, max_velocity }`):
+/// the slide's Z then holds still and the tool tip is Z plus the servo.
+/// `None`: the fast axis is written on Z (or into a servo table).
+pub(super) fn servo_letter(spec: &SpiralSpec) -> Option<char> {
+    spec.servo_axis
+        .filter(|_| !spec.slow && writes_moves(spec))
+        .map(|(letter, _)| letter)
+}
+
 /// The commands a spiral's points are printed as, batch by batch: the
 /// planned path, or where the program leads the servo
 /// (`program_leads`), the path led by the servo's inverse model, a point
@@ -57,10 +68,17 @@ pub(super) struct Commands {
     aims: Vec<f64>,
     /// The lowest and highest command (mm) led so far.
     pub range: (f64, f64),
-    /// The fastest move between two commands as printed so far: its feed
-    /// (mm/s, its X and W travel over its planned time, as the controller
-    /// reads an inverse-time move) and radius (mm).
+    /// The fastest move between two commands as printed so far: its
+    /// slides' feed (mm/s: its X and Z travel over its planned time, as
+    /// the controller reads an inverse-time move; Z carrying the fast axis
+    /// unless the servo has a letter of its own, `own_axis`) and radius
+    /// (mm).
     pub fastest: Option<(f64, f64)>,
+    /// Where the servo is written on its own letter: the fastest it is
+    /// driven, its travel over the move's planned time (mm/s), and the
+    /// radius (mm).
+    pub fastest_servo: Option<(f64, f64)>,
+    own_axis: bool,
     /// The last command as printed, the start of the next move.
     last: Option<lensc_runtime::plan::spiral::SpiralPoint>,
     resolution: f64,
@@ -84,6 +102,8 @@ impl Commands {
             aims: Vec::new(),
             range: (f64::INFINITY, f64::NEG_INFINITY),
             fastest: None,
+            fastest_servo: None,
+            own_axis: servo_letter(spec).is_some(),
             last: None,
             resolution,
             written: 0,
@@ -128,9 +148,17 @@ impl Commands {
             if let Some(p) = self.last
                 && q.t > p.t
             {
-                let feed = (q.x - p.x).hypot(q.w - p.w) / (q.t - p.t);
+                let dt = q.t - p.t;
+                // The Z slide carries W, or (the servo on its own letter)
+                // holds still.
+                let slide_z = if self.own_axis { 0.0 } else { q.w - p.w };
+                let feed = (q.x - p.x).hypot(slide_z) / dt;
                 if self.fastest.is_none_or(|(f, _)| feed > f) {
                     self.fastest = Some((feed, q.x.abs()));
+                }
+                let servo = (q.w - p.w).abs() / dt;
+                if self.own_axis && self.fastest_servo.is_none_or(|(v, _)| servo > v) {
+                    self.fastest_servo = Some((servo, q.x.abs()));
                 }
             }
             self.last = Some(*q);
@@ -143,6 +171,14 @@ impl Commands {
     pub fn over_max_feed(&self, spec: &SpiralSpec) -> Option<(f64, f64)> {
         self.fastest
             .filter(|&(feed, _)| writes_moves(spec) && feed > spec.max_feed)
+    }
+
+    /// The servo's fastest move (mm/s) and radius where the servo is
+    /// written on its own letter (`servo_letter`) and that move drives it
+    /// faster than its `max_velocity`.
+    pub fn over_servo_velocity(&self, spec: &SpiralSpec) -> Option<(f64, f64)> {
+        let (_, most) = spec.servo_axis?;
+        self.fastest_servo.filter(|&(v, _)| v > most)
     }
 
     /// Runs `sim` on the batch's commands as printed (at `resolution`,
