@@ -265,7 +265,8 @@ type Commanded = Option<(f64, f64, f64)>;
 
 /// The nose-centre points a spiral's output commands, as (C rad, X, W),
 /// read from its text alone: the program's moves as the controller reads
-/// them (Z carrying W), or, where the dialect drives the fast tool servo
+/// them (Z carrying W, or the tip Z + W where the machine gives its servo
+/// the letter W), or, where the dialect drives the fast tool servo
 /// from a table, the table's rows (C X W). Rapids start a new pass (None).
 fn spiral_points(dir: &Path, args: &[&str]) -> (Vec<Commanded>, serde_json::Value) {
     let mut all = vec!["build", "job.lens"];
@@ -288,12 +289,13 @@ fn spiral_points(dir: &Path, args: &[&str]) -> (Vec<Commanded>, serde_json::Valu
     let c = driver::check_path(&RealFs, &dir.join("job.lens")).expect("checks");
     let (spec, _) = lensc_build::pipeline::lower(&c.checked.jobs[0], None, &Default::default())
         .expect("lowers");
+    // The job's own machine: its servo's letter, if it has one.
     let machine = MachineLimits {
+        servo: lensc_lang::lower::read_back::job_machine(&c.checked.jobs[0]).servo,
         lathe: true,
         travel: [None; 4],
         max_feed: None,
         max_spindle_rpm: None,
-        servo: None,
     };
     let mut moves = reader::read_moves(&program, &spec.head().dialect, &machine).1;
     let offset = reader::header_control_offset(&program).expect("control point");

@@ -230,24 +230,140 @@ fn build_own(source: &str) -> (Option<i32>, String, Option<String>) {
     (out.status.code(), text(&out.stderr), program)
 }
 
+/// The corner at `speed` (m/min) on the standard library's servo lathe
+/// as a machine of its own (a restated block is merged with the
+/// library's, whose servo has the letter W), in LinuxCNC's dialect, its
+/// fast axis with `fast_axis` added (a letter of its own, or none), its
+/// `max_feed` as `max_feed`.
+fn linuxcnc_job(speed: &str, fast_axis: &str, max_feed: &str) -> String {
+    format!(
+        "surface lenslet = sphere {{ radius: 20 mm, sense: concave, aperture: circle(diameter: 1.7 mm) }}
+surface corner = grid(lenslet, pitch_x: 3.5 mm, pitch_y: 3.5 mm, count_x: 2, count_y: 2)
+use std::tools::diamond_r496um
+machine servo = fts_lathe {{ dialect: linuxcnc, resolution: 1 nm, travel: {{ x: -10 mm .. 220 mm, z: -150 mm .. 150 mm }}, max_feed: {max_feed}, spindle: {{ max_speed: 1000 rpm }}, fast_axis: {{ stroke: 5 mm, max_acceleration: 25 G, resonance: 1367 Hz, resonant_peak: 1.0, data_rate: 20 kHz, feed_forward: none{fast_axis} }} }}
+strategy coarse = fts_spiral {{ feed: 50 um/rev, surface_speed: {speed} m/min, spindle_cap: 1000 rpm, settling_time: 1 ms, chord_tolerance: 50 nm }}
+job corner {{ surface: corner, tool: diamond_r496um, machine: servo, strategy: coarse, accept: none }}
+"
+    )
+}
+
+/// The feed moves of `program`, built from `source`, as the reader makes
+/// them against the job's own machine and dialect (`lensc verify`'s and
+/// the read-back's limits): no finding, and each move's end (X, Z, C).
+fn read_feeds(source: &str, program: &str) -> Vec<[f64; 3]> {
+    let dir = tempfile::tempdir().expect("tmp");
+    let file = dir.path().join("corner.lens");
+    std::fs::write(&file, source).expect("write");
+    let c = lensc_build::driver::check_path(&lensc_lang::loader::RealFs, &file).expect("checks");
+    let (spec, _) = lensc_build::pipeline::lower(&c.checked.jobs[0], None, &Default::default())
+        .expect("lowers");
+    let machine = lensc_lang::lower::read_back::job_machine(&c.checked.jobs[0]);
+    let (found, moves) = lensc_runtime::reader::read_moves(program, &spec.head().dialect, &machine);
+    assert!(found.is_empty(), "{found:?}");
+    moves
+        .iter()
+        .filter(|m| m.path == lensc_runtime::reader::Path::Line)
+        .map(|m| {
+            let v = |i: usize| m.to[i].expect("stated");
+            [v(0), v(2), v(3)]
+        })
+        .collect()
+}
+
+#[test]
+fn a_servo_on_its_own_letter_is_written_there_and_reads_back_as_the_planned_cut() {
+    // The corner at 5 m/min, its servo led by the program. On the
+    // standard library's machine the servo is W: the program moves the
+    // Z slide to 0 and the servo on W. The same job on a machine with no
+    // letter and a slide fast enough for the lead writes the tip on Z:
+    // both plans are the same, and the tip the reader makes of the W
+    // program (Z + W) is, move for move, the Z program's Z.
+    let w_job = linuxcnc_job("5", ", letter: w, max_velocity: 45 m/min", "1000 mm/min");
+    let z_job = linuxcnc_job("5", "", "5000 mm/min");
+    let (code, said, w_program) = build_own(&w_job);
+    assert_eq!(code, Some(0), "{said}");
+    let (code, said, z_program) = build_own(&z_job);
+    assert_eq!(code, Some(0), "{said}");
+    let (w_program, z_program) = (w_program.expect("written"), z_program.expect("written"));
+    let words = |p: &str, letter: char| -> Vec<String> {
+        p.lines()
+            .filter(|l| !l.starts_with('('))
+            .flat_map(|l| l.split_whitespace().map(str::to_string).collect::<Vec<_>>())
+            .filter(|w| w.starts_with(letter))
+            .collect()
+    };
+    assert!(words(&w_program, 'W').len() > 1000, "the servo on W");
+    assert!(words(&z_program, 'W').is_empty(), "no W without the letter");
+    // The slide: up, down to 0 with the plunge, held there, up again.
+    let z: Vec<String> = words(&w_program, 'Z');
+    assert_eq!(z.len(), 4, "{z:?}");
+    assert_eq!(z[1], "Z0.", "{z:?}");
+    // The header names the servo's axis.
+    assert!(
+        w_program
+            .contains("while the fast tool servo moves on its own axis W [the tool tip at Z + W]"),
+        "{}",
+        &w_program[..2000]
+    );
+    let tip = read_feeds(&w_job, &w_program);
+    let planned = read_feeds(&z_job, &z_program);
+    assert_eq!(tip.len(), planned.len());
+    assert!(tip.len() > 10_000, "{}", tip.len());
+    let worst = tip
+        .iter()
+        .zip(&planned)
+        .map(|(a, b)| (0..3).map(|i| (a[i] - b[i]).abs()).fold(0.0, f64::max))
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-9, "the W program's tip strays {worst} mm");
+}
+
+#[test]
+fn a_servo_move_faster_than_its_own_limit_is_refused_naming_both_figures() {
+    // The corner at 5 m/min with the servo on W limited to 600 mm/min:
+    // the lead's moves beside the rims drive it at over 1000 mm/min.
+    let (code, said, program) = build_own(&linuxcnc_job(
+        "5",
+        ", letter: w, max_velocity: 600 mm/min",
+        "1000 mm/min",
+    ));
+    assert_eq!(code, Some(1), "{said}");
+    assert!(program.is_none(), "nothing is written");
+    assert!(
+        said.contains("E0192")
+            && said.contains("drives the servo, written on W, at ")
+            && said.contains("above its `max_velocity` of 600 mm/min"),
+        "{said}"
+    );
+    let velocity: f64 = said
+        .split("written on W, at ")
+        .nth(1)
+        .and_then(|s| s.split(" mm/min").next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("{said}"));
+    assert!(velocity > 1000.0 && velocity < 1100.0, "{velocity}");
+    // The speed the help names builds, its every servo move within 600.
+    let advised = said
+        .split("a surface speed of ")
+        .nth(1)
+        .and_then(|s| s.split(" m/min").next())
+        .unwrap_or_else(|| panic!("{said}"));
+    let (code, said, _) = build_own(&linuxcnc_job(
+        advised,
+        ", letter: w, max_velocity: 600 mm/min",
+        "1000 mm/min",
+    ));
+    assert_eq!(code, Some(0), "{said}");
+}
+
 #[test]
 fn a_lead_faster_than_the_machine_s_feed_is_refused_with_the_speed_that_fits() {
-    // The corner on the standard library's servo lathe, whose dialect
-    // (LinuxCNC) programs the fast axis on Z, each move held by the
-    // controller to the machine's 1000 mm/min: at 5 m/min the lead's
-    // moves beside the lenslets' rims would run at 1034.6 mm/min (the
-    // read-back refused it, E0314, before the plan measured them).
-    let job = |speed: &str| {
-        format!(
-            "surface lenslet = sphere {{ radius: 20 mm, sense: concave, aperture: circle(diameter: 1.7 mm) }}
-surface corner = grid(lenslet, pitch_x: 3.5 mm, pitch_y: 3.5 mm, count_x: 2, count_y: 2)
-use std::machines::nanoform_x_fts5000
-use std::tools::diamond_r496um
-strategy coarse = fts_spiral {{ feed: 50 um/rev, surface_speed: {speed} m/min, spindle_cap: 1000 rpm, settling_time: 1 ms, chord_tolerance: 50 nm }}
-job corner {{ surface: corner, tool: diamond_r496um, machine: nanoform_x_fts5000, strategy: coarse, accept: none }}
-"
-        )
-    };
+    // The corner on the standard library's servo lathe restated with no
+    // letter for its servo: its dialect (LinuxCNC) then programs the fast
+    // axis on Z, each move held by the controller to the machine's
+    // 1000 mm/min, and at 5 m/min the lead's moves beside the lenslets'
+    // rims would run at 1034.6 mm/min (the read-back refused it, E0314,
+    // before the plan measured them).
+    let job = |speed: &str| linuxcnc_job(speed, "", "1000 mm/min");
     let (code, said, program) = build_own(&job("5"));
     assert_eq!(code, Some(1), "{said}");
     assert!(program.is_none(), "nothing is written");
@@ -278,4 +394,41 @@ job corner {{ surface: corner, tool: diamond_r496um, machine: nanoform_x_fts5000
     assert_eq!(code, Some(0), "{said}");
     let program = program.expect("written");
     assert!(program.contains("G93"), "inverse time");
+}
+
+#[test]
+fn a_servo_letter_needs_its_velocity_limit_and_the_limit_its_letter() {
+    for (stated, missing) in [
+        (", letter: w", "`letter` needs its `max_velocity`"),
+        (
+            ", max_velocity: 45 m/min",
+            "`max_velocity` needs its `letter`",
+        ),
+    ] {
+        let dir = tempfile::tempdir().expect("tmp");
+        let file = dir.path().join("corner.lens");
+        std::fs::write(&file, linuxcnc_job("5", stated, "1000 mm/min")).expect("write");
+        let out = lensc(
+            &root(),
+            &["check", file.to_str().expect("utf8"), "--color", "never"],
+        );
+        let said = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{said}");
+        assert!(said.contains("E0121") && said.contains(missing), "{said}");
+    }
+    // A letter the control gives the slides is not the servo's.
+    let dir = tempfile::tempdir().expect("tmp");
+    let file = dir.path().join("corner.lens");
+    std::fs::write(
+        &file,
+        linuxcnc_job("5", ", letter: z, max_velocity: 45 m/min", "1000 mm/min"),
+    )
+    .expect("write");
+    let out = lensc(
+        &root(),
+        &["check", file.to_str().expect("utf8"), "--color", "never"],
+    );
+    let said = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{said}");
+    assert!(said.contains("E0126"), "{said}");
 }
