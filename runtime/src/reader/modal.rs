@@ -184,6 +184,16 @@ pub(crate) struct State {
     fast_taken: usize,
 }
 
+/// The tool tip's position: `p` with the servo on its own letter (at
+/// `servo`, where stated) added to Z.
+pub(super) fn tip(p: [Option<f64>; 4], servo: Option<f64>) -> [Option<f64>; 4] {
+    let mut t = p;
+    if let (Some(z), Some(s)) = (t[2], servo) {
+        t[2] = Some(z + s);
+    }
+    t
+}
+
 impl State {
     pub fn new(d: &Dialect, machine: &MachineLimits) -> State {
         let lex = Lexer::new(d);

@@ -29,7 +29,7 @@
 
 use super::chord::chord;
 use super::lexer::{Block, Found, Word};
-use super::modal::{FeedMode, Motion, State};
+use super::modal::{FeedMode, Motion, State, tip};
 use super::{Controller, Executed, Path, Rule};
 use crate::moves::Plane;
 
@@ -871,16 +871,6 @@ impl State {
 pub(super) type Over = Option<(f64, f64)>;
 
 /// The block's axis words (X, Y, Z, C), in order.
-/// The tool tip's position: `p` with the servo on its own letter (at
-/// `servo`, where stated) added to Z.
-pub(super) fn tip(p: [Option<f64>; 4], servo: Option<f64>) -> [Option<f64>; 4] {
-    let mut t = p;
-    if let (Some(z), Some(s)) = (t[2], servo) {
-        t[2] = Some(z + s);
-    }
-    t
-}
-
 fn axes(b: &Block) -> impl Iterator<Item = &Word> {
     b.words.iter().filter(|w| LETTERS.contains(&w.letter))
 }

@@ -983,3 +983,64 @@ fn heidenhain_iso_reads_i_j_alone_as_the_circle_centre() {
     let none = program("N8 G02 X1. *\n");
     assert_eq!(rules(&none, &d, &mill()), vec![Rule::ArcWords]);
 }
+
+/// A LinuxCNC fast-tool-servo spiral's opening: the slide to 0 with the
+/// plunge, the servo on W (`W1` and `W2` its words), inverse time.
+fn servo_program(w1: &str, w2: &str) -> String {
+    format!(
+        "(units mm; X is the radius, C the spindle angle, +Z out of the material)
+G18 G21 G90 G8 G40 G49 G80 G94
+T1 M6 G43
+G0 Z2
+G0 X3 C0
+G93 G1 W{w1} Z0 F60
+G1 X2.9 C10 F600
+G1 X2.8 W{w2} C20 F600
+G0 W0 Z2
+M2
+"
+    )
+}
+
+#[test]
+fn a_servo_on_its_own_letter_moves_the_tip_and_is_held_to_its_limit() {
+    let d = Dialect::linuxcnc();
+    let servo = |max_velocity| MachineLimits {
+        servo: Some(ServoAxis {
+            letter: 'W',
+            max_velocity,
+        }),
+        ..lathe()
+    };
+    // The tip is Z + W: the plunge ends at 0.5, the next move holds it
+    // (the servo still), the next takes it to 0.4.
+    let text = servo_program("0.5", "0.4");
+    let (found, moves) = read_moves(&text, &d, &servo(1000.0));
+    assert!(found.is_empty(), "{found:?}");
+    let tips: Vec<Option<f64>> = moves.iter().map(|m| m.to[2]).collect();
+    assert_eq!(
+        tips,
+        [
+            Some(2.0),
+            Some(2.0),
+            Some(0.5),
+            Some(0.5),
+            Some(0.4),
+            Some(2.0)
+        ]
+    );
+    // The last move drives W 0.1 mm in 0.1 s: 60 mm/min, over a 50 mm/min
+    // limit; the slides' 0.1 mm in the same time is within their 2000.
+    let found = read(&text, &d, &servo(50.0));
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert_eq!((found[0].rule, found[0].line), (Rule::FeedTooHigh, 8));
+    assert!(
+        found[0]
+            .message
+            .contains("axis W at 60 mm/min, above its 50 mm/min"),
+        "{}",
+        found[0].message
+    );
+    // Where the machine has no such axis, W is no word of the control's.
+    assert!(rules(&text, &d, &lathe()).contains(&Rule::UnknownWord));
+}

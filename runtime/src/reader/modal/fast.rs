@@ -162,8 +162,8 @@ impl State {
         // The tool tip: Z plus a servo on its own letter, which this
         // line (no word of its letter) leaves where it is.
         let (tip_start, tip_end) = (
-            super::super::motion::tip(start, self.servo_at),
-            super::super::motion::tip(end, self.servo_at),
+            super::tip(start, self.servo_at),
+            super::tip(end, self.servo_at),
         );
         if let Some(v) = tip_end[self.away] {
             self.top = Some(self.top.map_or(v, |t| t.max(v)));
