@@ -105,6 +105,7 @@ fn main() {
         travel: [Some((-10.0, 220.0)), None, Some((-150.0, 150.0)), None],
         max_feed: Some(1500.0),
         max_spindle_rpm: Some(3000.0),
+        servo: None,
     };
     let runs: usize = std::env::var("READER_RUNS")
         .ok()

@@ -44,6 +44,12 @@ impl Position {
             y: f64::NAN,
         }
     }
+    /// X, Z and C of a lathe whose fast tool servo is programmed as an
+    /// axis of its own: a lathe has no Y, so the servo's position goes in
+    /// Y's place (`ProgramWriter::servo_in_y` prints it with its letter).
+    pub fn xzc_servo(x: f64, z: f64, c: f64, servo: f64) -> Position {
+        Position { x, y: servo, z, c }
+    }
     /// The axes in the order X, Y, Z, C.
     pub fn axes(&self) -> [f64; 4] {
         [self.x, self.y, self.z, self.c]

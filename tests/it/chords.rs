@@ -38,7 +38,10 @@ fn waves(chords: &str, accept: &str) -> String {
 }
 
 /// The waves judged on `judged` (a `simulate` block, or empty for the
-/// whole part).
+/// whole part). Their servo is led by its controller: the points the
+/// program cuts are then the planner's, which the placements are
+/// compared on (where lensc leads the servo it adds points beside the
+/// path's bends, more or fewer as a placement moves W).
 fn waves_judged(chords: &str, judged: &str, accept: &str) -> String {
     let judged = if judged.is_empty() {
         String::new()
@@ -52,8 +55,9 @@ fn waves_judged(chords: &str, judged: &str, accept: &str) -> String {
          }}\n\
          use std::machines::nanoform_x_fts5000\n\
          use std::tools::diamond_r496um\n\
+         machine led = nanoform_x_fts5000 {{ fast_axis: {{ feed_forward: inverse_model }} }}\n\
          strategy s = fts_spiral {{ feed: 20 um/rev, spindle_speed: 60 rpm, chord_tolerance: 200 nm{chords} }}\n\
-         job waves {{ surface: waves, tool: diamond_r496um, machine: nanoform_x_fts5000, strategy: s{judged}{accept} }}\n"
+         job waves {{ surface: waves, tool: diamond_r496um, machine: led, strategy: s{judged}{accept} }}\n"
     )
 }
 

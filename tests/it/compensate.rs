@@ -125,6 +125,7 @@ fn cut(dir: &Path, program: &str, s: SetUp) -> impl Fn(f64) -> f64 {
         travel: [None; 4],
         max_feed: None,
         max_spindle_rpm: None,
+        servo: None,
     };
     let mut moves: Vec<Executed> = reader::read_moves(program, &spec.head().dialect, &machine).1;
     let offset =
@@ -773,6 +774,7 @@ fn raster_cut(dir: &Path, program: &str, nose: f64, n: usize, dx: f64, within: f
         travel: [None; 4],
         max_feed: None,
         max_spindle_rpm: None,
+        servo: None,
     };
     let (_, mut moves) = reader::read_moves(program, &spec.head().dialect, &machine);
     let offset =

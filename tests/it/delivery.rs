@@ -49,6 +49,7 @@ const MILL: MachineLimits = MachineLimits {
     travel: [None; 4],
     max_feed: None,
     max_spindle_rpm: None,
+    servo: None,
 };
 
 #[test]
@@ -206,9 +207,14 @@ fn spiral_and_servo_programs_split_at_joins_the_control_passes_and_read_back_who
             "{what}: {}",
             text(&v.stderr)
         );
-        // The very moves of the whole program.
+        // The very moves of the whole program (the servo job's machine,
+        // the standard library's, gives its servo the letter W).
         let machine = MachineLimits {
             lathe: true,
+            servo: (what == "servo").then_some(reader::ServoAxis {
+                letter: 'W',
+                max_velocity: 45_000.0,
+            }),
             ..MILL
         };
         let mut load = |n: &str| std::fs::read_to_string(split.join(n)).map_err(|e| e.to_string());

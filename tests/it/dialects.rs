@@ -302,6 +302,35 @@ fn modal_feeds(program: &str) -> Vec<[f64; 3]> {
     out
 }
 
+/// `modal_feeds` of a program whose fast tool servo is written on W
+/// beside the Z slide: X, the tool tip Z + W (W at 0 until stated), C.
+fn modal_tip_feeds(program: &str) -> Vec<[f64; 3]> {
+    let mut at = [f64::NAN, f64::NAN, f64::NAN, 0.0];
+    let mut feeding = false;
+    let mut out = Vec::new();
+    for line in program.lines().filter(|l| !l.starts_with('(')) {
+        let mut moved = false;
+        for w in line.split_whitespace() {
+            match w {
+                "G0" => feeding = false,
+                "G1" => feeding = true,
+                _ => {}
+            }
+            for (k, letter) in ['X', 'Z', 'C', 'W'].into_iter().enumerate() {
+                if let Some(v) = w.strip_prefix(letter) {
+                    at[k] = v.parse().expect("number");
+                    moved = true;
+                }
+            }
+        }
+        if moved && feeding {
+            // (The slide at 0 under the cut: the tip is W as printed.)
+            out.push([at[0], at[1] + at[3], at[2]]);
+        }
+    }
+    out
+}
+
 #[test]
 fn a_fast_tool_servo_table_holds_the_same_points_as_the_linuxcnc_program() {
     let file = root().join("tests/jobs/fts_small_array.lens");
@@ -344,9 +373,10 @@ fn a_fast_tool_servo_table_holds_the_same_points_as_the_linuxcnc_program() {
             [v[0], v[1], v[2]]
         })
         .collect();
-    // LinuxCNC's program carries W on Z: after its plunge, the same points
-    // as the table's rows, X Z C against C X W.
-    let lin = modal_feeds(&linuxcnc.program.text().expect("text"));
+    // LinuxCNC's program carries the servo on W, the Z slide at 0: after
+    // its plunge, the same points as the table's rows, X (Z + W) C
+    // against C X W.
+    let lin = modal_tip_feeds(&linuxcnc.program.text().expect("text"));
     let points = linuxcnc.report.to_json()["toolpath"]["cut_points"]
         .as_u64()
         .expect("n") as usize;

@@ -88,6 +88,7 @@ fn cut_pv(dir: &Path, program: &str, nose: &Nose) -> f64 {
         travel: [None; 4],
         max_feed: None,
         max_spindle_rpm: None,
+        servo: None,
     };
     let mut moves = reader::read_moves(program, &spec.head().dialect, &machine).1;
     let offset = reader::header_control_offset(program).expect("control point");
@@ -231,19 +232,29 @@ const STS: (&str, &str) = (
     "moore_nanotech_450fg",
     "spiral_turning { feed: 10 um/rev, spindle_speed: 50 rpm, chord_tolerance: 2 nm }",
 );
+// Its controller leads the servo (`feed_forward: inverse_model`, as
+// machine `led`): the table's W is then the path, which this test sweeps
+// as the nose's. Where lensc leads the servo itself the table holds the
+// led command, the servo's input and not where the nose goes
+// (tests/it/servo_lead.rs judges that table through the servo).
 const FTS: (&str, &str) = (
     "nanoform_x_fts5000",
-    "fts_spiral { feed: 10 um/rev, spindle_speed: 300 rpm, chord_tolerance: 2 nm }",
+    "fts_spiral { feed: 10 um/rev, spindle_speed: 300 rpm, chord_tolerance: 2 nm }
+machine led = nanoform_x_fts5000 { fast_axis: { stroke: 5 mm, max_acceleration: 25 G, resonance: 1367 Hz, resonant_peak: 1.0, data_rate: 20 kHz, feed_forward: inverse_model } }",
 );
 
 /// TILTED on `machine` with `strategy`, its tool given `tool`, and the
 /// edge's file.
 fn spiral_project((machine, strategy): (&str, &str), tool: &str) -> tempfile::TempDir {
     let dir = tempfile::tempdir().expect("tmp");
-    let job = TILTED
+    let mut job = TILTED
         .replace("MACHINE", machine)
         .replace("STRATEGY", strategy)
         .replace("TOOL", tool);
+    // A strategy that brings its own machine (`led`) is cut on it.
+    if strategy.contains("\nmachine led = ") {
+        job = job.replace(&format!("machine: {machine},"), "machine: led,");
+    }
     std::fs::write(dir.path().join("job.lens"), job).expect("write");
     std::fs::write(dir.path().join("edge.txt"), wavy_text()).expect("write");
     dir
@@ -254,7 +265,8 @@ type Commanded = Option<(f64, f64, f64)>;
 
 /// The nose-centre points a spiral's output commands, as (C rad, X, W),
 /// read from its text alone: the program's moves as the controller reads
-/// them (Z carrying W), or, where the dialect drives the fast tool servo
+/// them (Z carrying W, or the tip Z + W where the machine gives its servo
+/// the letter W), or, where the dialect drives the fast tool servo
 /// from a table, the table's rows (C X W). Rapids start a new pass (None).
 fn spiral_points(dir: &Path, args: &[&str]) -> (Vec<Commanded>, serde_json::Value) {
     let mut all = vec!["build", "job.lens"];
@@ -277,7 +289,9 @@ fn spiral_points(dir: &Path, args: &[&str]) -> (Vec<Commanded>, serde_json::Valu
     let c = driver::check_path(&RealFs, &dir.join("job.lens")).expect("checks");
     let (spec, _) = lensc_build::pipeline::lower(&c.checked.jobs[0], None, &Default::default())
         .expect("lowers");
+    // The job's own machine: its servo's letter, if it has one.
     let machine = MachineLimits {
+        servo: lensc_lang::lower::read_back::job_machine(&c.checked.jobs[0]).servo,
         lathe: true,
         travel: [None; 4],
         max_feed: None,
@@ -478,6 +492,7 @@ fn roller_points(dir: &Path) -> (Vec<Commanded>, serde_json::Value) {
         travel: [None; 4],
         max_feed: None,
         max_spindle_rpm: None,
+        servo: None,
     };
     let mut moves = reader::read_moves(&program, &spec.head().dialect, &machine).1;
     let offset = reader::header_control_offset(&program).expect("control point");

@@ -4,8 +4,9 @@
 //! the advised speed passes (its servo's lag within the job's limit, or,
 //! where the advice says it lags more, within the limit the advice says
 //! to state), and the speed the advice names as refused,
-//! within 5 % above it, is refused by the planner itself: the advice is
-//! neither optimistic nor absurdly conservative.
+//! within 5 % above it, is refused by the planner itself or by the
+//! build's checks of the led commands it writes: the advice is neither
+//! optimistic nor absurdly conservative.
 
 use std::path::Path;
 
@@ -92,9 +93,14 @@ fn advice_holds(name: &str, text: &str, judged: bool) -> (String, String) {
         number(&fails) <= 1.05 * number(&passes),
         "{name}: {passes} passes, {fails} fails: too conservative"
     );
-    // Refused at the speed named as refused, by the planner itself.
+    // Refused at the speed named as refused: by the planner itself, or,
+    // where the program leads the servo, by the build's checks of what
+    // it writes (the lead's acceleration, a move over the machine's feed).
     std::fs::write(&file, with_speed(text, &fails)).expect("write");
-    assert!(refused_at(&file).is_some(), "{name}: {fails} passes");
+    assert!(
+        refused_at(&file).is_some() || advice::refused_as_written(&spiral_of(&file)),
+        "{name}: {fails} passes"
+    );
     // Built at the advised speed: the servo follows, with no error at
     // all, its lag within the job's limit, or (the advice says so) within
     // the limit the advice names. The part's form is not what the advice

@@ -50,6 +50,7 @@ mod read_back;
 mod rs274;
 mod sandbox;
 mod seed_sketches;
+mod servo_lead;
 mod spline_examples;
 mod splines;
 mod surface_fixtures;

@@ -262,6 +262,7 @@ fn the_curve_read_passes_through_linuxcncs_points() {
         travel: [None; 4],
         max_feed: None,
         max_spindle_rpm: None,
+        servo: None,
     };
     let mut checked = 0;
     let mut worst: f64 = 0.0;

@@ -216,6 +216,7 @@ pub(crate) fn read_program(
         travel: [None; 4],
         max_feed: None,
         max_spindle_rpm: None,
+        servo: head.servo,
     };
     // The machine's travel, feed and speed only add findings: the moves
     // are the same read by either. A read-back of another kind of machine

@@ -135,6 +135,7 @@ pub fn deliver(head: &JobHead, b: &mut Built, lathe: bool) -> Result<(), Vec<Dia
         travel: [None; 4],
         max_feed: None,
         max_spindle_rpm: None,
+        servo: head.servo,
     };
     let assembled = reader::parts::assemble(&split.main, &head.dialect, &head.name, &mut load)
         .map_err(|e| vec![head.error(codes::SPLIT_READS_DIFFERENTLY, e.message())])?;
@@ -307,6 +308,7 @@ pub fn peak_warning(head: &JobHead, b: &Built, lathe: bool) -> Option<Diagnostic
         travel: [None; 4],
         max_feed: None,
         max_spindle_rpm: None,
+        servo: head.servo,
     };
     let lines = line_times(&text, &head.dialect, &machine);
     let total: f64 = lines.iter().map(|l| f64::from(l.bytes)).sum();

@@ -89,6 +89,10 @@ pub struct JobHead {
     pub resolution: f64,
     /// The machine's travel in X, Y, Z and C, where it states one (mm, rad).
     pub travel: [Option<(f64, f64)>; 4],
+    /// A fast tool servo the machine gives an axis of its own (its
+    /// letter and limit, mm/min), as every reading of the program's text
+    /// takes it (the tip is Z plus the servo).
+    pub servo: Option<lensc_runtime::reader::ServoAxis>,
     /// The job's `simulate` window, if it states one.
     pub simulate: Option<Simulate>,
     /// What the simulated part must meet for the program to be written.
@@ -578,6 +582,14 @@ impl<'a> Parts<'a> {
             dialect,
             resolution: self.machine_params.resolution,
             travel: self.machine_params.travel,
+            servo: self
+                .machine_params
+                .fast_axis
+                .and_then(|f| f.own_axis)
+                .map(|(letter, v)| lensc_runtime::reader::ServoAxis {
+                    letter,
+                    max_velocity: v * 60.0,
+                }),
             simulate: simulate(&self.params).ok().flatten(),
             accept: accept::lower(&self.params).unwrap_or_default(),
             start: Start {

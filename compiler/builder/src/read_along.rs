@@ -112,6 +112,7 @@ mod tests {
             travel: [Some((-10.0, 150.0)), None, Some((-100.0, 100.0)), None],
             max_feed: Some(2000.0),
             max_spindle_rpm: Some(3000.0),
+            servo: None,
         };
         // Out of travel, a feed too high (twice), an unknown word, a line
         // ending CR LF, and no program end.

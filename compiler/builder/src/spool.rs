@@ -231,6 +231,7 @@ mod tests {
                 travel: [Some((-10.0, 150.0)), None, Some((-100.0, 100.0)), None],
                 max_feed: Some(2000.0),
                 max_spindle_rpm: Some(3000.0),
+                servo: None,
             },
         };
         let pieces = [

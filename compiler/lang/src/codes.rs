@@ -327,6 +327,10 @@ pub const PROGRAM_NURBS_WEIGHT: &str = "E0338";
 /// A fast-tool-servo table (`lensc verify`) with a row that is not three
 /// numbers C X W, or whose C runs backwards.
 pub const SERVO_TABLE_ROW: &str = "E0190";
+/// A fast tool servo with no feed-forward whose lead, the command lensc
+/// writes for it, would exceed its stroke or drive it beyond its
+/// acceleration.
+pub const LEAD_REFUSED: &str = "E0192";
 
 /// The code of a rule a program read back breaks.
 pub fn program_rule(rule: lensc_runtime::reader::Rule) -> &'static str {
@@ -525,6 +529,7 @@ pub const ALL: &[&str] = &[
     PROGRAM_NURBS_NOT_CUT,
     PROGRAM_NURBS_WEIGHT,
     SERVO_TABLE_ROW,
+    LEAD_REFUSED,
     ACCEPTANCE_MISSED_WARNING,
     ACCEPTANCE_UNMEASURED_WARNING,
     SURFACE_UNDEFINED_WARNING,

@@ -220,6 +220,7 @@ mod tests {
             travel: [None; 4],
             max_feed: Some(1500.0),
             max_spindle_rpm: Some(3000.0),
+            servo: None,
         };
         reader::read(text, dialect, &machine)
             .into_iter()

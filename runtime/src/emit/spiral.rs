@@ -13,13 +13,17 @@ use std::fmt::Write as _;
 /// A LinuxCNC program for a spiral (fast or slow tool servo), written as
 /// the planner hands over its points: X (radius, G8) and C (degrees,
 /// counted on from the start) on the spiral, the nose-centre height on Z,
-/// each move timed by inverse-time feed (G93: F = 1/minutes). LinuxCNC has
-/// no fast-axis word its interpreter accepts, so a fast tool servo's
-/// motion is programmed on Z (the form of a slow-tool-servo program);
-/// controllers with a W axis get their own dialect.
+/// each move timed by inverse-time feed (G93: F = 1/minutes). A fast tool
+/// servo's motion is programmed on Z (the form of a slow-tool-servo
+/// program), or where the machine gives the servo an axis of its own
+/// (`servo_on`: LinuxCNC's U, V or W, configured as a joint with its own
+/// velocity limit) on that letter, the Z slide held at 0 and the tool tip
+/// at Z plus the servo; controllers that take a servo table get it.
 pub struct FtsProgram {
     writer: ProgramWriter,
     safe_w: f64,
+    /// The servo is written on its own letter (`servo_on`).
+    servo: bool,
     /// The last point written (None before the first).
     last: Option<crate::plan::spiral::SpiralPoint>,
     /// Where the fast axis goes when the dialect takes it as a table.
@@ -104,10 +108,18 @@ impl FtsProgram {
                 chord_tolerance * optimise::BLEND_SHARE,
             )?,
             safe_w,
+            servo: false,
             last: None,
             table,
             spindle: None,
         })
+    }
+
+    /// Writes the servo's motion on its own axis `letter` (U, V or W),
+    /// the Z slide held at 0: the tool tip is Z plus the servo.
+    pub fn servo_on(&mut self, letter: char) {
+        self.writer.servo_in_y(letter);
+        self.servo = true;
     }
 
     /// Holds every move's C under the spindle's limit as printed (a spiral
@@ -122,19 +134,43 @@ impl FtsProgram {
 
     /// The move stream of spiral points: the first is reached by rapids
     /// above the part and a one-second plunge.
+    /// With `servo` the servo's motion goes on its own axis (in the
+    /// stream's Y, `Position::xzc_servo`), Z held at 0.
     pub fn moves(
         last: Option<crate::plan::spiral::SpiralPoint>,
         safe_w: f64,
         points: &[crate::plan::spiral::SpiralPoint],
         spindle: Option<SpindleHold>,
+        servo: bool,
     ) -> Vec<moves::Move> {
         let mut out = Vec::with_capacity(points.len() + 3);
         let mut last = last;
+        let at = |p: &crate::plan::spiral::SpiralPoint| {
+            if servo {
+                Position::xzc_servo(p.x, 0.0, p.c, p.w)
+            } else {
+                Position::xzc(p.x, p.w, p.c)
+            }
+        };
         for p in points {
             match last {
+                None if servo => {
+                    // The plunge brings the slide to 0 and the servo to
+                    // the first point together: the tip from above the
+                    // part to it.
+                    let [above, over, _] = approach(p, p.w, safe_w);
+                    out.extend([
+                        above,
+                        over,
+                        moves::Move::Linear {
+                            to: at(p),
+                            feed: Some(moves::Feed::InverseTime(1.0)),
+                        },
+                    ]);
+                }
                 None => out.extend(approach(p, p.w, safe_w)),
                 Some(q) => out.push(moves::Move::Linear {
-                    to: Position::xzc(p.x, p.w, p.c),
+                    to: at(p),
                     feed: Some(moves::Feed::InverseTime(
                         spindle.map_or(p.t - q.t, |s| s.time(p.t - q.t, q.c, p.c)),
                     )),
@@ -159,7 +195,7 @@ impl FtsProgram {
         if self.table.is_some() {
             return self.extend_table(points);
         }
-        let stream = Self::moves(self.last, self.safe_w, points, self.spindle);
+        let stream = Self::moves(self.last, self.safe_w, points, self.spindle, self.servo);
         if let Some(p) = points.last() {
             self.last = Some(*p);
         }
@@ -246,8 +282,11 @@ impl FtsProgram {
                     .block_line(&line.replace("{table}", &table.name))?;
             }
         }
+        // The slide retracts; a servo on its own axis goes back to its
+        // zero with it.
         self.writer.write(&moves::Move::Rapid(Position {
             z: self.safe_w,
+            y: if self.servo { 0.0 } else { f64::NAN },
             ..Position::KEEP
         }))?;
         self.writer.finish()

@@ -1,6 +1,7 @@
 //! Machines: their kinematics, limits and the dialect they speak.
 
 pub mod edge;
+pub mod lead;
 pub mod servo;
 pub mod tool;
 

@@ -248,6 +248,18 @@ impl ProgramWriter {
         Ok(w)
     }
 
+    /// A lathe's fast tool servo programmed as an axis of its own, on
+    /// `letter` (U, V or W): a lathe has no Y, so the move stream carries
+    /// the servo in Y's place (`Position::xzc_servo`) and its words are
+    /// printed with this letter, to the resolution, as X and Z are.
+    pub fn servo_in_y(&mut self, letter: char) {
+        let limit = integer_limits(&self.dialect)[letter_index(letter)];
+        self.letters[1] = Some(letter);
+        self.lettered_axes |= 1 << 1;
+        self.axis_heads[1] = WordHead::new(letter);
+        self.axis_unit_limits[1] = limit.saturating_mul(pow10(self.axis_decimals[1]));
+    }
+
     /// A writer with nothing written yet, every word of the dialect
     /// prepared and no axis position known.
     fn blank(dialect: &Dialect, setup: Setup, job: &str, axes: &str, decimals: u32) -> Self {

@@ -24,6 +24,7 @@ fn mill() -> MachineLimits {
         ],
         max_feed: Some(5000.0),
         max_spindle_rpm: Some(20000.0),
+        servo: None,
     }
 }
 

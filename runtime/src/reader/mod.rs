@@ -55,6 +55,19 @@ pub struct MachineLimits {
     pub max_feed: Option<f64>,
     /// Highest spindle speed (rpm).
     pub max_spindle_rpm: Option<f64>,
+    /// A fast tool servo the control programs as an axis of its own
+    /// (LinuxCNC's U, V or W): its words are moves of the servo, the tool
+    /// tip at Z plus the servo.
+    pub servo: Option<ServoAxis>,
+}
+
+/// A fast tool servo programmed on its own letter, beside Z.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ServoAxis {
+    /// Its letter (upper case: U, V or W).
+    pub letter: char,
+    /// Its velocity limit (mm/min): no move may drive it faster.
+    pub max_velocity: f64,
 }
 
 /// The family of controller whose rules a dialect is read by.
@@ -166,7 +179,10 @@ pub struct Finding {
 /// A move as the controller makes it from the text, in machine
 /// coordinates: absolute, in mm (an inch program's too), X the radius on a
 /// lathe (a diameter program's too), C in degrees; an axis is `None`
-/// until the program first states it.
+/// until the program first states it. On a machine whose fast tool servo
+/// is an axis of its own (`MachineLimits::servo`), Z is the tool tip's:
+/// the slide's Z plus the servo (taken at its zero until the program
+/// states it).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Executed {
     pub from: [Option<f64>; 4],

@@ -132,6 +132,9 @@ pub(crate) struct State {
     pub diameter: bool,
     /// X (radius), Y, Z (mm), C (degrees), where known.
     pub pos: [Option<f64>; 4],
+    /// The fast tool servo on its own letter (`MachineLimits::servo`),
+    /// where the program has stated it (mm).
+    pub servo_at: Option<f64>,
     /// The axis whose + leads out of the material (header).
     pub away: usize,
     /// Where the program's control point lies from the tool's centre (mm
@@ -179,6 +182,16 @@ pub(crate) struct State {
     /// Lines the fast path has read.
     #[cfg(test)]
     fast_taken: usize,
+}
+
+/// The tool tip's position: `p` with the servo on its own letter (at
+/// `servo`, where stated) added to Z.
+pub(super) fn tip(p: [Option<f64>; 4], servo: Option<f64>) -> [Option<f64>; 4] {
+    let mut t = p;
+    if let (Some(z), Some(s)) = (t[2], servo) {
+        t[2] = Some(z + s);
+    }
+    t
 }
 
 impl State {
@@ -249,6 +262,7 @@ impl State {
             tool_loaded: false,
             diameter: machine.lathe && d.lathe_x_diameter,
             pos: [None; 4],
+            servo_at: None,
             away: 2,
             control: [0.0; 3],
             top: None,
@@ -571,8 +585,12 @@ impl State {
             Controller::HeidenhainIso => "XYZABCIJKRFSTLPHN",
             Controller::HeidenhainKlartext => "XYZIJKFSTN",
         };
+        // LinuxCNC reads U V W where the machine configures them as axes:
+        // the fast tool servo's letter, where it is one.
+        let servo = self.lex.controller == Controller::LinuxCnc
+            && self.machine.servo.is_some_and(|s| s.letter == l);
         // Every letter listed is ASCII: a byte compare, not a char search.
-        l.is_ascii() && letters.as_bytes().contains(&(l as u8))
+        servo || (l.is_ascii() && letters.as_bytes().contains(&(l as u8)))
     }
 
     fn g_group(&self, code: i64) -> Option<GGroup> {

@@ -29,7 +29,7 @@
 
 use super::chord::chord;
 use super::lexer::{Block, Found, Word};
-use super::modal::{FeedMode, Motion, State};
+use super::modal::{FeedMode, Motion, State, tip};
 use super::{Controller, Executed, Path, Rule};
 use crate::moves::Plane;
 
@@ -65,8 +65,10 @@ impl State {
         // Centre words alone make a move only in an arc mode (a full
         // circle); elsewhere they belong to their block (`M19 R0`).
         let arc_mode = matches!(self.motion, Some(Motion::Cw | Motion::Ccw)) && !iso;
+        let servo_word = self.servo_word(b);
         let Some(first) = axes(b)
             .next()
+            .or(servo_word)
             .or(centre.first().copied().filter(|_| arc_mode))
         else {
             return;
@@ -88,6 +90,14 @@ impl State {
         self.stated(span, out);
         let start = self.pos;
         let end = self.end_point(b);
+        // The servo on its own letter: where it goes, and the tool tip
+        // (Z plus the servo) at each end of the move.
+        let servo_start = self.servo_at;
+        let servo_end = match servo_word {
+            Some(w) => self.servo_end(w.value),
+            None => servo_start,
+        };
+        let (tip_start, tip_end) = (tip(start, servo_start), tip(end, servo_end));
         if self.lex.controller == Controller::LinuxCnc && axes(b).any(|w| w.letter == 'C') {
             // LinuxCNC drives the spindle as the rotary axis C.
             self.position_mode = true;
@@ -98,11 +108,21 @@ impl State {
         }
         let path = match motion {
             Motion::Rapid => {
-                self.rapid(&start, &end, span, out);
+                self.rapid(&tip_start, &tip_end, span, out);
                 Some(Path::Rapid)
             }
-            _ => self.feed_move(motion, b, &start, &end, &centre, span, line, out),
+            _ => {
+                let path = self.feed_move(motion, b, &start, &end, &centre, span, line, out);
+                self.servo_limit(b, &start, &end, (servo_start, servo_end), span, out);
+                if let Some(v) = tip_end[self.away].filter(|_| self.away == 2) {
+                    // The highest point cut is the tip's.
+                    self.top = Some(self.top.map_or(v, |t| t.max(v)));
+                }
+                path
+            }
         };
+        let slide_end = end;
+        let (start, end) = (tip_start, tip_end);
         if let (Some(moves), Some(path)) = (&mut self.moves, path) {
             if matches!(motion, Motion::Spline(_)) {
                 // A spline's straight moves, X and Y along its points.
@@ -122,7 +142,90 @@ impl State {
                 });
             }
         }
-        self.pos = end;
+        self.pos = slide_end;
+        self.servo_at = servo_end;
+    }
+
+    /// The block's word of the fast tool servo's own letter, on a
+    /// LinuxCNC machine that has one (`MachineLimits::servo`).
+    fn servo_word<'b>(&self, b: &'b Block) -> Option<&'b Word> {
+        let letter = self.machine.servo.map(|s| s.letter)?;
+        (self.lex.controller == Controller::LinuxCnc)
+            .then(|| b.words.iter().find(|w| w.letter == letter))
+            .flatten()
+    }
+
+    /// Where the servo ends for its word's `value` in the program's units:
+    /// incremental values added to where it is (unknown if it is).
+    fn servo_end(&self, value: f64) -> Option<f64> {
+        let v = value * self.mm_per_unit();
+        if self.absolute == Some(false) {
+            self.servo_at.map(|p| p + v)
+        } else {
+            Some(v)
+        }
+    }
+
+    /// A feed move that drives the servo on its own letter (from `servo.0`
+    /// to `servo.1`, mm) faster than its velocity limit. Its time is the
+    /// move's by LinuxCNC's feed rule (`over_limits`): in inverse time
+    /// 1/F; per minute the slides' X Y Z length at F where they move, else
+    /// the servo's own travel at F (the U V W rule); per revolution the
+    /// same at F times the spindle's speed.
+    fn servo_limit(
+        &self,
+        b: &Block,
+        start: &[Option<f64>; 4],
+        end: &[Option<f64>; 4],
+        servo: (Option<f64>, Option<f64>),
+        span: (usize, usize),
+        out: &mut Vec<Found>,
+    ) {
+        let (Some(axis), (Some(s0), Some(s1))) = (self.machine.servo, servo) else {
+            return;
+        };
+        let (Some(f), Some(mode)) = (self.feed, self.feed_mode) else {
+            return;
+        };
+        let travel = (s1 - s0).abs();
+        if travel == 0.0 {
+            return;
+        }
+        let unit = self.mm_per_unit();
+        let slides = chord(start, end).unwrap_or(0.0);
+        let along = |rate: f64| {
+            if slides > 0.0 {
+                travel * rate / slides
+            } else {
+                rate
+            }
+        };
+        let velocity = match mode {
+            FeedMode::InverseTime => Some(travel * f),
+            FeedMode::PerMinute => Some(along(f * unit)),
+            FeedMode::PerRevolution => self
+                .revolutions(start, end)
+                .map(|rpm| along(f * unit * rpm)),
+        };
+        let Some(v) = velocity.filter(|&v| v > axis.max_velocity * (1.0 + 1e-9)) else {
+            return;
+        };
+        let fspan = b
+            .words
+            .iter()
+            .find(|w| w.letter == 'F')
+            .map_or(span, |w| w.span);
+        out.push((
+            Rule::FeedTooHigh,
+            fspan,
+            format!(
+                "this move drives the fast tool servo's axis {} at {} mm/min, above its {} mm/min",
+                axis.letter,
+                num(v),
+                num(axis.max_velocity)
+            ),
+            None,
+        ));
     }
 
     /// Units and distance mode must be stated before the first move.
@@ -333,7 +436,9 @@ impl State {
         if let Some(length) = length {
             self.feed_limit(b, start, end, length, span, out);
         }
-        if let Some(v) = end[self.away] {
+        // (With a servo on its own letter the tip's Z is the top's,
+        // `move_block`.)
+        if let Some(v) = end[self.away].filter(|_| self.machine.servo.is_none() || self.away != 2) {
             self.top = Some(self.top.map_or(v, |t| t.max(v)));
         }
         path

@@ -6,6 +6,7 @@ fn lathe() -> MachineLimits {
         travel: [Some((-10.0, 150.0)), None, Some((-100.0, 100.0)), None],
         max_feed: Some(2000.0),
         max_spindle_rpm: Some(3000.0),
+        servo: None,
     }
 }
 
@@ -138,6 +139,7 @@ fn heidenhain_reads_arc_centres_where_they_are() {
         ],
         max_feed: Some(5000.0),
         max_spindle_rpm: None,
+        servo: None,
     };
     // The centre (X0.2, Z-10) is the circle's, not an offset from the start.
     let good = "%J G71 *\nN1 ; +Z out of the material *\nN2 G17 G90 G40 *\nN3 T1 G17 S1000 *\nN4 M3 *\nN5 G00 Z1. *\nN6 G00 X-1. Y0. *\nN7 G94 G01 Z-0.1 F100. *\nN8 G18 G03 X1.5 Z-0.1126 I0.2 K-10. *\nN9 G00 Z1. *\nN10 M30 *\nN99999999 %J G71 *\n";
@@ -437,6 +439,7 @@ fn linuxcnc_reads_splines_as_moves_along_the_curve() {
         travel: [None; 4],
         max_feed: None,
         max_spindle_rpm: None,
+        servo: None,
     };
     let program = |moves: &str| {
         format!(
@@ -539,6 +542,7 @@ fn heidenhain_iso_reads_g36_and_the_blank() {
         ],
         max_feed: Some(5000.0),
         max_spindle_rpm: Some(12000.0),
+        servo: None,
     };
     let good = "%J G71 *\nN1 ; +Z out of the material *\nN2 G17 G90 G40 G94 *\nN3 G30 G17 X-1 Y-1 Z-2 *\nN4 G31 G90 X1 Y1 Z0.5 *\nN5 T1 G17 *\nN6 G36 S0 *\nN7 G00 Z1. *\nN8 G00 X-1. Y0. *\nN9 G01 Z-0.1 F100. *\nN10 G01 X1. *\nN11 G00 Z1. *\nN12 M5 *\nN13 G00 Z0 M91 *\nN14 M30 *\nN99999999 %J G71 *\n";
     assert_eq!(rules(good, &d, &mill), vec![]);
@@ -566,6 +570,7 @@ fn mill() -> MachineLimits {
         ],
         max_feed: Some(5000.0),
         max_spindle_rpm: Some(12000.0),
+        servo: None,
     }
 }
 
@@ -789,6 +794,7 @@ fn nurbs_mill() -> MachineLimits {
         ],
         max_feed: Some(5000.0),
         max_spindle_rpm: Some(20000.0),
+        servo: None,
     }
 }
 
@@ -877,6 +883,7 @@ fn linuxcnc_reads_a_nurbs_block_as_the_interpreter_evaluates_it() {
         travel: [None; 4],
         max_feed: None,
         max_spindle_rpm: None,
+        servo: None,
     };
     let program = |moves: &str| {
         format!(
@@ -975,4 +982,65 @@ fn heidenhain_iso_reads_i_j_alone_as_the_circle_centre() {
     // No centre defined at all: still refused.
     let none = program("N8 G02 X1. *\n");
     assert_eq!(rules(&none, &d, &mill()), vec![Rule::ArcWords]);
+}
+
+/// A LinuxCNC fast-tool-servo spiral's opening: the slide to 0 with the
+/// plunge, the servo on W (`W1` and `W2` its words), inverse time.
+fn servo_program(w1: &str, w2: &str) -> String {
+    format!(
+        "(units mm; X is the radius, C the spindle angle, +Z out of the material)
+G18 G21 G90 G8 G40 G49 G80 G94
+T1 M6 G43
+G0 Z2
+G0 X3 C0
+G93 G1 W{w1} Z0 F60
+G1 X2.9 C10 F600
+G1 X2.8 W{w2} C20 F600
+G0 W0 Z2
+M2
+"
+    )
+}
+
+#[test]
+fn a_servo_on_its_own_letter_moves_the_tip_and_is_held_to_its_limit() {
+    let d = Dialect::linuxcnc();
+    let servo = |max_velocity| MachineLimits {
+        servo: Some(ServoAxis {
+            letter: 'W',
+            max_velocity,
+        }),
+        ..lathe()
+    };
+    // The tip is Z + W: the plunge ends at 0.5, the next move holds it
+    // (the servo still), the next takes it to 0.4.
+    let text = servo_program("0.5", "0.4");
+    let (found, moves) = read_moves(&text, &d, &servo(1000.0));
+    assert!(found.is_empty(), "{found:?}");
+    let tips: Vec<Option<f64>> = moves.iter().map(|m| m.to[2]).collect();
+    assert_eq!(
+        tips,
+        [
+            Some(2.0),
+            Some(2.0),
+            Some(0.5),
+            Some(0.5),
+            Some(0.4),
+            Some(2.0)
+        ]
+    );
+    // The last move drives W 0.1 mm in 0.1 s: 60 mm/min, over a 50 mm/min
+    // limit; the slides' 0.1 mm in the same time is within their 2000.
+    let found = read(&text, &d, &servo(50.0));
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert_eq!((found[0].rule, found[0].line), (Rule::FeedTooHigh, 8));
+    assert!(
+        found[0]
+            .message
+            .contains("axis W at 60 mm/min, above its 50 mm/min"),
+        "{}",
+        found[0].message
+    );
+    // Where the machine has no such axis, W is no word of the control's.
+    assert!(rules(&text, &d, &lathe()).contains(&Rule::UnknownWord));
 }

@@ -128,6 +128,7 @@ mod tests {
             travel: [None; 4],
             max_feed: None,
             max_spindle_rpm: None,
+            servo: None,
         }
     }
 

@@ -12,6 +12,14 @@
 //! over: the simulation keeps only the servo's state (and, led, the few
 //! points of the next data period).
 //!
+//! Led by the program ([`FollowingSimulation::extend_toward`]): the
+//! commands are the pre-compensated ones a program writes for a servo with
+//! no feed-forward (`machine::lead`), each with the point of the path it
+//! is meant to put the servo at; the servo runs on the commands unled and
+//! its error is measured from the path. The servo's acceleration, the
+//! change of its velocity over each data period, is measured too: the
+//! lead must not drive it beyond its limit.
+//!
 //! Led ([`FollowingSimulation::led`]): the servo is driven not by the
 //! commanded position r(t) itself but by its inverse model applied to it,
 //! u = r + (2ζ/ωn) ṙ + r̈/ωn² (velocity and acceleration feed-forward), so
@@ -54,6 +62,10 @@ pub struct Following {
     pub max_error: f64,
     pub max_error_at: f64,
     pub lenslets: Vec<LensletFollowing>,
+    /// The servo's largest acceleration (mm/s²; its velocity's change
+    /// over a data period) and the radius (mm) where it is.
+    pub max_acceleration: f64,
+    pub max_acceleration_at: f64,
     /// Every sample's error where the nose cuts (`cutting_below`)
     /// gathered in bins of radius, for plots.
     pub by_radius: RadialBins,
@@ -174,6 +186,9 @@ fn new_peak(error: f64, radius: f64) -> (f64, f64) {
 struct Move<'a> {
     q: SpiralPoint,
     p: SpiralPoint,
+    /// The path's W (mm) at `q` and `p`: the commands' own, or where the
+    /// program's lead means them to put the servo.
+    aims: (f64, f64),
     /// `p` and the points after it known so far (led: up to a data period
     /// past `p`, or the end of the spiral).
     from_p: &'a [SpiralPoint],
@@ -211,6 +226,8 @@ pub struct FollowingSimulation {
     next: f64,
     k: u64,
     last: Option<SpiralPoint>,
+    /// The path's W at `last` (its own W unless led by the program).
+    last_aim: f64,
     /// Led: the feed-forward gains (2ζ/ωn in s, 1/ωn² in s²), and the
     /// points received whose moves wait for the path a data period on.
     lead: Option<(f64, f64)>,
@@ -232,6 +249,8 @@ pub struct FollowingSimulation {
     acc: Vec<Acc>,
     max_error: f64,
     max_error_at: f64,
+    max_acceleration: f64,
+    max_acceleration_at: f64,
     by_radius: RadialBins,
 }
 
@@ -277,6 +296,7 @@ impl FollowingSimulation {
             next: 0.0,
             k: 0,
             last: None,
+            last_aim: 0.0,
             lead: None,
             ahead: Vec::new(),
             prior: None,
@@ -297,6 +317,8 @@ impl FollowingSimulation {
                 .collect(),
             max_error: 0.0,
             max_error_at: f64::NAN,
+            max_acceleration: 0.0,
+            max_acceleration_at: f64::NAN,
             by_radius,
         })
     }
@@ -335,11 +357,25 @@ impl FollowingSimulation {
     pub fn extend(&mut self, points: &[SpiralPoint]) {
         for &p in points {
             if self.lead.is_none() {
-                self.run_to(p, &[p]);
+                self.run_to(p, p.w, &[p]);
                 continue;
             }
             self.ahead.push(p);
             self.run_known(false);
+        }
+    }
+
+    /// Runs the servo, unled, over the next `commands` as a program that
+    /// leads it itself prints them (`machine::lead`), `aims[i]` the W of
+    /// the path `commands[i]` is meant to put it at: the error is the
+    /// servo's position minus the path. (A simulation led by its
+    /// controller, [`led`](Self::led), takes the commands as the path.)
+    pub fn extend_toward(&mut self, commands: &[SpiralPoint], aims: &[f64]) {
+        if self.lead.is_some() {
+            return self.extend(commands);
+        }
+        for (&p, &aim) in commands.iter().zip(aims) {
+            self.run_to(p, aim, &[p]);
         }
     }
 
@@ -351,7 +387,7 @@ impl FollowingSimulation {
         let horizon = ahead.last().map_or(f64::NEG_INFINITY, |p| p.t);
         let mut used = 0;
         while used < ahead.len() && (end || horizon >= ahead[used].t + 2.0 * self.dt) {
-            self.run_to(ahead[used], &ahead[used..]);
+            self.run_to(ahead[used], ahead[used].w, &ahead[used..]);
             used += 1;
         }
         self.ahead = ahead;
@@ -360,21 +396,24 @@ impl FollowingSimulation {
 
     /// Runs the servo from the last point to `p`, the first of `from_p`
     /// (the points known from `p` on).
-    fn run_to(&mut self, p: SpiralPoint, from_p: &[SpiralPoint]) {
+    fn run_to(&mut self, p: SpiralPoint, aim: f64, from_p: &[SpiralPoint]) {
         let xy = (p.x * p.c.cos(), p.x * p.c.sin());
         let Some(q) = self.last else {
-            self.state = Some(Vector2::new(p.w, 0.0));
+            // At rest where the path starts.
+            self.state = Some(Vector2::new(aim, 0.0));
             self.t0 = p.t;
             self.next = p.t;
             self.last = Some(p);
+            self.last_aim = aim;
             self.last_xy = xy;
             return;
         };
         if p.t - q.t > 0.0 {
-            self.run_move(q, self.last_xy, p, xy, from_p);
+            self.run_move(q, self.last_xy, p, xy, (self.last_aim, aim), from_p);
         }
         self.prior = self.last;
         self.last = Some(p);
+        self.last_aim = aim;
         self.last_xy = xy;
     }
 
@@ -386,6 +425,7 @@ impl FollowingSimulation {
         (xq, yq): (f64, f64),
         p: SpiralPoint,
         (xp, yp): (f64, f64),
+        aims: (f64, f64),
         from_p: &[SpiralPoint],
     ) {
         let span = p.t - q.t;
@@ -405,6 +445,7 @@ impl FollowingSimulation {
         let mv = Move {
             q,
             p,
+            aims,
             from_p,
             per_second: 1.0 / span,
             step,
@@ -413,7 +454,7 @@ impl FollowingSimulation {
         // carries no test that cannot change within the move.
         // A move wholly in the air (`cutting_below`) cuts nothing: the
         // servo runs, its error is not gathered.
-        let in_air = q.w.min(p.w) >= self.air;
+        let in_air = aims.0.min(aims.1) >= self.air;
         let acc = match (one_bin, lenslet.is_some()) {
             _ if in_air => self.samples::<true, false, false>(&mv),
             (true, true) => self.samples::<true, true, true>(&mv),
@@ -449,10 +490,12 @@ impl FollowingSimulation {
         let Move {
             q,
             p,
+            aims: (aim_q, aim_p),
             from_p,
             per_second,
             step,
         } = *mv;
+        let aim_dw = aim_p - aim_q;
         let (p00, p01, p10, p11) = (
             self.phi[(0, 0)],
             self.phi[(0, 1)],
@@ -475,6 +518,8 @@ impl FollowingSimulation {
         let (half, velocity) = (0.5 * dt * per_second * dw, dw * per_second);
         let (mut k, mut next) = (self.k, self.next);
         let (mut max_error, mut max_error_at) = (self.max_error, self.max_error_at);
+        let (mut max_acceleration, mut max_acceleration_at) =
+            (self.max_acceleration, self.max_acceleration_at);
         let mut last_error = self.last_error;
         let mut acc = MoveAcc {
             samples: 0,
@@ -486,7 +531,7 @@ impl FollowingSimulation {
         while next < p.t {
             let f = (next - q.t) * per_second;
             let command = q.w + f * dw;
-            let error = pos - command;
+            let error = pos - (aim_q + f * aim_dw);
             let radius = || (q.x + f * (p.x - q.x)).abs();
             if CUTTING && error.abs() > max_error {
                 // Rare once the spiral is under way: a branch, not a
@@ -518,16 +563,22 @@ impl FollowingSimulation {
                 }
                 Some((c1, c2)) => path.held_command(next + 0.5 * dt, dt, c1, c2),
             };
+            let v0 = vel;
             (pos, vel) = (
                 p00 * pos + p01 * vel + g0 * drive,
                 p10 * pos + p11 * vel + g1 * drive,
             );
+            let acceleration = (vel - v0).abs() / dt;
+            if acceleration > max_acceleration {
+                (max_acceleration, max_acceleration_at) = new_peak(acceleration, radius());
+            }
             k += 1;
             next = t0 + k as f64 * dt;
         }
         self.state = Some(Vector2::new(pos, vel));
         (self.k, self.next) = (k, next);
         (self.max_error, self.max_error_at) = (max_error, max_error_at);
+        (self.max_acceleration, self.max_acceleration_at) = (max_acceleration, max_acceleration_at);
         self.last_error = last_error;
         acc
     }
@@ -556,6 +607,8 @@ impl FollowingSimulation {
             max_error: self.max_error,
             max_error_at: self.max_error_at,
             lenslets,
+            max_acceleration: self.max_acceleration,
+            max_acceleration_at: self.max_acceleration_at,
             by_radius: self.by_radius,
         }
     }

@@ -27,6 +27,7 @@ impl<'a> Checker<'a> {
             "ellipsoid" => self.ellipsoid_rim(o),
             "profile_turning" => self.profile_turning_passes(o),
             "gcode" => self.arc_planes_named(o),
+            "fts_lathe" => self.servo_axis_whole(o),
             _ => true,
         }
     }
@@ -128,6 +129,49 @@ impl<'a> Checker<'a> {
             );
         }
         ok
+    }
+
+    /// E0121: a fast tool servo given its own axis states both its
+    /// letter and its velocity limit: a letter with no limit would write
+    /// moves no check holds, a limit with no letter names no axis.
+    fn servo_axis_whole(&mut self, o: &Object) -> bool {
+        let Some(f) = value::field(&o.fields, "fast_axis") else {
+            return true;
+        };
+        let Value::Block(fields) = &f.value else {
+            return true;
+        };
+        let (letter, velocity) = (
+            value::field(fields, "letter"),
+            value::field(fields, "max_velocity"),
+        );
+        let (given, missing, help) = match (letter, velocity) {
+            (Some(l), None) => (
+                l,
+                "max_velocity",
+                "state the servo's velocity limit as its axis, `max_velocity: …` (LinuxCNC's `[AXIS_W] MAX_VELOCITY`)",
+            ),
+            (None, Some(v)) => (
+                v,
+                "letter",
+                "state the letter the control gives the servo, `letter: w` (or u, v); without one the servo is written on Z and held to `max_feed`",
+            ),
+            _ => return true,
+        };
+        self.err(
+            Diagnostic::error(
+                codes::MISSING_PARAMETER,
+                format!(
+                    "the fast axis's `{}` needs its `{missing}`: the servo as an axis of its own is given by both",
+                    given.name
+                ),
+                given.file,
+                given.name_span,
+            )
+            .with_label(format!("stated without `{missing}`"))
+            .with_help(help),
+        );
+        false
     }
 
     /// E0123: an array has at most `MAX_LENSLETS` lenslets in all (each

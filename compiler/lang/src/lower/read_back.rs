@@ -24,12 +24,19 @@ pub fn machine_limits(machine: &Object) -> MachineLimits {
             travel: m.travel,
             max_feed: Some(m.max_feed * 60.0),
             max_spindle_rpm: m.max_spindle_speed.map(rpm),
+            servo: m.fast_axis.and_then(|f| f.own_axis).map(|(letter, v)| {
+                lensc_runtime::reader::ServoAxis {
+                    letter,
+                    max_velocity: v * 60.0,
+                }
+            }),
         },
         Err(_) => MachineLimits {
             lathe,
             travel: [None; 4],
             max_feed: None,
             max_spindle_rpm: None,
+            servo: None,
         },
     }
 }
@@ -44,6 +51,7 @@ pub fn job_machine(job: &CheckedJob) -> MachineLimits {
             travel: [None; 4],
             max_feed: None,
             max_spindle_rpm: None,
+            servo: None,
         },
     }
 }

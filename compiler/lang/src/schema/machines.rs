@@ -200,6 +200,24 @@ pub(super) const FTS_LATHE: Kind = Kind {
                     Check::Positive,
                     "settling band as a fraction of the step; default 0.002 (0.2 %)",
                 ),
+                opt(
+                    "feed_forward",
+                    Ty::Word(&["none", "inverse_model"]),
+                    Check::Any,
+                    "whether the controller leads the servo: `inverse_model` (it feeds the commanded velocity and acceleration forward through the servo's inverse model, so the servo follows the commanded path) or `none` (it does not: lensc writes the pre-compensated command, the inverse model applied to the path, and judges the servo unled on it); default none",
+                ),
+                opt(
+                    "letter",
+                    Ty::Word(&["u", "v", "w"]),
+                    Check::Any,
+                    "the axis letter the control gives the servo, its own axis beside the slides (with `max_velocity`): a dialect that programs the fast axis as moves (LinuxCNC) writes the servo's motion on this letter and holds the Z slide still, the tool tip at Z plus the servo; without it the servo's motion is written on Z and held to the machine's `max_feed`",
+                ),
+                opt(
+                    "max_velocity",
+                    Ty::Quantity(&[Dim::SPEED]),
+                    Check::Positive,
+                    "the servo's velocity limit as its own axis (with `letter`; LinuxCNC's `[AXIS_W] MAX_VELOCITY`): no move may drive the servo faster",
+                ),
             ]),
             Check::Any,
             "the fast tool servo (W axis) and its second-order model",
@@ -346,6 +364,14 @@ pub struct FastAxisParams {
     pub data_rate: Option<f64>,
     /// Settling band as a fraction of the step.
     pub settling_band: Option<f64>,
+    /// The controller leads the servo by its inverse model
+    /// (`feed_forward: inverse_model`); otherwise (`none`, the default)
+    /// the program must.
+    pub controller_leads: bool,
+    /// The servo's own axis letter (upper case) and velocity limit (mm/s),
+    /// where the control programs it as an axis of its own (`letter`,
+    /// `max_velocity`); `None`: the servo's motion is written on Z.
+    pub own_axis: Option<(char, f64)>,
 }
 
 /// A slow tool servo's Z (`z_axis { … }`).
@@ -377,6 +403,12 @@ impl MachineParams {
                 damping: f.num("damping"),
                 data_rate: f.num("data_rate"),
                 settling_band: f.num("settling_band"),
+                controller_leads: f.word("feed_forward") == Some("inverse_model"),
+                own_axis: f
+                    .word("letter")
+                    .and_then(|l| l.chars().next())
+                    .map(|l| l.to_ascii_uppercase())
+                    .zip(f.num("max_velocity")),
             }),
             z_axis: r.block("z_axis", |z| ZAxisParams {
                 max_acceleration: z.required_num("max_acceleration"),

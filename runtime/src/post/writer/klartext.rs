@@ -274,6 +274,7 @@ mod tests {
             ],
             max_feed: Some(5000.0),
             max_spindle_rpm: Some(24000.0),
+            servo: None,
         }
     }
 

@@ -159,13 +159,19 @@ impl State {
         self.motion = Some(Motion::Linear);
         self.feed = feed;
         self.position_mode = position_mode;
-        if let Some(v) = end[self.away] {
+        // The tool tip: Z plus a servo on its own letter, which this
+        // line (no word of its letter) leaves where it is.
+        let (tip_start, tip_end) = (
+            super::tip(start, self.servo_at),
+            super::tip(end, self.servo_at),
+        );
+        if let Some(v) = tip_end[self.away] {
             self.top = Some(self.top.map_or(v, |t| t.max(v)));
         }
         if let Some(moves) = &mut self.moves {
             moves.push(Executed {
-                from: start,
-                to: end,
+                from: tip_start,
+                to: tip_end,
                 path: Path::Line,
             });
         }

@@ -1,5 +1,6 @@
 //! The advice of a spiral refused for its fast axis's acceleration
-//! (E0147): the highest speed that passes, found by planning the real
+//! (E0147), or for a move written faster than the machine's feed
+//! (E0192): the highest speed that passes, found by planning the real
 //! check at trial speeds, a bounded number of them.
 //!
 //! No scaling law gives it. Were the points and the trajectory fixed,
@@ -52,13 +53,32 @@ const PRECISION: f64 = 1.02;
 /// the servo simulated at it, and its lag where that misses the job's
 /// limit.
 pub fn search(spec: &SpiralSpec, acceleration: f64) -> SpeedAdvice {
+    search_below(spec, acceleration / spec.fast_axis.max_acceleration)
+}
+
+/// The highest speed that passes, below the job's own, whose fastest
+/// move as written fed at `feed` (mm/s) over the machine's `max_feed`
+/// (E0192): planned at trial speeds, each trial's commands led as the
+/// build leads them.
+pub fn search_feed(spec: &SpiralSpec, feed: f64) -> SpeedAdvice {
+    search_below(spec, feed / spec.max_feed)
+}
+
+/// The highest speed that passes, below the job's own, whose fastest
+/// servo move, the servo written on its own letter, drove it at `velocity`
+/// (mm/s) over its `max_velocity` (E0192).
+pub fn search_servo(spec: &SpiralSpec, velocity: f64) -> SpeedAdvice {
+    let most = spec.servo_axis.map_or(f64::INFINITY, |(_, v)| v);
+    search_below(spec, velocity / most)
+}
+
+/// The search below the job's speed, which failed by `excess` (its
+/// acceleration or feed over the limit).
+fn search_below(spec: &SpiralSpec, excess: f64) -> SpeedAdvice {
     let unit = Unit::of(spec.spiral.speed);
     // The slowest failure so far (in the job's unit) and by how much it
-    // failed (the acceleration over its limit).
-    let mut fails = (
-        unit.shown(spec.spiral.speed),
-        acceleration / spec.fast_axis.max_acceleration,
-    );
+    // failed (the acceleration or feed over its limit).
+    let mut fails = (unit.shown(spec.spiral.speed), excess);
     let mut passes: Option<f64> = None;
     let mut trials = 0;
     // Bracket: step down assuming the excess ∝ speed^p, p = 1 (a corner's
@@ -129,6 +149,18 @@ fn following_limit(spec: &SpiralSpec) -> Option<f64> {
     )
 }
 
+/// Whether the job as written is refused by the planner (E0147) or by
+/// the checks the build makes of the commands it writes (the lead's
+/// acceleration, a move faster than the machine's feed: E0192), its lag
+/// not gated: what the speed the advice names as refused must meet.
+pub fn refused_as_written(spec: &SpiralSpec) -> bool {
+    let unit = Unit::of(spec.spiral.speed);
+    matches!(
+        check(spec, unit, unit.shown(spec.spiral.speed), None),
+        Verdict::Fails(..)
+    )
+}
+
 enum Verdict {
     Passes,
     /// Refused: by how much (the acceleration or the lag over its limit;
@@ -150,8 +182,13 @@ fn check(spec: &SpiralSpec, unit: Unit, speed: f64, lag_limit: Option<f64>) -> V
     };
     let kernel = evaluator(&trajectory.tape).0;
     let data_rate = 1.0 / at.spiral.min_interval;
-    let mut following =
-        lag_limit.and_then(|_| super::servo::following(spec, &at.spiral, &bounds, data_rate));
+    // The servo is simulated where its lag is gated, and wherever the
+    // program leads it: the lead's own acceleration is checked at every
+    // trial (the build refuses it, E0192), gated or not.
+    let leads = super::servo::program_leads(spec);
+    let mut following = (lag_limit.is_some() || leads)
+        .then(|| super::servo::following(spec, &at.spiral, &bounds, data_rate))
+        .flatten();
     let planner = Planner {
         spiral: &at.spiral,
         surface: kernel.as_ref(),
@@ -160,25 +197,52 @@ fn check(spec: &SpiralSpec, unit: Unit, speed: f64, lag_limit: Option<f64>) -> V
         edge: spec.edge.as_ref().map(|(m, _)| &m.profile),
         bounds,
     };
-    let (mut printed, resolution) = (Vec::new(), spec.head.resolution);
+    let resolution = spec.head.resolution;
+    let mut commands = super::servo::Commands::of(spec, data_rate);
+    // The commands are made where the servo is simulated or the moves
+    // written are held to the machine's feed.
     let planned = match following.as_mut() {
         Some(sim) => planner.check_with(&spec.fast_axis, |pts| {
-            super::servo::as_printed(pts, resolution, &mut printed);
-            sim.extend(&printed);
+            commands.next(pts);
+            commands.drive(sim, resolution);
         }),
+        None if super::servo::writes_moves(spec) => {
+            planner.check_with(&spec.fast_axis, |pts| commands.next(pts))
+        }
         None => planner.check(&spec.fast_axis),
     };
+    if planned.is_ok() {
+        commands.finish();
+        if let Some(sim) = following.as_mut() {
+            commands.drive(sim, resolution);
+        }
+    }
+    if let (Ok(_), Some((feed, _))) = (&planned, commands.over_max_feed(spec)) {
+        return Verdict::Fails(feed / spec.max_feed, None);
+    }
+    if let (Ok(_), Some((v, _)), Some((_, most))) = (
+        &planned,
+        commands.over_servo_velocity(spec),
+        spec.servo_axis,
+    ) {
+        return Verdict::Fails(v / most, None);
+    }
     match planned {
-        Ok(_) => match (following, lag_limit) {
-            (Some(sim), Some(limit)) => {
-                let lag = sim.finish().max_error;
-                if lag > limit {
+        Ok(_) => match following {
+            Some(sim) => {
+                let f = sim.finish();
+                let lag = f.max_error;
+                let most = spec.fast_axis.max_acceleration;
+                if leads && f.max_acceleration > most {
+                    // The lead the program writes drives the servo too hard.
+                    Verdict::Fails(f.max_acceleration / most, None)
+                } else if let Some(limit) = lag_limit.filter(|&l| lag > l) {
                     Verdict::Fails(lag / limit, Some(LagMissed { lag, limit }))
                 } else {
                     Verdict::Passes
                 }
             }
-            _ => Verdict::Passes,
+            None => Verdict::Passes,
         },
         Err(FtsError::AccelerationExceeded {
             acceleration, max, ..

@@ -6,7 +6,7 @@
 //! written, and the report of what it makes.
 
 use super::SpiralSpec;
-use super::servo::{as_printed, following};
+use super::servo::{Commands, as_printed, following, program_leads};
 use lensc_grammar::Diagnostic;
 use lensc_lang::check::trim_num;
 use lensc_lang::codes;
@@ -89,6 +89,9 @@ pub(super) fn build(spec: &SpiralSpec, cx: &BuildContext) -> Result<Built, Vec<D
         table_name.as_deref(),
     )
     .map_err(not_printable)?;
+    if let Some(letter) = super::servo::servo_letter(spec) {
+        program.servo_on(letter);
+    }
     program.hold_spindle_under(spec.max_spindle_speed);
     program.call_tool(&head.start).map_err(not_printable)?;
     let mut sink = cx.sink(head)?;
@@ -137,23 +140,36 @@ pub(super) fn build(spec: &SpiralSpec, cx: &BuildContext) -> Result<Built, Vec<D
     } else {
         spec.spiral.start_radius
     };
-    let planned = prepared.planner().plan(&p.fast_axis, |pts| {
-        as_printed(pts, head.resolution, &mut printed);
+    // What the program prints: the path, or the path led by the servo's
+    // inverse model where the controller does not lead it.
+    let mut commands = Commands::of(spec, data_rate);
+    let mut write = |commands: &mut Commands, planned: usize| {
+        // The nose cuts the path; the servo is driven by the commands.
+        as_printed(&commands.path, head.resolution, &mut printed);
         for q in &printed {
             sweep.path().point(q.c, q.x, q.w);
         }
         near_axis.extend(printed.iter().filter(|q| q.x.abs() < rho));
         if let Some(sim) = following.as_mut() {
-            sim.extend(&printed);
+            commands.drive(sim, head.resolution);
         }
-        sink.extend(|| program.extend(pts));
+        sink.extend(|| program.extend(&commands.commands));
         sink.push(program.take_text());
-        sink.planned(pts.len());
+        sink.planned(planned);
         if let Some(t) = table_sink.as_mut() {
             t.push(program.take_table_text());
         }
+    };
+    let planned = prepared.planner().plan(&p.fast_axis, |pts| {
+        commands.next(pts);
+        write(&mut commands, pts.len());
     });
-    let summary = planned.map_err(|error| {
+    if planned.is_ok() {
+        // The path's last point, led once the path is known to end.
+        commands.finish();
+        write(&mut commands, 0);
+    }
+    let mut summary = planned.map_err(|error| {
         let advice = match error {
             FtsError::AccelerationExceeded { acceleration, .. } => {
                 Some(super::advice::search(spec, acceleration))
@@ -176,6 +192,24 @@ pub(super) fn build(spec: &SpiralSpec, cx: &BuildContext) -> Result<Built, Vec<D
     if spec.edge.is_none() {
         across_axis(sweep.path(), &near_axis);
     }
+    // The points the program cuts: the planned path's, and the lead's
+    // added beside its bends.
+    summary.points = commands.written;
+    // Every move written as a move within the machine's feed (the lead's
+    // short moves beside a bend are the fastest).
+    if let Some(fastest) = commands.over_max_feed(spec) {
+        let advice = super::advice::search_feed(spec, fastest.0);
+        return Err(vec![
+            super::errors::feed_refused(spec, fastest, advice).at(site),
+        ]);
+    }
+    // The servo on its own letter within its own velocity limit.
+    if let Some(fastest) = commands.over_servo_velocity(spec) {
+        let advice = super::advice::search_servo(spec, fastest.0);
+        return Err(vec![
+            super::errors::servo_velocity_refused(spec, fastest, advice).at(site),
+        ]);
+    }
     let mut sink = sink.written(head)?;
     if let Some(t) = table_sink.as_mut() {
         t.push(program.take_table_text());
@@ -188,7 +222,14 @@ pub(super) fn build(spec: &SpiralSpec, cx: &BuildContext) -> Result<Built, Vec<D
     let text = sink.finish(site)?;
     let mut plots = crate::plots::PlotSeries::default();
     let height_map = simulated_height_map(spec, sweep, window, disc, &mut plots);
-    let simulation = simulation(following, height_map, data_rate, p.slow, &mut plots);
+    let followed = following.map(|sim| sim.finish());
+    if program_leads(spec) {
+        let led = super::errors::lead_refused(spec, commands.range, followed.as_ref());
+        if let Some(e) = led {
+            return Err(vec![e.at(site)]);
+        }
+    }
+    let simulation = simulation(followed, height_map, data_rate, p.slow, &mut plots);
     let toolpath = toolpath(spec, &summary);
     let cut = (summary.points, summary.time);
     let mut built = parts::built(head, prov, text, toolpath, simulation, plots, cut);
@@ -320,13 +361,13 @@ fn chords_warning(spec: &SpiralSpec, summary: &FtsSummary, data_rate: f64) -> Op
 /// it has a servo model (at `data_rate`, Hz; its series go into `plots`),
 /// and the height map either way.
 fn simulation(
-    following: Option<lensc_runtime::verify::follow::FollowingSimulation>,
+    following: Option<lensc_runtime::verify::follow::Following>,
     height_map: report::HeightMap,
     data_rate: f64,
     slow: bool,
     plots: &mut crate::plots::PlotSeries,
 ) -> report::Simulation {
-    let Some(sim) = following else {
+    let Some(f) = following else {
         return report::Simulation::Skipped(report::Skipped {
             skipped: if slow {
                 "slow tool servo: Z is a machine axis, with no servo model here"
@@ -336,7 +377,6 @@ fn simulation(
             height_map: Some(height_map),
         });
     };
-    let f = sim.finish();
     let following = report::Following::new(&f, data_rate, height_map);
     plots.following = Some(crate::plots::FollowingSeries {
         by_radius: f.by_radius,
@@ -358,6 +398,11 @@ fn header_lines(spec: &SpiralSpec, prov: &Provenance, table: Option<&str>) -> Ve
     } else if let Some(table) = table {
         table_words = format!(
             "Z held at 0 while the fast tool servo follows the table {table} [rows C X W, one per point]"
+        );
+        ("fast-tool-servo", table_words.as_str())
+    } else if let Some(letter) = super::servo::servo_letter(spec) {
+        table_words = format!(
+            "Z the slide, held at 0 while the fast tool servo moves on its own axis {letter} [the tool tip at Z + {letter}]"
         );
         ("fast-tool-servo", table_words.as_str())
     } else {
@@ -395,8 +440,18 @@ fn header_lines(spec: &SpiralSpec, prov: &Provenance, table: Option<&str>) -> Ve
         ),
         trim_num(spiral.chord_tolerance * lensc_runtime::plan::optimise::BLEND_SHARE * 1e6)
     ));
+    let lead = if super::servo::program_leads(spec) {
+        match super::servo::servo_letter(spec) {
+            Some('W') | None => ", feed_forward none: the servo led by this program [its W written as the servo's inverse model of the path]".to_string(),
+            Some(l) => format!(", feed_forward none: the servo led by this program [its {l} written as the servo's inverse model of the path]"),
+        }
+    } else if spec.controller_leads && !slow {
+        ", feed_forward inverse_model: the servo led by its controller [its W the path]".to_string()
+    } else {
+        String::new()
+    };
     lines.push(format!(
-        "machine {}: {} {servo_words} lathe",
+        "machine {}: {} {servo_words} lathe{lead}",
         head.names.machine, head.dialect.name
     ));
     match settling {

@@ -48,6 +48,18 @@ pub(crate) fn estimate(s: &super::SpiralSpec, evaluate: Evaluate) -> Estimate {
             })
         })
     };
+    // Where the program leads the servo, a bending point whose moves are
+    // longer than two data periods gets a point of the path added a
+    // period either side (`machine::lead`): up to three points where the
+    // path had one.
+    let leads = super::servo::program_leads(s);
+    let led = |h: f64, shortest: f64| {
+        if leads && h > 2.0 * shortest {
+            3.0
+        } else {
+            1.0
+        }
+    };
     let (mut points, mut seeded, mut seconds) = (1.0, 0.0, 0.0);
     let (mut xs, mut ys) = (Vec::new(), Vec::new());
     let mut out = Vec::new();
@@ -74,9 +86,9 @@ pub(crate) fn estimate(s: &super::SpiralSpec, evaluate: Evaluate) -> Estimate {
             let (x, y) = (xs[i], ys[i]);
             let on = on_feature(x, y);
             if !on {
-                // A level stretch: its two ends.
+                // A level stretch: its two ends (bends, its moves long).
                 if was_on {
-                    n += 2.0;
+                    n += 2.0 * led(f64::INFINITY, shortest);
                 }
                 was_on = false;
                 continue;
@@ -88,7 +100,7 @@ pub(crate) fn estimate(s: &super::SpiralSpec, evaluate: Evaluate) -> Estimate {
             let tht = sn * sn * o[3] - 2.0 * sn * cs * o[4] + cs * cs * o[5];
             let w2 = r * r * tht - r * (cs * o[1] + sn * o[2]);
             let h = chord_for(w2, tol).max(shortest);
-            n += chords(dc, span, h);
+            n += chords(dc, span, h) * led(h, shortest);
             seeded += per_ring * dc / span;
         }
         points += per_ring * n.max(1.0);

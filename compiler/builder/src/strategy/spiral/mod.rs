@@ -57,6 +57,10 @@ pub struct SpiralSpec {
     pub correction: Option<crate::compensate::Applied>,
     /// The fast axis's servo model (none for a slow tool servo).
     pub servo: Option<SecondOrderServo>,
+    /// The fast axis's controller leads its servo by the servo's inverse
+    /// model (`feed_forward: inverse_model`); otherwise the program does
+    /// (`servo::Commands`).
+    pub controller_leads: bool,
     pub settling: Option<Settling>,
     /// The fast axis's position (mm) clear of the part.
     pub safe_w: f64,
@@ -69,6 +73,15 @@ pub struct SpiralSpec {
     /// The machine's spindle limit (rad/s): no move of the program may
     /// turn C faster, as printed.
     pub max_spindle_speed: f64,
+    /// The machine's fastest feed (mm/s): where the program writes the
+    /// surface's axis as moves (no servo table), no move it writes, led or
+    /// not, may be faster (`servo::Commands::fastest`).
+    pub max_feed: f64,
+    /// A fast tool servo the control programs as its own axis: its letter
+    /// and velocity limit (mm/s). Where the program writes the fast axis
+    /// as moves, the servo's motion goes on that letter, held to that
+    /// limit, and the Z slide holds still (`servo::Commands`).
+    pub servo_axis: Option<(char, f64)>,
 }
 
 /// A spiral job at another speed: what a search for the highest speed
@@ -316,11 +329,17 @@ pub(crate) fn lower(
         trajectory_declared,
         correction,
         servo,
+        controller_leads: matches!(fast, Carrier::Servo(f) if f.controller_leads),
         settling,
         safe_w,
         lenslets: lenslets(surface),
         surface_object: surface.clone(),
         max_spindle_speed: p.max_spindle_speed(),
+        max_feed: p.machine_params.max_feed,
+        servo_axis: match fast {
+            Carrier::Servo(f) => f.own_axis,
+            Carrier::SlowZ(_) => None,
+        },
     })
 }
 

@@ -390,6 +390,7 @@ fn machines() -> Vec<MachineLimits> {
             ],
             max_feed: Some(1500.0),
             max_spindle_rpm: Some(3000.0),
+            servo: None,
         },
         // A mill with no limits stated.
         MachineLimits {
@@ -397,6 +398,7 @@ fn machines() -> Vec<MachineLimits> {
             travel: [None; 4],
             max_feed: None,
             max_spindle_rpm: None,
+            servo: None,
         },
     ]
 }
