@@ -1012,7 +1012,7 @@ fn a_stated_spiral_start_that_leaves_the_rim_proud_is_refused() {
     // Issue #29: `from: 4.05 mm` on the dome puts the contact 0.15 mm
     // inside the rim, left 28 um proud; its contacts were fine, so the
     // build passed. The whole part's residual now counts every cell
-    // beyond the highest scallop, as each lenslet's does.
+    // beyond the scallops beside it, as each lenslet's does.
     let (code, said, _) = build_text(&spiral_rim_from("4.05 mm"), &[], "dome_sts");
     assert_eq!(code, Some(1), "{said}");
     assert!(said.contains("[E0195] Error"), "{said}");
@@ -1036,6 +1036,49 @@ fn a_spirals_axis_is_judged_as_cut_from_both_sides() {
     let surface = figure(&report, &["surface", "max_residual_nm", "value"]);
     assert!(surface < 40.0, "{surface}");
     assert_eq!(report["acceptance"]["passed"], true);
+}
+
+/// The example `tilted_lens_sts` (`examples/off_axis_and_tilt.lens`)
+/// with its spiral's `from` stated.
+fn tilted_lens_from(from: &str) -> String {
+    std::fs::read_to_string(root().join("examples/off_axis_and_tilt.lens"))
+        .expect("read")
+        .replace(
+            "spindle_speed: 50 rpm, chord_tolerance: 10 nm }",
+            &format!("spindle_speed: 50 rpm, chord_tolerance: 10 nm, from: {from} }}"),
+        )
+}
+
+#[test]
+fn a_proud_rim_is_judged_against_the_scallops_beside_it_not_the_parts_highest() {
+    // Issue #29: the tilted lens's spiral leaves scallops of 97 nm on
+    // average and up to 392 nm. Started at 2.637 mm instead of its
+    // default 2.671, its first revolution's contact falls inside the rim
+    // at y = 0 and the flank leaves the rim 82 nm beyond the scallop its
+    // neighbouring passes leave there. Less the part's highest scallop
+    // (one figure for the whole part: its highest cell, 334 nm, is below
+    // it), nothing was left and the build passed; each cell is now
+    // judged against the scallops beside it.
+    let source = tilted_lens_from("2.637 mm");
+    assert!(source.contains("from: 2.637 mm"), "{source}");
+    let (code, said, _) = build_text(&source, &[], "tilted_lens_sts");
+    assert_eq!(code, Some(1), "{said}");
+    assert!(said.contains("[E0195] Error"), "{said}");
+    assert!(
+        said.contains("misses `max_residual`: 82.4")
+            && said
+                .contains("highest where no contact reached, at the rim at x = 2.5, y = -0.0071"),
+        "{said}"
+    );
+    let (_, said, report) = build_text(&source, &["--accept=warn"], "tilted_lens_sts");
+    let report = report.unwrap_or_else(|| panic!("{said}"));
+    // The old figure: the highest cell less the highest scallop is nothing.
+    let surface = figure(&report, &["surface", "max_residual_nm", "value"]);
+    let scallop = figure(&report, &["scallops", "simulated", "max_nm"]);
+    assert!(surface < scallop, "{surface} {scallop}");
+    // The contacts are within a few nm.
+    let contact = figure(&report, &["contact", "max_residual_nm", "value"]);
+    assert!(contact < 2.0, "{contact}");
 }
 
 #[test]

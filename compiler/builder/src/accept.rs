@@ -383,9 +383,10 @@ fn form_figure(c: Criterion, form: Form, domain: &Domain) -> Result<Measured, &'
                 ),
                 Criterion::FormRms => m(f.rms_nm, Vec::new()),
                 Criterion::MaxResidual => {
-                    // At the contacts, or at any cell beyond the highest
-                    // scallop (a rim or an axis no contact reaches), the
-                    // larger: as each lenslet is judged.
+                    // At the contacts, or at any cell beyond the scallops
+                    // its own neighbouring passes leave beside it (a rim
+                    // or an axis no contact reaches), the larger: as each
+                    // lenslet is judged.
                     let r = crate::report::max_residual(Some(f), h.residual_beyond_scallops_nm)
                         .unwrap_or(f.max_residual_nm);
                     let what = if r.value <= f.max_residual_nm.value {

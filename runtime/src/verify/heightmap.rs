@@ -463,6 +463,15 @@ struct Column {
     /// Per cusp between neighbouring passes: where and the scallop height
     /// above the neighbours' contacts.
     cusps: Vec<(f64, f64)>,
+    /// The scallops that bound the pieces of the cut, in order of u, for
+    /// the scallop each cell is allowed ([`local_scallop`]): every cusp
+    /// between two pieces, wherever it lies (beyond the rows, the window,
+    /// the axis), its height above the mean of the nearest contacts on
+    /// either side of it in the column (of one, where the other side has
+    /// none): a rim's last cusp with a pass whose contact lies beyond the
+    /// aperture, the cusps beside the axis between passes of the opposite
+    /// ray that cut away each other's contacts.
+    bounds: Vec<(f64, f64)>,
     /// The rows (from, to) that may hold a cell of the window: those
     /// beyond are outside it (see [`Frame::column_reach`]).
     rows: (usize, usize),
@@ -600,6 +609,7 @@ fn column(
             errors: vec![f64::NAN; g.nu],
             valleys: Vec::new(),
             cusps: Vec::new(),
+            bounds: Vec::new(),
             rows: (0, 0),
         };
     };
@@ -621,9 +631,11 @@ fn column(
         rows: (from, to.max(from)),
     };
     let valleys = cut.valleys(g);
+    let (cusps, bounds) = cut.cusps(g, &valleys);
     Column {
         errors: cut.errors(g),
-        cusps: cut.cusps(g, &valleys),
+        cusps,
+        bounds,
         valleys: valleys.into_iter().filter(|v| !v.1.is_nan()).collect(),
         rows: cut.rows,
     }
@@ -804,40 +816,94 @@ impl ColumnCut<'_> {
     }
 
     /// Cusps between neighbouring pieces whose circles meet there: where
-    /// and how high above the mean of the two valleys.
-    fn cusps(&self, g: &Grid, valleys: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    /// and how high above the mean of the two valleys, those in the rows
+    /// and the window between two contacts (the scallops reported); and
+    /// every cusp beside a contact, wherever it lies, for the scallop a
+    /// cell is allowed ([`Column::bounds`]).
+    #[allow(clippy::type_complexity)]
+    fn cusps(&self, g: &Grid, valleys: &[(f64, f64)]) -> (Vec<(f64, f64)>, Vec<(f64, f64)>) {
         let (u_lo, u_hi) = (g.u0, g.u_end());
-        // Each cusp's piece, where and its height above the mean of the
-        // two valleys but for the design's height, asked of all at once.
-        let mut found: Vec<(f64, f64)> = Vec::new();
+        // Each cusp's height above the mean of its known valleys but for
+        // the design's height, and whether it is a scallop reported; the
+        // design asked of all at once.
+        let mut found: Vec<(f64, f64, bool)> = Vec::new();
         let mut points: Vec<(f64, f64)> = Vec::new();
+        let nearest = nearest_contacts(valleys);
         for q in 1..self.pieces.len() {
             let u = self.pieces[q].1;
             let (cu_a, cu_b) = (
                 self.centres[self.pieces[q - 1].0].0,
                 self.centres[self.pieces[q].0].0,
             );
-            if u < u_lo || u > u_hi || (u - cu_a).abs() > self.r || (u - cu_b).abs() > self.r {
+            if (u - cu_a).abs() > self.r || (u - cu_b).abs() > self.r {
                 continue;
             }
             let (va, vb) = (valleys[q - 1].1, valleys[q].1);
-            if va.is_nan() || vb.is_nan() {
+            let reported =
+                !va.is_nan() && !vb.is_nan() && u >= u_lo && u <= u_hi && self.in_window(u);
+            let mean = if reported {
+                (va + vb) / 2.0
+            } else {
+                nearest[q - 1].0.mean_with(nearest[q].1)
+            };
+            if mean.is_nan() {
                 continue;
             }
-            if !self.in_window(u) {
-                continue;
-            }
-            found.push((self.height(q, u), (va + vb) / 2.0));
+            found.push((self.height(q, u), mean, reported));
             points.push((self.s, u));
         }
         let mut design = vec![0.0; points.len()];
         self.frame.design(&points, &mut design);
-        found
-            .iter()
-            .zip(&points)
-            .zip(&design)
-            .map(|((&(h, mean), &(_, u)), d)| (u, (h - d) - mean))
-            .collect()
+        let (mut cusps, mut bounds) = (Vec::new(), Vec::new());
+        for ((&(h, mean, reported), &(_, u)), d) in found.iter().zip(&points).zip(&design) {
+            let height = (h - d) - mean;
+            if reported {
+                cusps.push((u, height));
+            }
+            if !height.is_nan() {
+                bounds.push((u, height));
+            }
+        }
+        (cusps, bounds)
+    }
+}
+
+/// Per piece of a column (in order of u, each with its contact's error
+/// or NaN where it has none), the error at the nearest contact at or
+/// before it and at or after it (NaN where there is none).
+fn nearest_contacts(valleys: &[(f64, f64)]) -> Vec<(Contact, Contact)> {
+    let mut out = vec![(Contact(f64::NAN), Contact(f64::NAN)); valleys.len()];
+    let mut last = f64::NAN;
+    for (o, v) in out.iter_mut().zip(valleys) {
+        if !v.1.is_nan() {
+            last = v.1;
+        }
+        o.0 = Contact(last);
+    }
+    last = f64::NAN;
+    for (o, v) in out.iter_mut().zip(valleys).rev() {
+        if !v.1.is_nan() {
+            last = v.1;
+        }
+        o.1 = Contact(last);
+    }
+    out
+}
+
+/// A contact's error (mm), NaN for none.
+#[derive(Clone, Copy, Debug)]
+struct Contact(f64);
+
+impl Contact {
+    /// The mean of this and `other`, or the one that is a contact; NaN if
+    /// neither is.
+    fn mean_with(self, other: Contact) -> f64 {
+        match (self.0.is_nan(), other.0.is_nan()) {
+            (false, false) => (self.0 + other.0) / 2.0,
+            (false, true) => self.0,
+            (true, false) => other.0,
+            (true, true) => f64::NAN,
+        }
     }
 }
 
@@ -880,6 +946,8 @@ pub struct FeatureFigures {
     /// At the passes' contacts (scallops excluded).
     pub contact: Option<ErrorFigures>,
     pub scallops: Option<Scallops>,
+    /// As the map's [`HeightMap::beyond_scallops`], over its cells.
+    pub beyond_scallops: Option<(f64, (f64, f64))>,
 }
 
 /// A height map's error on square blocks of the part's x–y plane (see
@@ -1013,6 +1081,14 @@ pub struct HeightMap {
     /// At the passes' contacts: the path's own form error.
     pub contact: Option<ErrorFigures>,
     pub scallops: Option<Scallops>,
+    /// The most material beyond the scallops (mm, negative where every
+    /// cell is within them) and where: of every cut cell, its error less
+    /// the scallop its own neighbouring passes leave there, the higher of
+    /// the two cusps of its column either side of it (beyond a column's
+    /// outermost cusp, that one); in a column with no cusp beside a
+    /// contact in the judged area (a window's corner), the map's highest
+    /// scallop. `None` if no cell was cut.
+    pub beyond_scallops: Option<(f64, (f64, f64))>,
     /// Cells in the window that no pass reached.
     pub uncut: usize,
     /// The part's area (mm²) those cells cover, and one of them (x, y),
@@ -1132,13 +1208,88 @@ impl CuspTally {
     }
 }
 
+/// The scallop a cell at `u` is allowed, from its column's bounding
+/// cusps ([`Column::bounds`], sorted by u, `next` the first at or beyond
+/// `u`): the higher of the nearest cusp on either side of it, the two
+/// that bound the piece of the cut it lies on, so the scallop its own
+/// neighbouring passes leave there (mm, ≥ 0); beyond a column's outermost
+/// cusp (a rim the last pass left to its flank) the one on its inner
+/// side; `None` in a column with none (no contact of its in the judged
+/// area: a window's corner).
+fn local_scallop(cusps: &[(f64, f64)], next: usize) -> Option<f64> {
+    let before = next.checked_sub(1).and_then(|k| cusps.get(k));
+    let after = cusps.get(next);
+    (!cusps.is_empty()).then(|| {
+        before
+            .into_iter()
+            .chain(after)
+            .map(|c| c.1)
+            .fold(0.0, f64::max)
+    })
+}
+
+/// The most material beyond the scallops as it is gathered: of every cut
+/// cell, its error less the scallop its neighbouring passes leave there
+/// ([`local_scallop`]), the largest and where; and of the cells of
+/// columns without cusps, the largest error, less the highest scallop
+/// once every tile is in ([`BeyondTally::max`]). The first of equals, in
+/// column order; tiles merge in theirs.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct BeyondTally {
+    local: Largest,
+    unbounded: Largest,
+}
+
+/// The largest of some values and where (the first of equals).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Largest(Option<(f64, (f64, f64))>);
+
+impl Largest {
+    fn add(&mut self, e: f64, at: (f64, f64)) {
+        if !e.is_nan() && self.0.is_none_or(|(m, _)| e > m) {
+            self.0 = Some((e, at));
+        }
+    }
+    fn merge(&mut self, o: &Largest) {
+        if let Some((e, at)) = o.0 {
+            self.add(e, at);
+        }
+    }
+}
+
+impl BeyondTally {
+    /// Counts a cell with error `e` at `at`, allowed the scallop
+    /// `scallop` beside it (`None`: its column has none).
+    fn add(&mut self, e: f64, scallop: Option<f64>, at: (f64, f64)) {
+        match scallop {
+            Some(s) => self.local.add(e - s, at),
+            None => self.unbounded.add(e, at),
+        }
+    }
+    fn merge(&mut self, o: &BeyondTally) {
+        self.local.merge(&o.local);
+        self.unbounded.merge(&o.unbounded);
+    }
+    /// The most material beyond the scallops and where, the cells of
+    /// columns without cusps judged against `highest` (the highest
+    /// scallop of the map, or of the lenslet; 0 without one).
+    fn max(&self, highest: Option<&Scallops>) -> Option<(f64, (f64, f64))> {
+        let mut all = self.local;
+        if let Some((e, at)) = self.unbounded.0 {
+            all.add(e - highest.map_or(0.0, |s| s.max.max(0.0)), at);
+        }
+        all.0
+    }
+}
+
 /// One lenslet's statistics as they are gathered: surface, contacts,
-/// scallops.
+/// scallops, the material beyond them.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct FeatureTally {
     surface: Tally,
     contact: Tally,
     cusps: CuspTally,
+    beyond: BeyondTally,
 }
 
 /// A height map's statistics as they are gathered, over a whole window
@@ -1152,6 +1303,7 @@ pub(crate) struct Totals {
     surface: Tally,
     contact: Tally,
     cusps: CuspTally,
+    beyond: BeyondTally,
     /// By the whole map's feature index.
     features: std::collections::BTreeMap<usize, FeatureTally>,
     uncut: usize,
@@ -1184,6 +1336,9 @@ impl Totals {
         let mut t = Totals::default();
         for (j, c) in columns.iter().enumerate() {
             let s = g.s(j);
+            // The first of the column's bounding cusps at or beyond the
+            // row's u.
+            let mut next = 0;
             for (i, &e) in c.errors.iter().enumerate() {
                 if e.is_nan() && !c.may_hold(i) {
                     continue;
@@ -1203,8 +1358,16 @@ impl Totals {
                 t.cells += 1;
                 t.area += frame.cell_area(g, s, g.u(i));
                 t.surface.add(e, (x, y));
+                let u = g.u(i);
+                while next < c.bounds.len() && c.bounds[next].0 < u {
+                    next += 1;
+                }
+                let scallop = local_scallop(&c.bounds, next);
+                t.beyond.add(e, scallop, (x, y));
                 if let Some(f) = which(x, y) {
-                    t.features.entry(f).or_default().surface.add(e, (x, y));
+                    let f = t.features.entry(f).or_default();
+                    f.surface.add(e, (x, y));
+                    f.beyond.add(e, scallop, (x, y));
                 }
             }
             for &(u, e) in &c.valleys {
@@ -1242,11 +1405,13 @@ impl Totals {
         self.surface.merge(&o.surface);
         self.contact.merge(&o.contact);
         self.cusps.merge(&o.cusps);
+        self.beyond.merge(&o.beyond);
         for (&k, f) in &o.features {
             let mine = self.features.entry(k).or_default();
             mine.surface.merge(&f.surface);
             mine.contact.merge(&f.contact);
             mine.cusps.merge(&f.cusps);
+            mine.beyond.merge(&f.beyond);
         }
         self.uncut += o.uncut;
         self.uncut_area += o.uncut_area;
@@ -1286,6 +1451,7 @@ impl HeightMap {
             surface: t.surface.figures(),
             contact: t.contact.figures(),
             scallops: t.cusps.scallops(),
+            beyond_scallops: t.beyond.max(t.cusps.scallops().as_ref()),
             uncut: t.uncut,
             uncut_area: t.uncut_area,
             uncut_at: t.uncut_at,
@@ -1302,6 +1468,7 @@ impl HeightMap {
                     surface: f.surface.figures(),
                     contact: f.contact.figures(),
                     scallops: f.cusps.scallops(),
+                    beyond_scallops: f.beyond.max(f.cusps.scallops().as_ref()),
                 })
                 .collect(),
             cells: t.cells,

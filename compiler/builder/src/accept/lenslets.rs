@@ -62,7 +62,7 @@ pub(super) fn judge(h: &HeightMap, limits: &[FormLimit]) -> Vec<LensletCriterion
 }
 
 /// A lenslet's figure for `c` (nm): PV and RMS at its contacts; the
-/// residual at its contacts or at any cell beyond its highest scallop
+/// residual at its contacts or at any cell beyond the scallops beside it
 /// (the nub a spiral leaves on the spindle axis has no contact), the
 /// larger; gouge the deepest at its contacts or cells. `None` for a
 /// criterion that is not a form figure, or a lenslet with no contact.

@@ -387,12 +387,15 @@ pub struct HeightMap {
     pub contact: Option<Figures>,
     /// The scallops between passes.
     pub scallops: ScallopReport,
-    /// The most material left above the design at any cell less the
-    /// highest scallop (nm, ≥ 0; 0 without scallops: the whole residual),
-    /// and where: material no pass's contact reached and no scallop
-    /// explains, such as a rim left to the nose's flank or a nub on the
-    /// spindle axis. The gate's `max_residual` is the larger of this and
-    /// the contacts' (as for each lenslet). Null if no cell was cut.
+    /// The most material left above the design beyond the scallops (nm,
+    /// ≥ 0), and where: of every cell, its error less the scallop its own
+    /// neighbouring passes leave there (the higher of the two cusps of
+    /// its column either side of it; beyond a column's outermost cusp,
+    /// that one; the whole error in a column without cusps), the
+    /// largest. Material no pass's contact reached and no scallop beside
+    /// it explains, such as a rim left to the nose's flank or a nub on
+    /// the spindle axis. The gate's `max_residual` is the larger of this
+    /// and the contacts' (as for each lenslet). Null if no cell was cut.
     pub residual_beyond_scallops_nm: Option<AtPoint>,
     /// RMS roughness along the cut (nm), null if not measured.
     pub rq_cutting_direction_nm: Option<f64>,
@@ -463,10 +466,7 @@ impl HeightMap {
                 flat_theory_nm: Map::flat_scallop(map.nose_radius, stepover) * 1e6,
                 simulated: map.scallops.as_ref().map(Scallops::from),
             },
-            residual_beyond_scallops_nm: beyond_scallops(
-                map.surface.as_ref(),
-                map.scallops.as_ref(),
-            ),
+            residual_beyond_scallops_nm: beyond_scallops(map.beyond_scallops),
             rq_cutting_direction_nm: finite(map.rq_cutting * 1e6),
             rq_stepover_direction_nm: finite(map.rq_stepover * 1e6),
             worst_lenslet: worst_lenslet(&lenslets),
@@ -620,12 +620,12 @@ pub struct LensletHeightMap {
     pub contact: Option<Figures>,
     /// Scallops there, null if none.
     pub scallops: Option<Scallops>,
-    /// The most material left above the design at any of its cells less
-    /// its highest scallop (nm, ≥ 0; 0 without scallops: the whole
-    /// residual), and where: material no pass's contact reached and no
-    /// scallop explains, such as the nub a spiral leaves on the spindle
-    /// axis when the lenslet is not centred there. Null if no cell was
-    /// cut.
+    /// The most material left above the design beyond the scallops at
+    /// any of its cells (nm, ≥ 0), as the whole map's: each cell's error
+    /// less the scallop its own neighbouring passes leave there. Material
+    /// no pass's contact reached and no scallop beside it explains, such
+    /// as the nub a spiral leaves on the spindle axis when the lenslet is
+    /// not centred there. Null if no cell was cut.
     pub residual_beyond_scallops_nm: Option<AtPoint>,
 }
 
@@ -637,33 +637,32 @@ impl From<&FeatureFigures> for LensletHeightMap {
             surface: f.surface.as_ref().map(Figures::from),
             contact: f.contact.as_ref().map(Figures::from),
             scallops: f.scallops.as_ref().map(Scallops::from),
-            residual_beyond_scallops_nm: beyond_scallops(f.surface.as_ref(), f.scallops.as_ref()),
+            residual_beyond_scallops_nm: beyond_scallops(f.beyond_scallops),
         }
     }
 }
 
-/// The most material left above the design at any cell less the highest
-/// scallop (nm, ≥ 0; without scallops the whole residual), and where:
-/// material no pass's contact reached and no scallop explains (a rim left
-/// to the nose's flank, the nub a spiral leaves on the spindle axis).
-/// `None` if no cell was cut. The whole part's and each lenslet's alike.
-fn beyond_scallops(
-    surface: Option<&ErrorFigures>,
-    scallops: Option<&lensc_runtime::verify::heightmap::Scallops>,
-) -> Option<AtPoint> {
-    let scallop = scallops.map_or(0.0, |s| s.max.max(0.0));
-    surface.map(|s| {
-        let (v, (x, y)) = s.max_residual;
-        AtPoint {
-            value: (v - scallop).max(0.0) * 1e6,
-            x_mm: x,
-            y_mm: y,
-        }
+/// The most material left above the design beyond the scallops (nm,
+/// ≥ 0) and where: of every cell, its error less the scallop its own
+/// neighbouring passes leave there (the higher of the two cusps of its
+/// column either side of it; beyond a column's outermost cusp that one;
+/// none without cusps), the largest ([`HeightMap::beyond_scallops`] of
+/// the runtime's map). Material no pass's contact reached and no scallop
+/// beside it explains: a rim left to the nose's flank, the nub a spiral
+/// leaves on the spindle axis. `None` if no cell was cut. The whole
+/// part's and each lenslet's alike.
+///
+/// [`HeightMap::beyond_scallops`]: lensc_runtime::verify::heightmap::HeightMap::beyond_scallops
+fn beyond_scallops(beyond: Option<(f64, (f64, f64))>) -> Option<AtPoint> {
+    beyond.map(|(v, (x, y))| AtPoint {
+        value: v.max(0.0) * 1e6,
+        x_mm: x,
+        y_mm: y,
     })
 }
 
 /// The most material left above the design (nm) and where: at the
-/// contacts, or at any cell beyond the highest scallop where that is
+/// contacts, or at any cell beyond the scallops beside it where that is
 /// more; `None` without contacts. What the gate holds to `max_residual`,
 /// on the whole part and on each lenslet.
 pub fn max_residual(contact: Option<&Figures>, beyond: Option<AtPoint>) -> Option<AtPoint> {
@@ -689,7 +688,7 @@ pub struct WorstLenslet {
     /// Its contacts' RMS (nm).
     pub rms_nm: f64,
     /// The most material left above the design (nm): at its contacts, or
-    /// at any cell beyond its highest scallop, the larger.
+    /// at any cell beyond the scallops beside it, the larger.
     pub max_residual_nm: f64,
     /// The deepest cut below the design there, at a contact or any cell
     /// (nm).
@@ -698,7 +697,7 @@ pub struct WorstLenslet {
 
 impl LensletHeightMap {
     /// The most material left above the design (nm): at its contacts, or
-    /// at any cell beyond its highest scallop, the larger; `None` without
+    /// at any cell beyond the scallops beside it, the larger; `None` without
     /// contacts.
     pub fn max_residual_nm(&self) -> Option<f64> {
         max_residual(self.contact.as_ref(), self.residual_beyond_scallops_nm).map(|a| a.value)

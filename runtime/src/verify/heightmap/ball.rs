@@ -350,11 +350,12 @@ impl BallSweep {
             .iter()
             .map(|run| cut_by.valley(&g, &cut, run))
             .collect();
-        let cusps = cut_by.cusps(&g, &runs, &valleys);
+        let (cusps, bounds) = cut_by.cusps(&g, &runs, &valleys);
         Column {
             errors: cut,
             valleys: valleys.into_iter().filter(|v| !v.1.is_nan()).collect(),
             cusps,
+            bounds,
             rows: (0, g.nu),
         }
     }
@@ -686,20 +687,38 @@ impl ColumnCut<'_> {
 
     /// Where neighbouring runs' passes cut alike (between their rows,
     /// [`ColumnCut::meet`]), and how high the cut is there above the mean
-    /// of their contacts.
-    fn cusps(&self, g: &Grid, runs: &[Run], valleys: &[(f64, f64)]) -> Vec<(f64, f64)> {
-        let mut cusps = Vec::new();
+    /// of their contacts: between two contacts (the scallops reported),
+    /// and elsewhere above the nearest contacts either side
+    /// (`Column::bounds`, for the scallop a cell is allowed: a rim's last
+    /// cusp with a pass whose contact lies beyond the window).
+    #[allow(clippy::type_complexity)]
+    fn cusps(
+        &self,
+        g: &Grid,
+        runs: &[Run],
+        valleys: &[(f64, f64)],
+    ) -> (Vec<(f64, f64)>, Vec<(f64, f64)>) {
+        let (mut cusps, mut bounds) = (Vec::new(), Vec::new());
+        let nearest = super::nearest_contacts(valleys);
         for k in 1..runs.len() {
             let (left, right) = (runs[k - 1], runs[k]);
             let (va, vb) = (valleys[k - 1].1, valleys[k].1);
-            if left.last + 1 != right.first || va.is_nan() || vb.is_nan() {
+            let mean = nearest[k - 1].0.mean_with(nearest[k].1);
+            if left.last + 1 != right.first || mean.is_nan() {
                 continue;
             }
             let u = self.meet(left.pass, right.pass, (g.u(left.last), g.u(right.first)));
             let e = self.cut(left.pass, u).min(self.cut(right.pass, u)) - self.design_at(u);
+            if va.is_nan() || vb.is_nan() {
+                if !(e - mean).is_nan() {
+                    bounds.push((u, e - mean));
+                }
+                continue;
+            }
             cusps.push((u, e - (va + vb) / 2.0));
+            bounds.push((u, e - (va + vb) / 2.0));
         }
-        cusps
+        (cusps, bounds)
     }
 }
 

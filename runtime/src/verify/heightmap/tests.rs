@@ -101,6 +101,7 @@ fn a_raster_keeps_each_blocks_worst_error_and_its_sign() {
         surface: None,
         contact: None,
         scallops: None,
+        beyond_scallops: None,
         uncut: 1,
         uncut_area: 1e-6,
         uncut_at: Some((0.0, 0.0)),
@@ -519,4 +520,83 @@ fn a_measured_edge_leaves_the_brute_force_envelope_of_its_copies() {
         .map(|(a, b)| (a - b).abs())
         .fold(0.0, f64::max);
     assert!(apart > 20e-6, "{apart}");
+}
+
+/// Issue #29: a zone of wide passes leaves scallops 16 times the rest's,
+/// and a narrow groove in the design between two of the close passes,
+/// which no contact reaches, is left 0.55 µm proud. Judged against the
+/// part's highest scallop (2.35 µm) the groove vanished; against the
+/// scallops its own neighbouring passes leave (147 nm) it stands 0.4 µm
+/// beyond them, where it is.
+#[test]
+fn material_beyond_the_scallops_is_judged_against_the_scallops_beside_it() {
+    let (r, close, wide) = (0.085, 0.010, 0.040);
+    let g = grid(101, 0.001);
+    let mut sweep = Sweep::new(g, r);
+    // Passes 10 µm apart up to u = 40 µm, 40 µm apart beyond.
+    let passes = (-12..=4)
+        .map(|k| k as f64 * close)
+        .chain((1..=4).map(|k| 0.04 + k as f64 * wide));
+    for u in passes {
+        sweep.lift();
+        sweep.point(-0.01, u, r);
+        sweep.point(0.2, u, r);
+    }
+    // The groove: 0.5 µm deep from u = 21.5 to 23.5 µm, between the
+    // contact at 20 µm and the cusp at 25 µm.
+    let groove = |u: f64| {
+        if (0.0215..=0.0235).contains(&u) {
+            -0.5e-3
+        } else {
+            0.0
+        }
+    };
+    let frame = Flat {
+        z: |_, u| groove(u),
+        window: (0.0, 0.1, 0.0, 0.1),
+    };
+    let map = sweep.finish(&frame);
+    let sc = map.scallops.unwrap();
+    assert!(
+        (sc.max - HeightMap::flat_scallop(r, wide)).abs() < 1e-9,
+        "{sc:?}"
+    );
+    // The contacts see nothing of it.
+    let contact = map.contact.unwrap().max_residual.0;
+    assert!(contact < 1e-9, "{contact}");
+    // The part's highest residual is below its highest scallop: less
+    // that one figure, nothing was left.
+    let surface = map.surface.unwrap();
+    assert!(surface.max_residual.0 <= sc.max + 1e-9, "{surface:?}");
+    // Less the scallop beside it, the groove is left: the 0.5 µm and the
+    // nose's rise 2.5 to 3.5 µm from its contact, less 147 nm.
+    let (beyond, (_, y)) = map.beyond_scallops.unwrap();
+    let rise = |d: f64| r - (r * r - d * d).sqrt();
+    let want = 0.5e-3 + rise(0.003) - HeightMap::flat_scallop(r, close);
+    assert!((beyond - want).abs() < 1e-9, "{beyond} vs {want}");
+    assert!((0.0215..=0.0235).contains(&y), "at y = {y}");
+}
+
+/// Without the groove the same part has nothing beyond its scallops,
+/// the wide passes' zone included: each cell is within the scallop its
+/// own neighbours leave.
+#[test]
+fn every_cell_within_its_own_scallops_leaves_nothing_beyond_them() {
+    let (r, close, wide) = (0.085, 0.010, 0.040);
+    let mut sweep = Sweep::new(grid(101, 0.001), r);
+    let passes = (-12..=4)
+        .map(|k| k as f64 * close)
+        .chain((1..=4).map(|k| 0.04 + k as f64 * wide));
+    for u in passes {
+        sweep.lift();
+        sweep.point(-0.01, u, r);
+        sweep.point(0.2, u, r);
+    }
+    let frame = Flat {
+        z: |_, _| 0.0,
+        window: (0.0, 0.1, 0.0, 0.1),
+    };
+    let map = sweep.finish(&frame);
+    let (beyond, _) = map.beyond_scallops.unwrap();
+    assert!(beyond <= 1e-9, "{beyond}");
 }
