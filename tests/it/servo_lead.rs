@@ -278,7 +278,7 @@ fn a_servo_on_its_own_letter_is_written_there_and_reads_back_as_the_planned_cut(
     // letter and a slide fast enough for the lead writes the tip on Z:
     // both plans are the same, and the tip the reader makes of the W
     // program (Z + W) is, move for move, the Z program's Z.
-    let w_job = linuxcnc_job("5", ", letter: w, max_velocity: 45 m/min", "1000 mm/min");
+    let w_job = linuxcnc_job("5", ", letter: W, max_velocity: 45 m/min", "1000 mm/min");
     let z_job = linuxcnc_job("5", "", "5000 mm/min");
     let (code, said, w_program) = build_own(&w_job);
     assert_eq!(code, Some(0), "{said}");
@@ -323,7 +323,7 @@ fn a_servo_move_faster_than_its_own_limit_is_refused_naming_both_figures() {
     // the lead's moves beside the rims drive it at over 1000 mm/min.
     let (code, said, program) = build_own(&linuxcnc_job(
         "5",
-        ", letter: w, max_velocity: 600 mm/min",
+        ", letter: W, max_velocity: 600 mm/min",
         "1000 mm/min",
     ));
     assert_eq!(code, Some(1), "{said}");
@@ -349,7 +349,7 @@ fn a_servo_move_faster_than_its_own_limit_is_refused_naming_both_figures() {
         .unwrap_or_else(|| panic!("{said}"));
     let (code, said, _) = build_own(&linuxcnc_job(
         advised,
-        ", letter: w, max_velocity: 600 mm/min",
+        ", letter: W, max_velocity: 600 mm/min",
         "1000 mm/min",
     ));
     assert_eq!(code, Some(0), "{said}");
@@ -399,7 +399,7 @@ fn a_lead_faster_than_the_machine_s_feed_is_refused_with_the_speed_that_fits() {
 #[test]
 fn a_servo_letter_needs_its_velocity_limit_and_the_limit_its_letter() {
     for (stated, missing) in [
-        (", letter: w", "`letter` needs its `max_velocity`"),
+        (", letter: W", "`letter` needs its `max_velocity`"),
         (
             ", max_velocity: 45 m/min",
             "`max_velocity` needs its `letter`",

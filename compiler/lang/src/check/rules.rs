@@ -154,7 +154,7 @@ impl<'a> Checker<'a> {
             (None, Some(v)) => (
                 v,
                 "letter",
-                "state the letter the control gives the servo, `letter: w` (or u, v); without one the servo is written on Z and held to `max_feed`",
+                "state the letter the control gives the servo, `letter: W` (or U, V); without one the servo is written on Z and held to `max_feed`",
             ),
             _ => return true,
         };

@@ -424,6 +424,33 @@ pub fn job_site(job: &CheckedJob) -> (FileId, lensc_grammar::Span) {
 /// shortest decimal whose product with the unit is that f64's neighbour
 /// (one unit in the last place, the rounding of the unit conversion
 /// itself): `200 nm`, not `200.00000000000003 nm`.
+/// A figure lensc derived rather than one the job states (a default
+/// start radius, a settling offset): [`exact_in`] where that takes at
+/// most 10 significant digits, else `v` in `unit` to `decimals` places,
+/// trailing zeros trimmed: `83.3333 um`, not `83.33333333333334 um`.
+pub fn derived_in(v: f64, unit: &str, decimals: usize) -> String {
+    let exact = exact_in(v, unit);
+    let digits = exact
+        .split(['e', 'E'])
+        .next()
+        .unwrap_or("")
+        .chars()
+        .filter(char::is_ascii_digit)
+        .skip_while(|&c| c == '0')
+        .count();
+    if digits <= 10 || !v.is_finite() {
+        return exact;
+    }
+    let size = crate::units::size_of(unit).unwrap_or(1.0);
+    let s = format!("{:.decimals$}", v / size);
+    let s = if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        &s
+    };
+    if s == "-0" { "0".into() } else { s.to_string() }
+}
+
 pub fn exact_in(v: f64, unit: &str) -> String {
     let size = crate::units::size_of(unit).unwrap_or(1.0);
     let exact = lensc_runtime::post::header::exact_in(v, size);
@@ -466,4 +493,20 @@ fn capitalised(s: &str) -> String {
     c.next()
         .map(|f| f.to_uppercase().chain(c).collect())
         .unwrap_or_default()
+}
+
+#[cfg(test)]
+mod derived_tests {
+    use super::derived_in;
+
+    #[test]
+    fn a_derived_figure_is_exact_when_short_and_rounded_when_not() {
+        // A settling trajectory of 1 ms at 5 m/min: 83.333… um.
+        assert_eq!(derived_in(5000.0 / 60.0 * 1e-3, "um", 4), "83.3333");
+        // The default start radius of seed 003's corner: 3.5 √2 mm.
+        assert_eq!(derived_in(3.5 * 2f64.sqrt(), "mm", 7), "4.9497475");
+        // What a job states stays as stated.
+        assert_eq!(derived_in(2.637, "mm", 7), "2.637");
+        assert_eq!(derived_in(0.0037, "um", 4), "3.7");
+    }
 }

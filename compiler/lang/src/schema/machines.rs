@@ -208,7 +208,7 @@ pub(super) const FTS_LATHE: Kind = Kind {
                 ),
                 opt(
                     "letter",
-                    Ty::Word(&["u", "v", "w"]),
+                    Ty::Word(&["U", "V", "W"]),
                     Check::Any,
                     "the axis letter the control gives the servo, its own axis beside the slides (with `max_velocity`): a dialect that programs the fast axis as moves (LinuxCNC) writes the servo's motion on this letter and holds the Z slide still, the tool tip at Z plus the servo; without it the servo's motion is written on Z and held to the machine's `max_feed`",
                 ),

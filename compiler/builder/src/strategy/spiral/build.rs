@@ -10,7 +10,7 @@ use super::servo::{Commands, as_printed, following, program_leads};
 use lensc_grammar::Diagnostic;
 use lensc_lang::check::trim_num;
 use lensc_lang::codes;
-use lensc_lang::lower::exact_in;
+use lensc_lang::lower::{derived_in, exact_in};
 use lensc_runtime::emit::spiral::FtsProgram;
 use lensc_runtime::plan::spiral::{FtsError, FtsSummary, Planner, SpindleSpeed, SpiralPoint};
 use lensc_runtime::post::Provenance;
@@ -432,7 +432,7 @@ fn header_lines(spec: &SpiralSpec, prov: &Provenance, table: Option<&str>) -> Ve
     lines.push(format!(
         "strategy {}: {servo_words} spiral from r = {} mm, feed {} um/rev, {speed}, path tolerance {} nm [chords {}, blending {} nm]",
         head.names.strategy,
-        exact_in(spiral.start_radius, "mm"),
+        derived_in(spiral.start_radius, "mm", 7),
         exact_in(spiral.feed_per_rev, "um"),
         exact_in(spiral.chord_tolerance, "nm"),
         trim_num(
@@ -458,8 +458,8 @@ fn header_lines(spec: &SpiralSpec, prov: &Provenance, table: Option<&str>) -> Ve
         None if slow => {}
         Some(s) => lines.push(format!(
             "settling: tool held {} um above the land, lenslets continued {} um past their rims [settling time {} ms at {} m/min]",
-            exact_in(s.offset, "um"),
-            exact_in(s.d_traj, "um"),
+            derived_in(s.offset, "um", 4),
+            derived_in(s.d_traj, "um", 4),
             exact_in(s.time, "ms"),
             exact_in(s.surface_speed, "m/min")
         )),
