@@ -371,3 +371,43 @@ fn a_roller_pitch_of_1_nm_is_refused_by_its_size_estimate() {
     assert!(stderr.contains("[E0161]"), "{stderr}");
     assert_eq!(std::fs::read_dir(dir.path()).expect("out").count(), 0);
 }
+
+/// The two build inputs the campaign's second build leg reported as hangs
+/// (issue #33; seed 1795953692975992825, inputs 2944 and 16804): fast
+/// tool servo spirals over 2 × 2 lenslet arrays whose refusal (E0147)
+/// took 9.9 and 11.9 s. Their acceleration does not fall with the spindle
+/// speed (9.5× and 2× over the limit from the job's speed down to a
+/// 380th of it), and the advice's search tried fourteen speeds down to
+/// 0.136 and 0.254 rpm, simulating the servo at its data rate through
+/// each refused trial's cut. The search now stops once a sixteenfold
+/// slower spindle has not brought the excess down, and refuses a trial
+/// without simulating the servo: the help names the lowest speed tried,
+/// within 32× of the job's own (one step past the span).
+#[test]
+fn a_path_whose_acceleration_does_not_fall_with_the_speed_ends_its_search() {
+    for (file, job_rpm) in [
+        ("build_fts_grid_path_step_52_rpm.lens", 52.0),
+        ("build_fts_hex_path_step_32_rpm.lens", 32.0),
+    ] {
+        let dir = tempfile::tempdir().expect("tmp");
+        let out = dir.path().to_str().expect("utf-8");
+        let o = common::lensc(
+            &common::root().join("tests/fuzz_crashes"),
+            &["build", file, "--out", out],
+        );
+        let stderr = common::text(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{file}: {stderr}");
+        assert!(stderr.contains("[E0147]"), "{file}: {stderr}");
+        let lowest: f64 = stderr
+            .split("down to ")
+            .nth(1)
+            .and_then(|rest| rest.split(" rpm").next())
+            .and_then(|n| n.parse().ok())
+            .unwrap_or_else(|| panic!("{file}: no lowest speed tried in {stderr}"));
+        assert!(
+            lowest >= job_rpm / 32.0 && lowest < job_rpm,
+            "{file}: searched down to {lowest} rpm from {job_rpm}"
+        );
+        assert_eq!(std::fs::read_dir(dir.path()).expect("out").count(), 0);
+    }
+}

@@ -191,8 +191,11 @@ pub enum SpeedAdvice {
         fails: f64,
         lag: Option<LagMissed>,
     },
-    /// No speed tried passes; `lowest_tried` was the slowest.
-    NotFound { lowest_tried: f64 },
+    /// No speed tried passes; `lowest_tried` was the slowest. `budget`:
+    /// the search stopped because a slower trial would have simulated the
+    /// servo over more samples than it had left (rather than because the
+    /// excess stopped falling with the speed).
+    NotFound { lowest_tried: f64, budget: bool },
 }
 
 /// The servo's lag at the advised speed, beyond what the job accepts.

@@ -210,11 +210,7 @@ impl State {
         let Some(v) = velocity.filter(|&v| v > axis.max_velocity * (1.0 + 1e-9)) else {
             return;
         };
-        let fspan = b
-            .words
-            .iter()
-            .find(|w| w.letter == 'F')
-            .map_or(span, |w| w.span);
+        let fspan = feed_span(b, span);
         out.push((
             Rule::FeedTooHigh,
             fspan,
@@ -505,11 +501,7 @@ impl State {
         if feed.is_none() && turning.is_none() {
             return;
         }
-        let fspan = b
-            .words
-            .iter()
-            .find(|w| w.letter == 'F')
-            .map_or(span, |w| w.span);
+        let fspan = feed_span(b, span);
         if let Some((rate, max)) = feed {
             out.push((
                 Rule::FeedTooHigh,
@@ -954,4 +946,13 @@ impl State {
         };
         Some(points)
     }
+}
+
+/// Where a feed finding points: the block's F word, else the whole move
+/// (`span`), whose feed was modal from an earlier block.
+fn feed_span(b: &Block, span: (usize, usize)) -> (usize, usize) {
+    b.words
+        .iter()
+        .find(|w| w.letter == 'F')
+        .map_or(span, |w| w.span)
 }

@@ -38,11 +38,17 @@ use lensc_runtime::plan::spiral::{FtsError, LagMissed, Planner, SpeedAdvice, Spi
 
 use crate::evaluate::evaluator;
 use crate::job::accept::Criterion;
+use crate::job::estimate::MAX_SERVO_SAMPLES;
 use crate::strategy::Strategy;
 
 /// Most plans a search makes: failing ones stop early, passing ones run
 /// the whole spiral.
 const MAX_TRIALS: usize = 14;
+
+/// The slowdown over which an excess that has not fallen ends the search
+/// (`flat`), and the least power of the speed it must fall by.
+const FLAT_SPAN: f64 = 16.0;
+const FLAT_POWER: f64 = 0.25;
 
 /// The search stops once the fastest pass is within this ratio of the
 /// slowest failure above it.
@@ -86,6 +92,9 @@ fn search_below(spec: &SpiralSpec, excess: f64) -> SpeedAdvice {
     // measure it; where it hardly falls with the speed (or rises: another
     // corner takes over), by a fifth.
     let mut p: Option<f64> = Some(1.0);
+    let job = fails;
+    let mut budget = Budget::of(spec, job.0);
+    let mut spent = false;
     while passes.is_none() && trials < MAX_TRIALS {
         let (s, excess) = fails;
         let ratio = p.map_or(0.8, |p| (1.0 / excess).powf(1.0 / p).clamp(0.5, 0.99));
@@ -93,19 +102,30 @@ fn search_below(spec: &SpiralSpec, excess: f64) -> SpeedAdvice {
         let Some(trial) = decimal(guess).filter(|&t| t < s && t > 0.0) else {
             break;
         };
+        if !budget.affords(trial) {
+            spent = true;
+            break;
+        }
         trials += 1;
         match check(spec, unit, trial, None) {
-            Verdict::Passes => passes = Some(trial),
+            Verdict::Passes => {
+                budget.spend(trial);
+                passes = Some(trial);
+            }
             Verdict::Fails(at, _) => {
                 let measured = (excess / at).ln() / (s / trial).ln();
                 p = (measured.is_finite() && measured > 0.25).then(|| measured.min(2.0));
                 fails = (trial, at);
+                if flat(job, fails) {
+                    break;
+                }
             }
         }
     }
     let Some(mut lo) = passes else {
         return SpeedAdvice::NotFound {
             lowest_tried: unit.value(fails.0),
+            budget: spent,
         };
     };
     // Bisect (geometrically) between the fastest pass and the slowest
@@ -115,9 +135,15 @@ fn search_below(spec: &SpiralSpec, excess: f64) -> SpeedAdvice {
         let Some(m) = decimal((lo * hi).sqrt()).filter(|&m| m > lo && m < hi) else {
             break;
         };
+        if !budget.affords(m) {
+            break;
+        }
         trials += 1;
         match check(spec, unit, m, None) {
-            Verdict::Passes => lo = m,
+            Verdict::Passes => {
+                budget.spend(m);
+                lo = m;
+            }
             Verdict::Fails(..) => hi = m,
         }
     }
@@ -131,6 +157,76 @@ fn search_below(spec: &SpiralSpec, excess: f64) -> SpeedAdvice {
         fails: unit.value(hi),
         lag,
     }
+}
+
+/// The servo samples a search may simulate in all, at least: a tenth of
+/// what one build may (`MAX_SERVO_SAMPLES`), some nine seconds.
+const SEARCH_SAMPLES: f64 = MAX_SERVO_SAMPLES as f64 / 10.0;
+
+/// What is left of the search's servo simulation. A trial that plans is
+/// simulated over its whole cut, whose samples grow as the speed falls
+/// (the cutting time at the servo's data rate): the job's own estimate
+/// scaled by the job's speed over the trial's, which bounds it (a surface
+/// speed's capped spindle grows it less). A search may simulate
+/// `SEARCH_SAMPLES`, or four times the job's own where that is more (a
+/// refused job is advised at about the cost of a few builds of it), so
+/// the advice stops at a speed whose simulation it cannot afford, rather
+/// than at one that takes hours.
+struct Budget {
+    /// The job's own servo samples (0 where no trial simulates its servo)
+    /// and speed (in its unit).
+    job: (f64, f64),
+    left: f64,
+}
+
+impl Budget {
+    fn of(spec: &SpiralSpec, speed: f64) -> Budget {
+        let simulated = following_limit(spec).is_some() || super::servo::program_leads(spec);
+        let samples = if simulated {
+            super::estimate::estimate(spec, &|tape| evaluator(tape).0).servo_samples
+        } else {
+            0.0
+        };
+        Budget {
+            job: (samples, speed),
+            left: SEARCH_SAMPLES.max(4.0 * samples),
+        }
+    }
+
+    /// The samples a trial at `speed` simulates, at most.
+    fn cost(&self, speed: f64) -> f64 {
+        let (samples, job_speed) = self.job;
+        if samples == 0.0 {
+            0.0
+        } else {
+            samples * job_speed / speed
+        }
+    }
+
+    fn affords(&self, speed: f64) -> bool {
+        self.cost(speed) <= self.left
+    }
+
+    fn spend(&mut self, speed: f64) {
+        self.left -= self.cost(speed);
+    }
+}
+
+/// Whether the excess has not fallen with the speed over a span wide
+/// enough to say so: from the job's own speed and excess to a trial's,
+/// the speed down `FLAT_SPAN` times or more, the excess fell slower than
+/// the speed to the power `FLAT_POWER` (or rose). A smooth path's
+/// acceleration falls with the square of the speed and a corner's with
+/// the speed itself; one that holds over a sixteenfold slower spindle is
+/// the path's own (a step at the servo's data period), or a spindle cap,
+/// and slower trials only cost more (each plans a longer cut).
+fn flat(job: (f64, f64), trial: (f64, f64)) -> bool {
+    let span = job.0 / trial.0;
+    let fell = job.1 / trial.1;
+    // (A NaN power, an excess infinitely over at both, is flat too.)
+    use std::cmp::Ordering::{Equal, Greater};
+    let power = fell.ln() / span.ln();
+    span >= FLAT_SPAN && !matches!(power.partial_cmp(&FLAT_POWER), Some(Greater | Equal))
 }
 
 /// The following error (mm) the build's gate holds the job's servo to:
@@ -171,6 +267,14 @@ enum Verdict {
 /// Plans the job at `speed` (in its own unit) up to its first refusal,
 /// its servo (`lag_limit`, mm: where it is gated) simulated on the
 /// commands as printed, led as the build leads it (`servo::following`).
+///
+/// The plan comes first, alone: a trial the planner refuses (or whose
+/// moves as written are too fast) is refused without simulating the
+/// servo, which steps at its data rate through the cut so far, so costs
+/// in proportion to the cutting time: at a crawling trial speed millions
+/// of samples for the same few thousand points (two fuzzed hex arrays
+/// spent 10 s there, `tests/fuzz_crashes/build_fts_*`). Only a trial
+/// that plans is planned again with its servo simulated.
 fn check(spec: &SpiralSpec, unit: Unit, speed: f64, lag_limit: Option<f64>) -> Verdict {
     let speed = unit.speed(spec.spiral.speed, speed);
     let Ok(at) = spec.at_speed(speed, &|tape| evaluator(tape).0) else {
@@ -182,72 +286,67 @@ fn check(spec: &SpiralSpec, unit: Unit, speed: f64, lag_limit: Option<f64>) -> V
     };
     let kernel = evaluator(&trajectory.tape).0;
     let data_rate = 1.0 / at.spiral.min_interval;
-    // The servo is simulated where its lag is gated, and wherever the
-    // program leads it: the lead's own acceleration is checked at every
-    // trial (the build refuses it, E0192), gated or not.
-    let leads = super::servo::program_leads(spec);
-    let mut following = (lag_limit.is_some() || leads)
-        .then(|| super::servo::following(spec, &at.spiral, &bounds, data_rate))
-        .flatten();
     let planner = Planner {
         spiral: &at.spiral,
         surface: kernel.as_ref(),
         less: None,
         nose_radius: spec.nose_radius,
         edge: spec.edge.as_ref().map(|(m, _)| &m.profile),
-        bounds,
+        bounds: bounds.clone(),
+    };
+    // The commands are made where the moves written are held to the
+    // machine's feed (or the servo's letter to its velocity).
+    let mut commands = super::servo::Commands::of(spec, data_rate);
+    let planned = if super::servo::writes_moves(spec) {
+        planner.check_with(&spec.fast_axis, |pts| commands.next(pts))
+    } else {
+        planner.check(&spec.fast_axis)
+    };
+    match planned {
+        Ok(_) => commands.finish(),
+        Err(FtsError::AccelerationExceeded {
+            acceleration, max, ..
+        }) => return Verdict::Fails(acceleration / max, None),
+        Err(_) => return Verdict::Fails(f64::INFINITY, None),
+    }
+    if let Some((feed, _)) = commands.over_max_feed(spec) {
+        return Verdict::Fails(feed / spec.max_feed, None);
+    }
+    if let (Some((v, _)), Some((_, most))) = (commands.over_servo_velocity(spec), spec.servo_axis) {
+        return Verdict::Fails(v / most, None);
+    }
+    // The servo is simulated where its lag is gated, and wherever the
+    // program leads it: the lead's own acceleration is checked at every
+    // trial (the build refuses it, E0192), gated or not.
+    let leads = super::servo::program_leads(spec);
+    let Some(mut sim) = (lag_limit.is_some() || leads)
+        .then(|| super::servo::following(spec, &at.spiral, &bounds, data_rate))
+        .flatten()
+    else {
+        return Verdict::Passes;
     };
     let resolution = spec.head.resolution;
     let mut commands = super::servo::Commands::of(spec, data_rate);
-    // The commands are made where the servo is simulated or the moves
-    // written are held to the machine's feed.
-    let planned = match following.as_mut() {
-        Some(sim) => planner.check_with(&spec.fast_axis, |pts| {
-            commands.next(pts);
-            commands.drive(sim, resolution);
-        }),
-        None if super::servo::writes_moves(spec) => {
-            planner.check_with(&spec.fast_axis, |pts| commands.next(pts))
-        }
-        None => planner.check(&spec.fast_axis),
-    };
-    if planned.is_ok() {
-        commands.finish();
-        if let Some(sim) = following.as_mut() {
-            commands.drive(sim, resolution);
-        }
+    let planned = planner.check_with(&spec.fast_axis, |pts| {
+        commands.next(pts);
+        commands.drive(&mut sim, resolution);
+    });
+    if planned.is_err() {
+        // The same plan again (the planner is deterministic): not met.
+        return Verdict::Fails(f64::INFINITY, None);
     }
-    if let (Ok(_), Some((feed, _))) = (&planned, commands.over_max_feed(spec)) {
-        return Verdict::Fails(feed / spec.max_feed, None);
-    }
-    if let (Ok(_), Some((v, _)), Some((_, most))) = (
-        &planned,
-        commands.over_servo_velocity(spec),
-        spec.servo_axis,
-    ) {
-        return Verdict::Fails(v / most, None);
-    }
-    match planned {
-        Ok(_) => match following {
-            Some(sim) => {
-                let f = sim.finish();
-                let lag = f.max_error;
-                let most = spec.fast_axis.max_acceleration;
-                if leads && f.max_acceleration > most {
-                    // The lead the program writes drives the servo too hard.
-                    Verdict::Fails(f.max_acceleration / most, None)
-                } else if let Some(limit) = lag_limit.filter(|&l| lag > l) {
-                    Verdict::Fails(lag / limit, Some(LagMissed { lag, limit }))
-                } else {
-                    Verdict::Passes
-                }
-            }
-            None => Verdict::Passes,
-        },
-        Err(FtsError::AccelerationExceeded {
-            acceleration, max, ..
-        }) => Verdict::Fails(acceleration / max, None),
-        Err(_) => Verdict::Fails(f64::INFINITY, None),
+    commands.finish();
+    commands.drive(&mut sim, resolution);
+    let f = sim.finish();
+    let lag = f.max_error;
+    let most = spec.fast_axis.max_acceleration;
+    if leads && f.max_acceleration > most {
+        // The lead the program writes drives the servo too hard.
+        Verdict::Fails(f.max_acceleration / most, None)
+    } else if let Some(limit) = lag_limit.filter(|&l| lag > l) {
+        Verdict::Fails(lag / limit, Some(LagMissed { lag, limit }))
+    } else {
+        Verdict::Passes
     }
 }
 
@@ -339,6 +438,40 @@ mod tests {
         assert_eq!(trim_num(accepted_lag_nm(12.6e-6)), "13");
         assert_eq!(trim_num(accepted_lag_nm(1.3e-3)), "1300");
         assert_eq!(trim_num(accepted_lag_nm(0.4955e-3)), "500");
+    }
+
+    #[test]
+    fn an_excess_that_holds_over_a_sixteenfold_slowdown_is_flat() {
+        // The fuzzed grid: 9.5x over at 52 rpm, 17.2x at 2.662.
+        assert!(flat((52.0, 9.536), (2.662, 17.17)));
+        // Not yet a span wide enough to say.
+        assert!(!flat((52.0, 9.536), (3.328, 15.0)));
+        // A corner's law (the excess in proportion to the speed) and a
+        // slow fall (power 0.3) go on; a power of 0.2 is flat.
+        assert!(!flat((52.0, 20.0), (2.6, 1.0)));
+        assert!(!flat((32.0, 10.0), (1.0, 10.0 / 32f64.powf(0.3))));
+        assert!(flat((32.0, 10.0), (1.0, 10.0 / 32f64.powf(0.2))));
+        // A trial refused for another reason (infinitely over).
+        assert!(flat((32.0, 2.0), (1.0, f64::INFINITY)));
+    }
+
+    #[test]
+    fn a_trial_costs_the_jobs_samples_scaled_by_the_slowdown() {
+        // A job of 100 M samples at 100 rpm: a budget of four times that.
+        let mut b = Budget {
+            job: (1e8, 100.0),
+            left: SEARCH_SAMPLES.max(4e8),
+        };
+        assert_eq!(b.cost(50.0), 2e8);
+        assert!(b.affords(25.0) && !b.affords(24.9));
+        b.spend(50.0);
+        assert!(b.affords(50.0) && !b.affords(49.9));
+        // No trial simulates the servo: every speed is affordable.
+        let free = Budget {
+            job: (0.0, 100.0),
+            left: SEARCH_SAMPLES,
+        };
+        assert!(free.affords(1e-9));
     }
 
     #[test]

@@ -141,8 +141,18 @@ fn advice_help(speed: &SpindleSpeed, advice: Option<SpeedAdvice>, what: &str) ->
             trim_num(l.limit * 1e6),
             trim_num(super::advice::accepted_lag_nm(l.lag))
         ),
-        Some(SpeedAdvice::NotFound { lowest_tried }) => format!(
+        Some(SpeedAdvice::NotFound {
+            lowest_tried,
+            budget: false,
+        }) => format!(
             "no {kind} tried respects it, down to {}: {what} does not fall with the speed there (a spindle cap, or the path itself)",
+            words(lowest_tried)
+        ),
+        Some(SpeedAdvice::NotFound {
+            lowest_tried,
+            budget: true,
+        }) => format!(
+            "no {kind} tried respects it, down to {}: a slower trial would simulate the servo over more samples than the search allows (its cutting time grows as the speed falls); try a lower {kind} yourself",
             words(lowest_tried)
         ),
         None => format!("lower the {kind}"),
