@@ -45,6 +45,20 @@ pub fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
 }
 
+/// The words of `said` between the first `before` and the next `after`
+/// (a figure a message names: "down to 2.662 rpm"), or `None`.
+pub fn between<'a>(said: &'a str, before: &str, after: &str) -> Option<&'a str> {
+    said.split_once(before)?.1.split(after).next()
+}
+
+/// The figure of `said` between `before` and `after`, parsed; the test
+/// fails, showing `said`, where there is none.
+pub fn figure(said: &str, before: &str, after: &str) -> f64 {
+    between(said, before, after)
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no figure between {before:?} and {after:?} in {said}"))
+}
+
 /// Whether a job file declares at least one job (files without one are
 /// libraries of surfaces and the like: checked and sampled, not built).
 pub fn has_job(path: &Path) -> bool {

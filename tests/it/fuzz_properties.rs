@@ -353,23 +353,27 @@ fn check_refuses_the_jobs_the_fuzzer_found() {
 /// fraction of the time the build took, and nothing is written.
 #[test]
 fn a_roller_pitch_of_1_nm_is_refused_by_its_size_estimate() {
+    refused_crash_input(
+        "build_roller_pitch_1_nm.lens",
+        &["--max-program-size", "10MB"],
+        "E0161",
+    );
+}
+
+/// `lensc build` of the kept fuzz input `file` (with `flags`), which must
+/// be refused with `code` and write nothing; what it said.
+fn refused_crash_input(file: &str, flags: &[&str], code: &str) -> String {
     let dir = tempfile::tempdir().expect("tmp");
     let out = dir.path().to_str().expect("utf-8");
-    let o = common::lensc(
-        &common::root().join("tests/fuzz_crashes"),
-        &[
-            "build",
-            "build_roller_pitch_1_nm.lens",
-            "--out",
-            out,
-            "--max-program-size",
-            "10MB",
-        ],
-    );
+    let mut args = vec!["build", file, "--out", out];
+    args.extend_from_slice(flags);
+    let o = common::lensc(&common::root().join("tests/fuzz_crashes"), &args);
     let stderr = common::text(&o.stderr);
-    assert_eq!(o.status.code(), Some(1), "{stderr}");
-    assert!(stderr.contains("[E0161]"), "{stderr}");
-    assert_eq!(std::fs::read_dir(dir.path()).expect("out").count(), 0);
+    assert_eq!(o.status.code(), Some(1), "{file}: {stderr}");
+    assert!(stderr.contains(&format!("[{code}]")), "{file}: {stderr}");
+    let written = std::fs::read_dir(dir.path()).expect("out").count();
+    assert_eq!(written, 0, "{file}: wrote {written} files");
+    stderr
 }
 
 /// The two build inputs the campaign's second build leg reported as hangs
@@ -389,25 +393,11 @@ fn a_path_whose_acceleration_does_not_fall_with_the_speed_ends_its_search() {
         ("build_fts_grid_path_step_52_rpm.lens", 52.0),
         ("build_fts_hex_path_step_32_rpm.lens", 32.0),
     ] {
-        let dir = tempfile::tempdir().expect("tmp");
-        let out = dir.path().to_str().expect("utf-8");
-        let o = common::lensc(
-            &common::root().join("tests/fuzz_crashes"),
-            &["build", file, "--out", out],
-        );
-        let stderr = common::text(&o.stderr);
-        assert_eq!(o.status.code(), Some(1), "{file}: {stderr}");
-        assert!(stderr.contains("[E0147]"), "{file}: {stderr}");
-        let lowest: f64 = stderr
-            .split("down to ")
-            .nth(1)
-            .and_then(|rest| rest.split(" rpm").next())
-            .and_then(|n| n.parse().ok())
-            .unwrap_or_else(|| panic!("{file}: no lowest speed tried in {stderr}"));
+        let stderr = refused_crash_input(file, &[], "E0147");
+        let lowest = common::figure(&stderr, "down to ", " rpm");
         assert!(
             lowest >= job_rpm / 32.0 && lowest < job_rpm,
             "{file}: searched down to {lowest} rpm from {job_rpm}"
         );
-        assert_eq!(std::fs::read_dir(dir.path()).expect("out").count(), 0);
     }
 }

@@ -315,6 +315,30 @@ job good { surface: bowl, tool: small, machine: my_lathe, strategy: turn }
     assert_eq!(listing(&out_dir), vec!["good.profile.svg"]);
 }
 
+/// `--dialect` plots the program `build --dialect` writes; a dialect the
+/// machine does not offer is refused as `build` refuses it, nothing
+/// written.
+#[test]
+fn a_dialect_the_machine_offers_is_plotted_and_one_it_does_not_is_refused() {
+    let file = "examples/kim2008_convex_asphere.lens";
+    let job = ["--job", "kim_convex"];
+    let (dir, out) = report(&[
+        file,
+        job[0],
+        job[1],
+        "--dialect",
+        "siemens_840d_lathe",
+        "-q",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert_eq!(listing(dir.path()), vec!["kim_convex.profile.svg"]);
+    let (dir, out) = report(&[file, job[0], job[1], "--dialect", "fanuc_0i_mill", "-q"]);
+    let said = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{said}");
+    assert!(said.contains("[E0148]"), "{said}");
+    assert!(listing(dir.path()).is_empty(), "{:?}", listing(dir.path()));
+}
+
 #[test]
 fn report_is_described_in_help() {
     let out = lensc(&root(), &["report", "--help"]);
@@ -325,6 +349,7 @@ fn report_is_described_in_help() {
         "form_error.svg",
         "following.svg",
         "--job",
+        "--dialect",
         "--out",
     ] {
         assert!(help.contains(word), "{word}: {help}");

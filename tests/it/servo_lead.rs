@@ -4,7 +4,7 @@
 //! tables two builds write are read back from their text and the servo run
 //! unled on each, as its machine would run it.
 
-use crate::common::{lensc, root, text};
+use crate::common::{self, lensc, root, text};
 use lensc_runtime::machine::servo::SecondOrderServo;
 use lensc_runtime::plan::spiral::SpiralPoint;
 use lensc_runtime::verify::follow::{FollowingSimulation, RadialBins};
@@ -334,19 +334,11 @@ fn a_servo_move_faster_than_its_own_limit_is_refused_naming_both_figures() {
             && said.contains("above its `max_velocity` of 600 mm/min"),
         "{said}"
     );
-    let velocity: f64 = said
-        .split("written on W, at ")
-        .nth(1)
-        .and_then(|s| s.split(" mm/min").next())
-        .and_then(|s| s.parse().ok())
-        .unwrap_or_else(|| panic!("{said}"));
+    let velocity = common::figure(&said, "written on W, at ", " mm/min");
     assert!(velocity > 1000.0 && velocity < 1100.0, "{velocity}");
     // The speed the help names builds, its every servo move within 600.
-    let advised = said
-        .split("a surface speed of ")
-        .nth(1)
-        .and_then(|s| s.split(" m/min").next())
-        .unwrap_or_else(|| panic!("{said}"));
+    let advised =
+        common::between(&said, "a surface speed of ", " m/min").unwrap_or_else(|| panic!("{said}"));
     let (code, said, _) = build_own(&linuxcnc_job(
         advised,
         ", letter: W, max_velocity: 600 mm/min",
@@ -374,20 +366,12 @@ fn a_lead_faster_than_the_machine_s_feed_is_refused_with_the_speed_that_fits() {
         "{said}"
     );
     // The move's feed, as the plan measured it.
-    let feed: f64 = said
-        .split("written on Z, at ")
-        .nth(1)
-        .and_then(|s| s.split(" mm/min").next())
-        .and_then(|s| s.parse().ok())
-        .unwrap_or_else(|| panic!("{said}"));
+    let feed = common::figure(&said, "written on Z, at ", " mm/min");
     assert!(feed > 1000.0 && feed < 1100.0, "{feed}");
     // The speed the help names, planned and checked: built at it, every
     // move fits, and the read-back (the controller's view) passes it.
-    let advised = said
-        .split("a surface speed of ")
-        .nth(1)
-        .and_then(|s| s.split(" m/min").next())
-        .unwrap_or_else(|| panic!("{said}"));
+    let advised =
+        common::between(&said, "a surface speed of ", " m/min").unwrap_or_else(|| panic!("{said}"));
     let speed: f64 = advised.parse().expect("a speed");
     assert!(speed < 5.0 && speed > 4.0, "{speed}");
     let (code, said, program) = build_own(&job(advised));

@@ -201,3 +201,43 @@ fn a_raster_jobs_page_loads_draws_and_shows_its_reports_figures() {
     // One pass per stroke of the raster.
     assert!(status["moves"]["passes"].as_u64().unwrap() > 10, "{status}");
 }
+
+/// `--dialect` views the program `build --dialect` writes (its page names
+/// that dialect, its backplot read in it); a dialect the machine does not
+/// offer is refused as `build` refuses it, nothing written. No browser:
+/// the page's own data is read.
+#[test]
+fn a_page_is_of_the_program_in_the_dialect_asked() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let file = dir.path().join("small_plate.lens");
+    std::fs::write(&file, SMALL_RASTER).expect("write");
+    let file = file.to_str().expect("utf8");
+    let view = |dialect: &str, out: &str| {
+        let out = dir.path().join(out);
+        let o = lensc(
+            &root(),
+            &[
+                "view",
+                file,
+                "--dialect",
+                dialect,
+                "--out",
+                out.to_str().expect("utf8"),
+                "-q",
+            ],
+        );
+        (o, out.join("small_plate.view.html"))
+    };
+    let (o, page) = view("heidenhain_tnc_klartext", "klartext");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let page = std::fs::read_to_string(page).expect("the page");
+    assert!(
+        page.contains(r#""dialect":"heidenhain_tnc_klartext""#),
+        "the page does not name the dialect asked"
+    );
+    let (o, page) = view("fanuc_0i_lathe", "lathe");
+    let said = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{said}");
+    assert!(said.contains("[E0148]"), "{said}");
+    assert!(!page.exists() && !page.parent().expect("dir").exists());
+}

@@ -124,6 +124,11 @@ pub enum Command {
         /// Plot only this job.
         #[arg(long)]
         job: Option<String>,
+        /// Plot the program as `build --dialect` writes it in this
+        /// dialect, one the machine offers (its `dialect` or one of its
+        /// `other_dialects`): its moves are what is simulated.
+        #[arg(long)]
+        dialect: Option<String>,
         /// Directory for the plots.
         #[arg(long, default_value = "out")]
         out: PathBuf,
@@ -152,6 +157,11 @@ pub enum Command {
         /// View only this job.
         #[arg(long)]
         job: Option<String>,
+        /// View the program as `build --dialect` writes it in this
+        /// dialect, one the machine offers (its `dialect` or one of its
+        /// `other_dialects`): its moves are what is simulated.
+        #[arg(long)]
+        dialect: Option<String>,
         /// Directory for the pages.
         #[arg(long, default_value = "out")]
         out: PathBuf,

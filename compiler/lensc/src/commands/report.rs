@@ -12,7 +12,7 @@ use crate::progress::Reporter;
 pub fn run(
     out: &Output,
     file: &Path,
-    job: Option<&str>,
+    (job, dialect): (Option<&str>, Option<&str>),
     dir: &Path,
     max_program_size: u64,
     quiet: bool,
@@ -24,7 +24,14 @@ pub fn run(
     };
     let source = file.display().to_string();
     let reporter = Reporter::new(out, quiet, &source, jobs_asked(&c, job));
-    let code = plot(out, &c, (&source, job), dir, max_program_size, &reporter);
+    let code = plot(
+        out,
+        &c,
+        (&source, job, dialect),
+        dir,
+        max_program_size,
+        &reporter,
+    );
     reporter.done(code == 0);
     code
 }
@@ -34,7 +41,7 @@ pub fn run(
 fn plot(
     out: &Output,
     c: &driver::Checked,
-    (source, job): (&str, Option<&str>),
+    (source, job, dialect): (&str, Option<&str>, Option<&str>),
     dir: &Path,
     max_program_size: u64,
     reporter: &Reporter,
@@ -47,7 +54,7 @@ fn plot(
         c,
         driver::Request {
             job,
-            dialect: None,
+            dialect,
             max_program_size: Some(max_program_size),
             accept: lensc_build::accept::Mode::Warn,
             progress: reporter.observer(),

@@ -17,7 +17,7 @@ use crate::progress::Reporter;
 pub fn run(
     out: &Output,
     file: &Path,
-    job: Option<&str>,
+    (job, dialect): (Option<&str>, Option<&str>),
     dir: &Path,
     max_program_size: u64,
     quiet: bool,
@@ -36,7 +36,7 @@ pub fn run(
         &c,
         driver::Request {
             job,
-            dialect: None,
+            dialect,
             max_program_size: Some(max_program_size),
             accept: lensc_build::accept::Mode::Warn,
             progress: reporter.observer(),

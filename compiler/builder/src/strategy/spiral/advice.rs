@@ -183,7 +183,9 @@ impl Budget {
     fn of(spec: &SpiralSpec, speed: f64) -> Budget {
         let simulated = following_limit(spec).is_some() || super::servo::program_leads(spec);
         let samples = if simulated {
-            super::estimate::estimate(spec, &|tape| evaluator(tape).0).servo_samples
+            // The build's own estimate, made before planning (or made
+            // here, where the search is called on a job not estimated).
+            Strategy::estimate(spec, &|tape| evaluator(tape).0).servo_samples
         } else {
             0.0
         };

@@ -82,6 +82,10 @@ pub struct SpiralSpec {
     /// as moves, the servo's motion goes on that letter, held to that
     /// limit, and the Z slide holds still (`servo::Commands`).
     pub servo_axis: Option<(char, f64)>,
+    /// The job's estimate (`estimate`), made once: the build's check
+    /// against the limits makes it, and a refused job's speed advice
+    /// bounds its search by its servo samples (`advice::Budget`).
+    pub estimated: std::sync::OnceLock<crate::job::Estimate>,
 }
 
 /// A spiral job at another speed: what a search for the highest speed
@@ -156,7 +160,9 @@ impl crate::strategy::Strategy for SpiralSpec {
         Some(self.spiral.chord_tolerance)
     }
     fn estimate(&self, evaluate: Evaluate) -> crate::job::Estimate {
-        estimate::estimate(self, evaluate)
+        *self
+            .estimated
+            .get_or_init(|| estimate::estimate(self, evaluate))
     }
     /// The disc the spiral sweeps from its start radius (`from:`, or
     /// the surface's farthest point from the axis) in to the axis, within
@@ -340,6 +346,7 @@ pub(crate) fn lower(
             Carrier::Servo(f) => f.own_axis,
             Carrier::SlowZ(_) => None,
         },
+        estimated: std::sync::OnceLock::new(),
     })
 }
 
