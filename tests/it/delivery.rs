@@ -214,6 +214,7 @@ fn spiral_and_servo_programs_split_at_joins_the_control_passes_and_read_back_who
             servo: (what == "servo").then_some(reader::ServoAxis {
                 letter: 'W',
                 max_velocity: 45_000.0,
+                stroke: 5.0,
             }),
             ..MILL
         };

@@ -416,3 +416,37 @@ fn a_servo_letter_needs_its_velocity_limit_and_the_limit_its_letter() {
     assert_eq!(out.status.code(), Some(1), "{said}");
     assert!(said.contains("E0126"), "{said}");
 }
+
+#[test]
+fn verify_holds_a_servo_on_its_own_letter_to_its_stroke() {
+    // The corner's program as built reads clean; its last retract put
+    // 5.5 mm out (the servo's positions then spanning from the cut's,
+    // about 0.5 mm, to 5.5 mm) is over the 5 mm stroke of the machine its header names, whatever
+    // the servo's zero.
+    let dir = tempfile::tempdir().expect("tmp");
+    let job = linuxcnc_job("5", ", letter: W, max_velocity: 45 m/min", "1000 mm/min");
+    std::fs::write(dir.path().join("corner.lens"), job).expect("write");
+    let built = lensc(
+        dir.path(),
+        &["build", "corner.lens", "--accept", "warn", "--out", "."],
+    );
+    assert!(built.status.success(), "{}", text(&built.stderr));
+    let program = std::fs::read_to_string(dir.path().join("corner.ngc")).expect("written");
+    let verify = |name: &str, body: &str| {
+        std::fs::write(dir.path().join(name), body).expect("write");
+        lensc(dir.path(), &["verify", name, "--source", "corner.lens"])
+    };
+    let v = verify("corner.ngc", &program);
+    assert!(v.status.success(), "{}", text(&v.stderr));
+    let at = program.rfind("G0 W0. ").expect("the servo's retract");
+    let edited = format!("{}G0 W5.5 {}", &program[..at], &program[at + 7..]);
+    let v = verify("edited.ngc", &edited);
+    let said = text(&v.stderr);
+    assert_eq!(v.status.code(), Some(1), "{said}");
+    assert!(
+        said.contains("policy over-travel: this move takes the fast tool servo's axis W to 5.5 mm")
+            && said.contains(" .. 5.5 mm, ")
+            && said.contains("more than its 5 mm stroke"),
+        "{said}"
+    );
+}

@@ -585,11 +585,8 @@ impl<'a> Parts<'a> {
             servo: self
                 .machine_params
                 .fast_axis
-                .and_then(|f| f.own_axis)
-                .map(|(letter, v)| lensc_runtime::reader::ServoAxis {
-                    letter,
-                    max_velocity: v * 60.0,
-                }),
+                .as_ref()
+                .and_then(lensc_lang::lower::read_back::servo_axis),
             simulate: simulate(&self.params).ok().flatten(),
             accept: accept::lower(&self.params).unwrap_or_default(),
             start: Start {

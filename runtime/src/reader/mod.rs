@@ -68,6 +68,9 @@ pub struct ServoAxis {
     pub letter: char,
     /// Its velocity limit (mm/min): no move may drive it faster.
     pub max_velocity: f64,
+    /// Its stroke (mm): the positions a program gives it may span no
+    /// more, wherever its zero is set.
+    pub stroke: f64,
 }
 
 /// The family of controller whose rules a dialect is read by.

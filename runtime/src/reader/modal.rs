@@ -135,6 +135,9 @@ pub(crate) struct State {
     /// The fast tool servo on its own letter (`MachineLimits::servo`),
     /// where the program has stated it (mm).
     pub servo_at: Option<f64>,
+    /// The least and largest positions the program has given the servo on
+    /// its own letter (mm).
+    pub servo_span: Option<(f64, f64)>,
     /// The axis whose + leads out of the material (header).
     pub away: usize,
     /// Where the program's control point lies from the tool's centre (mm
@@ -263,6 +266,7 @@ impl State {
             diameter: machine.lathe && d.lathe_x_diameter,
             pos: [None; 4],
             servo_at: None,
+            servo_span: None,
             away: 2,
             control: [0.0; 3],
             top: None,

@@ -98,6 +98,9 @@ impl State {
             None => servo_start,
         };
         let (tip_start, tip_end) = (tip(start, servo_start), tip(end, servo_end));
+        if let Some(w) = servo_word {
+            self.servo_stroke(w, servo_end, out);
+        }
         if self.lex.controller == Controller::LinuxCnc && axes(b).any(|w| w.letter == 'C') {
             // LinuxCNC drives the spindle as the rotary axis C.
             self.position_mode = true;
@@ -153,6 +156,36 @@ impl State {
         (self.lex.controller == Controller::LinuxCnc)
             .then(|| b.words.iter().find(|w| w.letter == letter))
             .flatten()
+    }
+
+    /// A servo word (`w`, ending at `end` mm) that widens the span of the
+    /// servo's positions beyond its stroke: no zero of the servo reaches
+    /// them all. Said at each move that widens it further.
+    fn servo_stroke(&mut self, w: &Word, end: Option<f64>, out: &mut Vec<Found>) {
+        let (Some(axis), Some(v)) = (self.machine.servo, end) else {
+            return;
+        };
+        let (lo, hi) = self
+            .servo_span
+            .map_or((v, v), |(lo, hi)| (lo.min(v), hi.max(v)));
+        let widened = self.servo_span != Some((lo, hi));
+        self.servo_span = Some((lo, hi));
+        if widened && hi - lo > axis.stroke + 1e-9 {
+            out.push((
+                Rule::OutsideTravel,
+                w.span,
+                format!(
+                    "this move takes the fast tool servo's axis {} to {} mm: the program moves it over {} .. {} mm, {} mm, more than its {} mm stroke",
+                    axis.letter,
+                    num(v),
+                    num(lo),
+                    num(hi),
+                    num(hi - lo),
+                    num(axis.stroke)
+                ),
+                None,
+            ));
+        }
     }
 
     /// Where the servo ends for its word's `value` in the program's units:

@@ -1009,6 +1009,7 @@ fn a_servo_on_its_own_letter_moves_the_tip_and_is_held_to_its_limit() {
         servo: Some(ServoAxis {
             letter: 'W',
             max_velocity,
+            stroke: 5.0,
         }),
         ..lathe()
     };
@@ -1043,4 +1044,39 @@ fn a_servo_on_its_own_letter_moves_the_tip_and_is_held_to_its_limit() {
     );
     // Where the machine has no such axis, W is no word of the control's.
     assert!(rules(&text, &d, &lathe()).contains(&Rule::UnknownWord));
+}
+
+/// A servo on its own letter may be given positions spanning no more
+/// than its stroke, wherever its zero is: the move that widens the span
+/// past it is found (over-travel), once per widening; the retract to W0
+/// counts, as the servo must reach it.
+#[test]
+fn a_servo_on_its_own_letter_is_held_to_its_stroke() {
+    let d = Dialect::linuxcnc();
+    let servo = |stroke| MachineLimits {
+        servo: Some(ServoAxis {
+            letter: 'W',
+            max_velocity: 10_000.0,
+            stroke,
+        }),
+        ..lathe()
+    };
+    // W at 0.5, then -0.3 (0.8 mm apart), then 0 (inside the span).
+    let text = servo_program("0.5", "-0.3");
+    assert!(read(&text, &d, &servo(0.8)).is_empty());
+    let found = read(&text, &d, &servo(0.6));
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert_eq!((found[0].rule, found[0].line), (Rule::OutsideTravel, 8));
+    assert!(
+        found[0]
+            .message
+            .contains("axis W to -0.3 mm: the program moves it over -0.3 .. 0.5 mm, 0.8 mm, more than its 0.6 mm stroke"),
+        "{}",
+        found[0].message
+    );
+    // Where the retract widens it: W at 0.5 and 0.4, then 0.
+    let text = servo_program("0.5", "0.4");
+    let found = read(&text, &d, &servo(0.3));
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert_eq!(found[0].line, 9, "{found:?}");
 }

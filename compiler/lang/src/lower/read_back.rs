@@ -8,7 +8,7 @@ use lensc_runtime::post::Dialect;
 use lensc_runtime::reader::MachineLimits;
 
 use crate::check::CheckedJob;
-use crate::schema::machines::MachineParams;
+use crate::schema::machines::{FastAxisParams, MachineParams};
 use crate::schema::{OfferedDialect, offered_dialects};
 use crate::value::{Object, Reader};
 
@@ -24,12 +24,7 @@ pub fn machine_limits(machine: &Object) -> MachineLimits {
             travel: m.travel,
             max_feed: Some(m.max_feed * 60.0),
             max_spindle_rpm: m.max_spindle_speed.map(rpm),
-            servo: m.fast_axis.and_then(|f| f.own_axis).map(|(letter, v)| {
-                lensc_runtime::reader::ServoAxis {
-                    letter,
-                    max_velocity: v * 60.0,
-                }
-            }),
+            servo: m.fast_axis.as_ref().and_then(servo_axis),
         },
         Err(_) => MachineLimits {
             lathe,
@@ -134,4 +129,16 @@ pub fn policy_message(f: &lensc_runtime::reader::Finding) -> String {
         Some(p) => format!("policy {}: {}", p.name, f.message),
         None => f.message.clone(),
     }
+}
+
+/// A fast tool servo the control programs on its own letter, as the
+/// reader holds it (its velocity in mm/min, its stroke); `None` where
+/// the program writes the servo otherwise (a table, or Z).
+pub fn servo_axis(f: &FastAxisParams) -> Option<lensc_runtime::reader::ServoAxis> {
+    f.own_axis
+        .map(|(letter, v)| lensc_runtime::reader::ServoAxis {
+            letter,
+            max_velocity: v * 60.0,
+            stroke: f.stroke,
+        })
 }
