@@ -1002,17 +1002,23 @@ M2
     )
 }
 
-#[test]
-fn a_servo_on_its_own_letter_moves_the_tip_and_is_held_to_its_limit() {
-    let d = Dialect::linuxcnc();
-    let servo = |max_velocity| MachineLimits {
+/// The lathe with a fast tool servo on its own letter W, of velocity
+/// limit `max_velocity` (mm/min) and `stroke` (mm).
+fn servo_lathe(max_velocity: f64, stroke: f64) -> MachineLimits {
+    MachineLimits {
         servo: Some(ServoAxis {
             letter: 'W',
             max_velocity,
-            stroke: 5.0,
+            stroke,
         }),
         ..lathe()
-    };
+    }
+}
+
+#[test]
+fn a_servo_on_its_own_letter_moves_the_tip_and_is_held_to_its_limit() {
+    let d = Dialect::linuxcnc();
+    let servo = |max_velocity| servo_lathe(max_velocity, 5.0);
     // The tip is Z + W: the plunge ends at 0.5, the next move holds it
     // (the servo still), the next takes it to 0.4.
     let text = servo_program("0.5", "0.4");
@@ -1053,14 +1059,7 @@ fn a_servo_on_its_own_letter_moves_the_tip_and_is_held_to_its_limit() {
 #[test]
 fn a_servo_on_its_own_letter_is_held_to_its_stroke() {
     let d = Dialect::linuxcnc();
-    let servo = |stroke| MachineLimits {
-        servo: Some(ServoAxis {
-            letter: 'W',
-            max_velocity: 10_000.0,
-            stroke,
-        }),
-        ..lathe()
-    };
+    let servo = |stroke| servo_lathe(10_000.0, stroke);
     // W at 0.5, then -0.3 (0.8 mm apart), then 0 (inside the span).
     let text = servo_program("0.5", "-0.3");
     assert!(read(&text, &d, &servo(0.8)).is_empty());
